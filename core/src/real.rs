@@ -285,3 +285,45 @@ mod tests {
         assert_eq!(4.0f64.signed_pow(1.5), 8.0);
     }
 }
+
+/// Square root by the FPU's `vsqrt.f32` on the Cortex-M4F (14 cycles); `libm::sqrtf`
+/// elsewhere. Both are IEEE correctly rounded, so both give the same bits for every input.
+///
+/// The instruction sits in a two-instruction function written in `global_asm!`: Rust's
+/// inline `asm!` refuses single-precision registers on `thumbv7em-none-eabihf` (its `vfp2`
+/// feature implies double precision, which the M4F lacks), and the hard-float ABI passes the
+/// argument and the result in `s0`.
+#[inline]
+#[allow(unsafe_code)]
+pub fn fpu_sqrt(x: f32) -> f32 {
+    #[cfg(all(target_arch = "arm", target_abi = "eabihf"))]
+    {
+        extern "C" {
+            fn impact_core_vsqrt_f32(x: f32) -> f32;
+        }
+        // SAFETY: the function below reads s0, writes s0 and returns; it touches no memory.
+        unsafe { impact_core_vsqrt_f32(x) }
+    }
+    #[cfg(not(all(target_arch = "arm", target_abi = "eabihf")))]
+    {
+        libm::sqrtf(x)
+    }
+}
+
+#[cfg(all(target_arch = "arm", target_abi = "eabihf"))]
+#[allow(unsafe_code)]
+mod vsqrt {
+    core::arch::global_asm!(
+        ".syntax unified",
+        ".thumb",
+        ".fpu fpv4-sp-d16",
+        ".section .text.impact_core_vsqrt_f32,\"ax\",%progbits",
+        ".global impact_core_vsqrt_f32",
+        ".type impact_core_vsqrt_f32,%function",
+        ".thumb_func",
+        "impact_core_vsqrt_f32:",
+        "vsqrt.f32 s0, s0",
+        "bx lr",
+        ".size impact_core_vsqrt_f32, . - impact_core_vsqrt_f32",
+    );
+}

@@ -293,6 +293,12 @@ fn workspace_root() -> PathBuf {
 
 /// Builds the emulator firmware with cargo (a no-op when it is up to date); returns the ELF.
 pub fn build_firmware() -> Result<PathBuf, String> {
+    build_firmware_bin("emulator", None)
+}
+
+/// Builds a firmware binary for QEMU with cargo feature `feature` (`emulator`, or `m4-bench`
+/// with `bin` = `m4-bench`); returns the ELF.
+pub fn build_firmware_bin(feature: &str, bin: Option<&str>) -> Result<PathBuf, String> {
     let root = workspace_root();
     if !root.join("firmware").join("Cargo.toml").is_file() {
         return Err(format!(
@@ -305,10 +311,12 @@ pub fn build_firmware() -> Result<PathBuf, String> {
         .map(|d| if d.is_absolute() { d } else { root.join(d) })
         .unwrap_or_else(|| root.join("target"));
     let cargo = std::env::var_os("CARGO").unwrap_or_else(|| "cargo".into());
-    eprintln!("building the emulator firmware (cargo build --release -p impact-firmware --no-default-features --features emulator)");
+    let bin_args = bin.map(|b| vec!["--bin", b]).unwrap_or_default();
+    eprintln!("building the QEMU firmware (cargo build --release -p impact-firmware --no-default-features --features {feature} {})", bin_args.join(" "));
     let status = Command::new(&cargo)
         .current_dir(&root)
         .env("CARGO_TARGET_DIR", &target_dir)
+        .args(bin_args)
         .args([
             "build",
             "--quiet",
@@ -319,7 +327,7 @@ pub fn build_firmware() -> Result<PathBuf, String> {
             "thumbv7em-none-eabihf",
             "--no-default-features",
             "--features",
-            "emulator",
+            feature,
         ])
         .stdout(Stdio::null())
         .status()
@@ -332,7 +340,7 @@ pub fn build_firmware() -> Result<PathBuf, String> {
     Ok(target_dir
         .join("thumbv7em-none-eabihf")
         .join("release")
-        .join("impact-firmware"))
+        .join(bin.unwrap_or("impact-firmware")))
 }
 
 /// Checks that a tool runs; else says how to install it.

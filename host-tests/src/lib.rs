@@ -5,6 +5,7 @@ pub mod analyze;
 pub mod cases;
 pub mod compare;
 pub mod emulate;
+pub mod m4;
 pub mod plot;
 pub mod precision;
 pub mod recording;

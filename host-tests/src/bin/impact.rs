@@ -6,7 +6,7 @@ use std::time::Duration;
 
 use clap::{Parser, Subcommand};
 use impact_host::{
-    analyze, emulate, plot, precision, simulate, soak, stability, synth, throughput,
+    analyze, emulate, m4, plot, precision, simulate, soak, stability, synth, throughput,
 };
 
 #[derive(Parser)]
@@ -73,6 +73,9 @@ enum Bench {
         #[arg(long, default_value_t = 500)]
         pulse: u64,
     },
+    /// Cost on the Cortex-M4F (QEMU, exact instruction counts): per sample, per impact, per
+    /// solve and fit, and the maths back-ends.
+    M4(m4::M4Args),
     /// Host cost of the streaming pipeline per sample (idle, in impact) and per report.
     Pipeline {
         /// Samples per block (the firmware hands over DMA halves of 256).
@@ -178,6 +181,30 @@ fn run(cli: Cli) -> Result<(), String> {
                 std::fs::write(&path, bytes).map_err(|e| format!("{}: {e}", path.display()))?;
             }
             print!("{csv}");
+        }
+        Command::Bench {
+            which: Bench::M4(args),
+        } => {
+            let (report, profile) = m4::run(&args)?;
+            if args.json {
+                println!(
+                    "{}",
+                    serde_json::to_string_pretty(&report).map_err(|e| e.to_string())?
+                );
+            } else {
+                print!("{}", m4::table(&report));
+            }
+            if !profile.is_empty() {
+                eprint!("{profile}");
+            }
+            if let Some(path) = &args.check {
+                let text = std::fs::read_to_string(path)
+                    .map_err(|e| format!("{}: {e}", path.display()))?;
+                let baseline: m4::M4Report =
+                    serde_json::from_str(&text).map_err(|e| format!("{}: {e}", path.display()))?;
+                eprint!("{}", m4::check(&report, &baseline)?);
+                eprintln!("M4 instruction counts within 10 % of {}", path.display());
+            }
         }
         Command::Bench {
             which: Bench::Stability { full, json },
