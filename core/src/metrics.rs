@@ -318,29 +318,49 @@ fn kinematics(
     let dt = 1.0 / fs;
     let v0d = v0 as f64;
     let kv = per_d / fs;
-    let mut c: i64 = 0;
+    if !(kv > 0.0 && kv.is_finite() && v0d > 0.0) {
+        return None;
+    }
     // Between the edge crossing and the onset sample the body still moves at ~v0.
     let lead = (w.onset as f64 - t_on as f64).max(0.0);
-    let (mut v, mut x) = (v0d, v0d * lead * dt);
+    let x_lead = v0d * lead * dt;
+    // After k samples from the onset, with C_k = Σ d (exact), the velocity is
+    // v_k = v0 - kv C_k and the trapezoid deformation x_k = x_lead + dt (k v0 - kv T_k / 2),
+    // with T_k = Σ_{j<k} (C_j + C_{j+1}) also exact: the loop below is integer-only (no
+    // soft-float per sample on the Cortex-M4) and loses nothing to rounding until the end.
+    let velocity = |c: i64| v0d - kv * c as f64;
+    let deformation = |k: usize, t: i128| x_lead + dt * (k as f64 * v0d - kv * t as f64 / 2.0);
+    // Stopped (v <= 0) once C >= v0 / kv.
+    let c_stop = libm::ceil(v0d / kv);
+    let c_stop = if c_stop < i64::MAX as f64 {
+        c_stop as i64
+    } else {
+        i64::MAX
+    };
+    let mut c: i64 = 0;
+    let mut t: i128 = 0;
     let mut crush: Option<(f64, f64)> = None; // (time index, x_m)
     let mut at_sep: Option<f64> = None;
     let sep_floor = libm::floorf(t_sep) as usize;
     let sep_frac = (t_sep - sep_floor as f32) as f64;
-    for (i, &raw) in w.samples.iter().enumerate().skip(w.onset) {
+    let samples = w.samples.get(w.onset..).unwrap_or(&[]);
+    for (k, &raw) in samples.iter().enumerate() {
         let d = raw as i64 * w.base_n - w.base_sum;
-        c += d;
-        let v_next = v0d - kv * c as f64;
-        let x_next = x + dt * (v + v_next) / 2.0;
-        if crush.is_none() && v_next <= 0.0 && v > 0.0 {
+        let c_next = c + d;
+        let t_next = t + (c + c_next) as i128;
+        let i = w.onset + k;
+        if crush.is_none() && c_next >= c_stop && c < c_stop {
+            let (v, v_next) = (velocity(c), velocity(c_next));
             let f = v / (v - v_next);
-            crush = Some((i as f64 + f, x + dt * f * v / 2.0));
+            crush = Some((i as f64 + f, deformation(k, t) + dt * f * v / 2.0));
         }
         if i == sep_floor {
+            let (x, x_next) = (deformation(k, t), deformation(k + 1, t_next));
             at_sep = Some(x + sep_frac * (x_next - x));
             break;
         }
-        v = v_next;
-        x = x_next;
+        c = c_next;
+        t = t_next;
     }
     let (t_crush, x_m) = crush?;
     let x_p = at_sep?;

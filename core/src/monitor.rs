@@ -21,6 +21,10 @@ use crate::solve::Error;
 
 /// Quiet strides in the baseline window (`64 * STRIDE` = 4096 samples).
 const BASELINE_STRIDES: usize = 64;
+/// Samples in a full baseline, the largest `W` of `d = W x - S`.
+const BASELINE_SPAN: usize = BASELINE_STRIDES * crate::signal::baseline::STRIDE;
+// The in-impact loop computes d in i32: |x| <= 2^15 and W <= 2^12 keep |d| below 2^28.
+const _: () = assert!(BASELINE_SPAN <= 1 << 12);
 
 /// Counters that cannot wrap: 2^64 samples at 2.4 MS/s is 240 000 years.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
@@ -417,51 +421,81 @@ impl<const PRE: usize, const CAP: usize> Monitor<PRE, CAP> {
     }
 
     /// Feeds samples to the active impact until it ends; returns how many it used.
+    ///
+    /// The hot loop of an impact: the running state lives in locals (the compiler cannot
+    /// keep fields of `self` in registers across the capture's push) and is written back
+    /// once per call.
     fn run_active(&mut self, samples: &[i16], out: &mut impl FnMut(&ImpactReport)) -> usize {
         let hold = self.hold;
         let (lo, hi) = self.scene.clip_counts;
         let max_samples = self.max_samples;
+        let capture = &mut self.capture;
         let Some(a) = self.active.as_mut() else {
             return 0;
         };
-        let mut used = 0usize;
+        // At most the samples that keep the impact within its longest duration.
+        let room = max_samples
+            .saturating_sub(a.samples)
+            .min(samples.len() as u64) as usize;
+        let samples = samples.get(..room).unwrap_or(&[]);
+        // d = W x - S in i32: W <= BASELINE_SPAN = 2^12 samples, so |S| < 2^27 and
+        // |d| < 2^28 (see the assertion by `BASELINE_SPAN`): the wrapping operations never wrap.
+        let (n32, s32) = (a.base_n as i32, a.base_sum as i32);
+        // edge_d >= 0: the scene's edge level is positive (validated).
+        let edge = a.edge_d.clamp(0, u32::MAX as i64) as u32;
+        let before = a.samples;
+        let mut peak_abs = a.peak_d.unsigned_abs().min(u32::MAX as u64) as u32;
+        let mut new_peak: Option<(usize, i32)> = None;
+        let (mut separation, mut quiet, mut clipped) = (a.separation, a.quiet, a.clipped);
+        let mut sum: i64 = 0;
+        let mut used = samples.len();
         let mut ended = None;
-        for &x in samples {
-            let d = x as i64 * a.base_n - a.base_sum;
-            let at = a.first_index + a.samples;
-            a.total_c += d;
-            a.samples += 1;
-            used += 1;
-            if d.unsigned_abs() > a.peak_d.unsigned_abs() {
-                a.peak_d = d;
-                a.peak_index = at;
-                a.separation = None;
+        for (k, &x) in samples.iter().enumerate() {
+            let d = (x as i32).wrapping_mul(n32).wrapping_sub(s32);
+            sum += d as i64;
+            let abs = d.unsigned_abs();
+            if abs > peak_abs {
+                peak_abs = abs;
+                new_peak = Some((k, d));
+                separation = None;
             }
-            a.clipped |= x <= lo || x >= hi;
-            if self.capture.push(x).is_err() {
-                a.full = true;
-            }
-            if d.abs() <= a.edge_d {
-                if a.separation.is_none() {
-                    a.separation = Some((at - a.first_index) as usize);
+            clipped |= x <= lo || x >= hi;
+            if abs <= edge {
+                if separation.is_none() {
+                    separation = Some(before as usize + k);
                 }
-                a.quiet += 1;
-                if a.quiet >= hold && at > a.trigger_index {
-                    ended = Some(if a.full {
-                        Status::BufferFull
-                    } else {
-                        Status::Complete
-                    });
+                quiet += 1;
+                if quiet >= hold && a.first_index + before + k as u64 > a.trigger_index {
+                    ended = Some(());
+                    used = k + 1;
                     break;
                 }
             } else {
-                a.quiet = 0;
-            }
-            if a.samples >= max_samples {
-                ended = Some(Status::TooLong);
-                break;
+                quiet = 0;
             }
         }
+        // The capture keeps the first CAP samples of the impact.
+        let kept = samples.get(..used).unwrap_or(&[]);
+        let fits = CAP.saturating_sub(capture.len()).min(kept.len());
+        a.full |= capture
+            .extend_from_slice(kept.get(..fits).unwrap_or(&[]))
+            .is_err()
+            || fits < kept.len();
+        if let Some((k, d)) = new_peak {
+            a.peak_d = d as i64;
+            a.peak_index = a.first_index + before + k as u64;
+        }
+        a.total_c += sum;
+        a.separation = separation;
+        a.quiet = quiet;
+        a.clipped = clipped;
+        a.samples += used as u64;
+        let ended = match ended {
+            Some(()) if a.full => Some(Status::BufferFull),
+            Some(()) => Some(Status::Complete),
+            None if a.samples >= max_samples => Some(Status::TooLong),
+            None => None,
+        };
         self.index += used as u64;
         self.counters.samples += used as u64;
         if let Some(status) = ended {
@@ -483,7 +517,14 @@ impl<const PRE: usize, const CAP: usize> Monitor<PRE, CAP> {
         let gain = self.scene.calibration.gain_m_s2_per_count;
         let per_count = gain / a.base_n as f32;
         for (slot, &x) in self.accel.iter_mut().zip(self.capture.iter()) {
-            *slot = (x as i64 * a.base_n - a.base_sum) as f32 * per_count;
+            let d = x as i64 * a.base_n - a.base_sum;
+            // The FPU converts i32; i64 is a soft-float call on the Cortex-M4. Both round
+            // to nearest, so the value is the same.
+            let d = match i32::try_from(d) {
+                Ok(d) => d as f32,
+                Err(_) => d as f32,
+            };
+            *slot = d * per_count;
         }
         #[cfg(feature = "cfc")]
         if let Some(class) = self.scene.cfc {
