@@ -13,8 +13,9 @@
 //! after the maximum deformation at which the force returns to zero; the deformation left then
 //! is the permanent deformation, the speed then the rebound speed `v'`, and `COR = v'/v0`.
 #![no_std]
-// No unsafe code but the FPU square root on the Cortex-M4F (`real::fpu_sqrt`, one
-// `global_asm!` function), which allows it for itself.
+// No unsafe code but two `global_asm!` routines for the Cortex-M4F, each allowing it for
+// itself: the FPU square root (`real::fpu_sqrt`) and the idle path's SIMD stride statistics
+// (`signal::baseline::Stats::of`).
 #![deny(unsafe_code)]
 // Guards are written `!(x > 0)` on purpose: they are true for NaN, so NaN never passes.
 #![allow(clippy::neg_cmp_op_on_partial_ord)]

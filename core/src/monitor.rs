@@ -344,8 +344,8 @@ impl<const PRE: usize, const CAP: usize> Monitor<PRE, CAP> {
     /// Trigger thresholds in raw counts around the baseline.
     fn thresholds(&self) -> (i32, i32) {
         let mean = self.baseline.mean();
-        let lo = libm::floorf(mean - self.trigger_counts);
-        let hi = libm::ceilf(mean + self.trigger_counts);
+        let lo = floor(mean - self.trigger_counts);
+        let hi = -floor(-(mean + self.trigger_counts));
         (clamp_i32(lo), clamp_i32(hi))
     }
 
@@ -516,15 +516,12 @@ impl<const PRE: usize, const CAP: usize> Monitor<PRE, CAP> {
         let n = self.capture.len();
         let gain = self.scene.calibration.gain_m_s2_per_count;
         let per_count = gain / a.base_n as f32;
+        // d in i32 as in `run_active` (exact, see `BASELINE_SPAN`): the FPU converts i32,
+        // while i64 is a soft-float call on the Cortex-M4.
+        let (n32, s32) = (a.base_n as i32, a.base_sum as i32);
         for (slot, &x) in self.accel.iter_mut().zip(self.capture.iter()) {
-            let d = x as i64 * a.base_n - a.base_sum;
-            // The FPU converts i32; i64 is a soft-float call on the Cortex-M4. Both round
-            // to nearest, so the value is the same.
-            let d = match i32::try_from(d) {
-                Ok(d) => d as f32,
-                Err(_) => d as f32,
-            };
-            *slot = d * per_count;
+            let d = (x as i32).wrapping_mul(n32).wrapping_sub(s32);
+            *slot = d as f32 * per_count;
         }
         #[cfg(feature = "cfc")]
         if let Some(class) = self.scene.cfc {
@@ -564,6 +561,21 @@ impl<const PRE: usize, const CAP: usize> Monitor<PRE, CAP> {
     }
 }
 
+/// `floorf` by the FPU's conversions (libm's is a software bit-twiddle, ~30 instructions on the
+/// Cortex-M4): exact for |v| < 2^23; larger values are integers already; NaN stays NaN.
+fn floor(v: f32) -> f32 {
+    if libm::fabsf(v) < 8_388_608.0 {
+        let t = v as i32 as f32;
+        if t > v {
+            t - 1.0
+        } else {
+            t
+        }
+    } else {
+        v
+    }
+}
+
 fn clamp_i32(v: f32) -> i32 {
     if v >= i32::MAX as f32 {
         i32::MAX
@@ -571,5 +583,22 @@ fn clamp_i32(v: f32) -> i32 {
         i32::MIN
     } else {
         v as i32
+    }
+}
+
+#[cfg(test)]
+mod floor_tests {
+    #[test]
+    fn floor_matches_libm() {
+        for k in 0..200_000 {
+            // Both signs, every magnitude up to 3e7 and fractions near the integers.
+            let v = (k as f32 - 100_000.0) * 300.013 + (k % 7) as f32 * 0.125;
+            for x in [v, v / 1e3, v / 1e6, v * 1e-4 + 0.5] {
+                assert_eq!(super::floor(x), libm::floorf(x), "{x}");
+            }
+        }
+        assert!(super::floor(f32::NAN).is_nan());
+        assert_eq!(super::floor(f32::INFINITY), f32::INFINITY);
+        assert_eq!(super::floor(-0.5), -1.0);
     }
 }

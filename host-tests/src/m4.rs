@@ -645,7 +645,7 @@ pub fn run(args: &M4Args) -> Result<(M4Report, String), String> {
     let result = (|| {
         std::fs::write(
             &trace_jobs,
-            format!("{}\nstream pipeline\n", scene_line(NO_FITS)),
+            format!("selftest\n{}\nstream pipeline\n", scene_line(NO_FITS)),
         )
         .map_err(|e| e.to_string())?;
         // Trace run: per-block regions.
@@ -659,6 +659,9 @@ pub fn run(args: &M4Args) -> Result<(M4Report, String), String> {
             &["trace".into(), path_arg(&raw)?, path_arg(&trace_jobs)?],
             Some(&mut on_line),
         )?;
+        if !out.lines().any(|l| l == "selftest ok") {
+            return Err(format!("the M4 self-test did not pass:\n{out}"));
+        }
         let kinds: String = out
             .lines()
             .filter_map(|l| l.strip_prefix("kinds "))

@@ -9,7 +9,9 @@
 /// Samples per stride.
 pub const STRIDE: usize = 64;
 
-/// Sum, minimum and maximum of a run of samples (one pass the compiler vectorises).
+/// Sum, minimum and maximum of a run of samples: one pass, vectorised by the compiler on the
+/// host and written with the Cortex-M4's SIMD instructions (two samples per `SMLAD`,
+/// `SSUB16`+`SEL`) on the board.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct Stats {
     pub len: usize,
@@ -22,6 +24,19 @@ impl Stats {
     /// Of at most [`STRIDE`] samples (the sum cannot overflow).
     #[inline]
     pub fn of(samples: &[i16]) -> Self {
+        #[cfg(all(target_arch = "arm", target_abi = "eabihf"))]
+        {
+            dsp::stats(samples)
+        }
+        #[cfg(not(all(target_arch = "arm", target_abi = "eabihf")))]
+        {
+            Self::of_portable(samples)
+        }
+    }
+
+    /// [`Self::of`] in plain Rust (the reference for the Cortex-M4 version).
+    #[inline]
+    pub fn of_portable(samples: &[i16]) -> Self {
         let mut s = Self {
             len: samples.len(),
             sum: 0,
@@ -35,6 +50,97 @@ impl Stats {
         }
         s
     }
+}
+
+/// [`Stats::of`] with the Cortex-M4's DSP extension, two samples per 32-bit word.
+#[cfg(all(target_arch = "arm", target_abi = "eabihf"))]
+#[allow(unsafe_code)]
+mod dsp {
+    use super::Stats;
+
+    extern "C" {
+        /// `pairs` words from the word-aligned `words`: writes the sum of the 2 × `pairs`
+        /// samples, the lane-wise minimum and the lane-wise maximum (two i16 each) to `out`.
+        fn impact_core_stats_i16(words: *const i16, pairs: usize, out: *mut [u32; 3]);
+    }
+
+    #[inline]
+    pub fn stats(samples: &[i16]) -> Stats {
+        // A first sample off a word boundary and an odd last one go the portable way.
+        let head = (samples.as_ptr() as usize / 2) & 1;
+        let head = head.min(samples.len());
+        let (first, rest) = samples.split_at(head);
+        let pairs = rest.len() / 2;
+        let (middle, tail) = rest.split_at(2 * pairs);
+        let mut out = [0u32, 0x7FFF_7FFF, 0x8000_8000];
+        if pairs > 0 {
+            // SAFETY: `middle` is word-aligned (the head took the odd half-word) and holds
+            // exactly `pairs` words; the routine reads them and writes `out`, nothing else.
+            unsafe { impact_core_stats_i16(middle.as_ptr(), pairs, &mut out) };
+        }
+        let edges = Stats::of_portable(first);
+        let last = Stats::of_portable(tail);
+        let lanes = |w: u32| (w as u16 as i16, (w >> 16) as u16 as i16);
+        let (min_lo, min_hi) = lanes(out[1]);
+        let (max_lo, max_hi) = lanes(out[2]);
+        Stats {
+            len: samples.len(),
+            sum: (out[0] as i32) + edges.sum + last.sum,
+            min: min_lo.min(min_hi).min(edges.min).min(last.min),
+            max: max_lo.max(max_hi).max(edges.max).max(last.max),
+        }
+    }
+
+    // r0 = words, r1 = pairs (> 0), r2 = out. Per word: SMLAD adds both halves to the sum;
+    // SSUB16 sets the GE flags of the lanes where x >= min (resp. max) and SEL picks lane-wise.
+    core::arch::global_asm!(
+        ".syntax unified",
+        ".thumb",
+        ".section .text.impact_core_stats_i16,\"ax\",%progbits",
+        ".global impact_core_stats_i16",
+        ".type impact_core_stats_i16,%function",
+        ".thumb_func",
+        "impact_core_stats_i16:",
+        "push {{r4, r5, r6, r7, lr}}",
+        "movs r3, #0",
+        "movw r12, #0x7fff",
+        "movt r12, #0x7fff",
+        "mov.w r4, #0x80008000",
+        "mov.w r5, #0x00010001",
+        // Two words per pass while at least two are left.
+        "subs r1, r1, #2",
+        "blo 2f",
+        "1:",
+        "ldrd r6, r7, [r0], #8",
+        "smlad r3, r6, r5, r3",
+        "ssub16 lr, r6, r12",
+        "sel r12, r12, r6",
+        "ssub16 lr, r6, r4",
+        "sel r4, r6, r4",
+        "smlad r3, r7, r5, r3",
+        "ssub16 lr, r7, r12",
+        "sel r12, r12, r7",
+        "ssub16 lr, r7, r4",
+        "sel r4, r7, r4",
+        "subs r1, r1, #2",
+        "bhs 1b",
+        "2:",
+        // r1 is -1 if one word is left, -2 if none.
+        "adds r1, r1, #1",
+        "bne 3f",
+        "ldr r6, [r0]",
+        "smlad r3, r6, r5, r3",
+        "ssub16 lr, r6, r12",
+        "sel r12, r12, r6",
+        "ssub16 lr, r6, r4",
+        "sel r4, r6, r4",
+        "3:",
+        "str r3, [r2]",
+        "str r12, [r2, #4]",
+        "str r4, [r2, #8]",
+        "pop {{r4, r5, r6, r7, pc}}",
+        ".size impact_core_stats_i16, . - impact_core_stats_i16",
+    );
 }
 
 /// The last `K` quiet strides' sums.
@@ -85,7 +191,13 @@ impl<const K: usize> Baseline<K> {
         if self.len == 0 {
             0.0
         } else {
-            self.total as f32 / (self.len * STRIDE) as f32
+            // The FPU converts i32 (a baseline of up to 2^16 samples of i16 fits); i64 is a
+            // soft-float call on the Cortex-M4, kept for larger windows.
+            let total = match i32::try_from(self.total) {
+                Ok(t) => t as f32,
+                Err(_) => self.total as f64 as f32,
+            };
+            total / (self.len * STRIDE) as f32
         }
     }
 

@@ -14,6 +14,8 @@
 //! * `solve <label> <method> <steps|rtol> <mass> <v0> <model> <p1> <p2> <p3> <permanent|none>`:
 //!   one f32
 //!   [`impact_core::solve`] call; prints its SysTick time and the outcome's bits;
+//! * `selftest`: the board's hand-written routines (SIMD stride statistics, FPU square root)
+//!   against their portable references; prints `selftest ok`;
 //! * `math <op> <backend> <lo> <hi>`: [`MATH_CALLS`] calls of one maths function (`libm`,
 //!   `micromath`, or the FPU's `vsqrt`) on inputs spread over `lo..hi`; prints the SysTick time of the calls and of the bare loop.
 //!
@@ -180,6 +182,7 @@ fn run() -> Result<(), ()> {
             ),
             Some("solve") if mode == Mode::Count => solve_job(words),
             Some("math") if mode == Mode::Count => math_job(words),
+            Some("selftest") => selftest(),
             Some(_) => Ok(()),
         };
         if result.is_err() {
@@ -326,6 +329,55 @@ fn stream(
             r.duration_s
         );
     }
+    Ok(())
+}
+
+/// The board's hand-written routines against their portable references: the SIMD stride
+/// statistics at every alignment and length up to two strides, on extreme and random values,
+/// and the FPU square root on a sweep of magnitudes. Prints `selftest ok` or the first mismatch.
+fn selftest() -> Result<(), ()> {
+    use impact_core::signal::baseline::Stats;
+    let mut buf = [0i16; 160];
+    let mut state = 0x2545_f491u32;
+    for round in 0..8u32 {
+        for (k, x) in buf.iter_mut().enumerate() {
+            state ^= state << 13;
+            state ^= state >> 17;
+            state ^= state << 5;
+            *x = match (round, k % 5) {
+                (0, _) => i16::MIN,
+                (1, _) => i16::MAX,
+                (2, 0) => i16::MIN,
+                (2, 1) => i16::MAX,
+                _ => state as i16,
+            };
+        }
+        for start in 0..4 {
+            for len in 0..=(buf.len() - start).min(130) {
+                let s = &buf[start..start + len];
+                if Stats::of(s) != Stats::of_portable(s) {
+                    hprintln!(
+                        "selftest stats mismatch round={} start={} len={}",
+                        round,
+                        start,
+                        len
+                    );
+                    return Err(());
+                }
+            }
+        }
+    }
+    let mut x = 1e-30f32;
+    while x < 1e30 {
+        for v in [x, x * 1.000_001, x * 3.7] {
+            if impact_core::real::fpu_sqrt(v).to_bits() != libm::sqrtf(v).to_bits() {
+                hprintln!("selftest sqrt mismatch x={:e}", v);
+                return Err(());
+            }
+        }
+        x *= 1.37;
+    }
+    hprintln!("selftest ok");
     Ok(())
 }
 
