@@ -250,21 +250,30 @@ impl<const PRE: usize, const CAP: usize> Monitor<PRE, CAP> {
                 }
                 continue;
             }
-            let (lo, hi) = match self.thresholds {
-                Some(t) => t,
-                None => {
-                    let t = self.thresholds();
-                    self.thresholds = Some(t);
-                    t
-                }
-            };
+            let (lo, hi) = self.current_thresholds();
             let found = match self.trigger_filter.as_mut() {
                 None => {
                     // One vectorised pass for the stride statistics; the samples are
                     // scanned one by one only when the segment crosses a threshold.
                     let stats = Stats::of(segment);
                     if (stats.max as i32) <= hi && (stats.min as i32) >= lo {
-                        self.idle_with(segment, &stats);
+                        // A run of quiet strides: the baseline (and so the thresholds)
+                        // follows each one, the ring and the counters take the run at once.
+                        self.learn(&stats);
+                        let mut run = segment.len();
+                        while let Some(next) = rest.get(run..run + self.baseline.to_stride_end()) {
+                            let (lo, hi) = self.current_thresholds();
+                            let stats = Stats::of(next);
+                            if (stats.max as i32) > hi || (stats.min as i32) < lo {
+                                break;
+                            }
+                            self.learn(&stats);
+                            run += next.len();
+                        }
+                        let (quiet, after) = rest.split_at(run.min(rest.len()));
+                        self.ring.extend(quiet);
+                        self.index += quiet.len() as u64;
+                        self.counters.samples += quiet.len() as u64;
                         rest = after;
                         continue;
                     }
@@ -311,8 +320,27 @@ impl<const PRE: usize, const CAP: usize> Monitor<PRE, CAP> {
         self.ring.extend(samples);
         self.index += samples.len() as u64;
         self.counters.samples += samples.len() as u64;
+        self.learn(stats);
+    }
+
+    /// A stretch of idle samples into the baseline (not while the history is replayed).
+    #[inline]
+    fn learn(&mut self, stats: &Stats) {
         if !self.replaying && self.baseline.add_stats(stats, self.edge_counts) {
             self.thresholds = None;
+        }
+    }
+
+    /// The trigger thresholds for the current baseline (computed once per change).
+    #[inline]
+    fn current_thresholds(&mut self) -> (i32, i32) {
+        match self.thresholds {
+            Some(t) => t,
+            None => {
+                let t = self.thresholds();
+                self.thresholds = Some(t);
+                t
+            }
         }
     }
 

@@ -2,6 +2,7 @@
 
 pub mod baseline;
 pub mod cfc;
+pub mod copy;
 pub mod integrate;
 pub mod ring;
 

@@ -44,12 +44,10 @@ impl<const N: usize> Ring<N> {
         let to_end = block.get(..first).unwrap_or(&[]);
         let wrapped = block.get(first..).unwrap_or(&[]);
         if let Some(dst) = self.buf.get_mut(head..) {
-            for (d, s) in dst.iter_mut().zip(to_end) {
-                *d = *s;
-            }
+            super::copy::copy_samples(dst, to_end);
         }
-        for (d, s) in self.buf.iter_mut().zip(wrapped) {
-            *d = *s;
+        if !wrapped.is_empty() {
+            super::copy::copy_samples(&mut self.buf, wrapped);
         }
         self.head = (head + block.len()) & Self::MASK;
         self.len = (self.len + block.len()).min(N);

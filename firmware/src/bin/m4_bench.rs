@@ -14,7 +14,8 @@
 //! * `solve <label> <method> <steps|rtol> <mass> <v0> <model> <p1> <p2> <p3> <permanent|none>`:
 //!   one f32
 //!   [`impact_core::solve`] call; prints its SysTick time and the outcome's bits;
-//! * `selftest`: the board's hand-written routines (SIMD stride statistics, FPU square root)
+//! * `selftest`: the board's hand-written routines (SIMD stride statistics, word-wise copy,
+//!   FPU square root)
 //!   against their portable references; prints `selftest ok`;
 //! * `math <op> <backend> <lo> <hi>`: [`MATH_CALLS`] calls of one maths function (`libm`,
 //!   `micromath`, or the FPU's `vsqrt`) on inputs spread over `lo..hi`; prints the SysTick time of the calls and of the bare loop.
@@ -360,6 +361,29 @@ fn selftest() -> Result<(), ()> {
                         "selftest stats mismatch round={} start={} len={}",
                         round,
                         start,
+                        len
+                    );
+                    return Err(());
+                }
+            }
+        }
+    }
+    let mut dst = [0i16; 160];
+    for start in 0..4 {
+        for at in 0..4 {
+            for len in 0..=100 {
+                dst.fill(7);
+                impact_core::signal::copy::copy_samples(
+                    &mut dst[at..at + len],
+                    &buf[start..start + len],
+                );
+                let same = dst[at..at + len] == buf[start..start + len];
+                let untouched = dst[..at].iter().chain(&dst[at + len..]).all(|&x| x == 7);
+                if !(same && untouched) {
+                    hprintln!(
+                        "selftest copy mismatch start={} at={} len={}",
+                        start,
+                        at,
                         len
                     );
                     return Err(());
