@@ -99,3 +99,216 @@ fn measure_inner(block: usize) -> Result<PipelineCost, String> {
         idle_samples_per_second: 1e9 / idle_ns,
     })
 }
+
+/// `impact bench throughput`: the pipeline over a long in-memory stream, and `impact analyze`
+/// end to end on a large CSV.
+#[derive(Clone, Debug, Serialize)]
+pub struct Throughput {
+    /// Samples streamed (in memory, blocks of `block`).
+    pub samples: u64,
+    pub block: usize,
+    pub impacts_inserted: u64,
+    pub impacts_reported: u64,
+    /// Wall time of the pipeline over the stream, s (one core, best of three runs).
+    pub seconds: f64,
+    pub samples_per_second: f64,
+    /// The median of the three runs.
+    pub median_samples_per_second: f64,
+    /// `impact analyze` on a CSV of the stream's first samples, parsing included.
+    pub analyze: AnalyzeThroughput,
+}
+
+#[derive(Clone, Debug, Serialize)]
+pub struct AnalyzeThroughput {
+    pub rows: u64,
+    pub bytes: u64,
+    pub impacts_reported: u64,
+    pub seconds: f64,
+    pub rows_per_second: f64,
+    pub megabytes_per_second: f64,
+    /// Peak resident memory of the `impact analyze` process, MiB.
+    pub peak_rss_mib: f64,
+}
+
+/// A quiet stream (±1 count of noise around mid-scale) with `impacts` half-sine pulses of 500
+/// samples and 150 counts (about 60 m/s² at the board's gain), evenly spaced.
+pub fn impact_stream(samples: usize, impacts: usize) -> Vec<i16> {
+    let mut state = 0x9e37_79b9_7f4a_7c15u64;
+    let mut v: Vec<i16> = (0..samples)
+        .map(|_| {
+            state ^= state << 13;
+            state ^= state >> 7;
+            state ^= state << 17;
+            2048 + (state >> 62) as i16 - 1
+        })
+        .collect();
+    let spacing = samples / impacts.max(1);
+    for i in 0..impacts {
+        let at = i * spacing + spacing / 2;
+        for k in 0..500 {
+            if let Some(x) = v.get_mut(at + k) {
+                *x += (150.0 * (std::f64::consts::PI * k as f64 / 500.0).sin()) as i16;
+            }
+        }
+    }
+    v
+}
+
+fn stream_scene() -> Scene {
+    let mut s = Scene::new(
+        Calibration {
+            gain_m_s2_per_count: 1600.0 / 4096.0,
+            sample_rate_hz: 500_000.0,
+        },
+        10.0,
+    );
+    s.edge_m_s2 = 2.0;
+    s.hold_s = 2e-3;
+    s.mass_kg = Some(0.06);
+    s.approach = impact_core::Approach::Speed { v0_m_s: 0.1 };
+    s.fits = FitSet::none();
+    s
+}
+
+/// Runs the stream through the pipeline, then `analyze_exe analyze` on the first
+/// `csv_rows` samples written as CSV.
+pub fn throughput(
+    samples: usize,
+    impacts: usize,
+    block: usize,
+    csv_rows: usize,
+    analyze_exe: &std::path::Path,
+) -> Result<Throughput, String> {
+    let block = block.max(1);
+    let stream = impact_stream(samples, impacts);
+    // Best of three runs (a fresh monitor each), the usual way to quote a throughput on a
+    // machine shared with other work; the median is kept beside it.
+    let mut runs = Vec::new();
+    for _ in 0..3 {
+        runs.push(crate::on_big_stack({
+            let stream = stream.clone();
+            move || -> Result<(f64, u64), String> {
+                let mut m = M::new(stream_scene()).map_err(|e| e.to_string())?;
+                let mut n = 0u64;
+                let t = Instant::now();
+                for b in stream.chunks(block) {
+                    m.push_block(std::hint::black_box(b), &mut |_r: &ImpactReport| n += 1);
+                }
+                m.finish(&mut |_r: &ImpactReport| n += 1);
+                Ok((t.elapsed().as_secs_f64(), n))
+            }
+        })?);
+    }
+    runs.sort_by(|a, b| a.0.total_cmp(&b.0));
+    let (seconds, reported) = runs[0];
+    let median_seconds = runs[1].0;
+    if let Some(r) = runs.iter().find(|r| r.1 != reported) {
+        return Err(format!("runs disagree: {} and {} impacts", reported, r.1));
+    }
+    if reported != impacts as u64 {
+        return Err(format!("{impacts} impacts inserted, {reported} reported"));
+    }
+    let analyze = analyze_csv(
+        &stream[..csv_rows.min(stream.len())],
+        impacts,
+        samples,
+        analyze_exe,
+    )?;
+    Ok(Throughput {
+        samples: samples as u64,
+        block,
+        impacts_inserted: impacts as u64,
+        impacts_reported: reported,
+        seconds,
+        samples_per_second: samples as f64 / seconds,
+        median_samples_per_second: samples as f64 / median_seconds,
+        analyze,
+    })
+}
+
+fn analyze_csv(
+    counts: &[i16],
+    impacts: usize,
+    samples: usize,
+    exe: &std::path::Path,
+) -> Result<AnalyzeThroughput, String> {
+    use std::io::Write;
+    let path = std::env::temp_dir().join(format!("impact-throughput-{}.csv", std::process::id()));
+    let result = (|| {
+        let file = std::fs::File::create(&path).map_err(|e| format!("{}: {e}", path.display()))?;
+        let mut w = std::io::BufWriter::with_capacity(1 << 20, file);
+        let gain_g = 1600.0 / 4096.0 / impact_core::solve::bounce::STANDARD_GRAVITY;
+        writeln!(w, "time_s,accel_g").map_err(|e| e.to_string())?;
+        for (k, &c) in counts.iter().enumerate() {
+            writeln!(
+                w,
+                "{:.7},{:.5}",
+                k as f64 * 2e-6,
+                (c as f64 - 2048.0) * gain_g
+            )
+            .map_err(|e| e.to_string())?;
+        }
+        w.flush().map_err(|e| e.to_string())?;
+        drop(w);
+        let bytes = std::fs::metadata(&path).map_err(|e| e.to_string())?.len();
+        let t = Instant::now();
+        let child = std::process::Command::new(exe)
+            .arg("analyze")
+            .arg(&path)
+            .args(["--json"])
+            .stdout(std::process::Stdio::piped())
+            .stderr(std::process::Stdio::piped())
+            .spawn()
+            .map_err(|e| format!("{}: {e}", exe.display()))?;
+        let pid = child.id() as libc::pid_t;
+        // Reap with wait4 for the child's own peak resident set.
+        let out = {
+            let mut child = child;
+            let stdout = child.stdout.take();
+            let reader = std::thread::spawn(move || {
+                let mut s = String::new();
+                if let Some(mut o) = stdout {
+                    use std::io::Read;
+                    let _ = o.read_to_string(&mut s);
+                }
+                s
+            });
+            let mut status = 0;
+            // SAFETY: a zeroed rusage is a valid value; wait4 fills it for our own child.
+            let mut usage: libc::rusage = unsafe { std::mem::zeroed() };
+            // SAFETY: `pid` is our child, not yet reaped; the pointers are valid.
+            let r = unsafe { libc::wait4(pid, &mut status, 0, &mut usage) };
+            if r != pid {
+                return Err("wait4 failed".into());
+            }
+            if !libc::WIFEXITED(status) || libc::WEXITSTATUS(status) != 0 {
+                return Err(format!("impact analyze failed (status {status})"));
+            }
+            (
+                reader.join().unwrap_or_default(),
+                usage.ru_maxrss as f64 / 1024.0,
+            )
+        };
+        let seconds = t.elapsed().as_secs_f64();
+        let v: serde_json::Value =
+            serde_json::from_str(&out.0).map_err(|e| format!("analyze JSON: {e}"))?;
+        let reported = v["impacts"].as_array().map_or(0, |a| a.len()) as u64;
+        let expected = (impacts as u64 * counts.len() as u64) / samples.max(1) as u64;
+        if reported.abs_diff(expected) > 1 {
+            return Err(format!(
+                "analyze reported {reported} impacts, about {expected} expected"
+            ));
+        }
+        Ok(AnalyzeThroughput {
+            rows: counts.len() as u64,
+            bytes,
+            impacts_reported: reported,
+            seconds,
+            rows_per_second: counts.len() as f64 / seconds,
+            megabytes_per_second: bytes as f64 / 1e6 / seconds,
+            peak_rss_mib: out.1,
+        })
+    })();
+    let _ = std::fs::remove_file(&path);
+    result
+}

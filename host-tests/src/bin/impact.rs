@@ -76,6 +76,25 @@ enum Bench {
     /// Cost on the Cortex-M4F (QEMU, exact instruction counts): per sample, per impact, per
     /// solve and fit, and the maths back-ends.
     M4(m4::M4Args),
+    /// Host throughput: the pipeline over a long in-memory stream with many impacts (one
+    /// core), and `impact analyze` end to end on a large CSV with its peak memory.
+    Throughput {
+        /// Samples in the stream.
+        #[arg(long, default_value_t = 100_000_000)]
+        samples: usize,
+        /// Impacts in the stream.
+        #[arg(long, default_value_t = 2000)]
+        impacts: usize,
+        /// Samples per block.
+        #[arg(long, default_value_t = 256)]
+        block: usize,
+        /// Rows of the CSV given to `impact analyze`.
+        #[arg(long, default_value_t = 20_000_000)]
+        csv_rows: usize,
+        /// Print JSON.
+        #[arg(long)]
+        json: bool,
+    },
     /// Host cost of the streaming pipeline per sample (idle, in impact) and per report.
     Pipeline {
         /// Samples per block (the firmware hands over DMA halves of 256).
@@ -204,6 +223,35 @@ fn run(cli: Cli) -> Result<(), String> {
                     serde_json::from_str(&text).map_err(|e| format!("{}: {e}", path.display()))?;
                 eprint!("{}", m4::check(&report, &baseline)?);
                 eprintln!("M4 instruction counts within 10 % of {}", path.display());
+            }
+        }
+        Command::Bench {
+            which:
+                Bench::Throughput {
+                    samples,
+                    impacts,
+                    block,
+                    csv_rows,
+                    json,
+                },
+        } => {
+            let exe = std::env::current_exe().map_err(|e| e.to_string())?;
+            let r = throughput::throughput(samples, impacts, block, csv_rows, &exe)?;
+            if json {
+                println!(
+                    "{}",
+                    serde_json::to_string_pretty(&r).map_err(|e| e.to_string())?
+                );
+            } else {
+                println!(
+                    "pipeline: {} samples, {} impacts (all reported) in {:.3} s on one core: {:.3e} samples/s best of 3, {:.3e} median (target 1e9)",
+                    r.samples, r.impacts_reported, r.seconds, r.samples_per_second, r.median_samples_per_second
+                );
+                let a = &r.analyze;
+                println!(
+                    "impact analyze: {} rows ({:.0} MB CSV), {} impacts in {:.2} s: {:.3e} rows/s, {:.0} MB/s, peak memory {:.0} MiB",
+                    a.rows, a.bytes as f64 / 1e6, a.impacts_reported, a.seconds, a.rows_per_second, a.megabytes_per_second, a.peak_rss_mib
+                );
             }
         }
         Command::Bench {
