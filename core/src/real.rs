@@ -201,7 +201,9 @@ macro_rules! impl_real {
 impl_real!(
     f32,
     "f32",
-    libm::sqrtf,
+    // The FPU's vsqrt on the Cortex-M4F: 3 instructions + 14 cycles against libm's 48
+    // instructions, the same bits (both correctly rounded); `impact bench m4` measures both.
+    fpu_sqrt,
     libm::cbrtf,
     libm::powf,
     libm::expf,

@@ -1053,31 +1053,35 @@ pub fn table(r: &M4Report) -> String {
 
 /// Compares `r` with a stored baseline: every instruction count may grow by 10 % at most.
 pub fn check(r: &M4Report, baseline: &M4Report) -> Result<String, String> {
-    let mut rows = vec![
+    let mut rows: Vec<(String, f64, f64)> = vec![
         (
-            "idle instructions/sample",
+            "idle instructions/sample".into(),
             r.idle_instructions_per_sample,
             baseline.idle_instructions_per_sample,
         ),
         (
-            "in-impact instructions/sample",
+            "in-impact instructions/sample".into(),
             r.impact_instructions_per_sample,
             baseline.impact_instructions_per_sample,
         ),
         (
-            "trigger instructions",
+            "trigger instructions".into(),
             r.trigger_instructions as f64,
             baseline.trigger_instructions as f64,
         ),
         (
-            "report instructions",
+            "report instructions".into(),
             r.report_instructions as f64,
             baseline.report_instructions as f64,
         ),
     ];
     for f in &r.fits {
         if let Some(b) = baseline.fits.iter().find(|b| b.fit == f.fit) {
-            rows.push(("fit", f.instructions as f64, b.instructions as f64));
+            rows.push((
+                format!("fit {}", f.fit),
+                f.instructions as f64,
+                b.instructions as f64,
+            ));
         }
     }
     for v in &r.solves {
@@ -1086,7 +1090,11 @@ pub fn check(r: &M4Report, baseline: &M4Report) -> Result<String, String> {
             .iter()
             .find(|b| b.case == v.case && b.method == v.method && b.setting == v.setting)
         {
-            rows.push(("solve", v.instructions as f64, b.instructions as f64));
+            rows.push((
+                format!("solve {} {}", v.case, v.method),
+                v.instructions as f64,
+                b.instructions as f64,
+            ));
         }
     }
     let mut text = String::new();
@@ -1094,12 +1102,18 @@ pub fn check(r: &M4Report, baseline: &M4Report) -> Result<String, String> {
     for (name, now, then) in rows {
         let ratio = if then > 0.0 { now / then } else { 1.0 };
         text.push_str(&format!(
-            "  {name:<32} {now:>14.2} vs {then:>14.2} ({:+.1} %)\n",
+            "  {name:<44} {now:>14.2} vs {then:>14.2} ({:+.1} %)\n",
             100.0 * (ratio - 1.0)
         ));
         if ratio > 1.10 {
             failed.push(format!("{name}: {now:.2} against {then:.2}"));
         }
+    }
+    for v in r.solves.iter().filter(|v| !v.same_bits_as_host) {
+        failed.push(format!(
+            "solve {} {}: the M4 and the host disagree",
+            v.case, v.method
+        ));
     }
     if failed.is_empty() {
         Ok(text)
@@ -1108,5 +1122,96 @@ pub fn check(r: &M4Report, baseline: &M4Report) -> Result<String, String> {
             "M4 instruction counts regressed by more than 10 %:\n{text}{}",
             failed.join("\n")
         ))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn insn(mnemonic: &str, operands: &str) -> Insn {
+        Insn {
+            size: 4,
+            mnemonic: mnemonic.into(),
+            operands: operands.into(),
+        }
+    }
+
+    #[test]
+    fn cortex_m4_timings() {
+        // Cortex-M4 TRM: ALU 1, loads 2 (1 when pipelined after a load), immediate-offset
+        // stores 1, LDM/STM/PUSH/POP 1 + N (+ refill when loading pc), taken branches
+        // 1 + refill, MLA 2, divisions 2..12 (12 taken), VMLA 3, VDIV/VSQRT 14.
+        assert_eq!(cycles(&insn("adds", "r0, r1, r2"), false, false), 1);
+        assert_eq!(
+            cycles(&insn("ldrsh.w", "r6, [r0, r3, lsl #1]"), false, false),
+            2
+        );
+        assert_eq!(cycles(&insn("ldr", "r1, [r2, #4]"), false, true), 1);
+        assert_eq!(cycles(&insn("str", "r1, [r2, #4]"), false, false), 1);
+        assert_eq!(cycles(&insn("str.w", "r1, [r2, r3]"), false, false), 2);
+        assert_eq!(
+            cycles(&insn("push", "{r4, r5, r6, r7, lr}"), false, false),
+            6
+        );
+        assert_eq!(
+            cycles(&insn("pop", "{r4, r5, r6, pc}"), true, false),
+            5 + REFILL
+        );
+        assert_eq!(
+            cycles(&insn("ldmia", "r1!, {r3, r4, r5, r6}"), false, false),
+            5
+        );
+        assert_eq!(cycles(&insn("vpush", "{d8-d9}"), false, false), 5);
+        assert_eq!(
+            cycles(&insn("bne.n", "75ec <f+0x38c>"), true, false),
+            1 + REFILL
+        );
+        assert_eq!(cycles(&insn("bne.n", "75ec <f+0x38c>"), false, false), 1);
+        assert_eq!(cycles(&insn("bl", "15eaa <g>"), true, false), 1 + REFILL);
+        assert_eq!(cycles(&insn("mla", "r2, r5, r4, r2"), false, false), 2);
+        assert_eq!(cycles(&insn("sdiv", "r0, r1, r2"), false, false), 12);
+        assert_eq!(cycles(&insn("vmla.f32", "s0, s1, s2"), false, false), 3);
+        assert_eq!(cycles(&insn("vsqrt.f32", "s0, s0"), false, false), 14);
+        assert_eq!(cycles(&insn("vldr", "d0, [r0]"), false, false), 3);
+        assert_eq!(cycles(&insn("vmov", "r0, r1, d0"), false, false), 2);
+    }
+
+    fn report(idle: f64, solve_instructions: u64, same: bool) -> M4Report {
+        M4Report {
+            block: 256,
+            idle_instructions_per_sample: idle,
+            impact_instructions_per_sample: 40.0,
+            idle_cycles_per_sample: 0.0,
+            impact_cycles_per_sample: 0.0,
+            estimated_cycles_per_sample: 0.0,
+            headroom_at_500k: 0.0,
+            headroom_at_adc_top_rate: 0.0,
+            trigger_instructions: 1000,
+            report_instructions: 1000,
+            impact_samples: 100,
+            fits: vec![],
+            solves: vec![SolveCost {
+                case: "c".into(),
+                method: "rk4".into(),
+                setting: 16.0,
+                error: 1e-5,
+                instructions: solve_instructions,
+                same_bits_as_host: same,
+            }],
+            maths: vec![],
+            instructions_per_tick: 40.0,
+        }
+    }
+
+    #[test]
+    fn baseline_check_fails_on_a_regression_beyond_ten_percent() {
+        let base = report(10.0, 1000, true);
+        assert!(check(&report(10.9, 1099, true), &base).is_ok());
+        assert!(check(&report(11.1, 1000, true), &base).is_err());
+        assert!(check(&report(10.0, 1101, true), &base).is_err());
+        assert!(check(&report(10.0, 1000, false), &base).is_err());
+        // Getting faster is never a failure.
+        assert!(check(&report(5.0, 10, true), &base).is_ok());
     }
 }
