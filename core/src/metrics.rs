@@ -224,17 +224,45 @@ pub(crate) fn report(w: &Window<'_>, scene: &Scene, index: u32, v0: Option<f32>)
             .unwrap_or(w.onset as f32)
     });
 
-    // Peak and half-width on the (possibly filtered) acceleration.
-    let (peak_i, peak_a) = a
-        .iter()
-        .enumerate()
-        .fold((w.onset, 0.0f32), |best, (i, &v)| {
-            if libm::fabsf(v) > libm::fabsf(best.1) {
-                (i, v)
-            } else {
-                best
-            }
-        });
+    // Peak and half-width on the (possibly filtered) acceleration. Unfiltered, the first
+    // largest |a| is the first largest |d| the monitor already found: a = d · per_count is
+    // strictly monotonic in |d| while |d| < 2^22 (neighbouring integers stay more than an
+    // f32 ulp apart after the product), so the scan over the window is skipped.
+    let raw_i = (w.peak_index.checked_sub(w.first_index)).map(|i| i as usize);
+    let raw_peak_exact = scene.cfc.is_none()
+        && w.status != Status::BufferFull
+        && w.peak_d != 0
+        && w.peak_d.unsigned_abs() < 1 << 22;
+    let (peak_i, peak_a) = match (
+        raw_peak_exact,
+        raw_i.and_then(|i| a.get(i).map(|&v| (i, v))),
+    ) {
+        (true, Some(found)) => found,
+        _ => a
+            .iter()
+            .enumerate()
+            .fold((w.onset, 0.0f32), |best, (i, &v)| {
+                if libm::fabsf(v) > libm::fabsf(best.1) {
+                    (i, v)
+                } else {
+                    best
+                }
+            }),
+    };
+    #[cfg(test)]
+    {
+        let scan = a
+            .iter()
+            .enumerate()
+            .fold((w.onset, 0.0f32), |best, (i, &v)| {
+                if libm::fabsf(v) > libm::fabsf(best.1) {
+                    (i, v)
+                } else {
+                    best
+                }
+            });
+        assert_eq!((peak_i, peak_a.to_bits()), (scan.0, scan.1.to_bits()));
+    }
     let (peak_acc, peak_time) = if w.status == Status::BufferFull {
         (raw_peak, w.peak_index as f64 / fs)
     } else {

@@ -434,8 +434,10 @@ impl<const PRE: usize, const CAP: usize> Monitor<PRE, CAP> {
             return;
         };
         let (lo, hi) = self.scene.clip_counts;
+        // d in i32 as in `run_active`.
+        let (n32, s32) = (a.base_n as i32, a.base_sum as i32);
         for (k, &x) in samples.iter().enumerate() {
-            let d = x as i64 * a.base_n - a.base_sum;
+            let d = (x as i32).wrapping_mul(n32).wrapping_sub(s32) as i64;
             a.total_c += d;
             let at = a.first_index + a.samples + k as u64;
             if d.unsigned_abs() > a.peak_d.unsigned_abs() {
@@ -628,5 +630,61 @@ mod floor_tests {
         assert!(super::floor(f32::NAN).is_nan());
         assert_eq!(super::floor(f32::INFINITY), f32::INFINITY);
         assert_eq!(super::floor(-0.5), -1.0);
+    }
+}
+
+#[cfg(test)]
+mod peak_tests {
+    use crate::{Approach, Calibration, ImpactReport, Monitor, Scene};
+
+    /// Reports of many pulses (both signs, flat tops with ties, noise, several gains): the
+    /// report's peak from the monitor's integer peak must equal a scan of the window
+    /// (`metrics::report` asserts it under `cfg(test)`).
+    #[test]
+    fn peak_from_the_integer_peak_equals_the_scan() {
+        for gain in [1600.0 / 4096.0, 0.0123, -0.5] {
+            let mut s = Scene::new(
+                Calibration {
+                    gain_m_s2_per_count: gain,
+                    sample_rate_hz: 100_000.0,
+                },
+                40.0 * libm::fabsf(gain),
+            );
+            s.edge_m_s2 = 8.0 * libm::fabsf(gain);
+            s.hold_s = 1e-3;
+            s.mass_kg = Some(0.1);
+            s.approach = Approach::Speed { v0_m_s: 0.5 };
+            let mut m = Monitor::<1024, 4096>::new(s).unwrap();
+            let mut state = 12345u32;
+            let mut noise = move || {
+                state ^= state << 13;
+                state ^= state >> 17;
+                state ^= state << 5;
+                (state % 5) as i16 - 2
+            };
+            let mut n = 0;
+            let mut out = |_: &ImpactReport| n += 1;
+            let mut block = [0i16; 100];
+            for pulse in 0..60i32 {
+                let amplitude = (pulse % 7 + 1) * 60 * if pulse % 2 == 0 { 1 } else { -1 };
+                let width = 50 + (pulse % 5) * 40;
+                let mut k = 0i32;
+                while k < 3000 {
+                    for x in block.iter_mut() {
+                        let shape = if (0..width).contains(&(k - 1000)) {
+                            // A flat top over the middle third: ties at the peak.
+                            let t = ((k - 1000) as f32 / width as f32).min(0.67).max(0.33);
+                            libm::sinf(core::f32::consts::PI * t)
+                        } else {
+                            0.0
+                        };
+                        *x = 2048 + (amplitude as f32 * shape) as i16 + noise();
+                        k += 1;
+                    }
+                    m.push_block(&block, &mut out);
+                }
+            }
+            assert!(n >= 55, "gain {gain}: {n} reports");
+        }
     }
 }

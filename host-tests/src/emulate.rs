@@ -316,7 +316,6 @@ pub fn build_firmware_bin(feature: &str, bin: Option<&str>) -> Result<PathBuf, S
     let status = Command::new(&cargo)
         .current_dir(&root)
         .env("CARGO_TARGET_DIR", &target_dir)
-        .args(bin_args)
         .args([
             "build",
             "--quiet",
@@ -329,12 +328,13 @@ pub fn build_firmware_bin(feature: &str, bin: Option<&str>) -> Result<PathBuf, S
             "--features",
             feature,
         ])
+        .args(&bin_args)
         .stdout(Stdio::null())
         .status()
         .map_err(|e| format!("cargo: {e}"))?;
     if !status.success() {
         return Err(format!(
-            "building the emulator firmware failed ({status}); is the thumbv7em-none-eabihf target installed (scripts/setup.sh)?"
+            "building the QEMU firmware ({feature}) failed ({status}); is the thumbv7em-none-eabihf target installed (scripts/setup.sh)?"
         ));
     }
     Ok(target_dir
