@@ -11,9 +11,9 @@
 //!   [`bench_begin`] and [`bench_end`]. Prints the kind of every block (`i` idle, `t` the
 //!   trigger fired, `a` inside an impact, `e` an impact ended and was reported, `m` mixed) and,
 //!   in `count` mode, the SysTick time of each kind and of the whole stream;
-//! * `solve <label> <method> <steps|rtol> <mass> <v0> <model> <p1> <p2> <p3> <permanent|none>`:
-//!   one f32
-//!   [`impact_core::solve`] call; prints its SysTick time and the outcome's bits;
+//! * `solve <label> <reps> <method> <steps|rtol> <mass> <v0> <model> <p1> <p2> <p3>
+//!   <permanent|none>`: `reps` identical f32
+//!   [`impact_core::solve`] calls; prints their SysTick time and the outcome's bits;
 //! * `selftest`: the board's hand-written routines (SIMD stride statistics, word-wise copy,
 //!   FPU square root)
 //!   against their portable references; prints `selftest ok`;
@@ -411,6 +411,7 @@ fn float(w: Option<&str>) -> Result<f32, ()> {
 
 fn solve_job<'a>(mut w: impl Iterator<Item = &'a str>) -> Result<(), ()> {
     let label = w.next().ok_or(())?;
+    let reps = w.next().ok_or(())?.parse::<u32>().map_err(|_| ())?.max(1);
     let method = w.next().ok_or(())?;
     let knob = w.next().ok_or(())?;
     let mass = float(w.next())?;
@@ -454,13 +455,17 @@ fn solve_job<'a>(mut w: impl Iterator<Item = &'a str>) -> Result<(), ()> {
     let impact = Impact::new(mass, v0);
     let t0 = now();
     bench_begin();
-    let outcome = solve(black_box(&model), black_box(&impact), black_box(&settings));
+    let mut outcome = solve(black_box(&model), black_box(&impact), black_box(&settings));
+    for _ in 1..reps {
+        outcome = solve(black_box(&model), black_box(&impact), black_box(&settings));
+    }
     bench_end();
     let ticks = now() - t0;
     match outcome {
         Ok(o) => hprintln!(
-            "solve {} ticks={} ok=1 rhs={} bits={:08x},{:08x},{:08x},{:08x},{:08x},{:08x}",
+            "solve {} reps={} ticks={} ok=1 rhs={} bits={:08x},{:08x},{:08x},{:08x},{:08x},{:08x}",
             label,
+            reps,
             ticks,
             o.rhs_evaluations,
             o.max_deformation_m.to_bits(),
