@@ -673,7 +673,7 @@ mod peak_tests {
                     for x in block.iter_mut() {
                         let shape = if (0..width).contains(&(k - 1000)) {
                             // A flat top over the middle third: ties at the peak.
-                            let t = ((k - 1000) as f32 / width as f32).min(0.67).max(0.33);
+                            let t = ((k - 1000) as f32 / width as f32).clamp(0.33, 0.67);
                             libm::sinf(core::f32::consts::PI * t)
                         } else {
                             0.0

@@ -262,32 +262,6 @@ pub fn pow<R: Real>(x: R, e: R) -> R {
     }
 }
 
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn pow_fast_paths_agree_with_powf() {
-        for x in [0.0f64, 1e-300, 0.3, 2.0, 7.5e8] {
-            for e in [0.5, 1.0, 1.5, 2.0, 3.0, 0.4, 2.7] {
-                let want = if x == 0.0 { 0.0 } else { libm::pow(x, e) };
-                let got = pow(x, e);
-                assert!(
-                    (got - want).abs() <= 4.0 * f64::EPSILON * want,
-                    "{x}^{e}: {got} vs {want}"
-                );
-            }
-        }
-    }
-
-    #[test]
-    fn signed_pow_is_odd_and_exact_at_zero() {
-        assert_eq!(0.0f64.signed_pow(1.5), 0.0);
-        assert_eq!((-4.0f64).signed_pow(1.5), -8.0);
-        assert_eq!(4.0f64.signed_pow(1.5), 8.0);
-    }
-}
-
 /// Square root by the FPU's `vsqrt.f32` on the Cortex-M4F (14 cycles); `libm::sqrtf`
 /// elsewhere. Both are IEEE correctly rounded, so both give the same bits for every input.
 ///
@@ -328,4 +302,30 @@ mod vsqrt {
         "bx lr",
         ".size impact_core_vsqrt_f32, . - impact_core_vsqrt_f32",
     );
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn pow_fast_paths_agree_with_powf() {
+        for x in [0.0f64, 1e-300, 0.3, 2.0, 7.5e8] {
+            for e in [0.5, 1.0, 1.5, 2.0, 3.0, 0.4, 2.7] {
+                let want = if x == 0.0 { 0.0 } else { libm::pow(x, e) };
+                let got = pow(x, e);
+                assert!(
+                    (got - want).abs() <= 4.0 * f64::EPSILON * want,
+                    "{x}^{e}: {got} vs {want}"
+                );
+            }
+        }
+    }
+
+    #[test]
+    fn signed_pow_is_odd_and_exact_at_zero() {
+        assert_eq!(0.0f64.signed_pow(1.5), 0.0);
+        assert_eq!((-4.0f64).signed_pow(1.5), -8.0);
+        assert_eq!(4.0f64.signed_pow(1.5), 8.0);
+    }
 }
