@@ -67,6 +67,12 @@ pub struct M4Report {
     pub maths: Vec<MathCost>,
     /// Instructions per SysTick tick in the count run (40 expected).
     pub instructions_per_tick: f64,
+    /// The whole emulator firmware (sampler, channel, monitor, reporter, executor, SysTick
+    /// time driver), per idle sample: the difference between two idle recordings of 2^17
+    /// and 2^18 samples. Its sampler replays a host file through semihosting, which the
+    /// board's DMA does without the CPU.
+    #[serde(default)]
+    pub firmware_idle_instructions_per_sample: f64,
 }
 
 #[derive(Clone, Debug, Serialize, Deserialize)]
@@ -319,6 +325,7 @@ fn run_qemu(
     elf: &Path,
     args: &[String],
     trace: Option<&mut dyn FnMut(&str)>,
+    icount: bool,
 ) -> Result<String, String> {
     let dir = std::env::temp_dir().join(format!("impact-m4-{}", std::process::id()));
     std::fs::create_dir_all(&dir).map_err(|e| format!("{}: {e}", dir.display()))?;
@@ -331,8 +338,10 @@ fn run_qemu(
         "-nographic",
         "-monitor",
         "none",
+        "-serial",
+        "null",
     ]);
-    let mut config = String::from("enable=on,target=native,arg=m4-bench");
+    let mut config = String::from("enable=on,target=native,arg=firmware");
     for a in args {
         config.push_str(",arg=");
         config.push_str(a);
@@ -340,12 +349,12 @@ fn run_qemu(
     cmd.args(["-semihosting-config", &config]);
     cmd.arg("-kernel").arg(elf);
     cmd.stdout(Stdio::piped()).stderr(Stdio::piped());
+    if icount {
+        cmd.args(["-icount", "shift=0"]);
+    }
     let fifo = dir.join("trace.fifo");
     let result = match trace {
-        None => {
-            cmd.args(["-icount", "shift=0"]);
-            cmd.output().map_err(|e| format!("qemu-system-arm: {e}"))
-        }
+        None => cmd.output().map_err(|e| format!("qemu-system-arm: {e}")),
         Some(on_line) => {
             let _ = std::fs::remove_file(&fifo);
             let status = Command::new("mkfifo")
@@ -658,6 +667,7 @@ pub fn run(args: &M4Args) -> Result<(M4Report, String), String> {
             &elf,
             &["trace".into(), path_arg(&raw)?, path_arg(&trace_jobs)?],
             Some(&mut on_line),
+            false,
         )?;
         if !out.lines().any(|l| l == "selftest ok") {
             return Err(format!("the M4 self-test did not pass:\n{out}"));
@@ -773,6 +783,7 @@ pub fn run(args: &M4Args) -> Result<(M4Report, String), String> {
             &elf,
             &["count".into(), path_arg(&raw)?, path_arg(&count_jobs)?],
             None,
+            true,
         )?;
         let lines: Vec<&str> = out.lines().collect();
         let find = |prefix: &str| {
@@ -828,6 +839,8 @@ pub fn run(args: &M4Args) -> Result<(M4Report, String), String> {
                 max_relative_error: err,
             });
         }
+        let firmware = crate::emulate::build_firmware()?;
+        let firmware_idle = firmware_idle_marginal(&firmware)?;
         let report = M4Report {
             block,
             idle_instructions_per_sample: idle_ips,
@@ -844,6 +857,7 @@ pub fn run(args: &M4Args) -> Result<(M4Report, String), String> {
             solves,
             maths: maths_out,
             instructions_per_tick: ipt,
+            firmware_idle_instructions_per_sample: firmware_idle,
         };
         let prof = if args.profile {
             profile_text(&kinds, &profile)
@@ -856,6 +870,35 @@ pub fn run(args: &M4Args) -> Result<(M4Report, String), String> {
         let _ = std::fs::remove_file(f);
     }
     result
+}
+
+/// Instructions the whole emulator firmware executes per idle sample (see
+/// [`M4Report::firmware_idle_instructions_per_sample`]).
+fn firmware_idle_marginal(firmware: &Path) -> Result<f64, String> {
+    let dir = std::env::temp_dir();
+    let mut totals = Vec::new();
+    for n in [1usize << 17, 1 << 18] {
+        let counts = crate::throughput::impact_stream(n, 0);
+        let raw = dir.join(format!("impact-m4-idle-{}-{n}.i16", std::process::id()));
+        let bytes: Vec<u8> = counts.iter().flat_map(|c| c.to_le_bytes()).collect();
+        std::fs::write(&raw, bytes).map_err(|e| format!("{}: {e}", raw.display()))?;
+        let mut lines = 0u64;
+        let mut count = |_: &str| lines += 1;
+        // icount: SysTick (the time driver) then ticks with the instructions, not the wall
+        // clock, so the count is deterministic.
+        let result = run_qemu(
+            firmware,
+            &[path_arg(&raw)?, "lossless".into()],
+            Some(&mut count),
+            true,
+        );
+        let _ = std::fs::remove_file(&raw);
+        result?;
+        totals.push((n, lines));
+    }
+    let (n1, i1) = totals[0];
+    let (n2, i2) = totals[1];
+    Ok(i2.saturating_sub(i1) as f64 / (n2 - n1) as f64)
 }
 
 /// The cases solved on the M4: one per model (the standard set's first of each).
@@ -1009,6 +1052,10 @@ pub fn table(r: &M4Report) -> String {
         r.impact_instructions_per_sample, r.impact_cycles_per_sample
     ));
     s.push_str(&format!(
+        "  whole emulator firmware, idle: {:.2} instructions/sample (tasks, channel, executor, replay source)\n",
+        r.firmware_idle_instructions_per_sample
+    ));
+    s.push_str(&format!(
         "  worst ~{:.1} cycles/sample: headroom {:.1} % at 500 kS/s (336 cycles), {:.1} % at 2.4 MS/s (70 cycles)\n",
         r.estimated_cycles_per_sample,
         100.0 * r.headroom_at_500k,
@@ -1067,6 +1114,11 @@ pub fn check(r: &M4Report, baseline: &M4Report) -> Result<String, String> {
             "in-impact instructions/sample".into(),
             r.impact_instructions_per_sample,
             baseline.impact_instructions_per_sample,
+        ),
+        (
+            "firmware idle instructions/sample".into(),
+            r.firmware_idle_instructions_per_sample,
+            baseline.firmware_idle_instructions_per_sample,
         ),
         (
             "trigger instructions".into(),
@@ -1205,6 +1257,7 @@ mod tests {
             }],
             maths: vec![],
             instructions_per_tick: 40.0,
+            firmware_idle_instructions_per_sample: 20.0,
         }
     }
 
