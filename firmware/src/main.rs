@@ -52,7 +52,8 @@ async fn main(spawner: Spawner) {
         tasks::monitor::PRE_TRIGGER_LEN,
         tasks::monitor::CAPTURE_LEN
     );
-    let scene = board::start(spawner);
+    let (samples_in, samples_out) = unwrap!(tasks::sample_queue());
+    let scene = board::start(spawner, samples_in);
     spawner.spawn(unwrap!(tasks::reporter::reporter()));
-    spawner.spawn(unwrap!(tasks::monitor::monitor(scene)));
+    spawner.spawn(unwrap!(tasks::monitor::monitor(scene, samples_out)));
 }

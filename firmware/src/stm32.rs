@@ -25,7 +25,7 @@ bind_interrupts!(
 
 /// Brings the chip up at 168 MHz and spawns the sample source; the monitor runs the scene
 /// compiled in ([`crate::scene::BENCH`]).
-pub fn start(spawner: Spawner) -> impact_core::Scene {
+pub fn start(spawner: Spawner, samples: crate::tasks::SampleSender) -> impact_core::Scene {
     let p = embassy_stm32::init(clock_config());
 
     #[cfg(not(feature = "adxl375"))]
@@ -33,7 +33,7 @@ pub fn start(spawner: Spawner) -> impact_core::Scene {
         use crate::source::adc;
         let dma_buf = adc::dma_buffer();
         let sampler = adc::AdcSampler::new(p.ADC1, p.PA1, p.DMA2_CH0, p.TIM3, Irqs, dma_buf);
-        spawner.spawn(unwrap!(adc::sampler(sampler)));
+        spawner.spawn(unwrap!(adc::sampler(sampler, samples)));
     }
 
     #[cfg(feature = "adxl375")]
@@ -47,7 +47,7 @@ pub fn start(spawner: Spawner) -> impact_core::Scene {
             lis3dsh_cs: p.PE3,
         };
         let sensor = accel::sensor(p.SPI1, pins, p.DMA2_CH3, p.DMA2_CH2, Irqs);
-        spawner.spawn(unwrap!(accel::sampler(sensor)));
+        spawner.spawn(unwrap!(accel::sampler(sensor, samples)));
     }
 
     #[cfg(feature = "light-gate")]

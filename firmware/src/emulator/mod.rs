@@ -88,7 +88,7 @@ fn parse(line: &'static str) -> Result<Config, ConfigError> {
 
 /// Reads the command line, brings the board up and spawns the sample source; returns the
 /// scene for the monitor. A bad command line ends the run (exit status 1).
-pub fn start(spawner: Spawner) -> Scene {
+pub fn start(spawner: Spawner, samples: crate::tasks::SampleSender) -> Scene {
     static LINE: ConstStaticCell<[u8; COMMAND_LINE_LEN]> =
         ConstStaticCell::new([0; COMMAND_LINE_LEN]);
     let Some(buf) = LINE.try_take() else {
@@ -110,6 +110,7 @@ pub fn start(spawner: Spawner) -> Scene {
         config.samples_path,
         config.pacing,
         config.scene.calibration.sample_rate_hz,
+        samples,
     )));
     config.scene
 }

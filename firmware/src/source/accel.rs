@@ -127,8 +127,8 @@ fn pick(sample: &Sample) -> i16 {
 /// Brings the sensor up, then polls its FIFO forever, one block per [`BLOCK_LEN`] samples.
 /// If the sensor cannot be brought up the stream ends as failed.
 #[embassy_executor::task]
-pub async fn sampler(mut sensor: Sensor) {
-    let mut sender = BlockSender::new();
+pub async fn sampler(mut sensor: Sensor, samples: crate::tasks::SampleSender) {
+    let mut sender = BlockSender::new(samples);
 
     let mut attempt = 1;
     while let Err(e) = sensor.init(DATA_RATE).await {

@@ -100,8 +100,8 @@ fn clear_adc_overrun() -> bool {
 
 /// Samples forever, one block per DMA half-buffer.
 #[embassy_executor::task]
-pub async fn sampler(mut s: AdcSampler) {
-    let mut sender = BlockSender::new();
+pub async fn sampler(mut s: AdcSampler, samples: crate::tasks::SampleSender) {
+    let mut sender = BlockSender::new(samples);
     let mut half = [0u16; BLOCK_LEN];
 
     s.adc.start();

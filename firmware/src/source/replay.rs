@@ -40,8 +40,13 @@ impl From<HostError> for ReplayError {
 
 /// Replays the file at `path` as if sampled at `rate_hz`, then ends the stream.
 #[embassy_executor::task]
-pub async fn replay(path: &'static str, pacing: Pacing, rate_hz: f32) {
-    let mut sender = BlockSender::new();
+pub async fn replay(
+    path: &'static str,
+    pacing: Pacing,
+    rate_hz: f32,
+    samples: crate::tasks::SampleSender,
+) {
+    let mut sender = BlockSender::new(samples);
     let end = match run(&mut sender, path, pacing, rate_hz).await {
         Ok(()) => StreamEnd::Complete,
         Err(e) => {

@@ -11,7 +11,7 @@ use impact_core::{ImpactReport, Monitor, Scene};
 use static_cell::ConstStaticCell;
 
 use super::reporter::{Heartbeat, Report, Tally};
-use super::{SourceEvent, StreamEnd, REPORTS, SAMPLES};
+use super::{SampleReceiver, SourceEvent, StreamEnd, REPORTS};
 
 /// Pre-trigger ring (and baseline window), samples: the host's value.
 pub const PRE_TRIGGER_LEN: usize = 4096;
@@ -82,10 +82,12 @@ impl Run {
         self.next_seq = seq.wrapping_add(1);
         tally.blocks = tally.blocks.wrapping_add(1);
         tally.samples += samples.len() as u64;
-        for &sample in samples {
-            tally.min = tally.min.min(sample);
-            tally.max = tally.max.max(sample);
-            tally.sum = tally.sum.wrapping_add(i64::from(sample));
+        // The core's stride statistics (SIMD on the Cortex-M4), a stride at a time.
+        for stride in samples.chunks(impact_core::signal::baseline::STRIDE) {
+            let s = impact_core::signal::baseline::Stats::of(stride);
+            tally.min = tally.min.min(s.min);
+            tally.max = tally.max.max(s.max);
+            tally.sum = tally.sum.wrapping_add(i64::from(s.sum));
         }
     }
 
@@ -147,7 +149,7 @@ async fn forward(pending: &mut heapless::Vec<ImpactReport, IMPACTS_PER_BLOCK>) {
 
 /// Runs the pipeline over the blocks until the source ends, reporting through [`REPORTS`].
 #[embassy_executor::task]
-pub async fn monitor(scene: Scene) {
+pub async fn monitor(scene: Scene, mut samples: SampleReceiver) {
     // Built at compile time into its static: the buffers are far too big for the stack, and
     // `Monitor::new` would build the monitor on the stack and move it.
     static MONITOR: ConstStaticCell<FwMonitor> = ConstStaticCell::new(FwMonitor::unconfigured());
@@ -174,7 +176,9 @@ pub async fn monitor(scene: Scene) {
         if let Some(v0) = APPROACH_SPEED.try_take() {
             m.set_approach_speed(Some(v0));
         }
-        match SAMPLES.receive().await {
+        // The block is read in its queue slot, which goes back to the source as soon as
+        // the pipeline has seen it.
+        let end = match samples.receive().await {
             SourceEvent::Block(block) => {
                 let samples = block.samples();
                 run.count(block.seq, samples);
@@ -186,6 +190,13 @@ pub async fn monitor(scene: Scene) {
                     }
                 });
                 run.busy(since);
+                (None, dropped)
+            }
+            SourceEvent::End(end) => (Some(*end), 0),
+        };
+        samples.receive_done();
+        match end {
+            (None, dropped) => {
                 if dropped > 0 {
                     run.impacts_dropped = run.impacts_dropped.saturating_add(dropped);
                     error!(
@@ -202,7 +213,7 @@ pub async fn monitor(scene: Scene) {
                     }
                 }
             }
-            SourceEvent::End(end) => {
+            (Some(end), _) => {
                 let since = Instant::now();
                 let mut dropped = 0u32;
                 m.finish(&mut |r: &ImpactReport| {

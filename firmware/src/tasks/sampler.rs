@@ -3,10 +3,8 @@
 
 use core::sync::atomic::{AtomicU32, Ordering};
 
+use super::{Block, SampleSender, SourceEvent, StreamEnd, BLOCK_LEN};
 use defmt::{info, warn};
-use embassy_sync::channel::TrySendError;
-
-use super::{Block, SourceEvent, StreamEnd, BLOCK_LEN, SAMPLES};
 
 /// Loss and error counters of the sample source, read by the reporter.
 pub struct SourceStats {
@@ -65,39 +63,52 @@ impl SourceStats {
 /// The one set of source counters.
 pub static SOURCE_STATS: SourceStats = SourceStats::new();
 
-/// Numbers the blocks of one source and sends them into [`SAMPLES`].
+/// Numbers the blocks of one source and writes them into the sample queue's slots.
 pub struct BlockSender {
+    queue: SampleSender,
     next_seq: u32,
     /// Blocks lost since the queue last accepted one; logged when it does again.
     losing: u32,
 }
 
+/// Fills `slot` as the next block (in place: the samples are written once, into the queue).
+fn fill_slot(slot: &mut SourceEvent, seq: u32, fill: impl FnOnce(&mut [i16; BLOCK_LEN]) -> usize) {
+    if !matches!(slot, SourceEvent::Block(_)) {
+        *slot = SourceEvent::Block(Block::new(seq, [0; BLOCK_LEN], 0));
+    }
+    if let SourceEvent::Block(block) = slot {
+        let len = fill(&mut block.samples);
+        block.seq = seq;
+        block.set_len(len);
+    }
+}
+
 impl BlockSender {
-    /// A sender whose first block gets sequence number 0.
-    pub const fn new() -> Self {
+    /// A sender into `queue` whose first block gets sequence number 0.
+    pub const fn new(queue: SampleSender) -> Self {
         Self {
+            queue,
             next_seq: 0,
             losing: 0,
         }
     }
 
-    fn block(&mut self, fill: impl FnOnce(&mut [i16; BLOCK_LEN]) -> usize) -> Block {
-        let mut samples = [0i16; BLOCK_LEN];
-        let len = fill(&mut samples);
-        let block = Block::new(self.next_seq, samples, len);
+    fn take_seq(&mut self) -> u32 {
+        let seq = self.next_seq;
         self.next_seq = self.next_seq.wrapping_add(1);
-        block
+        seq
     }
 
     /// For real-time sources: fills a block with `fill` (which returns how many samples it
     /// wrote) and queues it without waiting. If the queue is full the block is dropped and
-    /// counted; the first loss of a run is logged at once, the run's length when it ends.
-    /// Returns whether the block was queued.
+    /// counted (`fill` is not called); the first loss of a run is logged at once, the run's
+    /// length when it ends. Returns whether the block was queued.
     pub fn publish(&mut self, fill: impl FnOnce(&mut [i16; BLOCK_LEN]) -> usize) -> bool {
-        let block = self.block(fill);
-        let seq = block.seq;
-        match SAMPLES.try_send(SourceEvent::Block(block)) {
-            Ok(()) => {
+        let seq = self.take_seq();
+        match self.queue.try_send() {
+            Some(slot) => {
+                fill_slot(slot, seq, fill);
+                self.queue.send_done();
                 SOURCE_STATS.blocks_sent.fetch_add(1, Ordering::Relaxed);
                 if self.losing > 0 {
                     warn!(
@@ -108,7 +119,7 @@ impl BlockSender {
                 }
                 true
             }
-            Err(TrySendError::Full(_)) => {
+            None => {
                 let total = SOURCE_STATS.blocks_lost.fetch_add(1, Ordering::Relaxed) + 1;
                 if self.losing == 0 {
                     warn!(
@@ -122,19 +133,21 @@ impl BlockSender {
         }
     }
 
-    /// For sources that can wait (file replay): fills a block and waits for room in the
-    /// queue, so nothing is lost.
+    /// For sources that can wait (file replay): waits for room in the queue, then fills the
+    /// block in place, so nothing is lost.
     #[cfg_attr(feature = "stm32", allow(dead_code))]
     pub async fn send(&mut self, fill: impl FnOnce(&mut [i16; BLOCK_LEN]) -> usize) {
-        let block = self.block(fill);
-        SAMPLES.send(SourceEvent::Block(block)).await;
+        let seq = self.take_seq();
+        let slot = self.queue.send().await;
+        fill_slot(slot, seq, fill);
+        self.queue.send_done();
         SOURCE_STATS.blocks_sent.fetch_add(1, Ordering::Relaxed);
     }
 
     /// Ends a finite stream (the replay's, or a live source that gave up); waits for room so
     /// the end is never lost.
     #[cfg_attr(all(feature = "stm32", not(feature = "adxl375")), allow(dead_code))]
-    pub async fn finish(self, end: StreamEnd) {
+    pub async fn finish(mut self, end: StreamEnd) {
         if self.losing > 0 {
             warn!(
                 "sample queue: {} blocks lost at the end of the stream",
@@ -145,12 +158,7 @@ impl BlockSender {
             "sample source ended ({}) after {} blocks",
             end, self.next_seq
         );
-        SAMPLES.send(SourceEvent::End(end)).await;
-    }
-}
-
-impl Default for BlockSender {
-    fn default() -> Self {
-        Self::new()
+        *self.queue.send().await = SourceEvent::End(end);
+        self.queue.send_done();
     }
 }
