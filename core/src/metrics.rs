@@ -203,6 +203,17 @@ fn flank_zero(a: &[f32], from: usize, forward: bool, edge: f32) -> Option<f32> {
     ok.then_some(zero as f32)
 }
 
+/// The first sample of largest |a| (index and value); `(onset, 0)` if every sample is 0.
+fn scan_peak(a: &[f32], onset: usize) -> (usize, f32) {
+    a.iter().enumerate().fold((onset, 0.0f32), |best, (i, &v)| {
+        if libm::fabsf(v) > libm::fabsf(best.1) {
+            (i, v)
+        } else {
+            best
+        }
+    })
+}
+
 /// Builds the report of one window.
 pub(crate) fn report(w: &Window<'_>, scene: &Scene, index: u32, v0: Option<f32>) -> ImpactReport {
     let cal = &scene.calibration;
@@ -238,29 +249,11 @@ pub(crate) fn report(w: &Window<'_>, scene: &Scene, index: u32, v0: Option<f32>)
         raw_i.and_then(|i| a.get(i).map(|&v| (i, v))),
     ) {
         (true, Some(found)) => found,
-        _ => a
-            .iter()
-            .enumerate()
-            .fold((w.onset, 0.0f32), |best, (i, &v)| {
-                if libm::fabsf(v) > libm::fabsf(best.1) {
-                    (i, v)
-                } else {
-                    best
-                }
-            }),
+        _ => scan_peak(a, w.onset),
     };
     #[cfg(test)]
     {
-        let scan = a
-            .iter()
-            .enumerate()
-            .fold((w.onset, 0.0f32), |best, (i, &v)| {
-                if libm::fabsf(v) > libm::fabsf(best.1) {
-                    (i, v)
-                } else {
-                    best
-                }
-            });
+        let scan = scan_peak(a, w.onset);
         assert_eq!((peak_i, peak_a.to_bits()), (scan.0, scan.1.to_bits()));
     }
     let (peak_acc, peak_time) = if w.status == Status::BufferFull {

@@ -422,28 +422,11 @@ pub fn seed_recording() -> Result<Vec<i16>, String> {
         #[command(flatten)]
         synth: crate::synth::SynthArgs,
     }
-    let args = Wrap::try_parse_from([
-        "synth",
-        "--law",
-        "two-phase",
-        "--mass",
-        "0.06",
-        "--v0",
-        "1.3357",
-        "--max-deformation",
-        "0.0186",
-        "--kr",
-        "12376",
-        "--permanent",
-        "0.0182",
-        "--damping",
-        "2",
-        "--touch",
-        "0.04",
-        "--duration",
-        "0.12",
-    ])
-    .map_err(|e| e.to_string())?;
+    let args = ["synth"]
+        .into_iter()
+        .chain(crate::synth::SEED_BENCH_ARGS)
+        .chain(["--touch", "0.04", "--duration", "0.12"]);
+    let args = Wrap::try_parse_from(args).map_err(|e| e.to_string())?;
     Ok(crate::synth::synth(&args.synth)?.0.samples)
 }
 

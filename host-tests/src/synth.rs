@@ -217,6 +217,26 @@ pub struct SynthArgs {
     pub seed: u64,
 }
 
+/// `impact synth` arguments of the seed-001 bench impact (60 g at 1.3357 m/s into the
+/// two-phase Kelvin–Voigt law matching Table 1's x_m and x_p), shared by the tests and the M4
+/// benchmark.
+pub const SEED_BENCH_ARGS: [&str; 14] = [
+    "--law",
+    "two-phase",
+    "--mass",
+    "0.06",
+    "--v0",
+    "1.3357",
+    "--max-deformation",
+    "0.0186",
+    "--kr",
+    "12376",
+    "--permanent",
+    "0.0182",
+    "--damping",
+    "2",
+];
+
 /// Renders the recording described by `args`; the CSV has `time_s,accel_g` (mid-scale code
 /// taken as zero) and the raw codes are returned too.
 pub fn synth(args: &SynthArgs) -> Result<(Recording, String), String> {

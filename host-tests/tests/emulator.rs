@@ -109,23 +109,11 @@ fn seed_001_bench_impact_with_kinematics_and_fits() {
     if firmware().is_none() {
         return;
     }
-    let (csv, _) = impact(&[
-        "synth",
-        "--law",
-        "two-phase",
-        "--mass",
-        "0.06",
-        "--v0",
-        "1.3357",
-        "--max-deformation",
-        "0.0186",
-        "--kr",
-        "12376",
-        "--permanent",
-        "0.0182",
-        "--damping",
-        "2",
-    ]);
+    let args: Vec<&str> = ["synth"]
+        .into_iter()
+        .chain(impact_host::synth::SEED_BENCH_ARGS)
+        .collect();
+    let (csv, _) = impact(&args);
     let file = tmp("seed-001.csv");
     std::fs::write(&file, csv).unwrap();
     let file = file.to_string_lossy().into_owned();
