@@ -23,8 +23,25 @@ use crate::solve::Error;
 const BASELINE_STRIDES: usize = 64;
 /// Samples in a full baseline, the largest `W` of `d = W x - S`.
 const BASELINE_SPAN: usize = BASELINE_STRIDES * crate::signal::baseline::STRIDE;
-// The in-impact loop computes d in i32: |x| <= 2^15 and W <= 2^12 keep |d| below 2^28.
+// `Deviation` computes d in i32: |x| <= 2^15 and W <= 2^12 keep |S| below 2^27 and |d|
+// below 2^28.
 const _: () = assert!(BASELINE_SPAN <= 1 << 12);
+
+/// `d = W x - S` for one impact's frozen baseline, in i32: exact, since `W <= BASELINE_SPAN`
+/// (the wrapping operations never wrap), and the FPU converts i32 while i64 arithmetic and
+/// conversions are longer or soft-float calls on the Cortex-M4.
+#[derive(Clone, Copy)]
+struct Deviation {
+    w: i32,
+    s: i32,
+}
+
+impl Deviation {
+    #[inline]
+    fn of(self, x: i16) -> i32 {
+        (x as i32).wrapping_mul(self.w).wrapping_sub(self.s)
+    }
+}
 
 /// Counters that cannot wrap: 2^64 samples at 2.4 MS/s is 240 000 years.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
@@ -60,6 +77,15 @@ struct Active {
     samples: u64,
     clipped: bool,
     full: bool,
+}
+
+impl Active {
+    fn deviation(&self) -> Deviation {
+        Deviation {
+            w: self.base_n as i32,
+            s: self.base_sum as i32,
+        }
+    }
 }
 
 /// Streams samples of one channel through a [`Scene`].
@@ -256,7 +282,7 @@ impl<const PRE: usize, const CAP: usize> Monitor<PRE, CAP> {
                     // One vectorised pass for the stride statistics; the samples are
                     // scanned one by one only when the segment crosses a threshold.
                     let stats = Stats::of(segment);
-                    if (stats.max as i32) <= hi && (stats.min as i32) >= lo {
+                    if stats.within(lo, hi) {
                         // A run of quiet strides: the baseline (and so the thresholds)
                         // follows each one, the ring and the counters take the run at once.
                         self.learn(&stats);
@@ -264,16 +290,14 @@ impl<const PRE: usize, const CAP: usize> Monitor<PRE, CAP> {
                         while let Some(next) = rest.get(run..run + self.baseline.to_stride_end()) {
                             let (lo, hi) = self.current_thresholds();
                             let stats = Stats::of(next);
-                            if (stats.max as i32) > hi || (stats.min as i32) < lo {
+                            if !stats.within(lo, hi) {
                                 break;
                             }
                             self.learn(&stats);
                             run += next.len();
                         }
                         let (quiet, after) = rest.split_at(run.min(rest.len()));
-                        self.ring.extend(quiet);
-                        self.index += quiet.len() as u64;
-                        self.counters.samples += quiet.len() as u64;
+                        self.keep(quiet);
                         rest = after;
                         continue;
                     }
@@ -309,18 +333,19 @@ impl<const PRE: usize, const CAP: usize> Monitor<PRE, CAP> {
         }
     }
 
+    /// Idle samples: into the ring and the baseline.
     #[inline]
     fn idle(&mut self, samples: &[i16]) {
-        self.idle_with(samples, &Stats::of(samples));
+        self.keep(samples);
+        self.learn(&Stats::of(samples));
     }
 
-    /// Idle samples whose statistics are known: into the ring and the baseline.
+    /// Idle samples into the pre-trigger ring and the stream position.
     #[inline]
-    fn idle_with(&mut self, samples: &[i16], stats: &Stats) {
+    fn keep(&mut self, samples: &[i16]) {
         self.ring.extend(samples);
         self.index += samples.len() as u64;
         self.counters.samples += samples.len() as u64;
-        self.learn(stats);
     }
 
     /// A stretch of idle samples into the baseline (not while the history is replayed).
@@ -434,10 +459,9 @@ impl<const PRE: usize, const CAP: usize> Monitor<PRE, CAP> {
             return;
         };
         let (lo, hi) = self.scene.clip_counts;
-        // d in i32 as in `run_active`.
-        let (n32, s32) = (a.base_n as i32, a.base_sum as i32);
+        let deviation = a.deviation();
         for (k, &x) in samples.iter().enumerate() {
-            let d = (x as i32).wrapping_mul(n32).wrapping_sub(s32) as i64;
+            let d = deviation.of(x) as i64;
             a.total_c += d;
             let at = a.first_index + a.samples + k as u64;
             if d.unsigned_abs() > a.peak_d.unsigned_abs() {
@@ -468,9 +492,7 @@ impl<const PRE: usize, const CAP: usize> Monitor<PRE, CAP> {
             .saturating_sub(a.samples)
             .min(samples.len() as u64) as usize;
         let samples = samples.get(..room).unwrap_or(&[]);
-        // d = W x - S in i32: W <= BASELINE_SPAN = 2^12 samples, so |S| < 2^27 and
-        // |d| < 2^28 (see the assertion by `BASELINE_SPAN`): the wrapping operations never wrap.
-        let (n32, s32) = (a.base_n as i32, a.base_sum as i32);
+        let deviation = a.deviation();
         // edge_d >= 0: the scene's edge level is positive (validated).
         let edge = a.edge_d.clamp(0, u32::MAX as i64) as u32;
         let before = a.samples;
@@ -481,7 +503,7 @@ impl<const PRE: usize, const CAP: usize> Monitor<PRE, CAP> {
         let mut used = samples.len();
         let mut ended = None;
         for (k, &x) in samples.iter().enumerate() {
-            let d = (x as i32).wrapping_mul(n32).wrapping_sub(s32);
+            let d = deviation.of(x);
             sum += d as i64;
             let abs = d.unsigned_abs();
             if abs > peak_abs {
@@ -546,12 +568,9 @@ impl<const PRE: usize, const CAP: usize> Monitor<PRE, CAP> {
         let n = self.capture.len();
         let gain = self.scene.calibration.gain_m_s2_per_count;
         let per_count = gain / a.base_n as f32;
-        // d in i32 as in `run_active` (exact, see `BASELINE_SPAN`): the FPU converts i32,
-        // while i64 is a soft-float call on the Cortex-M4.
-        let (n32, s32) = (a.base_n as i32, a.base_sum as i32);
+        let deviation = a.deviation();
         for (slot, &x) in self.accel.iter_mut().zip(self.capture.iter()) {
-            let d = (x as i32).wrapping_mul(n32).wrapping_sub(s32);
-            *slot = d as f32 * per_count;
+            *slot = deviation.of(x) as f32 * per_count;
         }
         #[cfg(feature = "cfc")]
         if let Some(class) = self.scene.cfc {

@@ -147,8 +147,8 @@ fn disassemble(elf: &Path) -> Result<Code, String> {
     }
     let text = String::from_utf8_lossy(&out.stdout);
     let mut insns = HashMap::new();
-    let mut symbols: HashMap<String, u32> = HashMap::new();
-    let mut current: Option<(String, u32)> = None;
+    // The function being read, and each function's address range.
+    let mut current: Option<String> = None;
     let mut ranges: HashMap<String, (u32, u32)> = HashMap::new();
     for line in text.lines() {
         // Function header: `00000458 <impact_core_vsqrt_f32>:`
@@ -157,13 +157,8 @@ fn disassemble(elf: &Path) -> Result<Code, String> {
             .and_then(|l| l.split_once(" <"))
             .and_then(|(a, n)| u32::from_str_radix(a.trim(), 16).ok().map(|a| (n, a)))
         {
-            if let Some((n, start)) = current.take() {
-                let end = ranges.get(&n).map_or(start, |r| r.1);
-                ranges.insert(n, (start, end));
-            }
-            symbols.insert(name.0.to_string(), name.1);
             ranges.insert(name.0.to_string(), (name.1, name.1));
-            current = Some((name.0.to_string(), name.1));
+            current = Some(name.0.to_string());
             continue;
         }
         // Instruction: `     458:\teeb1 0ac0 \tvsqrt.f32\ts0, s0`
@@ -189,7 +184,7 @@ fn disassemble(elf: &Path) -> Result<Code, String> {
                 operands,
             },
         );
-        if let Some((n, _)) = &current {
+        if let Some(n) = &current {
             if let Some(r) = ranges.get_mut(n) {
                 r.1 = addr + size;
             }
@@ -919,7 +914,8 @@ struct TraceState {
     /// Inside `bench_begin` (the region starts when it returns).
     in_begin: bool,
     current: Region,
-    prev: Option<(u32, u32)>,
+    /// The last counted instruction, whose cycles wait for the next address.
+    prev: Option<u32>,
     after_load: bool,
     symbols: HashMap<String, u64>,
 }
@@ -969,7 +965,7 @@ impl TraceState {
             return;
         }
         self.close_prev(pc, code);
-        self.prev = Some((pc, 0));
+        self.prev = Some(pc);
         self.current.instructions += 1;
         if keep_profile {
             let sym = line.rsplit(' ').next().unwrap_or("?").trim().to_string();
@@ -979,7 +975,7 @@ impl TraceState {
 
     /// Adds the cycles of the previous instruction, now that the next address is known.
     fn close_prev(&mut self, next_pc: u32, code: &Code) {
-        if let Some((pc, _)) = self.prev.take() {
+        if let Some(pc) = self.prev.take() {
             if let Some(insn) = code.insns.get(&pc) {
                 let taken = next_pc != pc + insn.size;
                 self.current.cycles += cycles(insn, taken, self.after_load) as u64;

@@ -34,6 +34,12 @@ impl Stats {
         }
     }
 
+    /// True if every sample lies within `lo..=hi` (raw counts).
+    #[inline]
+    pub fn within(&self, lo: i32, hi: i32) -> bool {
+        (self.max as i32) <= hi && (self.min as i32) >= lo
+    }
+
     /// [`Self::of`] in plain Rust (the reference for the Cortex-M4 version).
     #[inline]
     pub fn of_portable(samples: &[i16]) -> Self {

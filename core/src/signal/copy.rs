@@ -24,13 +24,18 @@ mod words {
         fn impact_core_copy_words(dst: *mut i16, src: *const i16, words: usize);
     }
 
-    /// Equal lengths. Word-wise when both start on the same half of a word.
+    /// Equal lengths (others copy nothing). Word-wise when both start on the same half of
+    /// a word.
     #[inline]
     pub fn copy(dst: &mut [i16], src: &[i16]) {
+        if dst.len() != src.len() {
+            return;
+        }
         let phase = |p: usize| (p / 2) & 1;
         let (d, s) = (dst.as_ptr() as usize, src.as_ptr() as usize);
-        if phase(d) != phase(s) || dst.len() < 8 || dst.len() != src.len() {
-            if !dst.is_empty() && dst.len() == src.len() {
+        if phase(d) != phase(s) || dst.len() < 8 {
+            // No `memcpy` call for an empty run.
+            if !dst.is_empty() {
                 dst.copy_from_slice(src);
             }
             return;
