@@ -20,20 +20,25 @@
 // Guards are written `!(x > 0)` on purpose: they are true for NaN, so NaN never passes.
 #![allow(clippy::neg_cmp_op_on_partial_ord)]
 
-#[cfg(feature = "fit")]
+pub mod analysis;
+pub mod capture;
 pub mod fit;
-pub mod metrics;
 pub mod model;
 pub mod monitor;
 pub mod real;
+pub mod report;
 pub mod scene;
 pub mod signal;
 pub mod solve;
+pub mod stream;
 
-pub use metrics::{ImpactReport, Kinematics, Status};
+pub use analysis::{analyse, Workspace};
+pub use capture::{Capture, Sink, Summary};
+pub use report::{Analysis, ImpactReport, Kinematics, Status};
 pub use model::{ContactLaw, Model};
 pub use monitor::Monitor;
 pub use real::Real;
 pub use scene::{Approach, FitSet, Scene};
 pub use signal::Calibration;
 pub use solve::{solve, Error, Impact, ImpactOutcome, Method, Settings};
+pub use stream::{Counters, Stream};

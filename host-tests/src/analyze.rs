@@ -3,11 +3,11 @@
 use std::path::{Path, PathBuf};
 
 use clap::{Args, ValueEnum};
-use impact_core::metrics::Fits;
+use impact_core::report::Fits;
 use impact_core::monitor::Monitor;
 use impact_core::signal::cfc::Cfc;
 use impact_core::solve::bounce::STANDARD_GRAVITY;
-use impact_core::{Approach, Calibration, FitSet, ImpactReport, Scene, Status};
+use impact_core::{Approach, Calibration, FitSet, ImpactReport, Scene};
 use serde::{Deserialize, Serialize};
 
 use crate::recording::{read_csv, read_table, ColumnRef, ReadOptions};
@@ -159,14 +159,20 @@ pub struct HertzJson {
 pub struct ImpactJson {
     pub index: u32,
     pub status: String,
+    /// "full", or "skipped" when no capture buffer was free (streaming fields only).
+    pub analysis: String,
     pub clipped: bool,
+    pub start_sample: u64,
+    pub end_sample: u64,
     pub start_s: f64,
     pub peak_time_s: f64,
     pub peak_acceleration_m_s2: f64,
     pub peak_force_n: Option<f64>,
     pub delta_v_m_s: f64,
     pub duration_s: f64,
-    pub fwhm_s: f64,
+    pub baseline_m_s2: f64,
+    pub fwhm_s: Option<f64>,
+    pub filtered_peak_acceleration_m_s2: Option<f64>,
     pub impact_velocity_m_s: Option<f64>,
     pub crush_time_s: Option<f64>,
     pub max_deformation_m: Option<f64>,
@@ -175,6 +181,10 @@ pub struct ImpactJson {
     pub permanent_deformation_m: Option<f64>,
     pub absorbed_energy_j: Option<f64>,
     pub fits: FitsJson,
+    /// Real-time emulation only: virtual time from the end of the impact's hold to its
+    /// report, s.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub report_latency_s: Option<f64>,
 }
 
 /// The whole analysis as JSON.
@@ -187,15 +197,6 @@ pub struct AnalysisJson {
     /// Free fall measured on the DC channel, s.
     pub free_fall_s: Option<f64>,
     pub impacts: Vec<ImpactJson>,
-}
-
-fn status_name(s: Status) -> &'static str {
-    match s {
-        Status::Complete => "complete",
-        Status::StreamEnded => "stream-ended",
-        Status::BufferFull => "buffer-full",
-        Status::TooLong => "too-long",
-    }
 }
 
 fn fits_json(f: &Fits) -> FitsJson {
@@ -226,15 +227,20 @@ pub fn impact_json(r: &ImpactReport, t0: f64) -> ImpactJson {
     let f = |v: f32| v as f64;
     ImpactJson {
         index: r.index,
-        status: status_name(r.status).into(),
+        status: r.status.name().into(),
+        analysis: r.analysis.name().into(),
         clipped: r.clipped,
+        start_sample: r.start_sample,
+        end_sample: r.end_sample,
         start_s: t0 + r.start_s,
         peak_time_s: t0 + r.peak_time_s,
         peak_acceleration_m_s2: f(r.peak_acceleration_m_s2),
         peak_force_n: r.peak_force_n.map(f),
         delta_v_m_s: f(r.delta_v_m_s),
         duration_s: f(r.duration_s),
-        fwhm_s: f(r.fwhm_s),
+        baseline_m_s2: f(r.baseline_m_s2),
+        fwhm_s: r.fwhm_s.map(f),
+        filtered_peak_acceleration_m_s2: r.filtered_peak_acceleration_m_s2.map(f),
         impact_velocity_m_s: k.map(|k| f(k.impact_velocity_m_s)),
         crush_time_s: k.map(|k| f(k.crush_time_s)),
         max_deformation_m: k.map(|k| f(k.max_deformation_m)),
@@ -243,6 +249,7 @@ pub fn impact_json(r: &ImpactReport, t0: f64) -> ImpactJson {
         permanent_deformation_m: k.map(|k| f(k.permanent_deformation_m)),
         absorbed_energy_j: k.and_then(|k| k.absorbed_energy_j).map(f),
         fits: fits_json(&r.fits),
+        report_latency_s: None,
     }
 }
 
@@ -515,7 +522,7 @@ pub fn to_json(setup: &Setup, reports: &[ImpactReport]) -> AnalysisJson {
 /// CSV text: one row per impact.
 pub fn to_csv(a: &AnalysisJson) -> String {
     let mut s = String::from(
-        "index,status,clipped,start_s,peak_time_s,peak_acceleration_m_s2,peak_force_n,delta_v_m_s,duration_s,fwhm_s,\
+        "index,status,analysis,clipped,start_sample,end_sample,start_s,peak_time_s,peak_acceleration_m_s2,peak_force_n,delta_v_m_s,duration_s,baseline_m_s2,fwhm_s,filtered_peak_acceleration_m_s2,\
 impact_velocity_m_s,crush_time_s,max_deformation_m,rebound_velocity_m_s,cor,permanent_deformation_m,absorbed_energy_j,\
 two_phase_kc_n_m,two_phase_kr_n_m,two_phase_c_n_s_m,two_phase_permanent_deformation_m,two_phase_residual,\
 nonlinear_k,nonlinear_c_s_m,nonlinear_exponent,nonlinear_residual,hertz_k,hertz_residual\n",
@@ -528,14 +535,19 @@ nonlinear_k,nonlinear_c_s_m,nonlinear_exponent,nonlinear_residual,hertz_k,hertz_
         let cells = [
             i.index.to_string(),
             i.status.clone(),
+            i.analysis.clone(),
             i.clipped.to_string(),
+            i.start_sample.to_string(),
+            i.end_sample.to_string(),
             format!("{:e}", i.start_s),
             format!("{:e}", i.peak_time_s),
             format!("{:e}", i.peak_acceleration_m_s2),
             o(i.peak_force_n),
             format!("{:e}", i.delta_v_m_s),
             format!("{:e}", i.duration_s),
-            format!("{:e}", i.fwhm_s),
+            format!("{:e}", i.baseline_m_s2),
+            o(i.fwhm_s),
+            o(i.filtered_peak_acceleration_m_s2),
             o(i.impact_velocity_m_s),
             o(i.crush_time_s),
             o(i.max_deformation_m),
@@ -575,17 +587,18 @@ pub fn to_table(a: &AnalysisJson) -> String {
     );
     for i in &a.impacts {
         s.push_str(&format!(
-            "impact {} [{}{}] at {:.6} s: peak {:.4e} m/s² ({:.2} g){}, Δv {:.4} m/s, duration {:.4e} s, FWHM {:.4e} s\n",
+            "impact {} [{}{}{}] at {:.6} s: peak {:.4e} m/s² ({:.2} g){}, Δv {:.4} m/s, duration {:.4e} s, FWHM {}\n",
             i.index,
             i.status,
             if i.clipped { ", CLIPPED" } else { "" },
+            if i.analysis == "skipped" { ", analysis skipped" } else { "" },
             i.start_s,
             i.peak_acceleration_m_s2,
             i.peak_acceleration_m_s2 / STANDARD_GRAVITY,
             i.peak_force_n.map_or(String::new(), |f| format!(", force {f:.4e} N")),
             i.delta_v_m_s,
             i.duration_s,
-            i.fwhm_s,
+            i.fwhm_s.map_or("unknown".to_string(), |w| format!("{w:.4e} s")),
         ));
         if let (Some(v0), Some(tm), Some(xm), Some(v1), Some(cor), Some(xp)) = (
             i.impact_velocity_m_s,

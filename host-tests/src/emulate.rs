@@ -15,8 +15,8 @@ use std::process::{Command, ExitStatus, Stdio};
 use std::time::{Duration, Instant};
 
 use clap::Args;
-use impact_core::metrics::{Fits, HertzFit, NonlinearFit, TwoPhaseFit};
-use impact_core::{Approach, ImpactReport, Kinematics, Scene, Status};
+use impact_core::report::{Fits, HertzFit, NonlinearFit, TwoPhaseFit};
+use impact_core::{Analysis, Approach, ImpactReport, Kinematics, Scene, Status};
 
 use crate::analyze::{self, AnalysisJson, AnalyzeArgs};
 
@@ -122,13 +122,22 @@ fn flag(m: &HashMap<String, String>, key: &str) -> Result<bool, String> {
 /// An `impact` line's fields as the core's report (floats parsed at their own width, so the
 /// firmware's shortest round-trip decimals give back its exact bits).
 pub fn parse_impact(m: &HashMap<String, String>) -> Result<ImpactReport, String> {
-    let status = match get(m, "status")? {
-        "complete" => Status::Complete,
-        "stream-ended" => Status::StreamEnded,
-        "buffer-full" => Status::BufferFull,
-        "too-long" => Status::TooLong,
-        s => return Err(format!("status={s}: unknown status")),
-    };
+    let status = get(m, "status")?;
+    let status = [
+        Status::Complete,
+        Status::StreamEnded,
+        Status::BufferFull,
+        Status::TooLong,
+        Status::Gap,
+    ]
+    .into_iter()
+    .find(|s| s.name() == status)
+    .ok_or_else(|| format!("status={status}: unknown status"))?;
+    let analysis = get(m, "analysis")?;
+    let analysis = [Analysis::Full, Analysis::Skipped]
+        .into_iter()
+        .find(|a| a.name() == analysis)
+        .ok_or_else(|| format!("analysis={analysis}: not full or skipped"))?;
     let kinematics = match opt::<f32>(m, "impact_velocity_m_s")? {
         None => None,
         Some(v0) => Some(Kinematics {
@@ -170,16 +179,19 @@ pub fn parse_impact(m: &HashMap<String, String>) -> Result<ImpactReport, String>
     Ok(ImpactReport {
         index: num(m, "index")?,
         status,
+        analysis,
         clipped: flag(m, "clipped")?,
         start_sample: num(m, "start_sample")?,
+        end_sample: num(m, "end_sample")?,
         start_s: num(m, "start_s")?,
         peak_time_s: num(m, "peak_time_s")?,
         peak_acceleration_m_s2: num(m, "peak_acceleration_m_s2")?,
         peak_force_n: opt(m, "peak_force_n")?,
         delta_v_m_s: num(m, "delta_v_m_s")?,
         duration_s: num(m, "duration_s")?,
-        fwhm_s: num(m, "fwhm_s")?,
         baseline_m_s2: num(m, "baseline_m_s2")?,
+        fwhm_s: opt(m, "fwhm_s")?,
+        filtered_peak_acceleration_m_s2: opt(m, "filtered_peak_acceleration_m_s2")?,
         kinematics,
         fits: Fits {
             two_phase,
@@ -589,7 +601,7 @@ pub fn log(args: &LogArgs) -> Result<(), String> {
 mod tests {
     use super::*;
 
-    const LINE: &str = "0.013931 INFO  impact index=0 status=complete clipped=false start_sample=5000 start_s=0.01 peak_time_s=0.0100251 peak_acceleration_m_s2=4321.5 peak_force_n=259.29 delta_v_m_s=2.5 duration_s=0.0219 fwhm_s=0.001 baseline_m_s2=0.2 impact_velocity_m_s=1.3357 crush_time_s=0.0218 max_deformation_m=0.0186 rebound_velocity_m_s=1.16 cor=0.87 permanent_deformation_m=0.0182 absorbed_energy_j=none two_phase_kc_n_m=none two_phase_kr_n_m=none two_phase_c_n_s_m=none two_phase_permanent_deformation_m=none two_phase_residual=none nonlinear_k=1e6 nonlinear_c_s_m=0.5 nonlinear_exponent=1.2 nonlinear_residual=0.01 hertz_k=none hertz_residual=none";
+    const LINE: &str = "0.013931 INFO  impact index=0 status=complete analysis=full clipped=false start_sample=5000 end_sample=17000 start_s=0.01 peak_time_s=0.0100251 peak_acceleration_m_s2=4321.5 peak_force_n=259.29 delta_v_m_s=2.5 duration_s=0.0219 baseline_m_s2=0.2 fwhm_s=0.001 filtered_peak_acceleration_m_s2=none impact_velocity_m_s=1.3357 crush_time_s=0.0218 max_deformation_m=0.0186 rebound_velocity_m_s=1.16 cor=0.87 permanent_deformation_m=0.0182 absorbed_energy_j=none two_phase_kc_n_m=none two_phase_kr_n_m=none two_phase_c_n_s_m=none two_phase_permanent_deformation_m=none two_phase_residual=none nonlinear_k=1e6 nonlinear_c_s_m=0.5 nonlinear_exponent=1.2 nonlinear_residual=0.01 hertz_k=none hertz_residual=none";
 
     #[test]
     fn parses_an_impact_line() {

@@ -3,6 +3,7 @@
 pub mod baseline;
 pub mod cfc;
 pub mod copy;
+pub mod flank;
 pub mod integrate;
 pub mod ring;
 

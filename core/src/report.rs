@@ -1,0 +1,161 @@
+//! The per-impact report: what the streaming stage measured exactly (peak, Δv, times), and,
+//! when the analysis ran, the widths, the kinematics (with the approach speed) and the fits.
+
+use crate::capture::Summary;
+pub use crate::fit::{Fits, HertzFit, NonlinearFit, TwoPhaseFit};
+use crate::scene::Scene;
+
+/// How an impact's capture ended.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub enum Status {
+    /// The signal came back to the baseline and stayed there.
+    Complete,
+    /// The stream ended inside the impact.
+    StreamEnded,
+    /// The capture buffer filled up: Δv and the peak cover the whole impact, the rest only
+    /// the captured part (no kinematics, no fits).
+    BufferFull,
+    /// The signal stayed away from the baseline longer than the scene's maximum impact time
+    /// (stuck, drifting or disconnected sensor); the baseline is learned again.
+    TooLong,
+    /// Samples were lost inside the impact (the sample source overran): Δv and the peak cover
+    /// only what arrived, and nothing that needs the whole impact is reported.
+    Gap,
+}
+
+impl Status {
+    /// The name the reports use (`complete`, `stream-ended`, `buffer-full`, `too-long`, `gap`).
+    pub fn name(self) -> &'static str {
+        match self {
+            Status::Complete => "complete",
+            Status::StreamEnded => "stream-ended",
+            Status::BufferFull => "buffer-full",
+            Status::TooLong => "too-long",
+            Status::Gap => "gap",
+        }
+    }
+}
+
+/// Whether the per-impact analysis ran.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub enum Analysis {
+    /// The impact was captured and analysed: every field the scene asks for is there.
+    Full,
+    /// No capture buffer was free when the impact started (the analysis of earlier impacts
+    /// was still running): only the streaming fields are reported.
+    Skipped,
+}
+
+impl Analysis {
+    /// The name the reports use (`full`, `skipped`).
+    pub fn name(self) -> &'static str {
+        match self {
+            Analysis::Full => "full",
+            Analysis::Skipped => "skipped",
+        }
+    }
+}
+
+/// What the deceleration says once `v0` is known. SI.
+#[derive(Clone, Copy, Debug, PartialEq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct Kinematics {
+    /// Approach speed used, m/s.
+    pub impact_velocity_m_s: f32,
+    /// From first touch to zero velocity, s.
+    pub crush_time_s: f32,
+    /// Deformation at zero velocity, m.
+    pub max_deformation_m: f32,
+    /// Speed after the impact (`Δv - v0`), m/s.
+    pub rebound_velocity_m_s: f32,
+    /// `v' / v0`.
+    pub cor: f32,
+    /// Deformation left at separation, m.
+    pub permanent_deformation_m: f32,
+    /// `m (v0² - v'²) / 2`, J (when the mass is known).
+    pub absorbed_energy_j: Option<f32>,
+}
+
+/// One impact. Times are from the start of the stream unless named otherwise.
+///
+/// The streaming fields (from `status` to `baseline_m_s2`) come from the streaming stage's
+/// exact integer sums over the raw samples and are the same whether or not the analysis ran;
+/// the analysis fields (`fwhm_s` and after) are absent when it was skipped.
+#[derive(Clone, Copy, Debug, PartialEq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct ImpactReport {
+    /// 0 for the stream's first impact.
+    pub index: u32,
+    pub status: Status,
+    pub analysis: Analysis,
+    /// The sensor reached a rail inside the impact: peak and Δv are lower bounds.
+    pub clipped: bool,
+    /// Sample index of the pulse's first sample beyond the edge level.
+    pub start_sample: u64,
+    /// Sample index just after the impact: the end of the hold (or where it was cut).
+    pub end_sample: u64,
+    /// First touch, s: the raw pulse's rising flank extrapolated to zero, or its edge crossing.
+    pub start_s: f64,
+    /// Time of the (raw) peak, s.
+    pub peak_time_s: f64,
+    /// Signed raw peak deceleration, m/s² (positive: the body was slowed).
+    pub peak_acceleration_m_s2: f32,
+    /// `m a` at the peak, N (when the mass is known).
+    pub peak_force_n: Option<f32>,
+    /// Velocity change over the impact, m/s (`v0 + v'` for a rebound).
+    pub delta_v_m_s: f32,
+    /// From first touch to separation (both flank-extrapolated), or to the end of the capture
+    /// if the signal never came back, s.
+    pub duration_s: f32,
+    /// Baseline the pulse was measured from, m/s² (sensor offset).
+    pub baseline_m_s2: f32,
+    /// Width at half the peak, s (on the filtered signal with a CFC).
+    pub fwhm_s: Option<f32>,
+    /// Peak of the CFC-filtered signal, m/s² (only with a CFC).
+    pub filtered_peak_acceleration_m_s2: Option<f32>,
+    pub kinematics: Option<Kinematics>,
+    pub fits: Fits,
+}
+
+/// Acceleration per unit of `d = W x - S`, m/s², in f32 as the analysis converts samples:
+/// `a = d as f32 * per_count(..)`.
+pub(crate) fn per_count(scene: &Scene, base_n: i64) -> f32 {
+    scene.calibration.gain_m_s2_per_count / base_n.max(1) as f32
+}
+
+/// The report of the streaming fields alone (`analysis` skipped); the analysis fills in the
+/// rest.
+pub fn streaming(s: &Summary, scene: &Scene) -> ImpactReport {
+    let fs = scene.calibration.sample_rate_hz as f64;
+    let n = s.base_n.max(1) as f64;
+    let per_d = scene.calibration.gain_m_s2_per_count as f64 / n;
+    // The same conversion as the analysis's acceleration array, so the peak here and the
+    // peak of the (unfiltered) array have the same bits.
+    let peak = s.peak_d as f32 * per_count(scene, s.base_n);
+    let start = s.onset_index as f64 + s.touch_offset as f64;
+    let end = match s.separation_index {
+        Some(i) => i as f64 + s.separation_offset as f64,
+        None => s.end_index as f64,
+    };
+    ImpactReport {
+        index: s.index,
+        status: s.status,
+        analysis: Analysis::Skipped,
+        clipped: s.clipped,
+        start_sample: s.onset_index,
+        end_sample: s.end_index,
+        start_s: start / fs,
+        peak_time_s: s.peak_index as f64 / fs,
+        peak_acceleration_m_s2: peak,
+        peak_force_n: scene.mass_kg.map(|m| m * peak),
+        delta_v_m_s: (s.total_c as f64 * per_d / fs) as f32,
+        duration_s: ((end - start) / fs) as f32,
+        baseline_m_s2: (s.base_sum as f64 * per_d) as f32,
+        fwhm_s: None,
+        filtered_peak_acceleration_m_s2: None,
+        kinematics: None,
+        fits: Fits::default(),
+    }
+}

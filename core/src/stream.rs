@@ -1,0 +1,761 @@
+//! The streaming stage: raw samples in (any block size), impacts detected, captured and
+//! summarised out; the per-sample half of the pipeline, cheap enough for any sample rate.
+//!
+//! ```text
+//! idle ──|a| > trigger──► active ──|a| < edge for `hold`──► summary ──► idle
+//!   ▲ ring of PRE samples (history for     capture (if the sink has a free buffer) from
+//!   │ the pre-trigger and the flanks);     before the onset; exact integer Δv and peak
+//!   │ baseline from quiet strides          over the whole impact
+//! ```
+//! Idle samples go into the ring and the stride sums of the baseline, and are compared with
+//! two integer thresholds fixed per stride. Everything the stage reports is computed from raw
+//! integer samples and stream positions, so feeding a stream in blocks of any size, or one
+//! sample at a time, gives identical results. The per-impact analysis of a captured impact
+//! (widths, kinematics, filtering, fits) is [`crate::analysis`], run by whoever receives the
+//! capture from the [`Sink`].
+
+use crate::capture::{Capture, Sink, Summary};
+use crate::report::{self, Status};
+use crate::scene::{Approach, FitSet, Scene};
+use crate::signal::baseline::{Baseline, Stats, STRIDE};
+use crate::signal::flank::{crossing, Flank};
+use crate::signal::ring::Ring;
+use crate::signal::Calibration;
+use crate::solve::Error;
+
+/// Quiet strides in the baseline window (`64 * STRIDE` = 4096 samples).
+const BASELINE_STRIDES: usize = 64;
+/// Samples in a full baseline, the largest `W` of `d = W x - S`.
+const BASELINE_SPAN: usize = BASELINE_STRIDES * STRIDE;
+// `Deviation` computes d in i32: |x| <= 2^15 and W <= 2^12 keep |S| below 2^27 and |d|
+// below 2^28.
+const _: () = assert!(BASELINE_SPAN <= 1 << 12);
+
+/// The flanks are fitted between the edge level and this many times it (or the trigger level,
+/// if lower, so the trigger sample always ends the rising flank).
+const FLANK_EDGES: i64 = 4;
+
+/// `d = W x - S` for one impact's frozen baseline, in i32: exact, since `W <= BASELINE_SPAN`
+/// (the wrapping operations never wrap), and the FPU converts i32 while i64 arithmetic and
+/// conversions are longer or soft-float calls on the Cortex-M4.
+#[derive(Clone, Copy)]
+pub(crate) struct Deviation {
+    w: i32,
+    s: i32,
+}
+
+impl Deviation {
+    pub(crate) fn new(base_sum: i64, base_n: i64) -> Self {
+        Self {
+            w: base_n as i32,
+            s: base_sum as i32,
+        }
+    }
+
+    #[inline]
+    pub(crate) fn of(self, x: i16) -> i32 {
+        (x as i32).wrapping_mul(self.w).wrapping_sub(self.s)
+    }
+}
+
+/// Counters that cannot wrap: 2^64 samples at 2.4 MS/s is 240 000 years.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct Counters {
+    /// Samples processed.
+    pub samples: u64,
+    /// Impacts reported.
+    pub impacts: u64,
+    /// Reports with a status other than complete.
+    pub incomplete: u64,
+    /// Impacts that found no free capture buffer (reported without analysis).
+    pub analyses_skipped: u64,
+    /// Samples the source lost (announced with [`Stream::gap`]).
+    pub samples_lost: u64,
+    /// Gaps announced.
+    pub gaps: u64,
+}
+
+struct Active {
+    /// Stream index of the capture's first sample.
+    first_index: u64,
+    /// Stream index of the sample that fired the trigger.
+    trigger_index: u64,
+    onset_index: u64,
+    touch_offset: f32,
+    base_sum: i64,
+    base_n: i64,
+    /// Edge level in units of `d = W x - S`.
+    edge_d: i64,
+    /// Flank level in units of `d`.
+    flank_d: i64,
+    quiet: u32,
+    /// Stream index of the first sample back within the edge level after the peak
+    /// (separation: later ringing or a second hit within the hold does not move it unless it
+    /// brings a new peak).
+    separation: Option<u64>,
+    peak_d: i64,
+    peak_index: u64,
+    total_c: i64,
+    /// Samples since `first_index`.
+    samples: u64,
+    clipped: bool,
+    /// The sink gave a buffer for this impact.
+    captured: bool,
+    /// The buffer overflowed.
+    full: bool,
+}
+
+impl Active {
+    fn deviation(&self) -> Deviation {
+        Deviation::new(self.base_sum, self.base_n)
+    }
+}
+
+/// The streaming stage of one channel through a [`Scene`]. `PRE` (a power of two) is the
+/// ring of recent samples: the pre-trigger history, the baseline window and the reach of the
+/// flank fits.
+pub struct Stream<const PRE: usize> {
+    scene: Scene,
+    ring: Ring<PRE>,
+    baseline: Baseline<BASELINE_STRIDES>,
+    active: Option<Active>,
+    /// Stream index of the next sample.
+    index: u64,
+    v0: Option<f32>,
+    counters: Counters,
+    trigger_counts: f32,
+    edge_counts: f32,
+    hold: u32,
+    max_samples: u64,
+    /// Trigger thresholds (raw counts) in force until the next refresh.
+    thresholds: Option<(i32, i32)>,
+    /// The ring's history is being run again after the first baseline (see `replay_history`).
+    replaying: bool,
+    /// The causal trigger filter, if the scene asks for one.
+    trigger_filter: Option<crate::signal::cfc::Causal>,
+}
+
+impl<const PRE: usize> Stream<PRE> {
+    /// A stream for `scene`; fails on an invalid scene or ring size.
+    pub fn new(scene: Scene) -> Result<Self, Error> {
+        let mut s = Self::unconfigured();
+        s.configure(scene)?;
+        Ok(s)
+    }
+
+    /// A stream evaluated at compile time, for a `static` on a small MCU. It runs a
+    /// placeholder scene (1 S/s, 1 m/s² per count, no mass, no fits) until
+    /// [`Self::configure`] gives it the real one.
+    pub const fn unconfigured() -> Self {
+        Self {
+            scene: Scene {
+                calibration: Calibration {
+                    gain_m_s2_per_count: 1.0,
+                    sample_rate_hz: 1.0,
+                },
+                mass_kg: None,
+                approach: Approach::Unknown,
+                trigger_m_s2: 1.0,
+                edge_m_s2: 0.25,
+                hold_s: 1.0,
+                max_impact_s: 1.0,
+                clip_counts: (i16::MIN, i16::MAX),
+                cfc: None,
+                trigger_cfc: None,
+                fits: FitSet {
+                    two_phase: false,
+                    nonlinear: false,
+                    fit_exponent: false,
+                    nonlinear_exponent: 1.0,
+                    hertz: false,
+                },
+            },
+            ring: Ring::new(),
+            baseline: Baseline::new(),
+            active: None,
+            index: 0,
+            v0: None,
+            counters: Counters {
+                samples: 0,
+                impacts: 0,
+                incomplete: 0,
+                analyses_skipped: 0,
+                samples_lost: 0,
+                gaps: 0,
+            },
+            trigger_counts: 1.0,
+            edge_counts: 0.25,
+            hold: 1,
+            max_samples: 1,
+            thresholds: None,
+            replaying: false,
+            trigger_filter: None,
+        }
+    }
+
+    /// Starts over with `scene`, in place: the stream, the baseline, the counters and the
+    /// approach speed are reset. Captures of `CAP` samples must hold more than twice the
+    /// hold time. Fails on an invalid scene or sizes, and then leaves the stream as it was.
+    pub fn configure_for(&mut self, scene: Scene, cap: usize) -> Result<(), Error> {
+        scene.validate()?;
+        let hold = scene.samples(scene.hold_s);
+        if cap < 4 * STRIDE || (hold as usize) >= cap / 2 {
+            return Err(Error::InvalidParameter {
+                name: "hold",
+                reason: "hold time must be under half the capture length",
+            });
+        }
+        self.configure(scene)
+    }
+
+    /// As [`Self::configure_for`], without a capture length to check.
+    pub fn configure(&mut self, scene: Scene) -> Result<(), Error> {
+        scene.validate()?;
+        if PRE < STRIDE || !PRE.is_power_of_two() {
+            return Err(Error::InvalidParameter {
+                name: "pre-trigger",
+                reason: "ring must be a power of two of at least 64 samples",
+            });
+        }
+        let gain = libm::fabsf(scene.calibration.gain_m_s2_per_count);
+        self.scene = scene;
+        self.ring.clear();
+        self.baseline.clear();
+        self.active = None;
+        self.index = 0;
+        self.v0 = scene.approach.v0_m_s();
+        self.counters = Counters::default();
+        self.trigger_counts = scene.trigger_m_s2 / gain;
+        self.edge_counts = scene.edge_m_s2 / gain;
+        self.hold = scene.samples(scene.hold_s);
+        self.max_samples = scene.samples(scene.max_impact_s) as u64;
+        self.thresholds = None;
+        self.replaying = false;
+        // At rest at 0 until the first baseline resets it to the baseline's level.
+        self.trigger_filter = scene
+            .trigger_cfc
+            .and_then(|class| {
+                crate::signal::cfc::Biquad::cfc(class, scene.calibration.sample_rate_hz as f64)
+            })
+            .map(|b| crate::signal::cfc::Causal::new(b, 0.0));
+        Ok(())
+    }
+
+    /// The scene in use.
+    pub fn scene(&self) -> &Scene {
+        &self.scene
+    }
+
+    /// Counters so far.
+    pub fn counters(&self) -> Counters {
+        self.counters
+    }
+
+    /// True while an impact is being followed.
+    pub fn in_impact(&self) -> bool {
+        self.active.is_some()
+    }
+
+    /// True once a baseline has been learned (impacts can be detected).
+    pub fn is_armed(&self) -> bool {
+        self.baseline.is_armed()
+    }
+
+    /// Stream index of the next sample.
+    pub fn position(&self) -> u64 {
+        self.index
+    }
+
+    /// Sets the approach speed for the next impacts (a light gate's reading), m/s.
+    pub fn set_approach_speed(&mut self, v0_m_s: Option<f32>) {
+        self.v0 = v0_m_s.filter(|v| v.is_finite() && *v > 0.0);
+    }
+
+    /// A block of samples (whatever the DMA hands over). Impacts go to `sink`.
+    pub fn push_block<const CAP: usize>(&mut self, block: &[i16], sink: &mut impl Sink<CAP>) {
+        let mut rest = block;
+        while !rest.is_empty() {
+            if self.active.is_some() {
+                let used = self.run_active(rest, sink);
+                rest = rest.get(used..).unwrap_or(&[]);
+                continue;
+            }
+            // Idle: learn a first baseline stride, then look for the first sample beyond the
+            // thresholds, one stride segment at a time. Every decision depends on stream
+            // positions only, so any split of the stream gives the same reports.
+            let segment_len = self.baseline.to_stride_end().min(rest.len());
+            let (segment, after) = rest.split_at(segment_len);
+            if !self.baseline.is_armed() {
+                self.idle(segment);
+                rest = after;
+                if self.baseline.is_armed() {
+                    let level = self.baseline.mean() as f64;
+                    if let Some(f) = self.trigger_filter.as_mut() {
+                        f.reset(level);
+                    }
+                    // The first baseline: look again at the history it did not cover, so an
+                    // impact at the very start of the stream is not lost.
+                    self.replay_history(sink);
+                }
+                continue;
+            }
+            let (lo, hi) = self.current_thresholds();
+            let found = match self.trigger_filter.as_mut() {
+                None => {
+                    // One vectorised pass for the stride statistics; the samples are
+                    // scanned one by one only when the segment crosses a threshold.
+                    let stats = Stats::of(segment);
+                    if stats.within(lo, hi) {
+                        // A run of quiet strides: the baseline (and so the thresholds)
+                        // follows each one, the ring and the counters take the run at once.
+                        self.learn(&stats);
+                        let mut run = segment.len();
+                        while let Some(next) = rest.get(run..run + self.baseline.to_stride_end()) {
+                            let (lo, hi) = self.current_thresholds();
+                            let stats = Stats::of(next);
+                            if !stats.within(lo, hi) {
+                                break;
+                            }
+                            self.learn(&stats);
+                            run += next.len();
+                        }
+                        let (quiet, after) = rest.split_at(run.min(rest.len()));
+                        self.keep(quiet);
+                        rest = after;
+                        continue;
+                    }
+                    segment
+                        .iter()
+                        .position(|&x| (x as i32) > hi || (x as i32) < lo)
+                }
+                Some(f) => segment.iter().position(|&x| {
+                    let y = f.step(x as f64);
+                    y > hi as f64 || y < lo as f64
+                }),
+            };
+            match found {
+                None => {
+                    self.idle(segment);
+                    rest = after;
+                }
+                Some(at) => {
+                    // `at` lies inside `segment`, a prefix of `rest` (written with `get` so
+                    // the target build has no panic path here).
+                    self.idle(rest.get(..at).unwrap_or(&[]));
+                    self.start(sink);
+                    rest = rest.get(at..).unwrap_or(&[]);
+                }
+            }
+        }
+    }
+
+    /// `lost` samples never arrived (the source overran): an impact in progress ends with
+    /// [`Status::Gap`], the stream position moves on by `lost`, and the history before the
+    /// gap is forgotten (the baseline is kept).
+    pub fn gap<const CAP: usize>(&mut self, lost: u64, sink: &mut impl Sink<CAP>) {
+        if lost == 0 {
+            return;
+        }
+        if self.active.is_some() {
+            self.end(Status::Gap, sink);
+        }
+        self.index += lost;
+        self.counters.samples_lost += lost;
+        self.counters.gaps += 1;
+        self.ring.clear();
+        self.baseline.restart_stride();
+        let level = self.baseline.mean() as f64;
+        if let Some(f) = self.trigger_filter.as_mut() {
+            f.reset(level);
+        }
+    }
+
+    /// Ends the stream: an impact in progress ends with [`Status::StreamEnded`].
+    pub fn finish<const CAP: usize>(&mut self, sink: &mut impl Sink<CAP>) {
+        if self.active.is_some() {
+            self.end(Status::StreamEnded, sink);
+        }
+    }
+
+    /// Idle samples: into the ring and the baseline.
+    #[inline]
+    fn idle(&mut self, samples: &[i16]) {
+        self.keep(samples);
+        self.learn(&Stats::of(samples));
+    }
+
+    /// Samples into the ring and the stream position.
+    #[inline]
+    fn keep(&mut self, samples: &[i16]) {
+        self.ring.extend(samples);
+        self.index += samples.len() as u64;
+        self.counters.samples += samples.len() as u64;
+    }
+
+    /// A stretch of idle samples into the baseline (not while the history is replayed).
+    #[inline]
+    fn learn(&mut self, stats: &Stats) {
+        if !self.replaying && self.baseline.add_stats(stats, self.edge_counts) {
+            self.thresholds = None;
+        }
+    }
+
+    /// The trigger thresholds for the current baseline (computed once per change).
+    #[inline]
+    fn current_thresholds(&mut self) -> (i32, i32) {
+        match self.thresholds {
+            Some(t) => t,
+            None => {
+                let t = self.thresholds();
+                self.thresholds = Some(t);
+                t
+            }
+        }
+    }
+
+    /// Runs the samples held in the ring through the idle path again, with the baseline just
+    /// learned (and without learning from them twice).
+    // Never inlined: its `PRE`-sample copy of the history would otherwise sit in every
+    // `push_block` frame, twice over since it calls `push_block` (17 KiB of stack at PRE = 4096,
+    // more than the STM32F407 has left beside the buffers).
+    #[inline(never)]
+    fn replay_history<const CAP: usize>(&mut self, sink: &mut impl Sink<CAP>) {
+        let n = self.ring.len();
+        let mut history = [0i16; PRE];
+        for (slot, x) in history.iter_mut().zip(self.ring.iter_oldest_first()) {
+            *slot = x;
+        }
+        self.ring.clear();
+        self.index -= n as u64;
+        self.counters.samples -= n as u64;
+        self.replaying = true;
+        self.push_block(history.get(..n).unwrap_or(&[]), sink);
+        self.replaying = false;
+    }
+
+    /// Trigger thresholds in raw counts around the baseline.
+    fn thresholds(&self) -> (i32, i32) {
+        let mean = self.baseline.mean();
+        let lo = floor(mean - self.trigger_counts);
+        let hi = -floor(-(mean + self.trigger_counts));
+        (clamp_i32(lo), clamp_i32(hi))
+    }
+
+    /// The trigger fired at `self.index`: find the onset in the ring, fix the baseline from
+    /// the samples before it, fit the rising flank, and replay the pre-trigger samples into
+    /// the capture (if the sink has a buffer) and the running sums.
+    fn start<const CAP: usize>(&mut self, sink: &mut impl Sink<CAP>) {
+        let (base_sum, base_n) = self.baseline.rational();
+        let deviation = Deviation::new(base_sum, base_n);
+        let edge_d = (self.edge_counts * base_n as f32) as i64;
+        // The flank level: FLANK_EDGES edges, or just under the trigger thresholds.
+        let (lo, hi) = self.current_thresholds();
+        let trigger_d = (hi as i64 * base_n - base_sum).min(base_sum - lo as i64 * base_n);
+        let flank_d = (FLANK_EDGES * edge_d).min(trigger_d).max(edge_d);
+        let ring = &self.ring;
+        let abs_d = |i: usize| ring.back(i).map(|x| deviation.of(x).unsigned_abs() as i64);
+        // Walk back from the newest sample while it is beyond the edge level.
+        let mut pulse = 0usize;
+        while let Some(y) = abs_d(pulse) {
+            if y <= edge_d {
+                break;
+            }
+            pulse += 1;
+        }
+        // The rising flank from the onset forwards (the trigger sample, next, ends it).
+        let mut flank = Flank::default();
+        for k in 0..pulse {
+            match abs_d(pulse - 1 - k) {
+                Some(y) if y <= flank_d && flank.add(k as i64, y) => {}
+                _ => break,
+            }
+        }
+        let touch_offset = match flank.zero(true, -1.0, edge_d as f64) {
+            Some(z) => z as f32,
+            // The edge crossing between the last quiet sample and the onset.
+            None => match (abs_d(pulse), abs_d(pulse.wrapping_sub(1))) {
+                (Some(y0), Some(y1)) if pulse > 0 => {
+                    (crossing(y0 as f64, y1 as f64, edge_d as f64) - 1.0) as f32
+                }
+                _ => 0.0,
+            },
+        };
+        // Capture from `margin` samples before the onset (as far as the ring reaches).
+        let margin = (pulse + self.hold as usize / 2)
+            .min(self.ring.len())
+            .min(CAP / 2);
+        let first_index = self.index - margin as u64;
+        let mut capture = sink.buffer();
+        if let Some(c) = capture.as_mut() {
+            c.clear();
+        }
+        let mut a = Active {
+            first_index,
+            trigger_index: self.index,
+            onset_index: self.index - pulse as u64,
+            touch_offset,
+            base_sum,
+            base_n,
+            edge_d,
+            flank_d,
+            quiet: 0,
+            separation: None,
+            peak_d: 0,
+            peak_index: self.index,
+            total_c: 0,
+            samples: 0,
+            clipped: false,
+            captured: capture.is_some(),
+            full: false,
+        };
+        let (clip_lo, clip_hi) = self.scene.clip_counts;
+        let mut replay = [0i16; 64];
+        let mut left = margin;
+        while left > 0 {
+            let n = left.min(replay.len());
+            for (k, slot) in replay.iter_mut().take(n).enumerate() {
+                *slot = self.ring.back(left - 1 - k).unwrap_or(0);
+            }
+            let chunk = replay.get(..n).unwrap_or(&[]);
+            for (k, &x) in chunk.iter().enumerate() {
+                let d = deviation.of(x) as i64;
+                a.total_c += d;
+                if d.unsigned_abs() > a.peak_d.unsigned_abs() {
+                    a.peak_d = d;
+                    a.peak_index = a.first_index + a.samples + k as u64;
+                }
+                a.clipped |= x <= clip_lo || x >= clip_hi;
+            }
+            if let Some(c) = capture.as_mut() {
+                a.full |= c.extend(chunk) < chunk.len();
+            }
+            a.samples += n as u64;
+            left -= n;
+        }
+        self.active = Some(a);
+    }
+
+    /// Feeds samples to the active impact until it ends; returns how many it used.
+    ///
+    /// The hot loop of an impact: the running state lives in locals (the compiler cannot
+    /// keep fields of `self` in registers across the capture's push) and is written back
+    /// once per call.
+    fn run_active<const CAP: usize>(&mut self, samples: &[i16], sink: &mut impl Sink<CAP>) -> usize {
+        let hold = self.hold;
+        let (lo, hi) = self.scene.clip_counts;
+        let max_samples = self.max_samples;
+        let Some(a) = self.active.as_mut() else {
+            return 0;
+        };
+        // At most the samples that keep the impact within its longest duration.
+        let room = max_samples
+            .saturating_sub(a.samples)
+            .min(samples.len() as u64) as usize;
+        let samples = samples.get(..room).unwrap_or(&[]);
+        let deviation = a.deviation();
+        // edge_d >= 0: the scene's edge level is positive (validated).
+        let edge = a.edge_d.clamp(0, u32::MAX as i64) as u32;
+        let before = a.samples;
+        let mut peak_abs = a.peak_d.unsigned_abs().min(u32::MAX as u64) as u32;
+        let mut new_peak: Option<(usize, i32)> = None;
+        let (mut separation, mut quiet, mut clipped) = (a.separation, a.quiet, a.clipped);
+        let mut sum: i64 = 0;
+        let mut used = samples.len();
+        let mut ended = None;
+        let start = a.first_index + before;
+        for (k, &x) in samples.iter().enumerate() {
+            let d = deviation.of(x);
+            sum += d as i64;
+            let abs = d.unsigned_abs();
+            if abs > peak_abs {
+                peak_abs = abs;
+                new_peak = Some((k, d));
+                separation = None;
+            }
+            clipped |= x <= lo || x >= hi;
+            if abs <= edge {
+                if separation.is_none() {
+                    separation = Some(start + k as u64);
+                }
+                quiet += 1;
+                if quiet >= hold && start + k as u64 > a.trigger_index {
+                    ended = Some(());
+                    used = k + 1;
+                    break;
+                }
+            } else {
+                quiet = 0;
+            }
+        }
+        let kept = samples.get(..used).unwrap_or(&[]);
+        // The capture keeps the first CAP samples of the impact.
+        if a.captured && !a.full {
+            a.full = match sink.buffer() {
+                Some(c) => c.extend(kept) < kept.len(),
+                None => true,
+            };
+        }
+        if let Some((k, d)) = new_peak {
+            a.peak_d = d as i64;
+            a.peak_index = start + k as u64;
+        }
+        a.total_c += sum;
+        a.separation = separation;
+        a.quiet = quiet;
+        a.clipped = clipped;
+        a.samples += used as u64;
+        let ended = match ended {
+            Some(()) if a.full => Some(Status::BufferFull),
+            Some(()) => Some(Status::Complete),
+            None if a.samples >= max_samples => Some(Status::TooLong),
+            None => None,
+        };
+        // The ring keeps following the stream: the separation flank and the next impact's
+        // pre-trigger history come from it.
+        self.keep(kept);
+        if let Some(status) = ended {
+            self.end(status, sink);
+        }
+        used
+    }
+
+    /// The separation relative to `separation_index`: the falling flank (from the ring)
+    /// extrapolated to zero, or the edge crossing between the last sample beyond the edge and
+    /// the first within it.
+    fn separation_offset(&self, a: &Active, separation: u64) -> f32 {
+        let deviation = a.deviation();
+        // The ring ends at `self.index - 1`: sample `i` is `back(index - 1 - i)`.
+        let abs_d = |i: u64| {
+            let back = self.index.checked_sub(1)?.checked_sub(i)?;
+            let x = self.ring.back(usize::try_from(back).ok()?)?;
+            Some(deviation.of(x).unsigned_abs() as i64)
+        };
+        let Some(last) = separation.checked_sub(1) else {
+            return 0.0;
+        };
+        let mut flank = Flank::default();
+        let mut j = 0u64;
+        while let Some(i) = last.checked_sub(j) {
+            match abs_d(i) {
+                Some(y) if y <= a.flank_d && flank.add(-(j as i64), y) => j += 1,
+                _ => break,
+            }
+        }
+        // Positions relative to `last`: the first quiet sample is at +1.
+        match flank.zero(false, 1.0, a.edge_d as f64) {
+            Some(z) => (z - 1.0) as f32,
+            None => match (abs_d(last), abs_d(separation)) {
+                (Some(y0), Some(y1)) => {
+                    (crossing(y0 as f64, y1 as f64, a.edge_d as f64) - 1.0) as f32
+                }
+                _ => 0.0,
+            },
+        }
+    }
+
+    /// Hands the active impact over and returns to idle.
+    fn end<const CAP: usize>(&mut self, status: Status, sink: &mut impl Sink<CAP>) {
+        let Some(a) = self.active.take() else { return };
+        self.thresholds = None;
+        self.baseline.restart_stride();
+        let level = self.baseline.mean() as f64;
+        if let Some(f) = self.trigger_filter.as_mut() {
+            f.reset(level);
+        }
+        let separation_offset = a
+            .separation
+            .map_or(0.0, |s| self.separation_offset(&a, s));
+        let summary = Summary {
+            index: self.counters.impacts.min(u32::MAX as u64) as u32,
+            status,
+            clipped: a.clipped,
+            first_index: a.first_index,
+            onset_index: a.onset_index,
+            touch_offset: a.touch_offset,
+            separation_index: a.separation,
+            separation_offset,
+            end_index: self.index,
+            base_sum: a.base_sum,
+            base_n: a.base_n,
+            peak_d: a.peak_d,
+            peak_index: a.peak_index,
+            total_c: a.total_c,
+            v0_m_s: self.v0,
+        };
+        self.counters.impacts += 1;
+        if status != Status::Complete {
+            self.counters.incomplete += 1;
+        }
+        if status == Status::TooLong {
+            // The baseline moved (or the sensor is stuck): learn it again.
+            self.ring.clear();
+            self.baseline.clear();
+        }
+        match sink.buffer() {
+            Some(c) if a.captured => {
+                c.set_summary(summary);
+                sink.captured(&self.scene);
+            }
+            _ => {
+                self.counters.analyses_skipped += 1;
+                sink.skipped(&report::streaming(&summary, &self.scene));
+            }
+        }
+    }
+}
+
+/// A capture buffer that is never there: the streaming stage alone.
+pub struct NoCapture<F: FnMut(&crate::ImpactReport)>(pub F);
+
+impl<F: FnMut(&crate::ImpactReport)> Sink<0> for NoCapture<F> {
+    fn buffer(&mut self) -> Option<&mut Capture<0>> {
+        None
+    }
+    fn captured(&mut self, _scene: &Scene) {}
+    fn skipped(&mut self, report: &crate::ImpactReport) {
+        (self.0)(report)
+    }
+}
+
+/// `floorf` by the FPU's conversions (libm's is a software bit-twiddle, ~30 instructions on the
+/// Cortex-M4): exact for |v| < 2^23; larger values are integers already; NaN stays NaN.
+fn floor(v: f32) -> f32 {
+    if libm::fabsf(v) < 8_388_608.0 {
+        let t = v as i32 as f32;
+        if t > v {
+            t - 1.0
+        } else {
+            t
+        }
+    } else {
+        v
+    }
+}
+
+fn clamp_i32(v: f32) -> i32 {
+    if v >= i32::MAX as f32 {
+        i32::MAX
+    } else if v <= i32::MIN as f32 {
+        i32::MIN
+    } else {
+        v as i32
+    }
+}
+
+#[cfg(test)]
+mod floor_tests {
+    #[test]
+    fn floor_matches_libm() {
+        for k in 0..200_000 {
+            // Both signs, every magnitude up to 3e7 and fractions near the integers.
+            let v = (k as f32 - 100_000.0) * 300.013 + (k % 7) as f32 * 0.125;
+            for x in [v, v / 1e3, v / 1e6, v * 1e-4 + 0.5] {
+                assert_eq!(super::floor(x), libm::floorf(x), "{x}");
+            }
+        }
+        assert!(super::floor(f32::NAN).is_nan());
+        assert_eq!(super::floor(f32::INFINITY), f32::INFINITY);
+        assert_eq!(super::floor(-0.5), -1.0);
+    }
+}
