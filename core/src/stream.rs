@@ -415,22 +415,23 @@ impl<const PRE: usize> Stream<PRE> {
     }
 
     /// Runs the samples held in the ring through the idle path again, with the baseline just
-    /// learned (and without learning from them twice).
-    // Never inlined: its `PRE`-sample copy of the history would otherwise sit in every
-    // `push_block` frame, twice over since it calls `push_block` (17 KiB of stack at PRE = 4096,
-    // more than the STM32F407 has left beside the buffers).
+    /// learned (and without learning from them twice). The ring replays its own history in
+    /// place, a stride at a time, so no copy of it sits on the stack.
     #[inline(never)]
     fn replay_history<const CAP: usize>(&mut self, sink: &mut impl Sink<CAP>) {
-        let n = self.ring.len();
-        let mut history = [0i16; PRE];
-        for (slot, x) in history.iter_mut().zip(self.ring.iter_oldest_first()) {
-            *slot = x;
-        }
-        self.ring.clear();
+        let n = self.ring.take_history();
         self.index -= n as u64;
         self.counters.samples -= n as u64;
         self.replaying = true;
-        self.push_block(history.get(..n).unwrap_or(&[]), sink);
+        let mut chunk = [0i16; STRIDE];
+        let mut k = 0;
+        while k < n {
+            let m = (n - k).min(STRIDE);
+            let part = chunk.get_mut(..m).unwrap_or(&mut []);
+            self.ring.replayed(k, part);
+            self.push_block(part, sink);
+            k += m;
+        }
         self.replaying = false;
     }
 

@@ -82,6 +82,29 @@ impl<const N: usize> Ring<N> {
         (0..self.len).rev().filter_map(move |i| self.back(i))
     }
 
+    /// Empties the ring for a replay of its history: the samples, oldest first, stay readable
+    /// with [`Self::replayed`] at positions `0..n` (`n` is returned) while the ring fills
+    /// again from position 0, so a replay that reads each sample before it writes it back
+    /// sees them intact. No copy of the history is made (no `N`-sample buffer on the stack).
+    pub fn take_history(&mut self) -> usize {
+        let n = self.len;
+        if n == N {
+            // Full: the oldest sample is at `head`; rotate it to the front.
+            self.buf.rotate_left(self.head & Self::MASK);
+        }
+        // Not full: written from position 0 since the last clear, so already in order.
+        self.clear();
+        n
+    }
+
+    /// The history's samples at positions `from..from + out.len()` (see
+    /// [`Self::take_history`]) into `out`.
+    pub fn replayed(&self, from: usize, out: &mut [i16]) {
+        if let Some(src) = self.buf.get(from..from + out.len()) {
+            out.copy_from_slice(src);
+        }
+    }
+
     /// Forgets everything.
     pub fn clear(&mut self) {
         self.head = 0;
@@ -101,6 +124,28 @@ mod tests {
         assert!(r.iter_oldest_first().eq([3, 4, 5, 6]));
         r.extend(&[7, 8, 9]);
         assert!(r.iter_oldest_first().eq([6, 7, 8, 9]));
+    }
+
+    #[test]
+    fn the_history_replays_in_place() {
+        for pushed in [3usize, 4, 6, 9] {
+            let mut r = Ring::<4>::new();
+            for x in 0..pushed as i16 {
+                r.extend(&[x]);
+            }
+            let expected: [i16; 4] = core::array::from_fn(|i| r.back(3 - i).unwrap_or(-1));
+            let n = r.take_history();
+            assert_eq!((n, r.len()), (pushed.min(4), 0));
+            // Read one, write it back: the rest stays intact.
+            let mut got = [0i16; 4];
+            for k in 0..n {
+                r.replayed(k, &mut got[k..k + 1]);
+                r.extend(&got[k..k + 1]);
+            }
+            let want = &expected[4 - n..];
+            assert_eq!(&got[..n], want, "{pushed}");
+            assert!(r.iter_oldest_first().eq(want.iter().copied()));
+        }
     }
 
     #[test]

@@ -1,20 +1,27 @@
 //! The `emulator` board: QEMU `-machine mps2-an386` (Cortex-M4F). It has no STM32
-//! peripherals, so the STM32 HAL is left out; instead SysTick drives embassy-time ([`time`]),
-//! samples come from a host file ([`crate::source::replay`]) and defmt frames and the exit
-//! status go to the host through semihosting ([`host`]).
+//! peripherals, so the STM32 HAL is left out; instead the FPGA counter and a CMSDK timer drive
+//! embassy-time ([`time`]), samples come from a host file ([`crate::source::replay`]), through
+//! an emulated DMA paced by the other CMSDK timer in real time ([`dma`]), and defmt frames and
+//! the exit status go to the host through semihosting ([`host`]).
 
+pub mod dma;
 pub mod host;
+pub mod irq;
 pub mod time;
+pub mod timer;
 
 use core::sync::atomic::{AtomicBool, Ordering};
 
 use cortex_m_rt::{exception, ExceptionFrame};
-use defmt::{error, unwrap};
-use embassy_executor::Spawner;
+use defmt::{error, info, unwrap};
+use embassy_executor::SendSpawner;
 use impact_core::Scene;
 use static_cell::ConstStaticCell;
 
 use crate::scene::SceneError;
+use crate::tasks::stream::Backpressure;
+
+pub use irq::start_executors;
 
 use defmt_semihosting as _;
 
@@ -22,24 +29,29 @@ use defmt_semihosting as _;
 const COMMAND_LINE_LEN: usize = 2048;
 
 /// What the semihosting command line asks for:
-/// `<program> <samples-file> [realtime|lossless] [key=value ...]` (scene keys: see
-/// [`crate::scene::apply`]; unset keys keep the seed bench's values, [`crate::scene::BENCH`]).
+/// `<program> <samples-file> [realtime|lossless] [rate_scale=X] [key=value ...]` (scene keys:
+/// see [`crate::scene::apply`]; unset keys keep the seed bench's values,
+/// [`crate::scene::BENCH`]).
 pub struct Config {
     /// Host path of the raw little-endian i16 samples.
     pub samples_path: &'static str,
     /// Replay pacing.
     pub pacing: Pacing,
-    /// The scene the monitor runs.
+    /// Real time only: the samples come this many times faster than the scene's rate.
+    pub rate_scale: f32,
+    /// The scene the stream runs.
     pub scene: Scene,
 }
 
-/// How the replay hands blocks to the monitor.
+/// How the replay hands blocks to the stream.
 #[derive(Clone, Copy, PartialEq, Eq, defmt::Format)]
 pub enum Pacing {
-    /// One block per block period of the scene's sample rate, dropped (and counted) when the
-    /// monitor is behind, as on the board.
+    /// The emulated DMA writes one block per block period of virtual time (run QEMU with
+    /// `-icount`), whatever the tasks are doing; the stream never waits for the analysis.
+    /// Samples are lost (and counted) exactly when the board would lose them.
     RealTime,
-    /// Waits for room in the queue: every sample reaches the monitor.
+    /// Waits for room at every step: every sample reaches the stream and every impact is
+    /// analysed, whatever the emulator's speed.
     Lossless,
 }
 
@@ -49,6 +61,8 @@ enum ConfigError {
     NoSamplesFile,
     /// A positional argument after the samples file that is not a pacing.
     BadPacing,
+    /// `rate_scale` is not a positive number.
+    BadRateScale,
     Scene {
         key: &'static str,
         error: SceneError,
@@ -72,23 +86,42 @@ fn parse(line: &'static str) -> Result<Config, ConfigError> {
         return Err(ConfigError::BadPacing);
     }
     let mut scene = crate::scene::BENCH;
+    let mut rate_scale = 1.0f32;
     for arg in line.split(' ') {
-        if let Some((key, value)) = arg.split_once('=') {
-            crate::scene::apply(&mut scene, key, value)
-                .map_err(|error| ConfigError::Scene { key, error })?;
+        match arg.split_once('=') {
+            Some(("rate_scale", value)) => {
+                rate_scale = value
+                    .parse::<f32>()
+                    .ok()
+                    .filter(|x| x.is_finite() && *x > 0.0)
+                    .ok_or(ConfigError::BadRateScale)?;
+            }
+            Some((key, value)) => crate::scene::apply(&mut scene, key, value)
+                .map_err(|error| ConfigError::Scene { key, error })?,
+            None => {}
         }
     }
     scene.validate().map_err(ConfigError::Invalid)?;
     Ok(Config {
         samples_path,
         pacing,
+        rate_scale,
         scene,
     })
 }
 
-/// Reads the command line, brings the board up and spawns the sample source; returns the
-/// scene for the monitor. A bad command line ends the run (exit status 1).
-pub fn start(spawner: Spawner, samples: crate::tasks::SampleSender) -> Scene {
+/// What the board hands the tasks.
+pub struct Setup {
+    /// The scene the stream and the analysis run.
+    pub scene: Scene,
+    /// Whether the stream may wait for the analysis (lossless replay only).
+    pub backpressure: Backpressure,
+    config: Config,
+}
+
+/// Reads the command line and brings the board up (the time driver). A bad command line ends
+/// the run (exit status 1).
+pub fn init() -> Setup {
     static LINE: ConstStaticCell<[u8; COMMAND_LINE_LEN]> =
         ConstStaticCell::new([0; COMMAND_LINE_LEN]);
     let Some(buf) = LINE.try_take() else {
@@ -106,13 +139,44 @@ pub fn start(spawner: Spawner, samples: crate::tasks::SampleSender) -> Scene {
         }
     };
     time::init();
-    spawner.spawn(unwrap!(crate::source::replay::replay(
-        config.samples_path,
-        config.pacing,
-        config.scene.calibration.sample_rate_hz,
-        samples,
-    )));
-    config.scene
+    Setup {
+        scene: config.scene,
+        backpressure: match config.pacing {
+            Pacing::RealTime => Backpressure::Never,
+            Pacing::Lossless => Backpressure::WaitForCapture,
+        },
+        config,
+    }
+}
+
+/// Spawns the sample source on the highest-priority executor.
+pub fn spawn_sources(setup: Setup, high: SendSpawner, samples: crate::tasks::SampleSender) {
+    let c = &setup.config;
+    let rate = c.scene.calibration.sample_rate_hz;
+    let file = match crate::source::replay::open(c.samples_path, rate) {
+        Ok(file) => file,
+        Err(e) => {
+            error!("replay: {}", e);
+            host::exit(false)
+        }
+    };
+    match c.pacing {
+        Pacing::RealTime => {
+            info!(
+                "replay: real time, {=f32} x the recording's rate",
+                c.rate_scale
+            );
+            high.spawn(unwrap!(crate::source::replay::realtime(
+                file,
+                rate * c.rate_scale,
+                samples
+            )));
+        }
+        Pacing::Lossless => {
+            info!("replay: lossless");
+            high.spawn(unwrap!(crate::source::replay::lossless(file, samples)));
+        }
+    }
 }
 
 /// The stream is over: exit QEMU with status 0 if `success`, else 1. The defmt frames are

@@ -1,133 +1,127 @@
-//! embassy-time driver for the emulator: SysTick on the core clock, interrupting once per
-//! millisecond; alarms are checked on each interrupt.
+//! embassy-time driver for the emulator: the MPS2 FPGA's free-running 25 MHz counter for the
+//! time, and CMSDK timer 1 (0x4000_1000, IRQ 9) in one-shot mode for the alarms.
 //!
-//! QEMU's mps2-an386 clocks the CPU, and so SysTick with CLKSOURCE = core, at 25 MHz (its
-//! SysTick reference clock, CLKSOURCE = external, is 1 MHz). QEMU's SysTick follows the host's
-//! clock, so `Instant`s in the emulator are host time, not simulated cycles.
-//!
-//! Time is `periods * PERIOD_CYCLES + cycles into the current period`, in core cycles,
-//! divided down to embassy-time ticks. An alarm fires at the first SysTick interrupt at or
-//! after its deadline, so timers are up to one period (1 ms) late, never early.
+//! Both follow QEMU's virtual clock, so under `-icount` the firmware's time is instruction
+//! time. One-shot alarms re-armed from the interrupt, rather than a periodic tick, because
+//! QEMU 7.2 with `-icount sleep=off` skips every other period of a periodic timer that wakes
+//! the CPU from `wfi` (fixed upstream in QEMU 10.0, gitlab issue 2703).
 
 use core::cell::RefCell;
 use core::task::Waker;
 
-use cortex_m::peripheral::syst::SystClkSource;
-use cortex_m::peripheral::{SCB, SYST};
-use cortex_m_rt::exception;
+use cortex_m::peripheral::NVIC;
 use embassy_sync::blocking_mutex::raw::CriticalSectionRawMutex;
 use embassy_sync::blocking_mutex::Mutex;
 use embassy_time_driver::{Driver, TICK_HZ};
 use embassy_time_queue_utils::Queue;
 
-/// SysTick's clock on QEMU's mps2-an386 (the CPU clock, SYSCLK_FRQ in QEMU's hw/arm/mps2.c).
-pub const CORE_CLOCK_HZ: u64 = 25_000_000;
+use super::irq::Irq;
+use super::timer::CmsdkTimer;
 
-/// SysTick interrupt period: also the alarm resolution.
-pub const PERIOD_US: u64 = 1_000;
+/// The clock of the FPGA counter and of the CMSDK timers (SYSCLK_FRQ in QEMU's hw/arm/mps2.c).
+pub const CLOCK_HZ: u64 = 25_000_000;
 
-const CYCLES_PER_TICK: u64 = CORE_CLOCK_HZ / TICK_HZ;
-const PERIOD_CYCLES: u64 = CORE_CLOCK_HZ * PERIOD_US / 1_000_000;
+/// The FPGA I/O block's COUNTER register: counts `CLOCK_HZ`, wraps every 171.8 s.
+const FPGAIO_COUNTER: *const u32 = 0x4002_8018 as *const u32;
 
-const _: () = {
-    assert!(
-        CORE_CLOCK_HZ % TICK_HZ == 0,
-        "embassy-time's tick rate must divide the 25 MHz core clock"
-    );
-    assert!(PERIOD_CYCLES % CYCLES_PER_TICK == 0);
-    // SysTick's reload value is 24 bits.
-    assert!(PERIOD_CYCLES > 1 && PERIOD_CYCLES <= 1 << 24);
-};
+/// The alarm timer.
+const ALARM: CmsdkTimer = CmsdkTimer::at(0x4000_1000);
+
+/// Longest one-shot delay, counter ticks: well under half the counter's wrap, so the
+/// interrupt handler extends the counter to 64 bits at least twice per wrap.
+const MAX_DELAY: u64 = 1 << 31;
+
+const CYCLES_PER_TICK: u64 = CLOCK_HZ / TICK_HZ;
+const _: () = assert!(
+    CLOCK_HZ % TICK_HZ == 0,
+    "embassy-time's tick rate must divide the 25 MHz counter"
+);
 
 struct State {
-    /// SysTick wraps counted by the interrupt handler.
-    periods: u64,
-    /// When the queue next needs attention, in ticks (u64::MAX: never).
-    alarm_at: u64,
+    /// Counter wraps seen.
+    wraps: u64,
+    /// The counter at the last read.
+    last: u32,
     queue: Queue,
 }
 
-struct SysTickDriver {
+impl State {
+    /// The counter extended to 64 bits (called at least once per wrap: see `MAX_DELAY`).
+    fn counter(&mut self) -> u64 {
+        // SAFETY: a read of a device register.
+        let now = unsafe { core::ptr::read_volatile(FPGAIO_COUNTER) };
+        if now < self.last {
+            self.wraps += 1;
+        }
+        self.last = now;
+        (self.wraps << 32) | u64::from(now)
+    }
+
+    /// Arms the alarm for `at` (embassy ticks; `u64::MAX`: none).
+    fn arm(&mut self, at: u64) {
+        if at == u64::MAX {
+            ALARM.stop();
+            return;
+        }
+        let now = self.counter();
+        let delay = at
+            .saturating_mul(CYCLES_PER_TICK)
+            .saturating_sub(now)
+            .clamp(1, MAX_DELAY);
+        ALARM.one_shot(delay as u32);
+    }
+}
+
+struct CounterDriver {
     state: Mutex<CriticalSectionRawMutex, RefCell<State>>,
 }
 
-embassy_time_driver::time_driver_impl!(static DRIVER: SysTickDriver = SysTickDriver {
+embassy_time_driver::time_driver_impl!(static DRIVER: CounterDriver = CounterDriver {
     state: Mutex::new(RefCell::new(State {
-        periods: 0,
-        alarm_at: u64::MAX,
+        wraps: 0,
+        last: 0,
         queue: Queue::new(),
     })),
 });
 
-/// Starts SysTick. Call once, before anything waits on a timer; `Instant::now()` reads 0
-/// until then.
+/// Counter ticks (25 MHz) since power-up, for the emulated DMA's deadlines.
+pub fn counter() -> u64 {
+    critical_section::with(|cs| DRIVER.state.borrow(cs).borrow_mut().counter())
+}
+
+/// Unmasks the alarm interrupt. Call once, before anything waits on a timer.
 pub fn init() {
-    // SAFETY: nothing else in the emulator build uses SysTick; this only configures it.
-    let mut syst = unsafe { cortex_m::Peripherals::steal() }.SYST;
-    syst.disable_counter();
-    syst.set_clock_source(SystClkSource::Core);
-    syst.set_reload((PERIOD_CYCLES - 1) as u32);
-    syst.clear_current();
-    syst.enable_interrupt();
-    syst.enable_counter();
+    ALARM.stop();
+    // SAFETY: the alarm interrupt's handler is `on_alarm`, reached through `irq::dispatch`.
+    unsafe { NVIC::unmask(Irq::Timer1) };
 }
 
-/// Core cycles since [`init`], given the wraps the interrupt handler has counted. Must be
-/// called with interrupts off (inside the critical section that guards `periods`).
-fn cycles_now(periods: u64) -> u64 {
-    // SysTick counts down from PERIOD_CYCLES - 1 to 0, sets PENDST on reaching 0 and
-    // reloads. With interrupts off a wrap shows as PENDST still pending: if it is, the
-    // wrap happened before the second read, which then belongs to the next period; if it
-    // is not, the first read was taken before any wrap.
-    let first = SYST::get_current();
-    let wrapped = SCB::is_pendst_pending();
-    let second = SYST::get_current();
-    let (periods, current) = if wrapped {
-        (periods + 1, second)
-    } else {
-        (periods, first)
-    };
-    // current = 0 is the start of a period (its wrap has been counted above), current = k
-    // is PERIOD_CYCLES - k cycles in.
-    let into_period = (PERIOD_CYCLES - u64::from(current)) % PERIOD_CYCLES;
-    periods * PERIOD_CYCLES + into_period
+/// The alarm timer's interrupt.
+pub fn on_alarm() {
+    ALARM.clear();
+    critical_section::with(|cs| {
+        let mut state = DRIVER.state.borrow(cs).borrow_mut();
+        let now = state.counter() / CYCLES_PER_TICK;
+        // Wakes every expired timer; returns the next deadline.
+        let next = state.queue.next_expiration(now);
+        state.arm(next);
+    });
 }
 
-impl SysTickDriver {
-    fn on_systick(&self) {
-        critical_section::with(|cs| {
-            let mut state = self.state.borrow(cs).borrow_mut();
-            state.periods += 1;
-            let now = cycles_now(state.periods) / CYCLES_PER_TICK;
-            if now >= state.alarm_at {
-                // Wakes every expired timer; returns the next deadline.
-                state.alarm_at = state.queue.next_expiration(now);
-            }
-        });
-    }
-}
-
-impl Driver for SysTickDriver {
+impl Driver for CounterDriver {
     fn now(&self) -> u64 {
-        critical_section::with(|cs| {
-            let periods = self.state.borrow(cs).borrow().periods;
-            cycles_now(periods) / CYCLES_PER_TICK
-        })
+        critical_section::with(|cs| self.state.borrow(cs).borrow_mut().counter() / CYCLES_PER_TICK)
     }
 
     fn schedule_wake(&self, at: u64, waker: &Waker) {
         critical_section::with(|cs| {
             let mut state = self.state.borrow(cs).borrow_mut();
             if state.queue.schedule_wake(at, waker) {
-                let now = cycles_now(state.periods) / CYCLES_PER_TICK;
+                let now = state.counter() / CYCLES_PER_TICK;
                 // Wakes at once whatever is already due (including `at` if it has passed).
-                state.alarm_at = state.queue.next_expiration(now);
+                let next = state.queue.next_expiration(now);
+                state.arm(next);
             }
         });
     }
-}
-
-#[exception]
-fn SysTick() {
-    DRIVER.on_systick();
 }

@@ -1,30 +1,29 @@
-//! Emulator sample source: replays a host file of raw little-endian i16 samples, read
-//! through semihosting in blocks of [`BLOCK_LEN`] samples, as the ADC would deliver them.
+//! Emulator sample sources: a host file of raw little-endian i16 samples, replayed
 //!
-//! The semihosting command line (see [`crate::emulator::Config`]) names the file and the
-//! pacing (`scripts/emulate.sh` and `impact emulate` pass it with `-semihosting-config arg=...`):
-//!
-//! * `realtime` (default): one block every `BLOCK_LEN` sample periods of the scene's rate,
-//!   queued without waiting like the DMA does; blocks the monitor cannot take in time are
-//!   lost and counted, as they would be on the board (here the budget is the emulator's speed);
-//! * `lossless`: waits for room in the queue, so every sample reaches the monitor whatever
-//!   the emulator's speed (reproducible runs over recorded signals).
+//! * in real time ([`realtime`]): the emulated DMA ([`crate::emulator::dma`]) writes one block
+//!   per block period of virtual time into its ring, and this task, at the highest priority,
+//!   copies the blocks into the sample queue as the board's sampler copies the DMA's halves;
+//!   a ring overrun or a full queue is a counted loss, announced to the stream;
+//! * losslessly ([`lossless`]): read through semihosting as fast as the stream takes the
+//!   blocks, waiting for room in the queue, so every sample reaches the stream whatever the
+//!   emulator's speed (reproducible runs over recorded signals).
 //!
 //! Paths cannot contain spaces (semihosting joins the arguments with spaces).
 
-use defmt::{error, info, Format};
-use embassy_time::{Duration, Ticker};
+use core::sync::atomic::Ordering;
 
+use defmt::{error, info, Format};
+
+use crate::emulator::dma::{self, Take};
 use crate::emulator::host::{HostError, HostFile};
-use crate::emulator::Pacing;
-use crate::tasks::sampler::{BlockSender, SOURCE_STATS};
-use crate::tasks::{StreamEnd, BLOCK_LEN};
+use crate::tasks::sampler::{BlockSender, SAMPLE_CLOCK, SOURCE_STATS};
+use crate::tasks::{SampleSender, StreamEnd, BLOCK_LEN};
 
 /// Bytes per sample in the file.
 const SAMPLE_BYTES: usize = 2;
 
 #[derive(Format)]
-enum ReplayError {
+pub enum ReplayError {
     Host(HostError),
     /// The file ends in half a sample.
     OddLength {
@@ -38,16 +37,27 @@ impl From<HostError> for ReplayError {
     }
 }
 
-/// Replays the file at `path` as if sampled at `rate_hz`, then ends the stream.
+/// Opens the file and checks its length; logs what is replayed.
+pub fn open(path: &str, rate_hz: f32) -> Result<HostFile, ReplayError> {
+    let file = HostFile::open(path)?;
+    let bytes = file.len_bytes()?;
+    if bytes % SAMPLE_BYTES != 0 {
+        return Err(ReplayError::OddLength { bytes });
+    }
+    info!(
+        "replay: {=str}: {} samples at {=f32} S/s",
+        path,
+        bytes / SAMPLE_BYTES,
+        rate_hz
+    );
+    Ok(file)
+}
+
+/// Replays the file block by block, waiting for room in the queue, then ends the stream.
 #[embassy_executor::task]
-pub async fn replay(
-    path: &'static str,
-    pacing: Pacing,
-    rate_hz: f32,
-    samples: crate::tasks::SampleSender,
-) {
+pub async fn lossless(file: HostFile, samples: SampleSender) {
     let mut sender = BlockSender::new(samples);
-    let end = match run(&mut sender, path, pacing, rate_hz).await {
+    let end = match replay_all(&mut sender, file).await {
         Ok(()) => StreamEnd::Complete,
         Err(e) => {
             SOURCE_STATS.error();
@@ -58,29 +68,7 @@ pub async fn replay(
     sender.finish(end).await;
 }
 
-async fn run(
-    sender: &mut BlockSender,
-    path: &'static str,
-    pacing: Pacing,
-    rate_hz: f32,
-) -> Result<(), ReplayError> {
-    let mut file = HostFile::open(path)?;
-    let bytes = file.len_bytes()?;
-    if bytes % SAMPLE_BYTES != 0 {
-        return Err(ReplayError::OddLength { bytes });
-    }
-    info!(
-        "replay: {=str}: {} samples at {=f32} S/s, {}",
-        path,
-        bytes / SAMPLE_BYTES,
-        rate_hz,
-        pacing
-    );
-
-    // The time the ADC takes to fill one block (at least 1 us; the scene's rate is
-    // validated as finite and positive).
-    let block_period_us = (BLOCK_LEN as f32 * 1e6 / rate_hz).max(1.0) as u64;
-    let mut ticker = Ticker::every(Duration::from_micros(block_period_us));
+async fn replay_all(sender: &mut BlockSender, mut file: HostFile) -> Result<(), ReplayError> {
     let mut raw = [0u8; BLOCK_LEN * SAMPLE_BYTES];
     loop {
         let n = file.read_full(&mut raw)?;
@@ -91,24 +79,52 @@ async fn run(
         if n % SAMPLE_BYTES != 0 {
             return Err(ReplayError::OddLength { bytes: n });
         }
-        let fill = |block: &mut [i16; BLOCK_LEN]| {
-            let bytes = raw.get(..n).unwrap_or(&[]);
-            for (sample, le) in block.iter_mut().zip(bytes.chunks_exact(SAMPLE_BYTES)) {
-                if let [lo, hi] = *le {
-                    *sample = i16::from_le_bytes([lo, hi]);
+        let bytes = raw.get(..n).unwrap_or(&[]);
+        sender
+            .send(n / SAMPLE_BYTES, |block| {
+                for (sample, le) in block.iter_mut().zip(bytes.chunks_exact(SAMPLE_BYTES)) {
+                    if let [lo, hi] = *le {
+                        *sample = i16::from_le_bytes([lo, hi]);
+                    }
                 }
-            }
-            n / SAMPLE_BYTES
-        };
-        match pacing {
-            Pacing::RealTime => {
-                ticker.next().await;
-                sender.publish(fill);
-            }
-            Pacing::Lossless => sender.send(fill).await,
-        }
+            })
+            .await;
         if n < raw.len() {
             return Ok(());
         }
     }
+}
+
+/// Starts the emulated DMA on the file at `rate_hz` (the recording's rate times the rate
+/// scale) and copies its blocks into the sample queue until the file ends.
+#[embassy_executor::task]
+pub async fn realtime(file: HostFile, rate_hz: f32, samples: SampleSender) {
+    let mut sender = BlockSender::new(samples);
+    SAMPLE_CLOCK.start(rate_hz);
+    dma::start(file, rate_hz as f64);
+    let mut next = 0u32;
+    loop {
+        match dma::take(next, |block| {
+            sender.publish(block.len(), |slot| {
+                impact_core::signal::copy::copy_samples(slot, block);
+            });
+        }) {
+            Take::Block => next += 1,
+            Take::Overrun { lost } => {
+                SOURCE_STATS.overrun();
+                sender.lost(lost * BLOCK_LEN as u32);
+                next += lost;
+            }
+            Take::Empty => dma::WRITTEN.wait().await,
+            Take::End => break,
+        }
+    }
+    let end = if dma::FAILED.load(Ordering::Relaxed) {
+        SOURCE_STATS.error();
+        error!("replay: the host file could not be read");
+        StreamEnd::Failed
+    } else {
+        StreamEnd::Complete
+    };
+    sender.finish(end).await;
 }

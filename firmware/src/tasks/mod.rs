@@ -1,46 +1,83 @@
-//! Tasks shared by the `stm32` and `emulator` builds, and the bounded channels joining them.
+//! Tasks shared by the `stm32` and `emulator` builds, the queues joining them, and the three
+//! priorities they run at (see `firmware/README.md`, "Priorities").
 //!
 //! ```text
-//! sample source ──blocks (zero-copy)──> monitor ──REPORTS──> reporter ──> defmt log
-//! (ADC+DMA, ADXL375 or host-file replay)                    (and, in QEMU, the exit status)
+//!  high    sample source ──blocks (zero-copy, 8 deep)──► stream: baseline, trigger,   medium
+//!                                                        capture, exact sums
+//!                                         skipped impacts, heartbeats │   │ captures (zero-copy,
+//!                                                                     ▼   ▼ 2 slots)
+//!  medium  defmt log ◄── reporter ◄──────── analysed impacts ── analysis: widths,      low
+//!                        (index order)                          kinematics, CFC, fits
 //! ```
 //!
-//! Only the sample source (see [`crate::source`]), the clocks and the embassy-time driver
-//! differ between the builds; everything in this module runs unchanged on both.
+//! The source never waits for the stream and the stream never waits for the analysis: a full
+//! sample queue is a counted gap, announced to the stream with the next block; an impact that
+//! finds both capture slots busy is reported from its streaming fields alone
+//! (`analysis=skipped`). Only the sample source, the clocks and the embassy-time driver differ
+//! between the builds.
 
-pub mod monitor;
+pub mod analysis;
 pub mod reporter;
 pub mod sampler;
+pub mod stream;
 
 use embassy_sync::blocking_mutex::raw::CriticalSectionRawMutex;
 use embassy_sync::channel::Channel;
 use embassy_sync::zerocopy_channel;
-use static_cell::StaticCell;
+use impact_core::{Capture, ImpactReport};
+use static_cell::{ConstStaticCell, StaticCell};
 
-/// Samples per block: one DMA half-buffer on the STM32, one file read in the emulator.
+/// Samples per block: one DMA half-buffer on the STM32, one emulated DMA transfer in QEMU.
 pub const BLOCK_LEN: usize = 256;
 
 /// Blocks the sample queue holds before the source starts losing (counting) them:
 /// 8 x 256 samples = 4.1 ms of signal at 500 kS/s.
 pub const SAMPLE_QUEUE_BLOCKS: usize = 8;
 
-/// Reports the reporter's queue holds. The monitor waits for room for impact reports and the
-/// summary; heartbeats that find it full are dropped (and counted).
-pub const REPORT_QUEUE_LEN: usize = 4;
+/// Pre-trigger ring (and baseline window, and reach of the flank fits), samples: the host's.
+pub const PRE_TRIGGER_LEN: usize = 4096;
+
+/// Capture length, samples: 15360 (30.7 ms at 500 kS/s, the seed bench's 26 ms capture with
+/// room). Two captures (60 KiB) and the analysis's f32 workspace (60 KiB, in the CCM RAM) are
+/// the bulk of the board's RAM; see firmware/README.md.
+#[cfg(feature = "stm32")]
+pub const CAPTURE_LEN: usize = 15360;
+
+/// Capture length, samples: the host's (`impact analyze`'s `HostMonitor`), so that emulated
+/// and host reports agree bit for bit even for long impacts (two captures of 256 KiB and a
+/// 512 KiB workspace: the emulator's RAM is QEMU's 4 MiB).
+#[cfg(feature = "emulator")]
+pub const CAPTURE_LEN: usize = 131072;
+
+/// Capture buffers: one being filled by the stream while the other is analysed.
+pub const CAPTURE_SLOTS: usize = 2;
+
+/// Reports the analysis task can queue for the reporter.
+pub const REPORT_QUEUE_LEN: usize = 2;
+
+/// Skipped-impact reports, heartbeats and the end of the stream the stream task can queue
+/// for the reporter without waiting.
+pub const STREAM_QUEUE_LEN: usize = 8;
 
 /// One block of samples, in the order the source produced them.
 pub struct Block {
-    /// Sequence number given by the source, from 0; a gap means blocks were lost.
+    /// Sequence number given by the source, from 0, one per block taken or lost.
     pub seq: u32,
+    /// Samples the source lost just before this block (overruns, a full queue).
+    pub lost_before: u32,
     len: u16,
     samples: [i16; BLOCK_LEN],
 }
 
 impl Block {
-    /// Builds a block from `samples[..len]`; `len` is clamped to [`BLOCK_LEN`].
-    pub fn new(seq: u32, samples: [i16; BLOCK_LEN], len: usize) -> Self {
-        let len = len.min(BLOCK_LEN) as u16;
-        Self { seq, len, samples }
+    /// An empty block.
+    pub const fn new() -> Self {
+        Self {
+            seq: 0,
+            lost_before: 0,
+            len: 0,
+            samples: [0; BLOCK_LEN],
+        }
     }
 
     /// Sets the number of valid samples, clamped to [`BLOCK_LEN`].
@@ -50,10 +87,16 @@ impl Block {
 
     /// The valid samples (a source's last block may be short).
     pub fn samples(&self) -> &[i16] {
-        // `len` is clamped in `new`; `get` keeps this path free of panics regardless.
+        // `len` is clamped in `set_len`; `get` keeps this path free of panics regardless.
         self.samples
             .get(..usize::from(self.len))
             .unwrap_or(&self.samples)
+    }
+}
+
+impl Default for Block {
+    fn default() -> Self {
+        Self::new()
     }
 }
 
@@ -68,38 +111,64 @@ pub enum StreamEnd {
     Failed,
 }
 
-/// What a sample source sends to the monitor.
+/// What a sample source sends to the stream task.
 // Every queue slot has to hold a block anyway (no heap to box it into); `End` comes once.
 #[allow(clippy::large_enum_variant)]
 pub enum SourceEvent {
     /// The next block of samples.
     Block(Block),
-    /// No more samples will come.
+    /// No more samples will come; `lost` were lost after the last block.
     #[cfg_attr(all(feature = "stm32", not(feature = "adxl375")), allow(dead_code))]
-    End(StreamEnd),
+    End { end: StreamEnd, lost: u32 },
 }
 
 /// The source's end of the sample queue: it fills the queue's own slots in place.
 pub type SampleSender = zerocopy_channel::Sender<'static, CriticalSectionRawMutex, SourceEvent>;
-/// The monitor's end of the sample queue: it reads the slots in place.
+/// The stream task's end of the sample queue: it reads the slots in place.
 pub type SampleReceiver = zerocopy_channel::Receiver<'static, CriticalSectionRawMutex, SourceEvent>;
 
+/// One capture buffer of the firmware.
+pub type FwCapture = Capture<CAPTURE_LEN>;
+/// The stream task's end of the capture queue: it captures into the free slot in place.
+pub type CaptureSender = zerocopy_channel::Sender<'static, CriticalSectionRawMutex, FwCapture>;
+/// The analysis task's end: it analyses the captured slot in place.
+pub type CaptureReceiver = zerocopy_channel::Receiver<'static, CriticalSectionRawMutex, FwCapture>;
+
 /// The sample queue, [`SAMPLE_QUEUE_BLOCKS`] blocks deep. A zero-copy channel: the source
-/// writes each block into a slot of the queue and the monitor reads it there, where an
+/// writes each block into a slot of the queue and the stream task reads it there, where an
 /// ordinary channel would move every 512-byte block by value several times (about 34
 /// instructions per sample on the Cortex-M4, measured by `impact bench m4`). `None` if
 /// called twice.
 pub fn sample_queue() -> Option<(SampleSender, SampleReceiver)> {
-    static SLOTS: StaticCell<[SourceEvent; SAMPLE_QUEUE_BLOCKS]> = StaticCell::new();
+    // All zeros (empty blocks), so the slots start in `.bss`.
+    static SLOTS: ConstStaticCell<[SourceEvent; SAMPLE_QUEUE_BLOCKS]> =
+        ConstStaticCell::new([const { SourceEvent::Block(Block::new()) }; SAMPLE_QUEUE_BLOCKS]);
     static QUEUE: StaticCell<
         zerocopy_channel::Channel<'static, CriticalSectionRawMutex, SourceEvent>,
     > = StaticCell::new();
-    let slots =
-        SLOTS.try_init_with(|| core::array::from_fn(|_| SourceEvent::End(StreamEnd::Complete)))?;
+    let slots = SLOTS.try_take()?;
     let queue = QUEUE.try_init(zerocopy_channel::Channel::new(slots))?;
     Some(queue.split())
 }
 
-/// Monitor -> reporter.
-pub static REPORTS: Channel<CriticalSectionRawMutex, reporter::Report, REPORT_QUEUE_LEN> =
+/// The capture queue: [`CAPTURE_SLOTS`] captures of [`CAPTURE_LEN`] samples. `None` if called
+/// twice.
+pub fn capture_queue() -> Option<(CaptureSender, CaptureReceiver)> {
+    // `Capture::new()` is all zeros: the buffers start in `.bss`, not in flash.
+    static SLOTS: ConstStaticCell<[FwCapture; CAPTURE_SLOTS]> =
+        ConstStaticCell::new([const { Capture::new() }; CAPTURE_SLOTS]);
+    static QUEUE: StaticCell<
+        zerocopy_channel::Channel<'static, CriticalSectionRawMutex, FwCapture>,
+    > = StaticCell::new();
+    let slots = SLOTS.try_take()?;
+    let queue = QUEUE.try_init(zerocopy_channel::Channel::new(slots))?;
+    Some(queue.split())
+}
+
+/// Analysis -> reporter: analysed impacts.
+pub static ANALYSED: Channel<CriticalSectionRawMutex, ImpactReport, REPORT_QUEUE_LEN> =
+    Channel::new();
+
+/// Stream -> reporter: what the stream task reports itself (never waiting for room).
+pub static FROM_STREAM: Channel<CriticalSectionRawMutex, reporter::FromStream, STREAM_QUEUE_LEN> =
     Channel::new();

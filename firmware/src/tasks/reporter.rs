@@ -1,9 +1,12 @@
-//! Reporter task: logs the monitor's reports as defmt lines in a fixed, machine-parseable
-//! `name key=value ...` format (documented in firmware/README.md and parsed back by the
-//! host's `impact log` / `impact emulate`), warns when reports stop coming, and hands the end
-//! of a finite stream to the board (which, in the emulator, exits QEMU with the run's status).
+//! Reporter task (middle priority, beside the stream): logs the impacts (analysed ones from the analysis task,
+//! skipped ones from the stream task, merged back into index order), the heartbeats and the
+//! summary as defmt lines in a fixed, machine-parseable `name key=value ...` format
+//! (documented in firmware/README.md and parsed back by the host's `impact log` /
+//! `impact emulate`), warns when reports stop coming, and hands the end of a finite stream to
+//! the board (which, in the emulator, exits QEMU with the run's status).
 //!
-//! * `impact ...`: one line per impact, every field of [`ImpactReport`];
+//! * `impact ...`: one line per impact, every field of [`ImpactReport`] and the report's
+//!   latency;
 //! * `heartbeat ...`: once per second of signal;
 //! * `summary ...`: at the end of a finite stream (the emulator's replay).
 //!
@@ -14,14 +17,17 @@
 use core::sync::atomic::{AtomicU32, Ordering};
 
 use defmt::{error, info, warn};
-use embassy_futures::select::{select, Either};
+use embassy_futures::select::{select3, Either3};
 use embassy_time::{Duration, Instant, Timer};
-use impact_core::monitor::Counters;
-use impact_core::{ImpactReport, Status};
+use heapless::Vec;
+use impact_core::{Counters, ImpactReport};
 
-use super::sampler::SOURCE_STATS;
-use super::{StreamEnd, REPORTS};
+use super::sampler::{SAMPLE_CLOCK, SOURCE_STATS};
+use super::{StreamEnd, ANALYSED, FROM_STREAM};
 use crate::scene::Opt;
+
+/// Impacts held back while an earlier one is still being analysed.
+const REORDER_LEN: usize = 8;
 
 /// Warn when no report has arrived for this long (heartbeats come once per second of signal).
 const SILENCE_WARNING: Duration = Duration::from_secs(3);
@@ -33,7 +39,7 @@ pub fn count_dropped_heartbeat() {
     HEARTBEATS_DROPPED.fetch_add(1, Ordering::Relaxed);
 }
 
-/// Running totals over the blocks the monitor has received.
+/// Running totals over the blocks the stream task has received.
 #[derive(Clone, Copy, defmt::Format)]
 pub struct Tally {
     /// Blocks received.
@@ -70,32 +76,32 @@ impl Default for Tally {
     }
 }
 
-/// The monitor's state at one instant.
+/// The stream's state at one instant.
 #[derive(Clone, Copy)]
 pub struct Heartbeat {
     /// What arrived from the source.
     pub tally: Tally,
-    /// The pipeline's counters.
+    /// The streaming stage's counters.
     pub counters: Counters,
     /// The scene's sample rate, S/s.
     pub rate_hz: f32,
-    /// Share of the time spent in the pipeline (monitor task), per mille: since the previous
-    /// heartbeat, or over the whole run in the summary.
+    /// Share of the time spent in the streaming stage, per mille: since the previous heartbeat,
+    /// or over the whole run in the summary.
     pub busy_permille: u32,
     /// A baseline has been learned (impacts can be detected).
     pub armed: bool,
     /// An impact is being captured.
     pub in_impact: bool,
-    /// Impact reports the monitor could not queue.
-    pub impacts_dropped: u32,
+    /// Skipped-impact reports the stream task could not queue.
+    pub reports_dropped: u32,
 }
 
-/// What the monitor tells the reporter.
+/// What the stream task tells the reporter.
 // Every queue slot holds the largest variant anyway (no heap to box it into).
 #[allow(clippy::large_enum_variant)]
-pub enum Report {
-    /// One finished impact.
-    Impact(ImpactReport),
+pub enum FromStream {
+    /// An impact that found no free capture slot: its streaming fields only.
+    Skipped(ImpactReport),
     /// Periodic state.
     Heartbeat(Heartbeat),
     /// The stream ended.
@@ -107,13 +113,72 @@ pub enum Report {
     },
 }
 
-/// The status as the host's JSON spells it.
-pub fn status_name(s: Status) -> &'static str {
-    match s {
-        Status::Complete => "complete",
-        Status::StreamEnded => "stream-ended",
-        Status::BufferFull => "buffer-full",
-        Status::TooLong => "too-long",
+/// Prints impacts in index order: one that arrives before an earlier one (a skipped impact
+/// overtaking one still in analysis) waits here. If the buffer fills, the lowest held one
+/// goes out anyway and the broken order is counted.
+struct Order {
+    next: u32,
+    held: Vec<ImpactReport, REORDER_LEN>,
+    out_of_order: u32,
+}
+
+impl Order {
+    const fn new() -> Self {
+        Self {
+            next: 0,
+            held: Vec::new(),
+            out_of_order: 0,
+        }
+    }
+
+    fn accept(&mut self, r: ImpactReport) {
+        if r.index != self.next {
+            if self.held.is_full() {
+                self.release_lowest();
+            }
+            if self.held.push(r).is_ok() {
+                self.flush();
+                return;
+            }
+        }
+        self.print(&r);
+        self.flush();
+    }
+
+    fn print(&mut self, r: &ImpactReport) {
+        log_impact(r);
+        self.next = r.index.wrapping_add(1);
+    }
+
+    /// Prints the held impacts that are next in line.
+    fn flush(&mut self) {
+        while let Some(at) = self.held.iter().position(|h| h.index == self.next) {
+            let r = self.held.swap_remove(at);
+            self.print(&r);
+        }
+    }
+
+    /// Gives up waiting for `next`: prints the lowest held impact.
+    fn release_lowest(&mut self) {
+        let lowest = self
+            .held
+            .iter()
+            .enumerate()
+            .min_by_key(|(_, h)| h.index)
+            .map(|(i, _)| i);
+        if let Some(at) = lowest {
+            let r = self.held.swap_remove(at);
+            self.out_of_order = self.out_of_order.saturating_add(1);
+            self.print(&r);
+            self.flush();
+        }
+    }
+
+    /// Prints everything held.
+    fn drain(&mut self) {
+        while !self.held.is_empty() {
+            self.release_lowest();
+        }
     }
 }
 
@@ -121,46 +186,75 @@ pub fn status_name(s: Status) -> &'static str {
 #[embassy_executor::task]
 pub async fn reporter() {
     let started = Instant::now();
+    let mut order = Order::new();
+    let mut end: Option<(Heartbeat, StreamEnd)> = None;
     let success = loop {
-        match select(REPORTS.receive(), Timer::after(SILENCE_WARNING)).await {
-            Either::First(Report::Impact(r)) => log_impact(&r),
-            Either::First(Report::Heartbeat(h)) => log_heartbeat(&h),
-            Either::First(Report::End { last, end }) => {
-                break summarize(&last, end, started.elapsed().as_millis());
+        if let Some((last, stream_end)) = end {
+            // Every impact the stream saw has been printed (or its report was dropped).
+            let printed = u64::from(order.next) + u64::from(last.reports_dropped);
+            if printed >= last.counters.impacts {
+                order.drain();
+                let elapsed = started.elapsed().as_millis();
+                break summarize(&last, stream_end, order.out_of_order, elapsed);
             }
-            Either::Second(()) => {
-                warn!(
+        }
+        match select3(
+            ANALYSED.receive(),
+            FROM_STREAM.receive(),
+            Timer::after(SILENCE_WARNING),
+        )
+        .await
+        {
+            Either3::First(r) | Either3::Second(FromStream::Skipped(r)) => order.accept(r),
+            Either3::Second(FromStream::Heartbeat(h)) => log_heartbeat(&h),
+            Either3::Second(FromStream::End { last, end: e }) => end = Some((last, e)),
+            Either3::Third(()) => match end {
+                // The stream is over and nothing more comes: print what is held.
+                Some((last, _)) if order.held.is_empty() => {
+                    error!(
+                        "{} impacts seen, {} printed: reports were lost",
+                        last.counters.impacts, order.next
+                    );
+                    order.next = u32::MAX;
+                }
+                Some(_) => order.drain(),
+                None => warn!(
                     "no report for {} ms; source: {}",
                     SILENCE_WARNING.as_millis(),
                     SOURCE_STATS.snapshot()
-                );
-            }
+                ),
+            },
         }
     };
     crate::board::end_of_stream(success);
 }
 
 /// The `impact` line: every field of the report, in its order, kinematics and fits
-/// flattened under the names of `impact analyze --csv`; `none` for an absent value.
+/// flattened under the names of `impact analyze --csv`; `none` for an absent value; then the
+/// time from the end of the impact's hold to now (`none` unless the source runs in real
+/// time).
 fn log_impact(r: &ImpactReport) {
     let k = r.kinematics;
     let tp = r.fits.two_phase;
     let nl = r.fits.nonlinear;
     let hz = r.fits.hertz;
     info!(
-        "impact index={=u32} status={=str} clipped={=bool} start_sample={=u64} start_s={=f64} peak_time_s={=f64} peak_acceleration_m_s2={=f32} peak_force_n={} delta_v_m_s={=f32} duration_s={=f32} fwhm_s={=f32} baseline_m_s2={=f32} impact_velocity_m_s={} crush_time_s={} max_deformation_m={} rebound_velocity_m_s={} cor={} permanent_deformation_m={} absorbed_energy_j={} two_phase_kc_n_m={} two_phase_kr_n_m={} two_phase_c_n_s_m={} two_phase_permanent_deformation_m={} two_phase_residual={} nonlinear_k={} nonlinear_c_s_m={} nonlinear_exponent={} nonlinear_residual={} hertz_k={} hertz_residual={}",
+        "impact index={=u32} status={=str} analysis={=str} clipped={=bool} start_sample={=u64} end_sample={=u64} start_s={=f64} peak_time_s={=f64} peak_acceleration_m_s2={=f32} peak_force_n={} delta_v_m_s={=f32} duration_s={=f32} baseline_m_s2={=f32} fwhm_s={} filtered_peak_acceleration_m_s2={} impact_velocity_m_s={} crush_time_s={} max_deformation_m={} rebound_velocity_m_s={} cor={} permanent_deformation_m={} absorbed_energy_j={} two_phase_kc_n_m={} two_phase_kr_n_m={} two_phase_c_n_s_m={} two_phase_permanent_deformation_m={} two_phase_residual={} nonlinear_k={} nonlinear_c_s_m={} nonlinear_exponent={} nonlinear_residual={} hertz_k={} hertz_residual={} report_latency_s={}",
         r.index,
-        status_name(r.status),
+        r.status.name(),
+        r.analysis.name(),
         r.clipped,
         r.start_sample,
+        r.end_sample,
         r.start_s,
         r.peak_time_s,
         r.peak_acceleration_m_s2,
         Opt(r.peak_force_n),
         r.delta_v_m_s,
         r.duration_s,
-        r.fwhm_s,
         r.baseline_m_s2,
+        Opt(r.fwhm_s),
+        Opt(r.filtered_peak_acceleration_m_s2),
         Opt(k.map(|k| k.impact_velocity_m_s)),
         Opt(k.map(|k| k.crush_time_s)),
         Opt(k.map(|k| k.max_deformation_m)),
@@ -179,6 +273,7 @@ fn log_impact(r: &ImpactReport) {
         Opt(nl.map(|t| t.residual)),
         Opt(hz.map(|t| t.k)),
         Opt(hz.map(|t| t.residual)),
+        Opt(SAMPLE_CLOCK.since_sample_s(r.end_sample)),
     );
 }
 
@@ -200,7 +295,7 @@ fn log_heartbeat(h: &Heartbeat) {
     let source = SOURCE_STATS.snapshot();
     let (stack_peak, stack_size) = stack();
     info!(
-        "heartbeat samples={=u64} rate_hz={=f32} blocks={=u32} busy_permille={=u32} overruns={=u32} blocks_lost={=u32} blocks_missing={=u32} source_errors={=u32} impacts={=u64} incomplete={=u64} impacts_dropped={=u32} heartbeats_dropped={=u32} armed={=bool} in_impact={=bool} stack_peak_bytes={=u32} stack_size_bytes={=u32}",
+        "heartbeat samples={=u64} rate_hz={=f32} blocks={=u32} busy_permille={=u32} overruns={=u32} blocks_lost={=u32} blocks_missing={=u32} samples_lost={=u64} gaps={=u64} source_errors={=u32} impacts={=u64} incomplete={=u64} analyses_skipped={=u64} reports_dropped={=u32} heartbeats_dropped={=u32} armed={=bool} in_impact={=bool} stack_peak_bytes={=u32} stack_size_bytes={=u32}",
         h.counters.samples,
         h.rate_hz,
         h.tally.blocks,
@@ -208,10 +303,13 @@ fn log_heartbeat(h: &Heartbeat) {
         source.overruns,
         source.blocks_lost,
         h.tally.blocks_missing,
+        h.counters.samples_lost,
+        h.counters.gaps,
         source.errors,
         h.counters.impacts,
         h.counters.incomplete,
-        h.impacts_dropped,
+        h.counters.analyses_skipped,
+        h.reports_dropped,
         HEARTBEATS_DROPPED.load(Ordering::Relaxed),
         h.armed,
         h.in_impact,
@@ -221,21 +319,21 @@ fn log_heartbeat(h: &Heartbeat) {
 }
 
 /// Logs the `summary` line; returns whether the run succeeded.
-fn summarize(h: &Heartbeat, end: StreamEnd, elapsed_ms: u64) -> bool {
+fn summarize(h: &Heartbeat, end: StreamEnd, out_of_order: u32, elapsed_ms: u64) -> bool {
     let source = SOURCE_STATS.snapshot();
-    let success = end == StreamEnd::Complete && source.errors == 0 && h.impacts_dropped == 0;
+    let success = end == StreamEnd::Complete && source.errors == 0 && h.reports_dropped == 0;
     let end_name = match end {
         StreamEnd::Complete => "complete",
         StreamEnd::Failed => "failed",
     };
     // blocks_missing should equal blocks_lost (both count the same drops, one at each end of
     // the queue); both are shown so that a mismatch is visible.
-    if source.blocks_lost > 0 || h.tally.blocks_missing > 0 || source.overruns > 0 {
-        warn!("samples were lost (see blocks_lost, blocks_missing, overruns)");
+    if h.counters.samples_lost > 0 || h.tally.blocks_missing > 0 {
+        warn!("samples were lost (see samples_lost, gaps, blocks_lost, overruns)");
     }
     let (stack_peak, stack_size) = stack();
     info!(
-        "summary result={=str} end={=str} samples={=u64} rate_hz={=f32} blocks={=u32} impacts={=u64} incomplete={=u64} min={=i16} max={=i16} sum={=i64} blocks_lost={=u32} blocks_missing={=u32} overruns={=u32} source_errors={=u32} impacts_dropped={=u32} heartbeats_dropped={=u32} busy_permille={=u32} elapsed_ms={=u64} stack_peak_bytes={=u32} stack_size_bytes={=u32}",
+        "summary result={=str} end={=str} samples={=u64} rate_hz={=f32} blocks={=u32} impacts={=u64} incomplete={=u64} analyses_skipped={=u64} min={=i16} max={=i16} sum={=i64} samples_lost={=u64} gaps={=u64} blocks_lost={=u32} blocks_missing={=u32} overruns={=u32} source_errors={=u32} reports_dropped={=u32} reports_out_of_order={=u32} heartbeats_dropped={=u32} busy_permille={=u32} elapsed_ms={=u64} stack_peak_bytes={=u32} stack_size_bytes={=u32}",
         if success { "ok" } else { "failed" },
         end_name,
         h.counters.samples,
@@ -243,14 +341,18 @@ fn summarize(h: &Heartbeat, end: StreamEnd, elapsed_ms: u64) -> bool {
         h.tally.blocks,
         h.counters.impacts,
         h.counters.incomplete,
+        h.counters.analyses_skipped,
         h.tally.min,
         h.tally.max,
         h.tally.sum,
+        h.counters.samples_lost,
+        h.counters.gaps,
         source.blocks_lost,
         h.tally.blocks_missing,
         source.overruns,
         source.errors,
-        h.impacts_dropped,
+        h.reports_dropped,
+        out_of_order,
         HEARTBEATS_DROPPED.load(Ordering::Relaxed),
         h.busy_permille,
         elapsed_ms,

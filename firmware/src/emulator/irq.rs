@@ -1,0 +1,88 @@
+//! The emulator's interrupts (QEMU `mps2-an386`, 32 external lines, 8 priority bits) and the
+//! three executor priorities. There is no PAC for the MPS2, so every external interrupt goes
+//! through cortex-m-rt's `DefaultHandler`, which dispatches on the interrupt number.
+
+use cortex_m::interrupt::InterruptNumber;
+use cortex_m::peripheral::NVIC;
+use cortex_m_rt::exception;
+use embassy_executor::SendSpawner;
+
+use crate::executors::{HIGH, LOW, MEDIUM};
+
+/// The interrupt lines used (the AN386's map, hw/arm/mps2.c): the two CMSDK timers, and three
+/// lines that no device drives (free for the executors, pended by software).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[repr(u16)]
+pub enum Irq {
+    /// CMSDK timer 0: the emulated ADC + DMA ([`super::dma`]).
+    Timer0 = 8,
+    /// CMSDK timer 1: embassy-time's alarms ([`super::time`]).
+    Timer1 = 9,
+    /// The lowest executor: analysis and reporter.
+    Low = 29,
+    /// The middle executor: the streaming stage.
+    Medium = 30,
+    /// The highest executor: the sample source.
+    High = 31,
+}
+
+// SAFETY: every value is an interrupt line of the AN386's NVIC (0..32).
+unsafe impl InterruptNumber for Irq {
+    fn number(self) -> u16 {
+        self as u16
+    }
+}
+
+/// NVIC priorities (lower is more urgent; multiples of 0x20 so they behave as on a 3-bit
+/// part): the device interrupts (the DMA's timer, the time driver) above everything, then the
+/// executors.
+const DEVICE_PRIORITY: u8 = 0x00;
+const HIGH_PRIORITY: u8 = 0x20;
+const MEDIUM_PRIORITY: u8 = 0x40;
+const LOW_PRIORITY: u8 = 0x60;
+
+/// Sets the priorities and starts the three executors; returns their spawners (high, medium,
+/// low).
+pub fn start_executors() -> (SendSpawner, SendSpawner, SendSpawner) {
+    // SAFETY: priorities are set once, before the interrupts they concern are unmasked.
+    let mut nvic = unsafe { cortex_m::Peripherals::steal() }.NVIC;
+    unsafe {
+        nvic.set_priority(Irq::Timer0, DEVICE_PRIORITY);
+        nvic.set_priority(Irq::Timer1, DEVICE_PRIORITY);
+        nvic.set_priority(Irq::High, HIGH_PRIORITY);
+        nvic.set_priority(Irq::Medium, MEDIUM_PRIORITY);
+        nvic.set_priority(Irq::Low, LOW_PRIORITY);
+    }
+    let high = HIGH.start(Irq::High);
+    let medium = MEDIUM.start(Irq::Medium);
+    let low = LOW.start(Irq::Low);
+    (high, medium, low)
+}
+
+/// Every external interrupt.
+#[exception]
+unsafe fn DefaultHandler(irqn: i16) {
+    match irqn {
+        8 => super::dma::on_timer(),
+        9 => super::time::on_alarm(),
+        // SAFETY: each executor's interrupt calls its `on_interrupt` and nothing else does.
+        29 => unsafe { LOW.on_interrupt() },
+        30 => unsafe { MEDIUM.on_interrupt() },
+        31 => unsafe { HIGH.on_interrupt() },
+        // An interrupt nobody unmasked: mask it so it cannot come back.
+        n if n >= 0 => NVIC::mask(Raw(n as u16)),
+        // A system exception without a handler (cortex-m-rt routes them here too).
+        _ => {}
+    }
+}
+
+/// Any line, to mask it.
+#[derive(Clone, Copy)]
+struct Raw(u16);
+
+// SAFETY: only used with the number the NVIC reported as active.
+unsafe impl InterruptNumber for Raw {
+    fn number(self) -> u16 {
+        self.0
+    }
+}
