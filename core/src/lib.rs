@@ -34,10 +34,10 @@ pub mod stream;
 
 pub use analysis::{analyse, Workspace};
 pub use capture::{Capture, Sink, Summary};
-pub use report::{Analysis, ImpactReport, Kinematics, Status};
 pub use model::{ContactLaw, Model};
 pub use monitor::Monitor;
 pub use real::Real;
+pub use report::{Analysis, ImpactReport, Kinematics, Status};
 pub use scene::{Approach, FitSet, Scene};
 pub use signal::Calibration;
 pub use solve::{solve, Error, Impact, ImpactOutcome, Method, Settings};

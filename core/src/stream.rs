@@ -542,7 +542,11 @@ impl<const PRE: usize> Stream<PRE> {
     /// The hot loop of an impact: the running state lives in locals (the compiler cannot
     /// keep fields of `self` in registers across the capture's push) and is written back
     /// once per call.
-    fn run_active<const CAP: usize>(&mut self, samples: &[i16], sink: &mut impl Sink<CAP>) -> usize {
+    fn run_active<const CAP: usize>(
+        &mut self,
+        samples: &[i16],
+        sink: &mut impl Sink<CAP>,
+    ) -> usize {
         let hold = self.hold;
         let (lo, hi) = self.scene.clip_counts;
         let max_samples = self.max_samples;
@@ -664,9 +668,7 @@ impl<const PRE: usize> Stream<PRE> {
         if let Some(f) = self.trigger_filter.as_mut() {
             f.reset(level);
         }
-        let separation_offset = a
-            .separation
-            .map_or(0.0, |s| self.separation_offset(&a, s));
+        let separation_offset = a.separation.map_or(0.0, |s| self.separation_offset(&a, s));
         let summary = Summary {
             index: self.counters.impacts.min(u32::MAX as u64) as u32,
             status,

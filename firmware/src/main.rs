@@ -61,7 +61,10 @@ fn main() -> ! {
     let (samples_in, samples_out) = unwrap!(tasks::sample_queue());
     let (captures_in, captures_out) = unwrap!(tasks::capture_queue());
     let (high, medium, low) = board::start_executors();
-    low.spawn(unwrap!(tasks::analysis::analysis(setup.scene, captures_out)));
+    low.spawn(unwrap!(tasks::analysis::analysis(
+        setup.scene,
+        captures_out
+    )));
     medium.spawn(unwrap!(tasks::reporter::reporter()));
     medium.spawn(unwrap!(tasks::stream::stream(
         setup.scene,

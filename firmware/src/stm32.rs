@@ -1,10 +1,16 @@
-//! The `stm32` board: STM32F4-Discovery (STM32F407VG). Clock tree, interrupt bindings and
-//! the sample source's peripherals; defmt over RTT, panics through panic-probe.
+//! The `stm32` board: STM32F4-Discovery (STM32F407VG). Clock tree and flash accelerator, the
+//! executors' interrupt lines, the sample source's peripherals, the light gate; defmt over RTT,
+//! panics through panic-probe.
 
 use defmt::{info, unwrap};
-use embassy_executor::Spawner;
-use embassy_stm32::{bind_interrupts, dma, peripherals, Config};
+use embassy_executor::SendSpawner;
+use embassy_stm32::interrupt::{InterruptExt, Priority};
+use embassy_stm32::{bind_interrupts, dma, interrupt, peripherals, Config, Peripherals};
+use impact_core::Scene;
 use {defmt_rtt as _, panic_probe as _};
+
+use crate::executors::{HIGH, LOW, MEDIUM};
+use crate::tasks::stream::Backpressure;
 
 #[cfg(not(feature = "adxl375"))]
 bind_interrupts!(
@@ -23,17 +29,109 @@ bind_interrupts!(
     }
 );
 
-/// Brings the chip up at 168 MHz and spawns the sample source; the monitor runs the scene
-/// compiled in ([`crate::scene::BENCH`]).
-pub fn start(spawner: Spawner, samples: crate::tasks::SampleSender) -> impact_core::Scene {
+// Three interrupt lines of peripherals this board does not use serve the executors (as in
+// embassy's `multiprio` example).
+#[interrupt]
+unsafe fn UART4() {
+    // SAFETY: this line is only the high executor's.
+    unsafe { HIGH.on_interrupt() }
+}
+
+#[interrupt]
+unsafe fn UART5() {
+    // SAFETY: this line is only the middle executor's.
+    unsafe { MEDIUM.on_interrupt() }
+}
+
+#[interrupt]
+unsafe fn USART6() {
+    // SAFETY: this line is only the low executor's.
+    unsafe { LOW.on_interrupt() }
+}
+
+/// What the board hands the tasks.
+pub struct Setup {
+    /// The compiled-in scene ([`crate::scene::BENCH`]).
+    pub scene: Scene,
+    /// A live source: the stream never waits for the analysis.
+    pub backpressure: Backpressure,
+    p: Peripherals,
+}
+
+extern "C" {
+    /// Start and end of the `.ccmram` section (firmware/stm32/board-memory.x).
+    static mut __sccmram: u32;
+    static mut __eccmram: u32;
+}
+
+/// Brings the chip up at 168 MHz with the flash accelerator on, and zeroes the CCM RAM (the
+/// statics there start as zeros; cortex-m-rt only zeroes `.bss`).
+pub fn init() -> Setup {
+    // SAFETY: first thing after reset, before anything in `.ccmram` is used: the section is
+    // word-aligned and nothing else touches it yet.
+    unsafe {
+        let start = core::ptr::addr_of_mut!(__sccmram);
+        let end = core::ptr::addr_of_mut!(__eccmram);
+        let words = (end as usize).saturating_sub(start as usize) / 4;
+        core::ptr::write_bytes(start, 0, words);
+    }
     let p = embassy_stm32::init(clock_config());
+    enable_flash_accelerator();
+    Setup {
+        scene: crate::scene::BENCH,
+        backpressure: Backpressure::Never,
+        p,
+    }
+}
+
+/// ART accelerator on: prefetch and the instruction and data caches (RM0090 3.5.2).
+/// embassy-stm32's clock set-up writes FLASH.ACR with the wait states alone (5 at 168 MHz),
+/// leaving all three off; every cycle figure in the README assumes them on.
+fn enable_flash_accelerator() {
+    use embassy_stm32::pac::FLASH;
+    // A cache may only be reset while it is disabled.
+    FLASH.acr().modify(|w| {
+        w.set_icen(false);
+        w.set_dcen(false);
+    });
+    FLASH.acr().modify(|w| {
+        w.set_icrst(true);
+        w.set_dcrst(true);
+    });
+    FLASH.acr().modify(|w| {
+        w.set_icrst(false);
+        w.set_dcrst(false);
+    });
+    FLASH.acr().modify(|w| {
+        w.set_prften(true);
+        w.set_icen(true);
+        w.set_dcen(true);
+    });
+}
+
+/// Starts the three executors (high, middle, low) below the device interrupts (DMA, EXTI and
+/// the time driver's timer stay at priority 0).
+pub fn start_executors() -> (SendSpawner, SendSpawner, SendSpawner) {
+    interrupt::UART4.set_priority(Priority::P2);
+    interrupt::UART5.set_priority(Priority::P3);
+    interrupt::USART6.set_priority(Priority::P4);
+    let high = HIGH.start(interrupt::UART4);
+    let medium = MEDIUM.start(interrupt::UART5);
+    let low = LOW.start(interrupt::USART6);
+    (high, medium, low)
+}
+
+/// Spawns the sample source (and the light gate) on the high executor.
+pub fn spawn_sources(setup: Setup, high: SendSpawner, samples: crate::tasks::SampleSender) {
+    let p = setup.p;
 
     #[cfg(not(feature = "adxl375"))]
     {
         use crate::source::adc;
         let dma_buf = adc::dma_buffer();
-        let sampler = adc::AdcSampler::new(p.ADC1, p.PA1, p.DMA2_CH0, p.TIM3, Irqs, dma_buf);
-        spawner.spawn(unwrap!(adc::sampler(sampler, samples)));
+        let sampler =
+            adc::AdcSampler::new(p.ADC1, p.PA1, p.DMA2_CH0, p.TIM3, p.TIM2, Irqs, dma_buf);
+        high.spawn(unwrap!(adc::sampler(sampler, samples)));
     }
 
     #[cfg(feature = "adxl375")]
@@ -47,60 +145,13 @@ pub fn start(spawner: Spawner, samples: crate::tasks::SampleSender) -> impact_co
             lis3dsh_cs: p.PE3,
         };
         let sensor = accel::sensor(p.SPI1, pins, p.DMA2_CH3, p.DMA2_CH2, Irqs);
-        spawner.spawn(unwrap!(accel::sampler(sensor, samples)));
+        high.spawn(unwrap!(accel::sampler(sensor, samples)));
     }
 
     #[cfg(feature = "light-gate")]
     {
-        use embassy_stm32::exti::ExtiInput;
-        use embassy_stm32::gpio::Pull;
-        let first = ExtiInput::new(p.PB0, p.EXTI0, Pull::Down, GateIrqs);
-        let second = ExtiInput::new(p.PB1, p.EXTI1, Pull::Down, GateIrqs);
-        spawner.spawn(unwrap!(light_gate(first, second)));
-    }
-    crate::scene::BENCH
-}
-
-#[cfg(feature = "light-gate")]
-bind_interrupts!(
-    /// EXTI lines of the two light-gate beams (PB0, PB1).
-    pub struct GateIrqs {
-        EXTI0 => embassy_stm32::exti::InterruptHandler<embassy_stm32::interrupt::typelevel::EXTI0>;
-        EXTI1 => embassy_stm32::exti::InterruptHandler<embassy_stm32::interrupt::typelevel::EXTI1>;
-    }
-);
-
-/// Times the two beam cuts (rising edges on PB0 then PB1) and hands the approach speed to the
-/// monitor for the next impact. A second cut that does not come within a second, or a speed
-/// that is not plausible, is logged and ignored: the scene's v0 stays in force.
-#[cfg(feature = "light-gate")]
-#[embassy_executor::task]
-async fn light_gate(
-    mut first: embassy_stm32::exti::ExtiInput<'static, embassy_stm32::mode::Async>,
-    mut second: embassy_stm32::exti::ExtiInput<'static, embassy_stm32::mode::Async>,
-) {
-    use crate::source::light_gate::speed_m_s;
-    use embassy_time::{with_timeout, Duration, Instant};
-    loop {
-        first.wait_for_rising_edge().await;
-        let t1 = Instant::now().as_micros();
-        match with_timeout(Duration::from_secs(1), second.wait_for_rising_edge()).await {
-            Ok(()) => {
-                let t2 = Instant::now().as_micros();
-                match speed_m_s(t1, t2, crate::scene::LIGHT_GATE_SPACING_M) {
-                    Ok(v0) => {
-                        info!("light_gate v0_m_s={=f32} dt_us={=u64}", v0, t2 - t1);
-                        crate::tasks::monitor::APPROACH_SPEED.signal(v0);
-                    }
-                    Err(e) => defmt::warn!(
-                        "light_gate refused dt_us={=u64}: {}",
-                        t2.saturating_sub(t1),
-                        e
-                    ),
-                }
-            }
-            Err(_) => defmt::warn!("light_gate: second beam not cut within 1 s"),
-        }
+        let beams = crate::source::gate::Beams::new(p.PB0, p.EXTI0, p.PB1, p.EXTI1);
+        high.spawn(unwrap!(crate::source::gate::light_gate(beams)));
     }
 }
 

@@ -3,8 +3,8 @@
 use std::path::{Path, PathBuf};
 
 use clap::{Args, ValueEnum};
-use impact_core::report::Fits;
 use impact_core::monitor::Monitor;
+use impact_core::report::Fits;
 use impact_core::signal::cfc::Cfc;
 use impact_core::solve::bounce::STANDARD_GRAVITY;
 use impact_core::{Approach, Calibration, FitSet, ImpactReport, Scene};

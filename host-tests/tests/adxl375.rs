@@ -14,7 +14,10 @@ use std::task::{Context, Poll, Waker};
 
 use adxl375::{reg, Adxl375, DataRate, Error, Sample};
 use embedded_hal_async::spi::{ErrorKind, ErrorType, Operation, SpiDevice};
+use embedded_hal_mock::eh1::delay::NoopDelay;
 use embedded_hal_mock::eh1::spi::{Mock, Transaction as T};
+use std::cell::RefCell;
+use std::rc::Rc;
 
 /// Runs a future whose I/O never waits (mocks answer at once).
 fn block_on<F: Future>(future: F) -> F::Output {
@@ -46,13 +49,13 @@ fn write_reg(address: u8, value: u8) -> Vec<T<u8>> {
     ]
 }
 
-/// Expected traffic of one FIFO pop: multi-byte read of DATAX0..DATAZ1, then the 5 us delay.
+/// Expected traffic of one FIFO pop: multi-byte read of DATAX0..DATAZ1 (the 5 us pop delay
+/// follows, chip select high: see `each_fifo_pop_waits_after_chip_select_rises`).
 fn read_data(bytes: [u8; 6]) -> Vec<T<u8>> {
     vec![
         T::transaction_start(),
         T::write(0x80 | 0x40 | 0x32),
         T::read_vec(bytes.to_vec()),
-        T::delay(5_000),
         T::transaction_end(),
     ]
 }
@@ -71,7 +74,7 @@ fn init_checks_the_id_then_configures_in_standby_and_measures() {
     ]
     .concat();
     let mut spi = Mock::new(&expected);
-    let mut sensor = Adxl375::new(spi.clone());
+    let mut sensor = Adxl375::new(spi.clone(), NoopDelay);
     assert_eq!(block_on(sensor.init(DataRate::Hz3200)), Ok(()));
     spi.done();
 }
@@ -81,7 +84,7 @@ fn wrong_device_id_is_an_error_and_nothing_is_written() {
     for found in [0x00, 0xFF, 0xAD, 0xE6] {
         let expected = read_reg(0x00, found);
         let mut spi = Mock::new(&expected);
-        let mut sensor = Adxl375::new(spi.clone());
+        let mut sensor = Adxl375::new(spi.clone(), NoopDelay);
         assert_eq!(
             block_on(sensor.init(DataRate::Hz3200)),
             Err(Error::WrongDeviceId { found })
@@ -100,7 +103,7 @@ fn fifo_read_pops_each_entry_with_one_multibyte_read() {
     ]
     .concat();
     let mut spi = Mock::new(&expected);
-    let mut sensor = Adxl375::new(spi.clone());
+    let mut sensor = Adxl375::new(spi.clone(), NoopDelay);
     let mut out = [Sample::default(); 4];
     assert_eq!(block_on(sensor.read_fifo(&mut out)), Ok(2));
     // 13-bit two's complement, right-justified and sign-extended: -4096..=4095.
@@ -128,7 +131,7 @@ fn fifo_read_pops_each_entry_with_one_multibyte_read() {
 fn empty_fifo_reads_no_data() {
     let expected: Vec<T<u8>> = [read_reg(0x39, 0), read_reg(0x30, 0)].concat();
     let mut spi = Mock::new(&expected);
-    let mut sensor = Adxl375::new(spi.clone());
+    let mut sensor = Adxl375::new(spi.clone(), NoopDelay);
     let mut out = [Sample::default(); 4];
     assert_eq!(block_on(sensor.read_fifo(&mut out)), Ok(0));
     spi.done();
@@ -152,13 +155,30 @@ fn counts_convert_at_49_mg_per_lsb() {
     assert_eq!(DataRate::Hz100 as u8, 0x0A);
 }
 
+/// What the simulated bus saw, in order: one command byte per transaction, and [`DELAY`] for
+/// each delay the driver waited (between transactions: chip select high).
+type Events = Rc<RefCell<Vec<u8>>>;
+
+/// The mark of a delay in [`Events`].
+const DELAY: u8 = 0xDD;
+
+/// A delay that only records itself.
+struct LogDelay(Events);
+
+impl embedded_hal_async::delay::DelayNs for LogDelay {
+    async fn delay_ns(&mut self, ns: u32) {
+        assert!(ns >= 5_000, "the FIFO pop delay is 5 us: {ns} ns");
+        self.0.borrow_mut().push(DELAY);
+    }
+}
+
 /// A register-level ADXL375: 64 registers, a FIFO of samples, the overrun flag.
 struct SimAdxl375 {
     regs: [u8; 64],
     fifo: VecDeque<Sample>,
     overrun: bool,
-    /// Commands seen, one per transaction.
-    commands: Vec<u8>,
+    /// Commands seen, one per transaction, and the delays between them.
+    commands: Events,
 }
 
 impl SimAdxl375 {
@@ -169,8 +189,14 @@ impl SimAdxl375 {
             regs,
             fifo: samples.into_iter().collect(),
             overrun,
-            commands: Vec::new(),
+            commands: Events::default(),
         }
+    }
+
+    /// The sensor on this bus, with a delay that logs into the same event list.
+    fn sensor(self) -> Adxl375<Self, LogDelay> {
+        let delay = LogDelay(self.commands.clone());
+        Adxl375::new(self, delay)
     }
 
     fn read(&mut self, address: u8) -> u8 {
@@ -225,7 +251,7 @@ impl SpiDevice for SimAdxl375 {
                 _ => return Err(ErrorKind::Other),
             }
         }
-        self.commands.extend(command);
+        self.commands.borrow_mut().extend(command);
         // Reading data pops one FIFO level on chip-select release and clears the overrun.
         if data_read {
             self.fifo.pop_front();
@@ -245,7 +271,7 @@ fn ramp(n: i16) -> impl Iterator<Item = Sample> {
 
 #[test]
 fn fifo_read_stops_at_the_buffer_and_leaves_the_rest() {
-    let mut sensor = Adxl375::new(SimAdxl375::with_fifo(ramp(10), false));
+    let mut sensor = SimAdxl375::with_fifo(ramp(10), false).sensor();
     let mut out = [Sample::default(); 4];
     assert_eq!(block_on(sensor.read_fifo(&mut out)), Ok(4));
     assert_eq!(out.to_vec(), ramp(4).collect::<Vec<_>>());
@@ -256,18 +282,19 @@ fn fifo_read_stops_at_the_buffer_and_leaves_the_rest() {
     assert_eq!(rest[..6].to_vec(), ramp(10).skip(4).collect::<Vec<_>>());
     let sim = sensor.release();
     assert!(sim.fifo.is_empty());
-    // FIFO_STATUS, INT_SOURCE, 4 pops; then FIFO_STATUS; FIFO_STATUS, INT_SOURCE, 6 pops.
-    let pop = 0x80 | 0x40 | 0x32;
+    // FIFO_STATUS, INT_SOURCE, 4 pops; then FIFO_STATUS; FIFO_STATUS, INT_SOURCE, 6 pops;
+    // every pop followed by the pop delay, outside the transaction (chip select high).
+    let pop = [0x80 | 0x40 | 0x32, DELAY];
     let mut expected = vec![0x80 | 0x39, 0x80 | 0x30];
-    expected.extend([pop; 4]);
+    expected.extend(pop.repeat(4));
     expected.extend([0x80 | 0x39, 0x80 | 0x39, 0x80 | 0x30]);
-    expected.extend([pop; 6]);
-    assert_eq!(sim.commands, expected);
+    expected.extend(pop.repeat(6));
+    assert_eq!(*sim.commands.borrow(), expected);
 }
 
 #[test]
 fn fifo_overrun_is_reported_after_draining_and_then_clears() {
-    let mut sensor = Adxl375::new(SimAdxl375::with_fifo(ramp(33), true));
+    let mut sensor = SimAdxl375::with_fifo(ramp(33), true).sensor();
     let mut out = [Sample::default(); 33];
     assert_eq!(
         block_on(sensor.read_fifo(&mut out)),
@@ -280,7 +307,7 @@ fn fifo_overrun_is_reported_after_draining_and_then_clears() {
 
 #[test]
 fn init_on_the_simulated_sensor_sets_the_registers() {
-    let mut sensor = Adxl375::new(SimAdxl375::with_fifo([], false));
+    let mut sensor = SimAdxl375::with_fifo([], false).sensor();
     assert_eq!(block_on(sensor.init(DataRate::Hz1600)), Ok(()));
     let sim = sensor.release();
     assert_eq!(sim.regs[usize::from(reg::DATA_FORMAT)], 0x0B);
@@ -304,7 +331,7 @@ impl SpiDevice for BrokenBus {
 
 #[test]
 fn bus_errors_are_passed_up() {
-    let mut sensor = Adxl375::new(BrokenBus);
+    let mut sensor = Adxl375::new(BrokenBus, NoopDelay);
     assert_eq!(
         block_on(sensor.init(DataRate::Hz3200)),
         Err(Error::Spi(ErrorKind::ModeFault))

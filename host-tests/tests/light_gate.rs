@@ -22,3 +22,35 @@ fn bad_readings_are_refused_not_guessed() {
     assert_eq!(speed_m_s(0, 10_000, f32::NAN), Err(GateError::Spacing));
     assert_eq!(speed_m_s(0, 10_000, -0.01), Err(GateError::Spacing));
 }
+
+#[test]
+fn cuts_pair_into_passages_with_their_direction() {
+    use light_gate::{Beam, Pairing, Passage, PAIRING_WINDOW_US};
+    let mut g = Pairing::new();
+    // Toward the barrier: first then second beam.
+    assert_eq!(g.cut(Beam::First, 1_000, 0.01), None);
+    assert_eq!(
+        g.cut(Beam::Second, 11_000, 0.01),
+        Some(Ok(Passage::Toward(1.0)))
+    );
+    // The rebound: second then first.
+    assert_eq!(g.cut(Beam::Second, 50_000, 0.01), None);
+    assert_eq!(
+        g.cut(Beam::First, 70_000, 0.01),
+        Some(Ok(Passage::Away(0.5)))
+    );
+    // A repeated cut of one beam replaces the pending one; a late second cut starts anew.
+    assert_eq!(g.cut(Beam::First, 100_000, 0.01), None);
+    assert_eq!(g.cut(Beam::First, 105_000, 0.01), None);
+    assert_eq!(
+        g.cut(Beam::Second, 115_000, 0.01),
+        Some(Ok(Passage::Toward(1.0)))
+    );
+    assert_eq!(g.cut(Beam::First, 200_000, 0.01), None);
+    assert_eq!(g.cut(Beam::Second, 200_001 + PAIRING_WINDOW_US, 0.01), None);
+    // Same instant: not a speed.
+    assert_eq!(
+        g.cut(Beam::First, 200_001 + PAIRING_WINDOW_US, 0.01),
+        Some(Err(GateError::Order))
+    );
+}

@@ -52,4 +52,3 @@ pub struct HertzFit {
     pub k: f32,
     pub residual: f32,
 }
-

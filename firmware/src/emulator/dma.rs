@@ -76,7 +76,9 @@ pub fn start(file: HostFile, rate_hz: f64) {
 /// Arms the timer for the next block's deadline.
 fn arm(d: &Dma) {
     let deadline = d.start + (f64::from(d.written + 1) * d.period) as u64;
-    let delay = deadline.saturating_sub(counter()).clamp(1, u64::from(u32::MAX));
+    let delay = deadline
+        .saturating_sub(counter())
+        .clamp(1, u64::from(u32::MAX));
     TIMER.one_shot(delay as u32);
 }
 

@@ -12,22 +12,24 @@ use embassy_stm32::peripherals::{DMA2_CH2, DMA2_CH3, PA5, PA6, PA7, PE3, PE7, SP
 use embassy_stm32::spi::{self, mode::Master, Spi, MODE_3};
 use embassy_stm32::time::Hertz;
 use embassy_stm32::Peri;
-use embassy_time::{Delay, Duration, Ticker, Timer};
+use embassy_time::{Delay, Duration, Instant, Ticker, Timer};
 use embedded_hal_bus::spi::ExclusiveDevice;
 
 use super::adxl375::{Adxl375, DataRate, Error, Sample, MAX_FIFO_ENTRIES};
 use super::SAMPLE_RATE_HZ;
 use crate::stm32::Irqs;
-use crate::tasks::sampler::{BlockSender, SOURCE_STATS};
+use crate::tasks::sampler::{BlockSender, SAMPLE_CLOCK, SOURCE_STATS};
 use crate::tasks::{StreamEnd, BLOCK_LEN};
 
 /// Output data rate; [`SAMPLE_RATE_HZ`] is set to match.
 const DATA_RATE: DataRate = DataRate::Hz3200;
 const _: () = assert!(DATA_RATE.hz() == SAMPLE_RATE_HZ);
 
-/// SPI clock: the ADXL375 allows up to 5 MHz and wants >= 2 MHz at 3200 Hz. SPI1 runs from
-/// APB2 = 84 MHz, so embassy-stm32 picks 84 / 32 = 2.6 MHz (84 / 16 = 5.25 MHz is too fast).
-const SPI_CLOCK_HZ: u32 = 5_000_000;
+/// SPI clock request: the ADXL375 allows up to 5 MHz and wants >= 2 MHz at 3200 Hz. SPI1 runs
+/// from APB2 = 84 MHz and embassy-stm32 0.6 maps `84 MHz / f` (floored) to a divider that may
+/// be below it: any request in (3.5, 7] MHz gives 84 / 16 = 5.25 MHz, over the part's maximum.
+/// This one gives exactly 84 / 32 = 2.625 MHz (checked at start-up).
+const SPI_CLOCK_HZ: u32 = 2_625_000;
 
 /// FIFO poll period: 5 ms = 16 samples at 3200 Hz, half of the 32-sample FIFO, which gives
 /// another 5 ms of slack before it overruns.
@@ -51,7 +53,7 @@ const AXIS: Axis = Axis::Z;
 pub type Device = ExclusiveDevice<Spi<'static, Async, Master>, Output<'static>, Delay>;
 
 /// The sensor as the sampler task gets it.
-pub type Sensor = Adxl375<Device>;
+pub type Sensor = Adxl375<Device, Delay>;
 
 /// SPI1 pins and the chip selects on its bus.
 pub struct Spi1Pins {
@@ -81,6 +83,10 @@ pub fn sensor(
     let bus = Spi::new(
         spi1, pins.sck, pins.mosi, pins.miso, tx_dma, rx_dma, irqs, config,
     );
+    let sck = bus.get_current_config().frequency.0;
+    if sck > 5_000_000 {
+        defmt::error!("SPI1 at {} Hz: over the ADXL375's 5 MHz", sck);
+    }
 
     // Deselected for good; the pin must stay driven, so the output is never dropped.
     core::mem::forget(Output::new(pins.lis3dsh_cs, Level::High, Speed::Low));
@@ -88,7 +94,7 @@ pub fn sensor(
     let cs = Output::new(pins.cs, Level::High, Speed::VeryHigh);
     // Setting a GPIO output cannot fail (the error type is `Infallible`).
     let Ok(device) = ExclusiveDevice::new(bus, cs, Delay);
-    Adxl375::new(device)
+    Adxl375::new(device, Delay)
 }
 
 impl<E: embedded_hal::spi::Error> defmt::Format for Error<E> {
@@ -151,13 +157,31 @@ pub async fn sampler(mut sensor: Sensor, samples: crate::tasks::SampleSender) {
     let mut block = [0i16; BLOCK_LEN];
     let mut filled = 0;
     let mut ticker = Ticker::every(POLL_PERIOD);
+    let started = Instant::now();
+    SAMPLE_CLOCK.start(SAMPLE_RATE_HZ as f32);
+    // Samples read or counted lost since the start.
+    let mut accounted = 0u64;
     loop {
         ticker.next().await;
         let read = match sensor.read_fifo(&mut fifo).await {
             Ok(n) => n,
             Err(Error::FifoOverrun { samples_read }) => {
                 let n = SOURCE_STATS.overrun();
-                warn!("ADXL375 FIFO overrun (#{}): samples lost", n);
+                // The FIFO overwrote what was not read in time: what the data rate should
+                // have given since the start, less what was read (the FIFO has no count of
+                // its own; good to a poll period's jitter).
+                let due = started.elapsed().as_micros() * u64::from(SAMPLE_RATE_HZ) / 1_000_000;
+                let lost = due.saturating_sub(accounted + samples_read as u64);
+                accounted += lost;
+                // The samples before the gap go out first, in a short block; the gap is
+                // announced with the block that holds the samples read after it.
+                if filled > 0 {
+                    let before = block;
+                    sender.publish(filled, |b| *b = before);
+                    filled = 0;
+                }
+                sender.lost(lost.min(u64::from(u32::MAX)) as u32);
+                warn!("ADXL375 FIFO overrun (#{}): {} samples lost", n, lost);
                 samples_read
             }
             Err(e) => {
@@ -166,16 +190,14 @@ pub async fn sampler(mut sensor: Sensor, samples: crate::tasks::SampleSender) {
                 0
             }
         };
+        accounted += read as u64;
         for sample in fifo.iter().take(read) {
             if let Some(slot) = block.get_mut(filled) {
                 *slot = pick(sample);
                 filled += 1;
             }
             if filled == BLOCK_LEN {
-                sender.publish(|b| {
-                    *b = block;
-                    BLOCK_LEN
-                });
+                sender.publish(BLOCK_LEN, |b| *b = block);
                 filled = 0;
             }
         }

@@ -17,22 +17,24 @@
 //! 36 MHz, i.e. APB2 = 72 MHz (SYSCLK 144 MHz); the triple-interleaved mode (7.2 MS/s) is not
 //! used here. TIM3 runs from 84 MHz: 500 kS/s is exactly 168 timer clocks per sample.
 //!
-//! Losses are counted and logged, never silent: a DMA ring overrun (the sampler task fell a
-//! full ring behind) and an ADC overrun (no DMA service in time, which stops the ADC's DMA
-//! requests and is only seen as a stall) are each followed by a restart of the ring.
+//! Losses are counted exactly, never silent: TIM2 (32 bits) counts every TIM3 trigger, i.e.
+//! every conversion, so after a DMA ring overrun (the sampler task fell a full ring behind) or
+//! an ADC overrun (no DMA service in time, which stops the ADC's DMA requests and is only seen
+//! as a stall) the number of samples lost is the count minus the samples delivered (±1 for a
+//! conversion in flight), announced to the stream with the next block.
 
 use defmt::{info, warn};
 use embassy_stm32::adc::{Adc, AdcChannel, Exten, RingBufferedAdc, SampleTime};
-use embassy_stm32::peripherals::{ADC1, DMA2_CH0, PA1, TIM3};
+use embassy_stm32::peripherals::{ADC1, DMA2_CH0, PA1, TIM2, TIM3};
 use embassy_stm32::time::Hertz;
-use embassy_stm32::timer::low_level::{MasterMode, RoundTo, Timer};
+use embassy_stm32::timer::low_level::{MasterMode, RoundTo, SlaveMode, Timer, TriggerSource};
 use embassy_stm32::{triggers, Peri};
 use embassy_time::{with_timeout, Duration};
 use static_cell::ConstStaticCell;
 
 use super::SAMPLE_RATE_HZ;
 use crate::stm32::Irqs;
-use crate::tasks::sampler::{BlockSender, SOURCE_STATS};
+use crate::tasks::sampler::{BlockSender, SAMPLE_CLOCK, SOURCE_STATS};
 use crate::tasks::BLOCK_LEN;
 
 /// DMA ring length in samples: two blocks, so the DMA fills one half while the task reads
@@ -51,11 +53,39 @@ pub fn dma_buffer() -> &'static mut [u16; DMA_BUF_LEN] {
     BUF.take()
 }
 
+/// TIM2 in external clock mode 1 on ITR2 = TIM3's TRGO: a 32-bit count of the conversions
+/// triggered (dropping the timer would stop its clock, so it is kept).
+struct ConversionCounter(Timer<'static, TIM2>);
+
+impl ConversionCounter {
+    fn new(tim2: Peri<'static, TIM2>) -> Self {
+        let t = Timer::new(tim2);
+        let r = t.regs_gp32();
+        r.psc().write_value(0);
+        r.arr().write_value(u32::MAX);
+        t.generate_update_event();
+        t.set_trigger_source(TriggerSource::ITR2);
+        t.set_slave_mode(SlaveMode::EXT_CLOCK_MODE);
+        r.cnt().write_value(0);
+        t.start();
+        Self(t)
+    }
+
+    fn conversions(&self) -> u32 {
+        self.0.regs_gp32().cnt().read()
+    }
+
+    fn zero(&self) {
+        self.0.regs_gp32().cnt().write_value(0);
+    }
+}
+
 /// ADC1 in DMA ring-buffer mode with the TIM3 trigger that paces it (dropping the timer
-/// would stop its clock, so it is kept here).
+/// would stop its clock, so it is kept here) and the counter of its triggers.
 pub struct AdcSampler {
     adc: RingBufferedAdc<'static, ADC1>,
     trigger: Timer<'static, TIM3>,
+    counter: ConversionCounter,
 }
 
 impl AdcSampler {
@@ -65,6 +95,7 @@ impl AdcSampler {
         pin: Peri<'static, PA1>,
         dma: Peri<'static, DMA2_CH0>,
         tim: Peri<'static, TIM3>,
+        count: Peri<'static, TIM2>,
         irqs: Irqs,
         dma_buf: &'static mut [u16; DMA_BUF_LEN],
     ) -> Self {
@@ -74,6 +105,8 @@ impl AdcSampler {
         trigger.set_frequency(Hertz(SAMPLE_RATE_HZ), RoundTo::Slower);
         trigger.generate_update_event();
         trigger.set_master_mode(MasterMode::UPDATE);
+        // After TRGO follows the updates only (the update event above pulsed it).
+        let counter = ConversionCounter::new(count);
 
         let adc = Adc::new(adc).into_ring_buffered(
             dma,
@@ -83,7 +116,11 @@ impl AdcSampler {
             triggers::TIM3_TRGO,
             Exten::RISING_EDGE,
         );
-        Self { adc, trigger }
+        Self {
+            adc,
+            trigger,
+            counter,
+        }
     }
 }
 
@@ -103,9 +140,13 @@ fn clear_adc_overrun() -> bool {
 pub async fn sampler(mut s: AdcSampler, samples: crate::tasks::SampleSender) {
     let mut sender = BlockSender::new(samples);
     let mut half = [0u16; BLOCK_LEN];
+    // Conversions taken out of the ring or counted lost (wrapping, like the counter).
+    let mut delivered = 0u32;
 
+    s.counter.zero();
     s.adc.start();
     s.trigger.start();
+    SAMPLE_CLOCK.start(SAMPLE_RATE_HZ as f32);
     info!(
         "ADC1/PA1 sampling at {} Hz (TIM3 TRGO), blocks of {}",
         s.trigger.get_frequency().0,
@@ -115,23 +156,21 @@ pub async fn sampler(mut s: AdcSampler, samples: crate::tasks::SampleSender) {
     loop {
         match with_timeout(STALL_TIMEOUT, s.adc.read(&mut half)).await {
             Ok(Ok(_)) => {
-                sender.publish(|block| {
+                sender.publish(BLOCK_LEN, |block| {
                     for (sample, &raw) in block.iter_mut().zip(half.iter()) {
                         // 12-bit right-aligned conversions: 0..=4095 always fits.
                         *sample = raw as i16;
                     }
-                    BLOCK_LEN
                 });
+                delivered = delivered.wrapping_add(BLOCK_LEN as u32);
             }
-            // embassy-stm32's `OverrunError` (not exported by name): the DMA lapped the reader.
+            // embassy-stm32's `OverrunError` (not exported by name): the DMA lapped the reader
+            // and the ring has dropped what it held. The DMA keeps running.
             Ok(Err(_overrun)) => {
                 let n = SOURCE_STATS.overrun();
-                warn!(
-                    "ADC DMA ring overrun (#{}): samples lost, ring restarted",
-                    n
-                );
-                s.adc.clear();
-                s.adc.start();
+                let lost = resync(&mut s, &mut delivered);
+                sender.lost(lost);
+                warn!("ADC DMA ring overrun (#{}): {} samples lost", n, lost);
             }
             Err(_timeout) => {
                 if clear_adc_overrun() {
@@ -140,10 +179,23 @@ pub async fn sampler(mut s: AdcSampler, samples: crate::tasks::SampleSender) {
                 } else {
                     let n = SOURCE_STATS.error();
                     warn!("ADC stalled without overrun (error #{}): restarting", n);
+                    s.adc.start();
                 }
-                s.adc.clear();
-                s.adc.start();
+                let lost = resync(&mut s, &mut delivered);
+                sender.lost(lost);
             }
         }
     }
+}
+
+/// Drops what the ring holds and returns how many conversions were not delivered since the
+/// last block (the ring's contents included).
+fn resync(s: &mut AdcSampler, delivered: &mut u32) -> u32 {
+    let now = critical_section::with(|_| {
+        s.adc.clear();
+        s.counter.conversions()
+    });
+    let lost = now.wrapping_sub(*delivered);
+    *delivered = now;
+    lost
 }

@@ -17,11 +17,12 @@
 //! data sheet asks for an SPI clock of at least 2 MHz. A command byte is the register address
 //! with bit 7 set to read and bit 6 set for a multi-byte access. Between the end of one FIFO
 //! read and the next read of FIFO or FIFO_STATUS the data sheet asks for 5 us (the FIFO pops on
-//! chip-select release), which each FIFO read adds as a delay at its end.
+//! chip-select release), which each FIFO read waits after its transaction, chip select high.
 //!
 //! (DEVID_AD / DEVID_MST / PARTID are ADXL372/ADXL355-family registers; the ADXL375 has only
 //! DEVID, 0xE5, at 0x00.)
 
+use embedded_hal_async::delay::DelayNs;
 use embedded_hal_async::spi::{Operation, SpiDevice};
 
 /// Register addresses (ADXL375 data sheet, Table 14).
@@ -168,14 +169,16 @@ pub enum Error<E> {
 }
 
 /// An ADXL375 on an SPI device (which owns the chip select).
-pub struct Adxl375<S> {
+pub struct Adxl375<S, D> {
     spi: S,
+    delay: D,
 }
 
-impl<S: SpiDevice> Adxl375<S> {
-    /// Wraps the SPI device; talks to the chip only from [`Self::init`] on.
-    pub fn new(spi: S) -> Self {
-        Self { spi }
+impl<S: SpiDevice, D: DelayNs> Adxl375<S, D> {
+    /// Wraps the SPI device and a delay (for the FIFO pop gap, with chip select high); talks
+    /// to the chip only from [`Self::init`] on.
+    pub fn new(spi: S, delay: D) -> Self {
+        Self { spi, delay }
     }
 
     /// Gives the SPI device back.
@@ -226,18 +229,19 @@ impl<S: SpiDevice> Adxl375<S> {
         Ok(usize::from(status & FIFO_STATUS_ENTRIES))
     }
 
-    /// Reads one sample: a multi-byte read of DATAX0..DATAZ1, which pops one FIFO entry,
-    /// followed by the FIFO pop delay.
+    /// Reads one sample: a multi-byte read of DATAX0..DATAZ1, which pops one FIFO entry when
+    /// chip select rises, then the FIFO pop delay with chip select high (data sheet: 5 us
+    /// between the end of a FIFO read and the next FIFO or FIFO_STATUS read).
     pub async fn read_sample(&mut self) -> Result<Sample, Error<S::Error>> {
         let mut data = [0u8; 6];
         self.spi
             .transaction(&mut [
                 Operation::Write(&[SPI_READ | SPI_MULTI_BYTE | reg::DATAX0]),
                 Operation::Read(&mut data),
-                Operation::DelayNs(FIFO_POP_DELAY_NS),
             ])
             .await
             .map_err(Error::Spi)?;
+        self.delay.delay_ns(FIFO_POP_DELAY_NS).await;
         Ok(Sample::from_le_bytes(data))
     }
 

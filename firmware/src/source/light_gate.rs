@@ -1,7 +1,9 @@
 //! Light-gate speed: two beams a known distance apart, cut in turn by the body just before it
 //! hits, give the approach speed `v0 = spacing / (t2 - t1)` that an accelerometer cannot.
 //!
-//! Hardware-free (the host tests include this file); the EXTI task is in `stm32.rs`.
+//! Hardware-free (the host tests include this file): the speed, and the pairing of beam cuts
+//! into passages with their direction. The EXTI handlers that time-stamp the cuts and the
+//! task that pairs them are in `gate.rs`.
 
 /// Slowest and fastest approach speeds believed, m/s: outside them the gate was cut by
 /// something else (a hand, a bounce) and the reading is refused.
@@ -34,5 +36,66 @@ pub fn speed_m_s(t1_us: u64, t2_us: u64, spacing_m: f32) -> Result<f32, GateErro
         Ok(v)
     } else {
         Err(GateError::Implausible)
+    }
+}
+
+/// One of the two beams: `First` is the one farther from the barrier.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[cfg_attr(target_os = "none", derive(defmt::Format))]
+pub enum Beam {
+    First,
+    Second,
+}
+
+/// A body through both beams.
+#[derive(Clone, Copy, Debug, PartialEq)]
+#[cfg_attr(target_os = "none", derive(defmt::Format))]
+pub enum Passage {
+    /// First then second beam: moving toward the barrier at this speed, m/s (the approach
+    /// speed of the next impact).
+    Toward(f32),
+    /// Second then first beam: moving away (a rebound) at this speed, m/s.
+    Away(f32),
+}
+
+/// Longest time between the two cuts of one passage, µs: a later cut starts a new passage.
+pub const PAIRING_WINDOW_US: u64 = 1_000_000;
+
+/// Pairs time-stamped beam cuts into passages. A cut of the same beam again replaces the
+/// pending one (the body wobbled in the beam, or a previous passage was incomplete); a cut of
+/// the other beam within [`PAIRING_WINDOW_US`] completes a passage, whose direction is the
+/// order of the beams.
+#[derive(Clone, Copy, Debug, Default)]
+pub struct Pairing {
+    pending: Option<(Beam, u64)>,
+}
+
+impl Pairing {
+    pub const fn new() -> Self {
+        Self { pending: None }
+    }
+
+    /// A cut of `beam` at `t_us`: the passage it completes, if any.
+    pub fn cut(
+        &mut self,
+        beam: Beam,
+        t_us: u64,
+        spacing_m: f32,
+    ) -> Option<Result<Passage, GateError>> {
+        match self.pending {
+            Some((earlier, t0))
+                if earlier != beam && t_us.saturating_sub(t0) <= PAIRING_WINDOW_US =>
+            {
+                self.pending = None;
+                Some(speed_m_s(t0, t_us, spacing_m).map(|v| match earlier {
+                    Beam::First => Passage::Toward(v),
+                    Beam::Second => Passage::Away(v),
+                }))
+            }
+            _ => {
+                self.pending = Some((beam, t_us));
+                None
+            }
+        }
     }
 }

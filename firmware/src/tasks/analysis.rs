@@ -12,8 +12,7 @@ use super::{CaptureReceiver, ANALYSED, CAPTURE_LEN};
 /// starts in `.bss`; on the board it lives in the CCM RAM (`firmware/stm32/board-memory.x`),
 /// which the DMA cannot reach and the analysis does not need it to.
 #[cfg_attr(feature = "stm32", link_section = ".ccmram.workspace")]
-static WORKSPACE: ConstStaticCell<Workspace<CAPTURE_LEN>> =
-    ConstStaticCell::new(Workspace::new());
+static WORKSPACE: ConstStaticCell<Workspace<CAPTURE_LEN>> = ConstStaticCell::new(Workspace::new());
 
 /// Analyses captures until the stream ends (it then waits forever).
 #[embassy_executor::task]

@@ -122,7 +122,7 @@ impl SampleClock {
     pub fn since_sample_s(&self, index: u64) -> Option<f32> {
         let start = self.start_ticks.load().checked_sub(1)?;
         let rate = f32::from_bits(self.rate_bits.load(Ordering::Relaxed));
-        if !(rate > 0.0) {
+        if rate.is_nan() || rate <= 0.0 {
             return None;
         }
         let now = embassy_time::Instant::now().as_ticks();
