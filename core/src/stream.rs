@@ -102,6 +102,8 @@ struct Active {
     clipped: bool,
     /// The sink gave a buffer for this impact.
     captured: bool,
+    /// The pulse was already under way when the last gap ended: its start is unknown.
+    began_in_gap: bool,
     /// The buffer overflowed.
     full: bool,
 }
@@ -134,6 +136,8 @@ pub struct Stream<const PRE: usize> {
     replaying: bool,
     /// The causal trigger filter, if the scene asks for one.
     trigger_filter: Option<crate::signal::cfc::Causal>,
+    /// Stream index of the first sample after the last gap.
+    gap_end: Option<u64>,
 }
 
 impl<const PRE: usize> Stream<PRE> {
@@ -191,6 +195,7 @@ impl<const PRE: usize> Stream<PRE> {
             thresholds: None,
             replaying: false,
             trigger_filter: None,
+            gap_end: None,
         }
     }
 
@@ -232,6 +237,7 @@ impl<const PRE: usize> Stream<PRE> {
         self.max_samples = scene.samples(scene.max_impact_s) as u64;
         self.thresholds = None;
         self.replaying = false;
+        self.gap_end = None;
         // At rest at 0 until the first baseline resets it to the baseline's level.
         self.trigger_filter = scene
             .trigger_cfc
@@ -352,7 +358,8 @@ impl<const PRE: usize> Stream<PRE> {
 
     /// `lost` samples never arrived (the source overran): an impact in progress ends with
     /// [`Status::Gap`], the stream position moves on by `lost`, and the history before the
-    /// gap is forgotten (the baseline is kept).
+    /// gap is forgotten (the baseline is kept). A pulse already under way when the samples
+    /// come back is reported with [`Status::Gap`] too: its start is unknown.
     pub fn gap<const CAP: usize>(&mut self, lost: u64, sink: &mut impl Sink<CAP>) {
         if lost == 0 {
             return;
@@ -361,6 +368,7 @@ impl<const PRE: usize> Stream<PRE> {
             self.end(Status::Gap, sink);
         }
         self.index += lost;
+        self.gap_end = Some(self.index);
         self.counters.samples_lost += lost;
         self.counters.gaps += 1;
         self.ring.clear();
@@ -509,6 +517,8 @@ impl<const PRE: usize> Stream<PRE> {
             clipped: false,
             captured: capture.is_some(),
             full: false,
+            // The walk back reached the gap: the pulse began while samples were lost.
+            began_in_gap: self.gap_end.is_some_and(|g| self.index - pulse as u64 <= g),
         };
         let (clip_lo, clip_hi) = self.scene.clip_counts;
         let mut replay = [0i16; 64];
@@ -611,6 +621,7 @@ impl<const PRE: usize> Stream<PRE> {
         a.clipped = clipped;
         a.samples += used as u64;
         let ended = match ended {
+            Some(()) if a.began_in_gap => Some(Status::Gap),
             Some(()) if a.full => Some(Status::BufferFull),
             Some(()) => Some(Status::Complete),
             None if a.samples >= max_samples => Some(Status::TooLong),

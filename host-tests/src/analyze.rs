@@ -196,6 +196,10 @@ pub struct AnalysisJson {
     pub v0_source: Option<String>,
     /// Free fall measured on the DC channel, s.
     pub free_fall_s: Option<f64>,
+    /// Samples the source lost (only a real-time run on the firmware loses any).
+    pub samples_lost: u64,
+    /// Impacts reported without analysis because no capture buffer was free (likewise).
+    pub analyses_skipped: u64,
     pub impacts: Vec<ImpactJson>,
 }
 
@@ -512,6 +516,11 @@ pub fn to_json(setup: &Setup, reports: &[ImpactReport]) -> AnalysisJson {
         sample_rate_hz: setup.rate_hz,
         v0_source: setup.v0_source.clone(),
         free_fall_s: setup.free_fall_s,
+        samples_lost: 0,
+        analyses_skipped: reports
+            .iter()
+            .filter(|r| r.analysis == impact_core::Analysis::Skipped)
+            .count() as u64,
         impacts: reports
             .iter()
             .map(|r| impact_json(r, setup.prepared.t0))
@@ -576,14 +585,24 @@ nonlinear_k,nonlinear_c_s_m,nonlinear_exponent,nonlinear_residual,hertz_k,hertz_
 /// A readable table.
 pub fn to_table(a: &AnalysisJson) -> String {
     let mut s = format!(
-        "{} samples at {:.6} Hz{}\n",
+        "{} samples at {:.6} Hz{}{}{}\n",
         a.samples,
         a.sample_rate_hz,
         match (&a.v0_source, a.free_fall_s) {
             (Some(src), Some(t)) => format!("; v0 from {src} ({t:.4} s)"),
             (Some(src), None) => format!("; v0 from {src}"),
             _ => String::new(),
-        }
+        },
+        if a.samples_lost > 0 {
+            format!("; {} SAMPLES LOST", a.samples_lost)
+        } else {
+            String::new()
+        },
+        if a.analyses_skipped > 0 {
+            format!("; {} analyses skipped", a.analyses_skipped)
+        } else {
+            String::new()
+        },
     );
     for i in &a.impacts {
         s.push_str(&format!(
@@ -600,6 +619,12 @@ pub fn to_table(a: &AnalysisJson) -> String {
             i.duration_s,
             i.fwhm_s.map_or("unknown".to_string(), |w| format!("{w:.4e} s")),
         ));
+        if let Some(latency) = i.report_latency_s {
+            s.push_str(&format!(
+                "    reported {:.1} ms after the end of its hold\n",
+                latency * 1e3
+            ));
+        }
         if let (Some(v0), Some(tm), Some(xm), Some(v1), Some(cor), Some(xp)) = (
             i.impact_velocity_m_s,
             i.crush_time_s,

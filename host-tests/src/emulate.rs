@@ -32,6 +32,36 @@ pub struct EmulateArgs {
     /// Stop QEMU after this many seconds.
     #[arg(long, default_value_t = 600)]
     pub timeout: u64,
+    /// Real time: QEMU with an instruction-paced clock (`-icount shift=3`, 8 ns of virtual
+    /// time per instruction, standing for the STM32F407 at 168 MHz), the samples written by an
+    /// emulated DMA at the recording's rate whatever the firmware is doing; samples lost,
+    /// analyses skipped and each report's latency are reported. Default: lossless replay.
+    #[arg(long)]
+    pub realtime: bool,
+    /// With --realtime: replay this many times faster than the recording's rate (headroom).
+    #[arg(long, requires = "realtime", default_value_t = 1.0, value_parser = positive_f32)]
+    pub rate_scale: f32,
+}
+
+fn positive_f32(s: &str) -> Result<f32, String> {
+    match s.parse::<f32>() {
+        Ok(v) if v.is_finite() && v > 0.0 => Ok(v),
+        _ => Err(format!("{s}: not a positive number")),
+    }
+}
+
+/// How the emulator replays the samples.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Pacing {
+    /// Every sample reaches the firmware and every impact is analysed, at QEMU's own speed.
+    Lossless,
+    /// An emulated DMA at `rate_scale` times the recording's rate, in instruction-paced
+    /// virtual time. `stall` (tests only): before block `.0` the firmware's sampler
+    /// busy-waits `.1` µs, so the DMA ring overruns as on a board whose sampler is held up.
+    RealTime {
+        rate_scale: f32,
+        stall: Option<(u32, u32)>,
+    },
 }
 
 /// `impact log` options.
@@ -57,6 +87,8 @@ pub struct Log {
     /// The `scene` line's fields, if the log has one.
     pub scene: Option<HashMap<String, String>>,
     pub impacts: Vec<ImpactReport>,
+    /// Each impact's `report_latency_s` (real-time sources only).
+    pub latencies: Vec<Option<f32>>,
     /// The last `heartbeat` line's fields.
     pub heartbeat: Option<HashMap<String, String>>,
     /// The `summary` line's fields (only at the end of a finite stream).
@@ -207,7 +239,9 @@ pub fn parse_log(text: &str) -> Result<Log, String> {
     for (n, line) in text.lines().enumerate() {
         let at = |e: String| format!("line {}: {e}", n + 1);
         if let Some(m) = fields(line, "impact ") {
-            log.impacts.push(parse_impact(&m.map_err(at)?).map_err(at)?);
+            let m = m.map_err(at)?;
+            log.impacts.push(parse_impact(&m).map_err(at)?);
+            log.latencies.push(opt(&m, "report_latency_s").map_err(at)?);
         } else if let Some(m) = fields(line, "heartbeat ") {
             log.heartbeat = Some(m.map_err(at)?);
         } else if let Some(m) = fields(line, "summary ") {
@@ -220,6 +254,11 @@ pub fn parse_log(text: &str) -> Result<Log, String> {
             };
         }
     }
+    // The firmware prints impacts in index order unless an analysis kept the later ones
+    // waiting too long; the reports are in index order whatever the log's.
+    let mut both: Vec<_> = log.impacts.drain(..).zip(log.latencies.drain(..)).collect();
+    both.sort_by_key(|(r, _)| r.index);
+    (log.impacts, log.latencies) = both.into_iter().unzip();
     Ok(log)
 }
 
@@ -246,15 +285,28 @@ pub fn log_json(log: &Log, t0: f64) -> Result<AnalysisJson, String> {
         Some(m) if get(m, "v0_m_s")? != "none" => Some("v0".to_string()),
         _ => None,
     };
+    let counter = |key: &str| -> Result<u64, String> {
+        match state {
+            Some(m) if m.contains_key(key) => num::<u64>(m, key),
+            _ => Ok(0),
+        }
+    };
     Ok(AnalysisJson {
         samples,
         sample_rate_hz: rate as f64,
         v0_source,
         free_fall_s: None,
+        samples_lost: counter("samples_lost")?,
+        analyses_skipped: counter("analyses_skipped")?,
         impacts: log
             .impacts
             .iter()
-            .map(|r| analyze::impact_json(r, t0))
+            .zip(&log.latencies)
+            .map(|(r, latency)| {
+                let mut j = analyze::impact_json(r, t0);
+                j.report_latency_s = latency.map(f64::from);
+                j
+            })
             .collect(),
     })
 }
@@ -407,12 +459,13 @@ pub struct EmulatorRun {
     pub seconds: f64,
 }
 
-/// Replays `counts` on the emulator firmware `elf` with `scene`, losslessly; each decoded
+/// Replays `counts` on the emulator firmware `elf` with `scene` and `pacing`; each decoded
 /// line is passed to `echo` as it arrives.
 pub fn run_emulator(
     elf: &Path,
     counts: &[i16],
     scene: &Scene,
+    pacing: Pacing,
     timeout: Duration,
     echo: impl FnMut(&str) + Send + 'static,
 ) -> Result<EmulatorRun, String> {
@@ -436,7 +489,20 @@ pub fn run_emulator(
     let bytes: Vec<u8> = counts.iter().flat_map(|c| c.to_le_bytes()).collect();
     std::fs::write(&raw.0, bytes).map_err(|e| format!("{raw_s}: {e}"))?;
 
-    let mut config = format!("enable=on,target=native,arg={elf_s},arg={raw_s},arg=lossless");
+    let mut config = format!("enable=on,target=native,arg={elf_s},arg={raw_s}");
+    let mut icount = Vec::new();
+    match pacing {
+        Pacing::Lossless => config.push_str(",arg=lossless"),
+        Pacing::RealTime { rate_scale, stall } => {
+            config.push_str(&format!(",arg=realtime,arg=rate_scale={rate_scale:e}"));
+            if let Some((block, us)) = stall {
+                config.push_str(&format!(",arg=stall={block}:{us}"));
+            }
+            // 8 ns of virtual time per instruction; idle time (wfi) skipped, so runs are
+            // deterministic and fast.
+            icount = vec!["-icount", "shift=3,sleep=off"];
+        }
+    }
     for a in scene_args(scene) {
         check_arg("a scene argument", &a)?;
         config.push_str(",arg=");
@@ -446,6 +512,7 @@ pub fn run_emulator(
     let mut qemu = Command::new("qemu-system-arm")
         .args(["-machine", "mps2-an386", "-cpu", "cortex-m4", "-nographic"])
         .args(["-monitor", "none", "-serial", "null"])
+        .args(&icount)
         .args(["-semihosting-config", &config])
         .arg("-kernel")
         .arg(&elf)
@@ -530,10 +597,19 @@ pub fn emulate(args: &EmulateArgs) -> Result<(), String> {
     };
     // The log goes to stderr when stdout carries JSON or CSV.
     let to_stderr = a.json || a.csv;
+    let pacing = if args.realtime {
+        Pacing::RealTime {
+            rate_scale: args.rate_scale,
+            stall: None,
+        }
+    } else {
+        Pacing::Lossless
+    };
     let run = run_emulator(
         &elf,
         &setup.prepared.counts,
         &setup.scene,
+        pacing,
         Duration::from_secs(args.timeout),
         move |line| {
             if to_stderr {
@@ -555,15 +631,21 @@ pub fn emulate(args: &EmulateArgs) -> Result<(), String> {
         .as_ref()
         .ok_or("the emulator's log has no summary line")?;
     let samples: u64 = num(summary, "samples")?;
-    if samples != setup.prepared.counts.len() as u64 || get(summary, "result")? != "ok" {
+    let lost: u64 = num(summary, "samples_lost")?;
+    if samples + lost != setup.prepared.counts.len() as u64 || get(summary, "result")? != "ok" {
         return Err(format!(
-            "the emulator processed {samples} of {} samples (result={})",
+            "the emulator processed {samples} and lost {lost} of {} samples (result={})",
             setup.prepared.counts.len(),
             get(summary, "result")?
         ));
     }
     eprintln!("emulated in {:.2} s", run.seconds);
-    let json = analyze::to_json(&setup, &log.impacts);
+    let mut json = analyze::to_json(&setup, &log.impacts);
+    json.samples_lost = lost;
+    json.analyses_skipped = num(summary, "analyses_skipped")?;
+    for (j, latency) in json.impacts.iter_mut().zip(&log.latencies) {
+        j.report_latency_s = latency.map(f64::from);
+    }
     let mut out = std::io::stdout().lock();
     let text = if a.json {
         serde_json::to_string_pretty(&json).map_err(|e| e.to_string())? + "\n"

@@ -212,6 +212,12 @@ pub struct SynthArgs {
     /// Recording length, s.
     #[arg(long, default_value_t = 0.1)]
     pub duration: f64,
+    /// The same impact this many times (a train for the real-time emulation), `--every` apart.
+    #[arg(long, default_value_t = 1)]
+    pub repeat: usize,
+    /// Time between the first touches of a `--repeat` train, s.
+    #[arg(long, default_value_t = 0.08)]
+    pub every: f64,
     /// Noise seed.
     #[arg(long, default_value_t = 1)]
     pub seed: u64,
@@ -259,16 +265,20 @@ pub fn synth(args: &SynthArgs) -> Result<(Recording, String), String> {
         drop_every: args.drop_every,
         seed: args.seed,
     };
-    let rec = record(
-        &sensor,
-        args.duration,
-        &[Placed {
-            touch_s: args.touch,
+    if args.repeat == 0 || args.repeat > 100_000 {
+        return Err("--repeat: must lie in 1..=100000".into());
+    }
+    if args.repeat > 1 && !(args.every.is_finite() && args.every > 0.0) {
+        return Err("--every: must be finite and > 0".into());
+    }
+    let contacts: Vec<Placed> = (0..args.repeat)
+        .map(|k| Placed {
+            touch_s: args.touch + k as f64 * args.every,
             law: &model,
             impact,
-        }],
-    )
-    .map_err(|e| e.to_string())?;
+        })
+        .collect();
+    let rec = record(&sensor, args.duration, &contacts).map_err(|e| e.to_string())?;
     let mid = (1u64 << (args.bits - 1)) as f64;
     let g = impact_core::solve::bounce::STANDARD_GRAVITY;
     let mut csv = String::from("time_s,accel_g\n");

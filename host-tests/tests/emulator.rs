@@ -129,3 +129,176 @@ fn seed_001_bench_impact_with_kinematics_and_fits() {
         assert!(i["fits"][fit].is_object(), "{fit} missing: {i}");
     }
 }
+
+/// The streaming fields of a report: the same whether or not the analysis ran.
+const STREAMING_FIELDS: [&str; 12] = [
+    "index",
+    "status",
+    "clipped",
+    "start_sample",
+    "end_sample",
+    "start_s",
+    "peak_time_s",
+    "peak_acceleration_m_s2",
+    "peak_force_n",
+    "delta_v_m_s",
+    "duration_s",
+    "baseline_m_s2",
+];
+
+/// A train of `n` seed-bench impacts `every` seconds apart, as a CSV file.
+fn seed_train(n: usize, every: f64) -> String {
+    let (n_s, every_s) = (n.to_string(), every.to_string());
+    let duration = (0.01 + n as f64 * every).to_string();
+    let args: Vec<&str> = ["synth"]
+        .into_iter()
+        .chain(impact_host::synth::SEED_BENCH_ARGS)
+        .chain([
+            "--repeat",
+            &n_s,
+            "--every",
+            &every_s,
+            "--duration",
+            &duration,
+        ])
+        .collect();
+    let (csv, _) = impact(&args);
+    let file = tmp(&format!("train-{n}-{every}.csv"));
+    std::fs::write(&file, csv).unwrap();
+    file.to_string_lossy().into_owned()
+}
+
+/// `impact emulate --realtime` on a seed-bench train: nothing lost, one report per impact,
+/// every streaming field equal to `impact analyze`'s, the analysed ones equal in full, the
+/// skipped ones marked and counted. Returns the emulator's JSON.
+fn realtime_matches_host(file: &str, extra: &[&str]) -> serde_json::Value {
+    let Some(elf) = firmware() else {
+        return serde_json::Value::Null;
+    };
+    let elf = elf.to_string_lossy().into_owned();
+    let scene = ["--mass", "0.06", "--v0", "1.3357"];
+    let mut args = vec!["analyze", file, "--json"];
+    args.extend(scene);
+    let (host, _) = impact(&args);
+    let host: serde_json::Value = serde_json::from_str(&host).unwrap();
+    let mut args = vec!["emulate", file, "--json", "--realtime", "--elf", &elf];
+    args.extend(scene);
+    args.extend(extra);
+    let t = Instant::now();
+    let (emulated, log) = impact(&args);
+    eprintln!(
+        "{file} {extra:?}: real-time emulation took {:.2} s",
+        t.elapsed().as_secs_f64()
+    );
+    let emulated: serde_json::Value = serde_json::from_str(&emulated).unwrap();
+    let (h, e) = (
+        host["impacts"].as_array().unwrap(),
+        emulated["impacts"].as_array().unwrap(),
+    );
+    assert_eq!(emulated["samples_lost"], 0, "{log}");
+    assert_eq!(e.len(), h.len(), "one report per impact\n{log}");
+    let mut skipped = 0;
+    for (e, h) in e.iter().zip(h) {
+        for field in STREAMING_FIELDS {
+            assert_eq!(e[field], h[field], "impact {}: {field}\n{log}", h["index"]);
+        }
+        assert!(e["report_latency_s"].as_f64().unwrap() > 0.0, "{e}");
+        match e["analysis"].as_str().unwrap() {
+            "full" => {
+                let mut e = e.clone();
+                e.as_object_mut().unwrap().remove("report_latency_s");
+                assert_eq!(&e, h, "a full analysis equals the host's");
+            }
+            "skipped" => {
+                skipped += 1;
+                for field in ["fwhm_s", "crush_time_s", "cor"] {
+                    assert!(e[field].is_null(), "skipped but {field} = {}", e[field]);
+                }
+            }
+            other => panic!("analysis = {other}"),
+        }
+    }
+    assert_eq!(
+        e[0]["analysis"], "full",
+        "the first impact is always analysed"
+    );
+    assert_eq!(emulated["analyses_skipped"], skipped);
+    emulated
+}
+
+#[test]
+fn realtime_five_impacts_80_ms_apart_lose_nothing() {
+    if firmware().is_none() {
+        return;
+    }
+    let file = seed_train(5, 0.08);
+    let json = realtime_matches_host(&file, &[]);
+    assert_eq!(json["impacts"].as_array().unwrap().len(), 5);
+    // Half as much time again between blocks is still enough.
+    realtime_matches_host(&file, &["--rate-scale", "1.5"]);
+}
+
+#[test]
+fn a_forced_dma_overrun_is_a_counted_gap_and_later_positions_stay_right() {
+    let Some(elf) = firmware() else { return };
+    let file = seed_train(3, 0.08);
+    let setup = impact_host::analyze::setup(
+        &impact_host::analyze::AnalyzeArgs {
+            file: file.clone().into(),
+            mass: Some(0.06),
+            v0: Some(1.3357),
+            ..Default::default()
+        },
+        None,
+    )
+    .unwrap();
+    let host = impact_host::analyze::run(&setup.prepared.counts, &setup.scene).unwrap();
+    assert_eq!(host.len(), 3);
+    // The sampler stalls 3 ms at block 30 (15 ms into the stream, inside the first impact):
+    // the emulated DMA laps its two-block ring.
+    let run = impact_host::emulate::run_emulator(
+        &elf,
+        &setup.prepared.counts,
+        &setup.scene,
+        impact_host::emulate::Pacing::RealTime {
+            rate_scale: 1.0,
+            stall: Some((30, 3000)),
+        },
+        std::time::Duration::from_secs(300),
+        |_| {},
+    )
+    .unwrap();
+    let text = run.lines.join("\n");
+    let log = impact_host::emulate::parse_log(&text).unwrap();
+    let summary = log.summary.as_ref().unwrap();
+    let lost: u64 = summary["samples_lost"].parse().unwrap();
+    let samples: u64 = summary["samples"].parse().unwrap();
+    assert!(
+        lost >= 256 && lost % 256 == 0,
+        "whole blocks lost: {lost}\n{text}"
+    );
+    assert_eq!(summary["gaps"], "1");
+    assert_eq!(samples + lost, setup.prepared.counts.len() as u64);
+    let cut: Vec<_> = log
+        .impacts
+        .iter()
+        .filter(|r| r.status == impact_core::Status::Gap)
+        .collect();
+    assert!(!cut.is_empty(), "{text}");
+    assert!(cut.iter().all(|r| r.kinematics.is_none()));
+    assert_eq!(cut[0].start_sample, host[0].start_sample);
+    // After the gap, the impacts are where the host finds them, to the sample.
+    let later: Vec<_> = log
+        .impacts
+        .iter()
+        .filter(|r| r.status != impact_core::Status::Gap)
+        .collect();
+    assert_eq!(later.len(), 2, "{text}");
+    for (r, h) in later.iter().zip(&host[1..]) {
+        assert_eq!(
+            (r.start_sample, r.end_sample),
+            (h.start_sample, h.end_sample)
+        );
+        assert_eq!(r.delta_v_m_s, h.delta_v_m_s);
+    }
+}

@@ -712,3 +712,58 @@ fn a_trigger_set_into_the_noise_reports_but_never_misses_or_panics() {
         "{reports:#?}"
     );
 }
+
+#[test]
+fn a_gap_is_counted_cuts_its_impact_and_keeps_later_positions_right() {
+    // Three bench impacts 80 ms apart; 1000 samples (2 ms) vanish inside the first one.
+    let kc = cases::bench_kc();
+    let law = TwoPhase {
+        kc,
+        kr: 40.0 * kc,
+        c: 2.0,
+        permanent_m: Some(cases::BENCH_X_P),
+    };
+    let placed: Vec<Placed<'_>> = (0..3)
+        .map(|k| Placed {
+            touch_s: 0.01 + 0.08 * k as f64,
+            law: &law,
+            impact: bench_impact(),
+        })
+        .collect();
+    let rec = record(&Sensor::adc12(800.0), 0.25, &placed).unwrap();
+    let sc = scene(&rec, Some(cases::BENCH_V0_M_S));
+    let whole = run(&mut Bench::new(sc).unwrap(), &rec.samples, 256);
+    assert_eq!(whole.len(), 3);
+    assert!(whole.iter().all(|r| r.status == Status::Complete));
+
+    let (cut_at, lost) = (10_000usize, 1000usize);
+    let mut m = Bench::new(sc).unwrap();
+    let mut got = Vec::new();
+    let mut out = |r: &ImpactReport| got.push(*r);
+    for chunk in rec.samples[..cut_at].chunks(256) {
+        m.push_block(chunk, &mut out);
+    }
+    m.gap(lost as u64, &mut out);
+    for chunk in rec.samples[cut_at + lost..].chunks(256) {
+        m.push_block(chunk, &mut out);
+    }
+    m.finish(&mut out);
+    let c = m.counters();
+    assert_eq!((c.samples_lost, c.gaps), (lost as u64, 1));
+    assert_eq!(c.samples + c.samples_lost, rec.samples.len() as u64);
+    // The impact the gap cut, and the rest of its pulse after the gap, are flagged, with no
+    // kinematics; nothing after them is.
+    let cut: Vec<_> = got.iter().filter(|r| r.status == Status::Gap).collect();
+    assert!(!cut.is_empty() && cut.len() <= 2, "{got:#?}");
+    assert!(cut.iter().all(|r| r.kinematics.is_none()));
+    assert_eq!(cut[0].start_sample, whole[0].start_sample);
+    assert!(cut.iter().all(|r| r.end_sample <= whole[0].end_sample));
+    // The later impacts are where they were, sample for sample, and unchanged.
+    let later: Vec<_> = got.iter().filter(|r| r.status != Status::Gap).collect();
+    assert_eq!(later.len(), 2, "{got:#?}");
+    for (r, w) in later.iter().zip(&whole[1..]) {
+        let mut r = **r;
+        r.index = w.index;
+        assert_eq!(r, *w);
+    }
+}

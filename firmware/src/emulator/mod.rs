@@ -29,7 +29,8 @@ use defmt_semihosting as _;
 const COMMAND_LINE_LEN: usize = 2048;
 
 /// What the semihosting command line asks for:
-/// `<program> <samples-file> [realtime|lossless] [rate_scale=X] [key=value ...]` (scene keys:
+/// `<program> <samples-file> [realtime|lossless] [rate_scale=X] [stall=BLOCK:US]
+/// [key=value ...]` (scene keys:
 /// see [`crate::scene::apply`]; unset keys keep the seed bench's values,
 /// [`crate::scene::BENCH`]).
 pub struct Config {
@@ -39,6 +40,9 @@ pub struct Config {
     pub pacing: Pacing,
     /// Real time only: the samples come this many times faster than the scene's rate.
     pub rate_scale: f32,
+    /// Real time only, fault injection for tests: the sampler busy-waits this long (µs) before
+    /// taking this block, so the emulated DMA laps it as it would a stalled board.
+    pub stall: Option<(u32, u32)>,
     /// The scene the stream runs.
     pub scene: Scene,
 }
@@ -63,6 +67,8 @@ enum ConfigError {
     BadPacing,
     /// `rate_scale` is not a positive number.
     BadRateScale,
+    /// `stall` is not `BLOCK:MICROSECONDS`.
+    BadStall,
     Scene {
         key: &'static str,
         error: SceneError,
@@ -87,8 +93,14 @@ fn parse(line: &'static str) -> Result<Config, ConfigError> {
     }
     let mut scene = crate::scene::BENCH;
     let mut rate_scale = 1.0f32;
+    let mut stall = None;
     for arg in line.split(' ') {
         match arg.split_once('=') {
+            Some(("stall", value)) => {
+                let (block, us) = value.split_once(':').ok_or(ConfigError::BadStall)?;
+                let parse = |v: &str| v.parse::<u32>().map_err(|_| ConfigError::BadStall);
+                stall = Some((parse(block)?, parse(us)?));
+            }
             Some(("rate_scale", value)) => {
                 rate_scale = value
                     .parse::<f32>()
@@ -106,6 +118,7 @@ fn parse(line: &'static str) -> Result<Config, ConfigError> {
         samples_path,
         pacing,
         rate_scale,
+        stall,
         scene,
     })
 }
@@ -169,6 +182,7 @@ pub fn spawn_sources(setup: Setup, high: SendSpawner, samples: crate::tasks::Sam
             high.spawn(unwrap!(crate::source::replay::realtime(
                 file,
                 rate * c.rate_scale,
+                c.stall,
                 samples
             )));
         }

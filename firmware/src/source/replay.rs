@@ -12,7 +12,8 @@
 
 use core::sync::atomic::Ordering;
 
-use defmt::{error, info, Format};
+use defmt::{error, info, warn, Format};
+use embassy_time::{Duration, Instant};
 
 use crate::emulator::dma::{self, Take};
 use crate::emulator::host::{HostError, HostFile};
@@ -96,14 +97,33 @@ async fn replay_all(sender: &mut BlockSender, mut file: HostFile) -> Result<(), 
 }
 
 /// Starts the emulated DMA on the file at `rate_hz` (the recording's rate times the rate
-/// scale) and copies its blocks into the sample queue until the file ends.
+/// scale) and copies its blocks into the sample queue until the file ends. `stall` (a test's
+/// fault injection): before block `.0`, busy-wait `.1` µs, as a board whose sampler was held
+/// up would.
 #[embassy_executor::task]
-pub async fn realtime(file: HostFile, rate_hz: f32, samples: SampleSender) {
+pub async fn realtime(
+    file: HostFile,
+    rate_hz: f32,
+    stall: Option<(u32, u32)>,
+    samples: SampleSender,
+) {
     let mut sender = BlockSender::new(samples);
     SAMPLE_CLOCK.start(rate_hz);
     dma::start(file, rate_hz as f64);
     let mut next = 0u32;
+    let mut stall = stall;
     loop {
+        if let Some((block, us)) = stall {
+            if block == next {
+                stall = None;
+                warn!(
+                    "replay: stalling the sampler for {} us (fault injection)",
+                    us
+                );
+                let until = Instant::now() + Duration::from_micros(u64::from(us));
+                while Instant::now() < until {}
+            }
+        }
         match dma::take(next, |block| {
             sender.publish(block.len(), |slot| {
                 impact_core::signal::copy::copy_samples(slot, block);

@@ -119,6 +119,7 @@ pub enum FromStream {
 struct Order {
     next: u32,
     held: Vec<ImpactReport, REORDER_LEN>,
+    printed: u64,
     out_of_order: u32,
 }
 
@@ -127,12 +128,13 @@ impl Order {
         Self {
             next: 0,
             held: Vec::new(),
+            printed: 0,
             out_of_order: 0,
         }
     }
 
     fn accept(&mut self, r: ImpactReport) {
-        if r.index != self.next {
+        if r.index > self.next {
             if self.held.is_full() {
                 self.release_lowest();
             }
@@ -140,6 +142,9 @@ impl Order {
                 self.flush();
                 return;
             }
+        } else if r.index < self.next {
+            // Its successors went out while it was awaited.
+            self.out_of_order = self.out_of_order.saturating_add(1);
         }
         self.print(&r);
         self.flush();
@@ -147,7 +152,10 @@ impl Order {
 
     fn print(&mut self, r: &ImpactReport) {
         log_impact(r);
-        self.next = r.index.wrapping_add(1);
+        self.printed += 1;
+        if r.index >= self.next {
+            self.next = r.index.wrapping_add(1);
+        }
     }
 
     /// Prints the held impacts that are next in line.
@@ -191,8 +199,7 @@ pub async fn reporter() {
     let success = loop {
         if let Some((last, stream_end)) = end {
             // Every impact the stream saw has been printed (or its report was dropped).
-            let printed = u64::from(order.next) + u64::from(last.reports_dropped);
-            if printed >= last.counters.impacts {
+            if order.printed + u64::from(last.reports_dropped) >= last.counters.impacts {
                 order.drain();
                 let elapsed = started.elapsed().as_millis();
                 break summarize(&last, stream_end, order.out_of_order, elapsed);
@@ -208,22 +215,13 @@ pub async fn reporter() {
             Either3::First(r) | Either3::Second(FromStream::Skipped(r)) => order.accept(r),
             Either3::Second(FromStream::Heartbeat(h)) => log_heartbeat(&h),
             Either3::Second(FromStream::End { last, end: e }) => end = Some((last, e)),
-            Either3::Third(()) => match end {
-                // The stream is over and nothing more comes: print what is held.
-                Some((last, _)) if order.held.is_empty() => {
-                    error!(
-                        "{} impacts seen, {} printed: reports were lost",
-                        last.counters.impacts, order.next
-                    );
-                    order.next = u32::MAX;
-                }
-                Some(_) => order.drain(),
-                None => warn!(
-                    "no report for {} ms; source: {}",
-                    SILENCE_WARNING.as_millis(),
-                    SOURCE_STATS.snapshot()
-                ),
-            },
+            // Nothing for a while: what is held goes out (an analysis is taking long).
+            Either3::Third(()) if !order.held.is_empty() => order.drain(),
+            Either3::Third(()) => warn!(
+                "no report for {} ms; source: {}",
+                SILENCE_WARNING.as_millis(),
+                SOURCE_STATS.snapshot()
+            ),
         }
     };
     crate::board::end_of_stream(success);
