@@ -15,8 +15,14 @@
 # setup errors.
 #
 # Options:
-#   --lossless    wait for the monitor instead of pacing at the ADC rate (no lost blocks,
-#                 whatever the emulator's speed); default: real-time pacing, losses counted
+#   --realtime    real time: QEMU with an instruction-paced clock (-icount shift=3,sleep=off:
+#                 8 ns of virtual time per instruction, standing for the STM32F407 at 168 MHz)
+#                 and an emulated DMA writing the samples at the scene's rate whatever the
+#                 firmware does; samples lost, analyses skipped and report latencies are in
+#                 the log. Default: lossless (every sample reaches the firmware and every
+#                 impact is analysed, at QEMU's own speed)
+#   --rate-scale X  with --realtime: replay X times faster than the scene's rate
+#   --lossless    the default (kept for old command lines)
 #   --timeout S   stop QEMU after S seconds (default 120)
 #   --no-build    use the ELF already built
 #   --install     install the tools first: qemu-system-arm (apt-get) and defmt-print (cargo)
@@ -35,7 +41,8 @@ TARGET=thumbv7em-none-eabihf
 TARGET_DIR="${CARGO_TARGET_DIR:-$ROOT/target}"
 ELF="$TARGET_DIR/$TARGET/release/impact-firmware"
 
-pacing=realtime
+pacing=lossless
+rate_scale=1
 timeout_s=120
 build=1
 install=0
@@ -47,6 +54,8 @@ usage() { sed -n '2,/^$/{s/^# \{0,1\}//;p}' "${BASH_SOURCE[0]}"; }
 while [[ $# -gt 0 ]]; do
   case "$1" in
     --lossless) pacing=lossless ;;
+    --realtime) pacing=realtime ;;
+    --rate-scale) rate_scale="${2:?--rate-scale needs a number}"; shift ;;
     --timeout) timeout_s="${2:?--timeout needs seconds}"; shift ;;
     --no-build) build=0 ;;
     --install) install=1 ;;
@@ -109,6 +118,11 @@ for arg in "$ELF" "$samples" "${scene[@]}"; do
   }
 done
 config="enable=on,target=native,arg=$ELF,arg=$samples,arg=$pacing"
+icount=()
+if [[ $pacing == realtime ]]; then
+  config+=",arg=rate_scale=$rate_scale"
+  icount=(-icount shift=3,sleep=off)
+fi
 for kv in "${scene[@]}"; do config+=",arg=$kv"; done
 
 # Semihosting output (the binary defmt stream) goes to QEMU's stdout; QEMU's own messages go
@@ -116,7 +130,7 @@ for kv in "${scene[@]}"; do config+=",arg=$kv"; done
 set +e
 timeout --foreground -k 5 "$timeout_s" \
   qemu-system-arm -machine mps2-an386 -cpu cortex-m4 -nographic -monitor none -serial null \
-    -semihosting-config "$config" \
+    "${icount[@]}" -semihosting-config "$config" \
     -kernel "$ELF" \
   | defmt-print -e "$ELF"
 statuses=("${PIPESTATUS[@]}")

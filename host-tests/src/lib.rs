@@ -8,6 +8,7 @@ pub mod emulate;
 pub mod m4;
 pub mod plot;
 pub mod precision;
+pub mod realtime;
 pub mod recording;
 pub mod simulate;
 pub mod soak;

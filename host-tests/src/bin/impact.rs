@@ -6,7 +6,7 @@ use std::time::Duration;
 
 use clap::{Parser, Subcommand};
 use impact_host::{
-    analyze, emulate, m4, plot, precision, simulate, soak, stability, synth, throughput,
+    analyze, emulate, m4, plot, precision, realtime, simulate, soak, stability, synth, throughput,
 };
 
 #[derive(Parser)]
@@ -76,6 +76,9 @@ enum Bench {
     /// Cost on the Cortex-M4F (QEMU, exact instruction counts): per sample, per impact, per
     /// solve and fit, and the maths back-ends.
     M4(m4::M4Args),
+    /// The firmware in real-time emulation on trains of impacts: report latency, and the
+    /// highest impact rate with nothing lost and every impact analysed, with and without fits.
+    Realtime(realtime::RealtimeArgs),
     /// Host throughput: the pipeline over a long in-memory stream with many impacts (one
     /// core), and `impact analyze` end to end on a large CSV with its peak memory.
     Throughput {
@@ -200,6 +203,19 @@ fn run(cli: Cli) -> Result<(), String> {
                 std::fs::write(&path, bytes).map_err(|e| format!("{}: {e}", path.display()))?;
             }
             print!("{csv}");
+        }
+        Command::Bench {
+            which: Bench::Realtime(args),
+        } => {
+            let results = realtime::run(&args)?;
+            if args.json {
+                println!(
+                    "{}",
+                    serde_json::to_string_pretty(&results).map_err(|e| e.to_string())?
+                );
+            } else {
+                print!("{}", realtime::table(&results));
+            }
         }
         Command::Bench {
             which: Bench::M4(args),

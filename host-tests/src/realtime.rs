@@ -1,0 +1,255 @@
+//! `impact bench realtime`: the firmware in real-time emulation (QEMU `-icount shift=3`, the
+//! emulated DMA) on trains of impacts: how late each report comes, and how many impacts per
+//! second it sustains with nothing lost and every impact fully analysed, with and without
+//! the fits, for the seed bench at 500 kS/s and for AFRL-like short pulses at 1 MS/s.
+
+use std::path::Path;
+use std::time::Duration;
+
+use clap::Args;
+use impact_core::model::{Linear, TwoPhase};
+use impact_core::{Analysis, Approach, Calibration, FitSet, Impact, Scene};
+use serde::Serialize;
+
+use crate::cases;
+use crate::emulate::{self, Pacing};
+use crate::synth::{record, DynLaw, Placed, Sensor};
+
+/// `impact bench realtime` options.
+#[derive(Args, Clone, Debug)]
+pub struct RealtimeArgs {
+    /// Impacts per train.
+    #[arg(long, default_value_t = 10)]
+    pub impacts: usize,
+    /// Print JSON.
+    #[arg(long)]
+    pub json: bool,
+    /// Emulator firmware ELF [default: build it].
+    #[arg(long)]
+    pub elf: Option<std::path::PathBuf>,
+}
+
+/// One bench and pulse shape.
+struct Case {
+    name: &'static str,
+    sensor: Sensor,
+    law: Box<dyn DynLaw>,
+    impact: Impact<f64>,
+    scene: Scene,
+    /// Spacings tried, s, from the widest: the train's nominal spacing first.
+    spacings: &'static [f64],
+}
+
+fn cases() -> Vec<Case> {
+    // The seed bench as the board sees it: 12-bit ADC over ±800 m/s², 500 kS/s, its scene.
+    let seed_sensor = Sensor::adc12(800.0);
+    let kc = cases::bench_kc();
+    let seed = Case {
+        name: "seed bench (two-phase, 26 ms pulses), 500 kS/s",
+        scene: scene(&seed_sensor, 10.0, 2.0, 2e-3, cases::BENCH_V0_M_S),
+        sensor: seed_sensor,
+        law: Box::new(TwoPhase {
+            kc,
+            kr: 40.0 * kc,
+            c: 2.0,
+            permanent_m: Some(cases::BENCH_X_P),
+        }),
+        impact: Impact::new(cases::BENCH_MASS_KG, cases::BENCH_V0_M_S),
+        // Below ~27.3 ms (26 ms of pulse and the 2 ms hold) two impacts are one.
+        spacings: &[0.08, 0.06, 0.05, 0.04, 0.035, 0.03, 0.028],
+    };
+    // AFRL-like: a 150 µs pulse of ~7 kg_n (Δv 7 m/s), 12 bits over ±2e5 m/s², 1 MS/s.
+    let mut afrl_sensor = Sensor::adc12(2e5);
+    afrl_sensor.rate_hz = 1e6;
+    let (m, v0, t_contact) = (0.06, 3.5, 150e-6);
+    let k = m * (std::f64::consts::PI / t_contact).powi(2);
+    let afrl = Case {
+        name: "AFRL-like (150 µs pulses, ~7 kg_n), 1 MS/s",
+        scene: scene(&afrl_sensor, 2000.0, 500.0, 1e-3, v0),
+        sensor: afrl_sensor,
+        law: Box::new(Linear { k }),
+        impact: Impact::new(m, v0),
+        // Below ~1.2 ms (the pulse and the 1 ms hold) two impacts are one.
+        spacings: &[0.01, 0.005, 0.003, 0.002, 0.0015, 0.00125],
+    };
+    vec![seed, afrl]
+}
+
+fn scene(sensor: &Sensor, trigger: f32, edge: f32, hold: f32, v0: f64) -> Scene {
+    let mut s = Scene::new(sensor.calibration(), trigger);
+    s.edge_m_s2 = edge;
+    s.hold_s = hold;
+    s.mass_kg = Some(0.06);
+    s.approach = Approach::Speed { v0_m_s: v0 as f32 };
+    s.clip_counts = (0, 4095);
+    s
+}
+
+/// What one train gave.
+#[derive(Clone, Debug, Serialize)]
+pub struct TrainRun {
+    pub spacing_s: f64,
+    pub impacts: usize,
+    pub reports: usize,
+    pub samples_lost: u64,
+    pub analyses_skipped: u64,
+    pub latency_median_s: Option<f64>,
+    pub latency_max_s: Option<f64>,
+}
+
+/// One case with or without fits.
+#[derive(Clone, Debug, Serialize)]
+pub struct CaseResult {
+    pub case: String,
+    pub rate_hz: f64,
+    pub fits: bool,
+    /// The train at the widest spacing.
+    pub nominal: TrainRun,
+    /// Highest impact rate tried with nothing lost and every impact analysed, per second.
+    pub max_rate_fully_analysed_hz: Option<f64>,
+    /// Highest impact rate tried with nothing lost (analyses may be skipped), per second.
+    pub max_rate_lossless_hz: Option<f64>,
+    pub runs: Vec<TrainRun>,
+}
+
+fn counts(case: &Case, n: usize, spacing: f64) -> Result<(Vec<i16>, Calibration), String> {
+    let placed: Vec<Placed<'_>> = (0..n)
+        .map(|k| Placed {
+            touch_s: 0.01 + spacing * k as f64,
+            law: case.law.as_ref(),
+            impact: case.impact,
+        })
+        .collect();
+    let duration = 0.01 + spacing * n as f64;
+    let rec = record(&case.sensor, duration, &placed).map_err(|e| e.to_string())?;
+    Ok((rec.samples, rec.calibration))
+}
+
+fn median(v: &mut [f64]) -> Option<f64> {
+    v.sort_by(f64::total_cmp);
+    v.get(v.len() / 2).copied()
+}
+
+fn train(
+    elf: &Path,
+    case: &Case,
+    scene: &Scene,
+    n: usize,
+    spacing: f64,
+) -> Result<TrainRun, String> {
+    let (samples, _) = counts(case, n, spacing)?;
+    let run = emulate::run_emulator(
+        elf,
+        &samples,
+        scene,
+        Pacing::RealTime {
+            rate_scale: 1.0,
+            stall: None,
+        },
+        Duration::from_secs(1200),
+        |_| {},
+    )?;
+    let log = emulate::parse_log(&run.lines.join("\n"))?;
+    let summary = log
+        .summary
+        .as_ref()
+        .ok_or("the emulator's log has no summary line")?;
+    let get = |k: &str| -> Result<u64, String> {
+        summary
+            .get(k)
+            .and_then(|v| v.parse().ok())
+            .ok_or(format!("summary: no {k}"))
+    };
+    let mut latencies: Vec<f64> = log.latencies.iter().flatten().map(|&l| l as f64).collect();
+    let max = latencies.iter().copied().reduce(f64::max);
+    Ok(TrainRun {
+        spacing_s: spacing,
+        impacts: n,
+        reports: log.impacts.len(),
+        samples_lost: get("samples_lost")?,
+        analyses_skipped: log
+            .impacts
+            .iter()
+            .filter(|r| r.analysis == Analysis::Skipped)
+            .count() as u64,
+        latency_median_s: median(&mut latencies),
+        latency_max_s: max,
+    })
+}
+
+/// Runs every case with and without fits.
+pub fn run(args: &RealtimeArgs) -> Result<Vec<CaseResult>, String> {
+    emulate::tools_available()?;
+    let elf = match &args.elf {
+        Some(p) => p.clone(),
+        None => emulate::build_firmware()?,
+    };
+    let mut out = Vec::new();
+    for case in cases() {
+        for fits in [true, false] {
+            let mut scene = case.scene;
+            scene.fits = if fits { FitSet::all() } else { FitSet::none() };
+            let mut runs = Vec::new();
+            for &spacing in case.spacings {
+                let r = train(&elf, &case, &scene, args.impacts, spacing)?;
+                if !args.json {
+                    eprintln!(
+                        "{} {} fits, {:.1} ms apart: {} of {} reported, lost {}, skipped {}, latency median {} max {}",
+                        case.name,
+                        if fits { "with" } else { "without" },
+                        spacing * 1e3,
+                        r.reports,
+                        r.impacts,
+                        r.samples_lost,
+                        r.analyses_skipped,
+                        ms(r.latency_median_s),
+                        ms(r.latency_max_s),
+                    );
+                }
+                runs.push(r);
+            }
+            let ok = |r: &&TrainRun| r.samples_lost == 0 && r.reports == r.impacts;
+            let rate = |r: Option<&TrainRun>| r.map(|r| 1.0 / r.spacing_s);
+            out.push(CaseResult {
+                case: case.name.to_string(),
+                rate_hz: case.sensor.rate_hz,
+                fits,
+                nominal: runs[0].clone(),
+                max_rate_fully_analysed_hz: rate(
+                    runs.iter()
+                        .take_while(|r| ok(r) && r.analyses_skipped == 0)
+                        .last(),
+                ),
+                max_rate_lossless_hz: rate(runs.iter().take_while(ok).last()),
+                runs,
+            });
+        }
+    }
+    Ok(out)
+}
+
+fn ms(v: Option<f64>) -> String {
+    v.map_or("-".into(), |v| format!("{:.1} ms", v * 1e3))
+}
+
+/// The results as a table.
+pub fn table(results: &[CaseResult]) -> String {
+    let mut s = String::from(
+        "case | fits | report latency at the widest spacing (median / max) | highest rate tried, every impact analysed | highest rate tried, nothing lost\n",
+    );
+    for r in results {
+        s.push_str(&format!(
+            "{} | {} | {} / {} ({:.0} ms apart) | {} | {}\n",
+            r.case,
+            if r.fits { "yes" } else { "no" },
+            ms(r.nominal.latency_median_s),
+            ms(r.nominal.latency_max_s),
+            r.nominal.spacing_s * 1e3,
+            r.max_rate_fully_analysed_hz
+                .map_or("below the widest spacing".into(), |h| format!("{h:.0} /s")),
+            r.max_rate_lossless_hz
+                .map_or("below the widest spacing".into(), |h| format!("{h:.0} /s")),
+        ));
+    }
+    s
+}
