@@ -1,17 +1,25 @@
-//! The per-impact analysis of a finished capture: acceleration (CFC-filtered if the scene asks),
-//! width at half maximum, and, when the approach speed is known, the kinematics (crush time,
-//! deformations, COR) and the model fits. Runs once per impact, wherever the capture was
-//! handed (inline on the host, in a low-priority task on the firmware).
+//! The per-impact analysis of a finished capture: width at half maximum (on the CFC-filtered
+//! signal if the scene asks for a filter), and, when the approach speed is known, the
+//! kinematics (crush time, deformations, COR) and the model fits. Runs once per impact,
+//! wherever the capture was handed (inline on the host, in a low-priority task on the
+//! firmware), in one integer pass over the capture ([`crate::motion`]) plus the fits over a
+//! few thousand points: no per-sample floating point unless a CFC filter is asked for.
 
-use crate::capture::{Capture, Summary};
+use crate::capture::Capture;
+use crate::motion::{self, PointsOut, Scale};
 use crate::report::{self, Analysis, ImpactReport, Kinematics, Status};
 use crate::scene::Scene;
 use crate::stream::Deviation;
 
-/// Scratch memory of the analysis: the acceleration of every captured sample, m/s².
+/// Points the fits see at most: a contact of 12 600 samples (the seed bench at 500 kS/s) is
+/// thinned to every 6th sample, which moves no fitted value beyond its noise.
+pub const MAX_FIT_POINTS: usize = 2048;
+
+/// Scratch memory of the analysis (f32): the filtered acceleration of a capture when the
+/// scene asks for a CFC, then the fit points (deformation, velocity, force, `ln x`).
 /// `Workspace::new()` is all zeros, so a `static` one starts in `.bss`.
 pub struct Workspace<const CAP: usize> {
-    accel: [f32; CAP],
+    buf: [f32; CAP],
 }
 
 impl<const CAP: usize> Default for Workspace<CAP> {
@@ -21,47 +29,71 @@ impl<const CAP: usize> Default for Workspace<CAP> {
 }
 
 impl<const CAP: usize> Workspace<CAP> {
+    /// Captures longer than [`motion::MAX_SAMPLES`] would overflow the exact sums.
+    const CHECK: () = assert!(
+        CAP <= motion::MAX_SAMPLES,
+        "capture too long for the exact sums"
+    );
+
     pub const fn new() -> Self {
-        Self { accel: [0.0; CAP] }
+        #[allow(clippy::let_unit_value)]
+        let _ = Self::CHECK;
+        Self { buf: [0.0; CAP] }
     }
 }
 
-/// Where `|a|` crosses `level` between samples `i` and `i + 1` (fractional sample index),
-/// if both samples are held.
-fn abs_crossing(a: &[f32], i: usize, level: f32) -> Option<f32> {
-    let (&y0, &y1) = (a.get(i)?, a.get(i + 1)?);
-    let dy = libm::fabsf(y1) - libm::fabsf(y0);
+/// Where `|a|` crosses `level` between samples `i` and `i + 1` (fractional sample index).
+fn crossing(i: usize, y0: f32, y1: f32, level: f32) -> f32 {
+    let dy = y1 - y0;
     let f = if dy == 0.0 {
         0.0
     } else {
-        ((level - libm::fabsf(y0)) / dy).clamp(0.0, 1.0)
+        ((level - y0) / dy).clamp(0.0, 1.0)
     };
-    Some(i as f32 + f)
+    i as f32 + f
 }
 
-/// The first sample of largest |a| (index and value); `(onset, 0)` if every sample is 0.
-fn scan_peak(a: &[f32], onset: usize) -> (usize, f32) {
-    a.iter().enumerate().fold((onset, 0.0f32), |best, (i, &v)| {
+/// Width at half of `|a(peak)|`, samples, for a window of `len` samples with `|a(i)|` given:
+/// from the last sample below half before the peak to the first after it, both interpolated;
+/// `None` if either side lies outside the window.
+fn fwhm(len: usize, abs: impl Fn(usize) -> f32, peak: usize) -> Option<f32> {
+    if peak >= len {
+        return None;
+    }
+    let half = abs(peak) / 2.0;
+    let before = (0..peak).rev().find(|&i| abs(i) < half)?;
+    let left = crossing(before, abs(before), abs(before + 1), half);
+    let after = (peak + 1..len).find(|&i| abs(i) < half)?;
+    let right = crossing(after - 1, abs(after - 1), abs(after), half);
+    Some(right - left)
+}
+
+/// Width at half of `|d(peak)|`, samples, on the raw samples (`d = W x - S`): the samples
+/// below half are found by integers (`2 |d| < |d_peak|`), the two crossings interpolated in
+/// `|a| = |d| per_count`; `None` if either side lies outside the capture.
+fn fwhm_raw(samples: &[i16], dev: Deviation, per_count: f32, peak: usize) -> Option<f32> {
+    // |d| < 2^28: twice it fits in u32.
+    let d_abs = |x: i16| dev.of(x).unsigned_abs();
+    let top = d_abs(*samples.get(peak)?);
+    let below = |x: &i16| 2 * d_abs(*x) < top;
+    let a = |i: usize| samples.get(i).map_or(0.0, |&x| d_abs(x) as f32 * per_count);
+    let half = top as f32 * per_count / 2.0;
+    let before = samples.get(..peak)?.iter().rposition(below)?;
+    let after = peak + 1 + samples.get(peak + 1..)?.iter().position(below)?;
+    let left = crossing(before, a(before), a(before + 1), half);
+    let right = crossing(after - 1, a(after - 1), a(after), half);
+    Some(right - left)
+}
+
+/// The first sample of largest `|a|` (index and value); `(0, 0)` if every sample is 0.
+fn scan_peak(a: &[f32]) -> (usize, f32) {
+    a.iter().enumerate().fold((0, 0.0f32), |best, (i, &v)| {
         if libm::fabsf(v) > libm::fabsf(best.1) {
             (i, v)
         } else {
             best
         }
     })
-}
-
-/// Width at half of `|a[peak]|`: from the last sample below half before the peak to the first
-/// after it, both interpolated; `None` if either side lies outside the window.
-fn fwhm(a: &[f32], peak: usize) -> Option<f32> {
-    let half = libm::fabsf(*a.get(peak)?) / 2.0;
-    let left = (0..peak)
-        .rev()
-        .find(|&i| a.get(i).is_some_and(|v| libm::fabsf(*v) < half))
-        .and_then(|i| abs_crossing(a, i, half))?;
-    let right = (peak..a.len().saturating_sub(1))
-        .find(|&i| a.get(i + 1).is_some_and(|v| libm::fabsf(*v) < half))
-        .and_then(|i| abs_crossing(a, i, half))?;
-    Some(right - left)
 }
 
 /// Analyses a finished capture: the streaming fields of its summary, and the analysis fields.
@@ -73,155 +105,158 @@ pub fn analyse<const CAP: usize>(
     let s = capture.summary();
     let mut r = report::streaming(s, scene);
     r.analysis = Analysis::Full;
-    let cal = &scene.calibration;
-    let fs = cal.sample_rate_hz as f64;
     let samples = capture.samples();
-    let a = work.accel.get_mut(..samples.len()).unwrap_or(&mut []);
+    let n = samples.len();
     let per_count = report::per_count(scene, s.base_n);
     let deviation = Deviation::new(s.base_sum, s.base_n);
-    for (slot, &x) in a.iter_mut().zip(samples) {
-        *slot = deviation.of(x) as f32 * per_count;
-    }
-    let mut filtered = false;
+    let raw = |i: usize| samples.get(i).map_or(0, |&x| deviation.of(x));
+
+    // Peak and width: on the filtered acceleration with a CFC, else on the raw samples (the
+    // stream's peak, if the capture holds it).
+    let mut filtered: Option<(usize, f32)> = None;
     #[cfg(feature = "cfc")]
     if let Some(class) = scene.cfc {
-        if let Some(b) = crate::signal::cfc::Biquad::cfc(class, fs) {
+        let fs = scene.calibration.sample_rate_hz as f64;
+        if let (Some(b), Some(a)) = (
+            crate::signal::cfc::Biquad::cfc(class, fs),
+            work.buf.get_mut(..n),
+        ) {
+            for (slot, i) in a.iter_mut().zip(0..) {
+                *slot = raw(i) as f32 * per_count;
+            }
             b.phaseless_f32(a);
-            filtered = true;
+            filtered = Some(scan_peak(a));
         }
     }
-    let a = &*a;
-    let onset = s.onset_index.saturating_sub(s.first_index) as usize;
-    // The peak of the analysed signal. Unfiltered, the first largest |a| is the first largest
-    // |d| the stream found: a = d · per_count is strictly monotonic in |d| while |d| < 2^22
-    // (neighbouring integers stay more than an f32 ulp apart after the product), so the scan
-    // is skipped.
-    let raw = s
-        .peak_index
-        .checked_sub(s.first_index)
-        .and_then(|i| usize::try_from(i).ok())
-        .and_then(|i| a.get(i).map(|&v| (i, v)));
-    let (peak_i, peak_a) = match raw {
-        Some(found) if !filtered && s.peak_d != 0 && s.peak_d.unsigned_abs() < 1 << 22 => found,
-        _ => scan_peak(a, onset),
+    let (peak_i, peak_a) = match filtered {
+        Some((i, v)) => {
+            let a = work.buf.get(..n).unwrap_or(&[]);
+            r.fwhm_s = fwhm(n, |j| a.get(j).map_or(0.0, |v| libm::fabsf(*v)), i)
+                .map(|w| w / scene.calibration.sample_rate_hz);
+            r.filtered_peak_acceleration_m_s2 = Some(v);
+            (i, v)
+        }
+        None => {
+            let (i, v) = match s.peak_index.checked_sub(s.first_index) {
+                Some(i) if (i as usize) < n => (i as usize, r.peak_acceleration_m_s2),
+                // The peak lies beyond a full capture: the captured part's own.
+                _ => (0..n).fold((0, 0.0f32), |best, i| {
+                    let v = raw(i) as f32 * per_count;
+                    if libm::fabsf(v) > libm::fabsf(best.1) {
+                        (i, v)
+                    } else {
+                        best
+                    }
+                }),
+            };
+            r.fwhm_s = fwhm_raw(samples, deviation, per_count, i)
+                .map(|w| w / scene.calibration.sample_rate_hz);
+            (i, v)
+        }
     };
-    #[cfg(test)]
-    {
-        let scan = scan_peak(a, onset);
-        assert_eq!((peak_i, peak_a.to_bits()), (scan.0, scan.1.to_bits()));
-    }
-    if filtered {
-        r.filtered_peak_acceleration_m_s2 = Some(peak_a);
-    }
-    r.fwhm_s = fwhm(a, peak_i).map(|w| (w as f64 / fs) as f32);
+    let _ = peak_i;
 
-    // Times relative to the capture's first sample.
-    let at = |index: u64, offset: f32| (index as f64 - s.first_index as f64 + offset as f64) as f32;
-    let t_on = at(s.onset_index, s.touch_offset);
-    let t_sep = s.separation_index.map(|i| at(i, s.separation_offset));
-    r.kinematics = match (s.v0_m_s, s.status, t_sep) {
-        (Some(v0), Status::Complete, Some(t_sep)) if s.onset_index >= s.first_index => {
-            kinematics(samples, s, onset, v0, t_on, t_sep, scene)
-        }
-        _ => None,
+    // Kinematics (and the fit points) need the approach speed and the whole impact.
+    let (Some(v0), Status::Complete, Some(sep_index)) = (s.v0_m_s, s.status, s.separation_index)
+    else {
+        return r;
     };
-    #[cfg(feature = "fit")]
-    if let (Some(k), Some(m)) = (r.kinematics, scene.mass_kg) {
-        if scene.fits.any() {
-            let separation = s
-                .separation_index
-                .map_or(a.len(), |i| i.saturating_sub(s.first_index) as usize);
-            r.fits = crate::fit::fit(
-                &crate::fit::Trajectory {
-                    accel: a,
-                    onset,
-                    separation,
-                    v0: k.impact_velocity_m_s,
-                    dt: 1.0 / cal.sample_rate_hz,
-                    mass_kg: m,
-                    x_m: k.max_deformation_m,
-                    x0_m: k.impact_velocity_m_s * (onset as f32 - t_on).max(0.0)
-                        / cal.sample_rate_hz,
-                },
-                &scene.fits,
-            );
-        }
-    }
-    r
-}
-
-/// Velocity and deformation by exact summation of the raw counts from the onset.
-fn kinematics(
-    samples: &[i16],
-    s: &Summary,
-    onset: usize,
-    v0: f32,
-    t_on: f32,
-    t_sep: f32,
-    scene: &Scene,
-) -> Option<Kinematics> {
+    let Some(onset) = s.onset_index.checked_sub(s.first_index).map(|o| o as usize) else {
+        return r;
+    };
     let fs = scene.calibration.sample_rate_hz as f64;
-    let per_d = scene.calibration.gain_m_s2_per_count as f64 / s.base_n.max(1) as f64;
-    let delta_v = (s.total_c as f64 * per_d / fs) as f32;
     let dt = 1.0 / fs;
+    // Fractional positions from the onset sample: first touch (<= 0) and separation.
+    let touch = s.touch_offset as f64;
+    let separation = (sep_index - s.onset_index) as f64 + s.separation_offset as f64;
     let v0d = v0 as f64;
-    let kv = per_d / fs;
-    if !(kv > 0.0 && kv.is_finite() && v0d > 0.0) {
-        return None;
-    }
-    // Between the edge crossing and the onset sample the body still moves at ~v0.
-    let lead = (onset as f64 - t_on as f64).max(0.0);
-    let x_lead = v0d * lead * dt;
-    // After k samples from the onset, with C_k = Σ d (exact), the velocity is
-    // v_k = v0 - kv C_k and the trapezoid deformation x_k = x_lead + dt (k v0 - kv T_k / 2),
-    // with T_k = Σ_{j<k} (C_j + C_{j+1}) also exact: the loop below is integer-only (no
-    // soft-float per sample on the Cortex-M4) and loses nothing to rounding until the end.
-    let velocity = |c: i64| v0d - kv * c as f64;
-    let deformation = |k: usize, t: i128| x_lead + dt * (k as f64 * v0d - kv * t as f64 / 2.0);
-    // Stopped (v <= 0) once C >= v0 / kv.
-    let c_stop = libm::ceil(v0d / kv);
-    let c_stop = if c_stop < i64::MAX as f64 {
-        c_stop as i64
-    } else {
-        i64::MAX
+    let motion_scale = Scale {
+        v0: v0d,
+        kv: scene.calibration.gain_m_s2_per_count as f64 / s.base_n.max(1) as f64 / fs,
+        dt,
+        // Between first touch and the onset sample the body still moves at ~v0.
+        x_lead: v0d * (-touch).max(0.0) * dt,
     };
-    let mut c: i64 = 0;
-    let mut t: i128 = 0;
-    let mut crush: Option<(f64, f64)> = None; // (time index, x_m)
-    let mut at_sep: Option<f64> = None;
-    let sep_floor = libm::floorf(t_sep) as usize;
-    let sep_frac = (t_sep - sep_floor as f32) as f64;
     let from_onset = samples.get(onset..).unwrap_or(&[]);
-    for (k, &raw) in from_onset.iter().enumerate() {
-        let d = raw as i64 * s.base_n - s.base_sum;
-        let c_next = c + d;
-        let t_next = t + (c + c_next) as i128;
-        let i = onset + k;
-        if crush.is_none() && c_next >= c_stop && c < c_stop {
-            let (v, v_next) = (velocity(c), velocity(c_next));
-            let f = v / (v - v_next);
-            crush = Some((i as f64 + f, deformation(k, t) + dt * f * v / 2.0));
+    let contact = from_onset.len();
+
+    // The fit points, if the scene asks for fits: `points` of each of force, velocity,
+    // deformation and ln x in the workspace, one every `every` samples of the contact.
+    let fit_mass = scene
+        .mass_kg
+        .filter(|_| cfg!(feature = "fit") && scene.fits.any());
+    let fit_len = contact.min(libm::ceil(separation) as usize);
+    let every = fit_len.div_ceil(MAX_FIT_POINTS).max(1);
+    let points = match fit_mass {
+        Some(_) => fit_len.div_ceil(every).min(work.buf.len() / 4),
+        None => 0,
+    };
+    let f_peak = libm::fabsf(peak_a) * fit_mass.unwrap_or(0.0);
+    if points > 0 {
+        let f_scale = fit_mass.unwrap_or(0.0) / f_peak;
+        // With a CFC the filtered acceleration fills the workspace: point i reads sample
+        // onset + i every >= i, so compacting it forwards in place overwrites nothing unread.
+        for i in 0..points {
+            let j = i * every;
+            let a = if filtered.is_some() {
+                work.buf.get(onset + j).copied().unwrap_or(0.0)
+            } else {
+                from_onset.get(j).map_or(0, |&x| deviation.of(x)) as f32 * per_count
+            };
+            if let Some(slot) = work.buf.get_mut(i) {
+                *slot = a * f_scale;
+            }
         }
-        if i == sep_floor {
-            let (x, x_next) = (deformation(k, t), deformation(k + 1, t_next));
-            at_sep = Some(x + sep_frac * (x_next - x));
-            break;
-        }
-        c = c_next;
-        t = t_next;
     }
-    let (t_crush, x_m) = crush?;
-    let x_p = at_sep?;
-    let rebound = delta_v - v0;
-    Some(Kinematics {
+    let (force, rest) = work.buf.split_at_mut(points);
+    let (velocity, rest) = rest.split_at_mut(points);
+    let (deformation, ln_x) = rest.split_at_mut(points);
+    let out = (points > 0).then_some(PointsOut {
+        x: &mut *deformation,
+        v: &mut *velocity,
+        every,
+    });
+    let Some(found) = motion::integrate(from_onset, deviation, &motion_scale, separation, out)
+    else {
+        return r;
+    };
+    let rebound = r.delta_v_m_s - v0;
+    let k = Kinematics {
         impact_velocity_m_s: v0,
-        crush_time_s: ((t_crush - t_on as f64) * dt) as f32,
-        max_deformation_m: x_m as f32,
+        crush_time_s: ((found.crush - touch) * dt) as f32,
+        max_deformation_m: found.x_max as f32,
         rebound_velocity_m_s: rebound,
         cor: rebound / v0,
-        permanent_deformation_m: x_p as f32,
+        permanent_deformation_m: found.x_sep as f32,
         absorbed_energy_j: scene
             .mass_kg
             .map(|m| 0.5 * m * (v0 * v0 - rebound * rebound)),
-    })
+    };
+    r.kinematics = Some(k);
+
+    #[cfg(feature = "fit")]
+    if points > 0 {
+        use crate::fit;
+        // The points were integrated in metres: scale them by the maximum deformation.
+        let inv_x = (1.0 / found.x_max) as f32;
+        for x in deformation.iter_mut() {
+            *x *= inv_x;
+        }
+        let p = fit::Points {
+            x: deformation,
+            v: velocity,
+            f: force,
+            x_m: k.max_deformation_m,
+            v0,
+            f_peak,
+        };
+        let set = &scene.fits;
+        let n = (!set.fit_exponent).then_some(set.nonlinear_exponent);
+        r.fits = crate::report::Fits {
+            two_phase: set.two_phase.then(|| fit::two_phase(&p)).flatten(),
+            nonlinear: set.nonlinear.then(|| fit::nonlinear(&p, n, ln_x)).flatten(),
+            hertz: set.hertz.then(|| fit::hertz(&p)).flatten(),
+        };
+    }
+    r
 }

@@ -25,6 +25,7 @@ pub mod capture;
 pub mod fit;
 pub mod model;
 pub mod monitor;
+pub mod motion;
 pub mod real;
 pub mod report;
 pub mod scene;

@@ -35,17 +35,20 @@ const _: () = assert!(BASELINE_SPAN <= 1 << 12);
 /// if lower, so the trigger sample always ends the rising flank).
 const FLANK_EDGES: i64 = 4;
 
-/// `d = W x - S` for one impact's frozen baseline, in i32: exact, since `W <= BASELINE_SPAN`
-/// (the wrapping operations never wrap), and the FPU converts i32 while i64 arithmetic and
-/// conversions are longer or soft-float calls on the Cortex-M4.
-#[derive(Clone, Copy)]
-pub(crate) struct Deviation {
+/// A raw sample with one impact's frozen baseline removed, `d = W x - S` (the baseline is the
+/// rational `S / W` counts), in i32: exact, since `W <= 4096` and `|x| <= 2^15` keep `|S|`
+/// below 2^27 and `|d|` below 2^28 (the wrapping operations never wrap); i32 because the FPU
+/// converts it while i64 arithmetic and conversions are longer or soft-float calls on the
+/// Cortex-M4.
+#[derive(Clone, Copy, Debug)]
+pub struct Deviation {
     w: i32,
     s: i32,
 }
 
 impl Deviation {
-    pub(crate) fn new(base_sum: i64, base_n: i64) -> Self {
+    /// For the baseline `base_sum / base_n` (`base_n <= 4096`, as the stream's baseline).
+    pub fn new(base_sum: i64, base_n: i64) -> Self {
         Self {
             w: base_n as i32,
             s: base_sum as i32,
@@ -53,7 +56,7 @@ impl Deviation {
     }
 
     #[inline]
-    pub(crate) fn of(self, x: i16) -> i32 {
+    pub fn of(self, x: i16) -> i32 {
         (x as i32).wrapping_mul(self.w).wrapping_sub(self.s)
     }
 }
@@ -521,15 +524,9 @@ impl<const PRE: usize> Stream<PRE> {
             began_in_gap: self.gap_end.is_some_and(|g| self.index - pulse as u64 <= g),
         };
         let (clip_lo, clip_hi) = self.scene.clip_counts;
-        let mut replay = [0i16; 64];
-        let mut left = margin;
-        while left > 0 {
-            let n = left.min(replay.len());
-            for (k, slot) in replay.iter_mut().take(n).enumerate() {
-                *slot = self.ring.back(left - 1 - k).unwrap_or(0);
-            }
-            let chunk = replay.get(..n).unwrap_or(&[]);
-            for (k, &x) in chunk.iter().enumerate() {
+        let (older, newer) = self.ring.last(margin);
+        for run in [older, newer] {
+            for (k, &x) in run.iter().enumerate() {
                 let d = deviation.of(x) as i64;
                 a.total_c += d;
                 if d.unsigned_abs() > a.peak_d.unsigned_abs() {
@@ -539,10 +536,9 @@ impl<const PRE: usize> Stream<PRE> {
                 a.clipped |= x <= clip_lo || x >= clip_hi;
             }
             if let Some(c) = capture.as_mut() {
-                a.full |= c.extend(chunk) < chunk.len();
+                a.full |= c.extend(run) < run.len();
             }
-            a.samples += n as u64;
-            left -= n;
+            a.samples += run.len() as u64;
         }
         self.active = Some(a);
     }

@@ -226,6 +226,23 @@ fn realtime_matches_host(file: &str, extra: &[&str]) -> serde_json::Value {
     emulated
 }
 
+/// Every impact of a real-time run fully analysed, each report within `latency_s` of the end
+/// of its hold.
+fn all_analysed_within(json: &serde_json::Value, impacts: usize, latency_s: f64) {
+    let list = json["impacts"].as_array().unwrap();
+    assert_eq!(list.len(), impacts);
+    assert_eq!(json["analyses_skipped"], 0);
+    for i in list {
+        assert_eq!(i["analysis"], "full", "{i}");
+        let latency = i["report_latency_s"].as_f64().unwrap();
+        assert!(
+            latency <= latency_s,
+            "impact {}: reported after {latency} s",
+            i["index"]
+        );
+    }
+}
+
 #[test]
 fn realtime_five_impacts_80_ms_apart_lose_nothing() {
     if firmware().is_none() {
@@ -233,9 +250,20 @@ fn realtime_five_impacts_80_ms_apart_lose_nothing() {
     }
     let file = seed_train(5, 0.08);
     let json = realtime_matches_host(&file, &[]);
-    assert_eq!(json["impacts"].as_array().unwrap().len(), 5);
+    all_analysed_within(&json, 5, 0.05);
     // Half as much time again between blocks is still enough.
-    realtime_matches_host(&file, &["--rate-scale", "1.5"]);
+    let json = realtime_matches_host(&file, &["--rate-scale", "1.5"]);
+    all_analysed_within(&json, 5, 0.05);
+}
+
+#[test]
+fn realtime_twenty_impacts_40_ms_apart_are_all_analysed() {
+    if firmware().is_none() {
+        return;
+    }
+    let file = seed_train(20, 0.04);
+    let json = realtime_matches_host(&file, &[]);
+    all_analysed_within(&json, 20, 0.05);
 }
 
 #[test]

@@ -1,15 +1,21 @@
 //! Per-impact model identification from the measured force–deformation loop.
 //!
-//! Linear least squares in scaled variables (`x / x_m`, `v / v0`, `F / F_peak`), sums in f64:
-//! two-phase Kelvin–Voigt (compression `F = kc x`; restitution `F = kr (x - x_p) + c v`),
-//! nonlinear `F = k x^n (1 + c v)` (linear in `k` and `k c` for a given `n`; `n` by
-//! golden-section search), and Hertz `F = K x^1.5`. Each reports its RMS force residual
-//! relative to the peak force.
+//! The fits take the loop as [`Points`] (deformation, velocity and force at evenly spaced
+//! points of the contact, in scaled units; [`crate::motion`] integrates them once per impact)
+//! and return their own result types; the report assembles them. Linear least squares in the
+//! scaled variables `X = x / x_m`, `V = v / v0`, `F = m a / F_peak`, the products in f32 (the
+//! Cortex-M4's FPU) and their sums to f64 accuracy ([`sums`]): two-phase Kelvin–Voigt
+//! (compression `F = kc x`; restitution `F = kr (x - x_p) + c v`), nonlinear
+//! `F = k x^n (1 + c v)` (linear in `k` and `k c` for a given `n`; `n` by Brent's method on
+//! the residual, with `ln x` taken once per point), and Hertz `F = K x^1.5`. Each reports its
+//! RMS force residual relative to the peak force.
 
 #[cfg(feature = "fit")]
-mod identify;
+mod least_squares;
 #[cfg(feature = "fit")]
-pub use identify::{fit, Trajectory};
+mod sums;
+#[cfg(feature = "fit")]
+pub use least_squares::{hertz, nonlinear, two_phase, Points};
 
 /// Two-phase Kelvin–Voigt parameters identified from one impact.
 #[derive(Clone, Copy, Debug, PartialEq)]

@@ -77,6 +77,21 @@ impl<const N: usize> Ring<N> {
         }
     }
 
+    /// The newest `n` samples (as many as are held), oldest first, as two contiguous runs.
+    pub fn last(&self, n: usize) -> (&[i16], &[i16]) {
+        let n = n.min(self.len);
+        let head = self.head & Self::MASK;
+        if n <= head {
+            (self.buf.get(head - n..head).unwrap_or(&[]), &[])
+        } else {
+            let wrapped = n - head;
+            (
+                self.buf.get(N - wrapped..).unwrap_or(&[]),
+                self.buf.get(..head).unwrap_or(&[]),
+            )
+        }
+    }
+
     /// The samples oldest first.
     pub fn iter_oldest_first(&self) -> impl Iterator<Item = i16> + '_ {
         (0..self.len).rev().filter_map(move |i| self.back(i))
@@ -146,6 +161,20 @@ mod tests {
             assert_eq!(&got[..n], want, "{pushed}");
             assert!(r.iter_oldest_first().eq(want.iter().copied()));
         }
+    }
+
+    #[test]
+    fn the_last_samples_come_in_two_runs() {
+        let mut r = Ring::<4>::new();
+        r.extend(&[1, 2, 3]);
+        assert_eq!(r.last(2), (&[2, 3][..], &[][..]));
+        assert_eq!(r.last(9), (&[1, 2, 3][..], &[][..]));
+        r.extend(&[4, 5, 6]);
+        let (a, b) = r.last(4);
+        assert_eq!([a, b].concat(), [3, 4, 5, 6]);
+        let (a, b) = r.last(3);
+        assert_eq!([a, b].concat(), [4, 5, 6]);
+        assert_eq!(r.last(0), (&[][..], &[][..]));
     }
 
     #[test]

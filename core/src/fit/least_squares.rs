@@ -1,0 +1,248 @@
+//! The three fits over the points of one impact.
+
+use super::sums::Sums;
+use super::{HertzFit, NonlinearFit, TwoPhaseFit};
+use crate::real::Real;
+
+/// `x^1.5` with the FPU's square root on the Cortex-M4 (`Real::sqrt`).
+fn pow15(x: f32) -> f32 {
+    x * <f32 as Real>::sqrt(x)
+}
+use crate::solve::roots::brent_min;
+
+/// Bracket of the nonlinear exponent search.
+const EXPONENT_RANGE: (f64, f64) = (1.0, 2.5);
+/// Resolution of the exponent search: far below what the data can tell (the pipeline tests
+/// recover n to 0.5 %).
+const EXPONENT_TOL: f64 = 5e-4;
+/// Most residual evaluations the exponent search may take (it needs about ten).
+const EXPONENT_EVALS: u32 = 30;
+
+/// The measured force–deformation loop at evenly spaced points of the contact, scaled:
+/// `x[i] = x / x_m`, `v[i] = v / v0`, `f[i] = m a / f_peak`; the same length each.
+pub struct Points<'a> {
+    pub x: &'a [f32],
+    pub v: &'a [f32],
+    pub f: &'a [f32],
+    /// Maximum deformation, m.
+    pub x_m: f32,
+    /// Approach speed, m/s.
+    pub v0: f32,
+    /// Peak force, N.
+    pub f_peak: f32,
+}
+
+impl Points<'_> {
+    fn len(&self) -> usize {
+        self.x.len().min(self.v.len()).min(self.f.len())
+    }
+
+    /// `(x, v, f)` of each point.
+    fn iter(&self) -> impl Iterator<Item = (f32, f32, f32)> + '_ {
+        let n = self.len();
+        self.x[..n]
+            .iter()
+            .zip(&self.v[..n])
+            .zip(&self.f[..n])
+            .map(|((&x, &v), &f)| (x, v, f))
+    }
+
+    /// Enough points and positive scales to fit anything.
+    fn usable(&self) -> bool {
+        self.len() > 4 && self.x_m > 0.0 && self.v0 > 0.0 && self.f_peak > 0.0
+    }
+}
+
+/// Solves the 3×3 system `A θ = b` by Gaussian elimination with partial pivoting.
+#[allow(clippy::needless_range_loop)]
+fn solve3(mut a: [[f64; 3]; 3], mut b: [f64; 3]) -> Option<[f64; 3]> {
+    for col in 0..3 {
+        let pivot =
+            (col..3).max_by(|&i, &j| libm::fabs(a[i][col]).total_cmp(&libm::fabs(a[j][col])))?;
+        if !(libm::fabs(a[pivot][col]) > 1e-300) {
+            return None;
+        }
+        a.swap(col, pivot);
+        b.swap(col, pivot);
+        for row in col + 1..3 {
+            let f = a[row][col] / a[col][col];
+            for k in col..3 {
+                a[row][k] -= f * a[col][k];
+            }
+            b[row] -= f * b[col];
+        }
+    }
+    let mut x = [0.0; 3];
+    for row in (0..3).rev() {
+        let mut s = b[row];
+        for k in row + 1..3 {
+            s -= a[row][k] * x[k];
+        }
+        x[row] = s / a[row][row];
+    }
+    x.iter().all(|v| v.is_finite()).then_some(x)
+}
+
+/// RMS of the residuals `f - model(x, v)` over the points, relative to the peak force.
+fn residual(p: &Points<'_>, mut model: impl FnMut(f32, f32) -> f32) -> f32 {
+    let mut s = Sums::<1>::new();
+    for (x, v, f) in p.iter() {
+        let r = f - model(x, v);
+        s.add([r * r]);
+    }
+    let [rss] = s.get();
+    libm::sqrt(rss / p.len().max(1) as f64) as f32
+}
+
+/// Two-phase Kelvin–Voigt: compression (up to the first point moving back out) `F = kc x`;
+/// restitution `F = kr (x - x_p) + c v`, fitted as `kr (X - 1) + b + c V` (columns centred
+/// at the maximum deformation, where `X` and 1 would be nearly collinear).
+pub fn two_phase(p: &Points<'_>) -> Option<TwoPhaseFit> {
+    if !p.usable() {
+        return None;
+    }
+    let mut compression = Sums::<2>::new();
+    let mut restitution = Sums::<9>::new();
+    let mut restoring = false;
+    for (x, v, f) in p.iter() {
+        restoring |= v <= 0.0;
+        if restoring {
+            let u = x - 1.0;
+            restitution.add([u * u, u, u * v, 1.0, v, v * v, u * f, f, v * f]);
+        } else {
+            compression.add([f * x, x * x]);
+        }
+    }
+    let [sfx, sxx] = compression.get();
+    let [uu, u, uv, n, sv, vv, uf, sf, vf] = restitution.get();
+    let kc = sfx / sxx;
+    let [kr, b, c] = solve3([[uu, u, uv], [u, n, sv], [uv, sv, vv]], [uf, sf, vf])?;
+    if !(kc.is_finite() && kr > 0.0) {
+        return None;
+    }
+    // F = kr X - (kr - b) + c V: kr x_p (scaled) = kr - b.
+    let krxp = kr - b;
+    let (kc32, kr32, krxp32, c32) = (kc as f32, kr as f32, krxp as f32, c as f32);
+    let mut restoring = false;
+    let rms = residual(p, |x, v| {
+        restoring |= v <= 0.0;
+        if restoring {
+            kr32 * x - krxp32 + c32 * v
+        } else {
+            kc32 * x
+        }
+    });
+    let (xs, vs, fs) = (p.x_m as f64, p.v0 as f64, p.f_peak as f64);
+    Some(TwoPhaseFit {
+        kc_n_m: (kc * fs / xs) as f32,
+        kr_n_m: (kr * fs / xs) as f32,
+        c_n_s_m: (c * fs / vs) as f32,
+        permanent_m: (krxp / kr * xs) as f32,
+        residual: rms,
+    })
+}
+
+/// `F = k X^n + q X^n V` at one exponent: `(k, q, rss)` in scaled units, from the normal
+/// equations (`rss = Σ F² - k Σ X^n F - q Σ X^n V F`), `X^n` given per point.
+fn nonlinear_at(p: &Points<'_>, xn: impl Fn(usize, f32) -> f32) -> Option<(f64, f64, f64)> {
+    let mut s = Sums::<6>::new();
+    for (i, (x, v, f)) in p.iter().enumerate() {
+        let a = xn(i, x);
+        let av = a * v;
+        s.add([a * a, a * av, av * av, a * f, av * f, f * f]);
+    }
+    let [a11, a12, a22, b1, b2, ff] = s.get();
+    let det = a11 * a22 - a12 * a12;
+    if !(det > 1e-300) {
+        return None;
+    }
+    let k = (b1 * a22 - b2 * a12) / det;
+    let q = (a11 * b2 - a12 * b1) / det;
+    Some((k, q, (ff - k * b1 - q * b2).max(0.0)))
+}
+
+/// Nonlinear `F = k x^n (1 + c v)`, the exponent fixed at `n`, or searched in [1, 2.5] when
+/// `n` is `None` (`ln_x`, at least as long as the points, is scratch for `ln X`).
+pub fn nonlinear(p: &Points<'_>, n: Option<f32>, ln_x: &mut [f32]) -> Option<NonlinearFit> {
+    if !p.usable() {
+        return None;
+    }
+    fn power(n: f32, ln: &[f32]) -> impl Fn(usize, f32) -> f32 + '_ {
+        move |i: usize, x: f32| -> f32 {
+            if n == 1.0 {
+                x
+            } else if n == 1.5 {
+                pow15(x)
+            } else {
+                // x^n = exp(n ln x); ln 0 = -inf gives 0.
+                ln.get(i).map_or(0.0, |&l| libm::expf(n * l))
+            }
+        }
+    }
+    // ln x once per point, for the exponents x^n is taken as exp(n ln x).
+    let needs_ln = n.is_none_or(|n| n != 1.0 && n != 1.5);
+    if needs_ln {
+        if ln_x.len() < p.len() {
+            return None;
+        }
+        for (l, &x) in ln_x.iter_mut().zip(p.x) {
+            *l = libm::logf(x);
+        }
+    }
+    let ln = &ln_x[..ln_x.len().min(p.len())];
+    let n = match n {
+        Some(n) => n,
+        None => {
+            let (n, _, _) = brent_min(
+                |n| nonlinear_at(p, power(n as f32, ln)).map_or(f64::INFINITY, |(_, _, rss)| rss),
+                EXPONENT_RANGE.0,
+                EXPONENT_RANGE.1,
+                EXPONENT_TOL,
+                EXPONENT_EVALS,
+            );
+            n as f32
+        }
+    };
+    let (k, q, _) = nonlinear_at(p, power(n, ln))?;
+    if !(k > 0.0) {
+        return None;
+    }
+    let (k32, q32) = (k as f32, q as f32);
+    let xn = power(n, ln);
+    let mut i = 0;
+    let rms = residual(p, |x, v| {
+        let a = xn(i, x);
+        i += 1;
+        a * (k32 + q32 * v)
+    });
+    let (xs, vs, fs) = (p.x_m as f64, p.v0 as f64, p.f_peak as f64);
+    Some(NonlinearFit {
+        k: (k * fs / libm::pow(xs, n as f64)) as f32,
+        c_s_m: (q / (k * vs)) as f32,
+        n,
+        residual: rms,
+    })
+}
+
+/// Hertz `F = K x^1.5`.
+pub fn hertz(p: &Points<'_>) -> Option<HertzFit> {
+    if !p.usable() {
+        return None;
+    }
+    let mut s = Sums::<2>::new();
+    for (x, _, f) in p.iter() {
+        let x15 = pow15(x);
+        s.add([f * x15, x15 * x15]);
+    }
+    let [sfx, sxx] = s.get();
+    let k = sfx / sxx;
+    if !(k > 0.0 && k.is_finite()) {
+        return None;
+    }
+    let k32 = k as f32;
+    let rms = residual(p, |x, _| k32 * pow15(x));
+    Some(HertzFit {
+        k: (k * p.f_peak as f64 / libm::pow(p.x_m as f64, 1.5)) as f32,
+        residual: rms,
+    })
+}
