@@ -4,8 +4,19 @@
 #   - qemu-system-arm (Debian package) for the emulated firmware;
 #   - defmt-print (crates.io) to decode the firmware's defmt log;
 #   - arm-none-eabi-size (Debian binutils-arm-none-eabi) to print flash and RAM use.
+# With --board, also probe-rs (crates.io `probe-rs-tools`, a few minutes to build) to flash
+# the STM32F4-Discovery and read its defmt log (`cargo fw-run`).
 # Run as root or with sudo available for apt-get.
 set -euo pipefail
+
+board=0
+for arg in "$@"; do
+  case "$arg" in
+    --board) board=1 ;;
+    -h|--help) sed -n '2,/^set -e/{s/^# \{0,1\}//;/^set -e/d;p}' "${BASH_SOURCE[0]}"; exit 0 ;;
+    *) echo "setup.sh: unknown option $arg" >&2; exit 2 ;;
+  esac
+done
 
 need_apt=()
 command -v qemu-system-arm >/dev/null || need_apt+=(qemu-system-arm)
@@ -21,3 +32,12 @@ rustup component list --installed | grep -q '^rustfmt' || rustup component add r
 rustup component list --installed | grep -q '^clippy' || rustup component add clippy
 
 command -v defmt-print >/dev/null || cargo install defmt-print --locked --quiet
+
+if [[ $board == 1 ]]; then
+  # probe-rs needs libudev to find USB probes.
+  if ! dpkg -s libudev-dev >/dev/null 2>&1; then
+    sudo=""; [[ $(id -u) == 0 ]] || sudo="sudo"
+    DEBIAN_FRONTEND=noninteractive $sudo apt-get install -y -qq libudev-dev pkg-config >/dev/null
+  fi
+  command -v probe-rs >/dev/null || cargo install probe-rs-tools --locked --quiet
+fi

@@ -3,11 +3,13 @@
 //! The panic handler calls `__pipeline_can_panic`, which is defined nowhere: if the release
 //! build for `thumbv7em-none-eabihf` keeps any path to a panic (an index out of bounds, an
 //! overflow check, an `unwrap`, a division by zero, …) the link fails with an undefined
-//! symbol. The entry runs [`Monitor::configure`], [`Monitor::push_block`],
-//! [`Monitor::finish`] and [`impact_core::solve`] (every model, exact and adaptive, f32) on
+//! symbol. The entry runs [`Monitor::configure`], [`Monitor::push_block`], [`Monitor::gap`],
+//! [`Monitor::finish`], [`Monitor::set_approach_speed`] (the streaming stage and the
+//! per-impact analysis with every fit) and [`impact_core::solve`] (every model, exact and
+//! adaptive, f32) on
 //! values the optimizer cannot know: the scene, the models and the impacts go through
 //! `black_box`, the samples and the block lengths are volatile reads of ADC1's data
-//! register. The monitor is the board's `Monitor<4096, 16384>`, with CFC and fits compiled in.
+//! register. The monitor is the board's `Monitor<4096, 15360>`, with CFC and fits compiled in.
 //!
 //! Build: `cargo build --release -p impact-firmware --target thumbv7em-none-eabihf
 //! --no-default-features --features panic-check --bin panic-check`. Nothing runs it.
@@ -43,8 +45,8 @@ fn panic(_: &core::panic::PanicInfo) -> ! {
     unsafe { __pipeline_can_panic() }
 }
 
-/// The board's monitor: 4096-sample pre-trigger ring, 16384-sample capture.
-static MONITOR: ConstStaticCell<Monitor<4096, 16384>> =
+/// The board's monitor: 4096-sample pre-trigger ring, 15360-sample capture (the board's CAPTURE_LEN).
+static MONITOR: ConstStaticCell<Monitor<4096, 15360>> =
     ConstStaticCell::new(Monitor::unconfigured());
 
 /// STM32F407 ADC1 data register: a source of values the compiler cannot know.
@@ -108,11 +110,15 @@ fn main() -> ! {
     };
     let mut block = [0i16; 256];
     loop {
-        match unknown() & 3 {
+        match unknown() & 7 {
             0 => {
                 let _ = black_box(monitor.configure(scene()));
             }
             1 => monitor.finish(&mut out),
+            // A loss of any size, anywhere (the firmware's gap events).
+            3 => monitor.gap(u64::from(unknown()), &mut out),
+            // A light gate's reading, any value.
+            4 => monitor.set_approach_speed(Some(f32::from_bits(unknown()))),
             2 => {
                 let impact = black_box(Impact::new(0.06f32, 1.3357));
                 for model in models() {

@@ -7,7 +7,7 @@
 
 #![no_main]
 
-use impact_core::monitor::Counters;
+use impact_core::Counters;
 use impact_core::signal::cfc::Cfc;
 use impact_core::{Approach, Calibration, FitSet, ImpactReport, Monitor, Scene, Status};
 use libfuzzer_sys::fuzz_target;
@@ -109,7 +109,8 @@ fn finite(r: &ImpactReport) -> bool {
         && r.peak_acceleration_m_s2.is_finite()
         && r.delta_v_m_s.is_finite()
         && r.duration_s.is_finite()
-        && r.fwhm_s.is_finite()
+        && r.fwhm_s.is_none_or(f32::is_finite)
+        && r.filtered_peak_acceleration_m_s2.is_none_or(f32::is_finite)
         && r.baseline_m_s2.is_finite()
         && r.peak_force_n.is_none_or(f32::is_finite);
     if let Some(k) = &r.kinematics {
