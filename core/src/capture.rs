@@ -42,6 +42,9 @@ pub struct Summary {
     pub peak_index: u64,
     /// `Σ d` over the whole impact (also beyond a full capture), in `W · counts`.
     pub total_c: i64,
+    /// `Σ d` over the contact, from the onset to the separation (exclusive), if the signal
+    /// came back.
+    pub contact_c: Option<i64>,
     /// The approach speed in force when the impact ended, m/s.
     pub v0_m_s: Option<f32>,
 }
@@ -63,6 +66,7 @@ impl Summary {
         peak_d: 0,
         peak_index: 0,
         total_c: 0,
+        contact_c: None,
         v0_m_s: None,
     };
 }

@@ -189,3 +189,54 @@ mod peak_tests {
         }
     }
 }
+
+#[cfg(test)]
+mod next_hit_tests {
+    extern crate std;
+    use crate::{Calibration, ImpactReport, Monitor, Scene};
+
+    /// Two pulses 0.6 ms apart with noise that flickers at the edge level on their flanks:
+    /// the signal came back for longer than an eighth of the hold, so they are two impacts,
+    /// the second starting where the first's window ends.
+    #[test]
+    fn a_second_hit_after_a_return_to_the_baseline_is_its_own_impact() {
+        let mut s = Scene::new(
+            Calibration {
+                gain_m_s2_per_count: 0.390625,
+                sample_rate_hz: 500_000.0,
+            },
+            10.0,
+        );
+        s.edge_m_s2 = 1.0;
+        s.hold_s = 2e-3;
+        let mut m = Monitor::<4096, 32768>::new(s).unwrap();
+        let mut v = std::vec::Vec::new();
+        v.extend(core::iter::repeat_n(100i16, 5000));
+        for k in 0..2000 {
+            v.push(100 + (50.0 * libm::sinf(core::f32::consts::PI * k as f32 / 2000.0)) as i16);
+        }
+        v.extend(core::iter::repeat_n(100i16, 300));
+        for k in 0..2000 {
+            v.push(100 + (50.0 * libm::sinf(core::f32::consts::PI * k as f32 / 2000.0)) as i16);
+        }
+        v.extend(core::iter::repeat_n(100i16, 5000));
+        let mut state = 1u32;
+        for x in v.iter_mut() {
+            state ^= state << 13;
+            state ^= state >> 17;
+            state ^= state << 5;
+            *x += (state % 3) as i16 - 1;
+        }
+        let mut out = std::vec::Vec::new();
+        for b in v.chunks(256) {
+            m.push_block(b, &mut |r: &ImpactReport| out.push(*r));
+        }
+        m.finish(&mut |r: &ImpactReport| out.push(*r));
+        assert_eq!(out.len(), 2, "{out:#?}");
+        assert_eq!(out[0].end_sample, out[1].start_sample);
+        // The second pulse leaves the edge band ~32 samples after it starts at 7300.
+        assert!((out[1].start_sample as i64 - 7332).abs() < 20, "{out:#?}");
+        let dv = (out[0].delta_v_m_s, out[1].delta_v_m_s);
+        assert!((dv.0 / dv.1 - 1.0).abs() < 0.01, "{dv:?}");
+    }
+}

@@ -22,10 +22,15 @@ pub enum Status {
     /// Samples were lost inside the impact (the sample source overran): Δv and the peak cover
     /// only what arrived, and nothing that needs the whole impact is reported.
     Gap,
+    /// After the pulse the signal settled at a new level instead of coming back (the body came
+    /// to rest on a DC sensor, or the sensor's offset moved): no kinematics; the baseline is
+    /// learned again.
+    Settled,
 }
 
 impl Status {
-    /// The name the reports use (`complete`, `stream-ended`, `buffer-full`, `too-long`, `gap`).
+    /// The name the reports use (`complete`, `stream-ended`, `buffer-full`, `too-long`, `gap`,
+    /// `settled`).
     pub fn name(self) -> &'static str {
         match self {
             Status::Complete => "complete",
@@ -33,6 +38,7 @@ impl Status {
             Status::BufferFull => "buffer-full",
             Status::TooLong => "too-long",
             Status::Gap => "gap",
+            Status::Settled => "settled",
         }
     }
 }
@@ -104,7 +110,8 @@ pub struct ImpactReport {
     pub peak_acceleration_m_s2: f32,
     /// `m a` at the peak, N (when the mass is known).
     pub peak_force_n: Option<f32>,
-    /// Velocity change over the impact, m/s (`v0 + v'` for a rebound).
+    /// Velocity change over the contact, from first touch to separation, m/s (`v0 + v'` for a
+    /// rebound); over the whole window if the signal never came back.
     pub delta_v_m_s: f32,
     /// From first touch to separation (both flank-extrapolated), or to the end of the capture
     /// if the signal never came back, s.
@@ -150,7 +157,7 @@ pub fn streaming(s: &Summary, scene: &Scene) -> ImpactReport {
         peak_time_s: s.peak_index as f64 / fs,
         peak_acceleration_m_s2: peak,
         peak_force_n: scene.mass_kg.map(|m| m * peak),
-        delta_v_m_s: (s.total_c as f64 * per_d / fs) as f32,
+        delta_v_m_s: (s.contact_c.unwrap_or(s.total_c) as f64 * per_d / fs) as f32,
         duration_s: ((end - start) / fs) as f32,
         baseline_m_s2: (s.base_sum as f64 * per_d) as f32,
         fwhm_s: None,

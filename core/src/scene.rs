@@ -88,6 +88,10 @@ pub struct Scene {
     pub hold_s: f32,
     /// An impact still going after this long is reported as too long, s (a stuck sensor).
     pub max_impact_s: f32,
+    /// A signal that stays flat at a new level (beyond the edge level from the baseline) for
+    /// this long has settled there, s: a DC sensor's free fall or rest, not an impact; the
+    /// baseline is learned again. Longer than any pulse's flat top, at least the hold.
+    pub settle_s: f32,
     /// Raw values at or beyond which the sensor is clipped (`(low, high)` rails).
     pub clip_counts: (i16, i16),
     /// Phaseless SAE J211 filter for the captured window's acceleration.
@@ -100,7 +104,8 @@ pub struct Scene {
 
 impl Scene {
     /// A scene with the usual defaults: trigger at `trigger_m_s2`, edges at a quarter of it,
-    /// 1 ms hold, 1 s maximum impact, full i16 rails, no filter, no fits.
+    /// 1 ms hold, 50 ms to settle at a new level, 1 s maximum impact, full i16 rails, no
+    /// filter, no fits.
     pub fn new(calibration: Calibration, trigger_m_s2: f32) -> Self {
         Self {
             calibration,
@@ -110,6 +115,7 @@ impl Scene {
             edge_m_s2: trigger_m_s2 / 4.0,
             hold_s: 1e-3,
             max_impact_s: 1.0,
+            settle_s: 0.05,
             clip_counts: (i16::MIN, i16::MAX),
             cfc: None,
             trigger_cfc: None,
@@ -152,6 +158,13 @@ impl Scene {
         positive(self.hold_s, "hold")?;
         positive(self.max_impact_s, "max-impact")?;
         non_negative(self.max_impact_s - self.hold_s, "max-impact")?;
+        positive(self.settle_s, "settle")?;
+        if self.settle_s < self.hold_s {
+            return Err(Error::InvalidParameter {
+                name: "settle",
+                reason: "must be at least the hold time",
+            });
+        }
         if self.clip_counts.0 >= self.clip_counts.1 {
             return Err(Error::InvalidParameter {
                 name: "clip",

@@ -41,6 +41,7 @@ pub const BENCH: Scene = Scene {
     edge_m_s2: 2.0,
     hold_s: 2e-3,
     max_impact_s: 1.0,
+    settle_s: 0.05,
     clip_counts: CLIP_COUNTS,
     cfc: None,
     trigger_cfc: None,
@@ -85,7 +86,7 @@ impl Format for SceneError {
 /// | `v0` | approach speed, m/s, or `none` (unknown) |
 /// | `drop_height` | drop height, m (`v0 = sqrt(2 g h)`) |
 /// | `trigger`, `edge` | levels, m/s² |
-/// | `hold`, `max_impact` | s |
+/// | `hold`, `max_impact`, `settle` | s |
 /// | `clip` | `LOW:HIGH` rails in counts (i16) |
 /// | `cfc`, `trigger_cfc` | 60, 180, 600, 1000 or `none` |
 /// | `two_phase`, `nonlinear`, `fit_exponent`, `hertz` | `0` or `1` |
@@ -140,6 +141,7 @@ pub fn apply(scene: &mut Scene, key: &str, value: &str) -> Result<(), SceneError
         "edge" => scene.edge_m_s2 = float(value)?,
         "hold" => scene.hold_s = float(value)?,
         "max_impact" => scene.max_impact_s = float(value)?,
+        "settle" => scene.settle_s = float(value)?,
         "clip" => {
             let (lo, hi) = value.split_once(':').ok_or(SceneError::BadValue)?;
             let lo = lo.parse::<i16>().map_err(|_| SceneError::BadValue)?;
@@ -188,7 +190,7 @@ pub fn log(scene: &Scene) {
     };
     let fits = &scene.fits;
     info!(
-        "scene rate_hz={=f32} gain_m_s2_per_count={=f32} mass_kg={} v0_m_s={} drop_height_m={} trigger_m_s2={=f32} edge_m_s2={=f32} hold_s={=f32} max_impact_s={=f32} clip_low={=i16} clip_high={=i16} cfc={} trigger_cfc={} two_phase={=bool} nonlinear={=bool} fit_exponent={=bool} exponent={=f32} hertz={=bool}",
+        "scene rate_hz={=f32} gain_m_s2_per_count={=f32} mass_kg={} v0_m_s={} drop_height_m={} trigger_m_s2={=f32} edge_m_s2={=f32} hold_s={=f32} max_impact_s={=f32} settle_s={=f32} clip_low={=i16} clip_high={=i16} cfc={} trigger_cfc={} two_phase={=bool} nonlinear={=bool} fit_exponent={=bool} exponent={=f32} hertz={=bool}",
         scene.calibration.sample_rate_hz,
         scene.calibration.gain_m_s2_per_count,
         Opt(scene.mass_kg),
@@ -198,6 +200,7 @@ pub fn log(scene: &Scene) {
         scene.edge_m_s2,
         scene.hold_s,
         scene.max_impact_s,
+        scene.settle_s,
         scene.clip_counts.0,
         scene.clip_counts.1,
         Opt(scene.cfc.map(|c| c.class())),

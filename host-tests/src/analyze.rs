@@ -48,6 +48,7 @@ pub struct SceneFile {
     pub edge_m_s2: Option<f64>,
     pub hold_s: Option<f64>,
     pub max_impact_s: Option<f64>,
+    pub settle_s: Option<f64>,
     pub cfc: Option<u32>,
     pub units: Option<Units>,
     pub invert: Option<bool>,
@@ -112,6 +113,10 @@ pub struct AnalyzeArgs {
     /// Quiet time that ends an impact, s [default: 2 ms].
     #[arg(long)]
     pub hold: Option<f64>,
+    /// How long a flat new level must last to be a level change (a DC channel's free fall
+    /// or rest), not an impact, s [default: 50 ms, at least the hold].
+    #[arg(long)]
+    pub settle: Option<f64>,
     /// Scene file (JSON); options given here override it.
     #[arg(long)]
     pub scene: Option<PathBuf>,
@@ -361,6 +366,10 @@ pub fn setup(args: &AnalyzeArgs, progress: Option<fn(f64)>) -> Result<Setup, Str
     if let Some(m) = file.max_impact_s {
         scene.max_impact_s = m as f32;
     }
+    scene.settle_s = match args.settle.or(file.settle_s) {
+        Some(s) => s as f32,
+        None => scene.settle_s.max(scene.hold_s),
+    };
     scene.mass_kg = mass.map(|m| m as f32);
     scene.cfc = match args.cfc.or(file.cfc) {
         Some(c) => Some(

@@ -335,6 +335,7 @@ pub fn scene_args(scene: &Scene) -> Vec<String> {
         format!("edge={}", f(scene.edge_m_s2)),
         format!("hold={}", f(scene.hold_s)),
         format!("max_impact={}", f(scene.max_impact_s)),
+        format!("settle={}", f(scene.settle_s)),
         format!("clip={}:{}", scene.clip_counts.0, scene.clip_counts.1),
         format!("cfc={}", class(scene.cfc)),
         format!("trigger_cfc={}", class(scene.trigger_cfc)),

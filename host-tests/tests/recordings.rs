@@ -112,19 +112,41 @@ fn endaq_drop_free_fall_gives_the_impact_speed() {
     assert_eq!(a.impacts.len(), 1, "{:#?}", a.impacts);
 }
 
+/// Reports in time order, each one's contact before the next one's (and its window too).
+fn ordered_and_disjoint(a: &AnalysisJson) {
+    for (r, next) in a.impacts.iter().zip(a.impacts.iter().skip(1)) {
+        assert!(r.start_s + r.duration_s <= next.start_s, "{r:#?} {next:#?}");
+        assert!(r.end_sample <= next.start_sample, "{r:#?} {next:#?}");
+    }
+}
+
 #[test]
-fn water_entry_gives_one_pulse() {
+fn water_entry_gives_the_slam_first_and_ordered_disjoint_pulses() {
+    // The 100 g channel at 20 kS/s: the slam at 10.18 s, then pulses tens of ms apart with
+    // the signal back at its level between them (each its own report).
     let a = analyze(AnalyzeArgs {
         column: Some(ColumnRef::Name("y_g".into())),
         ..file("impack-water-entry/4mps_sphere_1_100g-PR_9.9-10.6s.csv")
     });
-    assert_eq!(a.impacts.len(), 1, "{:#?}", a.impacts);
     let i = &a.impacts[0];
     assert!(
         (60.0..66.0).contains(&(i.peak_acceleration_m_s2 / G)),
         "{}",
         i.peak_acceleration_m_s2 / G
     );
+    assert!((10.18..10.19).contains(&i.start_s), "{}", i.start_s);
+    ordered_and_disjoint(&a);
+    // The 40 g DC channel at 2 kS/s sees the slam in one sample at the same time, and no
+    // report starts before it (its slow drift before the entry is no impact).
+    let dc = analyze(AnalyzeArgs {
+        column: Some(ColumnRef::Name("y_g".into())),
+        ..file("impack-water-entry/4mps_sphere_1_40g-DC_9.9-10.6s.csv")
+    });
+    assert!(
+        (dc.impacts[0].peak_time_s - i.peak_time_s).abs() < 1e-3,
+        "{dc:#?}"
+    );
+    ordered_and_disjoint(&dc);
 }
 
 #[test]

@@ -1,10 +1,12 @@
 //! Running baseline (sensor offset) learned only from quiet stretches of the signal.
 //!
 //! The stream is cut into strides of `STRIDE` samples at fixed stream positions. A stride whose
-//! samples all lie within the edge level of the current baseline is quiet, and its sum enters
-//! a window of the last `K` quiet strides; a stride with any excursion is left out. So a slow
-//! pulse's rising flank cannot drag the baseline along (and hide itself from the trigger), and
-//! the baseline is the exact rational `sum / count` of raw counts.
+//! samples all lie within the edge level of the current baseline, and whose mean lies within
+//! its own noise of it, is quiet, and its sum enters a window of the last `K` quiet strides;
+//! a stride with any excursion is left out. So a slow pulse's rising flank cannot drag the
+//! baseline along (and hide itself from the trigger), nor can a slow ramp below the edge level
+//! before an impact (a drop tower's table settling, a sensor warming): the baseline stays the
+//! sensor's zero. It is the exact rational `sum / count` of raw counts.
 
 /// Samples per stride.
 pub const STRIDE: usize = 64;
@@ -213,9 +215,11 @@ impl<const K: usize> Baseline<K> {
     }
 
     /// Adds samples (at most [`Self::to_stride_end`] of them); when a stride completes, it
-    /// enters the window if every sample was within `edge` counts of the baseline, or, while
-    /// nothing is learned yet, if its samples span at most `4 edge` (so a pulse in the first
-    /// stride cannot become the baseline). Returns true when a stride completed.
+    /// enters the window if every sample was within `edge` counts of the baseline and its mean
+    /// within a tenth of its own span (about four standard errors of a mean of 64 noisy
+    /// samples; at least one count) of it, or, while nothing is learned yet, if its samples
+    /// span at most `4 edge` (so a pulse in the first stride cannot become the baseline).
+    /// Returns true when a stride completed.
     #[inline]
     pub fn add(&mut self, samples: &[i16], edge: f32) -> bool {
         let stats = Stats::of(samples);
@@ -234,10 +238,17 @@ impl<const K: usize> Baseline<K> {
         }
         let (acc, lo, hi) = (self.acc, self.min, self.max);
         let mean = self.mean();
+        let span = hi as f32 - lo as f32;
         let quiet = if self.len == 0 {
-            (hi as f32 - lo as f32) <= 4.0 * edge
+            span <= 4.0 * edge
         } else {
-            lo as f32 >= mean - edge && hi as f32 <= mean + edge
+            // The mean of a stride of noise is within ~4 standard errors (σ / 8) of the
+            // baseline; the span of 64 noisy samples is ~5 σ.
+            let band = (span / 10.0).max(1.0);
+            let stride_mean = acc as f32 / self.filled as f32;
+            lo as f32 >= mean - edge
+                && hi as f32 <= mean + edge
+                && libm::fabsf(stride_mean - mean) <= band
         };
         if quiet {
             if self.len == K {
@@ -289,10 +300,36 @@ mod tests {
         loud[10] = 120;
         assert!(b.add(&loud, 5.0));
         assert_eq!(b.rational(), (100 * STRIDE as i64, STRIDE as i64));
-        // Quiet but offset by 2: enters, in two pieces.
-        assert!(!b.add(&[102; 10], 5.0));
-        assert!(b.add(&[102; STRIDE - 10], 5.0));
-        assert_eq!(b.rational(), (202 * STRIDE as i64, 2 * STRIDE as i64));
-        assert_eq!(b.mean(), 101.0);
+        // Quiet but offset by 1 (within the stride mean's band of one count): enters, in two
+        // pieces.
+        assert!(!b.add(&[101; 10], 5.0));
+        assert!(b.add(&[101; STRIDE - 10], 5.0));
+        assert_eq!(b.rational(), (201 * STRIDE as i64, 2 * STRIDE as i64));
+        assert_eq!(b.mean(), 100.5);
+        // Flat but 3 counts off: its mean is beyond its own noise, so it is not the zero.
+        assert!(b.add(&[103; STRIDE], 5.0));
+        assert_eq!(b.rational(), (201 * STRIDE as i64, 2 * STRIDE as i64));
+    }
+
+    #[test]
+    fn a_slow_ramp_below_the_edge_level_is_not_learned() {
+        // Noise of ±10 counts around 0; then strides whose mean creeps up by 3 counts each
+        // (well inside the edge level of 50): the baseline stays at the sensor's zero.
+        let noisy = |offset: i16| -> [i16; STRIDE] {
+            core::array::from_fn(|i| offset + [-10, -3, 4, 10, 0, -6, 7, 2][i % 8])
+        };
+        let mut b = Baseline::<64>::new();
+        for _ in 0..32 {
+            b.add(&noisy(0), 50.0);
+        }
+        let zero = b.mean();
+        for k in 1..=10 {
+            b.add(&noisy(3 * k), 50.0);
+        }
+        assert!((b.mean() - zero).abs() < 0.5, "{} {zero}", b.mean());
+        // A stride of plain noise still enters.
+        let (_, n) = b.rational();
+        b.add(&noisy(1), 50.0);
+        assert_eq!(b.rational().1, n + STRIDE as i64);
     }
 }

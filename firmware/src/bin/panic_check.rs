@@ -71,6 +71,7 @@ fn scene() -> Scene {
         edge_m_s2: 2.0,
         hold_s: 2e-3,
         max_impact_s: 1.0,
+        settle_s: 0.05,
         clip_counts: (0, 4095),
         cfc: Some(Cfc::Cfc1000),
         trigger_cfc: Some(Cfc::Cfc1000),

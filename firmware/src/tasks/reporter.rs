@@ -293,7 +293,7 @@ fn log_heartbeat(h: &Heartbeat) {
     let source = SOURCE_STATS.snapshot();
     let (stack_peak, stack_size) = stack();
     info!(
-        "heartbeat samples={=u64} rate_hz={=f32} blocks={=u32} busy_permille={=u32} overruns={=u32} blocks_lost={=u32} blocks_missing={=u32} samples_lost={=u64} gaps={=u64} source_errors={=u32} impacts={=u64} incomplete={=u64} analyses_skipped={=u64} reports_dropped={=u32} heartbeats_dropped={=u32} armed={=bool} in_impact={=bool} stack_peak_bytes={=u32} stack_size_bytes={=u32}",
+        "heartbeat samples={=u64} rate_hz={=f32} blocks={=u32} busy_permille={=u32} overruns={=u32} blocks_lost={=u32} blocks_missing={=u32} samples_lost={=u64} gaps={=u64} source_errors={=u32} impacts={=u64} incomplete={=u64} analyses_skipped={=u64} level_changes={=u64} reports_dropped={=u32} heartbeats_dropped={=u32} armed={=bool} in_impact={=bool} stack_peak_bytes={=u32} stack_size_bytes={=u32}",
         h.counters.samples,
         h.rate_hz,
         h.tally.blocks,
@@ -307,6 +307,7 @@ fn log_heartbeat(h: &Heartbeat) {
         h.counters.impacts,
         h.counters.incomplete,
         h.counters.analyses_skipped,
+        h.counters.level_changes,
         h.reports_dropped,
         HEARTBEATS_DROPPED.load(Ordering::Relaxed),
         h.armed,
@@ -331,7 +332,7 @@ fn summarize(h: &Heartbeat, end: StreamEnd, out_of_order: u32, elapsed_ms: u64) 
     }
     let (stack_peak, stack_size) = stack();
     info!(
-        "summary result={=str} end={=str} samples={=u64} rate_hz={=f32} blocks={=u32} impacts={=u64} incomplete={=u64} analyses_skipped={=u64} min={=i16} max={=i16} sum={=i64} samples_lost={=u64} gaps={=u64} blocks_lost={=u32} blocks_missing={=u32} overruns={=u32} source_errors={=u32} reports_dropped={=u32} reports_out_of_order={=u32} heartbeats_dropped={=u32} busy_permille={=u32} elapsed_ms={=u64} stack_peak_bytes={=u32} stack_size_bytes={=u32}",
+        "summary result={=str} end={=str} samples={=u64} rate_hz={=f32} blocks={=u32} impacts={=u64} incomplete={=u64} analyses_skipped={=u64} level_changes={=u64} min={=i16} max={=i16} sum={=i64} samples_lost={=u64} gaps={=u64} blocks_lost={=u32} blocks_missing={=u32} overruns={=u32} source_errors={=u32} reports_dropped={=u32} reports_out_of_order={=u32} heartbeats_dropped={=u32} busy_permille={=u32} elapsed_ms={=u64} stack_peak_bytes={=u32} stack_size_bytes={=u32}",
         if success { "ok" } else { "failed" },
         end_name,
         h.counters.samples,
@@ -340,6 +341,7 @@ fn summarize(h: &Heartbeat, end: StreamEnd, out_of_order: u32, elapsed_ms: u64) 
         h.counters.impacts,
         h.counters.incomplete,
         h.counters.analyses_skipped,
+        h.counters.level_changes,
         h.tally.min,
         h.tally.max,
         h.tally.sum,

@@ -14,14 +14,17 @@
 //! (widths, kinematics, filtering, fits) is [`crate::analysis`], run by whoever receives the
 //! capture from the [`Sink`].
 
-use crate::capture::{Capture, Sink, Summary};
-use crate::report::{self, Status};
+mod impact;
+mod level;
+
+use crate::capture::Sink;
+use crate::report::Status;
 use crate::scene::{Approach, FitSet, Scene};
 use crate::signal::baseline::{Baseline, Stats, STRIDE};
-use crate::signal::flank::{crossing, Flank};
 use crate::signal::ring::Ring;
 use crate::signal::Calibration;
 use crate::solve::Error;
+use impact::Active;
 
 /// Quiet strides in the baseline window (`64 * STRIDE` = 4096 samples).
 const BASELINE_STRIDES: usize = 64;
@@ -77,44 +80,9 @@ pub struct Counters {
     pub samples_lost: u64,
     /// Gaps announced.
     pub gaps: u64,
-}
-
-struct Active {
-    /// Stream index of the capture's first sample.
-    first_index: u64,
-    /// Stream index of the sample that fired the trigger.
-    trigger_index: u64,
-    onset_index: u64,
-    touch_offset: f32,
-    base_sum: i64,
-    base_n: i64,
-    /// Edge level in units of `d = W x - S`.
-    edge_d: i64,
-    /// Flank level in units of `d`.
-    flank_d: i64,
-    quiet: u32,
-    /// Stream index of the first sample back within the edge level after the peak
-    /// (separation: later ringing or a second hit within the hold does not move it unless it
-    /// brings a new peak).
-    separation: Option<u64>,
-    peak_d: i64,
-    peak_index: u64,
-    total_c: i64,
-    /// Samples since `first_index`.
-    samples: u64,
-    clipped: bool,
-    /// The sink gave a buffer for this impact.
-    captured: bool,
-    /// The pulse was already under way when the last gap ended: its start is unknown.
-    began_in_gap: bool,
-    /// The buffer overflowed.
-    full: bool,
-}
-
-impl Active {
-    fn deviation(&self) -> Deviation {
-        Deviation::new(self.base_sum, self.base_n)
-    }
+    /// Times the signal settled at a new level without a pulse (a DC sensor's free fall or
+    /// rest): not impacts; the baseline is learned again.
+    pub level_changes: u64,
 }
 
 /// The streaming stage of one channel through a [`Scene`]. `PRE` (a power of two) is the
@@ -132,6 +100,8 @@ pub struct Stream<const PRE: usize> {
     trigger_counts: f32,
     edge_counts: f32,
     hold: u32,
+    /// Samples a flat new level must last to be a level change.
+    settle: u32,
     max_samples: u64,
     /// Trigger thresholds (raw counts) in force until the next refresh.
     thresholds: Option<(i32, i32)>,
@@ -141,6 +111,11 @@ pub struct Stream<const PRE: usize> {
     trigger_filter: Option<crate::signal::cfc::Causal>,
     /// Stream index of the first sample after the last gap.
     gap_end: Option<u64>,
+    /// Where the last impact's contact ended (its separation, or the end of its window): no
+    /// report starts before it.
+    last_end: u64,
+    /// Where the last impact's window ended: the next capture does not reach back into it.
+    window_end: u64,
 }
 
 impl<const PRE: usize> Stream<PRE> {
@@ -167,6 +142,7 @@ impl<const PRE: usize> Stream<PRE> {
                 edge_m_s2: 0.25,
                 hold_s: 1.0,
                 max_impact_s: 1.0,
+                settle_s: 1.0,
                 clip_counts: (i16::MIN, i16::MAX),
                 cfc: None,
                 trigger_cfc: None,
@@ -190,15 +166,19 @@ impl<const PRE: usize> Stream<PRE> {
                 analyses_skipped: 0,
                 samples_lost: 0,
                 gaps: 0,
+                level_changes: 0,
             },
             trigger_counts: 1.0,
             edge_counts: 0.25,
             hold: 1,
+            settle: 1,
             max_samples: 1,
             thresholds: None,
             replaying: false,
             trigger_filter: None,
             gap_end: None,
+            last_end: 0,
+            window_end: 0,
         }
     }
 
@@ -237,10 +217,13 @@ impl<const PRE: usize> Stream<PRE> {
         self.trigger_counts = scene.trigger_m_s2 / gain;
         self.edge_counts = scene.edge_m_s2 / gain;
         self.hold = scene.samples(scene.hold_s);
+        self.settle = scene.samples(scene.settle_s);
         self.max_samples = scene.samples(scene.max_impact_s) as u64;
         self.thresholds = None;
         self.replaying = false;
         self.gap_end = None;
+        self.last_end = 0;
+        self.window_end = 0;
         // At rest at 0 until the first baseline resets it to the baseline's level.
         self.trigger_filter = scene
             .trigger_cfc
@@ -446,285 +429,20 @@ impl<const PRE: usize> Stream<PRE> {
         self.replaying = false;
     }
 
+    /// Forgets the baseline and the history (the level moved, or the sensor is stuck): the
+    /// next quiet stride arms the stream again.
+    fn relearn_baseline(&mut self) {
+        self.ring.clear();
+        self.baseline.clear();
+        self.thresholds = None;
+    }
+
     /// Trigger thresholds in raw counts around the baseline.
     fn thresholds(&self) -> (i32, i32) {
         let mean = self.baseline.mean();
         let lo = floor(mean - self.trigger_counts);
         let hi = -floor(-(mean + self.trigger_counts));
         (clamp_i32(lo), clamp_i32(hi))
-    }
-
-    /// The trigger fired at `self.index`: find the onset in the ring, fix the baseline from
-    /// the samples before it, fit the rising flank, and replay the pre-trigger samples into
-    /// the capture (if the sink has a buffer) and the running sums.
-    fn start<const CAP: usize>(&mut self, sink: &mut impl Sink<CAP>) {
-        let (base_sum, base_n) = self.baseline.rational();
-        let deviation = Deviation::new(base_sum, base_n);
-        let edge_d = (self.edge_counts * base_n as f32) as i64;
-        // The flank level: FLANK_EDGES edges, or just under the trigger thresholds.
-        let (lo, hi) = self.current_thresholds();
-        let trigger_d = (hi as i64 * base_n - base_sum).min(base_sum - lo as i64 * base_n);
-        let flank_d = (FLANK_EDGES * edge_d).min(trigger_d).max(edge_d);
-        let ring = &self.ring;
-        let abs_d = |i: usize| ring.back(i).map(|x| deviation.of(x).unsigned_abs() as i64);
-        // Walk back from the newest sample while it is beyond the edge level.
-        let mut pulse = 0usize;
-        while let Some(y) = abs_d(pulse) {
-            if y <= edge_d {
-                break;
-            }
-            pulse += 1;
-        }
-        // The rising flank from the onset forwards (the trigger sample, next, ends it).
-        let mut flank = Flank::default();
-        for k in 0..pulse {
-            match abs_d(pulse - 1 - k) {
-                Some(y) if y <= flank_d && flank.add(k as i64, y) => {}
-                _ => break,
-            }
-        }
-        let touch_offset = match flank.zero(true, -1.0, edge_d as f64) {
-            Some(z) => z as f32,
-            // The edge crossing between the last quiet sample and the onset.
-            None => match (abs_d(pulse), abs_d(pulse.wrapping_sub(1))) {
-                (Some(y0), Some(y1)) if pulse > 0 => {
-                    (crossing(y0 as f64, y1 as f64, edge_d as f64) - 1.0) as f32
-                }
-                _ => 0.0,
-            },
-        };
-        // Capture from `margin` samples before the onset (as far as the ring reaches).
-        let margin = (pulse + self.hold as usize / 2)
-            .min(self.ring.len())
-            .min(CAP / 2);
-        let first_index = self.index - margin as u64;
-        let mut capture = sink.buffer();
-        if let Some(c) = capture.as_mut() {
-            c.clear();
-        }
-        let mut a = Active {
-            first_index,
-            trigger_index: self.index,
-            onset_index: self.index - pulse as u64,
-            touch_offset,
-            base_sum,
-            base_n,
-            edge_d,
-            flank_d,
-            quiet: 0,
-            separation: None,
-            peak_d: 0,
-            peak_index: self.index,
-            total_c: 0,
-            samples: 0,
-            clipped: false,
-            captured: capture.is_some(),
-            full: false,
-            // The walk back reached the gap: the pulse began while samples were lost.
-            began_in_gap: self.gap_end.is_some_and(|g| self.index - pulse as u64 <= g),
-        };
-        let (clip_lo, clip_hi) = self.scene.clip_counts;
-        let (older, newer) = self.ring.last(margin);
-        for run in [older, newer] {
-            for (k, &x) in run.iter().enumerate() {
-                let d = deviation.of(x) as i64;
-                a.total_c += d;
-                if d.unsigned_abs() > a.peak_d.unsigned_abs() {
-                    a.peak_d = d;
-                    a.peak_index = a.first_index + a.samples + k as u64;
-                }
-                a.clipped |= x <= clip_lo || x >= clip_hi;
-            }
-            if let Some(c) = capture.as_mut() {
-                a.full |= c.extend(run) < run.len();
-            }
-            a.samples += run.len() as u64;
-        }
-        self.active = Some(a);
-    }
-
-    /// Feeds samples to the active impact until it ends; returns how many it used.
-    ///
-    /// The hot loop of an impact: the running state lives in locals (the compiler cannot
-    /// keep fields of `self` in registers across the capture's push) and is written back
-    /// once per call.
-    fn run_active<const CAP: usize>(
-        &mut self,
-        samples: &[i16],
-        sink: &mut impl Sink<CAP>,
-    ) -> usize {
-        let hold = self.hold;
-        let (lo, hi) = self.scene.clip_counts;
-        let max_samples = self.max_samples;
-        let Some(a) = self.active.as_mut() else {
-            return 0;
-        };
-        // At most the samples that keep the impact within its longest duration.
-        let room = max_samples
-            .saturating_sub(a.samples)
-            .min(samples.len() as u64) as usize;
-        let samples = samples.get(..room).unwrap_or(&[]);
-        let deviation = a.deviation();
-        // edge_d >= 0: the scene's edge level is positive (validated).
-        let edge = a.edge_d.clamp(0, u32::MAX as i64) as u32;
-        let before = a.samples;
-        let mut peak_abs = a.peak_d.unsigned_abs().min(u32::MAX as u64) as u32;
-        let mut new_peak: Option<(usize, i32)> = None;
-        let (mut separation, mut quiet, mut clipped) = (a.separation, a.quiet, a.clipped);
-        let mut sum: i64 = 0;
-        let mut used = samples.len();
-        let mut ended = None;
-        let start = a.first_index + before;
-        for (k, &x) in samples.iter().enumerate() {
-            let d = deviation.of(x);
-            sum += d as i64;
-            let abs = d.unsigned_abs();
-            if abs > peak_abs {
-                peak_abs = abs;
-                new_peak = Some((k, d));
-                separation = None;
-            }
-            clipped |= x <= lo || x >= hi;
-            if abs <= edge {
-                if separation.is_none() {
-                    separation = Some(start + k as u64);
-                }
-                quiet += 1;
-                if quiet >= hold && start + k as u64 > a.trigger_index {
-                    ended = Some(());
-                    used = k + 1;
-                    break;
-                }
-            } else {
-                quiet = 0;
-            }
-        }
-        let kept = samples.get(..used).unwrap_or(&[]);
-        // The capture keeps the first CAP samples of the impact.
-        if a.captured && !a.full {
-            a.full = match sink.buffer() {
-                Some(c) => c.extend(kept) < kept.len(),
-                None => true,
-            };
-        }
-        if let Some((k, d)) = new_peak {
-            a.peak_d = d as i64;
-            a.peak_index = start + k as u64;
-        }
-        a.total_c += sum;
-        a.separation = separation;
-        a.quiet = quiet;
-        a.clipped = clipped;
-        a.samples += used as u64;
-        let ended = match ended {
-            Some(()) if a.began_in_gap => Some(Status::Gap),
-            Some(()) if a.full => Some(Status::BufferFull),
-            Some(()) => Some(Status::Complete),
-            None if a.samples >= max_samples => Some(Status::TooLong),
-            None => None,
-        };
-        // The ring keeps following the stream: the separation flank and the next impact's
-        // pre-trigger history come from it.
-        self.keep(kept);
-        if let Some(status) = ended {
-            self.end(status, sink);
-        }
-        used
-    }
-
-    /// The separation relative to `separation_index`: the falling flank (from the ring)
-    /// extrapolated to zero, or the edge crossing between the last sample beyond the edge and
-    /// the first within it.
-    fn separation_offset(&self, a: &Active, separation: u64) -> f32 {
-        let deviation = a.deviation();
-        // The ring ends at `self.index - 1`: sample `i` is `back(index - 1 - i)`.
-        let abs_d = |i: u64| {
-            let back = self.index.checked_sub(1)?.checked_sub(i)?;
-            let x = self.ring.back(usize::try_from(back).ok()?)?;
-            Some(deviation.of(x).unsigned_abs() as i64)
-        };
-        let Some(last) = separation.checked_sub(1) else {
-            return 0.0;
-        };
-        let mut flank = Flank::default();
-        let mut j = 0u64;
-        while let Some(i) = last.checked_sub(j) {
-            match abs_d(i) {
-                Some(y) if y <= a.flank_d && flank.add(-(j as i64), y) => j += 1,
-                _ => break,
-            }
-        }
-        // Positions relative to `last`: the first quiet sample is at +1.
-        match flank.zero(false, 1.0, a.edge_d as f64) {
-            Some(z) => (z - 1.0) as f32,
-            None => match (abs_d(last), abs_d(separation)) {
-                (Some(y0), Some(y1)) => {
-                    (crossing(y0 as f64, y1 as f64, a.edge_d as f64) - 1.0) as f32
-                }
-                _ => 0.0,
-            },
-        }
-    }
-
-    /// Hands the active impact over and returns to idle.
-    fn end<const CAP: usize>(&mut self, status: Status, sink: &mut impl Sink<CAP>) {
-        let Some(a) = self.active.take() else { return };
-        self.thresholds = None;
-        self.baseline.restart_stride();
-        let level = self.baseline.mean() as f64;
-        if let Some(f) = self.trigger_filter.as_mut() {
-            f.reset(level);
-        }
-        let separation_offset = a.separation.map_or(0.0, |s| self.separation_offset(&a, s));
-        let summary = Summary {
-            index: self.counters.impacts.min(u32::MAX as u64) as u32,
-            status,
-            clipped: a.clipped,
-            first_index: a.first_index,
-            onset_index: a.onset_index,
-            touch_offset: a.touch_offset,
-            separation_index: a.separation,
-            separation_offset,
-            end_index: self.index,
-            base_sum: a.base_sum,
-            base_n: a.base_n,
-            peak_d: a.peak_d,
-            peak_index: a.peak_index,
-            total_c: a.total_c,
-            v0_m_s: self.v0,
-        };
-        self.counters.impacts += 1;
-        if status != Status::Complete {
-            self.counters.incomplete += 1;
-        }
-        if status == Status::TooLong {
-            // The baseline moved (or the sensor is stuck): learn it again.
-            self.ring.clear();
-            self.baseline.clear();
-        }
-        match sink.buffer() {
-            Some(c) if a.captured => {
-                c.set_summary(summary);
-                sink.captured(&self.scene);
-            }
-            _ => {
-                self.counters.analyses_skipped += 1;
-                sink.skipped(&report::streaming(&summary, &self.scene));
-            }
-        }
-    }
-}
-
-/// A capture buffer that is never there: the streaming stage alone.
-pub struct NoCapture<F: FnMut(&crate::ImpactReport)>(pub F);
-
-impl<F: FnMut(&crate::ImpactReport)> Sink<0> for NoCapture<F> {
-    fn buffer(&mut self) -> Option<&mut Capture<0>> {
-        None
-    }
-    fn captured(&mut self, _scene: &Scene) {}
-    fn skipped(&mut self, report: &crate::ImpactReport) {
-        (self.0)(report)
     }
 }
 

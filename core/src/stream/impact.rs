@@ -1,0 +1,479 @@
+//! The stream inside an impact: from the trigger (onset, rising flank, pre-trigger replay)
+//! through the in-impact loop (exact sums, peak, separation, end) to the hand-over of the
+//! summary.
+//!
+//! An impact ends when the signal has stayed within the edge level for `hold` samples; or,
+//! once it has come back to the baseline for at least an eighth of the hold (not a ringing
+//! crossing), when a new hit in the same direction crosses the trigger level (the next impact
+//! starts there); or when it settles at a new level for `hold` samples
+//! (rest, free fall: the baseline is learned again, and a level change without a pulse is no
+//! impact at all); or for the reasons of [`Status`].
+
+use super::level::LevelWatch;
+use super::{Deviation, Stream, FLANK_EDGES};
+use crate::capture::{Sink, Summary};
+use crate::report::{self, Status};
+use crate::signal::flank::{crossing, Flank};
+
+/// The impact being followed.
+pub(super) struct Active {
+    /// Stream index of the capture's first sample.
+    first_index: u64,
+    /// Stream index of the sample that fired the trigger.
+    trigger_index: u64,
+    onset_index: u64,
+    touch_offset: f32,
+    base_sum: i64,
+    base_n: i64,
+    /// Edge level in units of `d = W x - S`.
+    edge_d: i64,
+    /// Flank level in units of `d`.
+    flank_d: i64,
+    /// The trigger thresholds in units of `d` (a sample fires when `d > d_hi` or `d < d_lo`).
+    d_hi: i32,
+    d_lo: i32,
+    quiet: u32,
+    /// The longest run of quiet samples since the separation.
+    longest_quiet: u32,
+    /// Stream index of the first sample back within the edge level (or across it, a sign
+    /// flip) after the peak (separation: later ringing does not move it unless it brings a
+    /// new peak).
+    separation: Option<u64>,
+    /// `Σ d` from `first_index` to the separation (exclusive).
+    separation_c: i64,
+    /// `Σ d` over the samples before the onset.
+    pre_onset_c: i64,
+    peak_d: i64,
+    peak_index: u64,
+    total_c: i64,
+    /// Samples since `first_index`.
+    samples: u64,
+    clipped: bool,
+    /// The sink gave a buffer for this impact.
+    captured: bool,
+    /// The buffer overflowed.
+    full: bool,
+    /// The pulse was already under way when the last gap ended: its start is unknown.
+    began_in_gap: bool,
+    /// Stream index just after the latest sample within the edge level.
+    last_quiet: u64,
+    /// Where the impact's window ends if not at the current position (a next hit began
+    /// after the last quiet sample).
+    end_at: Option<u64>,
+    level: LevelWatch,
+}
+
+impl Active {
+    pub(super) fn deviation(&self) -> Deviation {
+        Deviation::new(self.base_sum, self.base_n)
+    }
+}
+
+/// How a run of samples ended the impact.
+enum End {
+    /// Back within the edge level for the hold time.
+    Quiet,
+    /// A new hit after separation: the next impact starts at the sample not used.
+    NextHit,
+    /// Settled at a new level.
+    Settled(super::level::Settled),
+}
+
+impl<const PRE: usize> Stream<PRE> {
+    /// The trigger fired at `self.index`: find the onset in the ring, fix the baseline from
+    /// the samples before it, fit the rising flank, and replay the pre-trigger samples into
+    /// the capture (if the sink has a buffer) and the running sums.
+    pub(super) fn start<const CAP: usize>(&mut self, sink: &mut impl Sink<CAP>) {
+        let (base_sum, base_n) = self.baseline.rational();
+        let deviation = Deviation::new(base_sum, base_n);
+        let edge_d = (self.edge_counts * base_n as f32) as i64;
+        let (lo, hi) = self.current_thresholds();
+        let d_hi = hi as i64 * base_n - base_sum;
+        let d_lo = lo as i64 * base_n - base_sum;
+        // The flank level: FLANK_EDGES edges, or just under the trigger thresholds.
+        let flank_d = (FLANK_EDGES * edge_d).min(d_hi.min(-d_lo)).max(edge_d);
+        let ring = &self.ring;
+        let abs_d = |i: usize| ring.back(i).map(|x| deviation.of(x).unsigned_abs() as i64);
+        // Walk back from the newest sample while it is beyond the edge level.
+        let mut pulse = 0usize;
+        while let Some(y) = abs_d(pulse) {
+            if y <= edge_d {
+                break;
+            }
+            pulse += 1;
+        }
+        // The rising flank from the onset forwards (the trigger sample, next, ends it).
+        let mut flank = Flank::default();
+        for k in 0..pulse {
+            match abs_d(pulse - 1 - k) {
+                Some(y) if y <= flank_d && flank.add(k as i64, y) => {}
+                _ => break,
+            }
+        }
+        let onset_index = self.index - pulse as u64;
+        let touch_offset = match flank.zero(true, -1.0, edge_d as f64) {
+            Some(z) => z as f32,
+            // The edge crossing between the last quiet sample and the onset.
+            None => match (abs_d(pulse), abs_d(pulse.wrapping_sub(1))) {
+                (Some(y0), Some(y1)) if pulse > 0 => {
+                    (crossing(y0 as f64, y1 as f64, edge_d as f64) - 1.0) as f32
+                }
+                _ => 0.0,
+            },
+        };
+        // First touch cannot come before the previous contact ended: reports never overlap.
+        let earliest = self.last_end as f64 - onset_index as f64;
+        let touch_offset = touch_offset.max(earliest.min(0.0) as f32);
+        // Capture from `margin` samples before the onset (as far as the ring reaches, and not
+        // into the previous impact's window).
+        let since_last =
+            usize::try_from(self.index - self.window_end.min(self.index)).unwrap_or(usize::MAX);
+        let margin = (pulse + self.hold as usize / 2)
+            .min(self.ring.len())
+            .min(CAP / 2)
+            .min(since_last.max(pulse));
+        let first_index = self.index - margin as u64;
+        let mut capture = sink.buffer();
+        if let Some(c) = capture.as_mut() {
+            c.clear();
+        }
+        let mut a = Active {
+            first_index,
+            trigger_index: self.index,
+            onset_index,
+            touch_offset,
+            base_sum,
+            base_n,
+            edge_d,
+            flank_d,
+            d_hi: d_hi.clamp(i32::MIN as i64, i32::MAX as i64) as i32,
+            d_lo: d_lo.clamp(i32::MIN as i64, i32::MAX as i64) as i32,
+            quiet: 0,
+            longest_quiet: 0,
+            separation: None,
+            separation_c: 0,
+            pre_onset_c: 0,
+            peak_d: 0,
+            peak_index: self.index,
+            total_c: 0,
+            samples: 0,
+            clipped: false,
+            captured: capture.is_some(),
+            full: false,
+            // The walk back reached the gap: the pulse began while samples were lost.
+            began_in_gap: self.gap_end.is_some_and(|g| onset_index <= g),
+            last_quiet: onset_index,
+            end_at: None,
+            level: LevelWatch::new(),
+        };
+        let (clip_lo, clip_hi) = self.scene.clip_counts;
+        let (older, newer) = self.ring.last(margin);
+        let before_onset = margin.saturating_sub(pulse) as u64;
+        for run in [older, newer] {
+            for (k, &x) in run.iter().enumerate() {
+                let d = deviation.of(x) as i64;
+                a.total_c += d;
+                if a.samples + (k as u64) < before_onset {
+                    a.pre_onset_c += d;
+                }
+                if d.unsigned_abs() > a.peak_d.unsigned_abs() {
+                    a.peak_d = d;
+                    a.peak_index = a.first_index + a.samples + k as u64;
+                }
+                a.clipped |= x <= clip_lo || x >= clip_hi;
+            }
+            if let Some(c) = capture.as_mut() {
+                a.full |= c.extend(run) < run.len();
+            }
+            a.samples += run.len() as u64;
+        }
+        self.active = Some(a);
+    }
+
+    /// Feeds samples to the active impact until it ends; returns how many it used.
+    pub(super) fn run_active<const CAP: usize>(
+        &mut self,
+        samples: &[i16],
+        sink: &mut impl Sink<CAP>,
+    ) -> usize {
+        let mut used = 0;
+        // A stride (aligned from the trigger sample) at a time, for the level watch.
+        while used < samples.len() {
+            let Some(a) = self.active.as_ref() else {
+                break;
+            };
+            let n = a.level.to_stride_end().min(samples.len() - used);
+            let part = samples.get(used..used + n).unwrap_or(&[]);
+            let (taken, end) = self.run_part(part, sink);
+            used += taken;
+            if let Some(end) = end {
+                self.finish_impact(end, sink);
+                break;
+            }
+            if taken < n {
+                break;
+            }
+        }
+        used
+    }
+
+    /// The in-impact loop over at most one stride: returns how many samples it took and how
+    /// the impact ended, if it did.
+    ///
+    /// The running state lives in locals (the compiler cannot keep fields of `self` in
+    /// registers across the capture's push) and is written back once per call.
+    fn run_part<const CAP: usize>(
+        &mut self,
+        samples: &[i16],
+        sink: &mut impl Sink<CAP>,
+    ) -> (usize, Option<End>) {
+        let hold = self.hold;
+        // A return to the baseline that lets a new hit start a new impact.
+        let min_gap = (hold / 8).max(2);
+        let settle = self.settle;
+        let (lo, hi) = self.scene.clip_counts;
+        let max_samples = self.max_samples;
+        let edge_counts = self.edge_counts;
+        let Some(a) = self.active.as_mut() else {
+            return (0, None);
+        };
+        // At most the samples that keep the impact within its longest duration.
+        let room = max_samples
+            .saturating_sub(a.samples)
+            .min(samples.len() as u64) as usize;
+        let samples = samples.get(..room).unwrap_or(&[]);
+        let deviation = a.deviation();
+        // edge_d >= 0: the scene's edge level is positive (validated).
+        let edge = a.edge_d.clamp(0, u32::MAX as i64) as u32;
+        let before = a.samples;
+        let mut peak_abs = a.peak_d.unsigned_abs().min(u32::MAX as u64) as u32;
+        let mut peak_positive = a.peak_d >= 0;
+        let mut new_peak: Option<(usize, i32)> = None;
+        let (mut separation, mut quiet, mut clipped) = (a.separation, a.quiet, a.clipped);
+        let mut last_quiet = a.last_quiet;
+        let mut longest_quiet = a.longest_quiet;
+        let mut separation_c = a.separation_c;
+        let (d_hi, d_lo) = (a.d_hi, a.d_lo);
+        let mut sum: i64 = 0;
+        let mut used = samples.len();
+        let mut ended = None;
+        let start = a.first_index + before;
+        for (k, &x) in samples.iter().enumerate() {
+            let d = deviation.of(x);
+            // Back at the baseline, then a new hit the same way beyond the trigger: the next
+            // impact starts with this sample.
+            if separation.is_some()
+                && quiet.max(longest_quiet) >= min_gap
+                && if peak_positive { d > d_hi } else { d < d_lo }
+            {
+                ended = Some(End::NextHit);
+                used = k;
+                a.end_at = Some(last_quiet);
+                break;
+            }
+            let abs = d.unsigned_abs();
+            if abs > peak_abs {
+                peak_abs = abs;
+                peak_positive = d >= 0;
+                new_peak = Some((k, d));
+                separation = None;
+                longest_quiet = 0;
+            }
+            clipped |= x <= lo || x >= hi;
+            if abs <= edge {
+                last_quiet = start + k as u64 + 1;
+                if separation.is_none() {
+                    separation = Some(start + k as u64);
+                    separation_c = a.total_c + sum;
+                }
+                quiet += 1;
+                sum += d as i64;
+                if quiet >= hold && start + k as u64 > a.trigger_index {
+                    ended = Some(End::Quiet);
+                    used = k + 1;
+                    break;
+                }
+            } else {
+                // Across the whole band between two samples (a sign flip): the signal came
+                // back between them.
+                if separation.is_none() && (d >= 0) != peak_positive {
+                    separation = Some(start + k as u64);
+                    separation_c = a.total_c + sum;
+                }
+                longest_quiet = longest_quiet.max(quiet);
+                quiet = 0;
+                sum += d as i64;
+            }
+        }
+        let kept = samples.get(..used).unwrap_or(&[]);
+        // The capture keeps the first CAP samples of the impact.
+        if a.captured && !a.full {
+            a.full = match sink.buffer() {
+                Some(c) => c.extend(kept) < kept.len(),
+                None => true,
+            };
+        }
+        if let Some((k, d)) = new_peak {
+            a.peak_d = d as i64;
+            a.peak_index = start + k as u64;
+        }
+        a.total_c += sum;
+        a.separation = separation;
+        a.separation_c = separation_c;
+        a.quiet = quiet;
+        a.last_quiet = last_quiet;
+        a.longest_quiet = longest_quiet;
+        a.clipped = clipped;
+        a.samples += used as u64;
+        if ended.is_none() {
+            let settled = a.level.add(
+                kept,
+                a.base_n,
+                a.base_sum,
+                edge_counts,
+                (lo, hi),
+                u64::from(settle),
+            );
+            ended = settled.map(End::Settled);
+        }
+        let too_long = ended.is_none() && a.samples >= max_samples;
+        // The ring keeps following the stream: the separation flank and the next impact's
+        // pre-trigger history come from it.
+        self.keep(kept);
+        if too_long {
+            self.end(Status::TooLong, sink);
+            return (used, None);
+        }
+        (used, ended)
+    }
+
+    /// The impact ended (see [`End`]): hand it over, or, for a level change without a pulse,
+    /// drop it; learn the baseline again after a level change.
+    fn finish_impact<const CAP: usize>(&mut self, end: End, sink: &mut impl Sink<CAP>) {
+        let Some(a) = self.active.as_mut() else {
+            return;
+        };
+        let status = match end {
+            End::Quiet | End::NextHit => {
+                if a.began_in_gap {
+                    Status::Gap
+                } else if a.full {
+                    Status::BufferFull
+                } else {
+                    Status::Complete
+                }
+            }
+            End::Settled(s) => {
+                // The flat run began `run_n` samples ago: the contact ended there at the
+                // latest.
+                if a.separation.is_none() {
+                    a.separation = Some(self.index - s.run_n);
+                    a.separation_c = a.total_c - s.run_d;
+                }
+                // A pulse is a peak beyond the trigger from the new level too; else the
+                // "impact" was the level change itself.
+                let trigger_d = a.d_hi.min(-a.d_lo) as f64;
+                if libm::fabs(a.peak_d as f64 - s.level_d) <= trigger_d {
+                    self.active = None;
+                    self.counters.level_changes += 1;
+                } else {
+                    self.end(Status::Settled, sink);
+                }
+                self.relearn_baseline();
+                return;
+            }
+        };
+        self.end(status, sink);
+    }
+
+    /// The separation relative to `separation_index`: the falling flank (from the ring)
+    /// extrapolated to zero, the zero crossing for a sign flip across the whole edge band,
+    /// or the edge crossing between the last sample beyond the edge and the first within it.
+    fn separation_offset(&self, a: &Active, separation: u64) -> f32 {
+        let deviation = a.deviation();
+        // The ring ends at `self.index - 1`: sample `i` is `back(index - 1 - i)`.
+        let d_at = |i: u64| {
+            let back = self.index.checked_sub(1)?.checked_sub(i)?;
+            let x = self.ring.back(usize::try_from(back).ok()?)?;
+            Some(deviation.of(x) as i64)
+        };
+        let abs_d = |i: u64| d_at(i).map(i64::abs);
+        let Some(last) = separation.checked_sub(1) else {
+            return 0.0;
+        };
+        if let (Some(d0), Some(d1)) = (d_at(last), d_at(separation)) {
+            if d1.abs() > a.edge_d && (d0 >= 0) != (d1 >= 0) {
+                // Where the line between the two samples crosses zero.
+                return (d0 as f64 / (d0 - d1) as f64 - 1.0) as f32;
+            }
+        }
+        let mut flank = Flank::default();
+        let mut j = 0u64;
+        while let Some(i) = last.checked_sub(j) {
+            match abs_d(i) {
+                Some(y) if y <= a.flank_d && flank.add(-(j as i64), y) => j += 1,
+                _ => break,
+            }
+        }
+        // Positions relative to `last`: the first quiet sample is at +1.
+        match flank.zero(false, 1.0, a.edge_d as f64) {
+            Some(z) => (z - 1.0) as f32,
+            None => match (abs_d(last), abs_d(separation)) {
+                (Some(y0), Some(y1)) => {
+                    (crossing(y0 as f64, y1 as f64, a.edge_d as f64) - 1.0) as f32
+                }
+                _ => 0.0,
+            },
+        }
+    }
+
+    /// Hands the active impact over and returns to idle.
+    pub(super) fn end<const CAP: usize>(&mut self, status: Status, sink: &mut impl Sink<CAP>) {
+        let Some(a) = self.active.take() else { return };
+        self.thresholds = None;
+        self.baseline.restart_stride();
+        self.last_end = a.separation.unwrap_or(self.index);
+        self.window_end = a.end_at.unwrap_or(self.index);
+        let level = self.baseline.mean() as f64;
+        if let Some(f) = self.trigger_filter.as_mut() {
+            f.reset(level);
+        }
+        let separation_offset = a.separation.map_or(0.0, |s| self.separation_offset(&a, s));
+        let summary = Summary {
+            index: self.counters.impacts.min(u32::MAX as u64) as u32,
+            status,
+            clipped: a.clipped,
+            first_index: a.first_index,
+            onset_index: a.onset_index,
+            touch_offset: a.touch_offset,
+            separation_index: a.separation,
+            separation_offset,
+            end_index: a.end_at.unwrap_or(self.index),
+            base_sum: a.base_sum,
+            base_n: a.base_n,
+            peak_d: a.peak_d,
+            peak_index: a.peak_index,
+            total_c: a.total_c,
+            contact_c: a.separation.map(|_| a.separation_c - a.pre_onset_c),
+            v0_m_s: self.v0,
+        };
+        self.counters.impacts += 1;
+        if status != Status::Complete {
+            self.counters.incomplete += 1;
+        }
+        if status == Status::TooLong {
+            // The baseline moved (or the sensor is stuck): learn it again.
+            self.relearn_baseline();
+        }
+        match sink.buffer() {
+            Some(c) if a.captured => {
+                c.set_summary(summary);
+                sink.captured(&self.scene);
+            }
+            _ => {
+                self.counters.analyses_skipped += 1;
+                sink.skipped(&report::streaming(&summary, &self.scene));
+            }
+        }
+    }
+}
