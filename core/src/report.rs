@@ -29,6 +29,16 @@ pub enum Status {
 }
 
 impl Status {
+    /// Every status.
+    pub const ALL: [Status; 6] = [
+        Status::Complete,
+        Status::StreamEnded,
+        Status::BufferFull,
+        Status::TooLong,
+        Status::Gap,
+        Status::Settled,
+    ];
+
     /// The name the reports use (`complete`, `stream-ended`, `buffer-full`, `too-long`, `gap`,
     /// `settled`).
     pub fn name(self) -> &'static str {

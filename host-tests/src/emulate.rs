@@ -155,16 +155,10 @@ fn flag(m: &HashMap<String, String>, key: &str) -> Result<bool, String> {
 /// firmware's shortest round-trip decimals give back its exact bits).
 pub fn parse_impact(m: &HashMap<String, String>) -> Result<ImpactReport, String> {
     let status = get(m, "status")?;
-    let status = [
-        Status::Complete,
-        Status::StreamEnded,
-        Status::BufferFull,
-        Status::TooLong,
-        Status::Gap,
-    ]
-    .into_iter()
-    .find(|s| s.name() == status)
-    .ok_or_else(|| format!("status={status}: unknown status"))?;
+    let status = Status::ALL
+        .into_iter()
+        .find(|s| s.name() == status)
+        .ok_or_else(|| format!("status={status}: unknown status"))?;
     let analysis = get(m, "analysis")?;
     let analysis = [Analysis::Full, Analysis::Skipped]
         .into_iter()
