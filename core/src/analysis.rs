@@ -7,9 +7,12 @@
 
 use crate::capture::Capture;
 use crate::motion::{self, PointsOut, Scale};
-use crate::report::{self, Analysis, ImpactReport, Kinematics, Status};
+use crate::report::{self, Analysis, Flags, ImpactReport, Kinematics, Status};
 use crate::scene::Scene;
 use crate::stream::Deviation;
+
+/// How far beyond [0, 1] a measured COR may lie before it is taken as wrong, not noisy.
+const COR_TOLERANCE: f32 = 0.02;
 
 /// Points the fits see at most: a contact of 12 600 samples (the seed bench at 500 kS/s) is
 /// thinned to every 6th sample, which moves no fitted value beyond its noise.
@@ -114,10 +117,20 @@ pub fn analyse<const CAP: usize>(
     // Peak and width: on the filtered acceleration with a CFC, else on the raw samples (the
     // stream's peak, if the capture holds it).
     let mut filtered: Option<(usize, f32)> = None;
+    let mut cfc_refused = false;
     #[cfg(feature = "cfc")]
     if let Some(class) = scene.cfc {
         let fs = scene.calibration.sample_rate_hz as f64;
-        if let (Some(b), Some(a)) = (
+        // The filter needs signal to settle on both sides of the contact (J211's padding):
+        // without it, no filtered peak and no width.
+        let pad = class.padding_samples(scene.calibration.sample_rate_hz) as u64;
+        let before = s.onset_index.saturating_sub(s.first_index);
+        let contact_end = s.separation_index.unwrap_or(s.end_index);
+        let after = (s.first_index + n as u64).saturating_sub(contact_end);
+        if before < pad || after < pad {
+            r.flags.insert(Flags::CFC_WINDOW);
+            cfc_refused = true;
+        } else if let (Some(b), Some(a)) = (
             crate::signal::cfc::Biquad::cfc(class, fs),
             work.buf.get_mut(..n),
         ) {
@@ -149,12 +162,17 @@ pub fn analyse<const CAP: usize>(
                     }
                 }),
             };
-            r.fwhm_s = fwhm_raw(samples, deviation, per_count, i)
-                .map(|w| w / scene.calibration.sample_rate_hz);
+            if !cfc_refused {
+                r.fwhm_s = fwhm_raw(samples, deviation, per_count, i)
+                    .map(|w| w / scene.calibration.sample_rate_hz);
+            }
             (i, v)
         }
     };
     let _ = peak_i;
+    if r.fwhm_s.is_none() && !cfc_refused {
+        r.flags.insert(Flags::HALF_MAXIMUM_OUTSIDE);
+    }
 
     // Kinematics (and the fit points) need the approach speed and the whole impact.
     let (Some(v0), Status::Complete, Some(sep_index)) = (s.v0_m_s, s.status, s.separation_index)
@@ -218,15 +236,24 @@ pub fn analyse<const CAP: usize>(
     });
     let Some(found) = motion::integrate(from_onset, deviation, &motion_scale, separation, out)
     else {
+        r.flags.insert(Flags::NO_STOP);
         return r;
     };
-    let rebound = r.delta_v_m_s - v0;
+    let Some(delta_v) = r.delta_v_m_s else {
+        return r;
+    };
+    let rebound = delta_v - v0;
+    let cor = rebound / v0;
+    if !(-COR_TOLERANCE..=1.0 + COR_TOLERANCE).contains(&cor) {
+        r.flags.insert(Flags::COR_OUT_OF_RANGE);
+        return r;
+    }
     let k = Kinematics {
         impact_velocity_m_s: v0,
         crush_time_s: ((found.crush - touch) * dt) as f32,
         max_deformation_m: found.x_max as f32,
         rebound_velocity_m_s: rebound,
-        cor: rebound / v0,
+        cor,
         permanent_deformation_m: found.x_sep as f32,
         absorbed_energy_j: scene
             .mass_kg

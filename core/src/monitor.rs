@@ -236,7 +236,7 @@ mod next_hit_tests {
         assert_eq!(out[0].end_sample, out[1].start_sample);
         // The second pulse leaves the edge band ~32 samples after it starts at 7300.
         assert!((out[1].start_sample as i64 - 7332).abs() < 20, "{out:#?}");
-        let dv = (out[0].delta_v_m_s, out[1].delta_v_m_s);
+        let dv = (out[0].delta_v_m_s.unwrap(), out[1].delta_v_m_s.unwrap());
         assert!((dv.0 / dv.1 - 1.0).abs() < 0.01, "{dv:?}");
     }
 }

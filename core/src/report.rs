@@ -74,6 +74,65 @@ impl Analysis {
     }
 }
 
+/// Why fields of a report are absent (a bit set): each flag names what was found and which
+/// fields it empties. A value that cannot be known is absent, never a plausible-looking
+/// number.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct Flags(pub u16);
+
+impl Flags {
+    /// After the pulse the signal undid most of its velocity change within the window (a
+    /// sustained undershoot): the channel does not hold DC (a piezoelectric, AC-coupled
+    /// sensor). Δv, the kinematics and the fits are absent.
+    pub const AC_COUPLED: Flags = Flags(1 << 0);
+    /// The coefficient of restitution came out outside [0, 1] (beyond a 2 % tolerance): the
+    /// rebound went the wrong way or gained energy, so the approach speed or the signal is
+    /// wrong. The kinematics and the fits are absent.
+    pub const COR_OUT_OF_RANGE: Flags = Flags(1 << 1);
+    /// The velocity never reached zero: the approach speed is more than the measured Δv
+    /// could stop. The kinematics and the fits are absent.
+    pub const NO_STOP: Flags = Flags(1 << 2);
+    /// Half the peak is not reached on both sides inside the capture: no FWHM.
+    pub const HALF_MAXIMUM_OUTSIDE: Flags = Flags(1 << 3);
+    /// The capture holds less signal around the contact than the CFC filter needs to settle
+    /// (SAE J211's padding): the filtered peak and the FWHM are absent.
+    pub const CFC_WINDOW: Flags = Flags(1 << 4);
+    /// The approach speed is unknown (no `v0`, drop height, free fall or light gate): the
+    /// kinematics and the fits are absent.
+    pub const NO_APPROACH_SPEED: Flags = Flags(1 << 5);
+
+    /// Every flag with its name in the reports.
+    pub const NAMES: [(Flags, &'static str); 6] = [
+        (Flags::AC_COUPLED, "ac-coupled"),
+        (Flags::COR_OUT_OF_RANGE, "cor-out-of-range"),
+        (Flags::NO_STOP, "no-stop"),
+        (Flags::HALF_MAXIMUM_OUTSIDE, "half-maximum-outside"),
+        (Flags::CFC_WINDOW, "cfc-window"),
+        (Flags::NO_APPROACH_SPEED, "no-approach-speed"),
+    ];
+
+    pub const fn empty() -> Self {
+        Flags(0)
+    }
+
+    pub const fn contains(self, other: Flags) -> bool {
+        self.0 & other.0 == other.0
+    }
+
+    pub fn insert(&mut self, other: Flags) {
+        self.0 |= other.0;
+    }
+
+    /// The names of the flags set, in [`Self::NAMES`] order.
+    pub fn names(self) -> impl Iterator<Item = &'static str> {
+        Self::NAMES
+            .into_iter()
+            .filter(move |(f, _)| self.contains(*f))
+            .map(|(_, n)| n)
+    }
+}
+
 /// What the deceleration says once `v0` is known. SI.
 #[derive(Clone, Copy, Debug, PartialEq)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
@@ -108,6 +167,8 @@ pub struct ImpactReport {
     pub analysis: Analysis,
     /// The sensor reached a rail inside the impact: peak and Δv are lower bounds.
     pub clipped: bool,
+    /// Why fields below are absent.
+    pub flags: Flags,
     /// Sample index of the pulse's first sample beyond the edge level.
     pub start_sample: u64,
     /// Sample index just after the impact: the end of the hold (or where it was cut).
@@ -121,8 +182,9 @@ pub struct ImpactReport {
     /// `m a` at the peak, N (when the mass is known).
     pub peak_force_n: Option<f32>,
     /// Velocity change over the contact, from first touch to separation, m/s (`v0 + v'` for a
-    /// rebound); over the whole window if the signal never came back.
-    pub delta_v_m_s: f32,
+    /// rebound); over the whole window if the signal never came back. Absent for an
+    /// AC-coupled channel.
+    pub delta_v_m_s: Option<f32>,
     /// From first touch to separation (both flank-extrapolated), or to the end of the capture
     /// if the signal never came back, s.
     pub duration_s: f32,
@@ -135,6 +197,11 @@ pub struct ImpactReport {
     pub kinematics: Option<Kinematics>,
     pub fits: Fits,
 }
+
+/// A window whose Δv is less than this share of its contact's (the rest undone after
+/// separation) is from an AC-coupled channel. A DC sensor on a body that flies off or rings
+/// keeps most of it (the AFRL drop tower's ringing table: 88 %).
+const AC_COUPLED_RATIO: f64 = 0.5;
 
 /// Acceleration per unit of `d = W x - S`, m/s², in f32 as the analysis converts samples:
 /// `a = d as f32 * per_count(..)`.
@@ -152,6 +219,19 @@ pub fn streaming(s: &Summary, scene: &Scene) -> ImpactReport {
     // peak of the (unfiltered) array have the same bits.
     let peak = s.peak_d as f32 * per_count(scene, s.base_n);
     let start = s.onset_index as f64 + s.touch_offset as f64;
+    // Δv over the contact; the whole window's (the contact and the hold after it) undoing
+    // most of it is the mark of a channel that does not hold DC.
+    let mut flags = Flags::empty();
+    if s.v0_m_s.is_none() {
+        flags.insert(Flags::NO_APPROACH_SPEED);
+    }
+    let delta_v = match s.contact_c {
+        Some(c) if c != 0 && (s.total_c as f64 / c as f64) < AC_COUPLED_RATIO => {
+            flags.insert(Flags::AC_COUPLED);
+            None
+        }
+        c => Some((c.unwrap_or(s.total_c) as f64 * per_d / fs) as f32),
+    };
     let end = match s.separation_index {
         Some(i) => i as f64 + s.separation_offset as f64,
         None => s.end_index as f64,
@@ -161,13 +241,14 @@ pub fn streaming(s: &Summary, scene: &Scene) -> ImpactReport {
         status: s.status,
         analysis: Analysis::Skipped,
         clipped: s.clipped,
+        flags,
         start_sample: s.onset_index,
         end_sample: s.end_index,
         start_s: start / fs,
         peak_time_s: s.peak_index as f64 / fs,
         peak_acceleration_m_s2: peak,
         peak_force_n: scene.mass_kg.map(|m| m * peak),
-        delta_v_m_s: (s.contact_c.unwrap_or(s.total_c) as f64 * per_d / fs) as f32,
+        delta_v_m_s: delta_v,
         duration_s: ((end - start) / fs) as f32,
         baseline_m_s2: (s.base_sum as f64 * per_d) as f32,
         fwhm_s: None,

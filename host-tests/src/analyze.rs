@@ -1,13 +1,14 @@
 //! `impact analyze`: a recorded signal through the same core pipeline the firmware runs.
 
+use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 
 use clap::{Args, ValueEnum};
 use impact_core::monitor::Monitor;
-use impact_core::report::Fits;
+use impact_core::report::{Fits, Flags};
 use impact_core::signal::cfc::Cfc;
 use impact_core::solve::bounce::STANDARD_GRAVITY;
-use impact_core::{Approach, Calibration, FitSet, ImpactReport, Scene};
+use impact_core::{Approach, Calibration, FitSet, ImpactReport, Scene, Status};
 use serde::{Deserialize, Serialize};
 
 use crate::recording::{read_csv, read_table, ColumnRef, ReadOptions};
@@ -167,13 +168,15 @@ pub struct ImpactJson {
     /// "full", or "skipped" when no capture buffer was free (streaming fields only).
     pub analysis: String,
     pub clipped: bool,
+    /// What was found that empties fields ("ac-coupled", "cor-out-of-range", ...).
+    pub flags: Vec<String>,
     pub start_sample: u64,
     pub end_sample: u64,
     pub start_s: f64,
     pub peak_time_s: f64,
     pub peak_acceleration_m_s2: f64,
     pub peak_force_n: Option<f64>,
-    pub delta_v_m_s: f64,
+    pub delta_v_m_s: Option<f64>,
     pub duration_s: f64,
     pub baseline_m_s2: f64,
     pub fwhm_s: Option<f64>,
@@ -186,6 +189,8 @@ pub struct ImpactJson {
     pub permanent_deformation_m: Option<f64>,
     pub absorbed_energy_j: Option<f64>,
     pub fits: FitsJson,
+    /// Why each absent (null) field is absent: the field's name and the reason.
+    pub null_reasons: BTreeMap<String, String>,
     /// Real-time emulation only: virtual time from the end of the impact's hold to its
     /// report, s.
     #[serde(skip_serializing_if = "Option::is_none")]
@@ -230,8 +235,89 @@ fn fits_json(f: &Fits) -> FitsJson {
     }
 }
 
-/// A core report as JSON; times shifted by `t0` (the recording's first time stamp).
-pub fn impact_json(r: &ImpactReport, t0: f64) -> ImpactJson {
+/// Why each absent field of `r` is absent; `fits` is what the scene asked for.
+pub fn null_reasons(r: &ImpactReport, fits: &FitSet) -> BTreeMap<String, String> {
+    let mut out = BTreeMap::new();
+    let skipped = r.analysis == impact_core::Analysis::Skipped;
+    let flag = |f: Flags| r.flags.contains(f);
+    let mut put = |field: &str, reason: &str| {
+        out.insert(field.to_string(), reason.to_string());
+    };
+    if r.peak_force_n.is_none() {
+        put("peak_force_n", "no-mass");
+    }
+    if r.delta_v_m_s.is_none() {
+        put("delta_v_m_s", "ac-coupled");
+    }
+    let analysis = |own: Option<&'static str>| {
+        if skipped {
+            "analysis-skipped"
+        } else if flag(Flags::CFC_WINDOW) {
+            "cfc-window"
+        } else {
+            own.unwrap_or("not-found")
+        }
+    };
+    if r.fwhm_s.is_none() {
+        put("fwhm_s", analysis(Some("half-maximum-outside")));
+    }
+    if r.filtered_peak_acceleration_m_s2.is_none() {
+        put("filtered_peak_acceleration_m_s2", analysis(Some("no-cfc")));
+    }
+    // The kinematics: the first reason that applies.
+    let kinematics = if r.kinematics.is_some() {
+        None
+    } else if flag(Flags::NO_APPROACH_SPEED) {
+        Some("no-approach-speed".to_string())
+    } else if skipped {
+        Some("analysis-skipped".to_string())
+    } else if flag(Flags::AC_COUPLED) {
+        Some("ac-coupled".to_string())
+    } else if r.status != Status::Complete {
+        Some(format!("status-{}", r.status.name()))
+    } else if flag(Flags::COR_OUT_OF_RANGE) {
+        Some("cor-out-of-range".to_string())
+    } else if flag(Flags::NO_STOP) {
+        Some("no-stop".to_string())
+    } else {
+        Some("not-found".to_string())
+    };
+    if let Some(why) = &kinematics {
+        for field in [
+            "impact_velocity_m_s",
+            "crush_time_s",
+            "max_deformation_m",
+            "rebound_velocity_m_s",
+            "cor",
+            "permanent_deformation_m",
+            "absorbed_energy_j",
+        ] {
+            put(field, why);
+        }
+    } else if r.kinematics.is_some_and(|k| k.absorbed_energy_j.is_none()) {
+        put("absorbed_energy_j", "no-mass");
+    }
+    for (name, asked, got) in [
+        ("fits.two_phase", fits.two_phase, r.fits.two_phase.is_some()),
+        ("fits.nonlinear", fits.nonlinear, r.fits.nonlinear.is_some()),
+        ("fits.hertz", fits.hertz, r.fits.hertz.is_some()),
+    ] {
+        if !got {
+            let why = match &kinematics {
+                _ if !asked => "not-asked",
+                _ if r.peak_force_n.is_none() => "no-mass",
+                Some(k) => k.as_str(),
+                None => "not-identifiable",
+            };
+            put(name, why);
+        }
+    }
+    out
+}
+
+/// A core report as JSON; times shifted by `t0` (the recording's first time stamp); `fits`
+/// is what the scene asked for (for the reasons of absent fits).
+pub fn impact_json(r: &ImpactReport, t0: f64, fits: &FitSet) -> ImpactJson {
     let k = r.kinematics;
     let f = |v: f32| v as f64;
     ImpactJson {
@@ -239,13 +325,14 @@ pub fn impact_json(r: &ImpactReport, t0: f64) -> ImpactJson {
         status: r.status.name().into(),
         analysis: r.analysis.name().into(),
         clipped: r.clipped,
+        flags: r.flags.names().map(str::to_string).collect(),
         start_sample: r.start_sample,
         end_sample: r.end_sample,
         start_s: t0 + r.start_s,
         peak_time_s: t0 + r.peak_time_s,
         peak_acceleration_m_s2: f(r.peak_acceleration_m_s2),
         peak_force_n: r.peak_force_n.map(f),
-        delta_v_m_s: f(r.delta_v_m_s),
+        delta_v_m_s: r.delta_v_m_s.map(f),
         duration_s: f(r.duration_s),
         baseline_m_s2: f(r.baseline_m_s2),
         fwhm_s: r.fwhm_s.map(f),
@@ -258,6 +345,7 @@ pub fn impact_json(r: &ImpactReport, t0: f64) -> ImpactJson {
         permanent_deformation_m: k.map(|k| f(k.permanent_deformation_m)),
         absorbed_energy_j: k.and_then(|k| k.absorbed_energy_j).map(f),
         fits: fits_json(&r.fits),
+        null_reasons: null_reasons(r, fits),
         report_latency_s: None,
     }
 }
@@ -532,7 +620,7 @@ pub fn to_json(setup: &Setup, reports: &[ImpactReport]) -> AnalysisJson {
             .count() as u64,
         impacts: reports
             .iter()
-            .map(|r| impact_json(r, setup.prepared.t0))
+            .map(|r| impact_json(r, setup.prepared.t0, &setup.scene.fits))
             .collect(),
     }
 }
@@ -540,7 +628,7 @@ pub fn to_json(setup: &Setup, reports: &[ImpactReport]) -> AnalysisJson {
 /// CSV text: one row per impact.
 pub fn to_csv(a: &AnalysisJson) -> String {
     let mut s = String::from(
-        "index,status,analysis,clipped,start_sample,end_sample,start_s,peak_time_s,peak_acceleration_m_s2,peak_force_n,delta_v_m_s,duration_s,baseline_m_s2,fwhm_s,filtered_peak_acceleration_m_s2,\
+        "index,status,analysis,clipped,flags,start_sample,end_sample,start_s,peak_time_s,peak_acceleration_m_s2,peak_force_n,delta_v_m_s,duration_s,baseline_m_s2,fwhm_s,filtered_peak_acceleration_m_s2,\
 impact_velocity_m_s,crush_time_s,max_deformation_m,rebound_velocity_m_s,cor,permanent_deformation_m,absorbed_energy_j,\
 two_phase_kc_n_m,two_phase_kr_n_m,two_phase_c_n_s_m,two_phase_permanent_deformation_m,two_phase_residual,\
 nonlinear_k,nonlinear_c_s_m,nonlinear_exponent,nonlinear_residual,hertz_k,hertz_residual\n",
@@ -555,13 +643,14 @@ nonlinear_k,nonlinear_c_s_m,nonlinear_exponent,nonlinear_residual,hertz_k,hertz_
             i.status.clone(),
             i.analysis.clone(),
             i.clipped.to_string(),
+            i.flags.join(";"),
             i.start_sample.to_string(),
             i.end_sample.to_string(),
             format!("{:e}", i.start_s),
             format!("{:e}", i.peak_time_s),
             format!("{:e}", i.peak_acceleration_m_s2),
             o(i.peak_force_n),
-            format!("{:e}", i.delta_v_m_s),
+            o(i.delta_v_m_s),
             format!("{:e}", i.duration_s),
             format!("{:e}", i.baseline_m_s2),
             o(i.fwhm_s),
@@ -615,7 +704,7 @@ pub fn to_table(a: &AnalysisJson) -> String {
     );
     for i in &a.impacts {
         s.push_str(&format!(
-            "impact {} [{}{}{}] at {:.6} s: peak {:.4e} m/s² ({:.2} g){}, Δv {:.4} m/s, duration {:.4e} s, FWHM {}\n",
+            "impact {} [{}{}{}] at {:.6} s: peak {:.4e} m/s² ({:.2} g){}, Δv {}, duration {:.4e} s, FWHM {}\n",
             i.index,
             i.status,
             if i.clipped { ", CLIPPED" } else { "" },
@@ -624,10 +713,24 @@ pub fn to_table(a: &AnalysisJson) -> String {
             i.peak_acceleration_m_s2,
             i.peak_acceleration_m_s2 / STANDARD_GRAVITY,
             i.peak_force_n.map_or(String::new(), |f| format!(", force {f:.4e} N")),
-            i.delta_v_m_s,
+            i.delta_v_m_s.map_or_else(
+                || format!("unknown ({})", i.null_reasons["delta_v_m_s"]),
+                |v| format!("{v:.4} m/s")
+            ),
             i.duration_s,
-            i.fwhm_s.map_or("unknown".to_string(), |w| format!("{w:.4e} s")),
+            i.fwhm_s.map_or_else(
+                || format!("unknown ({})", i.null_reasons["fwhm_s"]),
+                |w| format!("{w:.4e} s")
+            ),
         ));
+        // Why the kinematics are missing, unless simply because v0 was not given.
+        if let Some(why) = i
+            .null_reasons
+            .get("cor")
+            .filter(|r| *r != "no-approach-speed")
+        {
+            s.push_str(&format!("    no kinematics: {why}\n"));
+        }
         if let Some(latency) = i.report_latency_s {
             s.push_str(&format!(
                 "    reported {:.1} ms after the end of its hold\n",

@@ -15,7 +15,7 @@ use std::process::{Command, ExitStatus, Stdio};
 use std::time::{Duration, Instant};
 
 use clap::Args;
-use impact_core::report::{Fits, HertzFit, NonlinearFit, TwoPhaseFit};
+use impact_core::report::{Fits, Flags, HertzFit, NonlinearFit, TwoPhaseFit};
 use impact_core::{Analysis, Approach, ImpactReport, Kinematics, Scene, Status};
 
 use crate::analyze::{self, AnalysisJson, AnalyzeArgs};
@@ -207,13 +207,14 @@ pub fn parse_impact(m: &HashMap<String, String>) -> Result<ImpactReport, String>
         status,
         analysis,
         clipped: flag(m, "clipped")?,
+        flags: Flags(num(m, "flags")?),
         start_sample: num(m, "start_sample")?,
         end_sample: num(m, "end_sample")?,
         start_s: num(m, "start_s")?,
         peak_time_s: num(m, "peak_time_s")?,
         peak_acceleration_m_s2: num(m, "peak_acceleration_m_s2")?,
         peak_force_n: opt(m, "peak_force_n")?,
-        delta_v_m_s: num(m, "delta_v_m_s")?,
+        delta_v_m_s: opt(m, "delta_v_m_s")?,
         duration_s: num(m, "duration_s")?,
         baseline_m_s2: num(m, "baseline_m_s2")?,
         fwhm_s: opt(m, "fwhm_s")?,
@@ -279,6 +280,20 @@ pub fn log_json(log: &Log, t0: f64) -> Result<AnalysisJson, String> {
         Some(m) if get(m, "v0_m_s")? != "none" => Some("v0".to_string()),
         _ => None,
     };
+    // What the scene asked for (the scene line's flags), for the reasons of absent fits.
+    let asked = |key: &str| -> Result<bool, String> {
+        match &log.scene {
+            Some(m) => flag(m, key),
+            None => Ok(false),
+        }
+    };
+    let fits = impact_core::FitSet {
+        two_phase: asked("two_phase")?,
+        nonlinear: asked("nonlinear")?,
+        fit_exponent: asked("fit_exponent")?,
+        nonlinear_exponent: 1.0,
+        hertz: asked("hertz")?,
+    };
     let counter = |key: &str| -> Result<u64, String> {
         match state {
             Some(m) if m.contains_key(key) => num::<u64>(m, key),
@@ -297,7 +312,7 @@ pub fn log_json(log: &Log, t0: f64) -> Result<AnalysisJson, String> {
             .iter()
             .zip(&log.latencies)
             .map(|(r, latency)| {
-                let mut j = analyze::impact_json(r, t0);
+                let mut j = analyze::impact_json(r, t0, &fits);
                 j.report_latency_s = latency.map(f64::from);
                 j
             })
@@ -678,7 +693,7 @@ pub fn log(args: &LogArgs) -> Result<(), String> {
 mod tests {
     use super::*;
 
-    const LINE: &str = "0.013931 INFO  impact index=0 status=complete analysis=full clipped=false start_sample=5000 end_sample=17000 start_s=0.01 peak_time_s=0.0100251 peak_acceleration_m_s2=4321.5 peak_force_n=259.29 delta_v_m_s=2.5 duration_s=0.0219 baseline_m_s2=0.2 fwhm_s=0.001 filtered_peak_acceleration_m_s2=none impact_velocity_m_s=1.3357 crush_time_s=0.0218 max_deformation_m=0.0186 rebound_velocity_m_s=1.16 cor=0.87 permanent_deformation_m=0.0182 absorbed_energy_j=none two_phase_kc_n_m=none two_phase_kr_n_m=none two_phase_c_n_s_m=none two_phase_permanent_deformation_m=none two_phase_residual=none nonlinear_k=1e6 nonlinear_c_s_m=0.5 nonlinear_exponent=1.2 nonlinear_residual=0.01 hertz_k=none hertz_residual=none report_latency_s=0.0123";
+    const LINE: &str = "0.013931 INFO  impact index=0 status=complete analysis=full clipped=false flags=0 start_sample=5000 end_sample=17000 start_s=0.01 peak_time_s=0.0100251 peak_acceleration_m_s2=4321.5 peak_force_n=259.29 delta_v_m_s=2.5 duration_s=0.0219 baseline_m_s2=0.2 fwhm_s=0.001 filtered_peak_acceleration_m_s2=none impact_velocity_m_s=1.3357 crush_time_s=0.0218 max_deformation_m=0.0186 rebound_velocity_m_s=1.16 cor=0.87 permanent_deformation_m=0.0182 absorbed_energy_j=none two_phase_kc_n_m=none two_phase_kr_n_m=none two_phase_c_n_s_m=none two_phase_permanent_deformation_m=none two_phase_residual=none nonlinear_k=1e6 nonlinear_c_s_m=0.5 nonlinear_exponent=1.2 nonlinear_residual=0.01 hertz_k=none hertz_residual=none report_latency_s=0.0123";
 
     #[test]
     fn parses_an_impact_line() {

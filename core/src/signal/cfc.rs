@@ -28,6 +28,19 @@ impl Cfc {
         }
     }
 
+    /// Samples of signal the phaseless filter needs on each side of a pulse to settle: one
+    /// period of its -3 dB frequency (1.667 × the class, SAE J211), rounded up.
+    pub fn padding_samples(self, sample_rate_hz: f32) -> u32 {
+        let n = libm::ceilf(sample_rate_hz / (1.667 * self.class() as f32));
+        if n >= u32::MAX as f32 {
+            u32::MAX
+        } else if n >= 1.0 {
+            n as u32
+        } else {
+            1
+        }
+    }
+
     /// The class from its number.
     pub fn from_class(class: u32) -> Option<Self> {
         match class {

@@ -128,7 +128,11 @@ impl<const PRE: usize> Stream<PRE> {
         // into the previous impact's window).
         let since_last =
             usize::try_from(self.index - self.window_end.min(self.index)).unwrap_or(usize::MAX);
-        let margin = (pulse + self.hold as usize / 2)
+        // With a CFC filter, the samples it needs to settle before the onset.
+        let pad = self.scene.cfc.map_or(0, |c| {
+            c.padding_samples(self.scene.calibration.sample_rate_hz) as usize
+        });
+        let margin = (pulse + (self.hold as usize / 2).max(pad))
             .min(self.ring.len())
             .min(CAP / 2)
             .min(since_last.max(pulse));

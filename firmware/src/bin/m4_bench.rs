@@ -322,7 +322,7 @@ fn stream(
     }
     if let Some(r) = last {
         hprintln!(
-            "report {} status={:?} peak_m_s2={:e} delta_v_m_s={:e} duration_s={:e}",
+            "report {} status={:?} peak_m_s2={:e} delta_v_m_s={:?} duration_s={:e}",
             label,
             r.status,
             r.peak_acceleration_m_s2,

@@ -237,18 +237,19 @@ fn log_impact(r: &ImpactReport) {
     let nl = r.fits.nonlinear;
     let hz = r.fits.hertz;
     info!(
-        "impact index={=u32} status={=str} analysis={=str} clipped={=bool} start_sample={=u64} end_sample={=u64} start_s={=f64} peak_time_s={=f64} peak_acceleration_m_s2={=f32} peak_force_n={} delta_v_m_s={=f32} duration_s={=f32} baseline_m_s2={=f32} fwhm_s={} filtered_peak_acceleration_m_s2={} impact_velocity_m_s={} crush_time_s={} max_deformation_m={} rebound_velocity_m_s={} cor={} permanent_deformation_m={} absorbed_energy_j={} two_phase_kc_n_m={} two_phase_kr_n_m={} two_phase_c_n_s_m={} two_phase_permanent_deformation_m={} two_phase_residual={} nonlinear_k={} nonlinear_c_s_m={} nonlinear_exponent={} nonlinear_residual={} hertz_k={} hertz_residual={} report_latency_s={}",
+        "impact index={=u32} status={=str} analysis={=str} clipped={=bool} flags={=u16} start_sample={=u64} end_sample={=u64} start_s={=f64} peak_time_s={=f64} peak_acceleration_m_s2={=f32} peak_force_n={} delta_v_m_s={} duration_s={=f32} baseline_m_s2={=f32} fwhm_s={} filtered_peak_acceleration_m_s2={} impact_velocity_m_s={} crush_time_s={} max_deformation_m={} rebound_velocity_m_s={} cor={} permanent_deformation_m={} absorbed_energy_j={} two_phase_kc_n_m={} two_phase_kr_n_m={} two_phase_c_n_s_m={} two_phase_permanent_deformation_m={} two_phase_residual={} nonlinear_k={} nonlinear_c_s_m={} nonlinear_exponent={} nonlinear_residual={} hertz_k={} hertz_residual={} report_latency_s={}",
         r.index,
         r.status.name(),
         r.analysis.name(),
         r.clipped,
+        r.flags.0,
         r.start_sample,
         r.end_sample,
         r.start_s,
         r.peak_time_s,
         r.peak_acceleration_m_s2,
         Opt(r.peak_force_n),
-        r.delta_v_m_s,
+        Opt(r.delta_v_m_s),
         r.duration_s,
         r.baseline_m_s2,
         Opt(r.fwhm_s),
