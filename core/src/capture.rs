@@ -6,8 +6,6 @@
 //! sink with no free buffer (every one waiting for or in analysis) is not an error: the
 //! impact is still followed to its end and reported from the streaming fields alone.
 
-use heapless::Vec;
-
 use crate::report::{ImpactReport, Status};
 use crate::scene::Scene;
 
@@ -74,7 +72,9 @@ impl Summary {
 /// One impact's raw samples (up to `CAP` of them, from the pre-trigger margin on) and its
 /// [`Summary`]. `Capture::new()` is all zeros, so a `static` of captures starts in `.bss`.
 pub struct Capture<const CAP: usize> {
-    samples: Vec<i16, CAP>,
+    samples: [i16; CAP],
+    /// Samples held (`<= CAP`).
+    len: usize,
     summary: Summary,
 }
 
@@ -88,14 +88,15 @@ impl<const CAP: usize> Capture<CAP> {
     /// An empty capture.
     pub const fn new() -> Self {
         Self {
-            samples: Vec::new(),
+            samples: [0; CAP],
+            len: 0,
             summary: Summary::EMPTY,
         }
     }
 
     /// The raw samples, from stream index `summary().first_index` on.
     pub fn samples(&self) -> &[i16] {
-        &self.samples
+        self.samples.get(..self.len).unwrap_or(&[])
     }
 
     /// What the streaming stage measured (valid once the capture has been handed over).
@@ -105,20 +106,19 @@ impl<const CAP: usize> Capture<CAP> {
 
     /// True if the impact had more samples than the buffer holds.
     pub fn is_full(&self) -> bool {
-        self.samples.is_full()
+        self.len >= CAP
     }
 
     pub(crate) fn clear(&mut self) {
-        self.samples.clear();
+        self.len = 0;
     }
 
     /// Appends what fits; returns how many samples did.
     pub(crate) fn extend(&mut self, samples: &[i16]) -> usize {
-        let fits = (CAP - self.samples.len()).min(samples.len());
-        // `fits` samples always fit, so this never fails.
-        let _ = self
-            .samples
-            .extend_from_slice(samples.get(..fits).unwrap_or(&[]));
+        let free = self.samples.get_mut(self.len..).unwrap_or(&mut []);
+        let fits = free.len().min(samples.len());
+        crate::signal::copy::copy_samples(free, samples);
+        self.len += fits;
         fits
     }
 

@@ -157,6 +157,8 @@ pub struct Baseline<const K: usize> {
     head: usize,
     len: usize,
     total: i64,
+    /// `total / (len * STRIDE)` (0 before arming), kept with the window.
+    mean: f32,
     // The stride being accumulated.
     acc: i32,
     min: i16,
@@ -177,6 +179,7 @@ impl<const K: usize> Baseline<K> {
             head: 0,
             len: 0,
             total: 0,
+            mean: 0.0,
             acc: 0,
             min: i16::MAX,
             max: i16::MIN,
@@ -195,7 +198,13 @@ impl<const K: usize> Baseline<K> {
     }
 
     /// The baseline in counts (0 before arming).
+    #[inline]
     pub fn mean(&self) -> f32 {
+        self.mean
+    }
+
+    /// `total / (len * STRIDE)`, for the window just changed.
+    fn window_mean(&self) -> f32 {
         if self.len == 0 {
             0.0
         } else {
@@ -244,7 +253,9 @@ impl<const K: usize> Baseline<K> {
         } else {
             // The mean of a stride of noise is within ~4 standard errors (σ / 8) of the
             // baseline; the span of 64 noisy samples is ~5 σ.
-            let band = (span / 10.0).max(1.0);
+            // (`f32::max` is a library call on the M4.)
+            let band = span / 10.0;
+            let band = if band > 1.0 { band } else { 1.0 };
             let stride_mean = acc as f32 / self.filled as f32;
             lo as f32 >= mean - edge
                 && hi as f32 <= mean + edge
@@ -259,6 +270,7 @@ impl<const K: usize> Baseline<K> {
             self.sums[self.head % K] = acc;
             self.total += acc as i64;
             self.head = (self.head + 1) % K;
+            self.mean = self.window_mean();
         }
         self.acc = 0;
         self.min = i16::MAX;

@@ -13,6 +13,7 @@ use super::level::LevelWatch;
 use super::{Deviation, Stream, FLANK_EDGES};
 use crate::capture::{Sink, Summary};
 use crate::report::{self, Status};
+use crate::signal::baseline::{Stats, STRIDE};
 use crate::signal::flank::{crossing, Flank};
 
 /// The impact being followed.
@@ -33,8 +34,9 @@ pub(super) struct Active {
     d_hi: i32,
     d_lo: i32,
     quiet: u32,
-    /// The longest run of quiet samples since the separation.
-    longest_quiet: u32,
+    /// Since the latest peak, the signal stayed within the edge level for at least an
+    /// eighth of the hold (so a new hit is a new impact, not ringing).
+    returned: bool,
     /// Stream index of the first sample back within the edge level (or across it, a sign
     /// flip) after the peak (separation: later ringing does not move it unless it brings a
     /// new peak).
@@ -153,7 +155,7 @@ impl<const PRE: usize> Stream<PRE> {
             d_hi: d_hi.clamp(i32::MIN as i64, i32::MAX as i64) as i32,
             d_lo: d_lo.clamp(i32::MIN as i64, i32::MAX as i64) as i32,
             quiet: 0,
-            longest_quiet: 0,
+            returned: false,
             separation: None,
             separation_c: 0,
             pre_onset_c: 0,
@@ -168,28 +170,51 @@ impl<const PRE: usize> Stream<PRE> {
             began_in_gap: self.gap_end.is_some_and(|g| onset_index <= g),
             last_quiet: onset_index,
             end_at: None,
-            level: LevelWatch::new(),
+            level: LevelWatch::new(
+                base_n,
+                base_sum,
+                self.edge_counts,
+                self.scene.clip_counts,
+                u64::from(self.settle),
+            ),
         };
         let (clip_lo, clip_hi) = self.scene.clip_counts;
         let (older, newer) = self.ring.last(margin);
-        let before_onset = margin.saturating_sub(pulse) as u64;
+        let before_onset = margin.saturating_sub(pulse);
+        let (w, s) = (base_n, base_sum);
         for run in [older, newer] {
-            for (k, &x) in run.iter().enumerate() {
-                let d = deviation.of(x) as i64;
-                a.total_c += d;
-                if a.samples + (k as u64) < before_onset {
-                    a.pre_onset_c += d;
-                }
-                if d.unsigned_abs() > a.peak_d.unsigned_abs() {
-                    a.peak_d = d;
-                    a.peak_index = a.first_index + a.samples + k as u64;
-                }
-                a.clipped |= x <= clip_lo || x >= clip_hi;
-            }
             if let Some(c) = capture.as_mut() {
                 a.full |= c.extend(run) < run.len();
             }
-            a.samples += run.len() as u64;
+            // A stride at a time (split at the onset), from the stride statistics: Σd
+            // exactly, the peak from the extremes (its first sample found only when it
+            // beats the peak so far), the rails from min and max.
+            let mut rest = run;
+            while !rest.is_empty() {
+                let pos = a.samples as usize;
+                let to_onset = before_onset.checked_sub(pos).filter(|&n| n > 0);
+                let n = rest.len().min(STRIDE).min(to_onset.unwrap_or(usize::MAX));
+                let (part, after) = rest.split_at(n);
+                let st = Stats::of(part);
+                let c = w * i64::from(st.sum) - n as i64 * s;
+                a.total_c += c;
+                if to_onset.is_some() {
+                    a.pre_onset_c += c;
+                }
+                let extreme = (deviation.of(st.max) as i64).max(-(deviation.of(st.min) as i64));
+                if extreme.unsigned_abs() > a.peak_d.unsigned_abs() {
+                    for (k, &x) in part.iter().enumerate() {
+                        let d = deviation.of(x) as i64;
+                        if d.unsigned_abs() > a.peak_d.unsigned_abs() {
+                            a.peak_d = d;
+                            a.peak_index = a.first_index + (pos + k) as u64;
+                        }
+                    }
+                }
+                a.clipped |= st.min <= clip_lo || st.max >= clip_hi;
+                a.samples += n as u64;
+                rest = after;
+            }
         }
         self.active = Some(a);
     }
@@ -200,32 +225,20 @@ impl<const PRE: usize> Stream<PRE> {
         samples: &[i16],
         sink: &mut impl Sink<CAP>,
     ) -> usize {
-        let mut used = 0;
-        // A stride (aligned from the trigger sample) at a time, for the level watch.
-        while used < samples.len() {
-            let Some(a) = self.active.as_ref() else {
-                break;
-            };
-            let n = a.level.to_stride_end().min(samples.len() - used);
-            let part = samples.get(used..used + n).unwrap_or(&[]);
-            let (taken, end) = self.run_part(part, sink);
-            used += taken;
-            if let Some(end) = end {
-                self.finish_impact(end, sink);
-                break;
-            }
-            if taken < n {
-                break;
-            }
+        let (used, end) = self.run_part(samples, sink);
+        if let Some(end) = end {
+            self.finish_impact(end, sink);
         }
         used
     }
 
-    /// The in-impact loop over at most one stride: returns how many samples it took and how
-    /// the impact ended, if it did.
+    /// The in-impact loop: returns how many samples it took and how the impact ended, if it
+    /// did.
     ///
-    /// The running state lives in locals (the compiler cannot keep fields of `self` in
-    /// registers across the capture's push) and is written back once per call.
+    /// The level watch runs first, over whole strides of raw samples: where the signal
+    /// settles (if it does) is known before the per-sample loop, which stops there. The
+    /// running state lives in locals (the compiler cannot keep fields of `self` in registers
+    /// across the capture's push) and is written back once per call.
     fn run_part<const CAP: usize>(
         &mut self,
         samples: &[i16],
@@ -234,10 +247,9 @@ impl<const PRE: usize> Stream<PRE> {
         let hold = self.hold;
         // A return to the baseline that lets a new hit start a new impact.
         let min_gap = (hold / 8).max(2);
-        let settle = self.settle;
+        let first_mark = min_gap.min(hold);
         let (lo, hi) = self.scene.clip_counts;
         let max_samples = self.max_samples;
-        let edge_counts = self.edge_counts;
         let Some(a) = self.active.as_mut() else {
             return (0, None);
         };
@@ -246,70 +258,114 @@ impl<const PRE: usize> Stream<PRE> {
             .saturating_sub(a.samples)
             .min(samples.len() as u64) as usize;
         let samples = samples.get(..room).unwrap_or(&[]);
+        let scan = a.level.scan(samples);
+        let samples = samples.get(..scan.used).unwrap_or(&[]);
         let deviation = a.deviation();
         // edge_d >= 0: the scene's edge level is positive (validated).
         let edge = a.edge_d.clamp(0, u32::MAX as i64) as u32;
-        let before = a.samples;
+        let start = a.first_index + a.samples;
         let mut peak_abs = a.peak_d.unsigned_abs().min(u32::MAX as u64) as u32;
         let mut peak_positive = a.peak_d >= 0;
         let mut new_peak: Option<(usize, i32)> = None;
-        let (mut separation, mut quiet, mut clipped) = (a.separation, a.quiet, a.clipped);
-        let mut last_quiet = a.last_quiet;
-        let mut longest_quiet = a.longest_quiet;
+        let mut separation = a.separation;
         let mut separation_c = a.separation_c;
-        let (d_hi, d_lo) = (a.d_hi, a.d_lo);
+        let mut quiet = a.quiet;
+        // Back at the baseline long enough since the peak for a new hit to be a new impact.
+        let mut returned = a.returned;
+        // `k` after the latest quiet sample before a louder one, in this call.
+        let mut last_quiet_k: Option<usize> = None;
         let mut sum: i64 = 0;
         let mut used = samples.len();
         let mut ended = None;
-        let start = a.first_index + before;
-        for (k, &x) in samples.iter().enumerate() {
-            let d = deviation.of(x);
-            // Back at the baseline, then a new hit the same way beyond the trigger: the next
-            // impact starts with this sample.
-            if separation.is_some()
-                && quiet.max(longest_quiet) >= min_gap
-                && if peak_positive { d > d_hi } else { d < d_lo }
-            {
-                ended = Some(End::NextHit);
-                used = k;
-                a.end_at = Some(last_quiet);
-                break;
+        let (d_hi, d_lo) = (a.d_hi, a.d_lo);
+        let n = samples.len();
+        let mut k = 0;
+        // Alternating stretches of samples beyond the edge level (loud) and within it
+        // (quiet), each in a tight loop; what is rare (a new peak, a sign flip, a new hit,
+        // the hold reached) leaves the tight loop for the full test.
+        'scan: while k < n {
+            // Loud: `e` is the deviation signed so that the peak's direction is positive.
+            // Anything that may matter lies outside `lo..=hi`: a new peak either way, a sign
+            // flip while there is no separation, a new hit beyond the trigger once the
+            // signal has returned.
+            let marks = |peak_abs: u32, positive: bool, returned: bool, open: bool| {
+                let peak = peak_abs.min(i32::MAX as u32) as i32;
+                let trigger = if positive {
+                    d_hi
+                } else {
+                    d_lo.saturating_neg()
+                };
+                let hi = if returned { trigger.min(peak) } else { peak };
+                let lo = if open { 0 } else { -peak };
+                (if positive { 1 } else { -1 }, trigger, lo, hi)
+            };
+            let (mut sign, mut trigger, mut lo, mut hi) =
+                marks(peak_abs, peak_positive, returned, separation.is_none());
+            while let Some(&x) = samples.get(k) {
+                let d = deviation.of(x);
+                let abs = d.unsigned_abs();
+                if abs <= edge {
+                    break;
+                }
+                let e = d.wrapping_mul(sign);
+                if e > hi || e < lo {
+                    if returned && e > trigger {
+                        // Back at the baseline, then a new hit the same way beyond the
+                        // trigger: the next impact starts with this sample.
+                        ended = Some(End::NextHit);
+                        used = k;
+                        break 'scan;
+                    }
+                    if abs > peak_abs {
+                        peak_abs = abs;
+                        peak_positive = d >= 0;
+                        new_peak = Some((k, d));
+                        separation = None;
+                        returned = false;
+                    } else if separation.is_none() && e < 0 {
+                        // Across the whole band between two samples (a sign flip): the
+                        // signal came back between them.
+                        separation = Some(start + k as u64);
+                        separation_c = a.total_c + sum;
+                    }
+                    (sign, trigger, lo, hi) =
+                        marks(peak_abs, peak_positive, returned, separation.is_none());
+                }
+                if quiet > 0 {
+                    last_quiet_k = Some(k);
+                    quiet = 0;
+                }
+                sum += d as i64;
+                k += 1;
             }
-            let abs = d.unsigned_abs();
-            if abs > peak_abs {
-                peak_abs = abs;
-                peak_positive = d >= 0;
-                new_peak = Some((k, d));
-                separation = None;
-                longest_quiet = 0;
+            // Quiet: the first quiet sample after the peak is the separation.
+            if k < n && separation.is_none() {
+                separation = Some(start + k as u64);
+                separation_c = a.total_c + sum;
             }
-            clipped |= x <= lo || x >= hi;
-            if abs <= edge {
-                last_quiet = start + k as u64 + 1;
-                if separation.is_none() {
-                    separation = Some(start + k as u64);
-                    separation_c = a.total_c + sum;
+            while let Some(&x) = samples.get(k) {
+                let d = deviation.of(x);
+                if d.unsigned_abs() > edge {
+                    break;
                 }
                 quiet += 1;
                 sum += d as i64;
-                if quiet >= hold && start + k as u64 > a.trigger_index {
-                    ended = Some(End::Quiet);
-                    used = k + 1;
-                    break;
+                if quiet >= first_mark {
+                    returned |= quiet >= min_gap;
+                    if quiet >= hold && start + k as u64 > a.trigger_index {
+                        ended = Some(End::Quiet);
+                        used = k + 1;
+                        break 'scan;
+                    }
                 }
-            } else {
-                // Across the whole band between two samples (a sign flip): the signal came
-                // back between them.
-                if separation.is_none() && (d >= 0) != peak_positive {
-                    separation = Some(start + k as u64);
-                    separation_c = a.total_c + sum;
-                }
-                longest_quiet = longest_quiet.max(quiet);
-                quiet = 0;
-                sum += d as i64;
+                k += 1;
             }
         }
         let kept = samples.get(..used).unwrap_or(&[]);
+        // Only when the samples reach a rail does it matter which of them did.
+        if scan.min <= lo || scan.max >= hi {
+            a.clipped |= kept.iter().any(|&x| x <= lo || x >= hi);
+        }
         // The capture keeps the first CAP samples of the impact.
         if a.captured && !a.full {
             a.full = match sink.buffer() {
@@ -321,24 +377,24 @@ impl<const PRE: usize> Stream<PRE> {
             a.peak_d = d as i64;
             a.peak_index = start + k as u64;
         }
+        // Just after the latest quiet sample: the end of the run of quiet samples that
+        // is still going, or the one before the latest louder sample.
+        if quiet > 0 {
+            a.last_quiet = start + used as u64;
+        } else if let Some(k) = last_quiet_k {
+            a.last_quiet = start + k as u64;
+        }
+        if matches!(ended, Some(End::NextHit)) {
+            a.end_at = Some(a.last_quiet);
+        }
         a.total_c += sum;
         a.separation = separation;
         a.separation_c = separation_c;
         a.quiet = quiet;
-        a.last_quiet = last_quiet;
-        a.longest_quiet = longest_quiet;
-        a.clipped = clipped;
+        a.returned = returned;
         a.samples += used as u64;
         if ended.is_none() {
-            let settled = a.level.add(
-                kept,
-                a.base_n,
-                a.base_sum,
-                edge_counts,
-                (lo, hi),
-                u64::from(settle),
-            );
-            ended = settled.map(End::Settled);
+            ended = scan.settled.map(End::Settled);
         }
         let too_long = ended.is_none() && a.samples >= max_samples;
         // The ring keeps following the stream: the separation flank and the next impact's

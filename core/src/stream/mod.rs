@@ -268,9 +268,28 @@ impl<const PRE: usize> Stream<PRE> {
     pub fn push_block<const CAP: usize>(&mut self, block: &[i16], sink: &mut impl Sink<CAP>) {
         let mut rest = block;
         while !rest.is_empty() {
+            let used = self.push_to_impact_end(rest, sink);
+            rest = rest.get(used..).unwrap_or(&[]);
+        }
+    }
+
+    /// As [`Self::push_block`], but returns after the first impact that ends in `block`:
+    /// the number of samples taken (all of them if no impact ended). A caller that must have
+    /// a free capture buffer for every impact (the emulator's lossless replay) waits for one
+    /// between calls; the reports are the same for any split of the stream.
+    pub fn push_to_impact_end<const CAP: usize>(
+        &mut self,
+        block: &[i16],
+        sink: &mut impl Sink<CAP>,
+    ) -> usize {
+        let mut rest = block;
+        while !rest.is_empty() {
             if self.active.is_some() {
                 let used = self.run_active(rest, sink);
                 rest = rest.get(used..).unwrap_or(&[]);
+                if self.active.is_none() {
+                    break;
+                }
                 continue;
             }
             // Idle: learn a first baseline stride, then look for the first sample beyond the
@@ -340,6 +359,7 @@ impl<const PRE: usize> Stream<PRE> {
                 }
             }
         }
+        block.len() - rest.len()
     }
 
     /// `lost` samples never arrived (the source overran): an impact in progress ends with

@@ -30,8 +30,9 @@ pub enum Backpressure {
     /// Never (a live source): an impact that finds no free capture slot is reported from its
     /// streaming fields alone.
     Never,
-    /// Before each block outside an impact, wait for a free capture slot (the emulator's
-    /// lossless replay: every impact analysed, as on the host).
+    /// Before each impact, wait for a free capture slot (the emulator's lossless replay:
+    /// every impact analysed, as on the host).
+    #[cfg_attr(not(feature = "emulator"), allow(dead_code))]
     WaitForCapture,
 }
 
@@ -194,30 +195,48 @@ pub async fn stream(
         if let Some(v0) = APPROACH_SPEED.try_take() {
             s.set_approach_speed(Some(v0));
         }
-        if backpressure == Backpressure::WaitForCapture && !s.in_impact() {
-            // A free slot for the next impact (only the wait matters; the slot is taken
-            // when an impact starts).
-            let _ = captures.send().await;
-        }
         // The block is read in its queue slot, which goes back to the source as soon as
         // the stream has seen it.
         let event = samples.receive().await;
         let since = Instant::now();
         let mut dropped = 0u32;
-        let mut sink = QueueSink {
-            captures: &mut captures,
-            reports_dropped: &mut dropped,
-        };
         let end = match event {
             SourceEvent::Block(block) => {
                 run.count(block.seq, block.samples());
+                let mut sink = QueueSink {
+                    captures: &mut captures,
+                    reports_dropped: &mut dropped,
+                };
                 if block.lost_before > 0 {
                     s.gap(u64::from(block.lost_before), &mut sink);
                 }
-                s.push_block(block.samples(), &mut sink);
+                match backpressure {
+                    Backpressure::Never => s.push_block(block.samples(), &mut sink),
+                    Backpressure::WaitForCapture => {
+                        // Up to each impact's end, then wait for a free slot for the next
+                        // one (only the wait matters; the slot is taken when an impact
+                        // starts): several impacts in one block are all analysed.
+                        let mut rest = block.samples();
+                        while !rest.is_empty() {
+                            if !s.in_impact() {
+                                let _ = captures.send().await;
+                            }
+                            let mut sink = QueueSink {
+                                captures: &mut captures,
+                                reports_dropped: &mut dropped,
+                            };
+                            let used = s.push_to_impact_end(rest, &mut sink);
+                            rest = rest.get(used..).unwrap_or(&[]);
+                        }
+                    }
+                }
                 None
             }
             SourceEvent::End { end, lost } => {
+                let mut sink = QueueSink {
+                    captures: &mut captures,
+                    reports_dropped: &mut dropped,
+                };
                 s.gap(u64::from(*lost), &mut sink);
                 s.finish(&mut sink);
                 Some(*end)
