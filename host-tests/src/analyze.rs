@@ -11,7 +11,8 @@ use impact_core::solve::bounce::STANDARD_GRAVITY;
 use impact_core::{Approach, Calibration, FitSet, ImpactReport, Scene, Status};
 use serde::{Deserialize, Serialize};
 
-use crate::recording::{read_csv, read_table, ColumnRef, ReadOptions};
+use crate::recording::{read_csv, read_table, time_unit_s, ColumnRef, ReadOptions};
+use crate::screen::{self, Clipping, Spike};
 
 /// Units of the recorded column.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum, Deserialize)]
@@ -52,6 +53,8 @@ pub struct SceneFile {
     pub settle_s: Option<f64>,
     pub cfc: Option<u32>,
     pub units: Option<Units>,
+    /// The sensor's full scale, in the channel's units (as `--range`).
+    pub range: Option<f64>,
     pub invert: Option<bool>,
     pub fits: Option<FitsFile>,
 }
@@ -87,6 +90,19 @@ pub struct AnalyzeArgs {
     /// Negate the channel (by default a positive reading is a deceleration).
     #[arg(long)]
     pub invert: bool,
+    /// The sensor's full scale, in the channel's units (e.g. 16 for a ±16 g sensor read in
+    /// g): readings at the rail mark their impact clipped [default: flat tops at the
+    /// recording's extremes are taken for the rails].
+    #[arg(long)]
+    pub range: Option<f64>,
+    /// Keep isolated one- or two-sample spikes that dwarf the rest of the recording (by
+    /// default they are removed, listed, and flag the impact they fall in).
+    #[arg(long)]
+    pub keep_spikes: bool,
+    /// Interpolate an uneven time axis (gaps, rate changes) onto an even grid at the median
+    /// interval [default: refuse it, naming the line].
+    #[arg(long, conflicts_with = "rate")]
+    pub resample: bool,
     /// Mass of the instrumented body, kg.
     #[arg(long)]
     pub mass: Option<f64>,
@@ -210,6 +226,14 @@ pub struct AnalysisJson {
     pub samples_lost: u64,
     /// Impacts reported without analysis because no capture buffer was free (likewise).
     pub analyses_skipped: u64,
+    /// Whether the time axis was interpolated onto an even grid (`--resample`).
+    pub resampled: bool,
+    /// Isolated glitches removed before the analysis (an impact containing one is flagged
+    /// `spike-removed`).
+    pub spikes_removed: Vec<Spike>,
+    /// The channel's rails: from `--range`, or flat tops found in the recording; null when
+    /// neither is known (then `clipped` means a reading at the i16 rail).
+    pub clipping: Option<Clipping>,
     pub impacts: Vec<ImpactJson>,
 }
 
@@ -364,11 +388,19 @@ pub struct Prepared {
     pub accel_m_s2: Vec<f64>,
 }
 
-/// Quantises a signal (m/s²) to i16 counts with the finest gain that holds its range.
-pub fn quantise(accel: &[f64], rate_hz: f64) -> (Vec<i16>, Calibration) {
-    let peak = accel.iter().fold(0.0f64, |m, v| m.max(v.abs())).max(1e-30);
+/// Quantises a signal (m/s²) to i16 counts: the sensor's full scale, if known, to 32000
+/// counts (so readings a little past it still fit), else the finest gain that holds the
+/// signal's range.
+pub fn quantise(
+    accel: &[f64],
+    rate_hz: f64,
+    full_scale_m_s2: Option<f64>,
+) -> (Vec<i16>, Calibration) {
+    let peak = full_scale_m_s2
+        .unwrap_or_else(|| accel.iter().fold(0.0f64, |m, v| m.max(v.abs())))
+        .max(1e-30);
     let gain = peak / 32000.0;
-    let counts = accel.iter().map(|v| (v / gain).round() as i16).collect();
+    let counts = accel.iter().map(|v| to_count(*v, gain)).collect();
     (
         counts,
         Calibration {
@@ -376,6 +408,11 @@ pub fn quantise(accel: &[f64], rate_hz: f64) -> (Vec<i16>, Calibration) {
             sample_rate_hz: rate_hz as f32,
         },
     )
+}
+
+/// One reading in counts (saturating at the i16 rails, as an ADC does).
+fn to_count(v: f64, gain: f64) -> i16 {
+    (v / gain).round() as i16
 }
 
 /// Robust noise estimate, m/s²: MAD of first differences / sqrt(2).
@@ -402,6 +439,12 @@ pub struct Setup {
     pub free_fall_s: Option<f64>,
     pub samples: u64,
     pub rate_hz: f64,
+    /// Isolated spikes removed before quantising (see [`screen::remove_spikes`]).
+    pub spikes: Vec<Spike>,
+    /// The channel's rails, if known.
+    pub clipping: Option<Clipping>,
+    /// Whether the time axis was interpolated onto an even grid.
+    pub resampled: bool,
 }
 
 /// Reads the file and builds the scene (v0 from a free fall needs a first pass).
@@ -416,6 +459,7 @@ pub fn setup(args: &AnalyzeArgs, progress: Option<fn(f64)>) -> Result<Setup, Str
             column: args.column.clone(),
             time_column: args.time_column.clone(),
             rate_hz: args.rate,
+            resample: args.resample,
             progress,
         },
     )
@@ -429,8 +473,27 @@ pub fn setup(args: &AnalyzeArgs, progress: Option<fn(f64)>) -> Result<Setup, Str
     let units = args.units.or(file.units).unwrap_or(Units::G);
     let invert = args.invert || file.invert.unwrap_or(false);
     let scale = units.to_m_s2(mass) * if invert { -1.0 } else { 1.0 };
-    let accel: Vec<f64> = ch.values.iter().map(|v| v * scale).collect();
-    let (counts, calibration) = quantise(&accel, ch.rate_hz);
+    let mut accel: Vec<f64> = ch.values.iter().map(|v| v * scale).collect();
+    let spikes = if args.keep_spikes {
+        Vec::new()
+    } else {
+        let noise = noise_rms(&accel);
+        let mut spikes = screen::remove_spikes(&mut accel, noise);
+        for s in &mut spikes {
+            s.time_s = ch.time_s[s.sample as usize];
+        }
+        spikes
+    };
+    let full_scale = match args.range.or(file.range) {
+        Some(r) if r.is_finite() && r > 0.0 => Some(r * scale.abs()),
+        Some(r) => return Err(format!("--range: {r} must be finite and > 0")),
+        None => None,
+    };
+    let clipping = match full_scale {
+        Some(fs) => Some(screen::from_range(fs)),
+        None => screen::flat_tops(&accel),
+    };
+    let (counts, calibration) = quantise(&accel, ch.rate_hz, full_scale);
     let t0 = ch.time_s.first().copied().unwrap_or(0.0);
 
     // Levels: from the options, the scene file, or the signal's own noise and range.
@@ -450,6 +513,13 @@ pub fn setup(args: &AnalyzeArgs, progress: Option<fn(f64)>) -> Result<Setup, Str
         .unwrap_or_else(|| (3.0 * sigma).max(trigger / 5.0).min(trigger / 2.0));
     let mut scene = Scene::new(calibration, trigger as f32);
     scene.edge_m_s2 = edge as f32;
+    if let Some(c) = &clipping {
+        let gain = calibration.gain_m_s2_per_count as f64;
+        scene.clip_counts = (
+            c.low_m_s2.map_or(i16::MIN, |v| to_count(v, gain)),
+            c.high_m_s2.map_or(i16::MAX, |v| to_count(v, gain)),
+        );
+    }
     scene.hold_s = args.hold.or(file.hold_s).unwrap_or(2e-3) as f32;
     if let Some(m) = file.max_impact_s {
         scene.max_impact_s = m as f32;
@@ -509,6 +579,9 @@ pub fn setup(args: &AnalyzeArgs, progress: Option<fn(f64)>) -> Result<Setup, Str
         free_fall_s: None,
         samples: ch.values.len() as u64,
         rate_hz: ch.rate_hz,
+        spikes,
+        clipping,
+        resampled: ch.resampled,
     };
     if let Some(spec) = &args.free_fall {
         // First pass without v0 to find the first impact, then the free fall before it.
@@ -562,7 +635,8 @@ pub fn free_fall_before(spec: &str, impact_s: f64) -> Result<f64, String> {
         .time_column(None)
         .map_err(|e| format!("--free-fall {}: {e}", path.display()))?
         .ok_or_else(|| format!("--free-fall {}: needs a time column", path.display()))?;
-    let time = &table.columns[tcol];
+    let unit = time_unit_s(&table.headers.get(tcol).cloned().unwrap_or_default());
+    let time: Vec<f64> = table.columns[tcol].iter().map(|t| t * unit).collect();
     let cols: Vec<usize> = match &column {
         Some(c) => vec![table
             .find(c, "column")
@@ -579,6 +653,17 @@ pub fn free_fall_before(spec: &str, impact_s: f64) -> Result<f64, String> {
         .iter()
         .rposition(|&t| t <= impact_s)
         .ok_or("--free-fall: the DC channel starts after the impact")?;
+    // The DC channel must run up to the impact: a file that ends before it cannot tell when
+    // the fall ended.
+    let interval = (time[time.len() - 1] - time[0]) / (time.len().max(2) - 1) as f64;
+    if end + 1 == time.len() && impact_s - time[end] > 2.0 * interval {
+        return Err(format!(
+            "--free-fall {}: the DC channel ends at {:.6} s, before the impact at {:.6} s",
+            path.display(),
+            time[end],
+            impact_s
+        ));
+    }
     // Walk back from the impact to the last free-falling sample, then to the release.
     let mut i = end;
     while i > 0 && mag(i) >= FREE_FALL_G && impact_s - time[i] < 0.05 {
@@ -618,12 +703,28 @@ pub fn to_json(setup: &Setup, reports: &[ImpactReport]) -> AnalysisJson {
             .iter()
             .filter(|r| r.analysis == impact_core::Analysis::Skipped)
             .count() as u64,
+        resampled: setup.resampled,
+        spikes_removed: setup.spikes.clone(),
+        clipping: setup.clipping.clone(),
         impacts: reports
             .iter()
-            .map(|r| impact_json(r, setup.prepared.t0, &setup.scene.fits))
+            .map(|r| {
+                let mut j = impact_json(r, setup.prepared.t0, &setup.scene.fits);
+                if setup
+                    .spikes
+                    .iter()
+                    .any(|s| (r.start_sample..=r.end_sample).contains(&s.sample))
+                {
+                    j.flags.push(SPIKE_REMOVED.to_string());
+                }
+                j
+            })
             .collect(),
     }
 }
+
+/// The host's flag on an impact that contained a removed spike.
+pub const SPIKE_REMOVED: &str = "spike-removed";
 
 /// CSV text: one row per impact.
 pub fn to_csv(a: &AnalysisJson) -> String {
@@ -702,14 +803,37 @@ pub fn to_table(a: &AnalysisJson) -> String {
             String::new()
         },
     );
+    if a.resampled {
+        s.push_str("time axis resampled onto an even grid (--resample)\n");
+    }
+    if let Some(c) = &a.clipping {
+        let level = |v: Option<f64>| v.map_or("-".to_string(), |v| format!("{v:.4e}"));
+        s.push_str(&format!(
+            "rails ({}): {} / {} m/s²; a clipped peak is a lower bound (≥)\n",
+            c.from,
+            level(c.low_m_s2),
+            level(c.high_m_s2)
+        ));
+    }
+    for sp in &a.spikes_removed {
+        s.push_str(&format!(
+            "spike removed at {:.6} s (sample {}, {} sample{}, {:.4e} m/s²); --keep-spikes keeps it\n",
+            sp.time_s,
+            sp.sample,
+            sp.samples,
+            if sp.samples == 1 { "" } else { "s" },
+            sp.value_m_s2
+        ));
+    }
     for i in &a.impacts {
         s.push_str(&format!(
-            "impact {} [{}{}{}] at {:.6} s: peak {:.4e} m/s² ({:.2} g){}, Δv {}, duration {:.4e} s, FWHM {}\n",
+            "impact {} [{}{}{}] at {:.6} s: peak {}{:.4e} m/s² ({:.2} g){}, Δv {}, duration {:.4e} s, FWHM {}\n",
             i.index,
             i.status,
             if i.clipped { ", CLIPPED" } else { "" },
             if i.analysis == "skipped" { ", analysis skipped" } else { "" },
             i.start_s,
+            if i.clipped { "≥" } else { "" },
             i.peak_acceleration_m_s2,
             i.peak_acceleration_m_s2 / STANDARD_GRAVITY,
             i.peak_force_n.map_or(String::new(), |f| format!(", force {f:.4e} N")),

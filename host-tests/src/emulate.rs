@@ -307,6 +307,9 @@ pub fn log_json(log: &Log, t0: f64) -> Result<AnalysisJson, String> {
         free_fall_s: None,
         samples_lost: counter("samples_lost")?,
         analyses_skipped: counter("analyses_skipped")?,
+        resampled: false,
+        spikes_removed: Vec::new(),
+        clipping: None,
         impacts: log
             .impacts
             .iter()

@@ -10,6 +10,7 @@ pub mod plot;
 pub mod precision;
 pub mod realtime;
 pub mod recording;
+pub mod screen;
 pub mod simulate;
 pub mod soak;
 pub mod stability;

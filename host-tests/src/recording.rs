@@ -54,6 +54,8 @@ pub struct Channel {
     pub rate_hz: f64,
     /// Largest deviation of a sample interval from the mean interval, relative.
     pub jitter: f64,
+    /// Whether the samples were interpolated onto an even grid (`resample`).
+    pub resampled: bool,
 }
 
 /// How to read the file.
@@ -61,10 +63,13 @@ pub struct Channel {
 pub struct ReadOptions {
     /// The channel [default: the first column that is not the time column].
     pub column: Option<ColumnRef>,
-    /// The time column [default: a column whose header starts with "time", if any].
+    /// The time column [default: the one column whose header looks like a time, if any].
     pub time_column: Option<ColumnRef>,
     /// Sample rate, Hz, when there is no time column (overrides it if both are given).
     pub rate_hz: Option<f64>,
+    /// Interpolate an uneven time axis onto an even grid at the median interval (instead of
+    /// refusing it).
+    pub resample: bool,
     /// Called with the fraction of the file read, for progress display.
     pub progress: Option<fn(f64)>,
 }
@@ -171,32 +176,84 @@ impl Table {
         }
     }
 
-    /// The time column: the one asked for, or a column whose header starts with "time".
+    /// The time column: the one asked for, or the one column whose header looks like a time
+    /// (`time…`, `t`, `t_…`); several such columns without `--time-column` are an error naming
+    /// them.
     pub fn time_column(&self, asked: Option<&ColumnRef>) -> Result<Option<usize>, String> {
-        match asked {
-            Some(c) => self.find(c, "time column").map(Some),
-            None => Ok(self
-                .headers
-                .iter()
-                .position(|h| h.to_ascii_lowercase().starts_with("time"))
-                .filter(|&p| p < self.columns.len())),
+        if let Some(c) = asked {
+            return self.find(c, "time column").map(Some);
+        }
+        let candidates: Vec<usize> = (0..self.columns.len().min(self.headers.len()))
+            .filter(|&c| looks_like_time(&self.headers[c]))
+            .collect();
+        match candidates.as_slice() {
+            [] => Ok(None),
+            [one] => Ok(Some(*one)),
+            many => Err(format!(
+                "several columns could be the time: {}; choose one with --time-column",
+                many.iter()
+                    .map(|&c| format!("{:?}", self.headers[c]))
+                    .collect::<Vec<_>>()
+                    .join(", ")
+            )),
         }
     }
 }
 
-/// Checks a time column: finite and strictly increasing. Returns `(rate, jitter)`.
+/// Whether a header names a time column: its first word is `time`, `timestamp` or `t`.
+fn looks_like_time(header: &str) -> bool {
+    let h = header.to_ascii_lowercase();
+    let first = words(&h).next();
+    matches!(first, Some("time" | "timestamp" | "times" | "t"))
+}
+
+fn words(h: &str) -> impl Iterator<Item = &str> {
+    h.split(|c: char| !(c.is_alphanumeric() || c == 'µ'))
+        .filter(|w| !w.is_empty())
+}
+
+/// Seconds per unit of a time column, from a unit word in its header (`timestamp_us`,
+/// `time [ms]`, `time - seconds`); seconds when the header names none.
+pub fn time_unit_s(header: &str) -> f64 {
+    let h = header.to_ascii_lowercase();
+    let unit = words(&h)
+        .skip(1)
+        .find_map(|w| match w {
+            "s" | "sec" | "secs" | "second" | "seconds" => Some(1.0),
+            "ms" | "msec" | "millisecond" | "milliseconds" => Some(1e-3),
+            "us" | "µs" | "usec" | "microsecond" | "microseconds" => Some(1e-6),
+            "ns" | "nsec" | "nanosecond" | "nanoseconds" => Some(1e-9),
+            _ => None,
+        })
+        .unwrap_or(1.0);
+    unit
+}
+
+/// Every sample interval must lie within this range of the median interval, or the time axis
+/// counts as uneven (a gap or a rate change). Jittered time stamps, as enDAQ's, stay within
+/// 0.6..1.25.
+const INTERVAL_RANGE: std::ops::RangeInclusive<f64> = 0.5..=1.5;
+
+/// Checks a time column: finite, strictly increasing and evenly sampled (every interval within
+/// [`INTERVAL_RANGE`] times the median). Returns `(rate, jitter)`; with `resample`, uneven
+/// intervals are allowed and the rate is the median interval's.
 fn check_time(
     path: &Path,
     t: &[f64],
     first_data_line: usize,
+    resample: bool,
 ) -> Result<(f64, f64), RecordingError> {
+    let at = |i: usize, message: String| RecordingError {
+        file: path.to_path_buf(),
+        line: Some(first_data_line + i),
+        message,
+    };
     for (i, w) in t.windows(2).enumerate() {
         if w[1] <= w[0] {
-            return Err(RecordingError {
-                file: path.to_path_buf(),
-                line: Some(first_data_line + i + 1),
-                message: format!("time {} s does not increase (previous {} s)", w[1], w[0]),
-            });
+            return Err(at(
+                i + 1,
+                format!("time {} s does not increase (previous {} s)", w[1], w[0]),
+            ));
         }
     }
     if t.len() < 2 {
@@ -206,12 +263,72 @@ fn check_time(
             message: "one sample: the rate cannot be told; give --rate".into(),
         });
     }
-    let dt = (t[t.len() - 1] - t[0]) / (t.len() - 1) as f64;
-    let jitter = t
-        .windows(2)
-        .map(|w| ((w[1] - w[0]) / dt - 1.0).abs())
-        .fold(0.0, f64::max);
-    Ok((1.0 / dt, jitter))
+    let mut dts: Vec<f64> = t.windows(2).map(|w| w[1] - w[0]).collect();
+    let mid = dts.len() / 2;
+    let median = *dts.select_nth_unstable_by(mid, f64::total_cmp).1;
+    if !resample {
+        for (i, w) in t.windows(2).enumerate() {
+            let ratio = (w[1] - w[0]) / median;
+            if !INTERVAL_RANGE.contains(&ratio) {
+                return Err(at(
+                    i + 1,
+                    format!(
+                        "uneven time axis: {:.6e} s since the previous sample, {ratio:.3} times \
+                         the median interval {median:.6e} s (a gap or a rate change); give \
+                         --resample to interpolate onto an even grid, or cut the file",
+                        w[1] - w[0]
+                    ),
+                ));
+            }
+        }
+        let dt = (t[t.len() - 1] - t[0]) / (t.len() - 1) as f64;
+        let jitter = t
+            .windows(2)
+            .map(|w| ((w[1] - w[0]) / dt - 1.0).abs())
+            .fold(0.0, f64::max);
+        Ok((1.0 / dt, jitter))
+    } else {
+        Ok((1.0 / median, 0.0))
+    }
+}
+
+/// A resampled recording may hold at most this many times the file's samples (a long gap in
+/// a fast recording would otherwise fill the memory with interpolated nothing).
+const MAX_RESAMPLE_GROWTH: usize = 4;
+
+/// Linear interpolation of `(t, v)` onto `t0 + k / rate`.
+fn resample(
+    path: &Path,
+    t: &[f64],
+    v: &[f64],
+    rate: f64,
+) -> Result<(Vec<f64>, Vec<f64>), RecordingError> {
+    let span = t[t.len() - 1] - t[0];
+    let n = (span * rate).floor() as usize + 1;
+    if n > MAX_RESAMPLE_GROWTH * t.len() + 1024 {
+        return Err(RecordingError {
+            file: path.to_path_buf(),
+            line: None,
+            message: format!(
+                "--resample: {span:.6e} s at {rate:.6e} Hz would be {n} samples from {} in the \
+                 file (a long gap?): cut the file",
+                t.len()
+            ),
+        });
+    }
+    let mut times = Vec::with_capacity(n);
+    let mut values = Vec::with_capacity(n);
+    let mut j = 0;
+    for k in 0..n {
+        let tk = t[0] + k as f64 / rate;
+        while j + 2 < t.len() && t[j + 1] < tk {
+            j += 1;
+        }
+        let f = ((tk - t[j]) / (t[j + 1] - t[j])).clamp(0.0, 1.0);
+        times.push(tk);
+        values.push(v[j] + f * (v[j + 1] - v[j]));
+    }
+    Ok((times, values))
 }
 
 /// Reads one channel and its time base (see [`read_table`] for the format).
@@ -234,28 +351,37 @@ pub fn read_csv(path: &Path, opts: &ReadOptions) -> Result<Channel, RecordingErr
             .find(|&c| Some(c) != tcol)
             .ok_or_else(|| err("no data column besides the time column".into()))?,
     };
+    if Some(col) == tcol {
+        return Err(err(format!(
+            "column {col} is the time column: choose another with --column"
+        )));
+    }
     let values = table.columns[col].clone();
     let name = table
         .headers
         .get(col)
         .cloned()
         .unwrap_or_else(|| format!("column {col}"));
-    let (rate_hz, time_s, jitter) = match (opts.rate_hz, tcol) {
+    let unit = |t: usize| table.headers.get(t).map_or(1.0, |h| time_unit_s(h));
+    let (rate_hz, time_s, values, jitter, resampled) = match (opts.rate_hz, tcol) {
         (Some(r), _) => {
             if !(r.is_finite() && r > 0.0 && r <= 1e9) {
                 return Err(err(format!("rate {r} Hz is not in (0, 1e9]")));
             }
-            let t0 = tcol.map_or(0.0, |t| table.columns[t][0]);
-            (
-                r,
-                (0..values.len()).map(|i| t0 + i as f64 / r).collect(),
-                0.0,
-            )
+            let t0 = tcol.map_or(0.0, |t| table.columns[t][0] * unit(t));
+            let times = (0..values.len()).map(|i| t0 + i as f64 / r).collect();
+            (r, times, values, 0.0, false)
         }
         (None, Some(t)) => {
-            let times = table.columns[t].clone();
-            let (rate, jitter) = check_time(path, &times, header_lines + 1)?;
-            (rate, times, jitter)
+            let scale = unit(t);
+            let times: Vec<f64> = table.columns[t].iter().map(|v| v * scale).collect();
+            let (rate, jitter) = check_time(path, &times, header_lines + 1, opts.resample)?;
+            if opts.resample {
+                let (times, values) = resample(path, &times, &values, rate)?;
+                (rate, times, values, 0.0, true)
+            } else {
+                (rate, times, values, jitter, false)
+            }
         }
         (None, None) => {
             return Err(err(
@@ -269,6 +395,7 @@ pub fn read_csv(path: &Path, opts: &ReadOptions) -> Result<Channel, RecordingErr
         time_s,
         rate_hz,
         jitter,
+        resampled,
     })
 }
 

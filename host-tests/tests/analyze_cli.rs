@@ -165,3 +165,147 @@ fn impact_log_rejects_garbage_with_one_line() {
     assert_ne!(code, 0);
     assert_eq!(err.trim().lines().count(), 1, "{err}");
 }
+
+/// A recording at 1 kHz: `n` rows of `time_s,a` with a half-sine pulse of 50 g at 0.1 s.
+fn kilohertz(n: usize, time: impl Fn(usize) -> f64) -> String {
+    let mut s = String::from("time_s,a_g\n");
+    for i in 0..n {
+        let t = i as f64 * 1e-3;
+        let a = if (0.1..0.11).contains(&t) {
+            50.0 * (std::f64::consts::PI * (t - 0.1) / 0.01).sin()
+        } else {
+            0.0
+        } + 0.01 * ((i * 7919 % 5) as f64 - 2.0);
+        s.push_str(&format!("{:.6},{a:.4}\n", time(i)));
+    }
+    s
+}
+
+#[test]
+fn an_uneven_time_axis_is_an_error_naming_the_line_unless_resampled() {
+    // A gap of 1000 s after row 300 (file line 302), and ten leading rows 10 ms apart.
+    let gap = temp_csv(
+        "gap.csv",
+        &kilohertz(600, |i| {
+            i as f64 * 1e-3 + if i >= 300 { 1000.0 } else { 0.0 }
+        }),
+    );
+    let (code, _, err) = impact(&["analyze", gap.to_str().unwrap()]);
+    assert_ne!(code, 0);
+    assert_eq!(err.trim().lines().count(), 1, "{err}");
+    assert!(
+        err.contains("gap.csv:302:") && err.contains("--resample"),
+        "{err}"
+    );
+    // Resampling a 1000 s gap at 1 kHz would invent a million samples: refused.
+    let (code, _, err) = impact(&["analyze", gap.to_str().unwrap(), "--resample"]);
+    assert_ne!(code, 0);
+    assert!(err.contains("cut the file"), "{err}");
+
+    let lead = temp_csv(
+        "lead.csv",
+        &kilohertz(600, |i| {
+            if i < 10 {
+                (i as f64 - 10.0) * 1e-2
+            } else {
+                (i - 10) as f64 * 1e-3
+            }
+        }),
+    );
+    let (code, _, err) = impact(&["analyze", lead.to_str().unwrap()]);
+    assert_ne!(code, 0);
+    assert!(err.contains("lead.csv:3:"), "{err}");
+    // Resampled at the median interval: 1 kHz, the leading rows interpolated.
+    let (code, out, err) = impact(&["analyze", lead.to_str().unwrap(), "--resample", "--json"]);
+    assert_eq!(code, 0, "{err}");
+    let v: serde_json::Value = serde_json::from_str(&out).unwrap();
+    assert_eq!(v["resampled"], true);
+    assert!(
+        (v["sample_rate_hz"].as_f64().unwrap() - 1000.0).abs() < 1e-6,
+        "{v}"
+    );
+    // From -0.1 s to 0.589 s at 1 ms.
+    assert!((689..=690).contains(&v["samples"].as_u64().unwrap()), "{v}");
+    assert_eq!(v["impacts"].as_array().unwrap().len(), 1, "{v}");
+}
+
+#[test]
+fn an_ambiguous_time_column_names_the_candidates_and_units_are_read_from_the_header() {
+    let even = kilohertz(400, |i| i as f64 * 1e-3);
+    let both: String = even
+        .lines()
+        .enumerate()
+        .map(|(i, l)| {
+            if i == 0 {
+                format!("timestamp_us,{l}\n")
+            } else {
+                let t: f64 = l.split(',').next().unwrap().parse().unwrap();
+                format!("{},{l}\n", (t * 1e6).round())
+            }
+        })
+        .collect();
+    let f = temp_csv("two-times.csv", &both);
+    let (code, _, err) = impact(&["analyze", f.to_str().unwrap()]);
+    assert_ne!(code, 0);
+    assert_eq!(err.trim().lines().count(), 1, "{err}");
+    assert!(
+        err.contains("\"timestamp_us\"") && err.contains("\"time_s\""),
+        "{err}"
+    );
+    // Either column gives the same time base: microseconds are read as such.
+    for t in ["timestamp_us", "time_s"] {
+        let (code, out, err) = impact(&[
+            "analyze",
+            f.to_str().unwrap(),
+            "--time-column",
+            t,
+            "--column",
+            "a_g",
+            "--json",
+        ]);
+        assert_eq!(code, 0, "{t}: {err}");
+        let v: serde_json::Value = serde_json::from_str(&out).unwrap();
+        assert!(
+            (v["sample_rate_hz"].as_f64().unwrap() - 1000.0).abs() < 1e-6,
+            "{t}: {v}"
+        );
+        let start = v["impacts"][0]["start_s"].as_f64().unwrap();
+        assert!((0.099..0.102).contains(&start), "{t}: {start}");
+    }
+}
+
+#[test]
+fn a_free_fall_file_must_reach_the_impact() {
+    let dir = concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/../../shared/signals/endaq-high-drop"
+    );
+    let dc = std::fs::read_to_string(format!("{dir}/High-Drop_16g-DC_full.csv")).unwrap();
+    // The DC channel cut at 4.6 s, 10 s before the impact (at rest, before the release).
+    let short: String = dc
+        .lines()
+        .filter(|l| {
+            l.split(',')
+                .next()
+                .unwrap()
+                .parse::<f64>()
+                .map_or(true, |t| t < 4.6)
+        })
+        .map(|l| format!("{l}\n"))
+        .collect();
+    let f = temp_csv("short-dc.csv", &short);
+    let (code, _, err) = impact(&[
+        "analyze",
+        &format!("{dir}/High-Drop_2000g-PE_13.4-15.0s.csv"),
+        "--column",
+        "z_g",
+        "--free-fall",
+        f.to_str().unwrap(),
+    ]);
+    assert_ne!(code, 0);
+    assert_eq!(err.trim().lines().count(), 1, "{err}");
+    assert!(
+        err.contains("ends at") && err.contains("before the impact"),
+        "{err}"
+    );
+}

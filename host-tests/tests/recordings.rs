@@ -177,3 +177,287 @@ fn hammer_strikes_give_one_pulse_each() {
         );
     }
 }
+
+/// Integral of the piecewise-linear signal `(t, a - zero)` over `[t0, t1]`, m/s.
+fn integral(t: &[f64], a: &[f64], zero: f64, t0: f64, t1: f64) -> f64 {
+    let at = |x: f64| {
+        let j = t.partition_point(|&ti| ti <= x).clamp(1, t.len() - 1);
+        let f = (x - t[j - 1]) / (t[j] - t[j - 1]);
+        a[j - 1] + f * (a[j] - a[j - 1]) - zero
+    };
+    let mut knots = vec![t0];
+    knots.extend(t.iter().copied().filter(|&ti| ti > t0 && ti < t1));
+    knots.push(t1);
+    knots
+        .windows(2)
+        .map(|w| (w[1] - w[0]) * (at(w[0]) + at(w[1])) / 2.0)
+        .sum()
+}
+
+fn read_columns(rel: &str, skip: usize) -> Vec<Vec<f64>> {
+    let text = std::fs::read_to_string(signals().join(rel)).unwrap();
+    let rows: Vec<Vec<f64>> = text
+        .lines()
+        .skip(skip)
+        .map(|l| l.split(',').map(|v| v.trim().parse().unwrap()).collect())
+        .collect();
+    (0..rows[0].len())
+        .map(|c| rows.iter().map(|r| r[c]).collect())
+        .collect()
+}
+
+fn median(v: impl Iterator<Item = f64>) -> f64 {
+    let mut v: Vec<f64> = v.collect();
+    v.sort_by(f64::total_cmp);
+    v[v.len() / 2]
+}
+
+#[test]
+fn afrl_delta_v_is_within_two_percent_of_the_sensor_zero_value() {
+    // The sensor's zero: the median of the full record's quiet stretches before the ramp
+    // (0-9.5 ms) and after the ringing (30-100 ms); the pre-impact ramp must not bias Δv.
+    let full = read_columns("afrl-drop-tower/series1_test1_full_100ms.csv", 1);
+    let kgn = 1000.0 * G;
+    for (channel, col, short) in [
+        ("bottom_kgn", 1, "afrl-drop-tower/accel_5.csv"),
+        ("top_kgn", 2, "afrl-drop-tower/accel_6.csv"),
+    ] {
+        let a: Vec<f64> = full[col].iter().map(|v| v * kgn).collect();
+        let zero = median(a[..9500].iter().chain(&a[30_000..]).copied());
+        // The full record and the 5 ms file of the same test (which starts inside the ramp).
+        for (args, t, x) in [
+            (
+                AnalyzeArgs {
+                    units: Some(Units::Kgn),
+                    column: Some(ColumnRef::Name(channel.into())),
+                    ..file("afrl-drop-tower/series1_test1_full_100ms.csv")
+                },
+                full[0].clone(),
+                a.clone(),
+            ),
+            (
+                AnalyzeArgs {
+                    units: Some(Units::Kgn),
+                    rate: Some(1e6),
+                    column: Some(ColumnRef::Index(1)),
+                    ..file(short)
+                },
+                (0..5000).map(|i| i as f64 * 1e-6).collect(),
+                read_columns(short, 2)[1].iter().map(|v| v * kgn).collect(),
+            ),
+        ] {
+            let r = analyze(args);
+            assert_eq!(r.impacts.len(), 1, "{channel}: {:#?}", r.impacts);
+            let i = &r.impacts[0];
+            let want = integral(&t, &x, zero, i.start_s, i.start_s + i.duration_s);
+            let got = i.delta_v_m_s.expect("Δv");
+            println!("{channel}: Δv {got:.4} m/s, sensor-zero value {want:.4} m/s");
+            assert!(
+                (got / want - 1.0).abs() < 0.02,
+                "{channel}: {got} vs {want}"
+            );
+        }
+    }
+}
+
+#[test]
+fn endaq_dc_channel_gives_one_report_per_bounce_and_marks_the_clipped_ones() {
+    // Free fall 13.62-14.62 s, bounces from 14.62 s, then rest: the z axis (16 g DC) sits
+    // flat at its rail (16.03 g) for 5-6 samples in the first three bounces.
+    for range in [None, Some(16.0)] {
+        let a = analyze(AnalyzeArgs {
+            column: Some(ColumnRef::Name("z_g".into())),
+            range,
+            ..file("endaq-high-drop/High-Drop_16g-DC_full.csv")
+        });
+        let starts: Vec<f64> = a.impacts.iter().map(|i| i.start_s).collect();
+        // One report per bounce; none in the free fall or the rest after the last bounce.
+        assert_eq!(a.impacts.len(), 7, "{range:?}: {starts:?}");
+        assert!(
+            starts.iter().all(|t| (14.6..18.0).contains(t)),
+            "{range:?}: {starts:?}"
+        );
+        ordered_and_disjoint(&a);
+        let clipped: Vec<bool> = a.impacts.iter().map(|i| i.clipped).collect();
+        assert_eq!(
+            clipped,
+            [true, true, true, false, false, false, false],
+            "{range:?}"
+        );
+        let c = a.clipping.as_ref().expect("rails");
+        let rail = c.high_m_s2.unwrap() / G;
+        match range {
+            None => {
+                assert_eq!(c.from, "flat-top");
+                assert!((16.0..16.1).contains(&rail), "{rail}");
+            }
+            Some(_) => {
+                assert_eq!(c.from, "range");
+                assert!((15.9..16.0).contains(&rail), "{rail}");
+            }
+        }
+        // Δv of the bounces comes from the DC channel itself (no AC flag).
+        assert!(a.impacts.iter().all(|i| i.delta_v_m_s.is_some()));
+    }
+}
+
+fn temp_dir() -> PathBuf {
+    let dir = std::env::temp_dir().join(format!("impact-recordings-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    dir
+}
+
+/// A copy of a bundled recording with `change(row, line)` applied to each data row.
+fn copy_with(rel: &str, name: &str, change: impl Fn(usize, &str) -> String) -> PathBuf {
+    let text = std::fs::read_to_string(signals().join(rel)).unwrap();
+    let mut out = String::new();
+    for (i, l) in text.lines().enumerate() {
+        out.push_str(&if i == 0 {
+            l.to_string()
+        } else {
+            change(i - 1, l)
+        });
+        out.push('\n');
+    }
+    let p = temp_dir().join(name);
+    std::fs::write(&p, out).unwrap();
+    p
+}
+
+/// Replaces field `col` of a CSV line.
+fn set_field(line: &str, col: usize, value: &str) -> String {
+    let mut f: Vec<&str> = line.split(',').collect();
+    f[col] = value;
+    f.join(",")
+}
+
+#[test]
+fn a_spiked_copy_reports_the_same_real_impact() {
+    // One 220 kg_n sample in the AFRL record (20x its real 11 kg_n pulse), after the impact
+    // and before it; a 1e4 g sample and a two-sample -5e3 g glitch in the water entry (real
+    // slam 63 g). A glitch after the impacts leaves them bit for bit as in the clean file; one
+    // before them is replaced by its neighbours' line, which the baseline sees.
+    let afrl = AnalyzeArgs {
+        units: Some(Units::Kgn),
+        ..Default::default()
+    };
+    let water = AnalyzeArgs {
+        column: Some(ColumnRef::Name("y_g".into())),
+        ..Default::default()
+    };
+    /// File, column, (row, value) glitches, options, whether the reports stay bit for bit.
+    type Case<'a> = (&'a str, usize, Vec<(usize, &'a str)>, AnalyzeArgs, bool);
+    let cases: [Case; 3] = [
+        (
+            "afrl-drop-tower/series1_test1_full_100ms.csv",
+            1,
+            vec![(50_000, "220")],
+            afrl.clone(),
+            true,
+        ),
+        (
+            "afrl-drop-tower/series1_test1_full_100ms.csv",
+            1,
+            vec![(5_000, "220")],
+            afrl,
+            false,
+        ),
+        (
+            "impack-water-entry/4mps_sphere_1_100g-PR_9.9-10.6s.csv",
+            2,
+            vec![(13_000, "1e4"), (13_500, "-5e3"), (13_501, "-4e3")],
+            water,
+            true,
+        ),
+    ];
+    for (n, (rel, col, spikes, args, exact)) in cases.into_iter().enumerate() {
+        let clean = analyze(AnalyzeArgs {
+            file: signals().join(rel),
+            ..args.clone()
+        });
+        let path = copy_with(rel, &format!("spiked-{n}.csv"), |row, line| {
+            match spikes.iter().find(|(r, _)| *r == row) {
+                Some((_, v)) => set_field(line, col, v),
+                None => line.to_string(),
+            }
+        });
+        let spiked = analyze(AnalyzeArgs {
+            file: path.clone(),
+            ..args.clone()
+        });
+        // Listed once per glitch, at its first sample.
+        let rows: Vec<u64> = spiked.spikes_removed.iter().map(|s| s.sample).collect();
+        let want: Vec<u64> = spikes
+            .iter()
+            .map(|(r, _)| *r as u64)
+            .filter(|r| !spikes.iter().any(|(p, _)| *p as u64 + 1 == *r))
+            .collect();
+        assert_eq!(rows, want, "{rel}");
+        if exact {
+            assert_eq!(spiked.impacts, clean.impacts, "{rel}");
+        } else {
+            assert_eq!(spiked.impacts.len(), clean.impacts.len(), "{rel}");
+            for (s, c) in spiked.impacts.iter().zip(&clean.impacts) {
+                assert!((s.start_s - c.start_s).abs() < 2e-6, "{s:#?} {c:#?}");
+                let rel_peak = s.peak_acceleration_m_s2 / c.peak_acceleration_m_s2 - 1.0;
+                assert!(rel_peak.abs() < 1e-3, "{s:#?} {c:#?}");
+                let rel_dv = s.delta_v_m_s.unwrap() / c.delta_v_m_s.unwrap() - 1.0;
+                assert!(rel_dv.abs() < 1e-2, "{s:#?} {c:#?}");
+            }
+        }
+        // Kept on request: the glitch then dominates the scaling and the trigger level.
+        let kept = analyze(AnalyzeArgs {
+            file: path,
+            keep_spikes: true,
+            ..args
+        });
+        assert!(kept.spikes_removed.is_empty());
+        assert_ne!(kept.impacts, clean.impacts, "{rel}");
+    }
+}
+
+#[test]
+fn a_half_sine_cut_flat_at_the_sensor_range_is_clipped() {
+    // A 40 g, 8.81 ms half-sine at 100 kS/s read by a 16 g sensor: flat at 16 g for ~650
+    // samples (quantised to 0.01 g, with a little noise).
+    let write = |name: &str, cut: f64| {
+        let mut s = String::from("time_s,a_g\n");
+        for i in 0..5000 {
+            let t = i as f64 * 1e-5;
+            let a = if (0.01..0.01881).contains(&t) {
+                40.0 * (std::f64::consts::PI * (t - 0.01) / 0.00881).sin()
+            } else {
+                0.0
+            };
+            let noise = 0.01 * ((i * 7919 % 5) as f64 - 2.0);
+            s.push_str(&format!("{t:.6},{:.2}\n", (a + noise).min(cut)));
+        }
+        let p = temp_dir().join(name);
+        std::fs::write(&p, s).unwrap();
+        p
+    };
+    let cut = write("cut.csv", 16.0);
+    for range in [None, Some(16.0)] {
+        let a = analyze(AnalyzeArgs {
+            file: cut.clone(),
+            range,
+            ..Default::default()
+        });
+        assert_eq!(a.impacts.len(), 1, "{range:?}: {:#?}", a.impacts);
+        assert!(a.impacts[0].clipped, "{range:?}");
+    }
+    // The whole pulse, read by a sensor with range to spare: not clipped.
+    let whole = write("whole.csv", f64::INFINITY);
+    for range in [None, Some(50.0)] {
+        let a = analyze(AnalyzeArgs {
+            file: whole.clone(),
+            range,
+            ..Default::default()
+        });
+        assert_eq!(a.impacts.len(), 1, "{range:?}");
+        assert!(!a.impacts[0].clipped, "{range:?}");
+        assert!(a.clipping.is_none() == range.is_none(), "{range:?}");
+        let peak = a.impacts[0].peak_acceleration_m_s2 / G;
+        assert!((39.9..40.1).contains(&peak), "{peak}");
+    }
+}
