@@ -83,8 +83,9 @@ pub struct Scene {
     pub trigger_m_s2: f32,
     /// A pulse's edges (onset, separation) are where |a| crosses this, m/s²; `< trigger`.
     pub edge_m_s2: f32,
-    /// An impact ends after |a| stays below `edge` for this long, s (also the shortest gap
-    /// that separates two impacts).
+    /// An impact ends after |a| stays below `edge` for this long, s; with a CFC, for at least
+    /// the filter's padding (SAE J211: `rate / (1.667 class)` samples, as far as half the
+    /// capture allows). A new hit after an eighth of it back at the baseline is a new impact.
     pub hold_s: f32,
     /// An impact still going after this long is reported as too long, s (a stuck sensor).
     pub max_impact_s: f32,

@@ -585,6 +585,56 @@ fn cfc_filtering_keeps_delta_v_and_tames_noise_on_the_peak() {
 }
 
 #[test]
+fn every_cfc_class_leaves_onset_and_kinematics_and_pads_its_window_or_says_so() {
+    // J211's padding before the onset and after the separation: a hold shorter than the
+    // padding is lengthened to it, so the filter sees settled signal on both sides; where the
+    // pre-trigger ring cannot hold it (CFC 60 at 500 kS/s: 10 ms > 4096 samples), the width
+    // and the filtered peak are refused with a flag, never computed from a cut window.
+    let (rec, _) = one_impact(
+        &Nonlinear {
+            k: cases::bench_kc(),
+            c: 1.0,
+            n: 1.0,
+        },
+        0.03,
+    );
+    let sc = scene(&rec, Some(cases::BENCH_V0_M_S));
+    let raw = run(&mut Bench::new(sc).unwrap(), &rec.samples, 256)[0];
+    let k = raw.kinematics.unwrap();
+    for class in [1000, 600, 180, 60] {
+        let cfc = impact_core::signal::cfc::Cfc::from_class(class).unwrap();
+        let mut filtered = sc;
+        filtered.cfc = Some(cfc);
+        let r = run(&mut Bench::new(filtered).unwrap(), &rec.samples, 256)[0];
+        assert_eq!(r.start_s, raw.start_s, "CFC {class}");
+        assert_eq!(r.peak_acceleration_m_s2, raw.peak_acceleration_m_s2);
+        let kf = r.kinematics.unwrap();
+        assert_eq!(kf.crush_time_s, k.crush_time_s, "CFC {class}");
+        assert_eq!(kf.max_deformation_m, k.max_deformation_m, "CFC {class}");
+        let pad = cfc.padding_samples(rec.calibration.sample_rate_hz) as usize;
+        if pad < 4096 {
+            assert!(
+                !r.flags.contains(impact_core::report::Flags::CFC_WINDOW),
+                "CFC {class}"
+            );
+            let w = r.fwhm_s.expect("FWHM");
+            let w_raw = raw.fwhm_s.unwrap();
+            assert!(
+                (w / w_raw - 1.0).abs() < 0.05,
+                "CFC {class}: {w} vs {w_raw}"
+            );
+            assert!(r.filtered_peak_acceleration_m_s2.is_some());
+        } else {
+            assert!(
+                r.flags.contains(impact_core::report::Flags::CFC_WINDOW),
+                "CFC {class}"
+            );
+            assert!(r.fwhm_s.is_none() && r.filtered_peak_acceleration_m_s2.is_none());
+        }
+    }
+}
+
+#[test]
 fn a_causal_trigger_filter_ignores_a_glitch_but_not_the_impact() {
     let (mut rec, t) = one_impact(
         &Nonlinear {

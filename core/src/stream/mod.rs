@@ -194,7 +194,11 @@ impl<const PRE: usize> Stream<PRE> {
                 reason: "hold time must be under half the capture length",
             });
         }
-        self.configure(scene)
+        self.configure(scene)?;
+        // A CFC's padding lengthens the hold only as far as the capture allows (beyond, the
+        // analysis refuses the filter: `cfc-window`).
+        self.hold = self.hold.min((cap / 2 - 1) as u32).max(hold);
+        Ok(())
     }
 
     /// As [`Self::configure_for`], without a capture length to check.
@@ -216,7 +220,12 @@ impl<const PRE: usize> Stream<PRE> {
         self.counters = Counters::default();
         self.trigger_counts = scene.trigger_m_s2 / gain;
         self.edge_counts = scene.edge_m_s2 / gain;
-        self.hold = scene.samples(scene.hold_s);
+        // With a CFC on the captured windows the filter needs its padding of signal after
+        // the contact (SAE J211): an impact ends after at least that much quiet signal.
+        let pad = scene
+            .cfc
+            .map_or(0, |c| c.padding_samples(scene.calibration.sample_rate_hz));
+        self.hold = scene.samples(scene.hold_s).max(pad);
         self.settle = scene.samples(scene.settle_s);
         self.max_samples = scene.samples(scene.max_impact_s) as u64;
         self.thresholds = None;
