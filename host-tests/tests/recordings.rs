@@ -461,3 +461,149 @@ fn a_half_sine_cut_flat_at_the_sensor_range_is_clipped() {
         assert!((39.9..40.1).contains(&peak), "{peak}");
     }
 }
+
+/// `scripts/peer_endaq.csv`: case -> quantity -> value (see `scripts/peer_endaq.py`).
+fn peer() -> std::collections::HashMap<String, std::collections::HashMap<String, f64>> {
+    let path = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../scripts/peer_endaq.csv");
+    let text = std::fs::read_to_string(&path).unwrap();
+    let mut out: std::collections::HashMap<_, std::collections::HashMap<_, _>> = Default::default();
+    for line in text.lines().filter(|l| !l.starts_with('#')).skip(1) {
+        let f: Vec<&str> = line.split(',').collect();
+        out.entry(f[0].to_string())
+            .or_default()
+            .insert(f[1].to_string(), f[2].parse::<f64>().unwrap());
+    }
+    out
+}
+
+/// `got` against the peer's `want` within `rel` (relative) or `abs` (absolute).
+fn agree(case: &str, what: &str, got: f64, want: f64, rel: f64, abs: f64) {
+    let ok = (got - want).abs() <= abs.max(rel * want.abs());
+    println!("{case:24} {what:18} ours {got:<14.7e} peer {want:<14.7e}");
+    assert!(ok, "{case} {what}: ours {got}, peer {want}");
+}
+
+#[test]
+fn peer_endaq_and_j211_agree_on_every_recording() {
+    let peer = peer();
+    let p = |case: &str, q: &str| -> f64 {
+        *peer
+            .get(case)
+            .and_then(|m| m.get(q))
+            .unwrap_or_else(|| panic!("no {case} {q} in scripts/peer_endaq.csv"))
+    };
+    // Peak (above the baseline; the peer's zero is a median before the pulse) within
+    // 0.3 %, its time within 1.5 samples, FWHM within 0.5 %.
+    let check = |case: &str, a: &AnalysisJson, dt: f64| {
+        let r = &a.impacts[0];
+        agree(
+            case,
+            "peak",
+            r.peak_acceleration_m_s2,
+            p(case, "peak_m_s2"),
+            3e-3,
+            0.0,
+        );
+        agree(
+            case,
+            "peak time",
+            r.peak_time_s,
+            p(case, "peak_time_s"),
+            0.0,
+            1.5 * dt,
+        );
+        let w = r.fwhm_s.expect("FWHM");
+        agree(case, "FWHM", w, p(case, "fwhm_s"), 5e-3, 0.0);
+    };
+    let with_cfc = |args: &AnalyzeArgs| {
+        analyze(AnalyzeArgs {
+            cfc: Some(1000),
+            ..args.clone()
+        })
+    };
+    for col in ["bottom_kgn", "top_kgn"] {
+        let case = format!("afrl-full-{col}");
+        let args = AnalyzeArgs {
+            units: Some(Units::Kgn),
+            column: Some(ColumnRef::Name(col.into())),
+            ..file("afrl-drop-tower/series1_test1_full_100ms.csv")
+        };
+        let a = analyze(args.clone());
+        check(&case, &a, 1e-6);
+        let dv = a.impacts[0].delta_v_m_s.unwrap();
+        agree(&case, "Δv", dv, p(&case, "delta_v_m_s"), 5e-3, 0.0);
+        let f = with_cfc(&args).impacts[0]
+            .filtered_peak_acceleration_m_s2
+            .unwrap();
+        agree(
+            &case,
+            "CFC 1000 peak",
+            f,
+            p(&case, "cfc1000_peak_m_s2"),
+            5e-3,
+            0.0,
+        );
+    }
+    for (name, rel) in [("accel5", "accel_5"), ("accel6", "accel_6")] {
+        for c in 1..=5 {
+            let a = analyze(AnalyzeArgs {
+                units: Some(Units::Kgn),
+                rate: Some(1e6),
+                column: Some(ColumnRef::Index(c)),
+                ..file(&format!("afrl-drop-tower/{rel}.csv"))
+            });
+            check(&format!("afrl-{name}-test{c}"), &a, 1e-6);
+        }
+    }
+    let piezo = analyze(AnalyzeArgs {
+        column: Some(ColumnRef::Name("z_g".into())),
+        ..file("endaq-high-drop/High-Drop_2000g-PE_13.4-15.0s.csv")
+    });
+    check("endaq-piezo-z", &piezo, 1.0 / piezo.sample_rate_hz);
+    let water = analyze(AnalyzeArgs {
+        column: Some(ColumnRef::Name("y_g".into())),
+        ..file("impack-water-entry/4mps_sphere_1_100g-PR_9.9-10.6s.csv")
+    });
+    check("impack-100g-y", &water, 1.0 / water.sample_rate_hz);
+    for n in 1..=5 {
+        let case = format!("pyfrf-{n}");
+        let args = AnalyzeArgs {
+            column: Some(ColumnRef::Name("force_n".into())),
+            units: Some(Units::N),
+            ..file(&format!("pyfrf-impact-hammer/measurement_{n}.csv"))
+        };
+        let a = analyze(args.clone());
+        check(&case, &a, 1.0 / a.sample_rate_hz);
+        let f = with_cfc(&args).impacts[0]
+            .filtered_peak_acceleration_m_s2
+            .unwrap();
+        agree(
+            &case,
+            "CFC 1000 peak",
+            f,
+            p(&case, "cfc1000_peak_m_s2"),
+            5e-3,
+            0.0,
+        );
+    }
+    // The DC channel's bounces: enDAQ's events are our reports, peak for peak (a clipped
+    // peak's time is anywhere on its flat top of up to 6 samples).
+    let dc = analyze(AnalyzeArgs {
+        column: Some(ColumnRef::Name("z_g".into())),
+        ..file("endaq-high-drop/High-Drop_16g-DC_full.csv")
+    });
+    assert_eq!(dc.impacts.len() as f64, p("endaq-dc-z", "bounces"));
+    let dt = 1.0 / dc.sample_rate_hz;
+    for (k, r) in dc.impacts.iter().enumerate() {
+        let slack = if r.clipped { 6.5 } else { 1.5 };
+        let want = p("endaq-dc-z", &format!("bounce{k}_time_s"));
+        agree(
+            "endaq-dc-z",
+            &format!("bounce {k} time"),
+            r.peak_time_s,
+            want,
+            0.0,
+            slack * dt,
+        );
+    }
+}
