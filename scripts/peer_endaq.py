@@ -5,7 +5,8 @@ Independent of this repository's code: each recording is read with pandas, its s
 taken as the median of a quiet stretch named below, its impacts found with
 `endaq.calc.stats.find_peaks` (enDAQ's shock-event finder), the velocity change integrated
 with `endaq.calc.integrate.integrals` over the contact, the width at half maximum by linear interpolation of
-the two half-maximum crossings around the peak, and the CFC 1000 peak with an own SAE J211
+the two half-maximum crossings around the peak (and where a hammer strike crosses zero after
+its peak), and the CFC 1000 peak with an own SAE J211
 filter (two-pole Butterworth run forwards and backwards, J211's corner correction, on
 SciPy's `lfilter`). `host-tests/tests/recordings.rs` compares `impact analyze` with the
 stored output; CI never runs this script (no network there).
@@ -91,7 +92,18 @@ def median_over(s, lo, hi):
     return float(np.median(s[(s.index >= lo) & (s.index < hi)]))
 
 
-def pulse(case, s, zero, time_distance, out, cfc=None, delta_v=False):
+def separation(t, y, i):
+    """Where the pulse through sample i first crosses zero after its peak (linear)."""
+    sign = np.sign(y[i])
+    b = i
+    while b < len(y) - 1 and sign * y[b + 1] > 0:
+        b += 1
+    if b == len(y) - 1:
+        return float("nan")
+    return t[b] + y[b] / (y[b] - y[b + 1]) * (t[b + 1] - t[b])
+
+
+def pulse(case, s, zero, time_distance, out, cfc=None, delta_v=False, contact=False):
     """The largest event's peak, time, FWHM (and Δv over its contact), measured from `zero`."""
     t = s.index.to_numpy()
     z = s - zero
@@ -102,6 +114,8 @@ def pulse(case, s, zero, time_distance, out, cfc=None, delta_v=False):
     out.append((case, "peak_m_s2", y[i]))
     out.append((case, "peak_time_s", t[i]))
     out.append((case, "fwhm_s", half_width(t, y, i)))
+    if contact:
+        out.append((case, "separation_time_s", separation(t, y, i)))
     if delta_v:
         # The contact: from the last sample within 1 % of the peak from zero before it (the
         # pulse has a slow foot of 3-5 % of its peak for 80 µs) to the first sample back
@@ -156,7 +170,7 @@ def main():
     pulse("impack-100g-y", water, median_over(water, 10.15, 10.182), 1.0, out)
     for n in range(1, 6):
         s = load(f"pyfrf-impact-hammer/measurement_{n}.csv", "force_n", 1.0)
-        pulse(f"pyfrf-{n}", s, float(np.median(s)), 1.0, out, cfc=1000)
+        pulse(f"pyfrf-{n}", s, float(np.median(s)), 1.0, out, cfc=1000, contact=True)
 
     w = sys.stdout
     w.write(f"# made by scripts/peer_endaq.py on {datetime.date.today().isoformat()}\n")

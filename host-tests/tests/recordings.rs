@@ -175,6 +175,21 @@ fn hammer_strikes_give_one_pulse_each() {
             "{n}: {}",
             i.peak_acceleration_m_s2
         );
+        // The anti-alias filter rings before the sharp edge (samples of both signs beyond
+        // the edge level): the strike starts after the last sample of the other sign.
+        let cols = read_columns(&format!("pyfrf-impact-hammer/measurement_{n}.csv"), 1);
+        let (t, f) = (&cols[0], &cols[1]);
+        let peak = (0..f.len()).max_by(|&a, &b| f[a].total_cmp(&f[b])).unwrap();
+        let last_negative = (0..peak).rev().find(|&k| f[k] < 0.0).unwrap();
+        let rising = (last_negative..peak)
+            .find(|&k| f[k] > 0.1 * f[peak])
+            .unwrap();
+        assert!(
+            i.start_s > t[last_negative] && i.start_s < t[rising],
+            "{n}: start {} after {}",
+            i.start_s,
+            t[last_negative]
+        );
     }
 }
 
@@ -573,7 +588,20 @@ fn peer_endaq_and_j211_agree_on_every_recording() {
             ..file(&format!("pyfrf-impact-hammer/measurement_{n}.csv"))
         };
         let a = analyze(args.clone());
-        check(&case, &a, 1.0 / a.sample_rate_hz);
+        let dt = 1.0 / a.sample_rate_hz;
+        check(&case, &a, dt);
+        // The separation: where the strike crosses zero after its peak (within a fraction
+        // of a sample: the ADC's ringing around the edge level does not hold it back).
+        let r = &a.impacts[0];
+        let end = r.start_s + r.duration_s;
+        agree(
+            &case,
+            "separation",
+            end,
+            p(&case, "separation_time_s"),
+            0.0,
+            0.6 * dt,
+        );
         let f = with_cfc(&args).impacts[0]
             .filtered_peak_acceleration_m_s2
             .unwrap();

@@ -85,7 +85,7 @@ impl<const PRE: usize> Stream<PRE> {
     /// The trigger fired at `self.index`: find the onset in the ring, fix the baseline from
     /// the samples before it, fit the rising flank, and replay the pre-trigger samples into
     /// the capture (if the sink has a buffer) and the running sums.
-    pub(super) fn start<const CAP: usize>(&mut self, sink: &mut impl Sink<CAP>) {
+    pub(super) fn start<const CAP: usize>(&mut self, sink: &mut impl Sink<CAP>, trigger_x: i16) {
         let (base_sum, base_n) = self.baseline.rational();
         let deviation = Deviation::new(base_sum, base_n);
         let edge_d = (self.edge_counts * base_n as f32) as i64;
@@ -94,11 +94,15 @@ impl<const PRE: usize> Stream<PRE> {
         let d_lo = lo as i64 * base_n - base_sum;
         // The flank level: FLANK_EDGES edges, or just under the trigger thresholds.
         let flank_d = (FLANK_EDGES * edge_d).min(d_hi.min(-d_lo)).max(edge_d);
+        // Deviations signed so that the pulse (the trigger sample's direction) is positive:
+        // samples of the other sign just before it are ringing (an anti-alias filter's
+        // before a sharp edge), not the pulse.
+        let sign: i64 = if deviation.of(trigger_x) >= 0 { 1 } else { -1 };
         let ring = &self.ring;
-        let abs_d = |i: usize| ring.back(i).map(|x| deviation.of(x).unsigned_abs() as i64);
-        // Walk back from the newest sample while it is beyond the edge level.
+        let pd = |i: usize| ring.back(i).map(|x| sign * deviation.of(x) as i64);
+        // Walk back from the newest sample while it is beyond the edge level that way.
         let mut pulse = 0usize;
-        while let Some(y) = abs_d(pulse) {
+        while let Some(y) = pd(pulse) {
             if y <= edge_d {
                 break;
             }
@@ -107,7 +111,7 @@ impl<const PRE: usize> Stream<PRE> {
         // The rising flank from the onset forwards (the trigger sample, next, ends it).
         let mut flank = Flank::default();
         for k in 0..pulse {
-            match abs_d(pulse - 1 - k) {
+            match pd(pulse - 1 - k) {
                 Some(y) if y <= flank_d && flank.add(k as i64, y) => {}
                 _ => break,
             }
@@ -115,13 +119,20 @@ impl<const PRE: usize> Stream<PRE> {
         let onset_index = self.index - pulse as u64;
         let touch_offset = match flank.zero(true, -1.0, edge_d as f64) {
             Some(z) => z as f32,
-            // The edge crossing between the last quiet sample and the onset.
-            None => match (abs_d(pulse), abs_d(pulse.wrapping_sub(1))) {
-                (Some(y0), Some(y1)) if pulse > 0 => {
-                    (crossing(y0 as f64, y1 as f64, edge_d as f64) - 1.0) as f32
+            // The edge crossing between the last sample before the pulse and the onset (the
+            // trigger sample itself when the pulse starts there).
+            None => {
+                let onset = match pulse.checked_sub(1) {
+                    Some(i) => pd(i),
+                    None => Some(sign * deviation.of(trigger_x) as i64),
+                };
+                match (pd(pulse), onset) {
+                    (Some(y0), Some(y1)) => {
+                        (crossing(y0 as f64, y1 as f64, edge_d as f64) - 1.0) as f32
+                    }
+                    _ => 0.0,
                 }
-                _ => 0.0,
-            },
+            }
         };
         // First touch cannot come before the previous contact ended: reports never overlap.
         let earliest = self.last_end as f64 - onset_index as f64;
@@ -457,10 +468,16 @@ impl<const PRE: usize> Stream<PRE> {
             let x = self.ring.back(usize::try_from(back).ok()?)?;
             Some(deviation.of(x) as i64)
         };
-        let abs_d = |i: u64| d_at(i).map(i64::abs);
         let Some(last) = separation.checked_sub(1) else {
             return 0.0;
         };
+        // Deviations signed so that the pulse's last sample (beyond the edge) is positive.
+        let sign = if d_at(last).is_some_and(|d| d < 0) {
+            -1
+        } else {
+            1
+        };
+        let pd = |i: u64| d_at(i).map(|d| sign * d);
         if let (Some(d0), Some(d1)) = (d_at(last), d_at(separation)) {
             if d1.abs() > a.edge_d && (d0 >= 0) != (d1 >= 0) {
                 // Where the line between the two samples crosses zero.
@@ -470,7 +487,7 @@ impl<const PRE: usize> Stream<PRE> {
         let mut flank = Flank::default();
         let mut j = 0u64;
         while let Some(i) = last.checked_sub(j) {
-            match abs_d(i) {
+            match pd(i) {
                 Some(y) if y <= a.flank_d && flank.add(-(j as i64), y) => j += 1,
                 _ => break,
             }
@@ -478,7 +495,7 @@ impl<const PRE: usize> Stream<PRE> {
         // Positions relative to `last`: the first quiet sample is at +1.
         match flank.zero(false, 1.0, a.edge_d as f64) {
             Some(z) => (z - 1.0) as f32,
-            None => match (abs_d(last), abs_d(separation)) {
+            None => match (pd(last), pd(separation)) {
                 (Some(y0), Some(y1)) => {
                     (crossing(y0 as f64, y1 as f64, a.edge_d as f64) - 1.0) as f32
                 }

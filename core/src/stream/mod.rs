@@ -363,7 +363,7 @@ impl<const PRE: usize> Stream<PRE> {
                     // `at` lies inside `segment`, a prefix of `rest` (written with `get` so
                     // the target build has no panic path here).
                     self.idle(rest.get(..at).unwrap_or(&[]));
-                    self.start(sink);
+                    self.start(sink, rest.get(at).copied().unwrap_or(0));
                     rest = rest.get(at..).unwrap_or(&[]);
                 }
             }
