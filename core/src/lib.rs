@@ -32,6 +32,7 @@ pub mod scene;
 pub mod signal;
 pub mod solve;
 pub mod stream;
+pub mod target;
 
 pub use analysis::{analyse, Workspace};
 pub use capture::{Capture, Sink, Summary};

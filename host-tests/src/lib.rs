@@ -15,6 +15,8 @@ pub mod simulate;
 pub mod soak;
 pub mod stability;
 pub mod synth;
+pub mod target;
+pub mod target_bench;
 pub mod throughput;
 
 /// Runs `f` on a thread with a 64 MiB stack: the core's monitors hold their capture buffers

@@ -105,9 +105,10 @@ pub struct SimulateArgs {
     pub v0: f64,
     #[command(flatten)]
     pub params: ModelArgs,
-    /// Solver [default: exact, the most accurate].
-    #[arg(long, value_enum, default_value_t = SolverName::Exact)]
-    pub solver: SolverName,
+    /// Solver [default: exact, the most accurate; on a target, exact where a closed form
+    /// exists (a free body; linear, Kelvin–Voigt, two-phase laws), else adaptive].
+    #[arg(long, value_enum)]
+    pub solver: Option<SolverName>,
     /// Relative tolerance of the adaptive solver.
     #[arg(long, default_value_t = 1e-10)]
     pub rtol: f64,
@@ -123,6 +124,8 @@ pub struct SimulateArgs {
     /// Solve the same impact N times and report the wall time per impact.
     #[arg(long)]
     pub repeat: Option<u32>,
+    #[command(flatten)]
+    pub target: crate::target::TargetArgs,
 }
 
 /// A parameter problem, worded for the command line.
@@ -281,12 +284,37 @@ fn timed<R: Real>(
     ))
 }
 
-/// Runs `impact simulate`.
+/// What `impact simulate` found: a contact with a wall or with a target.
+pub enum Outcome {
+    Wall(SimulateReport),
+    Target(Box<crate::target::TargetReport>),
+}
+
+/// Runs `impact simulate`, on the target if one is given.
+pub fn run_any(args: &SimulateArgs) -> Result<Outcome, String> {
+    if !args.target.given() {
+        if args.target.plot.is_some() {
+            return Err(
+                "--plot: draws a contact with a target; give --target-mass or --target".into(),
+            );
+        }
+        return run(args).map(Outcome::Wall);
+    }
+    if args.repeat.is_some() {
+        return Err("--repeat: times the wall solvers; not with a target".into());
+    }
+    let impact = Impact::new(args.mass, args.v0);
+    impact.validate().map_err(|e| e.to_string())?;
+    let model = args.params.model(args.model, &impact)?;
+    crate::target::run(args, &model).map(|r| Outcome::Target(Box::new(r)))
+}
+
+/// Runs `impact simulate` against a wall.
 pub fn run(args: &SimulateArgs) -> Result<SimulateReport, String> {
     let impact = Impact::new(args.mass, args.v0);
     impact.validate().map_err(|e| e.to_string())?;
     let model = args.params.model(args.model, &impact)?;
-    let method = args.solver.method();
+    let method = args.solver.unwrap_or(SolverName::Exact).method();
     let settings = match method {
         Method::Exact => Settings::exact(),
         Method::Adaptive => Settings::adaptive(args.rtol),

@@ -359,3 +359,189 @@ fn too_few_steps_is_an_error_not_a_wrong_answer() {
     assert_eq!(code, 1);
     assert!(err.contains("--steps"), "{err}");
 }
+
+// ------------------------------------------------------------------------------- targets
+
+#[test]
+fn simulate_on_a_target_reports_the_two_bodies_and_the_ring_down() {
+    let base = [
+        "simulate",
+        "--model",
+        "linear",
+        "--mass",
+        "1",
+        "--v0",
+        "1",
+        "--stiffness",
+        "1e6",
+        "--json",
+    ];
+    // A heavy impactor on a light sprung target: it hits again (the seed's single hit fails).
+    let mut args = base.to_vec();
+    args.extend(["--target-mass", "0.01", "--target-stiffness", "1e4"]);
+    let v = json(&args);
+    for field in [
+        "contact_time_s",
+        "max_deformation_m",
+        "peak_force_n",
+        "rebound_velocity_m_s",
+        "target_velocity_m_s",
+        "target_energy_j",
+        "cor",
+        "recontact",
+        "recontact_time_s",
+        "ring_frequency_hz",
+        "ring_amplitude_m",
+        "null_reasons",
+    ] {
+        assert!(v.get(field).is_some(), "{field} missing: {v}");
+    }
+    assert_eq!(v["recontact"], true);
+    assert_eq!(v["solver"], "exact");
+    // Momentum: m1 (v0 - u1) = m2 w, with the impactor still moving on (rebound < 0).
+    let u1 = -v["rebound_velocity_m_s"].as_f64().unwrap();
+    let w = v["target_velocity_m_s"].as_f64().unwrap();
+    assert!(u1 > 0.0 && ((1.0 - u1) - 0.01 * w).abs() < 1e-3, "{v}");
+    // Hertz on a damped mount has no closed form: adaptive by default, said in the report.
+    let v = json(&[
+        "simulate",
+        "--model",
+        "hertz",
+        "--mass",
+        "0.06",
+        "--v0",
+        "1.3357",
+        "--stiffness",
+        "5e8",
+        "--target-mass",
+        "0.3",
+        "--target-stiffness",
+        "4e4",
+        "--target-damping",
+        "12",
+        "--json",
+    ]);
+    assert_eq!(v["solver"], "adaptive");
+    assert_eq!(v["recontact"], false);
+    assert!(v["recontact_time_s"].is_null() && v["null_reasons"]["recontact_time_s"].is_string());
+    // A state-space target file is the same spring–mass; its energy is null with a reason.
+    let dir = std::env::temp_dir().join(format!("impact-target-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let file = dir.join("mount.json");
+    std::fs::write(&file, r#"{"a": [[0, 1], [-133333.333333333333, -40]], "b": [0, 3.33333333333333333], "c": [[1, 0], [0, 1]], "d": [0, 0]}"#).unwrap();
+    let s = json(&[
+        "simulate",
+        "--model",
+        "hertz",
+        "--mass",
+        "0.06",
+        "--v0",
+        "1.3357",
+        "--stiffness",
+        "5e8",
+        "--target",
+        file.to_str().unwrap(),
+        "--json",
+    ]);
+    let rel =
+        (s["contact_time_s"].as_f64().unwrap() / v["contact_time_s"].as_f64().unwrap() - 1.0).abs();
+    assert!(rel < 1e-9, "{rel}");
+    assert!(s["target_energy_j"].is_null() && s["null_reasons"]["target_energy_j"].is_string());
+    assert!(s["target_work_j"].as_f64().unwrap() > 0.0);
+    // --plot draws an SVG.
+    let svg = dir.join("t.svg");
+    let (code, _, err) = impact(&[
+        "simulate",
+        "--model",
+        "linear",
+        "--mass",
+        "1",
+        "--v0",
+        "1",
+        "--stiffness",
+        "1e6",
+        "--target-mass",
+        "0.01",
+        "--target-stiffness",
+        "1e4",
+        "--plot",
+        svg.to_str().unwrap(),
+    ]);
+    assert_eq!(code, 0, "{err}");
+    assert!(std::fs::read_to_string(&svg)
+        .unwrap()
+        .contains("recontact at"));
+}
+
+#[test]
+fn a_target_that_cannot_be_pushed_is_a_one_line_error_naming_the_option() {
+    let dir = std::env::temp_dir().join(format!("impact-target-bad-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let unstable = dir.join("unstable.json");
+    std::fs::write(
+        &unstable,
+        r#"{"a": [[0, 1], [-1e4, 1]], "b": [0, 1], "c": [[1, 0], [0, 1]]}"#,
+    )
+    .unwrap();
+    let ragged = dir.join("ragged.json");
+    std::fs::write(
+        &ragged,
+        r#"{"a": [[0, 1], [-1e4]], "b": [0, 1], "c": [[1, 0], [0, 1]]}"#,
+    )
+    .unwrap();
+    let nan = dir.join("nan.json");
+    std::fs::write(
+        &nan,
+        r#"{"a": [[0, 1], [NaN, 0]], "b": [0, 1], "c": [[1, 0], [0, 1]]}"#,
+    )
+    .unwrap();
+    let law = [
+        "simulate",
+        "--model",
+        "hertz",
+        "--mass",
+        "0.06",
+        "--v0",
+        "1",
+        "--stiffness",
+        "5e8",
+    ];
+    for (extra, want) in [
+        (vec!["--target-mass", "0"], "--target-mass"),
+        (vec!["--target-mass", "-1"], "--target-mass"),
+        (vec!["--target-mass", "NaN"], "--target-mass"),
+        (
+            vec!["--target-mass", "1", "--target-stiffness", "-5"],
+            "--target-stiffness",
+        ),
+        (
+            vec!["--target-mass", "1", "--target-damping", "inf"],
+            "--target-damping",
+        ),
+        (vec!["--target", unstable.to_str().unwrap()], "unstable"),
+        (vec!["--target", ragged.to_str().unwrap()], "row 1"),
+        (vec!["--target", nan.to_str().unwrap()], "--target"),
+        (vec!["--target", "/nonexistent/t.json"], "--target"),
+        (vec!["--plot", "x.svg"], "--plot"),
+        (
+            vec![
+                "--target-mass",
+                "1",
+                "--target-stiffness",
+                "1e4",
+                "--solver",
+                "rk4",
+            ],
+            "--solver",
+        ),
+    ] {
+        let mut args = law.to_vec();
+        args.extend(extra.iter().copied());
+        let (code, out, err) = impact(&args);
+        assert_ne!(code, 0, "{extra:?}: {out}");
+        assert!(
+            err.contains(want) && err.trim().lines().count() == 1,
+            "{extra:?}: {err}"
+        );
+    }
+}

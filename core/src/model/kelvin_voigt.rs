@@ -1,6 +1,6 @@
 //! Linear Kelvin–Voigt spring-damper `F = k x + c v` (seed 001, Eq. 2).
 
-use super::{non_negative, positive, ContactLaw, Phase};
+use super::{non_negative, positive, Affine, ContactLaw, Phase};
 use crate::real::Real;
 use crate::solve::{exact, Error, Impact, ImpactOutcome};
 
@@ -19,6 +19,13 @@ impl<R: Real> ContactLaw<R> for KelvinVoigt<R> {
     }
     fn velocity_dependent(&self) -> bool {
         self.c != R::ZERO
+    }
+    fn affine(&self, _phase: Phase<R>) -> Option<Affine<R>> {
+        Some(Affine {
+            k: self.k,
+            c: self.c,
+            f0: R::ZERO,
+        })
     }
     fn validate(&self) -> Result<(), Error> {
         positive(self.k, "stiffness")?;

@@ -1,6 +1,6 @@
 //! Linear spring `F = k x`: the cheap stand-in for Hertz (seed 000, section 3.2.1).
 
-use super::{positive, ContactLaw, Hertz, Phase};
+use super::{positive, Affine, ContactLaw, Hertz, Phase};
 use crate::real::Real;
 use crate::solve::{exact, Error, Impact, ImpactOutcome};
 
@@ -34,6 +34,13 @@ impl<R: Real> ContactLaw<R> for Linear<R> {
     }
     fn velocity_dependent(&self) -> bool {
         false
+    }
+    fn affine(&self, _phase: Phase<R>) -> Option<Affine<R>> {
+        Some(Affine {
+            k: self.k,
+            c: R::ZERO,
+            f0: R::ZERO,
+        })
     }
     fn validate(&self) -> Result<(), Error> {
         positive(self.k, "stiffness")

@@ -31,6 +31,14 @@ pub enum Phase<R> {
     Restitution { x_max: R },
 }
 
+/// A force affine in deformation and rate: `F = k x + c v + f0` (N/m, N s/m, N).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Affine<R> {
+    pub k: R,
+    pub c: R,
+    pub f0: R,
+}
+
 /// A force law between an impacting body and a barrier.
 pub trait ContactLaw<R: Real> {
     /// Contact force in N at deformation `x` (m) and rate `v` (m/s), extended smoothly past
@@ -58,6 +66,12 @@ pub trait ContactLaw<R: Real> {
     /// False if the force depends on `x` alone (integrators can then skip work).
     fn velocity_dependent(&self) -> bool {
         true
+    }
+
+    /// The force as `k x + c v + f0` within `phase`, for laws that are affine there (linear,
+    /// Kelvin–Voigt, two-phase): linear targets then have a closed-form solution.
+    fn affine(&self, _phase: Phase<R>) -> Option<Affine<R>> {
+        None
     }
 
     /// Checks the parameters; names the offending one.
@@ -140,6 +154,9 @@ impl<R: Real> ContactLaw<R> for Model<R> {
     }
     fn admissible(&self, x: R, v: R) -> bool {
         each_model!(self, m => m.admissible(x, v))
+    }
+    fn affine(&self, phase: Phase<R>) -> Option<Affine<R>> {
+        each_model!(self, m => m.affine(phase))
     }
     fn validate(&self) -> Result<(), Error> {
         each_model!(self, m => m.validate())

@@ -2,7 +2,7 @@
 //! restitution with `kr` and `c` around a permanent set `x_p`.
 
 use super::kelvin_voigt::damped_time_scale;
-use super::{non_negative, positive, ContactLaw, Phase};
+use super::{non_negative, positive, Affine, ContactLaw, Phase};
 use crate::real::Real;
 use crate::solve::{exact, Error, Impact, ImpactOutcome};
 
@@ -47,6 +47,20 @@ impl<R: Real> ContactLaw<R> for TwoPhase<R> {
     }
     fn switches_at_max(&self) -> bool {
         true
+    }
+    fn affine(&self, phase: Phase<R>) -> Option<Affine<R>> {
+        Some(match phase {
+            Phase::Compression => Affine {
+                k: self.kc,
+                c: R::ZERO,
+                f0: R::ZERO,
+            },
+            Phase::Restitution { x_max } => Affine {
+                k: self.kr,
+                c: self.c,
+                f0: -self.kr * self.permanent_set(x_max),
+            },
+        })
     }
     fn velocity_dependent(&self) -> bool {
         self.c != R::ZERO

@@ -11,16 +11,16 @@ use super::{Error, Impact, ImpactOutcome};
 use crate::model::{ContactLaw, Phase};
 use crate::real::Real;
 
-const A2: [f64; 1] = [0.2];
-const A3: [f64; 2] = [3.0 / 40.0, 9.0 / 40.0];
-const A4: [f64; 3] = [44.0 / 45.0, -56.0 / 15.0, 32.0 / 9.0];
-const A5: [f64; 4] = [
+pub(crate) const A2: [f64; 1] = [0.2];
+pub(crate) const A3: [f64; 2] = [3.0 / 40.0, 9.0 / 40.0];
+pub(crate) const A4: [f64; 3] = [44.0 / 45.0, -56.0 / 15.0, 32.0 / 9.0];
+pub(crate) const A5: [f64; 4] = [
     19372.0 / 6561.0,
     -25360.0 / 2187.0,
     64448.0 / 6561.0,
     -212.0 / 729.0,
 ];
-const A6: [f64; 5] = [
+pub(crate) const A6: [f64; 5] = [
     9017.0 / 3168.0,
     -355.0 / 33.0,
     46732.0 / 5247.0,
@@ -28,7 +28,7 @@ const A6: [f64; 5] = [
     -5103.0 / 18656.0,
 ];
 /// 5th-order weights (also row 7 of the tableau: first same as last).
-const B: [f64; 6] = [
+pub(crate) const B: [f64; 6] = [
     35.0 / 384.0,
     0.0,
     500.0 / 1113.0,
@@ -37,7 +37,7 @@ const B: [f64; 6] = [
     11.0 / 84.0,
 ];
 /// Error weights `b - b*` for stages 1..7.
-const E: [f64; 7] = [
+pub(crate) const E: [f64; 7] = [
     71.0 / 57600.0,
     0.0,
     -71.0 / 16695.0,
@@ -47,7 +47,7 @@ const E: [f64; 7] = [
     -1.0 / 40.0,
 ];
 /// Dense output weights (Shampine 1986, as in Hairer's `CONTD5`).
-const D: [f64; 7] = [
+pub(crate) const D: [f64; 7] = [
     -12715105075.0 / 11282082432.0,
     0.0,
     87487479700.0 / 32700410799.0,

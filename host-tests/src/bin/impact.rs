@@ -6,7 +6,8 @@ use std::time::Duration;
 
 use clap::{Parser, Subcommand};
 use impact_host::{
-    analyze, emulate, m4, plot, precision, realtime, simulate, soak, stability, synth, throughput,
+    analyze, emulate, m4, plot, precision, realtime, simulate, soak, stability, synth, target,
+    target_bench, throughput,
 };
 
 #[derive(Parser)]
@@ -158,14 +159,14 @@ fn main() -> ExitCode {
 fn run(cli: Cli) -> Result<(), String> {
     match cli.command {
         Command::Simulate(args) => {
-            let report = simulate::run(&args)?;
-            if args.json {
-                println!(
-                    "{}",
-                    serde_json::to_string(&report).map_err(|e| e.to_string())?
-                );
-            } else {
-                print!("{}", simulate::table(&report));
+            fn json<T: serde::Serialize>(v: &T) -> Result<String, String> {
+                serde_json::to_string(v).map_err(|e| e.to_string())
+            }
+            match simulate::run_any(&args)? {
+                simulate::Outcome::Wall(report) if args.json => println!("{}", json(&report)?),
+                simulate::Outcome::Wall(report) => print!("{}", simulate::table(&report)),
+                simulate::Outcome::Target(report) if args.json => println!("{}", json(&*report)?),
+                simulate::Outcome::Target(report) => print!("{}", target::table(&report)),
             }
         }
         Command::Analyze(args) => {
@@ -273,7 +274,8 @@ fn run(cli: Cli) -> Result<(), String> {
         Command::Bench {
             which: Bench::Stability { full, json },
         } => {
-            let rows = stability::run(full);
+            let mut rows = stability::run(full);
+            rows.extend(target_bench::stability(full));
             if json {
                 println!(
                     "{}",
@@ -337,10 +339,11 @@ fn run(cli: Cli) -> Result<(), String> {
                     json,
                 },
         } => {
-            let points = precision::run(
+            let mut points = precision::run(
                 &precision::standard_cases(),
                 Duration::from_millis(budget_ms),
             );
+            points.extend(target_bench::precision(Duration::from_millis(budget_ms)));
             std::fs::create_dir_all(&out).map_err(|e| format!("{}: {e}", out.display()))?;
             let csv_path = out.join("work-precision.csv");
             std::fs::write(&csv_path, precision::csv(&points))
