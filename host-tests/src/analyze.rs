@@ -554,10 +554,13 @@ pub fn setup(args: &AnalyzeArgs, progress: Option<fn(f64)>) -> Result<Setup, Str
     if mass.is_none() {
         scene.fits = FitSet::none();
     }
-    let (approach, source) = match (
-        args.v0.or(file.v0_m_s),
-        args.drop_height.or(file.drop_height_m),
-    ) {
+    // A speed or height on the command line overrides either one from the scene.
+    let (v0, height) = if args.v0.is_some() || args.drop_height.is_some() {
+        (args.v0, args.drop_height)
+    } else {
+        (file.v0_m_s, file.drop_height_m)
+    };
+    let (approach, source) = match (v0, height) {
         (Some(v), _) => (Approach::Speed { v0_m_s: v as f32 }, Some("v0")),
         (None, Some(h)) => (
             Approach::DropHeight { height_m: h as f32 },

@@ -4,6 +4,33 @@ use plotters::prelude::*;
 
 use crate::precision::Point;
 
+/// Checks that `path` can take an SVG before any work is done: its directory exists and it is
+/// none of the `inputs` (an analysis never overwrites its recording).
+pub fn check_output(path: &std::path::Path, inputs: &[&std::path::Path]) -> Result<(), String> {
+    let dir = match path.parent() {
+        Some(d) if !d.as_os_str().is_empty() => d,
+        _ => std::path::Path::new("."),
+    };
+    if !dir.is_dir() {
+        return Err(format!(
+            "--plot {}: directory {} does not exist",
+            path.display(),
+            dir.display()
+        ));
+    }
+    if let Ok(out) = path.canonicalize() {
+        for input in inputs {
+            if input.canonicalize().is_ok_and(|i| i == out) {
+                return Err(format!(
+                    "--plot {}: is an input file; it would be overwritten",
+                    path.display()
+                ));
+            }
+        }
+    }
+    Ok(())
+}
+
 /// Draws time per impact (µs) against max relative error, one series per solver, one panel
 /// per model case, into an SVG file.
 pub fn work_precision(points: &[Point], path: &std::path::Path) -> Result<(), String> {

@@ -65,11 +65,14 @@ pub struct Placed<'a> {
 /// Object-safe view of a contact law (so a recording can mix models).
 pub trait DynLaw {
     /// Decelerations at `lead_s + k period_s` after first touch, m/s², and the exact outcome.
+    /// At most `max` samples are kept (the rest fall outside the recording): memory follows
+    /// the recording, not the model's contact time.
     fn decelerations(
         &self,
         impact: &Impact<f64>,
         lead_s: f64,
         period_s: f64,
+        max: usize,
     ) -> Result<(Vec<f64>, ImpactOutcome<f64>), Error>;
 }
 
@@ -79,12 +82,15 @@ impl<L: ContactLaw<f64>> DynLaw for L {
         impact: &Impact<f64>,
         lead_s: f64,
         period_s: f64,
+        max: usize,
     ) -> Result<(Vec<f64>, ImpactOutcome<f64>), Error> {
         let mut a = Vec::new();
         let exact = self.exact(impact)?;
         // The trajectory at the samples, to 1e-12 (far below any ADC's resolution).
         trajectory::sample(self, impact, 1e-12, lead_s, period_s, |s| {
-            a.push(s.force_n / impact.mass_kg)
+            if a.len() < max {
+                a.push(s.force_n / impact.mass_kg)
+            }
         })?;
         Ok((a, exact))
     }
@@ -134,7 +140,9 @@ pub fn record(
         let first = (c.touch_s * sensor.rate_hz).ceil() as usize;
         // Rounding can make the lead a hair negative when the touch falls on a sample.
         let lead = (first as f64 * period - c.touch_s).max(0.0);
-        let (a, exact) = c.law.decelerations(&c.impact, lead, period)?;
+        let (a, exact) = c
+            .law
+            .decelerations(&c.impact, lead, period, n.saturating_sub(first))?;
         for (k, v) in a.into_iter().enumerate() {
             if let Some(slot) = accel.get_mut(first + k) {
                 *slot += v;
@@ -170,6 +178,9 @@ pub fn record(
         clipped,
     })
 }
+
+/// Most samples `impact synth` renders (80 s at 500 kS/s; the recording is held in memory).
+pub const MAX_SAMPLES: usize = 40_000_000;
 
 /// `impact synth` options: one model impact rendered as an accelerometer recording.
 #[derive(clap::Args, Clone, Debug)]
@@ -252,8 +263,38 @@ pub fn synth(args: &SynthArgs) -> Result<(Recording, String), String> {
     if !(args.rate.is_finite() && args.rate > 0.0) {
         return Err("--rate: must be finite and > 0".into());
     }
-    if !(2..=16).contains(&args.bits) {
-        return Err("--bits: must lie in 2..=16".into());
+    if !(2..=15).contains(&args.bits) {
+        // Codes are offset binary (mid-scale is zero) in the i16 sample path.
+        return Err(
+            "--bits: must lie in 2..=15 (offset-binary codes in the i16 sample path)".into(),
+        );
+    }
+    let finite = |name: &str, x: f64| {
+        if x.is_finite() {
+            Ok(())
+        } else {
+            Err(format!("--{name}: must be finite"))
+        }
+    };
+    finite("offset", args.offset)?;
+    finite("drift", args.drift)?;
+    if !(args.noise.is_finite() && args.noise >= 0.0) {
+        return Err("--noise: must be finite and >= 0".into());
+    }
+    if !(args.full_scale.is_finite() && args.full_scale > 0.0) {
+        return Err("--full-scale: must be finite and > 0".into());
+    }
+    if !(args.duration.is_finite() && args.duration > 0.0) {
+        return Err("--duration: must be finite and > 0".into());
+    }
+    let samples = args.duration * args.rate;
+    if samples > MAX_SAMPLES as f64 {
+        return Err(format!(
+            "--duration x --rate: {samples:.3e} samples; at most {MAX_SAMPLES:.0e} in one synthetic recording"
+        ));
+    }
+    if !(args.touch.is_finite() && args.touch >= 0.0 && args.touch < args.duration) {
+        return Err("--touch: must lie in [0, --duration)".into());
     }
     let sensor = Sensor {
         rate_hz: args.rate,

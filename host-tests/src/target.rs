@@ -210,6 +210,9 @@ pub fn widen(o: &TargetOutcome<f32>) -> TargetOutcome<f64> {
 /// Runs `impact simulate` with a target.
 pub fn run(args: &SimulateArgs, model: &Model<f64>) -> Result<TargetReport, String> {
     let t = build(&args.target)?;
+    if let Some(path) = &args.target.plot {
+        crate::plot::check_output(path, &[])?;
+    }
     let impact = Impact::new(args.mass, args.v0);
     let closed_form = t.is_free_body()
         || model

@@ -309,3 +309,57 @@ fn a_free_fall_file_must_reach_the_impact() {
         "{err}"
     );
 }
+
+#[test]
+fn the_plot_never_overwrites_the_input_and_the_command_line_overrides_the_scene() {
+    let (code, csv, err) = impact(&[
+        "synth",
+        "--law",
+        "two-phase",
+        "--mass",
+        "0.06",
+        "--v0",
+        "1.3357",
+        "--kc",
+        "1e4",
+        "--kr",
+        "5e4",
+        "--damping",
+        "5",
+    ]);
+    assert_eq!(code, 0, "{err}");
+    let f = temp_csv("overwrite.csv", &csv);
+    let name = f.to_str().unwrap();
+    // --plot onto the recording itself: refused before anything is printed; the file stays.
+    let (code, out, err) = impact(&["analyze", name, "--plot", name]);
+    assert_eq!(code, 1);
+    assert!(out.is_empty() && err.contains("input file"), "{err}");
+    assert_eq!(std::fs::read_to_string(&f).unwrap(), csv);
+    // --plot into a missing directory: refused up front, naming it.
+    let (code, out, err) = impact(&["analyze", name, "--plot", "/nonexistent-dir/x.svg"]);
+    assert_eq!(code, 1);
+    assert!(out.is_empty() && err.contains("/nonexistent-dir"), "{err}");
+    // A drop height on the command line replaces the scene's v0 (the help's promise).
+    let scene = temp_csv("scene.json", r#"{"mass_kg": 0.06, "v0_m_s": 5.0}"#);
+    let first = |extra: &[&str]| {
+        let mut args = vec![
+            "analyze",
+            name,
+            "--scene",
+            scene.to_str().unwrap(),
+            "--json",
+        ];
+        args.extend(extra);
+        let (code, out, err) = impact(&args);
+        assert_eq!(code, 0, "{err}");
+        let v: serde_json::Value = serde_json::from_str(&out).unwrap();
+        v["impacts"][0].clone()
+    };
+    // The scene's 5 m/s is more than this impact's Δv could stop.
+    assert!(first(&[])["flags"].to_string().contains("no-stop"));
+    let h = 1.3357f64 * 1.3357 / (2.0 * 9.80665);
+    let from_height = first(&["--drop-height", &h.to_string()])["impact_velocity_m_s"]
+        .as_f64()
+        .unwrap();
+    assert!((from_height - 1.3357).abs() < 1e-4, "{from_height}");
+}

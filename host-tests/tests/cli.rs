@@ -545,3 +545,131 @@ fn a_target_that_cannot_be_pushed_is_a_one_line_error_naming_the_option() {
         );
     }
 }
+
+// ------------------------------------------------------------------- hostile synth options
+
+const T2: [&str; 12] = [
+    "synth",
+    "--law",
+    "two-phase",
+    "--mass",
+    "0.06",
+    "--v0",
+    "1.3357",
+    "--kc",
+    "1e4",
+    "--kr",
+    "5e4",
+    "--damping=5",
+];
+
+#[test]
+fn synth_refuses_what_it_cannot_render_in_one_line_naming_the_option() {
+    for (extra, want) in [
+        (vec!["--duration", "inf"], "--duration"),
+        (vec!["--duration", "1e300"], "--duration x --rate"),
+        (vec!["--duration", "NaN"], "--duration"),
+        (vec!["--duration", "-1"], "--duration"),
+        (vec!["--duration", "1e6"], "--duration x --rate"),
+        (vec!["--rate", "1e12"], "--duration x --rate"),
+        (vec!["--bits", "16"], "--bits"),
+        (vec!["--noise", "NaN"], "--noise"),
+        (vec!["--noise", "-1"], "--noise"),
+        (vec!["--offset", "NaN"], "--offset"),
+        (vec!["--drift", "inf"], "--drift"),
+        (vec!["--full-scale", "0"], "--full-scale"),
+        (vec!["--full-scale", "NaN"], "--full-scale"),
+        (vec!["--touch", "inf"], "--touch"),
+        (vec!["--touch", "1e300"], "--touch"),
+        (vec!["--touch", "NaN"], "--touch"),
+    ] {
+        let mut args = T2.to_vec();
+        args.extend(extra.iter().copied());
+        let (code, _, err) = impact(&args);
+        assert_eq!(code, 1, "{extra:?}: {err}");
+        assert!(
+            err.contains(want) && err.trim().lines().count() == 1,
+            "{extra:?}: {err}"
+        );
+    }
+}
+
+#[test]
+fn synth_memory_follows_the_recording_not_the_contact_time() {
+    // A contact of ~3e4 s rendered into 10 samples: 10 rows, promptly.
+    let (code, out, err) = impact(&[
+        "synth",
+        "--law",
+        "linear",
+        "--mass",
+        "1",
+        "--v0",
+        "1",
+        "--stiffness",
+        "1e-8",
+        "--duration",
+        "0.01",
+        "--rate",
+        "1000",
+        "--touch",
+        "0.001",
+    ]);
+    assert_eq!(code, 0, "{err}");
+    assert_eq!(out.lines().count(), 11, "{out}");
+}
+
+#[cfg(unix)]
+#[test]
+fn a_closed_output_pipe_ends_the_tool_quietly() {
+    use std::io::{BufRead, BufReader};
+    use std::os::unix::process::ExitStatusExt;
+    use std::process::{Command, Stdio};
+    let mut child = Command::new(env!("CARGO_BIN_EXE_impact"))
+        .args(T2)
+        .args(["--duration", "2"])
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .expect("runs");
+    let mut first = String::new();
+    BufReader::new(child.stdout.take().unwrap())
+        .read_line(&mut first)
+        .unwrap();
+    assert_eq!(first.trim(), "time_s,accel_g");
+    // The reader is gone: the next write gets SIGPIPE, not a panic (exit 101).
+    let out = child.wait_with_output().unwrap();
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(!err.contains("panicked"), "{err}");
+    assert_eq!(
+        out.status.signal(),
+        Some(libc_sigpipe()),
+        "{:?} {err}",
+        out.status
+    );
+}
+
+#[cfg(unix)]
+fn libc_sigpipe() -> i32 {
+    13 // SIGPIPE on Linux and the BSDs
+}
+
+#[test]
+fn an_underflowing_contact_is_an_error_not_zeros() {
+    for extra in [
+        ["--mass", "8.419e-3", "--v0", "1e-160", "--precision", "f64"],
+        ["--mass", "1e-45", "--v0", "1", "--precision", "f32"],
+    ] {
+        let mut args = vec![
+            "simulate",
+            "--model",
+            "hertz",
+            "--stiffness",
+            "1e10",
+            "--json",
+        ];
+        args.extend(extra);
+        let (code, out, err) = impact(&args);
+        assert_eq!(code, 1, "{extra:?}: {out}");
+        assert!(err.contains("underflowed"), "{err}");
+    }
+}

@@ -21,13 +21,23 @@ fn finite<R: Real>(o: ImpactOutcome<R>) -> Result<ImpactOutcome<R>, Error> {
         o.peak_force_n,
         o.permanent_deformation_m,
     ];
-    if fields.iter().all(|f| f.is_finite()) {
-        Ok(o)
-    } else {
-        Err(Error::Unresolved(
+    if !fields.iter().all(|f| f.is_finite()) {
+        return Err(Error::Unresolved(
             "result not finite: parameters outside the range of the number type",
-        ))
+        ));
     }
+    // A contact always takes time, deforms and pushes: zeros here are underflow (v0² below
+    // the smallest number), not an answer.
+    if !(o.max_deformation_m > R::ZERO
+        && o.crush_time_s > R::ZERO
+        && o.contact_time_s > R::ZERO
+        && o.peak_force_n > R::ZERO)
+    {
+        return Err(Error::Unresolved(
+            "result underflowed: parameters outside the range of the number type",
+        ));
+    }
+    Ok(o)
 }
 
 /// `I(n) = ∫0^1 du / sqrt(1 - u^(n+1)) = sqrt(pi) Γ(1 + 1/(n+1)) / Γ(1/2 + 1/(n+1))`:

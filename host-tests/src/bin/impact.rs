@@ -122,7 +122,19 @@ enum Bench {
     },
 }
 
+/// A closed output pipe (`impact … | head -1`) ends the tool quietly, as it does any Unix
+/// filter, instead of panicking in `println!` (Rust ignores SIGPIPE by default).
+#[cfg(unix)]
+fn restore_sigpipe() {
+    // SAFETY: sets the default disposition of one signal before any thread starts.
+    unsafe {
+        libc::signal(libc::SIGPIPE, libc::SIG_DFL);
+    }
+}
+
 fn main() -> ExitCode {
+    #[cfg(unix)]
+    restore_sigpipe();
     let cli = match Cli::try_parse() {
         Ok(cli) => cli,
         Err(e) => {
@@ -177,6 +189,9 @@ fn run(cli: Cli) -> Result<(), String> {
                     .unwrap_or(false);
                 (big && std::io::stderr().is_terminal()).then_some(show_progress as fn(f64))
             };
+            if let Some(path) = &args.plot {
+                plot::check_output(path, &[args.file.as_path()])?;
+            }
             let setup = analyze::setup(&args, progress)?;
             let reports = analyze::run(&setup.prepared.counts, &setup.scene)?;
             let a = analyze::to_json(&setup, &reports);
