@@ -3,7 +3,7 @@
 
 use std::fmt;
 use std::fs::File;
-use std::io::{BufRead, BufReader};
+use std::io::{BufRead, BufReader, Read};
 use std::path::{Path, PathBuf};
 
 /// A column chosen by header name or 0-based index.
@@ -83,7 +83,17 @@ fn split(line: &str) -> impl Iterator<Item = &str> {
 pub struct Table {
     pub headers: Vec<String>,
     pub columns: Vec<Vec<f64>>,
+    /// Lines before the first data row (headers and blank lines).
+    pub header_lines: usize,
 }
+
+/// Longest line read, bytes: a file without line breaks (`/dev/zero`) is an error, not a
+/// memory blow-up.
+pub const MAX_LINE_BYTES: usize = 1 << 20;
+
+/// Largest magnitude a value may have: beyond it no sensor reading or time is meant (and the
+/// f32 sample path would overflow).
+pub const MAX_VALUE: f64 = 1e30;
 
 /// Reads a CSV table. Leading lines that are not all numbers are headers (the last one names
 /// the columns); after the first numeric row every row must be numeric, with the same number
@@ -96,15 +106,37 @@ pub fn read_table(path: &Path, progress: Option<fn(f64)>) -> Result<Table, Recor
     };
     let file = File::open(path).map_err(|e| err(None, e.to_string()))?;
     let size = file.metadata().map(|m| m.len()).unwrap_or(0).max(1);
-    let reader = BufReader::with_capacity(1 << 20, file);
+    let mut reader = BufReader::with_capacity(1 << 20, file);
     let mut table = Table::default();
     let mut read_bytes = 0u64;
     let mut next_progress = size / 20;
     let mut row = Vec::new();
-    for (i, line) in reader.lines().enumerate() {
+    let mut buf = Vec::new();
+    for i in 0.. {
         let lineno = i + 1;
-        let line = line.map_err(|e| err(Some(lineno), e.to_string()))?;
-        read_bytes += line.len() as u64 + 1;
+        buf.clear();
+        let n = Read::take(&mut reader, MAX_LINE_BYTES as u64 + 1)
+            .read_until(b'\n', &mut buf)
+            .map_err(|e| err(Some(lineno), e.to_string()))?;
+        if n == 0 {
+            break;
+        }
+        if buf.len() > MAX_LINE_BYTES && buf.last() != Some(&b'\n') {
+            return Err(err(
+                Some(lineno),
+                format!("line longer than {MAX_LINE_BYTES} bytes: not a CSV recording"),
+            ));
+        }
+        let text =
+            std::str::from_utf8(&buf).map_err(|_| err(Some(lineno), "not UTF-8 text".into()))?;
+        // A UTF-8 byte-order mark (spreadsheet exports) is not part of the first header.
+        let text = if i == 0 {
+            text.trim_start_matches('\u{feff}')
+        } else {
+            text
+        };
+        let line = text.trim_end_matches(['\n', '\r']);
+        read_bytes += n as u64;
         if let Some(p) = progress {
             if read_bytes >= next_progress {
                 p(read_bytes as f64 / size as f64);
@@ -112,29 +144,39 @@ pub fn read_table(path: &Path, progress: Option<fn(f64)>) -> Result<Table, Recor
             }
         }
         if line.trim().is_empty() {
+            if table.columns.is_empty() {
+                table.header_lines = lineno;
+            }
             continue;
         }
         row.clear();
         let mut bad = None;
-        for f in split(&line) {
+        // Text makes a header line; a number that is not finite or beyond any sensor is an
+        // error wherever it is (a NaN row before the data is not a header).
+        let mut text_field = false;
+        for f in split(line) {
             match f.parse::<f64>() {
-                Ok(v) if v.is_finite() => row.push(v),
+                Ok(v) if v.is_finite() && v.abs() <= MAX_VALUE => row.push(v),
                 Ok(v) => {
-                    bad = Some(format!("value is {v}"));
-                    break;
+                    bad.get_or_insert(format!(
+                        "value is {v:e}: not a finite reading within ±{MAX_VALUE:e}"
+                    ));
                 }
                 Err(_) => {
-                    bad = Some(format!("not a number: {f:?}"));
-                    break;
+                    text_field = true;
+                    bad.get_or_insert(format!("not a number: {f:?}"));
                 }
             }
         }
         if table.columns.is_empty() {
-            if bad.is_some() {
-                table.headers = split(&line).map(str::to_string).collect();
+            if text_field {
+                table.headers = split(line).map(str::to_string).collect();
+                table.header_lines = lineno;
                 continue;
             }
-            table.columns = vec![Vec::new(); row.len()];
+            if bad.is_none() {
+                table.columns = vec![Vec::new(); row.len()];
+            }
         }
         if let Some(message) = bad {
             return Err(err(Some(lineno), message));
@@ -339,7 +381,7 @@ pub fn read_csv(path: &Path, opts: &ReadOptions) -> Result<Channel, RecordingErr
         message,
     };
     let table = read_table(path, opts.progress)?;
-    let header_lines = count_header_lines(path);
+    let header_lines = table.header_lines;
     let tcol = if opts.rate_hz.is_some() && opts.time_column.is_none() {
         None
     } else {
@@ -397,14 +439,4 @@ pub fn read_csv(path: &Path, opts: &ReadOptions) -> Result<Channel, RecordingErr
         jitter,
         resampled,
     })
-}
-
-/// Lines before the first data row (for line numbers of time errors).
-fn count_header_lines(path: &Path) -> usize {
-    let Ok(file) = File::open(path) else { return 0 };
-    BufReader::new(file)
-        .lines()
-        .map_while(Result::ok)
-        .take_while(|l| l.trim().is_empty() || split(l).any(|f| f.parse::<f64>().is_err()))
-        .count()
 }

@@ -363,3 +363,105 @@ fn the_plot_never_overwrites_the_input_and_the_command_line_overrides_the_scene(
         .unwrap();
     assert!((from_height - 1.3357).abs() < 1e-4, "{from_height}");
 }
+
+#[test]
+fn odd_files_are_one_line_errors_or_read_right() {
+    // No line breaks at all: an error after a bounded read, not a memory blow-up.
+    let (code, _, err) = impact(&["analyze", "/dev/zero"]);
+    assert_eq!(code, 1);
+    assert!(
+        err.contains("/dev/zero:1") && err.contains("longer than"),
+        "{err}"
+    );
+    // Leading NaN rows are data rows with a bad value, not header lines.
+    let f = temp_csv("nan-lead.csv", "time_s,a_g\nNaN,NaN\n0.001,1\n0.002,2\n");
+    let (code, _, err) = impact(&["analyze", f.to_str().unwrap()]);
+    assert_eq!(code, 1);
+    assert!(err.contains("nan-lead.csv:2"), "{err}");
+    // A reading no sensor gives.
+    let f = temp_csv("huge.csv", "time_s,a_g\n0.000,0\n0.001,1e38\n0.002,0\n");
+    let (code, _, err) = impact(&["analyze", f.to_str().unwrap()]);
+    assert_eq!(code, 1);
+    assert!(err.contains("huge.csv:3") && err.contains("1e38"), "{err}");
+    // A byte-order mark before the header (spreadsheet exports) is not part of its name.
+    let (code, csv, err) = impact(&[
+        "synth",
+        "--law",
+        "two-phase",
+        "--mass",
+        "0.06",
+        "--v0",
+        "1.3357",
+        "--kc",
+        "1e4",
+        "--kr",
+        "5e4",
+        "--damping",
+        "5",
+    ]);
+    assert_eq!(code, 0, "{err}");
+    let plain = temp_csv("plain.csv", &csv);
+    let bom = temp_csv("bom.csv", &format!("\u{feff}{csv}"));
+    let (c1, a, e1) = impact(&["analyze", plain.to_str().unwrap(), "--json"]);
+    let (c2, b, e2) = impact(&["analyze", bom.to_str().unwrap(), "--json"]);
+    assert_eq!((c1, c2), (0, 0), "{e1} {e2}");
+    let impacts =
+        |s: &str| serde_json::from_str::<serde_json::Value>(s).unwrap()["impacts"].clone();
+    assert_eq!(impacts(&a), impacts(&b));
+}
+
+#[cfg(unix)]
+#[test]
+fn a_fifo_is_read_once_not_waited_on_forever() {
+    use std::io::Write;
+    use std::process::{Command, Stdio};
+    let dir = std::env::temp_dir().join(format!("impact-fifo-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let fifo = dir.join("stream.csv");
+    let _ = std::fs::remove_file(&fifo);
+    let made = Command::new("mkfifo").arg(&fifo).status().expect("mkfifo");
+    assert!(made.success());
+    let (code, csv, _) = impact(&[
+        "synth",
+        "--law",
+        "two-phase",
+        "--mass",
+        "0.06",
+        "--v0",
+        "1.3357",
+        "--kc",
+        "1e4",
+        "--kr",
+        "5e4",
+        "--damping",
+        "5",
+    ]);
+    assert_eq!(code, 0);
+    let child = Command::new(env!("CARGO_BIN_EXE_impact"))
+        .args(["analyze", fifo.to_str().unwrap(), "--json"])
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .expect("runs");
+    std::fs::OpenOptions::new()
+        .write(true)
+        .open(&fifo)
+        .unwrap()
+        .write_all(csv.as_bytes())
+        .unwrap();
+    // The writer closed: the tool must finish (before, it opened the FIFO a second time and
+    // waited for a writer forever).
+    let (tx, rx) = std::sync::mpsc::channel();
+    std::thread::spawn(move || tx.send(child.wait_with_output()).unwrap());
+    let out = rx
+        .recv_timeout(std::time::Duration::from_secs(60))
+        .expect("impact analyze on a FIFO finished")
+        .unwrap();
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    assert_eq!(v["impacts"].as_array().unwrap().len(), 1);
+}
