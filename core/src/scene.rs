@@ -1,6 +1,6 @@
 //! What a bench is and which stages of the pipeline it needs; shared by host and firmware.
 
-use crate::model::{non_negative, positive};
+use crate::model::positive;
 use crate::signal::cfc::Cfc;
 use crate::signal::Calibration;
 use crate::solve::bounce::STANDARD_GRAVITY;
@@ -158,7 +158,12 @@ impl Scene {
         }
         positive(self.hold_s, "hold")?;
         positive(self.max_impact_s, "max-impact")?;
-        non_negative(self.max_impact_s - self.hold_s, "max-impact")?;
+        if !(self.hold_s <= self.max_impact_s) {
+            return Err(Error::InvalidParameter {
+                name: "hold",
+                reason: "must not exceed the longest impact (max-impact, default 1 s)",
+            });
+        }
         positive(self.settle_s, "settle")?;
         if self.settle_s < self.hold_s {
             return Err(Error::InvalidParameter {

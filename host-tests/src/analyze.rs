@@ -16,15 +16,20 @@ use crate::screen::{self, Clipping, Spike};
 
 /// Units of the recorded column.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum, Deserialize)]
+/// Scene files use the command line's spellings (`g`, `m/s2`, `kgn`, `n`).
 pub enum Units {
     /// Standard gravities (9.80665 m/s²).
+    #[serde(rename = "g", alias = "G")]
     G,
     /// m/s².
     #[value(name = "m/s2")]
+    #[serde(rename = "m/s2", alias = "MS2", alias = "ms2")]
     MS2,
     /// Kilo-g (1000 g), as in the AFRL drop-tower data.
+    #[serde(rename = "kgn", alias = "Kgn")]
     Kgn,
     /// Force in N (divided by the mass, or by 1 kg if none is given).
+    #[serde(rename = "n", alias = "N")]
     N,
 }
 

@@ -465,3 +465,59 @@ fn a_fifo_is_read_once_not_waited_on_forever() {
     let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
     assert_eq!(v["impacts"].as_array().unwrap().len(), 1);
 }
+
+#[test]
+fn messages_name_the_option_the_user_gave() {
+    let (code, csv, err) = impact(&[
+        "synth",
+        "--law",
+        "two-phase",
+        "--mass",
+        "0.06",
+        "--v0",
+        "1.3357",
+        "--kc",
+        "1e4",
+        "--kr",
+        "5e4",
+        "--damping",
+        "5",
+    ]);
+    assert_eq!(code, 0, "{err}");
+    let f = temp_csv("messages.csv", &csv);
+    let name = f.to_str().unwrap();
+    let (code, _, err) = impact(&["analyze", name, "--hold", "10"]);
+    assert_eq!(code, 1);
+    assert!(
+        err.contains("--hold") && err.contains("max-impact"),
+        "{err}"
+    );
+    let (code, _, err) = impact(&["analyze", name, "--rate", "1e8"]);
+    assert_eq!(code, 1);
+    assert!(
+        err.contains("--hold") && err.contains("lower the rate"),
+        "{err}"
+    );
+    // A scene file spells units as the command line does.
+    let scene = temp_csv("units.json", r#"{"units": "kgn"}"#);
+    let (code, _, err) = impact(&["analyze", name, "--scene", scene.to_str().unwrap()]);
+    assert_eq!(code, 0, "{err}");
+    // A sample no sensor gives is the file's line, not a --gain or --trigger problem.
+    for v in ["1e308", "1e39"] {
+        let text = csv.replacen(
+            "\n0.005000000,",
+            &format!("\n0.005000000,{v}\n0.005000001,"),
+            1,
+        );
+        let g = temp_csv("big.csv", &text);
+        let (code, _, err) = impact(&["analyze", g.to_str().unwrap()]);
+        assert_eq!(code, 1);
+        assert!(
+            err.contains("big.csv:")
+                && err.contains("value is")
+                && !err.contains("--gain")
+                && !err.contains("--trigger"),
+            "{err}"
+        );
+    }
+}

@@ -191,7 +191,7 @@ impl<const PRE: usize> Stream<PRE> {
         if cap < 4 * STRIDE || (hold as usize) >= cap / 2 {
             return Err(Error::InvalidParameter {
                 name: "hold",
-                reason: "hold time must be under half the capture length",
+                reason: "hold time at this sample rate must be under half the capture length (shorten the hold or lower the rate)",
             });
         }
         self.configure(scene)?;
