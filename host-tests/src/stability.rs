@@ -3,7 +3,7 @@
 //! solver says it could not resolve the contact.
 
 use impact_core::model::{KelvinVoigt, Linear, Model, Nonlinear, TwoPhase};
-use impact_core::{solve, ContactLaw, Error, Impact, Method, Settings};
+use impact_core::{solve, ContactLaw, Impact, Method, Settings};
 use serde::Serialize;
 
 use crate::compare::{max_relative_error, widen};
@@ -40,6 +40,56 @@ pub struct Row {
     pub bound: f64,
     /// Worst case, for the record.
     pub worst: String,
+}
+
+impl Row {
+    /// The row for `model`, `solver` and `precision` in `rows`, added (with `bound`) if new.
+    pub fn find_or_add<'a>(
+        rows: &'a mut Vec<Row>,
+        model: &str,
+        solver: &str,
+        precision: &str,
+        bound: f64,
+    ) -> &'a mut Row {
+        match rows
+            .iter()
+            .position(|r| r.model == model && r.solver == solver && r.precision == precision)
+        {
+            Some(i) => &mut rows[i],
+            None => {
+                rows.push(Row {
+                    model: model.into(),
+                    solver: solver.into(),
+                    precision: precision.into(),
+                    bound,
+                    ..Row::default()
+                });
+                rows.last_mut().expect("just pushed")
+            }
+        }
+    }
+
+    /// Counts one case: `None` if the solver declined, else its largest relative error and the
+    /// field it is in; `desc` names the case for the worst one.
+    pub fn tally(&mut self, error: Option<(f64, &str)>, desc: &str) {
+        self.cases += 1;
+        let Some((err, field)) = error else {
+            self.unresolved += 1;
+            return;
+        };
+        if !err.is_finite() {
+            self.non_finite += 1;
+            return;
+        }
+        self.resolved += 1;
+        if err > self.bound {
+            self.out_of_bound += 1;
+        }
+        if err > self.max_error {
+            self.max_error = err;
+            self.worst = format!("{desc}: {field}");
+        }
+    }
 }
 
 /// Grid of impacts and laws: `(description, model, impact)`.
@@ -164,42 +214,14 @@ pub fn run(full: bool) -> Vec<Row> {
                     Method::Adaptive => format!("adaptive {:.0e}", s.rtol),
                     _ => format!("{} {}", key.1, s.steps),
                 };
-                let row = match rows
-                    .iter_mut()
-                    .position(|r| r.model == key.0 && r.solver == label && r.precision == key.2)
-                {
-                    Some(i) => &mut rows[i],
-                    None => {
-                        rows.push(Row {
-                            model: key.0.into(),
-                            solver: label,
-                            precision: key.2.into(),
-                            bound: stated_bound(s.method, f32, s.rtol),
-                            ..Row::default()
-                        });
-                        rows.last_mut().expect("just pushed")
-                    }
-                };
-                row.cases += 1;
-                match result {
-                    Err(Error::Unresolved(_)) => row.unresolved += 1,
-                    Err(Error::InvalidParameter { .. }) => row.unresolved += 1,
-                    Ok(o) => {
-                        let (err, field) = max_relative_error(&o, &exact);
-                        if !err.is_finite() {
-                            row.non_finite += 1;
-                        } else {
-                            row.resolved += 1;
-                            if err > row.bound {
-                                row.out_of_bound += 1;
-                            }
-                            if err > row.max_error {
-                                row.max_error = err;
-                                row.worst = format!("{desc}: {field}");
-                            }
-                        }
-                    }
-                }
+                let row = Row::find_or_add(
+                    &mut rows,
+                    key.0,
+                    &label,
+                    key.2,
+                    stated_bound(s.method, f32, s.rtol),
+                );
+                row.tally(result.ok().map(|o| max_relative_error(&o, &exact)), desc);
             }
         }
     }

@@ -293,38 +293,14 @@ pub fn stability(full: bool) -> Vec<Row> {
                                         _ => format!("adaptive {:.0e}", s.rtol),
                                     };
                                     let name = format!("{}+target", law.name());
-                                    let row = match rows.iter().position(|r| r.model == name && r.solver == label && r.precision == precision) {
-                                        Some(i) => &mut rows[i],
-                                        None => {
-                                            rows.push(Row {
-                                                model: name,
-                                                solver: label,
-                                                precision: precision.into(),
-                                                bound: stated_bound(s.method, f32, s.rtol),
-                                                ..Row::default()
-                                            });
-                                            rows.last_mut().expect("just pushed")
-                                        }
-                                    };
-                                    row.cases += 1;
-                                    match result {
-                                        Err(_) => row.unresolved += 1,
-                                        Ok(o) => {
-                                            let (err, field) = error(&o, &reference, v0);
-                                            if !err.is_finite() {
-                                                row.non_finite += 1;
-                                            } else {
-                                                row.resolved += 1;
-                                                if err > row.bound {
-                                                    row.out_of_bound += 1;
-                                                }
-                                                if err > row.max_error {
-                                                    row.max_error = err;
-                                                    row.worst = format!("{desc}: {field}");
-                                                }
-                                            }
-                                        }
-                                    }
+                                    Row::find_or_add(
+                                        &mut rows,
+                                        &name,
+                                        &label,
+                                        precision,
+                                        stated_bound(s.method, f32, s.rtol),
+                                    )
+                                    .tally(result.ok().map(|o| error(&o, &reference, v0)), &desc);
                                 };
                                 let has_exact = t.is_free_body()
                                     || law.affine(impact_core::model::Phase::Compression).is_some();
