@@ -312,22 +312,7 @@ fn a_free_fall_file_must_reach_the_impact() {
 
 #[test]
 fn the_plot_never_overwrites_the_input_and_the_command_line_overrides_the_scene() {
-    let (code, csv, err) = impact(&[
-        "synth",
-        "--law",
-        "two-phase",
-        "--mass",
-        "0.06",
-        "--v0",
-        "1.3357",
-        "--kc",
-        "1e4",
-        "--kr",
-        "5e4",
-        "--damping",
-        "5",
-    ]);
-    assert_eq!(code, 0, "{err}");
+    let csv = common::synth_t2();
     let f = temp_csv("overwrite.csv", &csv);
     let name = f.to_str().unwrap();
     // --plot onto the recording itself: refused before anything is printed; the file stays.
@@ -384,22 +369,7 @@ fn odd_files_are_one_line_errors_or_read_right() {
     assert_eq!(code, 1);
     assert!(err.contains("huge.csv:3") && err.contains("1e38"), "{err}");
     // A byte-order mark before the header (spreadsheet exports) is not part of its name.
-    let (code, csv, err) = impact(&[
-        "synth",
-        "--law",
-        "two-phase",
-        "--mass",
-        "0.06",
-        "--v0",
-        "1.3357",
-        "--kc",
-        "1e4",
-        "--kr",
-        "5e4",
-        "--damping",
-        "5",
-    ]);
-    assert_eq!(code, 0, "{err}");
+    let csv = common::synth_t2();
     let plain = temp_csv("plain.csv", &csv);
     let bom = temp_csv("bom.csv", &format!("\u{feff}{csv}"));
     let (c1, a, e1) = impact(&["analyze", plain.to_str().unwrap(), "--json"]);
@@ -421,22 +391,7 @@ fn a_fifo_is_read_once_not_waited_on_forever() {
     let _ = std::fs::remove_file(&fifo);
     let made = Command::new("mkfifo").arg(&fifo).status().expect("mkfifo");
     assert!(made.success());
-    let (code, csv, _) = impact(&[
-        "synth",
-        "--law",
-        "two-phase",
-        "--mass",
-        "0.06",
-        "--v0",
-        "1.3357",
-        "--kc",
-        "1e4",
-        "--kr",
-        "5e4",
-        "--damping",
-        "5",
-    ]);
-    assert_eq!(code, 0);
+    let csv = common::synth_t2();
     let child = Command::new(env!("CARGO_BIN_EXE_impact"))
         .args(["analyze", fifo.to_str().unwrap(), "--json"])
         .stdout(Stdio::piped())
@@ -468,22 +423,7 @@ fn a_fifo_is_read_once_not_waited_on_forever() {
 
 #[test]
 fn messages_name_the_option_the_user_gave() {
-    let (code, csv, err) = impact(&[
-        "synth",
-        "--law",
-        "two-phase",
-        "--mass",
-        "0.06",
-        "--v0",
-        "1.3357",
-        "--kc",
-        "1e4",
-        "--kr",
-        "5e4",
-        "--damping",
-        "5",
-    ]);
-    assert_eq!(code, 0, "{err}");
+    let csv = common::synth_t2();
     let f = temp_csv("messages.csv", &csv);
     let name = f.to_str().unwrap();
     let (code, _, err) = impact(&["analyze", name, "--hold", "10"]);

@@ -548,20 +548,7 @@ fn a_target_that_cannot_be_pushed_is_a_one_line_error_naming_the_option() {
 
 // ------------------------------------------------------------------- hostile synth options
 
-const T2: [&str; 12] = [
-    "synth",
-    "--law",
-    "two-phase",
-    "--mass",
-    "0.06",
-    "--v0",
-    "1.3357",
-    "--kc",
-    "1e4",
-    "--kr",
-    "5e4",
-    "--damping=5",
-];
+use common::SYNTH_T2 as T2;
 
 #[test]
 fn synth_refuses_what_it_cannot_render_in_one_line_naming_the_option() {

@@ -22,3 +22,28 @@ pub fn impact_ok(args: &[&str]) -> (String, String) {
     assert_eq!(code, 0, "impact {}: exit {code}\n{err}", args.join(" "));
     (out, err)
 }
+
+/// `impact synth` of a two-phase impact (seed-001 bench body; kc 1e4, kr 5e4, damping 5): one
+/// 55.6 g impact at 10 ms, the hostile-input issue's `T2`.
+#[allow(dead_code)] // not every test file needs it
+pub const SYNTH_T2: [&str; 13] = [
+    "synth",
+    "--law",
+    "two-phase",
+    "--mass",
+    "0.06",
+    "--v0",
+    "1.3357",
+    "--kc",
+    "1e4",
+    "--kr",
+    "5e4",
+    "--damping",
+    "5",
+];
+
+/// The CSV of [`SYNTH_T2`].
+#[allow(dead_code)] // not every test file needs it
+pub fn synth_t2() -> String {
+    impact_ok(&SYNTH_T2).0
+}
