@@ -12,7 +12,7 @@ use crate::scene::Scene;
 use crate::stream::Deviation;
 
 /// How far beyond [0, 1] a measured COR may lie before it is taken as wrong, not noisy.
-const COR_TOLERANCE: f32 = 0.02;
+pub const COR_TOLERANCE: f32 = 0.02;
 
 /// Points the fits see at most: a contact of 12 600 samples (the seed bench at 500 kS/s) is
 /// thinned to every 6th sample, which moves no fitted value beyond its noise.

@@ -6,6 +6,9 @@ use crate::signal::Calibration;
 use crate::solve::bounce::STANDARD_GRAVITY;
 use crate::solve::Error;
 
+/// Heaviest impactor, kg: above any drop weight, and forces and energies stay finite f32.
+pub const MAX_MASS_KG: f32 = 1e6;
+
 /// How the approach speed `v0` is known (an accelerometer alone cannot tell it).
 #[derive(Clone, Copy, Debug, PartialEq)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
@@ -142,6 +145,16 @@ impl Scene {
         }
         if let Some(m) = self.mass_kg {
             positive(m, "mass")?;
+            // `m a` at the largest reading the gain allows (±2^16 counts from the baseline)
+            // must be a finite f32 force, with room for the energies.
+            let largest_force = m as f64 * c.gain_m_s2_per_count.abs() as f64 * 65536.0;
+            if !(m <= MAX_MASS_KG && largest_force <= f32::MAX as f64 / 1e3) {
+                return Err(Error::InvalidParameter {
+                    name: "mass",
+                    reason:
+                        "must be at most 1e6 kg, and mass x the gain's full scale a finite force",
+                });
+            }
         }
         match self.approach {
             Approach::Unknown => {}

@@ -11,8 +11,9 @@ use impact_core::solve::bounce::STANDARD_GRAVITY;
 use impact_core::{Approach, Calibration, FitSet, ImpactReport, Scene, Status};
 use serde::{Deserialize, Serialize};
 
-use crate::recording::{read_csv, read_table, time_unit_s, ColumnRef, ReadOptions};
+use crate::recording::{read_csv, time_unit_s, ColumnRef, ReadOptions};
 use crate::screen::{self, Clipping, Spike};
+use crate::table::{read_table, CsvFormat};
 
 /// Units of the recorded column.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum, Deserialize)]
@@ -75,11 +76,28 @@ pub struct FitsFile {
     pub hertz: Option<bool>,
 }
 
+/// A command-line number that must be finite and > 0.
+pub fn positive_f64(s: &str) -> Result<f64, String> {
+    match s.parse::<f64>() {
+        Ok(v) if v.is_finite() && v > 0.0 => Ok(v),
+        Ok(_) => Err("must be finite and > 0".into()),
+        Err(_) => Err("not a number".into()),
+    }
+}
+
 /// Options shared by `analyze` and `emulate`.
 #[derive(Args, Clone, Debug, Default)]
 pub struct AnalyzeArgs {
-    /// CSV file: a header line (or lines) and numeric rows.
+    /// CSV file (`-`: standard input): a header line (or lines) and numeric rows.
     pub file: PathBuf,
+    /// Field separator: one character, or `tab` [default: tab or `;` if the first lines hold
+    /// one, else `,`].
+    #[arg(long, value_parser = crate::table::parse_delimiter)]
+    pub delimiter: Option<u8>,
+    /// Numbers are written with a decimal comma (`0,5`); the delimiter must be another
+    /// character.
+    #[arg(long)]
+    pub decimal_comma: bool,
     /// The channel: header name or 0-based index [default: first non-time column].
     #[arg(long)]
     pub column: Option<ColumnRef>,
@@ -87,7 +105,7 @@ pub struct AnalyzeArgs {
     #[arg(long)]
     pub time_column: Option<ColumnRef>,
     /// Sample rate, Hz (instead of a time column).
-    #[arg(long)]
+    #[arg(long, value_parser = positive_f64)]
     pub rate: Option<f64>,
     /// Units of the channel [default: g].
     #[arg(long, value_enum)]
@@ -98,7 +116,7 @@ pub struct AnalyzeArgs {
     /// The sensor's full scale, in the channel's units (e.g. 16 for a ±16 g sensor read in
     /// g): readings at the rail mark their impact clipped [default: flat tops at the
     /// recording's extremes are taken for the rails].
-    #[arg(long)]
+    #[arg(long, value_parser = positive_f64)]
     pub range: Option<f64>,
     /// Keep isolated one- or two-sample spikes that dwarf the rest of the recording (by
     /// default they are removed, listed, and flag the impact they fall in).
@@ -109,13 +127,13 @@ pub struct AnalyzeArgs {
     #[arg(long, conflicts_with = "rate")]
     pub resample: bool,
     /// Mass of the instrumented body, kg.
-    #[arg(long)]
+    #[arg(long, value_parser = positive_f64)]
     pub mass: Option<f64>,
     /// Approach speed, m/s.
-    #[arg(long, conflicts_with_all = ["drop_height", "free_fall"])]
+    #[arg(long, conflicts_with_all = ["drop_height", "free_fall"], value_parser = positive_f64)]
     pub v0: Option<f64>,
     /// Drop height, m: v0 = sqrt(2 g h).
-    #[arg(long, conflicts_with = "free_fall")]
+    #[arg(long, conflicts_with = "free_fall", value_parser = positive_f64)]
     pub drop_height: Option<f64>,
     /// DC accelerometer file (g), optionally `:COLUMN`: v0 = g × free-fall time before the impact.
     #[arg(long)]
@@ -127,17 +145,17 @@ pub struct AnalyzeArgs {
     #[arg(long)]
     pub trigger_cfc: Option<u32>,
     /// Trigger level, m/s² above the baseline [default: from the signal's noise].
-    #[arg(long)]
+    #[arg(long, value_parser = positive_f64)]
     pub trigger: Option<f64>,
     /// Edge level (onset, separation), m/s² [default: a fifth of the trigger].
-    #[arg(long)]
+    #[arg(long, value_parser = positive_f64)]
     pub edge: Option<f64>,
     /// Quiet time that ends an impact, s [default: 2 ms].
-    #[arg(long)]
+    #[arg(long, value_parser = positive_f64)]
     pub hold: Option<f64>,
     /// How long a flat new level must last to be a level change (a DC channel's free fall
     /// or rest), not an impact, s [default: 50 ms, at least the hold].
-    #[arg(long)]
+    #[arg(long, value_parser = positive_f64)]
     pub settle: Option<f64>,
     /// Scene file (JSON); options given here override it.
     #[arg(long)]
@@ -465,6 +483,10 @@ pub fn setup(args: &AnalyzeArgs, progress: Option<fn(f64)>) -> Result<Setup, Str
             time_column: args.time_column.clone(),
             rate_hz: args.rate,
             resample: args.resample,
+            format: CsvFormat {
+                delimiter: args.delimiter,
+                decimal_comma: args.decimal_comma,
+            },
             progress,
         },
     )
@@ -638,7 +660,7 @@ pub fn free_fall_before(spec: &str, impact_s: f64) -> Result<f64, String> {
         _ => (spec, None),
     };
     let path = Path::new(path);
-    let table = read_table(path, None).map_err(|e| e.to_string())?;
+    let table = read_table(path, &CsvFormat::default(), None).map_err(|e| e.to_string())?;
     let tcol = table
         .time_column(None)
         .map_err(|e| format!("--free-fall {}: {e}", path.display()))?

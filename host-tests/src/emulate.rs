@@ -8,17 +8,17 @@
 //! firmware's `impact ...` lines back into [`ImpactReport`]s. The log's line format is in
 //! `firmware/README.md`.
 
-use std::collections::HashMap;
 use std::io::{BufRead, BufReader, Write};
 use std::path::{Path, PathBuf};
 use std::process::{Command, ExitStatus, Stdio};
 use std::time::{Duration, Instant};
 
 use clap::Args;
-use impact_core::report::{Fits, Flags, HertzFit, NonlinearFit, TwoPhaseFit};
-use impact_core::{Analysis, Approach, ImpactReport, Kinematics, Scene, Status};
 
-use crate::analyze::{self, AnalysisJson, AnalyzeArgs};
+use impact_core::{Approach, Scene};
+
+use crate::analyze::{self, AnalyzeArgs};
+use crate::log::{get, num, parse_log};
 
 /// `impact emulate` options: `impact analyze`'s, and where the firmware comes from.
 #[derive(Args, Clone, Debug)]
@@ -62,265 +62,6 @@ pub enum Pacing {
         rate_scale: f32,
         stall: Option<(u32, u32)>,
     },
-}
-
-/// `impact log` options.
-#[derive(Args, Clone, Debug)]
-pub struct LogArgs {
-    /// Decoded defmt log (defmt-print's or probe-rs's text output).
-    pub file: PathBuf,
-    /// Print one JSON object (the default).
-    #[arg(long, conflicts_with = "csv")]
-    pub json: bool,
-    /// Print one CSV row per impact.
-    #[arg(long)]
-    pub csv: bool,
-    /// Time of the stream's first sample, s (added to start_s and peak_time_s, as
-    /// `impact analyze` adds the recording's first time stamp).
-    #[arg(long, default_value_t = 0.0)]
-    pub t0: f64,
-}
-
-/// What a firmware log says.
-#[derive(Clone, Debug, Default)]
-pub struct Log {
-    /// The `scene` line's fields, if the log has one.
-    pub scene: Option<HashMap<String, String>>,
-    pub impacts: Vec<ImpactReport>,
-    /// Each impact's `report_latency_s` (real-time sources only).
-    pub latencies: Vec<Option<f32>>,
-    /// The last `heartbeat` line's fields.
-    pub heartbeat: Option<HashMap<String, String>>,
-    /// The `summary` line's fields (only at the end of a finite stream).
-    pub summary: Option<HashMap<String, String>>,
-}
-
-/// The `key=value` fields following `marker` (e.g. `"impact "`) in a decoded line, or `None`
-/// if the line is not such a line. Tokens without `=` (decoder decorations) are skipped.
-fn fields(line: &str, marker: &str) -> Option<Result<HashMap<String, String>, String>> {
-    // The marker at the start of the message: at the start of the line or after a space
-    // (defmt-print puts a time stamp and the level first).
-    let at = line
-        .match_indices(marker)
-        .map(|(i, _)| i)
-        .find(|&i| i == 0 || line[..i].ends_with(' '))?;
-    let rest = &line[at + marker.len()..];
-    // The first token must be a field, so that a prose message starting with the same word
-    // is not taken for one.
-    if !rest.split_whitespace().next()?.contains('=') {
-        return None;
-    }
-    let mut map = HashMap::new();
-    for token in rest.split_whitespace() {
-        if let Some((k, v)) = token.split_once('=') {
-            if map.insert(k.to_string(), v.to_string()).is_some() {
-                return Some(Err(format!("field {k} given twice")));
-            }
-        }
-    }
-    Some(Ok(map))
-}
-
-fn get<'a>(m: &'a HashMap<String, String>, key: &str) -> Result<&'a str, String> {
-    m.get(key)
-        .map(String::as_str)
-        .ok_or_else(|| format!("missing field {key}"))
-}
-
-fn num<T: std::str::FromStr>(m: &HashMap<String, String>, key: &str) -> Result<T, String> {
-    let v = get(m, key)?;
-    v.parse::<T>()
-        .map_err(|_| format!("{key}={v}: not a number"))
-}
-
-fn opt<T: std::str::FromStr>(m: &HashMap<String, String>, key: &str) -> Result<Option<T>, String> {
-    match get(m, key)? {
-        "none" => Ok(None),
-        v => v
-            .parse::<T>()
-            .map(Some)
-            .map_err(|_| format!("{key}={v}: not a number")),
-    }
-}
-
-fn flag(m: &HashMap<String, String>, key: &str) -> Result<bool, String> {
-    match get(m, key)? {
-        "true" => Ok(true),
-        "false" => Ok(false),
-        v => Err(format!("{key}={v}: not true or false")),
-    }
-}
-
-/// An `impact` line's fields as the core's report (floats parsed at their own width, so the
-/// firmware's shortest round-trip decimals give back its exact bits).
-pub fn parse_impact(m: &HashMap<String, String>) -> Result<ImpactReport, String> {
-    let status = get(m, "status")?;
-    let status = Status::ALL
-        .into_iter()
-        .find(|s| s.name() == status)
-        .ok_or_else(|| format!("status={status}: unknown status"))?;
-    let analysis = get(m, "analysis")?;
-    let analysis = [Analysis::Full, Analysis::Skipped]
-        .into_iter()
-        .find(|a| a.name() == analysis)
-        .ok_or_else(|| format!("analysis={analysis}: not full or skipped"))?;
-    let kinematics = match opt::<f32>(m, "impact_velocity_m_s")? {
-        None => None,
-        Some(v0) => Some(Kinematics {
-            impact_velocity_m_s: v0,
-            crush_time_s: num(m, "crush_time_s")?,
-            max_deformation_m: num(m, "max_deformation_m")?,
-            rebound_velocity_m_s: num(m, "rebound_velocity_m_s")?,
-            cor: num(m, "cor")?,
-            permanent_deformation_m: num(m, "permanent_deformation_m")?,
-            absorbed_energy_j: opt(m, "absorbed_energy_j")?,
-        }),
-    };
-    let two_phase = match opt::<f32>(m, "two_phase_kc_n_m")? {
-        None => None,
-        Some(kc) => Some(TwoPhaseFit {
-            kc_n_m: kc,
-            kr_n_m: num(m, "two_phase_kr_n_m")?,
-            c_n_s_m: num(m, "two_phase_c_n_s_m")?,
-            permanent_m: num(m, "two_phase_permanent_deformation_m")?,
-            residual: num(m, "two_phase_residual")?,
-        }),
-    };
-    let nonlinear = match opt::<f32>(m, "nonlinear_k")? {
-        None => None,
-        Some(k) => Some(NonlinearFit {
-            k,
-            c_s_m: num(m, "nonlinear_c_s_m")?,
-            n: num(m, "nonlinear_exponent")?,
-            residual: num(m, "nonlinear_residual")?,
-        }),
-    };
-    let hertz = match opt::<f32>(m, "hertz_k")? {
-        None => None,
-        Some(k) => Some(HertzFit {
-            k,
-            residual: num(m, "hertz_residual")?,
-        }),
-    };
-    Ok(ImpactReport {
-        index: num(m, "index")?,
-        status,
-        analysis,
-        clipped: flag(m, "clipped")?,
-        flags: Flags(num(m, "flags")?),
-        start_sample: num(m, "start_sample")?,
-        end_sample: num(m, "end_sample")?,
-        start_s: num(m, "start_s")?,
-        peak_time_s: num(m, "peak_time_s")?,
-        peak_acceleration_m_s2: num(m, "peak_acceleration_m_s2")?,
-        peak_force_n: opt(m, "peak_force_n")?,
-        delta_v_m_s: opt(m, "delta_v_m_s")?,
-        duration_s: num(m, "duration_s")?,
-        baseline_m_s2: num(m, "baseline_m_s2")?,
-        fwhm_s: opt(m, "fwhm_s")?,
-        filtered_peak_acceleration_m_s2: opt(m, "filtered_peak_acceleration_m_s2")?,
-        kinematics,
-        fits: Fits {
-            two_phase,
-            nonlinear,
-            hertz,
-        },
-    })
-}
-
-/// Parses a decoded firmware log (any other lines are ignored).
-pub fn parse_log(text: &str) -> Result<Log, String> {
-    let mut log = Log::default();
-    for (n, line) in text.lines().enumerate() {
-        let at = |e: String| format!("line {}: {e}", n + 1);
-        if let Some(m) = fields(line, "impact ") {
-            let m = m.map_err(at)?;
-            log.impacts.push(parse_impact(&m).map_err(at)?);
-            log.latencies.push(opt(&m, "report_latency_s").map_err(at)?);
-        } else if let Some(m) = fields(line, "heartbeat ") {
-            log.heartbeat = Some(m.map_err(at)?);
-        } else if let Some(m) = fields(line, "summary ") {
-            log.summary = Some(m.map_err(at)?);
-        } else if let Some(m) = fields(line, "scene ") {
-            // A restart (a new scene) starts a new stream.
-            log = Log {
-                scene: Some(m.map_err(at)?),
-                ..Log::default()
-            };
-        }
-    }
-    // The firmware prints impacts in index order unless an analysis kept the later ones
-    // waiting too long; the reports are in index order whatever the log's.
-    let mut both: Vec<_> = log.impacts.drain(..).zip(log.latencies.drain(..)).collect();
-    both.sort_by_key(|(r, _)| r.index);
-    (log.impacts, log.latencies) = both.into_iter().unzip();
-    Ok(log)
-}
-
-/// `impact analyze`'s JSON from a log alone: samples from the summary (or the last
-/// heartbeat), the rate from the scene line (or a heartbeat), `v0_source` from the scene line
-/// (a free fall measured on the host cannot be told from a plain `v0`).
-pub fn log_json(log: &Log, t0: f64) -> Result<AnalysisJson, String> {
-    let state = log.summary.as_ref().or(log.heartbeat.as_ref());
-    let samples = match state {
-        Some(m) => num::<u64>(m, "samples")?,
-        None => 0,
-    };
-    let rate = match (&log.scene, state) {
-        (Some(m), _) => num::<f32>(m, "rate_hz")?,
-        (None, Some(m)) => num::<f32>(m, "rate_hz")?,
-        (None, None) => {
-            return Err(
-                "the log has no scene, heartbeat or summary line: sample rate unknown".into(),
-            )
-        }
-    };
-    let v0_source = match &log.scene {
-        Some(m) if get(m, "drop_height_m")? != "none" => Some("drop-height".to_string()),
-        Some(m) if get(m, "v0_m_s")? != "none" => Some("v0".to_string()),
-        _ => None,
-    };
-    // What the scene asked for (the scene line's flags), for the reasons of absent fits.
-    let asked = |key: &str| -> Result<bool, String> {
-        match &log.scene {
-            Some(m) => flag(m, key),
-            None => Ok(false),
-        }
-    };
-    let fits = impact_core::FitSet {
-        two_phase: asked("two_phase")?,
-        nonlinear: asked("nonlinear")?,
-        fit_exponent: asked("fit_exponent")?,
-        nonlinear_exponent: 1.0,
-        hertz: asked("hertz")?,
-    };
-    let counter = |key: &str| -> Result<u64, String> {
-        match state {
-            Some(m) if m.contains_key(key) => num::<u64>(m, key),
-            _ => Ok(0),
-        }
-    };
-    Ok(AnalysisJson {
-        samples,
-        sample_rate_hz: rate as f64,
-        v0_source,
-        free_fall_s: None,
-        samples_lost: counter("samples_lost")?,
-        analyses_skipped: counter("analyses_skipped")?,
-        resampled: false,
-        spikes_removed: Vec::new(),
-        clipping: None,
-        impacts: log
-            .impacts
-            .iter()
-            .zip(&log.latencies)
-            .map(|(r, latency)| {
-                let mut j = analyze::impact_json(r, t0, &fits);
-                j.report_latency_s = latency.map(f64::from);
-                j
-            })
-            .collect(),
-    })
 }
 
 /// The scene as the firmware's `key=value` semihosting arguments. Floats are written as
@@ -675,59 +416,9 @@ pub fn emulate(args: &EmulateArgs) -> Result<(), String> {
     Ok(())
 }
 
-/// `impact log`: a decoded firmware log as JSON (default) or CSV.
-pub fn log(args: &LogArgs) -> Result<(), String> {
-    let text =
-        std::fs::read_to_string(&args.file).map_err(|e| format!("{}: {e}", args.file.display()))?;
-    let log = parse_log(&text).map_err(|e| format!("{}: {e}", args.file.display()))?;
-    let json = log_json(&log, args.t0)?;
-    if args.csv {
-        print!("{}", analyze::to_csv(&json));
-    } else {
-        println!(
-            "{}",
-            serde_json::to_string_pretty(&json).map_err(|e| e.to_string())?
-        );
-    }
-    Ok(())
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
-
-    const LINE: &str = "0.013931 INFO  impact index=0 status=complete analysis=full clipped=false flags=0 start_sample=5000 end_sample=17000 start_s=0.01 peak_time_s=0.0100251 peak_acceleration_m_s2=4321.5 peak_force_n=259.29 delta_v_m_s=2.5 duration_s=0.0219 baseline_m_s2=0.2 fwhm_s=0.001 filtered_peak_acceleration_m_s2=none impact_velocity_m_s=1.3357 crush_time_s=0.0218 max_deformation_m=0.0186 rebound_velocity_m_s=1.16 cor=0.87 permanent_deformation_m=0.0182 absorbed_energy_j=none two_phase_kc_n_m=none two_phase_kr_n_m=none two_phase_c_n_s_m=none two_phase_permanent_deformation_m=none two_phase_residual=none nonlinear_k=1e6 nonlinear_c_s_m=0.5 nonlinear_exponent=1.2 nonlinear_residual=0.01 hertz_k=none hertz_residual=none report_latency_s=0.0123";
-
-    #[test]
-    fn parses_an_impact_line() {
-        let log = parse_log(&format!(
-            "noise\n{LINE}\n└─ impact_firmware::tasks::reporter @ src/tasks/reporter.rs:150\n"
-        ))
-        .unwrap();
-        let r = log.impacts[0];
-        assert_eq!(
-            (r.index, r.status, r.start_sample),
-            (0, Status::Complete, 5000)
-        );
-        assert_eq!(r.peak_acceleration_m_s2, 4321.5f32);
-        assert_eq!(r.kinematics.unwrap().absorbed_energy_j, None);
-        assert_eq!(r.fits.nonlinear.unwrap().n, 1.2f32);
-        assert!(r.fits.two_phase.is_none() && r.fits.hertz.is_none());
-        assert_eq!(log.latencies, [Some(0.0123f32)]);
-    }
-
-    #[test]
-    fn a_missing_field_is_an_error_naming_it() {
-        let line = LINE.replace(" fwhm_s=0.001", "");
-        let e = parse_log(&line).unwrap_err();
-        assert!(e.contains("line 1") && e.contains("fwhm_s"), "{e}");
-    }
-
-    #[test]
-    fn prose_starting_with_a_marker_word_is_not_a_line() {
-        let log = parse_log("INFO  impact-firmware 0.1.0 up\nWARN summary of nothing").unwrap();
-        assert!(log.impacts.is_empty() && log.summary.is_none());
-    }
 
     #[test]
     fn scene_floats_round_trip() {

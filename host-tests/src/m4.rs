@@ -434,7 +434,7 @@ pub fn seed_recording() -> Result<Vec<i16>, String> {
         .chain(crate::synth::SEED_BENCH_ARGS)
         .chain(["--touch", "0.04", "--duration", "0.12"]);
     let args = Wrap::try_parse_from(args).map_err(|e| e.to_string())?;
-    Ok(crate::synth::synth(&args.synth)?.0.samples)
+    Ok(crate::synth::synth(&args.synth)?.samples)
 }
 
 /// The board's scene with the fits switched by `fits` (`key=value` overrides of

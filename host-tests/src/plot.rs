@@ -182,10 +182,12 @@ pub fn impacts(
                     }),
                 ));
             }
+            // A model's curve over a few times the measured window at most.
+            let points = 4 * meas.len() as u64 + 1024;
             for (name, color, model) in models {
                 let mut series = Vec::new();
                 if model.validate().is_ok()
-                    && trajectory::sample(&model, &impact, 1e-8, 0.0, 1.0 / fs, |s| {
+                    && trajectory::sample(&model, &impact, 1e-8, 0.0, 1.0 / fs, points, |s| {
                         series.push((s.t_s * 1e3, s.force_n / m as f64))
                     })
                     .is_ok()

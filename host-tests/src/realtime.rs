@@ -149,7 +149,7 @@ fn train(
         Duration::from_secs(1200),
         |_| {},
     )?;
-    let log = emulate::parse_log(&run.lines.join("\n"))?;
+    let log = crate::log::parse_log(&run.lines.join("\n"))?;
     let summary = log
         .summary
         .as_ref()

@@ -1,46 +1,10 @@
 //! Reading recorded signals from CSV: one channel and its time base, with errors that name
 //! the file and line.
 
-use std::fmt;
-use std::fs::File;
-use std::io::{BufRead, BufReader, Read};
-use std::path::{Path, PathBuf};
+use std::path::Path;
 
-/// A column chosen by header name or 0-based index.
-#[derive(Clone, Debug, PartialEq, Eq)]
-pub enum ColumnRef {
-    Name(String),
-    Index(usize),
-}
-
-impl std::str::FromStr for ColumnRef {
-    type Err = String;
-    fn from_str(s: &str) -> Result<Self, String> {
-        Ok(match s.parse::<usize>() {
-            Ok(i) => ColumnRef::Index(i),
-            Err(_) => ColumnRef::Name(s.to_string()),
-        })
-    }
-}
-
-/// What went wrong, and where.
-#[derive(Debug)]
-pub struct RecordingError {
-    pub file: PathBuf,
-    pub line: Option<usize>,
-    pub message: String,
-}
-
-impl fmt::Display for RecordingError {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        match self.line {
-            Some(l) => write!(f, "{}:{}: {}", self.file.display(), l, self.message),
-            None => write!(f, "{}: {}", self.file.display(), self.message),
-        }
-    }
-}
-
-impl std::error::Error for RecordingError {}
+use crate::table::{read_table, words, CsvFormat, Table};
+pub use crate::table::{ColumnRef, RecordingError};
 
 /// One channel of a recording.
 #[derive(Clone, Debug)]
@@ -70,188 +34,10 @@ pub struct ReadOptions {
     /// Interpolate an uneven time axis onto an even grid at the median interval (instead of
     /// refusing it).
     pub resample: bool,
+    /// Delimiter and decimal mark.
+    pub format: CsvFormat,
     /// Called with the fraction of the file read, for progress display.
     pub progress: Option<fn(f64)>,
-}
-
-fn split(line: &str) -> impl Iterator<Item = &str> {
-    line.split([',', ';', '\t']).map(str::trim)
-}
-
-/// All numeric columns of a CSV file, with the header names.
-#[derive(Clone, Debug, Default)]
-pub struct Table {
-    pub headers: Vec<String>,
-    pub columns: Vec<Vec<f64>>,
-    /// Lines before the first data row (headers and blank lines).
-    pub header_lines: usize,
-}
-
-/// Longest line read, bytes: a file without line breaks (`/dev/zero`) is an error, not a
-/// memory blow-up.
-pub const MAX_LINE_BYTES: usize = 1 << 20;
-
-/// Largest magnitude a value may have: beyond it no sensor reading or time is meant (and the
-/// f32 sample path would overflow).
-pub const MAX_VALUE: f64 = 1e30;
-
-/// Reads a CSV table. Leading lines that are not all numbers are headers (the last one names
-/// the columns); after the first numeric row every row must be numeric, with the same number
-/// of fields.
-pub fn read_table(path: &Path, progress: Option<fn(f64)>) -> Result<Table, RecordingError> {
-    let err = |line: Option<usize>, message: String| RecordingError {
-        file: path.to_path_buf(),
-        line,
-        message,
-    };
-    let file = File::open(path).map_err(|e| err(None, e.to_string()))?;
-    let size = file.metadata().map(|m| m.len()).unwrap_or(0).max(1);
-    let mut reader = BufReader::with_capacity(1 << 20, file);
-    let mut table = Table::default();
-    let mut read_bytes = 0u64;
-    let mut next_progress = size / 20;
-    let mut row = Vec::new();
-    let mut buf = Vec::new();
-    for i in 0.. {
-        let lineno = i + 1;
-        buf.clear();
-        let n = Read::take(&mut reader, MAX_LINE_BYTES as u64 + 1)
-            .read_until(b'\n', &mut buf)
-            .map_err(|e| err(Some(lineno), e.to_string()))?;
-        if n == 0 {
-            break;
-        }
-        if buf.len() > MAX_LINE_BYTES && buf.last() != Some(&b'\n') {
-            return Err(err(
-                Some(lineno),
-                format!("line longer than {MAX_LINE_BYTES} bytes: not a CSV recording"),
-            ));
-        }
-        let text =
-            std::str::from_utf8(&buf).map_err(|_| err(Some(lineno), "not UTF-8 text".into()))?;
-        // A UTF-8 byte-order mark (spreadsheet exports) is not part of the first header.
-        let text = if i == 0 {
-            text.trim_start_matches('\u{feff}')
-        } else {
-            text
-        };
-        let line = text.trim_end_matches(['\n', '\r']);
-        read_bytes += n as u64;
-        if let Some(p) = progress {
-            if read_bytes >= next_progress {
-                p(read_bytes as f64 / size as f64);
-                next_progress += size / 20;
-            }
-        }
-        if line.trim().is_empty() {
-            if table.columns.is_empty() {
-                table.header_lines = lineno;
-            }
-            continue;
-        }
-        row.clear();
-        let mut bad = None;
-        // Text makes a header line; a number that is not finite or beyond any sensor is an
-        // error wherever it is (a NaN row before the data is not a header).
-        let mut text_field = false;
-        for f in split(line) {
-            match f.parse::<f64>() {
-                Ok(v) if v.is_finite() && v.abs() <= MAX_VALUE => row.push(v),
-                Ok(v) => {
-                    bad.get_or_insert(format!(
-                        "value is {v:e}: not a finite reading within ±{MAX_VALUE:e}"
-                    ));
-                }
-                Err(_) => {
-                    text_field = true;
-                    bad.get_or_insert(format!("not a number: {f:?}"));
-                }
-            }
-        }
-        if table.columns.is_empty() {
-            if text_field {
-                table.headers = split(line).map(str::to_string).collect();
-                table.header_lines = lineno;
-                continue;
-            }
-            if bad.is_none() {
-                table.columns = vec![Vec::new(); row.len()];
-            }
-        }
-        if let Some(message) = bad {
-            return Err(err(Some(lineno), message));
-        }
-        if row.len() != table.columns.len() {
-            return Err(err(
-                Some(lineno),
-                format!("{} fields, expected {}", row.len(), table.columns.len()),
-            ));
-        }
-        for (c, v) in table.columns.iter_mut().zip(&row) {
-            c.push(*v);
-        }
-    }
-    if table.columns.first().is_none_or(|c| c.is_empty()) {
-        return Err(err(None, "no data rows".into()));
-    }
-    Ok(table)
-}
-
-impl Table {
-    /// Resolves a column reference.
-    pub fn find(&self, c: &ColumnRef, what: &str) -> Result<usize, String> {
-        let n = self.columns.len();
-        match c {
-            ColumnRef::Index(i) if *i < n => Ok(*i),
-            ColumnRef::Index(i) => Err(format!("{what} {i} does not exist (rows have {n} fields)")),
-            ColumnRef::Name(name) => self
-                .headers
-                .iter()
-                .position(|h| h.eq_ignore_ascii_case(name))
-                .filter(|&p| p < n)
-                .ok_or_else(|| {
-                    format!(
-                        "no {what} named {name:?} (columns: {})",
-                        self.headers.join(", ")
-                    )
-                }),
-        }
-    }
-
-    /// The time column: the one asked for, or the one column whose header looks like a time
-    /// (`time…`, `t`, `t_…`); several such columns without `--time-column` are an error naming
-    /// them.
-    pub fn time_column(&self, asked: Option<&ColumnRef>) -> Result<Option<usize>, String> {
-        if let Some(c) = asked {
-            return self.find(c, "time column").map(Some);
-        }
-        let candidates: Vec<usize> = (0..self.columns.len().min(self.headers.len()))
-            .filter(|&c| looks_like_time(&self.headers[c]))
-            .collect();
-        match candidates.as_slice() {
-            [] => Ok(None),
-            [one] => Ok(Some(*one)),
-            many => Err(format!(
-                "several columns could be the time: {}; choose one with --time-column",
-                many.iter()
-                    .map(|&c| format!("{:?}", self.headers[c]))
-                    .collect::<Vec<_>>()
-                    .join(", ")
-            )),
-        }
-    }
-}
-
-/// Whether a header names a time column: its first word is `time`, `timestamp` or `t`.
-fn looks_like_time(header: &str) -> bool {
-    let h = header.to_ascii_lowercase();
-    let first = words(&h).next();
-    matches!(first, Some("time" | "timestamp" | "times" | "t"))
-}
-
-fn words(h: &str) -> impl Iterator<Item = &str> {
-    h.split(|c: char| !(c.is_alphanumeric() || c == 'µ'))
-        .filter(|w| !w.is_empty())
 }
 
 /// Seconds per unit of a time column, from a unit word in its header (`timestamp_us`,
@@ -282,12 +68,12 @@ const INTERVAL_RANGE: std::ops::RangeInclusive<f64> = 0.5..=1.5;
 fn check_time(
     path: &Path,
     t: &[f64],
-    first_data_line: usize,
+    table: &Table,
     resample: bool,
 ) -> Result<(f64, f64), RecordingError> {
     let at = |i: usize, message: String| RecordingError {
         file: path.to_path_buf(),
-        line: Some(first_data_line + i),
+        line: Some(table.line_of(i)),
         message,
     };
     for (i, w) in t.windows(2).enumerate() {
@@ -380,8 +166,7 @@ pub fn read_csv(path: &Path, opts: &ReadOptions) -> Result<Channel, RecordingErr
         line: None,
         message,
     };
-    let table = read_table(path, opts.progress)?;
-    let header_lines = table.header_lines;
+    let table = read_table(path, &opts.format, opts.progress)?;
     let tcol = if opts.rate_hz.is_some() && opts.time_column.is_none() {
         None
     } else {
@@ -417,7 +202,7 @@ pub fn read_csv(path: &Path, opts: &ReadOptions) -> Result<Channel, RecordingErr
         (None, Some(t)) => {
             let scale = unit(t);
             let times: Vec<f64> = table.columns[t].iter().map(|v| v * scale).collect();
-            let (rate, jitter) = check_time(path, &times, header_lines + 1, opts.resample)?;
+            let (rate, jitter) = check_time(path, &times, &table, opts.resample)?;
             if opts.resample {
                 let (times, values) = resample(path, &times, &values, rate)?;
                 (rate, times, values, 0.0, true)

@@ -1,6 +1,8 @@
 //! Synthetic accelerometer recordings: model impacts turned into raw ADC samples with offset,
 //! noise, quantisation, clipping, drift and dropped samples, for tests.
 
+use std::io::Write;
+
 use impact_core::solve::trajectory;
 use impact_core::{Calibration, ContactLaw, Error, Impact, ImpactOutcome};
 
@@ -87,10 +89,8 @@ impl<L: ContactLaw<f64>> DynLaw for L {
         let mut a = Vec::new();
         let exact = self.exact(impact)?;
         // The trajectory at the samples, to 1e-12 (far below any ADC's resolution).
-        trajectory::sample(self, impact, 1e-12, lead_s, period_s, |s| {
-            if a.len() < max {
-                a.push(s.force_n / impact.mass_kg)
-            }
+        trajectory::sample(self, impact, 1e-12, lead_s, period_s, max as u64, |s| {
+            a.push(s.force_n / impact.mass_kg)
         })?;
         Ok((a, exact))
     }
@@ -254,9 +254,9 @@ pub const SEED_BENCH_ARGS: [&str; 14] = [
     "2",
 ];
 
-/// Renders the recording described by `args`; the CSV has `time_s,accel_g` (mid-scale code
-/// taken as zero) and the raw codes are returned too.
-pub fn synth(args: &SynthArgs) -> Result<(Recording, String), String> {
+/// Renders the recording described by `args` (raw codes; [`write_csv`] writes it as the
+/// tool's CSV).
+pub fn synth(args: &SynthArgs) -> Result<Recording, String> {
     let impact = Impact::new(args.mass, args.v0);
     impact.validate().map_err(|e| e.to_string())?;
     let model = args.model.model(args.law, &impact)?;
@@ -296,16 +296,7 @@ pub fn synth(args: &SynthArgs) -> Result<(Recording, String), String> {
     if !(args.touch.is_finite() && args.touch >= 0.0 && args.touch < args.duration) {
         return Err("--touch: must lie in [0, --duration)".into());
     }
-    let sensor = Sensor {
-        rate_hz: args.rate,
-        bits: args.bits,
-        full_scale_m_s2: args.full_scale,
-        offset_counts: args.offset,
-        noise_rms_counts: args.noise,
-        drift_counts_per_s: args.drift,
-        drop_every: args.drop_every,
-        seed: args.seed,
-    };
+    let sensor = sensor(args);
     if args.repeat == 0 || args.repeat > 100_000 {
         return Err("--repeat: must lie in 1..=100000".into());
     }
@@ -319,16 +310,38 @@ pub fn synth(args: &SynthArgs) -> Result<(Recording, String), String> {
             impact,
         })
         .collect();
-    let rec = record(&sensor, args.duration, &contacts).map_err(|e| e.to_string())?;
-    let mid = (1u64 << (args.bits - 1)) as f64;
-    let g = impact_core::solve::bounce::STANDARD_GRAVITY;
-    let mut csv = String::from("time_s,accel_g\n");
-    for (k, &c) in rec.samples.iter().enumerate() {
-        csv.push_str(&format!(
-            "{:.9},{:.6e}\n",
-            k as f64 / args.rate,
-            (c as f64 - mid) * sensor.gain() / g
-        ));
+    record(&sensor, args.duration, &contacts).map_err(|e| e.to_string())
+}
+
+/// The virtual sensor `args` describe.
+fn sensor(args: &SynthArgs) -> Sensor {
+    Sensor {
+        rate_hz: args.rate,
+        bits: args.bits,
+        full_scale_m_s2: args.full_scale,
+        offset_counts: args.offset,
+        noise_rms_counts: args.noise,
+        drift_counts_per_s: args.drift,
+        drop_every: args.drop_every,
+        seed: args.seed,
     }
-    Ok((rec, csv))
+}
+
+/// Writes a synthetic recording as `time_s,accel_g` (mid-scale code taken as zero), row by
+/// row: memory stays at the recording's codes (2 bytes a sample), whatever the text's size.
+pub fn write_csv(rec: &Recording, args: &SynthArgs, out: &mut impl Write) -> std::io::Result<()> {
+    let mid = (1u64 << (args.bits - 1)) as f64;
+    // The sensor's gain in f64, as the codes were made (the calibration holds it in f32).
+    let gain = sensor(args).gain();
+    let g = impact_core::solve::bounce::STANDARD_GRAVITY;
+    writeln!(out, "time_s,accel_g")?;
+    for (k, &c) in rec.samples.iter().enumerate() {
+        writeln!(
+            out,
+            "{:.9},{:.6e}",
+            k as f64 / args.rate,
+            (c as f64 - mid) * gain / g
+        )?;
+    }
+    out.flush()
 }

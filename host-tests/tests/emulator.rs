@@ -376,7 +376,7 @@ fn a_forced_dma_overrun_is_a_counted_gap_and_later_positions_stay_right() {
     )
     .unwrap();
     let text = run.lines.join("\n");
-    let log = impact_host::emulate::parse_log(&text).unwrap();
+    let log = impact_host::log::parse_log(&text).unwrap();
     let summary = log.summary.as_ref().unwrap();
     let lost: u64 = summary["samples_lost"].parse().unwrap();
     let samples: u64 = summary["samples"].parse().unwrap();

@@ -24,12 +24,14 @@ struct Sampler<'a, R, L, F> {
     offset: R,
     period: R,
     next: u64,
+    /// Samples wanted at most.
+    max: u64,
     out: F,
 }
 
 impl<R: Real, L: ContactLaw<R>, F: FnMut(Sample<R>)> Observer<R> for Sampler<'_, R, L, F> {
     fn piece(&mut self, t_a: R, t_b: R, at: &dyn Fn(R) -> (R, R), phase: Phase<R>) {
-        loop {
+        while self.next < self.max {
             // Sample times are offset + k * period, from k (no accumulated rounding).
             let t = R::from_f64(self.offset.to_f64() + self.next as f64 * self.period.to_f64());
             if t > t_b {
@@ -50,14 +52,16 @@ impl<R: Real, L: ContactLaw<R>, F: FnMut(Sample<R>)> Observer<R> for Sampler<'_,
 }
 
 /// Solves one contact with the adaptive solver at `rtol` and calls `out` with the state at
-/// the times `offset_s + k period_s` (`k = 0, 1, ...`, from first touch) up to separation.
-/// Returns the outcome.
+/// the times `offset_s + k period_s` (`k = 0, 1, ..., max_samples - 1`, from first touch) up
+/// to separation. Returns the outcome. The work follows the samples wanted, not the contact
+/// time divided by the period (a contact of 1e30 s at 1 kHz is a few solver steps).
 pub fn sample<R: Real, L: ContactLaw<R>>(
     law: &L,
     impact: &Impact<R>,
     rtol: R,
     offset_s: R,
     period_s: R,
+    max_samples: u64,
     out: impl FnMut(Sample<R>),
 ) -> Result<ImpactOutcome<R>, Error> {
     impact.validate()?;
@@ -74,6 +78,7 @@ pub fn sample<R: Real, L: ContactLaw<R>>(
         offset: offset_s,
         period: period_s,
         next: 0,
+        max: max_samples,
         out,
     };
     solve_observed(law, impact, rtol, &mut sampler)

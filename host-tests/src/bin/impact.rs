@@ -6,7 +6,7 @@ use std::time::Duration;
 
 use clap::{Parser, Subcommand};
 use impact_host::{
-    analyze, emulate, m4, plot, precision, realtime, simulate, soak, stability, synth, target,
+    analyze, emulate, log, m4, plot, precision, realtime, simulate, soak, stability, synth, target,
     target_bench, throughput,
 };
 
@@ -34,7 +34,7 @@ enum Command {
     #[command(allow_negative_numbers = true)]
     Emulate(Box<emulate::EmulateArgs>),
     /// Turn a decoded defmt log of the firmware into JSON (default) or CSV.
-    Log(emulate::LogArgs),
+    Log(log::LogArgs),
     /// Render a model impact as an accelerometer recording (CSV on stdout, raw codes with --raw).
     #[command(allow_negative_numbers = true)]
     Synth {
@@ -211,14 +211,20 @@ fn run(cli: Cli) -> Result<(), String> {
             }
         }
         Command::Emulate(args) => emulate::emulate(&args)?,
-        Command::Log(args) => emulate::log(&args)?,
+        Command::Log(args) => log::log(&args)?,
         Command::Synth { args, raw } => {
-            let (rec, csv) = synth::synth(&args)?;
+            let rec = synth::synth(&args)?;
             if let Some(path) = raw {
                 let bytes: Vec<u8> = rec.samples.iter().flat_map(|c| c.to_le_bytes()).collect();
                 std::fs::write(&path, bytes).map_err(|e| format!("{}: {e}", path.display()))?;
             }
-            print!("{csv}");
+            let stdout = std::io::stdout().lock();
+            synth::write_csv(
+                &rec,
+                &args,
+                &mut std::io::BufWriter::with_capacity(1 << 16, stdout),
+            )
+            .map_err(|e| format!("stdout: {e}"))?;
         }
         Command::Bench {
             which: Bench::Realtime(args),

@@ -1,0 +1,715 @@
+//! `impact log`: a decoded firmware log (the `scene`, `impact`, `heartbeat` and `summary`
+//! lines of `firmware/README.md`) read back, checked line by line, and turned into
+//! `impact analyze`'s JSON and CSV.
+
+use std::collections::HashMap;
+use std::io::{BufRead, BufReader, Read};
+use std::path::PathBuf;
+
+use clap::Args;
+use impact_core::analysis::COR_TOLERANCE;
+use impact_core::report::{Fits, Flags, HertzFit, NonlinearFit, TwoPhaseFit};
+use impact_core::{Analysis, ImpactReport, Kinematics, Status};
+
+use crate::analyze::{self, AnalysisJson};
+use crate::table::{is_stdin, MAX_LINE_BYTES};
+
+/// `impact log` options.
+#[derive(Args, Clone, Debug)]
+pub struct LogArgs {
+    /// Decoded defmt log (defmt-print's or probe-rs's text output; `-`: standard input).
+    pub file: PathBuf,
+    /// Print one JSON object (the default).
+    #[arg(long, conflicts_with = "csv")]
+    pub json: bool,
+    /// Print one CSV row per impact.
+    #[arg(long)]
+    pub csv: bool,
+    /// Time of the stream's first sample, s (added to start_s and peak_time_s, as
+    /// `impact analyze` adds the recording's first time stamp).
+    #[arg(long, default_value_t = 0.0, value_parser = finite_f64)]
+    pub t0: f64,
+}
+
+fn finite_f64(s: &str) -> Result<f64, String> {
+    match s.parse::<f64>() {
+        Ok(v) if v.is_finite() => Ok(v),
+        Ok(_) => Err("must be finite".into()),
+        Err(_) => Err("not a number".into()),
+    }
+}
+
+/// What a firmware log says.
+#[derive(Clone, Debug, Default)]
+pub struct Log {
+    /// The `scene` line's fields, if the log has one.
+    pub scene: Option<HashMap<String, String>>,
+    pub impacts: Vec<ImpactReport>,
+    /// Each impact's `report_latency_s` (real-time sources only).
+    pub latencies: Vec<Option<f32>>,
+    /// The last `heartbeat` line's fields.
+    pub heartbeat: Option<HashMap<String, String>>,
+    /// The `summary` line's fields (only at the end of a finite stream).
+    pub summary: Option<HashMap<String, String>>,
+    /// What looks wrong without being impossible (e.g. fewer impact lines than the last
+    /// heartbeat counts), by line.
+    pub warnings: Vec<String>,
+}
+
+/// The `key=value` fields following `marker` (e.g. `"impact "`) in a decoded line, or `None`
+/// if the line is not such a line. Tokens without `=` (decoder decorations) are skipped.
+fn fields(line: &str, marker: &str) -> Option<Result<HashMap<String, String>, String>> {
+    // The marker at the start of the message: at the start of the line or after a space
+    // (defmt-print puts a time stamp and the level first).
+    let at = line
+        .match_indices(marker)
+        .map(|(i, _)| i)
+        .find(|&i| i == 0 || line[..i].ends_with(' '))?;
+    let rest = &line[at + marker.len()..];
+    // The first token must be a field, so that a prose message starting with the same word
+    // is not taken for one.
+    if !rest.split_whitespace().next()?.contains('=') {
+        return None;
+    }
+    let mut map = HashMap::new();
+    for token in rest.split_whitespace() {
+        if let Some((k, v)) = token.split_once('=') {
+            if map.insert(k.to_string(), v.to_string()).is_some() {
+                return Some(Err(format!("field {k} given twice")));
+            }
+        }
+    }
+    Some(Ok(map))
+}
+
+pub(crate) fn get<'a>(m: &'a HashMap<String, String>, key: &str) -> Result<&'a str, String> {
+    m.get(key)
+        .map(String::as_str)
+        .ok_or_else(|| format!("missing field {key}"))
+}
+
+pub(crate) fn num<T: std::str::FromStr>(
+    m: &HashMap<String, String>,
+    key: &str,
+) -> Result<T, String> {
+    let v = get(m, key)?;
+    v.parse::<T>()
+        .map_err(|_| format!("{key}={v}: not a number"))
+}
+
+fn opt<T: std::str::FromStr>(m: &HashMap<String, String>, key: &str) -> Result<Option<T>, String> {
+    match get(m, key)? {
+        "none" => Ok(None),
+        v => v
+            .parse::<T>()
+            .map(Some)
+            .map_err(|_| format!("{key}={v}: not a number")),
+    }
+}
+
+fn flag(m: &HashMap<String, String>, key: &str) -> Result<bool, String> {
+    match get(m, key)? {
+        "true" => Ok(true),
+        "false" => Ok(false),
+        v => Err(format!("{key}={v}: not true or false")),
+    }
+}
+
+/// An `impact` line's fields as the core's report (floats parsed at their own width, so the
+/// firmware's shortest round-trip decimals give back its exact bits).
+pub fn parse_impact(m: &HashMap<String, String>) -> Result<ImpactReport, String> {
+    let status = get(m, "status")?;
+    let status = Status::ALL
+        .into_iter()
+        .find(|s| s.name() == status)
+        .ok_or_else(|| format!("status={status}: unknown status"))?;
+    let analysis = get(m, "analysis")?;
+    let analysis = [Analysis::Full, Analysis::Skipped]
+        .into_iter()
+        .find(|a| a.name() == analysis)
+        .ok_or_else(|| format!("analysis={analysis}: not full or skipped"))?;
+    let kinematics = match opt::<f32>(m, "impact_velocity_m_s")? {
+        None => None,
+        Some(v0) => Some(Kinematics {
+            impact_velocity_m_s: v0,
+            crush_time_s: num(m, "crush_time_s")?,
+            max_deformation_m: num(m, "max_deformation_m")?,
+            rebound_velocity_m_s: num(m, "rebound_velocity_m_s")?,
+            cor: num(m, "cor")?,
+            permanent_deformation_m: num(m, "permanent_deformation_m")?,
+            absorbed_energy_j: opt(m, "absorbed_energy_j")?,
+        }),
+    };
+    let two_phase = match opt::<f32>(m, "two_phase_kc_n_m")? {
+        None => None,
+        Some(kc) => Some(TwoPhaseFit {
+            kc_n_m: kc,
+            kr_n_m: num(m, "two_phase_kr_n_m")?,
+            c_n_s_m: num(m, "two_phase_c_n_s_m")?,
+            permanent_m: num(m, "two_phase_permanent_deformation_m")?,
+            residual: num(m, "two_phase_residual")?,
+        }),
+    };
+    let nonlinear = match opt::<f32>(m, "nonlinear_k")? {
+        None => None,
+        Some(k) => Some(NonlinearFit {
+            k,
+            c_s_m: num(m, "nonlinear_c_s_m")?,
+            n: num(m, "nonlinear_exponent")?,
+            residual: num(m, "nonlinear_residual")?,
+        }),
+    };
+    let hertz = match opt::<f32>(m, "hertz_k")? {
+        None => None,
+        Some(k) => Some(HertzFit {
+            k,
+            residual: num(m, "hertz_residual")?,
+        }),
+    };
+    Ok(ImpactReport {
+        index: num(m, "index")?,
+        status,
+        analysis,
+        clipped: flag(m, "clipped")?,
+        flags: Flags(num(m, "flags")?),
+        start_sample: num(m, "start_sample")?,
+        end_sample: num(m, "end_sample")?,
+        start_s: num(m, "start_s")?,
+        peak_time_s: num(m, "peak_time_s")?,
+        peak_acceleration_m_s2: num(m, "peak_acceleration_m_s2")?,
+        peak_force_n: opt(m, "peak_force_n")?,
+        delta_v_m_s: opt(m, "delta_v_m_s")?,
+        duration_s: num(m, "duration_s")?,
+        baseline_m_s2: num(m, "baseline_m_s2")?,
+        fwhm_s: opt(m, "fwhm_s")?,
+        filtered_peak_acceleration_m_s2: opt(m, "filtered_peak_acceleration_m_s2")?,
+        kinematics,
+        fits: Fits {
+            two_phase,
+            nonlinear,
+            hertz,
+        },
+    })
+}
+
+/// Parses a decoded firmware log (any other lines are ignored), checking what it reads (see
+/// [`LogReader`]).
+pub fn parse_log(text: &str) -> Result<Log, String> {
+    let mut reader = LogReader::default();
+    for (n, line) in text.lines().enumerate() {
+        reader.line(n as u64 + 1, line)?;
+    }
+    reader.finish()
+}
+
+/// A firmware log read line by line, checked as it goes: every number finite and within its
+/// field's range, impact indices unique and increasing (unless the summary counts reports
+/// printed out of order), heartbeat counters never going back, and at the end of a finite
+/// stream as many impact lines as the summary counts. Errors name the line.
+#[derive(Default)]
+pub struct LogReader {
+    log: Log,
+    /// Line of each impact report, in the order read.
+    impact_lines: Vec<u64>,
+    /// The first impact whose index did not increase: (line, index, previous index).
+    reordered: Option<(u64, u32, u32)>,
+    /// Line and counters (samples, impacts) of the last heartbeat.
+    last_heartbeat: Option<(u64, u64, u64)>,
+    summary_line: u64,
+}
+
+impl LogReader {
+    /// Reads line `n` (1-based).
+    pub fn line(&mut self, n: u64, line: &str) -> Result<(), String> {
+        let at = |e: String| format!("line {n}: {e}");
+        if let Some(m) = fields(line, "impact ") {
+            let m = m.map_err(at)?;
+            let r = parse_impact(&m).map_err(at)?;
+            check_report(&r).map_err(at)?;
+            let latency: Option<f32> = opt(&m, "report_latency_s").map_err(at)?;
+            if latency.is_some_and(|l| !(l.is_finite() && l >= 0.0)) {
+                return Err(at(format!(
+                    "report_latency_s={}: not a finite time >= 0",
+                    latency.unwrap_or_default()
+                )));
+            }
+            if let Some(k) = self.log.impacts.iter().position(|p| p.index == r.index) {
+                return Err(at(format!(
+                    "impact index={} again (first on line {}): two streams mixed, or a line repeated",
+                    r.index, self.impact_lines[k]
+                )));
+            }
+            if let Some(prev) = self.log.impacts.last() {
+                if r.index < prev.index && self.reordered.is_none() {
+                    self.reordered = Some((n, r.index, prev.index));
+                }
+            }
+            self.log.impacts.push(r);
+            self.log.latencies.push(latency);
+            self.impact_lines.push(n);
+        } else if let Some(m) = fields(line, "heartbeat ") {
+            let m = m.map_err(at)?;
+            let samples: u64 = num(&m, "samples").map_err(at)?;
+            let impacts: u64 = num(&m, "impacts").map_err(at)?;
+            rate(&m).map_err(at)?;
+            if let Some((line, s0, i0)) = self.last_heartbeat {
+                if samples < s0 || impacts < i0 {
+                    return Err(at(format!(
+                        "heartbeat samples={samples} impacts={impacts} after samples={s0} \
+                         impacts={i0} (line {line}): counters never go back within a stream"
+                    )));
+                }
+            }
+            self.last_heartbeat = Some((n, samples, impacts));
+            self.log.heartbeat = Some(m);
+        } else if let Some(m) = fields(line, "summary ") {
+            let m = m.map_err(at)?;
+            num::<u64>(&m, "samples").map_err(at)?;
+            num::<u64>(&m, "impacts").map_err(at)?;
+            rate(&m).map_err(at)?;
+            self.summary_line = n;
+            self.log.summary = Some(m);
+        } else if let Some(m) = fields(line, "scene ") {
+            let m = m.map_err(at)?;
+            rate(&m).map_err(at)?;
+            // A restart (a new scene) starts a new stream.
+            *self = LogReader::default();
+            self.log.scene = Some(m);
+        }
+        Ok(())
+    }
+
+    /// The log, its reports in index order; checks the counts against the summary.
+    pub fn finish(mut self) -> Result<Log, String> {
+        let printed = self.log.impacts.len() as u64;
+        if let Some(m) = &self.log.summary {
+            let at = |e: String| format!("line {}: {e}", self.summary_line);
+            let counted: u64 = num(m, "impacts").map_err(at)?;
+            let dropped: u64 = num(m, "reports_dropped").map_err(at)?;
+            if printed + dropped != counted {
+                return Err(at(format!(
+                    "the summary counts {counted} impacts ({dropped} reports dropped), the log \
+                     has {printed} impact lines: lines lost, or two streams mixed"
+                )));
+            }
+            if let Some(r) = self
+                .log
+                .impacts
+                .iter()
+                .find(|r| u64::from(r.index) >= counted)
+            {
+                return Err(at(format!(
+                    "impact index={} but the summary counts {counted} impacts",
+                    r.index
+                )));
+            }
+            if let Some((line, index, prev)) = self.reordered {
+                if num::<u64>(m, "reports_out_of_order").map_err(at)? == 0 {
+                    return Err(format!(
+                        "line {line}: impact index={index} after index={prev}, and the \
+                         summary counts no report out of order"
+                    ));
+                }
+            }
+        } else {
+            if let Some((line, index, prev)) = self.reordered {
+                return Err(format!(
+                    "line {line}: impact index={index} after index={prev} (the firmware prints \
+                     in index order; a reorder is counted only in a summary line)"
+                ));
+            }
+            if let (Some((line, _, counted)), Some(m)) = (self.last_heartbeat, &self.log.heartbeat)
+            {
+                let dropped: u64 =
+                    num(m, "reports_dropped").map_err(|e| format!("line {line}: {e}"))?;
+                if printed + dropped < counted {
+                    self.log.warnings.push(format!(
+                        "line {line}: the heartbeat counts {counted} impacts ({dropped} reports \
+                         dropped), the log has {printed} impact lines: a cut log, or lines lost \
+                         on the link"
+                    ));
+                }
+            }
+        }
+        let mut both: Vec<_> = self
+            .log
+            .impacts
+            .drain(..)
+            .zip(self.log.latencies.drain(..))
+            .collect();
+        both.sort_by_key(|(r, _)| r.index);
+        (self.log.impacts, self.log.latencies) = both.into_iter().unzip();
+        Ok(self.log)
+    }
+}
+
+/// A line's `rate_hz`: finite and > 0.
+fn rate(m: &HashMap<String, String>) -> Result<f32, String> {
+    let r: f32 = num(m, "rate_hz")?;
+    if r.is_finite() && r > 0.0 {
+        Ok(r)
+    } else {
+        Err(format!("rate_hz={r}: not a finite rate > 0"))
+    }
+}
+
+/// An impact report's numbers: finite, and each within what the firmware can report.
+fn check_report(r: &ImpactReport) -> Result<(), String> {
+    let mut values: Vec<(&str, f64)> = vec![
+        ("start_s", r.start_s),
+        ("peak_time_s", r.peak_time_s),
+        ("peak_acceleration_m_s2", r.peak_acceleration_m_s2.into()),
+        ("duration_s", r.duration_s.into()),
+        ("baseline_m_s2", r.baseline_m_s2.into()),
+    ];
+    let optional = [
+        ("peak_force_n", r.peak_force_n),
+        ("delta_v_m_s", r.delta_v_m_s),
+        ("fwhm_s", r.fwhm_s),
+        (
+            "filtered_peak_acceleration_m_s2",
+            r.filtered_peak_acceleration_m_s2,
+        ),
+    ];
+    values.extend(
+        optional
+            .iter()
+            .filter_map(|(k, v)| v.map(|v| (*k, v.into()))),
+    );
+    if let Some(k) = &r.kinematics {
+        values.extend([
+            ("impact_velocity_m_s", k.impact_velocity_m_s.into()),
+            ("crush_time_s", k.crush_time_s.into()),
+            ("max_deformation_m", k.max_deformation_m.into()),
+            ("rebound_velocity_m_s", k.rebound_velocity_m_s.into()),
+            ("cor", k.cor.into()),
+            ("permanent_deformation_m", k.permanent_deformation_m.into()),
+        ]);
+        if let Some(e) = k.absorbed_energy_j {
+            values.push(("absorbed_energy_j", e.into()));
+        }
+    }
+    if let Some(f) = &r.fits.two_phase {
+        values.extend([
+            ("two_phase_kc_n_m", f.kc_n_m.into()),
+            ("two_phase_kr_n_m", f.kr_n_m.into()),
+            ("two_phase_c_n_s_m", f.c_n_s_m.into()),
+            ("two_phase_permanent_deformation_m", f.permanent_m.into()),
+            ("two_phase_residual", f.residual.into()),
+        ]);
+    }
+    if let Some(f) = &r.fits.nonlinear {
+        values.extend([
+            ("nonlinear_k", f.k.into()),
+            ("nonlinear_c_s_m", f.c_s_m.into()),
+            ("nonlinear_exponent", f.n.into()),
+            ("nonlinear_residual", f.residual.into()),
+        ]);
+    }
+    if let Some(f) = &r.fits.hertz {
+        values.extend([
+            ("hertz_k", f.k.into()),
+            ("hertz_residual", f.residual.into()),
+        ]);
+    }
+    // As the log wrote it: an f32 field by its shortest decimal.
+    let show = |v: f64| {
+        if f64::from(v as f32) == v {
+            (v as f32).to_string()
+        } else {
+            v.to_string()
+        }
+    };
+    if let Some((k, v)) = values.iter().find(|(_, v)| !v.is_finite()) {
+        return Err(format!(
+            "{k}={}: not finite (a float out of range, or NaN)",
+            show(*v)
+        ));
+    }
+    let out_of_range = |field: &str, v: f64, range: &str| {
+        Err(format!(
+            "{field}={}: out of range (must be {range})",
+            show(v)
+        ))
+    };
+    for (k, v) in &values {
+        let non_negative = k.ends_with("_residual")
+            || matches!(
+                *k,
+                "start_s"
+                    | "peak_time_s"
+                    | "duration_s"
+                    | "fwhm_s"
+                    | "crush_time_s"
+                    | "max_deformation_m"
+            );
+        if non_negative && *v < 0.0 {
+            return out_of_range(k, *v, ">= 0");
+        }
+    }
+    if r.end_sample < r.start_sample {
+        return Err(format!(
+            "end_sample={} before start_sample={}",
+            r.end_sample, r.start_sample
+        ));
+    }
+    if let Some(k) = &r.kinematics {
+        if k.impact_velocity_m_s <= 0.0 {
+            return out_of_range("impact_velocity_m_s", k.impact_velocity_m_s.into(), "> 0");
+        }
+        // The core flags a COR further outside [0, 1] `cor-out-of-range` and leaves it out.
+        if !(-COR_TOLERANCE..=1.0 + COR_TOLERANCE).contains(&k.cor) {
+            return out_of_range(
+                "cor",
+                k.cor.into(),
+                &format!("within [-{COR_TOLERANCE}, {}]", 1.0 + COR_TOLERANCE),
+            );
+        }
+        let x = k.max_deformation_m;
+        if !(-x..=x).contains(&k.permanent_deformation_m) {
+            return out_of_range(
+                "permanent_deformation_m",
+                k.permanent_deformation_m.into(),
+                "within ± max_deformation_m",
+            );
+        }
+    }
+    Ok(())
+}
+
+/// `impact analyze`'s JSON from a log alone: samples from the summary (or the last
+/// heartbeat), the rate from the scene line (or a heartbeat), `v0_source` from the scene line
+/// (a free fall measured on the host cannot be told from a plain `v0`).
+pub fn log_json(log: &Log, t0: f64) -> Result<AnalysisJson, String> {
+    let state = log.summary.as_ref().or(log.heartbeat.as_ref());
+    let samples = match state {
+        Some(m) => num::<u64>(m, "samples")?,
+        None => 0,
+    };
+    let rate = match (&log.scene, state) {
+        (Some(m), _) => num::<f32>(m, "rate_hz")?,
+        (None, Some(m)) => num::<f32>(m, "rate_hz")?,
+        (None, None) => {
+            return Err(
+                "the log has no scene, heartbeat or summary line: sample rate unknown".into(),
+            )
+        }
+    };
+    let v0_source = match &log.scene {
+        Some(m) if get(m, "drop_height_m")? != "none" => Some("drop-height".to_string()),
+        Some(m) if get(m, "v0_m_s")? != "none" => Some("v0".to_string()),
+        _ => None,
+    };
+    // What the scene asked for (the scene line's flags), for the reasons of absent fits.
+    let asked = |key: &str| -> Result<bool, String> {
+        match &log.scene {
+            Some(m) => flag(m, key),
+            None => Ok(false),
+        }
+    };
+    let fits = impact_core::FitSet {
+        two_phase: asked("two_phase")?,
+        nonlinear: asked("nonlinear")?,
+        fit_exponent: asked("fit_exponent")?,
+        nonlinear_exponent: 1.0,
+        hertz: asked("hertz")?,
+    };
+    let counter = |key: &str| -> Result<u64, String> {
+        match state {
+            Some(m) if m.contains_key(key) => num::<u64>(m, key),
+            _ => Ok(0),
+        }
+    };
+    Ok(AnalysisJson {
+        samples,
+        sample_rate_hz: rate as f64,
+        v0_source,
+        free_fall_s: None,
+        samples_lost: counter("samples_lost")?,
+        analyses_skipped: counter("analyses_skipped")?,
+        resampled: false,
+        spikes_removed: Vec::new(),
+        clipping: None,
+        impacts: log
+            .impacts
+            .iter()
+            .zip(&log.latencies)
+            .map(|(r, latency)| {
+                let mut j = analyze::impact_json(r, t0, &fits);
+                j.report_latency_s = latency.map(f64::from);
+                j
+            })
+            .collect(),
+    })
+}
+
+/// `impact log`: a decoded firmware log as JSON (default) or CSV. The file (or stdin, `-`)
+/// is read line by line, each line at most [`MAX_LINE_BYTES`].
+pub fn log(args: &LogArgs) -> Result<(), String> {
+    let name = if is_stdin(&args.file) {
+        "stdin".to_string()
+    } else {
+        args.file.display().to_string()
+    };
+    let input: Box<dyn Read> = if is_stdin(&args.file) {
+        Box::new(std::io::stdin())
+    } else {
+        Box::new(std::fs::File::open(&args.file).map_err(|e| format!("{name}: {e}"))?)
+    };
+    let mut input = BufReader::with_capacity(1 << 16, input);
+    let mut reader = LogReader::default();
+    let mut buf = Vec::new();
+    for n in 1.. {
+        buf.clear();
+        let read = (&mut input)
+            .take(MAX_LINE_BYTES as u64 + 1)
+            .read_until(b'\n', &mut buf)
+            .map_err(|e| format!("{name}:{n}: {e}"))?;
+        if read == 0 {
+            break;
+        }
+        if buf.len() > MAX_LINE_BYTES {
+            return Err(format!(
+                "{name}:{n}: a line longer than {MAX_LINE_BYTES} bytes: not a decoded defmt log"
+            ));
+        }
+        reader
+            .line(n, String::from_utf8_lossy(&buf).trim_end())
+            .map_err(|e| format!("{name}: {e}"))?;
+    }
+    let log = reader.finish().map_err(|e| format!("{name}: {e}"))?;
+    for w in &log.warnings {
+        eprintln!("warning: {name}: {w}");
+    }
+    let json = log_json(&log, args.t0)?;
+    if args.csv {
+        print!("{}", analyze::to_csv(&json));
+    } else {
+        println!(
+            "{}",
+            serde_json::to_string_pretty(&json).map_err(|e| e.to_string())?
+        );
+    }
+    Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    const LINE: &str = "0.013931 INFO  impact index=0 status=complete analysis=full clipped=false flags=0 start_sample=5000 end_sample=17000 start_s=0.01 peak_time_s=0.0100251 peak_acceleration_m_s2=4321.5 peak_force_n=259.29 delta_v_m_s=2.5 duration_s=0.0219 baseline_m_s2=0.2 fwhm_s=0.001 filtered_peak_acceleration_m_s2=none impact_velocity_m_s=1.3357 crush_time_s=0.0218 max_deformation_m=0.0186 rebound_velocity_m_s=1.16 cor=0.87 permanent_deformation_m=0.0182 absorbed_energy_j=none two_phase_kc_n_m=none two_phase_kr_n_m=none two_phase_c_n_s_m=none two_phase_permanent_deformation_m=none two_phase_residual=none nonlinear_k=1e6 nonlinear_c_s_m=0.5 nonlinear_exponent=1.2 nonlinear_residual=0.01 hertz_k=none hertz_residual=none report_latency_s=0.0123";
+
+    #[test]
+    fn parses_an_impact_line() {
+        let log = parse_log(&format!(
+            "noise\n{LINE}\n└─ impact_firmware::tasks::reporter @ src/tasks/reporter.rs:150\n"
+        ))
+        .unwrap();
+        let r = log.impacts[0];
+        assert_eq!(
+            (r.index, r.status, r.start_sample),
+            (0, Status::Complete, 5000)
+        );
+        assert_eq!(r.peak_acceleration_m_s2, 4321.5f32);
+        assert_eq!(r.kinematics.unwrap().absorbed_energy_j, None);
+        assert_eq!(r.fits.nonlinear.unwrap().n, 1.2f32);
+        assert!(r.fits.two_phase.is_none() && r.fits.hertz.is_none());
+        assert_eq!(log.latencies, [Some(0.0123f32)]);
+    }
+
+    #[test]
+    fn a_missing_field_is_an_error_naming_it() {
+        let line = LINE.replace(" fwhm_s=0.001", "");
+        let e = parse_log(&line).unwrap_err();
+        assert!(e.contains("line 1") && e.contains("fwhm_s"), "{e}");
+    }
+
+    #[test]
+    fn prose_starting_with_a_marker_word_is_not_a_line() {
+        let log = parse_log("INFO  impact-firmware 0.1.0 up\nWARN summary of nothing").unwrap();
+        assert!(log.impacts.is_empty() && log.summary.is_none());
+    }
+
+    fn with(field: &str, value: &str) -> String {
+        let (head, tail) = LINE.split_once(&format!(" {field}=")).unwrap();
+        let rest = tail.split_once(' ').map_or("", |(_, r)| r);
+        format!("{head} {field}={value} {rest}")
+    }
+
+    #[test]
+    fn impossible_numbers_are_refused_by_line() {
+        for (field, value, says) in [
+            ("peak_acceleration_m_s2", "inf", "not finite"),
+            ("peak_acceleration_m_s2", "1e39", "not finite"),
+            ("duration_s", "NaN", "not finite"),
+            ("cor", "7.5", "cor=7.5: out of range"),
+            (
+                "permanent_deformation_m",
+                "-1",
+                "permanent_deformation_m=-1: out of range",
+            ),
+            ("fwhm_s", "-0.001", "fwhm_s=-0.001: out of range"),
+            ("report_latency_s", "-1", "report_latency_s=-1"),
+        ] {
+            let text = format!("noise\n{}\n", with(field, value));
+            let e = parse_log(&text).unwrap_err();
+            assert!(
+                e.starts_with("line 2: ") && e.contains(says),
+                "{field}={value}: {e}"
+            );
+        }
+        let scene = "scene rate_hz=NaN\n";
+        assert!(parse_log(scene)
+            .unwrap_err()
+            .contains("line 1: rate_hz=NaN"));
+        let beat = "heartbeat samples=5 impacts=0 rate_hz=-5 reports_dropped=0\n";
+        assert!(parse_log(beat).unwrap_err().contains("rate_hz=-5"));
+    }
+
+    #[test]
+    fn indices_must_be_unique_and_increasing() {
+        let zero = with("index", "0");
+        let e = parse_log(&format!("{zero}\n{zero}\n{zero}\n")).unwrap_err();
+        assert!(
+            e.starts_with("line 2: impact index=0 again (first on line 1)"),
+            "{e}"
+        );
+        let five = with("index", "5");
+        let e = parse_log(&format!("{five}\n{zero}\n")).unwrap_err();
+        assert!(e.starts_with("line 2: impact index=0 after index=5"), "{e}");
+        // The firmware's summary can own up to a reorder.
+        let summary = |out_of_order: u32| {
+            format!(
+                "summary samples=9 impacts=6 rate_hz=1000 reports_dropped=4 \
+                 reports_out_of_order={out_of_order}"
+            )
+        };
+        let log = parse_log(&format!("{five}\n{zero}\n{}\n", summary(1))).unwrap();
+        assert_eq!(
+            log.impacts.iter().map(|r| r.index).collect::<Vec<_>>(),
+            [0, 5]
+        );
+        assert!(parse_log(&format!("{five}\n{zero}\n{}\n", summary(0))).is_err());
+    }
+
+    #[test]
+    fn counts_are_checked_against_the_heartbeat_and_summary() {
+        let lines: String = (0..3)
+            .map(|i| with("index", &i.to_string()) + "\n")
+            .collect();
+        // A heartbeat counting more impacts than were printed: a warning naming its line.
+        let beat = "heartbeat samples=5 impacts=7 rate_hz=1000 reports_dropped=0";
+        let log = parse_log(&format!("{lines}{beat}\n")).unwrap();
+        assert_eq!(log.warnings.len(), 1);
+        assert!(log.warnings[0].starts_with("line 4: the heartbeat counts 7 impacts"));
+        // The end of a stream: the summary's count must match.
+        let summary =
+            "summary samples=9 impacts=7 rate_hz=1000 reports_dropped=0 reports_out_of_order=0";
+        let e = parse_log(&format!("{lines}{summary}\n")).unwrap_err();
+        assert!(e.starts_with("line 4: the summary counts 7 impacts"), "{e}");
+        // Counters never go back.
+        let back = "heartbeat samples=4 impacts=7 rate_hz=1000 reports_dropped=0";
+        let e = parse_log(&format!("{beat}\n{back}\n")).unwrap_err();
+        assert!(e.starts_with("line 2: heartbeat samples=4"), "{e}");
+    }
+}

@@ -1,0 +1,583 @@
+//! Numeric tables from CSV text (a file or stdin), on the `csv` crate: header lines, the
+//! delimiter, decimal commas, quoting and a UTF-8 byte-order mark handled; every size bounded.
+
+use std::fmt;
+use std::fs::File;
+use std::io::{self, BufRead, BufReader, Read};
+use std::path::{Path, PathBuf};
+
+/// A column chosen by header name or 0-based index.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub enum ColumnRef {
+    Name(String),
+    Index(usize),
+}
+
+impl std::str::FromStr for ColumnRef {
+    type Err = String;
+    fn from_str(s: &str) -> Result<Self, String> {
+        Ok(match s.parse::<usize>() {
+            Ok(i) => ColumnRef::Index(i),
+            Err(_) => ColumnRef::Name(s.to_string()),
+        })
+    }
+}
+
+/// What went wrong, and where.
+#[derive(Debug)]
+pub struct RecordingError {
+    pub file: PathBuf,
+    pub line: Option<u64>,
+    pub message: String,
+}
+
+impl fmt::Display for RecordingError {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        let file = if is_stdin(&self.file) {
+            "stdin".to_string()
+        } else {
+            self.file.display().to_string()
+        };
+        match self.line {
+            Some(l) => write!(f, "{file}:{l}: {}", self.message),
+            None => write!(f, "{file}: {}", self.message),
+        }
+    }
+}
+
+impl std::error::Error for RecordingError {}
+
+/// Whether a path names standard input (`-`).
+pub fn is_stdin(path: &Path) -> bool {
+    path.as_os_str() == "-"
+}
+
+/// Longest record (line) read, bytes: a file without line breaks (`/dev/zero`) or with an
+/// unclosed quote is an error, not a memory blow-up.
+pub const MAX_LINE_BYTES: usize = 1 << 20;
+
+/// Largest magnitude a value may have: beyond it no sensor reading or time is meant (and the
+/// f32 sample path would overflow).
+pub const MAX_VALUE: f64 = 1e30;
+
+/// How the text is laid out.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct CsvFormat {
+    /// Field separator [default: tab if the first lines hold one, else `;` if they hold one,
+    /// else `,`].
+    pub delimiter: Option<u8>,
+    /// Numbers are written with a decimal comma (`6,77e-1`); the delimiter must then be
+    /// another character.
+    pub decimal_comma: bool,
+}
+
+/// Parses a `--delimiter` value: one ASCII character, or `tab`.
+pub fn parse_delimiter(s: &str) -> Result<u8, String> {
+    match s {
+        "tab" | "\\t" | "\t" => Ok(b'\t'),
+        _ if s.len() == 1 && s.is_ascii() && s != "\"" && s != "\n" && s != "\r" => {
+            Ok(s.as_bytes()[0])
+        }
+        _ => Err("must be one ASCII character other than a quote or line break, or `tab`".into()),
+    }
+}
+
+/// All numeric columns of a CSV file, with the header names.
+#[derive(Clone, Debug, Default)]
+pub struct Table {
+    pub headers: Vec<String>,
+    pub columns: Vec<Vec<f64>>,
+    /// Line of the first data row (1-based).
+    pub first_data_line: u64,
+    /// `(row, line)` wherever a data row is not on the line after the previous one (blank
+    /// lines or quoted line breaks in between), so rows map back to lines.
+    breaks: Vec<(usize, u64)>,
+}
+
+impl Table {
+    /// The file line of data row `row` (0-based).
+    pub fn line_of(&self, row: usize) -> u64 {
+        match self.breaks.partition_point(|&(r, _)| r <= row) {
+            0 => self.first_data_line + row as u64,
+            i => {
+                let (r, l) = self.breaks[i - 1];
+                l + (row - r) as u64
+            }
+        }
+    }
+}
+
+/// Counts bytes since the last record end (a line break outside quotes, as `csv-core` reads
+/// quotes: opened at a field's start, `""` inside them an escaped quote) and fails past
+/// [`MAX_LINE_BYTES`]; also reports how many bytes went through, for progress.
+struct RecordLimit<R> {
+    inner: R,
+    delimiter: u8,
+    since_break: usize,
+    quote: Quote,
+    field_start: bool,
+    read: u64,
+    /// The last byte read, and whether the input has ended.
+    last: u8,
+    ended: bool,
+}
+
+#[derive(Clone, Copy, PartialEq, Eq)]
+enum Quote {
+    Outside,
+    Inside,
+    /// A quote inside quotes: the end of the quoted text, or the first half of `""`.
+    Closing,
+}
+
+impl<R: Read> Read for RecordLimit<R> {
+    fn read(&mut self, buf: &mut [u8]) -> io::Result<usize> {
+        let mut n = self.inner.read(buf)?;
+        if n == 0 && !self.ended && !buf.is_empty() {
+            // Every record ends with a line break, so that its line is `csv`'s line count
+            // less one (see `read_table`).
+            self.ended = true;
+            if self.read > 0 && self.last != b'\n' {
+                buf[0] = b'\n';
+                n = 1;
+            }
+        }
+        if n > 0 {
+            self.last = buf[n - 1];
+        }
+        self.read += n as u64;
+        let chunk = &buf[..n];
+        if self.quote == Quote::Outside && !chunk.contains(&b'"') {
+            // The common case, without a byte-by-byte walk: only line breaks matter.
+            match chunk.iter().rposition(|&b| b == b'\n') {
+                Some(p) => self.since_break = n - p - 1,
+                None => self.since_break += n,
+            }
+            if let Some(&b) = chunk.last() {
+                self.field_start = matches!(b, b'\n' | b'\r') || b == self.delimiter;
+            }
+            self.check()?;
+            return Ok(n);
+        }
+        for &b in chunk {
+            match self.quote {
+                Quote::Inside => {
+                    if b == b'"' {
+                        self.quote = Quote::Closing;
+                    }
+                    self.since_break += 1;
+                    self.check()?;
+                    continue;
+                }
+                Quote::Closing if b == b'"' => {
+                    self.quote = Quote::Inside;
+                    self.since_break += 1;
+                    continue;
+                }
+                Quote::Closing => self.quote = Quote::Outside,
+                Quote::Outside => {}
+            }
+            if b == b'\n' {
+                self.since_break = 0;
+                self.field_start = true;
+            } else {
+                if b == b'"' && self.field_start {
+                    self.quote = Quote::Inside;
+                }
+                self.field_start = b == self.delimiter || b == b'\r';
+                self.since_break += 1;
+                self.check()?;
+            }
+        }
+        Ok(n)
+    }
+}
+
+impl<R> RecordLimit<R> {
+    fn check(&self) -> io::Result<()> {
+        if self.since_break > MAX_LINE_BYTES {
+            Err(io::Error::new(
+                io::ErrorKind::InvalidData,
+                format!("a line longer than {MAX_LINE_BYTES} bytes: not a CSV recording"),
+            ))
+        } else {
+            Ok(())
+        }
+    }
+}
+
+/// Opens a file (or stdin for `-`) once, for reading (a FIFO is not opened twice); the size,
+/// if known, for progress.
+fn open(path: &Path) -> io::Result<(Box<dyn Read>, Option<u64>)> {
+    if is_stdin(path) {
+        return Ok((Box::new(io::stdin()), None));
+    }
+    let file = File::open(path)?;
+    let meta = file.metadata()?;
+    if meta.is_dir() {
+        return Err(io::Error::other("is a directory"));
+    }
+    let size = meta.is_file().then_some(meta.len());
+    Ok((Box::new(file), size))
+}
+
+/// The delimiter of `head` (the file's first bytes): tab if its lines hold one, else `;`,
+/// else `,`.
+fn sniff_delimiter(head: &[u8]) -> u8 {
+    if head.contains(&b'\t') {
+        b'\t'
+    } else if head.contains(&b';') {
+        b';'
+    } else {
+        b','
+    }
+}
+
+/// A decimal number (`1.5e-3`, `-2`, `.5`; also `NaN` and `inf`, refused by the caller).
+fn parse_number(field: &[u8]) -> Option<f64> {
+    match field.first() {
+        // fast-float2 reads a leading `+` as std does.
+        Some(_) => fast_float2::parse::<f64, _>(field).ok(),
+        None => None,
+    }
+}
+
+/// Why a field is not a number, with a hint where the layout suggests one.
+fn not_a_number(field: &str, format: &CsvFormat, delimiter: u8) -> String {
+    let hint = if !format.decimal_comma && delimiter != b',' && field.contains(',') {
+        " (decimal commas? give --decimal-comma)"
+    } else {
+        ""
+    };
+    format!("not a number: {field:?}{hint}")
+}
+
+/// Reads a numeric table. Leading lines with a field that is not a number are headers (the
+/// last one names the columns); from the first numeric row on, every row must be numeric
+/// (finite, within ±[`MAX_VALUE`]) with the first row's number of fields, at most the header's.
+/// Errors name the file and line.
+pub fn read_table(
+    path: &Path,
+    format: &CsvFormat,
+    progress: Option<fn(f64)>,
+) -> Result<Table, RecordingError> {
+    let err = |line: Option<u64>, message: String| RecordingError {
+        file: path.to_path_buf(),
+        line,
+        message,
+    };
+    let (input, size) = open(path).map_err(|e| err(None, e.to_string()))?;
+    let mut buffered = BufReader::with_capacity(1 << 16, input);
+    // Peek at the first bytes for a byte-order mark and the delimiter.
+    let head = buffered.fill_buf().map_err(|e| err(None, e.to_string()))?;
+    let bom = head.starts_with(b"\xEF\xBB\xBF");
+    let delimiter = format.delimiter.unwrap_or_else(|| sniff_delimiter(head));
+    if bom {
+        buffered.consume(3);
+    }
+    if format.decimal_comma && delimiter == b',' {
+        return Err(err(
+            None,
+            "--decimal-comma: the delimiter is ',' too; give --delimiter (e.g. ';')".into(),
+        ));
+    }
+    let limited = RecordLimit {
+        inner: buffered,
+        delimiter,
+        since_break: 0,
+        quote: Quote::Outside,
+        field_start: true,
+        read: 0,
+        last: 0,
+        ended: false,
+    };
+    let mut reader = csv::ReaderBuilder::new()
+        .has_headers(false)
+        .flexible(true)
+        .delimiter(delimiter)
+        // `\r` is trimmed as white space with the fields; only `\n` ends a record (see the
+        // line count below).
+        .terminator(csv::Terminator::Any(b'\n'))
+        .buffer_capacity(1 << 16)
+        .from_reader(limited);
+    let mut table = Table::default();
+    let mut header_fields = 0;
+    let mut header_line = 0;
+    let mut record = csv::ByteRecord::new();
+    let mut row = Vec::new();
+    let mut next_line = 0;
+    let mut rows = 0usize;
+    let step = size.map(|s| (s / 20).max(1));
+    let mut next_progress = step.unwrap_or(u64::MAX);
+    let mut scratch = Vec::new();
+    loop {
+        let more = match reader.read_byte_record(&mut record) {
+            Ok(more) => more,
+            Err(e) => {
+                // The line being read (lines consumed so far, plus one).
+                let line = e.position().map_or(reader.position().line(), |p| p.line());
+                let message = match e.into_kind() {
+                    csv::ErrorKind::Io(io) => io.to_string(),
+                    other => format!("{other:?}"),
+                };
+                return Err(err(Some(line), message));
+            }
+        };
+        if !more {
+            break;
+        }
+        // Every record ends with a consumed `\n` (the input's last one added if missing), and
+        // `csv` counts lines as it consumes `\n`s: the record's line is the count less its
+        // own line breaks (inside quotes, and the end).
+        let breaks = record.as_slice().iter().filter(|&&b| b == b'\n').count() as u64;
+        let lineno = reader.position().line() - breaks - 1;
+        if let (Some(p), Some(size)) = (progress, size) {
+            let read = reader.get_ref().read;
+            if read >= next_progress {
+                p(read as f64 / size.max(1) as f64);
+                next_progress = read + step.unwrap_or(u64::MAX);
+            }
+        }
+        // Empty lines are no records; a line of delimiters and white space only is blank too.
+        if record.iter().all(|f| f.trim_ascii().is_empty()) {
+            continue;
+        }
+        row.clear();
+        let mut bad = None;
+        let mut text_field = false;
+        for f in record.iter() {
+            let f = f.trim_ascii();
+            let parsed = if format.decimal_comma && f.contains(&b',') {
+                scratch.clear();
+                scratch.extend(f.iter().map(|&b| if b == b',' { b'.' } else { b }));
+                parse_number(&scratch)
+            } else {
+                parse_number(f)
+            };
+            match parsed {
+                Some(v) if v.is_finite() && v.abs() <= MAX_VALUE => row.push(v),
+                Some(v) => {
+                    bad.get_or_insert_with(|| {
+                        format!("value is {v:e}: not a finite reading within ±{MAX_VALUE:e}")
+                    });
+                }
+                None => {
+                    let text = String::from_utf8_lossy(f);
+                    // A number written with a decimal comma is a number, not header text: a
+                    // data row read without --decimal-comma is an error, not a header.
+                    let comma_number = !format.decimal_comma
+                        && text.contains(',')
+                        && parse_number(text.replace(',', ".").as_bytes()).is_some();
+                    text_field |= !comma_number;
+                    bad.get_or_insert_with(|| not_a_number(&text, format, delimiter));
+                }
+            }
+        }
+        if table.columns.is_empty() {
+            if text_field {
+                // Text makes a header line; a number that is not finite or beyond any sensor
+                // is an error wherever it is (a NaN row before the data is not a header).
+                table.headers = record
+                    .iter()
+                    .map(|f| String::from_utf8_lossy(f.trim_ascii()).into_owned())
+                    .collect();
+                header_fields = record.len();
+                header_line = lineno;
+                continue;
+            }
+            if bad.is_none() {
+                // A row wider than its header has fields no name covers (decimal commas
+                // split in two, most often); a narrower one leaves names over, as the AFRL
+                // drop tower's files do (seven names, six columns), and is read.
+                if header_fields != 0 && row.len() > header_fields {
+                    return Err(err(
+                        Some(lineno),
+                        format!(
+                            "{} fields, but the header (line {header_line}) has {header_fields}{}",
+                            row.len(),
+                            if delimiter == b',' {
+                                " (decimal commas? give --decimal-comma and --delimiter)"
+                            } else {
+                                ""
+                            }
+                        ),
+                    ));
+                }
+                table.columns = vec![Vec::new(); row.len()];
+                table.first_data_line = lineno;
+                next_line = lineno;
+            }
+        }
+        if let Some(message) = bad {
+            return Err(err(Some(lineno), message));
+        }
+        if row.len() != table.columns.len() {
+            return Err(err(
+                Some(lineno),
+                format!("{} fields, expected {}", row.len(), table.columns.len()),
+            ));
+        }
+        if lineno != next_line {
+            table.breaks.push((rows, lineno));
+        }
+        next_line = lineno + breaks + 1;
+        for (c, v) in table.columns.iter_mut().zip(&row) {
+            c.push(*v);
+        }
+        rows += 1;
+    }
+    if table.columns.first().is_none_or(|c| c.is_empty()) {
+        return Err(err(None, "no data rows".into()));
+    }
+    Ok(table)
+}
+
+impl Table {
+    /// Resolves a column reference.
+    pub fn find(&self, c: &ColumnRef, what: &str) -> Result<usize, String> {
+        let n = self.columns.len();
+        match c {
+            ColumnRef::Index(i) if *i < n => Ok(*i),
+            ColumnRef::Index(i) => Err(format!("{what} {i} does not exist (rows have {n} fields)")),
+            ColumnRef::Name(name) => self
+                .headers
+                .iter()
+                .position(|h| h.eq_ignore_ascii_case(name))
+                .filter(|&p| p < n)
+                .ok_or_else(|| {
+                    format!(
+                        "no {what} named {name:?} (columns: {})",
+                        self.headers.join(", ")
+                    )
+                }),
+        }
+    }
+
+    /// The time column: the one asked for, or the one column whose header looks like a time
+    /// (`time…`, `t`, `t_…`); several such columns without `--time-column` are an error naming
+    /// them.
+    pub fn time_column(&self, asked: Option<&ColumnRef>) -> Result<Option<usize>, String> {
+        if let Some(c) = asked {
+            return self.find(c, "time column").map(Some);
+        }
+        let candidates: Vec<usize> = (0..self.columns.len().min(self.headers.len()))
+            .filter(|&c| looks_like_time(&self.headers[c]))
+            .collect();
+        match candidates.as_slice() {
+            [] => Ok(None),
+            [one] => Ok(Some(*one)),
+            many => Err(format!(
+                "several columns could be the time: {}; choose one with --time-column",
+                many.iter()
+                    .map(|&c| format!("{:?}", self.headers[c]))
+                    .collect::<Vec<_>>()
+                    .join(", ")
+            )),
+        }
+    }
+}
+
+/// Whether a header names a time column: its first word is `time`, `timestamp` or `t`.
+fn looks_like_time(header: &str) -> bool {
+    let h = header.to_ascii_lowercase();
+    let first = words(&h).next();
+    matches!(first, Some("time" | "timestamp" | "times" | "t"))
+}
+
+/// The words of a header (letters, digits, `µ`).
+pub(crate) fn words(h: &str) -> impl Iterator<Item = &str> {
+    h.split(|c: char| !(c.is_alphanumeric() || c == 'µ'))
+        .filter(|w| !w.is_empty())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn read(text: &str, format: CsvFormat) -> Result<Table, String> {
+        let dir = std::env::temp_dir().join(format!("impact-table-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let path = dir.join(format!(
+            "{:x}.csv",
+            text.len() * 31 + text.bytes().map(usize::from).sum::<usize>()
+        ));
+        std::fs::write(&path, text).unwrap();
+        let t = read_table(&path, &format, None).map_err(|e| e.to_string());
+        std::fs::remove_file(&path).unwrap();
+        t
+    }
+
+    #[test]
+    fn quoted_fields_bom_and_semicolons() {
+        let t = read(
+            "\u{feff}\"time_s\";\"a\"\n\"0.0\";\"1.5\"\n0.5;2\n",
+            CsvFormat::default(),
+        )
+        .unwrap();
+        assert_eq!(t.headers, ["time_s", "a"]);
+        assert_eq!(t.columns, [vec![0.0, 0.5], vec![1.5, 2.0]]);
+    }
+
+    #[test]
+    fn decimal_commas_need_the_option_and_another_delimiter() {
+        let text = "time_s;a\n0,0;6,771553e-1\n0,5;1,25\n";
+        let e = read(text, CsvFormat::default()).unwrap_err();
+        assert!(
+            e.contains(":2: not a number: \"0,0\" (decimal commas? give --decimal-comma)"),
+            "{e}"
+        );
+        let t = read(
+            text,
+            CsvFormat {
+                delimiter: None,
+                decimal_comma: true,
+            },
+        )
+        .unwrap();
+        assert_eq!(t.columns[1], [0.6771553, 1.25]);
+        let e = read(
+            "a\n1,5\n",
+            CsvFormat {
+                delimiter: None,
+                decimal_comma: true,
+            },
+        )
+        .unwrap_err();
+        assert!(e.contains("--decimal-comma: the delimiter is ','"), "{e}");
+    }
+
+    #[test]
+    fn a_row_wider_than_its_header_is_an_error_at_its_line() {
+        let e = read("accel_g\n6,771553e-1\n", CsvFormat::default()).unwrap_err();
+        assert!(e.ends_with(":2: 2 fields, but the header (line 1) has 1 (decimal commas? give --decimal-comma and --delimiter)"), "{e}");
+        let e = read("t,a\n0,1\n1,2,3\n", CsvFormat::default()).unwrap_err();
+        assert!(e.ends_with(":3: 3 fields, expected 2"), "{e}");
+    }
+
+    #[test]
+    fn rows_map_back_to_lines_across_blank_lines() {
+        let t = read("t,a\n\n0,1\n1,2\n\n\n2,3\n3,4\n", CsvFormat::default()).unwrap();
+        assert_eq!(t.first_data_line, 3);
+        let lines: Vec<u64> = (0..4).map(|r| t.line_of(r)).collect();
+        assert_eq!(lines, [3, 4, 7, 8]);
+    }
+
+    #[test]
+    fn an_unclosed_quote_or_endless_line_is_bounded() {
+        let mut text = String::from("t,a\n0,1\n\"");
+        text.push_str(&"1,2\n".repeat(MAX_LINE_BYTES / 4 + 10));
+        let e = read(&text, CsvFormat::default()).unwrap_err();
+        assert!(e.contains("a line longer than 1048576 bytes"), "{e}");
+        // A quote inside a field is text, not an opening quote.
+        let t = read("t,a 5\" bar\n0,1\n", CsvFormat::default()).unwrap();
+        assert_eq!(t.headers, ["t", "a 5\" bar"]);
+    }
+
+    #[test]
+    fn delimiters_are_parsed_by_name() {
+        assert_eq!(parse_delimiter("tab"), Ok(b'\t'));
+        assert_eq!(parse_delimiter(";"), Ok(b';'));
+        assert!(parse_delimiter("ab").is_err());
+        assert!(parse_delimiter("\"").is_err());
+    }
+}

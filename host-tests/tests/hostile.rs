@@ -1,0 +1,603 @@
+//! Hostile input: every case of the hostile-input issue, run as a user would run it, each
+//! `impact` process under a 1 GiB address-space limit and a time limit. Asserted each time:
+//! no panic, no hang, no allocation failure; the exit status; a one-line error naming the
+//! option or the file and line, or a correct, flagged result; nothing non-finite written.
+#![cfg(unix)]
+
+use std::io::{BufRead, BufReader, Read, Write};
+use std::os::unix::process::{CommandExt, ExitStatusExt};
+use std::path::PathBuf;
+use std::process::{Child, Command, Stdio};
+use std::time::{Duration, Instant};
+
+mod common;
+use common::SYNTH_T2 as T2;
+
+/// Address space each `impact` process may map: far below what the cases used to take
+/// (2.5–12 GB), far above what a bounded run needs.
+const MEMORY_LIMIT_BYTES: u64 = 1 << 30;
+
+/// Longest a case may run.
+const TIME_LIMIT: Duration = Duration::from_secs(120);
+
+struct Run {
+    code: Option<i32>,
+    signal: Option<i32>,
+    out: String,
+    err: String,
+}
+
+/// Starts `impact ARGS` under [`MEMORY_LIMIT_BYTES`].
+fn spawn(args: &[&str], stdin: Stdio) -> Child {
+    let mut cmd = Command::new(env!("CARGO_BIN_EXE_impact"));
+    cmd.args(args)
+        .stdin(stdin)
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped());
+    // SAFETY: setrlimit is async-signal-safe; nothing else runs between fork and exec.
+    unsafe {
+        cmd.pre_exec(|| {
+            let limit = libc::rlimit {
+                rlim_cur: MEMORY_LIMIT_BYTES,
+                rlim_max: MEMORY_LIMIT_BYTES,
+            };
+            if libc::setrlimit(libc::RLIMIT_AS, &limit) != 0 {
+                return Err(std::io::Error::last_os_error());
+            }
+            Ok(())
+        });
+    }
+    cmd.spawn().expect("impact runs")
+}
+
+/// Waits for `child` (killing it past [`TIME_LIMIT`]) and checks what any run must satisfy.
+fn finish(mut child: Child, what: &str) -> Run {
+    // The caller may have read (and closed) stdout itself.
+    let out = child.stdout.take();
+    let mut err = child.stderr.take().unwrap();
+    let reader = std::thread::spawn(move || {
+        let mut o = Vec::new();
+        if let Some(mut out) = out {
+            let _ = out.read_to_end(&mut o);
+        }
+        o
+    });
+    let err_reader = std::thread::spawn(move || {
+        let mut e = Vec::new();
+        let _ = err.read_to_end(&mut e);
+        e
+    });
+    let start = Instant::now();
+    let status = loop {
+        if let Some(s) = child.try_wait().unwrap() {
+            break s;
+        }
+        if start.elapsed() > TIME_LIMIT {
+            let _ = child.kill();
+            panic!("{what}: still running after {TIME_LIMIT:?}");
+        }
+        std::thread::sleep(Duration::from_millis(5));
+    };
+    let run = Run {
+        code: status.code(),
+        signal: status.signal(),
+        out: String::from_utf8_lossy(&reader.join().unwrap()).into_owned(),
+        err: String::from_utf8_lossy(&err_reader.join().unwrap()).into_owned(),
+    };
+    assert!(
+        !run.err.contains("panicked") && !run.err.contains("memory allocation"),
+        "{what}: {}",
+        run.err
+    );
+    assert!(
+        run.code.is_some() || run.signal == Some(libc::SIGPIPE),
+        "{what}: killed by signal {:?}: {}",
+        run.signal,
+        run.err
+    );
+    // Nothing non-finite in what is written (JSON has no inf; CSV and tables must not).
+    let non_finite = run
+        .out
+        .split(|c: char| !c.is_ascii_alphanumeric())
+        .any(|w| matches!(w.to_ascii_lowercase().as_str(), "inf" | "nan" | "infinity"));
+    assert!(!non_finite, "{what}: non-finite output:\n{}", run.out);
+    run
+}
+
+fn run(args: &[&str]) -> Run {
+    finish(spawn(args, Stdio::null()), &args.join(" "))
+}
+
+fn run_with_stdin(args: &[&str], input: Vec<u8>) -> Run {
+    let mut child = spawn(args, Stdio::piped());
+    let mut stdin = child.stdin.take().unwrap();
+    let writer = std::thread::spawn(move || {
+        let _ = stdin.write_all(&input);
+    });
+    let r = finish(child, &args.join(" "));
+    writer.join().unwrap();
+    r
+}
+
+/// The run failed with one line that names `want`.
+fn fails(args: &[&str], want: &str) -> String {
+    let r = run(args);
+    refused(&r, &args.join(" "), want);
+    r.err
+}
+
+fn refused(r: &Run, what: &str, want: &str) {
+    assert!(
+        matches!(r.code, Some(1 | 2)),
+        "{what}: exit {:?}\n{}",
+        r.code,
+        r.out
+    );
+    assert_eq!(r.err.trim().lines().count(), 1, "{what}: {}", r.err);
+    assert!(r.err.contains(want), "{what}: wanted {want:?} in {}", r.err);
+}
+
+fn ok(args: &[&str]) -> Run {
+    let r = run(args);
+    assert_eq!(r.code, Some(0), "{}: {}", args.join(" "), r.err);
+    r
+}
+
+fn temp(name: &str, bytes: &[u8]) -> PathBuf {
+    let dir = std::env::temp_dir().join(format!("impact-hostile-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let p = dir.join(name);
+    std::fs::write(&p, bytes).unwrap();
+    p
+}
+
+fn t2(extra: &[&str]) -> Vec<String> {
+    T2.iter().chain(extra).map(|s| s.to_string()).collect()
+}
+
+fn strs(v: &[String]) -> Vec<&str> {
+    v.iter().map(String::as_str).collect()
+}
+
+/// `base.csv`: one 55.6 g two-phase impact at 10 ms.
+fn base() -> String {
+    ok(&T2).out
+}
+
+fn json(text: &str) -> serde_json::Value {
+    serde_json::from_str(text).unwrap_or_else(|e| panic!("{e}: {text}"))
+}
+
+#[test]
+fn synth_refuses_what_it_cannot_render_naming_the_option() {
+    for (extra, want) in [
+        (&["--duration", "inf"][..], "--duration"),
+        (&["--duration", "1e300"], "--duration x --rate"),
+        (&["--duration", "NaN"], "--duration"),
+        (&["--duration", "-1"], "--duration"),
+        (&["--duration", "1e6"], "--duration x --rate"),
+        (&["--rate", "1e12"], "--duration x --rate"),
+        (&["--rate", "1e9"], "--duration x --rate"),
+        (&["--bits", "16"], "--bits"),
+        (&["--noise", "NaN"], "--noise"),
+        (&["--noise", "-1"], "--noise"),
+        (&["--offset", "NaN"], "--offset"),
+        (&["--drift", "NaN"], "--drift"),
+        (&["--drift", "inf"], "--drift"),
+        (&["--full-scale", "NaN"], "--full-scale"),
+        (&["--full-scale", "inf"], "--full-scale"),
+        (&["--full-scale", "0"], "--full-scale"),
+        (&["--full-scale", "-1"], "--full-scale"),
+        (&["--touch", "inf"], "--touch"),
+        (&["--touch", "NaN"], "--touch"),
+        (&["--touch", "1e300"], "--touch"),
+    ] {
+        fails(&strs(&t2(extra)), want);
+    }
+}
+
+#[test]
+fn synth_memory_follows_the_recording_not_the_contact_time() {
+    // Contacts of ~3e4 s, ~3e5 s and ~1e30 s rendered into 10 samples each: 10 rows, promptly
+    // and in bounded memory.
+    for law in [
+        &["--mass", "1", "--stiffness", "1e-8"][..],
+        &["--mass", "1", "--stiffness", "1e-10"],
+        &["--mass", "1e30", "--stiffness", "1e-30"],
+    ] {
+        let mut args = vec!["synth", "--law", "linear", "--v0", "1"];
+        args.extend(law);
+        args.extend(["--duration", "0.01", "--rate", "1000", "--touch", "0.001"]);
+        let r = ok(&args);
+        assert_eq!(r.out.lines().count(), 11, "{args:?}: {}", r.out);
+    }
+}
+
+#[test]
+fn a_closed_output_pipe_ends_the_tool_quietly() {
+    // `impact synth … | head -1`: the next write after the reader left gets SIGPIPE (the usual
+    // status of a pipeline's writer), not a panic.
+    let args = strs(&t2(&["--duration", "2"])).join(" ");
+    let mut child = spawn(&strs(&t2(&["--duration", "2"])), Stdio::null());
+    let mut first = String::new();
+    let stdout = child.stdout.take().unwrap();
+    BufReader::new(stdout).read_line(&mut first).unwrap();
+    assert_eq!(first.trim(), "time_s,accel_g");
+    let r = finish(child, &args);
+    assert_eq!(r.signal, Some(libc::SIGPIPE), "{:?} {}", r.code, r.err);
+    // `impact analyze big.csv --csv | head -1`: the same.
+    let big = ok(&strs(&t2(&[
+        "--repeat",
+        "400",
+        "--every",
+        "0.02",
+        "--duration",
+        "8.1",
+        "--rate",
+        "50000",
+    ])))
+    .out;
+    let f = temp("big.csv", big.as_bytes());
+    let mut child = spawn(&["analyze", f.to_str().unwrap(), "--csv"], Stdio::null());
+    let mut first = String::new();
+    BufReader::new(child.stdout.take().unwrap())
+        .read_line(&mut first)
+        .unwrap();
+    assert!(first.starts_with("index,"), "{first}");
+    let r = finish(child, "analyze big.csv --csv | head -1");
+    assert!(
+        r.signal == Some(libc::SIGPIPE) || r.code == Some(0),
+        "{:?} {}",
+        r.code,
+        r.err
+    );
+}
+
+#[test]
+fn endless_or_blocking_inputs_end_in_bounded_memory() {
+    // No line break at all: an error after a bounded read.
+    fails(&["analyze", "/dev/zero"], "/dev/zero:1: a line longer than");
+    fails(&["log", "/dev/zero"], "/dev/zero:1: a line longer than");
+    // A FIFO is opened once: the tool reads what the writer sends and ends when it closes.
+    let dir = std::env::temp_dir().join(format!("impact-fifo-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let fifo = dir.join("stream.csv");
+    let _ = std::fs::remove_file(&fifo);
+    let path = std::ffi::CString::new(fifo.to_str().unwrap()).unwrap();
+    // SAFETY: a valid NUL-terminated path.
+    assert_eq!(unsafe { libc::mkfifo(path.as_ptr(), 0o600) }, 0);
+    let csv = base();
+    let child = spawn(
+        &["analyze", fifo.to_str().unwrap(), "--json"],
+        Stdio::null(),
+    );
+    std::fs::OpenOptions::new()
+        .write(true)
+        .open(&fifo)
+        .unwrap()
+        .write_all(csv.as_bytes())
+        .unwrap();
+    let r = finish(child, "analyze FIFO");
+    assert_eq!(r.code, Some(0), "{}", r.err);
+    assert_eq!(json(&r.out)["impacts"].as_array().unwrap().len(), 1);
+    // Standard input (`-`) reads the same.
+    let r = run_with_stdin(&["analyze", "-", "--json"], csv.into_bytes());
+    assert_eq!(r.code, Some(0), "{}", r.err);
+    assert_eq!(json(&r.out)["impacts"].as_array().unwrap().len(), 1);
+    // An unclosed quote does not swallow the rest of the file into one field.
+    let mut text = b"time_s,a_g\n0,1\n\"".to_vec();
+    text.extend(b"0.001,2\n".repeat(200_000));
+    let f = temp("open-quote.csv", &text);
+    fails(&["analyze", f.to_str().unwrap()], "a line longer than");
+}
+
+#[test]
+fn the_exact_solvers_refuse_results_that_underflow() {
+    for extra in [
+        ["--mass", "8.419e-3", "--v0", "1e-160", "--precision", "f64"],
+        ["--mass", "1e-45", "--v0", "1", "--precision", "f32"],
+    ] {
+        let mut args = vec![
+            "simulate",
+            "--model",
+            "hertz",
+            "--stiffness",
+            "1e10",
+            "--json",
+        ];
+        args.extend(extra);
+        fails(&args, "underflowed");
+    }
+}
+
+#[test]
+fn values_no_sensor_gives_are_the_files_line() {
+    let csv = base();
+    for (v, line) in [
+        ("1e38", 1002),
+        ("1e39", 1002),
+        ("1e308", 1002),
+        ("NaN", 1002),
+    ] {
+        let text = csv.replacen(
+            "\n0.002000000,",
+            &format!("\n0.002000000,{v}\n0.002000001,"),
+            1,
+        );
+        let f = temp(&format!("value-{v}.csv"), text.as_bytes());
+        let err = fails(
+            &["analyze", f.to_str().unwrap(), "--csv"],
+            &format!(":{line}:"),
+        );
+        assert!(
+            !err.contains("--gain") && !err.contains("--trigger"),
+            "{err}"
+        );
+    }
+    // Leading NaN rows are data with a bad value, not header lines.
+    let mut text = String::from("time_s,a_g\n");
+    text.push_str(&"NaN,NaN\n".repeat(1000));
+    text.push_str("0.001,1\n0.002,2\n");
+    let f = temp("nan-lead.csv", text.as_bytes());
+    fails(
+        &["analyze", f.to_str().unwrap()],
+        "nan-lead.csv:2: value is NaN",
+    );
+}
+
+#[test]
+fn csv_layouts_are_read_right_or_refused_with_a_hint() {
+    let csv = base();
+    let f = temp("plain.csv", csv.as_bytes());
+    let reference = json(&ok(&["analyze", f.to_str().unwrap(), "--json"]).out)["impacts"].clone();
+    let peak = reference[0]["peak_acceleration_m_s2"].as_f64().unwrap();
+    assert!((peak - 546.0).abs() < 1.0, "{peak}");
+    let same = |name: &str, text: String, extra: &[&str]| {
+        let f = temp(name, text.as_bytes());
+        let mut args = vec!["analyze", f.to_str().unwrap(), "--json"];
+        args.extend(extra);
+        let r = ok(&args);
+        assert_eq!(json(&r.out)["impacts"], reference, "{name}");
+    };
+    // A byte-order mark, quoted fields, semicolons, tabs, CRLF line ends.
+    same("bom.csv", format!("\u{feff}{csv}"), &[]);
+    let quoted: String = csv
+        .lines()
+        .map(|l| {
+            l.split(',')
+                .map(|f| format!("\"{f}\""))
+                .collect::<Vec<_>>()
+                .join(",")
+                + "\n"
+        })
+        .collect();
+    same("quoted.csv", quoted, &[]);
+    same("semicolon.csv", csv.replace(',', ";"), &[]);
+    same("tab.csv", csv.replace(',', "\t"), &["--delimiter", "tab"]);
+    same("crlf.csv", csv.replace('\n', "\r\n"), &[]);
+    // Decimal commas: read with the option, refused with a hint without it.
+    let comma = csv.replace(',', ";").replace('.', ",");
+    same(
+        "comma.csv",
+        comma.clone(),
+        &["--decimal-comma", "--delimiter", ";"],
+    );
+    let f = temp("comma.csv", comma.as_bytes());
+    fails(
+        &["analyze", f.to_str().unwrap()],
+        "comma.csv:2: not a number: \"0,000000000\" (decimal commas? give --decimal-comma)",
+    );
+    fails(
+        &[
+            "analyze",
+            f.to_str().unwrap(),
+            "--decimal-comma",
+            "--delimiter",
+            ",",
+        ],
+        "--decimal-comma: the delimiter is ','",
+    );
+    // One column of decimal commas under a one-field header: a ragged row, not the integer
+    // part analysed.
+    let one: String = std::iter::once("accel_g\n".to_string())
+        .chain(
+            csv.lines()
+                .skip(1)
+                .map(|l| l.split(',').nth(1).unwrap().replace('.', ",") + "\n"),
+        )
+        .collect();
+    let f = temp("one-column.csv", one.as_bytes());
+    fails(
+        &["analyze", f.to_str().unwrap(), "--rate", "500000"],
+        "one-column.csv:2: 2 fields, but the header (line 1) has 1",
+    );
+    let r = ok(&[
+        "analyze",
+        f.to_str().unwrap(),
+        "--rate",
+        "500000",
+        "--decimal-comma",
+        "--delimiter",
+        ";",
+        "--json",
+    ]);
+    let p = json(&r.out)["impacts"][0]["peak_acceleration_m_s2"]
+        .as_f64()
+        .unwrap();
+    assert!((p - peak).abs() < 1e-3, "{p}");
+    // Ragged rows against the header and against the first row.
+    let f = temp("ragged.csv", b"time_s,a_g\n0,1,2\n");
+    fails(
+        &["analyze", f.to_str().unwrap()],
+        "ragged.csv:2: 3 fields, but the header",
+    );
+    let f = temp("ragged2.csv", b"time_s,a_g\n0,1\n1e-6,2,3\n");
+    fails(
+        &["analyze", f.to_str().unwrap()],
+        "ragged2.csv:3: 3 fields, expected 2",
+    );
+    fails(&["analyze", "x.csv", "--delimiter", "ab"], "--delimiter");
+}
+
+#[test]
+fn options_are_checked_where_they_are_parsed_naming_themselves() {
+    let csv = base();
+    let f = temp("options.csv", csv.as_bytes());
+    let name = f.to_str().unwrap();
+    for (extra, want) in [
+        (&["--mass", "NaN"][..], "--mass"),
+        (&["--mass", "-1"], "--mass"),
+        (&["--mass", "3e38", "--v0", "1.3357"], "--mass"),
+        (&["--v0", "inf"], "--v0"),
+        (&["--drop-height", "0"], "--drop-height"),
+        (&["--rate", "0"], "--rate"),
+        (&["--trigger", "NaN"], "--trigger"),
+        (&["--hold", "-1"], "--hold"),
+        (&["--hold", "10"], "--hold"),
+        (&["--rate", "1e8"], "lower the rate"),
+        (&["--column", "0"], "time column"),
+        (&["--column", "9"], "column 9"),
+        (&["--plot", name], "input file"),
+        (&["--plot", "/nonexistent-dir/x.svg"], "/nonexistent-dir"),
+    ] {
+        let mut args = vec!["analyze", name];
+        args.extend(extra);
+        let r = run(&args);
+        refused(&r, &format!("{extra:?}"), want);
+        assert!(r.out.is_empty(), "{extra:?}: printed before the error");
+    }
+    assert_eq!(
+        std::fs::read_to_string(&f).unwrap(),
+        csv,
+        "--plot kept off the input"
+    );
+    // A scene file spells units as the command line does; a drop height given on the command
+    // line replaces the scene's v0.
+    let scene = temp(
+        "scene.json",
+        br#"{"mass_kg": 0.06, "v0_m_s": 5.0, "units": "g"}"#,
+    );
+    let first = |extra: &[&str]| {
+        let mut args = vec![
+            "analyze",
+            name,
+            "--scene",
+            scene.to_str().unwrap(),
+            "--json",
+        ];
+        args.extend(extra);
+        json(&ok(&args).out)["impacts"][0].clone()
+    };
+    // The scene's 5 m/s is more than this impact's Δv could stop: flagged, with reasons.
+    let fast = first(&[]);
+    assert!(fast["flags"].to_string().contains("no-stop"), "{fast}");
+    assert_eq!(fast["null_reasons"]["cor"], "no-stop");
+    let h = 1.3357f64 * 1.3357 / (2.0 * 9.80665);
+    let v0 = first(&["--drop-height", &h.to_string()])["impact_velocity_m_s"]
+        .as_f64()
+        .unwrap();
+    assert!((v0 - 1.3357).abs() < 1e-4, "{v0}");
+    // A hold too short to see the body stop: the kinematics are null with the reason.
+    let short = json(
+        &ok(&[
+            "analyze", name, "--mass", "0.06", "--v0", "1.3357", "--hold", "1e-5", "--json",
+        ])
+        .out,
+    );
+    let i = &short["impacts"][0];
+    assert!(
+        i["cor"].is_null() && i["null_reasons"]["cor"].is_string(),
+        "{i}"
+    );
+}
+
+#[test]
+fn impact_log_refuses_what_the_firmware_cannot_have_written_by_line() {
+    // A real line from the emulated firmware's format (see firmware/README.md).
+    let line = "impact index=0 status=complete analysis=full clipped=false flags=0 start_sample=5000 end_sample=17000 start_s=0.01 peak_time_s=0.0100251 peak_acceleration_m_s2=4321.5 peak_force_n=259.29 delta_v_m_s=2.5 duration_s=0.0219 baseline_m_s2=0.2 fwhm_s=0.001 filtered_peak_acceleration_m_s2=none impact_velocity_m_s=1.3357 crush_time_s=0.0218 max_deformation_m=0.0186 rebound_velocity_m_s=1.16 cor=0.87 permanent_deformation_m=0.0182 absorbed_energy_j=none two_phase_kc_n_m=none two_phase_kr_n_m=none two_phase_c_n_s_m=none two_phase_permanent_deformation_m=none two_phase_residual=none nonlinear_k=none nonlinear_c_s_m=none nonlinear_exponent=none nonlinear_residual=none hertz_k=none hertz_residual=none report_latency_s=0.0123";
+    let scene = "scene rate_hz=500000 v0_m_s=1.3357 drop_height_m=none two_phase=false nonlinear=false fit_exponent=false hertz=false";
+    let set = |field: &str, value: &str| {
+        let (head, tail) = line.split_once(&format!(" {field}=")).unwrap();
+        let rest = tail.split_once(' ').map_or("", |(_, r)| r);
+        format!("{head} {field}={value} {rest}")
+    };
+    let log = |name: &str, text: String| temp(name, text.as_bytes());
+    let good = log("good.log", format!("{scene}\n{line}\n"));
+    let r = ok(&["log", good.to_str().unwrap(), "--csv"]);
+    assert_eq!(r.out.lines().count(), 2, "{}", r.out);
+    for (name, text, want) in [
+        (
+            "rate.log",
+            format!(
+                "{}\n{line}\n",
+                scene.replace("rate_hz=500000", "rate_hz=NaN")
+            ),
+            "rate.log: line 1: rate_hz=NaN",
+        ),
+        (
+            "rate-neg.log",
+            format!(
+                "{}\n{line}\n",
+                scene.replace("rate_hz=500000", "rate_hz=-5")
+            ),
+            "line 1: rate_hz=-5",
+        ),
+        (
+            "inf.log",
+            format!("{scene}\n{}\n", set("peak_acceleration_m_s2", "inf")),
+            "line 2: peak_acceleration_m_s2=inf: not finite",
+        ),
+        (
+            "f32.log",
+            format!("{scene}\n{}\n", set("peak_force_n", "1e39")),
+            "line 2: peak_force_n=inf: not finite",
+        ),
+        (
+            "cor.log",
+            format!("{scene}\n{}\n", set("cor", "7.5")),
+            "line 2: cor=7.5: out of range",
+        ),
+        (
+            "xp.log",
+            format!("{scene}\n{}\n", set("permanent_deformation_m", "-1")),
+            "line 2: permanent_deformation_m=-1",
+        ),
+        (
+            "zeros.log",
+            format!("{scene}\n{line}\n{line}\n{line}\n"),
+            "line 3: impact index=0 again (first on line 2)",
+        ),
+        (
+            "order.log",
+            format!("{scene}\n{}\n{line}\n", set("index", "5")),
+            "line 3: impact index=0 after index=5",
+        ),
+        (
+            "garbage.log",
+            "0.01 INFO  impact index=zero status=complete\n".into(),
+            "line 1: missing field",
+        ),
+        (
+            "empty.log",
+            "nothing to see\n".into(),
+            "no scene, heartbeat or summary line",
+        ),
+    ] {
+        let f = log(name, text);
+        fails(&["log", f.to_str().unwrap()], want);
+    }
+    fails(&["log", good.to_str().unwrap(), "--t0", "NaN"], "--t0");
+    // A heartbeat counting more impacts than the log has lines: said, by line.
+    let beat = "heartbeat samples=500000 rate_hz=500000 impacts=7 reports_dropped=0";
+    let f = log("beat.log", format!("{scene}\n{line}\n{beat}\n"));
+    let r = ok(&["log", f.to_str().unwrap()]);
+    assert!(
+        r.err.contains("line 3: the heartbeat counts 7 impacts"),
+        "{}",
+        r.err
+    );
+    // Standard input.
+    let r = run_with_stdin(&["log", "-", "--csv"], std::fs::read(&good).unwrap());
+    assert_eq!(r.code, Some(0), "{}", r.err);
+    assert_eq!(r.out.lines().count(), 2);
+}
