@@ -157,6 +157,8 @@ pub struct AnalyzeArgs {
     /// or rest), not an impact, s [default: 50 ms, at least the hold].
     #[arg(long, value_parser = positive_f64)]
     pub settle: Option<f64>,
+    #[command(flatten)]
+    pub spectrum: crate::spectrum::SpectrumArgs,
     /// Scene file (JSON); options given here override it.
     #[arg(long)]
     pub scene: Option<PathBuf>,
@@ -234,6 +236,9 @@ pub struct ImpactJson {
     /// report, s.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub report_latency_s: Option<f64>,
+    /// With `--srs`: the impact's shock spectra.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub shock_spectrum: Option<crate::spectrum::ShockSpectrumJson>,
 }
 
 /// The whole analysis as JSON.
@@ -394,6 +399,7 @@ pub fn impact_json(r: &ImpactReport, t0: f64, fits: &FitSet) -> ImpactJson {
         fits: fits_json(&r.fits),
         null_reasons: null_reasons(r, fits),
         report_latency_s: None,
+        shock_spectrum: None,
     }
 }
 
@@ -762,8 +768,15 @@ pub fn to_csv(a: &AnalysisJson) -> String {
         "index,status,analysis,clipped,flags,start_sample,end_sample,start_s,peak_time_s,peak_acceleration_m_s2,peak_force_n,delta_v_m_s,duration_s,baseline_m_s2,fwhm_s,filtered_peak_acceleration_m_s2,\
 impact_velocity_m_s,crush_time_s,max_deformation_m,rebound_velocity_m_s,cor,permanent_deformation_m,absorbed_energy_j,\
 two_phase_kc_n_m,two_phase_kr_n_m,two_phase_c_n_s_m,two_phase_permanent_deformation_m,two_phase_residual,\
-nonlinear_k,nonlinear_c_s_m,nonlinear_exponent,nonlinear_residual,hertz_k,hertz_residual\n",
+nonlinear_k,nonlinear_c_s_m,nonlinear_exponent,nonlinear_residual,hertz_k,hertz_residual",
     );
+    // With --srs, the spectra's summary columns.
+    let with_spectrum = a.impacts.iter().any(|i| i.shock_spectrum.is_some());
+    if with_spectrum {
+        s.push(',');
+        s.push_str(crate::spectrum::CSV_HEADER);
+    }
+    s.push('\n');
     let o = |v: Option<f64>| v.map_or(String::new(), |v| format!("{v:e}"));
     for i in &a.impacts {
         let tp = i.fits.two_phase.as_ref();
@@ -806,6 +819,10 @@ nonlinear_k,nonlinear_c_s_m,nonlinear_exponent,nonlinear_residual,hertz_k,hertz_
             o(hz.map(|t| t.residual)),
         ];
         s.push_str(&cells.join(","));
+        if with_spectrum {
+            s.push(',');
+            s.push_str(&crate::spectrum::csv_cells(i.shock_spectrum.as_ref()));
+        }
         s.push('\n');
     }
     s
@@ -890,6 +907,9 @@ pub fn to_table(a: &AnalysisJson) -> String {
                 "    reported {:.1} ms after the end of its hold\n",
                 latency * 1e3
             ));
+        }
+        if let Some(sp) = &i.shock_spectrum {
+            s.push_str(&crate::spectrum::table_line(sp));
         }
         if let (Some(v0), Some(tm), Some(xm), Some(v1), Some(cor), Some(xp)) = (
             i.impact_velocity_m_s,

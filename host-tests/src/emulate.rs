@@ -342,6 +342,9 @@ pub fn run_emulator(
 /// `impact emulate`: prints what `impact analyze` would, computed by the emulated firmware.
 pub fn emulate(args: &EmulateArgs) -> Result<(), String> {
     let a = &args.analyze;
+    if a.spectrum.srs {
+        return Err("--srs: shock spectra are computed on the host only (`impact analyze --srs`); the firmware does not send them yet".into());
+    }
     // Check the tools before a possibly long build.
     tools_available()?;
     let setup = analyze::setup(a, None)?;

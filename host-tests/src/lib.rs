@@ -14,6 +14,7 @@ pub mod recording;
 pub mod screen;
 pub mod simulate;
 pub mod soak;
+pub mod spectrum;
 pub mod stability;
 pub mod synth;
 pub mod table;
