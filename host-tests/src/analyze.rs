@@ -828,6 +828,33 @@ nonlinear_k,nonlinear_c_s_m,nonlinear_exponent,nonlinear_residual,hertz_k,hertz_
     s
 }
 
+/// A quantity as a person reads it: four significant digits, times and lengths with a prefix
+/// that keeps the number in [1, 1000) (`5.521 ms`, `3.275 mm`), other units plain between
+/// 1e-3 and 1e5 and in exponent form beyond (`1.071e5 m/s²`).
+pub fn human(v: f64, unit: &str) -> String {
+    let digits = |x: f64| {
+        if x == 0.0 || !x.is_finite() {
+            return format!("{x}");
+        }
+        let decimals = (3 - x.abs().log10().floor() as i32).clamp(0, 6) as usize;
+        format!("{x:.decimals$}")
+    };
+    let prefixed = |prefixes: &[(f64, &str)]| {
+        let (scale, p) = prefixes
+            .iter()
+            .copied()
+            .find(|(scale, _)| v.abs() * scale >= 1.0)
+            .unwrap_or(*prefixes.last().unwrap());
+        format!("{} {p}", digits(v * scale))
+    };
+    match unit {
+        "s" if v.abs() < 1000.0 => prefixed(&[(1.0, "s"), (1e3, "ms"), (1e6, "µs"), (1e9, "ns")]),
+        "m" if v.abs() < 1000.0 => prefixed(&[(1.0, "m"), (1e3, "mm"), (1e6, "µm"), (1e9, "nm")]),
+        _ if v == 0.0 || (1e-3..1e5).contains(&v.abs()) => format!("{} {unit}", digits(v)),
+        _ => format!("{v:.3e} {unit}"),
+    }
+}
+
 /// A readable table.
 pub fn to_table(a: &AnalysisJson) -> String {
     let mut s = format!(
@@ -874,24 +901,29 @@ pub fn to_table(a: &AnalysisJson) -> String {
     }
     for i in &a.impacts {
         s.push_str(&format!(
-            "impact {} [{}{}{}] at {:.6} s: peak {}{:.4e} m/s² ({:.2} g){}, Δv {}, duration {:.4e} s, FWHM {}\n",
+            "impact {} [{}{}{}] at {:.6} s: peak {}{} ({}){}, Δv {}, duration {}, FWHM {}\n",
             i.index,
             i.status,
             if i.clipped { ", CLIPPED" } else { "" },
-            if i.analysis == "skipped" { ", analysis skipped" } else { "" },
+            if i.analysis == "skipped" {
+                ", analysis skipped"
+            } else {
+                ""
+            },
             i.start_s,
             if i.clipped { "≥" } else { "" },
-            i.peak_acceleration_m_s2,
-            i.peak_acceleration_m_s2 / STANDARD_GRAVITY,
-            i.peak_force_n.map_or(String::new(), |f| format!(", force {f:.4e} N")),
+            human(i.peak_acceleration_m_s2, "m/s²"),
+            human(i.peak_acceleration_m_s2 / STANDARD_GRAVITY, "g"),
+            i.peak_force_n
+                .map_or(String::new(), |f| format!(", force {}", human(f, "N"))),
             i.delta_v_m_s.map_or_else(
                 || format!("unknown ({})", i.null_reasons["delta_v_m_s"]),
-                |v| format!("{v:.4} m/s")
+                |v| human(v, "m/s")
             ),
-            i.duration_s,
+            human(i.duration_s, "s"),
             i.fwhm_s.map_or_else(
                 || format!("unknown ({})", i.null_reasons["fwhm_s"]),
-                |w| format!("{w:.4e} s")
+                |w| human(w, "s")
             ),
         ));
         // Why the kinematics are missing, unless simply because v0 was not given.
@@ -920,36 +952,59 @@ pub fn to_table(a: &AnalysisJson) -> String {
             i.permanent_deformation_m,
         ) {
             s.push_str(&format!(
-                "    v0 {v0:.4} m/s, crush time {tm:.4e} s, x_m {xm:.4e} m, rebound {v1:.4} m/s, COR {cor:.4}, x_p {xp:.4e} m{}\n",
-                i.absorbed_energy_j.map_or(String::new(), |e| format!(", absorbed {e:.4e} J"))
+                "    v0 {}, crush time {}, x_m {}, rebound {}, COR {cor:.4}, x_p {}{}\n",
+                human(v0, "m/s"),
+                human(tm, "s"),
+                human(xm, "m"),
+                human(v1, "m/s"),
+                human(xp, "m"),
+                i.absorbed_energy_j
+                    .map_or(String::new(), |e| format!(", absorbed {}", human(e, "J")))
             ));
         }
         if let Some(t) = &i.fits.two_phase {
             s.push_str(&format!(
-                "    two-phase: kc {:.4e} N/m, kr {:.4e} N/m, c {:.4e} N s/m, x_p {:.4e} m (residual {:.2} %)\n",
-                t.kc_n_m,
-                t.kr_n_m,
-                t.c_n_s_m,
-                t.permanent_deformation_m,
+                "    two-phase: kc {}, kr {}, c {}, x_p {} (residual {:.2} %)\n",
+                human(t.kc_n_m, "N/m"),
+                human(t.kr_n_m, "N/m"),
+                human(t.c_n_s_m, "N s/m"),
+                human(t.permanent_deformation_m, "m"),
                 100.0 * t.residual
             ));
         }
         if let Some(t) = &i.fits.nonlinear {
             s.push_str(&format!(
-                "    nonlinear: k {:.4e} N/m^{:.3}, c {:.4e} s/m (residual {:.2} %)\n",
-                t.k,
+                "    nonlinear: k {} N/m^{:.3}, c {} (residual {:.2} %)\n",
+                human(t.k, "").trim_end(),
                 t.exponent,
-                t.c_s_m,
+                human(t.c_s_m, "s/m"),
                 100.0 * t.residual
             ));
         }
         if let Some(t) = &i.fits.hertz {
             s.push_str(&format!(
-                "    hertz: K {:.4e} N/m^1.5 (residual {:.2} %)\n",
-                t.k,
+                "    hertz: K {} N/m^1.5 (residual {:.2} %)\n",
+                human(t.k, "").trim_end(),
                 100.0 * t.residual
             ));
         }
     }
     s
+}
+
+#[cfg(test)]
+mod tests {
+    use super::human;
+
+    #[test]
+    fn quantities_read_as_a_person_reads_them() {
+        assert_eq!(human(96.873, "m/s²"), "96.87 m/s²");
+        assert_eq!(human(9.878, "g"), "9.878 g");
+        assert_eq!(human(0.0055215, "s"), "5.522 ms");
+        assert_eq!(human(3.2748e-3, "m"), "3.275 mm");
+        assert_eq!(human(2.5e-7, "s"), "250.0 ns");
+        assert_eq!(human(1.0714e5, "m/s²"), "1.071e5 m/s²");
+        assert_eq!(human(-1.5, "m/s"), "-1.500 m/s");
+        assert_eq!(human(0.0, "J"), "0 J");
+    }
 }

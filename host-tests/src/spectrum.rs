@@ -7,7 +7,7 @@ use impact_core::signal::srs::{self, Oscillator, Response};
 use impact_core::ImpactReport;
 use serde::Serialize;
 
-use crate::analyze::Setup;
+use crate::analyze::{human, Setup};
 
 /// Shock-spectrum options.
 #[derive(Args, Clone, Debug, Default)]
@@ -139,14 +139,22 @@ pub fn csv_cells(s: Option<&ShockSpectrumJson>) -> String {
 
 /// The table's line for an impact's spectra.
 pub fn table_line(s: &ShockSpectrumJson) -> String {
+    let g = impact_core::solve::bounce::STANDARD_GRAVITY;
     let peak = srs_peak(s).map_or("none".to_string(), |(a, f)| {
         format!(
-            "{a:.4e} m/s² ({:.2} g) at {f:.0} Hz",
-            a / impact_core::solve::bounce::STANDARD_GRAVITY
+            "{} ({}) at {}",
+            human(a, "m/s²"),
+            human(a / g, "g"),
+            human(f, "Hz")
         )
     });
     let half = match (s.half_sine_amplitude_m_s2, s.half_sine_duration_s) {
-        (Some(a), Some(t)) => format!("{a:.4e} m/s² for {:.4} ms", t * 1e3),
+        (Some(a), Some(t)) => format!(
+            "{} ({}) for {}",
+            human(a, "m/s²"),
+            human(a / g, "g"),
+            human(t, "s")
+        ),
         _ => "none".to_string(),
     };
     format!(
