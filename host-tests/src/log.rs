@@ -88,22 +88,50 @@ pub(crate) fn get<'a>(m: &'a HashMap<String, String>, key: &str) -> Result<&'a s
         .ok_or_else(|| format!("missing field {key}"))
 }
 
-pub(crate) fn num<T: std::str::FromStr>(
-    m: &HashMap<String, String>,
-    key: &str,
-) -> Result<T, String> {
-    let v = get(m, key)?;
-    v.parse::<T>()
-        .map_err(|_| format!("{key}={v}: not a number"))
+/// A number a log line may hold: integers, and floats that must be finite (an `f32` field
+/// written beyond its range parses to infinity).
+pub(crate) trait Number: std::str::FromStr + std::fmt::Display {
+    fn is_finite(&self) -> bool {
+        true
+    }
 }
 
-fn opt<T: std::str::FromStr>(m: &HashMap<String, String>, key: &str) -> Result<Option<T>, String> {
+impl Number for u16 {}
+impl Number for u32 {}
+impl Number for u64 {}
+impl Number for f32 {
+    fn is_finite(&self) -> bool {
+        f32::is_finite(*self)
+    }
+}
+impl Number for f64 {
+    fn is_finite(&self) -> bool {
+        f64::is_finite(*self)
+    }
+}
+
+/// `key=v` as a number, finite.
+fn parse<T: Number>(key: &str, v: &str) -> Result<T, String> {
+    let x = v
+        .parse::<T>()
+        .map_err(|_| format!("{key}={v}: not a number"))?;
+    if x.is_finite() {
+        Ok(x)
+    } else {
+        Err(format!(
+            "{key}={x}: not finite (a float out of range, or NaN)"
+        ))
+    }
+}
+
+pub(crate) fn num<T: Number>(m: &HashMap<String, String>, key: &str) -> Result<T, String> {
+    parse(key, get(m, key)?)
+}
+
+fn opt<T: Number>(m: &HashMap<String, String>, key: &str) -> Result<Option<T>, String> {
     match get(m, key)? {
         "none" => Ok(None),
-        v => v
-            .parse::<T>()
-            .map(Some)
-            .map_err(|_| format!("{key}={v}: not a number")),
+        v => parse(key, v).map(Some),
     }
 }
 
@@ -227,11 +255,8 @@ impl LogReader {
             let r = parse_impact(&m).map_err(at)?;
             check_report(&r).map_err(at)?;
             let latency: Option<f32> = opt(&m, "report_latency_s").map_err(at)?;
-            if latency.is_some_and(|l| !(l.is_finite() && l >= 0.0)) {
-                return Err(at(format!(
-                    "report_latency_s={}: not a finite time >= 0",
-                    latency.unwrap_or_default()
-                )));
+            if let Some(l) = latency.filter(|&l| l < 0.0) {
+                return Err(at(format!("report_latency_s={l}: not a time >= 0")));
             }
             if let Some(k) = self.log.impacts.iter().position(|p| p.index == r.index) {
                 return Err(at(format!(
@@ -353,99 +378,24 @@ fn rate(m: &HashMap<String, String>) -> Result<f32, String> {
     }
 }
 
-/// An impact report's numbers: finite, and each within what the firmware can report.
+/// An impact report's numbers within what the firmware can report (finite already: see
+/// [`Number`]).
 fn check_report(r: &ImpactReport) -> Result<(), String> {
-    let mut values: Vec<(&str, f64)> = vec![
-        ("start_s", r.start_s),
-        ("peak_time_s", r.peak_time_s),
-        ("peak_acceleration_m_s2", r.peak_acceleration_m_s2.into()),
-        ("duration_s", r.duration_s.into()),
-        ("baseline_m_s2", r.baseline_m_s2.into()),
-    ];
-    let optional = [
-        ("peak_force_n", r.peak_force_n),
-        ("delta_v_m_s", r.delta_v_m_s),
-        ("fwhm_s", r.fwhm_s),
-        (
-            "filtered_peak_acceleration_m_s2",
-            r.filtered_peak_acceleration_m_s2,
-        ),
-    ];
-    values.extend(
-        optional
-            .iter()
-            .filter_map(|(k, v)| v.map(|v| (*k, v.into()))),
-    );
-    if let Some(k) = &r.kinematics {
-        values.extend([
-            ("impact_velocity_m_s", k.impact_velocity_m_s.into()),
-            ("crush_time_s", k.crush_time_s.into()),
-            ("max_deformation_m", k.max_deformation_m.into()),
-            ("rebound_velocity_m_s", k.rebound_velocity_m_s.into()),
-            ("cor", k.cor.into()),
-            ("permanent_deformation_m", k.permanent_deformation_m.into()),
-        ]);
-        if let Some(e) = k.absorbed_energy_j {
-            values.push(("absorbed_energy_j", e.into()));
-        }
+    fn out_of_range(field: &str, v: impl std::fmt::Display, range: &str) -> Result<(), String> {
+        Err(format!("{field}={v}: out of range (must be {range})"))
     }
-    if let Some(f) = &r.fits.two_phase {
-        values.extend([
-            ("two_phase_kc_n_m", f.kc_n_m.into()),
-            ("two_phase_kr_n_m", f.kr_n_m.into()),
-            ("two_phase_c_n_s_m", f.c_n_s_m.into()),
-            ("two_phase_permanent_deformation_m", f.permanent_m.into()),
-            ("two_phase_residual", f.residual.into()),
-        ]);
-    }
-    if let Some(f) = &r.fits.nonlinear {
-        values.extend([
-            ("nonlinear_k", f.k.into()),
-            ("nonlinear_c_s_m", f.c_s_m.into()),
-            ("nonlinear_exponent", f.n.into()),
-            ("nonlinear_residual", f.residual.into()),
-        ]);
-    }
-    if let Some(f) = &r.fits.hertz {
-        values.extend([
-            ("hertz_k", f.k.into()),
-            ("hertz_residual", f.residual.into()),
-        ]);
-    }
-    // As the log wrote it: an f32 field by its shortest decimal.
-    let show = |v: f64| {
-        if f64::from(v as f32) == v {
-            (v as f32).to_string()
+    let non_negative = |field: &str, v: f64, shown: &dyn std::fmt::Display| {
+        if v < 0.0 {
+            out_of_range(field, shown, ">= 0")
         } else {
-            v.to_string()
+            Ok(())
         }
     };
-    if let Some((k, v)) = values.iter().find(|(_, v)| !v.is_finite()) {
-        return Err(format!(
-            "{k}={}: not finite (a float out of range, or NaN)",
-            show(*v)
-        ));
-    }
-    let out_of_range = |field: &str, v: f64, range: &str| {
-        Err(format!(
-            "{field}={}: out of range (must be {range})",
-            show(v)
-        ))
-    };
-    for (k, v) in &values {
-        let non_negative = k.ends_with("_residual")
-            || matches!(
-                *k,
-                "start_s"
-                    | "peak_time_s"
-                    | "duration_s"
-                    | "fwhm_s"
-                    | "crush_time_s"
-                    | "max_deformation_m"
-            );
-        if non_negative && *v < 0.0 {
-            return out_of_range(k, *v, ">= 0");
-        }
+    non_negative("start_s", r.start_s, &r.start_s)?;
+    non_negative("peak_time_s", r.peak_time_s, &r.peak_time_s)?;
+    non_negative("duration_s", r.duration_s.into(), &r.duration_s)?;
+    if let Some(w) = r.fwhm_s {
+        non_negative("fwhm_s", w.into(), &w)?;
     }
     if r.end_sample < r.start_sample {
         return Err(format!(
@@ -454,14 +404,20 @@ fn check_report(r: &ImpactReport) -> Result<(), String> {
         ));
     }
     if let Some(k) = &r.kinematics {
+        non_negative("crush_time_s", k.crush_time_s.into(), &k.crush_time_s)?;
+        non_negative(
+            "max_deformation_m",
+            k.max_deformation_m.into(),
+            &k.max_deformation_m,
+        )?;
         if k.impact_velocity_m_s <= 0.0 {
-            return out_of_range("impact_velocity_m_s", k.impact_velocity_m_s.into(), "> 0");
+            return out_of_range("impact_velocity_m_s", k.impact_velocity_m_s, "> 0");
         }
         // The core flags a COR further outside [0, 1] `cor-out-of-range` and leaves it out.
         if !(-COR_TOLERANCE..=1.0 + COR_TOLERANCE).contains(&k.cor) {
             return out_of_range(
                 "cor",
-                k.cor.into(),
+                k.cor,
                 &format!("within [-{COR_TOLERANCE}, {}]", 1.0 + COR_TOLERANCE),
             );
         }
@@ -469,9 +425,19 @@ fn check_report(r: &ImpactReport) -> Result<(), String> {
         if !(-x..=x).contains(&k.permanent_deformation_m) {
             return out_of_range(
                 "permanent_deformation_m",
-                k.permanent_deformation_m.into(),
+                k.permanent_deformation_m,
                 "within ± max_deformation_m",
             );
+        }
+    }
+    let residuals = [
+        ("two_phase_residual", r.fits.two_phase.map(|f| f.residual)),
+        ("nonlinear_residual", r.fits.nonlinear.map(|f| f.residual)),
+        ("hertz_residual", r.fits.hertz.map(|f| f.residual)),
+    ];
+    for (field, v) in residuals {
+        if let Some(v) = v {
+            non_negative(field, v.into(), &v)?;
         }
     }
     Ok(())
