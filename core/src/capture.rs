@@ -8,6 +8,7 @@
 
 use crate::report::{ImpactReport, Status};
 use crate::scene::Scene;
+use crate::train::Bounce;
 
 /// What the streaming stage knows of one impact when it ends: positions, and exact integer
 /// sums of the baseline-removed raw counts `d = W x - S` (`S / W` is the frozen baseline).
@@ -43,8 +44,11 @@ pub struct Summary {
     /// `Σ d` over the contact, from the onset to the separation (exclusive), if the signal
     /// came back.
     pub contact_c: Option<i64>,
-    /// The approach speed in force when the impact ended, m/s.
+    /// The approach speed of this impact, m/s: the scene's (or a light gate's), or, in a
+    /// bounce train, the bounce's ([`crate::train`]).
     pub v0_m_s: Option<f32>,
+    /// The impact continues a bounce train: both measures of its approach speed.
+    pub bounce: Option<Bounce>,
 }
 
 impl Summary {
@@ -66,6 +70,7 @@ impl Summary {
         total_c: 0,
         contact_c: None,
         v0_m_s: None,
+        bounce: None,
     };
 }
 

@@ -33,6 +33,7 @@ pub mod signal;
 pub mod solve;
 pub mod stream;
 pub mod target;
+pub mod train;
 
 pub use analysis::{analyse, Workspace};
 pub use capture::{Capture, Sink, Summary};
@@ -44,3 +45,4 @@ pub use scene::{Approach, FitSet, Scene};
 pub use signal::Calibration;
 pub use solve::{solve, Error, Impact, ImpactOutcome, Method, Settings};
 pub use stream::{Counters, Stream};
+pub use train::{Bounce, Train, TrainSpeed};

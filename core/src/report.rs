@@ -4,6 +4,7 @@
 use crate::capture::Summary;
 pub use crate::fit::{Fits, HertzFit, NonlinearFit, TwoPhaseFit};
 use crate::scene::Scene;
+pub use crate::train::Bounce;
 
 /// How an impact's capture ended.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -196,6 +197,9 @@ pub struct ImpactReport {
     pub filtered_peak_acceleration_m_s2: Option<f32>,
     pub kinematics: Option<Kinematics>,
     pub fits: Fits,
+    /// The impact continues a bounce train (a streaming field): its flight and both measures
+    /// of its approach speed.
+    pub bounce: Option<Bounce>,
 }
 
 /// A window whose Δv is less than this share of its contact's (the rest undone after
@@ -255,5 +259,6 @@ pub fn streaming(s: &Summary, scene: &Scene) -> ImpactReport {
         filtered_peak_acceleration_m_s2: None,
         kinematics: None,
         fits: Fits::default(),
+        bounce: s.bounce,
     }
 }

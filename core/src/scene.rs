@@ -5,6 +5,7 @@ use crate::signal::cfc::Cfc;
 use crate::signal::Calibration;
 use crate::solve::bounce::STANDARD_GRAVITY;
 use crate::solve::Error;
+use crate::train::Train;
 
 /// Heaviest impactor, kg: above any drop weight, and forces and energies stay finite f32.
 pub const MAX_MASS_KG: f32 = 1e6;
@@ -104,6 +105,9 @@ pub struct Scene {
     /// class; costs an f64 biquad per idle sample, so it is off unless asked for).
     pub trigger_cfc: Option<Cfc>,
     pub fits: FitSet,
+    /// Bounce trains: each impact after the first takes its approach speed from the flight
+    /// since the previous separation or from the previous rebound ([`crate::train`]).
+    pub train: Option<Train>,
 }
 
 impl Scene {
@@ -124,6 +128,7 @@ impl Scene {
             cfc: None,
             trigger_cfc: None,
             fits: FitSet::none(),
+            train: None,
         }
     }
 
@@ -160,6 +165,10 @@ impl Scene {
             Approach::Unknown => {}
             Approach::Speed { v0_m_s } => positive(v0_m_s, "v0")?,
             Approach::DropHeight { height_m } => positive(height_m, "drop-height")?,
+        }
+        if let Some(t) = self.train {
+            positive(t.gravity_m_s2, "gravity")?;
+            positive(t.max_flight_s, "max-flight")?;
         }
         positive(self.trigger_m_s2, "trigger")?;
         positive(self.edge_m_s2, "edge")?;

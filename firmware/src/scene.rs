@@ -3,7 +3,7 @@
 //! `impact analyze` builds).
 
 use defmt::{info, Format, Formatter};
-use impact_core::{Approach, Calibration, FitSet, Scene};
+use impact_core::{Approach, Calibration, FitSet, Scene, Train, TrainSpeed};
 
 /// The seed bench's approach speed, m/s (a light gate may override it per impact through
 /// [`crate::tasks::monitor::APPROACH_SPEED`]).
@@ -25,12 +25,17 @@ const CALIBRATION: Calibration = Calibration {
     gain_m_s2_per_count: crate::source::adxl375::G_PER_LSB * 9.806_65,
     sample_rate_hz: crate::source::SAMPLE_RATE_HZ as f32,
 };
-/// ADXL375: 13-bit two's-complement output (±200 g is about ±4082 counts).
+/// ADXL375: 13-bit two's-complement output per axis (±200 g is about ±4082 counts); the
+/// stream is the resultant (never negative), which reaches 4095 whenever an axis is at its
+/// rail: `clipped` then means an axis may have clipped (conservative: a large hit spread over
+/// axes is marked too, none at a rail is missed).
 #[cfg(feature = "adxl375")]
-const CLIP_COUNTS: (i16, i16) = (-4096, 4095);
+const CLIP_COUNTS: (i16, i16) = (i16::MIN, 4095);
 
 /// The seed bench (60 g body at 1.3357 m/s): trigger at 10 m/s², edges at 2 m/s², 2 ms hold,
-/// 1 s longest impact, no CFC filter; two-phase, nonlinear (exponent fitted) and Hertz fits.
+/// 1 s longest impact, no CFC filter; two-phase, nonlinear (exponent fitted) and Hertz fits;
+/// no bounce trains (a vertical drop that bounces sets `train: Some(Train::new())`: each
+/// bounce then takes its approach speed from its flight; a horizontal bench must not).
 pub const BENCH: Scene = Scene {
     calibration: CALIBRATION,
     mass_kg: Some(0.06),
@@ -54,6 +59,7 @@ pub const BENCH: Scene = Scene {
         nonlinear_exponent: 1.0,
         hertz: true,
     },
+    train: None,
 };
 
 /// Why a `key=value` scene argument was refused.
@@ -91,6 +97,8 @@ impl Format for SceneError {
 /// | `cfc`, `trigger_cfc` | 60, 180, 600, 1000 or `none` |
 /// | `two_phase`, `nonlinear`, `fit_exponent`, `hertz` | `0` or `1` |
 /// | `exponent` | nonlinear exponent when not fitted (f32) |
+/// | `train` | bounce trains: `flight`, `rebound` (which speed the kinematics use) or `none` |
+/// | `gravity`, `max_flight` | the train's gravity, m/s², and longest flight, s |
 ///
 /// Floats are parsed by `core`'s correctly rounded parser, so the shortest round-trip decimal
 /// of an `f32` (Rust's `{}` or `{:e}`) gives back exactly that `f32`.
@@ -155,6 +163,29 @@ pub fn apply(scene: &mut Scene, key: &str, value: &str) -> Result<(), SceneError
         "fit_exponent" => scene.fits.fit_exponent = flag(value)?,
         "hertz" => scene.fits.hertz = flag(value)?,
         "exponent" => scene.fits.nonlinear_exponent = float(value)?,
+        "train" => {
+            let speed = match value {
+                "none" => {
+                    scene.train = None;
+                    return Ok(());
+                }
+                "flight" => TrainSpeed::Flight,
+                "rebound" => TrainSpeed::Rebound,
+                _ => return Err(SceneError::BadValue),
+            };
+            scene.train = Some(Train {
+                speed,
+                ..scene.train.unwrap_or_default()
+            });
+        }
+        "gravity" | "max_flight" => {
+            let mut t = scene.train.ok_or(SceneError::BadValue)?;
+            match key {
+                "gravity" => t.gravity_m_s2 = float(value)?,
+                _ => t.max_flight_s = float(value)?,
+            }
+            scene.train = Some(t);
+        }
         _ => return Err(SceneError::UnknownKey),
     }
     Ok(())
@@ -190,7 +221,7 @@ pub fn log(scene: &Scene) {
     };
     let fits = &scene.fits;
     info!(
-        "scene rate_hz={=f32} gain_m_s2_per_count={=f32} mass_kg={} v0_m_s={} drop_height_m={} trigger_m_s2={=f32} edge_m_s2={=f32} hold_s={=f32} max_impact_s={=f32} settle_s={=f32} clip_low={=i16} clip_high={=i16} cfc={} trigger_cfc={} two_phase={=bool} nonlinear={=bool} fit_exponent={=bool} exponent={=f32} hertz={=bool}",
+        "scene rate_hz={=f32} gain_m_s2_per_count={=f32} mass_kg={} v0_m_s={} drop_height_m={} trigger_m_s2={=f32} edge_m_s2={=f32} hold_s={=f32} max_impact_s={=f32} settle_s={=f32} clip_low={=i16} clip_high={=i16} cfc={} trigger_cfc={} two_phase={=bool} nonlinear={=bool} fit_exponent={=bool} exponent={=f32} hertz={=bool} train={=str} gravity_m_s2={} max_flight_s={}",
         scene.calibration.sample_rate_hz,
         scene.calibration.gain_m_s2_per_count,
         Opt(scene.mass_kg),
@@ -210,6 +241,9 @@ pub fn log(scene: &Scene) {
         fits.fit_exponent,
         fits.nonlinear_exponent,
         fits.hertz,
+        scene.train.map_or("none", |t| t.speed.name()),
+        Opt(scene.train.map(|t| t.gravity_m_s2)),
+        Opt(scene.train.map(|t| t.max_flight_s)),
     );
 }
 

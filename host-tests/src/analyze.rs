@@ -101,6 +101,12 @@ pub struct AnalyzeArgs {
     /// The channel: header name or 0-based index [default: first non-time column].
     #[arg(long)]
     pub column: Option<ColumnRef>,
+    /// Two or three axes (header names or indices, `x_g,y_g,z_g`): the pipeline runs on their
+    /// resultant (the trigger on |a|) and each impact reports every axis's peak and Δv.
+    /// The resultant's integral is not a velocity change, so Δv is per axis (and their
+    /// magnitude) and no approach speed applies.
+    #[arg(long, value_delimiter = ',', conflicts_with_all = ["column", "invert", "v0", "drop_height", "free_fall", "train"])]
+    pub axes: Vec<ColumnRef>,
     /// The time column [default: the column whose header starts with "time"].
     #[arg(long)]
     pub time_column: Option<ColumnRef>,
@@ -157,6 +163,8 @@ pub struct AnalyzeArgs {
     /// or rest), not an impact, s [default: 50 ms, at least the hold].
     #[arg(long, value_parser = positive_f64)]
     pub settle: Option<f64>,
+    #[command(flatten)]
+    pub train: crate::train::TrainArgs,
     #[command(flatten)]
     pub spectrum: crate::spectrum::SpectrumArgs,
     /// Scene file (JSON); options given here override it.
@@ -239,6 +247,12 @@ pub struct ImpactJson {
     /// With `--srs`: the impact's shock spectra.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub shock_spectrum: Option<crate::spectrum::ShockSpectrumJson>,
+    /// With `--axes`: the resultant's peak and each axis's peak and Δv.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub axes: Option<crate::axes::AxesJson>,
+    /// A bounce of a train (`--train`): its flight, both approach speeds and their CORs;
+    /// null for a train's first impact and without `--train`.
+    pub bounce: Option<crate::train::BounceJson>,
 }
 
 /// The whole analysis as JSON.
@@ -262,7 +276,11 @@ pub struct AnalysisJson {
     /// The channel's rails: from `--range`, or flat tops found in the recording; null when
     /// neither is known (then `clipped` means a reading at the i16 rail).
     pub clipping: Option<Clipping>,
+    /// With `--train`: which speed the bounces' kinematics use ("flight" or "rebound").
+    pub train_speed: Option<String>,
     pub impacts: Vec<ImpactJson>,
+    /// With `--train`: each train of bounces and its COR against impact speed.
+    pub trains: Vec<crate::train::TrainJson>,
 }
 
 fn fits_json(f: &Fits) -> FitsJson {
@@ -400,6 +418,8 @@ pub fn impact_json(r: &ImpactReport, t0: f64, fits: &FitSet) -> ImpactJson {
         null_reasons: null_reasons(r, fits),
         report_latency_s: None,
         shock_spectrum: None,
+        bounce: crate::train::bounce_json(r),
+        axes: None,
     }
 }
 
@@ -474,6 +494,8 @@ pub struct Setup {
     pub clipping: Option<Clipping>,
     /// Whether the time axis was interpolated onto an even grid.
     pub resampled: bool,
+    /// With `--axes`: each axis in m/s² and its rails.
+    pub axes: Vec<crate::axes::Axis>,
 }
 
 /// Reads the file and builds the scene (v0 from a free fall needs a first pass).
@@ -486,6 +508,7 @@ pub fn setup(args: &AnalyzeArgs, progress: Option<fn(f64)>) -> Result<Setup, Str
         &args.file,
         &ReadOptions {
             column: args.column.clone(),
+            axes: args.axes.clone(),
             time_column: args.time_column.clone(),
             rate_hz: args.rate,
             resample: args.resample,
@@ -522,9 +545,24 @@ pub fn setup(args: &AnalyzeArgs, progress: Option<fn(f64)>) -> Result<Setup, Str
         Some(r) => return Err(format!("--range: {r} must be finite and > 0")),
         None => None,
     };
-    let clipping = match full_scale {
-        Some(fs) => Some(screen::from_range(fs)),
-        None => screen::flat_tops(&accel),
+    // With --axes the range is each axis's (the resultant reaches sqrt(n) times it), and
+    // clipping is found per axis.
+    let axes: Vec<crate::axes::Axis> = ch
+        .axes
+        .iter()
+        .map(|(name, v)| {
+            let a = v.iter().map(|x| x * scale).collect();
+            crate::axes::Axis::new(name.clone(), a, full_scale)
+        })
+        .collect();
+    let (clipping, full_scale) = if axes.is_empty() {
+        let clipping = match full_scale {
+            Some(fs) => Some(screen::from_range(fs)),
+            None => screen::flat_tops(&accel),
+        };
+        (clipping, full_scale)
+    } else {
+        (None, full_scale.map(|fs| fs * (axes.len() as f64).sqrt()))
     };
     let (counts, calibration) = quantise(&accel, ch.rate_hz, full_scale);
     let t0 = ch.time_s.first().copied().unwrap_or(0.0);
@@ -602,6 +640,7 @@ pub fn setup(args: &AnalyzeArgs, progress: Option<fn(f64)>) -> Result<Setup, Str
         _ => (Approach::Unknown, None),
     };
     scene.approach = approach;
+    scene.train = args.train.train();
     scene.validate().map_err(|e| e.to_string())?;
     let mut setup = Setup {
         prepared: Prepared {
@@ -618,6 +657,7 @@ pub fn setup(args: &AnalyzeArgs, progress: Option<fn(f64)>) -> Result<Setup, Str
         spikes,
         clipping,
         resampled: ch.resampled,
+        axes,
     };
     if let Some(spec) = &args.free_fall {
         // First pass without v0 to find the first impact, then the free fall before it.
@@ -729,7 +769,7 @@ const FREE_FALL_G: f64 = 0.5;
 
 /// The report JSON.
 pub fn to_json(setup: &Setup, reports: &[ImpactReport]) -> AnalysisJson {
-    AnalysisJson {
+    let mut a = AnalysisJson {
         samples: setup.samples,
         sample_rate_hz: setup.rate_hz,
         v0_source: setup.v0_source.clone(),
@@ -742,10 +782,33 @@ pub fn to_json(setup: &Setup, reports: &[ImpactReport]) -> AnalysisJson {
         resampled: setup.resampled,
         spikes_removed: setup.spikes.clone(),
         clipping: setup.clipping.clone(),
+        train_speed: setup.scene.train.map(|t| t.speed.name().to_string()),
+        trains: Vec::new(),
         impacts: reports
             .iter()
-            .map(|r| {
+            .enumerate()
+            .map(|(k, r)| {
                 let mut j = impact_json(r, setup.prepared.t0, &setup.scene.fits);
+                if !setup.axes.is_empty() {
+                    let previous_end = k
+                        .checked_sub(1)
+                        .and_then(|p| reports.get(p))
+                        .map_or(0, |p| p.end_sample);
+                    let x = crate::axes::impact_axes(
+                        r,
+                        previous_end,
+                        &setup.axes,
+                        &setup.prepared.accel_m_s2,
+                        setup.rate_hz,
+                        setup.prepared.t0,
+                    );
+                    j.clipped |= x.axes.iter().any(|a| a.clipped);
+                    // ∫|a| dt is no velocity change: the axes give it.
+                    j.delta_v_m_s = None;
+                    j.null_reasons
+                        .insert("delta_v_m_s".into(), "resultant".into());
+                    j.axes = Some(x);
+                }
                 if setup
                     .spikes
                     .iter()
@@ -756,7 +819,9 @@ pub fn to_json(setup: &Setup, reports: &[ImpactReport]) -> AnalysisJson {
                 j
             })
             .collect(),
-    }
+    };
+    a.trains = crate::train::trains(&a.impacts);
+    a
 }
 
 /// The host's flag on an impact that contained a removed spike.
@@ -770,8 +835,26 @@ impact_velocity_m_s,crush_time_s,max_deformation_m,rebound_velocity_m_s,cor,perm
 two_phase_kc_n_m,two_phase_kr_n_m,two_phase_c_n_s_m,two_phase_permanent_deformation_m,two_phase_residual,\
 nonlinear_k,nonlinear_c_s_m,nonlinear_exponent,nonlinear_residual,hertz_k,hertz_residual",
     );
-    // With --srs, the spectra's summary columns.
+    // With --train, the bounce columns; with --srs, the spectra's summary columns.
+    let with_train = a.train_speed.is_some();
+    if with_train {
+        s.push_str(",bounce_number,flight_s,v0_flight_m_s,v0_rebound_m_s,cor_flight,cor_rebound");
+    }
     let with_spectrum = a.impacts.iter().any(|i| i.shock_spectrum.is_some());
+    // With --axes, the resultant's peak and each axis's peak and Δv (named by its column).
+    let axis_names: Vec<String> = a
+        .impacts
+        .iter()
+        .find_map(|i| i.axes.as_ref())
+        .map(|x| x.axes.iter().map(|a| a.column.clone()).collect())
+        .unwrap_or_default();
+    let with_axes = a.impacts.iter().any(|i| i.axes.is_some());
+    if with_axes {
+        s.push_str(",resultant_peak_m_s2");
+        for n in &axis_names {
+            s.push_str(&format!(",{n}_peak_acceleration_m_s2,{n}_delta_v_m_s"));
+        }
+    }
     if with_spectrum {
         s.push(',');
         s.push_str(crate::spectrum::CSV_HEADER);
@@ -819,6 +902,32 @@ nonlinear_k,nonlinear_c_s_m,nonlinear_exponent,nonlinear_residual,hertz_k,hertz_
             o(hz.map(|t| t.residual)),
         ];
         s.push_str(&cells.join(","));
+        if with_train {
+            let b = i.bounce.as_ref();
+            for cell in [
+                b.map_or(String::new(), |b| b.number.to_string()),
+                o(b.map(|b| b.flight_s)),
+                o(b.map(|b| b.v0_flight_m_s)),
+                o(b.and_then(|b| b.v0_rebound_m_s)),
+                o(b.and_then(|b| b.cor_flight)),
+                o(b.and_then(|b| b.cor_rebound)),
+            ] {
+                s.push(',');
+                s.push_str(&cell);
+            }
+        }
+        if with_axes {
+            let x = i.axes.as_ref();
+            s.push(',');
+            s.push_str(&o(x.map(|x| x.resultant_peak_m_s2)));
+            for k in 0..axis_names.len() {
+                let axis = x.and_then(|x| x.axes.get(k));
+                s.push(',');
+                s.push_str(&o(axis.map(|a| a.peak_acceleration_m_s2)));
+                s.push(',');
+                s.push_str(&o(axis.map(|a| a.delta_v_m_s)));
+            }
+        }
         if with_spectrum {
             s.push(',');
             s.push_str(&crate::spectrum::csv_cells(i.shock_spectrum.as_ref()));
@@ -940,6 +1049,12 @@ pub fn to_table(a: &AnalysisJson) -> String {
                 latency * 1e3
             ));
         }
+        if let Some(x) = &i.axes {
+            s.push_str(&crate::axes::table_line(x));
+        }
+        if let Some(b) = &i.bounce {
+            s.push_str(&crate::train::table_line(b));
+        }
         if let Some(sp) = &i.shock_spectrum {
             s.push_str(&crate::spectrum::table_line(sp));
         }
@@ -989,6 +1104,7 @@ pub fn to_table(a: &AnalysisJson) -> String {
             ));
         }
     }
+    s.push_str(&crate::train::table_lines(&a.trains));
     s
 }
 

@@ -98,6 +98,14 @@ pub fn scene_args(scene: &Scene) -> Vec<String> {
         format!("exponent={}", f(scene.fits.nonlinear_exponent)),
         format!("hertz={}", b(scene.fits.hertz)),
     ]);
+    match scene.train {
+        None => args.push("train=none".into()),
+        Some(t) => args.extend([
+            format!("train={}", t.speed.name()),
+            format!("gravity={}", f(t.gravity_m_s2)),
+            format!("max_flight={}", f(t.max_flight_s)),
+        ]),
+    }
     args
 }
 

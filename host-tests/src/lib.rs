@@ -2,6 +2,7 @@
 //! integration tests and the benchmarks.
 
 pub mod analyze;
+pub mod axes;
 pub mod cases;
 pub mod compare;
 pub mod emulate;
@@ -21,6 +22,7 @@ pub mod table;
 pub mod target;
 pub mod target_bench;
 pub mod throughput;
+pub mod train;
 
 /// Runs `f` on a thread with a 64 MiB stack: the core's monitors hold their capture buffers
 /// inline (no allocation in `core`), which is more than a default thread's stack.

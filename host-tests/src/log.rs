@@ -8,7 +8,7 @@ use std::path::PathBuf;
 
 use clap::Args;
 use impact_core::analysis::COR_TOLERANCE;
-use impact_core::report::{Fits, Flags, HertzFit, NonlinearFit, TwoPhaseFit};
+use impact_core::report::{Bounce, Fits, Flags, HertzFit, NonlinearFit, TwoPhaseFit};
 use impact_core::{Analysis, ImpactReport, Kinematics, Status};
 
 use crate::analyze::{self, AnalysisJson};
@@ -194,6 +194,21 @@ pub fn parse_impact(m: &HashMap<String, String>) -> Result<ImpactReport, String>
             residual: num(m, "hertz_residual")?,
         }),
     };
+    // Firmware before bounce trains wrote no bounce fields: absent means none.
+    let bounce = match m
+        .contains_key("bounce_number")
+        .then(|| opt::<u32>(m, "bounce_number"))
+        .transpose()?
+        .flatten()
+    {
+        None => None,
+        Some(number) => Some(Bounce {
+            number,
+            flight_s: num(m, "flight_s")?,
+            v0_flight_m_s: num(m, "v0_flight_m_s")?,
+            v0_rebound_m_s: opt(m, "v0_rebound_m_s")?,
+        }),
+    };
     Ok(ImpactReport {
         index: num(m, "index")?,
         status,
@@ -217,6 +232,7 @@ pub fn parse_impact(m: &HashMap<String, String>) -> Result<ImpactReport, String>
             nonlinear,
             hertz,
         },
+        bounce,
     })
 }
 
@@ -486,8 +502,16 @@ pub fn log_json(log: &Log, t0: f64) -> Result<AnalysisJson, String> {
             _ => Ok(0),
         }
     };
-    Ok(AnalysisJson {
+    let train_speed = log
+        .scene
+        .as_ref()
+        .and_then(|m| m.get("train"))
+        .filter(|t| *t != "none")
+        .cloned();
+    let mut a = AnalysisJson {
         samples,
+        train_speed,
+        trains: Vec::new(),
         sample_rate_hz: rate as f64,
         v0_source,
         free_fall_s: None,
@@ -506,7 +530,9 @@ pub fn log_json(log: &Log, t0: f64) -> Result<AnalysisJson, String> {
                 j
             })
             .collect(),
-    })
+    };
+    a.trains = crate::train::trains(&a.impacts);
+    Ok(a)
 }
 
 /// `impact log`: a decoded firmware log as JSON (default) or CSV. The file (or stdin, `-`)

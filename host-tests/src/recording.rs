@@ -20,6 +20,9 @@ pub struct Channel {
     pub jitter: f64,
     /// Whether the samples were interpolated onto an even grid (`resample`).
     pub resampled: bool,
+    /// With [`ReadOptions::axes`]: each axis (header name, values on the same time base);
+    /// `values` is then their resultant `sqrt(x² + y² + z²)`.
+    pub axes: Vec<(String, Vec<f64>)>,
 }
 
 /// How to read the file.
@@ -27,6 +30,8 @@ pub struct Channel {
 pub struct ReadOptions {
     /// The channel [default: the first column that is not the time column].
     pub column: Option<ColumnRef>,
+    /// Two or three axes read together instead of `column`: the channel is their resultant.
+    pub axes: Vec<ColumnRef>,
     /// The time column [default: the one column whose header looks like a time, if any].
     pub time_column: Option<ColumnRef>,
     /// Sample rate, Hz, when there is no time column (overrides it if both are given).
@@ -172,42 +177,68 @@ pub fn read_csv(path: &Path, opts: &ReadOptions) -> Result<Channel, RecordingErr
     } else {
         table.time_column(opts.time_column.as_ref()).map_err(err)?
     };
-    let col = match &opts.column {
-        Some(c) => table.find(c, "column").map_err(err)?,
-        None => (0..table.columns.len())
-            .find(|&c| Some(c) != tcol)
-            .ok_or_else(|| err("no data column besides the time column".into()))?,
+    let name_of = |c: usize| {
+        table
+            .headers
+            .get(c)
+            .cloned()
+            .unwrap_or_else(|| format!("column {c}"))
     };
-    if Some(col) == tcol {
-        return Err(err(format!(
-            "column {col} is the time column: choose another with --column"
-        )));
+    let cols: Vec<usize> = if opts.axes.is_empty() {
+        vec![match &opts.column {
+            Some(c) => table.find(c, "column").map_err(err)?,
+            None => (0..table.columns.len())
+                .find(|&c| Some(c) != tcol)
+                .ok_or_else(|| err("no data column besides the time column".into()))?,
+        }]
+    } else {
+        if !(2..=3).contains(&opts.axes.len()) {
+            return Err(err(format!(
+                "--axes: {} columns given; two or three (x,y or x,y,z)",
+                opts.axes.len()
+            )));
+        }
+        opts.axes
+            .iter()
+            .map(|c| table.find(c, "axis").map_err(err))
+            .collect::<Result<_, _>>()?
+    };
+    for (i, &col) in cols.iter().enumerate() {
+        if Some(col) == tcol {
+            return Err(err(format!(
+                "column {col} is the time column: choose another with --column or --axes"
+            )));
+        }
+        if cols[..i].contains(&col) {
+            return Err(err(format!("--axes: column {} given twice", name_of(col))));
+        }
     }
-    let values = table.columns[col].clone();
-    let name = table
-        .headers
-        .get(col)
-        .cloned()
-        .unwrap_or_else(|| format!("column {col}"));
+    let mut channels: Vec<Vec<f64>> = cols.iter().map(|&c| table.columns[c].clone()).collect();
+    let len = channels[0].len();
     let unit = |t: usize| table.headers.get(t).map_or(1.0, |h| time_unit_s(h));
-    let (rate_hz, time_s, values, jitter, resampled) = match (opts.rate_hz, tcol) {
+    let (rate_hz, time_s, jitter, resampled) = match (opts.rate_hz, tcol) {
         (Some(r), _) => {
             if !(r.is_finite() && r > 0.0 && r <= 1e9) {
                 return Err(err(format!("rate {r} Hz is not in (0, 1e9]")));
             }
             let t0 = tcol.map_or(0.0, |t| table.columns[t][0] * unit(t));
-            let times = (0..values.len()).map(|i| t0 + i as f64 / r).collect();
-            (r, times, values, 0.0, false)
+            let times = (0..len).map(|i| t0 + i as f64 / r).collect();
+            (r, times, 0.0, false)
         }
         (None, Some(t)) => {
             let scale = unit(t);
             let times: Vec<f64> = table.columns[t].iter().map(|v| v * scale).collect();
             let (rate, jitter) = check_time(path, &times, &table, opts.resample)?;
             if opts.resample {
-                let (times, values) = resample(path, &times, &values, rate)?;
-                (rate, times, values, 0.0, true)
+                let mut grid = Vec::new();
+                for values in &mut channels {
+                    let (t, v) = resample(path, &times, values, rate)?;
+                    *values = v;
+                    grid = t;
+                }
+                (rate, grid, 0.0, true)
             } else {
-                (rate, times, values, jitter, false)
+                (rate, times, jitter, false)
             }
         }
         (None, None) => {
@@ -216,6 +247,25 @@ pub fn read_csv(path: &Path, opts: &ReadOptions) -> Result<Channel, RecordingErr
             ))
         }
     };
+    let (name, values, axes) = if opts.axes.is_empty() {
+        (name_of(cols[0]), channels.remove(0), Vec::new())
+    } else {
+        let resultant = (0..time_s.len())
+            .map(|k| {
+                channels
+                    .iter()
+                    .map(|c| c.get(k).map_or(0.0, |v| v * v))
+                    .sum::<f64>()
+                    .sqrt()
+            })
+            .collect();
+        let names: Vec<String> = cols.iter().map(|&c| name_of(c)).collect();
+        (
+            format!("|{}|", names.join(",")),
+            resultant,
+            names.into_iter().zip(channels).collect(),
+        )
+    };
     Ok(Channel {
         name,
         values,
@@ -223,5 +273,6 @@ pub fn read_csv(path: &Path, opts: &ReadOptions) -> Result<Channel, RecordingErr
         rate_hz,
         jitter,
         resampled,
+        axes,
     })
 }

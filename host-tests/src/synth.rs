@@ -226,6 +226,11 @@ pub struct SynthArgs {
     /// The same impact this many times (a train for the real-time emulation), `--every` apart.
     #[arg(long, default_value_t = 1)]
     pub repeat: usize,
+    /// A bounce train: the body touches at --v0 (dropped from v0²/2g) and bounces under
+    /// standard gravity (flights in closed form, each contact at its own speed), this many
+    /// contacts in all, fewer if a rebound falls below 1 mm/s or the recording ends.
+    #[arg(long, default_value_t = 1, conflicts_with = "repeat")]
+    pub bounces: u32,
     /// Time between the first touches of a `--repeat` train, s.
     #[arg(long, default_value_t = 0.08)]
     pub every: f64,
@@ -303,14 +308,60 @@ pub fn synth(args: &SynthArgs) -> Result<Recording, String> {
     if args.repeat > 1 && !(args.every.is_finite() && args.every > 0.0) {
         return Err("--every: must be finite and > 0".into());
     }
-    let contacts: Vec<Placed> = (0..args.repeat)
-        .map(|k| Placed {
-            touch_s: args.touch + k as f64 * args.every,
-            law: &model,
-            impact,
-        })
-        .collect();
+    if args.bounces == 0 || args.bounces > 10_000 {
+        return Err("--bounces: must lie in 1..=10000".into());
+    }
+    let contacts: Vec<Placed> = if args.bounces > 1 {
+        bounce_train(args, &model)?
+            .into_iter()
+            .take_while(|b| args.touch + b.touch_time_s < args.duration)
+            .map(|b| Placed {
+                touch_s: args.touch + b.touch_time_s,
+                law: &model,
+                impact: Impact::new(args.mass, b.impact_velocity_m_s),
+            })
+            .collect()
+    } else {
+        (0..args.repeat)
+            .map(|k| Placed {
+                touch_s: args.touch + k as f64 * args.every,
+                law: &model,
+                impact,
+            })
+            .collect()
+    };
     record(&sensor, args.duration, &contacts).map_err(|e| e.to_string())
+}
+
+/// The contacts of `--bounces`: touch times from the first touch (0), approach speeds and
+/// the exact outcomes (the oracle of the bounce-train tests).
+pub fn bounce_train(
+    args: &SynthArgs,
+    model: &impact_core::Model<f64>,
+) -> Result<Vec<impact_core::solve::bounce::Bounce<f64>>, String> {
+    use impact_core::solve::bounce::{Bounces, STANDARD_GRAVITY};
+    let g = STANDARD_GRAVITY;
+    let height = args.v0 * args.v0 / (2.0 * g);
+    let release = (2.0 * height / g).sqrt();
+    let train = Bounces::new(
+        model,
+        impact_core::Settings::exact(),
+        args.mass,
+        height,
+        g,
+        1e-3,
+        args.bounces,
+    )
+    .map_err(|e| e.to_string())?;
+    train
+        .map(|b| {
+            b.map(|mut b| {
+                b.touch_time_s -= release;
+                b
+            })
+            .map_err(|e| e.to_string())
+        })
+        .collect()
 }
 
 /// The virtual sensor `args` describe.

@@ -350,3 +350,60 @@ fn bus_errors_are_passed_up() {
         Err(Error::Spi(ErrorKind::ModeFault))
     );
 }
+
+#[test]
+fn the_resultant_of_three_axes_is_the_rounded_magnitude() {
+    let exact = |s: Sample| {
+        let (x, y, z) = (s.x as f64, s.y as f64, s.z as f64);
+        (x * x + y * y + z * z).sqrt()
+    };
+    let mut cases = vec![
+        Sample { x: 0, y: 0, z: 0 },
+        Sample { x: 3, y: 4, z: 0 },
+        Sample {
+            x: -4096,
+            y: -4096,
+            z: -4096,
+        },
+        Sample {
+            x: 4095,
+            y: -4096,
+            z: 4095,
+        },
+        Sample { x: 0, y: 0, z: -1 },
+        Sample { x: 1, y: 1, z: 0 },
+    ];
+    let mut state = 0x9e37_79b9u32;
+    for _ in 0..100_000 {
+        let mut next = || {
+            state ^= state << 13;
+            state ^= state >> 17;
+            state ^= state << 5;
+            (state % 8192) as i16 - 4096
+        };
+        cases.push(Sample {
+            x: next(),
+            y: next(),
+            z: next(),
+        });
+    }
+    for s in cases {
+        let r = s.magnitude();
+        let e = exact(s);
+        assert!((r as f64 - e).abs() <= 0.5, "{s:?}: {r} vs {e}");
+        // At a rail on any axis the resultant reaches the scene's clip level.
+        if [s.x, s.y, s.z].iter().any(|v| *v >= 4095 || *v <= -4096) {
+            assert!(r >= 4095);
+        }
+    }
+    assert_eq!(Sample { x: 3, y: 4, z: 0 }.magnitude(), 5);
+    assert_eq!(
+        Sample {
+            x: -4096,
+            y: -4096,
+            z: -4096
+        }
+        .magnitude(),
+        7094
+    );
+}

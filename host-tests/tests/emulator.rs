@@ -94,7 +94,10 @@ fn emulator_and_log_match_host(file: &str, options: &[&str], log_too: bool) {
     }
 
     // The decoded log alone gives the same JSON and CSV (both files start at t = 0).
-    let log_file = tmp("emulator.log");
+    // One file per comparison: the tests run in parallel.
+    static RUNS: std::sync::atomic::AtomicUsize = std::sync::atomic::AtomicUsize::new(0);
+    let run_id = RUNS.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+    let log_file = tmp(&format!("emulator-{run_id}.log"));
     std::fs::write(&log_file, &log).unwrap();
     let log_path = log_file.to_string_lossy().into_owned();
     let (from_log, _) = impact(&["log", &log_path]);
@@ -207,6 +210,57 @@ fn seed_001_bench_impact_with_kinematics_and_fits() {
     for fit in ["two_phase", "nonlinear", "hertz"] {
         assert!(i["fits"][fit].is_object(), "{fit} missing: {i}");
     }
+}
+
+#[test]
+fn three_axes_give_the_same_reports_on_the_board() {
+    // The board streams the resultant the host computes; the axes' part comes from the file,
+    // so `impact log` alone cannot give it.
+    emulator_and_log_match_host(
+        &shared("endaq-high-drop/High-Drop_16g-DC_full.csv"),
+        &["--axes", "x_g,y_g,z_g"],
+        false,
+    );
+}
+
+#[test]
+fn a_bounce_train_gets_the_same_speeds_on_the_board() {
+    if firmware().is_none() {
+        return;
+    }
+    let (csv, _) = impact(&[
+        "synth",
+        "--law",
+        "nonlinear",
+        "--mass",
+        "0.06",
+        "--v0",
+        "1.3357",
+        "--stiffness",
+        "1e4",
+        "--damping",
+        "0.5",
+        "--bounces",
+        "8",
+        "--duration",
+        "1.2",
+    ]);
+    let file = tmp("bounce-train.csv");
+    std::fs::write(&file, csv).unwrap();
+    let file = file.to_string_lossy().into_owned();
+    for speed in ["flight", "rebound"] {
+        emulator_matches_host(
+            &file,
+            &["--mass", "0.06", "--v0", "1.3357", "--train", speed],
+        );
+    }
+    let (host, _) = impact(&[
+        "analyze", &file, "--mass", "0.06", "--v0", "1.3357", "--train", "flight", "--json",
+    ]);
+    let v: serde_json::Value = serde_json::from_str(&host).unwrap();
+    assert_eq!(v["impacts"].as_array().unwrap().len(), 8);
+    assert!(v["impacts"][7]["bounce"]["v0_rebound_m_s"].is_number());
+    assert!(v["trains"][0]["cor_vs_speed"].is_object());
 }
 
 /// The streaming fields of a report: the same whether or not the analysis ran.

@@ -316,6 +316,58 @@ fn endaq_dc_channel_gives_one_report_per_bounce_and_marks_the_clipped_ones() {
     }
 }
 
+#[test]
+fn endaq_three_axes_give_one_report_per_bounce_with_the_resultants_peak() {
+    let z = analyze(AnalyzeArgs {
+        column: Some(ColumnRef::Name("z_g".into())),
+        ..file("endaq-high-drop/High-Drop_16g-DC_full.csv")
+    });
+    let a = analyze(AnalyzeArgs {
+        axes: ["x_g", "y_g", "z_g"]
+            .map(|c| ColumnRef::Name(c.into()))
+            .to_vec(),
+        ..file("endaq-high-drop/High-Drop_16g-DC_full.csv")
+    });
+    // The same seven bounces as the z axis alone, each overlapping its z report (slow
+    // bounces at 390 S/s start a few samples apart).
+    assert_eq!(a.impacts.len(), z.impacts.len());
+    ordered_and_disjoint(&a);
+    for (r, zr) in a.impacts.iter().zip(&z.impacts) {
+        let overlap =
+            r.start_s < zr.start_s + zr.duration_s && zr.start_s < r.start_s + r.duration_s;
+        assert!(overlap, "{} vs {}", r.start_s, zr.start_s);
+        let x = r.axes.as_ref().expect("axes");
+        assert_eq!(x.axes.len(), 3);
+        // The resultant's peak is at least every axis's reading there and the z peak.
+        for axis in &x.axes {
+            assert!(x.resultant_peak_m_s2 >= axis.peak_acceleration_m_s2.abs() - 1.0);
+        }
+        assert!(x.resultant_peak_m_s2 >= zr.peak_acceleration_m_s2 - 1.0);
+        // Δv: per axis, never the resultant's integral.
+        assert!(r.delta_v_m_s.is_none());
+        assert_eq!(r.null_reasons["delta_v_m_s"], "resultant");
+        let zx = &x.axes[2];
+        assert_eq!(zx.column, "z_g");
+        assert!(x.delta_v_magnitude_m_s >= zx.delta_v_m_s.abs());
+        // z carries the drop: its Δv is close to the single-axis one where both found the
+        // same contact (within three samples at each end).
+        let same = (r.start_s - zr.start_s).abs() < 3.0 / 390.0
+            && (r.duration_s - zr.duration_s).abs() < 6.0 / 390.0;
+        if same && zr.status == "complete" && r.status == "complete" {
+            let dz = zr.delta_v_m_s.unwrap();
+            assert!(
+                (zx.delta_v_m_s - dz).abs() < 0.1 * dz.abs() + 0.3,
+                "{} vs {dz}",
+                zx.delta_v_m_s
+            );
+        }
+    }
+    // The z axis sits at its rail in the first three bounces: those impacts are clipped.
+    let clipped: Vec<bool> = a.impacts.iter().map(|i| i.clipped).collect();
+    assert_eq!(clipped[..4], [true, true, true, false]);
+    assert!(a.impacts[0].axes.as_ref().unwrap().axes[2].clipped);
+}
+
 fn temp_dir() -> PathBuf {
     let dir = std::env::temp_dir().join(format!("impact-recordings-{}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();

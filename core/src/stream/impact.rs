@@ -516,6 +516,8 @@ impl<const PRE: usize> Stream<PRE> {
             f.reset(level);
         }
         let separation_offset = a.separation.map_or(0.0, |s| self.separation_offset(&a, s));
+        let touch = a.onset_index as f64 + a.touch_offset as f64;
+        let (v0, bounce) = self.train.approach(&self.scene, touch, self.v0);
         let summary = Summary {
             index: self.counters.impacts.min(u32::MAX as u64) as u32,
             status,
@@ -532,8 +534,10 @@ impl<const PRE: usize> Stream<PRE> {
             peak_index: a.peak_index,
             total_c: a.total_c,
             contact_c: a.separation.map(|_| a.separation_c - a.pre_onset_c),
-            v0_m_s: self.v0,
+            v0_m_s: v0,
+            bounce,
         };
+        self.train.ended(&summary, &self.scene);
         self.counters.impacts += 1;
         if status != Status::Complete {
             self.counters.incomplete += 1;

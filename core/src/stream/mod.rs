@@ -96,6 +96,8 @@ pub struct Stream<const PRE: usize> {
     /// Stream index of the next sample.
     index: u64,
     v0: Option<f32>,
+    /// The previous impact, for bounce trains.
+    train: crate::train::Tracker,
     counters: Counters,
     trigger_counts: f32,
     edge_counts: f32,
@@ -146,6 +148,7 @@ impl<const PRE: usize> Stream<PRE> {
                 clip_counts: (i16::MIN, i16::MAX),
                 cfc: None,
                 trigger_cfc: None,
+                train: None,
                 fits: FitSet {
                     two_phase: false,
                     nonlinear: false,
@@ -159,6 +162,7 @@ impl<const PRE: usize> Stream<PRE> {
             active: None,
             index: 0,
             v0: None,
+            train: crate::train::Tracker::new(),
             counters: Counters {
                 samples: 0,
                 impacts: 0,
@@ -217,6 +221,7 @@ impl<const PRE: usize> Stream<PRE> {
         self.active = None;
         self.index = 0;
         self.v0 = scene.approach.v0_m_s();
+        self.train = crate::train::Tracker::new();
         self.counters = Counters::default();
         self.trigger_counts = scene.trigger_m_s2 / gain;
         self.edge_counts = scene.edge_m_s2 / gain;

@@ -76,6 +76,7 @@ fn scene() -> Scene {
         cfc: Some(Cfc::Cfc1000),
         trigger_cfc: Some(Cfc::Cfc1000),
         fits: FitSet::all(),
+        train: Some(impact_core::Train::new()),
     })
 }
 

@@ -1,5 +1,6 @@
 //! STM32 sample source (feature `adxl375`): an ADXL375 on SPI1 (PA5 SCK, PA6 MISO, PA7 MOSI,
-//! chip select PE7), its FIFO polled every few milliseconds; one axis becomes the samples.
+//! chip select PE7), its FIFO polled every few milliseconds; the three axes' resultant (or
+//! one axis) becomes the samples.
 //!
 //! On the STM32F4-Discovery SPI1 also reaches the on-board LIS3DSH, whose chip select (PE3)
 //! is held high here so it stays off the bus. PE7 is a free pin on the P2 header; any free
@@ -38,16 +39,19 @@ const POLL_PERIOD: Duration = Duration::from_millis(5);
 /// Tries at bringing the sensor up before the source gives up.
 const INIT_ATTEMPTS: u32 = 3;
 
-/// Which axis becomes the sample stream (the one along the expected impact direction).
+/// What becomes the sample stream: the resultant of the three axes (crash and drop practice:
+/// the trigger on |a| whatever the direction of the hit), or one axis along the expected
+/// impact direction.
 #[derive(Clone, Copy)]
 #[allow(dead_code)]
 enum Axis {
     X,
     Y,
     Z,
+    Resultant,
 }
 
-const AXIS: Axis = Axis::Z;
+const AXIS: Axis = Axis::Resultant;
 
 /// The SPI device: SPI1 with DMA, chip select by GPIO, embassy-time for the FIFO delays.
 pub type Device = ExclusiveDevice<Spi<'static, Async, Master>, Output<'static>, Delay>;
@@ -127,6 +131,7 @@ fn pick(sample: &Sample) -> i16 {
         Axis::X => sample.x,
         Axis::Y => sample.y,
         Axis::Z => sample.z,
+        Axis::Resultant => sample.magnitude(),
     }
 }
 

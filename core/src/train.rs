@@ -1,0 +1,240 @@
+//! Bounce trains: the approach speed of each bounce after the first, from the flight time
+//! since the previous separation and from the previous rebound.
+//!
+//! A body dropped on a barrier bounces: between two contacts it flies up and falls back under
+//! gravity, so it lands at the speed it left with (no drag; gravity along the sensor's axis,
+//! the flight vertical) and
+//!
+//! ```text
+//! v0_flight = g t_flight / 2        (t_flight from one separation to the next first touch)
+//! v0_rebound = Δv_prev - v0_prev     (the previous impact's measured rebound)
+//! ```
+//!
+//! are two independent measures of the same speed: the flight time needs only the stream's
+//! positions (exact) and `g`; the rebound carries the previous approach speed's error with
+//! the opposite sign. Both are reported; the scene picks the one the kinematics use.
+//! A flight longer than the scene's longest (a new drop, the body picked up), a previous
+//! impact without a separation (settled, too long, a gap, the stream ended) or without an
+//! approach speed ends the train: the next impact is a first one, with the scene's
+//! [`crate::scene::Approach`].
+
+use crate::capture::Summary;
+use crate::report::{self, Status};
+use crate::scene::Scene;
+
+/// Which measure of a bounce's approach speed the kinematics use.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub enum TrainSpeed {
+    /// `g t_flight / 2`: independent for every bounce (the default).
+    Flight,
+    /// The previous impact's rebound: no assumption on gravity or the flight's direction,
+    /// but each bounce inherits the previous one's error.
+    Rebound,
+}
+
+impl TrainSpeed {
+    /// The name options and reports use (`flight`, `rebound`).
+    pub fn name(self) -> &'static str {
+        match self {
+            TrainSpeed::Flight => "flight",
+            TrainSpeed::Rebound => "rebound",
+        }
+    }
+}
+
+/// A scene's bounce-train settings. SI units.
+#[derive(Clone, Copy, Debug, PartialEq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct Train {
+    /// The approach speed the kinematics use for bounces after the first.
+    pub speed: TrainSpeed,
+    /// Gravity along the sensor's axis, m/s² (standard gravity unless the bench says).
+    pub gravity_m_s2: f32,
+    /// A flight longer than this starts a new train, s (default 2 s: a 4.9 m bounce).
+    pub max_flight_s: f32,
+}
+
+impl Train {
+    /// Standard gravity, flights up to 2 s, the kinematics on the flight time.
+    pub const fn new() -> Self {
+        Self {
+            speed: TrainSpeed::Flight,
+            gravity_m_s2: crate::solve::bounce::STANDARD_GRAVITY as f32,
+            max_flight_s: 2.0,
+        }
+    }
+}
+
+impl Default for Train {
+    fn default() -> Self {
+        Self::new()
+    }
+}
+
+/// One bounce of a train (an impact after the first): its approach speed by both measures.
+#[derive(Clone, Copy, Debug, PartialEq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct Bounce {
+    /// 1 for the first bounce after the train's first impact.
+    pub number: u32,
+    /// From the previous separation to this first touch, s.
+    pub flight_s: f32,
+    /// `g t_flight / 2`, m/s.
+    pub v0_flight_m_s: f32,
+    /// The previous impact's rebound, m/s; absent if it had none (no Δv, a COR out of range).
+    pub v0_rebound_m_s: Option<f32>,
+}
+
+impl Bounce {
+    /// The COR with approach speed `v0` given this impact's Δv: `(Δv - v0) / v0`.
+    pub fn cor(v0: f32, delta_v: f32) -> f32 {
+        (delta_v - v0) / v0
+    }
+}
+
+/// What the stream remembers of the previous impact between two impacts.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(crate) struct Tracker {
+    /// Stream position of the previous separation (fractional samples), if it had one.
+    separation: Option<f64>,
+    /// The previous impact's rebound speed, m/s, if known and in range.
+    rebound_m_s: Option<f32>,
+    /// The previous impact's bounce number (0 for a train's first impact).
+    number: u32,
+}
+
+impl Tracker {
+    /// Before any impact.
+    pub(crate) const fn new() -> Self {
+        Self {
+            separation: None,
+            rebound_m_s: None,
+            number: 0,
+        }
+    }
+
+    /// The approach speed of an impact whose first touch is at stream position `touch`
+    /// (fractional samples), and its bounce, if it continues a train; `first` is the speed a
+    /// train's first impact gets (the scene's approach, or a light gate's).
+    pub(crate) fn approach(
+        &self,
+        scene: &Scene,
+        touch: f64,
+        first: Option<f32>,
+    ) -> (Option<f32>, Option<Bounce>) {
+        let (Some(train), Some(separation)) = (scene.train, self.separation) else {
+            return (first, None);
+        };
+        let flight_s = ((touch - separation) / scene.calibration.sample_rate_hz as f64) as f32;
+        if !(flight_s > 0.0 && flight_s <= train.max_flight_s) {
+            return (first, None);
+        }
+        let bounce = Bounce {
+            number: self.number.saturating_add(1),
+            flight_s,
+            v0_flight_m_s: train.gravity_m_s2 * flight_s / 2.0,
+            v0_rebound_m_s: self.rebound_m_s,
+        };
+        let v0 = match train.speed {
+            TrainSpeed::Flight => Some(bounce.v0_flight_m_s),
+            TrainSpeed::Rebound => bounce.v0_rebound_m_s,
+        };
+        (v0.filter(|v| v.is_finite() && *v > 0.0), Some(bounce))
+    }
+
+    /// Remembers the impact that just ended (its summary complete, `v0_m_s` included).
+    pub(crate) fn ended(&mut self, s: &Summary, scene: &Scene) {
+        if scene.train.is_none() {
+            return;
+        }
+        let separation = match (s.status, s.separation_index) {
+            (Status::Complete, Some(i)) => Some(i as f64 + s.separation_offset as f64),
+            _ => None,
+        };
+        let rebound = match (s.v0_m_s, separation) {
+            (Some(v0), Some(_)) => report::streaming(s, scene)
+                .delta_v_m_s
+                .map(|dv| dv - v0)
+                .filter(|r| {
+                    let cor = r / v0;
+                    cor.is_finite()
+                        && (0.0..=1.0 + crate::analysis::COR_TOLERANCE).contains(&cor)
+                        && *r > 0.0
+                }),
+            _ => None,
+        };
+        *self = Tracker {
+            separation,
+            rebound_m_s: rebound,
+            number: s.bounce.map_or(0, |b| b.number),
+        };
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::signal::Calibration;
+
+    fn scene() -> Scene {
+        let mut s = Scene::new(
+            Calibration {
+                gain_m_s2_per_count: 0.5,
+                sample_rate_hz: 100_000.0,
+            },
+            50.0,
+        );
+        s.train = Some(Train::new());
+        s
+    }
+
+    #[test]
+    fn the_first_impact_and_a_long_flight_take_the_scenes_speed() {
+        let s = scene();
+        let t = Tracker::new();
+        assert_eq!(t.approach(&s, 1e4, Some(1.5)), (Some(1.5), None));
+        let t = Tracker {
+            separation: Some(0.0),
+            rebound_m_s: Some(1.0),
+            number: 0,
+        };
+        // 2.5 s of flight: a new drop.
+        assert_eq!(t.approach(&s, 250_000.0, Some(1.5)), (Some(1.5), None));
+        // Without a train in the scene every impact is a first one.
+        let mut plain = s;
+        plain.train = None;
+        assert_eq!(t.approach(&plain, 10_000.0, Some(1.5)), (Some(1.5), None));
+    }
+
+    #[test]
+    fn a_bounce_gets_both_speeds_and_the_scene_picks_one() {
+        let mut s = scene();
+        let t = Tracker {
+            separation: Some(1000.0),
+            rebound_m_s: Some(0.4),
+            number: 2,
+        };
+        // 0.1 s of flight: g t / 2 = 0.4903 m/s.
+        let (v0, b) = t.approach(&s, 11_000.0, Some(1.5));
+        let b = b.unwrap();
+        assert_eq!(b.number, 3);
+        assert!((b.flight_s - 0.1).abs() < 1e-6);
+        assert!((b.v0_flight_m_s - 0.490_332_5).abs() < 1e-5);
+        assert_eq!(v0, Some(b.v0_flight_m_s));
+        s.train = Some(Train {
+            speed: TrainSpeed::Rebound,
+            ..Train::new()
+        });
+        assert_eq!(s.train.unwrap().speed.name(), "rebound");
+        assert_eq!(t.approach(&s, 11_000.0, Some(1.5)).0, Some(0.4));
+        // No rebound to chain from: no speed, but the bounce is still reported.
+        let t = Tracker {
+            rebound_m_s: None,
+            ..t
+        };
+        let (v0, b) = t.approach(&s, 11_000.0, Some(1.5));
+        assert_eq!(v0, None);
+        assert!(b.is_some());
+    }
+}

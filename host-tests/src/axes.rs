@@ -1,0 +1,181 @@
+//! Three axes (`--axes x,y,z`): the pipeline runs on the resultant `sqrt(x² + y² + z²)` (the
+//! trigger on |a|, as crash and drop practice report it), and each impact gets every axis's
+//! own peak and Δv over its contact.
+
+use impact_core::ImpactReport;
+use serde::Serialize;
+
+use crate::screen::{self, Clipping};
+
+/// One axis of a recording, in m/s², and its rails.
+#[derive(Clone, Debug)]
+pub struct Axis {
+    /// The column's header name.
+    pub name: String,
+    pub accel_m_s2: Vec<f64>,
+    /// From the sensor's full scale (`--range`, per axis) or the axis's flat tops.
+    pub rails: Option<Clipping>,
+}
+
+impl Axis {
+    /// An axis with its rails from `full_scale_m_s2` if given, else from its flat tops.
+    pub fn new(name: String, accel_m_s2: Vec<f64>, full_scale_m_s2: Option<f64>) -> Self {
+        let rails = match full_scale_m_s2 {
+            Some(fs) => Some(screen::from_range(fs)),
+            None => screen::flat_tops(&accel_m_s2),
+        };
+        Self {
+            name,
+            accel_m_s2,
+            rails,
+        }
+    }
+
+    fn at_rail(&self, v: f64) -> bool {
+        self.rails.as_ref().is_some_and(|r| {
+            r.low_m_s2.is_some_and(|lo| v <= lo) || r.high_m_s2.is_some_and(|hi| v >= hi)
+        })
+    }
+}
+
+/// One axis over one impact. SI.
+#[derive(Clone, Debug, Serialize, PartialEq)]
+pub struct AxisJson {
+    /// The column's header name.
+    pub column: String,
+    /// The axis's level before the impact (mean over the pre-trigger stretch), m/s².
+    pub baseline_m_s2: f64,
+    /// Largest deviation from that level inside the impact (signed), m/s².
+    pub peak_acceleration_m_s2: f64,
+    /// Time of that peak, s.
+    pub peak_time_s: f64,
+    /// `Σ (a - baseline) dt` over the contact (first touch to separation), m/s.
+    pub delta_v_m_s: f64,
+    /// The axis reached its rail inside the impact: its peak and Δv are lower bounds (and
+    /// the impact is marked clipped).
+    pub clipped: bool,
+}
+
+/// The per-axis part of an impact: the resultant's own peak (gravity included) and each axis.
+#[derive(Clone, Debug, Serialize, PartialEq)]
+pub struct AxesJson {
+    /// Largest resultant inside the impact, m/s² (the report's peak is above its baseline).
+    pub resultant_peak_m_s2: f64,
+    /// `sqrt(Σ Δv_axis²)`, m/s: the size of the velocity change (the report's own Δv is
+    /// null, reason `resultant`: `∫|a| dt` is not one).
+    pub delta_v_magnitude_m_s: f64,
+    pub axes: Vec<AxisJson>,
+}
+
+/// Samples before the onset the axis baselines are taken over (ending [`BASELINE_GAP`]
+/// samples before it, and never before the previous impact's end): the stream's own
+/// baseline is a stride of 64.
+const BASELINE_SAMPLES: usize = 64;
+const BASELINE_GAP: usize = 4;
+
+/// The axes over `r`'s window; `axes` are in m/s² on the recording's time base starting at
+/// `t0`, `resultant` their resultant, `rate` the sample rate; `previous_end` is the sample
+/// after the previous impact (0 for the first).
+pub fn impact_axes(
+    r: &ImpactReport,
+    previous_end: u64,
+    axes: &[Axis],
+    resultant: &[f64],
+    rate: f64,
+    t0: f64,
+) -> AxesJson {
+    let n = resultant.len();
+    let onset = (r.start_sample as usize).min(n);
+    let end = (r.end_sample as usize).clamp(onset, n);
+    // The contact: from first touch to separation, whole samples inside.
+    let touch = (r.start_s * rate).ceil().max(0.0) as usize;
+    let separation = ((r.start_s + r.duration_s as f64) * rate).floor().max(0.0) as usize;
+    let contact = touch.min(n)..separation.clamp(touch.min(n), n);
+    let before = onset.saturating_sub(BASELINE_GAP);
+    let quiet = before
+        .saturating_sub(BASELINE_SAMPLES)
+        .max((previous_end as usize).min(before))..before;
+    let resultant_peak_m_s2 = resultant
+        .get(onset..end)
+        .unwrap_or(&[])
+        .iter()
+        .fold(0.0f64, |m, v| m.max(*v));
+    let axes: Vec<AxisJson> = axes
+        .iter()
+        .map(|axis| {
+            let a = &axis.accel_m_s2;
+            let base = match a.get(quiet.clone()) {
+                Some(q) if !q.is_empty() => q.iter().sum::<f64>() / q.len() as f64,
+                _ => a.get(onset).copied().unwrap_or(0.0),
+            };
+            let (peak_i, peak) = (onset..end)
+                .filter_map(|i| a.get(i).map(|v| (i, v - base)))
+                .fold((onset, 0.0f64), |best, (i, d)| {
+                    if d.abs() > best.1.abs() {
+                        (i, d)
+                    } else {
+                        best
+                    }
+                });
+            let dv = a
+                .get(contact.clone())
+                .unwrap_or(&[])
+                .iter()
+                .map(|v| v - base)
+                .sum::<f64>()
+                / rate;
+            let clipped = a
+                .get(onset..end)
+                .unwrap_or(&[])
+                .iter()
+                .any(|&v| axis.at_rail(v));
+            AxisJson {
+                column: axis.name.clone(),
+                clipped,
+                baseline_m_s2: base,
+                peak_acceleration_m_s2: peak,
+                peak_time_s: t0 + peak_i as f64 / rate,
+                delta_v_m_s: dv,
+            }
+        })
+        .collect();
+    let delta_v_magnitude_m_s = axes
+        .iter()
+        .map(|a: &AxisJson| a.delta_v_m_s * a.delta_v_m_s)
+        .sum::<f64>()
+        .sqrt();
+    AxesJson {
+        resultant_peak_m_s2,
+        delta_v_magnitude_m_s,
+        axes,
+    }
+}
+
+/// The table's line for an impact's axes.
+pub fn table_line(a: &AxesJson) -> String {
+    let h = crate::analyze::human;
+    let axes: Vec<String> = a
+        .axes
+        .iter()
+        .map(|x| {
+            format!(
+                "{} {}{} (Δv {})",
+                x.column,
+                if x.clipped { "≥" } else { "" },
+                h(x.peak_acceleration_m_s2, "m/s²"),
+                h(x.delta_v_m_s, "m/s")
+            )
+        })
+        .collect();
+    format!(
+        "    resultant peak {}{}, |Δv| {}; {}\n",
+        if a.axes.iter().any(|x| x.clipped) {
+            "≥"
+        } else {
+            ""
+        },
+        h(a.resultant_peak_m_s2, "m/s²"),
+        h(a.delta_v_magnitude_m_s, "m/s"),
+        axes.join(", ")
+    )
+}

@@ -1,0 +1,205 @@
+//! Bounce trains (`--train`): eight bounces of the seed bench body (60 g touching at
+//! 1.3357 m/s) rendered with closed-form flights under gravity, analysed with each approach
+//! speed source; every bounce's v0 and COR against the exact contacts, and the train's COR
+//! against speed told apart for a constant-COR law (Kelvin–Voigt) and the nonlinear one.
+
+mod common;
+
+use clap::Parser;
+use common::impact_ok;
+use impact_host::synth::{bounce_train, SynthArgs};
+use serde_json::Value;
+
+#[derive(Parser)]
+struct Synth {
+    #[command(flatten)]
+    args: SynthArgs,
+}
+
+/// The exact (v0, COR) of each contact the synth arguments render.
+fn exact(args: &[&str]) -> Vec<(f64, f64)> {
+    let s = Synth::parse_from(std::iter::once("synth").chain(args.iter().copied()));
+    let impact = impact_core::Impact::new(s.args.mass, s.args.v0);
+    let model = s.args.model.model(s.args.law, &impact).unwrap();
+    bounce_train(&s.args, &model)
+        .unwrap()
+        .iter()
+        .map(|b| (b.impact_velocity_m_s, b.outcome.cor))
+        .collect()
+}
+
+fn analyse(csv: &std::path::Path, speed: &str) -> Value {
+    let (out, _) = impact_ok(&[
+        "analyze",
+        csv.to_str().unwrap(),
+        "--v0",
+        "1.3357",
+        "--mass",
+        "0.06",
+        "--train",
+        speed,
+        "--json",
+    ]);
+    serde_json::from_str(&out).unwrap()
+}
+
+fn within(got: f64, want: f64, rel: f64, what: &str) {
+    assert!(
+        ((got - want) / want).abs() < rel,
+        "{what}: {got} vs exact {want}"
+    );
+}
+
+/// Renders the train, checks both sources bounce by bounce; returns the verdict.
+fn train(law: &[&str]) -> String {
+    let mut args = vec!["--mass", "0.06", "--v0", "1.3357", "--bounces", "8"];
+    args.extend_from_slice(law);
+    args.extend_from_slice(&["--duration", "2"]);
+    let exact = exact(&args);
+    assert_eq!(exact.len(), 8);
+    let dir = std::env::temp_dir().join(format!("impact-train-{}-{}", std::process::id(), law[1]));
+    std::fs::create_dir_all(&dir).unwrap();
+    let csv = dir.join("train.csv");
+    let synth: Vec<&str> = std::iter::once("synth")
+        .chain(args.iter().copied())
+        .collect();
+    std::fs::write(&csv, impact_ok(&synth).0).unwrap();
+    let mut verdicts = Vec::new();
+    for speed in ["flight", "rebound"] {
+        let a = analyse(&csv, speed);
+        assert_eq!(a["train_speed"], speed);
+        let impacts = a["impacts"].as_array().unwrap();
+        assert_eq!(impacts.len(), 8, "{speed}: one report per contact");
+        for (i, (r, &(v0, cor))) in impacts.iter().zip(&exact).enumerate() {
+            let what = |f: &str| format!("{speed}, impact {i}: {f}");
+            within(
+                r["impact_velocity_m_s"].as_f64().unwrap(),
+                v0,
+                0.01,
+                &what("v0"),
+            );
+            within(r["cor"].as_f64().unwrap(), cor, 0.01, &what("COR"));
+            if i == 0 {
+                assert!(r["bounce"].is_null(), "the first impact is no bounce");
+                continue;
+            }
+            let b = &r["bounce"];
+            assert_eq!(b["number"], i as u64);
+            for source in ["flight", "rebound"] {
+                let v = b[format!("v0_{source}_m_s")].as_f64().unwrap();
+                within(v, v0, 0.01, &what(&format!("v0 from {source}")));
+                let c = b[format!("cor_{source}")].as_f64().unwrap();
+                within(c, cor, 0.01, &what(&format!("COR from {source}")));
+            }
+            // The flight itself: from the exact rebound, 2 v'/g.
+            let g = impact_core::solve::bounce::STANDARD_GRAVITY;
+            within(
+                b["flight_s"].as_f64().unwrap(),
+                2.0 * v0 / g,
+                0.01,
+                &what("flight"),
+            );
+        }
+        let trains = a["trains"].as_array().unwrap();
+        assert_eq!(trains.len(), 1);
+        assert_eq!(trains[0]["points"].as_array().unwrap().len(), 8);
+        verdicts.push(
+            trains[0]["cor_vs_speed"]["verdict"]
+                .as_str()
+                .unwrap()
+                .to_string(),
+        );
+    }
+    std::fs::remove_dir_all(&dir).ok();
+    assert_eq!(verdicts[0], verdicts[1], "both sources tell the same");
+    verdicts.remove(0)
+}
+
+#[test]
+fn a_kelvin_voigt_train_has_a_constant_cor() {
+    let verdict = train(&[
+        "--law",
+        "kelvin-voigt",
+        "--stiffness",
+        "1e4",
+        "--damping",
+        "2",
+    ]);
+    assert_eq!(verdict, "constant");
+}
+
+#[test]
+fn the_nonlinear_laws_cor_falls_with_speed() {
+    let verdict = train(&[
+        "--law",
+        "nonlinear",
+        "--stiffness",
+        "1e4",
+        "--damping",
+        "0.5",
+    ]);
+    assert_eq!(verdict, "falls-with-speed");
+}
+
+#[test]
+fn without_train_a_bounce_has_no_speed_and_a_long_flight_starts_a_new_train() {
+    let args = [
+        "synth",
+        "--law",
+        "kelvin-voigt",
+        "--mass",
+        "0.06",
+        "--v0",
+        "1.3357",
+        "--stiffness",
+        "1e4",
+        "--damping",
+        "2",
+        "--bounces",
+        "3",
+        "--duration",
+        "0.6",
+    ];
+    let dir = std::env::temp_dir().join(format!("impact-train-flight-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let csv = dir.join("train.csv");
+    std::fs::write(&csv, impact_ok(&args).0).unwrap();
+    let path = csv.to_str().unwrap();
+    // Without --train every impact takes --v0 (a horizontal bench's repeated impacts).
+    let (out, _) = impact_ok(&["analyze", path, "--v0", "1.3357", "--json"]);
+    let a: Value = serde_json::from_str(&out).unwrap();
+    let impacts = a["impacts"].as_array().unwrap();
+    assert_eq!(impacts.len(), 3);
+    assert!(impacts.iter().all(|i| i["bounce"].is_null()));
+    assert!(a["trains"].as_array().unwrap().is_empty());
+    assert!(impacts
+        .iter()
+        .all(|i| i["impact_velocity_m_s"].as_f64() == Some(1.3357f32 as f64)));
+    // Flights of about 0.24 s: with --max-flight 0.1 each impact starts its own train.
+    let (out, _) = impact_ok(&[
+        "analyze",
+        path,
+        "--v0",
+        "1.3357",
+        "--train",
+        "flight",
+        "--max-flight",
+        "0.1",
+        "--json",
+    ]);
+    let a: Value = serde_json::from_str(&out).unwrap();
+    assert!(a["impacts"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .all(|i| i["bounce"].is_null()));
+    // Without a first speed the bounces still get theirs from the flight.
+    let (out, _) = impact_ok(&["analyze", path, "--train", "flight", "--json"]);
+    let a: Value = serde_json::from_str(&out).unwrap();
+    let impacts = a["impacts"].as_array().unwrap();
+    assert!(impacts[0]["impact_velocity_m_s"].is_null());
+    assert!(impacts[1]["impact_velocity_m_s"].as_f64().unwrap() > 1.0);
+    assert!(impacts[1]["bounce"]["v0_rebound_m_s"].is_null());
+    assert!(impacts[2]["bounce"]["v0_rebound_m_s"].as_f64().is_some());
+    std::fs::remove_dir_all(&dir).ok();
+}
