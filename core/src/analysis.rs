@@ -99,8 +99,55 @@ fn scan_peak(a: &[f32]) -> (usize, f32) {
     })
 }
 
-/// Analyses a finished capture: the streaming fields of its summary, and the analysis fields.
+/// Samples before the onset a spectrum's window starts with (the pulse's lead-in).
+pub const SPECTRUM_LEAD: u64 = 64;
+
+/// Analyses a finished capture: the streaming fields of its summary, and the analysis fields;
+/// the shock spectra last (they reuse the workspace).
 pub fn analyse<const CAP: usize>(
+    capture: &Capture<CAP>,
+    scene: &Scene,
+    work: &mut Workspace<CAP>,
+) -> ImpactReport {
+    let mut r = analyse_kinematics(capture, scene, work);
+    if let Some(settings) = scene.spectrum {
+        r.spectrum = spectrum(capture, scene, &settings, work);
+    }
+    r
+}
+
+/// The window from [`SPECTRUM_LEAD`] samples before the onset to the end of the capture, in
+/// m/s² above the baseline, and its spectra.
+fn spectrum<const CAP: usize>(
+    capture: &Capture<CAP>,
+    scene: &Scene,
+    settings: &crate::signal::spectrum::SpectrumSettings,
+    work: &mut Workspace<CAP>,
+) -> Option<crate::signal::spectrum::Spectrum> {
+    let s = capture.summary();
+    let samples = capture.samples();
+    let per_count = report::per_count(scene, s.base_n);
+    let deviation = Deviation::new(s.base_sum, s.base_n);
+    let from = s
+        .onset_index
+        .saturating_sub(SPECTRUM_LEAD)
+        .max(s.first_index);
+    let skip = (from - s.first_index) as usize;
+    let window = samples.get(skip..)?;
+    let buf = work.buf.get_mut(..window.len())?;
+    for (slot, &x) in buf.iter_mut().zip(window) {
+        *slot = deviation.of(x) as f32 * per_count;
+    }
+    let len = buf.len();
+    let mut sp =
+        crate::signal::spectrum::spectrum(buf, len, scene.calibration.sample_rate_hz, settings)?;
+    sp.from_sample = from;
+    sp.to_sample = from + window.len() as u64;
+    Some(sp)
+}
+
+/// Everything but the spectra.
+fn analyse_kinematics<const CAP: usize>(
     capture: &Capture<CAP>,
     scene: &Scene,
     work: &mut Workspace<CAP>,

@@ -60,6 +60,9 @@ pub trait Real:
     fn cosh(self) -> Self;
     fn tanh(self) -> Self;
     fn tgamma(self) -> Self;
+    fn atan(self) -> Self;
+    fn atan2(self, x: Self) -> Self;
+    fn floor(self) -> Self;
     fn is_finite(self) -> bool;
 
     /// True for NaN.
@@ -99,7 +102,7 @@ pub trait Real:
 macro_rules! impl_real {
     ($t:ty, $name:literal, $sqrt:path, $cbrt:path, $pow:path, $exp:path, $expm1:path, $ln:path,
      $ln1p:path, $sin:path, $cos:path, $asin:path, $acos:path, $asinh:path, $sinh:path, $cosh:path,
-     $tanh:path, $tgamma:path) => {
+     $tanh:path, $tgamma:path, $atan:path, $atan2:path, $floor:path) => {
         impl Real for $t {
             const ZERO: Self = 0.0;
             const ONE: Self = 1.0;
@@ -191,6 +194,18 @@ macro_rules! impl_real {
                 $tgamma(self)
             }
             #[inline]
+            fn atan(self) -> Self {
+                $atan(self)
+            }
+            #[inline]
+            fn atan2(self, x: Self) -> Self {
+                $atan2(self, x)
+            }
+            #[inline]
+            fn floor(self) -> Self {
+                $floor(self)
+            }
+            #[inline]
             fn is_finite(self) -> bool {
                 <$t>::is_finite(self)
             }
@@ -218,7 +233,10 @@ impl_real!(
     libm::sinhf,
     libm::coshf,
     libm::tanhf,
-    libm::tgammaf
+    libm::tgammaf,
+    libm::atanf,
+    libm::atan2f,
+    libm::floorf
 );
 impl_real!(
     f64,
@@ -238,7 +256,10 @@ impl_real!(
     libm::sinh,
     libm::cosh,
     libm::tanh,
-    libm::tgamma
+    libm::tgamma,
+    libm::atan,
+    libm::atan2,
+    libm::floor
 );
 
 /// `x^e` with the exponents the contact laws use most (1/2, 1, 3/2, 2, 3) done by multiply and

@@ -4,6 +4,7 @@
 use crate::capture::Summary;
 pub use crate::fit::{Fits, HertzFit, NonlinearFit, TwoPhaseFit};
 use crate::scene::Scene;
+pub use crate::signal::spectrum::Spectrum;
 pub use crate::train::Bounce;
 
 /// How an impact's capture ended.
@@ -200,6 +201,8 @@ pub struct ImpactReport {
     /// The impact continues a bounce train (a streaming field): its flight and both measures
     /// of its approach speed.
     pub bounce: Option<Bounce>,
+    /// Shock spectra of the impact's window (an analysis field, when the scene asks).
+    pub spectrum: Option<Spectrum>,
 }
 
 /// A window whose Δv is less than this share of its contact's (the rest undone after
@@ -260,5 +263,6 @@ pub fn streaming(s: &Summary, scene: &Scene) -> ImpactReport {
         kinematics: None,
         fits: Fits::default(),
         bounce: s.bounce,
+        spectrum: None,
     }
 }

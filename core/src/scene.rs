@@ -2,6 +2,7 @@
 
 use crate::model::positive;
 use crate::signal::cfc::Cfc;
+use crate::signal::spectrum::SpectrumSettings;
 use crate::signal::Calibration;
 use crate::solve::bounce::STANDARD_GRAVITY;
 use crate::solve::Error;
@@ -108,6 +109,9 @@ pub struct Scene {
     /// Bounce trains: each impact after the first takes its approach speed from the flight
     /// since the previous separation or from the previous rebound ([`crate::train`]).
     pub train: Option<Train>,
+    /// Shock spectra (SRS, PVSS, enveloping half-sine) of each captured impact
+    /// ([`crate::signal::spectrum`]).
+    pub spectrum: Option<SpectrumSettings>,
 }
 
 impl Scene {
@@ -129,6 +133,7 @@ impl Scene {
             trigger_cfc: None,
             fits: FitSet::none(),
             train: None,
+            spectrum: None,
         }
     }
 
@@ -169,6 +174,13 @@ impl Scene {
         if let Some(t) = self.train {
             positive(t.gravity_m_s2, "gravity")?;
             positive(t.max_flight_s, "max-flight")?;
+        }
+        if let Some(sp) = self.spectrum {
+            sp.check(c.sample_rate_hz)
+                .map_err(|reason| Error::InvalidParameter {
+                    name: "srs",
+                    reason,
+                })?;
         }
         positive(self.trigger_m_s2, "trigger")?;
         positive(self.edge_m_s2, "edge")?;

@@ -60,6 +60,7 @@ pub const BENCH: Scene = Scene {
         hertz: true,
     },
     train: None,
+    spectrum: None,
 };
 
 /// Why a `key=value` scene argument was refused.
@@ -99,6 +100,8 @@ impl Format for SceneError {
 /// | `exponent` | nonlinear exponent when not fitted (f32) |
 /// | `train` | bounce trains: `flight`, `rebound` (which speed the kinematics use) or `none` |
 /// | `gravity`, `max_flight` | the train's gravity, m/s², and longest flight, s |
+/// | `srs` | `0` or `1`: shock spectra per impact |
+/// | `srs_damping`, `srs_bands`, `srs_low` | damping ratio, bands per octave (6, 12), lowest band, Hz |
 ///
 /// Floats are parsed by `core`'s correctly rounded parser, so the shortest round-trip decimal
 /// of an `f32` (Rust's `{}` or `{:e}`) gives back exactly that `f32`.
@@ -178,6 +181,20 @@ pub fn apply(scene: &mut Scene, key: &str, value: &str) -> Result<(), SceneError
                 ..scene.train.unwrap_or_default()
             });
         }
+        "srs" => {
+            scene.spectrum = flag(value)?.then(|| scene.spectrum.unwrap_or_default());
+        }
+        "srs_damping" | "srs_bands" | "srs_low" => {
+            let mut sp = scene.spectrum.ok_or(SceneError::BadValue)?;
+            match key {
+                "srs_damping" => sp.damping = float(value)?,
+                "srs_bands" => {
+                    sp.bands_per_octave = value.parse::<u8>().map_err(|_| SceneError::BadValue)?
+                }
+                _ => sp.low_hz = float(value)?,
+            }
+            scene.spectrum = Some(sp);
+        }
         "gravity" | "max_flight" => {
             let mut t = scene.train.ok_or(SceneError::BadValue)?;
             match key {
@@ -221,7 +238,7 @@ pub fn log(scene: &Scene) {
     };
     let fits = &scene.fits;
     info!(
-        "scene rate_hz={=f32} gain_m_s2_per_count={=f32} mass_kg={} v0_m_s={} drop_height_m={} trigger_m_s2={=f32} edge_m_s2={=f32} hold_s={=f32} max_impact_s={=f32} settle_s={=f32} clip_low={=i16} clip_high={=i16} cfc={} trigger_cfc={} two_phase={=bool} nonlinear={=bool} fit_exponent={=bool} exponent={=f32} hertz={=bool} train={=str} gravity_m_s2={} max_flight_s={}",
+        "scene rate_hz={=f32} gain_m_s2_per_count={=f32} mass_kg={} v0_m_s={} drop_height_m={} trigger_m_s2={=f32} edge_m_s2={=f32} hold_s={=f32} max_impact_s={=f32} settle_s={=f32} clip_low={=i16} clip_high={=i16} cfc={} trigger_cfc={} two_phase={=bool} nonlinear={=bool} fit_exponent={=bool} exponent={=f32} hertz={=bool} train={=str} gravity_m_s2={} max_flight_s={} srs={=bool}",
         scene.calibration.sample_rate_hz,
         scene.calibration.gain_m_s2_per_count,
         Opt(scene.mass_kg),
@@ -244,6 +261,7 @@ pub fn log(scene: &Scene) {
         scene.train.map_or("none", |t| t.speed.name()),
         Opt(scene.train.map(|t| t.gravity_m_s2)),
         Opt(scene.train.map(|t| t.max_flight_s)),
+        scene.spectrum.is_some(),
     );
 }
 

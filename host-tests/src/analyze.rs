@@ -417,7 +417,7 @@ pub fn impact_json(r: &ImpactReport, t0: f64, fits: &FitSet) -> ImpactJson {
         fits: fits_json(&r.fits),
         null_reasons: null_reasons(r, fits),
         report_latency_s: None,
-        shock_spectrum: None,
+        shock_spectrum: r.spectrum.as_ref().map(crate::spectrum::spectrum_json),
         bounce: crate::train::bounce_json(r),
         axes: None,
     }
@@ -641,6 +641,7 @@ pub fn setup(args: &AnalyzeArgs, progress: Option<fn(f64)>) -> Result<Setup, Str
     };
     scene.approach = approach;
     scene.train = args.train.train();
+    scene.spectrum = args.spectrum.settings();
     scene.validate().map_err(|e| e.to_string())?;
     let mut setup = Setup {
         prepared: Prepared {

@@ -98,6 +98,15 @@ pub fn scene_args(scene: &Scene) -> Vec<String> {
         format!("exponent={}", f(scene.fits.nonlinear_exponent)),
         format!("hertz={}", b(scene.fits.hertz)),
     ]);
+    match scene.spectrum {
+        None => args.push("srs=0".into()),
+        Some(sp) => args.extend([
+            "srs=1".to_string(),
+            format!("srs_damping={}", f(sp.damping)),
+            format!("srs_bands={}", sp.bands_per_octave),
+            format!("srs_low={}", f(sp.low_hz)),
+        ]),
+    }
     match scene.train {
         None => args.push("train=none".into()),
         Some(t) => args.extend([
@@ -350,9 +359,6 @@ pub fn run_emulator(
 /// `impact emulate`: prints what `impact analyze` would, computed by the emulated firmware.
 pub fn emulate(args: &EmulateArgs) -> Result<(), String> {
     let a = &args.analyze;
-    if a.spectrum.srs {
-        return Err("--srs: shock spectra are computed on the host only (`impact analyze --srs`); the firmware does not send them yet".into());
-    }
     // Check the tools before a possibly long build.
     tools_available()?;
     let setup = analyze::setup(a, None)?;

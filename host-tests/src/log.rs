@@ -8,7 +8,8 @@ use std::path::PathBuf;
 
 use clap::Args;
 use impact_core::analysis::COR_TOLERANCE;
-use impact_core::report::{Bounce, Fits, Flags, HertzFit, NonlinearFit, TwoPhaseFit};
+use impact_core::report::{Bounce, Fits, Flags, HertzFit, NonlinearFit, Spectrum, TwoPhaseFit};
+use impact_core::signal::spectrum::MAX_BANDS;
 use impact_core::{Analysis, ImpactReport, Kinematics, Status};
 
 use crate::analyze::{self, AnalysisJson};
@@ -96,6 +97,7 @@ pub(crate) trait Number: std::str::FromStr + std::fmt::Display {
     }
 }
 
+impl Number for u8 {}
 impl Number for u16 {}
 impl Number for u32 {}
 impl Number for u64 {}
@@ -233,7 +235,51 @@ pub fn parse_impact(m: &HashMap<String, String>) -> Result<ImpactReport, String>
             hertz,
         },
         bounce,
+        spectrum: None,
     })
+}
+
+/// An `srs` line: the spectra of the impact with its `index`.
+fn parse_spectrum(m: &HashMap<String, String>) -> Result<(u32, Spectrum), String> {
+    let list = |key: &str| -> Result<Vec<f32>, String> {
+        get(m, key)?
+            .split(',')
+            .map(|v| match v.parse::<f32>() {
+                Ok(x) if x.is_finite() && x >= 0.0 => Ok(x),
+                _ => Err(format!("{key}: {v} is not a finite value >= 0")),
+            })
+            .collect()
+    };
+    let bands: u8 = num(m, "bands")?;
+    let (srs, pvss) = (list("srs_m_s2")?, list("pvss_m_s")?);
+    let n = usize::from(bands);
+    if n == 0 || n > MAX_BANDS || srs.len() != n || pvss.len() != n {
+        return Err(format!(
+            "bands={bands} with {} SRS and {} PVSS values",
+            srs.len(),
+            pvss.len()
+        ));
+    }
+    let mut s = Spectrum {
+        bands,
+        first_hz: num(m, "first_hz")?,
+        bands_per_octave: num(m, "bands_per_octave")?,
+        damping: num(m, "damping")?,
+        srs_m_s2: [0.0; MAX_BANDS],
+        pvss_m_s: [0.0; MAX_BANDS],
+        half_sine: match (
+            opt::<f32>(m, "half_sine_amplitude_m_s2")?,
+            opt::<f32>(m, "half_sine_duration_s")?,
+        ) {
+            (Some(a), Some(d)) => Some((a, d)),
+            _ => None,
+        },
+        from_sample: num(m, "from_sample")?,
+        to_sample: num(m, "to_sample")?,
+    };
+    s.srs_m_s2[..n].copy_from_slice(&srs);
+    s.pvss_m_s[..n].copy_from_slice(&pvss);
+    Ok((num(m, "index")?, s))
 }
 
 /// Parses a decoded firmware log (any other lines are ignored), checking what it reads (see
@@ -288,6 +334,17 @@ impl LogReader {
             self.log.impacts.push(r);
             self.log.latencies.push(latency);
             self.impact_lines.push(n);
+        } else if let Some(m) = fields(line, "srs ") {
+            let m = m.map_err(at)?;
+            let (index, spectrum) = parse_spectrum(&m).map_err(at)?;
+            match self.log.impacts.iter_mut().rev().find(|r| r.index == index) {
+                Some(r) if r.spectrum.is_none() => r.spectrum = Some(spectrum),
+                _ => {
+                    return Err(at(format!(
+                        "srs index={index}: no impact line of that index before it, or a second srs line"
+                    )))
+                }
+            }
         } else if let Some(m) = fields(line, "heartbeat ") {
             let m = m.map_err(at)?;
             let samples: u64 = num(&m, "samples").map_err(at)?;

@@ -1,8 +1,11 @@
 //! `impact analyze --srs`: each impact's shock response spectrum (SRS), pseudo-velocity shock
-//! spectrum (PVSS) and enveloping half-sine, from the core's `signal::srs` on the impact's
-//! window of the quantised signal (the counts the pipeline saw, less the report's baseline).
+//! spectrum (PVSS) and enveloping half-sine as the core computes them on the board too
+//! (`signal::spectrum`, f32 multirate), as JSON, CSV and a table line; and the host's f64
+//! full-rate reference (`signal::srs`) the tests hold both against.
 
 use clap::Args;
+use impact_core::report::Spectrum;
+use impact_core::signal::spectrum::SpectrumSettings;
 use impact_core::signal::srs::{self, Oscillator, Response};
 use impact_core::ImpactReport;
 use serde::Serialize;
@@ -24,6 +27,34 @@ pub struct SpectrumArgs {
     /// Lowest band, Hz (the highest is an eighth of the sample rate).
     #[arg(long, default_value_t = 10.0, requires = "srs", value_parser = crate::analyze::positive_f64)]
     pub srs_low: f64,
+}
+
+impl SpectrumArgs {
+    /// The scene's spectrum settings, if asked for.
+    pub fn settings(&self) -> Option<SpectrumSettings> {
+        self.srs.then_some(SpectrumSettings {
+            damping: self.srs_damping as f32,
+            bands_per_octave: self.srs_bands as u8,
+            low_hz: self.srs_low as f32,
+        })
+    }
+}
+
+/// A core spectrum as JSON.
+pub fn spectrum_json(s: &Spectrum) -> ShockSpectrumJson {
+    let n = usize::from(s.bands);
+    let f = |v: &f32| *v as f64;
+    ShockSpectrumJson {
+        damping: s.damping as f64,
+        bands_per_octave: u32::from(s.bands_per_octave),
+        from_sample: s.from_sample,
+        to_sample: s.to_sample,
+        frequency_hz: (0..n).map(|k| s.frequency_hz(k)).collect(),
+        srs_m_s2: s.srs_m_s2[..n].iter().map(f).collect(),
+        pvss_m_s: s.pvss_m_s[..n].iter().map(f).collect(),
+        half_sine_amplitude_m_s2: s.half_sine.map(|h| h.0 as f64),
+        half_sine_duration_s: s.half_sine.map(|h| h.1 as f64),
+    }
 }
 
 fn per_octave(s: &str) -> Result<u32, String> {
@@ -67,8 +98,13 @@ const LEAD_SAMPLES: u64 = 64;
 /// Most bands: 12 per octave from 1 mHz to 100 MHz.
 const MAX_BANDS: usize = 12 * 37;
 
-/// The spectra of one impact: its onset less [`LEAD_SAMPLES`] to the end of its hold.
-pub fn impact_spectrum(setup: &Setup, r: &ImpactReport, args: &SpectrumArgs) -> ShockSpectrumJson {
+/// The f64 full-rate reference spectra of one impact (the tests' check on the board's): its
+/// onset less [`LEAD_SAMPLES`] to the end of its hold, the counts less the report's baseline.
+pub fn reference_spectrum(
+    setup: &Setup,
+    r: &ImpactReport,
+    args: &SpectrumArgs,
+) -> ShockSpectrumJson {
     let counts = &setup.prepared.counts;
     let gain = setup.scene.calibration.gain_m_s2_per_count as f64;
     let baseline = r.baseline_m_s2 as f64;

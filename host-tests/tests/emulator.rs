@@ -213,6 +213,15 @@ fn seed_001_bench_impact_with_kinematics_and_fits() {
 }
 
 #[test]
+fn shock_spectra_on_the_board_are_the_hosts() {
+    // The firmware's `srs` lines, decoded, give the host's spectra bit for bit.
+    emulator_matches_host(
+        &shared("afrl-drop-tower/series1_test1_full_100ms.csv"),
+        &["--units", "kgn", "--srs"],
+    );
+}
+
+#[test]
 fn three_axes_give_the_same_reports_on_the_board() {
     // The board streams the resultant the host computes; the axes' part comes from the file,
     // so `impact log` alone cannot give it.

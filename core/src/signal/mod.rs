@@ -6,6 +6,7 @@ pub mod copy;
 pub mod flank;
 pub mod integrate;
 pub mod ring;
+pub mod spectrum;
 pub mod srs;
 
 /// Converts raw integer samples to physical units. SI throughout.

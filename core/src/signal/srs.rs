@@ -8,21 +8,26 @@
 //! output is a decaying cosine whose largest magnitude is found in closed form rather than
 //! by running the filter on for half the lowest period.
 //!
-//! `f64` throughout: the oscillators of the low bands have poles within `ω T` of 1 (1e-4 at
-//! 10 Hz and 500 kS/s), where `f32` coefficients lose the response.
+//! `f64` here (the host's reference): the oscillators of the low bands have poles within
+//! `ω T` of 1 (1e-4 at 10 Hz and 500 kS/s), where `f32` coefficients lose the response; the
+//! board runs `f32` ones at lower rates ([`super::spectrum`]).
 
 use core::f64::consts::PI;
 
+use crate::real::Real;
+
 /// A second-order section `y[n] = b0 x[n] + b1 x[n-1] + b2 x[n-2] - a1 y[n-1] - a2 y[n-2]`,
-/// started at rest, with the pole data for the residual.
+/// started at rest, with the pole data for the residual. `f64` on the host (the reference);
+/// the board's multirate spectra ([`super::spectrum`]) use `f32` ones at rates where their
+/// poles stay clear of 1.
 #[derive(Clone, Copy, Debug, PartialEq)]
-pub struct Oscillator {
-    pub b: [f64; 3],
-    pub a: [f64; 2],
+pub struct Oscillator<R = f64> {
+    pub b: [R; 3],
+    pub a: [R; 2],
     /// `ζ ω T`: the decay per sample (the poles' radius is `exp(-decay)`).
-    decay: f64,
+    decay: R,
     /// `ω_d T`: the damped oscillation's phase advance per sample, rad.
-    advance: f64,
+    advance: R,
 }
 
 /// Which response of the oscillator a spectrum records.
@@ -34,41 +39,47 @@ pub enum Response {
     PseudoVelocity,
 }
 
-impl Oscillator {
+impl<R: Real> Oscillator<R> {
     /// The oscillator of natural frequency `freq_hz` and damping ratio `damping` (in
     /// `[0, 0.5]`) sampled at `rate_hz`; `None` outside `0 < freq_hz <= rate_hz / 4`.
-    pub fn new(response: Response, freq_hz: f64, damping: f64, rate_hz: f64) -> Option<Self> {
-        if !(freq_hz > 0.0
+    pub fn new(response: Response, freq_hz: R, damping: R, rate_hz: R) -> Option<Self> {
+        let four = R::TWO * R::TWO;
+        if !(freq_hz > R::ZERO
             && rate_hz.is_finite()
-            && freq_hz <= rate_hz / 4.0
-            && (0.0..=0.5).contains(&damping))
+            && freq_hz <= rate_hz / four
+            && damping >= R::ZERO
+            && damping <= R::HALF)
         {
             return None;
         }
-        let t = 1.0 / rate_hz;
-        let w = 2.0 * PI * freq_hz;
+        let t = R::ONE / rate_hz;
+        let w = R::TWO * R::PI * freq_hz;
         // ISO 18431-4 with Q = 1 / (2 ζ): A = ω T / (2 Q) = ζ ω T, B = ω_d T.
         let big_a = damping * w * t;
-        let s = libm::sqrt(1.0 - damping * damping);
+        let s = (R::ONE - damping * damping).sqrt();
         let big_b = w * t * s;
-        let e = libm::exp(-big_a);
-        let e2 = libm::exp(-2.0 * big_a);
-        let (sin_b, cos_b) = (libm::sin(big_b), libm::cos(big_b));
-        let a = [-2.0 * e * cos_b, e2];
+        let e = (-big_a).exp();
+        let e2 = (-R::TWO * big_a).exp();
+        let (sin_b, cos_b) = (big_b.sin(), big_b.cos());
+        let a = [-R::TWO * e * cos_b, e2];
         let b = match response {
             Response::AbsoluteAcceleration => {
                 let sinc = sin_b / big_b;
-                [1.0 - e * sinc, 2.0 * e * (sinc - cos_b), e2 - e * sinc]
+                [
+                    R::ONE - e * sinc,
+                    R::TWO * e * (sinc - cos_b),
+                    e2 - e * sinc,
+                ]
             }
             Response::PseudoVelocity => {
                 // 1/Q = 2 ζ; q = (1/(2 Q²) - 1) / sqrt(1 - 1/(4 Q²)) = (2 ζ² - 1) / s.
-                let inv_q = 2.0 * damping;
-                let q = (2.0 * damping * damping - 1.0) / s;
+                let inv_q = R::TWO * damping;
+                let q = (R::TWO * damping * damping - R::ONE) / s;
                 let wt = w * t;
                 let c = t * w * w;
                 [
-                    ((1.0 - e * cos_b) * inv_q - q * e * sin_b - wt) / c,
-                    (2.0 * e * cos_b * wt - (1.0 - e2) * inv_q + 2.0 * q * e * sin_b) / c,
+                    ((R::ONE - e * cos_b) * inv_q - q * e * sin_b - wt) / c,
+                    (R::TWO * e * cos_b * wt - (R::ONE - e2) * inv_q + R::TWO * q * e * sin_b) / c,
                     (-e2 * (wt + inv_q) + e * cos_b * inv_q - q * e * sin_b) / c,
                 ]
             }
@@ -81,16 +92,21 @@ impl Oscillator {
         })
     }
 
+    /// `ω_d T`, rad per sample.
+    pub fn advance(&self) -> R {
+        self.advance
+    }
+
     /// Largest `|y|` over the pulse `x` (from rest) and the free response after it.
-    pub fn peak(&self, x: impl IntoIterator<Item = f64>) -> f64 {
+    pub fn peak(&self, x: impl IntoIterator<Item = R>) -> R {
         let [b0, b1, b2] = self.b;
         let [a1, a2] = self.a;
-        let (mut x1, mut x2, mut y1, mut y2) = (0.0, 0.0, 0.0, 0.0);
-        let mut peak: f64 = 0.0;
+        let (mut x1, mut x2, mut y1, mut y2) = (R::ZERO, R::ZERO, R::ZERO, R::ZERO);
+        let mut peak = R::ZERO;
         // The pulse, then two zeros: the input's ramp back to zero.
-        for xn in x.into_iter().chain([0.0, 0.0]) {
+        for xn in x.into_iter().chain([R::ZERO, R::ZERO]) {
             let y = b0 * xn + b1 * x1 + b2 * x2 - a1 * y1 - a2 * y2;
-            peak = peak.max(libm::fabs(y));
+            peak = peak.max(y.abs());
             (x2, x1, y2, y1) = (x1, xn, y1, y);
         }
         peak.max(self.residual_peak(y2, y1))
@@ -98,27 +114,25 @@ impl Oscillator {
 
     /// Largest `|y(t)|`, `t >= 0`, of the free response through `y(0) = y0`, `y(1) = y1` (one
     /// sample apart): `y(t) = C r^t cos(θ t + φ)` with `r = exp(-decay)`, `θ = advance`.
-    fn residual_peak(&self, y0: f64, y1: f64) -> f64 {
-        let r = libm::exp(-self.decay);
-        let (sin_t, cos_t) = (libm::sin(self.advance), libm::cos(self.advance));
+    pub fn residual_peak(&self, y0: R, y1: R) -> R {
+        let r = (-self.decay).exp();
+        let (sin_t, cos_t) = (self.advance.sin(), self.advance.cos());
         // y0 = C cos φ; y1 = C r (cos θ cos φ - sin θ sin φ).
         let c_cos = y0;
         let c_sin = (y0 * r * cos_t - y1) / (r * sin_t);
-        let c = libm::sqrt(c_cos * c_cos + c_sin * c_sin);
-        if c == 0.0 {
-            return 0.0;
+        let c = (c_cos * c_cos + c_sin * c_sin).sqrt();
+        if !(c > R::ZERO) {
+            return y0.abs();
         }
-        let phi = libm::atan2(c_sin, c_cos);
+        let phi = c_sin.atan2(c_cos);
         // Extrema where tan(θ t + φ) = -decay / θ; the first one at t >= 0 is the largest
         // after t = 0 (the envelope decays).
-        let psi = libm::atan(-self.decay / self.advance);
-        let mut turn = libm::fmod(psi - phi, PI);
-        if turn < 0.0 {
-            turn += PI;
-        }
+        let psi = (-self.decay / self.advance).atan();
+        let d = psi - phi;
+        let turn = d - (d / R::PI).floor() * R::PI;
         let t = turn / self.advance;
-        let at_extremum = c * libm::exp(-self.decay * t) * libm::fabs(libm::cos(psi));
-        libm::fabs(y0).max(at_extremum)
+        let at_extremum = c * (-self.decay * t).exp() * psi.cos().abs();
+        y0.abs().max(at_extremum)
     }
 }
 

@@ -149,6 +149,7 @@ impl<const PRE: usize> Stream<PRE> {
                 cfc: None,
                 trigger_cfc: None,
                 train: None,
+                spectrum: None,
                 fits: FitSet {
                     two_phase: false,
                     nonlinear: false,

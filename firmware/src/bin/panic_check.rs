@@ -77,6 +77,7 @@ fn scene() -> Scene {
         trigger_cfc: Some(Cfc::Cfc1000),
         fits: FitSet::all(),
         train: Some(impact_core::Train::new()),
+        spectrum: Some(impact_core::signal::spectrum::SpectrumSettings::new()),
     })
 }
 

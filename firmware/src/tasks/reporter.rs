@@ -152,6 +152,9 @@ impl Order {
 
     fn print(&mut self, r: &ImpactReport) {
         log_impact(r);
+        if let Some(s) = &r.spectrum {
+            log_spectrum(r.index, s);
+        }
         self.printed += 1;
         if r.index >= self.next {
             self.next = r.index.wrapping_add(1);
@@ -279,6 +282,40 @@ fn log_impact(r: &ImpactReport) {
         Opt(b.and_then(|b| b.v0_rebound_m_s)),
         Opt(SAMPLE_CLOCK.since_sample_s(r.end_sample)),
     );
+}
+
+/// The `srs` line after an impact's line when the scene asks for spectra: the bands' SRS and
+/// PVSS as comma-separated lists (band `k` at `1000 × 2^(j/n)` Hz from `first_hz`).
+fn log_spectrum(index: u32, s: &impact_core::report::Spectrum) {
+    let n = usize::from(s.bands).min(s.srs_m_s2.len());
+    info!(
+        "srs index={=u32} bands={=u8} first_hz={=f32} bands_per_octave={=u8} damping={=f32} from_sample={=u64} to_sample={=u64} half_sine_amplitude_m_s2={} half_sine_duration_s={} srs_m_s2={} pvss_m_s={}",
+        index,
+        s.bands,
+        s.first_hz,
+        s.bands_per_octave,
+        s.damping,
+        s.from_sample,
+        s.to_sample,
+        Opt(s.half_sine.map(|h| h.0)),
+        Opt(s.half_sine.map(|h| h.1)),
+        List(&s.srs_m_s2[..n]),
+        List(&s.pvss_m_s[..n]),
+    );
+}
+
+/// Values separated by commas, no spaces (one `key=value` token).
+struct List<'a>(&'a [f32]);
+
+impl defmt::Format for List<'_> {
+    fn format(&self, f: defmt::Formatter<'_>) {
+        for (k, v) in self.0.iter().enumerate() {
+            if k > 0 {
+                defmt::write!(f, ",");
+            }
+            defmt::write!(f, "{=f32}", v);
+        }
+    }
 }
 
 /// Deepest stack use so far and the stack's size, bytes; warns if it reached the statics.

@@ -6,8 +6,8 @@ use std::time::Duration;
 
 use clap::{Parser, Subcommand};
 use impact_host::{
-    analyze, emulate, log, m4, plot, precision, realtime, simulate, soak, spectrum, stability,
-    synth, target, target_bench, throughput,
+    analyze, emulate, log, m4, plot, precision, realtime, simulate, soak, stability, synth, target,
+    target_bench, throughput,
 };
 
 #[derive(Parser)]
@@ -194,12 +194,7 @@ fn run(cli: Cli) -> Result<(), String> {
             }
             let setup = analyze::setup(&args, progress)?;
             let reports = analyze::run(&setup.prepared.counts, &setup.scene)?;
-            let mut a = analyze::to_json(&setup, &reports);
-            if args.spectrum.srs {
-                for (j, r) in a.impacts.iter_mut().zip(&reports) {
-                    j.shock_spectrum = Some(spectrum::impact_spectrum(&setup, r, &args.spectrum));
-                }
-            }
+            let a = analyze::to_json(&setup, &reports);
             if args.json {
                 println!(
                     "{}",
