@@ -114,25 +114,137 @@ pub fn work_precision(points: &[Point], path: &std::path::Path) -> Result<(), St
 /// A named, coloured series of (time, value) points.
 type Curve = (&'static str, RGBColor, Vec<(f64, f64)>);
 
-/// Acceleration, velocity and deformation of each impact (up to six), as in the seed
-/// paper's figures, with the fitted models' accelerations over the measured one.
+/// The measured curve: broad and light, so that fits drawn over it stay visible.
+const MEASURED: RGBColor = RGBColor(120, 170, 250);
+
+/// One panel: its title, axis labels, the measured series and each model's, whether both
+/// axes are logarithmic, and whether it carries the legend (the first of a row: the colours
+/// are the same in every panel).
+struct Panel<'a> {
+    title: &'a str,
+    x_label: &'a str,
+    measured: Vec<(f64, f64)>,
+    measured_label: &'a str,
+    models: Vec<Curve>,
+    log: bool,
+    legend: bool,
+}
+
+/// Draws one panel on `area`.
+fn draw_panel(
+    area: &DrawingArea<SVGBackend, plotters::coord::Shift>,
+    index: Option<u32>,
+    p: &Panel,
+) -> Result<(), String> {
+    let finite =
+        |q: &(f64, f64)| q.0.is_finite() && q.1.is_finite() && (!p.log || (q.0 > 0.0 && q.1 > 0.0));
+    let all = p
+        .measured
+        .iter()
+        .chain(p.models.iter().flat_map(|c| c.2.iter()))
+        .filter(|q| finite(q));
+    let (mut x0, mut x1, mut y0, mut y1) = (f64::MAX, f64::MIN, f64::MAX, f64::MIN);
+    for q in all {
+        (x0, x1, y0, y1) = (x0.min(q.0), x1.max(q.0), y0.min(q.1), y1.max(q.1));
+    }
+    if x0 > x1 {
+        (x0, x1, y0, y1) = (0.0, 1.0, 0.0, 1.0);
+    }
+    let caption = match index {
+        Some(i) => format!("impact {i} — {}", p.title),
+        None => p.title.to_string(),
+    };
+    let mut builder = ChartBuilder::on(area);
+    builder
+        .caption(caption, ("sans-serif", 15))
+        .margin(8)
+        .x_label_area_size(30)
+        .y_label_area_size(60);
+    macro_rules! finish {
+        ($chart:expr) => {{
+            let mut chart = $chart;
+            chart
+                .configure_mesh()
+                .x_desc(p.x_label)
+                .draw()
+                .map_err(|e| e.to_string())?;
+            if !p.measured.is_empty() {
+                chart
+                    .draw_series(LineSeries::new(
+                        p.measured.iter().copied().filter(|q| finite(q)),
+                        MEASURED.stroke_width(4),
+                    ))
+                    .map_err(|e| e.to_string())?
+                    .label(p.measured_label)
+                    .legend(|(x, y)| {
+                        PathElement::new(vec![(x, y), (x + 18, y)], MEASURED.stroke_width(4))
+                    });
+            }
+            for (name, color, s) in &p.models {
+                let c = *color;
+                chart
+                    .draw_series(LineSeries::new(
+                        s.iter().copied().filter(|q| finite(q)),
+                        c.stroke_width(2),
+                    ))
+                    .map_err(|e| e.to_string())?
+                    .label(*name)
+                    .legend(move |(x, y)| {
+                        PathElement::new(vec![(x, y), (x + 18, y)], c.stroke_width(2))
+                    });
+            }
+            if p.legend {
+                chart
+                    .configure_series_labels()
+                    .position(SeriesLabelPosition::UpperRight)
+                    .background_style(WHITE.mix(0.85))
+                    .border_style(BLACK)
+                    .draw()
+                    .map_err(|e| e.to_string())?;
+            }
+        }};
+    }
+    if p.log {
+        finish!(builder
+            .build_cartesian_2d(
+                (x0..x1.max(x0 * 1.01)).log_scale(),
+                (y0 * 0.8..(y1 * 1.25).max(y0 * 1.01)).log_scale()
+            )
+            .map_err(|e| e.to_string())?);
+    } else {
+        let pad = (y1 - y0).abs().max(1e-12) * 0.08;
+        finish!(builder
+            .build_cartesian_2d(x0..x1.max(x0 + 1e-9), (y0 - pad)..(y1 + pad))
+            .map_err(|e| e.to_string())?);
+    }
+    Ok(())
+}
+
+/// Per impact (up to six), as in the seed papers' figures: deceleration, velocity and
+/// deformation against time from touch, the force–deformation loop, with the fitted models
+/// (two-phase, nonlinear, Hertz) simulated from the same touch over the measured curves; with
+/// `--srs`, the SRS and the PVSS (log–log).
 pub fn impacts(
     setup: &crate::analyze::Setup,
     reports: &[impact_core::ImpactReport],
     path: &std::path::Path,
 ) -> Result<(), String> {
-    use impact_core::model::{Model, Nonlinear, TwoPhase};
+    use impact_core::model::{Hertz, Model, Nonlinear, TwoPhase};
     use impact_core::solve::trajectory;
     use impact_core::{ContactLaw, Impact};
     let shown: Vec<_> = reports.iter().take(6).collect();
     if shown.is_empty() {
         return Err("--plot: no impact to draw".into());
     }
-    let root = SVGBackend::new(path, (1200, 330 * shown.len() as u32)).into_drawing_area();
+    let spectra = shown.iter().any(|r| r.spectrum.is_some());
+    let cols = if spectra { 6 } else { 4 };
+    let root =
+        SVGBackend::new(path, (400 * cols as u32, 330 * shown.len() as u32)).into_drawing_area();
     root.fill(&WHITE).map_err(|e| e.to_string())?;
-    let rows = root.split_evenly((shown.len(), 3));
+    let rows = root.split_evenly((shown.len(), cols));
     let fs = setup.rate_hz;
     let a = &setup.prepared.accel_m_s2;
+    let mass = setup.scene.mass_kg.map(|m| m as f64);
     for (k, r) in shown.iter().enumerate() {
         let start = ((r.start_s * fs).floor() as usize).saturating_sub(2);
         let len = ((r.duration_s as f64 * fs).ceil() as usize + 4).max(4);
@@ -143,8 +255,7 @@ pub fn impacts(
         let v0 = r.kinematics.map(|k| k.impact_velocity_m_s as f64);
         // Velocity and deformation by integration from the touch.
         let (mut v, mut x) = (v0.unwrap_or(0.0), 0.0);
-        let mut vel = Vec::new();
-        let mut def = Vec::new();
+        let (mut vel, mut def, mut loop_) = (Vec::new(), Vec::new(), Vec::new());
         for (t, acc) in &meas {
             if *t >= 0.0 {
                 let v1 = v - acc / fs;
@@ -153,111 +264,219 @@ pub fn impacts(
             }
             vel.push((*t, v));
             def.push((*t, x * 1e3));
+            if *t >= 0.0 {
+                loop_.push((x * 1e3, acc * mass.unwrap_or(1.0)));
+            }
         }
         // Fitted models, simulated from the same touch.
-        let mut fitted: Vec<Curve> = Vec::new();
-        if let (Some(v0), Some(m)) = (v0, setup.scene.mass_kg) {
-            let impact = Impact::new(m as f64, v0);
-            let mut models: Vec<(&'static str, RGBColor, Model<f64>)> = Vec::new();
-            if let Some(f) = r.fits.two_phase {
-                models.push((
-                    "two-phase fit",
-                    RGBColor(200, 60, 40),
-                    Model::TwoPhase(TwoPhase {
-                        kc: f.kc_n_m as f64,
-                        kr: f.kr_n_m as f64,
-                        c: (f.c_n_s_m as f64).max(0.0),
-                        permanent_m: Some((f.permanent_m as f64).max(0.0)),
-                    }),
-                ));
-            }
-            if let Some(f) = r.fits.nonlinear {
-                models.push((
-                    "nonlinear fit",
-                    RGBColor(40, 140, 60),
-                    Model::Nonlinear(Nonlinear {
-                        k: f.k as f64,
-                        c: (f.c_s_m as f64).max(0.0),
-                        n: f.n as f64,
-                    }),
-                ));
-            }
-            // A model's curve over a few times the measured window at most.
+        let mut models: Vec<(&'static str, RGBColor, Model<f64>)> = Vec::new();
+        if let Some(f) = r.fits.two_phase {
+            models.push((
+                "two-phase fit",
+                RGBColor(200, 60, 40),
+                Model::TwoPhase(TwoPhase {
+                    kc: f.kc_n_m as f64,
+                    kr: f.kr_n_m as f64,
+                    c: (f.c_n_s_m as f64).max(0.0),
+                    permanent_m: Some((f.permanent_m as f64).max(0.0)),
+                }),
+            ));
+        }
+        if let Some(f) = r.fits.nonlinear {
+            models.push((
+                "nonlinear fit",
+                RGBColor(40, 140, 60),
+                Model::Nonlinear(Nonlinear {
+                    k: f.k as f64,
+                    c: (f.c_s_m as f64).max(0.0),
+                    n: f.n as f64,
+                }),
+            ));
+        }
+        if let Some(f) = r.fits.hertz {
+            models.push((
+                "Hertz fit",
+                RGBColor(150, 60, 170),
+                Model::Hertz(Hertz { k: f.k as f64 }),
+            ));
+        }
+        // Each model's a(t), v(t), x(t) and F(x), over a few times the window at most.
+        let mut curves: [Vec<Curve>; 4] = Default::default();
+        if let (Some(v0), Some(m)) = (v0, mass) {
+            let impact = Impact::new(m, v0);
             let points = 4 * meas.len() as u64 + 1024;
             for (name, color, model) in models {
-                let mut series = Vec::new();
+                let mut s = Vec::new();
                 if model.validate().is_ok()
-                    && trajectory::sample(&model, &impact, 1e-8, 0.0, 1.0 / fs, points, |s| {
-                        series.push((s.t_s * 1e3, s.force_n / m as f64))
+                    && trajectory::sample(&model, &impact, 1e-8, 0.0, 1.0 / fs, points, |p| {
+                        s.push(p)
                     })
                     .is_ok()
                 {
-                    fitted.push((name, color, series));
+                    let map = |f: &dyn Fn(&trajectory::Sample<f64>) -> (f64, f64)| {
+                        s.iter().map(f).collect::<Vec<_>>()
+                    };
+                    curves[0].push((name, color, map(&|p| (p.t_s * 1e3, p.force_n / m))));
+                    curves[1].push((name, color, map(&|p| (p.t_s * 1e3, p.v_m_s))));
+                    curves[2].push((name, color, map(&|p| (p.t_s * 1e3, p.x_m * 1e3))));
+                    curves[3].push((name, color, map(&|p| (p.x_m * 1e3, p.force_n))));
                 }
             }
         }
-        let panels = [
-            ("deceleration, m/s²", &meas, true),
-            ("velocity, m/s", &vel, false),
-            ("deformation, mm", &def, false),
+        let [c_a, c_v, c_x, c_f] = curves;
+        // Without v0 the integrals start from rest: said in the titles; no loop.
+        let known = v0.is_some();
+        let force_title = match (known, mass.is_some()) {
+            (false, _) => {
+                loop_.clear();
+                "force against deformation: needs v0"
+            }
+            (true, true) => "force against deformation, N",
+            (true, false) => "deceleration against deformation, m/s²",
+        };
+        let (vel_title, def_title) = if known {
+            ("velocity, m/s", "deformation, mm")
+        } else {
+            (
+                "velocity change from touch, m/s (no v0)",
+                "displacement from touch, mm (no v0)",
+            )
+        };
+        let mut panels = vec![
+            Panel {
+                title: "deceleration, m/s²",
+                x_label: "time from touch, ms",
+                measured: meas,
+                measured_label: "measured",
+                models: c_a,
+                log: false,
+                legend: true,
+            },
+            Panel {
+                title: vel_title,
+                x_label: "time from touch, ms",
+                measured: vel,
+                measured_label: "measured",
+                models: c_v,
+                log: false,
+                legend: false,
+            },
+            Panel {
+                title: def_title,
+                x_label: "time from touch, ms",
+                measured: def,
+                measured_label: "measured",
+                models: c_x,
+                log: false,
+                legend: false,
+            },
+            Panel {
+                title: force_title,
+                x_label: "deformation, mm",
+                measured: loop_,
+                measured_label: "measured",
+                models: c_f,
+                log: false,
+                legend: false,
+            },
         ];
-        for (j, (label, series, with_fits)) in panels.into_iter().enumerate() {
-            let area = &rows[k * 3 + j];
-            let (mut lo, mut hi) = series
-                .iter()
-                .fold((f64::MAX, f64::MIN), |(l, h), p| (l.min(p.1), h.max(p.1)));
-            if with_fits {
-                for (_, _, s) in &fitted {
-                    for p in s {
-                        lo = lo.min(p.1);
-                        hi = hi.max(p.1);
-                    }
+        if spectra {
+            let (srs, pvss) = match &r.spectrum {
+                Some(sp) => {
+                    let n = usize::from(sp.bands);
+                    let f = |i: usize| sp.frequency_hz(i);
+                    (
+                        (0..n).map(|i| (f(i), sp.srs_m_s2[i] as f64)).collect(),
+                        (0..n).map(|i| (f(i), sp.pvss_m_s[i] as f64)).collect(),
+                    )
                 }
-            }
-            let pad = (hi - lo).abs().max(1e-12) * 0.08;
-            let (t0, t1) = (
-                series.first().map_or(0.0, |p| p.0),
-                series.last().map_or(1.0, |p| p.0),
-            );
-            let mut chart = ChartBuilder::on(area)
-                .caption(format!("impact {} — {label}", r.index), ("sans-serif", 15))
-                .margin(8)
-                .x_label_area_size(30)
-                .y_label_area_size(55)
-                .build_cartesian_2d(t0..t1.max(t0 + 1e-9), (lo - pad)..(hi + pad))
-                .map_err(|e| e.to_string())?;
-            chart
-                .configure_mesh()
-                .x_desc("time from touch, ms")
-                .draw()
-                .map_err(|e| e.to_string())?;
-            chart
-                .draw_series(LineSeries::new(
-                    series.iter().copied(),
-                    BLUE.stroke_width(1),
-                ))
-                .map_err(|e| e.to_string())?
-                .label("measured")
-                .legend(|(x, y)| PathElement::new(vec![(x, y), (x + 18, y)], BLUE));
-            if with_fits {
-                for (name, color, s) in &fitted {
-                    let c = *color;
-                    chart
-                        .draw_series(LineSeries::new(s.iter().copied(), c.stroke_width(2)))
-                        .map_err(|e| e.to_string())?
-                        .label(*name)
-                        .legend(move |(x, y)| {
-                            PathElement::new(vec![(x, y), (x + 18, y)], c.stroke_width(2))
-                        });
-                }
-                chart
-                    .configure_series_labels()
-                    .background_style(WHITE.mix(0.8))
-                    .border_style(BLACK)
-                    .draw()
-                    .map_err(|e| e.to_string())?;
-            }
+                None => (Vec::new(), Vec::new()),
+            };
+            panels.push(Panel {
+                title: "SRS (maximax), m/s²",
+                x_label: "natural frequency, Hz",
+                measured: srs,
+                measured_label: "SRS",
+                models: Vec::new(),
+                log: true,
+                legend: false,
+            });
+            panels.push(Panel {
+                title: "pseudo-velocity shock spectrum, m/s",
+                x_label: "natural frequency, Hz",
+                measured: pvss,
+                measured_label: "PVSS",
+                models: Vec::new(),
+                log: true,
+                legend: false,
+            });
         }
+        for (j, p) in panels.iter().enumerate() {
+            draw_panel(&rows[k * cols + j], Some(r.index), p)?;
+        }
+    }
+    root.present().map_err(|e| e.to_string())
+}
+
+/// `impact simulate --plot` against a wall: each model's deformation, velocity and force
+/// against time and its force against deformation (seed 000's Figs. 17–18 when a Hertz
+/// contact and its linear spring are drawn together).
+pub fn wall_contact(
+    models: &[(crate::simulate::ModelName, impact_core::Model<f64>)],
+    impact: &impact_core::Impact<f64>,
+    path: &std::path::Path,
+) -> Result<(), String> {
+    use crate::simulate::ModelName;
+    use impact_core::solve::trajectory;
+    use impact_core::ContactLaw;
+    const COLOURS: [RGBColor; 3] = [
+        RGBColor(40, 90, 200),
+        RGBColor(200, 60, 40),
+        RGBColor(40, 140, 60),
+    ];
+    let mut curves: [Vec<Curve>; 4] = Default::default();
+    for ((name, model), colour) in models.iter().zip(COLOURS) {
+        let label = match name {
+            ModelName::Hertz => "Hertz",
+            ModelName::Linear => "linear",
+            ModelName::KelvinVoigt => "Kelvin–Voigt",
+            ModelName::TwoPhase => "two-phase",
+            ModelName::Nonlinear => "nonlinear",
+        };
+        let mut s = Vec::new();
+        // 400 points per time scale (a contact lasts a few).
+        let scale = model.time_scale(impact);
+        let dt = (scale / 400.0).max(f64::MIN_POSITIVE);
+        trajectory::sample(model, impact, 1e-10, 0.0, dt, 20_000, |p| s.push(p))
+            .map_err(|e| e.to_string())?;
+        let map = |f: &dyn Fn(&trajectory::Sample<f64>) -> (f64, f64)| {
+            s.iter().map(f).collect::<Vec<_>>()
+        };
+        curves[0].push((label, colour, map(&|p| (p.t_s * 1e3, p.x_m * 1e3))));
+        curves[1].push((label, colour, map(&|p| (p.t_s * 1e3, p.v_m_s))));
+        curves[2].push((label, colour, map(&|p| (p.t_s * 1e3, p.force_n))));
+        curves[3].push((label, colour, map(&|p| (p.x_m * 1e3, p.force_n))));
+    }
+    let root = SVGBackend::new(path, (1600, 360)).into_drawing_area();
+    root.fill(&WHITE).map_err(|e| e.to_string())?;
+    let areas = root.split_evenly((1, 4));
+    let titles = [
+        ("deformation x(t), mm", "time from touch, ms"),
+        ("velocity v(t), m/s", "time from touch, ms"),
+        ("contact force F(t), N", "time from touch, ms"),
+        ("force against deformation F(x), N", "deformation, mm"),
+    ];
+    for (j, (c, (title, x_label))) in curves.into_iter().zip(titles).enumerate() {
+        let p = Panel {
+            title,
+            x_label,
+            measured: Vec::new(),
+            measured_label: "",
+            models: c,
+            log: false,
+            legend: j == 0,
+        };
+        draw_panel(&areas[j], None, &p)?;
     }
     root.present().map_err(|e| e.to_string())
 }

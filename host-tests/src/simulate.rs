@@ -126,6 +126,10 @@ pub struct SimulateArgs {
     pub repeat: Option<u32>,
     #[command(flatten)]
     pub target: crate::target::TargetArgs,
+    /// With --plot against a wall and --model hertz: the linear spring of the same maximum
+    /// deformation on the same axes (seed 000, Figs. 17–18).
+    #[arg(long, requires = "plot")]
+    pub with_linear: bool,
 }
 
 /// A parameter problem, worded for the command line.
@@ -293,12 +297,27 @@ pub enum Outcome {
 /// Runs `impact simulate`, on the target if one is given.
 pub fn run_any(args: &SimulateArgs) -> Result<Outcome, String> {
     if !args.target.given() {
-        if args.target.plot.is_some() {
-            return Err(
-                "--plot: draws a contact with a target; give --target-mass or --target".into(),
-            );
+        let report = run(args)?;
+        if let Some(path) = &args.target.plot {
+            crate::plot::check_output(path, &[])?;
+            let impact = Impact::new(args.mass, args.v0);
+            let model = args.params.model(args.model, &impact)?;
+            let mut models = vec![(args.model, model)];
+            if args.with_linear {
+                let Model::Hertz(h) = model else {
+                    return Err("--with-linear: compares a Hertz contact with its linear spring; give --model hertz".into());
+                };
+                let l = impact_core::model::Linear::matching_max_deformation(&h, &impact)
+                    .map_err(|e| e.to_string())?;
+                models.push((ModelName::Linear, Model::Linear(l)));
+            }
+            crate::plot::wall_contact(&models, &impact, path)?;
+            eprintln!("wrote {}", path.display());
         }
-        return run(args).map(Outcome::Wall);
+        return Ok(Outcome::Wall(report));
+    }
+    if args.with_linear {
+        return Err("--with-linear: against a wall only".into());
     }
     if args.repeat.is_some() {
         return Err("--repeat: times the wall solvers; not with a target".into());

@@ -29,8 +29,9 @@ pub struct TargetArgs {
     /// and velocity (m/s), at most 6 states.
     #[arg(long)]
     pub target: Option<PathBuf>,
-    /// Draw impactor and target displacement, velocity and the contact force over the contact
-    /// and the ring-down into this SVG (needs a target).
+    /// Draw into this SVG: against a wall the deformation, velocity and force against time and
+    /// the force against deformation; on a target the impactor's and target's displacement,
+    /// velocity and the contact force over the contact and the ring-down.
     #[arg(long)]
     pub plot: Option<PathBuf>,
 }

@@ -108,6 +108,25 @@ fn with_mass_and_v0_the_kinematics_and_fits_appear_and_a_plot_is_drawn() {
     );
     let drawn = std::fs::read_to_string(&svg).unwrap();
     assert!(drawn.contains("<svg") && drawn.contains("nonlinear fit"));
+    // Every fit, the force–deformation loop; with --srs the spectra's panels.
+    for text in ["Hertz fit", "two-phase fit", "force against deformation, N"] {
+        assert!(drawn.contains(text), "{text} missing from the plot");
+    }
+    assert!(!drawn.contains("SRS (maximax)"));
+    let (code, _, err) = impact(&[
+        "analyze",
+        f.to_str().unwrap(),
+        "--mass",
+        "0.06",
+        "--v0",
+        "1.3357",
+        "--srs",
+        "--plot",
+        svg.to_str().unwrap(),
+    ]);
+    assert_eq!(code, 0, "{err}");
+    let drawn = std::fs::read_to_string(&svg).unwrap();
+    assert!(drawn.contains("SRS (maximax)") && drawn.contains("pseudo-velocity"));
 }
 
 #[test]

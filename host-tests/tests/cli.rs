@@ -191,6 +191,62 @@ fn simulate_repeat_adds_seconds_per_impact() {
 }
 
 #[test]
+fn simulate_plot_draws_a_hertz_contact_and_its_linear_spring() {
+    let dir = std::env::temp_dir().join(format!("impact-sim-plot-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let svg = dir.join("hertz.svg");
+    let hertz = [
+        "simulate",
+        "--model",
+        "hertz",
+        "--mass",
+        "0.06",
+        "--v0",
+        "1.3357",
+        "--radius",
+        "0.0125",
+        "--youngs",
+        "2e11",
+        "--poisson",
+        "0.3",
+        "--plot",
+    ];
+    let mut args = hertz.to_vec();
+    args.extend([svg.to_str().unwrap(), "--with-linear"]);
+    let (code, _, err) = impact(&args);
+    assert_eq!(code, 0, "{err}");
+    let drawn = std::fs::read_to_string(&svg).unwrap();
+    for text in [
+        "deformation x(t)",
+        "velocity v(t)",
+        "contact force F(t)",
+        "F(x)",
+        "Hertz",
+        "linear",
+    ] {
+        assert!(drawn.contains(text), "{text} missing");
+    }
+    // The linear comparison is for a Hertz contact.
+    let (code, _, err) = impact(&[
+        "simulate",
+        "--model",
+        "linear",
+        "--mass",
+        "0.06",
+        "--v0",
+        "1",
+        "--stiffness",
+        "1e4",
+        "--plot",
+        svg.to_str().unwrap(),
+        "--with-linear",
+    ]);
+    assert_ne!(code, 0);
+    assert!(err.contains("--with-linear"), "{err}");
+    std::fs::remove_dir_all(&dir).ok();
+}
+
+#[test]
 fn simulate_table_is_readable() {
     let (code, out, _) = impact(&[
         "simulate",
@@ -522,7 +578,10 @@ fn a_target_that_cannot_be_pushed_is_a_one_line_error_naming_the_option() {
         (vec!["--target", ragged.to_str().unwrap()], "row 1"),
         (vec!["--target", nan.to_str().unwrap()], "--target"),
         (vec!["--target", "/nonexistent/t.json"], "--target"),
-        (vec!["--plot", "x.svg"], "--plot"),
+        (
+            vec!["--target-mass", "1", "--plot", "x.svg", "--with-linear"],
+            "--with-linear",
+        ),
         (
             vec![
                 "--target-mass",
