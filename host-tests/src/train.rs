@@ -62,9 +62,15 @@ pub struct BounceJson {
     pub v0_flight_m_s: f64,
     /// The previous impact's rebound, m/s (null: it had none).
     pub v0_rebound_m_s: Option<f64>,
-    /// `(Δv - v0) / v0` with each speed (null without Δv).
+    /// `(Δv - v0) / v0` with each speed; null when it cannot be known, the reason beside:
+    /// `ac-coupled` (no Δv), `no-rebound` (no previous rebound), `cor-out-of-range` (outside
+    /// core's [-0.02, 1.02]: that speed or the signal is wrong).
     pub cor_flight: Option<f64>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub cor_flight_null_reason: Option<String>,
     pub cor_rebound: Option<f64>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub cor_rebound_null_reason: Option<String>,
     /// `v0_rebound / v0_flight - 1`.
     pub v0_disagreement: Option<f64>,
 }
@@ -73,18 +79,27 @@ pub struct BounceJson {
 pub fn bounce_json(r: &ImpactReport) -> Option<BounceJson> {
     let b = r.bounce?;
     let f = |v: f32| v as f64;
-    let cor = |v0: f32| {
-        r.delta_v_m_s
-            .map(|dv| f(impact_core::Bounce::cor(v0, dv)))
-            .filter(|c| c.is_finite())
+    let tol = impact_core::analysis::COR_TOLERANCE as f64;
+    let cor = |v0: Option<f32>| -> Result<f64, &'static str> {
+        let v0 = v0.ok_or("no-rebound")?;
+        let dv = r.delta_v_m_s.ok_or("ac-coupled")?;
+        let c = f(impact_core::Bounce::cor(v0, dv));
+        if c.is_finite() && (-tol..=1.0 + tol).contains(&c) {
+            Ok(c)
+        } else {
+            Err("cor-out-of-range")
+        }
     };
+    let (flight, rebound) = (cor(Some(b.v0_flight_m_s)), cor(b.v0_rebound_m_s));
     Some(BounceJson {
         number: b.number,
         flight_s: f(b.flight_s),
         v0_flight_m_s: f(b.v0_flight_m_s),
         v0_rebound_m_s: b.v0_rebound_m_s.map(f),
-        cor_flight: cor(b.v0_flight_m_s),
-        cor_rebound: b.v0_rebound_m_s.and_then(cor),
+        cor_flight: flight.ok(),
+        cor_flight_null_reason: flight.err().map(str::to_string),
+        cor_rebound: rebound.ok(),
+        cor_rebound_null_reason: rebound.err().map(str::to_string),
         v0_disagreement: b
             .v0_rebound_m_s
             .map(|r| f(r) / f(b.v0_flight_m_s) - 1.0)
@@ -222,16 +237,20 @@ pub fn cor_vs_speed(points: &[TrainPoint]) -> Option<CorVsSpeed> {
 /// The table's line for a bounce.
 pub fn table_line(b: &BounceJson) -> String {
     let h = crate::analyze::human;
-    let cor = |c: Option<f64>| c.map_or("-".to_string(), |c| format!("{c:.4}"));
+    let cor = |c: Option<f64>, why: &Option<String>| match (c, why) {
+        (Some(c), _) => format!("{c:.4}"),
+        (None, Some(why)) => why.clone(),
+        (None, None) => "-".to_string(),
+    };
     format!(
         "    bounce {}: flight {} → v0 {} (COR {}); previous rebound {} (COR {}){}\n",
         b.number,
         h(b.flight_s, "s"),
         h(b.v0_flight_m_s, "m/s"),
-        cor(b.cor_flight),
+        cor(b.cor_flight, &b.cor_flight_null_reason),
         b.v0_rebound_m_s
             .map_or("unknown".to_string(), |v| h(v, "m/s")),
-        cor(b.cor_rebound),
+        cor(b.cor_rebound, &b.cor_rebound_null_reason),
         b.v0_disagreement
             .map_or(String::new(), |d| format!(", {:+.2} % apart", 100.0 * d)),
     )
