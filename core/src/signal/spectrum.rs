@@ -158,11 +158,32 @@ fn halve(x: &mut [f32], len: usize) -> Option<usize> {
                 x.get(j as usize).copied().unwrap_or(0.0)
             }
         };
-        let mut acc = HALF_BAND_CENTRE * at(centre);
-        for (k, h) in HALF_BAND.iter().enumerate() {
-            let d = 2 * k as isize + 1;
-            acc += h * (at(centre - d) + at(centre + d));
-        }
+        // Away from both ends (and from the copied head) the 23 inputs are one slice.
+        let first = centre - SPAN as isize;
+        let inner = first >= head.len() as isize && (centre + SPAN as isize) < len as isize;
+        let window: Option<&[f32; 2 * SPAN + 1]> = if inner {
+            x.get(first as usize..first as usize + 2 * SPAN + 1)
+                .and_then(|w| w.try_into().ok())
+        } else {
+            None
+        };
+        let acc = match window {
+            Some(w) => {
+                let mut acc = HALF_BAND_CENTRE * w[SPAN];
+                for (k, h) in HALF_BAND.iter().enumerate() {
+                    acc += h * (w[SPAN - 1 - 2 * k] + w[SPAN + 1 + 2 * k]);
+                }
+                acc
+            }
+            None => {
+                let mut acc = HALF_BAND_CENTRE * at(centre);
+                for (k, h) in HALF_BAND.iter().enumerate() {
+                    let d = 2 * k as isize + 1;
+                    acc += h * (at(centre - d) + at(centre + d));
+                }
+                acc
+            }
+        };
         if let Some(slot) = x.get_mut(i) {
             *slot = acc;
         }
@@ -179,6 +200,14 @@ const EMPHASIS: [f32; 3] = [1.0 + 23.0 / 90.0 - 1.0 / 45.0, -23.0 / 180.0, 1.0 /
 /// samples before the first input to two after the last, `len + 4` of them).
 #[inline]
 fn emphasised(x: &[f32], n: usize) -> f32 {
+    // Inside: the five inputs are one slice.
+    if let Some(w) = n
+        .checked_sub(4)
+        .and_then(|a| x.get(a..a + 5))
+        .and_then(|w| <&[f32; 5]>::try_from(w).ok())
+    {
+        return EMPHASIS[0] * w[2] + EMPHASIS[1] * (w[1] + w[3]) + EMPHASIS[2] * (w[0] + w[4]);
+    }
     let at = |j: isize| {
         if j < 0 {
             0.0
@@ -290,7 +319,14 @@ fn band(
         (w2, w1) = (w1, w);
         (ya, yp)
     };
-    for i in 0..n {
+    // Two samples a turn: the recursion's state changes roles instead of being moved.
+    let mut i = 0;
+    while i + 1 < n {
+        step(i, x(i));
+        step(i + 1, x(i + 1));
+        i += 2;
+    }
+    if i < n {
         step(i, x(i));
     }
     let (ya_1, yp_1) = step(n, 0.0);
@@ -363,7 +399,7 @@ pub fn spectrum(
                 let data = x.get(range.clone()).unwrap_or(&[]);
                 band(data.len(), |i| at(data, i), f, settings.damping, rate, true)
             }
-            // No room for the copy: the same compensation, sample by sample.
+            // No room for the copy: the same pre-emphasis, sample by sample.
             (None, true) => {
                 let data = x.get(..len).unwrap_or(&[]);
                 band(
