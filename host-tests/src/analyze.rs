@@ -11,7 +11,7 @@ use impact_core::solve::bounce::STANDARD_GRAVITY;
 use impact_core::{Approach, Calibration, FitSet, ImpactReport, Scene, Status};
 use serde::{Deserialize, Serialize};
 
-use crate::recording::{read_csv, time_unit_s, ColumnRef, ReadOptions};
+use crate::recording::{read_recording, time_unit_s, ColumnRef, ReadOptions};
 use crate::screen::{self, Clipping, Spike};
 use crate::table::{read_table, CsvFormat};
 
@@ -88,7 +88,8 @@ pub fn positive_f64(s: &str) -> Result<f64, String> {
 /// Options shared by `analyze` and `emulate`.
 #[derive(Args, Clone, Debug, Default)]
 pub struct AnalyzeArgs {
-    /// CSV file (`-`: standard input): a header line (or lines) and numeric rows.
+    /// CSV file (`-`: standard input): a header line (or lines) and numeric rows; or a WAV
+    /// file (`.wav`: integer or float PCM, --column the 0-based channel).
     pub file: PathBuf,
     /// Field separator: one character, or `tab` [default: tab or `;` if the first lines hold
     /// one, else `,`].
@@ -113,6 +114,10 @@ pub struct AnalyzeArgs {
     /// Sample rate, Hz (instead of a time column).
     #[arg(long, value_parser = positive_f64)]
     pub rate: Option<f64>,
+    /// Multiply the channel's values by this first (e.g. g per code of a WAV file's integer
+    /// samples) [default: 1].
+    #[arg(long, value_parser = positive_f64)]
+    pub gain: Option<f64>,
     /// Units of the channel [default: g].
     #[arg(long, value_enum)]
     pub units: Option<Units>,
@@ -504,7 +509,7 @@ pub fn setup(args: &AnalyzeArgs, progress: Option<fn(f64)>) -> Result<Setup, Str
         Some(p) => load_scene(p)?,
         None => SceneFile::default(),
     };
-    let ch = read_csv(
+    let ch = read_recording(
         &args.file,
         &ReadOptions {
             column: args.column.clone(),
@@ -528,7 +533,7 @@ pub fn setup(args: &AnalyzeArgs, progress: Option<fn(f64)>) -> Result<Setup, Str
     }
     let units = args.units.or(file.units).unwrap_or(Units::G);
     let invert = args.invert || file.invert.unwrap_or(false);
-    let scale = units.to_m_s2(mass) * if invert { -1.0 } else { 1.0 };
+    let scale = units.to_m_s2(mass) * args.gain.unwrap_or(1.0) * if invert { -1.0 } else { 1.0 };
     let mut accel: Vec<f64> = ch.values.iter().map(|v| v * scale).collect();
     let spikes = if args.keep_spikes {
         Vec::new()

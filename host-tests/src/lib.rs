@@ -23,6 +23,7 @@ pub mod target;
 pub mod target_bench;
 pub mod throughput;
 pub mod train;
+pub mod wav;
 
 /// Runs `f` on a thread with a 64 MiB stack: the core's monitors hold their capture buffers
 /// inline (no allocation in `core`), which is more than a default thread's stack.

@@ -164,6 +164,16 @@ fn resample(
     Ok((times, values))
 }
 
+/// Reads one channel and its time base from a CSV file (see [`read_table`]) or a WAV file
+/// (by its extension, [`crate::wav`]).
+pub fn read_recording(path: &Path, opts: &ReadOptions) -> Result<Channel, RecordingError> {
+    if crate::wav::is_wav(path) {
+        crate::wav::read_wav(path, opts)
+    } else {
+        read_csv(path, opts)
+    }
+}
+
 /// Reads one channel and its time base (see [`read_table`] for the format).
 pub fn read_csv(path: &Path, opts: &ReadOptions) -> Result<Channel, RecordingError> {
     let err = |message: String| RecordingError {

@@ -1,0 +1,99 @@
+//! WAV recordings (`impact analyze FILE.wav`): one channel of integer or float PCM, at the
+//! rate the header gives, in the file's own units (integer codes or floats; `--gain` and
+//! `--units` turn them into an acceleration).
+
+use std::path::Path;
+
+use crate::recording::{Channel, ReadOptions};
+use crate::table::{ColumnRef, RecordingError};
+
+/// True for a `.wav` file name (any case).
+pub fn is_wav(path: &Path) -> bool {
+    path.extension()
+        .and_then(|e| e.to_str())
+        .is_some_and(|e| e.eq_ignore_ascii_case("wav"))
+}
+
+/// Reads the channel `opts.column` (a 0-based index, default 0).
+pub fn read_wav(path: &Path, opts: &ReadOptions) -> Result<Channel, RecordingError> {
+    let err = |message: String| RecordingError {
+        file: path.to_path_buf(),
+        line: None,
+        message,
+    };
+    if opts.rate_hz.is_some() || opts.time_column.is_some() || opts.resample {
+        return Err(err(
+            "a WAV file gives its own rate: no --rate, --time-column or --resample".into(),
+        ));
+    }
+    if !opts.axes.is_empty() {
+        return Err(err("--axes: not for WAV files yet; give --column".into()));
+    }
+    let mut reader = hound::WavReader::open(path).map_err(|e| err(format!("WAV: {e}")))?;
+    let spec = reader.spec();
+    let channels = usize::from(spec.channels);
+    let column = match &opts.column {
+        None => 0,
+        Some(ColumnRef::Index(i)) if *i < channels => *i,
+        Some(c) => {
+            let c = match c {
+                ColumnRef::Index(i) => i.to_string(),
+                ColumnRef::Name(n) => n.clone(),
+            };
+            return Err(err(format!(
+                "--column {c}: a WAV file's channels are numbered 0..{}",
+                channels.saturating_sub(1)
+            )));
+        }
+    };
+    let rate_hz = f64::from(spec.sample_rate);
+    if spec.sample_rate == 0 {
+        return Err(err("WAV: sample rate 0 in the header".into()));
+    }
+    let frames = reader.duration() as usize;
+    let mut values = Vec::with_capacity(frames);
+    // A sample that cannot be read (a file cut short) is an error naming its frame.
+    let at = |k: usize, e: hound::Error| {
+        err(format!(
+            "WAV: frame {} (of {frames} the header announces): {e}",
+            k / channels.max(1)
+        ))
+    };
+    match spec.sample_format {
+        hound::SampleFormat::Int => {
+            for (k, s) in reader.samples::<i32>().enumerate() {
+                let s = s.map_err(|e| at(k, e))?;
+                if k % channels == column {
+                    values.push(f64::from(s));
+                }
+            }
+        }
+        hound::SampleFormat::Float => {
+            for (k, s) in reader.samples::<f32>().enumerate() {
+                let s = s.map_err(|e| at(k, e))?;
+                if !s.is_finite() {
+                    return Err(err(format!(
+                        "WAV: frame {}: {s} is not finite",
+                        k / channels
+                    )));
+                }
+                if k % channels == column {
+                    values.push(f64::from(s));
+                }
+            }
+        }
+    }
+    if values.len() < 2 {
+        return Err(err(format!("WAV: {} frames; at least 2", values.len())));
+    }
+    let time_s = (0..values.len()).map(|k| k as f64 / rate_hz).collect();
+    Ok(Channel {
+        name: format!("channel {column}"),
+        values,
+        time_s,
+        rate_hz,
+        jitter: 0.0,
+        resampled: false,
+        axes: Vec::new(),
+    })
+}

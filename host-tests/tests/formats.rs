@@ -1,0 +1,121 @@
+//! Recordings in other formats than CSV give the same reports as their CSV twins: the WAV
+//! fixtures of `scripts/make_wav_fixtures.py` (CPython's `wave`, scipy), against CSV files
+//! made here from the same rows of the bundled AFRL record; malformed files are one-line
+//! errors naming the file and the frame.
+
+mod common;
+
+use std::path::PathBuf;
+
+use common::{impact, impact_ok};
+
+fn root() -> PathBuf {
+    PathBuf::from(env!("CARGO_MANIFEST_DIR"))
+}
+
+/// Rows 5000..25000 of AFRL test 1 (the fixtures' source): (bottom, top) in kg_n.
+fn source_rows() -> Vec<(f64, f64)> {
+    let text = std::fs::read_to_string(
+        root().join("../../shared/signals/afrl-drop-tower/series1_test1_full_100ms.csv"),
+    )
+    .unwrap();
+    text.lines()
+        .skip(1 + 5000)
+        .take(20_000)
+        .map(|l| {
+            let mut f = l.split(',').skip(1).map(|v| v.parse::<f64>().unwrap());
+            (f.next().unwrap(), f.next().unwrap())
+        })
+        .collect()
+}
+
+fn temp(name: &str) -> PathBuf {
+    let dir = std::env::temp_dir().join(format!("impact-formats-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    dir.join(name)
+}
+
+/// A CSV of `values` at 1 MS/s from t = 0.
+fn twin(name: &str, values: impl Iterator<Item = String>) -> PathBuf {
+    let mut text = String::from("time_s,value\n");
+    for (k, v) in values.enumerate() {
+        text.push_str(&format!("{:.6},{v}\n", k as f64 * 1e-6));
+    }
+    let path = temp(name);
+    std::fs::write(&path, text).unwrap();
+    path
+}
+
+fn json(file: &std::path::Path, extra: &[&str]) -> String {
+    let mut args = vec![
+        "analyze",
+        file.to_str().unwrap(),
+        "--units",
+        "kgn",
+        "--json",
+    ];
+    args.extend_from_slice(extra);
+    impact_ok(&args).0
+}
+
+#[test]
+fn integer_wav_channels_give_their_csv_twins_reports() {
+    let wav = root().join("fixtures/afrl-test1-int16.wav");
+    let rows = source_rows();
+    // The codes the fixture holds: round half to even of kg_n × 1000 (Python's round).
+    let code = |v: f64| ((v * 1000.0).round_ties_even() as i64).to_string();
+    for (channel, pick) in [(0, 0usize), (1, 1)] {
+        let csv = twin(
+            &format!("int16-{channel}.csv"),
+            rows.iter().map(|r| code(if pick == 0 { r.0 } else { r.1 })),
+        );
+        let ch = channel.to_string();
+        let from_wav = json(&wav, &["--column", &ch, "--gain", "0.001"]);
+        let from_csv = json(&csv, &["--gain", "0.001"]);
+        assert_eq!(from_wav, from_csv, "channel {channel}");
+        let v: serde_json::Value = serde_json::from_str(&from_wav).unwrap();
+        assert_eq!(v["samples"], 20_000);
+        assert!(!v["impacts"].as_array().unwrap().is_empty());
+    }
+}
+
+#[test]
+fn float_wav_gives_its_csv_twins_report() {
+    let wav = root().join("fixtures/afrl-test1-float32.wav");
+    // The fixture's float32 values exactly (as f64 decimals that give them back).
+    let csv = twin(
+        "float32.csv",
+        source_rows()
+            .iter()
+            .map(|r| format!("{}", r.0 as f32 as f64)),
+    );
+    assert_eq!(json(&wav, &[]), json(&csv, &[]));
+}
+
+#[test]
+fn malformed_wav_files_are_one_line_errors_naming_file_and_frame() {
+    let good = std::fs::read(root().join("fixtures/afrl-test1-int16.wav")).unwrap();
+    let cut = temp("cut.wav");
+    // Cut in the middle of the data: the header announces more frames than the file holds.
+    std::fs::write(&cut, &good[..good.len() / 2 + 1]).unwrap();
+    let garbage = temp("garbage.wav");
+    std::fs::write(&garbage, b"RIFF\x10\x00\x00\x00WAVEjunkjunkjunk").unwrap();
+    let wav = root().join("fixtures/afrl-test1-int16.wav");
+    for (file, extra, want) in [
+        (&cut, vec![], "frame"),
+        (&garbage, vec![], "WAV"),
+        (&wav, vec!["--column", "2"], "--column 2"),
+        (&wav, vec!["--column", "z_g"], "--column z_g"),
+        (&wav, vec!["--rate", "1000"], "own rate"),
+    ] {
+        let mut args = vec!["analyze", file.to_str().unwrap()];
+        args.extend(extra.iter().copied());
+        let (code, _, err) = impact(&args);
+        assert_ne!(code, 0, "{args:?}");
+        assert!(
+            err.contains(want) && err.contains(file.file_name().unwrap().to_str().unwrap()),
+            "{args:?}: {err}"
+        );
+        assert_eq!(err.trim().lines().count(), 1, "{err}");
+    }
+}
