@@ -89,7 +89,8 @@ pub fn positive_f64(s: &str) -> Result<f64, String> {
 #[derive(Args, Clone, Debug, Default)]
 pub struct AnalyzeArgs {
     /// CSV file (`-`: standard input): a header line (or lines) and numeric rows; or a WAV
-    /// file (`.wav`: integer or float PCM, --column the 0-based channel).
+    /// file (`.wav`: integer or float PCM, --column the 0-based channel); or a numpy array
+    /// (`.npy` with --rate: 1-D, or 2-D samples × channels, --column the channel).
     pub file: PathBuf,
     /// Field separator: one character, or `tab` [default: tab or `;` if the first lines hold
     /// one, else `,`].

@@ -8,6 +8,7 @@ pub mod compare;
 pub mod emulate;
 pub mod log;
 pub mod m4;
+pub mod npy;
 pub mod plot;
 pub mod precision;
 pub mod realtime;

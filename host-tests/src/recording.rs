@@ -164,11 +164,13 @@ fn resample(
     Ok((times, values))
 }
 
-/// Reads one channel and its time base from a CSV file (see [`read_table`]) or a WAV file
-/// (by its extension, [`crate::wav`]).
+/// Reads one channel and its time base from a CSV file (see [`read_table`]), a WAV file or
+/// an `.npy` array (by the extension: [`crate::wav`], [`crate::npy`]).
 pub fn read_recording(path: &Path, opts: &ReadOptions) -> Result<Channel, RecordingError> {
     if crate::wav::is_wav(path) {
         crate::wav::read_wav(path, opts)
+    } else if crate::npy::is_npy(path) {
+        crate::npy::read_npy(path, opts)
     } else {
         read_csv(path, opts)
     }

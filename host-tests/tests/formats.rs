@@ -1,7 +1,7 @@
 //! Recordings in other formats than CSV give the same reports as their CSV twins: the WAV
-//! fixtures of `scripts/make_wav_fixtures.py` (CPython's `wave`, scipy), against CSV files
-//! made here from the same rows of the bundled AFRL record; malformed files are one-line
-//! errors naming the file and the frame.
+//! and `.npy` fixtures of `scripts/make_format_fixtures.py` (CPython's `wave`, scipy, numpy),
+//! against CSV files made here from the same rows of the bundled AFRL record; malformed
+//! files are one-line errors naming the file (and the frame).
 
 mod common;
 
@@ -13,15 +13,20 @@ fn root() -> PathBuf {
     PathBuf::from(env!("CARGO_MANIFEST_DIR"))
 }
 
-/// Rows 5000..25000 of AFRL test 1 (the fixtures' source): (bottom, top) in kg_n.
+/// Rows 5000..25000 of AFRL test 1 (the WAV fixtures' source): (bottom, top) in kg_n.
 fn source_rows() -> Vec<(f64, f64)> {
+    rows(5000, 20_000)
+}
+
+/// `count` rows of AFRL test 1 from `first`: (bottom, top) in kg_n.
+fn rows(first: usize, count: usize) -> Vec<(f64, f64)> {
     let text = std::fs::read_to_string(
         root().join("../../shared/signals/afrl-drop-tower/series1_test1_full_100ms.csv"),
     )
     .unwrap();
     text.lines()
-        .skip(1 + 5000)
-        .take(20_000)
+        .skip(1 + first)
+        .take(count)
         .map(|l| {
             let mut f = l.split(',').skip(1).map(|v| v.parse::<f64>().unwrap());
             (f.next().unwrap(), f.next().unwrap())
@@ -107,6 +112,62 @@ fn malformed_wav_files_are_one_line_errors_naming_file_and_frame() {
         (&wav, vec!["--column", "2"], "--column 2"),
         (&wav, vec!["--column", "z_g"], "--column z_g"),
         (&wav, vec!["--rate", "1000"], "own rate"),
+    ] {
+        let mut args = vec!["analyze", file.to_str().unwrap()];
+        args.extend(extra.iter().copied());
+        let (code, _, err) = impact(&args);
+        assert_ne!(code, 0, "{args:?}");
+        assert!(
+            err.contains(want) && err.contains(file.file_name().unwrap().to_str().unwrap()),
+            "{args:?}: {err}"
+        );
+        assert_eq!(err.trim().lines().count(), 1, "{err}");
+    }
+}
+
+#[test]
+fn npy_arrays_in_either_order_give_their_csv_twins_reports() {
+    let rows = rows(8000, 10_000);
+    let code = |v: f64| ((v * 1000.0).round_ties_even() as i64).to_string();
+    let ints = root().join("fixtures/afrl-test1-int16.npy");
+    let floats = root().join("fixtures/afrl-test1-float32-fortran.npy");
+    for column in [0usize, 1] {
+        let pick = |r: &(f64, f64)| if column == 0 { r.0 } else { r.1 };
+        let c = column.to_string();
+        let csv = twin(
+            &format!("npy-int16-{column}.csv"),
+            rows.iter().map(|r| code(pick(r))),
+        );
+        assert_eq!(
+            json(&ints, &["--rate", "1e6", "--column", &c, "--gain", "0.001"]),
+            json(&csv, &["--gain", "0.001"]),
+            "int16 column {column}"
+        );
+        let csv = twin(
+            &format!("npy-f32-{column}.csv"),
+            rows.iter().map(|r| format!("{}", pick(r) as f32 as f64)),
+        );
+        assert_eq!(
+            json(&floats, &["--rate", "1e6", "--column", &c]),
+            json(&csv, &[]),
+            "float32 (Fortran order) column {column}"
+        );
+    }
+}
+
+#[test]
+fn malformed_npy_files_are_one_line_errors_naming_the_file() {
+    let good = std::fs::read(root().join("fixtures/afrl-test1-int16.npy")).unwrap();
+    let cut = temp("cut.npy");
+    std::fs::write(&cut, &good[..good.len() / 2]).unwrap();
+    let garbage = temp("garbage.npy");
+    std::fs::write(&garbage, b"\x93NUMPY\x01\x00junk").unwrap();
+    let npy = root().join("fixtures/afrl-test1-int16.npy");
+    for (file, extra, want) in [
+        (&cut, vec!["--rate", "1e6"], "npy"),
+        (&garbage, vec!["--rate", "1e6"], "npy"),
+        (&npy, vec![], "--rate"),
+        (&npy, vec!["--rate", "1e6", "--column", "2"], "--column 2"),
     ] {
         let mut args = vec!["analyze", file.to_str().unwrap()];
         args.extend(extra.iter().copied());

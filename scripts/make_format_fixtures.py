@@ -1,15 +1,19 @@
 #!/usr/bin/env python3
-"""Writes the WAV fixtures of host-tests/tests/formats.rs from the bundled AFRL record
+"""Writes the WAV and .npy fixtures of host-tests/tests/formats.rs from the bundled AFRL record
 (../shared/signals/afrl-drop-tower/series1_test1_full_100ms.csv, rows 5000..25000 of test 1):
 
 - host-tests/fixtures/afrl-test1-int16.wav: 2 channels (bottom, top), 16-bit integer PCM,
   codes = round_half_even(kg_n * 1000), written by CPython's standard `wave` module;
 - host-tests/fixtures/afrl-test1-float32.wav: 1 channel (bottom), 32-bit float PCM in kg_n,
-  written by scipy.io.wavfile.
+  written by scipy.io.wavfile;
+- host-tests/fixtures/afrl-test1-int16.npy: rows 8000..18000, shape (10000, 2) int16 codes as
+  above, C order, written by numpy.save;
+- host-tests/fixtures/afrl-test1-float32-fortran.npy: the same rows, shape (10000, 2) float32
+  kg_n in Fortran order, written by numpy.save.
 
 Made with CPython 3.11.7 (`wave`), numpy 2.4.6 and scipy 1.17.1:
     python3 -m venv /tmp/wavpy && /tmp/wavpy/bin/pip install numpy==2.4.6 scipy==1.17.1
-    /tmp/wavpy/bin/python scripts/make_wav_fixtures.py
+    /tmp/wavpy/bin/python scripts/make_format_fixtures.py
 """
 import csv
 import pathlib
@@ -42,4 +46,10 @@ with wave.open(str(OUT / "afrl-test1-int16.wav"), "wb") as w:
     w.writeframes(frames)
 
 scipy.io.wavfile.write(OUT / "afrl-test1-float32.wav", RATE, np.array(bottom, dtype=np.float32))
-print("wrote", sorted(p.name for p in OUT.glob("*.wav")))
+# .npy: a shorter window (rows 8000..18000 of the record: 3000..13000 of the slice above).
+b = np.array(bottom[3000:13000])
+t = np.array(top[3000:13000])
+codes = np.stack([np.round(b * 1000.0), np.round(t * 1000.0)], axis=1).astype(np.int16)
+np.save(OUT / "afrl-test1-int16.npy", codes)
+np.save(OUT / "afrl-test1-float32-fortran.npy", np.asfortranarray(np.stack([b, t], axis=1).astype(np.float32)))
+print("wrote", sorted(p.name for p in OUT.glob("*.*")))

@@ -1,0 +1,138 @@
+//! `.npy` arrays (`impact analyze FILE.npy --rate HZ`): numpy's format, read by `npyz`; a 1-D
+//! array is the channel, a 2-D one (rows are samples, C or Fortran order) gives its channel
+//! by `--column` (0-based). Little- or big-endian integers and floats.
+
+use std::io::BufReader;
+use std::path::Path;
+
+use crate::recording::{Channel, ReadOptions};
+use crate::table::{ColumnRef, RecordingError};
+
+/// True for a `.npy` file name (any case).
+pub fn is_npy(path: &Path) -> bool {
+    path.extension()
+        .and_then(|e| e.to_str())
+        .is_some_and(|e| e.eq_ignore_ascii_case("npy"))
+}
+
+/// Every element of `file` as f64, in storage order, whatever its numeric dtype.
+fn elements(file: npyz::NpyFile<BufReader<std::fs::File>>) -> Result<Vec<f64>, String> {
+    fn all<T: npyz::Deserialize + Into<f64>>(
+        r: npyz::NpyReader<T, BufReader<std::fs::File>>,
+    ) -> Result<Vec<f64>, String> {
+        r.enumerate()
+            .map(|(k, v)| v.map(Into::into).map_err(|e| format!("element {k}: {e}")))
+            .collect()
+    }
+    let dtype = file.dtype().descr();
+    let file = match file.try_data::<f64>() {
+        Ok(r) => return all(r),
+        Err(f) => f,
+    };
+    let file = match file.try_data::<f32>() {
+        Ok(r) => return all(r),
+        Err(f) => f,
+    };
+    let file = match file.try_data::<i32>() {
+        Ok(r) => return all(r),
+        Err(f) => f,
+    };
+    let file = match file.try_data::<i16>() {
+        Ok(r) => return all(r),
+        Err(f) => f,
+    };
+    let file = match file.try_data::<u16>() {
+        Ok(r) => return all(r),
+        Err(f) => f,
+    };
+    let file = match file.try_data::<i8>() {
+        Ok(r) => return all(r),
+        Err(f) => f,
+    };
+    match file.try_data::<u8>() {
+        Ok(r) => all(r),
+        Err(_) => Err(format!(
+            "dtype {dtype}: not one of float64, float32, int32, int16, uint16, int8, uint8"
+        )),
+    }
+}
+
+/// Reads the channel `opts.column` of a 1-D or 2-D array at `opts.rate_hz`.
+pub fn read_npy(path: &Path, opts: &ReadOptions) -> Result<Channel, RecordingError> {
+    let err = |message: String| RecordingError {
+        file: path.to_path_buf(),
+        line: None,
+        message,
+    };
+    let Some(rate_hz) = opts.rate_hz else {
+        return Err(err("an .npy array holds no time: give --rate".into()));
+    };
+    if !(rate_hz.is_finite() && rate_hz > 0.0 && rate_hz <= 1e9) {
+        return Err(err(format!("rate {rate_hz} Hz is not in (0, 1e9]")));
+    }
+    if opts.time_column.is_some() || opts.resample || !opts.axes.is_empty() {
+        return Err(err(
+            "an .npy array takes --rate and --column only (no --time-column, --resample, --axes)"
+                .into(),
+        ));
+    }
+    let f = std::fs::File::open(path).map_err(|e| err(e.to_string()))?;
+    let file = npyz::NpyFile::new(BufReader::new(f)).map_err(|e| err(format!("npy: {e}")))?;
+    let shape = file.shape().to_vec();
+    let order = file.order();
+    let (rows, cols) = match shape[..] {
+        [n] => (n as usize, 1),
+        [n, c] => (n as usize, c as usize),
+        _ => {
+            return Err(err(format!(
+                "npy: shape {shape:?}; a 1-D array or 2-D (samples × channels)"
+            )))
+        }
+    };
+    let column = match &opts.column {
+        None => 0,
+        Some(ColumnRef::Index(i)) if *i < cols => *i,
+        Some(c) => {
+            let c = match c {
+                ColumnRef::Index(i) => i.to_string(),
+                ColumnRef::Name(n) => n.clone(),
+            };
+            return Err(err(format!(
+                "--column {c}: the array's columns are numbered 0..{}",
+                cols.saturating_sub(1)
+            )));
+        }
+    };
+    let all = elements(file).map_err(|e| err(format!("npy: {e}")))?;
+    if all.len() != rows * cols {
+        return Err(err(format!(
+            "npy: {} elements for shape {shape:?}",
+            all.len()
+        )));
+    }
+    let at = |i: usize| match order {
+        npyz::Order::C => all.get(i * cols + column),
+        npyz::Order::Fortran => all.get(column * rows + i),
+    };
+    let mut values = Vec::with_capacity(rows);
+    for i in 0..rows {
+        match at(i).copied() {
+            Some(v) if v.is_finite() => values.push(v),
+            Some(v) => return Err(err(format!("npy: row {i}: {v} is not finite"))),
+            None => return Err(err(format!("npy: row {i} missing"))),
+        }
+    }
+    if values.len() < 2 {
+        return Err(err(format!("npy: {} samples; at least 2", values.len())));
+    }
+    let time_s = (0..values.len()).map(|k| k as f64 / rate_hz).collect();
+    Ok(Channel {
+        name: format!("column {column}"),
+        values,
+        time_s,
+        rate_hz,
+        jitter: 0.0,
+        resampled: false,
+        axes: Vec::new(),
+    })
+}
