@@ -9,7 +9,11 @@
 - host-tests/fixtures/afrl-test1-int16.npy: rows 8000..18000, shape (10000, 2) int16 codes as
   above, C order, written by numpy.save;
 - host-tests/fixtures/afrl-test1-float32-fortran.npy: the same rows, shape (10000, 2) float32
-  kg_n in Fortran order, written by numpy.save.
+  kg_n in Fortran order, written by numpy.save;
+- host-tests/fixtures/afrl-test1-2ch.i16: the int16 codes above, two channels interleaved,
+  little-endian, written by numpy's tofile;
+- host-tests/fixtures/afrl-test1.f32: the bottom channel's float32 kg_n, little-endian, by
+  numpy's tofile.
 
 Made with CPython 3.11.7 (`wave`), numpy 2.4.6 and scipy 1.17.1:
     python3 -m venv /tmp/wavpy && /tmp/wavpy/bin/pip install numpy==2.4.6 scipy==1.17.1
@@ -52,4 +56,6 @@ t = np.array(top[3000:13000])
 codes = np.stack([np.round(b * 1000.0), np.round(t * 1000.0)], axis=1).astype(np.int16)
 np.save(OUT / "afrl-test1-int16.npy", codes)
 np.save(OUT / "afrl-test1-float32-fortran.npy", np.asfortranarray(np.stack([b, t], axis=1).astype(np.float32)))
+codes.astype("<i2").tofile(OUT / "afrl-test1-2ch.i16")
+b.astype("<f4").tofile(OUT / "afrl-test1.f32")
 print("wrote", sorted(p.name for p in OUT.glob("*.*")))

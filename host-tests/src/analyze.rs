@@ -90,7 +90,8 @@ pub fn positive_f64(s: &str) -> Result<f64, String> {
 pub struct AnalyzeArgs {
     /// CSV file (`-`: standard input): a header line (or lines) and numeric rows; or a WAV
     /// file (`.wav`: integer or float PCM, --column the 0-based channel); or a numpy array
-    /// (`.npy` with --rate: 1-D, or 2-D samples × channels, --column the channel).
+    /// (`.npy` with --rate: 1-D, or 2-D samples × channels, --column the channel); or a raw
+    /// little-endian file (`.i16`, `.f32` with --rate, --raw-channels, --column).
     pub file: PathBuf,
     /// Field separator: one character, or `tab` [default: tab or `;` if the first lines hold
     /// one, else `,`].
@@ -115,6 +116,9 @@ pub struct AnalyzeArgs {
     /// Sample rate, Hz (instead of a time column).
     #[arg(long, value_parser = positive_f64)]
     pub rate: Option<f64>,
+    /// Interleaved channels of a raw `.i16`/`.f32` file [default: 1].
+    #[arg(long)]
+    pub raw_channels: Option<usize>,
     /// Multiply the channel's values by this first (e.g. g per code of a WAV file's integer
     /// samples) [default: 1].
     #[arg(long, value_parser = positive_f64)]
@@ -515,6 +519,7 @@ pub fn setup(args: &AnalyzeArgs, progress: Option<fn(f64)>) -> Result<Setup, Str
         &ReadOptions {
             column: args.column.clone(),
             axes: args.axes.clone(),
+            raw_channels: args.raw_channels,
             time_column: args.time_column.clone(),
             rate_hz: args.rate,
             resample: args.resample,

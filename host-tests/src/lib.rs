@@ -11,6 +11,7 @@ pub mod m4;
 pub mod npy;
 pub mod plot;
 pub mod precision;
+pub mod raw;
 pub mod realtime;
 pub mod recording;
 pub mod screen;

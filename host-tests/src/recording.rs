@@ -41,6 +41,8 @@ pub struct ReadOptions {
     pub resample: bool,
     /// Delimiter and decimal mark.
     pub format: CsvFormat,
+    /// Interleaved channels of a raw `.i16`/`.f32` file [default: 1].
+    pub raw_channels: Option<usize>,
     /// Called with the fraction of the file read, for progress display.
     pub progress: Option<fn(f64)>,
 }
@@ -164,13 +166,16 @@ fn resample(
     Ok((times, values))
 }
 
-/// Reads one channel and its time base from a CSV file (see [`read_table`]), a WAV file or
-/// an `.npy` array (by the extension: [`crate::wav`], [`crate::npy`]).
+/// Reads one channel and its time base from a CSV file (see [`read_table`]), a WAV file, an
+/// `.npy` array or a raw `.i16`/`.f32` file (by the extension: [`crate::wav`],
+/// [`crate::npy`], [`crate::raw`]).
 pub fn read_recording(path: &Path, opts: &ReadOptions) -> Result<Channel, RecordingError> {
     if crate::wav::is_wav(path) {
         crate::wav::read_wav(path, opts)
     } else if crate::npy::is_npy(path) {
         crate::npy::read_npy(path, opts)
+    } else if let Some(kind) = crate::raw::RawType::of(path) {
+        crate::raw::read_raw(path, kind, opts.raw_channels.unwrap_or(1), opts)
     } else {
         read_csv(path, opts)
     }

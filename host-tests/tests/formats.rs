@@ -180,3 +180,63 @@ fn malformed_npy_files_are_one_line_errors_naming_the_file() {
         assert_eq!(err.trim().lines().count(), 1, "{err}");
     }
 }
+
+#[test]
+fn raw_files_give_their_csv_twins_reports() {
+    let rows = rows(8000, 10_000);
+    let code = |v: f64| ((v * 1000.0).round_ties_even() as i64).to_string();
+    let ints = root().join("fixtures/afrl-test1-2ch.i16");
+    for column in [0usize, 1] {
+        let pick = |r: &(f64, f64)| if column == 0 { r.0 } else { r.1 };
+        let c = column.to_string();
+        let csv = twin(
+            &format!("raw-i16-{column}.csv"),
+            rows.iter().map(|r| code(pick(r))),
+        );
+        assert_eq!(
+            json(
+                &ints,
+                &[
+                    "--rate",
+                    "1e6",
+                    "--raw-channels",
+                    "2",
+                    "--column",
+                    &c,
+                    "--gain",
+                    "0.001"
+                ]
+            ),
+            json(&csv, &["--gain", "0.001"]),
+            "i16 column {column}"
+        );
+    }
+    let csv = twin(
+        "raw-f32.csv",
+        rows.iter().map(|r| format!("{}", r.0 as f32 as f64)),
+    );
+    assert_eq!(
+        json(&root().join("fixtures/afrl-test1.f32"), &["--rate", "1e6"]),
+        json(&csv, &[])
+    );
+    // A file that is not whole frames names the byte where the last one starts.
+    let good = std::fs::read(&ints).unwrap();
+    let cut = temp("cut.i16");
+    std::fs::write(&cut, &good[..good.len() - 3]).unwrap();
+    let (code, _, err) = impact(&[
+        "analyze",
+        cut.to_str().unwrap(),
+        "--rate",
+        "1e6",
+        "--raw-channels",
+        "2",
+    ]);
+    assert_ne!(code, 0);
+    assert!(
+        err.contains("cut.i16") && err.contains("byte 39996"),
+        "{err}"
+    );
+    let (code, _, err) = impact(&["analyze", ints.to_str().unwrap()]);
+    assert_ne!(code, 0);
+    assert!(err.contains("--rate"), "{err}");
+}

@@ -1,0 +1,119 @@
+//! Raw binary recordings (`FILE.i16` or `FILE.f32`: little-endian 16-bit integers or 32-bit
+//! floats, `--rate` and `--gain` given, channels interleaved by `--raw-channels`), as DAQ
+//! programs and DMA dumps write them.
+
+use std::path::Path;
+
+use crate::recording::{Channel, ReadOptions};
+use crate::table::{ColumnRef, RecordingError};
+
+/// The sample type a raw file's extension names.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum RawType {
+    I16,
+    F32,
+}
+
+impl RawType {
+    /// From the extension: `.i16` or `.f32` (any case).
+    pub fn of(path: &Path) -> Option<Self> {
+        let e = path.extension()?.to_str()?.to_ascii_lowercase();
+        match e.as_str() {
+            "i16" => Some(RawType::I16),
+            "f32" => Some(RawType::F32),
+            _ => None,
+        }
+    }
+
+    fn bytes(self) -> usize {
+        match self {
+            RawType::I16 => 2,
+            RawType::F32 => 4,
+        }
+    }
+}
+
+/// Reads channel `opts.column` (0-based) of `channels` interleaved ones.
+pub fn read_raw(
+    path: &Path,
+    kind: RawType,
+    channels: usize,
+    opts: &ReadOptions,
+) -> Result<Channel, RecordingError> {
+    let err = |message: String| RecordingError {
+        file: path.to_path_buf(),
+        line: None,
+        message,
+    };
+    let Some(rate_hz) = opts.rate_hz else {
+        return Err(err("a raw file holds no time: give --rate".into()));
+    };
+    if !(rate_hz.is_finite() && rate_hz > 0.0 && rate_hz <= 1e9) {
+        return Err(err(format!("rate {rate_hz} Hz is not in (0, 1e9]")));
+    }
+    if opts.time_column.is_some() || opts.resample || !opts.axes.is_empty() {
+        return Err(err(
+            "a raw file takes --rate, --raw-channels and --column only".into(),
+        ));
+    }
+    if !(1..=64).contains(&channels) {
+        return Err(err(format!(
+            "--raw-channels {channels}: must lie in 1..=64"
+        )));
+    }
+    let column = match &opts.column {
+        None => 0,
+        Some(ColumnRef::Index(i)) if *i < channels => *i,
+        Some(c) => {
+            let c = match c {
+                ColumnRef::Index(i) => i.to_string(),
+                ColumnRef::Name(n) => n.clone(),
+            };
+            return Err(err(format!(
+                "--column {c}: the file's {channels} interleaved channels are numbered 0..{}",
+                channels - 1
+            )));
+        }
+    };
+    let bytes = std::fs::read(path).map_err(|e| err(e.to_string()))?;
+    let frame = kind.bytes() * channels;
+    if bytes.len() % frame != 0 {
+        return Err(err(format!(
+            "{} bytes: not a whole number of {frame}-byte frames ({channels} channel(s) of {} bytes); the last frame starts at byte {}",
+            bytes.len(),
+            kind.bytes(),
+            bytes.len() / frame * frame
+        )));
+    }
+    let mut values = Vec::with_capacity(bytes.len() / frame);
+    for (k, f) in bytes.chunks_exact(frame).enumerate() {
+        let at = column * kind.bytes();
+        let v = match kind {
+            RawType::I16 => f64::from(i16::from_le_bytes([f[at], f[at + 1]])),
+            RawType::F32 => {
+                let v = f32::from_le_bytes([f[at], f[at + 1], f[at + 2], f[at + 3]]);
+                if !v.is_finite() {
+                    return Err(err(format!(
+                        "frame {k} (byte {}): {v} is not finite",
+                        k * frame + at
+                    )));
+                }
+                f64::from(v)
+            }
+        };
+        values.push(v);
+    }
+    if values.len() < 2 {
+        return Err(err(format!("{} frames; at least 2", values.len())));
+    }
+    let time_s = (0..values.len()).map(|k| k as f64 / rate_hz).collect();
+    Ok(Channel {
+        name: format!("channel {column}"),
+        values,
+        time_s,
+        rate_hz,
+        jitter: 0.0,
+        resampled: false,
+        axes: Vec::new(),
+    })
+}
