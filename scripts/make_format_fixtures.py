@@ -13,10 +13,12 @@
 - host-tests/fixtures/afrl-test1-2ch.i16: the int16 codes above, two channels interleaved,
   little-endian, written by numpy's tofile;
 - host-tests/fixtures/afrl-test1.f32: the bottom channel's float32 kg_n, little-endian, by
-  numpy's tofile.
+  numpy's tofile;
+- host-tests/fixtures/afrl-test1.tdms: group `afrl`, channels `bottom_kgn` (float64 kg_n) and
+  `top_codes` (int16 codes), both with wf_increment 1e-6, written by npTDMS 1.13.0.
 
-Made with CPython 3.11.7 (`wave`), numpy 2.4.6 and scipy 1.17.1:
-    python3 -m venv /tmp/wavpy && /tmp/wavpy/bin/pip install numpy==2.4.6 scipy==1.17.1
+Made with CPython 3.11.7 (`wave`), numpy 2.4.6, scipy 1.17.1 and npTDMS 1.13.0:
+    python3 -m venv /tmp/wavpy && /tmp/wavpy/bin/pip install numpy==2.4.6 scipy==1.17.1 npTDMS==1.13.0
     /tmp/wavpy/bin/python scripts/make_format_fixtures.py
 """
 import csv
@@ -58,4 +60,11 @@ np.save(OUT / "afrl-test1-int16.npy", codes)
 np.save(OUT / "afrl-test1-float32-fortran.npy", np.asfortranarray(np.stack([b, t], axis=1).astype(np.float32)))
 codes.astype("<i2").tofile(OUT / "afrl-test1-2ch.i16")
 b.astype("<f4").tofile(OUT / "afrl-test1.f32")
+from nptdms import ChannelObject, TdmsWriter
+
+with TdmsWriter(str(OUT / "afrl-test1.tdms")) as w:
+    w.write_segment([
+        ChannelObject("afrl", "bottom_kgn", b.astype(np.float64), properties={"wf_increment": 1e-6}),
+        ChannelObject("afrl", "top_codes", codes[:, 1].copy(), properties={"wf_increment": 1e-6}),
+    ])
 print("wrote", sorted(p.name for p in OUT.glob("*.*")))

@@ -90,8 +90,9 @@ pub fn positive_f64(s: &str) -> Result<f64, String> {
 pub struct AnalyzeArgs {
     /// CSV file (`-`: standard input): a header line (or lines) and numeric rows; or a WAV
     /// file (`.wav`: integer or float PCM, --column the 0-based channel); or a numpy array
-    /// (`.npy` with --rate: 1-D, or 2-D samples × channels, --column the channel); or a raw
-    /// little-endian file (`.i16`, `.f32` with --rate, --raw-channels, --column).
+    /// (`.npy` with --rate: 1-D, or 2-D samples × channels, --column the channel); or an NI
+    /// TDMS file (`.tdms`, --column group/channel); or a raw little-endian file (`.i16`,
+    /// `.f32` with --rate, --raw-channels, --column).
     pub file: PathBuf,
     /// Field separator: one character, or `tab` [default: tab or `;` if the first lines hold
     /// one, else `,`].

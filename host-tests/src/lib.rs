@@ -23,6 +23,7 @@ pub mod synth;
 pub mod table;
 pub mod target;
 pub mod target_bench;
+pub mod tdms;
 pub mod throughput;
 pub mod train;
 pub mod wav;

@@ -167,13 +167,15 @@ fn resample(
 }
 
 /// Reads one channel and its time base from a CSV file (see [`read_table`]), a WAV file, an
-/// `.npy` array or a raw `.i16`/`.f32` file (by the extension: [`crate::wav`],
-/// [`crate::npy`], [`crate::raw`]).
+/// `.npy` array, a TDMS file or a raw `.i16`/`.f32` file (by the extension: [`crate::wav`],
+/// [`crate::npy`], [`crate::tdms`], [`crate::raw`]).
 pub fn read_recording(path: &Path, opts: &ReadOptions) -> Result<Channel, RecordingError> {
     if crate::wav::is_wav(path) {
         crate::wav::read_wav(path, opts)
     } else if crate::npy::is_npy(path) {
         crate::npy::read_npy(path, opts)
+    } else if crate::tdms::is_tdms(path) {
+        crate::tdms::read_tdms(path, opts)
     } else if let Some(kind) = crate::raw::RawType::of(path) {
         crate::raw::read_raw(path, kind, opts.raw_channels.unwrap_or(1), opts)
     } else {

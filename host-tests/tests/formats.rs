@@ -240,3 +240,35 @@ fn raw_files_give_their_csv_twins_reports() {
     assert_ne!(code, 0);
     assert!(err.contains("--rate"), "{err}");
 }
+
+#[test]
+fn tdms_channels_give_their_csv_twins_reports() {
+    let rows = rows(8000, 10_000);
+    let tdms = root().join("fixtures/afrl-test1.tdms");
+    // float64 kg_n at the wf_increment's rate, by its full name.
+    let csv = twin("tdms-bottom.csv", rows.iter().map(|r| format!("{}", r.0)));
+    assert_eq!(
+        json(&tdms, &["--column", "afrl/bottom_kgn"]),
+        json(&csv, &[])
+    );
+    // int16 codes, by the channel's own name.
+    let code = |v: f64| ((v * 1000.0).round_ties_even() as i64).to_string();
+    let csv = twin("tdms-top.csv", rows.iter().map(|r| code(r.1)));
+    assert_eq!(
+        json(&tdms, &["--column", "top_codes", "--gain", "0.001"]),
+        json(&csv, &["--gain", "0.001"])
+    );
+    // A missing channel lists the file's; a file cut short is one line naming the file.
+    let (code, _, err) = impact(&["analyze", tdms.to_str().unwrap(), "--column", "z"]);
+    assert_ne!(code, 0);
+    assert!(err.contains("afrl/bottom_kgn, afrl/top_codes"), "{err}");
+    let good = std::fs::read(&tdms).unwrap();
+    let cut = temp("cut.tdms");
+    std::fs::write(&cut, &good[..good.len() / 3]).unwrap();
+    let (code, _, err) = impact(&["analyze", cut.to_str().unwrap()]);
+    assert_ne!(code, 0);
+    assert!(
+        err.contains("cut.tdms") && err.trim().lines().count() == 1,
+        "{err}"
+    );
+}
