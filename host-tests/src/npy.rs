@@ -6,7 +6,7 @@ use std::io::BufReader;
 use std::path::Path;
 
 use crate::recording::{Channel, ReadOptions};
-use crate::table::{ColumnRef, RecordingError};
+use crate::table::{one_line, ColumnRef, RecordingError};
 
 /// True for a `.npy` file name (any case).
 pub fn is_npy(path: &Path) -> bool {
@@ -21,7 +21,10 @@ fn elements(file: npyz::NpyFile<BufReader<std::fs::File>>) -> Result<Vec<f64>, S
         r: npyz::NpyReader<T, BufReader<std::fs::File>>,
     ) -> Result<Vec<f64>, String> {
         r.enumerate()
-            .map(|(k, v)| v.map(Into::into).map_err(|e| format!("element {k}: {e}")))
+            .map(|(k, v)| {
+                v.map(Into::into)
+                    .map_err(|e| format!("element {k}: {}", one_line(e)))
+            })
             .collect()
     }
     let dtype = file.dtype().descr();
@@ -77,7 +80,8 @@ pub fn read_npy(path: &Path, opts: &ReadOptions) -> Result<Channel, RecordingErr
         ));
     }
     let f = std::fs::File::open(path).map_err(|e| err(e.to_string()))?;
-    let file = npyz::NpyFile::new(BufReader::new(f)).map_err(|e| err(format!("npy: {e}")))?;
+    let file =
+        npyz::NpyFile::new(BufReader::new(f)).map_err(|e| err(format!("npy: {}", one_line(e))))?;
     let shape = file.shape().to_vec();
     let order = file.order();
     let (rows, cols) = match shape[..] {
@@ -103,7 +107,7 @@ pub fn read_npy(path: &Path, opts: &ReadOptions) -> Result<Channel, RecordingErr
             )));
         }
     };
-    let all = elements(file).map_err(|e| err(format!("npy: {e}")))?;
+    let all = elements(file).map_err(|e| err(format!("npy: {}", one_line(e))))?;
     if all.len() != rows * cols {
         return Err(err(format!(
             "npy: {} elements for shape {shape:?}",

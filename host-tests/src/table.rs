@@ -47,6 +47,18 @@ impl fmt::Display for RecordingError {
 
 impl std::error::Error for RecordingError {}
 
+/// An external library's message on one line (some span several, with pointers under a
+/// quoted source).
+pub fn one_line(message: impl std::fmt::Display) -> String {
+    message
+        .to_string()
+        .lines()
+        .map(str::trim)
+        .filter(|l| !l.is_empty())
+        .collect::<Vec<_>>()
+        .join(" ")
+}
+
 /// Whether a path names standard input (`-`).
 pub fn is_stdin(path: &Path) -> bool {
     path.as_os_str() == "-"

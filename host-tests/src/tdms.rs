@@ -9,13 +9,142 @@ use std::path::Path;
 use tdms_rs::{DataType, PropertyValue, TdmsChannel, TdmsFile};
 
 use crate::recording::{Channel, ReadOptions};
-use crate::table::{ColumnRef, RecordingError};
+use crate::table::{one_line, ColumnRef, RecordingError};
 
 /// True for a `.tdms` file name (any case).
 pub fn is_tdms(path: &Path) -> bool {
     path.extension()
         .and_then(|e| e.to_str())
         .is_some_and(|e| e.eq_ignore_ascii_case("tdms"))
+}
+
+/// Walks the file's segments and their metadata (NI's "TDMS File Format Internal Structure")
+/// and checks every length against the bytes there, so that the reader never allocates for a
+/// length a damaged file claims: the byte where the first inconsistency is, if any.
+fn check_structure(bytes: &[u8]) -> Result<(), String> {
+    struct Cursor<'a> {
+        b: &'a [u8],
+        at: usize,
+        end: usize,
+    }
+    impl Cursor<'_> {
+        fn take(&mut self, n: usize) -> Result<&[u8], String> {
+            let to = self
+                .at
+                .checked_add(n)
+                .filter(|&t| t <= self.end)
+                .ok_or(format!(
+                    "byte {}: {n} bytes announced, {} left in the segment's metadata",
+                    self.at,
+                    self.end.saturating_sub(self.at)
+                ))?;
+            let s = &self.b[self.at..to];
+            self.at = to;
+            Ok(s)
+        }
+        fn u32(&mut self) -> Result<u32, String> {
+            let s = self.take(4)?;
+            Ok(u32::from_le_bytes([s[0], s[1], s[2], s[3]]))
+        }
+        fn string(&mut self) -> Result<(), String> {
+            let n = self.u32()? as usize;
+            self.take(n).map(|_| ())
+        }
+    }
+    // Bytes of a property value of type `t` (strings are handled apart).
+    let fixed = |t: u32| -> Option<usize> {
+        match t {
+            1 | 5 | 0x21 => Some(1),
+            2 | 6 => Some(2),
+            3 | 7 | 9 => Some(4),
+            4 | 8 | 10 => Some(8),
+            11 => Some(10),
+            0x19 => Some(4),
+            0x1A => Some(8),
+            0x44 => Some(16),
+            0x08000C => Some(8),
+            0x10000D => Some(16),
+            _ => None,
+        }
+    };
+    let mut seg = 0usize;
+    while seg < bytes.len() {
+        let lead = bytes
+            .get(seg..seg + 28)
+            .ok_or(format!("byte {seg}: a segment's lead-in is cut short"))?;
+        if &lead[..4] != b"TDSm" {
+            return Err(format!("byte {seg}: no TDSm segment tag"));
+        }
+        let u64_at = |i: usize| u64::from_le_bytes(lead[i..i + 8].try_into().unwrap_or([0; 8]));
+        let toc = u32::from_le_bytes([lead[4], lead[5], lead[6], lead[7]]);
+        let next = u64_at(12);
+        let raw = u64_at(20);
+        let body = seg + 28;
+        let meta_end = body
+            .checked_add(raw as usize)
+            .filter(|&e| e <= bytes.len())
+            .ok_or(format!(
+                "byte {seg}: metadata of {raw} bytes runs past the file"
+            ))?;
+        if toc & (1 << 6) != 0 {
+            return Err(format!(
+                "byte {seg}: a big-endian segment, which this reader does not read"
+            ));
+        }
+        // Metadata (1 << 1) or a new object list (1 << 2): the reader parses either.
+        if toc & 0b110 != 0 {
+            let mut c = Cursor {
+                b: bytes,
+                at: body,
+                end: meta_end,
+            };
+            let objects = c.u32()?;
+            for _ in 0..objects {
+                c.string()?;
+                match c.u32()? {
+                    0xFFFF_FFFF | 0 => {}
+                    0x6912_0000 | 0x6913_0000 => {
+                        return Err(format!(
+                            "byte {}: DAQmx raw data, which this reader does not read",
+                            c.at - 4
+                        ))
+                    }
+                    n => {
+                        // Data type, dimension, value count, and for strings their size.
+                        let n = n as usize;
+                        if !(20..=28).contains(&n) {
+                            return Err(format!("byte {}: raw data index of {n} bytes", c.at - 4));
+                        }
+                        c.take(n - 4)?;
+                    }
+                }
+                let properties = c.u32()?;
+                for _ in 0..properties {
+                    c.string()?;
+                    match c.u32()? {
+                        0x20 => c.string()?,
+                        t => {
+                            let n = fixed(t)
+                                .ok_or(format!("byte {}: property type {t:#x}", c.at - 4))?;
+                            c.take(n)?;
+                        }
+                    }
+                }
+            }
+        }
+        let next_seg = body
+            .checked_add(next as usize)
+            .ok_or(format!("byte {seg}: next segment offset {next}"))?;
+        if next == u64::MAX || next_seg > bytes.len() {
+            // The last segment (still being written, or cut): nothing follows it.
+            break;
+        }
+        if next_seg <= seg {
+            return Err(format!("byte {seg}: next segment offset {next} goes back"));
+        }
+        seg = next_seg;
+    }
+    Ok(())
 }
 
 /// Every value of `ch` as f64.
@@ -52,7 +181,10 @@ pub fn read_tdms(path: &Path, opts: &ReadOptions) -> Result<Channel, RecordingEr
             "a TDMS file takes --column (group/channel) and --rate only".into(),
         ));
     }
-    let file = TdmsFile::open(path).map_err(|e| err(format!("TDMS: {e}")))?;
+    let bytes = std::fs::read(path).map_err(|e| err(e.to_string()))?;
+    check_structure(&bytes).map_err(|e| err(format!("TDMS: {}", one_line(e))))?;
+    drop(bytes);
+    let file = TdmsFile::open(path).map_err(|e| err(format!("TDMS: {}", one_line(e))))?;
     let all: Vec<(String, TdmsChannel)> = file
         .groups()
         .flat_map(|g| {
@@ -101,7 +233,21 @@ pub fn read_tdms(path: &Path, opts: &ReadOptions) -> Result<Channel, RecordingEr
     if !(rate_hz.is_finite() && rate_hz > 0.0 && rate_hz <= 1e9) {
         return Err(err(format!("rate {rate_hz} Hz is not in (0, 1e9]")));
     }
-    let values = values(ch).map_err(|e| err(format!("TDMS {name}: {e}")))?;
+    // A header may claim more values than the file holds: check before allocating.
+    let file_bytes = std::fs::metadata(path).map(|m| m.len()).unwrap_or(0);
+    let item = match ch.dtype() {
+        DataType::I8 | DataType::U8 => 1,
+        DataType::I16 | DataType::U16 => 2,
+        DataType::I32 | DataType::U32 | DataType::Float => 4,
+        _ => 8,
+    };
+    if (ch.len() as u128) * item > u128::from(file_bytes) {
+        return Err(err(format!(
+            "TDMS {name}: {} values announced, more than the file's {file_bytes} bytes hold",
+            ch.len()
+        )));
+    }
+    let values = values(ch).map_err(|e| err(format!("TDMS {name}: {}", one_line(e))))?;
     if let Some(k) = values.iter().position(|v| !v.is_finite()) {
         return Err(err(format!("TDMS {name}: value {k} is not finite")));
     }

@@ -5,7 +5,7 @@
 use std::path::Path;
 
 use crate::recording::{Channel, ReadOptions};
-use crate::table::{ColumnRef, RecordingError};
+use crate::table::{one_line, ColumnRef, RecordingError};
 
 /// True for a `.wav` file name (any case).
 pub fn is_wav(path: &Path) -> bool {
@@ -29,7 +29,8 @@ pub fn read_wav(path: &Path, opts: &ReadOptions) -> Result<Channel, RecordingErr
     if !opts.axes.is_empty() {
         return Err(err("--axes: not for WAV files yet; give --column".into()));
     }
-    let mut reader = hound::WavReader::open(path).map_err(|e| err(format!("WAV: {e}")))?;
+    let mut reader =
+        hound::WavReader::open(path).map_err(|e| err(format!("WAV: {}", one_line(e))))?;
     let spec = reader.spec();
     let channels = usize::from(spec.channels);
     let column = match &opts.column {
@@ -51,12 +52,16 @@ pub fn read_wav(path: &Path, opts: &ReadOptions) -> Result<Channel, RecordingErr
         return Err(err("WAV: sample rate 0 in the header".into()));
     }
     let frames = reader.duration() as usize;
-    let mut values = Vec::with_capacity(frames);
+    // Room for what the file can hold, whatever its header announces.
+    let file_bytes = std::fs::metadata(path).map_or(0, |m| m.len() as usize);
+    let frame_bytes = channels.max(1) * usize::from(spec.bits_per_sample.div_ceil(8)).max(1);
+    let mut values = Vec::with_capacity(frames.min(file_bytes / frame_bytes));
     // A sample that cannot be read (a file cut short) is an error naming its frame.
     let at = |k: usize, e: hound::Error| {
         err(format!(
-            "WAV: frame {} (of {frames} the header announces): {e}",
-            k / channels.max(1)
+            "WAV: frame {} (of {frames} the header announces): {}",
+            k / channels.max(1),
+            one_line(e)
         ))
     };
     match spec.sample_format {

@@ -601,3 +601,38 @@ fn impact_log_refuses_what_the_firmware_cannot_have_written_by_line() {
     assert_eq!(r.code, Some(0), "{}", r.err);
     assert_eq!(r.out.lines().count(), 2);
 }
+
+#[test]
+fn binary_recordings_with_lying_headers_are_refused_in_bounded_memory() {
+    let fixtures = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("fixtures");
+    // TDMS: the first object path claims 4 GiB (the reader would allocate it).
+    let mut tdms = std::fs::read(fixtures.join("afrl-test1.tdms")).unwrap();
+    tdms[32..36].copy_from_slice(&u32::MAX.to_le_bytes());
+    let f = temp("lying.tdms", &tdms);
+    fails(
+        &["analyze", f.to_str().unwrap()],
+        "lying.tdms: TDMS: byte 36",
+    );
+    // TDMS: a value count beyond the file.
+    let mut tdms = std::fs::read(fixtures.join("afrl-test1.tdms")).unwrap();
+    tdms.truncate(2000);
+    let f = temp("short.tdms", &tdms);
+    fails(&["analyze", f.to_str().unwrap()], "short.tdms");
+    // WAV: a header announcing 2^31 frames of a file that holds a few.
+    let mut wav = std::fs::read(fixtures.join("afrl-test1-int16.wav")).unwrap();
+    wav.truncate(4000);
+    let len = wav.len();
+    wav[40..44].copy_from_slice(&(u32::MAX - 3).to_le_bytes());
+    wav[4..8].copy_from_slice(&((len - 8) as u32).to_le_bytes());
+    let f = temp("lying.wav", &wav);
+    fails(&["analyze", f.to_str().unwrap()], "lying.wav");
+    // .npy: a shape of 2^40 rows.
+    let mut npy = std::fs::read(fixtures.join("afrl-test1-int16.npy")).unwrap();
+    let at = npy.windows(10).position(|w| w == b"(10000, 2)").unwrap();
+    npy[at..at + 10].copy_from_slice(b"(99999, 2)");
+    let f = temp("lying.npy", &npy);
+    fails(
+        &["analyze", f.to_str().unwrap(), "--rate", "1e6"],
+        "lying.npy",
+    );
+}
