@@ -5,8 +5,8 @@
 use std::io::BufReader;
 use std::path::Path;
 
-use crate::recording::{Channel, ReadOptions};
-use crate::table::{one_line, ColumnRef, RecordingError};
+use crate::recording::{evenly_sampled, numbered_column, Channel, ReadOptions};
+use crate::table::{one_line, RecordingError};
 
 /// True for a `.npy` file name (any case).
 pub fn is_npy(path: &Path) -> bool {
@@ -93,20 +93,7 @@ pub fn read_npy(path: &Path, opts: &ReadOptions) -> Result<Channel, RecordingErr
             )))
         }
     };
-    let column = match &opts.column {
-        None => 0,
-        Some(ColumnRef::Index(i)) if *i < cols => *i,
-        Some(c) => {
-            let c = match c {
-                ColumnRef::Index(i) => i.to_string(),
-                ColumnRef::Name(n) => n.clone(),
-            };
-            return Err(err(format!(
-                "--column {c}: the array's columns are numbered 0..{}",
-                cols.saturating_sub(1)
-            )));
-        }
-    };
+    let column = numbered_column(opts.column.as_ref(), cols, "the array's columns").map_err(err)?;
     let all = elements(file).map_err(|e| err(format!("npy: {}", one_line(e))))?;
     if all.len() != rows * cols {
         return Err(err(format!(
@@ -126,17 +113,6 @@ pub fn read_npy(path: &Path, opts: &ReadOptions) -> Result<Channel, RecordingErr
             None => return Err(err(format!("npy: row {i} missing"))),
         }
     }
-    if values.len() < 2 {
-        return Err(err(format!("npy: {} samples; at least 2", values.len())));
-    }
-    let time_s = (0..values.len()).map(|k| k as f64 / rate_hz).collect();
-    Ok(Channel {
-        name: format!("column {column}"),
-        values,
-        time_s,
-        rate_hz,
-        jitter: 0.0,
-        resampled: false,
-        axes: Vec::new(),
-    })
+    evenly_sampled(format!("column {column}"), values, rate_hz)
+        .map_err(|e| err(format!("npy: {e}")))
 }

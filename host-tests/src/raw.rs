@@ -4,8 +4,8 @@
 
 use std::path::Path;
 
-use crate::recording::{Channel, ReadOptions};
-use crate::table::{ColumnRef, RecordingError};
+use crate::recording::{evenly_sampled, numbered_column, Channel, ReadOptions};
+use crate::table::RecordingError;
 
 /// The sample type a raw file's extension names.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -61,20 +61,12 @@ pub fn read_raw(
             "--raw-channels {channels}: must lie in 1..=64"
         )));
     }
-    let column = match &opts.column {
-        None => 0,
-        Some(ColumnRef::Index(i)) if *i < channels => *i,
-        Some(c) => {
-            let c = match c {
-                ColumnRef::Index(i) => i.to_string(),
-                ColumnRef::Name(n) => n.clone(),
-            };
-            return Err(err(format!(
-                "--column {c}: the file's {channels} interleaved channels are numbered 0..{}",
-                channels - 1
-            )));
-        }
-    };
+    let column = numbered_column(
+        opts.column.as_ref(),
+        channels,
+        &format!("the file's {channels} interleaved channels"),
+    )
+    .map_err(err)?;
     let bytes = std::fs::read(path).map_err(|e| err(e.to_string()))?;
     let frame = kind.bytes() * channels;
     if bytes.len() % frame != 0 {
@@ -103,17 +95,5 @@ pub fn read_raw(
         };
         values.push(v);
     }
-    if values.len() < 2 {
-        return Err(err(format!("{} frames; at least 2", values.len())));
-    }
-    let time_s = (0..values.len()).map(|k| k as f64 / rate_hz).collect();
-    Ok(Channel {
-        name: format!("channel {column}"),
-        values,
-        time_s,
-        rate_hz,
-        jitter: 0.0,
-        resampled: false,
-        axes: Vec::new(),
-    })
+    evenly_sampled(format!("channel {column}"), values, rate_hz).map_err(err)
 }

@@ -47,6 +47,51 @@ pub struct ReadOptions {
     pub progress: Option<fn(f64)>,
 }
 
+/// The 0-based channel `column` asks for among `count` numbered ones (default 0), or the
+/// message naming what the file has (`what`, e.g. "a WAV file's channels").
+pub(crate) fn numbered_column(
+    column: Option<&ColumnRef>,
+    count: usize,
+    what: &str,
+) -> Result<usize, String> {
+    match column {
+        None => Ok(0),
+        Some(ColumnRef::Index(i)) if *i < count => Ok(*i),
+        Some(c) => {
+            let c = match c {
+                ColumnRef::Index(i) => i.to_string(),
+                ColumnRef::Name(n) => n.clone(),
+            };
+            Err(format!(
+                "--column {c}: {what} are numbered 0..{}",
+                count.saturating_sub(1)
+            ))
+        }
+    }
+}
+
+/// A channel of `values` sampled evenly at `rate_hz` from t = 0 (binary formats), or the
+/// message if it has fewer than two samples.
+pub(crate) fn evenly_sampled(
+    name: String,
+    values: Vec<f64>,
+    rate_hz: f64,
+) -> Result<Channel, String> {
+    if values.len() < 2 {
+        return Err(format!("{} samples; at least 2", values.len()));
+    }
+    let time_s = (0..values.len()).map(|k| k as f64 / rate_hz).collect();
+    Ok(Channel {
+        name,
+        values,
+        time_s,
+        rate_hz,
+        jitter: 0.0,
+        resampled: false,
+        axes: Vec::new(),
+    })
+}
+
 /// Seconds per unit of a time column, from a unit word in its header (`timestamp_us`,
 /// `time [ms]`, `time - seconds`); seconds when the header names none.
 pub fn time_unit_s(header: &str) -> f64 {

@@ -8,7 +8,7 @@ use std::path::Path;
 
 use tdms_rs::{DataType, PropertyValue, TdmsChannel, TdmsFile};
 
-use crate::recording::{Channel, ReadOptions};
+use crate::recording::{evenly_sampled, Channel, ReadOptions};
 use crate::table::{one_line, ColumnRef, RecordingError};
 
 /// True for a `.tdms` file name (any case).
@@ -251,20 +251,5 @@ pub fn read_tdms(path: &Path, opts: &ReadOptions) -> Result<Channel, RecordingEr
     if let Some(k) = values.iter().position(|v| !v.is_finite()) {
         return Err(err(format!("TDMS {name}: value {k} is not finite")));
     }
-    if values.len() < 2 {
-        return Err(err(format!(
-            "TDMS {name}: {} values; at least 2",
-            values.len()
-        )));
-    }
-    let time_s = (0..values.len()).map(|k| k as f64 / rate_hz).collect();
-    Ok(Channel {
-        name: name.clone(),
-        values,
-        time_s,
-        rate_hz,
-        jitter: 0.0,
-        resampled: false,
-        axes: Vec::new(),
-    })
+    evenly_sampled(name.clone(), values, rate_hz).map_err(|e| err(format!("TDMS {name}: {e}")))
 }

@@ -4,8 +4,8 @@
 
 use std::path::Path;
 
-use crate::recording::{Channel, ReadOptions};
-use crate::table::{one_line, ColumnRef, RecordingError};
+use crate::recording::{evenly_sampled, numbered_column, Channel, ReadOptions};
+use crate::table::{one_line, RecordingError};
 
 /// True for a `.wav` file name (any case).
 pub fn is_wav(path: &Path) -> bool {
@@ -33,20 +33,8 @@ pub fn read_wav(path: &Path, opts: &ReadOptions) -> Result<Channel, RecordingErr
         hound::WavReader::open(path).map_err(|e| err(format!("WAV: {}", one_line(e))))?;
     let spec = reader.spec();
     let channels = usize::from(spec.channels);
-    let column = match &opts.column {
-        None => 0,
-        Some(ColumnRef::Index(i)) if *i < channels => *i,
-        Some(c) => {
-            let c = match c {
-                ColumnRef::Index(i) => i.to_string(),
-                ColumnRef::Name(n) => n.clone(),
-            };
-            return Err(err(format!(
-                "--column {c}: a WAV file's channels are numbered 0..{}",
-                channels.saturating_sub(1)
-            )));
-        }
-    };
+    let column =
+        numbered_column(opts.column.as_ref(), channels, "a WAV file's channels").map_err(err)?;
     let rate_hz = f64::from(spec.sample_rate);
     if spec.sample_rate == 0 {
         return Err(err("WAV: sample rate 0 in the header".into()));
@@ -88,17 +76,6 @@ pub fn read_wav(path: &Path, opts: &ReadOptions) -> Result<Channel, RecordingErr
             }
         }
     }
-    if values.len() < 2 {
-        return Err(err(format!("WAV: {} frames; at least 2", values.len())));
-    }
-    let time_s = (0..values.len()).map(|k| k as f64 / rate_hz).collect();
-    Ok(Channel {
-        name: format!("channel {column}"),
-        values,
-        time_s,
-        rate_hz,
-        jitter: 0.0,
-        resampled: false,
-        axes: Vec::new(),
-    })
+    evenly_sampled(format!("channel {column}"), values, rate_hz)
+        .map_err(|e| err(format!("WAV: {e}")))
 }
