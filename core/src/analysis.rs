@@ -134,11 +134,12 @@ fn spectrum<const CAP: usize>(
         .max(s.first_index);
     let skip = (from - s.first_index) as usize;
     let window = samples.get(skip..)?;
-    let buf = work.buf.get_mut(..window.len())?;
+    // The whole workspace: the room beyond the window holds the decimated levels' copies.
+    let buf = &mut work.buf;
+    let len = window.len().min(buf.len());
     for (slot, &x) in buf.iter_mut().zip(window) {
         *slot = deviation.of(x) as f32 * per_count;
     }
-    let len = buf.len();
     let mut sp =
         crate::signal::spectrum::spectrum(buf, len, scene.calibration.sample_rate_hz, settings)?;
     sp.from_sample = from;

@@ -92,8 +92,9 @@ pub struct ShockSpectrumJson {
     pub half_sine_duration_s: Option<f64>,
 }
 
-/// Samples before the report's onset included in the window (the pulse's foot).
-const LEAD_SAMPLES: u64 = 64;
+/// Samples before the report's onset included in the window (the pulse's foot): the same
+/// as the board's.
+const LEAD_SAMPLES: u64 = impact_core::analysis::SPECTRUM_LEAD;
 
 /// Most bands: 12 per octave from 1 mHz to 100 MHz.
 const MAX_BANDS: usize = 12 * 37;

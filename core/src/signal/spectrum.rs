@@ -59,6 +59,15 @@ impl SpectrumSettings {
 
     /// Checks the settings at `rate_hz`: a reason if they cannot be computed.
     pub fn check(&self, rate_hz: f32) -> Result<(), &'static str> {
+        self.check_parameters()?;
+        if self.bands(rate_hz, &mut [0.0; MAX_BANDS]) == 0 {
+            return Err("no band between the lowest band and rate / 8, or more than 96 bands");
+        }
+        Ok(())
+    }
+
+    /// Damping, bands per octave and lowest band, whatever the rate.
+    fn check_parameters(&self) -> Result<(), &'static str> {
         if !(self.damping >= 0.0 && self.damping <= 0.5) {
             return Err("damping must lie in [0, 0.5]");
         }
@@ -68,19 +77,7 @@ impl SpectrumSettings {
         if !(self.low_hz > 0.0 && self.low_hz.is_finite()) {
             return Err("lowest band must be finite and > 0");
         }
-        if self.bands(rate_hz, &mut [0.0; MAX_BANDS]) == 0 {
-            return Err("no band between the lowest band and rate / 8, or more than 96 bands");
-        }
         Ok(())
-    }
-}
-
-impl Spectrum {
-    /// Band `k`'s frequency, Hz, in f64: `1000 × 2^(j/n)` for the `j` of the first band.
-    pub fn frequency_hz(&self, k: usize) -> f64 {
-        let n = f64::from(self.bands_per_octave.max(1));
-        let first = libm::round(n * libm::log2(self.first_hz as f64 / 1000.0));
-        1000.0 * libm::exp2((first + k as f64) / n)
     }
 }
 
@@ -111,6 +108,15 @@ pub struct Spectrum {
     /// Stream indices of the window's first sample and just after its last.
     pub from_sample: u64,
     pub to_sample: u64,
+}
+
+impl Spectrum {
+    /// Band `k`'s frequency, Hz, in f64: `1000 × 2^(j/n)` for the `j` of the first band.
+    pub fn frequency_hz(&self, k: usize) -> f64 {
+        let n = f64::from(self.bands_per_octave.max(1));
+        let first = libm::round(n * libm::log2(self.first_hz as f64 / 1000.0));
+        1000.0 * libm::exp2((first + k as f64) / n)
+    }
 }
 
 /// Half-band low-pass (windowed sinc, Kaiser β = 8, 23 taps, unit gain at 0 Hz): the centre
@@ -247,6 +253,22 @@ struct Peak {
 }
 
 impl Peak {
+    /// Takes output `y` (index `i`, after `before`, the recursion's state `w`, `w1`) if it is
+    /// the largest so far.
+    #[inline]
+    fn offer(&mut self, y: f32, before: f32, w: f32, w1: f32, index: usize) {
+        if y.abs() > self.best {
+            *self = Peak {
+                best: y.abs(),
+                before,
+                at: y,
+                w,
+                w1,
+                index,
+            };
+        }
+    }
+
     /// The peak between samples, given the output after the largest: never below the
     /// sampled peak, nor above it by more than 9 %.
     fn vertex(&self, after: f32) -> f32 {
@@ -295,26 +317,8 @@ fn band(
         let w = xn - a1 * w1 - a2 * w2;
         let ya = b0 * w + b1 * w1 + b2 * w2;
         let yp = c0 * w + c1 * w1 + c2 * w2;
-        if ya.abs() > pa.best {
-            pa = Peak {
-                best: ya.abs(),
-                before: ya_prev,
-                at: ya,
-                w,
-                w1,
-                index: i,
-            };
-        }
-        if yp.abs() > pp.best {
-            pp = Peak {
-                best: yp.abs(),
-                before: yp_prev,
-                at: yp,
-                w,
-                w1,
-                index: i,
-            };
-        }
+        pa.offer(ya, ya_prev, w, w1, i);
+        pp.offer(yp, yp_prev, w, w1, i);
         (ya_prev, yp_prev) = (ya, yp);
         (w2, w1) = (w1, w);
         (ya, yp)
@@ -358,9 +362,10 @@ pub fn spectrum(
     rate_hz: f32,
     settings: &SpectrumSettings,
 ) -> Option<Spectrum> {
+    settings.check_parameters().ok()?;
     let mut freqs = [0.0f32; MAX_BANDS];
     let n = settings.bands(rate_hz, &mut freqs);
-    if n == 0 || settings.check(rate_hz).is_err() {
+    if n == 0 {
         return None;
     }
     let mut out = Spectrum {
@@ -377,7 +382,7 @@ pub fn spectrum(
     let mut len = len.min(x.len());
     let mut rate = rate_hz;
     let mut compensated: Option<(f32, core::ops::Range<usize>)> = None;
-    // From the highest band down, halving the rate whenever a band falls to rate / 16.
+    // From the highest band down, halving the rate whenever a band falls to rate / 64.
     for k in (0..n).rev() {
         let f = freqs.get(k).copied().unwrap_or(0.0);
         while f <= rate / DECIMATE_BELOW {
@@ -436,7 +441,6 @@ pub fn spectrum(
     {
         (*f, *p) = (fk as f64, pk as f64);
     }
-    let n = n.min(MAX_BANDS);
     out.half_sine = srs::enveloping_half_sine(
         f64s.get(..n).unwrap_or(&[]),
         pv64.get(..n).unwrap_or(&[]),
