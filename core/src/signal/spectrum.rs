@@ -6,12 +6,17 @@
 //! of 1 where `f32` keeps the response (at the full rate a 10 Hz band at 500 kS/s would have
 //! `ω T` = 1.3e-4). On a decimated signal a 5-tap pre-emphasis undoes the ramp-invariant
 //! filter's linear interpolation (`sinc²`) and the peak is taken between samples (the
-//! sinusoid through the three samples around it): within 1.2e-4 of the full-rate f64
-//! reference on half-sines of 1 to 5.5 ms (1.5e-3 for 65 µs); content far
-//! above a low band, which reaches its absolute acceleration through the damping, is lost
-//! with the decimation (0.5 % of the AFRL record's SRS at 200 Hz).
+//! sinusoid through the three samples around it) at the instant the full-rate filter would
+//! sample it: within 1.2e-4 of the full-rate f64 reference on half-sines of 1 to 5.5 ms
+//! (1.5e-3 for 65 µs); content far above a low band, which reaches its absolute
+//! acceleration through the damping, is lost with the decimation (0.5 % of the AFRL record's
+//! SRS at 200 Hz; halving at rate / 32 instead would save a fifth of the work and lose 0.8 %).
+//!
+//! The recursion runs in blocks of [`BLOCK`] samples keeping each block's largest `|y|`
+//! without a branch; only the block that holds a response's peak is run again, for the
+//! samples around it.
 
-use super::srs::{self, Oscillator, Response};
+use super::srs::{self, Oscillator};
 
 /// Most bands a spectrum holds (1/6 octave from 10 Hz to 125 kHz is 81).
 pub const MAX_BANDS: usize = 96;
@@ -142,6 +147,7 @@ const SPAN: usize = 11;
 /// nothing before the first sample is lost and the filter's tail is kept); returns the new
 /// length `len / 2 + SPAN + 1`, if below `len` (shorter inputs are left alone and `None`
 /// returned).
+#[inline(never)]
 fn halve(x: &mut [f32], len: usize) -> Option<usize> {
     let len = len.min(x.len());
     let out_len = len / 2 + SPAN + 1;
@@ -229,6 +235,7 @@ fn emphasised(x: &[f32], n: usize) -> f32 {
 
 /// The pre-emphasis of `x[..len]` into `x[len..2 len + 4]`; the range written, or `None`
 /// without room.
+#[inline(never)]
 fn compensate(x: &mut [f32], len: usize) -> Option<core::ops::Range<usize>> {
     let (src, dst) = x.split_at_mut(len.min(x.len()));
     let dst = dst.get_mut(..src.len() + 4)?;
@@ -238,120 +245,206 @@ fn compensate(x: &mut [f32], len: usize) -> Option<core::ops::Range<usize>> {
     Some(len..2 * len + 4)
 }
 
-/// The largest `|y|` of one response, where it came, and what a fit through its neighbours
-/// needs.
-#[derive(Clone, Copy, Default)]
-struct Peak {
-    best: f32,
-    /// The output before the largest, the largest (signed), and the recursion's state then.
-    before: f32,
-    at: f32,
-    w: f32,
-    w1: f32,
-    /// Index of the largest output (the input's samples, then the two zeros).
-    index: usize,
+/// The peak between samples of one response from its largest sampled value `at` and the
+/// outputs `before` and `after` it, as the full-rate filter would sample it (`decimation`
+/// full-rate samples to one here): never below the sampled peak, nor above it by more
+/// than 9 %.
+fn between(before: f32, at: f32, after: f32, decimation: f32) -> f32 {
+    let best = at.abs();
+    // |y| near its peak: the signs such that the largest is positive.
+    let sign = if at < 0.0 { -1.0 } else { 1.0 };
+    let (before, at, after) = (sign * before, sign * at, sign * after);
+    // The sinusoid `A cos(φ m + ψ)` through the three samples (its frequency from them too):
+    // exact for any oscillation, where the sampled peak of one at 8 samples a period is up
+    // to 7.6 % low.
+    let cos = (before + after) / (2.0 * at);
+    if cos.is_finite() && cos > 0.0 && cos < 1.0 {
+        let sin = crate::real::fpu_sqrt(1.0 - cos * cos);
+        let slope = (after - before) / (2.0 * sin);
+        let amplitude = crate::real::fpu_sqrt(at * at + slope * slope);
+        // Its crest `crest` samples from the largest; the full-rate filter samples the
+        // sinusoid at multiples of `1 / decimation` from there.
+        let phi = libm::atan2f(sin, cos);
+        let crest = libm::atanf(slope / at) / phi;
+        let miss = crest - libm::roundf(crest * decimation) / decimation;
+        let sampled = amplitude * libm::cosf(phi * miss);
+        if sampled.is_finite() {
+            return sampled.max(best).min(best * 1.09);
+        }
+    }
+    best
 }
 
-impl Peak {
-    /// Takes output `y` (index `i`, after `before`, the recursion's state `w`, `w1`) if it is
-    /// the largest so far.
-    #[inline]
-    fn offer(&mut self, y: f32, before: f32, w: f32, w1: f32, index: usize) {
-        if y.abs() > self.best {
-            *self = Peak {
-                best: y.abs(),
-                before,
-                at: y,
-                w,
-                w1,
-                index,
-            };
+/// Samples a band's recursion takes at a time: the largest `|y|` is kept per block, and
+/// only the block that holds it is run again to find the outputs around it.
+const BLOCK: usize = 64;
+
+/// A band's input: a level's samples, or (without room for a pre-emphasised copy) the
+/// pre-emphasis of them computed as it goes, `len + 4` outputs.
+#[derive(Clone, Copy)]
+enum Input<'a> {
+    Plain(&'a [f32]),
+    Emphasised(&'a [f32]),
+}
+
+impl Input<'_> {
+    fn len(&self) -> usize {
+        match self {
+            Input::Plain(x) => x.len(),
+            Input::Emphasised(x) => x.len() + 4,
         }
     }
 
-    /// The peak between samples, given the output after the largest: never below the
-    /// sampled peak, nor above it by more than 9 %.
-    fn vertex(&self, after: f32) -> f32 {
-        let (before, at) = (self.before, self.at);
-        // The sinusoid through the three samples (its frequency from them too): exact for
-        // any oscillation, where the sampled peak of one at 8 samples a period is up to
-        // 7.6 % low.
-        let cos = (before + after) / (2.0 * at);
-        if cos.is_finite() && cos > 0.0 && cos < 1.0 {
-            let sin = crate::real::fpu_sqrt(1.0 - cos * cos);
-            let slope = (after - before) / (2.0 * sin);
-            let amplitude = crate::real::fpu_sqrt(at * at + slope * slope);
-            if amplitude.is_finite() {
-                return amplitude.max(self.best).min(self.best * 1.09);
+    /// Sample `i` (0 beyond the end).
+    fn at(&self, i: usize) -> f32 {
+        match self {
+            Input::Plain(x) => x.get(i).copied().unwrap_or(0.0),
+            Input::Emphasised(x) if i < x.len() + 4 => emphasised(x, i),
+            Input::Emphasised(_) => 0.0,
+        }
+    }
+
+    /// Samples `from..` (at most [`BLOCK`]): the slice itself, or computed into `buf`.
+    fn block<'b>(&'b self, from: usize, buf: &'b mut [f32; BLOCK]) -> &'b [f32] {
+        let to = self.len().min(from + BLOCK);
+        match self {
+            Input::Plain(x) => x.get(from..to).unwrap_or(&[]),
+            Input::Emphasised(x) => {
+                let buf = buf.get_mut(..to.saturating_sub(from)).unwrap_or(&mut []);
+                for (k, slot) in buf.iter_mut().enumerate() {
+                    *slot = emphasised(x, from + k);
+                }
+                buf
             }
         }
-        self.best
     }
 }
 
-/// One band: both responses over `x` and two zeros after it (the ramp back to rest), then
-/// each residual in closed form; with `between`, the peaks between samples (a decimated,
-/// coarsely sampled response).
-fn band(
-    n: usize,
-    x: impl Fn(usize) -> f32,
-    f_hz: f32,
-    damping: f32,
-    rate_hz: f32,
-    between: bool,
-) -> (f32, f32) {
-    let (Some(acc), Some(pv)) = (
-        Oscillator::<f32>::new(Response::AbsoluteAcceleration, f_hz, damping, rate_hz),
-        Oscillator::<f32>::new(Response::PseudoVelocity, f_hz, damping, rate_hz),
-    ) else {
+/// Where one response's largest `|y|` came: its block, the recursion's state at the
+/// block's start and the output before it.
+#[derive(Clone, Copy, Default)]
+struct Best {
+    value: f32,
+    from: usize,
+    w1: f32,
+    w2: f32,
+    before: f32,
+}
+
+/// One band: both responses over the input and two zeros after it (the ramp back to rest),
+/// then each residual in closed form. At a rate `decimation` (> 1) times below the full
+/// rate, the peaks between samples, where the full-rate filter would sample them; at the
+/// full rate (1), the largest samples, as the reference takes them.
+#[inline(never)]
+fn band(input: Input, f_hz: f32, damping: f32, rate_hz: f32, decimation: f32) -> (f32, f32) {
+    let Some([acc, pv]) = Oscillator::<f32>::pair(f_hz, damping, rate_hz) else {
         return (0.0, 0.0);
     };
     // Direct form II: one recursion (shared poles), two numerators.
     let [a1, a2] = acc.a;
     let [b0, b1, b2] = acc.b;
     let [c0, c1, c2] = pv.b;
+    let n = input.len();
     let (mut w1, mut w2) = (0.0f32, 0.0f32);
-    let (mut pa, mut pp) = (Peak::default(), Peak::default());
-    let (mut ya_prev, mut yp_prev) = (0.0f32, 0.0f32);
-    let mut step = |i: usize, xn: f32| -> (f32, f32) {
-        let w = xn - a1 * w1 - a2 * w2;
-        let ya = b0 * w + b1 * w1 + b2 * w2;
-        let yp = c0 * w + c1 * w1 + c2 * w2;
-        pa.offer(ya, ya_prev, w, w1, i);
-        pp.offer(yp, yp_prev, w, w1, i);
-        (ya_prev, yp_prev) = (ya, yp);
-        (w2, w1) = (w1, w);
-        (ya, yp)
-    };
-    // Two samples a turn: the recursion's state changes roles instead of being moved.
-    let mut i = 0;
-    while i + 1 < n {
-        step(i, x(i));
-        step(i + 1, x(i + 1));
-        i += 2;
-    }
-    if i < n {
-        step(i, x(i));
-    }
-    let (ya_1, yp_1) = step(n, 0.0);
-    let (ya_2, yp_2) = step(n + 1, 0.0);
-    // The output after the largest, from the state there (input 0 beyond the pulse).
-    let after = |p: &Peak, num: [f32; 3]| -> Option<f32> {
-        if p.index + 1 >= n + 2 {
-            return None;
+    let (mut ya, mut yp) = (0.0f32, 0.0f32);
+    let (mut best_a, mut best_p) = (Best::default(), Best::default());
+    let mut buf = [0.0f32; BLOCK];
+    let mut from = 0;
+    let mut residual = [(0.0f32, 0.0f32); 2];
+    // The input in blocks, then the two zeros as one more.
+    while from < n + 2 {
+        let block: &[f32] = if from < n {
+            input.block(from, &mut buf)
+        } else {
+            &[0.0, 0.0]
+        };
+        if block.is_empty() {
+            break;
         }
-        let xn = if p.index + 1 < n { x(p.index + 1) } else { 0.0 };
-        let w = xn - a1 * p.w - a2 * p.w1;
-        Some(num[0] * w + num[1] * p.w + num[2] * p.w1)
-    };
-    let peak = |p: &Peak, num| match after(p, num).filter(|_| between) {
-        Some(y) => p.vertex(y),
-        None => p.best,
+        let (s1, s2, sa, sp) = (w1, w2, ya, yp);
+        let (mut top_a, mut top_p) = (0.0f32, 0.0f32);
+        let mut step = |xn: f32| {
+            let w = xn - a1 * w1 - a2 * w2;
+            ya = b0 * w + b1 * w1 + b2 * w2;
+            yp = c0 * w + c1 * w1 + c2 * w2;
+            (w2, w1) = (w1, w);
+            // Comparisons, not `f32::max` (a library call without VMAXNM on the M4), and
+            // no branch.
+            if ya.abs() > top_a {
+                top_a = ya.abs();
+            }
+            if yp.abs() > top_p {
+                top_p = yp.abs();
+            }
+            (ya, yp)
+        };
+        let mut pairs = block.chunks_exact(2);
+        for pair in &mut pairs {
+            if let [x0, x1] = *pair {
+                let first = step(x0);
+                let second = step(x1);
+                if from >= n {
+                    residual = [first, second];
+                }
+            }
+        }
+        for &xn in pairs.remainder() {
+            step(xn);
+        }
+        if top_a > best_a.value {
+            best_a = Best {
+                value: top_a,
+                from,
+                w1: s1,
+                w2: s2,
+                before: sa,
+            };
+        }
+        if top_p > best_p.value {
+            best_p = Best {
+                value: top_p,
+                from,
+                w1: s1,
+                w2: s2,
+                before: sp,
+            };
+        }
+        from += block.len();
+    }
+    let [(ya_1, yp_1), (ya_2, yp_2)] = residual;
+    let peak = |best: &Best, num: [f32; 3]| {
+        if decimation > 1.0 {
+            if let Some([before, at, after]) = around(input, best, num, [a1, a2]) {
+                return between(before, at, after, decimation);
+            }
+        }
+        best.value
     };
     (
-        peak(&pa, acc.b).max(acc.residual_peak(ya_1, ya_2)),
-        peak(&pp, pv.b).max(pv.residual_peak(yp_1, yp_2)),
+        peak(&best_a, acc.b).max(acc.residual_peak(ya_1, ya_2)),
+        peak(&best_p, pv.b).max(pv.residual_peak(yp_1, yp_2)),
     )
+}
+
+/// The outputs before, at and after a response's largest `|y|` (the recursion run again
+/// over its block with the same operations, so the same values); `None` at the very end.
+fn around(input: Input, best: &Best, num: [f32; 3], [a1, a2]: [f32; 2]) -> Option<[f32; 3]> {
+    let n = input.len();
+    let (mut w1, mut w2, mut before) = (best.w1, best.w2, best.before);
+    let x = |i: usize| if i < n { input.at(i) } else { 0.0 };
+    for i in best.from..(best.from + BLOCK).min(n + 2) {
+        let w = x(i) - a1 * w1 - a2 * w2;
+        let y = num[0] * w + num[1] * w1 + num[2] * w2;
+        if y.abs() >= best.value {
+            if i + 1 >= n + 2 {
+                return None;
+            }
+            let next = x(i + 1) - a1 * w - a2 * w1;
+            return Some([before, y, num[0] * next + num[1] * w + num[2] * w1]);
+        }
+        (before, w2, w1) = (y, w1, w);
+    }
+    None
 }
 
 /// The spectra of the pulse `x[..len]` (m/s², baseline removed) sampled at `rate_hz`, which
@@ -398,36 +491,13 @@ pub fn spectrum(
         if rate < rate_hz && compensated.as_ref().is_none_or(|(r, _)| *r != rate) {
             compensated = compensate(x, len).map(|range| (rate, range));
         }
-        let at = |data: &[f32], i: usize| data.get(i).copied().unwrap_or(0.0);
-        let (s, p) = match (&compensated, rate < rate_hz) {
-            (Some((_, range)), true) => {
-                let data = x.get(range.clone()).unwrap_or(&[]);
-                band(data.len(), |i| at(data, i), f, settings.damping, rate, true)
-            }
-            // No room for the copy: the same pre-emphasis, sample by sample.
-            (None, true) => {
-                let data = x.get(..len).unwrap_or(&[]);
-                band(
-                    data.len() + 4,
-                    |i| emphasised(data, i),
-                    f,
-                    settings.damping,
-                    rate,
-                    true,
-                )
-            }
-            (_, false) => {
-                let data = x.get(..len).unwrap_or(&[]);
-                band(
-                    data.len(),
-                    |i| at(data, i),
-                    f,
-                    settings.damping,
-                    rate,
-                    false,
-                )
-            }
+        let input = match (&compensated, rate < rate_hz) {
+            (Some((_, range)), true) => Input::Plain(x.get(range.clone()).unwrap_or(&[])),
+            // No room for the copy: the same pre-emphasis, as the band goes.
+            (None, true) => Input::Emphasised(x.get(..len).unwrap_or(&[])),
+            (_, false) => Input::Plain(x.get(..len).unwrap_or(&[])),
         };
+        let (s, p) = band(input, f, settings.damping, rate, rate_hz / rate);
         if let (Some(a), Some(v)) = (out.srs_m_s2.get_mut(k), out.pvss_m_s.get_mut(k)) {
             (*a, *v) = (s, p);
         }
@@ -454,6 +524,7 @@ pub fn spectrum(
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::signal::srs::Response;
 
     #[test]
     fn the_half_band_filter_is_normalised_and_halving_keeps_a_constant() {

@@ -28,6 +28,14 @@ pub struct Oscillator<R = f64> {
     decay: R,
     /// `ω_d T`: the damped oscillation's phase advance per sample, rad.
     advance: R,
+    /// `exp(-decay)`, `sin advance`, `cos advance`: the poles.
+    radius: R,
+    sin_advance: R,
+    cos_advance: R,
+    /// The free response's extrema lie where its phase is `psi` (mod π): `atan(-decay /
+    /// advance)`, and `|cos psi|`.
+    psi: R,
+    cos_psi: R,
 }
 
 /// Which response of the oscillator a spectrum records.
@@ -43,52 +51,17 @@ impl<R: Real> Oscillator<R> {
     /// The oscillator of natural frequency `freq_hz` and damping ratio `damping` (in
     /// `[0, 0.5]`) sampled at `rate_hz`; `None` outside `0 < freq_hz <= rate_hz / 4`.
     pub fn new(response: Response, freq_hz: R, damping: R, rate_hz: R) -> Option<Self> {
-        let four = R::TWO * R::TWO;
-        if !(freq_hz > R::ZERO
-            && rate_hz.is_finite()
-            && freq_hz <= rate_hz / four
-            && damping >= R::ZERO
-            && damping <= R::HALF)
-        {
-            return None;
-        }
-        let t = R::ONE / rate_hz;
-        let w = R::TWO * R::PI * freq_hz;
-        // ISO 18431-4 with Q = 1 / (2 ζ): A = ω T / (2 Q) = ζ ω T, B = ω_d T.
-        let big_a = damping * w * t;
-        let s = (R::ONE - damping * damping).sqrt();
-        let big_b = w * t * s;
-        let e = (-big_a).exp();
-        let e2 = (-R::TWO * big_a).exp();
-        let (sin_b, cos_b) = (big_b.sin(), big_b.cos());
-        let a = [-R::TWO * e * cos_b, e2];
-        let b = match response {
-            Response::AbsoluteAcceleration => {
-                let sinc = sin_b / big_b;
-                [
-                    R::ONE - e * sinc,
-                    R::TWO * e * (sinc - cos_b),
-                    e2 - e * sinc,
-                ]
-            }
-            Response::PseudoVelocity => {
-                // 1/Q = 2 ζ; q = (1/(2 Q²) - 1) / sqrt(1 - 1/(4 Q²)) = (2 ζ² - 1) / s.
-                let inv_q = R::TWO * damping;
-                let q = (R::TWO * damping * damping - R::ONE) / s;
-                let wt = w * t;
-                let c = t * w * w;
-                [
-                    ((R::ONE - e * cos_b) * inv_q - q * e * sin_b - wt) / c,
-                    (R::TWO * e * cos_b * wt - (R::ONE - e2) * inv_q + R::TWO * q * e * sin_b) / c,
-                    (-e2 * (wt + inv_q) + e * cos_b * inv_q - q * e * sin_b) / c,
-                ]
-            }
-        };
-        Some(Self {
-            b,
-            a,
-            decay: big_a,
-            advance: big_b,
+        Poles::new(freq_hz, damping, rate_hz).map(|p| p.oscillator(response))
+    }
+
+    /// Both responses' oscillators, `[absolute acceleration, pseudo-velocity]`, for the
+    /// price of one (they share the poles).
+    pub fn pair(freq_hz: R, damping: R, rate_hz: R) -> Option<[Self; 2]> {
+        Poles::new(freq_hz, damping, rate_hz).map(|p| {
+            [
+                p.oscillator(Response::AbsoluteAcceleration),
+                p.oscillator(Response::PseudoVelocity),
+            ]
         })
     }
 
@@ -115,8 +88,7 @@ impl<R: Real> Oscillator<R> {
     /// Largest `|y(t)|`, `t >= 0`, of the free response through `y(0) = y0`, `y(1) = y1` (one
     /// sample apart): `y(t) = C r^t cos(θ t + φ)` with `r = exp(-decay)`, `θ = advance`.
     pub fn residual_peak(&self, y0: R, y1: R) -> R {
-        let r = (-self.decay).exp();
-        let (sin_t, cos_t) = (self.advance.sin(), self.advance.cos());
+        let (r, sin_t, cos_t) = (self.radius, self.sin_advance, self.cos_advance);
         // y0 = C cos φ; y1 = C r (cos θ cos φ - sin θ sin φ).
         let c_cos = y0;
         let c_sin = (y0 * r * cos_t - y1) / (r * sin_t);
@@ -127,12 +99,119 @@ impl<R: Real> Oscillator<R> {
         let phi = c_sin.atan2(c_cos);
         // Extrema where tan(θ t + φ) = -decay / θ; the first one at t >= 0 is the largest
         // after t = 0 (the envelope decays).
-        let psi = (-self.decay / self.advance).atan();
+        let psi = self.psi;
         let d = psi - phi;
         let turn = d - (d / R::PI).floor() * R::PI;
         let t = turn / self.advance;
-        let at_extremum = c * (-self.decay * t).exp() * psi.cos().abs();
+        let at_extremum = c * (-self.decay * t).exp() * self.cos_psi;
         y0.abs().max(at_extremum)
+    }
+}
+
+/// What both responses' oscillators share: the poles of one band at one rate.
+#[derive(Clone, Copy)]
+struct Poles<R> {
+    damping: R,
+    /// `ω T`, `ζ ω T`, `ω_d T`, `sqrt(1 - ζ²)`, `exp(-ζ ω T)`, `exp(-2 ζ ω T)`, `sin`,
+    /// `cos` of `ω_d T`.
+    wt: R,
+    big_a: R,
+    big_b: R,
+    s: R,
+    e: R,
+    e2: R,
+    sin_b: R,
+    cos_b: R,
+    t: R,
+    w: R,
+    psi: R,
+    cos_psi: R,
+}
+
+impl<R: Real> Poles<R> {
+    fn new(freq_hz: R, damping: R, rate_hz: R) -> Option<Self> {
+        let four = R::TWO * R::TWO;
+        if !(freq_hz > R::ZERO
+            && rate_hz.is_finite()
+            && freq_hz <= rate_hz / four
+            && damping >= R::ZERO
+            && damping <= R::HALF)
+        {
+            return None;
+        }
+        let t = R::ONE / rate_hz;
+        let w = R::TWO * R::PI * freq_hz;
+        // ISO 18431-4 with Q = 1 / (2 ζ): A = ω T / (2 Q) = ζ ω T, B = ω_d T.
+        let big_a = damping * w * t;
+        let s = (R::ONE - damping * damping).sqrt();
+        let big_b = w * t * s;
+        let psi = (-big_a / big_b).atan();
+        Some(Self {
+            damping,
+            wt: w * t,
+            big_a,
+            big_b,
+            s,
+            e: (-big_a).exp(),
+            e2: (-R::TWO * big_a).exp(),
+            sin_b: big_b.sin(),
+            cos_b: big_b.cos(),
+            t,
+            w,
+            psi,
+            cos_psi: psi.cos().abs(),
+        })
+    }
+
+    fn oscillator(&self, response: Response) -> Oscillator<R> {
+        let Self {
+            damping,
+            wt,
+            big_a,
+            big_b,
+            s,
+            e,
+            e2,
+            sin_b,
+            cos_b,
+            t,
+            w,
+            psi,
+            cos_psi,
+        } = *self;
+        let a = [-R::TWO * e * cos_b, e2];
+        let b = match response {
+            Response::AbsoluteAcceleration => {
+                let sinc = sin_b / big_b;
+                [
+                    R::ONE - e * sinc,
+                    R::TWO * e * (sinc - cos_b),
+                    e2 - e * sinc,
+                ]
+            }
+            Response::PseudoVelocity => {
+                // 1/Q = 2 ζ; q = (1/(2 Q²) - 1) / sqrt(1 - 1/(4 Q²)) = (2 ζ² - 1) / s.
+                let inv_q = R::TWO * damping;
+                let q = (R::TWO * damping * damping - R::ONE) / s;
+                let c = t * w * w;
+                [
+                    ((R::ONE - e * cos_b) * inv_q - q * e * sin_b - wt) / c,
+                    (R::TWO * e * cos_b * wt - (R::ONE - e2) * inv_q + R::TWO * q * e * sin_b) / c,
+                    (-e2 * (wt + inv_q) + e * cos_b * inv_q - q * e * sin_b) / c,
+                ]
+            }
+        };
+        Oscillator {
+            b,
+            a,
+            decay: big_a,
+            advance: big_b,
+            radius: e,
+            sin_advance: sin_b,
+            cos_advance: cos_b,
+            psi,
+            cos_psi,
+        }
     }
 }
 
