@@ -34,6 +34,7 @@ pub mod solve;
 pub mod stream;
 pub mod target;
 pub mod train;
+pub mod waveform;
 
 pub use analysis::{analyse, Workspace};
 pub use capture::{Capture, Sink, Summary};

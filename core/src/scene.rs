@@ -112,6 +112,9 @@ pub struct Scene {
     /// Shock spectra (SRS, PVSS, enveloping half-sine) of each captured impact
     /// ([`crate::signal::spectrum`]).
     pub spectrum: Option<SpectrumSettings>,
+    /// Send each captured window off the board after its analysis ([`crate::waveform`]):
+    /// 0 not, 1 whole, `N` the mean of every `N` samples.
+    pub waveform_every: u16,
 }
 
 impl Scene {
@@ -134,6 +137,7 @@ impl Scene {
             fits: FitSet::none(),
             train: None,
             spectrum: None,
+            waveform_every: 0,
         }
     }
 

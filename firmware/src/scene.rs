@@ -61,6 +61,8 @@ pub const BENCH: Scene = Scene {
     },
     train: None,
     spectrum: None,
+    // The captured windows stay on the board (`wave=1` in the emulator sends them).
+    waveform_every: 0,
 };
 
 /// Why a `key=value` scene argument was refused.
@@ -102,6 +104,7 @@ impl Format for SceneError {
 /// | `gravity`, `max_flight` | the train's gravity, m/s², and longest flight, s |
 /// | `srs` | `0` or `1`: shock spectra per impact |
 /// | `srs_damping`, `srs_bands`, `srs_low` | damping ratio, bands per octave (6, 12), lowest band, Hz |
+/// | `wave` | send each captured window: `0` not, `1` whole, `N` the mean of every `N` samples |
 ///
 /// Floats are parsed by `core`'s correctly rounded parser, so the shortest round-trip decimal
 /// of an `f32` (Rust's `{}` or `{:e}`) gives back exactly that `f32`.
@@ -203,6 +206,7 @@ pub fn apply(scene: &mut Scene, key: &str, value: &str) -> Result<(), SceneError
             }
             scene.train = Some(t);
         }
+        "wave" => scene.waveform_every = value.parse::<u16>().map_err(|_| SceneError::BadValue)?,
         _ => return Err(SceneError::UnknownKey),
     }
     Ok(())
@@ -238,7 +242,7 @@ pub fn log(scene: &Scene) {
     };
     let fits = &scene.fits;
     info!(
-        "scene rate_hz={=f32} gain_m_s2_per_count={=f32} mass_kg={} v0_m_s={} drop_height_m={} trigger_m_s2={=f32} edge_m_s2={=f32} hold_s={=f32} max_impact_s={=f32} settle_s={=f32} clip_low={=i16} clip_high={=i16} cfc={} trigger_cfc={} two_phase={=bool} nonlinear={=bool} fit_exponent={=bool} exponent={=f32} hertz={=bool} train={=str} gravity_m_s2={} max_flight_s={} srs={=bool}",
+        "scene rate_hz={=f32} gain_m_s2_per_count={=f32} mass_kg={} v0_m_s={} drop_height_m={} trigger_m_s2={=f32} edge_m_s2={=f32} hold_s={=f32} max_impact_s={=f32} settle_s={=f32} clip_low={=i16} clip_high={=i16} cfc={} trigger_cfc={} two_phase={=bool} nonlinear={=bool} fit_exponent={=bool} exponent={=f32} hertz={=bool} train={=str} gravity_m_s2={} max_flight_s={} srs={=bool} wave_every={=u16}",
         scene.calibration.sample_rate_hz,
         scene.calibration.gain_m_s2_per_count,
         Opt(scene.mass_kg),
@@ -262,6 +266,7 @@ pub fn log(scene: &Scene) {
         Opt(scene.train.map(|t| t.gravity_m_s2)),
         Opt(scene.train.map(|t| t.max_flight_s)),
         scene.spectrum.is_some(),
+        scene.waveform_every,
     );
 }
 

@@ -292,6 +292,9 @@ pub struct AnalysisJson {
     pub impacts: Vec<ImpactJson>,
     /// With `--train`: each train of bounces and its COR against impact speed.
     pub trains: Vec<crate::train::TrainJson>,
+    /// `impact log` / `impact emulate --waveforms`: the captured windows the board sent.
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub waveforms: Vec<crate::waves::WaveformJson>,
 }
 
 fn fits_json(f: &Fits) -> FitsJson {
@@ -507,6 +510,23 @@ pub struct Setup {
     pub resampled: bool,
     /// With `--axes`: each axis in m/s² and its rails.
     pub axes: Vec<crate::axes::Axis>,
+}
+
+impl Setup {
+    /// The signal the figure draws: the counts the pipeline analysed times the gain.
+    pub fn plot_signal(&self) -> crate::plot::Signal<'_> {
+        crate::plot::Signal {
+            rate_hz: f64::from(self.scene.calibration.sample_rate_hz),
+            mass_kg: self.scene.mass_kg.map(f64::from),
+            accel_m_s2: Box::new(move |i| {
+                let gain = f64::from(self.scene.calibration.gain_m_s2_per_count);
+                self.prepared
+                    .counts
+                    .get(usize::try_from(i).ok()?)
+                    .map(|&c| f64::from(c) * gain)
+            }),
+        }
+    }
 }
 
 /// Reads the file and builds the scene (v0 from a free fall needs a first pass).
@@ -797,6 +817,7 @@ pub fn to_json(setup: &Setup, reports: &[ImpactReport]) -> AnalysisJson {
         clipping: setup.clipping.clone(),
         train_speed: setup.scene.train.map(|t| t.speed.name().to_string()),
         trains: Vec::new(),
+        waveforms: Vec::new(),
         impacts: reports
             .iter()
             .enumerate()

@@ -41,6 +41,16 @@ pub struct EmulateArgs {
     /// With --realtime: replay this many times faster than the recording's rate (headroom).
     #[arg(long, requires = "realtime", default_value_t = 1.0, value_parser = positive_f32)]
     pub rate_scale: f32,
+    /// The firmware sends each impact's captured window after its analysis (scene `wave`):
+    /// whole, or the mean of every EVERY samples; checked against the replayed samples, and
+    /// in the JSON's `waveforms`. Keep them with --log, draw them with `impact log --plot`.
+    #[arg(long, num_args = 0..=1, default_missing_value = "1", value_name = "EVERY",
+          value_parser = clap::value_parser!(u16).range(1..))]
+    pub waveforms: Option<u16>,
+    /// Write the firmware's decoded log (what defmt-print prints, waveform frames included)
+    /// to this file, as `impact log` reads it.
+    #[arg(long)]
+    pub log: Option<PathBuf>,
 }
 
 fn positive_f32(s: &str) -> Result<f32, String> {
@@ -115,6 +125,7 @@ pub fn scene_args(scene: &Scene) -> Vec<String> {
             format!("max_flight={}", f(t.max_flight_s)),
         ]),
     }
+    args.push(format!("wave={}", scene.waveform_every));
     args
 }
 
@@ -361,7 +372,8 @@ pub fn emulate(args: &EmulateArgs) -> Result<(), String> {
     let a = &args.analyze;
     // Check the tools before a possibly long build.
     tools_available()?;
-    let setup = analyze::setup(a, None)?;
+    let mut setup = analyze::setup(a, None)?;
+    setup.scene.waveform_every = args.waveforms.unwrap_or(0);
     let elf = match &args.elf {
         Some(p) => p.clone(),
         None => build_firmware()?,
@@ -383,6 +395,10 @@ pub fn emulate(args: &EmulateArgs) -> Result<(), String> {
         pacing,
         Duration::from_secs(args.timeout),
         move |line| {
+            // The waveform frames are for files (--log), not for the terminal.
+            if line.contains("wave_frame ") {
+                return;
+            }
             if to_stderr {
                 eprintln!("{line}");
             } else {
@@ -396,7 +412,12 @@ pub fn emulate(args: &EmulateArgs) -> Result<(), String> {
             run.status
         ));
     }
-    let log = parse_log(&run.lines.join("\n"))?;
+    let text = run.lines.join("\n") + "\n";
+    if let Some(path) = &args.log {
+        std::fs::write(path, &text).map_err(|e| format!("{}: {e}", path.display()))?;
+        eprintln!("wrote {}", path.display());
+    }
+    let log = parse_log(&text)?;
     let summary = log
         .summary
         .as_ref()
@@ -417,6 +438,10 @@ pub fn emulate(args: &EmulateArgs) -> Result<(), String> {
     for (j, latency) in json.impacts.iter_mut().zip(&log.latencies) {
         j.report_latency_s = latency.map(f64::from);
     }
+    if let Some(every) = args.waveforms {
+        check_waveforms(&log, &setup.prepared.counts, every)?;
+        json.waveforms = log.waveforms.iter().map(|w| w.json()).collect();
+    }
     let mut out = std::io::stdout().lock();
     let text = if a.json {
         serde_json::to_string_pretty(&json).map_err(|e| e.to_string())? + "\n"
@@ -427,9 +452,59 @@ pub fn emulate(args: &EmulateArgs) -> Result<(), String> {
     };
     out.write_all(text.as_bytes()).map_err(|e| e.to_string())?;
     if let Some(path) = &a.plot {
-        crate::plot::impacts(&setup, &log.impacts, path)?;
+        crate::plot::impacts(&setup.plot_signal(), &log.impacts, path)?;
         eprintln!("wrote {}", path.display());
     }
+    Ok(())
+}
+
+/// Every analysed impact's window, as the firmware sent it, against the replayed samples
+/// (whole or averaged the same way): equal value for value, or an error naming the first
+/// difference. Prints what it checked.
+pub fn check_waveforms(log: &crate::log::Log, counts: &[i16], every: u16) -> Result<(), String> {
+    let analysed = log
+        .impacts
+        .iter()
+        .filter(|r| r.analysis != impact_core::Analysis::Skipped)
+        .count();
+    if log.waveforms.len() != analysed {
+        return Err(format!(
+            "the firmware sent {} waveforms for {analysed} analysed impacts",
+            log.waveforms.len()
+        ));
+    }
+    let mut frames = 0;
+    for w in &log.waveforms {
+        if w.every != every {
+            return Err(format!(
+                "impact {}: waveform every={}, asked {every}",
+                w.index, w.every
+            ));
+        }
+        let from = usize::try_from(w.first_sample).map_err(|e| e.to_string())?;
+        let window = counts
+            .get(from..from + w.samples as usize)
+            .ok_or_else(|| format!("impact {}: its window lies beyond the recording", w.index))?;
+        let mut expected = [0i16; impact_core::waveform::FRAME_LEN];
+        for k in 0..w.frames as usize {
+            let n = impact_core::waveform::frame(window, every, k, &mut expected);
+            for (j, want) in expected.iter().take(n).enumerate() {
+                let at = k * impact_core::waveform::FRAME_LEN + j;
+                let got = w.value(at);
+                if got != Some(*want) {
+                    return Err(format!(
+                        "impact {}: waveform value {at} is {got:?}, the replayed samples give {want}",
+                        w.index
+                    ));
+                }
+            }
+        }
+        frames += w.frames;
+    }
+    eprintln!(
+        "waveforms: {} windows, {frames} frames, equal to the replayed samples",
+        log.waveforms.len()
+    );
     Ok(())
 }
 

@@ -27,6 +27,7 @@ pub mod tdms;
 pub mod throughput;
 pub mod train;
 pub mod wav;
+pub mod waves;
 
 /// Runs `f` on a thread with a 64 MiB stack: the core's monitors hold their capture buffers
 /// inline (no allocation in `core`), which is more than a default thread's stack.

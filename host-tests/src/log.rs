@@ -30,6 +30,15 @@ pub struct LogArgs {
     /// `impact analyze` adds the recording's first time stamp).
     #[arg(long, default_value_t = 0.0, value_parser = finite_f64)]
     pub t0: f64,
+    /// Draw the impacts from the board's waveforms (the figure of `impact analyze --plot`)
+    /// to this SVG file.
+    #[arg(long)]
+    pub plot: Option<PathBuf>,
+    /// Write each waveform as a recording `impact analyze` reads: `NAME.csv` (time_s,
+    /// accel_m_s2) or `NAME.wav` (16-bit counts, give `--gain`), one file per impact,
+    /// `NAME-<index>.csv`.
+    #[arg(long)]
+    pub export: Option<PathBuf>,
 }
 
 fn finite_f64(s: &str) -> Result<f64, String> {
@@ -55,6 +64,8 @@ pub struct Log {
     /// What looks wrong without being impossible (e.g. fewer impact lines than the last
     /// heartbeat counts), by line.
     pub warnings: Vec<String>,
+    /// The captured windows the board sent (`wave` lines, scene `wave_every` > 0).
+    pub waveforms: Vec<crate::waves::Waveform>,
 }
 
 /// The `key=value` fields following `marker` (e.g. `"impact "`) in a decoded line, or `None`
@@ -101,6 +112,7 @@ impl Number for u8 {}
 impl Number for u16 {}
 impl Number for u32 {}
 impl Number for u64 {}
+impl Number for i64 {}
 impl Number for f32 {
     fn is_finite(&self) -> bool {
         f32::is_finite(*self)
@@ -345,6 +357,31 @@ impl LogReader {
                     )))
                 }
             }
+        } else if let Some(m) = fields(line, "wave_frame ") {
+            let m = m.map_err(at)?;
+            let (index, frame, counts) = crate::waves::parse_frame(line, &m).map_err(at)?;
+            let w = self
+                .log
+                .waveforms
+                .iter_mut()
+                .rev()
+                .find(|w| w.index == index)
+                .ok_or_else(|| {
+                    at(format!(
+                        "wave_frame index={index}: no wave line of that index before it"
+                    ))
+                })?;
+            w.add_frame(frame, counts).map_err(at)?;
+        } else if let Some(m) = fields(line, "wave ") {
+            let m = m.map_err(at)?;
+            let w = crate::waves::Waveform::from_header(&m).map_err(at)?;
+            if self.log.waveforms.iter().any(|p| p.index == w.index) {
+                return Err(at(format!(
+                    "wave index={} again: two streams mixed, or a line repeated",
+                    w.index
+                )));
+            }
+            self.log.waveforms.push(w);
         } else if let Some(m) = fields(line, "heartbeat ") {
             let m = m.map_err(at)?;
             let samples: u64 = num(&m, "samples").map_err(at)?;
@@ -429,6 +466,17 @@ impl LogReader {
                 }
             }
         }
+        for w in &self.log.waveforms {
+            if w.missing_frames() > 0 {
+                self.log.warnings.push(format!(
+                    "impact {}: {} of {} waveform frames missing (the link dropped them)",
+                    w.index,
+                    w.missing_frames(),
+                    w.frames
+                ));
+            }
+        }
+        self.log.waveforms.sort_by_key(|w| w.index);
         let mut both: Vec<_> = self
             .log
             .impacts
@@ -569,6 +617,7 @@ pub fn log_json(log: &Log, t0: f64) -> Result<AnalysisJson, String> {
         samples,
         train_speed,
         trains: Vec::new(),
+        waveforms: log.waveforms.iter().map(|w| w.json()).collect(),
         sample_rate_hz: rate as f64,
         v0_source,
         free_fall_s: None,
@@ -631,6 +680,38 @@ pub fn log(args: &LogArgs) -> Result<(), String> {
         eprintln!("warning: {name}: {w}");
     }
     let json = log_json(&log, args.t0)?;
+    if args.plot.is_some() || args.export.is_some() {
+        let scene = log
+            .scene
+            .as_ref()
+            .ok_or("--plot/--export: the log has no scene line (the rate and the gain)")?;
+        let rate = f64::from(rate(scene)?);
+        let gain = f64::from(num::<f32>(scene, "gain_m_s2_per_count")?);
+        if let Some(path) = &args.plot {
+            if log.waveforms.is_empty() {
+                return Err("--plot: the log has no waveforms (the scene's wave=0)".into());
+            }
+            let mass: Option<f32> = opt(scene, "mass_kg")?;
+            let waves = &log.waveforms;
+            let signal = crate::plot::Signal {
+                rate_hz: rate,
+                mass_kg: mass.map(f64::from),
+                accel_m_s2: Box::new(move |i| {
+                    waves
+                        .iter()
+                        .find_map(|w| w.at_sample(i))
+                        .map(|c| f64::from(c) * gain)
+                }),
+            };
+            crate::plot::impacts(&signal, &log.impacts, path)?;
+            eprintln!("wrote {}", path.display());
+        }
+        if let Some(path) = &args.export {
+            for p in crate::waves::export(&log.waveforms, path, rate, gain)? {
+                eprintln!("wrote {}", p.display());
+            }
+        }
+    }
     if args.csv {
         print!("{}", analyze::to_csv(&json));
     } else {

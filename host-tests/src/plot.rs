@@ -220,12 +220,24 @@ fn draw_panel(
     Ok(())
 }
 
+/// What the impact figure draws from: the signal the pipeline analysed (the counts times
+/// the gain, so that `impact analyze` and `impact log` on the board's waveforms draw the
+/// same), at the scene's rate.
+pub struct Signal<'a> {
+    /// Sample rate, Hz (the scene's, an `f32`).
+    pub rate_hz: f64,
+    /// The body's mass, kg, if known.
+    pub mass_kg: Option<f64>,
+    /// Acceleration of stream sample `i`, m/s² (`None` where it is not known).
+    pub accel_m_s2: Box<dyn Fn(u64) -> Option<f64> + 'a>,
+}
+
 /// Per impact (up to six), as in the seed papers' figures: deceleration, velocity and
 /// deformation against time from touch, the force–deformation loop, with the fitted models
 /// (two-phase, nonlinear, Hertz) simulated from the same touch over the measured curves; with
 /// `--srs`, the SRS and the PVSS (log–log).
 pub fn impacts(
-    setup: &crate::analyze::Setup,
+    signal: &Signal,
     reports: &[impact_core::ImpactReport],
     path: &std::path::Path,
 ) -> Result<(), String> {
@@ -242,16 +254,16 @@ pub fn impacts(
         SVGBackend::new(path, (400 * cols as u32, 330 * shown.len() as u32)).into_drawing_area();
     root.fill(&WHITE).map_err(|e| e.to_string())?;
     let rows = root.split_evenly((shown.len(), cols));
-    let fs = setup.rate_hz;
-    let a = &setup.prepared.accel_m_s2;
-    let mass = setup.scene.mass_kg.map(|m| m as f64);
+    let fs = signal.rate_hz;
+    let mass = signal.mass_kg;
     for (k, r) in shown.iter().enumerate() {
         let start = ((r.start_s * fs).floor() as usize).saturating_sub(2);
         let len = ((r.duration_s as f64 * fs).ceil() as usize + 4).max(4);
-        let end = (start + len).min(a.len());
         let base = r.baseline_m_s2 as f64;
         let t_ms = |i: usize| (i as f64 / fs - r.start_s) * 1e3;
-        let meas: Vec<(f64, f64)> = (start..end).map(|i| (t_ms(i), a[i] - base)).collect();
+        let meas: Vec<(f64, f64)> = (start..start + len)
+            .map_while(|i| Some((t_ms(i), (signal.accel_m_s2)(i as u64)? - base)))
+            .collect();
         let v0 = r.kinematics.map(|k| k.impact_velocity_m_s as f64);
         // Velocity and deformation by integration from the touch.
         let (mut v, mut x) = (v0.unwrap_or(0.0), 0.0);

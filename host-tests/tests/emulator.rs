@@ -212,6 +212,103 @@ fn seed_001_bench_impact_with_kinematics_and_fits() {
     }
 }
 
+/// The board's waveforms: `impact emulate --waveforms` checks every frame against the
+/// replayed samples and otherwise reports what `impact analyze` reports; `impact log --plot`
+/// on the board's log draws the figure `impact analyze --plot` draws, byte for byte; the
+/// exported window analyses again to the same impact; a dropped frame is counted.
+#[test]
+fn waveforms_off_the_board_draw_the_same_figure() {
+    let Some(elf) = firmware() else { return };
+    let elf = elf.to_string_lossy().into_owned();
+    let args: Vec<&str> = ["synth"]
+        .into_iter()
+        .chain(impact_host::synth::SEED_BENCH_ARGS)
+        .collect();
+    let (csv, _) = impact(&args);
+    let file = tmp("waves-seed.csv");
+    std::fs::write(&file, csv).unwrap();
+    let file = file.to_string_lossy().into_owned();
+    let path = |name: &str| tmp(name).to_string_lossy().into_owned();
+    let body = ["--mass", "0.06", "--v0", "1.3357"];
+    let with = |head: &[&str], tail: &[&str]| -> Vec<String> {
+        head.iter()
+            .chain(&body)
+            .chain(tail)
+            .map(|s| s.to_string())
+            .collect()
+    };
+    let run = |v: Vec<String>| impact(&v.iter().map(String::as_str).collect::<Vec<_>>());
+    let (host_svg, board_svg, log) = (path("host.svg"), path("board.svg"), path("board.log"));
+    let (host, _) = run(with(&["analyze", &file], &["--json", "--plot", &host_svg]));
+    let (emulated, err) = run(with(
+        &["emulate", &file],
+        &["--json", "--elf", &elf, "--waveforms", "--log", &log],
+    ));
+    assert!(err.contains("equal to the replayed samples"), "{err}");
+    let mut e: serde_json::Value = serde_json::from_str(&emulated).unwrap();
+    let waves = e.as_object_mut().unwrap().remove("waveforms").unwrap();
+    assert_eq!(waves[0]["every"], 1);
+    assert_eq!(waves[0]["missing_frames"], 0);
+    assert!(waves[0]["samples"].as_u64().unwrap() > 10_000, "{waves}");
+    let h: serde_json::Value = serde_json::from_str(&host).unwrap();
+    assert_eq!(e, h, "the waveforms changed the reports");
+
+    impact(&["log", &log, "--plot", &board_svg]);
+    let (a, b) = (
+        std::fs::read(&host_svg).unwrap(),
+        std::fs::read(&board_svg).unwrap(),
+    );
+    assert!(a.len() > 10_000 && a == b, "the figures differ");
+
+    // The exported window, analysed again: the same impact, its baseline learned from the
+    // window's pre-trigger part alone (so within 1e-3; the deformation, a double integral
+    // of the baseline's difference, within 3e-3).
+    let export = path("window.csv");
+    impact(&["log", &log, "--export", &export]);
+    let again_file = export.replace("window.csv", "window-0.csv");
+    let (again, _) = run(with(
+        &["analyze", &again_file],
+        &["--units", "m/s2", "--json"],
+    ));
+    let a: serde_json::Value = serde_json::from_str(&again).unwrap();
+    for (key, within) in [
+        ("peak_acceleration_m_s2", 1e-3),
+        ("delta_v_m_s", 1e-3),
+        ("cor", 1e-3),
+        ("max_deformation_m", 3e-3),
+    ] {
+        let (x, y) = (
+            a["impacts"][0][key].as_f64().unwrap(),
+            h["impacts"][0][key].as_f64().unwrap(),
+        );
+        assert!((x / y - 1.0).abs() < within, "{key}: {x} again, {y} first");
+    }
+
+    // A frame the link dropped: counted, warned about, and the figure still drawn.
+    let text = std::fs::read_to_string(&log).unwrap();
+    let cut: String = text
+        .lines()
+        .filter(|l| !l.contains("wave_frame index=0 frame=7 "))
+        .map(|l| format!("{l}\n"))
+        .collect();
+    let cut_log = path("cut.log");
+    std::fs::write(&cut_log, cut).unwrap();
+    let (json, err) = impact(&["log", &cut_log, "--plot", &path("cut.svg")]);
+    assert!(
+        err.contains("1 of") && err.contains("frames missing"),
+        "{err}"
+    );
+    let j: serde_json::Value = serde_json::from_str(&json).unwrap();
+    assert_eq!(j["waveforms"][0]["missing_frames"], 1);
+
+    // Averaged: every fourth sample's group mean, checked the same way.
+    let (_, err) = run(with(
+        &["emulate", &file],
+        &["--json", "--elf", &elf, "--waveforms", "4"],
+    ));
+    assert!(err.contains("equal to the replayed samples"), "{err}");
+}
+
 #[test]
 fn shock_spectra_on_the_board_are_the_hosts() {
     // The firmware's `srs` lines, decoded, give the host's spectra bit for bit.

@@ -150,6 +150,7 @@ impl<const PRE: usize> Stream<PRE> {
                 trigger_cfc: None,
                 train: None,
                 spectrum: None,
+                waveform_every: 0,
                 fits: FitSet {
                     two_phase: false,
                     nonlinear: false,

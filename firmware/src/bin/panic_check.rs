@@ -78,6 +78,7 @@ fn scene() -> Scene {
         fits: FitSet::all(),
         train: Some(impact_core::Train::new()),
         spectrum: Some(impact_core::signal::spectrum::SpectrumSettings::new()),
+        waveform_every: 1,
     })
 }
 
@@ -122,6 +123,17 @@ fn main() -> ! {
             3 => monitor.gap(u64::from(unknown()), &mut out),
             // A light gate's reading, any value.
             4 => monitor.set_approach_speed(Some(f32::from_bits(unknown()))),
+            // Any frame of any window at any averaging (the waveforms sent off the board).
+            5 => {
+                let n = (unknown() as usize).min(block.len());
+                let mut frame = [0i16; impact_core::waveform::FRAME_LEN];
+                let _ = black_box(impact_core::waveform::frame(
+                    block.get(..n).unwrap_or(&[]),
+                    unknown() as u16,
+                    unknown() as usize,
+                    &mut frame,
+                ));
+            }
             2 => {
                 let impact = black_box(Impact::new(0.06f32, 1.3357));
                 for model in models() {

@@ -1,18 +1,30 @@
 //! Analysis task (lowest priority): the per-impact analysis ([`impact_core::analyse`], the same
 //! code as the host's) of each capture the stream task hands over, read in its queue slot and
-//! released as soon as the report is made.
+//! released as soon as the report is made (and, when the scene asks for it, the captured
+//! window sent off the board as `wave` / `wave_frame` lines).
 
-use defmt::error;
+use defmt::{error, info};
+use embassy_time::{Duration, Timer};
+use impact_core::waveform::{self, FRAME_LEN};
 use impact_core::{analyse, Scene, Workspace};
 use static_cell::ConstStaticCell;
 
-use super::{CaptureReceiver, ANALYSED, CAPTURE_LEN};
+use super::{CaptureReceiver, FwCapture, ANALYSED, CAPTURE_LEN};
 
 /// The analysis's scratch memory (the acceleration of a whole capture, f32). All zeros, so it
 /// starts in `.bss`; on the board it lives in the CCM RAM (`firmware/stm32/board-memory.x`),
 /// which the DMA cannot reach and the analysis does not need it to.
 #[cfg_attr(feature = "stm32", link_section = ".ccmram.workspace")]
 static WORKSPACE: ConstStaticCell<Workspace<CAPTURE_LEN>> = ConstStaticCell::new(Workspace::new());
+
+/// Pause after each waveform frame on the board: 130 bytes a millisecond (130 KB/s) leaves
+/// `probe-rs` time to empty the 4 KiB RTT buffer, where a frame that does not fit would be
+/// dropped (the host counts the missing frame numbers). The emulator's semihosting output
+/// blocks instead, so it sends without pausing.
+#[cfg(feature = "stm32")]
+const FRAME_GAP: Option<Duration> = Some(Duration::from_millis(1));
+#[cfg(not(feature = "stm32"))]
+const FRAME_GAP: Option<Duration> = None;
 
 /// Analyses captures until the stream ends (it then waits forever).
 #[embassy_executor::task]
@@ -24,7 +36,41 @@ pub async fn analysis(scene: Scene, mut captures: CaptureReceiver) {
     loop {
         let capture = captures.receive().await;
         let report = analyse(capture, &scene, work);
+        if scene.waveform_every > 0 {
+            send_waveform(capture, scene.waveform_every).await;
+        }
         captures.receive_done();
         ANALYSED.send(report).await;
+    }
+}
+
+/// The captured window as a `wave` line and its `wave_frame` lines (firmware/README.md),
+/// before the impact's own line.
+async fn send_waveform(capture: &FwCapture, every: u16) {
+    let s = capture.summary();
+    let samples = capture.samples();
+    let frames = waveform::frames(samples.len(), every);
+    info!(
+        "wave index={=u32} first_sample={=u64} samples={=u32} every={=u16} frames={=u32} base_sum={=i64} base_n={=i64}",
+        s.index,
+        s.first_index,
+        samples.len() as u32,
+        every,
+        frames as u32,
+        s.base_sum,
+        s.base_n,
+    );
+    let mut buf = [0i16; FRAME_LEN];
+    for k in 0..frames {
+        let n = waveform::frame(samples, every, k, &mut buf);
+        info!(
+            "wave_frame index={=u32} frame={=u32} counts={=[?]}",
+            s.index,
+            k as u32,
+            buf.get(..n).unwrap_or(&buf),
+        );
+        if let Some(gap) = FRAME_GAP {
+            Timer::after(gap).await;
+        }
     }
 }

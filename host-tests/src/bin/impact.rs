@@ -206,7 +206,7 @@ fn run(cli: Cli) -> Result<(), String> {
                 print!("{}", analyze::to_table(&a));
             }
             if let Some(path) = &args.plot {
-                plot::impacts(&setup, &reports, path)?;
+                plot::impacts(&setup.plot_signal(), &reports, path)?;
                 eprintln!("wrote {}", path.display());
             }
         }
