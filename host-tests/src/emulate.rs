@@ -51,6 +51,10 @@ pub struct EmulateArgs {
     /// to this file, as `impact log` reads it.
     #[arg(long)]
     pub log: Option<PathBuf>,
+    /// Write the firmware's raw defmt stream (as `probe-rs` or an RTT reader saves it) to
+    /// this file: `impact log --elf FIRMWARE FILE` decodes it.
+    #[arg(long)]
+    pub raw: Option<PathBuf>,
 }
 
 fn positive_f32(s: &str) -> Result<f32, String> {
@@ -236,6 +240,8 @@ impl Drop for TempFile {
 pub struct EmulatorRun {
     /// The decoded defmt lines.
     pub lines: Vec<String>,
+    /// The raw defmt stream QEMU wrote (what `impact log --elf` decodes).
+    pub raw: Vec<u8>,
     pub status: ExitStatus,
     /// Wall time of the QEMU run, s.
     pub seconds: f64,
@@ -309,7 +315,7 @@ pub fn run_emulator(
     let mut decoder = match Command::new("defmt-print")
         .arg("-e")
         .arg(&elf)
-        .stdin(Stdio::from(frames))
+        .stdin(Stdio::piped())
         .stdout(Stdio::piped())
         .spawn()
     {
@@ -320,6 +326,30 @@ pub fn run_emulator(
             return Err(format!("defmt-print: {e}"));
         }
     };
+    // The raw frames go on to defmt-print and are kept (a tee).
+    let Some(mut to_decoder) = decoder.stdin.take() else {
+        let _ = qemu.kill();
+        let _ = qemu.wait();
+        return Err("defmt-print: no stdin".into());
+    };
+    let tee = std::thread::spawn(move || {
+        use std::io::Read;
+        let mut frames = frames;
+        let mut raw = Vec::new();
+        let mut buf = [0u8; 1 << 14];
+        loop {
+            match frames.read(&mut buf) {
+                Ok(0) | Err(_) => break,
+                Ok(n) => {
+                    raw.extend_from_slice(&buf[..n]);
+                    if to_decoder.write_all(&buf[..n]).is_err() {
+                        break;
+                    }
+                }
+            }
+        }
+        raw
+    });
     let Some(text) = decoder.stdout.take() else {
         let _ = qemu.kill();
         let _ = qemu.wait();
@@ -353,6 +383,9 @@ pub fn run_emulator(
         }
     };
     let seconds = started.elapsed().as_secs_f64();
+    let raw = tee
+        .join()
+        .map_err(|_| "copying the raw defmt stream failed".to_string())?;
     let decoded = decoder.wait().map_err(|e| format!("defmt-print: {e}"))?;
     let lines = reader
         .join()
@@ -362,6 +395,7 @@ pub fn run_emulator(
     }
     Ok(EmulatorRun {
         lines,
+        raw,
         status,
         seconds,
     })
@@ -416,6 +450,15 @@ pub fn emulate(args: &EmulateArgs) -> Result<(), String> {
     if let Some(path) = &args.log {
         std::fs::write(path, &text).map_err(|e| format!("{}: {e}", path.display()))?;
         eprintln!("wrote {}", path.display());
+    }
+    if let Some(path) = &args.raw {
+        std::fs::write(path, &run.raw).map_err(|e| format!("{}: {e}", path.display()))?;
+        eprintln!(
+            "wrote {} (decode: impact log --elf {} {})",
+            path.display(),
+            elf.display(),
+            path.display()
+        );
     }
     let log = parse_log(&text)?;
     let summary = log

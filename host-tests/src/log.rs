@@ -30,6 +30,11 @@ pub struct LogArgs {
     /// `impact analyze` adds the recording's first time stamp).
     #[arg(long, default_value_t = 0.0, value_parser = finite_f64)]
     pub t0: f64,
+    /// The input is the firmware's raw defmt stream (as QEMU's semihosting, `impact emulate
+    /// --raw` or an RTT reader saves it), decoded against this ELF (the firmware that wrote
+    /// it) with defmt-decoder, instead of defmt-print's text.
+    #[arg(long)]
+    pub elf: Option<PathBuf>,
     /// Draw the impacts from the board's waveforms (the figure of `impact analyze --plot`)
     /// to this SVG file.
     #[arg(long)]
@@ -654,8 +659,19 @@ pub fn log(args: &LogArgs) -> Result<(), String> {
     } else {
         Box::new(std::fs::File::open(&args.file).map_err(|e| format!("{name}: {e}"))?)
     };
-    let mut input = BufReader::with_capacity(1 << 16, input);
     let mut reader = LogReader::default();
+    if let Some(elf) = &args.elf {
+        let skipped = crate::decode::decode(elf, input, &name, |n, line| {
+            reader
+                .line(n, line)
+                .map_err(|e| format!("{name}: {}", e.replacen("line ", "frame ", 1)))
+        })?;
+        if skipped > 0 {
+            eprintln!("warning: {name}: {skipped} malformed defmt frames skipped (a cut stream)");
+        }
+        return report(args, reader, &name);
+    }
+    let mut input = BufReader::with_capacity(1 << 16, input);
     let mut buf = Vec::new();
     for n in 1.. {
         buf.clear();
@@ -675,6 +691,11 @@ pub fn log(args: &LogArgs) -> Result<(), String> {
             .line(n, String::from_utf8_lossy(&buf).trim_end())
             .map_err(|e| format!("{name}: {e}"))?;
     }
+    report(args, reader, &name)
+}
+
+/// The log read: its warnings on stderr, the figure and exports asked for, the JSON or CSV.
+fn report(args: &LogArgs, reader: LogReader, name: &str) -> Result<(), String> {
     let log = reader.finish().map_err(|e| format!("{name}: {e}"))?;
     for w in &log.warnings {
         eprintln!("warning: {name}: {w}");

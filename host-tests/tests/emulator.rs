@@ -240,9 +240,19 @@ fn waveforms_off_the_board_draw_the_same_figure() {
     let run = |v: Vec<String>| impact(&v.iter().map(String::as_str).collect::<Vec<_>>());
     let (host_svg, board_svg, log) = (path("host.svg"), path("board.svg"), path("board.log"));
     let (host, _) = run(with(&["analyze", &file], &["--json", "--plot", &host_svg]));
+    let raw = path("board.bin");
     let (emulated, err) = run(with(
         &["emulate", &file],
-        &["--json", "--elf", &elf, "--waveforms", "--log", &log],
+        &[
+            "--json",
+            "--elf",
+            &elf,
+            "--waveforms",
+            "--log",
+            &log,
+            "--raw",
+            &raw,
+        ],
     ));
     assert!(err.contains("equal to the replayed samples"), "{err}");
     let mut e: serde_json::Value = serde_json::from_str(&emulated).unwrap();
@@ -259,6 +269,20 @@ fn waveforms_off_the_board_draw_the_same_figure() {
         std::fs::read(&board_svg).unwrap(),
     );
     assert!(a.len() > 10_000 && a == b, "the figures differ");
+
+    // The raw defmt stream decoded against the ELF (defmt-decoder) reads as the text does;
+    // a stream with bytes lost mid-frame skips that frame and counts it missing.
+    let (from_text, _) = impact(&["log", &log]);
+    let (from_raw, _) = impact(&["log", "--elf", &elf, &raw]);
+    assert_eq!(from_raw, from_text);
+    let bytes = std::fs::read(&raw).unwrap();
+    let mid = bytes.len() / 2;
+    let cut_raw = path("cut.bin");
+    std::fs::write(&cut_raw, [&bytes[..mid], &bytes[mid + 50..]].concat()).unwrap();
+    let (json, err) = impact(&["log", "--elf", &elf, &cut_raw]);
+    assert!(err.contains("malformed defmt frames skipped"), "{err}");
+    let j: serde_json::Value = serde_json::from_str(&json).unwrap();
+    assert_eq!(j["waveforms"][0]["missing_frames"], 1, "{err}");
 
     // The exported window, analysed again: the same impact, its baseline learned from the
     // window's pre-trigger part alone (so within 1e-3; the deformation, a double integral

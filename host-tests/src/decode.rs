@@ -1,0 +1,58 @@
+//! The firmware's raw defmt stream (what QEMU's semihosting or an RTT reader saves) decoded
+//! against its ELF with `defmt-decoder`, the decoder `defmt-print` and `probe-rs` use: one
+//! text line per frame, as `defmt-print` prints it, for [`crate::log::LogReader`].
+
+use std::io::Read;
+use std::path::Path;
+
+use defmt_decoder::{DecodeError, Table};
+
+/// Decodes `input` against the ELF at `elf`, handing each frame's text line to `on_line`
+/// (numbered from 1); returns how many malformed frames were skipped (a stream cut by a
+/// dropped link recovers at the next frame with the `rzcobs` encoding), or an error naming
+/// the file.
+pub fn decode(
+    elf: &Path,
+    mut input: impl Read,
+    name: &str,
+    mut on_line: impl FnMut(u64, &str) -> Result<(), String>,
+) -> Result<u64, String> {
+    let bytes = std::fs::read(elf).map_err(|e| format!("{}: {e}", elf.display()))?;
+    let table = Table::parse(&bytes)
+        .map_err(|e| format!("{}: not the firmware's ELF ({e})", elf.display()))?
+        .ok_or_else(|| format!("{}: no defmt data (not the firmware's ELF)", elf.display()))?;
+    let mut decoder = table.new_stream_decoder();
+    let mut buf = vec![0u8; 1 << 16];
+    let (mut frames, mut skipped) = (0u64, 0u64);
+    loop {
+        let n = input.read(&mut buf).map_err(|e| format!("{name}: {e}"))?;
+        if n == 0 {
+            break;
+        }
+        decoder.received(&buf[..n]);
+        loop {
+            match decoder.decode() {
+                Ok(frame) => {
+                    frames += 1;
+                    let line = match (frame.display_timestamp(), frame.level()) {
+                        (Some(t), Some(l)) => {
+                            format!("{t} {} {}", l.as_str().to_uppercase(), frame.display_message())
+                        }
+                        (Some(t), None) => format!("{t} {}", frame.display_message()),
+                        (None, _) => frame.display_message().to_string(),
+                    };
+                    on_line(frames, &line)?;
+                }
+                Err(DecodeError::UnexpectedEof) => break,
+                Err(DecodeError::Malformed) if table.encoding().can_recover() => skipped += 1,
+                Err(DecodeError::Malformed) => {
+                    return Err(format!(
+                        "{name}: frame {}: malformed, and this encoding cannot recover: not this firmware's stream",
+                        frames + 1
+                    ))
+                }
+            }
+        }
+    }
+    Ok(skipped)
+}
