@@ -120,6 +120,14 @@ pub struct AnalyzeArgs {
     /// Interleaved channels of a raw `.i16`/`.f32` file [default: 1].
     #[arg(long)]
     pub raw_channels: Option<usize>,
+    /// The sample type of a raw stream without a `.i16`/`.f32` name (standard input).
+    #[arg(long, value_enum)]
+    pub raw_type: Option<crate::raw::RawType>,
+    /// Analyse a raw `.i16`/`.f32` recording (or standard input) as it is read, in memory
+    /// that does not grow with its length; needs --rate, --range and --trigger; spikes are
+    /// not screened; no --plot, --axes, --free-fall.
+    #[arg(long)]
+    pub stream: bool,
     /// Multiply the channel's values by this first (e.g. g per code of a WAV file's integer
     /// samples) [default: 1].
     #[arg(long, value_parser = positive_f64)]
@@ -474,7 +482,7 @@ pub fn quantise(
 }
 
 /// One reading in counts (saturating at the i16 rails, as an ADC does).
-fn to_count(v: f64, gain: f64) -> i16 {
+pub(crate) fn to_count(v: f64, gain: f64) -> i16 {
     (v / gain).round() as i16
 }
 
@@ -489,7 +497,7 @@ pub fn noise_rms(x: &[f64]) -> f64 {
     1.4826 * *m / std::f64::consts::SQRT_2
 }
 
-fn load_scene(path: &Path) -> Result<SceneFile, String> {
+pub(crate) fn load_scene(path: &Path) -> Result<SceneFile, String> {
     let text = std::fs::read_to_string(path).map_err(|e| format!("{}: {e}", path.display()))?;
     serde_json::from_str(&text).map_err(|e| format!("{}: {e}", path.display()))
 }
@@ -552,15 +560,7 @@ pub fn setup(args: &AnalyzeArgs, progress: Option<fn(f64)>) -> Result<Setup, Str
         },
     )
     .map_err(|e| e.to_string())?;
-    let mass = args.mass.or(file.mass_kg);
-    if let Some(m) = mass {
-        if !(m.is_finite() && m > 0.0) {
-            return Err("--mass: must be finite and > 0".into());
-        }
-    }
-    let units = args.units.or(file.units).unwrap_or(Units::G);
-    let invert = args.invert || file.invert.unwrap_or(false);
-    let scale = units.to_m_s2(mass) * args.gain.unwrap_or(1.0) * if invert { -1.0 } else { 1.0 };
+    let (mass, scale) = mass_and_scale(args, &file)?;
     let mut accel: Vec<f64> = ch.values.iter().map(|v| v * scale).collect();
     let spikes = if args.keep_spikes {
         Vec::new()
@@ -614,9 +614,81 @@ pub fn setup(args: &AnalyzeArgs, progress: Option<fn(f64)>) -> Result<Setup, Str
         .edge
         .or(file.edge_m_s2)
         .unwrap_or_else(|| (3.0 * sigma).max(trigger / 5.0).min(trigger / 2.0));
+    let (scene, source) = build_scene(
+        args,
+        &file,
+        calibration,
+        trigger,
+        edge,
+        clipping.as_ref(),
+        mass,
+    )?;
+    let mut setup = Setup {
+        prepared: Prepared {
+            counts,
+            calibration,
+            t0,
+            accel_m_s2: accel,
+        },
+        scene,
+        v0_source: source.map(str::to_string),
+        free_fall_s: None,
+        samples: ch.values.len() as u64,
+        rate_hz: ch.rate_hz,
+        spikes,
+        clipping,
+        resampled: ch.resampled,
+        axes,
+    };
+    if let Some(spec) = &args.free_fall {
+        // First pass without v0 to find the first impact, then the free fall before it.
+        let first = run(&setup.prepared.counts, &setup.scene)?;
+        let start = first
+            .first()
+            .map(|r| setup.prepared.t0 + r.start_s)
+            .ok_or("--free-fall: no impact in the recording")?;
+        let t_ff = free_fall_before(spec, start)?;
+        setup.free_fall_s = Some(t_ff);
+        setup.scene.approach = Approach::Speed {
+            v0_m_s: (STANDARD_GRAVITY * t_ff) as f32,
+        };
+        setup.v0_source = Some("free-fall".into());
+    }
+    Ok(setup)
+}
+
+/// The body's mass (checked) and the factor from the file's values to m/s² (units, `--gain`,
+/// `--invert`), from the options or the scene file.
+pub(crate) fn mass_and_scale(
+    args: &AnalyzeArgs,
+    file: &SceneFile,
+) -> Result<(Option<f64>, f64), String> {
+    let mass = args.mass.or(file.mass_kg);
+    if let Some(m) = mass {
+        if !(m.is_finite() && m > 0.0) {
+            return Err("--mass: must be finite and > 0".into());
+        }
+    }
+    let units = args.units.or(file.units).unwrap_or(Units::G);
+    let invert = args.invert || file.invert.unwrap_or(false);
+    let scale = units.to_m_s2(mass) * args.gain.unwrap_or(1.0) * if invert { -1.0 } else { 1.0 };
+    Ok((mass, scale))
+}
+
+/// The scene from the options and the scene file, with the levels and rails found; and
+/// where v0 comes from.
+pub(crate) fn build_scene(
+    args: &AnalyzeArgs,
+    file: &SceneFile,
+    calibration: Calibration,
+    trigger: f64,
+    edge: f64,
+    clipping: Option<&Clipping>,
+    mass: Option<f64>,
+) -> Result<(Scene, Option<&'static str>), String> {
     let mut scene = Scene::new(calibration, trigger as f32);
     scene.edge_m_s2 = edge as f32;
-    if let Some(c) = &clipping {
+    if let Some(c) = clipping {
         let gain = calibration.gain_m_s2_per_count as f64;
         scene.clip_counts = (
             c.low_m_s2.map_or(i16::MIN, |v| to_count(v, gain)),
@@ -675,38 +747,7 @@ pub fn setup(args: &AnalyzeArgs, progress: Option<fn(f64)>) -> Result<Setup, Str
     scene.train = args.train.train();
     scene.spectrum = args.spectrum.settings();
     scene.validate().map_err(|e| e.to_string())?;
-    let mut setup = Setup {
-        prepared: Prepared {
-            counts,
-            calibration,
-            t0,
-            accel_m_s2: accel,
-        },
-        scene,
-        v0_source: source.map(str::to_string),
-        free_fall_s: None,
-        samples: ch.values.len() as u64,
-        rate_hz: ch.rate_hz,
-        spikes,
-        clipping,
-        resampled: ch.resampled,
-        axes,
-    };
-    if let Some(spec) = &args.free_fall {
-        // First pass without v0 to find the first impact, then the free fall before it.
-        let first = run(&setup.prepared.counts, &setup.scene)?;
-        let start = first
-            .first()
-            .map(|r| setup.prepared.t0 + r.start_s)
-            .ok_or("--free-fall: no impact in the recording")?;
-        let t_ff = free_fall_before(spec, start)?;
-        setup.free_fall_s = Some(t_ff);
-        setup.scene.approach = Approach::Speed {
-            v0_m_s: (STANDARD_GRAVITY * t_ff) as f32,
-        };
-        setup.v0_source = Some("free-fall".into());
-    }
-    Ok(setup)
+    Ok((scene, source))
 }
 
 /// Runs the core pipeline over the counts (in blocks of 256, as the firmware's DMA halves).

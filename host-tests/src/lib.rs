@@ -20,6 +20,7 @@ pub mod simulate;
 pub mod soak;
 pub mod spectrum;
 pub mod stability;
+pub mod streaming;
 pub mod synth;
 pub mod table;
 pub mod target;

@@ -8,7 +8,7 @@ use crate::recording::{evenly_sampled, numbered_column, Channel, ReadOptions};
 use crate::table::RecordingError;
 
 /// The sample type a raw file's extension names.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
 pub enum RawType {
     I16,
     F32,
@@ -25,7 +25,7 @@ impl RawType {
         }
     }
 
-    fn bytes(self) -> usize {
+    pub(crate) fn bytes(self) -> usize {
         match self {
             RawType::I16 => 2,
             RawType::F32 => 4,

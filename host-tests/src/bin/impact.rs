@@ -181,6 +181,20 @@ fn run(cli: Cli) -> Result<(), String> {
                 simulate::Outcome::Target(report) => print!("{}", target::table(&report)),
             }
         }
+        Command::Analyze(args) if args.stream => {
+            let (setup, reports) = impact_host::streaming::analyze(&args)?;
+            let a = analyze::to_json(&setup, &reports);
+            if args.json {
+                println!(
+                    "{}",
+                    serde_json::to_string_pretty(&a).map_err(|e| e.to_string())?
+                );
+            } else if args.csv {
+                print!("{}", analyze::to_csv(&a));
+            } else {
+                print!("{}", analyze::to_table(&a));
+            }
+        }
         Command::Analyze(args) => {
             let progress: Option<fn(f64)> = {
                 use std::io::IsTerminal;

@@ -1,0 +1,163 @@
+//! `impact analyze --stream`: a raw recording analysed as it is read. The same reports as the
+//! whole-file path given the same levels; a stream too long to load (over 24 GiB as the
+//! whole-file path holds it) through standard input, in memory that does not grow.
+
+use std::io::Write;
+use std::process::{Command, Stdio};
+
+mod common;
+use common::impact_ok as impact;
+
+fn tmp(name: &str) -> String {
+    std::path::PathBuf::from(env!("CARGO_TARGET_TMPDIR"))
+        .join(format!("{}-{name}", std::process::id()))
+        .to_string_lossy()
+        .into_owned()
+}
+
+/// The seed bench's ADC codes (offset binary, 12 bits over ±800 m/s², so the full scale is
+/// 4096 codes) at 500 kS/s.
+const LEVELS: [&str; 16] = [
+    "--rate",
+    "500000",
+    "--gain",
+    "0.390625",
+    "--units",
+    "m/s2",
+    "--range",
+    "4096",
+    "--trigger",
+    "10",
+    "--edge",
+    "2",
+    "--mass",
+    "0.06",
+    "--v0",
+    "1.3357",
+];
+
+#[test]
+fn a_raw_stream_gives_the_whole_files_reports() {
+    let raw = tmp("seed.i16");
+    let args: Vec<&str> = ["synth", "--raw", &raw]
+        .into_iter()
+        .chain(impact_host::synth::SEED_BENCH_ARGS)
+        .collect();
+    impact(&args);
+    let with = |head: &[&str], tail: &[&str]| -> Vec<String> {
+        head.iter()
+            .chain(&LEVELS)
+            .chain(tail)
+            .map(|s| s.to_string())
+            .collect()
+    };
+    let run = |v: Vec<String>| impact(&v.iter().map(String::as_str).collect::<Vec<_>>()).0;
+    // The whole-file path screens spikes with the whole recording's noise: not here.
+    let whole = run(with(&["analyze", &raw], &["--json", "--keep-spikes"]));
+    let streamed = run(with(&["analyze", &raw], &["--json", "--stream"]));
+    assert_eq!(streamed, whole);
+    let v: serde_json::Value = serde_json::from_str(&whole).unwrap();
+    assert!(v["impacts"][0]["cor"].is_number(), "{v}");
+
+    // Through standard input, read in whatever pieces the pipe gives.
+    let mut child = Command::new(env!("CARGO_BIN_EXE_impact"))
+        .args(with(
+            &["analyze", "-"],
+            &["--json", "--stream", "--raw-type", "i16"],
+        ))
+        .stdin(Stdio::piped())
+        .stdout(Stdio::piped())
+        .spawn()
+        .unwrap();
+    let bytes = std::fs::read(&raw).unwrap();
+    let mut stdin = child.stdin.take().unwrap();
+    let writer = std::thread::spawn(move || {
+        for piece in bytes.chunks(777) {
+            stdin.write_all(piece).unwrap();
+        }
+    });
+    let out = child.wait_with_output().unwrap();
+    writer.join().unwrap();
+    assert!(out.status.success());
+    assert_eq!(String::from_utf8(out.stdout).unwrap(), whole);
+
+    // What needs the whole recording is refused, a cut frame named.
+    let (code, _, err) = common::impact(&["analyze", &raw, "--stream", "--rate", "500000"]);
+    assert!(code != 0 && err.contains("--range"), "{err}");
+    let (code, _, err) = common::impact(
+        &with(&["analyze", &raw], &["--stream", "--plot", &tmp("x.svg")])
+            .iter()
+            .map(String::as_str)
+            .collect::<Vec<_>>(),
+    );
+    assert!(
+        code != 0 && err.contains("--plot needs the whole recording"),
+        "{err}"
+    );
+    let odd = tmp("odd.i16");
+    std::fs::write(&odd, &std::fs::read(&raw).unwrap()[..1001]).unwrap();
+    let (code, _, err) = common::impact(
+        &with(&["analyze", &odd], &["--stream"])
+            .iter()
+            .map(String::as_str)
+            .collect::<Vec<_>>(),
+    );
+    assert!(
+        code != 0 && err.contains("the last frame starts at byte 1000"),
+        "{err}"
+    );
+}
+
+/// 2^30 samples (2 GiB of i16; 36 minutes at 500 kS/s; over 24 GiB as the whole-file path
+/// would hold them) generated as they are written into `impact analyze -`'s standard input:
+/// every impact reported, in under 64 MiB.
+#[test]
+fn a_stream_longer_than_memory_is_analysed_in_bounded_memory() {
+    const PERIOD: usize = 1 << 22; // 8.4 s at 500 kS/s, one impact each
+    const PERIODS: usize = 256;
+    let mut pattern = vec![0u8; PERIOD * 2];
+    for (k, b) in pattern.chunks_exact_mut(2).enumerate() {
+        // Mid-scale with ±1 count of noise, a 2 ms half-sine of 1000 counts (390 m/s²).
+        let noise = ((k as u32).wrapping_mul(2_654_435_761) >> 30) as i32 - 1;
+        let j = k as i64 - (PERIOD / 2) as i64;
+        let pulse = if (0..1000).contains(&j) {
+            (1000.0 * (std::f64::consts::PI * j as f64 / 1000.0).sin()).round() as i32
+        } else {
+            0
+        };
+        let code = (2048 + noise + pulse) as i16;
+        b.copy_from_slice(&code.to_le_bytes());
+    }
+    // Reaped by wait4 below (for its peak memory), which clippy cannot see.
+    #[allow(clippy::zombie_processes)]
+    let mut child = Command::new(env!("CARGO_BIN_EXE_impact"))
+        .args(["analyze", "-", "--stream", "--raw-type", "i16", "--csv"])
+        .args(&LEVELS[..12])
+        .stdin(Stdio::piped())
+        .stdout(Stdio::piped())
+        .spawn()
+        .unwrap();
+    let pid = child.id() as libc::pid_t;
+    let mut stdin = child.stdin.take().unwrap();
+    let writer = std::thread::spawn(move || {
+        for _ in 0..PERIODS {
+            stdin.write_all(&pattern).unwrap();
+        }
+    });
+    let stdout = child.stdout.take().unwrap();
+    let reader = std::thread::spawn(move || std::io::read_to_string(stdout).unwrap());
+    let mut status = 0;
+    // SAFETY: a zeroed rusage is a valid value; wait4 fills it for our own, unreaped child.
+    let mut usage: libc::rusage = unsafe { std::mem::zeroed() };
+    // SAFETY: `pid` is our child; the pointers are valid for the call.
+    let r = unsafe { libc::wait4(pid, &mut status, 0, &mut usage) };
+    assert_eq!(r, pid);
+    writer.join().unwrap();
+    let csv = reader.join().unwrap();
+    assert!(libc::WIFEXITED(status) && libc::WEXITSTATUS(status) == 0);
+    let rows = csv.lines().skip(1).filter(|l| !l.is_empty()).count();
+    assert_eq!(rows, PERIODS, "one report per inserted impact");
+    let peak_mib = usage.ru_maxrss as f64 / 1024.0;
+    eprintln!("2^30 samples streamed, {rows} impacts, peak memory {peak_mib:.1} MiB");
+    assert!(peak_mib < 64.0, "peak memory {peak_mib:.1} MiB");
+}
