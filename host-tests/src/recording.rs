@@ -112,7 +112,7 @@ pub fn time_unit_s(header: &str) -> f64 {
 /// Every sample interval must lie within this range of the median interval, or the time axis
 /// counts as uneven (a gap or a rate change). Jittered time stamps, as enDAQ's, stay within
 /// 0.6..1.25.
-const INTERVAL_RANGE: std::ops::RangeInclusive<f64> = 0.5..=1.5;
+pub(crate) const INTERVAL_RANGE: std::ops::RangeInclusive<f64> = 0.5..=1.5;
 
 /// Checks a time column: finite, strictly increasing and evenly sampled (every interval within
 /// [`INTERVAL_RANGE`] times the median). Returns `(rate, jitter)`; with `resample`, uneven

@@ -1,6 +1,7 @@
-//! `impact analyze --stream`: a raw recording (`.i16`/`.f32`, a file or standard input)
-//! analysed as it is read, a block at a time, in memory that does not grow with its length
-//! (an hour at 500 kS/s is 3.6 GB of i16). The per-sample arithmetic is the whole-file path's
+//! `impact analyze --stream`: a CSV or raw (`.i16`/`.f32`) recording, a file or standard
+//! input, analysed as it is read, a block at a time, in memory that does not grow with its
+//! length (an hour at 500 kS/s is 3.6 GB of i16, ~60 GB of CSV). The per-sample arithmetic is
+//! the whole-file path's
 //! (units, gain, quantisation to counts at the `--range` full scale), so with the same
 //! levels both give the same reports (tested); what needs the whole signal is refused or
 //! asked for instead: the quantisation's full scale (`--range`), the trigger level
@@ -22,19 +23,15 @@ const HEAD: usize = 1 << 16;
 const CHUNK: usize = 1 << 16;
 
 /// Reads and analyses `args.file` as a stream; the setup (without samples) and the reports.
-pub fn analyze(args: &AnalyzeArgs) -> Result<(Setup, Vec<ImpactReport>), String> {
+/// `progress` (a CSV's fraction read) for a bar on a terminal.
+pub fn analyze(
+    args: &AnalyzeArgs,
+    progress: Option<fn(f64)>,
+) -> Result<(Setup, Vec<ImpactReport>), String> {
     let name = if is_stdin(&args.file) {
         "stdin".to_string()
     } else {
         args.file.display().to_string()
-    };
-    let kind = match (args.raw_type, RawType::of(&args.file)) {
-        (Some(k), _) | (None, Some(k)) => k,
-        (None, None) => {
-            return Err(format!(
-                "{name}: --stream reads raw .i16/.f32 samples: give --raw-type i16 or f32"
-            ))
-        }
     };
     let refuse = |what: &str| Err(format!("--stream: {what} needs the whole recording"));
     if args.plot.is_some() {
@@ -46,24 +43,9 @@ pub fn analyze(args: &AnalyzeArgs) -> Result<(Setup, Vec<ImpactReport>), String>
     if args.free_fall.is_some() {
         return refuse("--free-fall");
     }
-    if args.resample || args.time_column.is_some() {
-        return Err("--stream: a raw stream has no time column (give --rate)".into());
+    if args.resample {
+        return refuse("--resample");
     }
-    let rate_hz = args
-        .rate
-        .ok_or("--stream: a raw stream holds no time: give --rate")?;
-    if !(rate_hz.is_finite() && rate_hz > 0.0 && rate_hz <= 1e9) {
-        return Err(format!("--rate {rate_hz}: not in (0, 1e9]"));
-    }
-    let channels = args.raw_channels.unwrap_or(1);
-    if !(1..=64).contains(&channels) {
-        return Err(format!("--raw-channels {channels}: must lie in 1..=64"));
-    }
-    let column = crate::recording::numbered_column(
-        args.column.as_ref(),
-        channels,
-        &format!("the stream's {channels} interleaved channels"),
-    )?;
     let file = match &args.scene {
         Some(p) => analyze::load_scene(p)?,
         None => analyze::SceneFile::default(),
@@ -81,41 +63,31 @@ pub fn analyze(args: &AnalyzeArgs) -> Result<(Setup, Vec<ImpactReport>), String>
     )?;
     let full_scale = range * scale.abs();
     let gain = full_scale / 32000.0;
-    let calibration = Calibration {
-        gain_m_s2_per_count: gain as f32,
-        sample_rate_hz: rate_hz as f32,
-    };
     let clipping = crate::screen::from_range(full_scale);
-
-    let input: Box<dyn Read + Send> = if is_stdin(&args.file) {
-        Box::new(std::io::stdin())
-    } else {
-        Box::new(std::fs::File::open(&args.file).map_err(|e| format!("{name}: {e}"))?)
+    let mut source: Box<dyn Source> = match args.raw_type.or_else(|| RawType::of(&args.file)) {
+        Some(kind) => Box::new(RawSource::open(args, kind, &name)?),
+        None => Box::new(CsvSource::open(args, progress)?),
     };
-    let mut samples = Samples {
-        input,
-        kind,
-        frame: kind.bytes() * channels,
-        at: column * kind.bytes(),
-        buf: vec![0u8; CHUNK],
-        held: 0,
-        read: 0,
-        name: name.clone(),
-    };
-    // The head: its noise sets the default edge level.
+    // The head: its noise sets the default edge level, a CSV's first intervals the rate.
     let mut head = Vec::with_capacity(HEAD);
     while head.len() < HEAD {
         let before = head.len();
-        samples.next_values(HEAD - head.len(), |v| head.push(v * scale))?;
+        source.next_values(HEAD - head.len(), &mut |v| head.push(v * scale))?;
         if head.len() == before {
             break;
         }
     }
+    source.head_read()?;
+    let rate_hz = source.rate_hz()?;
+    let calibration = Calibration {
+        gain_m_s2_per_count: gain as f32,
+        sample_rate_hz: rate_hz as f32,
+    };
     let edge = args.edge.or(file.edge_m_s2).unwrap_or_else(|| {
         let sigma = analyze::noise_rms(&head);
         (3.0 * sigma).max(trigger / 5.0).min(trigger / 2.0)
     });
-    let (scene, source) = analyze::build_scene(
+    let (scene, v0_source) = analyze::build_scene(
         args,
         &file,
         calibration,
@@ -124,7 +96,7 @@ pub fn analyze(args: &AnalyzeArgs) -> Result<(Setup, Vec<ImpactReport>), String>
         Some(&clipping),
         mass,
     )?;
-    let (reports, count) = crate::on_big_stack(move || {
+    let (reports, count, source) = crate::on_big_stack(move || {
         let mut m = HostMonitor::new(scene).map_err(|e| e.to_string())?;
         let mut out = Vec::new();
         let mut counts: Vec<i16> = head.iter().map(|a| analyze::to_count(*a, gain)).collect();
@@ -135,7 +107,9 @@ pub fn analyze(args: &AnalyzeArgs) -> Result<(Setup, Vec<ImpactReport>), String>
             }
             total += counts.len() as u64;
             counts.clear();
-            samples.next_values(CHUNK, |v| counts.push(analyze::to_count(v * scale, gain)))?;
+            source.next_values(CHUNK, &mut |v| {
+                counts.push(analyze::to_count(v * scale, gain))
+            })?;
             if counts.is_empty() {
                 break;
             }
@@ -144,20 +118,20 @@ pub fn analyze(args: &AnalyzeArgs) -> Result<(Setup, Vec<ImpactReport>), String>
         if !m.is_armed() {
             return Err("the signal never settled to a baseline (no quiet stretch of 64 samples within the edge level): give --edge".into());
         }
-        Ok((out, total))
+        Ok((out, total, source))
     })?;
     let setup = Setup {
         prepared: Prepared {
             counts: Vec::new(),
             calibration,
-            t0: 0.0,
+            t0: source.t0(),
             accel_m_s2: Vec::new(),
         },
         scene,
-        v0_source: source.map(str::to_string),
+        v0_source: v0_source.map(str::to_string),
         free_fall_s: None,
         samples: count,
-        rate_hz,
+        rate_hz: source.final_rate_hz(),
         spikes: Vec::new(),
         clipping: Some(clipping),
         resampled: false,
@@ -166,8 +140,25 @@ pub fn analyze(args: &AnalyzeArgs) -> Result<(Setup, Vec<ImpactReport>), String>
     Ok((setup, reports))
 }
 
-/// The chosen channel's values, read a chunk at a time.
-struct Samples {
+/// Where the stream's values come from.
+trait Source: Send {
+    /// Hands up to about `want` values to `push` (none at the end of the input).
+    fn next_values(&mut self, want: usize, push: &mut dyn FnMut(f64)) -> Result<(), String>;
+    /// The head has been read: what it tells (a CSV's rate) is fixed, and checked.
+    fn head_read(&mut self) -> Result<(), String> {
+        Ok(())
+    }
+    /// The rate the scene runs at (after the head).
+    fn rate_hz(&self) -> Result<f64, String>;
+    /// The rate the report gives (at the end: a CSV's mean interval over the whole file, as
+    /// the whole-file path computes it).
+    fn final_rate_hz(&self) -> f64;
+    /// Time of the first sample, s.
+    fn t0(&self) -> f64;
+}
+
+/// A raw file or stream: the chosen channel of interleaved little-endian frames.
+struct RawSource {
     input: Box<dyn Read + Send>,
     kind: RawType,
     /// Bytes per frame (all channels) and the channel's offset in it.
@@ -179,11 +170,62 @@ struct Samples {
     /// Bytes read so far.
     read: u64,
     name: String,
+    rate_hz: f64,
 }
 
-impl Samples {
-    /// Hands up to about `want` values to `push` (none at the end of the input).
-    fn next_values(&mut self, want: usize, mut push: impl FnMut(f64)) -> Result<(), String> {
+impl RawSource {
+    fn open(args: &AnalyzeArgs, kind: RawType, name: &str) -> Result<Self, String> {
+        if args.time_column.is_some() {
+            return Err("--stream: a raw stream has no time column (give --rate)".into());
+        }
+        let rate_hz = args
+            .rate
+            .ok_or("--stream: a raw stream holds no time: give --rate")?;
+        if !(rate_hz.is_finite() && rate_hz > 0.0 && rate_hz <= 1e9) {
+            return Err(format!("--rate {rate_hz}: not in (0, 1e9]"));
+        }
+        let channels = args.raw_channels.unwrap_or(1);
+        if !(1..=64).contains(&channels) {
+            return Err(format!("--raw-channels {channels}: must lie in 1..=64"));
+        }
+        let column = crate::recording::numbered_column(
+            args.column.as_ref(),
+            channels,
+            &format!("the stream's {channels} interleaved channels"),
+        )?;
+        let input: Box<dyn Read + Send> = if is_stdin(&args.file) {
+            Box::new(std::io::stdin())
+        } else {
+            Box::new(std::fs::File::open(&args.file).map_err(|e| format!("{name}: {e}"))?)
+        };
+        Ok(Self {
+            input,
+            kind,
+            frame: kind.bytes() * channels,
+            at: column * kind.bytes(),
+            buf: vec![0u8; CHUNK],
+            held: 0,
+            read: 0,
+            name: name.to_string(),
+            rate_hz,
+        })
+    }
+}
+
+impl Source for RawSource {
+    fn rate_hz(&self) -> Result<f64, String> {
+        Ok(self.rate_hz)
+    }
+
+    fn final_rate_hz(&self) -> f64 {
+        self.rate_hz
+    }
+
+    fn t0(&self) -> f64 {
+        0.0
+    }
+
+    fn next_values(&mut self, want: usize, push: &mut dyn FnMut(f64)) -> Result<(), String> {
         // At most `want` frames (the head stops at exactly HEAD samples whatever a pipe's
         // reads return), at least one whole frame's room.
         let end = (self.held + want.max(1) * self.frame).min(self.buf.len());
@@ -231,5 +273,205 @@ impl Samples {
         self.buf.copy_within(whole..have, 0);
         self.held = have - whole;
         Ok(())
+    }
+}
+
+/// A CSV file or stream: the channel's column, and the time column (or `--rate`), row by
+/// row, with the whole-file reader's checks ([`crate::table::Rows`]).
+struct CsvSource {
+    rows: crate::table::Rows,
+    name: String,
+    channel: usize,
+    /// The time column and its unit, s.
+    time: Option<(usize, f64)>,
+    /// `--rate`, if given.
+    rate_given: Option<f64>,
+    /// The first time and the latest one, s; the rows read.
+    t0: Option<f64>,
+    last: f64,
+    n: u64,
+    /// The head's intervals and the lines they end on, then their median and the head's
+    /// mean rate.
+    head_dts: Vec<(f64, u64)>,
+    median_dt: Option<f64>,
+    head_rate: Option<f64>,
+    /// The first row's value, read while resolving the columns and not yet handed on.
+    pending: Option<f64>,
+}
+
+impl CsvSource {
+    fn open(args: &AnalyzeArgs, progress: Option<fn(f64)>) -> Result<Self, String> {
+        let format = crate::table::CsvFormat {
+            delimiter: args.delimiter,
+            decimal_comma: args.decimal_comma,
+        };
+        let mut rows =
+            crate::table::Rows::open(&args.file, &format, progress).map_err(|e| e.to_string())?;
+        let name = if is_stdin(&args.file) {
+            "stdin".to_string()
+        } else {
+            args.file.display().to_string()
+        };
+        let err = |m: String| format!("{name}: {m}");
+        // The first data row gives the columns their number (the header their names).
+        let (line, first) = match rows.next_row().map_err(|e| e.to_string())? {
+            Some((line, _, row)) => (line, row.to_vec()),
+            None => return Err(err("no data rows".into())),
+        };
+        let shape = rows.shape();
+        let tcol = if args.rate.is_some() && args.time_column.is_none() {
+            None
+        } else {
+            shape.time_column(args.time_column.as_ref()).map_err(err)?
+        };
+        let channel = match &args.column {
+            Some(c) => shape.find(c, "column").map_err(err)?,
+            None => (0..shape.columns.len())
+                .find(|&c| Some(c) != tcol)
+                .ok_or_else(|| err("no data column besides the time column".into()))?,
+        };
+        if Some(channel) == tcol {
+            return Err(err(format!(
+                "column {channel} is the time column: choose another with --column"
+            )));
+        }
+        if tcol.is_none() && args.rate.is_none() {
+            return Err(err(
+                "no time column found: give --time-column or --rate".into()
+            ));
+        }
+        if let Some(r) = args.rate {
+            if !(r.is_finite() && r > 0.0 && r <= 1e9) {
+                return Err(err(format!("rate {r} Hz is not in (0, 1e9]")));
+            }
+        }
+        let time = tcol.map(|t| {
+            let unit = shape
+                .headers
+                .get(t)
+                .map_or(1.0, |h| crate::recording::time_unit_s(h));
+            (t, unit)
+        });
+        let mut source = Self {
+            rows,
+            name,
+            channel,
+            time,
+            rate_given: args.rate,
+            t0: None,
+            last: 0.0,
+            n: 0,
+            head_dts: Vec::new(),
+            median_dt: None,
+            head_rate: None,
+            pending: None,
+        };
+        source.pending = Some(source.take(line, &first)?);
+        Ok(source)
+    }
+
+    /// Checks the time of row `line` and returns its channel's value.
+    fn take(&mut self, line: u64, row: &[f64]) -> Result<f64, String> {
+        let value = row.get(self.channel).copied().unwrap_or(0.0);
+        if let Some((c, unit)) = self.time {
+            let t = row.get(c).copied().unwrap_or(0.0) * unit;
+            if self.t0.is_none() {
+                self.t0 = Some(t);
+            } else {
+                let at = |m: String| format!("{}: line {line}: {m}", self.name);
+                if t <= self.last {
+                    return Err(at(format!(
+                        "time {t} s does not increase (previous {} s)",
+                        self.last
+                    )));
+                }
+                let dt = t - self.last;
+                match self.median_dt {
+                    None => self.head_dts.push((dt, line)),
+                    Some(m) => check_interval(dt, m).map_err(at)?,
+                }
+            }
+            self.last = t;
+        }
+        self.n += 1;
+        Ok(value)
+    }
+}
+
+impl Source for CsvSource {
+    fn next_values(&mut self, want: usize, push: &mut dyn FnMut(f64)) -> Result<(), String> {
+        let mut left = want.max(1);
+        if let Some(v) = self.pending.take() {
+            push(v);
+            left -= 1;
+        }
+        let mut row = Vec::new();
+        for _ in 0..left {
+            let Some((line, _, r)) = self.rows.next_row().map_err(|e| e.to_string())? else {
+                break;
+            };
+            row.clear();
+            row.extend_from_slice(r);
+            let v = self.take(line, &row)?;
+            push(v);
+        }
+        Ok(())
+    }
+
+    fn head_read(&mut self) -> Result<(), String> {
+        if self.head_dts.is_empty() {
+            return Ok(());
+        }
+        let dts = std::mem::take(&mut self.head_dts);
+        let mut sorted: Vec<f64> = dts.iter().map(|d| d.0).collect();
+        let mid = sorted.len() / 2;
+        let median = *sorted.select_nth_unstable_by(mid, f64::total_cmp).1;
+        // The head's intervals against their median, as every later one.
+        for (dt, line) in dts {
+            check_interval(dt, median).map_err(|m| format!("{}: line {line}: {m}", self.name))?;
+        }
+        self.median_dt = Some(median);
+        if let Some(t0) = self.t0 {
+            self.head_rate = Some((self.n - 1) as f64 / (self.last - t0));
+        }
+        Ok(())
+    }
+
+    fn rate_hz(&self) -> Result<f64, String> {
+        if let Some(r) = self.rate_given {
+            return Ok(r);
+        }
+        self.head_rate.ok_or_else(|| {
+            format!(
+                "{}: one sample: the rate cannot be told; give --rate",
+                self.name
+            )
+        })
+    }
+
+    fn final_rate_hz(&self) -> f64 {
+        match (self.rate_given, self.t0) {
+            (Some(r), _) => r,
+            (None, Some(t0)) if self.n > 1 => (self.n - 1) as f64 / (self.last - t0),
+            _ => self.head_rate.unwrap_or(0.0),
+        }
+    }
+
+    fn t0(&self) -> f64 {
+        self.t0.unwrap_or(0.0)
+    }
+}
+
+/// An interval `dt` within [`crate::recording::INTERVAL_RANGE`] times the median `median`.
+fn check_interval(dt: f64, median: f64) -> Result<(), String> {
+    let ratio = dt / median;
+    if crate::recording::INTERVAL_RANGE.contains(&ratio) {
+        Ok(())
+    } else {
+        Err(format!(
+            "uneven time axis: {dt:.6e} s since the previous sample, {ratio:.3} times the first \
+             intervals' median {median:.6e} s (a gap or a rate change); --stream does not \
+             resample: cut the file"
+        ))
     }
 }

@@ -220,7 +220,7 @@ impl<R> RecordLimit<R> {
 
 /// Opens a file (or stdin for `-`) once, for reading (a FIFO is not opened twice); the size,
 /// if known, for progress.
-fn open(path: &Path) -> io::Result<(Box<dyn Read>, Option<u64>)> {
+fn open(path: &Path) -> io::Result<(Box<dyn Read + Send>, Option<u64>)> {
     if is_stdin(path) {
         return Ok((Box::new(io::stdin()), None));
     }
@@ -264,182 +264,287 @@ fn not_a_number(field: &str, format: &CsvFormat, delimiter: u8) -> String {
     format!("not a number: {field:?}{hint}")
 }
 
-/// Reads a numeric table. Leading lines with a field that is not a number are headers (the
-/// last one names the columns); from the first numeric row on, every row must be numeric
-/// (finite, within ±[`MAX_VALUE`]) with the first row's number of fields, at most the header's.
-/// Errors name the file and line.
+/// A data row: its line, the number of line breaks it spans (quoted ones and its end), and
+/// its values.
+pub type Row<'a> = (u64, u64, &'a [f64]);
+
+/// A numeric table's rows, read one at a time. Leading lines with a field that is not a
+/// number are headers (the last one names the columns); from the first numeric row on, every
+/// row must be numeric (finite, within ±[`MAX_VALUE`]) with the first row's number of fields,
+/// at most the header's. Errors name the file and line.
+pub struct Rows {
+    path: std::path::PathBuf,
+    format: CsvFormat,
+    delimiter: u8,
+    reader: csv::Reader<RecordLimit<BufReader<Box<dyn Read + Send>>>>,
+    record: csv::ByteRecord,
+    row: Vec<f64>,
+    scratch: Vec<u8>,
+    /// The header line's names (empty without one) and fields, and its line.
+    pub headers: Vec<String>,
+    header_fields: usize,
+    header_line: u64,
+    /// Fields per data row (0 before the first).
+    pub columns: usize,
+    /// Line of the first data row.
+    pub first_data_line: u64,
+    progress: Option<fn(f64)>,
+    size: Option<u64>,
+    step: Option<u64>,
+    next_progress: u64,
+}
+
+impl Rows {
+    /// Opens `path` (or stdin for `-`), past a byte-order mark, with the delimiter given or
+    /// sniffed from the first bytes.
+    pub fn open(
+        path: &Path,
+        format: &CsvFormat,
+        progress: Option<fn(f64)>,
+    ) -> Result<Self, RecordingError> {
+        let err = |message: String| RecordingError {
+            file: path.to_path_buf(),
+            line: None,
+            message,
+        };
+        let (input, size) = open(path).map_err(|e| err(e.to_string()))?;
+        let mut buffered = BufReader::with_capacity(1 << 16, input);
+        // Peek at the first bytes for a byte-order mark and the delimiter.
+        let head = buffered.fill_buf().map_err(|e| err(e.to_string()))?;
+        let bom = head.starts_with(b"\xEF\xBB\xBF");
+        let delimiter = format.delimiter.unwrap_or_else(|| sniff_delimiter(head));
+        if bom {
+            buffered.consume(3);
+        }
+        if format.decimal_comma && delimiter == b',' {
+            return Err(err(
+                "--decimal-comma: the delimiter is ',' too; give --delimiter (e.g. ';')".into(),
+            ));
+        }
+        let limited = RecordLimit {
+            inner: buffered,
+            delimiter,
+            since_break: 0,
+            quote: Quote::Outside,
+            field_start: true,
+            read: 0,
+            last: 0,
+            ended: false,
+        };
+        let reader = csv::ReaderBuilder::new()
+            .has_headers(false)
+            .flexible(true)
+            .delimiter(delimiter)
+            // `\r` is trimmed as white space with the fields; only `\n` ends a record (see the
+            // line count in `next`).
+            .terminator(csv::Terminator::Any(b'\n'))
+            .buffer_capacity(1 << 16)
+            .from_reader(limited);
+        let step = size.map(|s| (s / 20).max(1));
+        Ok(Self {
+            path: path.to_path_buf(),
+            format: *format,
+            delimiter,
+            reader,
+            record: csv::ByteRecord::new(),
+            row: Vec::new(),
+            scratch: Vec::new(),
+            headers: Vec::new(),
+            header_fields: 0,
+            header_line: 0,
+            columns: 0,
+            first_data_line: 0,
+            progress,
+            size,
+            step,
+            next_progress: step.unwrap_or(u64::MAX),
+        })
+    }
+
+    /// The file read (`-` for stdin).
+    pub fn path(&self) -> &Path {
+        &self.path
+    }
+
+    fn err(&self, line: Option<u64>, message: String) -> RecordingError {
+        RecordingError {
+            file: self.path.clone(),
+            line,
+            message,
+        }
+    }
+
+    /// The next data row ([`Row`]); `None` at the end.
+    pub fn next_row(&mut self) -> Result<Option<Row<'_>>, RecordingError> {
+        loop {
+            let more = match self.reader.read_byte_record(&mut self.record) {
+                Ok(more) => more,
+                Err(e) => {
+                    // The line being read (lines consumed so far, plus one).
+                    let line = e
+                        .position()
+                        .map_or(self.reader.position().line(), |p| p.line());
+                    let message = match e.into_kind() {
+                        csv::ErrorKind::Io(io) => io.to_string(),
+                        other => format!("{other:?}"),
+                    };
+                    return Err(self.err(Some(line), message));
+                }
+            };
+            if !more {
+                return Ok(None);
+            }
+            // Every record ends with a consumed `\n` (the input's last one added if missing),
+            // and `csv` counts lines as it consumes `\n`s: the record's line is the count less
+            // its own line breaks (inside quotes, and the end).
+            let breaks = self
+                .record
+                .as_slice()
+                .iter()
+                .filter(|&&b| b == b'\n')
+                .count() as u64;
+            let lineno = self.reader.position().line() - breaks - 1;
+            if let (Some(p), Some(size)) = (self.progress, self.size) {
+                let read = self.reader.get_ref().read;
+                if read >= self.next_progress {
+                    p(read as f64 / size.max(1) as f64);
+                    self.next_progress = read + self.step.unwrap_or(u64::MAX);
+                }
+            }
+            // Empty lines are no records; a line of delimiters and white space only is blank
+            // too.
+            if self.record.iter().all(|f| f.trim_ascii().is_empty()) {
+                continue;
+            }
+            self.row.clear();
+            let mut bad = None;
+            let mut text_field = false;
+            for f in self.record.iter() {
+                let f = f.trim_ascii();
+                let parsed = if self.format.decimal_comma && f.contains(&b',') {
+                    self.scratch.clear();
+                    self.scratch
+                        .extend(f.iter().map(|&b| if b == b',' { b'.' } else { b }));
+                    parse_number(&self.scratch)
+                } else {
+                    parse_number(f)
+                };
+                match parsed {
+                    Some(v) if v.is_finite() && v.abs() <= MAX_VALUE => self.row.push(v),
+                    Some(v) => {
+                        bad.get_or_insert_with(|| {
+                            format!("value is {v:e}: not a finite reading within ±{MAX_VALUE:e}")
+                        });
+                    }
+                    None => {
+                        let text = String::from_utf8_lossy(f);
+                        // A number written with a decimal comma is a number, not header text:
+                        // a data row read without --decimal-comma is an error, not a header.
+                        let comma_number = !self.format.decimal_comma
+                            && text.contains(',')
+                            && parse_number(text.replace(',', ".").as_bytes()).is_some();
+                        text_field |= !comma_number;
+                        bad.get_or_insert_with(|| {
+                            not_a_number(&text, &self.format, self.delimiter)
+                        });
+                    }
+                }
+            }
+            if self.columns == 0 {
+                if text_field {
+                    // Text makes a header line; a number that is not finite or beyond any
+                    // sensor is an error wherever it is (a NaN row before the data is not a
+                    // header).
+                    self.headers = self
+                        .record
+                        .iter()
+                        .map(|f| String::from_utf8_lossy(f.trim_ascii()).into_owned())
+                        .collect();
+                    self.header_fields = self.record.len();
+                    self.header_line = lineno;
+                    continue;
+                }
+                if bad.is_none() {
+                    // A row wider than its header has fields no name covers (decimal commas
+                    // split in two, most often); a narrower one leaves names over, as the
+                    // AFRL drop tower's files do (seven names, six columns), and is read.
+                    if self.header_fields != 0 && self.row.len() > self.header_fields {
+                        return Err(self.err(
+                            Some(lineno),
+                            format!(
+                                "{} fields, but the header (line {}) has {}{}",
+                                self.row.len(),
+                                self.header_line,
+                                self.header_fields,
+                                if self.delimiter == b',' {
+                                    " (decimal commas? give --decimal-comma and --delimiter)"
+                                } else {
+                                    ""
+                                }
+                            ),
+                        ));
+                    }
+                    self.columns = self.row.len();
+                    self.first_data_line = lineno;
+                }
+            }
+            if let Some(message) = bad {
+                return Err(self.err(Some(lineno), message));
+            }
+            if self.row.len() != self.columns {
+                return Err(self.err(
+                    Some(lineno),
+                    format!("{} fields, expected {}", self.row.len(), self.columns),
+                ));
+            }
+            return Ok(Some((lineno, breaks, &self.row)));
+        }
+    }
+
+    /// An empty table with this file's headers and number of columns (for resolving column
+    /// names before the rows are read).
+    pub fn shape(&self) -> Table {
+        Table {
+            headers: self.headers.clone(),
+            columns: vec![Vec::new(); self.columns],
+            first_data_line: self.first_data_line,
+            breaks: Vec::new(),
+        }
+    }
+}
+
+/// Reads a whole numeric table ([`Rows`]).
 pub fn read_table(
     path: &Path,
     format: &CsvFormat,
     progress: Option<fn(f64)>,
 ) -> Result<Table, RecordingError> {
-    let err = |line: Option<u64>, message: String| RecordingError {
-        file: path.to_path_buf(),
-        line,
-        message,
-    };
-    let (input, size) = open(path).map_err(|e| err(None, e.to_string()))?;
-    let mut buffered = BufReader::with_capacity(1 << 16, input);
-    // Peek at the first bytes for a byte-order mark and the delimiter.
-    let head = buffered.fill_buf().map_err(|e| err(None, e.to_string()))?;
-    let bom = head.starts_with(b"\xEF\xBB\xBF");
-    let delimiter = format.delimiter.unwrap_or_else(|| sniff_delimiter(head));
-    if bom {
-        buffered.consume(3);
-    }
-    if format.decimal_comma && delimiter == b',' {
-        return Err(err(
-            None,
-            "--decimal-comma: the delimiter is ',' too; give --delimiter (e.g. ';')".into(),
-        ));
-    }
-    let limited = RecordLimit {
-        inner: buffered,
-        delimiter,
-        since_break: 0,
-        quote: Quote::Outside,
-        field_start: true,
-        read: 0,
-        last: 0,
-        ended: false,
-    };
-    let mut reader = csv::ReaderBuilder::new()
-        .has_headers(false)
-        .flexible(true)
-        .delimiter(delimiter)
-        // `\r` is trimmed as white space with the fields; only `\n` ends a record (see the
-        // line count below).
-        .terminator(csv::Terminator::Any(b'\n'))
-        .buffer_capacity(1 << 16)
-        .from_reader(limited);
+    let mut rows = Rows::open(path, format, progress)?;
     let mut table = Table::default();
-    let mut header_fields = 0;
-    let mut header_line = 0;
-    let mut record = csv::ByteRecord::new();
-    let mut row = Vec::new();
     let mut next_line = 0;
-    let mut rows = 0usize;
-    let step = size.map(|s| (s / 20).max(1));
-    let mut next_progress = step.unwrap_or(u64::MAX);
-    let mut scratch = Vec::new();
-    loop {
-        let more = match reader.read_byte_record(&mut record) {
-            Ok(more) => more,
-            Err(e) => {
-                // The line being read (lines consumed so far, plus one).
-                let line = e.position().map_or(reader.position().line(), |p| p.line());
-                let message = match e.into_kind() {
-                    csv::ErrorKind::Io(io) => io.to_string(),
-                    other => format!("{other:?}"),
-                };
-                return Err(err(Some(line), message));
-            }
-        };
-        if !more {
-            break;
-        }
-        // Every record ends with a consumed `\n` (the input's last one added if missing), and
-        // `csv` counts lines as it consumes `\n`s: the record's line is the count less its
-        // own line breaks (inside quotes, and the end).
-        let breaks = record.as_slice().iter().filter(|&&b| b == b'\n').count() as u64;
-        let lineno = reader.position().line() - breaks - 1;
-        if let (Some(p), Some(size)) = (progress, size) {
-            let read = reader.get_ref().read;
-            if read >= next_progress {
-                p(read as f64 / size.max(1) as f64);
-                next_progress = read + step.unwrap_or(u64::MAX);
-            }
-        }
-        // Empty lines are no records; a line of delimiters and white space only is blank too.
-        if record.iter().all(|f| f.trim_ascii().is_empty()) {
-            continue;
-        }
-        row.clear();
-        let mut bad = None;
-        let mut text_field = false;
-        for f in record.iter() {
-            let f = f.trim_ascii();
-            let parsed = if format.decimal_comma && f.contains(&b',') {
-                scratch.clear();
-                scratch.extend(f.iter().map(|&b| if b == b',' { b'.' } else { b }));
-                parse_number(&scratch)
-            } else {
-                parse_number(f)
-            };
-            match parsed {
-                Some(v) if v.is_finite() && v.abs() <= MAX_VALUE => row.push(v),
-                Some(v) => {
-                    bad.get_or_insert_with(|| {
-                        format!("value is {v:e}: not a finite reading within ±{MAX_VALUE:e}")
-                    });
-                }
-                None => {
-                    let text = String::from_utf8_lossy(f);
-                    // A number written with a decimal comma is a number, not header text: a
-                    // data row read without --decimal-comma is an error, not a header.
-                    let comma_number = !format.decimal_comma
-                        && text.contains(',')
-                        && parse_number(text.replace(',', ".").as_bytes()).is_some();
-                    text_field |= !comma_number;
-                    bad.get_or_insert_with(|| not_a_number(&text, format, delimiter));
-                }
-            }
-        }
+    let mut n = 0usize;
+    while let Some((lineno, breaks, row)) = rows.next_row()? {
         if table.columns.is_empty() {
-            if text_field {
-                // Text makes a header line; a number that is not finite or beyond any sensor
-                // is an error wherever it is (a NaN row before the data is not a header).
-                table.headers = record
-                    .iter()
-                    .map(|f| String::from_utf8_lossy(f.trim_ascii()).into_owned())
-                    .collect();
-                header_fields = record.len();
-                header_line = lineno;
-                continue;
-            }
-            if bad.is_none() {
-                // A row wider than its header has fields no name covers (decimal commas
-                // split in two, most often); a narrower one leaves names over, as the AFRL
-                // drop tower's files do (seven names, six columns), and is read.
-                if header_fields != 0 && row.len() > header_fields {
-                    return Err(err(
-                        Some(lineno),
-                        format!(
-                            "{} fields, but the header (line {header_line}) has {header_fields}{}",
-                            row.len(),
-                            if delimiter == b',' {
-                                " (decimal commas? give --decimal-comma and --delimiter)"
-                            } else {
-                                ""
-                            }
-                        ),
-                    ));
-                }
-                table.columns = vec![Vec::new(); row.len()];
-                table.first_data_line = lineno;
-                next_line = lineno;
-            }
-        }
-        if let Some(message) = bad {
-            return Err(err(Some(lineno), message));
-        }
-        if row.len() != table.columns.len() {
-            return Err(err(
-                Some(lineno),
-                format!("{} fields, expected {}", row.len(), table.columns.len()),
-            ));
+            table.columns = vec![Vec::new(); row.len()];
+            table.first_data_line = lineno;
+            next_line = lineno;
         }
         if lineno != next_line {
-            table.breaks.push((rows, lineno));
+            table.breaks.push((n, lineno));
         }
         next_line = lineno + breaks + 1;
-        for (c, v) in table.columns.iter_mut().zip(&row) {
+        for (c, v) in table.columns.iter_mut().zip(row) {
             c.push(*v);
         }
-        rows += 1;
+        n += 1;
     }
+    table.headers = rows.headers;
     if table.columns.first().is_none_or(|c| c.is_empty()) {
-        return Err(err(None, "no data rows".into()));
+        return Err(RecordingError {
+            file: path.to_path_buf(),
+            line: None,
+            message: "no data rows".into(),
+        });
     }
     Ok(table)
 }

@@ -1,6 +1,6 @@
-//! `impact analyze --stream`: a raw recording analysed as it is read. The same reports as the
-//! whole-file path given the same levels; a stream too long to load (over 24 GiB as the
-//! whole-file path holds it) through standard input, in memory that does not grow.
+//! `impact analyze --stream`: a CSV or raw recording analysed as it is read. The same reports
+//! as the whole-file path given the same levels; a stream too long to load (over 24 GiB as
+//! the whole-file path holds it) through standard input, in memory that does not grow.
 
 use std::io::Write;
 use std::process::{Command, Stdio};
@@ -104,6 +104,81 @@ fn a_raw_stream_gives_the_whole_files_reports() {
     );
     assert!(
         code != 0 && err.contains("the last frame starts at byte 1000"),
+        "{err}"
+    );
+}
+
+#[test]
+fn a_csv_stream_gives_the_whole_files_reports() {
+    let (csv, _) = impact(
+        &["synth"]
+            .into_iter()
+            .chain(impact_host::synth::SEED_BENCH_ARGS)
+            .collect::<Vec<_>>(),
+    );
+    let file = tmp("seed.csv");
+    std::fs::write(&file, &csv).unwrap();
+    // In g (the file's unit): ±163 g is the ADC's ±1600 m/s².
+    let levels = [
+        "--range",
+        "163",
+        "--trigger",
+        "10",
+        "--edge",
+        "2",
+        "--mass",
+        "0.06",
+        "--v0",
+        "1.3357",
+    ];
+    let args = |head: &[&str], tail: &[&str]| -> Vec<String> {
+        head.iter()
+            .chain(&levels)
+            .chain(tail)
+            .map(|s| s.to_string())
+            .collect()
+    };
+    let run = |v: Vec<String>| impact(&v.iter().map(String::as_str).collect::<Vec<_>>()).0;
+    let whole = run(args(&["analyze", &file], &["--json", "--keep-spikes"]));
+    assert_eq!(
+        run(args(&["analyze", &file], &["--json", "--stream"])),
+        whole
+    );
+    let mut child = Command::new(env!("CARGO_BIN_EXE_impact"))
+        .args(args(&["analyze", "-"], &["--json", "--stream"]))
+        .stdin(Stdio::piped())
+        .stdout(Stdio::piped())
+        .spawn()
+        .unwrap();
+    let mut stdin = child.stdin.take().unwrap();
+    let bytes = csv.into_bytes();
+    let writer = std::thread::spawn(move || {
+        for piece in bytes.chunks(1013) {
+            stdin.write_all(piece).unwrap();
+        }
+    });
+    let out = child.wait_with_output().unwrap();
+    writer.join().unwrap();
+    assert!(out.status.success());
+    assert_eq!(String::from_utf8(out.stdout).unwrap(), whole);
+
+    // A gap in the time column is an error at its line, as in the whole-file path.
+    let mut lines: Vec<&str> = std::str::from_utf8(&std::fs::read(&file).unwrap())
+        .unwrap()
+        .lines()
+        .map(|l| l.to_owned().leak() as &str)
+        .collect();
+    lines.remove(30_000);
+    let gap = tmp("gap.csv");
+    std::fs::write(&gap, lines.join("\n")).unwrap();
+    let (code, _, err) = common::impact(
+        &args(&["analyze", &gap], &["--stream"])
+            .iter()
+            .map(String::as_str)
+            .collect::<Vec<_>>(),
+    );
+    assert!(
+        code != 0 && err.contains("line 30001") && err.contains("uneven time axis"),
         "{err}"
     );
 }

@@ -182,7 +182,7 @@ fn run(cli: Cli) -> Result<(), String> {
             }
         }
         Command::Analyze(args) if args.stream => {
-            let (setup, reports) = impact_host::streaming::analyze(&args)?;
+            let (setup, reports) = impact_host::streaming::analyze(&args, progress_for(&args))?;
             let a = analyze::to_json(&setup, &reports);
             if args.json {
                 println!(
@@ -196,13 +196,7 @@ fn run(cli: Cli) -> Result<(), String> {
             }
         }
         Command::Analyze(args) => {
-            let progress: Option<fn(f64)> = {
-                use std::io::IsTerminal;
-                let big = std::fs::metadata(&args.file)
-                    .map(|m| m.len() > 8 << 20)
-                    .unwrap_or(false);
-                (big && std::io::stderr().is_terminal()).then_some(show_progress as fn(f64))
-            };
+            let progress = progress_for(&args);
             if let Some(path) = &args.plot {
                 plot::check_output(path, &[args.file.as_path()])?;
             }
@@ -398,6 +392,15 @@ fn run(cli: Cli) -> Result<(), String> {
         }
     }
     Ok(())
+}
+
+/// A progress bar on stderr for a large file when stderr is a terminal.
+fn progress_for(args: &analyze::AnalyzeArgs) -> Option<fn(f64)> {
+    use std::io::IsTerminal;
+    let big = std::fs::metadata(&args.file)
+        .map(|m| m.len() > 8 << 20)
+        .unwrap_or(false);
+    (big && std::io::stderr().is_terminal()).then_some(show_progress as fn(f64))
 }
 
 fn show_progress(fraction: f64) {
