@@ -116,6 +116,10 @@ pub struct Throughput {
     pub median_samples_per_second: f64,
     /// `impact analyze` on a CSV of the stream's first samples, parsing included.
     pub analyze: AnalyzeThroughput,
+    /// The same samples per format, whole and streamed.
+    pub formats: Vec<FormatThroughput>,
+    /// Peers reading the same files in the same run (absent when not installed).
+    pub peers: Vec<PeerThroughput>,
 }
 
 #[derive(Clone, Debug, Serialize)]
@@ -208,7 +212,7 @@ pub fn throughput(
     if reported != impacts as u64 {
         return Err(format!("{impacts} impacts inserted, {reported} reported"));
     }
-    let analyze = analyze_csv(
+    let (analyze, formats, peers) = analyze_files(
         &stream[..csv_rows.min(stream.len())],
         impacts,
         samples,
@@ -223,19 +227,108 @@ pub fn throughput(
         samples_per_second: samples as f64 / seconds,
         median_samples_per_second: samples as f64 / median_seconds,
         analyze,
+        formats,
+        peers,
     })
 }
 
-fn analyze_csv(
+/// `impact analyze` on one file: its form, how fast, in how much memory.
+#[derive(Clone, Debug, Serialize)]
+pub struct FormatThroughput {
+    /// `csv` or `i16`, read whole or as a stream (`--stream`).
+    pub format: String,
+    pub stream: bool,
+    pub bytes: u64,
+    pub seconds: f64,
+    pub megabytes_per_second: f64,
+    pub samples_per_second: f64,
+    /// Peak resident memory of the `impact analyze` process, MiB.
+    pub peak_rss_mib: f64,
+}
+
+/// A peer reading the same file in the same run: pandas' `read_csv` (C engine) on the CSV,
+/// numpy's `fromfile` on the raw file (reading only, no analysis).
+#[derive(Clone, Debug, Serialize)]
+pub struct PeerThroughput {
+    pub tool: String,
+    pub format: String,
+    pub seconds: f64,
+    pub megabytes_per_second: f64,
+}
+
+/// Runs `exe ARGS` to the end: its stdout, wall time and peak resident memory, MiB (the
+/// child's own VmHWM, which it prints with IMPACT_PEAK_MEMORY set: wait4's ru_maxrss counts
+/// this process's memory at the fork too).
+fn run_child(exe: &std::path::Path, args: &[&str]) -> Result<(String, f64, f64), String> {
+    let t = Instant::now();
+    let child = std::process::Command::new(exe)
+        .env("IMPACT_PEAK_MEMORY", "1")
+        .args(args)
+        .stdout(std::process::Stdio::piped())
+        .stderr(std::process::Stdio::piped())
+        .spawn()
+        .map_err(|e| format!("{}: {e}", exe.display()))?;
+    let pid = child.id() as libc::pid_t;
+    // Reap with wait4 for the child's own peak resident set.
+    let _ = pid;
+    let out = child.wait_with_output().map_err(|e| e.to_string())?;
+    let seconds = t.elapsed().as_secs_f64();
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    if !out.status.success() {
+        return Err(format!(
+            "{} {} failed: {}",
+            exe.display(),
+            args.join(" "),
+            stderr.trim()
+        ));
+    }
+    let kib: f64 = stderr
+        .lines()
+        .find_map(|l| l.strip_prefix("peak memory: "))
+        .and_then(|v| v.trim_end_matches("kB").trim().parse().ok())
+        .ok_or("the child printed no peak memory")?;
+    Ok((
+        String::from_utf8_lossy(&out.stdout).into_owned(),
+        seconds,
+        kib / 1024.0,
+    ))
+}
+
+/// A peer's own timing of reading `path`, from the Python one-liner `code` (printing the
+/// seconds), or `None` when Python or the library is missing (CI has no network).
+fn peer(code: &str, path: &std::path::Path) -> Option<f64> {
+    let out = std::process::Command::new("python3")
+        .args(["-c", code])
+        .arg(path)
+        .output()
+        .ok()?;
+    if !out.status.success() {
+        return None;
+    }
+    String::from_utf8_lossy(&out.stdout).trim().parse().ok()
+}
+
+/// `impact analyze` on the counts written as CSV (whole and `--stream`) and as raw i16
+/// (`--stream`), and the peers reading the same files.
+fn analyze_files(
     counts: &[i16],
     impacts: usize,
     samples: usize,
     exe: &std::path::Path,
-) -> Result<AnalyzeThroughput, String> {
+) -> Result<
+    (
+        AnalyzeThroughput,
+        Vec<FormatThroughput>,
+        Vec<PeerThroughput>,
+    ),
+    String,
+> {
     use std::io::Write;
-    let path = std::env::temp_dir().join(format!("impact-throughput-{}.csv", std::process::id()));
+    let dir = std::env::temp_dir();
+    let csv = dir.join(format!("impact-throughput-{}.csv", std::process::id()));
+    let raw = dir.join(format!("impact-throughput-{}.i16", std::process::id()));
     let result = (|| {
-        let file = std::fs::File::create(&path).map_err(|e| format!("{}: {e}", path.display()))?;
+        let file = std::fs::File::create(&csv).map_err(|e| format!("{}: {e}", csv.display()))?;
         let mut w = std::io::BufWriter::with_capacity(1 << 20, file);
         let gain_g = 1600.0 / 4096.0 / impact_core::solve::bounce::STANDARD_GRAVITY;
         writeln!(w, "time_s,accel_g").map_err(|e| e.to_string())?;
@@ -250,65 +343,111 @@ fn analyze_csv(
         }
         w.flush().map_err(|e| e.to_string())?;
         drop(w);
-        let bytes = std::fs::metadata(&path).map_err(|e| e.to_string())?.len();
-        let t = Instant::now();
-        let child = std::process::Command::new(exe)
-            .arg("analyze")
-            .arg(&path)
-            .args(["--json"])
-            .stdout(std::process::Stdio::piped())
-            .stderr(std::process::Stdio::piped())
-            .spawn()
-            .map_err(|e| format!("{}: {e}", exe.display()))?;
-        let pid = child.id() as libc::pid_t;
-        // Reap with wait4 for the child's own peak resident set.
-        let out = {
-            let mut child = child;
-            let stdout = child.stdout.take();
-            let reader = std::thread::spawn(move || {
-                let mut s = String::new();
-                if let Some(mut o) = stdout {
-                    use std::io::Read;
-                    let _ = o.read_to_string(&mut s);
-                }
-                s
-            });
-            let mut status = 0;
-            // SAFETY: a zeroed rusage is a valid value; wait4 fills it for our own child.
-            let mut usage: libc::rusage = unsafe { std::mem::zeroed() };
-            // SAFETY: `pid` is our child, not yet reaped; the pointers are valid.
-            let r = unsafe { libc::wait4(pid, &mut status, 0, &mut usage) };
-            if r != pid {
-                return Err("wait4 failed".into());
-            }
-            if !libc::WIFEXITED(status) || libc::WEXITSTATUS(status) != 0 {
-                return Err(format!("impact analyze failed (status {status})"));
-            }
-            (
-                reader.join().unwrap_or_default(),
-                usage.ru_maxrss as f64 / 1024.0,
-            )
-        };
-        let seconds = t.elapsed().as_secs_f64();
-        let v: serde_json::Value =
-            serde_json::from_str(&out.0).map_err(|e| format!("analyze JSON: {e}"))?;
-        let reported = v["impacts"].as_array().map_or(0, |a| a.len()) as u64;
+        let bytes: Vec<u8> = counts.iter().flat_map(|c| c.to_le_bytes()).collect();
+        std::fs::write(&raw, bytes).map_err(|e| format!("{}: {e}", raw.display()))?;
+        let size = |p: &std::path::Path| std::fs::metadata(p).map(|m| m.len()).unwrap_or(0);
         let expected = (impacts as u64 * counts.len() as u64) / samples.max(1) as u64;
-        if reported.abs_diff(expected) > 1 {
-            return Err(format!(
-                "analyze reported {reported} impacts, about {expected} expected"
-            ));
+        let check = |out: &str| -> Result<u64, String> {
+            let v: serde_json::Value =
+                serde_json::from_str(out).map_err(|e| format!("analyze JSON: {e}"))?;
+            let reported = v["impacts"].as_array().map_or(0, |a| a.len()) as u64;
+            if reported.abs_diff(expected) > 1 {
+                return Err(format!(
+                    "analyze reported {reported} impacts, about {expected} expected"
+                ));
+            }
+            Ok(reported)
+        };
+        let (csv_s, raw_s) = (csv.to_string_lossy(), raw.to_string_lossy());
+        // The stream's levels: the ADC's full scale (±2048 codes) and a 20 m/s² trigger.
+        let range_g = format!("{}", 2048.0 * gain_g);
+        let gain = format!("{gain_g}");
+        let runs: [(&str, bool, Vec<&str>); 3] = [
+            ("csv", false, vec!["analyze", &csv_s, "--json"]),
+            (
+                "csv",
+                true,
+                vec![
+                    "analyze",
+                    &csv_s,
+                    "--json",
+                    "--stream",
+                    "--range",
+                    &range_g,
+                    "--trigger",
+                    "20",
+                ],
+            ),
+            (
+                "i16",
+                true,
+                vec![
+                    "analyze",
+                    &raw_s,
+                    "--json",
+                    "--stream",
+                    "--rate",
+                    "500000",
+                    "--gain",
+                    &gain,
+                    "--range",
+                    "4096",
+                    "--trigger",
+                    "20",
+                ],
+            ),
+        ];
+        let mut whole = None;
+        let mut formats = Vec::new();
+        for (format, stream, args) in runs {
+            let (out, seconds, peak) = run_child(exe, &args)?;
+            let reported = check(&out)?;
+            let bytes = if format == "csv" {
+                size(&csv)
+            } else {
+                size(&raw)
+            };
+            if format == "csv" && !stream {
+                whole = Some(AnalyzeThroughput {
+                    rows: counts.len() as u64,
+                    bytes,
+                    impacts_reported: reported,
+                    seconds,
+                    rows_per_second: counts.len() as f64 / seconds,
+                    megabytes_per_second: bytes as f64 / 1e6 / seconds,
+                    peak_rss_mib: peak,
+                });
+            }
+            formats.push(FormatThroughput {
+                format: format.into(),
+                stream,
+                bytes,
+                seconds,
+                megabytes_per_second: bytes as f64 / 1e6 / seconds,
+                samples_per_second: counts.len() as f64 / seconds,
+                peak_rss_mib: peak,
+            });
         }
-        Ok(AnalyzeThroughput {
-            rows: counts.len() as u64,
-            bytes,
-            impacts_reported: reported,
-            seconds,
-            rows_per_second: counts.len() as f64 / seconds,
-            megabytes_per_second: bytes as f64 / 1e6 / seconds,
-            peak_rss_mib: out.1,
-        })
+        let mut peers = Vec::new();
+        let pandas = "import sys,time,pandas; t=time.perf_counter(); pandas.read_csv(sys.argv[1], engine='c'); print(time.perf_counter()-t)";
+        let numpy = "import sys,time,numpy; t=time.perf_counter(); numpy.fromfile(sys.argv[1], dtype='<i2'); print(time.perf_counter()-t)";
+        for (tool, format, code, path) in [
+            ("pandas read_csv (C engine)", "csv", pandas, &csv),
+            ("numpy fromfile", "i16", numpy, &raw),
+        ] {
+            if let Some(seconds) = peer(code, path) {
+                peers.push(PeerThroughput {
+                    tool: tool.into(),
+                    format: format.into(),
+                    seconds,
+                    megabytes_per_second: size(path) as f64 / 1e6 / seconds,
+                });
+            }
+        }
+        let whole = whole.ok_or("no whole-file run")?;
+        Ok((whole, formats, peers))
     })();
-    let _ = std::fs::remove_file(&path);
+    let _ = std::fs::remove_file(&csv);
+    let _ = std::fs::remove_file(&raw);
     result
 }

@@ -203,36 +203,35 @@ fn a_stream_longer_than_memory_is_analysed_in_bounded_memory() {
         let code = (2048 + noise + pulse) as i16;
         b.copy_from_slice(&code.to_le_bytes());
     }
-    // Reaped by wait4 below (for its peak memory), which clippy cannot see.
-    #[allow(clippy::zombie_processes)]
     let mut child = Command::new(env!("CARGO_BIN_EXE_impact"))
         .args(["analyze", "-", "--stream", "--raw-type", "i16", "--csv"])
         .args(&LEVELS[..12])
+        // The child's own peak memory (VmHWM) on stderr.
+        .env("IMPACT_PEAK_MEMORY", "1")
         .stdin(Stdio::piped())
         .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
         .spawn()
         .unwrap();
-    let pid = child.id() as libc::pid_t;
     let mut stdin = child.stdin.take().unwrap();
     let writer = std::thread::spawn(move || {
         for _ in 0..PERIODS {
             stdin.write_all(&pattern).unwrap();
         }
     });
-    let stdout = child.stdout.take().unwrap();
-    let reader = std::thread::spawn(move || std::io::read_to_string(stdout).unwrap());
-    let mut status = 0;
-    // SAFETY: a zeroed rusage is a valid value; wait4 fills it for our own, unreaped child.
-    let mut usage: libc::rusage = unsafe { std::mem::zeroed() };
-    // SAFETY: `pid` is our child; the pointers are valid for the call.
-    let r = unsafe { libc::wait4(pid, &mut status, 0, &mut usage) };
-    assert_eq!(r, pid);
+    let out = child.wait_with_output().unwrap();
     writer.join().unwrap();
-    let csv = reader.join().unwrap();
-    assert!(libc::WIFEXITED(status) && libc::WEXITSTATUS(status) == 0);
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(out.status.success(), "{err}");
+    let csv = String::from_utf8(out.stdout).unwrap();
     let rows = csv.lines().skip(1).filter(|l| !l.is_empty()).count();
     assert_eq!(rows, PERIODS, "one report per inserted impact");
-    let peak_mib = usage.ru_maxrss as f64 / 1024.0;
+    let peak_mib = err
+        .lines()
+        .find_map(|l| l.strip_prefix("peak memory: "))
+        .and_then(|v| v.trim_end_matches("kB").trim().parse::<f64>().ok())
+        .expect("peak memory printed")
+        / 1024.0;
     eprintln!("2^30 samples streamed, {rows} impacts, peak memory {peak_mib:.1} MiB");
     assert!(peak_mib < 64.0, "peak memory {peak_mib:.1} MiB");
 }

@@ -159,7 +159,16 @@ fn main() -> ExitCode {
             return ExitCode::from(2);
         }
     };
-    match run(cli) {
+    let result = run(cli);
+    // For benchmarks and tests: this process's own peak memory (VmHWM: the address space
+    // since exec; wait4's ru_maxrss would include the parent's at the fork).
+    if std::env::var_os("IMPACT_PEAK_MEMORY").is_some() {
+        let status = std::fs::read_to_string("/proc/self/status").unwrap_or_default();
+        if let Some(line) = status.lines().find(|l| l.starts_with("VmHWM:")) {
+            eprintln!("peak memory: {}", line.trim_start_matches("VmHWM:").trim());
+        }
+    }
+    match result {
         Ok(()) => ExitCode::SUCCESS,
         Err(e) => {
             eprintln!("error: {e}");
@@ -298,6 +307,27 @@ fn run(cli: Cli) -> Result<(), String> {
                     "impact analyze: {} rows ({:.0} MB CSV), {} impacts in {:.2} s: {:.3e} rows/s, {:.0} MB/s, peak memory {:.0} MiB",
                     a.rows, a.bytes as f64 / 1e6, a.impacts_reported, a.seconds, a.rows_per_second, a.megabytes_per_second, a.peak_rss_mib
                 );
+                for f in &r.formats {
+                    println!(
+                        "  {:<3} {:<6} {:>5.0} MB in {:>5.2} s: {:>5.0} MB/s, {:.3e} samples/s, peak memory {:>4.0} MiB",
+                        f.format,
+                        if f.stream { "stream" } else { "whole" },
+                        f.bytes as f64 / 1e6,
+                        f.seconds,
+                        f.megabytes_per_second,
+                        f.samples_per_second,
+                        f.peak_rss_mib
+                    );
+                }
+                if r.peers.is_empty() {
+                    println!("  peers: none (python3 with pandas and numpy not found)");
+                }
+                for p in &r.peers {
+                    println!(
+                        "  peer {} on the {}: {:.2} s, {:.0} MB/s (reading only)",
+                        p.tool, p.format, p.seconds, p.megabytes_per_second
+                    );
+                }
             }
         }
         Command::Bench {
