@@ -406,6 +406,12 @@ pub fn emulate(args: &EmulateArgs) -> Result<(), String> {
     let a = &args.analyze;
     // Check the tools before a possibly long build.
     tools_available()?;
+    if a.stream {
+        return Err(
+            "--stream: the emulator replays a recording it has read whole (impact analyze --stream reads one as it comes)"
+                .into(),
+        );
+    }
     let mut setup = analyze::setup(a, None)?;
     setup.scene.waveform_every = args.waveforms.unwrap_or(0);
     let elf = match &args.elf {

@@ -190,27 +190,18 @@ fn run(cli: Cli) -> Result<(), String> {
                 simulate::Outcome::Target(report) => print!("{}", target::table(&report)),
             }
         }
-        Command::Analyze(args) if args.stream => {
-            let (setup, reports) = impact_host::streaming::analyze(&args, progress_for(&args))?;
-            let a = analyze::to_json(&setup, &reports);
-            if args.json {
-                println!(
-                    "{}",
-                    serde_json::to_string_pretty(&a).map_err(|e| e.to_string())?
-                );
-            } else if args.csv {
-                print!("{}", analyze::to_csv(&a));
-            } else {
-                print!("{}", analyze::to_table(&a));
-            }
-        }
         Command::Analyze(args) => {
             let progress = progress_for(&args);
             if let Some(path) = &args.plot {
                 plot::check_output(path, &[args.file.as_path()])?;
             }
-            let setup = analyze::setup(&args, progress)?;
-            let reports = analyze::run(&setup.prepared.counts, &setup.scene)?;
+            let (setup, reports) = if args.stream {
+                impact_host::streaming::analyze(&args, progress)?
+            } else {
+                let setup = analyze::setup(&args, progress)?;
+                let reports = analyze::run(&setup.prepared.counts, &setup.scene)?;
+                (setup, reports)
+            };
             let a = analyze::to_json(&setup, &reports);
             if args.json {
                 println!(
