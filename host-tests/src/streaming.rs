@@ -1,5 +1,5 @@
-//! `impact analyze --stream`: a CSV or raw (`.i16`/`.f32`) recording, a file or standard
-//! input, analysed as it is read, a block at a time, in memory that does not grow with its
+//! `impact analyze --stream`: a CSV, WAV or raw (`.i16`/`.f32`) recording, a file or (CSV,
+//! raw) standard input, analysed as it is read, a block at a time, in memory that does not grow with its
 //! length (an hour at 500 kS/s is 3.6 GB of i16, ~60 GB of CSV). The per-sample arithmetic is
 //! the whole-file path's
 //! (units, gain, quantisation to counts at the `--range` full scale), so with the same
@@ -46,6 +46,15 @@ pub fn analyze(
     if args.resample {
         return refuse("--resample");
     }
+    let ext = args
+        .file
+        .extension()
+        .map(|e| e.to_string_lossy().to_ascii_lowercase());
+    if matches!(ext.as_deref(), Some("npy" | "tdms")) {
+        return Err(format!(
+            "{name}: --stream reads CSV, WAV and raw files; .npy and .tdms files are read whole (drop --stream)"
+        ));
+    }
     let file = match &args.scene {
         Some(p) => analyze::load_scene(p)?,
         None => analyze::SceneFile::default(),
@@ -66,6 +75,7 @@ pub fn analyze(
     let clipping = crate::screen::from_range(full_scale);
     let mut source: Box<dyn Source> = match args.raw_type.or_else(|| RawType::of(&args.file)) {
         Some(kind) => Box::new(RawSource::open(args, kind, &name)?),
+        None if crate::wav::is_wav(&args.file) => Box::new(WavSource::open(args, &name)?),
         None => Box::new(CsvSource::open(args, progress)?),
     };
     // The head: its noise sets the default edge level, a CSV's first intervals the rate.
@@ -473,5 +483,101 @@ fn check_interval(dt: f64, median: f64) -> Result<(), String> {
              intervals' median {median:.6e} s (a gap or a rate change); --stream does not \
              resample: cut the file"
         ))
+    }
+}
+
+/// A WAV file's channel, through hound's sample iterator (which reads as it goes).
+struct WavSource {
+    samples: WavSamples,
+    /// Samples read (all channels), the channels, and the one wanted.
+    k: usize,
+    channels: usize,
+    column: usize,
+    rate_hz: f64,
+    name: String,
+}
+
+enum WavSamples {
+    Int(hound::WavIntoSamples<std::io::BufReader<std::fs::File>, i32>),
+    Float(hound::WavIntoSamples<std::io::BufReader<std::fs::File>, f32>),
+}
+
+impl WavSource {
+    fn open(args: &AnalyzeArgs, name: &str) -> Result<Self, String> {
+        if args.rate.is_some() || args.time_column.is_some() {
+            return Err(format!(
+                "{name}: a WAV file gives its own rate: no --rate or --time-column"
+            ));
+        }
+        let reader = hound::WavReader::open(&args.file)
+            .map_err(|e| format!("{name}: WAV: {}", crate::table::one_line(e)))?;
+        let spec = reader.spec();
+        if spec.sample_rate == 0 {
+            return Err(format!("{name}: WAV: sample rate 0 in the header"));
+        }
+        let channels = usize::from(spec.channels).max(1);
+        let column = crate::recording::numbered_column(
+            args.column.as_ref(),
+            channels,
+            "a WAV file's channels",
+        )
+        .map_err(|e| format!("{name}: {e}"))?;
+        let samples = match spec.sample_format {
+            hound::SampleFormat::Int => WavSamples::Int(reader.into_samples()),
+            hound::SampleFormat::Float => WavSamples::Float(reader.into_samples()),
+        };
+        Ok(Self {
+            samples,
+            k: 0,
+            channels,
+            column,
+            rate_hz: f64::from(spec.sample_rate),
+            name: name.to_string(),
+        })
+    }
+}
+
+impl Source for WavSource {
+    fn next_values(&mut self, want: usize, push: &mut dyn FnMut(f64)) -> Result<(), String> {
+        let mut pushed = 0;
+        while pushed < want.max(1) {
+            let next = match &mut self.samples {
+                WavSamples::Int(s) => s.next().map(|r| r.map(f64::from)),
+                WavSamples::Float(s) => s.next().map(|r| r.map(f64::from)),
+            };
+            let Some(sample) = next else { break };
+            let frame = self.k / self.channels;
+            let v = sample.map_err(|e| {
+                format!(
+                    "{}: WAV: frame {frame}: {}",
+                    self.name,
+                    crate::table::one_line(e)
+                )
+            })?;
+            if !v.is_finite() {
+                return Err(format!(
+                    "{}: WAV: frame {frame}: {v} is not finite",
+                    self.name
+                ));
+            }
+            if self.k % self.channels == self.column {
+                push(v);
+                pushed += 1;
+            }
+            self.k += 1;
+        }
+        Ok(())
+    }
+
+    fn rate_hz(&self) -> Result<f64, String> {
+        Ok(self.rate_hz)
+    }
+
+    fn final_rate_hz(&self) -> f64 {
+        self.rate_hz
+    }
+
+    fn t0(&self) -> f64 {
+        0.0
     }
 }

@@ -183,6 +183,45 @@ fn a_csv_stream_gives_the_whole_files_reports() {
     );
 }
 
+#[test]
+fn a_wav_stream_gives_the_whole_files_reports() {
+    let wav = concat!(env!("CARGO_MANIFEST_DIR"), "/fixtures/afrl-test1-int16.wav");
+    let levels = [
+        "--gain",
+        "0.001",
+        "--units",
+        "kgn",
+        "--range",
+        "32767",
+        "--trigger",
+        "20000",
+        "--json",
+    ];
+    fn args<'a>(wav: &'a str, levels: &[&'a str], tail: &[&'a str]) -> Vec<&'a str> {
+        ["analyze", wav]
+            .iter()
+            .chain(levels)
+            .chain(tail)
+            .copied()
+            .collect()
+    }
+    let (whole, _) = impact(&args(wav, &levels, &["--keep-spikes"]));
+    let (streamed, _) = impact(&args(wav, &levels, &["--stream"]));
+    assert_eq!(streamed, whole);
+    assert!(whole.contains("peak_acceleration_m_s2"), "{whole}");
+    // Cut in the middle of the data: an error naming the frame, as the whole-file reader's.
+    let cut = tmp("cut.wav");
+    let bytes = std::fs::read(wav).unwrap();
+    std::fs::write(&cut, &bytes[..bytes.len() / 2 + 1]).unwrap();
+    let args: Vec<&str> = ["analyze", &cut, "--stream"]
+        .iter()
+        .chain(&levels)
+        .copied()
+        .collect();
+    let (code, _, err) = common::impact(&args);
+    assert!(code != 0 && err.contains("WAV: frame"), "{err}");
+}
+
 /// 2^30 samples (2 GiB of i16; 36 minutes at 500 kS/s; over 24 GiB as the whole-file path
 /// would hold them) generated as they are written into `impact analyze -`'s standard input:
 /// every impact reported, in under 64 MiB.
