@@ -61,6 +61,60 @@ fn elements(file: npyz::NpyFile<BufReader<std::fs::File>>) -> Result<Vec<f64>, S
 }
 
 /// Reads the channel `opts.column` of a 1-D or 2-D array at `opts.rate_hz`.
+/// The array's elements as f64, read as they are asked for (for `analyze --stream`).
+pub type Elements = Box<dyn Iterator<Item = Result<f64, String>> + Send>;
+
+/// An .npy file opened for streaming: its elements (in file order), shape and order.
+pub fn open_elements(path: &Path) -> Result<(Elements, Vec<u64>, npyz::Order), String> {
+    fn boxed<T: npyz::Deserialize + Into<f64> + 'static>(
+        r: npyz::NpyReader<T, BufReader<std::fs::File>>,
+    ) -> Elements
+    where
+        npyz::NpyReader<T, BufReader<std::fs::File>>: Send,
+    {
+        Box::new(r.enumerate().map(|(k, v)| {
+            v.map(Into::into)
+                .map_err(|e| format!("element {k}: {}", one_line(e)))
+        }))
+    }
+    let f = std::fs::File::open(path).map_err(|e| e.to_string())?;
+    let file =
+        npyz::NpyFile::new(BufReader::new(f)).map_err(|e| format!("npy: {}", one_line(e)))?;
+    let shape = file.shape().to_vec();
+    let order = file.order();
+    let dtype = file.dtype().descr();
+    let file = match file.try_data::<f64>() {
+        Ok(r) => return Ok((boxed(r), shape, order)),
+        Err(f) => f,
+    };
+    let file = match file.try_data::<f32>() {
+        Ok(r) => return Ok((boxed(r), shape, order)),
+        Err(f) => f,
+    };
+    let file = match file.try_data::<i32>() {
+        Ok(r) => return Ok((boxed(r), shape, order)),
+        Err(f) => f,
+    };
+    let file = match file.try_data::<i16>() {
+        Ok(r) => return Ok((boxed(r), shape, order)),
+        Err(f) => f,
+    };
+    let file = match file.try_data::<u16>() {
+        Ok(r) => return Ok((boxed(r), shape, order)),
+        Err(f) => f,
+    };
+    let file = match file.try_data::<i8>() {
+        Ok(r) => return Ok((boxed(r), shape, order)),
+        Err(f) => f,
+    };
+    match file.try_data::<u8>() {
+        Ok(r) => Ok((boxed(r), shape, order)),
+        Err(_) => Err(format!(
+            "npy: dtype {dtype}: not one of float64, float32, int32, int16, uint16, int8, uint8"
+        )),
+    }
+}
+
 pub fn read_npy(path: &Path, opts: &ReadOptions) -> Result<Channel, RecordingError> {
     let err = |message: String| RecordingError {
         file: path.to_path_buf(),

@@ -222,6 +222,62 @@ fn a_wav_stream_gives_the_whole_files_reports() {
     assert!(code != 0 && err.contains("WAV: frame"), "{err}");
 }
 
+#[test]
+fn npy_streams_give_the_whole_files_reports_in_either_order() {
+    let dir = concat!(env!("CARGO_MANIFEST_DIR"), "/fixtures/");
+    for (file, gain) in [
+        ("afrl-test1-int16.npy", "0.001"),
+        ("afrl-test1-float32-fortran.npy", "1"),
+    ] {
+        let path = format!("{dir}{file}");
+        for column in ["0", "1"] {
+            let args = |tail: &str| -> Vec<String> {
+                [
+                    "analyze",
+                    &path,
+                    "--rate",
+                    "1000000",
+                    "--column",
+                    column,
+                    "--units",
+                    "kgn",
+                    "--gain",
+                    gain,
+                    "--range",
+                    "40000",
+                    "--trigger",
+                    "20000",
+                    "--json",
+                    tail,
+                ]
+                .iter()
+                .map(|s| s.to_string())
+                .collect()
+            };
+            let run = |v: Vec<String>| impact(&v.iter().map(String::as_str).collect::<Vec<_>>()).0;
+            let whole = run(args("--keep-spikes"));
+            assert_eq!(run(args("--stream")), whole, "{file} column {column}");
+            assert!(whole.contains("peak_time_s"), "{file}: no impact");
+        }
+    }
+    // A file cut short: an error naming where its data ends.
+    let bytes = std::fs::read(format!("{dir}afrl-test1-int16.npy")).unwrap();
+    let cut = tmp("cut.npy");
+    std::fs::write(&cut, &bytes[..bytes.len() - 1000]).unwrap();
+    let (code, _, err) = common::impact(&[
+        "analyze",
+        &cut,
+        "--rate",
+        "1000000",
+        "--range",
+        "40000",
+        "--trigger",
+        "20000",
+        "--stream",
+    ]);
+    assert!(code != 0 && err.contains("npy"), "{err}");
+}
+
 /// 2^30 samples (2 GiB of i16; 36 minutes at 500 kS/s; over 24 GiB as the whole-file path
 /// would hold them) generated as they are written into `impact analyze -`'s standard input:
 /// every impact reported, in under 64 MiB.
