@@ -308,6 +308,38 @@ fn waveforms_off_the_board_draw_the_same_figure() {
         assert!((x / y - 1.0).abs() < within, "{key}: {x} again, {y} first");
     }
 
+    // The same window as 16-bit WAV (the counts; the gain from the log's scene line).
+    let wav = path("window.wav");
+    impact(&["log", &log, "--export", &wav]);
+    let text = std::fs::read_to_string(&log).unwrap();
+    let gain = text
+        .split_whitespace()
+        .find_map(|t| t.strip_prefix("gain_m_s2_per_count="))
+        .unwrap()
+        .to_string();
+    let wav0 = wav.replace("window.wav", "window-0.wav");
+    let (from_wav, _) = run(with(
+        &["analyze", &wav0],
+        &["--units", "m/s2", "--gain", &gain, "--json"],
+    ));
+    // The same impact but for the time origin (the WAV starts at 0, the CSV at the stream's
+    // time) and the rate (the CSV's from its time stamps).
+    let strip = |text: &str| {
+        let mut v: serde_json::Value = serde_json::from_str(text).unwrap();
+        v.as_object_mut().unwrap().remove("sample_rate_hz");
+        for i in v["impacts"].as_array_mut().unwrap() {
+            let i = i.as_object_mut().unwrap();
+            i.remove("start_s");
+            i.remove("peak_time_s");
+        }
+        v
+    };
+    assert_eq!(
+        strip(&from_wav),
+        strip(&again),
+        "the WAV export reads as the CSV export"
+    );
+
     // A frame the link dropped: counted, warned about, and the figure still drawn.
     let text = std::fs::read_to_string(&log).unwrap();
     let cut: String = text
