@@ -5,7 +5,7 @@
 use std::io::BufReader;
 use std::path::Path;
 
-use crate::recording::{evenly_sampled, numbered_column, Channel, ReadOptions};
+use crate::recording::{evenly_sampled, numbered_column, Channel, ColumnRef, ReadOptions};
 use crate::table::{one_line, RecordingError};
 
 /// True for a `.npy` file name (any case).
@@ -15,56 +15,11 @@ pub fn is_npy(path: &Path) -> bool {
         .is_some_and(|e| e.eq_ignore_ascii_case("npy"))
 }
 
-/// Every element of `file` as f64, in storage order, whatever its numeric dtype.
-fn elements(file: npyz::NpyFile<BufReader<std::fs::File>>) -> Result<Vec<f64>, String> {
-    fn all<T: npyz::Deserialize + Into<f64>>(
-        r: npyz::NpyReader<T, BufReader<std::fs::File>>,
-    ) -> Result<Vec<f64>, String> {
-        r.enumerate()
-            .map(|(k, v)| {
-                v.map(Into::into)
-                    .map_err(|e| format!("element {k}: {}", one_line(e)))
-            })
-            .collect()
-    }
-    let dtype = file.dtype().descr();
-    let file = match file.try_data::<f64>() {
-        Ok(r) => return all(r),
-        Err(f) => f,
-    };
-    let file = match file.try_data::<f32>() {
-        Ok(r) => return all(r),
-        Err(f) => f,
-    };
-    let file = match file.try_data::<i32>() {
-        Ok(r) => return all(r),
-        Err(f) => f,
-    };
-    let file = match file.try_data::<i16>() {
-        Ok(r) => return all(r),
-        Err(f) => f,
-    };
-    let file = match file.try_data::<u16>() {
-        Ok(r) => return all(r),
-        Err(f) => f,
-    };
-    let file = match file.try_data::<i8>() {
-        Ok(r) => return all(r),
-        Err(f) => f,
-    };
-    match file.try_data::<u8>() {
-        Ok(r) => all(r),
-        Err(_) => Err(format!(
-            "dtype {dtype}: not one of float64, float32, int32, int16, uint16, int8, uint8"
-        )),
-    }
-}
-
-/// Reads the channel `opts.column` of a 1-D or 2-D array at `opts.rate_hz`.
-/// The array's elements as f64, read as they are asked for (for `analyze --stream`).
+/// An array's elements as f64, in storage order, read as they are asked for.
 pub type Elements = Box<dyn Iterator<Item = Result<f64, String>> + Send>;
 
-/// An .npy file opened for streaming: its elements (in file order), shape and order.
+/// An .npy file opened: its elements (in storage order, whatever the numeric dtype), shape
+/// and order.
 pub fn open_elements(path: &Path) -> Result<(Elements, Vec<u64>, npyz::Order), String> {
     fn boxed<T: npyz::Deserialize + Into<f64> + 'static>(
         r: npyz::NpyReader<T, BufReader<std::fs::File>>,
@@ -115,6 +70,23 @@ pub fn open_elements(path: &Path) -> Result<(Elements, Vec<u64>, npyz::Order), S
     }
 }
 
+/// Samples, channels and the chosen channel of an array of `shape`: 1-D, or 2-D samples ×
+/// channels.
+pub fn layout(shape: &[u64], column: Option<&ColumnRef>) -> Result<(u64, u64, usize), String> {
+    let (rows, cols) = match *shape {
+        [n] => (n, 1),
+        [n, c] => (n, c),
+        _ => {
+            return Err(format!(
+                "npy: shape {shape:?}; a 1-D array or 2-D (samples × channels)"
+            ))
+        }
+    };
+    let column = numbered_column(column, cols as usize, "the array's columns")?;
+    Ok((rows, cols, column))
+}
+
+/// Reads the channel `opts.column` of a 1-D or 2-D array at `opts.rate_hz`.
 pub fn read_npy(path: &Path, opts: &ReadOptions) -> Result<Channel, RecordingError> {
     let err = |message: String| RecordingError {
         file: path.to_path_buf(),
@@ -133,22 +105,12 @@ pub fn read_npy(path: &Path, opts: &ReadOptions) -> Result<Channel, RecordingErr
                 .into(),
         ));
     }
-    let f = std::fs::File::open(path).map_err(|e| err(e.to_string()))?;
-    let file =
-        npyz::NpyFile::new(BufReader::new(f)).map_err(|e| err(format!("npy: {}", one_line(e))))?;
-    let shape = file.shape().to_vec();
-    let order = file.order();
-    let (rows, cols) = match shape[..] {
-        [n] => (n as usize, 1),
-        [n, c] => (n as usize, c as usize),
-        _ => {
-            return Err(err(format!(
-                "npy: shape {shape:?}; a 1-D array or 2-D (samples × channels)"
-            )))
-        }
-    };
-    let column = numbered_column(opts.column.as_ref(), cols, "the array's columns").map_err(err)?;
-    let all = elements(file).map_err(|e| err(format!("npy: {}", one_line(e))))?;
+    let (elements, shape, order) = open_elements(path).map_err(err)?;
+    let (rows, cols, column) = layout(&shape, opts.column.as_ref()).map_err(err)?;
+    let (rows, cols) = (rows as usize, cols as usize);
+    let all: Vec<f64> = elements
+        .map(|e| e.map_err(|e| err(format!("npy: {}", one_line(e)))))
+        .collect::<Result<_, _>>()?;
     if all.len() != rows * cols {
         return Err(err(format!(
             "npy: {} elements for shape {shape:?}",

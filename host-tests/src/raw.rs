@@ -25,6 +25,35 @@ impl RawType {
         }
     }
 
+    /// The values at byte `at` of each `frame`-byte frame of `bytes` (whole frames), handed
+    /// to `push`; a float that is not finite stops it: its frame's index and value.
+    pub(crate) fn decode(
+        self,
+        bytes: &[u8],
+        frame: usize,
+        at: usize,
+        mut push: impl FnMut(f64),
+    ) -> Result<(), (usize, f32)> {
+        let frames = bytes.chunks_exact(frame);
+        match self {
+            RawType::I16 => {
+                for f in frames {
+                    push(f64::from(i16::from_le_bytes([f[at], f[at + 1]])));
+                }
+            }
+            RawType::F32 => {
+                for (k, f) in frames.enumerate() {
+                    let v = f32::from_le_bytes([f[at], f[at + 1], f[at + 2], f[at + 3]]);
+                    if !v.is_finite() {
+                        return Err((k, v));
+                    }
+                    push(f64::from(v));
+                }
+            }
+        }
+        Ok(())
+    }
+
     pub(crate) fn bytes(self) -> usize {
         match self {
             RawType::I16 => 2,
@@ -78,22 +107,13 @@ pub fn read_raw(
         )));
     }
     let mut values = Vec::with_capacity(bytes.len() / frame);
-    for (k, f) in bytes.chunks_exact(frame).enumerate() {
-        let at = column * kind.bytes();
-        let v = match kind {
-            RawType::I16 => f64::from(i16::from_le_bytes([f[at], f[at + 1]])),
-            RawType::F32 => {
-                let v = f32::from_le_bytes([f[at], f[at + 1], f[at + 2], f[at + 3]]);
-                if !v.is_finite() {
-                    return Err(err(format!(
-                        "frame {k} (byte {}): {v} is not finite",
-                        k * frame + at
-                    )));
-                }
-                f64::from(v)
-            }
-        };
-        values.push(v);
-    }
+    let at = column * kind.bytes();
+    kind.decode(&bytes, frame, at, |v| values.push(v))
+        .map_err(|(k, v)| {
+            err(format!(
+                "frame {k} (byte {}): {v} is not finite",
+                k * frame + at
+            ))
+        })?;
     evenly_sampled(format!("channel {column}"), values, rate_hz).map_err(err)
 }

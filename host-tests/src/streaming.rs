@@ -162,10 +162,14 @@ trait Source: Send {
     /// The rate the scene runs at (after the head).
     fn rate_hz(&self) -> Result<f64, String>;
     /// The rate the report gives (at the end: a CSV's mean interval over the whole file, as
-    /// the whole-file path computes it).
-    fn final_rate_hz(&self) -> f64;
-    /// Time of the first sample, s.
-    fn t0(&self) -> f64;
+    /// the whole-file path computes it); the scene's by default.
+    fn final_rate_hz(&self) -> f64 {
+        self.rate_hz().unwrap_or(0.0)
+    }
+    /// Time of the first sample, s (0 without a time column).
+    fn t0(&self) -> f64 {
+        0.0
+    }
 }
 
 /// A raw file or stream: the chosen channel of interleaved little-endian frames.
@@ -228,14 +232,6 @@ impl Source for RawSource {
         Ok(self.rate_hz)
     }
 
-    fn final_rate_hz(&self) -> f64 {
-        self.rate_hz
-    }
-
-    fn t0(&self) -> f64 {
-        0.0
-    }
-
     fn next_values(&mut self, want: usize, push: &mut dyn FnMut(f64)) -> Result<(), String> {
         // At most `want` frames (the head stops at exactly HEAD samples whatever a pipe's
         // reads return), at least one whole frame's room.
@@ -262,24 +258,16 @@ impl Source for RawSource {
         self.read += n as u64;
         let have = self.held + n;
         let whole = have / self.frame * self.frame;
-        for (k, f) in self.buf[..whole].chunks_exact(self.frame).enumerate() {
-            let at = self.at;
-            let v = match self.kind {
-                RawType::I16 => f64::from(i16::from_le_bytes([f[at], f[at + 1]])),
-                RawType::F32 => {
-                    let v = f32::from_le_bytes([f[at], f[at + 1], f[at + 2], f[at + 3]]);
-                    if !v.is_finite() {
-                        let frame_no = (self.read - have as u64) / self.frame as u64 + k as u64;
-                        return Err(format!(
-                            "{}: frame {frame_no} (byte {}): {v} is not finite",
-                            self.name,
-                            frame_no * self.frame as u64 + at as u64
-                        ));
-                    }
-                    f64::from(v)
-                }
-            };
-            push(v);
+        if let Err((k, v)) = self
+            .kind
+            .decode(&self.buf[..whole], self.frame, self.at, push)
+        {
+            let frame_no = (self.read - have as u64) / self.frame as u64 + k as u64;
+            return Err(format!(
+                "{}: frame {frame_no} (byte {}): {v} is not finite",
+                self.name,
+                frame_no * self.frame as u64 + self.at as u64
+            ));
         }
         self.buf.copy_within(whole..have, 0);
         self.held = have - whole;
@@ -487,20 +475,10 @@ fn check_interval(dt: f64, median: f64) -> Result<(), String> {
     }
 }
 
-/// A WAV file's channel, through hound's sample iterator (which reads as it goes).
+/// A WAV file's channel ([`crate::wav::WavChannel`], read as it goes).
 struct WavSource {
-    samples: WavSamples,
-    /// Samples read (all channels), the channels, and the one wanted.
-    k: usize,
-    channels: usize,
-    column: usize,
-    rate_hz: f64,
+    channel: crate::wav::WavChannel,
     name: String,
-}
-
-enum WavSamples {
-    Int(hound::WavIntoSamples<std::io::BufReader<std::fs::File>, i32>),
-    Float(hound::WavIntoSamples<std::io::BufReader<std::fs::File>, f32>),
 }
 
 impl WavSource {
@@ -510,29 +488,10 @@ impl WavSource {
                 "{name}: a WAV file gives its own rate: no --rate or --time-column"
             ));
         }
-        let reader = hound::WavReader::open(&args.file)
-            .map_err(|e| format!("{name}: WAV: {}", crate::table::one_line(e)))?;
-        let spec = reader.spec();
-        if spec.sample_rate == 0 {
-            return Err(format!("{name}: WAV: sample rate 0 in the header"));
-        }
-        let channels = usize::from(spec.channels).max(1);
-        let column = crate::recording::numbered_column(
-            args.column.as_ref(),
-            channels,
-            "a WAV file's channels",
-        )
-        .map_err(|e| format!("{name}: {e}"))?;
-        let samples = match spec.sample_format {
-            hound::SampleFormat::Int => WavSamples::Int(reader.into_samples()),
-            hound::SampleFormat::Float => WavSamples::Float(reader.into_samples()),
-        };
+        let channel = crate::wav::WavChannel::open(&args.file, args.column.as_ref())
+            .map_err(|e| format!("{name}: {e}"))?;
         Ok(Self {
-            samples,
-            k: 0,
-            channels,
-            column,
-            rate_hz: f64::from(spec.sample_rate),
+            channel,
             name: name.to_string(),
         })
     }
@@ -540,46 +499,14 @@ impl WavSource {
 
 impl Source for WavSource {
     fn next_values(&mut self, want: usize, push: &mut dyn FnMut(f64)) -> Result<(), String> {
-        let mut pushed = 0;
-        while pushed < want.max(1) {
-            let next = match &mut self.samples {
-                WavSamples::Int(s) => s.next().map(|r| r.map(f64::from)),
-                WavSamples::Float(s) => s.next().map(|r| r.map(f64::from)),
-            };
-            let Some(sample) = next else { break };
-            let frame = self.k / self.channels;
-            let v = sample.map_err(|e| {
-                format!(
-                    "{}: WAV: frame {frame}: {}",
-                    self.name,
-                    crate::table::one_line(e)
-                )
-            })?;
-            if !v.is_finite() {
-                return Err(format!(
-                    "{}: WAV: frame {frame}: {v} is not finite",
-                    self.name
-                ));
-            }
-            if self.k % self.channels == self.column {
-                push(v);
-                pushed += 1;
-            }
-            self.k += 1;
+        for v in self.channel.by_ref().take(want.max(1)) {
+            push(v.map_err(|e| format!("{}: {e}", self.name))?);
         }
         Ok(())
     }
 
     fn rate_hz(&self) -> Result<f64, String> {
-        Ok(self.rate_hz)
-    }
-
-    fn final_rate_hz(&self) -> f64 {
-        self.rate_hz
-    }
-
-    fn t0(&self) -> f64 {
-        0.0
+        Ok(self.channel.rate_hz)
     }
 }
 
@@ -613,21 +540,9 @@ impl NpySource {
         }
         let (elements, shape, order) =
             crate::npy::open_elements(&args.file).map_err(|e| format!("{name}: {e}"))?;
-        let (rows, cols) = match shape[..] {
-            [n] => (n, 1),
-            [n, c] => (n, c),
-            _ => {
-                return Err(format!(
-                    "{name}: npy: shape {shape:?}; a 1-D array or 2-D (samples × channels)"
-                ))
-            }
-        };
-        let column = crate::recording::numbered_column(
-            args.column.as_ref(),
-            cols as usize,
-            "the array's columns",
-        )
-        .map_err(|e| format!("{name}: {e}"))? as u64;
+        let (rows, cols, column) =
+            crate::npy::layout(&shape, args.column.as_ref()).map_err(|e| format!("{name}: {e}"))?;
+        let column = column as u64;
         Ok(Self {
             elements,
             rows,
@@ -678,13 +593,5 @@ impl Source for NpySource {
 
     fn rate_hz(&self) -> Result<f64, String> {
         Ok(self.rate_hz)
-    }
-
-    fn final_rate_hz(&self) -> f64 {
-        self.rate_hz
-    }
-
-    fn t0(&self) -> f64 {
-        0.0
     }
 }

@@ -14,6 +14,91 @@ pub fn is_wav(path: &Path) -> bool {
         .is_some_and(|e| e.eq_ignore_ascii_case("wav"))
 }
 
+/// One channel of a WAV file, read as it is asked for (hound's sample iterator): each value,
+/// or an error naming the frame.
+pub struct WavChannel {
+    samples: Samples,
+    /// Samples read (all channels), the channels, the one wanted, and the frames the header
+    /// announces.
+    k: usize,
+    channels: usize,
+    column: usize,
+    frames: usize,
+    /// Bytes a sample takes in the file.
+    sample_bytes: usize,
+    /// Sample rate, Hz (never 0).
+    pub rate_hz: f64,
+}
+
+enum Samples {
+    Int(hound::WavIntoSamples<std::io::BufReader<std::fs::File>, i32>),
+    Float(hound::WavIntoSamples<std::io::BufReader<std::fs::File>, f32>),
+}
+
+impl WavChannel {
+    /// Opens `path` and chooses the channel `column` (0-based, default 0).
+    pub fn open(path: &Path, column: Option<&crate::recording::ColumnRef>) -> Result<Self, String> {
+        let reader = hound::WavReader::open(path).map_err(|e| format!("WAV: {}", one_line(e)))?;
+        let spec = reader.spec();
+        let channels = usize::from(spec.channels);
+        let column = numbered_column(column, channels, "a WAV file's channels")?;
+        if spec.sample_rate == 0 {
+            return Err("WAV: sample rate 0 in the header".into());
+        }
+        let frames = reader.duration() as usize;
+        let samples = match spec.sample_format {
+            hound::SampleFormat::Int => Samples::Int(reader.into_samples()),
+            hound::SampleFormat::Float => Samples::Float(reader.into_samples()),
+        };
+        Ok(Self {
+            samples,
+            k: 0,
+            channels: channels.max(1),
+            column,
+            frames,
+            sample_bytes: usize::from(spec.bits_per_sample.div_ceil(8)).max(1),
+            rate_hz: f64::from(spec.sample_rate),
+        })
+    }
+
+    /// Frames the header announces.
+    pub fn frames(&self) -> usize {
+        self.frames
+    }
+}
+
+impl Iterator for WavChannel {
+    type Item = Result<f64, String>;
+
+    fn next(&mut self) -> Option<Self::Item> {
+        loop {
+            let sample = match &mut self.samples {
+                Samples::Int(s) => s.next()?.map(f64::from),
+                Samples::Float(s) => s.next()?.map(f64::from),
+            };
+            let frame = self.k / self.channels;
+            let mine = self.k % self.channels == self.column;
+            self.k += 1;
+            let v = match sample {
+                Ok(v) => v,
+                Err(e) => {
+                    return Some(Err(format!(
+                        "WAV: frame {frame} (of {} the header announces): {}",
+                        self.frames,
+                        one_line(e)
+                    )))
+                }
+            };
+            if !v.is_finite() {
+                return Some(Err(format!("WAV: frame {frame}: {v} is not finite")));
+            }
+            if mine {
+                return Some(Ok(v));
+            }
+        }
+    }
+}
+
 /// Reads the channel `opts.column` (a 0-based index, default 0).
 pub fn read_wav(path: &Path, opts: &ReadOptions) -> Result<Channel, RecordingError> {
     let err = |message: String| RecordingError {
@@ -29,52 +114,15 @@ pub fn read_wav(path: &Path, opts: &ReadOptions) -> Result<Channel, RecordingErr
     if !opts.axes.is_empty() {
         return Err(err("--axes: not for WAV files yet; give --column".into()));
     }
-    let mut reader =
-        hound::WavReader::open(path).map_err(|e| err(format!("WAV: {}", one_line(e))))?;
-    let spec = reader.spec();
-    let channels = usize::from(spec.channels);
-    let column =
-        numbered_column(opts.column.as_ref(), channels, "a WAV file's channels").map_err(err)?;
-    let rate_hz = f64::from(spec.sample_rate);
-    if spec.sample_rate == 0 {
-        return Err(err("WAV: sample rate 0 in the header".into()));
-    }
-    let frames = reader.duration() as usize;
-    // Room for what the file can hold, whatever its header announces.
+    let channel = WavChannel::open(path, opts.column.as_ref()).map_err(err)?;
+    let rate_hz = channel.rate_hz;
+    let column = channel.column;
+    // The header's frame count, but never more than the file's bytes could hold.
     let file_bytes = std::fs::metadata(path).map_or(0, |m| m.len() as usize);
-    let frame_bytes = channels.max(1) * usize::from(spec.bits_per_sample.div_ceil(8)).max(1);
-    let mut values = Vec::with_capacity(frames.min(file_bytes / frame_bytes));
-    // A sample that cannot be read (a file cut short) is an error naming its frame.
-    let at = |k: usize, e: hound::Error| {
-        err(format!(
-            "WAV: frame {} (of {frames} the header announces): {}",
-            k / channels.max(1),
-            one_line(e)
-        ))
-    };
-    match spec.sample_format {
-        hound::SampleFormat::Int => {
-            for (k, s) in reader.samples::<i32>().enumerate() {
-                let s = s.map_err(|e| at(k, e))?;
-                if k % channels == column {
-                    values.push(f64::from(s));
-                }
-            }
-        }
-        hound::SampleFormat::Float => {
-            for (k, s) in reader.samples::<f32>().enumerate() {
-                let s = s.map_err(|e| at(k, e))?;
-                if !s.is_finite() {
-                    return Err(err(format!(
-                        "WAV: frame {}: {s} is not finite",
-                        k / channels
-                    )));
-                }
-                if k % channels == column {
-                    values.push(f64::from(s));
-                }
-            }
-        }
+    let frame_bytes = channel.channels * channel.sample_bytes;
+    let mut values = Vec::with_capacity(channel.frames().min(file_bytes / frame_bytes));
+    for v in channel {
+        values.push(v.map_err(err)?);
     }
     evenly_sampled(format!("channel {column}"), values, rate_hz)
         .map_err(|e| err(format!("WAV: {e}")))
