@@ -236,11 +236,9 @@ pub fn read_csv(path: &Path, opts: &ReadOptions) -> Result<Channel, RecordingErr
         message,
     };
     let table = read_table(path, &opts.format, opts.progress)?;
-    let tcol = if opts.rate_hz.is_some() && opts.time_column.is_none() {
-        None
-    } else {
-        table.time_column(opts.time_column.as_ref()).map_err(err)?
-    };
+    let tcol = table
+        .time_column_unless_rate(opts.rate_hz.is_some(), opts.time_column.as_ref())
+        .map_err(err)?;
     let name_of = |c: usize| {
         table
             .headers
@@ -249,12 +247,7 @@ pub fn read_csv(path: &Path, opts: &ReadOptions) -> Result<Channel, RecordingErr
             .unwrap_or_else(|| format!("column {c}"))
     };
     let cols: Vec<usize> = if opts.axes.is_empty() {
-        vec![match &opts.column {
-            Some(c) => table.find(c, "column").map_err(err)?,
-            None => (0..table.columns.len())
-                .find(|&c| Some(c) != tcol)
-                .ok_or_else(|| err("no data column besides the time column".into()))?,
-        }]
+        vec![table.channel(opts.column.as_ref(), tcol).map_err(err)?]
     } else {
         if !(2..=3).contains(&opts.axes.len()) {
             return Err(err(format!(

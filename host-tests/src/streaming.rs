@@ -318,17 +318,10 @@ impl CsvSource {
             None => return Err(err("no data rows".into())),
         };
         let shape = rows.shape();
-        let tcol = if args.rate.is_some() && args.time_column.is_none() {
-            None
-        } else {
-            shape.time_column(args.time_column.as_ref()).map_err(err)?
-        };
-        let channel = match &args.column {
-            Some(c) => shape.find(c, "column").map_err(err)?,
-            None => (0..shape.columns.len())
-                .find(|&c| Some(c) != tcol)
-                .ok_or_else(|| err("no data column besides the time column".into()))?,
-        };
+        let tcol = shape
+            .time_column_unless_rate(args.rate.is_some(), args.time_column.as_ref())
+            .map_err(err)?;
+        let channel = shape.channel(args.column.as_ref(), tcol).map_err(err)?;
         if Some(channel) == tcol {
             return Err(err(format!(
                 "column {channel} is the time column: choose another with --column"

@@ -570,6 +570,30 @@ impl Table {
         }
     }
 
+    /// The time column to read: none when a rate is given and no time column asked for,
+    /// else [`Self::time_column`].
+    pub fn time_column_unless_rate(
+        &self,
+        rate_given: bool,
+        asked: Option<&ColumnRef>,
+    ) -> Result<Option<usize>, String> {
+        if rate_given && asked.is_none() {
+            Ok(None)
+        } else {
+            self.time_column(asked)
+        }
+    }
+
+    /// The channel: the column asked for, or the first one that is not the time column.
+    pub fn channel(&self, asked: Option<&ColumnRef>, time: Option<usize>) -> Result<usize, String> {
+        match asked {
+            Some(c) => self.find(c, "column"),
+            None => (0..self.columns.len())
+                .find(|&c| Some(c) != time)
+                .ok_or_else(|| "no data column besides the time column".to_string()),
+        }
+    }
+
     /// The time column: the one asked for, or the one column whose header looks like a time
     /// (`time…`, `t`, `t_…`); several such columns without `--time-column` are an error naming
     /// them.
