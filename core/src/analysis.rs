@@ -117,7 +117,10 @@ pub fn analyse<const CAP: usize>(
 }
 
 /// The window from [`SPECTRUM_LEAD`] samples before the onset to the end of the capture, in
-/// m/s² above the baseline, and its spectra.
+/// m/s² above the baseline, and its spectra. Not inlined: the spectra's marks (some 4 KiB)
+/// stay out of the kinematics' stack frame, which they would push beyond the M4's short
+/// stack offsets.
+#[inline(never)]
 fn spectrum<const CAP: usize>(
     capture: &Capture<CAP>,
     scene: &Scene,

@@ -1093,11 +1093,9 @@ pub fn table(r: &M4Report) -> String {
         r.analysis_instructions as f64 / 125e6 * 1e3
     ));
     s.push_str(&format!(
-        "  shock spectra of the impact (SRS, PVSS, half-sine; 1/6 octave from 10 Hz): {} instructions ({:.1} ms at 125 M instructions/s); the issue's target {} is {} (not enforced: open)\n",
+        "  shock spectra of the impact (SRS, PVSS, half-sine; 1/6 octave from 10 Hz): {} instructions ({:.1} ms at 125 M instructions/s)\n",
         r.spectrum_instructions,
         r.spectrum_instructions as f64 / 125e6 * 1e3,
-        SPECTRUM_TARGET,
-        if r.spectrum_instructions <= SPECTRUM_TARGET { "met" } else { "MISSED" }
     ));
     for (name, now, target) in targets(r) {
         s.push_str(&format!(
@@ -1255,6 +1253,11 @@ fn targets(r: &M4Report) -> Vec<(&'static str, u64, u64)> {
             r.analysis_instructions,
             ANALYSIS_TARGET,
         ),
+        (
+            "shock spectra (1/6 octave)",
+            r.spectrum_instructions,
+            SPECTRUM_TARGET,
+        ),
     ]
 }
 
@@ -1364,6 +1367,9 @@ mod tests {
         r.fits[0].instructions = EXPONENT_FIT_TARGET;
         assert!(check(&r, &base).is_ok());
         r.analysis_instructions = ANALYSIS_TARGET + 1;
+        assert!(check(&r, &base).is_err());
+        r.analysis_instructions = ANALYSIS_TARGET;
+        r.spectrum_instructions = SPECTRUM_TARGET + 1;
         assert!(check(&r, &base).is_err());
     }
 }

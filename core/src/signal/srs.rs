@@ -108,6 +108,31 @@ impl<R: Real> Oscillator<R> {
     }
 }
 
+/// `sin x` and `cos x` by their Taylor series for `|x| <= 2` (libm's otherwise), summed until a
+/// term no longer changes either sum: as accurate as `R` holds them there, and on the M4 some
+/// 150 instructions where libm's `sinf` takes 1 250 (it works in software `f64`).
+pub fn sin_cos<R: Real>(x: R) -> (R, R) {
+    if !(x.abs() <= R::TWO) {
+        return (x.sin(), x.cos());
+    }
+    let x2 = x * x;
+    let (mut sin, mut cos) = (x, R::ONE);
+    // x^(2k+1) / (2k+1)! and x^(2k) / (2k)!, signs alternating.
+    let (mut s_term, mut c_term) = (x, R::ONE);
+    let mut n = R::ZERO;
+    for _ in 0..16 {
+        c_term = -c_term * x2 / ((n + R::ONE) * (n + R::TWO));
+        s_term = -s_term * x2 / ((n + R::TWO) * (n + R::TWO + R::ONE));
+        n += R::TWO;
+        let (next_sin, next_cos) = (sin + s_term, cos + c_term);
+        if next_sin == sin && next_cos == cos {
+            break;
+        }
+        (sin, cos) = (next_sin, next_cos);
+    }
+    (sin, cos)
+}
+
 /// What both responses' oscillators share: the poles of one band at one rate.
 #[derive(Clone, Copy)]
 struct Poles<R> {
@@ -145,7 +170,9 @@ impl<R: Real> Poles<R> {
         let big_a = damping * w * t;
         let s = (R::ONE - damping * damping).sqrt();
         let big_b = w * t * s;
-        let psi = (-big_a / big_b).atan();
+        let ratio = -big_a / big_b;
+        let psi = ratio.atan();
+        let (sin_b, cos_b) = sin_cos(big_b);
         Some(Self {
             damping,
             wt: w * t,
@@ -154,12 +181,13 @@ impl<R: Real> Poles<R> {
             s,
             e: (-big_a).exp(),
             e2: (-R::TWO * big_a).exp(),
-            sin_b: big_b.sin(),
-            cos_b: big_b.cos(),
+            sin_b,
+            cos_b,
             t,
             w,
             psi,
-            cos_psi: psi.cos().abs(),
+            // cos(atan y) = 1 / sqrt(1 + y²).
+            cos_psi: R::ONE / (R::ONE + ratio * ratio).sqrt(),
         })
     }
 
@@ -250,12 +278,17 @@ pub struct HalfSine {
 /// `2π max(f PVSS)`, duration `max(PVSS) / (4 k(ζ) max(f PVSS))` with `k(ζ)` the damped
 /// oscillator's low-frequency PVSS attenuation. `None` for an empty or zero spectrum.
 pub fn enveloping_half_sine(freqs_hz: &[f64], pvss: &[f64], damping: f64) -> Option<HalfSine> {
-    let max_pvss = pvss.iter().copied().fold(0.0, f64::max);
-    let max_f_pvss = freqs_hz
-        .iter()
-        .zip(pvss)
-        .map(|(f, v)| f * v)
-        .fold(0.0, f64::max);
+    enveloping_half_sine_of(freqs_hz.iter().copied().zip(pvss.iter().copied()), damping)
+}
+
+/// [`enveloping_half_sine`] of `(frequency, PVSS)` pairs.
+pub fn enveloping_half_sine_of(
+    bands: impl Iterator<Item = (f64, f64)>,
+    damping: f64,
+) -> Option<HalfSine> {
+    let (max_pvss, max_f_pvss) = bands.fold((0.0f64, 0.0f64), |(m, mf), (f, v)| {
+        (m.max(v), mf.max(f * v))
+    });
     if !(max_pvss > 0.0 && max_f_pvss > 0.0) {
         return None;
     }
@@ -285,6 +318,24 @@ mod tests {
     fn fourier(amp: f64, dur: f64, w: f64) -> f64 {
         let p = PI / dur;
         2.0 * amp * p * libm::fabs(libm::cos(w * dur / 2.0)) / libm::fabs(p * p - w * w)
+    }
+
+    #[test]
+    fn the_series_sine_and_cosine_match_libm() {
+        let mut x = -2.0f64;
+        while x <= 2.0 {
+            let (s, c) = sin_cos(x);
+            assert!((s - libm::sin(x)).abs() < 4e-16 && (c - libm::cos(x)).abs() < 4e-16);
+            let (s, c) = sin_cos(x as f32);
+            let (ws, wc) = (libm::sinf(x as f32), libm::cosf(x as f32));
+            assert!(
+                (s - ws).abs() < 4e-7 && (c - wc).abs() < 4e-7,
+                "{x}: {s} {c}"
+            );
+            x += 0.01;
+        }
+        // Beyond the series' range: libm's.
+        assert_eq!(sin_cos(3.0f64), (libm::sin(3.0), libm::cos(3.0)));
     }
 
     #[test]
