@@ -5,6 +5,7 @@ pub mod analyze;
 pub mod axes;
 pub mod cases;
 pub mod compare;
+pub mod csv_fast;
 pub mod decode;
 pub mod emulate;
 pub mod log;

@@ -5,7 +5,9 @@
 //! (units, gain, quantisation to counts at the `--range` full scale), so with the same
 //! levels both give the same reports (tested); what needs the whole signal is refused or
 //! asked for instead: the quantisation's full scale (`--range`), the trigger level
-//! (`--trigger`), spike screening (not done), figures, axes, free fall, resampling.
+//! (`--trigger`), spike screening (not done), figures, axes, free fall, resampling. A
+//! reader thread reads and quantises ahead of the monitor; a CSV file's plain rows past the
+//! head are parsed in parallel ([`crate::csv_fast`]).
 
 use std::io::Read;
 
@@ -83,10 +85,13 @@ pub fn analyze(
     let mut head = Vec::with_capacity(HEAD);
     while head.len() < HEAD {
         let before = head.len();
-        source.next_values(HEAD - head.len(), &mut |v| head.push(v * scale))?;
+        source.next_values(HEAD - head.len(), &mut head)?;
         if head.len() == before {
             break;
         }
+    }
+    for v in &mut head {
+        *v *= scale;
     }
     source.head_read()?;
     let rate_hz = source.rate_hz()?;
@@ -108,22 +113,51 @@ pub fn analyze(
         mass,
     )?;
     let (reports, count, source) = crate::on_big_stack(move || {
+        // A reader thread reads, decodes and quantises the values ahead (a few chunks,
+        // so memory stays bounded) while this one runs the monitor.
+        let (tx, rx) = std::sync::mpsc::sync_channel::<Result<Vec<i16>, String>>(4);
+        let (back, spare) = std::sync::mpsc::channel::<Vec<i16>>();
+        let reader = std::thread::spawn(move || {
+            let mut scratch = Vec::with_capacity(CHUNK);
+            loop {
+                let mut counts = spare.try_recv().unwrap_or_default();
+                counts.clear();
+                if let Err(e) = source.next_counts(CHUNK, (scale, gain), &mut scratch, &mut counts)
+                {
+                    let _ = tx.send(Err(e));
+                    break;
+                }
+                if counts.is_empty() || tx.send(Ok(counts)).is_err() {
+                    break;
+                }
+            }
+            source
+        });
         let mut m = HostMonitor::new(scene).map_err(|e| e.to_string())?;
         let mut out = Vec::new();
-        let mut counts: Vec<i16> = head.iter().map(|a| analyze::to_count(*a, gain)).collect();
+        let head: Vec<i16> = head.iter().map(|a| analyze::to_count(*a, gain)).collect();
         let mut total = 0u64;
-        loop {
+        let mut failed = None;
+        for counts in std::iter::once(Ok(head)).chain(rx.iter()) {
+            let counts = match counts {
+                Ok(c) => c,
+                Err(e) => {
+                    failed = Some(e);
+                    break;
+                }
+            };
             for block in counts.chunks(256) {
                 m.push_block(block, &mut |r: &ImpactReport| out.push(*r));
             }
             total += counts.len() as u64;
-            counts.clear();
-            source.next_values(CHUNK, &mut |v| {
-                counts.push(analyze::to_count(v * scale, gain))
-            })?;
-            if counts.is_empty() {
-                break;
-            }
+            let _ = back.send(counts);
+        }
+        drop(rx);
+        let source = reader
+            .join()
+            .map_err(|_| "the reader thread panicked".to_string())?;
+        if let Some(e) = failed {
+            return Err(e);
         }
         m.finish(&mut |r: &ImpactReport| out.push(*r));
         if !m.is_armed() {
@@ -153,8 +187,22 @@ pub fn analyze(
 
 /// Where the stream's values come from.
 trait Source: Send {
-    /// Hands up to about `want` values to `push` (none at the end of the input).
-    fn next_values(&mut self, want: usize, push: &mut dyn FnMut(f64)) -> Result<(), String>;
+    /// Appends up to about `want` values to `out` (none at the end of the input).
+    fn next_values(&mut self, want: usize, out: &mut Vec<f64>) -> Result<(), String>;
+    /// Appends up to about `want` values to `out` as counts (`to_count(v × scale, gain)`),
+    /// through `scratch`.
+    fn next_counts(
+        &mut self,
+        want: usize,
+        (scale, gain): (f64, f64),
+        scratch: &mut Vec<f64>,
+        out: &mut Vec<i16>,
+    ) -> Result<(), String> {
+        scratch.clear();
+        self.next_values(want, scratch)?;
+        out.extend(scratch.iter().map(|v| analyze::to_count(v * scale, gain)));
+        Ok(())
+    }
     /// The head has been read: what it tells (a CSV's rate) is fixed, and checked.
     fn head_read(&mut self) -> Result<(), String> {
         Ok(())
@@ -186,6 +234,8 @@ struct RawSource {
     read: u64,
     name: String,
     rate_hz: f64,
+    /// For 16-bit codes: each code's count at `(scale, gain)`.
+    table: Option<((f64, f64), Vec<i16>)>,
 }
 
 impl RawSource {
@@ -223,6 +273,7 @@ impl RawSource {
             read: 0,
             name: name.to_string(),
             rate_hz,
+            table: None,
         })
     }
 }
@@ -232,9 +283,57 @@ impl Source for RawSource {
         Ok(self.rate_hz)
     }
 
-    fn next_values(&mut self, want: usize, push: &mut dyn FnMut(f64)) -> Result<(), String> {
-        // At most `want` frames (the head stops at exactly HEAD samples whatever a pipe's
-        // reads return), at least one whole frame's room.
+    fn next_values(&mut self, want: usize, out: &mut Vec<f64>) -> Result<(), String> {
+        let (kind, frame, at) = (self.kind, self.frame, self.at);
+        self.next_with(want, |bytes| kind.decode(bytes, frame, at, |v| out.push(v)))
+    }
+
+    /// 16-bit codes through a table of the 65 536 codes' counts (the same arithmetic, once
+    /// per code).
+    fn next_counts(
+        &mut self,
+        want: usize,
+        (scale, gain): (f64, f64),
+        scratch: &mut Vec<f64>,
+        out: &mut Vec<i16>,
+    ) -> Result<(), String> {
+        if self.kind != RawType::I16 {
+            scratch.clear();
+            self.next_values(want, scratch)?;
+            out.extend(scratch.iter().map(|v| analyze::to_count(v * scale, gain)));
+            return Ok(());
+        }
+        let table = match self.table.take() {
+            Some(t) if t.0 == (scale, gain) => t,
+            _ => {
+                let counts = (0..=u16::MAX)
+                    .map(|c| analyze::to_count(f64::from(c as i16) * scale, gain))
+                    .collect();
+                ((scale, gain), counts)
+            }
+        };
+        let (frame, at) = (self.frame, self.at);
+        let result = self.next_with(want, |bytes| {
+            out.extend(bytes.chunks_exact(frame).map(|f| {
+                let code = u16::from_le_bytes([f[at], f[at + 1]]);
+                table.1.get(usize::from(code)).copied().unwrap_or(0)
+            }));
+            Ok(())
+        });
+        self.table = Some(table);
+        result
+    }
+}
+
+impl RawSource {
+    /// Reads at most `want` frames (the head stops at exactly HEAD samples whatever a pipe's
+    /// reads return), at least one whole frame's room, and hands the whole frames to
+    /// `decode`.
+    fn next_with(
+        &mut self,
+        want: usize,
+        decode: impl FnOnce(&[u8]) -> Result<(), (usize, f32)>,
+    ) -> Result<(), String> {
         let end = (self.held + want.max(1) * self.frame).min(self.buf.len());
         let n = loop {
             match self.input.read(&mut self.buf[self.held..end]) {
@@ -258,10 +357,7 @@ impl Source for RawSource {
         self.read += n as u64;
         let have = self.held + n;
         let whole = have / self.frame * self.frame;
-        if let Err((k, v)) = self
-            .kind
-            .decode(&self.buf[..whole], self.frame, self.at, push)
-        {
+        if let Err((k, v)) = decode(&self.buf[..whole]) {
             let frame_no = (self.read - have as u64) / self.frame as u64 + k as u64;
             return Err(format!(
                 "{}: frame {frame_no} (byte {}): {v} is not finite",
@@ -296,7 +392,20 @@ struct CsvSource {
     head_rate: Option<f64>,
     /// The first row's value, read while resolving the columns and not yet handed on.
     pending: Option<f64>,
+    /// A regular file's path and size (stdin and pipes are read in one pass); the parallel
+    /// fast path once the head is read, and rows read since the sequential reader last took
+    /// over (it hands back after [`RESUME_FAST_AFTER`] rows).
+    file: Option<(std::path::PathBuf, u64)>,
+    fast: Option<crate::csv_fast::FastRows>,
+    head_done: bool,
+    ended: bool,
+    sequential: usize,
+    progress: Option<fn(f64)>,
 }
+
+/// Rows the sequential reader takes after a line the fast path could not, before the fast
+/// path goes on.
+const RESUME_FAST_AFTER: usize = 4096;
 
 impl CsvSource {
     fn open(args: &AnalyzeArgs, progress: Option<fn(f64)>) -> Result<Self, String> {
@@ -357,6 +466,15 @@ impl CsvSource {
             median_dt: None,
             head_rate: None,
             pending: None,
+            file: std::fs::metadata(&args.file)
+                .ok()
+                .filter(|m| m.is_file() && !is_stdin(&args.file))
+                .map(|m| (args.file.clone(), m.len())),
+            fast: None,
+            head_done: false,
+            ended: false,
+            sequential: RESUME_FAST_AFTER,
+            progress,
         };
         source.pending = Some(source.take(line, &first)?);
         Ok(source)
@@ -365,8 +483,14 @@ impl CsvSource {
     /// Checks the time of row `line` and returns its channel's value.
     fn take(&mut self, line: u64, row: &[f64]) -> Result<f64, String> {
         let value = row.get(self.channel).copied().unwrap_or(0.0);
-        if let Some((c, unit)) = self.time {
-            let t = row.get(c).copied().unwrap_or(0.0) * unit;
+        let time = self.time.map(|(c, _)| row.get(c).copied().unwrap_or(0.0));
+        self.take_values(line, value, time.unwrap_or(0.0))
+    }
+
+    /// [`CsvSource::take`] of a row's channel value and time column's value.
+    fn take_values(&mut self, line: u64, value: f64, time: f64) -> Result<f64, String> {
+        if let Some((_, unit)) = self.time {
+            let t = time * unit;
             if self.t0.is_none() {
                 self.t0 = Some(t);
             } else {
@@ -391,10 +515,62 @@ impl CsvSource {
 }
 
 impl Source for CsvSource {
-    fn next_values(&mut self, want: usize, push: &mut dyn FnMut(f64)) -> Result<(), String> {
+    fn next_values(&mut self, want: usize, out: &mut Vec<f64>) -> Result<(), String> {
+        if self.ended {
+            return Ok(());
+        }
+        // Past the head, a file's plain rows go through the parallel fast path.
+        if self.head_done && self.fast.is_none() && self.sequential >= RESUME_FAST_AFTER {
+            if let Some((path, size)) = &self.file {
+                let (byte, line) = self.rows.position();
+                let (delimiter, format) = self.rows.format();
+                let layout = crate::csv_fast::Layout {
+                    columns: self.rows.columns,
+                    channel: self.channel,
+                    time: self.time.map(|(c, _)| c),
+                    delimiter,
+                    decimal_comma: format.decimal_comma,
+                    time_unit_s: self.time.map_or(1.0, |(_, unit)| unit),
+                    median_dt: self.median_dt,
+                };
+                let progress = self.progress.map(|p| (p, *size));
+                self.fast = Some(
+                    crate::csv_fast::FastRows::start(path, byte, line, layout, progress)
+                        .map_err(|e| format!("{}: {e}", self.name))?,
+                );
+            }
+        }
+        if let Some(fast) = &mut self.fast {
+            let Some(chunk) = fast.next_chunk() else {
+                self.fast = None;
+                self.ended = true;
+                return Ok(());
+            };
+            out.reserve(chunk.rows.len());
+            // The first row follows the previous chunk's last: checked here; the others the
+            // worker checked against the row before them.
+            if let Some(&(value, time)) = chunk.rows.first() {
+                out.push(self.take_values(chunk.line, value, time)?);
+            }
+            let unit = self.time.map(|(_, unit)| unit);
+            for &(value, time) in chunk.rows.iter().skip(1) {
+                if let Some(unit) = unit {
+                    self.last = time * unit;
+                }
+                out.push(value);
+            }
+            self.n += chunk.rows.len().saturating_sub(1) as u64;
+            if let Some((byte, line)) = chunk.stop {
+                // The sequential reader from the line the fast path could not take.
+                self.fast = None;
+                self.rows = self.rows.resume(byte, line).map_err(|e| e.to_string())?;
+                self.sequential = 0;
+            }
+            return Ok(());
+        }
         let mut left = want.max(1);
         if let Some(v) = self.pending.take() {
-            push(v);
+            out.push(v);
             left -= 1;
         }
         let mut row = Vec::new();
@@ -405,12 +581,14 @@ impl Source for CsvSource {
             row.clear();
             row.extend_from_slice(r);
             let v = self.take(line, &row)?;
-            push(v);
+            out.push(v);
+            self.sequential += 1;
         }
         Ok(())
     }
 
     fn head_read(&mut self) -> Result<(), String> {
+        self.head_done = true;
         if self.head_dts.is_empty() {
             return Ok(());
         }
@@ -455,7 +633,7 @@ impl Source for CsvSource {
 }
 
 /// An interval `dt` within [`crate::recording::INTERVAL_RANGE`] times the median `median`.
-fn check_interval(dt: f64, median: f64) -> Result<(), String> {
+pub(crate) fn check_interval(dt: f64, median: f64) -> Result<(), String> {
     let ratio = dt / median;
     if crate::recording::INTERVAL_RANGE.contains(&ratio) {
         Ok(())
@@ -491,9 +669,9 @@ impl WavSource {
 }
 
 impl Source for WavSource {
-    fn next_values(&mut self, want: usize, push: &mut dyn FnMut(f64)) -> Result<(), String> {
+    fn next_values(&mut self, want: usize, out: &mut Vec<f64>) -> Result<(), String> {
         for v in self.channel.by_ref().take(want.max(1)) {
-            push(v.map_err(|e| format!("{}: {e}", self.name))?);
+            out.push(v.map_err(|e| format!("{}: {e}", self.name))?);
         }
         Ok(())
     }
@@ -551,7 +729,7 @@ impl NpySource {
 }
 
 impl Source for NpySource {
-    fn next_values(&mut self, want: usize, push: &mut dyn FnMut(f64)) -> Result<(), String> {
+    fn next_values(&mut self, want: usize, out: &mut Vec<f64>) -> Result<(), String> {
         let mut pushed = 0;
         while pushed < want.max(1) && self.given < self.rows {
             let Some(element) = self.elements.next() else {
@@ -576,7 +754,7 @@ impl Source for NpySource {
                         self.name, self.given
                     ));
                 }
-                push(v);
+                out.push(v);
                 pushed += 1;
                 self.given += 1;
             }

@@ -246,7 +246,7 @@ fn sniff_delimiter(head: &[u8]) -> u8 {
 }
 
 /// A decimal number (`1.5e-3`, `-2`, `.5`; also `NaN` and `inf`, refused by the caller).
-fn parse_number(field: &[u8]) -> Option<f64> {
+pub(crate) fn parse_number(field: &[u8]) -> Option<f64> {
     match field.first() {
         // fast-float2 reads a leading `+` as std does.
         Some(_) => fast_float2::parse::<f64, _>(field).ok(),
@@ -288,6 +288,10 @@ pub struct Rows {
     pub columns: usize,
     /// Line of the first data row.
     pub first_data_line: u64,
+    /// Lines before the first one read (a reader resumed mid-file), and the file's bytes
+    /// before the first one read (a byte-order mark, or a resumed reader's start).
+    line_offset: u64,
+    skip: u64,
     progress: Option<fn(f64)>,
     size: Option<u64>,
     step: Option<u64>,
@@ -321,8 +325,22 @@ impl Rows {
                 "--decimal-comma: the delimiter is ',' too; give --delimiter (e.g. ';')".into(),
             ));
         }
+        let mut rows = Self::build(path, format, delimiter, buffered, size, progress);
+        rows.skip = if bom { 3 } else { 0 };
+        Ok(rows)
+    }
+
+    /// The reader over `input` (past any byte-order mark) with `delimiter`.
+    fn build(
+        path: &Path,
+        format: &CsvFormat,
+        delimiter: u8,
+        input: BufReader<Box<dyn Read + Send>>,
+        size: Option<u64>,
+        progress: Option<fn(f64)>,
+    ) -> Self {
         let limited = RecordLimit {
-            inner: buffered,
+            inner: input,
             delimiter,
             since_break: 0,
             quote: Quote::Outside,
@@ -341,7 +359,7 @@ impl Rows {
             .buffer_capacity(1 << 16)
             .from_reader(limited);
         let step = size.map(|s| (s / 20).max(1));
-        Ok(Self {
+        Self {
             path: path.to_path_buf(),
             format: *format,
             delimiter,
@@ -354,11 +372,57 @@ impl Rows {
             header_line: 0,
             columns: 0,
             first_data_line: 0,
+            line_offset: 0,
+            skip: 0,
             progress,
             size,
             step,
             next_progress: step.unwrap_or(u64::MAX),
-        })
+        }
+    }
+
+    /// The same table read again from byte `byte` of the file, the start of line `line`,
+    /// past its header and first data row (so what it reads there reads as it would have
+    /// in one pass).
+    pub fn resume(&self, byte: u64, line: u64) -> Result<Self, RecordingError> {
+        use std::io::{Seek, SeekFrom};
+        let err = |message: String| self.err(Some(line), message);
+        let mut file = File::open(&self.path).map_err(|e| err(e.to_string()))?;
+        file.seek(SeekFrom::Start(byte))
+            .map_err(|e| err(e.to_string()))?;
+        let input: Box<dyn Read + Send> = Box::new(file);
+        let mut rows = Self::build(
+            &self.path,
+            &self.format,
+            self.delimiter,
+            BufReader::with_capacity(1 << 16, input),
+            None,
+            None,
+        );
+        rows.headers = self.headers.clone();
+        rows.header_fields = self.header_fields;
+        rows.header_line = self.header_line;
+        rows.columns = self.columns;
+        rows.first_data_line = self.first_data_line;
+        rows.line_offset = line.saturating_sub(1);
+        rows.skip = byte;
+        Ok(rows)
+    }
+
+    /// The byte of the file and the line the next row starts on.
+    pub fn position(&self) -> (u64, u64) {
+        let p = self.reader.position();
+        (p.byte() + self.skip, p.line() + self.line_offset)
+    }
+
+    /// The delimiter and the format.
+    pub fn format(&self) -> (u8, CsvFormat) {
+        (self.delimiter, self.format)
+    }
+
+    /// Columns per data row, the field counts a header allows, for the fast path.
+    pub fn header_fields(&self) -> usize {
+        self.header_fields
     }
 
     /// The file read (`-` for stdin).
@@ -403,7 +467,7 @@ impl Rows {
                 .iter()
                 .filter(|&&b| b == b'\n')
                 .count() as u64;
-            let lineno = self.reader.position().line() - breaks - 1;
+            let lineno = self.reader.position().line() - breaks - 1 + self.line_offset;
             if let (Some(p), Some(size)) = (self.progress, self.size) {
                 let read = self.reader.get_ref().read;
                 if read >= self.next_progress {

@@ -214,6 +214,7 @@ pub fn throughput(
     }
     let (analyze, formats, peers) = analyze_files(
         &stream[..csv_rows.min(stream.len())],
+        &stream,
         impacts,
         samples,
         analyze_exe,
@@ -308,10 +309,12 @@ fn peer(code: &str, path: &std::path::Path) -> Option<f64> {
     String::from_utf8_lossy(&out.stdout).trim().parse().ok()
 }
 
-/// `impact analyze` on the counts written as CSV (whole and `--stream`) and as raw i16
-/// (`--stream`), and the peers reading the same files.
+/// `impact analyze` on `counts` written as CSV (whole and `--stream`) and on the `long`
+/// stream as raw i16 (`--stream`; long enough that starting the process does not count),
+/// and the peers reading the same files.
 fn analyze_files(
     counts: &[i16],
+    long: &[i16],
     impacts: usize,
     samples: usize,
     exe: &std::path::Path,
@@ -343,11 +346,11 @@ fn analyze_files(
         }
         w.flush().map_err(|e| e.to_string())?;
         drop(w);
-        let bytes: Vec<u8> = counts.iter().flat_map(|c| c.to_le_bytes()).collect();
+        let bytes: Vec<u8> = long.iter().flat_map(|c| c.to_le_bytes()).collect();
         std::fs::write(&raw, bytes).map_err(|e| format!("{}: {e}", raw.display()))?;
         let size = |p: &std::path::Path| std::fs::metadata(p).map(|m| m.len()).unwrap_or(0);
-        let expected = (impacts as u64 * counts.len() as u64) / samples.max(1) as u64;
-        let check = |out: &str| -> Result<u64, String> {
+        let check = |out: &str, rows: usize| -> Result<u64, String> {
+            let expected = (impacts as u64 * rows as u64) / samples.max(1) as u64;
             let v: serde_json::Value =
                 serde_json::from_str(out).map_err(|e| format!("analyze JSON: {e}"))?;
             let reported = v["impacts"].as_array().map_or(0, |a| a.len()) as u64;
@@ -401,7 +404,12 @@ fn analyze_files(
         let mut formats = Vec::new();
         for (format, stream, args) in runs {
             let (out, seconds, peak) = run_child(exe, &args)?;
-            let reported = check(&out)?;
+            let rows = if format == "csv" {
+                counts.len()
+            } else {
+                long.len()
+            };
+            let reported = check(&out, rows)?;
             let bytes = if format == "csv" {
                 size(&csv)
             } else {
@@ -424,7 +432,7 @@ fn analyze_files(
                 bytes,
                 seconds,
                 megabytes_per_second: bytes as f64 / 1e6 / seconds,
-                samples_per_second: counts.len() as f64 / seconds,
+                samples_per_second: rows as f64 / seconds,
                 peak_rss_mib: peak,
             });
         }

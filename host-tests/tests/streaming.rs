@@ -330,3 +330,89 @@ fn a_stream_longer_than_memory_is_analysed_in_bounded_memory() {
     eprintln!("2^30 samples streamed, {rows} impacts, peak memory {peak_mib:.1} MiB");
     assert!(peak_mib < 64.0, "peak memory {peak_mib:.1} MiB");
 }
+
+/// Past its head (65 536 rows) a CSV file's plain rows are parsed in parallel; quoted fields,
+/// blank lines, `\r\n` and spaces hand over to the sequential reader for a while, and errors
+/// read as in one pass: the same reports as the whole-file path, the same messages and lines.
+#[test]
+fn a_long_csv_file_gives_the_same_reports_and_errors_through_the_parallel_reader() {
+    let (csv, _) = impact(
+        &["synth"]
+            .into_iter()
+            .chain(impact_host::synth::SEED_BENCH_ARGS)
+            .chain(["--touch", "0.3", "--duration", "0.6"])
+            .collect::<Vec<_>>(),
+    );
+    let lines: Vec<String> = csv.lines().map(str::to_owned).collect();
+    assert!(lines.len() > 290_000, "{}", lines.len());
+    let levels = [
+        "--range",
+        "163",
+        "--trigger",
+        "10",
+        "--edge",
+        "2",
+        "--mass",
+        "0.06",
+        "--v0",
+        "1.3357",
+    ];
+    let run = |file: &str, tail: &[&str]| {
+        let v: Vec<&str> = ["analyze", file]
+            .into_iter()
+            .chain(levels)
+            .chain(tail.iter().copied())
+            .collect();
+        common::impact(&v)
+    };
+    let write = |name: &str, lines: &[String]| {
+        let path = tmp(name);
+        std::fs::write(&path, lines.join("\n") + "\n").unwrap();
+        path
+    };
+    let plain = write("long.csv", &lines);
+    let whole = run(&plain, &["--json", "--keep-spikes"]);
+    assert_eq!(whole.0, 0, "{}", whole.2);
+    let v: serde_json::Value = serde_json::from_str(&whole.1).unwrap();
+    assert!(v["impacts"][0]["cor"].is_number(), "{v}");
+    assert_eq!(run(&plain, &["--json", "--stream"]).1, whole.1);
+
+    // Quoted fields, a blank line, `\r\n` and spaces past the head.
+    let mut odd = lines.clone();
+    for (at, how) in [
+        (100_000, 0),
+        (100_001, 1),
+        (150_000, 2),
+        (150_100, 3),
+        (200_000, 0),
+    ] {
+        let (t, a) = odd[at].split_once(',').unwrap();
+        odd[at] = match how {
+            0 => format!("\"{t}\",\"{a}\""),
+            1 => format!("{t},{a}\r"),
+            2 => format!(" {t} , {a}"),
+            _ => format!("{t},{a}\n"),
+        };
+    }
+    let odd = write("odd.csv", &odd);
+    let whole_odd = run(&odd, &["--json", "--keep-spikes"]);
+    assert_eq!(whole_odd.1, whole.1);
+    assert_eq!(run(&odd, &["--json", "--stream"]).1, whole.1);
+
+    // A text field and a gap, far past the head: the whole-file reader's message and line.
+    let mut text = lines.clone();
+    text[250_000] = text[250_000].replace(',', ",x");
+    let text = write("text.csv", &text);
+    let (code, _, err) = run(&text, &["--stream"]);
+    let (_, _, whole_err) = run(&text, &[]);
+    assert!(code != 0 && err.contains(":250001: not a number"), "{err}");
+    assert_eq!(err, whole_err);
+    let mut gap = lines.clone();
+    gap.remove(240_000);
+    let gap = write("gap-long.csv", &gap);
+    let (code, _, err) = run(&gap, &["--stream"]);
+    assert!(
+        code != 0 && err.contains("line 240001") && err.contains("uneven time axis"),
+        "{err}"
+    );
+}

@@ -1,0 +1,433 @@
+//! The parallel fast path of a streamed CSV file's data rows: 1 MiB chunks cut at line ends,
+//! parsed on worker threads and handed on in order. It takes plain rows only (numbers and
+//! delimiters with white space around them, no quotes, no blank lines, the table's number of
+//! fields); at the first line it cannot take plainly it stops, and the sequential reader
+//! ([`crate::table::Rows::resume`]) goes on from that line, so every error and edge case
+//! reads as in one pass.
+
+use std::collections::BTreeMap;
+use std::fs::File;
+use std::io::{Read, Seek, SeekFrom};
+use std::path::Path;
+use std::sync::mpsc::{sync_channel, Receiver};
+use std::sync::{Arc, Mutex};
+use std::thread::JoinHandle;
+
+use crate::table::{parse_number, MAX_LINE_BYTES, MAX_VALUE};
+
+/// Bytes a chunk holds (up to the last line end in them).
+const CHUNK: usize = 1 << 20;
+
+/// Which fields a row has and which of them are wanted; the time column's unit (s) and the
+/// head's median interval, which every interval is checked against.
+#[derive(Clone, Copy, Debug)]
+pub struct Layout {
+    pub columns: usize,
+    pub channel: usize,
+    pub time: Option<usize>,
+    pub delimiter: u8,
+    pub decimal_comma: bool,
+    pub time_unit_s: f64,
+    pub median_dt: Option<f64>,
+}
+
+/// One chunk's rows, in order, one a line (a chunk with a blank line stops there).
+pub struct Parsed {
+    /// The chunk's first line.
+    pub line: u64,
+    /// Per row: the channel's value and the time column's (0 without one).
+    pub rows: Vec<(f64, f64)>,
+    /// Where plain rows stopped, if they did: the file's byte and the line to resume at.
+    pub stop: Option<(u64, u64)>,
+}
+
+/// A chunk for a worker: its order, the file's byte it starts at, its bytes (`None`: a line
+/// longer than the sequential reader accepts, or a read error, starts here).
+struct Job {
+    seq: u64,
+    byte: u64,
+    bytes: Option<Vec<u8>>,
+}
+
+/// The chunks of a file from a byte and line on, parsed ahead by worker threads (a few
+/// chunks in flight, so memory stays bounded).
+pub struct FastRows {
+    results: Option<Receiver<(u64, Parsed)>>,
+    pending: BTreeMap<u64, Parsed>,
+    next: u64,
+    /// The next chunk's first line.
+    line: u64,
+    threads: Vec<JoinHandle<()>>,
+}
+
+impl FastRows {
+    /// Starts reading `path` at `byte` (the start of line `line`); `progress` gets the
+    /// fraction of `size` read.
+    pub fn start(
+        path: &Path,
+        byte: u64,
+        line: u64,
+        layout: Layout,
+        progress: Option<(fn(f64), u64)>,
+    ) -> std::io::Result<Self> {
+        let mut file = File::open(path)?;
+        file.seek(SeekFrom::Start(byte))?;
+        let workers = std::thread::available_parallelism().map_or(2, |n| n.get().clamp(1, 4));
+        let (job_tx, job_rx) = sync_channel::<Job>(2 * workers);
+        let (result_tx, result_rx) = sync_channel::<(u64, Parsed)>(2 * workers);
+        let jobs = Arc::new(Mutex::new(job_rx));
+        let mut threads = Vec::new();
+        for _ in 0..workers {
+            let (jobs, results) = (Arc::clone(&jobs), result_tx.clone());
+            threads.push(std::thread::spawn(move || loop {
+                let job = match jobs.lock() {
+                    Ok(rx) => rx.recv(),
+                    Err(_) => return,
+                };
+                let Ok(job) = job else { return };
+                let seq = job.seq;
+                if results.send((seq, parse(job, &layout))).is_err() {
+                    return;
+                }
+            }));
+        }
+        threads.push(std::thread::spawn(move || {
+            let (mut byte, mut seq) = (byte, 0u64);
+            let mut carry = Vec::new();
+            let mut next_progress = 0u64;
+            loop {
+                let mut buf = std::mem::take(&mut carry);
+                buf.reserve(CHUNK);
+                // Appended without zeroing the room first.
+                let n = loop {
+                    match (&mut file).take(CHUNK as u64).read_to_end(&mut buf) {
+                        Ok(n) => break Some(n),
+                        Err(e) if e.kind() == std::io::ErrorKind::Interrupted => continue,
+                        // The sequential reader meets the error again and reports it.
+                        Err(_) => break None,
+                    }
+                };
+                let job = |bytes| Job { seq, byte, bytes };
+                let Some(n) = n else {
+                    let _ = job_tx.send(job(None));
+                    return;
+                };
+                let eof = n == 0;
+                let cut = match buf.iter().rposition(|&b| b == b'\n') {
+                    Some(p) => p + 1,
+                    None if eof => buf.len(),
+                    None if buf.len() > MAX_LINE_BYTES => {
+                        let _ = job_tx.send(job(None));
+                        return;
+                    }
+                    None => {
+                        carry = buf;
+                        continue;
+                    }
+                };
+                if cut == 0 {
+                    return;
+                }
+                carry = buf.split_off(cut);
+                if job_tx.send(job(Some(buf))).is_err() {
+                    return;
+                }
+                (byte, seq) = (byte + cut as u64, seq + 1);
+                if let Some((p, size)) = progress {
+                    if byte >= next_progress {
+                        p(byte as f64 / size.max(1) as f64);
+                        next_progress = byte + (size / 20).max(1);
+                    }
+                }
+                if eof && carry.is_empty() {
+                    return;
+                }
+            }
+        }));
+        Ok(Self {
+            results: Some(result_rx),
+            pending: BTreeMap::new(),
+            next: 0,
+            line,
+            threads,
+        })
+    }
+
+    /// The next chunk, in order; `None` at the end of the file.
+    pub fn next_chunk(&mut self) -> Option<Parsed> {
+        loop {
+            if let Some(mut p) = self.pending.remove(&self.next) {
+                // Workers number lines from their chunk's start.
+                p.line = self.line;
+                if let Some((_, line)) = &mut p.stop {
+                    *line += self.line;
+                }
+                self.line += p.rows.len() as u64;
+                self.next += 1;
+                return Some(p);
+            }
+            let (seq, parsed) = self.results.as_ref()?.recv().ok()?;
+            self.pending.insert(seq, parsed);
+        }
+    }
+}
+
+impl Drop for FastRows {
+    fn drop(&mut self) {
+        // Closing the results ends the workers' sends, and with them the reader's.
+        self.results = None;
+        self.pending.clear();
+        for t in self.threads.drain(..) {
+            let _ = t.join();
+        }
+    }
+}
+
+/// A chunk's plain rows, up to the first line that is not one or whose time does not follow
+/// the previous row's by about the median interval (the chunk's first row is left to the
+/// caller, which knows the row before it).
+fn parse(job: Job, layout: &Layout) -> Parsed {
+    let Some(bytes) = job.bytes else {
+        return Parsed {
+            line: 0,
+            rows: Vec::new(),
+            stop: Some((job.byte, 0)),
+        };
+    };
+    // The one-pass scanner, where the delimiter cannot be part of a number.
+    let scan =
+        !layout.decimal_comma && !matches!(layout.delimiter, b'0'..=b'9' | b'.' | b'+' | b'-');
+    let mut rows = Vec::with_capacity(bytes.len() / 16);
+    let (mut at, mut line) = (0usize, 0u64);
+    let mut last_t: Option<f64> = None;
+    while at < bytes.len() {
+        let (row, next) = match scan.then(|| scan_row(&bytes, at, layout)).flatten() {
+            Some((row, next)) => (Some(row), next),
+            None => {
+                let end = bytes[at..]
+                    .iter()
+                    .position(|&b| b == b'\n')
+                    .map_or(bytes.len(), |p| at + p);
+                (plain_row(&bytes[at..end], layout), end + 1)
+            }
+        };
+        match row.filter(|&(_, t)| follows(t, &mut last_t, layout)) {
+            Some(row) => rows.push(row),
+            None => {
+                return Parsed {
+                    line: 0,
+                    rows,
+                    stop: Some((job.byte + at as u64, line)),
+                }
+            }
+        }
+        (at, line) = (next, line + 1);
+    }
+    Parsed {
+        line: 0,
+        rows,
+        stop: None,
+    }
+}
+
+/// Whether a row's time `time` follows the chunk's previous one (`last`) as the sequential
+/// checks want it to; keeps it in `last`.
+fn follows(time: f64, last: &mut Option<f64>, layout: &Layout) -> bool {
+    let (Some(_), Some(median)) = (layout.time, layout.median_dt) else {
+        return true;
+    };
+    let t = time * layout.time_unit_s;
+    let ok = last.is_none_or(|l| t > l && crate::streaming::check_interval(t - l, median).is_ok());
+    *last = Some(t);
+    ok
+}
+
+/// One plain row from `bytes[at..]` in one pass: fields of digits with at most one point and
+/// 15 digits (an optional sign), delimiters between them, `\n` or `\r\n` (or the chunk's
+/// end) after them. The row's channel value and time, and where the next row starts; `None`
+/// for anything else ([`plain_row`] decides).
+#[inline]
+fn scan_row(bytes: &[u8], at: usize, layout: &Layout) -> Option<((f64, f64), usize)> {
+    let (mut value, mut time) = (0.0, 0.0);
+    let (mut p, mut k) = (at, 0usize);
+    loop {
+        let negative = match bytes.get(p) {
+            Some(b'-') => {
+                p += 1;
+                true
+            }
+            Some(b'+') => {
+                p += 1;
+                false
+            }
+            _ => false,
+        };
+        // Digits, a point, digits: each run in a loop of its own.
+        let mut m = 0u64;
+        let whole = p;
+        while let Some(&b) = bytes.get(p).filter(|b| b.is_ascii_digit()) {
+            m = m.wrapping_mul(10).wrapping_add(u64::from(b - b'0'));
+            p += 1;
+        }
+        let mut count = p - whole;
+        let mut fraction = 0;
+        if bytes.get(p) == Some(&b'.') {
+            p += 1;
+            let from = p;
+            while let Some(&b) = bytes.get(p).filter(|b| b.is_ascii_digit()) {
+                m = m.wrapping_mul(10).wrapping_add(u64::from(b - b'0'));
+                p += 1;
+            }
+            fraction = p - from;
+            count += fraction;
+        }
+        let end = bytes.get(p).copied();
+        if count == 0 || count > 15 {
+            return None;
+        }
+        let x = m as f64 / EXACT_TENS.get(fraction).copied()?;
+        let x = if negative { -x } else { x };
+        if k == layout.channel {
+            value = x;
+        }
+        if Some(k) == layout.time {
+            time = x;
+        }
+        k += 1;
+        match end {
+            Some(d) if d == layout.delimiter => p += 1,
+            Some(b'\n') => {
+                p += 1;
+                break;
+            }
+            Some(b'\r') if bytes.get(p + 1) == Some(&b'\n') => {
+                p += 2;
+                break;
+            }
+            None => break,
+            Some(_) => return None,
+        }
+    }
+    (k == layout.columns).then_some(((value, time), p))
+}
+
+/// The channel's value and the time (0 without a time column) of a plain row: every field a
+/// number the sequential reader accepts, as many as the table's rows have, no quote.
+fn plain_row(text: &[u8], layout: &Layout) -> Option<(f64, f64)> {
+    let (mut value, mut time, mut fields) = (0.0, 0.0, 0);
+    let mut comma = [0u8; 64];
+    for (k, field) in text.split(|&b| b == layout.delimiter).enumerate() {
+        let field = field.trim_ascii();
+        if field.first() == Some(&b'"') {
+            return None;
+        }
+        let x = if layout.decimal_comma && field.contains(&b',') {
+            let buf = comma.get_mut(..field.len())?;
+            for (d, &b) in buf.iter_mut().zip(field) {
+                *d = if b == b',' { b'.' } else { b };
+            }
+            parse_number(buf)?
+        } else {
+            parse_number(field)?
+        };
+        if !(x.is_finite() && x.abs() <= MAX_VALUE) {
+            return None;
+        }
+        if k == layout.channel {
+            value = x;
+        }
+        if Some(k) == layout.time {
+            time = x;
+        }
+        fields += 1;
+    }
+    (fields == layout.columns).then_some((value, time))
+}
+
+/// Powers of ten that `f64` holds exactly.
+const EXACT_TENS: [f64; 23] = [
+    1e0, 1e1, 1e2, 1e3, 1e4, 1e5, 1e6, 1e7, 1e8, 1e9, 1e10, 1e11, 1e12, 1e13, 1e14, 1e15, 1e16,
+    1e17, 1e18, 1e19, 1e20, 1e21, 1e22,
+];
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn plain_decimals_read_as_the_general_parser_reads_them() {
+        let mut fields: Vec<String> = [
+            "0",
+            "-0",
+            "-0.0",
+            "+1.5",
+            "7.",
+            ".25",
+            "-.5",
+            "123456789012345",
+            "0.000000000000001",
+            "99999.9999999999",
+            "1.7976931348623157",
+            "3.14159265358979",
+            "0.1",
+            "0.3",
+            "-2.675",
+        ]
+        .iter()
+        .map(|s| s.to_string())
+        .collect();
+        let mut state = 0x9e37_79b9_7f4a_7c15u64;
+        for _ in 0..200_000 {
+            state ^= state << 13;
+            state ^= state >> 7;
+            state ^= state << 17;
+            let digits = (state % 15 + 1) as usize;
+            let mantissa = state >> 8;
+            let s = format!("{mantissa}");
+            let s = &s[..digits.min(s.len())];
+            let at = (state >> 4) as usize % (s.len() + 1);
+            let sign = if state & 1 == 1 { "-" } else { "" };
+            fields.push(format!("{sign}{}.{}", &s[..at], &s[at..]));
+        }
+        let layout = Layout {
+            columns: 2,
+            channel: 1,
+            time: Some(0),
+            delimiter: b',',
+            decimal_comma: false,
+            time_unit_s: 1.0,
+            median_dt: None,
+        };
+        let mut taken = 0;
+        for pair in fields.chunks(2) {
+            let text = format!("{},{}\n", pair[0], pair[pair.len() - 1]);
+            let general = plain_row(text.trim_end().as_bytes(), &layout);
+            if let Some((row, next)) = scan_row(text.as_bytes(), 0, &layout) {
+                assert_eq!(Some(row), general, "{text}");
+                assert_eq!(next, text.len());
+                taken += 1;
+            }
+        }
+        assert!(taken > 90_000);
+        // What it leaves to the general reader.
+        for f in [
+            "1e5,1",
+            ",1",
+            "-,1",
+            ".,1",
+            "1.2.3,1",
+            "nan,1",
+            "1234567890123456,1",
+            " 1,1",
+            "1,2,3",
+            "1",
+            "1;2",
+            "1,2 ",
+        ] {
+            assert_eq!(scan_row(f.as_bytes(), 0, &layout), None, "{f}");
+        }
+        // `\r\n` and a chunk's last line without a line end.
+        assert_eq!(scan_row(b"1,2\r\n3,4", 0, &layout), Some(((2.0, 1.0), 5)));
+        assert_eq!(scan_row(b"1,2\r\n3,4", 5, &layout), Some(((4.0, 3.0), 8)));
+    }
+}
