@@ -123,9 +123,10 @@ pub struct AnalyzeArgs {
     /// The sample type of a raw stream without a `.i16`/`.f32` name (standard input).
     #[arg(long, value_enum)]
     pub raw_type: Option<crate::raw::RawType>,
-    /// Analyse a raw `.i16`/`.f32` recording (or standard input) as it is read, in memory
-    /// that does not grow with its length; needs --rate, --range and --trigger; spikes are
-    /// not screened; no --plot, --axes, --free-fall.
+    /// Analyse the recording (CSV, WAV, .npy, TDMS, raw `.i16`/`.f32`; CSV and raw also
+    /// from standard input) as it is read, in memory that does not grow with its length;
+    /// needs --range and --trigger (and --rate where the file holds no time); spikes are
+    /// not screened; no --plot, --axes, --free-fall, --resample.
     #[arg(long)]
     pub stream: bool,
     /// Multiply the channel's values by this first (e.g. g per code of a WAV file's integer

@@ -1,5 +1,5 @@
-//! `impact analyze --stream`: a CSV, WAV, .npy or raw (`.i16`/`.f32`) recording, a file or (CSV,
-//! raw) standard input, analysed as it is read, a block at a time, in memory that does not grow with its
+//! `impact analyze --stream`: a CSV, WAV, .npy, TDMS or raw (`.i16`/`.f32`) recording, a file or
+//! (CSV, raw) standard input, analysed as it is read, a block at a time, in memory that does not grow with its
 //! length (an hour at 500 kS/s is 3.6 GB of i16, ~60 GB of CSV). The per-sample arithmetic is
 //! the whole-file path's
 //! (units, gain, quantisation to counts at the `--range` full scale), so with the same
@@ -48,15 +48,6 @@ pub fn analyze(
     if args.resample {
         return refuse("--resample");
     }
-    let ext = args
-        .file
-        .extension()
-        .map(|e| e.to_string_lossy().to_ascii_lowercase());
-    if ext.as_deref() == Some("tdms") {
-        return Err(format!(
-            "{name}: --stream reads CSV, WAV, .npy and raw files; TDMS files are read whole (drop --stream)"
-        ));
-    }
     let file = match &args.scene {
         Some(p) => analyze::load_scene(p)?,
         None => analyze::SceneFile::default(),
@@ -79,6 +70,7 @@ pub fn analyze(
         Some(kind) => Box::new(RawSource::open(args, kind, &name)?),
         None if crate::wav::is_wav(&args.file) => Box::new(WavSource::open(args, &name)?),
         None if crate::npy::is_npy(&args.file) => Box::new(NpySource::open(args, &name)?),
+        None if crate::tdms::is_tdms(&args.file) => Box::new(TdmsSource::open(args, &name)?),
         None => Box::new(CsvSource::open(args, progress)?),
     };
     // The head: its noise sets the default edge level, a CSV's first intervals the rate.
@@ -764,5 +756,39 @@ impl Source for NpySource {
 
     fn rate_hz(&self) -> Result<f64, String> {
         Ok(self.rate_hz)
+    }
+}
+
+/// A TDMS file's channel ([`crate::tdms::TdmsStream`], a range at a time).
+struct TdmsSource {
+    stream: crate::tdms::TdmsStream,
+    name: String,
+}
+
+impl TdmsSource {
+    fn open(args: &AnalyzeArgs, name: &str) -> Result<Self, String> {
+        if args.time_column.is_some() {
+            return Err(format!(
+                "{name}: a TDMS file takes --column (group/channel) and --rate only"
+            ));
+        }
+        let stream = crate::tdms::TdmsStream::open(&args.file, args.column.as_ref(), args.rate)
+            .map_err(|e| e.to_string())?;
+        Ok(Self {
+            stream,
+            name: name.to_string(),
+        })
+    }
+}
+
+impl Source for TdmsSource {
+    fn next_values(&mut self, want: usize, out: &mut Vec<f64>) -> Result<(), String> {
+        self.stream
+            .next_values(want, out)
+            .map_err(|e| format!("{}: {e}", self.name))
+    }
+
+    fn rate_hz(&self) -> Result<f64, String> {
+        Ok(self.stream.rate_hz)
     }
 }

@@ -18,12 +18,28 @@ pub fn is_tdms(path: &Path) -> bool {
         .is_some_and(|e| e.eq_ignore_ascii_case("tdms"))
 }
 
+/// Most bytes of metadata one segment may hold (a damaged length is not allocated).
+const MAX_METADATA: u64 = 64 << 20;
+
 /// Walks the file's segments and their metadata (NI's "TDMS File Format Internal Structure")
 /// and checks every length against the bytes there, so that the reader never allocates for a
 /// length a damaged file claims: the byte where the first inconsistency is, if any.
-fn check_structure(bytes: &[u8]) -> Result<(), String> {
+fn check_structure(path: &Path) -> Result<(), String> {
+    use std::io::{Read, Seek, SeekFrom};
+    let mut file = std::fs::File::open(path).map_err(|e| e.to_string())?;
+    let len = file.metadata().map_err(|e| e.to_string())?.len() as usize;
+    // Each segment's lead-in and metadata are read, never its data.
+    let mut read_at = |at: usize, n: usize| -> Result<Vec<u8>, String> {
+        let mut buf = vec![0u8; n];
+        file.seek(SeekFrom::Start(at as u64))
+            .and_then(|_| file.read_exact(&mut buf))
+            .map_err(|e| format!("byte {at}: {e}"))?;
+        Ok(buf)
+    };
     struct Cursor<'a> {
         b: &'a [u8],
+        /// The file's byte where `b` starts.
+        base: usize,
         at: usize,
         end: usize,
     }
@@ -35,7 +51,7 @@ fn check_structure(bytes: &[u8]) -> Result<(), String> {
                 .filter(|&t| t <= self.end)
                 .ok_or(format!(
                     "byte {}: {n} bytes announced, {} left in the segment's metadata",
-                    self.at,
+                    self.base + self.at,
                     self.end.saturating_sub(self.at)
                 ))?;
             let s = &self.b[self.at..to];
@@ -68,10 +84,11 @@ fn check_structure(bytes: &[u8]) -> Result<(), String> {
         }
     };
     let mut seg = 0usize;
-    while seg < bytes.len() {
-        let lead = bytes
-            .get(seg..seg + 28)
-            .ok_or(format!("byte {seg}: a segment's lead-in is cut short"))?;
+    while seg < len {
+        if seg + 28 > len {
+            return Err(format!("byte {seg}: a segment's lead-in is cut short"));
+        }
+        let lead = read_at(seg, 28)?;
         if &lead[..4] != b"TDSm" {
             return Err(format!("byte {seg}: no TDSm segment tag"));
         }
@@ -82,7 +99,7 @@ fn check_structure(bytes: &[u8]) -> Result<(), String> {
         let body = seg + 28;
         let meta_end = body
             .checked_add(raw as usize)
-            .filter(|&e| e <= bytes.len())
+            .filter(|&e| e <= len)
             .ok_or(format!(
                 "byte {seg}: metadata of {raw} bytes runs past the file"
             ))?;
@@ -93,10 +110,17 @@ fn check_structure(bytes: &[u8]) -> Result<(), String> {
         }
         // Metadata (1 << 1) or a new object list (1 << 2): the reader parses either.
         if toc & 0b110 != 0 {
+            if raw > MAX_METADATA {
+                return Err(format!(
+                    "byte {seg}: metadata of {raw} bytes, more than a recording's"
+                ));
+            }
+            let meta = read_at(body, meta_end - body)?;
             let mut c = Cursor {
-                b: bytes,
-                at: body,
-                end: meta_end,
+                b: &meta,
+                base: body,
+                at: 0,
+                end: meta.len(),
             };
             let objects = c.u32()?;
             for _ in 0..objects {
@@ -106,14 +130,17 @@ fn check_structure(bytes: &[u8]) -> Result<(), String> {
                     0x6912_0000 | 0x6913_0000 => {
                         return Err(format!(
                             "byte {}: DAQmx raw data, which this reader does not read",
-                            c.at - 4
+                            c.base + c.at - 4
                         ))
                     }
                     n => {
                         // Data type, dimension, value count, and for strings their size.
                         let n = n as usize;
                         if !(20..=28).contains(&n) {
-                            return Err(format!("byte {}: raw data index of {n} bytes", c.at - 4));
+                            return Err(format!(
+                                "byte {}: raw data index of {n} bytes",
+                                c.base + c.at - 4
+                            ));
                         }
                         c.take(n - 4)?;
                     }
@@ -124,8 +151,10 @@ fn check_structure(bytes: &[u8]) -> Result<(), String> {
                     match c.u32()? {
                         0x20 => c.string()?,
                         t => {
-                            let n = fixed(t)
-                                .ok_or(format!("byte {}: property type {t:#x}", c.at - 4))?;
+                            let n = fixed(t).ok_or(format!(
+                                "byte {}: property type {t:#x}",
+                                c.base + c.at - 4
+                            ))?;
                             c.take(n)?;
                         }
                     }
@@ -135,7 +164,7 @@ fn check_structure(bytes: &[u8]) -> Result<(), String> {
         let next_seg = body
             .checked_add(next as usize)
             .ok_or(format!("byte {seg}: next segment offset {next}"))?;
-        if next == u64::MAX || next_seg > bytes.len() {
+        if next == u64::MAX || next_seg > len {
             // The last segment (still being written, or cut): nothing follows it.
             break;
         }
@@ -148,25 +177,10 @@ fn check_structure(bytes: &[u8]) -> Result<(), String> {
 }
 
 /// Every value of `ch` as f64.
-fn values(ch: &TdmsChannel) -> Result<Vec<f64>, String> {
-    fn read<T: tdms_rs::api::reader::Pod + Default + Into<f64>>(
-        ch: &TdmsChannel,
-    ) -> Result<Vec<f64>, String> {
-        let mut out = vec![T::default(); ch.len()];
-        ch.read(0..ch.len(), &mut out).map_err(|e| e.to_string())?;
-        Ok(out.into_iter().map(Into::into).collect())
-    }
-    match ch.dtype() {
-        DataType::Double => read::<f64>(ch),
-        DataType::Float => read::<f32>(ch),
-        DataType::I8 => read::<i8>(ch),
-        DataType::I16 => read::<i16>(ch),
-        DataType::I32 => read::<i32>(ch),
-        DataType::U8 => read::<u8>(ch),
-        DataType::U16 => read::<u16>(ch),
-        DataType::U32 => read::<u32>(ch),
-        other => Err(format!("channel type {other:?} is not a number this reads")),
-    }
+fn values(ch: TdmsChannel) -> Result<Vec<f64>, String> {
+    let mut out = Vec::with_capacity(ch.len());
+    read_range(&ch, 0..ch.len(), &mut out)?;
+    Ok(out)
 }
 
 /// Reads the channel `opts.column` [default: the first one].
@@ -181,75 +195,180 @@ pub fn read_tdms(path: &Path, opts: &ReadOptions) -> Result<Channel, RecordingEr
             "a TDMS file takes --column (group/channel) and --rate only".into(),
         ));
     }
-    let bytes = std::fs::read(path).map_err(|e| err(e.to_string()))?;
-    check_structure(&bytes).map_err(|e| err(format!("TDMS: {}", one_line(e))))?;
-    drop(bytes);
-    let file = TdmsFile::open(path).map_err(|e| err(format!("TDMS: {}", one_line(e))))?;
-    let all: Vec<(String, TdmsChannel)> = file
-        .groups()
-        .flat_map(|g| {
-            let group = g.name().to_string();
-            g.channels()
-                .map(move |c| (format!("{group}/{}", c.name()), c))
-                .collect::<Vec<_>>()
-        })
-        .collect();
-    let names = || {
-        all.iter()
-            .map(|(n, _)| n.as_str())
-            .collect::<Vec<_>>()
-            .join(", ")
-    };
-    let found = match &opts.column {
-        None => all.first(),
-        Some(ColumnRef::Index(i)) => all.get(*i),
-        Some(ColumnRef::Name(n)) => all
-            .iter()
-            .find(|(full, c)| full == n || c.name() == n.as_str()),
-    };
-    let Some((name, ch)) = found else {
-        return Err(err(format!(
-            "no such channel{}; the file has: {}",
-            opts.column.as_ref().map_or(String::new(), |c| match c {
-                ColumnRef::Index(i) => format!(" {i}"),
-                ColumnRef::Name(n) => format!(" {n}"),
-            }),
-            names()
-        )));
-    };
-    let increment = match ch.property("wf_increment") {
-        Some(PropertyValue::Double(d)) if d.is_finite() && *d > 0.0 => Some(*d),
-        _ => None,
-    };
-    let rate_hz = match (opts.rate_hz, increment) {
-        (Some(r), _) => r,
-        (None, Some(dt)) => 1.0 / dt,
-        (None, None) => {
-            return Err(err(format!(
-                "{name} has no wf_increment property: give --rate"
-            )))
-        }
-    };
-    if !(rate_hz.is_finite() && rate_hz > 0.0 && rate_hz <= 1e9) {
-        return Err(err(format!("rate {rate_hz} Hz is not in (0, 1e9]")));
-    }
-    // A header may claim more values than the file holds: check before allocating.
-    let file_bytes = std::fs::metadata(path).map(|m| m.len()).unwrap_or(0);
-    let item = match ch.dtype() {
-        DataType::I8 | DataType::U8 => 1,
-        DataType::I16 | DataType::U16 => 2,
-        DataType::I32 | DataType::U32 | DataType::Float => 4,
-        _ => 8,
-    };
-    if (ch.len() as u128) * item > u128::from(file_bytes) {
-        return Err(err(format!(
-            "TDMS {name}: {} values announced, more than the file's {file_bytes} bytes hold",
-            ch.len()
-        )));
-    }
+    let open = TdmsStream::open(path, opts.column.as_ref(), opts.rate_hz)?;
+    let ch = open.channel().map_err(err)?;
+    let name = open.name.clone();
     let values = values(ch).map_err(|e| err(format!("TDMS {name}: {}", one_line(e))))?;
     if let Some(k) = values.iter().position(|v| !v.is_finite()) {
         return Err(err(format!("TDMS {name}: value {k} is not finite")));
     }
-    evenly_sampled(name.clone(), values, rate_hz).map_err(|e| err(format!("TDMS {name}: {e}")))
+    evenly_sampled(name.clone(), values, open.rate_hz).map_err(|e| err(format!("TDMS {name}: {e}")))
+}
+
+/// One channel of a TDMS file, read a range at a time (`impact analyze --stream`).
+pub struct TdmsStream {
+    file: TdmsFile,
+    group: String,
+    channel: String,
+    /// `group/channel`, its rate (Hz) and its values' count.
+    pub name: String,
+    pub rate_hz: f64,
+    pub len: usize,
+    /// Values read so far.
+    at: usize,
+}
+
+impl TdmsStream {
+    /// Opens `path`'s channel `column` [default: the first] after checking the file's
+    /// structure (segment by segment, without reading the data); the rate from `rate_hz` or
+    /// the channel's `wf_increment`.
+    pub fn open(
+        path: &Path,
+        column: Option<&ColumnRef>,
+        rate_hz: Option<f64>,
+    ) -> Result<Self, RecordingError> {
+        let err = |message: String| RecordingError {
+            file: path.to_path_buf(),
+            line: None,
+            message,
+        };
+        check_structure(path).map_err(|e| err(format!("TDMS: {}", one_line(e))))?;
+        let file = TdmsFile::open(path).map_err(|e| err(format!("TDMS: {}", one_line(e))))?;
+        let all: Vec<(String, String)> = file
+            .groups()
+            .flat_map(|g| {
+                let group = g.name().to_string();
+                g.channels()
+                    .map(move |c| (group.clone(), c.name().to_string()))
+                    .collect::<Vec<_>>()
+            })
+            .collect();
+        let names = || {
+            all.iter()
+                .map(|(g, c)| format!("{g}/{c}"))
+                .collect::<Vec<_>>()
+                .join(", ")
+        };
+        let found = match column {
+            None => all.first(),
+            Some(ColumnRef::Index(i)) => all.get(*i),
+            Some(ColumnRef::Name(n)) => {
+                all.iter().find(|(g, c)| format!("{g}/{c}") == *n || c == n)
+            }
+        };
+        let Some((group, channel)) = found.cloned() else {
+            return Err(err(format!(
+                "no such channel{}; the file has: {}",
+                column.map_or(String::new(), |c| match c {
+                    ColumnRef::Index(i) => format!(" {i}"),
+                    ColumnRef::Name(n) => format!(" {n}"),
+                }),
+                names()
+            )));
+        };
+        let mut open = Self {
+            file,
+            name: format!("{group}/{channel}"),
+            group,
+            channel,
+            rate_hz: 0.0,
+            len: 0,
+            at: 0,
+        };
+        let ch = open.channel().map_err(err)?;
+        let name = open.name.clone();
+        let increment = match ch.property("wf_increment") {
+            Some(PropertyValue::Double(d)) if d.is_finite() && *d > 0.0 => Some(*d),
+            _ => None,
+        };
+        let rate_hz = match (rate_hz, increment) {
+            (Some(r), _) => r,
+            (None, Some(dt)) => 1.0 / dt,
+            (None, None) => {
+                return Err(err(format!(
+                    "{name} has no wf_increment property: give --rate"
+                )))
+            }
+        };
+        if !(rate_hz.is_finite() && rate_hz > 0.0 && rate_hz <= 1e9) {
+            return Err(err(format!("rate {rate_hz} Hz is not in (0, 1e9]")));
+        }
+        // A header may claim more values than the file holds: check before allocating.
+        let file_bytes = std::fs::metadata(path).map(|m| m.len()).unwrap_or(0);
+        let item = match ch.dtype() {
+            DataType::I8 | DataType::U8 => 1,
+            DataType::I16 | DataType::U16 => 2,
+            DataType::I32 | DataType::U32 | DataType::Float => 4,
+            _ => 8,
+        };
+        if (ch.len() as u128) * item > u128::from(file_bytes) {
+            return Err(err(format!(
+                "TDMS {name}: {} values announced, more than the file's {file_bytes} bytes hold",
+                ch.len()
+            )));
+        }
+        let len = ch.len();
+        (open.rate_hz, open.len) = (rate_hz, len);
+        Ok(open)
+    }
+
+    /// The channel in the file.
+    fn channel(&self) -> Result<TdmsChannel<'_>, String> {
+        self.file
+            .groups()
+            .find(|g| g.name() == self.group)
+            .and_then(|g| g.channels().find(|c| c.name() == self.channel))
+            .ok_or_else(|| format!("TDMS: channel {} not found again", self.name))
+    }
+
+    /// Appends the next values (at most `want`, none at the end) to `out`; an error names the
+    /// value that is not finite.
+    pub fn next_values(&mut self, want: usize, out: &mut Vec<f64>) -> Result<(), String> {
+        let range = self.at..(self.at + want.max(1)).min(self.len);
+        if range.is_empty() {
+            return Ok(());
+        }
+        let ch = self.channel()?;
+        let from = out.len();
+        read_range(&ch, range.clone(), out)
+            .map_err(|e| format!("TDMS {}: {}", self.name, one_line(e)))?;
+        if let Some(k) = out[from..].iter().position(|v| !v.is_finite()) {
+            return Err(format!(
+                "TDMS {}: value {} is not finite",
+                self.name,
+                range.start + k
+            ));
+        }
+        self.at = range.end;
+        Ok(())
+    }
+}
+
+/// Values `range` of `ch` appended to `out` as f64.
+fn read_range(
+    ch: &TdmsChannel,
+    range: std::ops::Range<usize>,
+    out: &mut Vec<f64>,
+) -> Result<(), String> {
+    fn read<T: tdms_rs::api::reader::Pod + Default + Into<f64>>(
+        ch: &TdmsChannel,
+        range: std::ops::Range<usize>,
+        out: &mut Vec<f64>,
+    ) -> Result<(), String> {
+        let mut buf = vec![T::default(); range.len()];
+        ch.read(range, &mut buf).map_err(|e| e.to_string())?;
+        out.extend(buf.into_iter().map(Into::into));
+        Ok(())
+    }
+    match ch.dtype() {
+        DataType::Double => read::<f64>(ch, range, out),
+        DataType::Float => read::<f32>(ch, range, out),
+        DataType::I8 => read::<i8>(ch, range, out),
+        DataType::I16 => read::<i16>(ch, range, out),
+        DataType::I32 => read::<i32>(ch, range, out),
+        DataType::U8 => read::<u8>(ch, range, out),
+        DataType::U16 => read::<u16>(ch, range, out),
+        DataType::U32 => read::<u32>(ch, range, out),
+        other => Err(format!("channel type {other:?} is not a number this reads")),
+    }
 }

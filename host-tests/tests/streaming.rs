@@ -416,3 +416,50 @@ fn a_long_csv_file_gives_the_same_reports_and_errors_through_the_parallel_reader
         "{err}"
     );
 }
+
+/// A TDMS channel read a range at a time: the whole file's reports, either channel type;
+/// a file cut short is one line naming it.
+#[test]
+fn tdms_streams_give_the_whole_files_reports() {
+    let tdms = concat!(env!("CARGO_MANIFEST_DIR"), "/fixtures/afrl-test1.tdms");
+    for (column, gain) in [("afrl/bottom_kgn", "1"), ("top_codes", "0.001")] {
+        let args = |tail: &'static str| -> Vec<&str> {
+            [
+                "analyze",
+                tdms,
+                "--column",
+                column,
+                "--gain",
+                gain,
+                "--units",
+                "kgn",
+                "--range",
+                "40000",
+                "--trigger",
+                "20000",
+                "--json",
+                tail,
+            ]
+            .to_vec()
+        };
+        let (whole, _) = impact(&args("--keep-spikes"));
+        assert_eq!(impact(&args("--stream")).0, whole, "{column}");
+        assert!(whole.contains("peak_time_s"), "{column}: no impact");
+    }
+    let bytes = std::fs::read(tdms).unwrap();
+    let cut = tmp("cut.tdms");
+    std::fs::write(&cut, &bytes[..bytes.len() / 3]).unwrap();
+    let (code, _, err) = common::impact(&[
+        "analyze",
+        &cut,
+        "--stream",
+        "--range",
+        "40000",
+        "--trigger",
+        "20000",
+    ]);
+    assert!(
+        code != 0 && err.contains("cut.tdms") && err.trim().lines().count() == 1,
+        "{err}"
+    );
+}
