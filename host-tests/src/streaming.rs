@@ -190,10 +190,7 @@ trait Source: Send {
         scratch: &mut Vec<f64>,
         out: &mut Vec<i16>,
     ) -> Result<(), String> {
-        scratch.clear();
-        self.next_values(want, scratch)?;
-        out.extend(scratch.iter().map(|v| analyze::to_count(v * scale, gain)));
-        Ok(())
+        values_as_counts(self, want, (scale, gain), scratch, out)
     }
     /// The head has been read: what it tells (a CSV's rate) is fixed, and checked.
     fn head_read(&mut self) -> Result<(), String> {
@@ -210,6 +207,20 @@ trait Source: Send {
     fn t0(&self) -> f64 {
         0.0
     }
+}
+
+/// [`Source::next_counts`] through [`Source::next_values`] and `scratch`.
+fn values_as_counts<S: Source + ?Sized>(
+    source: &mut S,
+    want: usize,
+    (scale, gain): (f64, f64),
+    scratch: &mut Vec<f64>,
+    out: &mut Vec<i16>,
+) -> Result<(), String> {
+    scratch.clear();
+    source.next_values(want, scratch)?;
+    out.extend(scratch.iter().map(|v| analyze::to_count(v * scale, gain)));
+    Ok(())
 }
 
 /// A raw file or stream: the chosen channel of interleaved little-endian frames.
@@ -290,10 +301,7 @@ impl Source for RawSource {
         out: &mut Vec<i16>,
     ) -> Result<(), String> {
         if self.kind != RawType::I16 {
-            scratch.clear();
-            self.next_values(want, scratch)?;
-            out.extend(scratch.iter().map(|v| analyze::to_count(v * scale, gain)));
-            return Ok(());
+            return values_as_counts(self, want, (scale, gain), scratch, out);
         }
         let table = match self.table.take() {
             Some(t) if t.0 == (scale, gain) => t,
