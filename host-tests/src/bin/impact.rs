@@ -160,6 +160,9 @@ fn main() -> ExitCode {
         }
     };
     let result = run(cli);
+    if let Some(bar) = PROGRESS.get() {
+        bar.finish_and_clear();
+    }
     // For benchmarks and tests: this process's own peak memory (VmHWM: the address space
     // since exec; wait4's ru_maxrss would include the parent's at the fork).
     if std::env::var_os("IMPACT_PEAK_MEMORY").is_some() {
@@ -202,6 +205,10 @@ fn run(cli: Cli) -> Result<(), String> {
                 let reports = analyze::run(&setup.prepared.counts, &setup.scene)?;
                 (setup, reports)
             };
+            // Before the results: the bar's line cleared.
+            if let Some(bar) = PROGRESS.get() {
+                bar.finish_and_clear();
+            }
             let a = analyze::to_json(&setup, &reports);
             if args.json {
                 println!(
@@ -415,7 +422,7 @@ fn run(cli: Cli) -> Result<(), String> {
     Ok(())
 }
 
-/// A progress bar on stderr for a large file when stderr is a terminal.
+/// A progress bar on stderr (indicatif) for a file over 8 MiB when stderr is a terminal.
 fn progress_for(args: &analyze::AnalyzeArgs) -> Option<fn(f64)> {
     use std::io::IsTerminal;
     let big = std::fs::metadata(&args.file)
@@ -424,9 +431,21 @@ fn progress_for(args: &analyze::AnalyzeArgs) -> Option<fn(f64)> {
     (big && std::io::stderr().is_terminal()).then_some(show_progress as fn(f64))
 }
 
+/// The bar, per mille of the file read (a plain function for the readers' callbacks).
+static PROGRESS: std::sync::OnceLock<indicatif::ProgressBar> = std::sync::OnceLock::new();
+
 fn show_progress(fraction: f64) {
-    eprint!("\rreading {:3.0} %", 100.0 * fraction);
+    let bar = PROGRESS.get_or_init(|| {
+        let bar = indicatif::ProgressBar::new(1000);
+        if let Ok(style) = indicatif::ProgressStyle::with_template(
+            "reading {wide_bar} {percent:>3} % {elapsed} (about {eta} left)",
+        ) {
+            bar.set_style(style);
+        }
+        bar
+    });
+    bar.set_position((fraction.clamp(0.0, 1.0) * 1000.0) as u64);
     if fraction >= 1.0 {
-        eprintln!();
+        bar.finish_and_clear();
     }
 }
