@@ -198,6 +198,17 @@ fn run(cli: Cli) -> Result<(), String> {
             if let Some(path) = &args.plot {
                 plot::check_output(path, &[args.file.as_path()])?;
             }
+            // A file this large is better streamed: say so (the whole-file path holds about
+            // 40 bytes a row).
+            let size = std::fs::metadata(&args.file).map_or(0, |m| m.len());
+            if !args.stream && size > 1 << 30 {
+                eprintln!(
+                    "note: {} is {:.1} GB: read whole it takes some {:.0} GB of memory; --stream reads it in ~30 MiB (give --range and --trigger)",
+                    args.file.display(),
+                    size as f64 / 1e9,
+                    size as f64 * 2.0 / 1e9
+                );
+            }
             let (setup, reports) = if args.stream {
                 impact_host::streaming::analyze(&args, progress)?
             } else {
