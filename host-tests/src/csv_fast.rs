@@ -29,6 +29,8 @@ pub struct Layout {
     pub decimal_comma: bool,
     pub time_unit_s: f64,
     pub median_dt: Option<f64>,
+    /// Keep every field of every row too ([`Parsed::fields`]), for a whole table.
+    pub all: bool,
 }
 
 /// One chunk's rows, in order, one a line (a chunk with a blank line stops there).
@@ -37,6 +39,8 @@ pub struct Parsed {
     pub line: u64,
     /// Per row: the channel's value and the time column's (0 without one).
     pub rows: Vec<(f64, f64)>,
+    /// With [`Layout::all`]: every row's fields, one row after the other.
+    pub fields: Vec<f64>,
     /// Where plain rows stopped, if they did: the file's byte and the line to resume at.
     pub stop: Option<(u64, u64)>,
 }
@@ -191,6 +195,7 @@ fn parse(job: Job, layout: &Layout) -> Parsed {
         return Parsed {
             line: 0,
             rows: Vec::new(),
+            fields: Vec::new(),
             stop: Some((job.byte, 0)),
         };
     };
@@ -198,27 +203,35 @@ fn parse(job: Job, layout: &Layout) -> Parsed {
     let scan =
         !layout.decimal_comma && !matches!(layout.delimiter, b'0'..=b'9' | b'.' | b'+' | b'-');
     let mut rows = Vec::with_capacity(bytes.len() / 16);
+    let mut fields = Vec::new();
     let (mut at, mut line) = (0usize, 0u64);
     let mut last_t: Option<f64> = None;
     while at < bytes.len() {
-        let (row, next) = match scan.then(|| scan_row(&bytes, at, layout)).flatten() {
+        let kept = fields.len();
+        let (row, next) = match scan
+            .then(|| scan_row(&bytes, at, layout, &mut fields))
+            .flatten()
+        {
             Some((row, next)) => (Some(row), next),
             None => {
+                fields.truncate(kept);
                 let end = bytes[at..]
                     .iter()
                     .position(|&b| b == b'\n')
                     .map_or(bytes.len(), |p| at + p);
-                (plain_row(&bytes[at..end], layout), end + 1)
+                (plain_row(&bytes[at..end], layout, &mut fields), end + 1)
             }
         };
         match row.filter(|&(_, t)| follows(t, &mut last_t, layout)) {
             Some(row) => rows.push(row),
             None => {
+                fields.truncate(kept);
                 return Parsed {
                     line: 0,
                     rows,
+                    fields,
                     stop: Some((job.byte + at as u64, line)),
-                }
+                };
             }
         }
         (at, line) = (next, line + 1);
@@ -226,6 +239,7 @@ fn parse(job: Job, layout: &Layout) -> Parsed {
     Parsed {
         line: 0,
         rows,
+        fields,
         stop: None,
     }
 }
@@ -247,7 +261,12 @@ fn follows(time: f64, last: &mut Option<f64>, layout: &Layout) -> bool {
 /// end) after them. The row's channel value and time, and where the next row starts; `None`
 /// for anything else ([`plain_row`] decides).
 #[inline]
-fn scan_row(bytes: &[u8], at: usize, layout: &Layout) -> Option<((f64, f64), usize)> {
+fn scan_row(
+    bytes: &[u8],
+    at: usize,
+    layout: &Layout,
+    fields: &mut Vec<f64>,
+) -> Option<((f64, f64), usize)> {
     let (mut value, mut time) = (0.0, 0.0);
     let (mut p, mut k) = (at, 0usize);
     loop {
@@ -293,6 +312,9 @@ fn scan_row(bytes: &[u8], at: usize, layout: &Layout) -> Option<((f64, f64), usi
         if Some(k) == layout.time {
             time = x;
         }
+        if layout.all {
+            fields.push(x);
+        }
         k += 1;
         match end {
             Some(d) if d == layout.delimiter => p += 1,
@@ -313,7 +335,7 @@ fn scan_row(bytes: &[u8], at: usize, layout: &Layout) -> Option<((f64, f64), usi
 
 /// The channel's value and the time (0 without a time column) of a plain row: every field a
 /// number the sequential reader accepts, as many as the table's rows have, no quote.
-fn plain_row(text: &[u8], layout: &Layout) -> Option<(f64, f64)> {
+fn plain_row(text: &[u8], layout: &Layout, fields_out: &mut Vec<f64>) -> Option<(f64, f64)> {
     let (mut value, mut time, mut fields) = (0.0, 0.0, 0);
     let mut comma = [0u8; 64];
     for (k, field) in text.split(|&b| b == layout.delimiter).enumerate() {
@@ -338,6 +360,9 @@ fn plain_row(text: &[u8], layout: &Layout) -> Option<(f64, f64)> {
         }
         if Some(k) == layout.time {
             time = x;
+        }
+        if layout.all {
+            fields_out.push(x);
         }
         fields += 1;
     }
@@ -397,12 +422,14 @@ mod tests {
             decimal_comma: false,
             time_unit_s: 1.0,
             median_dt: None,
+            all: false,
         };
+        let mut out = Vec::new();
         let mut taken = 0;
         for pair in fields.chunks(2) {
             let text = format!("{},{}\n", pair[0], pair[pair.len() - 1]);
-            let general = plain_row(text.trim_end().as_bytes(), &layout);
-            if let Some((row, next)) = scan_row(text.as_bytes(), 0, &layout) {
+            let general = plain_row(text.trim_end().as_bytes(), &layout, &mut out);
+            if let Some((row, next)) = scan_row(text.as_bytes(), 0, &layout, &mut out) {
                 assert_eq!(Some(row), general, "{text}");
                 assert_eq!(next, text.len());
                 taken += 1;
@@ -424,10 +451,16 @@ mod tests {
             "1;2",
             "1,2 ",
         ] {
-            assert_eq!(scan_row(f.as_bytes(), 0, &layout), None, "{f}");
+            assert_eq!(scan_row(f.as_bytes(), 0, &layout, &mut out), None, "{f}");
         }
         // `\r\n` and a chunk's last line without a line end.
-        assert_eq!(scan_row(b"1,2\r\n3,4", 0, &layout), Some(((2.0, 1.0), 5)));
-        assert_eq!(scan_row(b"1,2\r\n3,4", 5, &layout), Some(((4.0, 3.0), 8)));
+        assert_eq!(
+            scan_row(b"1,2\r\n3,4", 0, &layout, &mut out),
+            Some(((2.0, 1.0), 5))
+        );
+        assert_eq!(
+            scan_row(b"1,2\r\n3,4", 5, &layout, &mut out),
+            Some(((4.0, 3.0), 8))
+        );
     }
 }

@@ -532,6 +532,7 @@ impl Source for CsvSource {
                     decimal_comma: format.decimal_comma,
                     time_unit_s: self.time.map_or(1.0, |(_, unit)| unit),
                     median_dt: self.median_dt,
+                    all: false,
                 };
                 let progress = self.progress.map(|p| (p, *size));
                 self.fast = Some(

@@ -577,6 +577,10 @@ impl Rows {
     }
 }
 
+/// Rows read one at a time before the parallel reader takes a file's plain rows (at the
+/// start, and after a line it could not take).
+const FAST_AFTER: usize = 4096;
+
 /// Reads a whole numeric table ([`Rows`]).
 pub fn read_table(
     path: &Path,
@@ -587,7 +591,62 @@ pub fn read_table(
     let mut table = Table::default();
     let mut next_line = 0;
     let mut n = 0usize;
-    while let Some((lineno, breaks, row)) = rows.next_row()? {
+    // A regular file's plain rows past the first few thousand go through the parallel
+    // reader ([`crate::csv_fast`]); any other line through this one, for a while.
+    let size = std::fs::metadata(path)
+        .ok()
+        .filter(|m| m.is_file() && !is_stdin(path))
+        .map(|m| m.len());
+    let mut fast: Option<crate::csv_fast::FastRows> = None;
+    let mut sequential = 0usize;
+    loop {
+        if let (Some(size), None, true) = (size, &fast, sequential >= FAST_AFTER) {
+            let (byte, line) = rows.position();
+            let layout = crate::csv_fast::Layout {
+                columns: table.columns.len(),
+                channel: 0,
+                time: None,
+                delimiter: rows.delimiter,
+                decimal_comma: rows.format.decimal_comma,
+                time_unit_s: 1.0,
+                median_dt: None,
+                all: true,
+            };
+            let started = crate::csv_fast::FastRows::start(
+                path,
+                byte,
+                line,
+                layout,
+                progress.map(|p| (p, size)),
+            )
+            .map_err(|e| rows.err(Some(line), e.to_string()))?;
+            fast = Some(started);
+        }
+        if let Some(reader) = &mut fast {
+            let Some(chunk) = reader.next_chunk() else {
+                break;
+            };
+            if !chunk.rows.is_empty() && chunk.line != next_line {
+                table.breaks.push((n, chunk.line));
+            }
+            for row in chunk.fields.chunks_exact(table.columns.len().max(1)) {
+                for (c, v) in table.columns.iter_mut().zip(row) {
+                    c.push(*v);
+                }
+            }
+            n += chunk.rows.len();
+            next_line = chunk.line + chunk.rows.len() as u64;
+            if let Some((byte, line)) = chunk.stop {
+                fast = None;
+                rows = rows.resume(byte, line)?;
+                sequential = 0;
+            }
+            continue;
+        }
+        let Some((lineno, breaks, row)) = rows.next_row()? else {
+            break;
+        };
+        sequential += 1;
         if table.columns.is_empty() {
             table.columns = vec![Vec::new(); row.len()];
             table.first_data_line = lineno;
