@@ -684,9 +684,10 @@ fn band(
         }
     }
     for k in 0..marked {
+        // Computed unless both bounds are below (a bound that is not a number never is).
         let reaches = marks
             .get(k)
-            .is_some_and(|m| m.bound[0] >= best[0].value || m.bound[1] >= best[1].value);
+            .is_some_and(|m| !(m.bound[0] < best[0].value && m.bound[1] < best[1].value));
         if reaches && k != first[0].0 && k != first[1].0 {
             evaluate(k, &mut best);
             #[cfg(test)]
