@@ -13,10 +13,14 @@ use std::sync::mpsc::{sync_channel, Receiver};
 use std::sync::{Arc, Mutex};
 use std::thread::JoinHandle;
 
-use crate::table::{parse_number, MAX_LINE_BYTES, MAX_VALUE};
+use crate::table::{is_reading, read_number, MAX_LINE_BYTES};
 
 /// Bytes a chunk holds (up to the last line end in them).
 const CHUNK: usize = 1 << 20;
+
+/// Rows the sequential reader takes (after a line the fast path could not take, and at the
+/// start of a whole table) before the fast path goes on.
+pub const SEQUENTIAL_ROWS: usize = 4096;
 
 /// Which fields a row has and which of them are wanted; the time column's unit (s) and the
 /// head's median interval, which every interval is checked against.
@@ -31,6 +35,23 @@ pub struct Layout {
     pub median_dt: Option<f64>,
     /// Keep every field of every row too ([`Parsed::fields`]), for a whole table.
     pub all: bool,
+}
+
+impl Layout {
+    /// Field `k`'s value `x`: into `row` (channel value, time) if wanted, and onto `fields`
+    /// when every field is kept.
+    #[inline]
+    fn keep(&self, k: usize, x: f64, row: &mut (f64, f64), fields: &mut Vec<f64>) {
+        if k == self.channel {
+            row.0 = x;
+        }
+        if Some(k) == self.time {
+            row.1 = x;
+        }
+        if self.all {
+            fields.push(x);
+        }
+    }
 }
 
 /// One chunk's rows, in order, one a line (a chunk with a blank line stops there).
@@ -267,7 +288,7 @@ fn scan_row(
     layout: &Layout,
     fields: &mut Vec<f64>,
 ) -> Option<((f64, f64), usize)> {
-    let (mut value, mut time) = (0.0, 0.0);
+    let mut row = (0.0, 0.0);
     let (mut p, mut k) = (at, 0usize);
     loop {
         let negative = match bytes.get(p) {
@@ -305,16 +326,7 @@ fn scan_row(
             return None;
         }
         let x = m as f64 / EXACT_TENS.get(fraction).copied()?;
-        let x = if negative { -x } else { x };
-        if k == layout.channel {
-            value = x;
-        }
-        if Some(k) == layout.time {
-            time = x;
-        }
-        if layout.all {
-            fields.push(x);
-        }
+        layout.keep(k, if negative { -x } else { x }, &mut row, fields);
         k += 1;
         match end {
             Some(d) if d == layout.delimiter => p += 1,
@@ -330,43 +342,27 @@ fn scan_row(
             Some(_) => return None,
         }
     }
-    (k == layout.columns).then_some(((value, time), p))
+    (k == layout.columns).then_some((row, p))
 }
 
 /// The channel's value and the time (0 without a time column) of a plain row: every field a
 /// number the sequential reader accepts, as many as the table's rows have, no quote.
-fn plain_row(text: &[u8], layout: &Layout, fields_out: &mut Vec<f64>) -> Option<(f64, f64)> {
-    let (mut value, mut time, mut fields) = (0.0, 0.0, 0);
-    let mut comma = [0u8; 64];
+fn plain_row(text: &[u8], layout: &Layout, fields: &mut Vec<f64>) -> Option<(f64, f64)> {
+    let (mut row, mut count) = ((0.0, 0.0), 0);
+    let mut scratch = Vec::new();
     for (k, field) in text.split(|&b| b == layout.delimiter).enumerate() {
         let field = field.trim_ascii();
         if field.first() == Some(&b'"') {
             return None;
         }
-        let x = if layout.decimal_comma && field.contains(&b',') {
-            let buf = comma.get_mut(..field.len())?;
-            for (d, &b) in buf.iter_mut().zip(field) {
-                *d = if b == b',' { b'.' } else { b };
-            }
-            parse_number(buf)?
-        } else {
-            parse_number(field)?
-        };
-        if !(x.is_finite() && x.abs() <= MAX_VALUE) {
+        let x = read_number(field, layout.decimal_comma, &mut scratch)?;
+        if !is_reading(x) {
             return None;
         }
-        if k == layout.channel {
-            value = x;
-        }
-        if Some(k) == layout.time {
-            time = x;
-        }
-        if layout.all {
-            fields_out.push(x);
-        }
-        fields += 1;
+        layout.keep(k, x, &mut row, fields);
+        count += 1;
     }
-    (fields == layout.columns).then_some((value, time))
+    (count == layout.columns).then_some(row)
 }
 
 /// Powers of ten that `f64` holds exactly.

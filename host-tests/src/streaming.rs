@@ -394,7 +394,7 @@ struct CsvSource {
     pending: Option<f64>,
     /// A regular file's path and size (stdin and pipes are read in one pass); the parallel
     /// fast path once the head is read, and rows read since the sequential reader last took
-    /// over (it hands back after [`RESUME_FAST_AFTER`] rows).
+    /// over (it hands back after [`crate::csv_fast::SEQUENTIAL_ROWS`] rows).
     file: Option<(std::path::PathBuf, u64)>,
     fast: Option<crate::csv_fast::FastRows>,
     head_done: bool,
@@ -402,10 +402,6 @@ struct CsvSource {
     sequential: usize,
     progress: Option<fn(f64)>,
 }
-
-/// Rows the sequential reader takes after a line the fast path could not, before the fast
-/// path goes on.
-const RESUME_FAST_AFTER: usize = 4096;
 
 impl CsvSource {
     fn open(args: &AnalyzeArgs, progress: Option<fn(f64)>) -> Result<Self, String> {
@@ -473,7 +469,7 @@ impl CsvSource {
             fast: None,
             head_done: false,
             ended: false,
-            sequential: RESUME_FAST_AFTER,
+            sequential: crate::csv_fast::SEQUENTIAL_ROWS,
             progress,
         };
         source.pending = Some(source.take(line, &first)?);
@@ -520,7 +516,10 @@ impl Source for CsvSource {
             return Ok(());
         }
         // Past the head, a file's plain rows go through the parallel fast path.
-        if self.head_done && self.fast.is_none() && self.sequential >= RESUME_FAST_AFTER {
+        if self.head_done
+            && self.fast.is_none()
+            && self.sequential >= crate::csv_fast::SEQUENTIAL_ROWS
+        {
             if let Some((path, size)) = &self.file {
                 let (byte, line) = self.rows.position();
                 let (delimiter, format) = self.rows.format();

@@ -246,12 +246,29 @@ fn sniff_delimiter(head: &[u8]) -> u8 {
 }
 
 /// A decimal number (`1.5e-3`, `-2`, `.5`; also `NaN` and `inf`, refused by the caller).
-pub(crate) fn parse_number(field: &[u8]) -> Option<f64> {
+fn parse_number(field: &[u8]) -> Option<f64> {
     match field.first() {
         // fast-float2 reads a leading `+` as std does.
         Some(_) => fast_float2::parse::<f64, _>(field).ok(),
         None => None,
     }
+}
+
+/// A trimmed field's number, its decimal commas read as points with `decimal_comma` (through
+/// `scratch`).
+pub(crate) fn read_number(field: &[u8], decimal_comma: bool, scratch: &mut Vec<u8>) -> Option<f64> {
+    if decimal_comma && field.contains(&b',') {
+        scratch.clear();
+        scratch.extend(field.iter().map(|&b| if b == b',' { b'.' } else { b }));
+        parse_number(scratch)
+    } else {
+        parse_number(field)
+    }
+}
+
+/// A number a data row may hold: finite, within ±[`MAX_VALUE`].
+pub(crate) fn is_reading(v: f64) -> bool {
+    v.is_finite() && v.abs() <= MAX_VALUE
 }
 
 /// Why a field is not a number, with a hint where the layout suggests one.
@@ -485,16 +502,8 @@ impl Rows {
             let mut text_field = false;
             for f in self.record.iter() {
                 let f = f.trim_ascii();
-                let parsed = if self.format.decimal_comma && f.contains(&b',') {
-                    self.scratch.clear();
-                    self.scratch
-                        .extend(f.iter().map(|&b| if b == b',' { b'.' } else { b }));
-                    parse_number(&self.scratch)
-                } else {
-                    parse_number(f)
-                };
-                match parsed {
-                    Some(v) if v.is_finite() && v.abs() <= MAX_VALUE => self.row.push(v),
+                match read_number(f, self.format.decimal_comma, &mut self.scratch) {
+                    Some(v) if is_reading(v) => self.row.push(v),
                     Some(v) => {
                         bad.get_or_insert_with(|| {
                             format!("value is {v:e}: not a finite reading within ±{MAX_VALUE:e}")
@@ -577,10 +586,6 @@ impl Rows {
     }
 }
 
-/// Rows read one at a time before the parallel reader takes a file's plain rows (at the
-/// start, and after a line it could not take).
-const FAST_AFTER: usize = 4096;
-
 /// Reads a whole numeric table ([`Rows`]).
 pub fn read_table(
     path: &Path,
@@ -600,7 +605,9 @@ pub fn read_table(
     let mut fast: Option<crate::csv_fast::FastRows> = None;
     let mut sequential = 0usize;
     loop {
-        if let (Some(size), None, true) = (size, &fast, sequential >= FAST_AFTER) {
+        if let (Some(size), None, true) =
+            (size, &fast, sequential >= crate::csv_fast::SEQUENTIAL_ROWS)
+        {
             let (byte, line) = rows.position();
             let layout = crate::csv_fast::Layout {
                 columns: table.columns.len(),

@@ -176,13 +176,6 @@ fn check_structure(path: &Path) -> Result<(), String> {
     Ok(())
 }
 
-/// Every value of `ch` as f64.
-fn values(ch: TdmsChannel) -> Result<Vec<f64>, String> {
-    let mut out = Vec::with_capacity(ch.len());
-    read_range(&ch, 0..ch.len(), &mut out)?;
-    Ok(out)
-}
-
 /// Reads the channel `opts.column` [default: the first one].
 pub fn read_tdms(path: &Path, opts: &ReadOptions) -> Result<Channel, RecordingError> {
     let err = |message: String| RecordingError {
@@ -195,13 +188,10 @@ pub fn read_tdms(path: &Path, opts: &ReadOptions) -> Result<Channel, RecordingEr
             "a TDMS file takes --column (group/channel) and --rate only".into(),
         ));
     }
-    let open = TdmsStream::open(path, opts.column.as_ref(), opts.rate_hz)?;
-    let ch = open.channel().map_err(err)?;
+    let mut open = TdmsStream::open(path, opts.column.as_ref(), opts.rate_hz)?;
+    let mut values = Vec::with_capacity(open.len);
+    open.next_values(open.len, &mut values).map_err(err)?;
     let name = open.name.clone();
-    let values = values(ch).map_err(|e| err(format!("TDMS {name}: {}", one_line(e))))?;
-    if let Some(k) = values.iter().position(|v| !v.is_finite()) {
-        return Err(err(format!("TDMS {name}: value {k} is not finite")));
-    }
     evenly_sampled(name.clone(), values, open.rate_hz).map_err(|e| err(format!("TDMS {name}: {e}")))
 }
 
