@@ -13,6 +13,7 @@ use serde::{Deserialize, Serialize};
 
 use crate::recording::{read_recording, time_unit_s, ColumnRef, ReadOptions};
 use crate::screen::{self, Clipping, Spike};
+use crate::survey::{self, Survey};
 use crate::table::{read_table, CsvFormat};
 
 /// Units of the recorded column.
@@ -468,10 +469,9 @@ pub fn quantise(
     rate_hz: f64,
     full_scale_m_s2: Option<f64>,
 ) -> (Vec<i16>, Calibration) {
-    let peak = full_scale_m_s2
-        .unwrap_or_else(|| accel.iter().fold(0.0f64, |m, v| m.max(v.abs())))
-        .max(1e-30);
-    let gain = peak / 32000.0;
+    let gain = gain_for(
+        full_scale_m_s2.unwrap_or_else(|| accel.iter().fold(0.0f64, |m, v| m.max(v.abs()))),
+    );
     let counts = accel.iter().map(|v| to_count(*v, gain)).collect();
     (
         counts,
@@ -480,6 +480,25 @@ pub fn quantise(
             sample_rate_hz: rate_hz as f32,
         },
     )
+}
+
+/// The gain, m/s² per count, that puts `full_scale_m_s2` at 32 000 counts.
+pub fn gain_for(full_scale_m_s2: f64) -> f64 {
+    full_scale_m_s2.max(1e-30) / 32000.0
+}
+
+/// The sensor's full scale in m/s² (`--range` or the scene's, in the file's units times
+/// `scale`), if given; an error if it is not finite and positive.
+pub(crate) fn full_scale_m_s2(
+    args: &AnalyzeArgs,
+    file: &SceneFile,
+    scale: f64,
+) -> Result<Option<f64>, String> {
+    match args.range.or(file.range) {
+        Some(r) if r.is_finite() && r > 0.0 => Ok(Some(r * scale.abs())),
+        Some(r) => Err(format!("--range: {r} must be finite and > 0")),
+        None => Ok(None),
+    }
 }
 
 /// One reading in counts (saturating at the i16 rails, as an ADC does).
@@ -500,15 +519,10 @@ pub(crate) fn round_to_i16(x: f64) -> i16 {
     r.clamp(i64::from(i16::MIN), i64::from(i16::MAX)) as i16
 }
 
-/// Robust noise estimate, m/s²: MAD of first differences / sqrt(2).
+/// Robust noise estimate, m/s²: MAD of first differences / sqrt(2), to 0.2 % (the
+/// survey's, [`Survey`]).
 pub fn noise_rms(x: &[f64]) -> f64 {
-    let mut d: Vec<f64> = x.windows(2).map(|w| (w[1] - w[0]).abs()).collect();
-    if d.is_empty() {
-        return 0.0;
-    }
-    let mid = d.len() / 2;
-    let (_, m, _) = d.select_nth_unstable_by(mid, f64::total_cmp);
-    1.4826 * *m / std::f64::consts::SQRT_2
+    Survey::of(x, false).map_or(0.0, |s| s.noise_rms_m_s2)
 }
 
 pub(crate) fn load_scene(path: &Path) -> Result<SceneFile, String> {
@@ -576,20 +590,15 @@ pub fn setup(args: &AnalyzeArgs, progress: Option<fn(f64)>) -> Result<Setup, Str
     .map_err(|e| e.to_string())?;
     let (mass, scale) = mass_and_scale(args, &file)?;
     let mut accel: Vec<f64> = ch.values.iter().map(|v| v * scale).collect();
-    let spikes = if args.keep_spikes {
-        Vec::new()
+    let full_scale = full_scale_m_s2(args, &file, scale)?;
+    let t0 = ch.time_s.first().copied().unwrap_or(0.0);
+    // The survey, and again after glitches are removed (they set the extremes).
+    let first = Survey::of(&accel, !args.keep_spikes)?;
+    let spikes = screen::apply(&first.removals, &mut accel, t0, ch.rate_hz);
+    let survey = if spikes.is_empty() {
+        first
     } else {
-        let noise = noise_rms(&accel);
-        let mut spikes = screen::remove_spikes(&mut accel, noise);
-        for s in &mut spikes {
-            s.time_s = ch.time_s[s.sample as usize];
-        }
-        spikes
-    };
-    let full_scale = match args.range.or(file.range) {
-        Some(r) if r.is_finite() && r > 0.0 => Some(r * scale.abs()),
-        Some(r) => return Err(format!("--range: {r} must be finite and > 0")),
-        None => None,
+        Survey::of(&accel, false)?
     };
     // With --axes the range is each axis's (the resultant reaches sqrt(n) times it), and
     // clipping is found per axis.
@@ -601,33 +610,27 @@ pub fn setup(args: &AnalyzeArgs, progress: Option<fn(f64)>) -> Result<Setup, Str
             crate::axes::Axis::new(name.clone(), a, full_scale)
         })
         .collect();
-    let (clipping, full_scale) = if axes.is_empty() {
-        let clipping = match full_scale {
-            Some(fs) => Some(screen::from_range(fs)),
-            None => screen::flat_tops(&accel),
-        };
-        (clipping, full_scale)
+    let trigger = args.trigger.or(file.trigger_m_s2);
+    let edge = args.edge.or(file.edge_m_s2);
+    let levels = if axes.is_empty() {
+        survey::levels(&survey, full_scale, trigger, edge)
     } else {
-        (None, full_scale.map(|fs| fs * (axes.len() as f64).sqrt()))
+        let fs = full_scale.map(|fs| fs * (axes.len() as f64).sqrt());
+        survey::Levels {
+            clipping: None,
+            ..survey::levels(&survey, fs, trigger, edge)
+        }
     };
-    let (counts, calibration) = quantise(&accel, ch.rate_hz, full_scale);
-    let t0 = ch.time_s.first().copied().unwrap_or(0.0);
-
-    // Levels: from the options, the scene file, or the signal's own noise and range.
-    let sigma = noise_rms(&accel);
-    let mut sorted = accel.clone();
-    let mid = sorted.len() / 2;
-    let median = *sorted.select_nth_unstable_by(mid, f64::total_cmp).1;
-    let range = accel.iter().fold(0.0f64, |m, v| m.max((v - median).abs()));
-    let trigger = args.trigger.or(file.trigger_m_s2).unwrap_or_else(|| {
-        (10.0 * sigma)
-            .max(0.05 * range)
-            .max(calibration.gain_m_s2_per_count as f64 * 4.0)
-    });
-    let edge = args
-        .edge
-        .or(file.edge_m_s2)
-        .unwrap_or_else(|| (3.0 * sigma).max(trigger / 5.0).min(trigger / 2.0));
+    let clipping = levels.clipping.clone();
+    let calibration = Calibration {
+        gain_m_s2_per_count: levels.gain_m_s2_per_count as f32,
+        sample_rate_hz: ch.rate_hz as f32,
+    };
+    let counts = accel
+        .iter()
+        .map(|v| to_count(*v, levels.gain_m_s2_per_count))
+        .collect();
+    let (trigger, edge) = (levels.trigger_m_s2, levels.edge_m_s2);
     let (scene, source) = build_scene(
         args,
         &file,

@@ -15,6 +15,8 @@ use impact_core::{Calibration, ImpactReport};
 
 use crate::analyze::{self, AnalyzeArgs, HostMonitor, Prepared, Setup};
 use crate::raw::RawType;
+use crate::screen::Removal;
+use crate::survey::{self, Survey, Surveyed};
 use crate::table::is_stdin;
 
 /// Samples whose noise sets the default edge level (the whole-file path uses the whole
@@ -66,26 +68,9 @@ pub fn analyze(
     let full_scale = range * scale.abs();
     let gain = full_scale / 32000.0;
     let clipping = crate::screen::from_range(full_scale);
-    let mut source: Box<dyn Source> = match args.raw_type.or_else(|| RawType::of(&args.file)) {
-        Some(kind) => Box::new(RawSource::open(args, kind, &name)?),
-        None if crate::wav::is_wav(&args.file) => Box::new(WavSource::open(args, &name)?),
-        None if crate::npy::is_npy(&args.file) => Box::new(NpySource::open(args, &name)?),
-        None if crate::tdms::is_tdms(&args.file) => Box::new(TdmsSource::open(args, &name)?),
-        None => Box::new(CsvSource::open(args, progress)?),
-    };
+    let mut source = open_source(args, &name, progress)?;
     // The head: its noise sets the default edge level, a CSV's first intervals the rate.
-    let mut head = Vec::with_capacity(HEAD);
-    while head.len() < HEAD {
-        let before = head.len();
-        source.next_values(HEAD - head.len(), &mut head)?;
-        if head.len() == before {
-            break;
-        }
-    }
-    for v in &mut head {
-        *v *= scale;
-    }
-    source.head_read()?;
+    let head = read_head(&mut *source, scale)?;
     let rate_hz = source.rate_hz()?;
     let calibration = Calibration {
         gain_m_s2_per_count: gain as f32,
@@ -104,59 +89,8 @@ pub fn analyze(
         Some(&clipping),
         mass,
     )?;
-    let (reports, count, source) = crate::on_big_stack(move || {
-        // A reader thread reads, decodes and quantises the values ahead (a few chunks,
-        // so memory stays bounded) while this one runs the monitor.
-        let (tx, rx) = std::sync::mpsc::sync_channel::<Result<Vec<i16>, String>>(4);
-        let (back, spare) = std::sync::mpsc::channel::<Vec<i16>>();
-        let reader = std::thread::spawn(move || {
-            let mut scratch = Vec::with_capacity(CHUNK);
-            loop {
-                let mut counts = spare.try_recv().unwrap_or_default();
-                counts.clear();
-                if let Err(e) = source.next_counts(CHUNK, (scale, gain), &mut scratch, &mut counts)
-                {
-                    let _ = tx.send(Err(e));
-                    break;
-                }
-                if counts.is_empty() || tx.send(Ok(counts)).is_err() {
-                    break;
-                }
-            }
-            source
-        });
-        let mut m = HostMonitor::new(scene).map_err(|e| e.to_string())?;
-        let mut out = Vec::new();
-        let head: Vec<i16> = head.iter().map(|a| analyze::to_count(*a, gain)).collect();
-        let mut total = 0u64;
-        let mut failed = None;
-        for counts in std::iter::once(Ok(head)).chain(rx.iter()) {
-            let counts = match counts {
-                Ok(c) => c,
-                Err(e) => {
-                    failed = Some(e);
-                    break;
-                }
-            };
-            for block in counts.chunks(256) {
-                m.push_block(block, &mut |r: &ImpactReport| out.push(*r));
-            }
-            total += counts.len() as u64;
-            let _ = back.send(counts);
-        }
-        drop(rx);
-        let source = reader
-            .join()
-            .map_err(|_| "the reader thread panicked".to_string())?;
-        if let Some(e) = failed {
-            return Err(e);
-        }
-        m.finish(&mut |r: &ImpactReport| out.push(*r));
-        if !m.is_armed() {
-            return Err("the signal never settled to a baseline (no quiet stretch of 64 samples within the edge level): give --edge".into());
-        }
-        Ok((out, total, source))
-    })?;
+    let head: Vec<i16> = head.iter().map(|a| analyze::to_count(*a, gain)).collect();
+    let (reports, count, source) = run_monitor(source, head, (scale, gain), scene, Vec::new())?;
     let setup = Setup {
         prepared: Prepared {
             counts: Vec::new(),
@@ -175,6 +109,284 @@ pub fn analyze(
         axes: Vec::new(),
     };
     Ok((setup, reports))
+}
+
+/// Reads and analyses a regular file in passes, in memory that does not grow with its
+/// length, with the whole-file path's rules: a survey of the whole recording (its median,
+/// noise, extremes, flat tops and glitches, [`Survey`]), a second one if glitches were
+/// removed, then the analysis. The same code as the whole-file path on the same values, so
+/// the same reports (tested); only the time axis is checked against the first intervals'
+/// median, as in a stream (the whole-file path takes the median of all of them).
+pub fn analyze_in_passes(
+    args: &AnalyzeArgs,
+    progress: Option<fn(f64)>,
+) -> Result<(Setup, Vec<ImpactReport>), String> {
+    let name = args.file.display().to_string();
+    let file = match &args.scene {
+        Some(p) => analyze::load_scene(p)?,
+        None => analyze::SceneFile::default(),
+    };
+    let (mass, scale) = analyze::mass_and_scale(args, &file)?;
+    let full_scale = analyze::full_scale_m_s2(args, &file, scale)?;
+    // The survey; again with the glitches replaced if there are any (they set the extremes).
+    let (first, source) = survey_pass(args, &name, progress, scale, &[], !args.keep_spikes)?;
+    source.rate_hz()?;
+    let (t0, rate_hz) = (source.t0(), source.final_rate_hz());
+    drop(source);
+    let removals = first.removals.clone();
+    let survey = if removals.is_empty() {
+        first
+    } else {
+        survey_pass(args, &name, progress, scale, &removals, false)?.0
+    };
+    let levels = survey::levels(
+        &survey,
+        full_scale,
+        args.trigger.or(file.trigger_m_s2),
+        args.edge.or(file.edge_m_s2),
+    );
+    let gain = levels.gain_m_s2_per_count;
+    let calibration = Calibration {
+        gain_m_s2_per_count: gain as f32,
+        sample_rate_hz: rate_hz as f32,
+    };
+    let (scene, v0_source) = analyze::build_scene(
+        args,
+        &file,
+        calibration,
+        levels.trigger_m_s2,
+        levels.edge_m_s2,
+        levels.clipping.as_ref(),
+        mass,
+    )?;
+    let mut source = open_source(args, &name, progress)?;
+    let head = read_head(&mut *source, scale)?;
+    let head = head.iter().map(|a| analyze::to_count(*a, gain)).collect();
+    let (reports, count, _) = run_monitor(source, head, (scale, gain), scene, removals.clone())?;
+    let spikes = crate::screen::apply(&removals, &mut [], t0, rate_hz);
+    let setup = Setup {
+        prepared: Prepared {
+            counts: Vec::new(),
+            calibration,
+            t0,
+            accel_m_s2: Vec::new(),
+        },
+        scene,
+        v0_source: v0_source.map(str::to_string),
+        free_fall_s: None,
+        samples: count,
+        rate_hz,
+        spikes,
+        clipping: levels.clipping,
+        resampled: false,
+        axes: Vec::new(),
+    };
+    Ok((setup, reports))
+}
+
+/// Whether `impact analyze` reads `args.file` in passes ([`analyze_in_passes`]): a regular
+/// file, without the options that need the whole recording in memory (figures, axes, free
+/// fall, resampling).
+pub fn in_passes(args: &AnalyzeArgs) -> bool {
+    !args.stream
+        && !is_stdin(&args.file)
+        && std::fs::metadata(&args.file).is_ok_and(|m| m.is_file())
+        && args.plot.is_none()
+        && args.axes.is_empty()
+        && args.free_fall.is_none()
+        && !args.resample
+}
+
+/// One survey of the file (values × `scale`, the `removals` put in), and the source read.
+fn survey_pass(
+    args: &AnalyzeArgs,
+    name: &str,
+    progress: Option<fn(f64)>,
+    scale: f64,
+    removals: &[Removal],
+    screen: bool,
+) -> Result<(Surveyed, Box<dyn Source>), String> {
+    let mut source = open_source(args, name, progress)?;
+    let mut survey = Survey::new(screen);
+    let mut patch = Patches::new(removals);
+    let mut head = read_head(&mut *source, scale)?;
+    patch.values(&mut head);
+    survey.push(&head);
+    let source = read_ahead(
+        source,
+        move |s, _, out: &mut Vec<f64>| {
+            s.next_values(CHUNK, out)?;
+            out.iter_mut().for_each(|v| *v *= scale);
+            Ok(())
+        },
+        |block| {
+            patch.values(block);
+            survey.push(block);
+        },
+    )?;
+    Ok((survey.finish()?, source))
+}
+
+/// Opens the reader for the file's format.
+fn open_source(
+    args: &AnalyzeArgs,
+    name: &str,
+    progress: Option<fn(f64)>,
+) -> Result<Box<dyn Source>, String> {
+    Ok(match args.raw_type.or_else(|| RawType::of(&args.file)) {
+        Some(kind) => Box::new(RawSource::open(args, kind, name)?),
+        None if crate::wav::is_wav(&args.file) => Box::new(WavSource::open(args, name)?),
+        None if crate::npy::is_npy(&args.file) => Box::new(NpySource::open(args, name)?),
+        None if crate::tdms::is_tdms(&args.file) => Box::new(TdmsSource::open(args, name)?),
+        None => Box::new(CsvSource::open(args, progress)?),
+    })
+}
+
+/// The first [`HEAD`] values × `scale` (fewer if the input is shorter); then what the head
+/// tells is fixed ([`Source::head_read`]).
+fn read_head(source: &mut dyn Source, scale: f64) -> Result<Vec<f64>, String> {
+    let mut head = Vec::with_capacity(HEAD);
+    while head.len() < HEAD {
+        let before = head.len();
+        source.next_values(HEAD - head.len(), &mut head)?;
+        if head.len() == before {
+            break;
+        }
+    }
+    for v in &mut head {
+        *v *= scale;
+    }
+    source.head_read()?;
+    Ok(head)
+}
+
+/// Runs `fill` on a reader thread a few chunks ahead of `take` (so memory stays bounded),
+/// until `fill` gives nothing; the source back, or the first error.
+fn read_ahead<T: Send + 'static>(
+    mut source: Box<dyn Source>,
+    fill: impl Fn(&mut dyn Source, &mut Vec<f64>, &mut Vec<T>) -> Result<(), String> + Send + 'static,
+    mut take: impl FnMut(&mut [T]),
+) -> Result<Box<dyn Source>, String> {
+    let (tx, rx) = std::sync::mpsc::sync_channel::<Result<Vec<T>, String>>(4);
+    let (back, spare) = std::sync::mpsc::channel::<Vec<T>>();
+    let reader = std::thread::spawn(move || {
+        let mut scratch = Vec::with_capacity(CHUNK);
+        loop {
+            let mut chunk = spare.try_recv().unwrap_or_default();
+            chunk.clear();
+            if let Err(e) = fill(&mut *source, &mut scratch, &mut chunk) {
+                let _ = tx.send(Err(e));
+                break;
+            }
+            if chunk.is_empty() || tx.send(Ok(chunk)).is_err() {
+                break;
+            }
+        }
+        source
+    });
+    let mut failed = None;
+    for chunk in rx.iter() {
+        match chunk {
+            Ok(mut c) => {
+                take(&mut c);
+                let _ = back.send(c);
+            }
+            Err(e) => {
+                failed = Some(e);
+                break;
+            }
+        }
+    }
+    drop(rx);
+    let source = reader
+        .join()
+        .map_err(|_| "the reader thread panicked".to_string())?;
+    match failed {
+        Some(e) => Err(e),
+        None => Ok(source),
+    }
+}
+
+/// Runs the monitor over the head's counts and the rest of the source (as counts at
+/// `(scale, gain)`, the `removals` put in); the reports, the samples read and the source.
+fn run_monitor(
+    source: Box<dyn Source>,
+    head: Vec<i16>,
+    (scale, gain): (f64, f64),
+    scene: impact_core::Scene,
+    removals: Vec<Removal>,
+) -> Result<Analysed, String> {
+    crate::on_big_stack(move || {
+        let mut m = HostMonitor::new(scene).map_err(|e| e.to_string())?;
+        let mut out = Vec::new();
+        let mut total = 0u64;
+        let mut patch = Patches::new(&removals);
+        let mut take = |counts: &mut [i16]| {
+            patch.counts(counts, gain);
+            for block in counts.chunks(256) {
+                m.push_block(block, &mut |r: &ImpactReport| out.push(*r));
+            }
+            total += counts.len() as u64;
+        };
+        let mut head = head;
+        take(&mut head);
+        let source = read_ahead(
+            source,
+            move |s, scratch, counts| s.next_counts(CHUNK, (scale, gain), scratch, counts),
+            take,
+        )?;
+        m.finish(&mut |r: &ImpactReport| out.push(*r));
+        if !m.is_armed() {
+            return Err("the signal never settled to a baseline (no quiet stretch of 64 samples within the edge level): give --edge".into());
+        }
+        Ok((out, total, source))
+    })
+}
+
+/// What [`run_monitor`] gives: the reports, the samples read and the source.
+type Analysed = (Vec<ImpactReport>, u64, Box<dyn Source>);
+
+/// Puts removed glitches' straight lines into a stream's blocks as they pass.
+struct Patches<'a> {
+    removals: &'a [Removal],
+    /// The index of the next sample to pass.
+    at: u64,
+}
+
+impl<'a> Patches<'a> {
+    fn new(removals: &'a [Removal]) -> Self {
+        Self { removals, at: 0 }
+    }
+
+    /// The (removal, sample) pairs in the next `len` samples, as (index in the block, value).
+    fn each(&mut self, len: usize, mut f: impl FnMut(usize, f64)) {
+        let end = self.at + len as u64;
+        while let Some(r) = self.removals.first() {
+            let first = r.spike.sample;
+            let last = first + u64::from(r.spike.samples);
+            if first >= end {
+                break;
+            }
+            for k in first.max(self.at)..last.min(end) {
+                f((k - self.at) as usize, r.value((k - first) as usize));
+            }
+            if last > end {
+                break;
+            }
+            self.removals = &self.removals[1..];
+        }
+        self.at = end;
+    }
+
+    fn values(&mut self, block: &mut [f64]) {
+        let len = block.len();
+        self.each(len, |i, v| block[i] = v);
+    }
+
+    fn counts(&mut self, block: &mut [i16], gain: f64) {
+        let len = block.len();
+        self.each(len, |i, v| block[i] = analyze::to_count(v, gain));
+    }
 }
 
 /// Where the stream's values come from.
@@ -490,7 +702,7 @@ impl CsvSource {
             if self.t0.is_none() {
                 self.t0 = Some(t);
             } else {
-                let at = |m: String| format!("{}: line {line}: {m}", self.name);
+                let at = |m: String| format!("{}:{line}: {m}", self.name);
                 if t <= self.last {
                     return Err(at(format!(
                         "time {t} s does not increase (previous {} s)",
@@ -598,7 +810,7 @@ impl Source for CsvSource {
         let median = *sorted.select_nth_unstable_by(mid, f64::total_cmp).1;
         // The head's intervals against their median, as every later one.
         for (dt, line) in dts {
-            check_interval(dt, median).map_err(|m| format!("{}: line {line}: {m}", self.name))?;
+            check_interval(dt, median).map_err(|m| format!("{}:{line}: {m}", self.name))?;
         }
         self.median_dt = Some(median);
         if let Some(t0) = self.t0 {
@@ -622,7 +834,7 @@ impl Source for CsvSource {
     fn final_rate_hz(&self) -> f64 {
         match (self.rate_given, self.t0) {
             (Some(r), _) => r,
-            (None, Some(t0)) if self.n > 1 => (self.n - 1) as f64 / (self.last - t0),
+            (None, Some(t0)) if self.n > 1 => 1.0 / ((self.last - t0) / (self.n - 1) as f64),
             _ => self.head_rate.unwrap_or(0.0),
         }
     }
@@ -640,8 +852,9 @@ pub(crate) fn check_interval(dt: f64, median: f64) -> Result<(), String> {
     } else {
         Err(format!(
             "uneven time axis: {dt:.6e} s since the previous sample, {ratio:.3} times the first \
-             intervals' median {median:.6e} s (a gap or a rate change); --stream does not \
-             resample: cut the file"
+             intervals' median {median:.6e} s (a gap or a rate change); give --resample to \
+             interpolate onto an even grid (the whole recording is then held in memory), or cut \
+             the file"
         ))
     }
 }

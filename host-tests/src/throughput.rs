@@ -236,9 +236,11 @@ pub fn throughput(
 /// `impact analyze` on one file: its form, how fast, in how much memory.
 #[derive(Clone, Debug, Serialize)]
 pub struct FormatThroughput {
-    /// `csv` or `i16`, read whole or as a stream (`--stream`).
+    /// `csv` or `i16`.
     pub format: String,
-    pub stream: bool,
+    /// How `impact analyze` read it: `passes` (a regular file, the default), `stream`
+    /// (`--stream`, levels given) or `whole` (from standard input, held in memory).
+    pub path: String,
     pub bytes: u64,
     pub seconds: f64,
     pub megabytes_per_second: f64,
@@ -260,11 +262,22 @@ pub struct PeerThroughput {
 /// Runs `exe ARGS` to the end: its stdout, wall time and peak resident memory, MiB (the
 /// child's own VmHWM, which it prints with IMPACT_PEAK_MEMORY set: wait4's ru_maxrss counts
 /// this process's memory at the fork too).
-fn run_child(exe: &std::path::Path, args: &[&str]) -> Result<(String, f64, f64), String> {
+fn run_child(
+    exe: &std::path::Path,
+    args: &[&str],
+    stdin: Option<&std::path::Path>,
+) -> Result<(String, f64, f64), String> {
+    let input = match stdin {
+        Some(p) => std::fs::File::open(p)
+            .map_err(|e| format!("{}: {e}", p.display()))?
+            .into(),
+        None => std::process::Stdio::null(),
+    };
     let t = Instant::now();
     let child = std::process::Command::new(exe)
         .env("IMPACT_PEAK_MEMORY", "1")
         .args(args)
+        .stdin(input)
         .stdout(std::process::Stdio::piped())
         .stderr(std::process::Stdio::piped())
         .spawn()
@@ -365,45 +378,23 @@ fn analyze_files(
         // The stream's levels: the ADC's full scale (±2048 codes) and a 20 m/s² trigger.
         let range_g = format!("{}", 2048.0 * gain_g);
         let gain = format!("{gain_g}");
-        let runs: [(&str, bool, Vec<&str>); 3] = [
-            ("csv", false, vec!["analyze", &csv_s, "--json"]),
-            (
-                "csv",
-                true,
-                vec![
-                    "analyze",
-                    &csv_s,
-                    "--json",
-                    "--stream",
-                    "--range",
-                    &range_g,
-                    "--trigger",
-                    "20",
-                ],
-            ),
-            (
-                "i16",
-                true,
-                vec![
-                    "analyze",
-                    &raw_s,
-                    "--json",
-                    "--stream",
-                    "--rate",
-                    "500000",
-                    "--gain",
-                    &gain,
-                    "--range",
-                    "4096",
-                    "--trigger",
-                    "20",
-                ],
-            ),
+        let csv_args = ["analyze", &*csv_s, "--json"];
+        let raw_args = [
+            "analyze", &*raw_s, "--json", "--rate", "500000", "--gain", &*gain,
         ];
-        let mut whole = None;
+        let stream_csv = ["--stream", "--range", &*range_g, "--trigger", "20"];
+        let stream_raw = ["--stream", "--range", "4096", "--trigger", "20"];
+        let runs: [(&str, &str, Vec<&str>, Option<&std::path::Path>); 5] = [
+            ("csv", "passes", csv_args.to_vec(), None),
+            ("csv", "stream", [&csv_args[..], &stream_csv].concat(), None),
+            ("csv", "whole", vec!["analyze", "-", "--json"], Some(&csv)),
+            ("i16", "passes", raw_args.to_vec(), None),
+            ("i16", "stream", [&raw_args[..], &stream_raw].concat(), None),
+        ];
+        let mut default = None;
         let mut formats = Vec::new();
-        for (format, stream, args) in runs {
-            let (out, seconds, peak) = run_child(exe, &args)?;
+        for (format, path, args, stdin) in runs {
+            let (out, seconds, peak) = run_child(exe, &args, stdin)?;
             let rows = if format == "csv" {
                 counts.len()
             } else {
@@ -415,8 +406,8 @@ fn analyze_files(
             } else {
                 size(&raw)
             };
-            if format == "csv" && !stream {
-                whole = Some(AnalyzeThroughput {
+            if format == "csv" && path == "passes" {
+                default = Some(AnalyzeThroughput {
                     rows: counts.len() as u64,
                     bytes,
                     impacts_reported: reported,
@@ -428,7 +419,7 @@ fn analyze_files(
             }
             formats.push(FormatThroughput {
                 format: format.into(),
-                stream,
+                path: path.into(),
                 bytes,
                 seconds,
                 megabytes_per_second: bytes as f64 / 1e6 / seconds,
@@ -452,8 +443,8 @@ fn analyze_files(
                 });
             }
         }
-        let whole = whole.ok_or("no whole-file run")?;
-        Ok((whole, formats, peers))
+        let default = default.ok_or("no run of the default path")?;
+        Ok((default, formats, peers))
     })();
     let _ = std::fs::remove_file(&csv);
     let _ = std::fs::remove_file(&raw);

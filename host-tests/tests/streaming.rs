@@ -178,7 +178,7 @@ fn a_csv_stream_gives_the_whole_files_reports() {
             .collect::<Vec<_>>(),
     );
     assert!(
-        code != 0 && err.contains("line 30001") && err.contains("uneven time axis"),
+        code != 0 && err.contains(":30001: uneven") && err.contains("uneven time axis"),
         "{err}"
     );
 }
@@ -412,7 +412,7 @@ fn a_long_csv_file_gives_the_same_reports_and_errors_through_the_parallel_reader
     let gap = write("gap-long.csv", &gap);
     let (code, _, err) = run(&gap, &["--stream"]);
     assert!(
-        code != 0 && err.contains("line 240001") && err.contains("uneven time axis"),
+        code != 0 && err.contains(":240001: uneven") && err.contains("uneven time axis"),
         "{err}"
     );
 }

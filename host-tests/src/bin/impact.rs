@@ -198,12 +198,14 @@ fn run(cli: Cli) -> Result<(), String> {
             if let Some(path) = &args.plot {
                 plot::check_output(path, &[args.file.as_path()])?;
             }
-            // A file this large is better streamed: say so (the whole-file path holds about
-            // 40 bytes a row).
+            // A regular file is read in passes in bounded memory, unless an option needs the
+            // whole recording: then a large one gets a note of the memory it takes (about 40
+            // bytes a row).
+            let in_passes = impact_host::streaming::in_passes(&args);
             let size = std::fs::metadata(&args.file).map_or(0, |m| m.len());
-            if !args.stream && size > 1 << 30 {
+            if !args.stream && !in_passes && size > 1 << 30 {
                 eprintln!(
-                    "note: {} is {:.1} GB: read whole it takes some {:.0} GB of memory; --stream reads it in ~30 MiB (give --range and --trigger)",
+                    "note: {} is {:.1} GB: read whole (for --plot, --axes, --free-fall, --resample or standard input) it takes some {:.0} GB of memory",
                     args.file.display(),
                     size as f64 / 1e9,
                     size as f64 * 2.0 / 1e9
@@ -211,6 +213,8 @@ fn run(cli: Cli) -> Result<(), String> {
             }
             let (setup, reports) = if args.stream {
                 impact_host::streaming::analyze(&args, progress)?
+            } else if in_passes {
+                impact_host::streaming::analyze_in_passes(&args, progress)?
             } else {
                 let setup = analyze::setup(&args, progress)?;
                 let reports = analyze::run(&setup.prepared.counts, &setup.scene)?;
@@ -320,7 +324,7 @@ fn run(cli: Cli) -> Result<(), String> {
                     println!(
                         "  {:<3} {:<6} {:>5.0} MB in {:>5.2} s: {:>5.0} MB/s, {:.3e} samples/s, peak memory {:>4.0} MiB",
                         f.format,
-                        if f.stream { "stream" } else { "whole" },
+                        f.path,
                         f.bytes as f64 / 1e6,
                         f.seconds,
                         f.megabytes_per_second,

@@ -1,0 +1,177 @@
+//! What the whole recording tells before it is analysed (its median, noise, extremes, flat
+//! tops and glitches), gathered a block at a time in bounded memory, and the levels and
+//! scale the analysis takes from it.
+//!
+//! The whole-file path runs it over the recording in memory, the passes path over the file
+//! as it is read: the same code on the same values, so both give the same reports.
+
+use crate::histogram::OrderHistogram;
+use crate::screen::{self, Clipping, FlatTops, Removal, SpikeScan};
+
+/// One pass over a recording (values in m/s²).
+pub struct Survey {
+    values: OrderHistogram,
+    steps: OrderHistogram,
+    flat: FlatTops,
+    spikes: Option<SpikeScan>,
+    last: Option<f64>,
+    min: f64,
+    max: f64,
+}
+
+/// What a pass found.
+#[derive(Clone, Debug)]
+pub struct Surveyed {
+    pub samples: u64,
+    /// The median, to 0.2 % ([`OrderHistogram`]); 0 for no samples.
+    pub median_m_s2: f64,
+    /// Robust noise: the median absolute step / sqrt(2) × 1.4826 (to 0.2 %).
+    pub noise_rms_m_s2: f64,
+    pub min_m_s2: f64,
+    pub max_m_s2: f64,
+    /// Flat tops at the extremes ([`FlatTops`]).
+    pub flat_tops: Option<Clipping>,
+    /// Isolated glitches (when screened).
+    pub removals: Vec<Removal>,
+}
+
+impl Surveyed {
+    /// The largest reading's magnitude (0 for none).
+    pub fn peak_m_s2(&self) -> f64 {
+        if self.samples == 0 {
+            return 0.0;
+        }
+        0.0f64.max(self.max_m_s2.abs()).max(self.min_m_s2.abs())
+    }
+
+    /// The largest distance of a reading from the median (0 for none).
+    pub fn range_m_s2(&self) -> f64 {
+        if self.samples == 0 {
+            return 0.0;
+        }
+        0.0f64
+            .max((self.max_m_s2 - self.median_m_s2).abs())
+            .max((self.min_m_s2 - self.median_m_s2).abs())
+    }
+}
+
+impl Survey {
+    /// A pass that also screens for glitches when `screen` is set.
+    pub fn new(screen: bool) -> Self {
+        Self {
+            values: OrderHistogram::new(),
+            steps: OrderHistogram::new(),
+            flat: FlatTops::default(),
+            spikes: screen.then(SpikeScan::default),
+            last: None,
+            min: f64::INFINITY,
+            max: f64::NEG_INFINITY,
+        }
+    }
+
+    pub fn push(&mut self, block: &[f64]) {
+        // (Loops of their own, on locals, so each runs at the machine's pace.)
+        if let (Some(p), Some(&first)) = (self.last, block.first()) {
+            self.steps.add((first - p).abs());
+        }
+        self.steps
+            .add_all(block.windows(2).map(|w| (w[1] - w[0]).abs()));
+        self.values.add_all(block.iter().copied());
+        let (mut min, mut max) = (self.min, self.max);
+        for &v in block {
+            min = if v < min { v } else { min };
+            max = if v > max { v } else { max };
+        }
+        (self.min, self.max) = (min, max);
+        if let Some(&v) = block.last() {
+            self.last = Some(v);
+        }
+        self.flat.push(block);
+        if let Some(s) = &mut self.spikes {
+            s.push(block);
+        }
+    }
+
+    pub fn finish(self) -> Result<Surveyed, String> {
+        let median = self.values.median().unwrap_or(0.0);
+        let noise = self
+            .steps
+            .median()
+            .map_or(0.0, |m| 1.4826 * m / std::f64::consts::SQRT_2);
+        let removals = match self.spikes {
+            Some(s) => s.finish(median)?,
+            None => Vec::new(),
+        };
+        Ok(Surveyed {
+            samples: self.values.len(),
+            median_m_s2: median,
+            noise_rms_m_s2: noise,
+            min_m_s2: self.min,
+            max_m_s2: self.max,
+            flat_tops: self.flat.finish(),
+            removals,
+        })
+    }
+
+    /// One pass over a slice.
+    pub fn of(x: &[f64], screen: bool) -> Result<Surveyed, String> {
+        let mut s = Self::new(screen);
+        s.push(x);
+        s.finish()
+    }
+}
+
+/// The levels the analysis takes from a recording's survey (after its glitches are
+/// removed) and the options.
+#[derive(Clone, Debug)]
+pub struct Levels {
+    pub clipping: Option<Clipping>,
+    /// The full scale quantised to 32 000 counts, m/s² (the sensor's, or the recording's
+    /// largest reading).
+    pub full_scale_m_s2: Option<f64>,
+    pub gain_m_s2_per_count: f64,
+    pub trigger_m_s2: f64,
+    pub edge_m_s2: f64,
+}
+
+/// The levels from a single channel's survey: the sensor's `range_m_s2` (full scale) if
+/// known, else the flat tops found; the trigger and edge levels given, or from the noise
+/// and range.
+pub fn levels(
+    s: &Surveyed,
+    range_m_s2: Option<f64>,
+    trigger: Option<f64>,
+    edge: Option<f64>,
+) -> Levels {
+    let clipping = match range_m_s2 {
+        Some(fs) => Some(screen::from_range(fs)),
+        None => s.flat_tops.clone(),
+    };
+    let gain = crate::analyze::gain_for(range_m_s2.unwrap_or_else(|| s.peak_m_s2()));
+    let (trigger, edge) = trigger_and_edge(s, gain, trigger, edge);
+    Levels {
+        clipping,
+        full_scale_m_s2: range_m_s2,
+        gain_m_s2_per_count: gain,
+        trigger_m_s2: trigger,
+        edge_m_s2: edge,
+    }
+}
+
+/// The trigger level (given, or 10 × the noise, 5 % of the range, 4 counts, the largest)
+/// and the edge level (given, or 3 × the noise within a fifth and a half of the trigger).
+pub fn trigger_and_edge(
+    s: &Surveyed,
+    gain: f64,
+    trigger: Option<f64>,
+    edge: Option<f64>,
+) -> (f64, f64) {
+    let sigma = s.noise_rms_m_s2;
+    let trigger = trigger.unwrap_or_else(|| {
+        (10.0 * sigma)
+            .max(0.05 * s.range_m_s2())
+            .max(f64::from(gain as f32) * 4.0)
+    });
+    let edge = edge.unwrap_or_else(|| (3.0 * sigma).max(trigger / 5.0).min(trigger / 2.0));
+    (trigger, edge)
+}

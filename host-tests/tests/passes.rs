@@ -1,0 +1,219 @@
+//! `impact analyze` on a regular file reads it in passes (a survey of the whole recording,
+//! a second one if glitches were removed, then the analysis) in memory that does not grow
+//! with its length. The reports equal the whole-file path's (standard input, or `--plot`,
+//! which needs the whole recording) for every format, with glitches, flat tops and the
+//! levels learned from the recording.
+
+use std::io::Write;
+use std::path::PathBuf;
+use std::process::{Command, Stdio};
+
+mod common;
+use common::impact_ok;
+
+fn tmp(name: &str) -> String {
+    PathBuf::from(env!("CARGO_TARGET_TMPDIR"))
+        .join(format!("{}-passes-{name}", std::process::id()))
+        .to_string_lossy()
+        .into_owned()
+}
+
+fn fixture(name: &str) -> String {
+    PathBuf::from(env!("CARGO_MANIFEST_DIR"))
+        .join("fixtures")
+        .join(name)
+        .to_string_lossy()
+        .into_owned()
+}
+
+/// `impact analyze FILE ARGS --json` read in passes, and read whole (`--plot`).
+fn passes_and_whole(file: &str, args: &[&str]) -> (String, String) {
+    let run = |extra: &[&str]| {
+        let mut v = vec!["analyze", file, "--json"];
+        v.extend_from_slice(args);
+        v.extend_from_slice(extra);
+        impact_ok(&v).0
+    };
+    let svg = tmp("whole.svg");
+    (run(&[]), run(&["--plot", &svg]))
+}
+
+/// `impact analyze - ARGS --json` with `bytes` on standard input (the whole-file path).
+fn from_stdin(bytes: Vec<u8>, args: &[&str]) -> String {
+    let mut child = Command::new(env!("CARGO_BIN_EXE_impact"))
+        .args(["analyze", "-", "--json"])
+        .args(args)
+        .stdin(Stdio::piped())
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    let mut stdin = child.stdin.take().unwrap();
+    let writer = std::thread::spawn(move || stdin.write_all(&bytes).unwrap());
+    let out = child.wait_with_output().unwrap();
+    writer.join().unwrap();
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    String::from_utf8(out.stdout).unwrap()
+}
+
+#[test]
+fn every_format_gives_the_whole_files_reports_in_passes() {
+    let cases: [(String, Vec<&str>); 8] = [
+        (
+            fixture("afrl-test1-int16.wav"),
+            vec!["--column", "1", "--gain", "0.001"],
+        ),
+        (fixture("afrl-test1-float32.wav"), vec![]),
+        (
+            fixture("afrl-test1-int16.npy"),
+            vec!["--rate", "1e6", "--column", "0", "--gain", "0.001"],
+        ),
+        (
+            fixture("afrl-test1-float32-fortran.npy"),
+            vec!["--rate", "1e6", "--column", "1"],
+        ),
+        (
+            fixture("afrl-test1-2ch.i16"),
+            vec!["--rate", "1e6", "--raw-channels", "2", "--column", "1"],
+        ),
+        (fixture("afrl-test1.f32"), vec!["--rate", "1e6"]),
+        (
+            fixture("afrl-test1.tdms"),
+            vec!["--column", "afrl/bottom_kgn"],
+        ),
+        (
+            PathBuf::from(env!("CARGO_MANIFEST_DIR"))
+                .join("data/afrl-drop-tower/series1_test1_full_100ms.csv")
+                .to_string_lossy()
+                .into_owned(),
+            vec!["--units", "kgn"],
+        ),
+    ];
+    for (file, args) in &cases {
+        let (passes, whole) = passes_and_whole(file, args);
+        assert_eq!(passes, whole, "{file}");
+        let v: serde_json::Value = serde_json::from_str(&passes).unwrap();
+        assert!(!v["impacts"].as_array().unwrap().is_empty(), "{file}: {v}");
+    }
+}
+
+/// Two 2 ms half-sine impacts of 50 g at 100 kS/s on ±1 count (0.01 g) of noise, in g,
+/// with glitches of one and two samples far above them and, if `clip_g` is given, the
+/// impacts' tops clipped flat there.
+fn glitched_csv(clip_g: Option<f64>) -> String {
+    let mut out = String::from("time_s,accel_g\n");
+    for k in 0..60_000u32 {
+        let t = f64::from(k) * 1e-5;
+        let noise = f64::from((k.wrapping_mul(2_654_435_761) >> 30) as i32 - 1) * 0.01;
+        let mut v = noise;
+        for at in [0.1, 0.4] {
+            if (at..at + 0.002).contains(&t) {
+                v += 50.0 * (std::f64::consts::PI * (t - at) / 0.002).sin();
+            }
+        }
+        if let Some(c) = clip_g {
+            v = v.min(c);
+        }
+        let v = match k {
+            20_000 => 4000.0,
+            30_000 => -3000.0,
+            30_001 => -2500.0,
+            _ => (v * 100.0).round() / 100.0,
+        };
+        out.push_str(&format!("{t:.5},{v}\n"));
+    }
+    out
+}
+
+#[test]
+fn glitches_flat_tops_and_learned_levels_give_the_whole_files_reports_in_passes() {
+    for clip in [None, Some(30.0)] {
+        let csv = glitched_csv(clip);
+        let file = tmp(&format!("glitched-{}.csv", clip.is_some()));
+        std::fs::write(&file, &csv).unwrap();
+        for args in [
+            vec!["--mass", "0.06", "--v0", "1.3357"],
+            vec!["--mass", "0.06", "--keep-spikes"],
+            vec![],
+            vec!["--range", "200", "--trigger", "5"],
+        ] {
+            let (passes, whole) = passes_and_whole(&file, &args);
+            assert_eq!(passes, whole, "clip {clip:?}, {args:?}");
+            assert_eq!(
+                from_stdin(csv.clone().into_bytes(), &args),
+                whole,
+                "stdin, clip {clip:?}, {args:?}"
+            );
+            let v: serde_json::Value = serde_json::from_str(&passes).unwrap();
+            let spikes = v["spikes_removed"].as_array().map_or(0, Vec::len);
+            let keep = args.contains(&"--keep-spikes");
+            assert_eq!(spikes, if keep { 0 } else { 2 }, "{args:?}: {v}");
+            // (A kept glitch is the recording's maximum: no flat top there.)
+            if clip.is_some() && !keep && !args.contains(&"--range") {
+                assert_eq!(v["clipping"]["from"], "flat-top", "{args:?}: {v}");
+            }
+        }
+    }
+}
+
+#[test]
+fn a_file_too_long_to_hold_whole_is_analysed_in_passes_in_bounded_memory() {
+    // 2^26 samples of raw i16 (128 MB; read whole, some 2.7 GB): one 2 ms impact every
+    // 2^21 samples on ±1 count of noise, and one glitch far above them all.
+    const PERIOD: usize = 1 << 21;
+    const PERIODS: usize = 32;
+    let mut pattern = vec![0u8; PERIOD * 2];
+    for (k, b) in pattern.chunks_exact_mut(2).enumerate() {
+        let noise = ((k as u32).wrapping_mul(2_654_435_761) >> 30) as i32 - 1;
+        let j = k as i64 - (PERIOD / 2) as i64;
+        let pulse = if (0..1000).contains(&j) {
+            (1000.0 * (std::f64::consts::PI * j as f64 / 1000.0).sin()).round() as i32
+        } else {
+            0
+        };
+        b.copy_from_slice(&((noise + pulse) as i16).to_le_bytes());
+    }
+    let file = tmp("long.i16");
+    {
+        let mut f = std::io::BufWriter::new(std::fs::File::create(&file).unwrap());
+        for p in 0..PERIODS {
+            let mut chunk = pattern.clone();
+            if p == 7 {
+                chunk[200..202].copy_from_slice(&30000i16.to_le_bytes());
+            }
+            f.write_all(&chunk).unwrap();
+        }
+    }
+    let out = Command::new(env!("CARGO_BIN_EXE_impact"))
+        .args([
+            "analyze", &file, "--rate", "500000", "--gain", "0.390625", "--units", "m/s2", "--json",
+        ])
+        // The child's own peak memory (VmHWM) on stderr.
+        .env("IMPACT_PEAK_MEMORY", "1")
+        .output()
+        .unwrap();
+    let _ = std::fs::remove_file(&file);
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(out.status.success(), "{err}");
+    let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    assert_eq!(v["impacts"].as_array().unwrap().len(), PERIODS, "{err}");
+    assert_eq!(
+        v["spikes_removed"][0]["sample"],
+        7 * PERIOD + 100,
+        "{}",
+        v["spikes_removed"]
+    );
+    assert_eq!(v["spikes_removed"].as_array().unwrap().len(), 1);
+    let peak_mib = err
+        .lines()
+        .find_map(|l| l.strip_prefix("peak memory: "))
+        .and_then(|v| v.trim_end_matches("kB").trim().parse::<f64>().ok())
+        .expect("peak memory printed")
+        / 1024.0;
+    eprintln!("2^26 samples in passes, peak memory {peak_mib:.1} MiB");
+    assert!(peak_mib < 64.0, "peak memory {peak_mib:.1} MiB");
+}
