@@ -129,7 +129,17 @@ pub fn analyze_in_passes(
     let (mass, scale) = analyze::mass_and_scale(args, &file)?;
     let full_scale = analyze::full_scale_m_s2(args, &file, scale)?;
     // The survey; again with the glitches replaced if there are any (they set the extremes).
-    let (first, source) = survey_pass(args, &name, progress, scale, &[], !args.keep_spikes)?;
+    // One bar over the passes: the survey fills its first half, a second survey (if any)
+    // the next sixth, the analysis the rest.
+    let bar = |from: f64, to: f64| {
+        progress.map(|p| {
+            if let Ok(mut span) = PASS_SPAN.lock() {
+                *span = (Some(p), from, to);
+            }
+            in_pass as fn(f64)
+        })
+    };
+    let (first, source) = survey_pass(args, &name, bar(0.0, 0.5), scale, &[], !args.keep_spikes)?;
     source.rate_hz()?;
     let (t0, rate_hz) = (source.t0(), source.final_rate_hz());
     drop(source);
@@ -137,7 +147,7 @@ pub fn analyze_in_passes(
     let survey = if removals.is_empty() {
         first
     } else {
-        survey_pass(args, &name, progress, scale, &removals, false)?.0
+        survey_pass(args, &name, bar(0.5, 2.0 / 3.0), scale, &removals, false)?.0
     };
     let levels = survey::levels(
         &survey,
@@ -159,7 +169,8 @@ pub fn analyze_in_passes(
         levels.clipping.as_ref(),
         mass,
     )?;
-    let mut source = open_source(args, &name, progress)?;
+    let from = if removals.is_empty() { 0.5 } else { 2.0 / 3.0 };
+    let mut source = open_source(args, &name, bar(from, 1.0))?;
     let head = read_head(&mut *source, scale)?;
     let head = head.iter().map(|a| analyze::to_count(*a, gain)).collect();
     let (reports, count, _) = run_monitor(source, head, (scale, gain), scene, removals.clone())?;
@@ -182,6 +193,19 @@ pub fn analyze_in_passes(
         axes: Vec::new(),
     };
     Ok((setup, reports))
+}
+
+/// The caller's progress bar and the span of it the current pass fills.
+static PASS_SPAN: std::sync::Mutex<(Option<fn(f64)>, f64, f64)> =
+    std::sync::Mutex::new((None, 0.0, 1.0));
+
+/// A pass's fraction read, shown on the caller's bar within the pass's span.
+fn in_pass(fraction: f64) {
+    if let Ok(span) = PASS_SPAN.lock() {
+        if let (Some(p), from, to) = *span {
+            p(from + (to - from) * fraction.clamp(0.0, 1.0));
+        }
+    }
 }
 
 /// Whether `impact analyze` reads `args.file` in passes ([`analyze_in_passes`]): a regular
