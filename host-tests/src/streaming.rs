@@ -195,9 +195,10 @@ pub fn analyze_in_passes(
     Ok((setup, reports))
 }
 
-/// The caller's progress bar and the span of it the current pass fills.
-static PASS_SPAN: std::sync::Mutex<(Option<fn(f64)>, f64, f64)> =
-    std::sync::Mutex::new((None, 0.0, 1.0));
+/// The caller's progress bar, and the span of it (from, to) the current pass fills.
+type Span = (Option<fn(f64)>, f64, f64);
+
+static PASS_SPAN: std::sync::Mutex<Span> = std::sync::Mutex::new((None, 0.0, 1.0));
 
 /// A pass's fraction read, shown on the caller's bar within the pass's span.
 fn in_pass(fraction: f64) {
