@@ -135,7 +135,6 @@ impl SpikeScan {
         let buf = std::mem::take(&mut self.buf);
         let base = self.base;
         let (mut lo, mut hi) = self.outside.unwrap_or((f64::INFINITY, f64::NEG_INFINITY));
-        let mut found = Vec::new();
         let mut j = (self.next - base) as usize;
         while j + 3 < buf.len() {
             let w = &buf[j - 2..j + 4];
@@ -150,35 +149,36 @@ impl SpikeScan {
             };
             // The sample counted outside the candidates: this one, or the one after the
             // candidate.
-            let outside = match len {
+            let (outside, candidate) = match len {
                 Some(len) => {
-                    found.push(Candidate {
+                    let c = Candidate {
                         at: base + j as u64,
                         len,
                         values: [w[2], if len == 2 { w[3] } else { w[2] }],
                         before: w[1],
                         after: w[2 + len],
-                    });
+                    };
                     j += len + 1;
-                    w[2 + len]
+                    (w[2 + len], Some(c))
                 }
                 None => {
                     j += 1;
-                    w[2]
+                    (w[2], None)
                 }
             };
             lo = if outside < lo { outside } else { lo };
             hi = if outside > hi { outside } else { hi };
+            // Held against the range up to here, whatever the blocks: what is held, and
+            // whether too many are, does not depend on how the recording was cut.
+            if let Some(c) = candidate {
+                self.outside = Some((lo, hi));
+                self.hold(c);
+            }
         }
         self.next = base + j as u64;
         self.buf = buf;
         if lo <= hi {
             self.outside = Some((lo, hi));
-        }
-        // Held against the range so far (dropping one later than it could have been
-        // dropped changes nothing: only the end decides).
-        for c in found {
-            self.hold(c);
         }
         // Keep the samples the next tries look back on.
         let keep_from = self.next.saturating_sub(2).max(self.base);
@@ -198,6 +198,9 @@ impl SpikeScan {
             self.outside_sample(v);
             k += 1;
         }
+        // Those the whole recording's range rules out go first.
+        let held = std::mem::take(&mut self.held);
+        self.held = held.into_iter().filter(|c| self.may_dwarf(c)).collect();
         if self.overflow || self.held.len() > MAX_GLITCHES {
             return Err(format!(
                 "more than {MAX_GLITCHES} isolated glitches each far beyond the rest of the \
@@ -763,6 +766,28 @@ mod tests {
                     "seed {seed}, {block}"
                 );
             }
+        }
+    }
+
+    #[test]
+    fn the_glitch_limit_does_not_depend_on_the_blocks() {
+        // Many glitches early that a real impact later dwarfs: none is a spike, however the
+        // recording is cut.
+        let n = 3 * (MAX_GLITCHES + 100) + 5000;
+        let mut x: Vec<f64> = (0..n).map(|i| (i % 3) as f64 * 0.01).collect();
+        for k in 0..MAX_GLITCHES + 100 {
+            x[3 * k + 10] = 1000.0;
+        }
+        for k in 0..1000 {
+            x[n - 2000 + k] += 500.0 * (std::f64::consts::PI * k as f64 / 1000.0).sin();
+        }
+        let m = median(&x);
+        let whole = remove_spikes(&mut x.clone(), m).unwrap();
+        assert!(whole.is_empty());
+        for block in [7, 4096, 65536] {
+            let mut scan = SpikeScan::default();
+            x.chunks(block).for_each(|b| scan.push(b));
+            assert!(scan.finish(m).unwrap().is_empty(), "blocks of {block}");
         }
     }
 

@@ -747,11 +747,11 @@ impl CsvSource {
     }
 }
 
-impl Source for CsvSource {
-    fn next_values(&mut self, want: usize, out: &mut Vec<f64>) -> Result<(), String> {
-        if self.ended {
-            return Ok(());
-        }
+impl CsvSource {
+    /// Appends the next rows' values: about `want` (the sequential reader) or a chunk (the
+    /// parallel one); none at a hand-over from one to the other, or at the end (then
+    /// `ended` is set).
+    fn next_some(&mut self, want: usize, out: &mut Vec<f64>) -> Result<(), String> {
         // Past the head, a file's plain rows go through the parallel fast path.
         if self.head_done
             && self.fast.is_none()
@@ -813,6 +813,7 @@ impl Source for CsvSource {
         let mut row = Vec::new();
         for _ in 0..left {
             let Some((line, _, r)) = self.rows.next_row().map_err(|e| e.to_string())? else {
+                self.ended = true;
                 break;
             };
             row.clear();
@@ -820,6 +821,17 @@ impl Source for CsvSource {
             let v = self.take(line, &row)?;
             out.push(v);
             self.sequential += 1;
+        }
+        Ok(())
+    }
+}
+
+impl Source for CsvSource {
+    fn next_values(&mut self, want: usize, out: &mut Vec<f64>) -> Result<(), String> {
+        // A hand-over between the readers can give no rows: only the end gives none.
+        let before = out.len();
+        while out.len() == before && !self.ended {
+            self.next_some(want, out)?;
         }
         Ok(())
     }

@@ -101,16 +101,17 @@ fn every_format_gives_the_whole_files_reports_in_passes() {
     }
 }
 
-/// Two 2 ms half-sine impacts of 50 g at 100 kS/s on ±1 count (0.01 g) of noise, in g,
+/// Three 2 ms half-sine impacts of 50 g at 100 kS/s (200 000 rows: past the head, the
+/// parallel reader's) on ±1 count (0.01 g) of noise, in g,
 /// with glitches of one and two samples far above them and, if `clip_g` is given, the
 /// impacts' tops clipped flat there.
 fn glitched_csv(clip_g: Option<f64>) -> String {
     let mut out = String::from("time_s,accel_g\n");
-    for k in 0..60_000u32 {
+    for k in 0..200_000u32 {
         let t = f64::from(k) * 1e-5;
         let noise = f64::from((k.wrapping_mul(2_654_435_761) >> 30) as i32 - 1) * 0.01;
         let mut v = noise;
-        for at in [0.1, 0.4] {
+        for at in [0.1, 0.4, 1.5] {
             if (at..at + 0.002).contains(&t) {
                 v += 50.0 * (std::f64::consts::PI * (t - at) / 0.002).sin();
             }
@@ -120,8 +121,8 @@ fn glitched_csv(clip_g: Option<f64>) -> String {
         }
         let v = match k {
             20_000 => 4000.0,
-            30_000 => -3000.0,
-            30_001 => -2500.0,
+            130_000 => -3000.0,
+            130_001 => -2500.0,
             _ => (v * 100.0).round() / 100.0,
         };
         out.push_str(&format!("{t:.5},{v}\n"));
@@ -158,6 +159,29 @@ fn glitches_flat_tops_and_learned_levels_give_the_whole_files_reports_in_passes(
             }
         }
     }
+}
+
+/// A hand-over from the parallel reader to the row-by-row one right after the head (every
+/// field quoted) reads on to the end.
+#[test]
+fn quoted_rows_past_the_head_are_all_read() {
+    let mut csv = String::from("time_s,accel_g\n");
+    for k in 0..100_000u32 {
+        let v = if (50_000..50_200).contains(&k) {
+            40.0 * (std::f64::consts::PI * f64::from(k - 50_000) / 200.0).sin()
+        } else {
+            f64::from(k % 3) * 0.01
+        };
+        csv.push_str(&format!("\"{:.5}\",\"{v:.4}\"\n", f64::from(k) * 1e-5));
+    }
+    let file = tmp("quoted.csv");
+    std::fs::write(&file, &csv).unwrap();
+    let (passes, whole) = passes_and_whole(&file, &[]);
+    assert_eq!(passes, whole);
+    assert_eq!(from_stdin(csv.into_bytes(), &[]), whole);
+    let v: serde_json::Value = serde_json::from_str(&passes).unwrap();
+    assert_eq!(v["samples"], 100_000);
+    assert_eq!(v["impacts"].as_array().unwrap().len(), 1, "{v}");
 }
 
 #[test]

@@ -370,11 +370,27 @@ fn a_long_csv_file_gives_the_same_reports_and_errors_through_the_parallel_reader
         std::fs::write(&path, lines.join("\n") + "\n").unwrap();
         path
     };
+    // The whole-file path, from standard input (read by one thread, row by row).
+    let run_stdin = |file: &str, tail: &[&str]| {
+        let out = Command::new(env!("CARGO_BIN_EXE_impact"))
+            .args(["analyze", "-"])
+            .args(levels)
+            .args(tail)
+            .stdin(std::fs::File::open(file).unwrap())
+            .output()
+            .unwrap();
+        (
+            out.status.code().unwrap_or(-1),
+            String::from_utf8_lossy(&out.stdout).into_owned(),
+            String::from_utf8_lossy(&out.stderr).into_owned(),
+        )
+    };
     let plain = write("long.csv", &lines);
-    let whole = run(&plain, &["--json", "--keep-spikes"]);
+    let whole = run_stdin(&plain, &["--json", "--keep-spikes"]);
     assert_eq!(whole.0, 0, "{}", whole.2);
     let v: serde_json::Value = serde_json::from_str(&whole.1).unwrap();
     assert!(v["impacts"][0]["cor"].is_number(), "{v}");
+    assert_eq!(run(&plain, &["--json", "--keep-spikes"]).1, whole.1);
     assert_eq!(run(&plain, &["--json", "--stream"]).1, whole.1);
 
     // Quoted fields, a blank line, `\r\n` and spaces past the head.
@@ -395,8 +411,8 @@ fn a_long_csv_file_gives_the_same_reports_and_errors_through_the_parallel_reader
         };
     }
     let odd = write("odd.csv", &odd);
-    let whole_odd = run(&odd, &["--json", "--keep-spikes"]);
-    assert_eq!(whole_odd.1, whole.1);
+    assert_eq!(run_stdin(&odd, &["--json", "--keep-spikes"]).1, whole.1);
+    assert_eq!(run(&odd, &["--json", "--keep-spikes"]).1, whole.1);
     assert_eq!(run(&odd, &["--json", "--stream"]).1, whole.1);
 
     // A text field and a gap, far past the head: the whole-file reader's message and line.
@@ -404,9 +420,11 @@ fn a_long_csv_file_gives_the_same_reports_and_errors_through_the_parallel_reader
     text[250_000] = text[250_000].replace(',', ",x");
     let text = write("text.csv", &text);
     let (code, _, err) = run(&text, &["--stream"]);
-    let (_, _, whole_err) = run(&text, &[]);
+    let (_, _, passes_err) = run(&text, &[]);
     assert!(code != 0 && err.contains(":250001: not a number"), "{err}");
-    assert_eq!(err, whole_err);
+    assert_eq!(err, passes_err);
+    let (_, _, whole_err) = run_stdin(&text, &[]);
+    assert_eq!(whole_err, err.replace(&text, "stdin"));
     let mut gap = lines.clone();
     gap.remove(240_000);
     let gap = write("gap-long.csv", &gap);
