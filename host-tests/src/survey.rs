@@ -93,7 +93,7 @@ impl Survey {
     }
 
     pub fn finish(self) -> Result<Surveyed, String> {
-        if self.values.len() > 0 && !(self.min.is_finite() && self.max.is_finite()) {
+        if !self.values.is_empty() && !(self.min.is_finite() && self.max.is_finite()) {
             return Err(
                 "a reading times the units and --gain is beyond the range of f64 (give a smaller --gain)"
                     .into(),
