@@ -93,7 +93,8 @@ impl Survey {
     }
 
     pub fn finish(self) -> Result<Surveyed, String> {
-        if !self.values.is_empty() && !(self.min.is_finite() && self.max.is_finite()) {
+        let finite = self.min.is_finite() && self.max.is_finite();
+        if !self.values.is_empty() && !finite {
             return Err(
                 "a reading times the units and --gain is beyond the range of f64 (give a smaller --gain)"
                     .into(),
