@@ -461,27 +461,6 @@ pub struct Prepared {
     pub accel_m_s2: Vec<f64>,
 }
 
-/// Quantises a signal (m/s²) to i16 counts: the sensor's full scale, if known, to 32000
-/// counts (so readings a little past it still fit), else the finest gain that holds the
-/// signal's range.
-pub fn quantise(
-    accel: &[f64],
-    rate_hz: f64,
-    full_scale_m_s2: Option<f64>,
-) -> (Vec<i16>, Calibration) {
-    let gain = gain_for(
-        full_scale_m_s2.unwrap_or_else(|| accel.iter().fold(0.0f64, |m, v| m.max(v.abs()))),
-    );
-    let counts = accel.iter().map(|v| to_count(*v, gain)).collect();
-    (
-        counts,
-        Calibration {
-            gain_m_s2_per_count: gain as f32,
-            sample_rate_hz: rate_hz as f32,
-        },
-    )
-}
-
 /// The gain, m/s² per count, that puts `full_scale_m_s2` at 32 000 counts.
 pub fn gain_for(full_scale_m_s2: f64) -> f64 {
     full_scale_m_s2.max(1e-30) / 32000.0
@@ -538,7 +517,7 @@ pub struct Setup {
     pub free_fall_s: Option<f64>,
     pub samples: u64,
     pub rate_hz: f64,
-    /// Isolated spikes removed before quantising (see [`screen::remove_spikes`]).
+    /// Isolated spikes removed before quantising (see [`screen::SpikeScan`]).
     pub spikes: Vec<Spike>,
     /// The channel's rails, if known.
     pub clipping: Option<Clipping>,

@@ -49,14 +49,6 @@ impl Removal {
     }
 }
 
-/// Finds isolated spikes in `x` and replaces each by the straight line between its
-/// neighbours ([`SpikeScan`] over the whole slice, `median` the recording's).
-pub fn remove_spikes(x: &mut [f64], median: f64) -> Result<Vec<Spike>, String> {
-    let mut scan = SpikeScan::default();
-    scan.push(x);
-    Ok(apply(&scan.finish(median)?, x, 0.0, 1.0))
-}
-
 /// Replaces each removal's samples in `x` by its straight line; the spikes, timed from the
 /// first sample's time `t0_s` at `rate_hz` (as the impacts are).
 pub fn apply(removals: &[Removal], x: &mut [f64], t0_s: f64, rate_hz: f64) -> Vec<Spike> {
@@ -583,6 +575,14 @@ mod tests {
                 (v * 100.0).round() / 100.0 + dither
             })
             .collect()
+    }
+
+    /// Finds isolated spikes in `x` and replaces each by the straight line between its
+    /// neighbours ([`SpikeScan`] over the whole slice, `median` the recording's).
+    fn remove_spikes(x: &mut [f64], median: f64) -> Result<Vec<Spike>, String> {
+        let mut scan = SpikeScan::default();
+        scan.push(x);
+        Ok(apply(&scan.finish(median)?, x, 0.0, 1.0))
     }
 
     fn median(x: &[f64]) -> f64 {

@@ -190,17 +190,7 @@ fn a_file_too_long_to_hold_whole_is_analysed_in_passes_in_bounded_memory() {
     // 2^21 samples on ±1 count of noise, and one glitch far above them all.
     const PERIOD: usize = 1 << 21;
     const PERIODS: usize = 32;
-    let mut pattern = vec![0u8; PERIOD * 2];
-    for (k, b) in pattern.chunks_exact_mut(2).enumerate() {
-        let noise = ((k as u32).wrapping_mul(2_654_435_761) >> 30) as i32 - 1;
-        let j = k as i64 - (PERIOD / 2) as i64;
-        let pulse = if (0..1000).contains(&j) {
-            (1000.0 * (std::f64::consts::PI * j as f64 / 1000.0).sin()).round() as i32
-        } else {
-            0
-        };
-        b.copy_from_slice(&((noise + pulse) as i16).to_le_bytes());
-    }
+    let pattern = common::impact_period(PERIOD, 0);
     let file = tmp("long.i16");
     {
         let mut f = std::io::BufWriter::new(std::fs::File::create(&file).unwrap());
@@ -232,12 +222,7 @@ fn a_file_too_long_to_hold_whole_is_analysed_in_passes_in_bounded_memory() {
         v["spikes_removed"]
     );
     assert_eq!(v["spikes_removed"].as_array().unwrap().len(), 1);
-    let peak_mib = err
-        .lines()
-        .find_map(|l| l.strip_prefix("peak memory: "))
-        .and_then(|v| v.trim_end_matches("kB").trim().parse::<f64>().ok())
-        .expect("peak memory printed")
-        / 1024.0;
+    let peak_mib = common::peak_memory_mib(&err);
     eprintln!("2^26 samples in passes, peak memory {peak_mib:.1} MiB");
     assert!(peak_mib < 64.0, "peak memory {peak_mib:.1} MiB");
 }

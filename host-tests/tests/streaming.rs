@@ -285,19 +285,8 @@ fn npy_streams_give_the_whole_files_reports_in_either_order() {
 fn a_stream_longer_than_memory_is_analysed_in_bounded_memory() {
     const PERIOD: usize = 1 << 22; // 8.4 s at 500 kS/s, one impact each
     const PERIODS: usize = 256;
-    let mut pattern = vec![0u8; PERIOD * 2];
-    for (k, b) in pattern.chunks_exact_mut(2).enumerate() {
-        // Mid-scale with ±1 count of noise, a 2 ms half-sine of 1000 counts (390 m/s²).
-        let noise = ((k as u32).wrapping_mul(2_654_435_761) >> 30) as i32 - 1;
-        let j = k as i64 - (PERIOD / 2) as i64;
-        let pulse = if (0..1000).contains(&j) {
-            (1000.0 * (std::f64::consts::PI * j as f64 / 1000.0).sin()).round() as i32
-        } else {
-            0
-        };
-        let code = (2048 + noise + pulse) as i16;
-        b.copy_from_slice(&code.to_le_bytes());
-    }
+    // Mid-scale with ±1 count of noise, a 2 ms half-sine of 1000 counts (390 m/s²).
+    let pattern = common::impact_period(PERIOD, 2048);
     let mut child = Command::new(env!("CARGO_BIN_EXE_impact"))
         .args(["analyze", "-", "--stream", "--raw-type", "i16", "--csv"])
         .args(&LEVELS[..12])
@@ -321,12 +310,7 @@ fn a_stream_longer_than_memory_is_analysed_in_bounded_memory() {
     let csv = String::from_utf8(out.stdout).unwrap();
     let rows = csv.lines().skip(1).filter(|l| !l.is_empty()).count();
     assert_eq!(rows, PERIODS, "one report per inserted impact");
-    let peak_mib = err
-        .lines()
-        .find_map(|l| l.strip_prefix("peak memory: "))
-        .and_then(|v| v.trim_end_matches("kB").trim().parse::<f64>().ok())
-        .expect("peak memory printed")
-        / 1024.0;
+    let peak_mib = common::peak_memory_mib(&err);
     eprintln!("2^30 samples streamed, {rows} impacts, peak memory {peak_mib:.1} MiB");
     assert!(peak_mib < 64.0, "peak memory {peak_mib:.1} MiB");
 }

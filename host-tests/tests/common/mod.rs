@@ -47,3 +47,32 @@ pub const SYNTH_T2: [&str; 13] = [
 pub fn synth_t2() -> String {
     impact_ok(&SYNTH_T2).0
 }
+
+/// `period` samples of little-endian i16 codes: `offset` with ±1 count of noise, and a 2 ms
+/// (1000-sample) half-sine of 1000 counts starting half way.
+#[allow(dead_code)] // not every test file needs it
+pub fn impact_period(period: usize, offset: i32) -> Vec<u8> {
+    let mut pattern = vec![0u8; period * 2];
+    for (k, b) in pattern.chunks_exact_mut(2).enumerate() {
+        let noise = ((k as u32).wrapping_mul(2_654_435_761) >> 30) as i32 - 1;
+        let j = k as i64 - (period / 2) as i64;
+        let pulse = if (0..1000).contains(&j) {
+            (1000.0 * (std::f64::consts::PI * j as f64 / 1000.0).sin()).round() as i32
+        } else {
+            0
+        };
+        b.copy_from_slice(&((offset + noise + pulse) as i16).to_le_bytes());
+    }
+    pattern
+}
+
+/// The peak memory, MiB, a child run with IMPACT_PEAK_MEMORY set printed on stderr.
+#[allow(dead_code)] // not every test file needs it
+pub fn peak_memory_mib(stderr: &str) -> f64 {
+    stderr
+        .lines()
+        .find_map(|l| l.strip_prefix("peak memory: "))
+        .and_then(|v| v.trim_end_matches("kB").trim().parse::<f64>().ok())
+        .expect("peak memory printed")
+        / 1024.0
+}
