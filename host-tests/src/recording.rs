@@ -114,9 +114,14 @@ pub fn time_unit_s(header: &str) -> f64 {
 /// 0.6..1.25.
 pub(crate) const INTERVAL_RANGE: std::ops::RangeInclusive<f64> = 0.5..=1.5;
 
+/// The intervals whose median every interval is checked against: the first 65 535 (those
+/// among the first 65 536 rows, as a file read in passes or a stream has them at hand).
+pub(crate) const HEAD_INTERVALS: usize = (1 << 16) - 1;
+
 /// Checks a time column: finite, strictly increasing and evenly sampled (every interval within
-/// [`INTERVAL_RANGE`] times the median). Returns `(rate, jitter)`; with `resample`, uneven
-/// intervals are allowed and the rate is the median interval's.
+/// [`INTERVAL_RANGE`] times the median of the first [`HEAD_INTERVALS`]). Returns `(rate,
+/// jitter)`; with `resample`, uneven intervals are allowed and the rate is the median
+/// interval's (of all of them).
 fn check_time(
     path: &Path,
     t: &[f64],
@@ -143,23 +148,16 @@ fn check_time(
             message: "one sample: the rate cannot be told; give --rate".into(),
         });
     }
-    let mut dts: Vec<f64> = t.windows(2).map(|w| w[1] - w[0]).collect();
-    let mid = dts.len() / 2;
-    let median = *dts.select_nth_unstable_by(mid, f64::total_cmp).1;
+    let dts: Vec<f64> = t.windows(2).map(|w| w[1] - w[0]).collect();
+    let median_of = |d: &[f64]| {
+        let mut d = d.to_vec();
+        let mid = d.len() / 2;
+        *d.select_nth_unstable_by(mid, f64::total_cmp).1
+    };
     if !resample {
-        for (i, w) in t.windows(2).enumerate() {
-            let ratio = (w[1] - w[0]) / median;
-            if !INTERVAL_RANGE.contains(&ratio) {
-                return Err(at(
-                    i + 1,
-                    format!(
-                        "uneven time axis: {:.6e} s since the previous sample, {ratio:.3} times \
-                         the median interval {median:.6e} s (a gap or a rate change); give \
-                         --resample to interpolate onto an even grid, or cut the file",
-                        w[1] - w[0]
-                    ),
-                ));
-            }
+        let median = median_of(&dts[..dts.len().min(HEAD_INTERVALS)]);
+        for (i, &dt) in dts.iter().enumerate() {
+            crate::streaming::check_interval(dt, median).map_err(|m| at(i + 1, m))?;
         }
         let dt = (t[t.len() - 1] - t[0]) / (t.len() - 1) as f64;
         let jitter = t
@@ -168,7 +166,7 @@ fn check_time(
             .fold(0.0, f64::max);
         Ok((1.0 / dt, jitter))
     } else {
-        Ok((1.0 / median, 0.0))
+        Ok((1.0 / median_of(&dts), 0.0))
     }
 }
 

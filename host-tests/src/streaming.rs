@@ -1,13 +1,16 @@
-//! `impact analyze --stream`: a CSV, WAV, .npy, TDMS or raw (`.i16`/`.f32`) recording, a file or
-//! (CSV, raw) standard input, analysed as it is read, a block at a time, in memory that does not grow with its
-//! length (an hour at 500 kS/s is 3.6 GB of i16, ~60 GB of CSV). The per-sample arithmetic is
-//! the whole-file path's
-//! (units, gain, quantisation to counts at the `--range` full scale), so with the same
-//! levels both give the same reports (tested); what needs the whole signal is refused or
-//! asked for instead: the quantisation's full scale (`--range`), the trigger level
-//! (`--trigger`), spike screening (not done), figures, axes, free fall, resampling. A
-//! reader thread reads and quantises ahead of the monitor; a CSV file's plain rows past the
-//! head are parsed in parallel ([`crate::csv_fast`]).
+//! Recordings read a block at a time, in memory that does not grow with their length (an
+//! hour at 500 kS/s is 3.6 GB of i16, ~60 GB of CSV): a CSV, WAV, .npy, TDMS or raw
+//! (`.i16`/`.f32`) file, or (CSV, raw) standard input.
+//!
+//! - `impact analyze FILE` on a regular file ([`analyze_in_passes`]): a survey of the whole
+//!   recording ([`crate::survey`]), then the analysis; the whole-file path's reports.
+//! - `impact analyze --stream` ([`analyze`]): one pass, with what needs the whole signal given
+//!   (`--range`, `--trigger`) or refused (spike screening is not done; figures, axes, free fall,
+//!   resampling); with the same levels, the same reports (tested).
+//!
+//! The per-sample arithmetic (units, gain, quantisation) is the whole-file path's. A reader
+//! thread reads ahead of the survey or the monitor; a CSV file's plain rows past the head are
+//! parsed in parallel ([`crate::csv_fast`]).
 
 use std::io::Read;
 
@@ -636,6 +639,10 @@ struct CsvSource {
     fast: Option<crate::csv_fast::FastRows>,
     head_done: bool,
     ended: bool,
+    /// The first time that does not increase, and the first uneven interval (reported at
+    /// the end, in this order, as the whole-file path does).
+    not_increasing: Option<String>,
+    uneven: Option<String>,
     sequential: usize,
     progress: Option<fn(f64)>,
 }
@@ -706,6 +713,8 @@ impl CsvSource {
             fast: None,
             head_done: false,
             ended: false,
+            not_increasing: None,
+            uneven: None,
             sequential: crate::csv_fast::SEQUENTIAL_ROWS,
             progress,
         };
@@ -727,17 +736,23 @@ impl CsvSource {
             if self.t0.is_none() {
                 self.t0 = Some(t);
             } else {
+                // Errors wait for the end, as in the whole-file path: a value that is not a
+                // number anywhere comes first, then time going back, then an uneven interval
+                // (the first of each).
                 let at = |m: String| format!("{}:{line}: {m}", self.name);
-                if t <= self.last {
-                    return Err(at(format!(
-                        "time {t} s does not increase (previous {} s)",
-                        self.last
-                    )));
-                }
                 let dt = t - self.last;
-                match self.median_dt {
-                    None => self.head_dts.push((dt, line)),
-                    Some(m) => check_interval(dt, m).map_err(at)?,
+                if t <= self.last {
+                    let m = format!("time {t} s does not increase (previous {} s)", self.last);
+                    self.not_increasing.get_or_insert_with(|| at(m));
+                } else {
+                    match self.median_dt {
+                        None => self.head_dts.push((dt, line)),
+                        Some(m) => {
+                            if let Err(e) = check_interval(dt, m) {
+                                self.uneven.get_or_insert_with(|| at(e));
+                            }
+                        }
+                    }
                 }
             }
             self.last = t;
@@ -833,6 +848,11 @@ impl Source for CsvSource {
         while out.len() == before && !self.ended {
             self.next_some(want, out)?;
         }
+        if self.ended {
+            if let Some(e) = self.not_increasing.take().or_else(|| self.uneven.take()) {
+                return Err(e);
+            }
+        }
         Ok(())
     }
 
@@ -847,11 +867,21 @@ impl Source for CsvSource {
         let median = *sorted.select_nth_unstable_by(mid, f64::total_cmp).1;
         // The head's intervals against their median, as every later one.
         for (dt, line) in dts {
-            check_interval(dt, median).map_err(|m| format!("{}:{line}: {m}", self.name))?;
+            if let Err(m) = check_interval(dt, median) {
+                self.uneven
+                    .get_or_insert_with(|| format!("{}:{line}: {m}", self.name));
+            }
         }
         self.median_dt = Some(median);
         if let Some(t0) = self.t0 {
-            self.head_rate = Some((self.n - 1) as f64 / (self.last - t0));
+            let rate = (self.n - 1) as f64 / (self.last - t0);
+            // A head whose time goes back gives no rate to go on with: its error now.
+            if !(rate.is_finite() && rate > 0.0) {
+                if let Some(e) = self.not_increasing.take() {
+                    return Err(e);
+                }
+            }
+            self.head_rate = Some(rate);
         }
         Ok(())
     }
@@ -890,8 +920,7 @@ pub(crate) fn check_interval(dt: f64, median: f64) -> Result<(), String> {
         Err(format!(
             "uneven time axis: {dt:.6e} s since the previous sample, {ratio:.3} times the first \
              intervals' median {median:.6e} s (a gap or a rate change); give --resample to \
-             interpolate onto an even grid (the whole recording is then held in memory), or cut \
-             the file"
+             interpolate onto an even grid, or cut the file"
         ))
     }
 }

@@ -226,3 +226,82 @@ fn a_file_too_long_to_hold_whole_is_analysed_in_passes_in_bounded_memory() {
     eprintln!("2^26 samples in passes, peak memory {peak_mib:.1} MiB");
     assert!(peak_mib < 64.0, "peak memory {peak_mib:.1} MiB");
 }
+
+/// A CSV's time errors read the same in passes, whole (standard input) and `--stream`: a
+/// value that is not a number first, then time going back, then an uneven interval (the
+/// first of each), every interval against the first intervals' median.
+#[test]
+fn time_axis_errors_read_the_same_on_every_path() {
+    let csv = |rows: usize, time: &dyn Fn(usize) -> f64, bad: Option<usize>| {
+        let mut s = String::from("time_s,accel_g\n");
+        for k in 0..rows {
+            let v = if Some(k) == bad {
+                "x".to_string()
+            } else {
+                format!("{:.2}", (k % 3) as f64 * 0.01)
+            };
+            s.push_str(&format!("{:.7},{v}\n", time(k)));
+        }
+        s
+    };
+    // 65 536 intervals of 10 µs, then 16 µs: uneven against the first intervals' median (the
+    // median of all of them would pass it).
+    let drift = |k: usize| {
+        if k <= 65_536 {
+            k as f64 * 1e-5
+        } else {
+            0.65536 + (k - 65_536) as f64 * 1.6e-5
+        }
+    };
+    let back = |k: usize| {
+        let t = k as f64 * 1e-5;
+        match k {
+            100_000 => t + 1.0, // a gap: uneven
+            150_000 => t - 0.5, // back in time
+            _ if k > 100_000 => t + 1.0,
+            _ => t,
+        }
+    };
+    let even = |k: usize| k as f64 * 1e-5;
+    let cases: [(&str, String, &str); 4] = [
+        (
+            "drift",
+            csv(200_000, &drift, None),
+            ":65539: uneven time axis",
+        ),
+        ("back", csv(200_000, &back, None), ":150002: time"),
+        ("text", csv(200_000, &back, Some(180_000)), ":180002:"),
+        ("text-even", csv(100_000, &even, Some(90_000)), ":90002:"),
+    ];
+    let svg = tmp("errors.svg");
+    for (name, text, want) in cases {
+        let file = tmp(&format!("{name}.csv"));
+        std::fs::write(&file, &text).unwrap();
+        let passes = common::impact(&["analyze", &file]);
+        let whole = common::impact(&["analyze", &file, "--plot", &svg]);
+        let stream = common::impact(&[
+            "analyze",
+            &file,
+            "--stream",
+            "--range",
+            "10",
+            "--trigger",
+            "1",
+        ]);
+        let out = Command::new(env!("CARGO_BIN_EXE_impact"))
+            .args(["analyze", "-"])
+            .stdin(std::fs::File::open(&file).unwrap())
+            .output()
+            .unwrap();
+        let stdin = String::from_utf8_lossy(&out.stderr).replace("stdin", &file);
+        assert!(
+            passes.0 != 0 && passes.2.contains(want),
+            "{name}: {}",
+            passes.2
+        );
+        assert_eq!(passes.2.trim().lines().count(), 1, "{name}: {}", passes.2);
+        assert_eq!(whole.2, passes.2, "{name}: whole");
+        assert_eq!(stdin, passes.2, "{name}: stdin");
+        assert_eq!(stream.2, passes.2, "{name}: --stream");
+    }
+}
