@@ -272,7 +272,7 @@ fn follows(time: f64, last: &mut Option<f64>, layout: &Layout) -> bool {
         return true;
     };
     let t = time * layout.time_unit_s;
-    let ok = last.is_none_or(|l| t > l && crate::streaming::check_interval(t - l, median).is_ok());
+    let ok = last.is_none_or(|l| t > l && crate::sources::check_interval(t - l, median).is_ok());
     *last = Some(t);
     ok
 }

@@ -20,6 +20,7 @@ pub mod recording;
 pub mod screen;
 pub mod simulate;
 pub mod soak;
+pub mod sources;
 pub mod spectrum;
 pub mod stability;
 pub mod streaming;

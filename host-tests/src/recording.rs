@@ -157,7 +157,7 @@ fn check_time(
     if !resample {
         let median = median_of(&dts[..dts.len().min(HEAD_INTERVALS)]);
         for (i, &dt) in dts.iter().enumerate() {
-            crate::streaming::check_interval(dt, median).map_err(|m| at(i + 1, m))?;
+            crate::sources::check_interval(dt, median).map_err(|m| at(i + 1, m))?;
         }
         let dt = (t[t.len() - 1] - t[0]) / (t.len() - 1) as f64;
         let jitter = t

@@ -1,0 +1,712 @@
+//! The readers a recording is taken from a block at a time, one per format (CSV, WAV, .npy,
+//! TDMS, raw), for a file read in passes or a stream ([`crate::streaming`]): values as they
+//! are read, the rate, the first time, and a CSV's checks as the whole-file path makes them.
+
+use std::io::Read;
+
+use crate::analyze::{self, AnalyzeArgs};
+use crate::raw::RawType;
+use crate::table::is_stdin;
+
+/// Samples whose noise sets the default edge level (the whole-file path uses the whole
+/// recording's): the first 65 536.
+pub(crate) const HEAD: usize = 1 << 16;
+
+/// Bytes read at a time.
+pub(crate) const CHUNK: usize = 1 << 16;
+
+/// Opens the reader for the file's format.
+pub(crate) fn open_source(
+    args: &AnalyzeArgs,
+    name: &str,
+    progress: Option<fn(f64)>,
+) -> Result<Box<dyn Source>, String> {
+    Ok(match args.raw_type.or_else(|| RawType::of(&args.file)) {
+        Some(kind) => Box::new(RawSource::open(args, kind, name)?),
+        None if crate::wav::is_wav(&args.file) => Box::new(WavSource::open(args, name)?),
+        None if crate::npy::is_npy(&args.file) => Box::new(NpySource::open(args, name)?),
+        None if crate::tdms::is_tdms(&args.file) => Box::new(TdmsSource::open(args, name)?),
+        None => Box::new(CsvSource::open(args, progress)?),
+    })
+}
+
+/// The first [`HEAD`] values × `scale` (fewer if the input is shorter); then what the head
+/// tells is fixed ([`Source::head_read`]).
+pub(crate) fn read_head(source: &mut dyn Source, scale: f64) -> Result<Vec<f64>, String> {
+    let mut head = Vec::with_capacity(HEAD);
+    while head.len() < HEAD {
+        let before = head.len();
+        source.next_values(HEAD - head.len(), &mut head)?;
+        if head.len() == before {
+            break;
+        }
+    }
+    for v in &mut head {
+        *v *= scale;
+    }
+    source.head_read()?;
+    Ok(head)
+}
+
+/// Where the stream's values come from.
+pub(crate) trait Source: Send {
+    /// Appends up to about `want` values to `out` (none at the end of the input).
+    fn next_values(&mut self, want: usize, out: &mut Vec<f64>) -> Result<(), String>;
+    /// Appends up to about `want` values to `out` as counts (`to_count(v × scale, gain)`),
+    /// through `scratch`.
+    fn next_counts(
+        &mut self,
+        want: usize,
+        (scale, gain): (f64, f64),
+        scratch: &mut Vec<f64>,
+        out: &mut Vec<i16>,
+    ) -> Result<(), String> {
+        values_as_counts(self, want, (scale, gain), scratch, out)
+    }
+    /// The head has been read: what it tells (a CSV's rate) is fixed, and checked.
+    fn head_read(&mut self) -> Result<(), String> {
+        Ok(())
+    }
+    /// The rate the scene runs at (after the head).
+    fn rate_hz(&self) -> Result<f64, String>;
+    /// The rate the report gives (at the end: a CSV's mean interval over the whole file, as
+    /// the whole-file path computes it); the scene's by default.
+    fn final_rate_hz(&self) -> f64 {
+        self.rate_hz().unwrap_or(0.0)
+    }
+    /// Time of the first sample, s (0 without a time column).
+    fn t0(&self) -> f64 {
+        0.0
+    }
+}
+
+/// [`Source::next_counts`] through [`Source::next_values`] and `scratch`.
+fn values_as_counts<S: Source + ?Sized>(
+    source: &mut S,
+    want: usize,
+    (scale, gain): (f64, f64),
+    scratch: &mut Vec<f64>,
+    out: &mut Vec<i16>,
+) -> Result<(), String> {
+    scratch.clear();
+    source.next_values(want, scratch)?;
+    out.extend(scratch.iter().map(|v| analyze::to_count(v * scale, gain)));
+    Ok(())
+}
+
+/// A raw file or stream: the chosen channel of interleaved little-endian frames.
+struct RawSource {
+    input: Box<dyn Read + Send>,
+    kind: RawType,
+    /// Bytes per frame (all channels) and the channel's offset in it.
+    frame: usize,
+    at: usize,
+    buf: Vec<u8>,
+    /// Bytes in `buf` not yet used (a partial frame).
+    held: usize,
+    /// Bytes read so far.
+    read: u64,
+    name: String,
+    rate_hz: f64,
+    /// For 16-bit codes: each code's count at `(scale, gain)`.
+    table: Option<((f64, f64), Vec<i16>)>,
+}
+
+impl RawSource {
+    fn open(args: &AnalyzeArgs, kind: RawType, name: &str) -> Result<Self, String> {
+        if args.time_column.is_some() {
+            return Err("--stream: a raw stream has no time column (give --rate)".into());
+        }
+        let rate_hz = args
+            .rate
+            .ok_or("--stream: a raw stream holds no time: give --rate")?;
+        if !(rate_hz.is_finite() && rate_hz > 0.0 && rate_hz <= 1e9) {
+            return Err(format!("--rate {rate_hz}: not in (0, 1e9]"));
+        }
+        let channels = args.raw_channels.unwrap_or(1);
+        if !(1..=64).contains(&channels) {
+            return Err(format!("--raw-channels {channels}: must lie in 1..=64"));
+        }
+        let column = crate::recording::numbered_column(
+            args.column.as_ref(),
+            channels,
+            &format!("the stream's {channels} interleaved channels"),
+        )?;
+        let input: Box<dyn Read + Send> = if is_stdin(&args.file) {
+            Box::new(std::io::stdin())
+        } else {
+            Box::new(std::fs::File::open(&args.file).map_err(|e| format!("{name}: {e}"))?)
+        };
+        Ok(Self {
+            input,
+            kind,
+            frame: kind.bytes() * channels,
+            at: column * kind.bytes(),
+            buf: vec![0u8; CHUNK],
+            held: 0,
+            read: 0,
+            name: name.to_string(),
+            rate_hz,
+            table: None,
+        })
+    }
+}
+
+impl Source for RawSource {
+    fn rate_hz(&self) -> Result<f64, String> {
+        Ok(self.rate_hz)
+    }
+
+    fn next_values(&mut self, want: usize, out: &mut Vec<f64>) -> Result<(), String> {
+        let (kind, frame, at) = (self.kind, self.frame, self.at);
+        self.next_with(want, |bytes| kind.decode(bytes, frame, at, |v| out.push(v)))
+    }
+
+    /// 16-bit codes through a table of the 65 536 codes' counts (the same arithmetic, once
+    /// per code).
+    fn next_counts(
+        &mut self,
+        want: usize,
+        (scale, gain): (f64, f64),
+        scratch: &mut Vec<f64>,
+        out: &mut Vec<i16>,
+    ) -> Result<(), String> {
+        if self.kind != RawType::I16 {
+            return values_as_counts(self, want, (scale, gain), scratch, out);
+        }
+        let table = match self.table.take() {
+            Some(t) if t.0 == (scale, gain) => t,
+            _ => {
+                let counts = (0..=u16::MAX)
+                    .map(|c| analyze::to_count(f64::from(c as i16) * scale, gain))
+                    .collect();
+                ((scale, gain), counts)
+            }
+        };
+        let (frame, at) = (self.frame, self.at);
+        let result = self.next_with(want, |bytes| {
+            out.extend(bytes.chunks_exact(frame).map(|f| {
+                let code = u16::from_le_bytes([f[at], f[at + 1]]);
+                table.1.get(usize::from(code)).copied().unwrap_or(0)
+            }));
+            Ok(())
+        });
+        self.table = Some(table);
+        result
+    }
+}
+
+impl RawSource {
+    /// Reads at most `want` frames (the head stops at exactly HEAD samples whatever a pipe's
+    /// reads return), at least one whole frame's room, and hands the whole frames to
+    /// `decode`.
+    fn next_with(
+        &mut self,
+        want: usize,
+        decode: impl FnOnce(&[u8]) -> Result<(), (usize, f32)>,
+    ) -> Result<(), String> {
+        let end = (self.held + want.max(1) * self.frame).min(self.buf.len());
+        let n = loop {
+            match self.input.read(&mut self.buf[self.held..end]) {
+                Ok(n) => break n,
+                Err(e) if e.kind() == std::io::ErrorKind::Interrupted => continue,
+                Err(e) => return Err(format!("{}: {e}", self.name)),
+            }
+        };
+        if n == 0 {
+            if self.held > 0 {
+                return Err(format!(
+                    "{}: {} bytes: not a whole number of {}-byte frames; the last frame starts at byte {}",
+                    self.name,
+                    self.read,
+                    self.frame,
+                    self.read - self.held as u64
+                ));
+            }
+            return Ok(());
+        }
+        self.read += n as u64;
+        let have = self.held + n;
+        let whole = have / self.frame * self.frame;
+        if let Err((k, v)) = decode(&self.buf[..whole]) {
+            let frame_no = (self.read - have as u64) / self.frame as u64 + k as u64;
+            return Err(format!(
+                "{}: frame {frame_no} (byte {}): {v} is not finite",
+                self.name,
+                frame_no * self.frame as u64 + self.at as u64
+            ));
+        }
+        self.buf.copy_within(whole..have, 0);
+        self.held = have - whole;
+        Ok(())
+    }
+}
+
+/// A CSV file or stream: the channel's column, and the time column (or `--rate`), row by
+/// row, with the whole-file reader's checks ([`crate::table::Rows`]).
+struct CsvSource {
+    rows: crate::table::Rows,
+    name: String,
+    channel: usize,
+    /// The time column and its unit, s.
+    time: Option<(usize, f64)>,
+    /// `--rate`, if given.
+    rate_given: Option<f64>,
+    /// The first time and the latest one, s; the rows read.
+    t0: Option<f64>,
+    last: f64,
+    n: u64,
+    /// The head's intervals and the lines they end on, then their median and the head's
+    /// mean rate.
+    head_dts: Vec<(f64, u64)>,
+    median_dt: Option<f64>,
+    head_rate: Option<f64>,
+    /// The first row's value, read while resolving the columns and not yet handed on.
+    pending: Option<f64>,
+    /// A regular file's path and size (stdin and pipes are read in one pass); the parallel
+    /// fast path once the head is read, and rows read since the sequential reader last took
+    /// over (it hands back after [`crate::csv_fast::SEQUENTIAL_ROWS`] rows).
+    file: Option<(std::path::PathBuf, u64)>,
+    fast: Option<crate::csv_fast::FastRows>,
+    head_done: bool,
+    ended: bool,
+    /// The first time that does not increase, and the first uneven interval (reported at
+    /// the end, in this order, as the whole-file path does).
+    not_increasing: Option<String>,
+    uneven: Option<String>,
+    sequential: usize,
+    progress: Option<fn(f64)>,
+}
+
+impl CsvSource {
+    fn open(args: &AnalyzeArgs, progress: Option<fn(f64)>) -> Result<Self, String> {
+        let format = crate::table::CsvFormat {
+            delimiter: args.delimiter,
+            decimal_comma: args.decimal_comma,
+        };
+        let mut rows =
+            crate::table::Rows::open(&args.file, &format, progress).map_err(|e| e.to_string())?;
+        let name = if is_stdin(&args.file) {
+            "stdin".to_string()
+        } else {
+            args.file.display().to_string()
+        };
+        let err = |m: String| format!("{name}: {m}");
+        // The first data row gives the columns their number (the header their names).
+        let (line, first) = match rows.next_row().map_err(|e| e.to_string())? {
+            Some((line, _, row)) => (line, row.to_vec()),
+            None => return Err(err("no data rows".into())),
+        };
+        let shape = rows.shape();
+        let tcol = shape
+            .time_column_unless_rate(args.rate.is_some(), args.time_column.as_ref())
+            .map_err(err)?;
+        let channel = shape.channel(args.column.as_ref(), tcol).map_err(err)?;
+        if Some(channel) == tcol {
+            return Err(err(format!(
+                "column {channel} is the time column: choose another with --column"
+            )));
+        }
+        if tcol.is_none() && args.rate.is_none() {
+            return Err(err(
+                "no time column found: give --time-column or --rate".into()
+            ));
+        }
+        if let Some(r) = args.rate {
+            if !(r.is_finite() && r > 0.0 && r <= 1e9) {
+                return Err(err(format!("rate {r} Hz is not in (0, 1e9]")));
+            }
+        }
+        let time = tcol.map(|t| {
+            let unit = shape
+                .headers
+                .get(t)
+                .map_or(1.0, |h| crate::recording::time_unit_s(h));
+            (t, unit)
+        });
+        let mut source = Self {
+            rows,
+            name,
+            channel,
+            time,
+            rate_given: args.rate,
+            t0: None,
+            last: 0.0,
+            n: 0,
+            head_dts: Vec::new(),
+            median_dt: None,
+            head_rate: None,
+            pending: None,
+            file: std::fs::metadata(&args.file)
+                .ok()
+                .filter(|m| m.is_file() && !is_stdin(&args.file))
+                .map(|m| (args.file.clone(), m.len())),
+            fast: None,
+            head_done: false,
+            ended: false,
+            not_increasing: None,
+            uneven: None,
+            sequential: crate::csv_fast::SEQUENTIAL_ROWS,
+            progress,
+        };
+        source.pending = Some(source.take(line, &first)?);
+        Ok(source)
+    }
+
+    /// Checks the time of row `line` and returns its channel's value.
+    fn take(&mut self, line: u64, row: &[f64]) -> Result<f64, String> {
+        let value = row.get(self.channel).copied().unwrap_or(0.0);
+        let time = self.time.map(|(c, _)| row.get(c).copied().unwrap_or(0.0));
+        self.take_values(line, value, time.unwrap_or(0.0))
+    }
+
+    /// [`CsvSource::take`] of a row's channel value and time column's value.
+    fn take_values(&mut self, line: u64, value: f64, time: f64) -> Result<f64, String> {
+        if let Some((_, unit)) = self.time {
+            let t = time * unit;
+            if self.t0.is_none() {
+                self.t0 = Some(t);
+            } else {
+                // Errors wait for the end, as in the whole-file path: a value that is not a
+                // number anywhere comes first, then time going back, then an uneven interval
+                // (the first of each).
+                let at = |m: String| format!("{}:{line}: {m}", self.name);
+                let dt = t - self.last;
+                if t <= self.last {
+                    let m = format!("time {t} s does not increase (previous {} s)", self.last);
+                    self.not_increasing.get_or_insert_with(|| at(m));
+                } else {
+                    match self.median_dt {
+                        None => self.head_dts.push((dt, line)),
+                        Some(m) => {
+                            if let Err(e) = check_interval(dt, m) {
+                                self.uneven.get_or_insert_with(|| at(e));
+                            }
+                        }
+                    }
+                }
+            }
+            self.last = t;
+        }
+        self.n += 1;
+        Ok(value)
+    }
+}
+
+impl CsvSource {
+    /// Appends the next rows' values: about `want` (the sequential reader) or a chunk (the
+    /// parallel one); none at a hand-over from one to the other, or at the end (then
+    /// `ended` is set).
+    fn next_some(&mut self, want: usize, out: &mut Vec<f64>) -> Result<(), String> {
+        // Past the head, a file's plain rows go through the parallel fast path.
+        if self.head_done
+            && self.fast.is_none()
+            && self.sequential >= crate::csv_fast::SEQUENTIAL_ROWS
+        {
+            if let Some((path, size)) = &self.file {
+                let (byte, line) = self.rows.position();
+                let (delimiter, format) = self.rows.format();
+                let layout = crate::csv_fast::Layout {
+                    columns: self.rows.columns,
+                    channel: self.channel,
+                    time: self.time.map(|(c, _)| c),
+                    delimiter,
+                    decimal_comma: format.decimal_comma,
+                    time_unit_s: self.time.map_or(1.0, |(_, unit)| unit),
+                    median_dt: self.median_dt,
+                    all: false,
+                };
+                let progress = self.progress.map(|p| (p, *size));
+                self.fast = Some(
+                    crate::csv_fast::FastRows::start(path, byte, line, layout, progress)
+                        .map_err(|e| format!("{}: {e}", self.name))?,
+                );
+            }
+        }
+        if let Some(fast) = &mut self.fast {
+            let Some(chunk) = fast.next_chunk() else {
+                self.fast = None;
+                self.ended = true;
+                return Ok(());
+            };
+            out.reserve(chunk.rows.len());
+            // The first row follows the previous chunk's last: checked here; the others the
+            // worker checked against the row before them.
+            if let Some(&(value, time)) = chunk.rows.first() {
+                out.push(self.take_values(chunk.line, value, time)?);
+            }
+            let unit = self.time.map(|(_, unit)| unit);
+            for &(value, time) in chunk.rows.iter().skip(1) {
+                if let Some(unit) = unit {
+                    self.last = time * unit;
+                }
+                out.push(value);
+            }
+            self.n += chunk.rows.len().saturating_sub(1) as u64;
+            if let Some((byte, line)) = chunk.stop {
+                // The sequential reader from the line the fast path could not take.
+                self.fast = None;
+                self.rows = self.rows.resume(byte, line).map_err(|e| e.to_string())?;
+                self.sequential = 0;
+            }
+            return Ok(());
+        }
+        let mut left = want.max(1);
+        if let Some(v) = self.pending.take() {
+            out.push(v);
+            left -= 1;
+        }
+        let mut row = Vec::new();
+        for _ in 0..left {
+            let Some((line, _, r)) = self.rows.next_row().map_err(|e| e.to_string())? else {
+                self.ended = true;
+                break;
+            };
+            row.clear();
+            row.extend_from_slice(r);
+            let v = self.take(line, &row)?;
+            out.push(v);
+            self.sequential += 1;
+        }
+        Ok(())
+    }
+}
+
+impl Source for CsvSource {
+    fn next_values(&mut self, want: usize, out: &mut Vec<f64>) -> Result<(), String> {
+        // A hand-over between the readers can give no rows: only the end gives none.
+        let before = out.len();
+        while out.len() == before && !self.ended {
+            self.next_some(want, out)?;
+        }
+        if self.ended {
+            if let Some(e) = self.not_increasing.take().or_else(|| self.uneven.take()) {
+                return Err(e);
+            }
+        }
+        Ok(())
+    }
+
+    fn head_read(&mut self) -> Result<(), String> {
+        self.head_done = true;
+        if self.head_dts.is_empty() {
+            return Ok(());
+        }
+        let dts = std::mem::take(&mut self.head_dts);
+        let mut sorted: Vec<f64> = dts.iter().map(|d| d.0).collect();
+        let mid = sorted.len() / 2;
+        let median = *sorted.select_nth_unstable_by(mid, f64::total_cmp).1;
+        // The head's intervals against their median, as every later one.
+        for (dt, line) in dts {
+            if let Err(m) = check_interval(dt, median) {
+                self.uneven
+                    .get_or_insert_with(|| format!("{}:{line}: {m}", self.name));
+            }
+        }
+        self.median_dt = Some(median);
+        if let Some(t0) = self.t0 {
+            let rate = (self.n - 1) as f64 / (self.last - t0);
+            // A head whose time goes back gives no rate to go on with: its error now.
+            if !(rate.is_finite() && rate > 0.0) {
+                if let Some(e) = self.not_increasing.take() {
+                    return Err(e);
+                }
+            }
+            self.head_rate = Some(rate);
+        }
+        Ok(())
+    }
+
+    fn rate_hz(&self) -> Result<f64, String> {
+        if let Some(r) = self.rate_given {
+            return Ok(r);
+        }
+        self.head_rate.ok_or_else(|| {
+            format!(
+                "{}: one sample: the rate cannot be told; give --rate",
+                self.name
+            )
+        })
+    }
+
+    fn final_rate_hz(&self) -> f64 {
+        match (self.rate_given, self.t0) {
+            (Some(r), _) => r,
+            (None, Some(t0)) if self.n > 1 => 1.0 / ((self.last - t0) / (self.n - 1) as f64),
+            _ => self.head_rate.unwrap_or(0.0),
+        }
+    }
+
+    fn t0(&self) -> f64 {
+        self.t0.unwrap_or(0.0)
+    }
+}
+
+/// An interval `dt` within [`crate::recording::INTERVAL_RANGE`] times the median `median`.
+pub(crate) fn check_interval(dt: f64, median: f64) -> Result<(), String> {
+    let ratio = dt / median;
+    if crate::recording::INTERVAL_RANGE.contains(&ratio) {
+        Ok(())
+    } else {
+        Err(format!(
+            "uneven time axis: {dt:.6e} s since the previous sample, {ratio:.3} times the first \
+             intervals' median {median:.6e} s (a gap or a rate change); give --resample to \
+             interpolate onto an even grid, or cut the file"
+        ))
+    }
+}
+
+/// A WAV file's channel ([`crate::wav::WavChannel`], read as it goes).
+struct WavSource {
+    channel: crate::wav::WavChannel,
+    name: String,
+}
+
+impl WavSource {
+    fn open(args: &AnalyzeArgs, name: &str) -> Result<Self, String> {
+        if args.rate.is_some() || args.time_column.is_some() {
+            return Err(format!(
+                "{name}: a WAV file gives its own rate: no --rate or --time-column"
+            ));
+        }
+        let channel = crate::wav::WavChannel::open(&args.file, args.column.as_ref())
+            .map_err(|e| format!("{name}: {e}"))?;
+        Ok(Self {
+            channel,
+            name: name.to_string(),
+        })
+    }
+}
+
+impl Source for WavSource {
+    fn next_values(&mut self, want: usize, out: &mut Vec<f64>) -> Result<(), String> {
+        for v in self.channel.by_ref().take(want.max(1)) {
+            out.push(v.map_err(|e| format!("{}: {e}", self.name))?);
+        }
+        Ok(())
+    }
+
+    fn rate_hz(&self) -> Result<f64, String> {
+        Ok(self.channel.rate_hz)
+    }
+}
+
+/// An .npy array's column: every `cols`-th element from `column` on (C order), or the
+/// `rows` elements after `column × rows` (Fortran order), as npyz reads them.
+struct NpySource {
+    elements: crate::npy::Elements,
+    rows: u64,
+    cols: u64,
+    column: u64,
+    fortran: bool,
+    /// Elements read, values handed on.
+    k: u64,
+    given: u64,
+    rate_hz: f64,
+    name: String,
+}
+
+impl NpySource {
+    fn open(args: &AnalyzeArgs, name: &str) -> Result<Self, String> {
+        let rate_hz = args
+            .rate
+            .ok_or_else(|| format!("{name}: an .npy array holds no time: give --rate"))?;
+        if !(rate_hz.is_finite() && rate_hz > 0.0 && rate_hz <= 1e9) {
+            return Err(format!("--rate {rate_hz}: not in (0, 1e9]"));
+        }
+        if args.time_column.is_some() {
+            return Err(format!(
+                "{name}: an .npy array has no time column (give --rate)"
+            ));
+        }
+        let (elements, shape, order) =
+            crate::npy::open_elements(&args.file).map_err(|e| format!("{name}: {e}"))?;
+        let (rows, cols, column) =
+            crate::npy::layout(&shape, args.column.as_ref()).map_err(|e| format!("{name}: {e}"))?;
+        let column = column as u64;
+        Ok(Self {
+            elements,
+            rows,
+            cols,
+            column,
+            fortran: order == npyz::Order::Fortran && cols > 1,
+            k: 0,
+            given: 0,
+            rate_hz,
+            name: name.to_string(),
+        })
+    }
+}
+
+impl Source for NpySource {
+    fn next_values(&mut self, want: usize, out: &mut Vec<f64>) -> Result<(), String> {
+        let mut pushed = 0;
+        while pushed < want.max(1) && self.given < self.rows {
+            let Some(element) = self.elements.next() else {
+                return Err(format!(
+                    "{}: npy: the data ends at element {} of the {} its shape holds",
+                    self.name,
+                    self.k,
+                    self.rows * self.cols
+                ));
+            };
+            let v = element.map_err(|e| format!("{}: npy: {e}", self.name))?;
+            let mine = if self.fortran {
+                self.k / self.rows == self.column
+            } else {
+                self.k % self.cols == self.column
+            };
+            self.k += 1;
+            if mine {
+                if !v.is_finite() {
+                    return Err(format!(
+                        "{}: npy: row {}: {v} is not finite",
+                        self.name, self.given
+                    ));
+                }
+                out.push(v);
+                pushed += 1;
+                self.given += 1;
+            }
+        }
+        Ok(())
+    }
+
+    fn rate_hz(&self) -> Result<f64, String> {
+        Ok(self.rate_hz)
+    }
+}
+
+/// A TDMS file's channel ([`crate::tdms::TdmsStream`], a range at a time).
+struct TdmsSource {
+    stream: crate::tdms::TdmsStream,
+    name: String,
+}
+
+impl TdmsSource {
+    fn open(args: &AnalyzeArgs, name: &str) -> Result<Self, String> {
+        if args.time_column.is_some() {
+            return Err(format!(
+                "{name}: a TDMS file takes --column (group/channel) and --rate only"
+            ));
+        }
+        let stream = crate::tdms::TdmsStream::open(&args.file, args.column.as_ref(), args.rate)
+            .map_err(|e| e.to_string())?;
+        Ok(Self {
+            stream,
+            name: name.to_string(),
+        })
+    }
+}
+
+impl Source for TdmsSource {
+    fn next_values(&mut self, want: usize, out: &mut Vec<f64>) -> Result<(), String> {
+        self.stream
+            .next_values(want, out)
+            .map_err(|e| format!("{}: {e}", self.name))
+    }
+
+    fn rate_hz(&self) -> Result<f64, String> {
+        Ok(self.stream.rate_hz)
+    }
+}
