@@ -227,22 +227,43 @@ fn survey_pass(
 ) -> Result<(Surveyed, Box<dyn Source>), String> {
     let mut source = open_source(args, name, progress)?;
     let mut survey = Survey::new(screen);
+    // The shape's part of the survey on a thread of its own (a copy of each block).
+    let mut shape = survey.take_shape();
+    let (tx, rx) = std::sync::mpsc::sync_channel::<Vec<f64>>(4);
+    let shaper = std::thread::spawn(move || {
+        for block in rx {
+            shape.push(&block);
+        }
+        shape
+    });
     let mut patch = Patches::new(removals);
-    let mut head = read_head(&mut *source, scale)?;
-    patch.values(&mut head);
-    survey.push(&head);
-    let source = read_ahead(
-        source,
-        move |s, _, out: &mut Vec<f64>| {
-            s.next_values(CHUNK, out)?;
-            out.iter_mut().for_each(|v| *v *= scale);
-            Ok(())
-        },
-        |block| {
-            patch.values(block);
-            survey.push(block);
-        },
-    )?;
+    // (The sender ends with this block, so the thread sees the end.)
+    let read = {
+        let tx = tx;
+        read_head(&mut *source, scale).and_then(|mut head| {
+            patch.values(&mut head);
+            survey.push_levels(&head);
+            let _ = tx.send(head);
+            read_ahead(
+                source,
+                move |s, _, out: &mut Vec<f64>| {
+                    s.next_values(CHUNK, out)?;
+                    out.iter_mut().for_each(|v| *v *= scale);
+                    Ok(())
+                },
+                |block| {
+                    patch.values(block);
+                    survey.push_levels(block);
+                    let _ = tx.send(block.to_vec());
+                },
+            )
+        })
+    };
+    let shape = shaper
+        .join()
+        .map_err(|_| "the survey's thread panicked".to_string())?;
+    let source = read?;
+    survey.put_shape(shape);
     Ok((survey.finish()?, source))
 }
 

@@ -12,11 +12,26 @@ use crate::screen::{self, Clipping, FlatTops, Removal, SpikeScan};
 pub struct Survey {
     values: OrderHistogram,
     steps: OrderHistogram,
-    flat: FlatTops,
-    spikes: Option<SpikeScan>,
+    shape: Shape,
     last: Option<f64>,
     min: f64,
     max: f64,
+}
+
+/// The part of a survey that follows the signal's shape (flat tops, glitches): independent
+/// of the rest, so it can run on a thread of its own ([`Survey::take_shape`]).
+pub struct Shape {
+    flat: FlatTops,
+    spikes: Option<SpikeScan>,
+}
+
+impl Shape {
+    pub fn push(&mut self, block: &[f64]) {
+        self.flat.push(block);
+        if let Some(s) = &mut self.spikes {
+            s.push(block);
+        }
+    }
 }
 
 /// What a pass found.
@@ -61,8 +76,10 @@ impl Survey {
         Self {
             values: OrderHistogram::new(),
             steps: OrderHistogram::new(),
-            flat: FlatTops::default(),
-            spikes: screen.then(SpikeScan::default),
+            shape: Shape {
+                flat: FlatTops::default(),
+                spikes: screen.then(SpikeScan::default),
+            },
             last: None,
             min: f64::INFINITY,
             max: f64::NEG_INFINITY,
@@ -70,6 +87,28 @@ impl Survey {
     }
 
     pub fn push(&mut self, block: &[f64]) {
+        self.push_levels(block);
+        self.shape.push(block);
+    }
+
+    /// The shape's part, to push on another thread (every block, in order) and put back
+    /// before [`Survey::finish`]; meanwhile [`Survey::push_levels`] takes the blocks here.
+    pub fn take_shape(&mut self) -> Shape {
+        std::mem::replace(
+            &mut self.shape,
+            Shape {
+                flat: FlatTops::default(),
+                spikes: None,
+            },
+        )
+    }
+
+    pub fn put_shape(&mut self, shape: Shape) {
+        self.shape = shape;
+    }
+
+    /// The median, noise and extremes' part of [`Survey::push`].
+    pub fn push_levels(&mut self, block: &[f64]) {
         // (Loops of their own, on locals, so each runs at the machine's pace.)
         if let (Some(p), Some(&first)) = (self.last, block.first()) {
             self.steps.add((first - p).abs());
@@ -86,10 +125,6 @@ impl Survey {
         if let Some(&v) = block.last() {
             self.last = Some(v);
         }
-        self.flat.push(block);
-        if let Some(s) = &mut self.spikes {
-            s.push(block);
-        }
     }
 
     pub fn finish(self) -> Result<Surveyed, String> {
@@ -105,7 +140,7 @@ impl Survey {
             .steps
             .median()
             .map_or(0.0, |m| 1.4826 * m / std::f64::consts::SQRT_2);
-        let removals = match self.spikes {
+        let removals = match self.shape.spikes {
             Some(s) => s.finish(median)?,
             None => Vec::new(),
         };
@@ -115,7 +150,7 @@ impl Survey {
             noise_rms_m_s2: noise,
             min_m_s2: self.min,
             max_m_s2: self.max,
-            flat_tops: self.flat.finish(),
+            flat_tops: self.shape.flat.finish(),
             removals,
         })
     }
