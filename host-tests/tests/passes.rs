@@ -139,6 +139,9 @@ fn glitches_flat_tops_and_learned_levels_give_the_whole_files_reports_in_passes(
         for args in [
             vec!["--mass", "0.06", "--v0", "1.3357"],
             vec!["--mass", "0.06", "--keep-spikes"],
+            vec![
+                "--mass", "0.06", "--v0", "1", "--srs", "--cfc", "1000", "--train", "flight",
+            ],
             vec![],
             vec!["--range", "200", "--trigger", "5"],
         ] {
