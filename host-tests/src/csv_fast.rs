@@ -32,6 +32,9 @@ pub struct Layout {
     pub delimiter: u8,
     pub decimal_comma: bool,
     pub time_unit_s: f64,
+    /// Check that each row's time follows the previous one's...
+    pub increasing: bool,
+    /// ...by this median interval within [`crate::recording::INTERVAL_RANGE`] (if given).
     pub median_dt: Option<f64>,
     /// Keep every field of every row too ([`Parsed::fields`]), for a whole table.
     pub all: bool,
@@ -268,11 +271,16 @@ fn parse(job: Job, layout: &Layout) -> Parsed {
 /// Whether a row's time `time` follows the chunk's previous one (`last`) as the sequential
 /// checks want it to; keeps it in `last`.
 fn follows(time: f64, last: &mut Option<f64>, layout: &Layout) -> bool {
-    let (Some(_), Some(median)) = (layout.time, layout.median_dt) else {
+    if layout.time.is_none() || !layout.increasing {
         return true;
-    };
+    }
     let t = time * layout.time_unit_s;
-    let ok = last.is_none_or(|l| t > l && crate::sources::check_interval(t - l, median).is_ok());
+    let ok = last.is_none_or(|l| {
+        t > l
+            && layout
+                .median_dt
+                .is_none_or(|m| crate::sources::check_interval(t - l, m).is_ok())
+    });
     *last = Some(t);
     ok
 }
@@ -417,6 +425,7 @@ mod tests {
             delimiter: b',',
             decimal_comma: false,
             time_unit_s: 1.0,
+            increasing: false,
             median_dt: None,
             all: false,
         };

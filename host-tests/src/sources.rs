@@ -372,12 +372,15 @@ impl CsvSource {
                 // (the first of each).
                 let at = |m: String| format!("{}:{line}: {m}", self.name);
                 let dt = t - self.last;
-                if t <= self.last {
+                // With --rate the column gives only the first time, as in the whole-file path.
+                if self.rate_given.is_some() {
+                } else if t <= self.last {
                     let m = format!("time {t} s does not increase (previous {} s)", self.last);
                     self.not_increasing.get_or_insert_with(|| at(m));
                 } else {
                     match self.median_dt {
-                        None => self.head_dts.push((dt, line)),
+                        None if !self.head_done => self.head_dts.push((dt, line)),
+                        None => {}
                         Some(m) => {
                             if let Err(e) = check_interval(dt, m) {
                                 self.uneven.get_or_insert_with(|| at(e));
@@ -413,7 +416,14 @@ impl CsvSource {
                     delimiter,
                     decimal_comma: format.decimal_comma,
                     time_unit_s: self.time.map_or(1.0, |(_, unit)| unit),
-                    median_dt: self.median_dt,
+                    // The workers check what may still be the first error of its kind: time
+                    // going back, then an uneven interval.
+                    increasing: self.rate_given.is_none() && self.not_increasing.is_none(),
+                    median_dt: self.median_dt.filter(|_| {
+                        self.rate_given.is_none()
+                            && self.not_increasing.is_none()
+                            && self.uneven.is_none()
+                    }),
                     all: false,
                 };
                 let progress = self.progress.map(|p| (p, *size));
@@ -489,30 +499,24 @@ impl Source for CsvSource {
 
     fn head_read(&mut self) -> Result<(), String> {
         self.head_done = true;
-        if self.head_dts.is_empty() {
-            return Ok(());
-        }
         let dts = std::mem::take(&mut self.head_dts);
-        let mut sorted: Vec<f64> = dts.iter().map(|d| d.0).collect();
-        let mid = sorted.len() / 2;
-        let median = *sorted.select_nth_unstable_by(mid, f64::total_cmp).1;
-        // The head's intervals against their median, as every later one.
-        for (dt, line) in dts {
-            if let Err(m) = check_interval(dt, median) {
-                self.uneven
-                    .get_or_insert_with(|| format!("{}:{line}: {m}", self.name));
-            }
-        }
-        self.median_dt = Some(median);
-        if let Some(t0) = self.t0 {
-            let rate = (self.n - 1) as f64 / (self.last - t0);
-            // A head whose time goes back gives no rate to go on with: its error now.
-            if !(rate.is_finite() && rate > 0.0) {
-                if let Some(e) = self.not_increasing.take() {
-                    return Err(e);
+        if !dts.is_empty() {
+            let mut sorted: Vec<f64> = dts.iter().map(|d| d.0).collect();
+            let mid = sorted.len() / 2;
+            let median = *sorted.select_nth_unstable_by(mid, f64::total_cmp).1;
+            // The head's intervals against their median, as every later one.
+            for (dt, line) in dts {
+                if let Err(m) = check_interval(dt, median) {
+                    self.uneven
+                        .get_or_insert_with(|| format!("{}:{line}: {m}", self.name));
                 }
             }
-            self.head_rate = Some(rate);
+            self.median_dt = Some(median);
+        }
+        if let Some(t0) = self.t0 {
+            // (None if time went back: `rate_hz` then gives that error.)
+            let rate = (self.n - 1) as f64 / (self.last - t0);
+            self.head_rate = (rate.is_finite() && rate > 0.0).then_some(rate);
         }
         Ok(())
     }
@@ -521,11 +525,14 @@ impl Source for CsvSource {
         if let Some(r) = self.rate_given {
             return Ok(r);
         }
+        // A head without a rate: time went back (that error), or one sample.
         self.head_rate.ok_or_else(|| {
-            format!(
-                "{}: one sample: the rate cannot be told; give --rate",
-                self.name
-            )
+            self.not_increasing.clone().unwrap_or_else(|| {
+                format!(
+                    "{}: one sample: the rate cannot be told; give --rate",
+                    self.name
+                )
+            })
         })
     }
 

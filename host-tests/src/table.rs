@@ -616,6 +616,7 @@ pub fn read_table(
                 delimiter: rows.delimiter,
                 decimal_comma: rows.format.decimal_comma,
                 time_unit_s: 1.0,
+                increasing: false,
                 median_dt: None,
                 all: true,
             };

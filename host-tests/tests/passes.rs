@@ -266,7 +266,10 @@ fn time_axis_errors_read_the_same_on_every_path() {
         }
     };
     let even = |k: usize| k as f64 * 1e-5;
-    let cases: [(&str, String, &str); 4] = [
+    // Time going back in the first rows (no rate to be had from them), a text value late.
+    let early = |k: usize| if k == 0 { 70_000.0 } else { k as f64 };
+    let stuck = |_: usize| 0.0;
+    let cases: [(&str, String, &str); 6] = [
         (
             "drift",
             csv(200_000, &drift, None),
@@ -275,6 +278,12 @@ fn time_axis_errors_read_the_same_on_every_path() {
         ("back", csv(200_000, &back, None), ":150002: time"),
         ("text", csv(200_000, &back, Some(180_000)), ":180002:"),
         ("text-even", csv(100_000, &even, Some(90_000)), ":90002:"),
+        ("early", csv(70_000, &early, Some(69_000)), ":69002:"),
+        (
+            "stuck",
+            csv(70_000, &stuck, None),
+            ":3: time 0 s does not increase",
+        ),
     ];
     let svg = tmp("errors.svg");
     for (name, text, want) in cases {
@@ -305,6 +314,22 @@ fn time_axis_errors_read_the_same_on_every_path() {
         assert_eq!(passes.2.trim().lines().count(), 1, "{name}: {}", passes.2);
         assert_eq!(whole.2, passes.2, "{name}: whole");
         assert_eq!(stdin, passes.2, "{name}: stdin");
-        assert_eq!(stream.2, passes.2, "{name}: --stream");
+        if name == "early" {
+            // A stream needs the rate after its first rows: it stops at the time going back.
+            assert!(
+                stream.2.contains(":3: time 1 s does not increase"),
+                "{}",
+                stream.2
+            );
+        } else {
+            assert_eq!(stream.2, passes.2, "{name}: --stream");
+        }
     }
+    // With --rate the time column gives only the first time (its drift is not checked).
+    let file = tmp("drift-rate.csv");
+    let text = csv(200_000, &drift, None);
+    std::fs::write(&file, &text).unwrap();
+    let rate = ["--rate", "100000", "--time-column", "time_s"];
+    let passes = impact_ok(&[&["analyze", &file, "--json"][..], &rate].concat()).0;
+    assert_eq!(passes, from_stdin(text.into_bytes(), &rate));
 }
