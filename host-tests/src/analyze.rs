@@ -125,9 +125,11 @@ pub struct AnalyzeArgs {
     #[arg(long, value_enum)]
     pub raw_type: Option<crate::raw::RawType>,
     /// Analyse the recording (CSV, WAV, .npy, TDMS, raw `.i16`/`.f32`; CSV and raw also
-    /// from standard input) as it is read, in memory that does not grow with its length;
-    /// needs --range and --trigger (and --rate where the file holds no time); spikes are
-    /// not screened; no --plot, --axes, --free-fall, --resample.
+    /// from standard input) in one pass as it is read, in memory that does not grow with its
+    /// length; needs --range and --trigger (and --rate where the file holds no time); spikes
+    /// are not screened; no --plot, --axes, --free-fall, --resample. Without it a regular
+    /// file is read in passes (a survey of the whole recording, then the analysis), also in
+    /// bounded memory, with the levels learned and spikes screened.
     #[arg(long)]
     pub stream: bool,
     /// Multiply the channel's values by this first (e.g. g per code of a WAV file's integer
