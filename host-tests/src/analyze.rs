@@ -500,12 +500,6 @@ pub(crate) fn round_to_i16(x: f64) -> i16 {
     r.clamp(i64::from(i16::MIN), i64::from(i16::MAX)) as i16
 }
 
-/// Robust noise estimate, m/s²: MAD of first differences / sqrt(2), to 0.2 % (the
-/// survey's, [`Survey`]).
-pub fn noise_rms(x: &[f64]) -> f64 {
-    Survey::of(x, false).map_or(0.0, |s| s.noise_rms_m_s2)
-}
-
 pub(crate) fn load_scene(path: &Path) -> Result<SceneFile, String> {
     let text = std::fs::read_to_string(path).map_err(|e| format!("{}: {e}", path.display()))?;
     serde_json::from_str(&text).map_err(|e| format!("{}: {e}", path.display()))

@@ -41,6 +41,14 @@ pub struct Removal {
 }
 
 impl Removal {
+    /// The spike, timed from the first sample's time `t0_s` at `rate_hz` (as the impacts are).
+    pub fn timed(&self, t0_s: f64, rate_hz: f64) -> Spike {
+        Spike {
+            time_s: t0_s + self.spike.sample as f64 / rate_hz,
+            ..self.spike.clone()
+        }
+    }
+
     /// The value that replaces its sample `j` (0 or 1): on the straight line between the
     /// neighbours.
     pub fn value(&self, j: usize) -> f64 {
@@ -59,10 +67,7 @@ pub fn apply(removals: &[Removal], x: &mut [f64], t0_s: f64, rate_hz: f64) -> Ve
                 *v = r.value(j);
             }
         }
-        spikes.push(Spike {
-            time_s: t0_s + r.spike.sample as f64 / rate_hz,
-            ..r.spike.clone()
-        });
+        spikes.push(r.timed(t0_s, rate_hz));
     }
     spikes
 }

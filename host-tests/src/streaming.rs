@@ -49,18 +49,14 @@ pub fn analyze(
         None => analyze::SceneFile::default(),
     };
     let (mass, scale) = analyze::mass_and_scale(args, &file)?;
-    let range = args.range.or(file.range).ok_or(
+    let full_scale = analyze::full_scale_m_s2(args, &file, scale)?.ok_or(
         "--stream: give --range (the sensor's full scale sets the quantisation before the \
          recording's extremes are known)",
     )?;
-    if !(range.is_finite() && range > 0.0) {
-        return Err(format!("--range: {range} must be finite and > 0"));
-    }
     let trigger = args.trigger.or(file.trigger_m_s2).ok_or(
         "--stream: give --trigger (the level cannot be learned from a recording not yet read)",
     )?;
-    let full_scale = range * scale.abs();
-    let gain = full_scale / 32000.0;
+    let gain = analyze::gain_for(full_scale);
     let clipping = crate::screen::from_range(full_scale);
     let mut source = open_source(args, &name, progress)?;
     // The head: its noise sets the default edge level, a CSV's first intervals the rate.
@@ -70,10 +66,10 @@ pub fn analyze(
         gain_m_s2_per_count: gain as f32,
         sample_rate_hz: rate_hz as f32,
     };
-    let edge = args.edge.or(file.edge_m_s2).unwrap_or_else(|| {
-        let sigma = analyze::noise_rms(&head);
-        (3.0 * sigma).max(trigger / 5.0).min(trigger / 2.0)
-    });
+    let edge = args
+        .edge
+        .or(file.edge_m_s2)
+        .unwrap_or_else(|| survey::default_edge(survey::noise_rms(&head), trigger));
     let (scene, v0_source) = analyze::build_scene(
         args,
         &file,
@@ -168,7 +164,7 @@ pub fn analyze_in_passes(
     let head = read_head(&mut *source, scale)?;
     let head = head.iter().map(|a| analyze::to_count(*a, gain)).collect();
     let (reports, count, _) = run_monitor(source, head, (scale, gain), scene, removals.clone())?;
-    let spikes = crate::screen::apply(&removals, &mut [], t0, rate_hz);
+    let spikes = removals.iter().map(|r| r.timed(t0, rate_hz)).collect();
     let setup = Setup {
         prepared: Prepared {
             counts: Vec::new(),

@@ -136,10 +136,7 @@ impl Survey {
             );
         }
         let median = self.values.median().unwrap_or(0.0);
-        let noise = self
-            .steps
-            .median()
-            .map_or(0.0, |m| 1.4826 * m / std::f64::consts::SQRT_2);
+        let noise = noise_of(&self.steps);
         let removals = match self.shape.spikes {
             Some(s) => s.finish(median)?,
             None => Vec::new(),
@@ -200,9 +197,31 @@ pub fn levels(
     }
 }
 
+/// Robust noise of the steps' histogram: their median / sqrt(2) × 1.4826 (0 for none).
+fn noise_of(steps: &OrderHistogram) -> f64 {
+    steps
+        .median()
+        .map_or(0.0, |m| 1.4826 * m / std::f64::consts::SQRT_2)
+}
+
+/// Robust noise estimate of `x`, m/s²: the median absolute step / sqrt(2) × 1.4826, to
+/// 0.2 % (as a survey takes it).
+pub fn noise_rms(x: &[f64]) -> f64 {
+    let mut steps = OrderHistogram::new();
+    steps.add_all(x.windows(2).map(|w| (w[1] - w[0]).abs()));
+    noise_of(&steps)
+}
+
+/// The default edge level: 3 × the noise, within a fifth and a half of the trigger.
+pub fn default_edge(noise_m_s2: f64, trigger_m_s2: f64) -> f64 {
+    (3.0 * noise_m_s2)
+        .max(trigger_m_s2 / 5.0)
+        .min(trigger_m_s2 / 2.0)
+}
+
 /// The trigger level (given, or 10 × the noise, 5 % of the range, 4 counts, the largest)
-/// and the edge level (given, or 3 × the noise within a fifth and a half of the trigger).
-pub fn trigger_and_edge(
+/// and the edge level (given, or [`default_edge`]).
+fn trigger_and_edge(
     s: &Surveyed,
     gain: f64,
     trigger: Option<f64>,
@@ -214,6 +233,6 @@ pub fn trigger_and_edge(
             .max(0.05 * s.range_m_s2())
             .max(f64::from(gain as f32) * 4.0)
     });
-    let edge = edge.unwrap_or_else(|| (3.0 * sigma).max(trigger / 5.0).min(trigger / 2.0));
+    let edge = edge.unwrap_or_else(|| default_edge(sigma, trigger));
     (trigger, edge)
 }

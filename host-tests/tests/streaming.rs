@@ -36,6 +36,21 @@ const LEVELS: [&str; 16] = [
     "1.3357",
 ];
 
+/// The same levels for the seed bench's CSV, in g (the file's unit): ±163 g is the ADC's
+/// ±1600 m/s².
+const SEED_CSV_LEVELS: [&str; 10] = [
+    "--range",
+    "163",
+    "--trigger",
+    "10",
+    "--edge",
+    "2",
+    "--mass",
+    "0.06",
+    "--v0",
+    "1.3357",
+];
+
 #[test]
 fn a_raw_stream_gives_the_whole_files_reports() {
     let raw = tmp("seed.i16");
@@ -118,19 +133,7 @@ fn a_csv_stream_gives_the_whole_files_reports() {
     );
     let file = tmp("seed.csv");
     std::fs::write(&file, &csv).unwrap();
-    // In g (the file's unit): ±163 g is the ADC's ±1600 m/s².
-    let levels = [
-        "--range",
-        "163",
-        "--trigger",
-        "10",
-        "--edge",
-        "2",
-        "--mass",
-        "0.06",
-        "--v0",
-        "1.3357",
-    ];
+    let levels = SEED_CSV_LEVELS;
     let args = |head: &[&str], tail: &[&str]| -> Vec<String> {
         head.iter()
             .chain(&levels)
@@ -329,18 +332,7 @@ fn a_long_csv_file_gives_the_same_reports_and_errors_through_the_parallel_reader
     );
     let lines: Vec<String> = csv.lines().map(str::to_owned).collect();
     assert!(lines.len() > 290_000, "{}", lines.len());
-    let levels = [
-        "--range",
-        "163",
-        "--trigger",
-        "10",
-        "--edge",
-        "2",
-        "--mass",
-        "0.06",
-        "--v0",
-        "1.3357",
-    ];
+    let levels = SEED_CSV_LEVELS;
     let run = |file: &str, tail: &[&str]| {
         let v: Vec<&str> = ["analyze", file]
             .into_iter()
