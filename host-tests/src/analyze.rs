@@ -128,8 +128,10 @@ pub struct AnalyzeArgs {
     /// from standard input) in one pass as it is read, in memory that does not grow with its
     /// length; needs --range and --trigger (and --rate where the file holds no time); spikes
     /// are not screened; no --plot, --axes, --free-fall, --resample. Without it a regular
-    /// file is read in passes (a survey of the whole recording, then the analysis), also in
-    /// bounded memory, with the levels learned and spikes screened.
+    /// file or standard input is read in passes (a survey of the whole recording, then the
+    /// analysis), also in bounded memory, with the levels learned and spikes screened; a
+    /// CSV's or standard input's values are kept from the first pass in a temporary file
+    /// (TMPDIR, 8 bytes a sample).
     #[arg(long)]
     pub stream: bool,
     /// Multiply the channel's values by this first (e.g. g per code of a WAV file's integer

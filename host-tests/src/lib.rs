@@ -22,6 +22,7 @@ pub mod simulate;
 pub mod soak;
 pub mod sources;
 pub mod spectrum;
+pub mod spool;
 pub mod stability;
 pub mod streaming;
 pub mod survey;

@@ -133,7 +133,30 @@ impl SpikeScan {
         let base = self.base;
         let (mut lo, mut hi) = self.outside.unwrap_or((f64::INFINITY, f64::NEG_INFINITY));
         let mut j = (self.next - base) as usize;
+        let finite = buf.iter().fold(true, |all, v| all & v.is_finite());
         while j + 3 < buf.len() {
+            // Almost every sample fails the first test of `isolated` (for both lengths):
+            // eight at a time while none passes, with the range updates as below. (For
+            // finite values only: their plain maxima and minima are `f64::max`'s and
+            // `min`'s, in a loop without branches.)
+            let (mut low, mut high) = ([lo; 8], [hi; 8]);
+            while finite && j + 11 <= buf.len() {
+                let w = &buf[j - 2..j + 11];
+                if (0..8).fold(false, |any, k| any | may_stand_out(&w[k..k + 6])) {
+                    break;
+                }
+                for k in 0..8 {
+                    let v = w[k + 2];
+                    low[k] = if v < low[k] { v } else { low[k] };
+                    high[k] = if v > high[k] { v } else { high[k] };
+                }
+                j += 8;
+            }
+            lo = low.iter().fold(lo, |l, &v| if v < l { v } else { l });
+            hi = high.iter().fold(hi, |h, &v| if v > h { v } else { h });
+            if j + 3 >= buf.len() {
+                break;
+            }
             let w = &buf[j - 2..j + 4];
             // A candidate's first sample steps from the one before at least 9.5 times the
             // step before that, and by more than 0 (a cheap test that most samples fail).
@@ -271,19 +294,43 @@ impl SpikeScan {
     }
 }
 
-/// Whether the middle of `w` (`w[2..2 + len]`) stands out from the line between `w[1]` and
-/// `w[2 + len]`; `w` holds two samples before it and two after.
-fn isolated(w: &[f64], len: usize) -> bool {
+/// The first test of [`isolated`], which almost every sample fails: the first sample steps
+/// from the one before by more than 0 and at least 9 times the steps around (its deviation
+/// is at least 10 of them, and the line starts within half of one of its neighbour, so it
+/// steps by at least 9.5: a test without a division).
+#[inline(always)]
+fn stands_out(w: &[f64], len: usize) -> bool {
     let (a, b) = (w[1], w[2 + len]);
     let local = (a - w[0])
         .abs()
         .max((w[3 + len] - b).abs())
         .max((b - a).abs());
-    // The first sample's deviation is at least 10 local, and the line starts within local /
-    // 2 of `a`: so it steps from `a` by at least 9.5 local (a test without a division).
-    if (w[2] - a).abs() < 9.0 * local {
+    let step = (w[2] - a).abs();
+    step > 0.0 && step >= 9.0 * local
+}
+
+/// Whether [`stands_out`] may hold for either length, for finite `w` (six samples).
+#[inline(always)]
+fn may_stand_out(w: &[f64]) -> bool {
+    let max = |a: f64, b: f64| if a > b { a } else { b };
+    let min = |a: f64, b: f64| if a < b { a } else { b };
+    let (a, step, before) = (w[1], (w[2] - w[1]).abs(), (w[1] - w[0]).abs());
+    let one = max(max(before, (w[4] - w[3]).abs()), (w[3] - a).abs());
+    let two = max(max(before, (w[5] - w[4]).abs()), (w[4] - a).abs());
+    (step > 0.0) & (step >= 9.0 * min(one, two))
+}
+
+/// Whether the middle of `w` (`w[2..2 + len]`) stands out from the line between `w[1]` and
+/// `w[2 + len]`; `w` holds two samples before it and two after.
+fn isolated(w: &[f64], len: usize) -> bool {
+    if !stands_out(w, len) {
         return false;
     }
+    let (a, b) = (w[1], w[2 + len]);
+    let local = (a - w[0])
+        .abs()
+        .max((w[3 + len] - b).abs())
+        .max((b - a).abs());
     let mut sign = 0.0;
     let mut least = f64::INFINITY;
     for j in 0..len {
@@ -431,6 +478,15 @@ impl FlatTops {
             // change nothing but the two last readings.
             if let (None, None, Some(_), Some(_)) = (self.run, self.ended, self.high, self.low) {
                 let start = i;
+                let (h, l) = (self.high_level(), self.low_level());
+                // Eight at a time while all lie strictly between (the extremes stay put).
+                while i + 8 <= block.len()
+                    && block[i..i + 8]
+                        .iter()
+                        .fold(true, |all, &v| all & (v < h) & (v > l))
+                {
+                    i += 8;
+                }
                 while i < block.len() {
                     let v = block[i];
                     let (h, l) = (self.high_level(), self.low_level());

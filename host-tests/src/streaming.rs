@@ -2,8 +2,10 @@
 //! hour at 500 kS/s is 3.6 GB of i16, ~60 GB of CSV): a CSV, WAV, .npy, TDMS or raw
 //! (`.i16`/`.f32`) file, or (CSV, raw) standard input.
 //!
-//! - `impact analyze FILE` on a regular file ([`analyze_in_passes`]): a survey of the whole
-//!   recording ([`crate::survey`]), then the analysis; the whole-file path's reports.
+//! - `impact analyze FILE` on a regular file or standard input ([`analyze_in_passes`]): a
+//!   survey of the whole recording ([`crate::survey`]), then the analysis; the whole-file
+//!   path's reports. A CSV's or standard input's values are kept from the first pass for the
+//!   later ones in a temporary file ([`crate::spool`]), so a CSV is parsed once.
 //! - `impact analyze --stream` ([`analyze`]): one pass, with what needs the whole signal given
 //!   (`--range`, `--trigger`) or refused (spike screening is not done; figures, axes, free fall,
 //!   resampling); with the same levels, the same reports (tested).
@@ -17,6 +19,7 @@ use impact_core::{Calibration, ImpactReport};
 use crate::analyze::{self, AnalyzeArgs, HostMonitor, Prepared, Setup};
 use crate::screen::Removal;
 use crate::sources::{open_source, read_head, Source, CHUNK};
+use crate::spool::{Axis, SpoolWriter};
 use crate::survey::{self, Survey, Surveyed};
 use crate::table::is_stdin;
 
@@ -101,17 +104,22 @@ pub fn analyze(
     Ok((setup, reports))
 }
 
-/// Reads and analyses a regular file in passes, in memory that does not grow with its
-/// length, with the whole-file path's rules: a survey of the whole recording (its median,
-/// noise, extremes, flat tops and glitches, [`Survey`]), a second one if glitches were
-/// removed, then the analysis. The same code as the whole-file path on the same values, so
+/// Reads and analyses a regular file or standard input in passes, in memory that does not
+/// grow with its length, with the whole-file path's rules: a survey of the whole recording
+/// (its median, noise, extremes, flat tops and glitches, [`Survey`]), a second one if
+/// glitches were removed, then the analysis. The later passes read the first's values back
+/// from a spool ([`spooled`]) or the file again. The same code as the whole-file path on the same values, so
 /// the same reports (tested); only the time axis is checked against the first intervals'
 /// median, as in a stream (the whole-file path takes the median of all of them).
 pub fn analyze_in_passes(
     args: &AnalyzeArgs,
     progress: Option<fn(f64)>,
 ) -> Result<(Setup, Vec<ImpactReport>), String> {
-    let name = args.file.display().to_string();
+    let name = if is_stdin(&args.file) {
+        "stdin".to_string()
+    } else {
+        args.file.display().to_string()
+    };
     let file = match &args.scene {
         Some(p) => analyze::load_scene(p)?,
         None => analyze::SceneFile::default(),
@@ -129,15 +137,36 @@ pub fn analyze_in_passes(
             in_pass as fn(f64)
         })
     };
-    let (first, source) = survey_pass(args, &name, bar(0.0, 0.5), scale, &[], !args.keep_spikes)?;
-    source.rate_hz()?;
-    let (t0, rate_hz) = (source.t0(), source.final_rate_hz());
+    let input = open_source(args, &name, bar(0.0, 0.5))?;
+    let writer = spooled(args).then(SpoolWriter::new).transpose();
+    let writer = match writer {
+        Err(e) if is_stdin(&args.file) => return Err(format!("stdin: {e}")),
+        w => w.ok().flatten(),
+    };
+    let (first, source, writer) = survey_pass(input, scale, &[], !args.keep_spikes, writer)?;
+    let axis = Axis {
+        rate_hz: source.rate_hz()?,
+        final_rate_hz: source.final_rate_hz(),
+        t0_s: source.t0(),
+    };
+    let (t0, rate_hz) = (axis.t0_s, axis.final_rate_hz);
     drop(source);
+    // The later passes read the spool if there is one (a file whose spool failed, a full
+    // disk, is read again).
+    let spool = match writer.map(|w| w.finish(axis)) {
+        Some(Err(e)) if is_stdin(&args.file) => return Err(format!("stdin: {e}")),
+        s => s.and_then(Result::ok),
+    };
+    let reopen = |progress: Option<fn(f64)>| match &spool {
+        Some(s) => Ok((s.source(progress)?, 1.0)),
+        None => Ok::<_, String>((open_source(args, &name, progress)?, scale)),
+    };
     let removals = first.removals.clone();
     let survey = if removals.is_empty() {
         first
     } else {
-        survey_pass(args, &name, bar(0.5, 2.0 / 3.0), scale, &removals, false)?.0
+        let (input, scale) = reopen(bar(0.5, 2.0 / 3.0))?;
+        survey_pass(input, scale, &removals, false, None)?.0
     };
     let levels = survey::levels(
         &survey,
@@ -160,7 +189,7 @@ pub fn analyze_in_passes(
         mass,
     )?;
     let from = if removals.is_empty() { 0.5 } else { 2.0 / 3.0 };
-    let mut source = open_source(args, &name, bar(from, 1.0))?;
+    let (mut source, scale) = reopen(bar(from, 1.0))?;
     let head = read_head(&mut *source, scale)?;
     let head = head.iter().map(|a| analyze::to_count(*a, gain)).collect();
     let (reports, count, _) = run_monitor(source, head, (scale, gain), scene, removals.clone())?;
@@ -200,37 +229,40 @@ fn in_pass(fraction: f64) {
 }
 
 /// Whether `impact analyze` reads `args.file` in passes ([`analyze_in_passes`]): a regular
-/// file, without the options that need the whole recording in memory (figures, axes, free
+/// file or standard input, without the options that need the whole recording in memory (figures, axes, free
 /// fall, resampling).
 pub fn in_passes(args: &AnalyzeArgs) -> bool {
     !args.stream
-        && !is_stdin(&args.file)
-        && std::fs::metadata(&args.file).is_ok_and(|m| m.is_file())
+        && (is_stdin(&args.file) || std::fs::metadata(&args.file).is_ok_and(|m| m.is_file()))
         && args.plot.is_none()
         && args.axes.is_empty()
         && args.free_fall.is_none()
         && !args.resample
 }
 
-/// One survey of the file (values × `scale`, the `removals` put in), and the source read.
+/// One survey of `source` (values × `scale`, the `removals` put in); the source read, and
+/// the `spool` with the values surveyed written (the first pass's, with no removals).
 fn survey_pass(
-    args: &AnalyzeArgs,
-    name: &str,
-    progress: Option<fn(f64)>,
+    mut source: Box<dyn Source>,
     scale: f64,
     removals: &[Removal],
     screen: bool,
-) -> Result<(Surveyed, Box<dyn Source>), String> {
-    let mut source = open_source(args, name, progress)?;
+    spool: Option<SpoolWriter>,
+) -> Result<SurveyPass, String> {
     let mut survey = Survey::new(screen);
-    // The shape's part of the survey on a thread of its own (a copy of each block).
+    // The shape's part of the survey, and the spool, on a thread of their own (a copy of
+    // each block, as read).
     let mut shape = survey.take_shape();
     let (tx, rx) = std::sync::mpsc::sync_channel::<Vec<f64>>(4);
     let shaper = std::thread::spawn(move || {
+        let mut spool = spool;
         for block in rx {
+            if let Some(s) = &mut spool {
+                s.write(&block);
+            }
             shape.push(&block);
         }
-        shape
+        (shape, spool)
     });
     let mut patch = Patches::new(removals);
     // (The sender ends with this block, so the thread sees the end.)
@@ -255,12 +287,26 @@ fn survey_pass(
             )
         })
     };
-    let shape = shaper
+    let (shape, spool) = shaper
         .join()
         .map_err(|_| "the survey's thread panicked".to_string())?;
     let source = read?;
     survey.put_shape(shape);
-    Ok((survey.finish()?, source))
+    Ok((survey.finish()?, source, spool))
+}
+
+/// What [`survey_pass`] gives: the survey, the source read and the spool written.
+type SurveyPass = (Surveyed, Box<dyn Source>, Option<SpoolWriter>);
+
+/// Whether the first pass keeps the values for the later ones ([`crate::spool`]): standard
+/// input (read once) and a CSV file (its parse costs more than reading the spool).
+fn spooled(args: &AnalyzeArgs) -> bool {
+    let binary = args.raw_type.is_some()
+        || crate::raw::RawType::of(&args.file).is_some()
+        || crate::wav::is_wav(&args.file)
+        || crate::npy::is_npy(&args.file)
+        || crate::tdms::is_tdms(&args.file);
+    is_stdin(&args.file) || !binary
 }
 
 /// Runs `fill` on a reader thread a few chunks ahead of `take` (so memory stays bounded),

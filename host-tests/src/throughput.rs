@@ -116,7 +116,7 @@ pub struct Throughput {
     pub median_samples_per_second: f64,
     /// `impact analyze` on a CSV of the stream's first samples, parsing included.
     pub analyze: AnalyzeThroughput,
-    /// The same samples per format, whole and streamed.
+    /// The same samples per format and path (passes, `--stream`, standard input).
     pub formats: Vec<FormatThroughput>,
     /// Peers reading the same files in the same run (absent when not installed).
     pub peers: Vec<PeerThroughput>,
@@ -239,7 +239,8 @@ pub struct FormatThroughput {
     /// `csv` or `i16`.
     pub format: String,
     /// How `impact analyze` read it: `passes` (a regular file, the default), `stream`
-    /// (`--stream`, levels given) or `whole` (from standard input, held in memory).
+    /// (`--stream`, levels given) or `stdin` (in passes from standard input: parsed by one
+    /// thread, the values kept in a temporary file for the later passes).
     pub path: String,
     pub bytes: u64,
     pub seconds: f64,
@@ -322,7 +323,8 @@ fn peer(code: &str, path: &std::path::Path) -> Option<f64> {
     String::from_utf8_lossy(&out.stdout).trim().parse().ok()
 }
 
-/// `impact analyze` on `counts` written as CSV (whole and `--stream`) and on the `long`
+/// `impact analyze` on `counts` written as CSV (in passes from the file and from standard
+/// input, and `--stream`) and on the `long`
 /// stream as raw i16 (`--stream`; long enough that starting the process does not count),
 /// and the peers reading the same files.
 fn analyze_files(
@@ -387,7 +389,7 @@ fn analyze_files(
         let runs: [(&str, &str, Vec<&str>, Option<&std::path::Path>); 5] = [
             ("csv", "passes", csv_args.to_vec(), None),
             ("csv", "stream", [&csv_args[..], &stream_csv].concat(), None),
-            ("csv", "whole", vec!["analyze", "-", "--json"], Some(&csv)),
+            ("csv", "stdin", vec!["analyze", "-", "--json"], Some(&csv)),
             ("i16", "passes", raw_args.to_vec(), None),
             ("i16", "stream", [&raw_args[..], &stream_raw].concat(), None),
         ];

@@ -1,8 +1,9 @@
-//! `impact analyze` on a regular file reads it in passes (a survey of the whole recording,
-//! a second one if glitches were removed, then the analysis) in memory that does not grow
-//! with its length. The reports equal the whole-file path's (standard input, or `--plot`,
-//! which needs the whole recording) for every format, with glitches, flat tops and the
-//! levels learned from the recording.
+//! `impact analyze` on a regular file or standard input reads it in passes (a survey of the
+//! whole recording, a second one if glitches were removed, then the analysis) in memory that
+//! does not grow with its length; a CSV's or standard input's values are kept from the first
+//! pass in a temporary file. The reports equal the whole-file path's (`--plot`, which needs
+//! the whole recording) for every format, with glitches, flat tops and the levels learned
+//! from the recording.
 
 use std::io::Write;
 use std::path::PathBuf;
@@ -38,7 +39,7 @@ fn passes_and_whole(file: &str, args: &[&str]) -> (String, String) {
     (run(&[]), run(&["--plot", &svg]))
 }
 
-/// `impact analyze - ARGS --json` with `bytes` on standard input (the whole-file path).
+/// `impact analyze - ARGS --json` with `bytes` on standard input.
 fn from_stdin(bytes: Vec<u8>, args: &[&str]) -> String {
     let mut child = Command::new(env!("CARGO_BIN_EXE_impact"))
         .args(["analyze", "-", "--json"])
@@ -228,6 +229,79 @@ fn a_file_too_long_to_hold_whole_is_analysed_in_passes_in_bounded_memory() {
     let peak_mib = common::peak_memory_mib(&err);
     eprintln!("2^26 samples in passes, peak memory {peak_mib:.1} MiB");
     assert!(peak_mib < 64.0, "peak memory {peak_mib:.1} MiB");
+    // The same samples on standard input (read once, the values kept in a temporary file
+    // for the later passes): the same reports, in bounded memory.
+    let mut child = Command::new(env!("CARGO_BIN_EXE_impact"))
+        .args([
+            "analyze",
+            "-",
+            "--raw-type",
+            "i16",
+            "--rate",
+            "500000",
+            "--gain",
+            "0.390625",
+            "--units",
+            "m/s2",
+            "--json",
+        ])
+        .env("IMPACT_PEAK_MEMORY", "1")
+        .env("TMPDIR", env!("CARGO_TARGET_TMPDIR"))
+        .stdin(Stdio::piped())
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    let mut stdin = child.stdin.take().unwrap();
+    let writer = std::thread::spawn(move || {
+        for p in 0..PERIODS {
+            let mut chunk = pattern.clone();
+            if p == 7 {
+                chunk[200..202].copy_from_slice(&30000i16.to_le_bytes());
+            }
+            stdin.write_all(&chunk).unwrap();
+        }
+    });
+    let piped = child.wait_with_output().unwrap();
+    writer.join().unwrap();
+    let err = String::from_utf8_lossy(&piped.stderr);
+    assert!(piped.status.success(), "{err}");
+    assert_eq!(piped.stdout, out.stdout);
+    let peak_mib = common::peak_memory_mib(&err);
+    eprintln!("2^26 samples from standard input, peak memory {peak_mib:.1} MiB");
+    assert!(peak_mib < 64.0, "peak memory {peak_mib:.1} MiB");
+}
+
+/// Without a temporary directory to keep the first pass's values in, a CSV file is read
+/// again for the later passes (the same reports), and standard input, which cannot be, is a
+/// one-line error that names the directory.
+#[test]
+fn without_a_temporary_file_a_file_is_read_again_and_stdin_is_refused() {
+    let csv = glitched_csv(None);
+    let file = tmp("no-spool.csv");
+    std::fs::write(&file, &csv).unwrap();
+    let missing = tmp("no-such-directory");
+    let run = |tmpdir: &str, input: &str| {
+        Command::new(env!("CARGO_BIN_EXE_impact"))
+            .args(["analyze", input, "--json", "--mass", "0.06"])
+            .env("TMPDIR", tmpdir)
+            .stdin(std::fs::File::open(&file).unwrap())
+            .output()
+            .unwrap()
+    };
+    let spooled = run(env!("CARGO_TARGET_TMPDIR"), &file);
+    let again = run(&missing, &file);
+    assert!(spooled.status.success() && again.status.success());
+    assert_eq!(again.stdout, spooled.stdout);
+    assert_eq!(run(env!("CARGO_TARGET_TMPDIR"), "-").stdout, spooled.stdout);
+    let refused = run(&missing, "-");
+    let err = String::from_utf8_lossy(&refused.stderr);
+    assert!(!refused.status.success());
+    assert!(
+        err.starts_with("error: stdin: ") && err.contains(&missing),
+        "{err}"
+    );
+    assert_eq!(err.trim_end().lines().count(), 1, "{err}");
 }
 
 /// A CSV's time errors read the same in passes, whole (standard input) and `--stream`: a

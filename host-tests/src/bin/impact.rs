@@ -198,14 +198,14 @@ fn run(cli: Cli) -> Result<(), String> {
             if let Some(path) = &args.plot {
                 plot::check_output(path, &[args.file.as_path()])?;
             }
-            // A regular file is read in passes in bounded memory, unless an option needs the
-            // whole recording: then a large one gets a note of the memory it takes (about 40
-            // bytes a row).
+            // A regular file or standard input is read in passes in bounded memory, unless
+            // an option needs the whole recording: then a large file gets a note of the
+            // memory it takes (about 40 bytes a row).
             let in_passes = impact_host::streaming::in_passes(&args);
             let size = std::fs::metadata(&args.file).map_or(0, |m| m.len());
             if !args.stream && !in_passes && size > 1 << 30 {
                 eprintln!(
-                    "note: {} is {:.1} GB: read whole (for --plot, --axes, --free-fall, --resample or standard input) it takes some {:.0} GB of memory",
+                    "note: {} is {:.1} GB: read whole (for --plot, --axes, --free-fall or --resample) it takes some {:.0} GB of memory",
                     args.file.display(),
                     size as f64 / 1e9,
                     size as f64 * 2.0 / 1e9

@@ -1,0 +1,186 @@
+//! A recording's values kept after its first pass, so the later passes read them back at
+//! memory speed instead of parsing the file again (a CSV's parse is most of its cost), or
+//! at all (standard input can be read only once).
+//!
+//! The values (× the units, as f64, so exactly those read) go to an unnamed temporary file
+//! in the system's temporary directory (`TMPDIR`): 8 bytes a sample, about 40 % of a CSV's
+//! size, on disk or in the page cache, never in the process's memory. The file is gone when
+//! the spool is dropped, or the process ends.
+
+use std::fs::File;
+use std::io::Write;
+use std::os::unix::fs::FileExt;
+
+use crate::sources::{Source, CHUNK};
+
+/// Values being written to the spool.
+pub struct SpoolWriter {
+    out: std::io::BufWriter<File>,
+    bytes: Vec<u8>,
+    samples: u64,
+    failed: Option<std::io::Error>,
+}
+
+impl SpoolWriter {
+    pub fn new() -> Result<Self, String> {
+        let file =
+            tempfile::tempfile().map_err(|e| format!("a temporary file in {}: {e}", temp_dir()))?;
+        Ok(Self {
+            out: std::io::BufWriter::with_capacity(1 << 20, file),
+            bytes: Vec::new(),
+            samples: 0,
+            failed: None,
+        })
+    }
+
+    /// Appends the values (after a failure, nothing: [`SpoolWriter::finish`] reports it).
+    pub fn write(&mut self, values: &[f64]) {
+        if self.failed.is_some() {
+            return;
+        }
+        self.bytes.clear();
+        self.bytes
+            .extend(values.iter().flat_map(|v| v.to_le_bytes()));
+        match self.out.write_all(&self.bytes) {
+            Ok(()) => self.samples += values.len() as u64,
+            Err(e) => self.failed = Some(e),
+        }
+    }
+
+    /// The spool, with what the first pass's source told of the time axis.
+    pub fn finish(self, axis: Axis) -> Result<Spool, String> {
+        let failed = |e: std::io::Error| format!("the spool in {}: {e}", temp_dir());
+        if let Some(e) = self.failed {
+            return Err(failed(e));
+        }
+        let file = self.out.into_inner().map_err(|e| failed(e.into_error()))?;
+        Ok(Spool {
+            file,
+            samples: self.samples,
+            axis,
+        })
+    }
+}
+
+/// What the first pass's source told of the time axis, which the spool's passes tell again.
+#[derive(Clone, Copy, Debug)]
+pub struct Axis {
+    pub rate_hz: f64,
+    pub final_rate_hz: f64,
+    pub t0_s: f64,
+}
+
+/// The values of a pass, read back as often as needed.
+pub struct Spool {
+    file: File,
+    samples: u64,
+    axis: Axis,
+}
+
+impl Spool {
+    /// A source of the values from the first, `progress` the fraction read.
+    pub(crate) fn source(&self, progress: Option<fn(f64)>) -> Result<Box<dyn Source>, String> {
+        let file = self
+            .file
+            .try_clone()
+            .map_err(|e| format!("the spool in {}: {e}", temp_dir()))?;
+        Ok(Box::new(SpoolSource {
+            file,
+            at: 0,
+            samples: self.samples,
+            axis: self.axis,
+            bytes: vec![0; CHUNK * 8],
+            progress,
+        }))
+    }
+}
+
+/// A spool read from its start (at its own offset, so two never interfere).
+struct SpoolSource {
+    file: File,
+    /// Samples read.
+    at: u64,
+    samples: u64,
+    axis: Axis,
+    bytes: Vec<u8>,
+    progress: Option<fn(f64)>,
+}
+
+impl Source for SpoolSource {
+    fn next_values(&mut self, want: usize, out: &mut Vec<f64>) -> Result<(), String> {
+        let n = (want.clamp(1, CHUNK) as u64).min(self.samples - self.at) as usize;
+        let bytes = &mut self.bytes[..n * 8];
+        self.file
+            .read_exact_at(bytes, self.at * 8)
+            .map_err(|e| format!("the spool in {}: {e}", temp_dir()))?;
+        out.extend(
+            bytes
+                .chunks_exact(8)
+                .map(|b| f64::from_le_bytes([b[0], b[1], b[2], b[3], b[4], b[5], b[6], b[7]])),
+        );
+        self.at += n as u64;
+        if let Some(p) = self.progress {
+            p(self.at as f64 / self.samples.max(1) as f64);
+        }
+        Ok(())
+    }
+
+    fn rate_hz(&self) -> Result<f64, String> {
+        Ok(self.axis.rate_hz)
+    }
+
+    fn final_rate_hz(&self) -> f64 {
+        self.axis.final_rate_hz
+    }
+
+    fn t0(&self) -> f64 {
+        self.axis.t0_s
+    }
+}
+
+fn temp_dir() -> String {
+    std::env::temp_dir().display().to_string()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn values_come_back_bit_for_bit_in_any_reads() {
+        let values: Vec<f64> = (0..200_000)
+            .map(|i| (i as f64 * 0.37).sin() * 1e3 + f64::from(i % 7) * 1e-300)
+            .chain([0.0, -0.0, f64::MAX, f64::MIN_POSITIVE])
+            .collect();
+        let mut w = SpoolWriter::new().unwrap();
+        for block in values.chunks(7777) {
+            w.write(block);
+        }
+        let axis = Axis {
+            rate_hz: 5e5,
+            final_rate_hz: 4.9e5,
+            t0_s: 1.5,
+        };
+        let spool = w.finish(axis).unwrap();
+        for want in [1, 1000, CHUNK, 10 * CHUNK] {
+            let mut s = spool.source(None).unwrap();
+            let mut back = Vec::new();
+            loop {
+                let before = back.len();
+                s.next_values(want, &mut back).unwrap();
+                if back.len() == before {
+                    break;
+                }
+            }
+            assert_eq!(back.len(), values.len());
+            assert!(back
+                .iter()
+                .zip(&values)
+                .all(|(a, b)| a.to_bits() == b.to_bits()));
+            assert_eq!(
+                (s.rate_hz().unwrap(), s.final_rate_hz(), s.t0()),
+                (5e5, 4.9e5, 1.5)
+            );
+        }
+    }
+}
