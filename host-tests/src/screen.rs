@@ -136,9 +136,11 @@ impl SpikeScan {
         let finite = buf.iter().fold(true, |all, v| all & v.is_finite());
         while j + 3 < buf.len() {
             // Almost every sample fails the first test of `isolated` (for both lengths):
-            // eight at a time while none passes, with the range updates as below. (For
-            // finite values only: their plain maxima and minima are `f64::max`'s and
-            // `min`'s, in a loop without branches.)
+            // eight at a time while none passes, with the range updates as below. (Only
+            // where every reading is finite: no step is NaN, so `may_stand_out`, with plain
+            // maxima and minima in a loop without branches, is `stands_out` for both. The
+            // readers refuse readings that are not finite; one that overflows with the
+            // units is an error at the survey's end.)
             let (mut low, mut high) = ([lo; 8], [hi; 8]);
             while finite && j + 11 <= buf.len() {
                 let w = &buf[j - 2..j + 11];
@@ -790,6 +792,9 @@ mod tests {
                         x[at + k] += 1.5 * (std::f64::consts::PI * k as f64 / w as f64).sin();
                     }
                 }
+                // Signed zeros, and readings near the end of f64's range (steps overflow).
+                4 => x[at] = if next() % 2 == 0 { 0.0 } else { -0.0 },
+                5 if seed % 3 == 0 => x[at] = if next() % 2 == 0 { 1e308 } else { -1e308 },
                 _ => {}
             }
         }

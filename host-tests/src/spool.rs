@@ -4,8 +4,8 @@
 //!
 //! The values (× the units, as f64, so exactly those read) go to an unnamed temporary file
 //! in the system's temporary directory (`TMPDIR`): 8 bytes a sample, about 40 % of a CSV's
-//! size, on disk or in the page cache, never in the process's memory. The file is gone when
-//! the spool is dropped, or the process ends.
+//! size, on disk or in the page cache, not in the process's own memory (on a `tmpfs`, in
+//! RAM or swap). The file is gone when the spool is dropped, or the process ends.
 
 use std::fs::File;
 use std::io::Write;
@@ -18,7 +18,6 @@ pub struct SpoolWriter {
     out: std::io::BufWriter<File>,
     bytes: Vec<u8>,
     samples: u64,
-    failed: Option<std::io::Error>,
 }
 
 impl SpoolWriter {
@@ -29,30 +28,22 @@ impl SpoolWriter {
             out: std::io::BufWriter::with_capacity(1 << 20, file),
             bytes: Vec::new(),
             samples: 0,
-            failed: None,
         })
     }
 
-    /// Appends the values (after a failure, nothing: [`SpoolWriter::finish`] reports it).
-    pub fn write(&mut self, values: &[f64]) {
-        if self.failed.is_some() {
-            return;
-        }
+    /// Appends the values. An error (a full disk) ends the spool: drop it, and its space is
+    /// freed at once.
+    pub fn write(&mut self, values: &[f64]) -> Result<(), String> {
         self.bytes.clear();
         self.bytes
             .extend(values.iter().flat_map(|v| v.to_le_bytes()));
-        match self.out.write_all(&self.bytes) {
-            Ok(()) => self.samples += values.len() as u64,
-            Err(e) => self.failed = Some(e),
-        }
+        self.out.write_all(&self.bytes).map_err(failed)?;
+        self.samples += values.len() as u64;
+        Ok(())
     }
 
     /// The spool, with what the first pass's source told of the time axis.
     pub fn finish(self, axis: Axis) -> Result<Spool, String> {
-        let failed = |e: std::io::Error| format!("the spool in {}: {e}", temp_dir());
-        if let Some(e) = self.failed {
-            return Err(failed(e));
-        }
         let file = self.out.into_inner().map_err(|e| failed(e.into_error()))?;
         Ok(Spool {
             file,
@@ -80,10 +71,7 @@ pub struct Spool {
 impl Spool {
     /// A source of the values from the first, `progress` the fraction read.
     pub(crate) fn source(&self, progress: Option<fn(f64)>) -> Result<Box<dyn Source>, String> {
-        let file = self
-            .file
-            .try_clone()
-            .map_err(|e| format!("the spool in {}: {e}", temp_dir()))?;
+        let file = self.file.try_clone().map_err(failed)?;
         Ok(Box::new(SpoolSource {
             file,
             at: 0,
@@ -112,7 +100,7 @@ impl Source for SpoolSource {
         let bytes = &mut self.bytes[..n * 8];
         self.file
             .read_exact_at(bytes, self.at * 8)
-            .map_err(|e| format!("the spool in {}: {e}", temp_dir()))?;
+            .map_err(failed)?;
         out.extend(
             bytes
                 .chunks_exact(8)
@@ -142,6 +130,10 @@ fn temp_dir() -> String {
     std::env::temp_dir().display().to_string()
 }
 
+fn failed(e: std::io::Error) -> String {
+    format!("the spool in {}: {e}", temp_dir())
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -154,7 +146,7 @@ mod tests {
             .collect();
         let mut w = SpoolWriter::new().unwrap();
         for block in values.chunks(7777) {
-            w.write(block);
+            w.write(block).unwrap();
         }
         let axis = Axis {
             rate_hz: 5e5,

@@ -108,7 +108,7 @@ pub fn analyze(
 /// grow with its length, with the whole-file path's rules: a survey of the whole recording
 /// (its median, noise, extremes, flat tops and glitches, [`Survey`]), a second one if
 /// glitches were removed, then the analysis. The later passes read the first's values back
-/// from a spool ([`spooled`]) or the file again. The same code as the whole-file path on the same values, so
+/// from a spool ([`crate::spool`]: a CSV, standard input) or the file again. The same code as the whole-file path on the same values, so
 /// the same reports (tested); only the time axis is checked against the first intervals'
 /// median, as in a stream (the whole-file path takes the median of all of them).
 pub fn analyze_in_passes(
@@ -137,13 +137,21 @@ pub fn analyze_in_passes(
             in_pass as fn(f64)
         })
     };
-    let input = open_source(args, &name, bar(0.0, 0.5))?;
-    let writer = spooled(args).then(SpoolWriter::new).transpose();
-    let writer = match writer {
-        Err(e) if is_stdin(&args.file) => return Err(format!("stdin: {e}")),
-        w => w.ok().flatten(),
+    // (The spool first: standard input without one is refused before it is read.)
+    let stdin = is_stdin(&args.file);
+    let spool = match spooled(args).then(SpoolWriter::new).transpose() {
+        Err(e) if stdin => return Err(format!("stdin: {e}")),
+        Err(e) => {
+            eprintln!("note: {e}: {name} is read again for each pass");
+            None
+        }
+        Ok(writer) => writer.map(|writer| Spooling {
+            writer,
+            stops: stdin.then(|| name.clone()),
+        }),
     };
-    let (first, source, writer) = survey_pass(input, scale, &[], !args.keep_spikes, writer)?;
+    let input = open_source(args, &name, bar(0.0, 0.5))?;
+    let (first, source, spool) = survey_pass(input, scale, &[], !args.keep_spikes, spool)?;
     let axis = Axis {
         rate_hz: source.rate_hz()?,
         final_rate_hz: source.final_rate_hz(),
@@ -153,9 +161,14 @@ pub fn analyze_in_passes(
     drop(source);
     // The later passes read the spool if there is one (a file whose spool failed, a full
     // disk, is read again).
-    let spool = match writer.map(|w| w.finish(axis)) {
-        Some(Err(e)) if is_stdin(&args.file) => return Err(format!("stdin: {e}")),
-        s => s.and_then(Result::ok),
+    let spool = match spool.map(|s| s.and_then(|w| w.finish(axis))) {
+        Some(Err(e)) if stdin => return Err(format!("stdin: {e}")),
+        Some(Err(e)) => {
+            eprintln!("note: {e}: {name} is read again");
+            None
+        }
+        Some(Ok(s)) => Some(s),
+        None => None,
     };
     let reopen = |progress: Option<fn(f64)>| match &spool {
         Some(s) => Ok((s.source(progress)?, 1.0)),
@@ -247,22 +260,32 @@ fn survey_pass(
     scale: f64,
     removals: &[Removal],
     screen: bool,
-    spool: Option<SpoolWriter>,
+    spool: Option<Spooling>,
 ) -> Result<SurveyPass, String> {
     let mut survey = Survey::new(screen);
     // The shape's part of the survey, and the spool, on a thread of their own (a copy of
-    // each block, as read).
+    // each block, as read). A spool that fails is dropped at once (its space freed); one
+    // that must not fail ends the pass.
+    let stops = spool.as_ref().and_then(|s| s.stops.clone());
+    let spool = spool.map(|s| Ok(s.writer));
+    let failure = std::sync::Arc::new(std::sync::OnceLock::<String>::new());
     let mut shape = survey.take_shape();
     let (tx, rx) = std::sync::mpsc::sync_channel::<Vec<f64>>(4);
-    let shaper = std::thread::spawn(move || {
-        let mut spool = spool;
-        for block in rx {
-            if let Some(s) = &mut spool {
-                s.write(&block);
+    let shaper = std::thread::spawn({
+        let failure = std::sync::Arc::clone(&failure);
+        move || {
+            let mut spool = spool;
+            for block in rx {
+                if let Some(Ok(w)) = &mut spool {
+                    if let Err(e) = w.write(&block) {
+                        let _ = failure.set(e.clone());
+                        spool = Some(Err(e));
+                    }
+                }
+                shape.push(&block);
             }
-            shape.push(&block);
+            (shape, spool)
         }
-        (shape, spool)
     });
     let mut patch = Patches::new(removals);
     // (The sender ends with this block, so the thread sees the end.)
@@ -280,9 +303,13 @@ fn survey_pass(
                     Ok(())
                 },
                 |block| {
+                    if let (Some(name), Some(e)) = (&stops, failure.get()) {
+                        return Err(format!("{name}: {e}"));
+                    }
                     patch.values(block);
                     survey.push_levels(block);
                     let _ = tx.send(block.to_vec());
+                    Ok(())
                 },
             )
         })
@@ -291,12 +318,27 @@ fn survey_pass(
         .join()
         .map_err(|_| "the survey's thread panicked".to_string())?;
     let source = read?;
+    if let (Some(name), Some(Err(e))) = (&stops, &spool) {
+        return Err(format!("{name}: {e}"));
+    }
     survey.put_shape(shape);
     Ok((survey.finish()?, source, spool))
 }
 
-/// What [`survey_pass`] gives: the survey, the source read and the spool written.
-type SurveyPass = (Surveyed, Box<dyn Source>, Option<SpoolWriter>);
+/// A spool for a first pass to write, and the input's name if its failure ends the pass
+/// (standard input, which cannot be read again).
+struct Spooling {
+    writer: SpoolWriter,
+    stops: Option<String>,
+}
+
+/// What [`survey_pass`] gives: the survey, the source read and the spool written (or why
+/// it failed).
+type SurveyPass = (
+    Surveyed,
+    Box<dyn Source>,
+    Option<Result<SpoolWriter, String>>,
+);
 
 /// Whether the first pass keeps the values for the later ones ([`crate::spool`]): standard
 /// input (read once) and a CSV file (its parse costs more than reading the spool).
@@ -310,11 +352,11 @@ fn spooled(args: &AnalyzeArgs) -> bool {
 }
 
 /// Runs `fill` on a reader thread a few chunks ahead of `take` (so memory stays bounded),
-/// until `fill` gives nothing; the source back, or the first error.
+/// until `fill` gives nothing; the source back, or the first error (of either).
 fn read_ahead<T: Send + 'static>(
     mut source: Box<dyn Source>,
     fill: impl Fn(&mut dyn Source, &mut Vec<f64>, &mut Vec<T>) -> Result<(), String> + Send + 'static,
-    mut take: impl FnMut(&mut [T]),
+    mut take: impl FnMut(&mut [T]) -> Result<(), String>,
 ) -> Result<Box<dyn Source>, String> {
     let (tx, rx) = std::sync::mpsc::sync_channel::<Result<Vec<T>, String>>(4);
     let (back, spare) = std::sync::mpsc::channel::<Vec<T>>();
@@ -337,7 +379,10 @@ fn read_ahead<T: Send + 'static>(
     for chunk in rx.iter() {
         match chunk {
             Ok(mut c) => {
-                take(&mut c);
+                if let Err(e) = take(&mut c) {
+                    failed = Some(e);
+                    break;
+                }
                 let _ = back.send(c);
             }
             Err(e) => {
@@ -376,9 +421,10 @@ fn run_monitor(
                 m.push_block(block, &mut |r: &ImpactReport| out.push(*r));
             }
             total += counts.len() as u64;
+            Ok(())
         };
         let mut head = head;
-        take(&mut head);
+        take(&mut head)?;
         let source = read_ahead(
             source,
             move |s, scratch, counts| s.next_counts(CHUNK, (scale, gain), scratch, counts),

@@ -272,9 +272,9 @@ fn a_file_too_long_to_hold_whole_is_analysed_in_passes_in_bounded_memory() {
     assert!(peak_mib < 64.0, "peak memory {peak_mib:.1} MiB");
 }
 
-/// Without a temporary directory to keep the first pass's values in, a CSV file is read
-/// again for the later passes (the same reports), and standard input, which cannot be, is a
-/// one-line error that names the directory.
+/// Without a temporary directory to keep the first pass's values in, or room there, a CSV
+/// file is read again for the later passes (the same reports, and a note), and standard
+/// input, which cannot be, is a one-line error that names the directory.
 #[test]
 fn without_a_temporary_file_a_file_is_read_again_and_stdin_is_refused() {
     let csv = glitched_csv(None);
@@ -302,11 +302,45 @@ fn without_a_temporary_file_a_file_is_read_again_and_stdin_is_refused() {
         "{err}"
     );
     assert_eq!(err.trim_end().lines().count(), 1, "{err}");
+    // A spool that cannot grow past 64 KiB (a full disk): the file is read again, standard
+    // input refused.
+    let capped = |input: &str| {
+        use std::os::unix::process::CommandExt;
+        let mut command = Command::new(env!("CARGO_BIN_EXE_impact"));
+        command
+            .args(["analyze", input, "--json", "--mass", "0.06"])
+            .env("TMPDIR", env!("CARGO_TARGET_TMPDIR"))
+            .stdin(std::fs::File::open(&file).unwrap());
+        // SAFETY: only async-signal-safe calls between fork and exec.
+        unsafe {
+            command.pre_exec(|| {
+                libc::signal(libc::SIGXFSZ, libc::SIG_IGN);
+                let limit = libc::rlimit {
+                    rlim_cur: 1 << 16,
+                    rlim_max: 1 << 16,
+                };
+                libc::setrlimit(libc::RLIMIT_FSIZE, &limit);
+                Ok(())
+            });
+        }
+        command.output().unwrap()
+    };
+    assert!(csv.len() > 8 << 16, "the spool outgrows the cap");
+    let again = capped(&file);
+    let err = String::from_utf8_lossy(&again.stderr);
+    assert!(again.status.success(), "{err}");
+    assert_eq!(again.stdout, spooled.stdout);
+    assert!(err.contains("is read again"), "{err}");
+    let refused = capped("-");
+    let err = String::from_utf8_lossy(&refused.stderr);
+    assert!(!refused.status.success());
+    assert!(err.starts_with("error: stdin: the spool in "), "{err}");
+    assert_eq!(err.trim_end().lines().count(), 1, "{err}");
 }
 
-/// A CSV's time errors read the same in passes, whole (standard input) and `--stream`: a
-/// value that is not a number first, then time going back, then an uneven interval (the
-/// first of each), every interval against the first intervals' median.
+/// A CSV's time errors read the same in passes (from the file and from standard input), whole
+/// and `--stream`: a value that is not a number first, then time going back, then an uneven
+/// interval (the first of each), every interval against the first intervals' median.
 #[test]
 fn time_axis_errors_read_the_same_on_every_path() {
     let csv = |rows: usize, time: &dyn Fn(usize) -> f64, bad: Option<usize>| {

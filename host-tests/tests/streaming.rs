@@ -346,7 +346,7 @@ fn a_long_csv_file_gives_the_same_reports_and_errors_through_the_parallel_reader
         std::fs::write(&path, lines.join("\n") + "\n").unwrap();
         path
     };
-    // The whole-file path, from standard input (read by one thread, row by row).
+    // Standard input (read by one thread, row by row, in passes).
     let run_stdin = |file: &str, tail: &[&str]| {
         let out = Command::new(env!("CARGO_BIN_EXE_impact"))
             .args(["analyze", "-"])
@@ -362,8 +362,11 @@ fn a_long_csv_file_gives_the_same_reports_and_errors_through_the_parallel_reader
         )
     };
     let plain = write("long.csv", &lines);
-    let whole = run_stdin(&plain, &["--json", "--keep-spikes"]);
+    // The whole-file path (`--plot` holds the recording).
+    let svg = tmp("long.svg");
+    let whole = run(&plain, &["--json", "--keep-spikes", "--plot", &svg]);
     assert_eq!(whole.0, 0, "{}", whole.2);
+    assert_eq!(run_stdin(&plain, &["--json", "--keep-spikes"]).1, whole.1);
     let v: serde_json::Value = serde_json::from_str(&whole.1).unwrap();
     assert!(v["impacts"][0]["cor"].is_number(), "{v}");
     assert_eq!(run(&plain, &["--json", "--keep-spikes"]).1, whole.1);
@@ -399,8 +402,10 @@ fn a_long_csv_file_gives_the_same_reports_and_errors_through_the_parallel_reader
     let (_, _, passes_err) = run(&text, &[]);
     assert!(code != 0 && err.contains(":250001: not a number"), "{err}");
     assert_eq!(err, passes_err);
-    let (_, _, whole_err) = run_stdin(&text, &[]);
-    assert_eq!(whole_err, err.replace(&text, "stdin"));
+    let (_, _, stdin_err) = run_stdin(&text, &[]);
+    assert_eq!(stdin_err, err.replace(&text, "stdin"));
+    let (_, _, whole_err) = run(&text, &["--plot", &svg]);
+    assert_eq!(whole_err, err);
     let mut gap = lines.clone();
     gap.remove(240_000);
     let gap = write("gap-long.csv", &gap);
