@@ -480,18 +480,24 @@ impl FlatTops {
             // change nothing but the two last readings.
             if let (None, None, Some(_), Some(_)) = (self.run, self.ended, self.high, self.low) {
                 let start = i;
-                let (h, l) = (self.high_level(), self.low_level());
-                // Eight at a time while all lie strictly between (the extremes stay put).
-                while i + 8 <= block.len()
-                    && block[i..i + 8]
-                        .iter()
-                        .fold(true, |all, &v| all & (v < h) & (v > l))
-                {
-                    i += 8;
-                }
                 while i < block.len() {
-                    let v = block[i];
                     let (h, l) = (self.high_level(), self.low_level());
+                    // Eight at a time while each lies strictly between the extremes, or at
+                    // one of them in a run of fewer than three (nothing changes for either;
+                    // the same tests as below, in a loop without branches).
+                    while i + 10 <= block.len()
+                        && block[i..i + 10].windows(3).fold(true, |all, w| {
+                            let v = w[0];
+                            let short = !((w[1] == v) & (w[2] == v));
+                            all & ((v < h) & (v > l) | ((v == h) | (v == l)) & short)
+                        })
+                    {
+                        i += 8;
+                    }
+                    if i == block.len() {
+                        break;
+                    }
+                    let v = block[i];
                     if v < h && v > l {
                         i += 1;
                         continue;

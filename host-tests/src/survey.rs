@@ -116,12 +116,24 @@ impl Survey {
         self.steps
             .add_all(block.windows(2).map(|w| (w[1] - w[0]).abs()));
         self.values.add_all(block.iter().copied());
-        let (mut min, mut max) = (self.min, self.max);
-        for &v in block {
-            min = if v < min { v } else { min };
-            max = if v > max { v } else { max };
+        // Eight running extremes, so no comparison waits for the one before (only their
+        // magnitudes are used: which zero is kept does not matter).
+        let (mut min, mut max) = ([self.min; 8], [self.max; 8]);
+        let eights = block.chunks_exact(8);
+        let rest = eights.remainder();
+        for eight in eights {
+            for k in 0..8 {
+                let v = eight[k];
+                min[k] = if v < min[k] { v } else { min[k] };
+                max[k] = if v > max[k] { v } else { max[k] };
+            }
         }
-        (self.min, self.max) = (min, max);
+        let lowest = |a: f64, &b: &f64| if b < a { b } else { a };
+        let highest = |a: f64, &b: &f64| if b > a { b } else { a };
+        self.min = rest.iter().fold(min.iter().fold(self.min, lowest), lowest);
+        self.max = rest
+            .iter()
+            .fold(max.iter().fold(self.max, highest), highest);
         if let Some(&v) = block.last() {
             self.last = Some(v);
         }
