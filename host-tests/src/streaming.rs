@@ -271,6 +271,8 @@ fn survey_pass(
     let failure = std::sync::Arc::new(std::sync::OnceLock::<String>::new());
     let mut shape = survey.take_shape();
     let (tx, rx) = std::sync::mpsc::sync_channel::<Vec<f64>>(4);
+    // (The copies go back to be filled again.)
+    let (back, spare) = std::sync::mpsc::channel::<Vec<f64>>();
     let shaper = std::thread::spawn({
         let failure = std::sync::Arc::clone(&failure);
         move || {
@@ -283,6 +285,7 @@ fn survey_pass(
                     }
                 }
                 shape.push(&block);
+                let _ = back.send(block);
             }
             (shape, spool)
         }
@@ -308,7 +311,10 @@ fn survey_pass(
                     }
                     patch.values(block);
                     survey.push_levels(block);
-                    let _ = tx.send(block.to_vec());
+                    let mut copy = spare.try_recv().unwrap_or_default();
+                    copy.clear();
+                    copy.extend_from_slice(block);
+                    let _ = tx.send(copy);
                     Ok(())
                 },
             )
