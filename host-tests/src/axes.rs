@@ -18,11 +18,14 @@ pub struct Axis {
 }
 
 impl Axis {
-    /// An axis with its rails from `full_scale_m_s2` if given, else from its flat tops.
+    /// An axis with its rails from `full_scale_m_s2` if given, else from its flat tops
+    /// beyond its noise (as the channel's, [`crate::survey`]).
     pub fn new(name: String, accel_m_s2: Vec<f64>, full_scale_m_s2: Option<f64>) -> Self {
         let rails = match full_scale_m_s2 {
             Some(fs) => Some(screen::from_range(fs)),
-            None => screen::flat_tops(&accel_m_s2),
+            None => crate::survey::Survey::of(&accel_m_s2, false)
+                .ok()
+                .and_then(|s| s.flat_tops),
         };
         Self {
             name,

@@ -44,7 +44,7 @@ pub struct Surveyed {
     pub noise_rms_m_s2: f64,
     pub min_m_s2: f64,
     pub max_m_s2: f64,
-    /// Flat tops at the extremes ([`FlatTops`]).
+    /// Flat tops at the extremes ([`FlatTops`]) beyond the noise ([`RAIL_NOISE`]).
     pub flat_tops: Option<Clipping>,
     /// Isolated glitches (when screened).
     pub removals: Vec<Removal>,
@@ -159,7 +159,11 @@ impl Survey {
             noise_rms_m_s2: noise,
             min_m_s2: self.min,
             max_m_s2: self.max,
-            flat_tops: self.shape.flat.finish(),
+            flat_tops: self
+                .shape
+                .flat
+                .finish()
+                .and_then(|c| beyond_noise(c, median, noise)),
             removals,
         })
     }
@@ -209,6 +213,22 @@ pub fn levels(
     }
 }
 
+/// A flat top is taken for a rail only this many times the noise from the median: nearer,
+/// it is the quantised noise floor of a channel at rest (the lowest of its few readings
+/// comes in runs), which no sensor's full scale is.
+const RAIL_NOISE: f64 = 10.0;
+
+/// The flat tops' levels that lie beyond the noise ([`RAIL_NOISE`]); `None` if none does.
+fn beyond_noise(c: Clipping, median: f64, noise: f64) -> Option<Clipping> {
+    let far = |level: &f64| (level - median).abs() > RAIL_NOISE * noise;
+    let (low, high) = (c.low_m_s2.filter(far), c.high_m_s2.filter(far));
+    (low.is_some() || high.is_some()).then_some(Clipping {
+        low_m_s2: low,
+        high_m_s2: high,
+        ..c
+    })
+}
+
 /// Robust noise of the steps' histogram: their median / sqrt(2) × 1.4826 (0 for none).
 fn noise_of(steps: &OrderHistogram) -> f64 {
     steps
@@ -247,4 +267,46 @@ fn trigger_and_edge(
     });
     let edge = edge.unwrap_or_else(|| default_edge(sigma, trigger));
     (trigger, edge)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// ±1 count of noise (0.05 g a count) with 300-count half-sine pulses every 100 000
+    /// samples, the reading clipped at `clip` counts if given.
+    fn at_rest(clip: Option<f64>) -> Vec<f64> {
+        let mut state = 0x2545_f491_4f6c_dd1du64;
+        (0..500_000usize)
+            .map(|i| {
+                state ^= state << 13;
+                state ^= state >> 7;
+                state ^= state << 17;
+                let noise = (state % 3) as f64 - 1.0;
+                let k = i % 100_000;
+                let pulse = if i >= 100_000 && k < 500 {
+                    (300.0 * (std::f64::consts::PI * k as f64 / 500.0).sin()).round()
+                } else {
+                    0.0
+                };
+                clip.map_or(noise + pulse, |c| (noise + pulse).min(c)) * 0.05 * 9.80665
+            })
+            .collect()
+    }
+
+    #[test]
+    fn the_noise_floor_of_a_channel_at_rest_is_no_rail() {
+        // The lowest reading, one count below rest, comes in runs of eight and more entered
+        // two counts steep: a flat top by shape alone, but within the noise.
+        let mut flat = FlatTops::default();
+        let x = at_rest(None);
+        flat.push(&x);
+        assert!(flat.finish().is_some_and(|c| c.low_m_s2.is_some()));
+        assert_eq!(Survey::of(&x, false).unwrap().flat_tops, None);
+        // The pulses clipped at 200 counts: that rail, and no other.
+        let s = Survey::of(&at_rest(Some(200.0)), false).unwrap();
+        let c = s.flat_tops.expect("the rail");
+        assert_eq!(c.low_m_s2, None);
+        assert_eq!(c.high_m_s2, Some(200.0 * 0.05 * 9.80665));
+    }
 }
