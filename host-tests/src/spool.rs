@@ -15,7 +15,8 @@ use crate::sources::{Source, CHUNK};
 
 /// Values being written to the spool.
 pub struct SpoolWriter {
-    out: std::io::BufWriter<File>,
+    /// (Written a block at a time: no buffer of its own.)
+    out: File,
     bytes: Vec<u8>,
     samples: u64,
 }
@@ -25,7 +26,7 @@ impl SpoolWriter {
         let file =
             tempfile::tempfile().map_err(|e| format!("a temporary file in {}: {e}", temp_dir()))?;
         Ok(Self {
-            out: std::io::BufWriter::with_capacity(1 << 20, file),
+            out: file,
             bytes: Vec::new(),
             samples: 0,
         })
@@ -43,13 +44,12 @@ impl SpoolWriter {
     }
 
     /// The spool, with what the first pass's source told of the time axis.
-    pub fn finish(self, axis: Axis) -> Result<Spool, String> {
-        let file = self.out.into_inner().map_err(|e| failed(e.into_error()))?;
-        Ok(Spool {
-            file,
+    pub fn finish(self, axis: Axis) -> Spool {
+        Spool {
+            file: self.out,
             samples: self.samples,
             axis,
-        })
+        }
     }
 }
 
@@ -177,7 +177,7 @@ mod tests {
             final_rate_hz: 4.9e5,
             t0_s: 1.5,
         };
-        let spool = w.finish(axis).unwrap();
+        let spool = w.finish(axis);
         for want in [1, 1000, CHUNK, 10 * CHUNK] {
             let mut s = spool.source(None).unwrap();
             let mut back = Vec::new();

@@ -161,7 +161,7 @@ pub fn analyze_in_passes(
     drop(source);
     // The later passes read the spool if there is one (a file whose spool failed, a full
     // disk, is read again).
-    let spool = match spool.map(|s| s.and_then(|w| w.finish(axis))) {
+    let spool = match spool.map(|s| s.map(|w| w.finish(axis))) {
         Some(Err(e)) if stdin => return Err(format!("stdin: {e}")),
         Some(Err(e)) => {
             eprintln!("note: {e}: {name} is read again");
