@@ -146,7 +146,8 @@ pub struct AnalyzeArgs {
     pub invert: bool,
     /// The sensor's full scale, in the channel's units (e.g. 16 for a ±16 g sensor read in
     /// g): readings at the rail mark their impact clipped [default: flat tops at the
-    /// recording's extremes are taken for the rails].
+    /// recording's extremes, more than 10 steps of its resolution from its median, are
+    /// taken for the rails].
     #[arg(long, value_parser = positive_f64)]
     pub range: Option<f64>,
     /// Keep isolated one- or two-sample spikes that dwarf the rest of the recording (by

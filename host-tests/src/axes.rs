@@ -13,7 +13,8 @@ pub struct Axis {
     /// The column's header name.
     pub name: String,
     pub accel_m_s2: Vec<f64>,
-    /// From the sensor's full scale (`--range`, per axis) or the axis's flat tops.
+    /// From the sensor's full scale (`--range`, per axis) or the axis's flat tops (beyond its
+    /// noise floor, as the channel's).
     pub rails: Option<Clipping>,
 }
 

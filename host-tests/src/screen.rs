@@ -370,9 +370,9 @@ pub fn from_range(full_scale_m_s2: f64) -> Clipping {
     }
 }
 
-/// Clipping levels found as flat tops: a run of at least three equal readings at the
+/// Flat tops by their shape alone: a run of at least three equal readings at the
 /// recording's maximum (or minimum), entered or left at a slope no smooth peak has at its top
-/// ([`FlatTops`] over the whole slice).
+/// ([`FlatTops`] over the whole slice; the survey also wants them beyond the noise floor).
 pub fn flat_tops(x: &[f64]) -> Option<Clipping> {
     let mut f = FlatTops::default();
     f.push(x);
@@ -603,6 +603,11 @@ impl FlatTops {
                 }
             }
         }
+    }
+
+    /// The recording's resolution so far: its smallest non-zero step (infinite if none).
+    pub fn resolution(&self) -> f64 {
+        self.q
     }
 
     /// The clipping levels found, `None` if none (or the recording has no non-zero step).

@@ -44,7 +44,7 @@ pub struct Surveyed {
     pub noise_rms_m_s2: f64,
     pub min_m_s2: f64,
     pub max_m_s2: f64,
-    /// Flat tops at the extremes ([`FlatTops`]) beyond the noise ([`RAIL_NOISE`]).
+    /// Flat tops at the extremes ([`FlatTops`]) beyond the noise floor ([`RAIL_STEPS`]).
     pub flat_tops: Option<Clipping>,
     /// Isolated glitches (when screened).
     pub removals: Vec<Removal>,
@@ -159,11 +159,11 @@ impl Survey {
             noise_rms_m_s2: noise,
             min_m_s2: self.min,
             max_m_s2: self.max,
-            flat_tops: self
-                .shape
-                .flat
-                .finish()
-                .and_then(|c| beyond_noise(c, median, noise)),
+            flat_tops: {
+                let q = self.shape.flat.resolution();
+                let found = self.shape.flat.finish();
+                found.and_then(|c| beyond_floor(c, median, q))
+            },
             removals,
         })
     }
@@ -213,14 +213,18 @@ pub fn levels(
     }
 }
 
-/// A flat top is taken for a rail only this many times the noise from the median: nearer,
-/// it is the quantised noise floor of a channel at rest (the lowest of its few readings
-/// comes in runs), which no sensor's full scale is.
-const RAIL_NOISE: f64 = 10.0;
+/// A flat top is taken for a rail only more than this many steps of the recording's
+/// resolution from its median. Nearer, it is the noise floor of a quantised channel at rest:
+/// with a few counts of noise its lowest reading comes in runs, entered steeply, which no
+/// sensor's full scale is (and with more noise, runs at the extremes are too rare to be
+/// taken for flat tops). A recording that sits at its rail for more than half its length
+/// has its median there: its flat top is not taken.
+const RAIL_STEPS: f64 = 10.0;
 
-/// The flat tops' levels that lie beyond the noise ([`RAIL_NOISE`]); `None` if none does.
-fn beyond_noise(c: Clipping, median: f64, noise: f64) -> Option<Clipping> {
-    let far = |level: &f64| (level - median).abs() > RAIL_NOISE * noise;
+/// The flat tops' levels more than [`RAIL_STEPS`] × `q` (the resolution) from the median;
+/// `None` if none is.
+fn beyond_floor(c: Clipping, median: f64, q: f64) -> Option<Clipping> {
+    let far = |level: &f64| (level - median).abs() > RAIL_STEPS * q;
     let (low, high) = (c.low_m_s2.filter(far), c.high_m_s2.filter(far));
     (low.is_some() || high.is_some()).then_some(Clipping {
         low_m_s2: low,
@@ -273,16 +277,31 @@ fn trigger_and_edge(
 mod tests {
     use super::*;
 
-    /// ±1 count of noise (0.05 g a count) with 300-count half-sine pulses every 100 000
-    /// samples, the reading clipped at `clip` counts if given.
-    fn at_rest(clip: Option<f64>) -> Vec<f64> {
+    /// ±1 count of noise (0.05 g a count; at rest with probability `rest`, else ±1 alike)
+    /// with 300-count half-sine pulses every 100 000 samples, the reading clipped at `clip`
+    /// counts if given.
+    fn at_rest(rest: f64, clip: Option<f64>) -> Vec<f64> {
         let mut state = 0x2545_f491_4f6c_dd1du64;
         (0..500_000usize)
             .map(|i| {
                 state ^= state << 13;
                 state ^= state >> 7;
                 state ^= state << 17;
-                let noise = (state % 3) as f64 - 1.0;
+                let u = (state >> 11) as f64 / (1u64 << 53) as f64;
+                let noise = if u < rest {
+                    0.0
+                } else if u < (1.0 + rest) / 2.0 {
+                    -1.0
+                } else {
+                    1.0
+                };
+                // (And a run of eight at -1 entered from +1 now and then, as a long
+                // recording holds them.)
+                let noise = match i % 50_000 {
+                    25_000 => 1.0,
+                    25_001..=25_008 => -1.0,
+                    _ => noise,
+                };
                 let k = i % 100_000;
                 let pulse = if i >= 100_000 && k < 500 {
                     (300.0 * (std::f64::consts::PI * k as f64 / 500.0).sin()).round()
@@ -298,15 +317,24 @@ mod tests {
     fn the_noise_floor_of_a_channel_at_rest_is_no_rail() {
         // The lowest reading, one count below rest, comes in runs of eight and more entered
         // two counts steep: a flat top by shape alone, but within the noise.
-        let mut flat = FlatTops::default();
-        let x = at_rest(None);
-        flat.push(&x);
-        assert!(flat.finish().is_some_and(|c| c.low_m_s2.is_some()));
-        assert_eq!(Survey::of(&x, false).unwrap().flat_tops, None);
-        // The pulses clipped at 200 counts: that rail, and no other.
-        let s = Survey::of(&at_rest(Some(200.0)), false).unwrap();
-        let c = s.flat_tops.expect("the rail");
-        assert_eq!(c.low_m_s2, None);
-        assert_eq!(c.high_m_s2, Some(200.0 * 0.05 * 9.80665));
+        // Also when most readings sit at rest, so that the noise estimate (the median step)
+        // is 0.
+        for rest in [1.0 / 3.0, 0.7] {
+            let mut flat = FlatTops::default();
+            let x = at_rest(rest, None);
+            flat.push(&x);
+            assert!(
+                flat.finish().is_some_and(|c| c.low_m_s2.is_some()),
+                "{rest}"
+            );
+            let s = Survey::of(&x, false).unwrap();
+            assert_eq!(s.flat_tops, None, "{rest}");
+            assert_eq!(s.noise_rms_m_s2 == 0.0, rest > 0.5);
+            // The pulses clipped at 200 counts: that rail, and no other.
+            let s = Survey::of(&at_rest(rest, Some(200.0)), false).unwrap();
+            let c = s.flat_tops.expect("the rail");
+            assert_eq!(c.low_m_s2, None);
+            assert_eq!(c.high_m_s2, Some(200.0 * 0.05 * 9.80665));
+        }
     }
 }
