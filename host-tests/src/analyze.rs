@@ -503,7 +503,11 @@ pub(crate) fn round_to_i16(x: f64) -> i16 {
     r.clamp(i64::from(i16::MIN), i64::from(i16::MAX)) as i16
 }
 
-pub(crate) fn load_scene(path: &Path) -> Result<SceneFile, String> {
+/// The `--scene` file's settings (all defaults without one).
+pub(crate) fn scene_file(args: &AnalyzeArgs) -> Result<SceneFile, String> {
+    let Some(path) = &args.scene else {
+        return Ok(SceneFile::default());
+    };
     let text = std::fs::read_to_string(path).map_err(|e| format!("{}: {e}", path.display()))?;
     serde_json::from_str(&text).map_err(|e| format!("{}: {e}", path.display()))
 }
@@ -545,10 +549,7 @@ impl Setup {
 
 /// Reads the file and builds the scene (v0 from a free fall needs a first pass).
 pub fn setup(args: &AnalyzeArgs, progress: Option<fn(f64)>) -> Result<Setup, String> {
-    let file = match &args.scene {
-        Some(p) => load_scene(p)?,
-        None => SceneFile::default(),
-    };
+    let file = scene_file(args)?;
     let ch = read_recording(
         &args.file,
         &ReadOptions {

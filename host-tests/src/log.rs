@@ -649,11 +649,7 @@ pub fn log_json(log: &Log, t0: f64) -> Result<AnalysisJson, String> {
 /// `impact log`: a decoded firmware log as JSON (default) or CSV. The file (or stdin, `-`)
 /// is read line by line, each line at most [`MAX_LINE_BYTES`].
 pub fn log(args: &LogArgs) -> Result<(), String> {
-    let name = if is_stdin(&args.file) {
-        "stdin".to_string()
-    } else {
-        args.file.display().to_string()
-    };
+    let name = crate::table::input_name(&args.file);
     let input: Box<dyn Read> = if is_stdin(&args.file) {
         Box::new(std::io::stdin())
     } else {

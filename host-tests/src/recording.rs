@@ -209,20 +209,38 @@ fn resample(
     Ok((times, values))
 }
 
+/// A recording's format: by the file's extension ([`crate::wav`], [`crate::npy`],
+/// [`crate::tdms`], [`crate::raw`]), or raw if its sample type is given; CSV otherwise.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Format {
+    Raw(crate::raw::RawType),
+    Wav,
+    Npy,
+    Tdms,
+    Csv,
+}
+
+impl Format {
+    pub fn of(path: &Path, raw_type: Option<crate::raw::RawType>) -> Self {
+        match raw_type.or_else(|| crate::raw::RawType::of(path)) {
+            Some(kind) => Format::Raw(kind),
+            None if crate::wav::is_wav(path) => Format::Wav,
+            None if crate::npy::is_npy(path) => Format::Npy,
+            None if crate::tdms::is_tdms(path) => Format::Tdms,
+            None => Format::Csv,
+        }
+    }
+}
+
 /// Reads one channel and its time base from a CSV file (see [`read_table`]), a WAV file, an
-/// `.npy` array, a TDMS file or a raw `.i16`/`.f32` file (by the extension: [`crate::wav`],
-/// [`crate::npy`], [`crate::tdms`], [`crate::raw`]).
+/// `.npy` array, a TDMS file or a raw `.i16`/`.f32` file ([`Format`]).
 pub fn read_recording(path: &Path, opts: &ReadOptions) -> Result<Channel, RecordingError> {
-    if crate::wav::is_wav(path) {
-        crate::wav::read_wav(path, opts)
-    } else if crate::npy::is_npy(path) {
-        crate::npy::read_npy(path, opts)
-    } else if crate::tdms::is_tdms(path) {
-        crate::tdms::read_tdms(path, opts)
-    } else if let Some(kind) = crate::raw::RawType::of(path) {
-        crate::raw::read_raw(path, kind, opts.raw_channels.unwrap_or(1), opts)
-    } else {
-        read_csv(path, opts)
+    match Format::of(path, None) {
+        Format::Wav => crate::wav::read_wav(path, opts),
+        Format::Npy => crate::npy::read_npy(path, opts),
+        Format::Tdms => crate::tdms::read_tdms(path, opts),
+        Format::Raw(kind) => crate::raw::read_raw(path, kind, opts.raw_channels.unwrap_or(1), opts),
+        Format::Csv => read_csv(path, opts),
     }
 }
 

@@ -6,6 +6,7 @@ use std::io::Read;
 
 use crate::analyze::{self, AnalyzeArgs};
 use crate::raw::RawType;
+use crate::recording::Format;
 use crate::table::is_stdin;
 
 /// Samples whose noise sets the default edge level (the whole-file path uses the whole
@@ -21,12 +22,12 @@ pub(crate) fn open_source(
     name: &str,
     progress: Option<fn(f64)>,
 ) -> Result<Box<dyn Source>, String> {
-    Ok(match args.raw_type.or_else(|| RawType::of(&args.file)) {
-        Some(kind) => Box::new(RawSource::open(args, kind, name)?),
-        None if crate::wav::is_wav(&args.file) => Box::new(WavSource::open(args, name)?),
-        None if crate::npy::is_npy(&args.file) => Box::new(NpySource::open(args, name)?),
-        None if crate::tdms::is_tdms(&args.file) => Box::new(TdmsSource::open(args, name)?),
-        None => Box::new(CsvSource::open(args, progress)?),
+    Ok(match Format::of(&args.file, args.raw_type) {
+        Format::Raw(kind) => Box::new(RawSource::open(args, kind, name)?),
+        Format::Wav => Box::new(WavSource::open(args, name)?),
+        Format::Npy => Box::new(NpySource::open(args, name)?),
+        Format::Tdms => Box::new(TdmsSource::open(args, name)?),
+        Format::Csv => Box::new(CsvSource::open(args, progress)?),
     })
 }
 
@@ -286,11 +287,7 @@ impl CsvSource {
         };
         let mut rows =
             crate::table::Rows::open(&args.file, &format, progress).map_err(|e| e.to_string())?;
-        let name = if is_stdin(&args.file) {
-            "stdin".to_string()
-        } else {
-            args.file.display().to_string()
-        };
+        let name = crate::table::input_name(&args.file);
         let err = |m: String| format!("{name}: {m}");
         // The first data row gives the columns their number (the header their names).
         let (line, first) = match rows.next_row().map_err(|e| e.to_string())? {

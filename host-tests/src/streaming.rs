@@ -21,7 +21,7 @@ use crate::screen::Removal;
 use crate::sources::{open_source, read_head, Source, CHUNK};
 use crate::spool::{Axis, SpoolWriter};
 use crate::survey::{self, Survey, Surveyed};
-use crate::table::is_stdin;
+use crate::table::{input_name, is_stdin};
 
 /// Reads and analyses `args.file` as a stream; the setup (without samples) and the reports.
 /// `progress` (a CSV's fraction read) for a bar on a terminal.
@@ -29,11 +29,7 @@ pub fn analyze(
     args: &AnalyzeArgs,
     progress: Option<fn(f64)>,
 ) -> Result<(Setup, Vec<ImpactReport>), String> {
-    let name = if is_stdin(&args.file) {
-        "stdin".to_string()
-    } else {
-        args.file.display().to_string()
-    };
+    let name = input_name(&args.file);
     let refuse = |what: &str| Err(format!("--stream: {what} needs the whole recording"));
     if args.plot.is_some() {
         return refuse("--plot");
@@ -47,10 +43,7 @@ pub fn analyze(
     if args.resample {
         return refuse("--resample");
     }
-    let file = match &args.scene {
-        Some(p) => analyze::load_scene(p)?,
-        None => analyze::SceneFile::default(),
-    };
+    let file = analyze::scene_file(args)?;
     let (mass, scale) = analyze::mass_and_scale(args, &file)?;
     let full_scale = analyze::full_scale_m_s2(args, &file, scale)?.ok_or(
         "--stream: give --range (the sensor's full scale sets the quantisation before the \
@@ -108,22 +101,16 @@ pub fn analyze(
 /// grow with its length, with the whole-file path's rules: a survey of the whole recording
 /// (its median, noise, extremes, flat tops and glitches, [`Survey`]), a second one if
 /// glitches were removed, then the analysis. The later passes read the first's values back
-/// from a spool ([`crate::spool`]: a CSV, standard input) or the file again. The same code as the whole-file path on the same values, so
-/// the same reports (tested); only the time axis is checked against the first intervals'
-/// median, as in a stream (the whole-file path takes the median of all of them).
+/// from a spool ([`crate::spool`]: a CSV, standard input) or the file again. The same code
+/// as the whole-file path on the same values, so the same reports (tested); only the time
+/// axis is checked against the first intervals' median, as in a stream (the whole-file path
+/// takes the median of all of them).
 pub fn analyze_in_passes(
     args: &AnalyzeArgs,
     progress: Option<fn(f64)>,
 ) -> Result<(Setup, Vec<ImpactReport>), String> {
-    let name = if is_stdin(&args.file) {
-        "stdin".to_string()
-    } else {
-        args.file.display().to_string()
-    };
-    let file = match &args.scene {
-        Some(p) => analyze::load_scene(p)?,
-        None => analyze::SceneFile::default(),
-    };
+    let name = input_name(&args.file);
+    let file = analyze::scene_file(args)?;
     let (mass, scale) = analyze::mass_and_scale(args, &file)?;
     let full_scale = analyze::full_scale_m_s2(args, &file, scale)?;
     // The survey; again with the glitches replaced if there are any (they set the extremes).
@@ -159,15 +146,14 @@ pub fn analyze_in_passes(
     };
     let (t0, rate_hz) = (axis.t0_s, axis.final_rate_hz);
     drop(source);
-    // The later passes read the spool if there is one (a file whose spool failed, a full
-    // disk, is read again).
-    let spool = match spool.map(|s| s.map(|w| w.finish(axis))) {
-        Some(Err(e)) if stdin => return Err(format!("stdin: {e}")),
+    // The later passes read the spool if there is one; a file whose spool failed (a full
+    // disk) is read again (standard input's failure ended its pass).
+    let spool = match spool {
+        Some(Ok(writer)) => Some(writer.finish(axis)),
         Some(Err(e)) => {
             eprintln!("note: {e}: {name} is read again");
             None
         }
-        Some(Ok(s)) => Some(s),
         None => None,
     };
     let reopen = |progress: Option<fn(f64)>| match &spool {
@@ -349,12 +335,8 @@ type SurveyPass = (
 /// Whether the first pass keeps the values for the later ones ([`crate::spool`]): standard
 /// input (read once) and a CSV file (its parse costs more than reading the spool).
 fn spooled(args: &AnalyzeArgs) -> bool {
-    let binary = args.raw_type.is_some()
-        || crate::raw::RawType::of(&args.file).is_some()
-        || crate::wav::is_wav(&args.file)
-        || crate::npy::is_npy(&args.file)
-        || crate::tdms::is_tdms(&args.file);
-    is_stdin(&args.file) || !binary
+    is_stdin(&args.file)
+        || crate::recording::Format::of(&args.file, args.raw_type) == crate::recording::Format::Csv
 }
 
 /// Runs `fill` on a reader thread a few chunks ahead of `take` (so memory stays bounded),

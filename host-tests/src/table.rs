@@ -33,11 +33,7 @@ pub struct RecordingError {
 
 impl fmt::Display for RecordingError {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        let file = if is_stdin(&self.file) {
-            "stdin".to_string()
-        } else {
-            self.file.display().to_string()
-        };
+        let file = input_name(&self.file);
         match self.line {
             Some(l) => write!(f, "{file}:{l}: {}", self.message),
             None => write!(f, "{file}: {}", self.message),
@@ -62,6 +58,15 @@ pub fn one_line(message: impl std::fmt::Display) -> String {
 /// Whether a path names standard input (`-`).
 pub fn is_stdin(path: &Path) -> bool {
     path.as_os_str() == "-"
+}
+
+/// How messages name an input: `stdin`, or the path.
+pub fn input_name(path: &Path) -> String {
+    if is_stdin(path) {
+        "stdin".to_string()
+    } else {
+        path.display().to_string()
+    }
 }
 
 /// Longest record (line) read, bytes: a file without line breaks (`/dev/zero`) or with an
