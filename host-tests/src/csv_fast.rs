@@ -1,4 +1,4 @@
-//! The parallel fast path of a streamed CSV file's data rows: 1 MiB chunks cut at line ends,
+//! The parallel fast path of a CSV file's or stream's data rows: 1 MiB chunks cut at line ends,
 //! parsed on worker threads and handed on in order. It takes plain rows only (numbers and
 //! delimiters with white space around them, no quotes, no blank lines, the table's number of
 //! fields); at the first line it cannot take plainly it stops, and the sequential reader
@@ -6,14 +6,13 @@
 //! reads as in one pass.
 
 use std::collections::BTreeMap;
-use std::fs::File;
-use std::io::{Read, Seek, SeekFrom};
-use std::path::Path;
+use std::io::Read;
 use std::sync::mpsc::{sync_channel, Receiver};
 use std::sync::{Arc, Mutex};
 use std::thread::JoinHandle;
 
 use crate::table::{is_reading, read_number, MAX_LINE_BYTES};
+use crate::tape::Tape;
 
 /// Bytes a chunk holds (up to the last line end in them).
 const CHUNK: usize = 1 << 20;
@@ -59,8 +58,9 @@ impl Layout {
 
 /// One chunk's rows, in order, one a line (a chunk with a blank line stops there).
 pub struct Parsed {
-    /// The chunk's first line.
+    /// The chunk's first line and byte.
     pub line: u64,
+    pub byte: u64,
     /// Per row: the channel's value and the time column's (0 without one).
     pub rows: Vec<(f64, f64)>,
     /// With [`Layout::all`]: every row's fields, one row after the other.
@@ -86,20 +86,21 @@ pub struct FastRows {
     /// The next chunk's first line.
     line: u64,
     threads: Vec<JoinHandle<()>>,
+    tape: Option<Arc<Tape>>,
 }
 
 impl FastRows {
-    /// Starts reading `path` at `byte` (the start of line `line`); `progress` gets the
-    /// fraction of `size` read.
+    /// Starts reading `input`, at byte `byte` of the file or stream (the start of line
+    /// `line`); `progress` gets the fraction of `size` read. With a stream's `tape`, each
+    /// chunk's start is released as it is handed on (the sequential reader may resume there
+    /// or later, never before).
     pub fn start(
-        path: &Path,
-        byte: u64,
-        line: u64,
+        mut input: Box<dyn Read + Send>,
+        (byte, line): (u64, u64),
         layout: Layout,
         progress: Option<(fn(f64), u64)>,
-    ) -> std::io::Result<Self> {
-        let mut file = File::open(path)?;
-        file.seek(SeekFrom::Start(byte))?;
+        tape: Option<Arc<Tape>>,
+    ) -> Self {
         let workers = std::thread::available_parallelism().map_or(2, |n| n.get().clamp(1, 4));
         let (job_tx, job_rx) = sync_channel::<Job>(2 * workers);
         let (result_tx, result_rx) = sync_channel::<(u64, Parsed)>(2 * workers);
@@ -128,7 +129,7 @@ impl FastRows {
                 buf.reserve(CHUNK);
                 // Appended without zeroing the room first.
                 let n = loop {
-                    match (&mut file).take(CHUNK as u64).read_to_end(&mut buf) {
+                    match (&mut input).take(CHUNK as u64).read_to_end(&mut buf) {
                         Ok(n) => break Some(n),
                         Err(e) if e.kind() == std::io::ErrorKind::Interrupted => continue,
                         // The sequential reader meets the error again and reports it.
@@ -172,13 +173,14 @@ impl FastRows {
                 }
             }
         }));
-        Ok(Self {
+        Self {
             results: Some(result_rx),
             pending: BTreeMap::new(),
             next: 0,
             line,
             threads,
-        })
+            tape,
+        }
     }
 
     /// The next chunk, in order; `None` at the end of the file.
@@ -192,6 +194,9 @@ impl FastRows {
                 }
                 self.line += p.rows.len() as u64;
                 self.next += 1;
+                if let Some(tape) = &self.tape {
+                    tape.release(p.byte);
+                }
                 return Some(p);
             }
             let (seq, parsed) = self.results.as_ref()?.recv().ok()?;
@@ -218,6 +223,7 @@ fn parse(job: Job, layout: &Layout) -> Parsed {
     let Some(bytes) = job.bytes else {
         return Parsed {
             line: 0,
+            byte: job.byte,
             rows: Vec::new(),
             fields: Vec::new(),
             stop: Some((job.byte, 0)),
@@ -252,6 +258,7 @@ fn parse(job: Job, layout: &Layout) -> Parsed {
                 fields.truncate(kept);
                 return Parsed {
                     line: 0,
+                    byte: job.byte,
                     rows,
                     fields,
                     stop: Some((job.byte + at as u64, line)),
@@ -262,6 +269,7 @@ fn parse(job: Job, layout: &Layout) -> Parsed {
     }
     Parsed {
         line: 0,
+        byte: job.byte,
         rows,
         fields,
         stop: None,

@@ -28,6 +28,7 @@ pub mod streaming;
 pub mod survey;
 pub mod synth;
 pub mod table;
+pub mod tape;
 pub mod target;
 pub mod target_bench;
 pub mod tdms;

@@ -264,8 +264,8 @@ struct CsvSource {
     head_rate: Option<f64>,
     /// The first row's value, read while resolving the columns and not yet handed on.
     pending: Option<f64>,
-    /// A regular file's path and size (stdin and pipes are read in one pass); the parallel
-    /// fast path once the head is read, and rows read since the sequential reader last took
+    /// A regular file's path and size (for progress; standard input and pipes are kept on
+    /// the reader's tape instead); the parallel fast path once the head is read, and rows read since the sequential reader last took
     /// over (it hands back after [`crate::csv_fast::SEQUENTIAL_ROWS`] rows).
     file: Option<(std::path::PathBuf, u64)>,
     fast: Option<crate::csv_fast::FastRows>,
@@ -398,37 +398,44 @@ impl CsvSource {
     /// parallel one); none at a hand-over from one to the other, or at the end (then
     /// `ended` is set).
     fn next_some(&mut self, want: usize, out: &mut Vec<f64>) -> Result<(), String> {
-        // Past the head, a file's plain rows go through the parallel fast path.
+        // Past the head, plain rows go through the parallel fast path (a file read again
+        // from the row, or a stream's tape played from it).
         if self.head_done
             && self.fast.is_none()
             && self.sequential >= crate::csv_fast::SEQUENTIAL_ROWS
+            && (self.file.is_some() || self.rows.tape().is_some())
         {
-            if let Some((path, size)) = &self.file {
-                let (byte, line) = self.rows.position();
-                let (delimiter, format) = self.rows.format();
-                let layout = crate::csv_fast::Layout {
-                    columns: self.rows.columns,
-                    channel: self.channel,
-                    time: self.time.map(|(c, _)| c),
-                    delimiter,
-                    decimal_comma: format.decimal_comma,
-                    time_unit_s: self.time.map_or(1.0, |(_, unit)| unit),
-                    // The workers check what may still be the first error of its kind: time
-                    // going back, then an uneven interval.
-                    increasing: self.rate_given.is_none() && self.not_increasing.is_none(),
-                    median_dt: self.median_dt.filter(|_| {
-                        self.rate_given.is_none()
-                            && self.not_increasing.is_none()
-                            && self.uneven.is_none()
-                    }),
-                    all: false,
-                };
-                let progress = self.progress.map(|p| (p, *size));
-                self.fast = Some(
-                    crate::csv_fast::FastRows::start(path, byte, line, layout, progress)
-                        .map_err(|e| format!("{}: {e}", self.name))?,
-                );
-            }
+            let (byte, line) = self.rows.position();
+            let (delimiter, format) = self.rows.format();
+            let layout = crate::csv_fast::Layout {
+                columns: self.rows.columns,
+                channel: self.channel,
+                time: self.time.map(|(c, _)| c),
+                delimiter,
+                decimal_comma: format.decimal_comma,
+                time_unit_s: self.time.map_or(1.0, |(_, unit)| unit),
+                // The workers check what may still be the first error of its kind: time
+                // going back, then an uneven interval.
+                increasing: self.rate_given.is_none() && self.not_increasing.is_none(),
+                median_dt: self.median_dt.filter(|_| {
+                    self.rate_given.is_none()
+                        && self.not_increasing.is_none()
+                        && self.uneven.is_none()
+                }),
+                all: false,
+            };
+            let progress = self.progress.zip(self.file.as_ref().map(|(_, size)| *size));
+            let input = self
+                .rows
+                .input_from(byte)
+                .map_err(|e| format!("{}: {e}", self.name))?;
+            self.fast = Some(crate::csv_fast::FastRows::start(
+                input,
+                (byte, line),
+                layout,
+                progress,
+                self.rows.tape(),
+            ));
         }
         if let Some(fast) = &mut self.fast {
             let Some(chunk) = fast.next_chunk() else {

@@ -5,6 +5,9 @@ use std::fmt;
 use std::fs::File;
 use std::io::{self, BufRead, BufReader, Read};
 use std::path::{Path, PathBuf};
+use std::sync::Arc;
+
+use crate::tape::Tape;
 
 /// A column chosen by header name or 0-based index.
 #[derive(Clone, Debug, PartialEq, Eq)]
@@ -318,6 +321,11 @@ pub struct Rows {
     size: Option<u64>,
     step: Option<u64>,
     next_progress: u64,
+    /// A stream that cannot be read again (standard input, a pipe), kept from the row being
+    /// read on so that another reader can take over at a line ([`Rows::input_from`]).
+    tape: Option<Arc<Tape>>,
+    /// Rows read since the tape was last released up to the next one.
+    unreleased: u32,
 }
 
 impl Rows {
@@ -334,6 +342,14 @@ impl Rows {
             message,
         };
         let (input, size) = open(path).map_err(|e| err(e.to_string()))?;
+        let (input, tape): (Box<dyn Read + Send>, _) = match size {
+            Some(_) => (input, None),
+            None => {
+                let tape = Tape::new(input);
+                let reader = tape.reader_at(0).map_err(|e| err(e.to_string()))?;
+                (Box::new(reader), Some(tape))
+            }
+        };
         let mut buffered = BufReader::with_capacity(1 << 16, input);
         // Peek at the first bytes for a byte-order mark and the delimiter.
         let head = buffered.fill_buf().map_err(|e| err(e.to_string()))?;
@@ -349,6 +365,7 @@ impl Rows {
         }
         let mut rows = Self::build(path, format, delimiter, buffered, size, progress);
         rows.skip = if bom { 3 } else { 0 };
+        rows.tape = tape;
         Ok(rows)
     }
 
@@ -400,6 +417,8 @@ impl Rows {
             size,
             step,
             next_progress: step.unwrap_or(u64::MAX),
+            tape: None,
+            unreleased: 0,
         }
     }
 
@@ -407,12 +426,9 @@ impl Rows {
     /// past its header and first data row (so what it reads there reads as it would have
     /// in one pass).
     pub fn resume(&self, byte: u64, line: u64) -> Result<Self, RecordingError> {
-        use std::io::{Seek, SeekFrom};
-        let err = |message: String| self.err(Some(line), message);
-        let mut file = File::open(&self.path).map_err(|e| err(e.to_string()))?;
-        file.seek(SeekFrom::Start(byte))
-            .map_err(|e| err(e.to_string()))?;
-        let input: Box<dyn Read + Send> = Box::new(file);
+        let input = self
+            .input_from(byte)
+            .map_err(|e| self.err(Some(line), e.to_string()))?;
         let mut rows = Self::build(
             &self.path,
             &self.format,
@@ -428,7 +444,26 @@ impl Rows {
         rows.first_data_line = self.first_data_line;
         rows.line_offset = line.saturating_sub(1);
         rows.skip = byte;
+        rows.tape = self.tape.clone();
         Ok(rows)
+    }
+
+    /// The input from its byte `byte` on: the file opened again, or a stream's tape played
+    /// from there (an error if that byte was released).
+    pub fn input_from(&self, byte: u64) -> io::Result<Box<dyn Read + Send>> {
+        use std::io::{Seek, SeekFrom};
+        if let Some(tape) = &self.tape {
+            return Ok(Box::new(tape.reader_at(byte)?));
+        }
+        let mut file = File::open(&self.path)?;
+        file.seek(SeekFrom::Start(byte))?;
+        Ok(Box::new(file))
+    }
+
+    /// A stream's tape (none for a regular file), for a reader that takes over to release
+    /// what it has read.
+    pub fn tape(&self) -> Option<Arc<Tape>> {
+        self.tape.clone()
     }
 
     /// The byte of the file and the line the next row starts on.
@@ -479,6 +514,14 @@ impl Rows {
             };
             if !more {
                 return Ok(None);
+            }
+            // Nothing before the next row is read again (a hand-over starts there).
+            if let Some(tape) = &self.tape {
+                self.unreleased += 1;
+                if self.unreleased >= 256 {
+                    self.unreleased = 0;
+                    tape.release(self.position().0);
+                }
             }
             // Every record ends with a consumed `\n` (the input's last one added if missing),
             // and `csv` counts lines as it consumes `\n`s: the record's line is the count less
@@ -601,8 +644,8 @@ pub fn read_table(
     let mut table = Table::default();
     let mut next_line = 0;
     let mut n = 0usize;
-    // A regular file's plain rows past the first few thousand go through the parallel
-    // reader ([`crate::csv_fast`]); any other line through this one, for a while.
+    // Plain rows past the first few thousand go through the parallel reader
+    // ([`crate::csv_fast`]); any other line through this one, for a while.
     let size = std::fs::metadata(path)
         .ok()
         .filter(|m| m.is_file() && !is_stdin(path))
@@ -610,9 +653,8 @@ pub fn read_table(
     let mut fast: Option<crate::csv_fast::FastRows> = None;
     let mut sequential = 0usize;
     loop {
-        if let (Some(size), None, true) =
-            (size, &fast, sequential >= crate::csv_fast::SEQUENTIAL_ROWS)
-        {
+        let replayable = size.is_some() || rows.tape.is_some();
+        if fast.is_none() && replayable && sequential >= crate::csv_fast::SEQUENTIAL_ROWS {
             let (byte, line) = rows.position();
             let layout = crate::csv_fast::Layout {
                 columns: table.columns.len(),
@@ -625,15 +667,16 @@ pub fn read_table(
                 median_dt: None,
                 all: true,
             };
-            let started = crate::csv_fast::FastRows::start(
-                path,
-                byte,
-                line,
+            let input = rows
+                .input_from(byte)
+                .map_err(|e| rows.err(Some(line), e.to_string()))?;
+            fast = Some(crate::csv_fast::FastRows::start(
+                input,
+                (byte, line),
                 layout,
-                progress.map(|p| (p, size)),
-            )
-            .map_err(|e| rows.err(Some(line), e.to_string()))?;
-            fast = Some(started);
+                progress.zip(size),
+                rows.tape(),
+            ));
         }
         if let Some(reader) = &mut fast {
             let Some(chunk) = reader.next_chunk() else {

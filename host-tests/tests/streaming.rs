@@ -346,15 +346,26 @@ fn a_long_csv_file_gives_the_same_reports_and_errors_through_the_parallel_reader
         std::fs::write(&path, lines.join("\n") + "\n").unwrap();
         path
     };
-    // Standard input (read by one thread, row by row, in passes).
+    // Through a pipe on standard input (which cannot be read twice: the readers hand it
+    // over on a tape).
     let run_stdin = |file: &str, tail: &[&str]| {
-        let out = Command::new(env!("CARGO_BIN_EXE_impact"))
+        let mut child = Command::new(env!("CARGO_BIN_EXE_impact"))
             .args(["analyze", "-"])
             .args(levels)
             .args(tail)
-            .stdin(std::fs::File::open(file).unwrap())
-            .output()
+            .stdin(Stdio::piped())
+            .stdout(Stdio::piped())
+            .stderr(Stdio::piped())
+            .spawn()
             .unwrap();
+        let bytes = std::fs::read(file).unwrap();
+        let mut stdin = child.stdin.take().unwrap();
+        // (The child may stop reading at an error: a broken pipe is no failure here.)
+        let writer = std::thread::spawn(move || {
+            let _ = stdin.write_all(&bytes);
+        });
+        let out = child.wait_with_output().unwrap();
+        writer.join().unwrap();
         (
             out.status.code().unwrap_or(-1),
             String::from_utf8_lossy(&out.stdout).into_owned(),
@@ -391,8 +402,17 @@ fn a_long_csv_file_gives_the_same_reports_and_errors_through_the_parallel_reader
     }
     let odd = write("odd.csv", &odd);
     assert_eq!(run_stdin(&odd, &["--json", "--keep-spikes"]).1, whole.1);
+    assert_eq!(run_stdin(&odd, &["--json", "--stream"]).1, whole.1);
     assert_eq!(run(&odd, &["--json", "--keep-spikes"]).1, whole.1);
     assert_eq!(run(&odd, &["--json", "--stream"]).1, whole.1);
+    // The whole-file path from the pipe draws the same figure.
+    let piped_svg = tmp("long-piped.svg");
+    let piped = run_stdin(&odd, &["--json", "--keep-spikes", "--plot", &piped_svg]);
+    assert_eq!(piped.1, whole.1, "{}", piped.2);
+    assert_eq!(
+        std::fs::read(&piped_svg).unwrap(),
+        std::fs::read(&svg).unwrap()
+    );
 
     // A text field and a gap, far past the head: the whole-file reader's message and line.
     let mut text = lines.clone();
@@ -414,6 +434,8 @@ fn a_long_csv_file_gives_the_same_reports_and_errors_through_the_parallel_reader
         code != 0 && err.contains(":240001: uneven") && err.contains("uneven time axis"),
         "{err}"
     );
+    let (code, _, stdin_err) = run_stdin(&gap, &["--stream"]);
+    assert_eq!((code, stdin_err), (1, err.replace(&gap, "stdin")));
 }
 
 /// A TDMS channel read a range at a time: the whole file's reports, either channel type;
