@@ -249,72 +249,114 @@ fn survey_pass(
     spool: Option<Spooling>,
 ) -> Result<SurveyPass, String> {
     let mut survey = Survey::new(screen);
-    // The shape's part of the survey, and the spool, on a thread of their own (a copy of
-    // each block, as read). A spool that fails is dropped at once (its space freed); one
-    // that must not fail ends the pass.
+    // The shape's two scans on threads of their own (a copy of each block to each, as
+    // read); with a spool, which a CSV's parse or standard input comes with, both on one
+    // thread with the spool (the parse keeps both cores busy: a third thread only costs).
+    // A spool that fails is dropped at once (its space freed); one that must not fail ends
+    // the pass.
     let stops = spool.as_ref().and_then(|s| s.stops.clone());
     let spool = spool.map(|s| Ok(s.writer));
     let failure = std::sync::Arc::new(std::sync::OnceLock::<String>::new());
-    let mut shape = survey.take_shape();
-    let (tx, rx) = std::sync::mpsc::sync_channel::<Vec<f64>>(4);
-    // (The copies go back to be filled again.)
-    let (back, spare) = std::sync::mpsc::channel::<Vec<f64>>();
-    let shaper = std::thread::spawn({
+    let (flat, spikes) = survey.take_shape().split();
+    let (with_flat, spikes) = match spool {
+        Some(_) => (spikes, None),
+        None => (None, spikes),
+    };
+    let flat = Scan::spawn((flat, with_flat, spool), {
         let failure = std::sync::Arc::clone(&failure);
-        move || {
-            let mut spool = spool;
-            for block in rx {
-                if let Some(Ok(w)) = &mut spool {
-                    if let Err(e) = w.write(&block) {
-                        let _ = failure.set(e.clone());
-                        spool = Some(Err(e));
-                    }
+        move |(flat, spikes, spool), block| {
+            if let Some(Ok(w)) = spool {
+                if let Err(e) = w.write(block) {
+                    let _ = failure.set(e.clone());
+                    *spool = Some(Err(e));
                 }
-                shape.push(&block);
-                let _ = back.send(block);
             }
-            (shape, spool)
+            flat.push(block);
+            if let Some(s) = spikes {
+                s.push(block);
+            }
         }
     });
+    let spikes = spikes.map(|s| Scan::spawn(s, |s, block| s.push(block)));
     let mut patch = Patches::new(removals);
-    // (The sender ends with this block, so the thread sees the end.)
-    let read = {
-        let tx = tx;
-        read_head(&mut *source, scale).and_then(|mut head| {
-            patch.values(&mut head);
-            survey.push_levels(&head);
-            let _ = tx.send(head);
-            read_ahead(
-                source,
-                move |s, _, out: &mut Vec<f64>| {
-                    s.next_values(CHUNK, out)?;
-                    out.iter_mut().for_each(|v| *v *= scale);
-                    Ok(())
-                },
-                |block| {
-                    if let (Some(name), Some(e)) = (&stops, failure.get()) {
-                        return Err(format!("{name}: {e}"));
-                    }
-                    patch.values(block);
-                    survey.push_levels(block);
-                    let mut copy = spare.try_recv().unwrap_or_default();
-                    copy.clear();
-                    copy.extend_from_slice(block);
-                    let _ = tx.send(copy);
-                    Ok(())
-                },
-            )
-        })
-    };
-    let (shape, spool) = shaper
-        .join()
-        .map_err(|_| "the survey's thread panicked".to_string())?;
+    let read = read_head(&mut *source, scale).and_then(|mut head| {
+        patch.values(&mut head);
+        survey.push_levels(&head);
+        flat.send(&head);
+        if let Some(s) = &spikes {
+            s.send(&head);
+        }
+        read_ahead(
+            source,
+            move |s, _, out: &mut Vec<f64>| {
+                s.next_values(CHUNK, out)?;
+                out.iter_mut().for_each(|v| *v *= scale);
+                Ok(())
+            },
+            |block| {
+                if let (Some(name), Some(e)) = (&stops, failure.get()) {
+                    return Err(format!("{name}: {e}"));
+                }
+                patch.values(block);
+                survey.push_levels(block);
+                flat.send(block);
+                if let Some(s) = &spikes {
+                    s.send(block);
+                }
+                Ok(())
+            },
+        )
+    });
+    let (flat, with_flat, spool) = flat.finish()?;
+    let spikes = spikes.map(Scan::finish).transpose()?.or(with_flat);
     let source = read?;
     if let (Some(name), Some(Err(e))) = (&stops, &spool) {
         return Err(format!("{name}: {e}"));
     }
-    survey.put_shape(shape);
+    survey.put_shape(crate::survey::Shape::join(flat, spikes));
     Ok((survey.finish()?, source, spool))
+}
+
+/// A scan on a thread of its own, given a copy of each block in order (the copies go back to
+/// be filled again; a few in flight).
+struct Scan<S> {
+    blocks: std::sync::mpsc::SyncSender<Vec<f64>>,
+    spare: std::sync::mpsc::Receiver<Vec<f64>>,
+    thread: std::thread::JoinHandle<S>,
+}
+
+impl<S: Send + 'static> Scan<S> {
+    fn spawn(mut state: S, mut push: impl FnMut(&mut S, &[f64]) + Send + 'static) -> Self {
+        let (blocks, rx) = std::sync::mpsc::sync_channel::<Vec<f64>>(4);
+        let (back, spare) = std::sync::mpsc::channel::<Vec<f64>>();
+        let thread = std::thread::spawn(move || {
+            for block in rx {
+                push(&mut state, &block);
+                let _ = back.send(block);
+            }
+            state
+        });
+        Self {
+            blocks,
+            spare,
+            thread,
+        }
+    }
+
+    fn send(&self, block: &[f64]) {
+        let mut copy = self.spare.try_recv().unwrap_or_default();
+        copy.clear();
+        copy.extend_from_slice(block);
+        let _ = self.blocks.send(copy);
+    }
+
+    /// The scan's state once it has every block sent.
+    fn finish(self) -> Result<S, String> {
+        drop(self.blocks);
+        self.thread
+            .join()
+            .map_err(|_| "the survey's thread panicked".to_string())
+    }
 }
 
 /// A spool for a first pass to write, and the input's name if its failure ends the pass

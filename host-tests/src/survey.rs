@@ -26,6 +26,16 @@ pub struct Shape {
 }
 
 impl Shape {
+    /// Its two scans apart, to push on threads of their own (every block to each, in order)
+    /// and [`Shape::join`] again.
+    pub fn split(self) -> (FlatTops, Option<SpikeScan>) {
+        (self.flat, self.spikes)
+    }
+
+    pub fn join(flat: FlatTops, spikes: Option<SpikeScan>) -> Self {
+        Self { flat, spikes }
+    }
+
     pub fn push(&mut self, block: &[f64]) {
         self.flat.push(block);
         if let Some(s) = &mut self.spikes {

@@ -11,11 +11,15 @@ use std::sync::{Arc, Mutex};
 
 /// The stream and the bytes read from it that are not yet released.
 pub struct Tape {
+    /// The stream and a buffer to read it into: locked only to read more of it, so a reader
+    /// waiting on the stream keeps no other from the bytes held (or from releasing them).
+    source: Mutex<(Stream, Box<[u8]>)>,
     state: Mutex<State>,
 }
 
+type Stream = Box<dyn Read + Send>;
+
 struct State {
-    source: Box<dyn Read + Send>,
     /// The stream's bytes from `start` on, up to the bytes read, in blocks of [`BLOCK`]
     /// (all full but the last): each block's room (zeroed once) and the bytes in it.
     blocks: VecDeque<(Box<[u8]>, usize)>,
@@ -25,6 +29,8 @@ struct State {
     released: u64,
     /// The stream's error, given again to any reader that reaches the byte it failed at.
     failed: Option<(io::ErrorKind, String)>,
+    /// Released blocks, to read into again.
+    spare: Vec<Box<[u8]>>,
 }
 
 /// Bytes a block holds, and the most read from the stream at a time (a pipe gives at most
@@ -34,20 +40,21 @@ const BLOCK: usize = 1 << 16;
 impl Tape {
     pub fn new(source: Box<dyn Read + Send>) -> Arc<Self> {
         Arc::new(Self {
+            source: Mutex::new((source, vec![0; BLOCK].into_boxed_slice())),
             state: Mutex::new(State {
-                source,
                 blocks: VecDeque::new(),
                 start: 0,
                 held: 0,
                 released: 0,
                 failed: None,
+                spare: Vec::new(),
             }),
         })
     }
 
     /// A reader from the stream's byte `byte` on; an error if that byte was released.
     pub fn reader_at(self: &Arc<Self>, byte: u64) -> io::Result<TapeReader> {
-        self.lock()?.check(byte)?;
+        lock(&self.state)?.check(byte)?;
         Ok(TapeReader {
             tape: Arc::clone(self),
             at: byte,
@@ -59,17 +66,70 @@ impl Tape {
         let Ok(mut s) = self.state.lock() else { return };
         s.released = s.released.max(byte);
         while s.blocks.len() > 1 && s.start + BLOCK as u64 <= s.released {
-            s.blocks.pop_front();
+            if let Some((block, _)) = s.blocks.pop_front() {
+                if s.spare.len() < 4 {
+                    s.spare.push(block);
+                }
+            }
             s.start += BLOCK as u64;
             s.held -= BLOCK as u64;
         }
     }
 
-    fn lock(&self) -> io::Result<std::sync::MutexGuard<'_, State>> {
-        self.state
-            .lock()
-            .map_err(|_| io::Error::other("a reader of the stream panicked"))
+    /// Reads more of the stream onto the blocks unless it has been read past `at` meanwhile;
+    /// false at its end.
+    fn fill(&self, at: u64) -> io::Result<bool> {
+        let mut source = lock(&self.source)?;
+        {
+            let s = lock(&self.state)?;
+            if at < s.start + s.held {
+                return Ok(true);
+            }
+            if let Some((kind, message)) = &s.failed {
+                return Err(io::Error::new(*kind, message.clone()));
+            }
+        }
+        let (stream, buf) = &mut *source;
+        let read = loop {
+            match stream.read(buf) {
+                Err(e) if e.kind() == io::ErrorKind::Interrupted => continue,
+                r => break r,
+            }
+        };
+        let mut s = lock(&self.state)?;
+        let n = match read {
+            Ok(n) => n.min(buf.len()),
+            Err(e) => {
+                s.failed = Some((e.kind(), e.to_string()));
+                return Err(e);
+            }
+        };
+        // Onto the last block while it has room; the rest (all of it, when reads come a
+        // block at a time) becomes the next block as it is, and a spare block is read into
+        // next.
+        let mut into_last = 0;
+        if let Some((block, len)) = s.blocks.back_mut() {
+            into_last = n.min(BLOCK - *len);
+            block[*len..*len + into_last].copy_from_slice(&buf[..into_last]);
+            *len += into_last;
+        }
+        let rest = n - into_last;
+        if rest > 0 {
+            buf.copy_within(into_last..n, 0);
+            let fresh = s
+                .spare
+                .pop()
+                .unwrap_or_else(|| vec![0; BLOCK].into_boxed_slice());
+            s.blocks.push_back((std::mem::replace(buf, fresh), rest));
+        }
+        s.held += n as u64;
+        Ok(n > 0)
     }
+}
+
+fn lock<T>(m: &Mutex<T>) -> io::Result<std::sync::MutexGuard<'_, T>> {
+    m.lock()
+        .map_err(|_| io::Error::other("a reader of the stream panicked"))
 }
 
 impl State {
@@ -81,35 +141,6 @@ impl State {
             )));
         }
         Ok(())
-    }
-
-    /// Reads more of the stream onto the last block (a new one if it is full); the bytes
-    /// read, 0 at its end.
-    fn fill(&mut self) -> io::Result<usize> {
-        if let Some((kind, message)) = &self.failed {
-            return Err(io::Error::new(*kind, message.clone()));
-        }
-        if self.blocks.back().is_none_or(|&(_, len)| len == BLOCK) {
-            self.blocks
-                .push_back((vec![0; BLOCK].into_boxed_slice(), 0));
-        }
-        let Self { source, blocks, .. } = self;
-        let Some((block, len)) = blocks.back_mut() else {
-            return Ok(0);
-        };
-        let n = loop {
-            match source.read(&mut block[*len..]) {
-                Ok(n) => break n.min(BLOCK - *len),
-                Err(e) if e.kind() == io::ErrorKind::Interrupted => continue,
-                Err(e) => {
-                    self.failed = Some((e.kind(), e.to_string()));
-                    return Err(e);
-                }
-            }
-        };
-        *len += n;
-        self.held += n as u64;
-        Ok(n)
     }
 }
 
@@ -124,11 +155,16 @@ impl Read for TapeReader {
         if buf.is_empty() {
             return Ok(0);
         }
-        let mut s = self.tape.lock()?;
-        s.check(self.at)?;
-        if self.at == s.start + s.held && s.fill()? == 0 {
+        let end = {
+            let s = lock(&self.tape.state)?;
+            s.check(self.at)?;
+            s.start + s.held
+        };
+        if self.at == end && !self.tape.fill(self.at)? {
             return Ok(0);
         }
+        let s = lock(&self.tape.state)?;
+        s.check(self.at)?;
         // Every block but the last is full.
         let offset = self.at - s.start;
         let (k, from) = (
@@ -218,5 +254,57 @@ mod tests {
             .unwrap_err();
         assert_eq!(e.to_string(), "the pipe broke");
         assert_eq!(again, data[50..]);
+    }
+
+    /// A source that gives what is sent to it, waiting for it.
+    struct Channel(std::sync::mpsc::Receiver<Vec<u8>>, Vec<u8>);
+
+    impl Read for Channel {
+        fn read(&mut self, buf: &mut [u8]) -> io::Result<usize> {
+            if self.1.is_empty() {
+                match self.0.recv() {
+                    Ok(v) => self.1 = v,
+                    Err(_) => return Ok(0),
+                }
+            }
+            let n = buf.len().min(self.1.len());
+            buf[..n].copy_from_slice(&self.1[..n]);
+            self.1.drain(..n);
+            Ok(n)
+        }
+    }
+
+    #[test]
+    fn a_reader_waiting_on_the_stream_keeps_no_one_from_the_bytes_held() {
+        let (tx, rx) = std::sync::mpsc::channel::<Vec<u8>>();
+        let t = Tape::new(Box::new(Channel(rx, Vec::new())));
+        tx.send(vec![1; 100]).unwrap();
+        let mut buf = [0; 100];
+        t.reader_at(0).unwrap().read_exact(&mut buf).unwrap();
+        // A reader at the end waits on the stream...
+        let mut last = t.reader_at(100).unwrap();
+        let waiting = std::thread::spawn(move || {
+            let mut b = [0; 10];
+            let n = last.read(&mut b).unwrap();
+            (n, b)
+        });
+        std::thread::sleep(std::time::Duration::from_millis(50));
+        // ...while another replays the bytes held, and releases them.
+        let (done, replayed) = std::sync::mpsc::channel();
+        let other = Arc::clone(&t);
+        std::thread::spawn(move || {
+            let mut again = [0; 100];
+            let r = other
+                .reader_at(0)
+                .and_then(|mut r| r.read_exact(&mut again));
+            other.release(50);
+            let _ = done.send(r.map(|_| again));
+        });
+        let again = replayed
+            .recv_timeout(std::time::Duration::from_secs(10))
+            .expect("the replay waited on the stream");
+        assert_eq!(again.unwrap(), [1; 100]);
+        tx.send(vec![2; 10]).unwrap();
+        assert_eq!(waiting.join().unwrap(), (10, [2; 10]));
     }
 }
