@@ -127,6 +127,12 @@ impl Table {
     }
 }
 
+/// How far behind its reading the sequential reader may still hand over on a stream's tape:
+/// a record (at most [`MAX_LINE_BYTES`]) and the `BufReader`'s and `csv`'s buffers (64 KiB
+/// each), with room to spare. The tape is released up to there as the reader reads, so a
+/// run of blank lines or of long rows is not held.
+const SEQUENTIAL_TRAIL: u64 = MAX_LINE_BYTES as u64 + (1 << 18);
+
 /// Counts bytes since the last record end (a line break outside quotes, as `csv-core` reads
 /// quotes: opened at a field's start, `""` inside them an escaped quote) and fails past
 /// [`MAX_LINE_BYTES`]; also reports how many bytes went through, for progress.
@@ -342,11 +348,31 @@ impl Rows {
             message,
         };
         let (input, size) = open(path).map_err(|e| err(e.to_string()))?;
+        Self::from_input(path, input, size, format, progress)
+    }
+
+    /// [`Rows::open`] on an input opened (`size`: a regular file's, `None` for a stream,
+    /// which is read through a tape).
+    fn from_input(
+        path: &Path,
+        input: Box<dyn Read + Send>,
+        size: Option<u64>,
+        format: &CsvFormat,
+        progress: Option<fn(f64)>,
+    ) -> Result<Self, RecordingError> {
+        let err = |message: String| RecordingError {
+            file: path.to_path_buf(),
+            line: None,
+            message,
+        };
         let (input, tape): (Box<dyn Read + Send>, _) = match size {
             Some(_) => (input, None),
             None => {
                 let tape = Tape::new(input);
-                let reader = tape.reader_at(0).map_err(|e| err(e.to_string()))?;
+                let reader = tape
+                    .reader_at(0)
+                    .map_err(|e| err(e.to_string()))?
+                    .releasing_behind(SEQUENTIAL_TRAIL);
                 (Box::new(reader), Some(tape))
             }
         };
@@ -426,9 +452,13 @@ impl Rows {
     /// past its header and first data row (so what it reads there reads as it would have
     /// in one pass).
     pub fn resume(&self, byte: u64, line: u64) -> Result<Self, RecordingError> {
-        let input = self
-            .input_from(byte)
-            .map_err(|e| self.err(Some(line), e.to_string()))?;
+        let input: Box<dyn Read + Send> = match &self.tape {
+            Some(tape) => tape
+                .reader_at(byte)
+                .map(|r| Box::new(r.releasing_behind(SEQUENTIAL_TRAIL)) as Box<dyn Read + Send>),
+            None => self.input_from(byte),
+        }
+        .map_err(|e| self.err(Some(line), e.to_string()))?;
         let mut rows = Self::build(
             &self.path,
             &self.format,
@@ -504,7 +534,8 @@ impl Rows {
                     // The line being read (lines consumed so far, plus one).
                     let line = e
                         .position()
-                        .map_or(self.reader.position().line(), |p| p.line());
+                        .map_or(self.reader.position().line(), |p| p.line())
+                        + self.line_offset;
                     let message = match e.into_kind() {
                         csv::ErrorKind::Io(io) => io.to_string(),
                         other => format!("{other:?}"),
@@ -813,6 +844,34 @@ pub(crate) fn words(h: &str) -> impl Iterator<Item = &str> {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// A stream read row by row holds only what a hand-over may still need: a run of blank
+    /// lines or of long rows is released as it is read, not held until rows are counted.
+    #[test]
+    fn a_stream_read_row_by_row_holds_a_bounded_tail() {
+        let mut text = String::from("t,a\n0,1\n");
+        text.push_str(&"\n".repeat(40 << 20));
+        let long = format!("1,{}2\n", "0".repeat(600_000));
+        for _ in 0..64 {
+            text.push_str(&long);
+        }
+        text.push_str("2,3\n");
+        let input = Box::new(std::io::Cursor::new(text.into_bytes()));
+        let mut rows =
+            Rows::from_input(Path::new("-"), input, None, &CsvFormat::default(), None).unwrap();
+        let tape = rows.tape().unwrap();
+        let mut most = 0;
+        let mut n = 0;
+        while let Some((line, _, row)) = rows.next_row().unwrap() {
+            n += 1;
+            if n == 2 {
+                assert_eq!((line, row.len()), (40 * (1 << 20) + 3, 2));
+            }
+            most = most.max(tape.held());
+        }
+        assert_eq!(n, 66);
+        assert!(most < 2 * SEQUENTIAL_TRAIL, "{most} bytes held");
+    }
 
     fn read(text: &str, format: CsvFormat) -> Result<Table, String> {
         let dir = std::env::temp_dir().join(format!("impact-table-{}", std::process::id()));

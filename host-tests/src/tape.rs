@@ -29,6 +29,8 @@ struct State {
     released: u64,
     /// The stream's error, given again to any reader that reaches the byte it failed at.
     failed: Option<(io::ErrorKind, String)>,
+    /// Whether the stream has ended (it is not read again: a terminal would wait).
+    ended: bool,
     /// Released blocks, to read into again.
     spare: Vec<Box<[u8]>>,
 }
@@ -47,6 +49,7 @@ impl Tape {
                 held: 0,
                 released: 0,
                 failed: None,
+                ended: false,
                 spare: Vec::new(),
             }),
         })
@@ -58,7 +61,13 @@ impl Tape {
         Ok(TapeReader {
             tape: Arc::clone(self),
             at: byte,
+            trail: None,
         })
+    }
+
+    /// The bytes held (read and not yet dropped).
+    pub fn held(&self) -> u64 {
+        self.state.lock().map_or(0, |s| s.held)
     }
 
     /// No reader will go back before `byte` any more: the blocks before it are dropped.
@@ -87,6 +96,9 @@ impl Tape {
             }
             if let Some((kind, message)) = &s.failed {
                 return Err(io::Error::new(*kind, message.clone()));
+            }
+            if s.ended {
+                return Ok(false);
             }
         }
         let (stream, buf) = &mut *source;
@@ -123,6 +135,7 @@ impl Tape {
             s.blocks.push_back((std::mem::replace(buf, fresh), rest));
         }
         s.held += n as u64;
+        s.ended |= n == 0;
         Ok(n > 0)
     }
 }
@@ -148,6 +161,19 @@ impl State {
 pub struct TapeReader {
     tape: Arc<Tape>,
     at: u64,
+    /// Release the tape this far behind the place as it reads.
+    trail: Option<u64>,
+}
+
+impl TapeReader {
+    /// The reader releasing the tape `trail` bytes behind its place as it reads (for a
+    /// reader that never hands over further back than that).
+    pub fn releasing_behind(self, trail: u64) -> Self {
+        Self {
+            trail: Some(trail),
+            ..self
+        }
+    }
 }
 
 impl Read for TapeReader {
@@ -177,6 +203,10 @@ impl Read for TapeReader {
         let n = buf.len().min(len.saturating_sub(from));
         buf[..n].copy_from_slice(&block[from..from + n]);
         self.at += n as u64;
+        drop(s);
+        if let Some(trail) = self.trail {
+            self.tape.release(self.at.saturating_sub(trail));
+        }
         Ok(n)
     }
 }
@@ -184,18 +214,31 @@ impl Read for TapeReader {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use std::sync::mpsc::{channel, Receiver, Sender};
+    use std::time::Duration;
 
-    /// A source that gives `data` a few bytes at a time, then an error if `fail`.
+    const B: u64 = BLOCK as u64;
+
+    /// A source that gives `data` a few bytes at a time, then an error once if `fail`, then
+    /// its end, and an error if read again past its end.
     struct Dribble {
         data: Vec<u8>,
         at: usize,
         fail: bool,
+        ended: bool,
     }
 
     impl Read for Dribble {
         fn read(&mut self, buf: &mut [u8]) -> io::Result<usize> {
-            if self.at == self.data.len() && self.fail {
-                return Err(io::Error::other("the pipe broke"));
+            if self.at == self.data.len() {
+                if std::mem::take(&mut self.fail) {
+                    return Err(io::Error::other("the pipe broke"));
+                }
+                if self.ended {
+                    return Err(io::Error::other("read again past its end"));
+                }
+                self.ended = true;
+                return Ok(0);
             }
             let n = buf.len().min(7).min(self.data.len() - self.at);
             buf[..n].copy_from_slice(&self.data[self.at..self.at + n]);
@@ -210,37 +253,38 @@ mod tests {
             data: data.clone(),
             at: 0,
             fail,
+            ended: false,
         };
         (Tape::new(Box::new(source)), data)
+    }
+
+    fn read_from(t: &Arc<Tape>, byte: u64) -> io::Result<Vec<u8>> {
+        let mut got = Vec::new();
+        t.reader_at(byte)?.read_to_end(&mut got)?;
+        Ok(got)
     }
 
     #[test]
     fn readers_replay_from_any_byte_not_released() {
         let (t, data) = tape(40 * BLOCK + 123, false);
-        const B: u64 = BLOCK as u64;
-        let mut first = Vec::new();
-        t.reader_at(0).unwrap().read_to_end(&mut first).unwrap();
-        assert_eq!(first, data);
-        // A second reader replays from the middle; the bytes before a release are gone.
-        let mut again = Vec::new();
-        t.reader_at(1000).unwrap().read_to_end(&mut again).unwrap();
-        assert_eq!(again, data[1000..]);
+        assert_eq!(read_from(&t, 0).unwrap(), data);
+        // A second reader replays from the middle (and meets the end without reading the
+        // stream past it again); the bytes before a release are gone.
+        assert_eq!(read_from(&t, 1000).unwrap(), data[1000..]);
         t.release(2 * B + 5);
         assert!(t.reader_at(2 * B + 4).is_err());
-        let mut tail = Vec::new();
-        let mut r = t.reader_at(2 * B + 5).unwrap();
-        r.read_to_end(&mut tail).unwrap();
-        assert_eq!(tail, data[2 * BLOCK + 5..]);
+        assert_eq!(read_from(&t, 2 * B + 5).unwrap(), data[2 * BLOCK + 5..]);
         // A reader left behind a release fails rather than read the wrong bytes.
         let mut behind = t.reader_at(2 * B + 5).unwrap();
         t.release(3 * B);
         // Only the blocks from the release on are held.
-        assert_eq!(t.state.lock().unwrap().held, 37 * B + 123);
+        assert_eq!(t.held(), 37 * B + 123);
         assert!(behind.read(&mut [0; 8]).is_err());
     }
 
     #[test]
     fn the_stream_error_is_given_again_where_it_happened() {
+        // The stream fails once (then would end): every reader meets the same error there.
         let (t, data) = tape(100, true);
         let mut got = Vec::new();
         let e = t.reader_at(0).unwrap().read_to_end(&mut got).unwrap_err();
@@ -256,31 +300,47 @@ mod tests {
         assert_eq!(again, data[50..]);
     }
 
-    /// A source that gives what is sent to it, waiting for it.
-    struct Channel(std::sync::mpsc::Receiver<Vec<u8>>, Vec<u8>);
+    /// A source that gives what is sent to it, saying when it starts to wait for it.
+    struct Channel {
+        sent: Receiver<Vec<u8>>,
+        waiting: Sender<()>,
+        left: Vec<u8>,
+    }
 
     impl Read for Channel {
         fn read(&mut self, buf: &mut [u8]) -> io::Result<usize> {
-            if self.1.is_empty() {
-                match self.0.recv() {
-                    Ok(v) => self.1 = v,
+            if self.left.is_empty() {
+                let _ = self.waiting.send(());
+                match self.sent.recv() {
+                    Ok(v) => self.left = v,
                     Err(_) => return Ok(0),
                 }
             }
-            let n = buf.len().min(self.1.len());
-            buf[..n].copy_from_slice(&self.1[..n]);
-            self.1.drain(..n);
+            let n = buf.len().min(self.left.len());
+            buf[..n].copy_from_slice(&self.left[..n]);
+            self.left.drain(..n);
             Ok(n)
         }
     }
 
+    fn channel_tape() -> (Arc<Tape>, Sender<Vec<u8>>, Receiver<()>) {
+        let (send, sent) = channel();
+        let (waiting, waits) = channel();
+        let source = Channel {
+            sent,
+            waiting,
+            left: Vec::new(),
+        };
+        (Tape::new(Box::new(source)), send, waits)
+    }
+
     #[test]
     fn a_reader_waiting_on_the_stream_keeps_no_one_from_the_bytes_held() {
-        let (tx, rx) = std::sync::mpsc::channel::<Vec<u8>>();
-        let t = Tape::new(Box::new(Channel(rx, Vec::new())));
-        tx.send(vec![1; 100]).unwrap();
+        let (t, send, waits) = channel_tape();
+        send.send(vec![1; 100]).unwrap();
         let mut buf = [0; 100];
         t.reader_at(0).unwrap().read_exact(&mut buf).unwrap();
+        waits.recv().unwrap();
         // A reader at the end waits on the stream...
         let mut last = t.reader_at(100).unwrap();
         let waiting = std::thread::spawn(move || {
@@ -288,9 +348,9 @@ mod tests {
             let n = last.read(&mut b).unwrap();
             (n, b)
         });
-        std::thread::sleep(std::time::Duration::from_millis(50));
+        waits.recv_timeout(Duration::from_secs(10)).unwrap();
         // ...while another replays the bytes held, and releases them.
-        let (done, replayed) = std::sync::mpsc::channel();
+        let (done, replayed) = channel();
         let other = Arc::clone(&t);
         std::thread::spawn(move || {
             let mut again = [0; 100];
@@ -301,10 +361,36 @@ mod tests {
             let _ = done.send(r.map(|_| again));
         });
         let again = replayed
-            .recv_timeout(std::time::Duration::from_secs(10))
+            .recv_timeout(Duration::from_secs(10))
             .expect("the replay waited on the stream");
         assert_eq!(again.unwrap(), [1; 100]);
-        tx.send(vec![2; 10]).unwrap();
+        send.send(vec![2; 10]).unwrap();
         assert_eq!(waiting.join().unwrap(), (10, [2; 10]));
+    }
+
+    #[test]
+    fn released_blocks_are_read_into_again_and_a_trailing_reader_releases() {
+        let (t, send, _waits) = channel_tape();
+        let data: Vec<u8> = (0..20 * BLOCK).map(|k| (k * 7 % 253) as u8).collect();
+        // In pieces that straddle the blocks.
+        for piece in data[..10 * BLOCK].chunks(BLOCK / 3 + 5) {
+            send.send(piece.to_vec()).unwrap();
+        }
+        let mut r = t.reader_at(0).unwrap().releasing_behind(2 * B);
+        let mut got = vec![0; 10 * BLOCK];
+        r.read_exact(&mut got).unwrap();
+        assert_eq!(got, data[..10 * BLOCK]);
+        // It held only the blocks within its trail (and the one being filled).
+        assert!(t.held() <= 4 * B, "{}", t.held());
+        // The blocks released are read into again: the later bytes come back right.
+        for piece in data[10 * BLOCK..].chunks(BLOCK) {
+            send.send(piece.to_vec()).unwrap();
+        }
+        drop(send);
+        let mut rest = Vec::new();
+        r.read_to_end(&mut rest).unwrap();
+        assert_eq!(rest, data[10 * BLOCK..]);
+        assert!(t.reader_at(8 * B).is_err());
+        assert_eq!(read_from(&t, 20 * B - 10).unwrap(), data[20 * BLOCK - 10..]);
     }
 }

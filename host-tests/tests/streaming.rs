@@ -426,6 +426,19 @@ fn a_long_csv_file_gives_the_same_reports_and_errors_through_the_parallel_reader
     assert_eq!(stdin_err, err.replace(&text, "stdin"));
     let (_, _, whole_err) = run(&text, &["--plot", &svg]);
     assert_eq!(whole_err, err);
+    // A line longer than the readers take, far past the head (the sequential reader takes
+    // over there): the same message at its line, from the file and through the pipe.
+    let mut long = lines.clone();
+    long[250_000].push_str(&" ".repeat(2 << 20));
+    let long = write("long-line.csv", &long);
+    let (code, _, err) = run(&long, &[]);
+    assert!(code != 0 && err.contains(":250001: "), "{err}");
+    assert_eq!(run_stdin(&long, &[]).2, err.replace(&long, "stdin"));
+    // A byte-order mark shifts every byte the readers hand over at by three.
+    let mut marked = lines.clone();
+    marked[0].insert(0, '\u{feff}');
+    let marked = write("bom-long.csv", &marked);
+    assert_eq!(run_stdin(&marked, &["--json", "--keep-spikes"]).1, whole.1);
     let mut gap = lines.clone();
     gap.remove(240_000);
     let gap = write("gap-long.csv", &gap);
