@@ -46,6 +46,17 @@ impl fmt::Display for RecordingError {
 
 impl std::error::Error for RecordingError {}
 
+impl RecordingError {
+    /// An error of the file as a whole (no line).
+    fn of(path: &Path, message: String) -> Self {
+        Self {
+            file: path.to_path_buf(),
+            line: None,
+            message,
+        }
+    }
+}
+
 /// An external library's message on one line (some span several, with pointers under a
 /// quoted source).
 pub fn one_line(message: impl std::fmt::Display) -> String {
@@ -342,12 +353,7 @@ impl Rows {
         format: &CsvFormat,
         progress: Option<fn(f64)>,
     ) -> Result<Self, RecordingError> {
-        let err = |message: String| RecordingError {
-            file: path.to_path_buf(),
-            line: None,
-            message,
-        };
-        let (input, size) = open(path).map_err(|e| err(e.to_string()))?;
+        let (input, size) = open(path).map_err(|e| RecordingError::of(path, e.to_string()))?;
         Self::from_input(path, input, size, format, progress)
     }
 
@@ -360,11 +366,7 @@ impl Rows {
         format: &CsvFormat,
         progress: Option<fn(f64)>,
     ) -> Result<Self, RecordingError> {
-        let err = |message: String| RecordingError {
-            file: path.to_path_buf(),
-            line: None,
-            message,
-        };
+        let err = |message: String| RecordingError::of(path, message);
         let (input, tape): (Box<dyn Read + Send>, _) = match size {
             Some(_) => (input, None),
             None => {
