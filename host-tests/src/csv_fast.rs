@@ -207,9 +207,15 @@ impl FastRows {
 
 impl Drop for FastRows {
     fn drop(&mut self) {
-        // Closing the results ends the workers' sends, and with them the reader's.
+        // Closing the results ends the workers' sends, and with them the reader's. A stream's
+        // reader may be waiting on the stream for its next chunk: it is left to end when that
+        // read returns, so a hand-over to the sequential reader (which goes on with the bytes
+        // the tape holds) does not wait for more of the stream. A file's is joined.
         self.results = None;
         self.pending.clear();
+        if self.tape.is_some() {
+            self.threads.clear();
+        }
         for t in self.threads.drain(..) {
             let _ = t.join();
         }
@@ -390,6 +396,70 @@ const EXACT_TENS: [f64; 23] = [
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// A stream that gives what is sent to it, waiting for more until the sender is gone.
+    struct Channel(std::sync::mpsc::Receiver<Vec<u8>>, Vec<u8>);
+
+    impl Read for Channel {
+        fn read(&mut self, buf: &mut [u8]) -> std::io::Result<usize> {
+            if self.1.is_empty() {
+                match self.0.recv() {
+                    Ok(v) => self.1 = v,
+                    Err(_) => return Ok(0),
+                }
+            }
+            let n = buf.len().min(self.1.len());
+            buf[..n].copy_from_slice(&self.1[..n]);
+            self.1.drain(..n);
+            Ok(n)
+        }
+    }
+
+    #[test]
+    fn a_stop_on_a_stream_does_not_wait_for_more_of_it() {
+        // A chunk and a bit of a stream, a quoted row in the first chunk; the stream then
+        // waits for more.
+        let (send, sent) = std::sync::mpsc::channel();
+        let tape = Tape::new(Box::new(Channel(sent, Vec::new())));
+        let mut text = "0,1\n".repeat(1000);
+        let stop_byte = text.len() as u64;
+        text.push_str("\"1\",2\n");
+        text.push_str(&"2,3\n".repeat(CHUNK / 4));
+        send.send(text.into_bytes()).unwrap();
+        let layout = Layout {
+            columns: 2,
+            channel: 1,
+            time: None,
+            delimiter: b',',
+            decimal_comma: false,
+            time_unit_s: 1.0,
+            increasing: false,
+            median_dt: None,
+            all: false,
+        };
+        let input = Box::new(tape.reader_at(0).unwrap());
+        let mut fast = FastRows::start(input, (0, 1), layout, None, Some(Arc::clone(&tape)));
+        let chunk = fast.next_chunk().unwrap();
+        assert_eq!(chunk.rows.len(), 1000);
+        assert_eq!(chunk.stop, Some((stop_byte, 1001)));
+        // The reader waits on the stream for its next chunk: dropping it does not.
+        let (done, dropped) = std::sync::mpsc::channel();
+        std::thread::spawn(move || {
+            drop(fast);
+            let _ = done.send(());
+        });
+        dropped
+            .recv_timeout(std::time::Duration::from_secs(10))
+            .expect("the hand-over waited for more of the stream");
+        // The sequential reader takes the stream from the quoted row.
+        let mut row = [0u8; 6];
+        tape.reader_at(stop_byte)
+            .unwrap()
+            .read_exact(&mut row)
+            .unwrap();
+        assert_eq!(&row, b"\"1\",2\n");
+        drop(send);
+    }
 
     #[test]
     fn plain_decimals_read_as_the_general_parser_reads_them() {
