@@ -397,6 +397,22 @@ const EXACT_TENS: [f64; 23] = [
 mod tests {
     use super::*;
 
+    /// Two comma-separated columns, the value in the second (`time`: the time column),
+    /// nothing checked.
+    fn two_columns(time: Option<usize>) -> Layout {
+        Layout {
+            columns: 2,
+            channel: 1,
+            time,
+            delimiter: b',',
+            decimal_comma: false,
+            time_unit_s: 1.0,
+            increasing: false,
+            median_dt: None,
+            all: false,
+        }
+    }
+
     /// A stream that gives what is sent to it, waiting for more until the sender is gone.
     struct Channel(std::sync::mpsc::Receiver<Vec<u8>>, Vec<u8>);
 
@@ -426,17 +442,7 @@ mod tests {
         text.push_str("\"1\",2\n");
         text.push_str(&"2,3\n".repeat(CHUNK / 4));
         send.send(text.into_bytes()).unwrap();
-        let layout = Layout {
-            columns: 2,
-            channel: 1,
-            time: None,
-            delimiter: b',',
-            decimal_comma: false,
-            time_unit_s: 1.0,
-            increasing: false,
-            median_dt: None,
-            all: false,
-        };
+        let layout = two_columns(None);
         let input = Box::new(tape.reader_at(0).unwrap());
         let mut fast = FastRows::start(input, (0, 1), layout, None, Some(Arc::clone(&tape)));
         let chunk = fast.next_chunk().unwrap();
@@ -496,17 +502,7 @@ mod tests {
             let sign = if state & 1 == 1 { "-" } else { "" };
             fields.push(format!("{sign}{}.{}", &s[..at], &s[at..]));
         }
-        let layout = Layout {
-            columns: 2,
-            channel: 1,
-            time: Some(0),
-            delimiter: b',',
-            decimal_comma: false,
-            time_unit_s: 1.0,
-            increasing: false,
-            median_dt: None,
-            all: false,
-        };
+        let layout = two_columns(Some(0));
         let mut out = Vec::new();
         let mut taken = 0;
         for pair in fields.chunks(2) {

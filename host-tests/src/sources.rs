@@ -264,10 +264,10 @@ struct CsvSource {
     head_rate: Option<f64>,
     /// The first row's value, read while resolving the columns and not yet handed on.
     pending: Option<f64>,
-    /// A regular file's path and size (for progress; standard input and pipes are kept on
-    /// the reader's tape instead); the parallel fast path once the head is read, and rows read since the sequential reader last took
-    /// over (it hands back after [`crate::csv_fast::SEQUENTIAL_ROWS`] rows).
-    file: Option<(std::path::PathBuf, u64)>,
+    /// A regular file's size (for progress); the parallel fast path once the head is read,
+    /// and rows read since the sequential reader last took over (it hands back after
+    /// [`crate::csv_fast::SEQUENTIAL_ROWS`] rows).
+    size: Option<u64>,
     fast: Option<crate::csv_fast::FastRows>,
     head_done: bool,
     ended: bool,
@@ -321,6 +321,7 @@ impl CsvSource {
                 .map_or(1.0, |h| crate::recording::time_unit_s(h));
             (t, unit)
         });
+        let size = rows.size();
         let mut source = Self {
             rows,
             name,
@@ -334,10 +335,7 @@ impl CsvSource {
             median_dt: None,
             head_rate: None,
             pending: None,
-            file: std::fs::metadata(&args.file)
-                .ok()
-                .filter(|m| m.is_file() && !is_stdin(&args.file))
-                .map(|m| (args.file.clone(), m.len())),
+            size,
             fast: None,
             head_done: false,
             ended: false,
@@ -403,7 +401,6 @@ impl CsvSource {
         if self.head_done
             && self.fast.is_none()
             && self.sequential >= crate::csv_fast::SEQUENTIAL_ROWS
-            && (self.file.is_some() || self.rows.tape().is_some())
         {
             let (byte, line) = self.rows.position();
             let (delimiter, format) = self.rows.format();
@@ -424,7 +421,7 @@ impl CsvSource {
                 }),
                 all: false,
             };
-            let progress = self.progress.zip(self.file.as_ref().map(|(_, size)| *size));
+            let progress = self.progress.zip(self.size);
             let input = self
                 .rows
                 .input_from(byte)

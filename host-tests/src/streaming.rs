@@ -228,8 +228,8 @@ fn in_pass(fraction: f64) {
 }
 
 /// Whether `impact analyze` reads `args.file` in passes ([`analyze_in_passes`]): a regular
-/// file or standard input, without the options that need the whole recording in memory (figures, axes, free
-/// fall, resampling).
+/// file or standard input, without the options that need the whole recording in memory
+/// (figures, axes, free fall, resampling).
 pub fn in_passes(args: &AnalyzeArgs) -> bool {
     !args.stream
         && (is_stdin(&args.file) || std::fs::metadata(&args.file).is_ok_and(|m| m.is_file()))
@@ -279,13 +279,21 @@ fn survey_pass(
     });
     let spikes = spikes.map(|s| Scan::spawn(s, |s, block| s.push(block)));
     let mut patch = Patches::new(removals);
-    let read = read_head(&mut *source, scale).and_then(|mut head| {
-        patch.values(&mut head);
-        survey.push_levels(&head);
-        flat.send(&head);
-        if let Some(s) = &spikes {
-            s.send(&head);
+    // Each block, the head first: the removals put in, surveyed here and sent to the scans.
+    let mut take = |block: &mut [f64]| {
+        if let (Some(name), Some(e)) = (&stops, failure.get()) {
+            return Err(format!("{name}: {e}"));
         }
+        patch.values(block);
+        survey.push_levels(block);
+        flat.send(block);
+        if let Some(s) = &spikes {
+            s.send(block);
+        }
+        Ok(())
+    };
+    let read = read_head(&mut *source, scale).and_then(|mut head| {
+        take(&mut head)?;
         read_ahead(
             source,
             move |s, _, out: &mut Vec<f64>| {
@@ -293,18 +301,7 @@ fn survey_pass(
                 out.iter_mut().for_each(|v| *v *= scale);
                 Ok(())
             },
-            |block| {
-                if let (Some(name), Some(e)) = (&stops, failure.get()) {
-                    return Err(format!("{name}: {e}"));
-                }
-                patch.values(block);
-                survey.push_levels(block);
-                flat.send(block);
-                if let Some(s) = &spikes {
-                    s.send(block);
-                }
-                Ok(())
-            },
+            take,
         )
     });
     let (flat, with_flat, spool) = flat.finish()?;

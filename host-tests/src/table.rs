@@ -144,6 +144,14 @@ impl Table {
 /// run of blank lines or of long rows is not held.
 const SEQUENTIAL_TRAIL: u64 = MAX_LINE_BYTES as u64 + (1 << 18);
 
+/// The sequential reader's input on a stream's tape from `byte` on, releasing it
+/// [`SEQUENTIAL_TRAIL`] behind.
+fn sequential_reader(tape: &Arc<Tape>, byte: u64) -> io::Result<Box<dyn Read + Send>> {
+    Ok(Box::new(
+        tape.reader_at(byte)?.releasing_behind(SEQUENTIAL_TRAIL),
+    ))
+}
+
 /// Counts bytes since the last record end (a line break outside quotes, as `csv-core` reads
 /// quotes: opened at a field's start, `""` inside them an escaped quote) and fails past
 /// [`MAX_LINE_BYTES`]; also reports how many bytes went through, for progress.
@@ -338,11 +346,10 @@ pub struct Rows {
     size: Option<u64>,
     step: Option<u64>,
     next_progress: u64,
-    /// A stream that cannot be read again (standard input, a pipe), kept from the row being
-    /// read on so that another reader can take over at a line ([`Rows::input_from`]).
+    /// A stream that cannot be read again (standard input, a pipe), kept from a record and
+    /// the buffers behind the reading on ([`SEQUENTIAL_TRAIL`]), so that another reader can
+    /// take over at a line ([`Rows::input_from`]).
     tape: Option<Arc<Tape>>,
-    /// Rows read since the tape was last released up to the next one.
-    unreleased: u32,
 }
 
 impl Rows {
@@ -371,11 +378,8 @@ impl Rows {
             Some(_) => (input, None),
             None => {
                 let tape = Tape::new(input);
-                let reader = tape
-                    .reader_at(0)
-                    .map_err(|e| err(e.to_string()))?
-                    .releasing_behind(SEQUENTIAL_TRAIL);
-                (Box::new(reader), Some(tape))
+                let reader = sequential_reader(&tape, 0).map_err(|e| err(e.to_string()))?;
+                (reader, Some(tape))
             }
         };
         let mut buffered = BufReader::with_capacity(1 << 16, input);
@@ -446,7 +450,6 @@ impl Rows {
             step,
             next_progress: step.unwrap_or(u64::MAX),
             tape: None,
-            unreleased: 0,
         }
     }
 
@@ -454,10 +457,8 @@ impl Rows {
     /// past its header and first data row (so what it reads there reads as it would have
     /// in one pass).
     pub fn resume(&self, byte: u64, line: u64) -> Result<Self, RecordingError> {
-        let input: Box<dyn Read + Send> = match &self.tape {
-            Some(tape) => tape
-                .reader_at(byte)
-                .map(|r| Box::new(r.releasing_behind(SEQUENTIAL_TRAIL)) as Box<dyn Read + Send>),
+        let input = match &self.tape {
+            Some(tape) => sequential_reader(tape, byte),
             None => self.input_from(byte),
         }
         .map_err(|e| self.err(Some(line), e.to_string()))?;
@@ -496,6 +497,11 @@ impl Rows {
     /// what it has read.
     pub fn tape(&self) -> Option<Arc<Tape>> {
         self.tape.clone()
+    }
+
+    /// The size of the file opened (none for a stream, or a reader resumed mid-file).
+    pub fn size(&self) -> Option<u64> {
+        self.size
     }
 
     /// The byte of the file and the line the next row starts on.
@@ -547,14 +553,6 @@ impl Rows {
             };
             if !more {
                 return Ok(None);
-            }
-            // Nothing before the next row is read again (a hand-over starts there).
-            if let Some(tape) = &self.tape {
-                self.unreleased += 1;
-                if self.unreleased >= 256 {
-                    self.unreleased = 0;
-                    tape.release(self.position().0);
-                }
             }
             // Every record ends with a consumed `\n` (the input's last one added if missing),
             // and `csv` counts lines as it consumes `\n`s: the record's line is the count less
@@ -678,16 +676,13 @@ pub fn read_table(
     let mut next_line = 0;
     let mut n = 0usize;
     // Plain rows past the first few thousand go through the parallel reader
-    // ([`crate::csv_fast`]); any other line through this one, for a while.
-    let size = std::fs::metadata(path)
-        .ok()
-        .filter(|m| m.is_file() && !is_stdin(path))
-        .map(|m| m.len());
+    // ([`crate::csv_fast`]; a file read again from the row, or a stream's tape played from
+    // it); any other line through this one, for a while.
+    let size = rows.size();
     let mut fast: Option<crate::csv_fast::FastRows> = None;
     let mut sequential = 0usize;
     loop {
-        let replayable = size.is_some() || rows.tape.is_some();
-        if fast.is_none() && replayable && sequential >= crate::csv_fast::SEQUENTIAL_ROWS {
+        if fast.is_none() && sequential >= crate::csv_fast::SEQUENTIAL_ROWS {
             let (byte, line) = rows.position();
             let layout = crate::csv_fast::Layout {
                 columns: table.columns.len(),
