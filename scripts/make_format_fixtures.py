@@ -1,6 +1,6 @@
 #!/usr/bin/env python3
 """Writes the WAV and .npy fixtures of host-tests/tests/formats.rs from the bundled AFRL record
-(../shared/signals/afrl-drop-tower/series1_test1_full_100ms.csv, rows 5000..25000 of test 1):
+(host-tests/data/afrl-drop-tower/series1_test1_full_100ms.csv, rows 5000..25000 of test 1):
 
 - host-tests/fixtures/afrl-test1-int16.wav: 2 channels (bottom, top), 16-bit integer PCM,
   codes = round_half_even(kg_n * 1000), written by CPython's standard `wave` module;
@@ -30,7 +30,7 @@ import numpy as np
 import scipy.io.wavfile
 
 ROOT = pathlib.Path(__file__).resolve().parent.parent
-SOURCE = ROOT / "../shared/signals/afrl-drop-tower/series1_test1_full_100ms.csv"
+SOURCE = ROOT / "host-tests/data/afrl-drop-tower/series1_test1_full_100ms.csv"
 OUT = ROOT / "host-tests/fixtures"
 FIRST, LAST = 5000, 25000  # data rows (0-based), LAST exclusive
 RATE = 1_000_000

@@ -35,7 +35,7 @@ import endaq.calc.stats
 G = 9.80665
 KGN = 1000.0 * G
 HERE = os.path.dirname(os.path.abspath(__file__))
-SIGNALS = os.path.normpath(os.path.join(HERE, "..", "..", "shared", "signals"))
+SIGNALS = os.path.normpath(os.path.join(HERE, "..", "host-tests", "data"))
 
 
 def load(rel, column, scale, skip=1, rate=None):

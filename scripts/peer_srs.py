@@ -37,7 +37,7 @@ import endaq.calc.shock as shock
 
 G = 9.80665
 HERE = os.path.dirname(os.path.abspath(__file__))
-SIGNALS = os.path.normpath(os.path.join(HERE, "..", "..", "shared", "signals"))
+SIGNALS = os.path.normpath(os.path.join(HERE, "..", "host-tests", "data"))
 DAMP = 0.05
 
 

@@ -18,7 +18,7 @@ fn temp_csv(name: &str, text: &str) -> std::path::PathBuf {
 fn afrl() -> String {
     concat!(
         env!("CARGO_MANIFEST_DIR"),
-        "/../../shared/signals/afrl-drop-tower/series1_test1_full_100ms.csv"
+        "/data/afrl-drop-tower/series1_test1_full_100ms.csv"
     )
     .to_string()
 }
@@ -284,7 +284,7 @@ fn an_ambiguous_time_column_names_the_candidates_and_units_are_read_from_the_hea
 fn a_free_fall_file_must_reach_the_impact() {
     let dir = concat!(
         env!("CARGO_MANIFEST_DIR"),
-        "/../../shared/signals/endaq-high-drop"
+        "/data/endaq-high-drop"
     );
     let dc = std::fs::read_to_string(format!("{dir}/High-Drop_16g-DC_full.csv")).unwrap();
     // The DC channel cut at 4.6 s, 10 s before the impact (at rest, before the release).

@@ -111,13 +111,13 @@ fn emulator_and_log_match_host(file: &str, options: &[&str], log_too: bool) {
 fn afrl_drop_tower_recording() {
     let file = concat!(
         env!("CARGO_MANIFEST_DIR"),
-        "/../../shared/signals/afrl-drop-tower/series1_test1_full_100ms.csv"
+        "/data/afrl-drop-tower/series1_test1_full_100ms.csv"
     );
     emulator_matches_host(file, &["--units", "kgn"]);
 }
 
-fn shared(rel: &str) -> String {
-    format!("{}/../../shared/signals/{rel}", env!("CARGO_MANIFEST_DIR"))
+fn data(rel: &str) -> String {
+    format!("{}/data/{rel}", env!("CARGO_MANIFEST_DIR"))
 }
 
 #[test]
@@ -128,24 +128,24 @@ fn every_other_bundled_recording() {
     // These start at a time stamp other than 0, take v0 from a free fall, or have a rate
     // (from their time column) that f32 does not hold: the emulator against
     // `impact analyze` only.
-    let dc = shared("endaq-high-drop/High-Drop_16g-DC_full.csv");
+    let dc = data("endaq-high-drop/High-Drop_16g-DC_full.csv");
     emulator_and_log_match_host(
-        &shared("endaq-high-drop/High-Drop_2000g-PE_13.4-15.0s.csv"),
+        &data("endaq-high-drop/High-Drop_2000g-PE_13.4-15.0s.csv"),
         &["--column", "z_g", "--free-fall", &dc],
         false,
     );
     emulator_and_log_match_host(
-        &shared("impack-water-entry/4mps_sphere_1_100g-PR_9.9-10.6s.csv"),
+        &data("impack-water-entry/4mps_sphere_1_100g-PR_9.9-10.6s.csv"),
         &["--column", "y_g"],
         false,
     );
     emulator_and_log_match_host(
-        &shared("pyfrf-impact-hammer/measurement_1.csv"),
+        &data("pyfrf-impact-hammer/measurement_1.csv"),
         &["--column", "force_n", "--units", "n"],
         false,
     );
     emulator_matches_host(
-        &shared("afrl-drop-tower/accel_5.csv"),
+        &data("afrl-drop-tower/accel_5.csv"),
         &["--column", "1", "--units", "kgn", "--rate", "1e6"],
     );
     // The DC channel: a free fall and a rest that are level changes, not impacts, and three
@@ -153,7 +153,7 @@ fn every_other_bundled_recording() {
     // counts).
     emulator_and_log_match_host(&dc, &["--column", "z_g"], false);
     emulator_and_log_match_host(
-        &shared("impack-water-entry/4mps_sphere_1_40g-DC_9.9-10.6s.csv"),
+        &data("impack-water-entry/4mps_sphere_1_40g-DC_9.9-10.6s.csv"),
         &["--column", "y_g", "--range", "40"],
         false,
     );
@@ -166,7 +166,7 @@ fn a_spiked_recording_is_screened_the_same_way() {
     }
     // A 220 kg_n glitch at 50 ms of the AFRL record: removed on the host before either runs.
     let text =
-        std::fs::read_to_string(shared("afrl-drop-tower/series1_test1_full_100ms.csv")).unwrap();
+        std::fs::read_to_string(data("afrl-drop-tower/series1_test1_full_100ms.csv")).unwrap();
     let spiked: String = text
         .lines()
         .enumerate()
@@ -369,7 +369,7 @@ fn waveforms_off_the_board_draw_the_same_figure() {
 fn shock_spectra_on_the_board_are_the_hosts() {
     // The firmware's `srs` lines, decoded, give the host's spectra bit for bit.
     emulator_matches_host(
-        &shared("afrl-drop-tower/series1_test1_full_100ms.csv"),
+        &data("afrl-drop-tower/series1_test1_full_100ms.csv"),
         &["--units", "kgn", "--srs"],
     );
 }
@@ -379,7 +379,7 @@ fn three_axes_give_the_same_reports_on_the_board() {
     // The board streams the resultant the host computes; the axes' part comes from the file,
     // so `impact log` alone cannot give it.
     emulator_and_log_match_host(
-        &shared("endaq-high-drop/High-Drop_16g-DC_full.csv"),
+        &data("endaq-high-drop/High-Drop_16g-DC_full.csv"),
         &["--axes", "x_g,y_g,z_g"],
         false,
     );

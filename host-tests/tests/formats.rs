@@ -21,7 +21,7 @@ fn source_rows() -> Vec<(f64, f64)> {
 /// `count` rows of AFRL test 1 from `first`: (bottom, top) in kg_n.
 fn rows(first: usize, count: usize) -> Vec<(f64, f64)> {
     let text = std::fs::read_to_string(
-        root().join("../../shared/signals/afrl-drop-tower/series1_test1_full_100ms.csv"),
+        root().join("data/afrl-drop-tower/series1_test1_full_100ms.csv"),
     )
     .unwrap();
     text.lines()

@@ -1,4 +1,4 @@
-//! Every model and solver against the exact results of `shared/reference/oracles.md`.
+//! Every model and solver against the exact results of `docs/oracles.md`.
 
 use impact_core::model::{Body, Hertz, KelvinVoigt, Linear, Model, Nonlinear, TwoPhase};
 use impact_core::{solve, ContactLaw, Error, Impact, ImpactOutcome, Method, Settings};

@@ -1,5 +1,5 @@
 //! Every bundled recording through `impact analyze` (the core pipeline), with what is known
-//! about it (see ../shared/signals/README.md).
+//! about it (see data/*/PROVENANCE).
 
 use std::path::PathBuf;
 
@@ -7,7 +7,7 @@ use impact_host::analyze::{self, AnalysisJson, AnalyzeArgs, Units};
 use impact_host::recording::ColumnRef;
 
 fn signals() -> PathBuf {
-    PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../shared/signals")
+    PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("data")
 }
 
 fn analyze(args: AnalyzeArgs) -> AnalysisJson {

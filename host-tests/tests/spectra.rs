@@ -125,7 +125,7 @@ fn a_half_sines_spectra_agree_with_endaq() {
 #[test]
 fn the_afrl_impacts_spectra_agree_with_endaq() {
     let (s, board, baseline) = spectra(AnalyzeArgs {
-        file: root().join("../../shared/signals/afrl-drop-tower/series1_test1_full_100ms.csv"),
+        file: root().join("data/afrl-drop-tower/series1_test1_full_100ms.csv"),
         units: Some(Units::Kgn),
         ..Default::default()
     });

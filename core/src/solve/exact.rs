@@ -1,5 +1,5 @@
 //! Exact and semi-analytic outcomes: closed forms for linear phases, the energy relation plus
-//! tanh-sinh quadrature for power-law and nonlinear forces (see `shared/reference/oracles.md`).
+//! tanh-sinh quadrature for power-law and nonlinear forces (see `docs/oracles.md`).
 //!
 //! Every formula here is written so that it stays accurate at the ends of its range: damping
 //! ratios near critical, vanishing or huge damping, and the inverse-power endpoint of the
