@@ -1,12 +1,28 @@
 #!/usr/bin/env bash
-# Sets up and runs every check: formatting, lints, all host tests (core unit tests,
-# oracles, CLI, recordings, property tests), both firmware builds (board and emulator)
-# with their flash/RAM use, the firmware on the emulated Cortex-M4, and the core's
-# instruction counts on the emulated Cortex-M4 against the stored baseline.
+# Sets up and runs every check: formatting, lints, the fuzz targets' build, the firmware builds
+# (board and emulator, the board's memory budget), all host tests (core unit tests, oracles,
+# CLI, the documented commands, recordings, property tests, the firmware on the emulated
+# Cortex-M4 against the host bit for bit and in real time), and the core's instruction counts
+# on the emulated Cortex-M4 against the stored baseline. Each step prints its time.
 set -euo pipefail
 cd "$(dirname "${BASH_SOURCE[0]}")/.."
 
-step() { printf '\n== %s\n' "$*"; }
+started=$SECONDS
+step_start=$SECONDS
+step() {
+  if [[ -n "${step_name:-}" ]]; then
+    printf -- '-- %s: %d s\n' "$step_name" $((SECONDS - step_start))
+  fi
+  step_name="$*"
+  step_start=$SECONDS
+  printf '\n== %s\n' "$*"
+}
+trap 'step_name_end=$?; [[ -n "${step_name:-}" ]] && printf -- "-- %s: %d s\n" "$step_name" $((SECONDS - step_start)); printf "\n== %s after %d s\n" "$([[ $step_name_end == 0 ]] && echo passed || echo FAILED)" $((SECONDS - started))' EXIT
+
+# The host tool and tests build with the `host-test` profile (release optimisation, no LTO:
+# the same results, built in less time); every firmware with `release`, the profile that is
+# flashed.
+HOST=(--profile host-test)
 
 step setup
 scripts/setup.sh
@@ -14,10 +30,10 @@ scripts/setup.sh
 step "cargo fmt --check"
 cargo fmt --all --check
 
-step "clippy (host crates, all targets)"
+step "clippy (host crates and fuzz targets, all targets)"
 cargo clippy --workspace --exclude impact-firmware --all-targets -- -D warnings
 
-step "clippy (firmware: board, board + ADXL375, board + light gate, emulator, panic check)"
+step "clippy (firmware: board, board + ADXL375, board + light gate, emulator, panic check, M4 bench)"
 cargo clippy --release -p impact-firmware --target thumbv7em-none-eabihf -- -D warnings
 cargo clippy --release -p impact-firmware --target thumbv7em-none-eabihf --features adxl375 -- -D warnings
 cargo clippy --release -p impact-firmware --target thumbv7em-none-eabihf --features light-gate -- -D warnings
@@ -28,21 +44,16 @@ cargo clippy --release -p impact-firmware --target thumbv7em-none-eabihf --no-de
 step "firmware: no reachable panic in the pipeline (links only if none survives optimization)"
 cargo build --release -p impact-firmware --target thumbv7em-none-eabihf --no-default-features --features panic-check --bin panic-check
 
-step "firmware: STM32F407VG release build"
-cargo build --release -p impact-firmware --target thumbv7em-none-eabihf
-arm-none-eabi-size target/thumbv7em-none-eabihf/release/impact-firmware
+step "firmware: STM32F407VG release build (what cargo fw-run flashes)"
+cargo fw
 
-step "firmware: emulator (mps2-an386) release build, run on QEMU"
-scripts/emulate.sh --lossless --timeout 120
-arm-none-eabi-size target/thumbv7em-none-eabihf/release/impact-firmware
+step "host tests (the documented commands, the emulated firmware against the host, real time)"
+# tests/emulator.rs compares the emulated firmware with the host bit for bit; the tools were
+# installed above, so a missing one is an error here, not a skip.
+IMPACT_REQUIRE_EMULATOR=1 cargo test --workspace --exclude impact-firmware "${HOST[@]}"
 
 step "M4 instruction counts (QEMU, exact) against the stored baseline: fails on a > 10 % regression"
 # Also checks the hand-written M4 routines against their portable versions and every f32
 # solve on the M4 against the host's, bit for bit. Refresh the baseline after an intended
 # change with: cargo run --release -p impact-host --bin impact -- bench m4 --json > host-tests/bench/m4-baseline.json
-cargo run --release --quiet -p impact-host --bin impact -- bench m4 --check host-tests/bench/m4-baseline.json
-
-step "host tests (release: the oracle and recording tests are numerically heavy)"
-# tests/emulator.rs compares the emulated firmware with the host bit for bit; the tools were
-# installed above, so a missing one is an error here, not a skip.
-IMPACT_REQUIRE_EMULATOR=1 cargo test --workspace --exclude impact-firmware --release
+cargo run --quiet "${HOST[@]}" -p impact-host --bin impact -- bench m4 --check host-tests/bench/m4-baseline.json

@@ -11,7 +11,7 @@
 //!   ADXL375 on SPI1) samples the sensor; defmt over RTT. `cargo fw` at the workspace root
 //!   builds it, `cargo run --release` inside `firmware/` flashes it and shows the log.
 //! * `emulator`: QEMU `-machine mps2-an386`; samples are replayed from a host file; defmt
-//!   and the exit status go through semihosting. `scripts/emulate.sh` builds and runs it.
+//!   and the exit status go through semihosting. `impact emulate` builds and runs it.
 
 #![no_std]
 #![no_main]

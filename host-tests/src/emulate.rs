@@ -4,11 +4,11 @@
 //! `impact emulate FILE [analyze options]` prepares the recording exactly as `impact analyze`
 //! does ([`analyze::setup`]: the same i16 counts, the same [`Scene`]), writes the counts to a
 //! raw file, builds the emulator firmware if needed, replays the file on QEMU with the scene on
-//! the semihosting command line, decodes the defmt log with `defmt-print`, and parses the
+//! the semihosting command line, decodes the defmt log against the ELF (`defmt-decoder`), and parses the
 //! firmware's `impact ...` lines back into [`ImpactReport`]s. The log's line format is in
 //! `firmware/README.md`.
 
-use std::io::{BufRead, BufReader, Write};
+use std::io::Write;
 use std::path::{Path, PathBuf};
 use std::process::{Command, ExitStatus, Stdio};
 use std::time::{Duration, Instant};
@@ -47,7 +47,7 @@ pub struct EmulateArgs {
     #[arg(long, num_args = 0..=1, default_missing_value = "1", value_name = "EVERY",
           value_parser = clap::value_parser!(u16).range(1..))]
     pub waveforms: Option<u16>,
-    /// Write the firmware's decoded log (what defmt-print prints, waveform frames included)
+    /// Write the firmware's decoded log (one line per defmt frame, waveform frames included)
     /// to this file, as `impact log` reads it.
     #[arg(long)]
     pub log: Option<PathBuf>,
@@ -141,13 +141,60 @@ fn workspace_root() -> PathBuf {
         .unwrap_or_else(|| PathBuf::from("."))
 }
 
-/// Builds the emulator firmware with cargo (a no-op when it is up to date); returns the ELF.
+/// Builds the emulator firmware with cargo (nothing to do when it is current); returns the ELF.
 pub fn build_firmware() -> Result<PathBuf, String> {
     build_firmware_bin("emulator", None)
 }
 
+/// The QEMU firmware's own cargo target directory (`target/emulator`, or under
+/// `$CARGO_TARGET_DIR`): apart from the board's (`target/thumbv7em-none-eabihf/release`), so
+/// that building one never replaces the other's ELF.
+fn emulator_target_dir(root: &Path) -> PathBuf {
+    let target = std::env::var_os("CARGO_TARGET_DIR")
+        .map(PathBuf::from)
+        .map(|d| if d.is_absolute() { d } else { root.join(d) })
+        .unwrap_or_else(|| root.join("target"));
+    target.join("emulator")
+}
+
+/// The newest modification time among the files a firmware build reads: the core's and the
+/// firmware's sources and manifests, the lock file, the memory maps and cargo's
+/// configuration. `None` if one cannot be read (then cargo decides).
+fn newest_input(root: &Path) -> Option<std::time::SystemTime> {
+    fn walk(dir: &Path, newest: &mut std::time::SystemTime) -> Option<()> {
+        for entry in std::fs::read_dir(dir).ok()? {
+            let entry = entry.ok()?;
+            let kind = entry.file_type().ok()?;
+            if kind.is_dir() {
+                walk(&entry.path(), newest)?;
+            } else {
+                *newest = (*newest).max(entry.metadata().ok()?.modified().ok()?);
+            }
+        }
+        Some(())
+    }
+    let mut newest = std::time::SystemTime::UNIX_EPOCH;
+    for dir in ["core/src", "firmware/src", "firmware/stm32", "firmware/emulator", "firmware/.cargo"] {
+        walk(&root.join(dir), &mut newest)?;
+    }
+    for file in [
+        "Cargo.toml",
+        "Cargo.lock",
+        "memory.x",
+        ".cargo/config.toml",
+        "core/Cargo.toml",
+        "firmware/Cargo.toml",
+        "firmware/build.rs",
+    ] {
+        newest = newest.max(std::fs::metadata(root.join(file)).ok()?.modified().ok()?);
+    }
+    Some(newest)
+}
+
 /// Builds a firmware binary for QEMU with cargo feature `feature` (`emulator`, or `m4-bench`
-/// with `bin` = `m4-bench`); returns the ELF.
+/// with `bin` = `m4-bench`) into the emulator's target directory; returns the ELF. Cargo is
+/// not run (it takes about a second to find there is nothing to do) when the ELF is newer
+/// than every file the build reads; `IMPACT_REBUILD=1` runs it anyway.
 pub fn build_firmware_bin(feature: &str, bin: Option<&str>) -> Result<PathBuf, String> {
     let root = workspace_root();
     if !root.join("firmware").join("Cargo.toml").is_file() {
@@ -156,13 +203,26 @@ pub fn build_firmware_bin(feature: &str, bin: Option<&str>) -> Result<PathBuf, S
             root.display()
         ));
     }
-    let target_dir = std::env::var_os("CARGO_TARGET_DIR")
-        .map(PathBuf::from)
-        .map(|d| if d.is_absolute() { d } else { root.join(d) })
-        .unwrap_or_else(|| root.join("target"));
+    let target_dir = emulator_target_dir(&root);
+    let elf = target_dir
+        .join("thumbv7em-none-eabihf")
+        .join("release")
+        .join(bin.unwrap_or("impact-firmware"));
+    let built = std::fs::metadata(&elf).and_then(|m| m.modified()).ok();
+    let current = match (built, newest_input(&root)) {
+        (Some(built), Some(newest)) => built > newest,
+        _ => false,
+    };
+    if current && std::env::var_os("IMPACT_REBUILD").is_none() {
+        return Ok(elf);
+    }
     let cargo = std::env::var_os("CARGO").unwrap_or_else(|| "cargo".into());
     let bin_args = bin.map(|b| vec!["--bin", b]).unwrap_or_default();
-    eprintln!("building the QEMU firmware (cargo build --release -p impact-firmware --no-default-features --features {feature} {})", bin_args.join(" "));
+    eprintln!(
+        "building the QEMU firmware (cargo build --release -p impact-firmware --no-default-features --features {feature}{}{})",
+        if bin.is_some() { " " } else { "" },
+        bin_args.join(" ")
+    );
     let status = Command::new(&cargo)
         .current_dir(&root)
         .env("CARGO_TARGET_DIR", &target_dir)
@@ -187,10 +247,7 @@ pub fn build_firmware_bin(feature: &str, bin: Option<&str>) -> Result<PathBuf, S
             "building the QEMU firmware ({feature}) failed ({status}); is the thumbv7em-none-eabihf target installed (scripts/setup.sh)?"
         ));
     }
-    Ok(target_dir
-        .join("thumbv7em-none-eabihf")
-        .join("release")
-        .join(bin.unwrap_or("impact-firmware")))
+    Ok(elf)
 }
 
 /// Checks that a tool runs; else says how to install it.
@@ -209,10 +266,9 @@ fn require(tool: &str, how: &str) -> Result<(), String> {
     }
 }
 
-/// True if `qemu-system-arm` and `defmt-print` can be run.
+/// True if `qemu-system-arm` can be run (the defmt log is decoded in this process).
 pub fn tools_available() -> Result<(), String> {
-    require("qemu-system-arm", "apt-get install qemu-system-arm")?;
-    require("defmt-print", "cargo install defmt-print --locked")
+    require("qemu-system-arm", "apt-get install qemu-system-arm")
 }
 
 /// A semihosting argument cannot hold spaces (arguments are joined by them) nor commas
@@ -224,6 +280,20 @@ fn check_arg(what: &str, s: &str) -> Result<(), String> {
         ))
     } else {
         Ok(())
+    }
+}
+
+/// A reader that keeps a copy of what it reads.
+struct Tee<R> {
+    inner: R,
+    raw: Vec<u8>,
+}
+
+impl<R: std::io::Read> std::io::Read for Tee<R> {
+    fn read(&mut self, buf: &mut [u8]) -> std::io::Result<usize> {
+        let n = self.inner.read(buf)?;
+        self.raw.extend_from_slice(&buf[..n]);
+        Ok(n)
     }
 }
 
@@ -312,66 +382,31 @@ pub fn run_emulator(
         let _ = qemu.kill();
         return Err("qemu-system-arm: no stdout".into());
     };
-    let mut decoder = match Command::new("defmt-print")
-        .arg("-e")
-        .arg(&elf)
-        .stdin(Stdio::piped())
-        .stdout(Stdio::piped())
-        .spawn()
-    {
-        Ok(d) => d,
-        Err(e) => {
-            let _ = qemu.kill();
-            let _ = qemu.wait();
-            return Err(format!("defmt-print: {e}"));
-        }
+    // The raw frames are kept and decoded here against the ELF (defmt-decoder, as
+    // defmt-print and probe-rs do), each line echoed as it comes.
+    let reader = {
+        let elf = elf.clone();
+        std::thread::spawn(move || {
+            let mut echo = echo;
+            let mut lines = Vec::new();
+            let mut tee = Tee {
+                inner: frames,
+                raw: Vec::new(),
+            };
+            let decoded = crate::decode::decode(&elf, &mut tee, "the emulator's defmt stream", |_, line| {
+                echo(line);
+                lines.push(line.to_string());
+                Ok(())
+            });
+            (decoded, lines, tee.raw)
+        })
     };
-    // The raw frames go on to defmt-print and are kept (a tee).
-    let Some(mut to_decoder) = decoder.stdin.take() else {
-        let _ = qemu.kill();
-        let _ = qemu.wait();
-        return Err("defmt-print: no stdin".into());
-    };
-    let tee = std::thread::spawn(move || {
-        use std::io::Read;
-        let mut frames = frames;
-        let mut raw = Vec::new();
-        let mut buf = [0u8; 1 << 14];
-        loop {
-            match frames.read(&mut buf) {
-                Ok(0) | Err(_) => break,
-                Ok(n) => {
-                    raw.extend_from_slice(&buf[..n]);
-                    if to_decoder.write_all(&buf[..n]).is_err() {
-                        break;
-                    }
-                }
-            }
-        }
-        raw
-    });
-    let Some(text) = decoder.stdout.take() else {
-        let _ = qemu.kill();
-        let _ = qemu.wait();
-        return Err("defmt-print: no stdout".into());
-    };
-    let reader = std::thread::spawn(move || {
-        let mut echo = echo;
-        let mut lines = Vec::new();
-        for line in BufReader::new(text).lines() {
-            let Ok(line) = line else { break };
-            echo(&line);
-            lines.push(line);
-        }
-        lines
-    });
     let status = loop {
         match qemu.try_wait() {
             Ok(Some(status)) => break status,
             Ok(None) if started.elapsed() > timeout => {
                 let _ = qemu.kill();
                 let _ = qemu.wait();
-                let _ = decoder.wait();
                 let _ = reader.join();
                 return Err(format!(
                     "the emulator did not finish within {} s (--timeout)",
@@ -383,15 +418,14 @@ pub fn run_emulator(
         }
     };
     let seconds = started.elapsed().as_secs_f64();
-    let raw = tee
+    let (decoded, lines, raw) = reader
         .join()
-        .map_err(|_| "copying the raw defmt stream failed".to_string())?;
-    let decoded = decoder.wait().map_err(|e| format!("defmt-print: {e}"))?;
-    let lines = reader
-        .join()
-        .map_err(|_| "reading the decoded log failed".to_string())?;
-    if !decoded.success() {
-        return Err(format!("defmt-print failed ({decoded})"));
+        .map_err(|_| "decoding the emulator's log failed".to_string())?;
+    let skipped = decoded?;
+    if skipped > 0 {
+        return Err(format!(
+            "the emulator's defmt stream had {skipped} malformed frames"
+        ));
     }
     Ok(EmulatorRun {
         lines,

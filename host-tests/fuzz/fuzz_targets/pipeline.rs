@@ -1,5 +1,6 @@
 //! Arbitrary bytes through the streaming pipeline: the first bytes make a [`Scene`] (levels,
-//! gain, rate, hold, longest impact, rails, filters, mass, v0, fits), the rest are i16 samples
+//! gain, rate, hold, longest impact, settle time, rails, filters, mass, v0, fits, bounce trains,
+//! spectra, waveform frames), the rest are i16 samples
 //! pushed in blocks of arbitrary sizes. Checks: no panic; the counters match the samples
 //! pushed and the reports delivered; report indices count up; with a sane scene (gain and rate
 //! in realistic ranges) every reported quantity is finite; and feeding the same stream one
@@ -9,7 +10,10 @@
 
 use impact_core::Counters;
 use impact_core::signal::cfc::Cfc;
-use impact_core::{Approach, Calibration, FitSet, ImpactReport, Monitor, Scene, Status};
+use impact_core::signal::spectrum::SpectrumSettings;
+use impact_core::{
+    Approach, Calibration, FitSet, ImpactReport, Monitor, Scene, Status, Train, TrainSpeed,
+};
 use libfuzzer_sys::fuzz_target;
 
 /// Small buffers, so that captures fill up and rings wrap with short inputs.
@@ -70,8 +74,10 @@ fn scene(b: &mut Bytes) -> (Scene, bool) {
     let hold_samples = 1 + b.u8() as u32 * 2;
     let max_samples = hold_samples + b.u16() as u32;
     let clip = (b.u16() as i16, b.u16() as i16);
+    let settle_samples = hold_samples + b.u16() as u32;
     let cfc_byte = b.u8();
     let fit_byte = b.u8();
+    let stage_byte = b.u8();
     let v0 = b.log_range(-2.0, 2.0);
     let g = gain.abs();
     let scene = Scene {
@@ -89,6 +95,7 @@ fn scene(b: &mut Bytes) -> (Scene, bool) {
         edge_m_s2: trigger_counts * edge_frac * g,
         hold_s: hold_samples as f32 / rate,
         max_impact_s: max_samples as f32 / rate,
+        settle_s: settle_samples as f32 / rate,
         clip_counts: clip,
         cfc: cfc(cfc_byte),
         trigger_cfc: cfc(cfc_byte / 6),
@@ -99,6 +106,22 @@ fn scene(b: &mut Bytes) -> (Scene, bool) {
             nonlinear_exponent: 1.0 + (fit_byte & 8) as f32 / 16.0,
             hertz: fit_byte & 16 != 0,
         },
+        // Bounce trains on either speed source, with short flights so that they chain.
+        train: (stage_byte & 3 != 0).then(|| Train {
+            speed: if stage_byte & 1 != 0 {
+                TrainSpeed::Flight
+            } else {
+                TrainSpeed::Rebound
+            },
+            max_flight_s: max_samples as f32 * 4.0 / rate,
+            ..Train::new()
+        }),
+        // Spectra at 1/6 or 1/12 octave.
+        spectrum: (stage_byte & 4 != 0).then(|| SpectrumSettings {
+            bands_per_octave: if stage_byte & 8 != 0 { 12 } else { 6 },
+            ..SpectrumSettings::new()
+        }),
+        waveform_every: u16::from(stage_byte >> 4),
     };
     (scene, !raw)
 }
@@ -107,7 +130,7 @@ fn finite(r: &ImpactReport) -> bool {
     let mut ok = r.start_s.is_finite()
         && r.peak_time_s.is_finite()
         && r.peak_acceleration_m_s2.is_finite()
-        && r.delta_v_m_s.is_finite()
+        && r.delta_v_m_s.is_none_or(f32::is_finite)
         && r.duration_s.is_finite()
         && r.fwhm_s.is_none_or(f32::is_finite)
         && r.filtered_peak_acceleration_m_s2.is_none_or(f32::is_finite)
@@ -121,6 +144,14 @@ fn finite(r: &ImpactReport) -> bool {
             && k.cor.is_finite()
             && k.permanent_deformation_m.is_finite()
             && k.absorbed_energy_j.is_none_or(f32::is_finite);
+    }
+    if let Some(b) = &r.bounce {
+        ok &= b.flight_s.is_finite()
+            && b.v0_flight_m_s.is_finite()
+            && b.v0_rebound_m_s.is_none_or(f32::is_finite);
+    }
+    if let Some(s) = &r.spectrum {
+        ok &= s.srs_m_s2.iter().chain(&s.pvss_m_s).all(|v| v.is_finite());
     }
     ok
 }
