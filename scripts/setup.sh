@@ -2,7 +2,6 @@
 # Installs what the project needs beyond a Rust toolchain, idempotently:
 #   - the Cortex-M4F Rust target (thumbv7em-none-eabihf), rustfmt and clippy;
 #   - qemu-system-arm (Debian package) for the emulated firmware;
-#   - defmt-print (crates.io) to decode the firmware's defmt log;
 #   - arm-none-eabi-size (Debian binutils-arm-none-eabi) to print flash and RAM use.
 # With --board, also probe-rs (crates.io `probe-rs-tools`, a few minutes to build) to flash
 # the STM32F4-Discovery and read its defmt log (`cargo fw-run`).
@@ -30,8 +29,6 @@ fi
 rustup target list --installed | grep -qx thumbv7em-none-eabihf || rustup target add thumbv7em-none-eabihf
 rustup component list --installed | grep -q '^rustfmt' || rustup component add rustfmt
 rustup component list --installed | grep -q '^clippy' || rustup component add clippy
-
-command -v defmt-print >/dev/null || cargo install defmt-print --locked --quiet
 
 if [[ $board == 1 ]]; then
   # probe-rs needs libudev to find USB probes.

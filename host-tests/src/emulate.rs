@@ -174,7 +174,13 @@ fn newest_input(root: &Path) -> Option<std::time::SystemTime> {
         Some(())
     }
     let mut newest = std::time::SystemTime::UNIX_EPOCH;
-    for dir in ["core/src", "firmware/src", "firmware/stm32", "firmware/emulator", "firmware/.cargo"] {
+    for dir in [
+        "core/src",
+        "firmware/src",
+        "firmware/stm32",
+        "firmware/emulator",
+        "firmware/.cargo",
+    ] {
         walk(&root.join(dir), &mut newest)?;
     }
     for file in [
@@ -393,11 +399,12 @@ pub fn run_emulator(
                 inner: frames,
                 raw: Vec::new(),
             };
-            let decoded = crate::decode::decode(&elf, &mut tee, "the emulator's defmt stream", |_, line| {
-                echo(line);
-                lines.push(line.to_string());
-                Ok(())
-            });
+            let decoded =
+                crate::decode::decode(&elf, &mut tee, "the emulator's defmt stream", |_, line| {
+                    echo(line);
+                    lines.push(line.to_string());
+                    Ok(())
+                });
             (decoded, lines, tee.raw)
         })
     };

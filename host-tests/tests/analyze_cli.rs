@@ -282,10 +282,7 @@ fn an_ambiguous_time_column_names_the_candidates_and_units_are_read_from_the_hea
 
 #[test]
 fn a_free_fall_file_must_reach_the_impact() {
-    let dir = concat!(
-        env!("CARGO_MANIFEST_DIR"),
-        "/data/endaq-high-drop"
-    );
+    let dir = concat!(env!("CARGO_MANIFEST_DIR"), "/data/endaq-high-drop");
     let dc = std::fs::read_to_string(format!("{dir}/High-Drop_16g-DC_full.csv")).unwrap();
     // The DC channel cut at 4.6 s, 10 s before the impact (at rest, before the release).
     let short: String = dc

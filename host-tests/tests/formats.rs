@@ -20,10 +20,9 @@ fn source_rows() -> Vec<(f64, f64)> {
 
 /// `count` rows of AFRL test 1 from `first`: (bottom, top) in kg_n.
 fn rows(first: usize, count: usize) -> Vec<(f64, f64)> {
-    let text = std::fs::read_to_string(
-        root().join("data/afrl-drop-tower/series1_test1_full_100ms.csv"),
-    )
-    .unwrap();
+    let text =
+        std::fs::read_to_string(root().join("data/afrl-drop-tower/series1_test1_full_100ms.csv"))
+            .unwrap();
     text.lines()
         .skip(1 + first)
         .take(count)

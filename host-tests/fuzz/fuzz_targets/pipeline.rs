@@ -8,9 +8,9 @@
 
 #![no_main]
 
-use impact_core::Counters;
 use impact_core::signal::cfc::Cfc;
 use impact_core::signal::spectrum::SpectrumSettings;
+use impact_core::Counters;
 use impact_core::{
     Approach, Calibration, FitSet, ImpactReport, Monitor, Scene, Status, Train, TrainSpeed,
 };
