@@ -245,6 +245,69 @@ fn affine_laws_on_a_damped_spring_mass_match_an_independent_integration() {
     }
 }
 
+/// Kelvin–Voigt (ζ = 0.2 on the impactor's mass) on a target 1000× lighter than the impactor:
+/// `(k, c, m2)` of the stability sweep at `m1 = v0 = 1`.
+fn kelvin_voigt_on_a_feather(f: f64, zeta: f64) -> (KelvinVoigt<f64>, Target<f64>) {
+    let pi = std::f64::consts::PI;
+    let k = (pi / 1e-3f64).powi(2);
+    let law = KelvinVoigt {
+        k,
+        c: 0.4 * k.sqrt(),
+    };
+    let m2 = 1e-3;
+    let k2 = m2 * (f * pi / 1e-3).powi(2);
+    let c2 = 2.0 * zeta * (k2 * m2).sqrt();
+    (law, Target::spring_mass(m2, k2, c2).unwrap())
+}
+
+#[test]
+fn kelvin_voigt_carrying_a_light_target_on_its_mount_matches_the_modal_solution() {
+    // The overdamped contact takes the feather along and the two swing on its mount for
+    // 0.31 s, 1e5 of the contact's own time scale: the largest deformation is at the top of
+    // that swing, where δ' is 1e-5 of v0. Reference: the modal solution of the linear system
+    // in 50-digit arithmetic (mpmath), events refined on it.
+    let (law, target) = kelvin_voigt_on_a_feather(0.1, 0.3);
+    let (tc, tm, xm) = (
+        0.31449168638228163,
+        0.1554632125784393,
+        9.9047811372633108e-7,
+    );
+    let (rebound, w) = (0.96985428673333789, -0.96984459775917649);
+    for rtol in [1e-6, 1e-10] {
+        let out = on(&law, 1.0, 1.0, &target, Settings::adaptive(rtol));
+        let what = format!("adaptive {rtol:e}");
+        close(out.contact_time_s, tc, 100.0 * rtol, &what);
+        close(out.crush_time_s, tm, 100.0 * rtol, &what);
+        close(out.max_deformation_m, xm, 100.0 * rtol, &what);
+        assert!(
+            (out.rebound_velocity_m_s - rebound).abs() <= 100.0 * rtol,
+            "{what}"
+        );
+        assert!(
+            (out.target_velocity_m_s - w).abs() <= 100.0 * rtol,
+            "{what}"
+        );
+    }
+}
+
+#[test]
+fn kelvin_voigt_separation_from_a_free_light_target_is_where_the_closed_form_puts_it() {
+    // Separation is where k δ + c δ' returns to zero, with δ' = u1 - w 170× smaller than v0.
+    let (law, target) = kelvin_voigt_on_a_feather(0.0, 0.0);
+    let exact = on(&law, 1.0, 1.0, &target, Settings::exact());
+    for rtol in [1e-6, 1e-10] {
+        let out = on(&law, 1.0, 1.0, &target, Settings::adaptive(rtol));
+        let what = format!("adaptive {rtol:e}");
+        close(
+            out.contact_time_s,
+            exact.contact_time_s,
+            100.0 * rtol,
+            &what,
+        );
+        close(out.crush_time_s, exact.crush_time_s, 100.0 * rtol, &what);
+    }
+}
+
 #[test]
 fn hertz_on_a_damped_spring_mass_matches_an_independent_integration() {
     let (m1, v0) = (8.4e-3, 1.0);

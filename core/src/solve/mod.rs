@@ -7,7 +7,7 @@
 
 pub mod adaptive;
 pub mod bounce;
-mod events;
+pub(crate) mod events;
 pub mod exact;
 pub mod fixed;
 pub mod quad;
