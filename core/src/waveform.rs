@@ -2,7 +2,7 @@
 //! mean of every `every` samples, [`FRAME_LEN`] values a frame.
 //!
 //! The firmware sends the frames after the impact's analysis (`wave` and `wave_frame`
-//! lines, firmware/README.md); the host (`impact log`) puts them back together, knowing
+//! lines, docs/board.md); the host (`impact log`) puts them back together, knowing
 //! from the numbering which frames the link dropped.
 
 /// Values per frame: 64 i16 values are 128 bytes of defmt payload, well within the RTT

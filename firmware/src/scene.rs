@@ -233,7 +233,7 @@ impl Format for Opt<u32> {
     }
 }
 
-/// Logs the scene in use as one `scene ...` line (the format is in firmware/README.md).
+/// Logs the scene in use as one `scene ...` line (the format is in docs/board.md).
 pub fn log(scene: &Scene) {
     let (v0, drop_height) = match scene.approach {
         Approach::Unknown => (None, None),

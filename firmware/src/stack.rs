@@ -1,7 +1,7 @@
 //! Stack high-water mark, on both builds: the free RAM between the statics and the current
 //! frame is painted at start-up, and [`peak_bytes`] finds how deep the stack has gone since
 //! (interrupts included: they share the main stack). The heartbeat and the summary report it,
-//! so a board run shows its margin (see firmware/README.md for the RAM budget).
+//! so a board run shows its margin (see docs/board.md for the RAM budget).
 
 use core::sync::atomic::{AtomicUsize, Ordering};
 

@@ -3,7 +3,7 @@
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 
-use clap::{Args, ValueEnum};
+use clap::Args;
 use impact_core::monitor::Monitor;
 use impact_core::report::{Fits, Flags};
 use impact_core::signal::cfc::Cfc;
@@ -16,52 +16,35 @@ use crate::screen::{self, Clipping, Spike};
 use crate::survey::{self, Survey};
 use crate::table::{read_table, CsvFormat};
 
-/// Units of the recorded column.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum, Deserialize)]
-/// Scene files use the command line's spellings (`g`, `m/s2`, `kgn`, `n`).
-pub enum Units {
-    /// Standard gravities (9.80665 m/s²).
-    #[serde(rename = "g", alias = "G")]
-    G,
-    /// m/s².
-    #[value(name = "m/s2")]
-    #[serde(rename = "m/s2", alias = "MS2", alias = "ms2")]
-    MS2,
-    /// Kilo-g (1000 g), as in the AFRL drop-tower data.
-    #[serde(rename = "kgn", alias = "Kgn")]
-    Kgn,
-    /// Force in N (divided by the mass, or by 1 kg if none is given).
-    #[serde(rename = "n", alias = "N")]
-    N,
-}
+pub use crate::units::{Level, Units};
 
-impl Units {
-    pub fn to_m_s2(self, mass_kg: Option<f64>) -> f64 {
-        match self {
-            Units::G => STANDARD_GRAVITY,
-            Units::MS2 => 1.0,
-            Units::Kgn => 1000.0 * STANDARD_GRAVITY,
-            Units::N => 1.0 / mass_kg.unwrap_or(1.0),
-        }
-    }
-}
-
-/// A scene file (JSON): every field optional; command-line options override it.
+/// A scene file (JSON): every field optional; command-line options override it. Its keys are
+/// the options' names (`mass`, `v0`, `trigger`, ...), in the options' units; the earlier
+/// spellings with the unit in the name (`mass_kg`, `v0_m_s`, `trigger_m_s2`, ...) are read too.
 #[derive(Clone, Debug, Default, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct SceneFile {
-    pub mass_kg: Option<f64>,
-    pub v0_m_s: Option<f64>,
-    pub drop_height_m: Option<f64>,
-    pub trigger_m_s2: Option<f64>,
-    pub edge_m_s2: Option<f64>,
-    pub hold_s: Option<f64>,
-    pub max_impact_s: Option<f64>,
-    pub settle_s: Option<f64>,
+    #[serde(alias = "mass_kg")]
+    pub mass: Option<f64>,
+    #[serde(alias = "v0_m_s")]
+    pub v0: Option<f64>,
+    #[serde(alias = "drop_height_m")]
+    pub drop_height: Option<f64>,
+    /// m/s², or a string with a unit (`"5g"`).
+    #[serde(alias = "trigger_m_s2")]
+    pub trigger: Option<Level>,
+    #[serde(alias = "edge_m_s2")]
+    pub edge: Option<Level>,
+    #[serde(alias = "hold_s")]
+    pub hold: Option<f64>,
+    #[serde(alias = "max_impact_s")]
+    pub max_impact: Option<f64>,
+    #[serde(alias = "settle_s")]
+    pub settle: Option<f64>,
     pub cfc: Option<u32>,
     pub units: Option<Units>,
-    /// The sensor's full scale, in the channel's units (as `--range`).
-    pub range: Option<f64>,
+    /// The sensor's full scale (as `--range`): m/s², or a string with a unit (`"16g"`).
+    pub range: Option<Level>,
     pub invert: Option<bool>,
     pub fits: Option<FitsFile>,
 }
@@ -86,44 +69,64 @@ pub fn positive_f64(s: &str) -> Result<f64, String> {
     }
 }
 
-/// Options shared by `analyze` and `emulate`.
+/// Options shared by `analyze` and `emulate`, in the help's sections.
 #[derive(Args, Clone, Debug, Default)]
 pub struct AnalyzeArgs {
-    /// CSV file (`-`: standard input): a header line (or lines) and numeric rows; or a WAV
-    /// file (`.wav`: integer or float PCM, --column the 0-based channel); or a numpy array
-    /// (`.npy` with --rate: 1-D, or 2-D samples × channels, --column the channel); or an NI
-    /// TDMS file (`.tdms`, --column group/channel); or a raw little-endian file (`.i16`,
-    /// `.f32` with --rate, --raw-channels, --column).
+    /// The recording: CSV (`-`: standard input), .ide, .wav, .npy, .tdms, raw .i16/.f32.
+    ///
+    /// A CSV file (`-`: standard input) with a header line (or lines) and numeric rows; an enDAQ `.ide` file; a WAV file (`.wav`: integer or float PCM); a numpy
+    /// array (`.npy`, with --rate: 1-D, or 2-D samples × channels); an NI TDMS file (`.tdms`);
+    /// a raw little-endian file (`.i16`, `.f32`, with --rate and --raw-channels).
     pub file: PathBuf,
-    /// Field separator: one character, or `tab` [default: tab or `;` if the first lines hold
-    /// one, else `,`].
-    #[arg(long, value_parser = crate::table::parse_delimiter)]
-    pub delimiter: Option<u8>,
-    /// Numbers are written with a decimal comma (`0,5`); the delimiter must be another
-    /// character.
-    #[arg(long)]
-    pub decimal_comma: bool,
-    /// The channel: header name or 0-based index [default: first non-time column].
-    #[arg(long)]
+    /// The channel: header name or 0-based index.
+    ///
+    /// A header name or 0-based index (a WAV or .npy channel, `group/channel` in
+    /// TDMS, `CH.SUB` or a subchannel's name in an .ide file) [default: the first column that
+    /// is not the time; a note names it when there are others].
+    #[arg(short = 'c', long, help_heading = "Input")]
     pub column: Option<ColumnRef>,
+    /// Two or three axes (`x_g,y_g,z_g`): the resultant, with each axis's peak and Δv.
+    ///
     /// Two or three axes (header names or indices, `x_g,y_g,z_g`): the pipeline runs on their
     /// resultant (the trigger on |a|) and each impact reports every axis's peak and Δv.
     /// The resultant's integral is not a velocity change, so Δv is per axis (and their
     /// magnitude) and no approach speed applies.
-    #[arg(long, value_delimiter = ',', conflicts_with_all = ["column", "invert", "v0", "drop_height", "free_fall", "train"])]
+    #[arg(long, help_heading = "Input", value_delimiter = ',', conflicts_with_all = ["column", "invert", "v0", "drop_height", "free_fall", "train"])]
     pub axes: Vec<ColumnRef>,
     /// The time column [default: the column whose header starts with "time"].
-    #[arg(long)]
+    #[arg(long, help_heading = "Input")]
     pub time_column: Option<ColumnRef>,
+    /// The time column's unit [default: named in its header, else s].
+    ///
+    /// The time column's unit [default: the one its header names (`time_ms`, `time [us]`),
+    /// else s; a header naming none that read in s gives under 100 S/s is refused].
+    #[arg(long, help_heading = "Input", value_enum)]
+    pub time_unit: Option<crate::recording::TimeUnit>,
     /// Sample rate, Hz (instead of a time column).
-    #[arg(long, value_parser = positive_f64)]
+    #[arg(short = 'r', long, help_heading = "Input", value_parser = positive_f64)]
     pub rate: Option<f64>,
+    /// Interpolate an uneven time axis onto an even grid [default: refuse it].
+    ///
+    /// Interpolate an uneven time axis (gaps, rate changes) onto an even grid at the median
+    /// interval [default: refuse it, naming the line].
+    #[arg(long, help_heading = "Input", conflicts_with = "rate")]
+    pub resample: bool,
+    /// Field separator: one character, or `tab` [default: tab or `;` if the first lines hold
+    /// one, else `,`].
+    #[arg(long, help_heading = "Input", value_parser = crate::table::parse_delimiter)]
+    pub delimiter: Option<u8>,
+    /// Numbers are written with a decimal comma (`0,5`); the delimiter must be another
+    /// character.
+    #[arg(long, help_heading = "Input")]
+    pub decimal_comma: bool,
     /// Interleaved channels of a raw `.i16`/`.f32` file [default: 1].
-    #[arg(long)]
+    #[arg(long, help_heading = "Input")]
     pub raw_channels: Option<usize>,
     /// The sample type of a raw stream without a `.i16`/`.f32` name (standard input).
-    #[arg(long, value_enum)]
+    #[arg(long, help_heading = "Input", value_enum)]
     pub raw_type: Option<crate::raw::RawType>,
+    /// One pass as the recording is read (needs --range and --trigger).
+    ///
     /// Analyse the recording (CSV, WAV, .npy, TDMS, raw `.i16`/`.f32`; CSV and raw also
     /// from standard input) in one pass as it is read, in memory that does not grow with its
     /// length; needs --range and --trigger (and --rate where the file holds no time); spikes
@@ -132,78 +135,94 @@ pub struct AnalyzeArgs {
     /// analysis), also in bounded memory, with the levels learned and spikes screened; a
     /// CSV's or standard input's values are kept from the first pass in a temporary file
     /// (TMPDIR, 8 bytes a sample).
-    #[arg(long)]
+    #[arg(long, help_heading = "Input")]
     pub stream: bool,
+    /// Units of the channel [default: named in its header, else g].
+    ///
+    /// Units of the channel [default: the ones its header names (`x_g`, `bottom_kgn`,
+    /// `table_m_s2`, `force_n`), else g; units that contradict the header are refused].
+    #[arg(short = 'u', long, help_heading = "Channel", value_enum)]
+    pub units: Option<Units>,
     /// Multiply the channel's values by this first (e.g. g per code of a WAV file's integer
     /// samples) [default: 1].
-    #[arg(long, value_parser = positive_f64)]
+    #[arg(long, help_heading = "Channel", value_parser = positive_f64)]
     pub gain: Option<f64>,
-    /// Units of the channel [default: g].
-    #[arg(long, value_enum)]
-    pub units: Option<Units>,
     /// Negate the channel (by default a positive reading is a deceleration).
-    #[arg(long)]
+    #[arg(long, help_heading = "Channel")]
     pub invert: bool,
-    /// The sensor's full scale, in the channel's units (e.g. 16 for a ±16 g sensor read in
-    /// g): readings at the rail mark their impact clipped [default: flat tops at the
-    /// recording's extremes, more than 10 steps of its resolution from its median, are
-    /// taken for the rails].
-    #[arg(long, value_parser = positive_f64)]
-    pub range: Option<f64>,
+    /// The sensor's full scale, in m/s² or with a unit (`16g`): clips at the rails.
+    ///
+    /// The sensor's full scale, in m/s² or with a unit (`16g`, `200kgn`, `500n`): readings at
+    /// the rail mark their impact clipped; a recording beyond twice the range is refused
+    /// [default: flat tops at the recording's extremes, more than 10 steps of its resolution
+    /// from its median, are taken for the rails].
+    #[arg(long, help_heading = "Channel", value_name = "LEVEL")]
+    pub range: Option<Level>,
+    /// Keep isolated glitches (by default removed, listed and flagged).
+    ///
     /// Keep isolated one- or two-sample spikes that dwarf the rest of the recording (by
     /// default they are removed, listed, and flag the impact they fall in).
-    #[arg(long)]
+    #[arg(long, help_heading = "Channel")]
     pub keep_spikes: bool,
-    /// Interpolate an uneven time axis (gaps, rate changes) onto an even grid at the median
-    /// interval [default: refuse it, naming the line].
-    #[arg(long, conflicts_with = "rate")]
-    pub resample: bool,
     /// Mass of the instrumented body, kg.
-    #[arg(long, value_parser = positive_f64)]
+    #[arg(short = 'm', long, help_heading = "Bench", value_parser = positive_f64)]
     pub mass: Option<f64>,
     /// Approach speed, m/s.
-    #[arg(long, conflicts_with_all = ["drop_height", "free_fall"], value_parser = positive_f64)]
+    #[arg(long, help_heading = "Bench", conflicts_with_all = ["drop_height", "free_fall"], value_parser = positive_f64)]
     pub v0: Option<f64>,
     /// Drop height, m: v0 = sqrt(2 g h).
-    #[arg(long, conflicts_with = "free_fall", value_parser = positive_f64)]
+    #[arg(long, help_heading = "Bench", conflicts_with = "free_fall", value_parser = positive_f64)]
     pub drop_height: Option<f64>,
     /// DC accelerometer file (g), optionally `:COLUMN`: v0 = g × free-fall time before the impact.
-    #[arg(long)]
+    #[arg(long, help_heading = "Bench", value_name = "FILE[:COLUMN]")]
     pub free_fall: Option<String>,
-    /// SAE J211 channel frequency class for the captured windows: 60, 180, 600 or 1000.
-    #[arg(long)]
-    pub cfc: Option<u32>,
-    /// Causal SAE J211 class on the live trigger path (ignores glitches shorter than the class).
-    #[arg(long)]
-    pub trigger_cfc: Option<u32>,
-    /// Trigger level, m/s² above the baseline [default: from the signal's noise].
-    #[arg(long, value_parser = positive_f64)]
-    pub trigger: Option<f64>,
-    /// Edge level (onset, separation), m/s² [default: a fifth of the trigger].
-    #[arg(long, value_parser = positive_f64)]
-    pub edge: Option<f64>,
+    /// Scene file (JSON) with any of these options; options given here override it.
+    ///
+    /// Scene file (JSON, keys as these options: `{"mass": 0.06, "v0": 1.3357, "range":
+    /// "16g"}`); options given here override it.
+    #[arg(long, help_heading = "Bench")]
+    pub scene: Option<PathBuf>,
+    /// Trigger level above the baseline, in m/s² or with a unit (`5g`) [default: from the
+    /// signal's noise].
+    #[arg(long, help_heading = "Detection", value_name = "LEVEL")]
+    pub trigger: Option<Level>,
+    /// Edge level (onset, separation), in m/s² or with a unit [default: a fifth of the
+    /// trigger, at least 3 × the noise].
+    #[arg(long, help_heading = "Detection", value_name = "LEVEL")]
+    pub edge: Option<Level>,
     /// Quiet time that ends an impact, s [default: 2 ms].
-    #[arg(long, value_parser = positive_f64)]
+    #[arg(long, help_heading = "Detection", value_parser = positive_f64)]
     pub hold: Option<f64>,
+    /// How long a new level must last to be a level change, not an impact, s [default: 50 ms].
+    ///
     /// How long a flat new level must last to be a level change (a DC channel's free fall
     /// or rest), not an impact, s [default: 50 ms, at least the hold].
-    #[arg(long, value_parser = positive_f64)]
+    #[arg(long, help_heading = "Detection", value_parser = positive_f64)]
     pub settle: Option<f64>,
+    /// Longest impact, s [default: 1 s].
+    ///
+    /// Longest impact, s: a signal away from its baseline longer is a stuck or drifting
+    /// sensor (`too-long`) [default: 1 s].
+    #[arg(long, help_heading = "Detection", value_parser = positive_f64)]
+    pub max_impact: Option<f64>,
+    /// Causal SAE J211 class on the live trigger path (ignores glitches shorter than the class).
+    #[arg(long, help_heading = "Detection")]
+    pub trigger_cfc: Option<u32>,
+    /// SAE J211 channel frequency class for the captured windows: 60, 180, 600 or 1000.
+    #[arg(long, help_heading = "Analysis")]
+    pub cfc: Option<u32>,
     #[command(flatten)]
     pub train: crate::train::TrainArgs,
     #[command(flatten)]
     pub spectrum: crate::spectrum::SpectrumArgs,
-    /// Scene file (JSON); options given here override it.
-    #[arg(long)]
-    pub scene: Option<PathBuf>,
     /// Print one JSON object.
-    #[arg(long, conflicts_with = "csv")]
+    #[arg(short = 'j', long, help_heading = "Output", conflicts_with = "csv")]
     pub json: bool,
     /// Print one CSV row per impact.
-    #[arg(long)]
+    #[arg(long, help_heading = "Output")]
     pub csv: bool,
-    /// Draw acceleration, velocity and deformation with the fitted models (SVG).
-    #[arg(long)]
+    /// Draw acceleration, velocity and deformation with the fitted models into this SVG file.
+    #[arg(short = 'p', long, help_heading = "Output", value_name = "FILE.svg")]
     pub plot: Option<PathBuf>,
 }
 
@@ -284,8 +303,18 @@ pub struct ImpactJson {
 /// The whole analysis as JSON.
 #[derive(Clone, Debug, Serialize, PartialEq)]
 pub struct AnalysisJson {
+    /// The channel analysed (its header; `|x,y,z|` for the resultant of axes), if known, and
+    /// its units (`g`, `m/s2`, `kgn`, `n`): shown in the table (the JSON of a recording read
+    /// through another format or the board's log has the same numbers under other names).
+    #[serde(skip_serializing)]
+    pub column: Option<String>,
+    #[serde(skip_serializing)]
+    pub units: Option<String>,
     pub samples: u64,
     pub sample_rate_hz: f64,
+    /// The approach speed of the first impact (from `--v0`, `--drop-height` or a free
+    /// fall), m/s.
+    pub v0_m_s: Option<f64>,
     /// Where v0 came from: "v0", "drop-height", "free-fall" or null.
     pub v0_source: Option<String>,
     /// Free fall measured on the DC channel, s.
@@ -471,18 +500,26 @@ pub fn gain_for(full_scale_m_s2: f64) -> f64 {
     full_scale_m_s2.max(1e-30) / 32000.0
 }
 
-/// The sensor's full scale in m/s² (`--range` or the scene's, in the file's units times
-/// `scale`), if given; an error if it is not finite and positive.
+/// The sensor's full scale in m/s² (`--range` or the scene's), if given.
 pub(crate) fn full_scale_m_s2(
     args: &AnalyzeArgs,
     file: &SceneFile,
-    scale: f64,
-) -> Result<Option<f64>, String> {
-    match args.range.or(file.range) {
-        Some(r) if r.is_finite() && r > 0.0 => Ok(Some(r * scale.abs())),
-        Some(r) => Err(format!("--range: {r} must be finite and > 0")),
-        None => Ok(None),
-    }
+    mass: Option<f64>,
+) -> Option<f64> {
+    args.range.or(file.range).map(|r| r.to_m_s2(mass))
+}
+
+/// The trigger and edge levels given (`--trigger`, `--edge` or the scene's), m/s².
+pub(crate) fn given_levels(
+    args: &AnalyzeArgs,
+    file: &SceneFile,
+    mass: Option<f64>,
+) -> (Option<f64>, Option<f64>) {
+    let m_s2 = |l: Option<Level>| l.map(|l| l.to_m_s2(mass));
+    (
+        m_s2(args.trigger.or(file.trigger)),
+        m_s2(args.edge.or(file.edge)),
+    )
 }
 
 /// One reading in counts (saturating at the i16 rails, as an ADC does).
@@ -514,6 +551,9 @@ pub(crate) fn scene_file(args: &AnalyzeArgs) -> Result<SceneFile, String> {
 
 /// Everything the pipeline needs, resolved from the options, the scene file and the signal.
 pub struct Setup {
+    /// The channel's header (or the axes') and its units.
+    pub column: Option<String>,
+    pub units: Units,
     pub prepared: Prepared,
     pub scene: Scene,
     pub v0_source: Option<String>,
@@ -558,6 +598,7 @@ pub fn setup(args: &AnalyzeArgs, progress: Option<fn(f64)>) -> Result<Setup, Str
             raw_channels: args.raw_channels,
             time_column: args.time_column.clone(),
             rate_hz: args.rate,
+            time_unit: args.time_unit,
             resample: args.resample,
             format: CsvFormat {
                 delimiter: args.delimiter,
@@ -567,9 +608,16 @@ pub fn setup(args: &AnalyzeArgs, progress: Option<fn(f64)>) -> Result<Setup, Str
         },
     )
     .map_err(|e| e.to_string())?;
-    let (mass, scale) = mass_and_scale(args, &file)?;
+    let column = ch
+        .axes
+        .first()
+        .map_or(ch.name.as_str(), |(name, _)| name.as_str());
+    let (mass, scale, units) = mass_and_scale(args, &file, column)?;
+    for (name, _) in ch.axes.iter().skip(1) {
+        mass_and_scale(args, &file, name)?;
+    }
     let mut accel: Vec<f64> = ch.values.iter().map(|v| v * scale).collect();
-    let full_scale = full_scale_m_s2(args, &file, scale)?;
+    let full_scale = full_scale_m_s2(args, &file, mass);
     let t0 = ch.time_s.first().copied().unwrap_or(0.0);
     // The survey, and again after glitches are removed (they set the extremes).
     let first = Survey::of(&accel, !args.keep_spikes)?;
@@ -589,15 +637,14 @@ pub fn setup(args: &AnalyzeArgs, progress: Option<fn(f64)>) -> Result<Setup, Str
             crate::axes::Axis::new(name.clone(), a, full_scale)
         })
         .collect();
-    let trigger = args.trigger.or(file.trigger_m_s2);
-    let edge = args.edge.or(file.edge_m_s2);
+    let (trigger, edge) = given_levels(args, &file, mass);
     let levels = if axes.is_empty() {
-        survey::levels(&survey, full_scale, trigger, edge)
+        survey::levels(&survey, full_scale, trigger, edge)?
     } else {
         let fs = full_scale.map(|fs| fs * (axes.len() as f64).sqrt());
         survey::Levels {
             clipping: None,
-            ..survey::levels(&survey, fs, trigger, edge)
+            ..survey::levels(&survey, fs, trigger, edge)?
         }
     };
     let clipping = levels.clipping.clone();
@@ -620,6 +667,8 @@ pub fn setup(args: &AnalyzeArgs, progress: Option<fn(f64)>) -> Result<Setup, Str
         mass,
     )?;
     let mut setup = Setup {
+        column: Some(ch.name.clone()),
+        units,
         prepared: Prepared {
             counts,
             calibration,
@@ -654,21 +703,23 @@ pub fn setup(args: &AnalyzeArgs, progress: Option<fn(f64)>) -> Result<Setup, Str
 }
 
 /// The body's mass (checked) and the factor from the file's values to m/s² (units, `--gain`,
-/// `--invert`), from the options or the scene file.
+/// `--invert`), from the options or the scene file; the units are those stated, else those
+/// the channel's header (`column`) names, else g (an error if the two disagree).
 pub(crate) fn mass_and_scale(
     args: &AnalyzeArgs,
     file: &SceneFile,
-) -> Result<(Option<f64>, f64), String> {
-    let mass = args.mass.or(file.mass_kg);
+    column: &str,
+) -> Result<(Option<f64>, f64, Units), String> {
+    let mass = args.mass.or(file.mass);
     if let Some(m) = mass {
         if !(m.is_finite() && m > 0.0) {
             return Err("--mass: must be finite and > 0".into());
         }
     }
-    let units = args.units.or(file.units).unwrap_or(Units::G);
+    let units = Units::resolve(args.units.or(file.units), column)?;
     let invert = args.invert || file.invert.unwrap_or(false);
     let scale = units.to_m_s2(mass) * args.gain.unwrap_or(1.0) * if invert { -1.0 } else { 1.0 };
-    Ok((mass, scale))
+    Ok((mass, scale, units))
 }
 
 /// The scene from the options and the scene file, with the levels and rails found; and
@@ -691,11 +742,11 @@ pub(crate) fn build_scene(
             c.high_m_s2.map_or(i16::MAX, |v| to_count(v, gain)),
         );
     }
-    scene.hold_s = args.hold.or(file.hold_s).unwrap_or(2e-3) as f32;
-    if let Some(m) = file.max_impact_s {
+    scene.hold_s = args.hold.or(file.hold).unwrap_or(2e-3) as f32;
+    if let Some(m) = args.max_impact.or(file.max_impact) {
         scene.max_impact_s = m as f32;
     }
-    scene.settle_s = match args.settle.or(file.settle_s) {
+    scene.settle_s = match args.settle.or(file.settle) {
         Some(s) => s as f32,
         None => scene.settle_s.max(scene.hold_s),
     };
@@ -729,7 +780,7 @@ pub(crate) fn build_scene(
     let (v0, height) = if args.v0.is_some() || args.drop_height.is_some() {
         (args.v0, args.drop_height)
     } else {
-        (file.v0_m_s, file.drop_height_m)
+        (file.v0, file.drop_height)
     };
     let (approach, source) = match (v0, height) {
         (Some(v), _) => (Approach::Speed { v0_m_s: v as f32 }, Some("v0")),
@@ -781,7 +832,7 @@ pub fn free_fall_before(spec: &str, impact_s: f64) -> Result<f64, String> {
         .time_column(None)
         .map_err(|e| format!("--free-fall {}: {e}", path.display()))?
         .ok_or_else(|| format!("--free-fall {}: needs a time column", path.display()))?;
-    let unit = time_unit_s(&table.headers.get(tcol).cloned().unwrap_or_default());
+    let unit = time_unit_s(&table.headers.get(tcol).cloned().unwrap_or_default(), None);
     let time: Vec<f64> = table.columns[tcol].iter().map(|t| t * unit).collect();
     let cols: Vec<usize> = match &column {
         Some(c) => vec![table
@@ -840,8 +891,17 @@ const FREE_FALL_G: f64 = 0.5;
 /// The report JSON.
 pub fn to_json(setup: &Setup, reports: &[ImpactReport]) -> AnalysisJson {
     let mut a = AnalysisJson {
+        column: setup.column.clone(),
+        units: Some(setup.units.name().to_string()),
         samples: setup.samples,
         sample_rate_hz: setup.rate_hz,
+        v0_m_s: match setup.scene.approach {
+            Approach::Speed { v0_m_s } => Some(shortest(v0_m_s)),
+            Approach::DropHeight { height_m } => {
+                Some((2.0 * STANDARD_GRAVITY * f64::from(height_m)).sqrt())
+            }
+            _ => None,
+        },
         v0_source: setup.v0_source.clone(),
         free_fall_s: setup.free_fall_s,
         samples_lost: 0,
@@ -1008,6 +1068,25 @@ nonlinear_k,nonlinear_c_s_m,nonlinear_exponent,nonlinear_residual,hertz_k,hertz_
     s
 }
 
+/// `x` with `digits` significant digits, without trailing zeros (`1000000`, `19986.9`, `20`).
+pub fn sig(x: f64, digits: usize) -> String {
+    if x == 0.0 || !x.is_finite() {
+        return format!("{x}");
+    }
+    let decimals = (digits as i32 - 1 - x.abs().log10().floor() as i32).max(0) as usize;
+    let s = format!("{x:.decimals$}");
+    if s.contains('.') {
+        s.trim_end_matches('0').trim_end_matches('.').to_string()
+    } else {
+        s
+    }
+}
+
+/// An f32 setting as the f64 its decimal digits name (`0.05`, not `0.05000000074505806`).
+pub fn shortest(x: f32) -> f64 {
+    x.to_string().parse().unwrap_or(f64::from(x))
+}
+
 /// A quantity as a person reads it: four significant digits, times and lengths with a prefix
 /// that keeps the number in [1, 1000) (`5.521 ms`, `3.275 mm`), other units plain between
 /// 1e-3 and 1e5 and in exponent form beyond (`1.071e5 m/s²`).
@@ -1038,12 +1117,28 @@ pub fn human(v: f64, unit: &str) -> String {
 /// A readable table.
 pub fn to_table(a: &AnalysisJson) -> String {
     let mut s = format!(
-        "{} samples at {:.6} Hz{}{}{}\n",
+        "{}{} samples at {} S/s{}{}{}\n",
+        match (&a.column, &a.units) {
+            (Some(c), Some(u)) => format!("{c} in {u}: "),
+            (Some(c), None) => format!("{c}: "),
+            _ => String::new(),
+        },
         a.samples,
-        a.sample_rate_hz,
-        match (&a.v0_source, a.free_fall_s) {
-            (Some(src), Some(t)) => format!("; v0 from {src} ({t:.4} s)"),
-            (Some(src), None) => format!("; v0 from {src}"),
+        sig(a.sample_rate_hz, 6),
+        match (&a.v0_source, a.v0_m_s, a.free_fall_s) {
+            (Some(_), Some(v), Some(t)) => format!(
+                "; v0 {} from {} of free fall",
+                human(v, "m/s"),
+                human(t, "s")
+            ),
+            (Some(src), Some(v), None) => format!(
+                "; v0 {} ({})",
+                human(v, "m/s"),
+                match src.as_str() {
+                    "drop-height" => "from the drop height",
+                    _ => "given",
+                }
+            ),
             _ => String::new(),
         },
         if a.samples_lost > 0 {
@@ -1061,9 +1156,9 @@ pub fn to_table(a: &AnalysisJson) -> String {
         s.push_str("time axis resampled onto an even grid (--resample)\n");
     }
     if let Some(c) = &a.clipping {
-        let level = |v: Option<f64>| v.map_or("-".to_string(), |v| format!("{v:.4e}"));
+        let level = |v: Option<f64>| v.map_or("-".to_string(), |v| human(v, "m/s²"));
         s.push_str(&format!(
-            "rails ({}): {} / {} m/s²; a clipped peak is a lower bound (≥)\n",
+            "rails ({}): {} / {}; a clipped peak is a lower bound (≥)\n",
             c.from,
             level(c.low_m_s2),
             level(c.high_m_s2)

@@ -6,7 +6,7 @@
 //! raw file, builds the emulator firmware if needed, replays the file on QEMU with the scene on
 //! the semihosting command line, decodes the defmt log against the ELF (`defmt-decoder`), and parses the
 //! firmware's `impact ...` lines back into [`ImpactReport`]s. The log's line format is in
-//! `firmware/README.md`.
+//! `docs/board.md`.
 
 use std::io::Write;
 use std::path::{Path, PathBuf};
@@ -25,36 +25,36 @@ use crate::log::{get, num, parse_log};
 pub struct EmulateArgs {
     #[command(flatten)]
     pub analyze: AnalyzeArgs,
-    /// Emulator firmware ELF (built with `--no-default-features --features emulator`)
-    /// [default: build it with cargo into $CARGO_TARGET_DIR or the workspace's target/].
-    #[arg(long)]
-    pub elf: Option<PathBuf>,
-    /// Stop QEMU after this many seconds.
-    #[arg(long, default_value_t = 600)]
-    pub timeout: u64,
     /// Real time: QEMU with an instruction-paced clock (`-icount shift=3`, 8 ns of virtual
     /// time per instruction, standing for the STM32F407 at 168 MHz), the samples written by an
     /// emulated DMA at the recording's rate whatever the firmware is doing; samples lost,
     /// analyses skipped and each report's latency are reported. Default: lossless replay.
-    #[arg(long)]
+    #[arg(long, help_heading = "Emulator")]
     pub realtime: bool,
     /// With --realtime: replay this many times faster than the recording's rate (headroom).
-    #[arg(long, requires = "realtime", default_value_t = 1.0, value_parser = positive_f32)]
+    #[arg(long, help_heading = "Emulator", requires = "realtime", default_value_t = 1.0, value_parser = positive_f32)]
     pub rate_scale: f32,
     /// The firmware sends each impact's captured window after its analysis (scene `wave`):
     /// whole, or the mean of every EVERY samples; checked against the replayed samples, and
     /// in the JSON's `waveforms`. Keep them with --log, draw them with `impact log --plot`.
-    #[arg(long, num_args = 0..=1, default_missing_value = "1", value_name = "EVERY",
+    #[arg(long, help_heading = "Emulator", num_args = 0..=1, default_missing_value = "1", value_name = "EVERY",
           value_parser = clap::value_parser!(u16).range(1..))]
     pub waveforms: Option<u16>,
+    /// Emulator firmware ELF (built with `--no-default-features --features emulator`)
+    /// [default: build it with cargo into target/emulator when its sources changed].
+    #[arg(long, help_heading = "Emulator")]
+    pub elf: Option<PathBuf>,
+    /// Stop QEMU after this many seconds.
+    #[arg(long, help_heading = "Emulator", default_value_t = 600)]
+    pub timeout: u64,
     /// Write the firmware's decoded log (one line per defmt frame, waveform frames included)
     /// to this file, as `impact log` reads it.
-    #[arg(long)]
+    #[arg(long, help_heading = "Output", value_name = "FILE")]
     pub log: Option<PathBuf>,
     /// Write the firmware's raw defmt stream (as `probe-rs` or an RTT reader saves it) to
     /// this file: `impact log --elf FIRMWARE FILE` decodes it.
-    #[arg(long)]
-    pub raw: Option<PathBuf>,
+    #[arg(long, help_heading = "Output", value_name = "FILE", alias = "raw")]
+    pub defmt: Option<PathBuf>,
 }
 
 fn positive_f32(s: &str) -> Result<f32, String> {
@@ -453,6 +453,9 @@ pub fn emulate(args: &EmulateArgs) -> Result<(), String> {
                 .into(),
         );
     }
+    if let Some(path) = &a.plot {
+        crate::plot::check_output(path, &[a.file.as_path()])?;
+    }
     let mut setup = analyze::setup(a, None)?;
     setup.scene.waveform_every = args.waveforms.unwrap_or(0);
     let elf = match &args.elf {
@@ -498,7 +501,7 @@ pub fn emulate(args: &EmulateArgs) -> Result<(), String> {
         std::fs::write(path, &text).map_err(|e| format!("{}: {e}", path.display()))?;
         eprintln!("wrote {}", path.display());
     }
-    if let Some(path) = &args.raw {
+    if let Some(path) = &args.defmt {
         std::fs::write(path, &run.raw).map_err(|e| format!("{}: {e}", path.display()))?;
         eprintln!(
             "wrote {} (decode: impact log --elf {} {})",

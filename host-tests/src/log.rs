@@ -1,5 +1,5 @@
 //! `impact log`: a decoded firmware log (the `scene`, `impact`, `heartbeat` and `summary`
-//! lines of `firmware/README.md`) read back, checked line by line, and turned into
+//! lines of `docs/board.md`) read back, checked line by line, and turned into
 //! `impact analyze`'s JSON and CSV.
 
 use std::collections::HashMap;
@@ -10,6 +10,7 @@ use clap::Args;
 use impact_core::analysis::COR_TOLERANCE;
 use impact_core::report::{Bounce, Fits, Flags, HertzFit, NonlinearFit, Spectrum, TwoPhaseFit};
 use impact_core::signal::spectrum::MAX_BANDS;
+use impact_core::solve::bounce::STANDARD_GRAVITY;
 use impact_core::{Analysis, ImpactReport, Kinematics, Status};
 
 use crate::analyze::{self, AnalysisJson};
@@ -18,31 +19,32 @@ use crate::table::{is_stdin, MAX_LINE_BYTES};
 /// `impact log` options.
 #[derive(Args, Clone, Debug)]
 pub struct LogArgs {
-    /// Decoded defmt log (defmt-print's or probe-rs's text output; `-`: standard input).
+    /// The firmware's decoded defmt log (probe-rs's or defmt-print's text output, `impact
+    /// emulate --log`; `-`: standard input), or with --elf its raw defmt stream.
     pub file: PathBuf,
     /// Print one JSON object (the default).
-    #[arg(long, conflicts_with = "csv")]
+    #[arg(short = 'j', long, help_heading = "Output", conflicts_with = "csv")]
     pub json: bool,
     /// Print one CSV row per impact.
-    #[arg(long)]
+    #[arg(long, help_heading = "Output")]
     pub csv: bool,
     /// Time of the stream's first sample, s (added to start_s and peak_time_s, as
     /// `impact analyze` adds the recording's first time stamp).
-    #[arg(long, default_value_t = 0.0, value_parser = finite_f64)]
+    #[arg(long, help_heading = "Input", default_value_t = 0.0, value_parser = finite_f64)]
     pub t0: f64,
     /// The input is the firmware's raw defmt stream (as QEMU's semihosting, `impact emulate
-    /// --raw` or an RTT reader saves it), decoded against this ELF (the firmware that wrote
-    /// it) with defmt-decoder, instead of defmt-print's text.
-    #[arg(long)]
+    /// --defmt` or an RTT reader saves it), decoded against this ELF (the firmware that wrote
+    /// it) with defmt-decoder.
+    #[arg(long, help_heading = "Input")]
     pub elf: Option<PathBuf>,
     /// Draw the impacts from the board's waveforms (the figure of `impact analyze --plot`)
     /// to this SVG file.
-    #[arg(long)]
+    #[arg(short = 'p', long, help_heading = "Output", value_name = "FILE.svg")]
     pub plot: Option<PathBuf>,
     /// Write each waveform as a recording `impact analyze` reads: `NAME.csv` (time_s,
     /// accel_m_s2) or `NAME.wav` (16-bit counts, give `--gain`), one file per impact,
     /// `NAME-<index>.csv`.
-    #[arg(long)]
+    #[arg(long, help_heading = "Output")]
     pub export: Option<PathBuf>,
 }
 
@@ -587,10 +589,19 @@ pub fn log_json(log: &Log, t0: f64) -> Result<AnalysisJson, String> {
             )
         }
     };
-    let v0_source = match &log.scene {
-        Some(m) if get(m, "drop_height_m")? != "none" => Some("drop-height".to_string()),
-        Some(m) if get(m, "v0_m_s")? != "none" => Some("v0".to_string()),
-        _ => None,
+    let (v0_m_s, v0_source) = match &log.scene {
+        Some(m) if get(m, "drop_height_m")? != "none" => {
+            let h = num::<f32>(m, "drop_height_m")?;
+            (
+                Some((2.0 * STANDARD_GRAVITY * f64::from(h)).sqrt()),
+                Some("drop-height".to_string()),
+            )
+        }
+        Some(m) if get(m, "v0_m_s")? != "none" => (
+            Some(analyze::shortest(num::<f32>(m, "v0_m_s")?)),
+            Some("v0".to_string()),
+        ),
+        _ => (None, None),
     };
     // What the scene asked for (the scene line's flags), for the reasons of absent fits.
     let asked = |key: &str| -> Result<bool, String> {
@@ -619,6 +630,9 @@ pub fn log_json(log: &Log, t0: f64) -> Result<AnalysisJson, String> {
         .filter(|t| *t != "none")
         .cloned();
     let mut a = AnalysisJson {
+        column: None,
+        units: None,
+        v0_m_s,
         samples,
         train_speed,
         trains: Vec::new(),
@@ -650,6 +664,11 @@ pub fn log_json(log: &Log, t0: f64) -> Result<AnalysisJson, String> {
 /// is read line by line, each line at most [`MAX_LINE_BYTES`].
 pub fn log(args: &LogArgs) -> Result<(), String> {
     let name = crate::table::input_name(&args.file);
+    if let Some(path) = &args.plot {
+        let mut inputs = vec![args.file.as_path()];
+        inputs.extend(args.elf.as_deref());
+        crate::plot::check_output(path, &inputs)?;
+    }
     let input: Box<dyn Read> = if is_stdin(&args.file) {
         Box::new(std::io::stdin())
     } else {

@@ -28,6 +28,15 @@ pub fn check_output(path: &std::path::Path, inputs: &[&std::path::Path]) -> Resu
             }
         }
     }
+    let svg = path
+        .extension()
+        .is_some_and(|e| e.eq_ignore_ascii_case("svg"));
+    if !svg {
+        return Err(format!(
+            "--plot {}: the figure is SVG: name the file .svg (rsvg-convert FILE.svg -o FILE.png makes a PNG of it)",
+            path.display()
+        ));
+    }
     Ok(())
 }
 

@@ -3,7 +3,7 @@
 
 use std::path::Path;
 
-use crate::table::{read_table, words, CsvFormat, Table};
+use crate::table::{read_table, words, CsvFormat};
 pub use crate::table::{ColumnRef, RecordingError};
 
 /// One channel of a recording.
@@ -43,6 +43,8 @@ pub struct ReadOptions {
     pub format: CsvFormat,
     /// Interleaved channels of a raw `.i16`/`.f32` file [default: 1].
     pub raw_channels: Option<usize>,
+    /// The time column's unit [default: the one its header names, else s].
+    pub time_unit: Option<TimeUnit>,
     /// Called with the fraction of the file read, for progress display.
     pub progress: Option<fn(f64)>,
 }
@@ -92,21 +94,65 @@ pub(crate) fn evenly_sampled(
     })
 }
 
+/// The unit of a time column (`--time-unit`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
+pub enum TimeUnit {
+    S,
+    Ms,
+    Us,
+    Ns,
+}
+
+impl TimeUnit {
+    /// Seconds per unit.
+    pub fn seconds(self) -> f64 {
+        match self {
+            TimeUnit::S => 1.0,
+            TimeUnit::Ms => 1e-3,
+            TimeUnit::Us => 1e-6,
+            TimeUnit::Ns => 1e-9,
+        }
+    }
+}
+
 /// Seconds per unit of a time column, from a unit word in its header (`timestamp_us`,
-/// `time [ms]`, `time - seconds`); seconds when the header names none.
-pub fn time_unit_s(header: &str) -> f64 {
+/// `time [ms]`, `time - seconds`); `None` when the header names none.
+pub fn named_time_unit_s(header: &str) -> Option<f64> {
     let h = header.to_ascii_lowercase();
-    let unit = words(&h)
-        .skip(1)
-        .find_map(|w| match w {
-            "s" | "sec" | "secs" | "second" | "seconds" => Some(1.0),
-            "ms" | "msec" | "millisecond" | "milliseconds" => Some(1e-3),
-            "us" | "µs" | "usec" | "microsecond" | "microseconds" => Some(1e-6),
-            "ns" | "nsec" | "nanosecond" | "nanoseconds" => Some(1e-9),
-            _ => None,
-        })
-        .unwrap_or(1.0);
+    let unit = words(&h).skip(1).find_map(|w| match w {
+        "s" | "sec" | "secs" | "second" | "seconds" => Some(1.0),
+        "ms" | "msec" | "millisecond" | "milliseconds" => Some(1e-3),
+        "us" | "µs" | "usec" | "microsecond" | "microseconds" => Some(1e-6),
+        "ns" | "nsec" | "nanosecond" | "nanoseconds" => Some(1e-9),
+        _ => None,
+    });
     unit
+}
+
+/// Seconds per unit of a time column: `given` (`--time-unit`), else the one its header names,
+/// else seconds.
+pub fn time_unit_s(header: &str, given: Option<TimeUnit>) -> f64 {
+    given
+        .map(TimeUnit::seconds)
+        .or_else(|| named_time_unit_s(header))
+        .unwrap_or(1.0)
+}
+
+/// The slowest rate an impact recording can have, S/s: a pulse of milliseconds needs many
+/// samples. A time column that names no unit and, read in seconds, gives less was written in
+/// another unit.
+pub const SLOWEST_RATE_HZ: f64 = 100.0;
+
+/// An error with the fix if a time column whose unit is neither named nor given gives a rate
+/// below [`SLOWEST_RATE_HZ`] read in seconds.
+pub fn check_time_unit(header: &str, given: Option<TimeUnit>, rate_hz: f64) -> Result<(), String> {
+    if given.is_some() || named_time_unit_s(header).is_some() || rate_hz >= SLOWEST_RATE_HZ {
+        return Ok(());
+    }
+    Err(format!(
+        "the time column {header:?} names no unit: read in seconds it gives {} S/s, too slow for an impact recording; if it is in ms or µs, give --time-unit ms (or us), or name the column time_ms (time_us)",
+        crate::analyze::sig(rate_hz, 4)
+    ))
 }
 
 /// Every sample interval must lie within this range of the median interval, or the time axis
@@ -122,17 +168,12 @@ pub(crate) const HEAD_INTERVALS: usize = (1 << 16) - 1;
 /// [`INTERVAL_RANGE`] times the median of the first [`HEAD_INTERVALS`]). Returns `(rate,
 /// jitter)`; with `resample`, uneven intervals are allowed and the rate is the median
 /// interval's (of all of them).
-fn check_time(
+pub(crate) fn check_time(
     path: &Path,
     t: &[f64],
-    table: &Table,
     resample: bool,
+    at: impl Fn(usize, String) -> RecordingError,
 ) -> Result<(f64, f64), RecordingError> {
-    let at = |i: usize, message: String| RecordingError {
-        file: path.to_path_buf(),
-        line: Some(table.line_of(i)),
-        message,
-    };
     for (i, w) in t.windows(2).enumerate() {
         if w[1] <= w[0] {
             return Err(at(
@@ -175,7 +216,7 @@ fn check_time(
 const MAX_RESAMPLE_GROWTH: usize = 4;
 
 /// Linear interpolation of `(t, v)` onto `t0 + k / rate`.
-fn resample(
+pub(crate) fn resample(
     path: &Path,
     t: &[f64],
     v: &[f64],
@@ -217,7 +258,10 @@ pub enum Format {
     Wav,
     Npy,
     Tdms,
+    Ide,
     Csv,
+    /// A file no reader takes: what it is and what to do instead.
+    Unsupported(&'static str),
 }
 
 impl Format {
@@ -227,8 +271,53 @@ impl Format {
             None if crate::wav::is_wav(path) => Format::Wav,
             None if crate::npy::is_npy(path) => Format::Npy,
             None if crate::tdms::is_tdms(path) => Format::Tdms,
-            None => Format::Csv,
+            None if crate::ide::is_ide(path) => Format::Ide,
+            None => match unsupported(path) {
+                Some(what) => Format::Unsupported(what),
+                None => Format::Csv,
+            },
         }
+    }
+
+    /// The error for a file no reader takes.
+    pub fn refuse(what: &str, name: &str) -> String {
+        format!("{name}: unsupported format: {what}")
+    }
+}
+
+/// What a file that is no CSV is, from its first bytes or its extension (a spreadsheet, a
+/// MATLAB or HDF5 file, an archive, other binary data); `None` for text.
+fn unsupported(path: &Path) -> Option<&'static str> {
+    let mut head = [0u8; 1024];
+    // Only a regular file is sniffed (a pipe's bytes would be gone).
+    let n = match std::fs::metadata(path) {
+        Ok(m) if m.is_file() => std::fs::File::open(path)
+            .and_then(|mut f| std::io::Read::read(&mut f, &mut head))
+            .unwrap_or(0),
+        _ => 0,
+    };
+    let head = &head[..n];
+    let ext = path
+        .extension()
+        .and_then(|e| e.to_str())
+        .map(str::to_ascii_lowercase)
+        .unwrap_or_default();
+    if head.starts_with(b"PK\x03\x04") || matches!(ext.as_str(), "xlsx" | "ods") {
+        Some("a spreadsheet or zip archive (.xlsx, .ods, .zip): save the sheet as CSV")
+    } else if head.starts_with(&[0xD0, 0xCF, 0x11, 0xE0]) || ext == "xls" {
+        Some("an Excel 97 workbook (.xls): save the sheet as CSV")
+    } else if head.starts_with(b"MATLAB") {
+        Some("a MATLAB .mat file: save the channel as CSV or .npy (scipy.io.loadmat, numpy.save)")
+    } else if head.starts_with(b"\x89HDF") || matches!(ext.as_str(), "h5" | "hdf5" | "mat") {
+        Some("an HDF5 file (.h5, MATLAB 7.3 .mat): save the channel as CSV or .npy (h5py, numpy.save)")
+    } else if head.starts_with(&[0x1F, 0x8B]) {
+        Some("a gzip archive: unpack it first")
+    } else if head.starts_with(b"MDF ") || ext == "mf4" {
+        Some("an ASAM MDF file: export the channel as CSV")
+    } else if head.contains(&0) {
+        Some("binary data: for raw samples name the file .i16 or .f32, or give --raw-type")
+    } else {
+        None
     }
 }
 
@@ -239,6 +328,12 @@ pub fn read_recording(path: &Path, opts: &ReadOptions) -> Result<Channel, Record
         Format::Wav => crate::wav::read_wav(path, opts),
         Format::Npy => crate::npy::read_npy(path, opts),
         Format::Tdms => crate::tdms::read_tdms(path, opts),
+        Format::Ide => crate::ide::read_ide(path, opts),
+        Format::Unsupported(what) => Err(RecordingError {
+            file: path.to_path_buf(),
+            line: None,
+            message: format!("unsupported format: {what}"),
+        }),
         Format::Raw(kind) => crate::raw::read_raw(path, kind, opts.raw_channels.unwrap_or(1), opts),
         Format::Csv => read_csv(path, opts),
     }
@@ -263,7 +358,11 @@ pub fn read_csv(path: &Path, opts: &ReadOptions) -> Result<Channel, RecordingErr
             .unwrap_or_else(|| format!("column {c}"))
     };
     let cols: Vec<usize> = if opts.axes.is_empty() {
-        vec![table.channel(opts.column.as_ref(), tcol).map_err(err)?]
+        // (With --rate a time column is not read, but it is no channel either.)
+        let time_like = tcol.or_else(|| table.time_column(None).ok().flatten());
+        vec![table
+            .channel(opts.column.as_ref(), time_like)
+            .map_err(err)?]
     } else {
         if !(2..=3).contains(&opts.axes.len()) {
             return Err(err(format!(
@@ -288,7 +387,8 @@ pub fn read_csv(path: &Path, opts: &ReadOptions) -> Result<Channel, RecordingErr
     }
     let mut channels: Vec<Vec<f64>> = cols.iter().map(|&c| table.columns[c].clone()).collect();
     let len = channels[0].len();
-    let unit = |t: usize| table.headers.get(t).map_or(1.0, |h| time_unit_s(h));
+    let header = |t: usize| table.headers.get(t).cloned().unwrap_or_default();
+    let unit = |t: usize| time_unit_s(&header(t), opts.time_unit);
     let (rate_hz, time_s, jitter, resampled) = match (opts.rate_hz, tcol) {
         (Some(r), _) => {
             if !(r.is_finite() && r > 0.0 && r <= 1e9) {
@@ -301,7 +401,13 @@ pub fn read_csv(path: &Path, opts: &ReadOptions) -> Result<Channel, RecordingErr
         (None, Some(t)) => {
             let scale = unit(t);
             let times: Vec<f64> = table.columns[t].iter().map(|v| v * scale).collect();
-            let (rate, jitter) = check_time(path, &times, &table, opts.resample)?;
+            let at = |i: usize, message: String| RecordingError {
+                file: path.to_path_buf(),
+                line: Some(table.line_of(i)),
+                message,
+            };
+            let (rate, jitter) = check_time(path, &times, opts.resample, at)?;
+            check_time_unit(&header(t), opts.time_unit, rate).map_err(err)?;
             if opts.resample {
                 let mut grid = Vec::new();
                 for values in &mut channels {

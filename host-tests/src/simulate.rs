@@ -49,6 +49,7 @@ pub enum Precision {
 
 /// Model parameters, shared by `simulate` and the scene options of other commands.
 #[derive(Args, Clone, Debug, Default)]
+#[command(next_help_heading = "Model parameters")]
 pub struct ModelArgs {
     /// Stiffness: N/m (linear, kelvin-voigt), N/m^1.5 (hertz), N/m^n (nonlinear).
     #[arg(long)]
@@ -95,40 +96,40 @@ pub struct ModelArgs {
 #[derive(Args, Clone, Debug)]
 pub struct SimulateArgs {
     /// Contact law.
-    #[arg(long, value_enum)]
+    #[arg(long, help_heading = "Model", value_enum)]
     pub model: ModelName,
     /// Mass of the impacting body, kg.
-    #[arg(long)]
+    #[arg(short = 'm', long, help_heading = "Model")]
     pub mass: f64,
     /// Approach speed at first touch, m/s.
-    #[arg(long)]
+    #[arg(long, help_heading = "Model")]
     pub v0: f64,
     #[command(flatten)]
     pub params: ModelArgs,
     /// Solver [default: exact, the most accurate; on a target, exact where a closed form
     /// exists (a free body; linear, Kelvin–Voigt, two-phase laws), else adaptive].
-    #[arg(long, value_enum)]
+    #[arg(long, help_heading = "Solver", value_enum)]
     pub solver: Option<SolverName>,
     /// Relative tolerance of the adaptive solver.
-    #[arg(long, default_value_t = 1e-10)]
+    #[arg(long, help_heading = "Solver", default_value_t = 1e-10)]
     pub rtol: f64,
     /// Steps per contact time scale for fixed-step solvers.
-    #[arg(long, default_value_t = 1000)]
+    #[arg(long, help_heading = "Solver", default_value_t = 1000)]
     pub steps: u32,
     /// Arithmetic of the solver.
-    #[arg(long, value_enum, default_value_t = Precision::F64)]
+    #[arg(long, help_heading = "Solver", value_enum, default_value_t = Precision::F64)]
     pub precision: Precision,
-    /// Print one JSON object instead of a table.
-    #[arg(long)]
-    pub json: bool,
     /// Solve the same impact N times and report the wall time per impact.
-    #[arg(long)]
+    #[arg(long, help_heading = "Solver")]
     pub repeat: Option<u32>,
+    /// Print one JSON object instead of a table.
+    #[arg(short = 'j', long, help_heading = "Output")]
+    pub json: bool,
     #[command(flatten)]
     pub target: crate::target::TargetArgs,
     /// With --plot against a wall and --model hertz: the linear spring of the same maximum
     /// deformation on the same axes (seed 000, Figs. 17–18).
-    #[arg(long, requires = "plot")]
+    #[arg(long, help_heading = "Output", requires = "plot")]
     pub with_linear: bool,
 }
 

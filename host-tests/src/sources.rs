@@ -27,6 +27,8 @@ pub(crate) fn open_source(
         Format::Wav => Box::new(WavSource::open(args, name)?),
         Format::Npy => Box::new(NpySource::open(args, name)?),
         Format::Tdms => Box::new(TdmsSource::open(args, name)?),
+        Format::Ide => Box::new(IdeSource::open(args, name)?),
+        Format::Unsupported(what) => return Err(Format::refuse(what, name)),
         Format::Csv => Box::new(CsvSource::open(args, progress)?),
     })
 }
@@ -78,6 +80,11 @@ pub(crate) trait Source: Send {
     /// Time of the first sample, s (0 without a time column).
     fn t0(&self) -> f64 {
         0.0
+    }
+    /// The channel's header (a CSV's column name; empty where the format names none), for
+    /// the units it names.
+    fn column(&self) -> &str {
+        ""
     }
 }
 
@@ -249,6 +256,10 @@ struct CsvSource {
     rows: crate::table::Rows,
     name: String,
     channel: usize,
+    /// The channel's header; the time column's, and its unit if given.
+    column: String,
+    time_header: String,
+    time_unit: Option<crate::recording::TimeUnit>,
     /// The time column and its unit, s.
     time: Option<(usize, f64)>,
     /// `--rate`, if given.
@@ -298,7 +309,11 @@ impl CsvSource {
         let tcol = shape
             .time_column_unless_rate(args.rate.is_some(), args.time_column.as_ref())
             .map_err(err)?;
-        let channel = shape.channel(args.column.as_ref(), tcol).map_err(err)?;
+        // (With --rate a time column is not read, but it is no channel either.)
+        let time_like = tcol.or_else(|| shape.time_column(None).ok().flatten());
+        let channel = shape
+            .channel(args.column.as_ref(), time_like)
+            .map_err(err)?;
         if Some(channel) == tcol {
             return Err(err(format!(
                 "column {channel} is the time column: choose another with --column"
@@ -314,18 +329,24 @@ impl CsvSource {
                 return Err(err(format!("rate {r} Hz is not in (0, 1e9]")));
             }
         }
+        let time_header = tcol
+            .and_then(|t| shape.headers.get(t).cloned())
+            .unwrap_or_default();
         let time = tcol.map(|t| {
-            let unit = shape
-                .headers
-                .get(t)
-                .map_or(1.0, |h| crate::recording::time_unit_s(h));
-            (t, unit)
+            (
+                t,
+                crate::recording::time_unit_s(&time_header, args.time_unit),
+            )
         });
         let size = rows.size();
+        let column = shape.headers.get(channel).cloned().unwrap_or_default();
         let mut source = Self {
             rows,
             name,
             channel,
+            column,
+            time_header,
+            time_unit: args.time_unit,
             time,
             rate_given: args.rate,
             t0: None,
@@ -518,6 +539,10 @@ impl Source for CsvSource {
             // (None if time went back: `rate_hz` then gives that error.)
             let rate = (self.n - 1) as f64 / (self.last - t0);
             self.head_rate = (rate.is_finite() && rate > 0.0).then_some(rate);
+            if let (Some(rate), None) = (self.head_rate, self.rate_given) {
+                crate::recording::check_time_unit(&self.time_header, self.time_unit, rate)
+                    .map_err(|m| format!("{}: {m}", self.name))?;
+            }
         }
         Ok(())
     }
@@ -548,6 +573,10 @@ impl Source for CsvSource {
     fn t0(&self) -> f64 {
         self.t0.unwrap_or(0.0)
     }
+
+    fn column(&self) -> &str {
+        &self.column
+    }
 }
 
 /// An interval `dt` within [`crate::recording::INTERVAL_RANGE`] times the median `median`.
@@ -561,6 +590,133 @@ pub(crate) fn check_interval(dt: f64, median: f64) -> Result<(), String> {
              intervals' median {median:.6e} s (a gap or a rate change); give --resample to \
              interpolate onto an even grid, or cut the file"
         ))
+    }
+}
+
+/// An `.ide` file's subchannel, read block by block on a thread of its own
+/// ([`crate::ide::Blocks`]), on the recorder's time stamps: the rate from the head's, every
+/// interval checked against the head's median as a CSV's are.
+struct IdeSource {
+    blocks: crate::ide::Blocks,
+    name: String,
+    column: String,
+    /// Values of the current block not yet handed on.
+    pending: std::collections::VecDeque<f64>,
+    t0: Option<f64>,
+    last: f64,
+    n: u64,
+    head_dts: Vec<f64>,
+    median_dt: Option<f64>,
+    head_rate: Option<f64>,
+}
+
+impl IdeSource {
+    fn open(args: &AnalyzeArgs, name: &str) -> Result<Self, String> {
+        if args.rate.is_some() || args.time_column.is_some() {
+            return Err(format!(
+                "{name}: an .ide file's samples carry their own time stamps: no --rate or --time-column"
+            ));
+        }
+        let file = crate::ide::IdeFile::open(&args.file).map_err(|e| format!("{name}: {e}"))?;
+        let pick = crate::ide::pick(&file, args.column.as_ref(), &[])
+            .map_err(|e| format!("{name}: {e}"))?;
+        drop(file);
+        Ok(Self {
+            blocks: crate::ide::Blocks::start(&args.file, pick.channel, pick.subs[0]),
+            name: name.to_string(),
+            column: pick.names[0].clone(),
+            pending: std::collections::VecDeque::new(),
+            t0: None,
+            last: 0.0,
+            n: 0,
+            head_dts: Vec::new(),
+            median_dt: None,
+            head_rate: None,
+        })
+    }
+
+    /// Takes the next block's times (checked) and values.
+    fn refill(&mut self) -> Result<bool, String> {
+        let Some(block) = self.blocks.next_block() else {
+            return Ok(false);
+        };
+        let (times, values) = block.map_err(|e| format!("{}: {e}", self.name))?;
+        for &t in &times {
+            if let Some(t0) = self.t0 {
+                let dt = t - self.last;
+                if dt <= 0.0 {
+                    return Err(format!(
+                        "{}: sample {}: time {t} s does not increase (previous {} s)",
+                        self.name, self.n, self.last
+                    ));
+                }
+                match self.median_dt {
+                    Some(m) => check_interval(dt, m)
+                        .map_err(|e| format!("{}: sample {}: {e}", self.name, self.n))?,
+                    None => self.head_dts.push(dt),
+                }
+                let _ = t0;
+            } else {
+                self.t0 = Some(t);
+            }
+            self.last = t;
+            self.n += 1;
+        }
+        self.pending.extend(values);
+        Ok(true)
+    }
+}
+
+impl Source for IdeSource {
+    fn next_values(&mut self, want: usize, out: &mut Vec<f64>) -> Result<(), String> {
+        if self.pending.is_empty() && !self.refill()? {
+            return Ok(());
+        }
+        let take = want.max(1).min(self.pending.len());
+        out.extend(self.pending.drain(..take));
+        Ok(())
+    }
+
+    fn head_read(&mut self) -> Result<(), String> {
+        if self.head_dts.is_empty() {
+            return Err(format!(
+                "{}: {} samples: the rate cannot be told",
+                self.name, self.n
+            ));
+        }
+        let mut d = self.head_dts.clone();
+        let mid = d.len() / 2;
+        let median = *d.select_nth_unstable_by(mid, f64::total_cmp).1;
+        for (i, &dt) in self.head_dts.iter().enumerate() {
+            check_interval(dt, median)
+                .map_err(|e| format!("{}: sample {}: {e}", self.name, i + 1))?;
+        }
+        self.median_dt = Some(median);
+        self.head_rate = self
+            .t0
+            .map(|t0| (self.head_dts.len()) as f64 / (self.last - t0))
+            .filter(|r| r.is_finite() && *r > 0.0);
+        Ok(())
+    }
+
+    fn rate_hz(&self) -> Result<f64, String> {
+        self.head_rate
+            .ok_or_else(|| format!("{}: the rate cannot be told", self.name))
+    }
+
+    fn final_rate_hz(&self) -> f64 {
+        match self.t0 {
+            Some(t0) if self.n > 1 => (self.n - 1) as f64 / (self.last - t0),
+            _ => self.head_rate.unwrap_or(0.0),
+        }
+    }
+
+    fn t0(&self) -> f64 {
+        self.t0.unwrap_or(0.0)
+    }
+
+    fn column(&self) -> &str {
+        &self.column
     }
 }
 
@@ -716,5 +872,9 @@ impl Source for TdmsSource {
 
     fn rate_hz(&self) -> Result<f64, String> {
         Ok(self.stream.rate_hz)
+    }
+
+    fn column(&self) -> &str {
+        &self.stream.name
     }
 }

@@ -16,16 +16,16 @@ use crate::analyze::{human, Setup};
 #[derive(Args, Clone, Debug, Default)]
 pub struct SpectrumArgs {
     /// Add each impact's SRS (maximax absolute acceleration), PVSS and enveloping half-sine.
-    #[arg(long)]
+    #[arg(long, help_heading = "Analysis")]
     pub srs: bool,
     /// Damping ratio of the oscillators, in [0, 0.5].
-    #[arg(long, default_value_t = 0.05, requires = "srs", value_parser = damping)]
+    #[arg(long, help_heading = "Analysis", default_value_t = 0.05, requires = "srs", value_parser = damping)]
     pub srs_damping: f64,
     /// Bands per octave: 6 or 12 (centres 1000 × 2^(k/n) Hz).
-    #[arg(long, default_value_t = 6, requires = "srs", value_parser = per_octave)]
+    #[arg(long, help_heading = "Analysis", default_value_t = 6, requires = "srs", value_parser = per_octave)]
     pub srs_bands: u32,
     /// Lowest band, Hz (the highest is an eighth of the sample rate).
-    #[arg(long, default_value_t = 10.0, requires = "srs", value_parser = crate::analyze::positive_f64)]
+    #[arg(long, help_heading = "Analysis", default_value_t = 10.0, requires = "srs", value_parser = crate::analyze::positive_f64)]
     pub srs_low: f64,
 }
 
@@ -45,7 +45,7 @@ pub fn spectrum_json(s: &Spectrum) -> ShockSpectrumJson {
     let n = usize::from(s.bands);
     let f = |v: &f32| *v as f64;
     ShockSpectrumJson {
-        damping: s.damping as f64,
+        damping: crate::analyze::shortest(s.damping),
         bands_per_octave: u32::from(s.bands_per_octave),
         from_sample: s.from_sample,
         to_sample: s.to_sample,

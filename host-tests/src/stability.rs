@@ -23,6 +23,25 @@ pub fn stated_bound(method: Method, f32: bool, rtol: f64) -> f64 {
     }
 }
 
+/// The bound a solver states on a target with its own dynamics: the wall's, but for the
+/// adaptive solver in f32, 3e-4. A light target carried along on a soft damped mount makes
+/// the crush time a flat maximum tens of thousands of contact time scales in: its condition
+/// number reaches ~500 (Kelvin–Voigt, a target 1000× lighter, measured), so one f32 rounding
+/// of the force (6e-8) moves it by 3e-5, and the roundings of a whole solve by up to 1.8e-4
+/// (16 copies of the case that agree to 2e-13 in f64), while every other field stays within
+/// 1e-7. f64 keeps the wall's bound.
+pub fn stated_bound_on_target(method: Method, f32: bool, rtol: f64) -> f64 {
+    match (method, f32) {
+        (Method::Adaptive, true) => 3e-4f64.max(stated_bound(method, f32, rtol)),
+        _ => stated_bound(method, f32, rtol),
+    }
+}
+
+/// Resolved results outside their bound, and non-finite ones, over `rows`.
+pub fn failures(rows: &[Row]) -> u32 {
+    rows.iter().map(|r| r.out_of_bound + r.non_finite).sum()
+}
+
 /// One row of the table: a model, a solver and a precision over the whole grid.
 #[derive(Clone, Debug, Default, Serialize)]
 pub struct Row {

@@ -44,28 +44,29 @@ pub fn analyze(
         return refuse("--resample");
     }
     let file = analyze::scene_file(args)?;
-    let (mass, scale) = analyze::mass_and_scale(args, &file)?;
-    let full_scale = analyze::full_scale_m_s2(args, &file, scale)?.ok_or(
+    let mut source = open_source(args, &name, progress)?;
+    let column = source.column().to_string();
+    let (mass, scale, units) = analyze::mass_and_scale(args, &file, &column)?;
+    let full_scale = analyze::full_scale_m_s2(args, &file, mass).ok_or(
         "--stream: give --range (the sensor's full scale sets the quantisation before the \
          recording's extremes are known)",
     )?;
-    let trigger = args.trigger.or(file.trigger_m_s2).ok_or(
+    let (trigger, edge) = analyze::given_levels(args, &file, mass);
+    let trigger = trigger.ok_or(
         "--stream: give --trigger (the level cannot be learned from a recording not yet read)",
     )?;
     let gain = analyze::gain_for(full_scale);
     let clipping = crate::screen::from_range(full_scale);
-    let mut source = open_source(args, &name, progress)?;
-    // The head: its noise sets the default edge level, a CSV's first intervals the rate.
+    // The head: its noise sets the default edge level, a CSV's first intervals the rate; its
+    // readings are checked against the range.
     let head = read_head(&mut *source, scale)?;
+    survey::check_range(head.iter().fold(0.0f64, |m, v| m.max(v.abs())), full_scale)?;
     let rate_hz = source.rate_hz()?;
     let calibration = Calibration {
         gain_m_s2_per_count: gain as f32,
         sample_rate_hz: rate_hz as f32,
     };
-    let edge = args
-        .edge
-        .or(file.edge_m_s2)
-        .unwrap_or_else(|| survey::default_edge(survey::noise_rms(&head), trigger));
+    let edge = edge.unwrap_or_else(|| survey::default_edge(survey::noise_rms(&head), trigger));
     let (scene, v0_source) = analyze::build_scene(
         args,
         &file,
@@ -78,6 +79,8 @@ pub fn analyze(
     let head: Vec<i16> = head.iter().map(|a| analyze::to_count(*a, gain)).collect();
     let (reports, count, source) = run_monitor(source, head, (scale, gain), scene, Vec::new())?;
     let setup = Setup {
+        column: (!column.is_empty()).then_some(column),
+        units,
         prepared: Prepared {
             counts: Vec::new(),
             calibration,
@@ -111,8 +114,6 @@ pub fn analyze_in_passes(
 ) -> Result<(Setup, Vec<ImpactReport>), String> {
     let name = input_name(&args.file);
     let file = analyze::scene_file(args)?;
-    let (mass, scale) = analyze::mass_and_scale(args, &file)?;
-    let full_scale = analyze::full_scale_m_s2(args, &file, scale)?;
     // The survey; again with the glitches replaced if there are any (they set the extremes).
     // One bar over the passes: the survey fills its first half, a second survey (if any)
     // the next sixth, the analysis the rest.
@@ -138,6 +139,9 @@ pub fn analyze_in_passes(
         }),
     };
     let input = open_source(args, &name, bar(0.0, 0.5))?;
+    let column = input.column().to_string();
+    let (mass, scale, units) = analyze::mass_and_scale(args, &file, &column)?;
+    let full_scale = analyze::full_scale_m_s2(args, &file, mass);
     let (first, source, spool) = survey_pass(input, scale, &[], !args.keep_spikes, spool)?;
     let axis = Axis {
         rate_hz: source.rate_hz()?,
@@ -167,12 +171,8 @@ pub fn analyze_in_passes(
         let (input, scale) = reopen(bar(0.5, 2.0 / 3.0))?;
         survey_pass(input, scale, &removals, false, None)?.0
     };
-    let levels = survey::levels(
-        &survey,
-        full_scale,
-        args.trigger.or(file.trigger_m_s2),
-        args.edge.or(file.edge_m_s2),
-    );
+    let (trigger, edge) = analyze::given_levels(args, &file, mass);
+    let levels = survey::levels(&survey, full_scale, trigger, edge)?;
     let gain = levels.gain_m_s2_per_count;
     let calibration = Calibration {
         gain_m_s2_per_count: gain as f32,
@@ -194,6 +194,8 @@ pub fn analyze_in_passes(
     let (reports, count, _) = run_monitor(source, head, (scale, gain), scene, removals.clone())?;
     let spikes = removals.iter().map(|r| r.timed(t0, rate_hz)).collect();
     let setup = Setup {
+        column: (!column.is_empty()).then_some(column),
+        units,
         prepared: Prepared {
             counts: Vec::new(),
             calibration,

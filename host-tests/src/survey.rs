@@ -207,20 +207,41 @@ pub fn levels(
     range_m_s2: Option<f64>,
     trigger: Option<f64>,
     edge: Option<f64>,
-) -> Levels {
+) -> Result<Levels, String> {
+    if let Some(fs) = range_m_s2 {
+        check_range(s.peak_m_s2(), fs)?;
+    }
     let clipping = match range_m_s2 {
         Some(fs) => Some(screen::from_range(fs)),
         None => s.flat_tops.clone(),
     };
     let gain = crate::analyze::gain_for(range_m_s2.unwrap_or_else(|| s.peak_m_s2()));
     let (trigger, edge) = trigger_and_edge(s, gain, trigger, edge);
-    Levels {
+    Ok(Levels {
         clipping,
         full_scale_m_s2: range_m_s2,
         gain_m_s2_per_count: gain,
         trigger_m_s2: trigger,
         edge_m_s2: edge,
+    })
+}
+
+/// A sensor reads at most a little past its full scale: a recording that reaches more than
+/// this many times the range given was given a range in the wrong unit.
+pub const RANGE_EXCEEDED: f64 = 2.0;
+
+/// An error if `peak_m_s2` (a reading's distance from zero) exceeds [`RANGE_EXCEEDED`] ×
+/// the full scale `range_m_s2`.
+pub fn check_range(peak_m_s2: f64, range_m_s2: f64) -> Result<(), String> {
+    if peak_m_s2 > RANGE_EXCEEDED * range_m_s2 {
+        return Err(format!(
+            "--range: the recording reaches {}, {:.1}× the full scale given ({}): a bare --range is in m/s²; give its unit, e.g. --range 16g for a ±16 g sensor",
+            crate::analyze::human(peak_m_s2, "m/s²"),
+            peak_m_s2 / range_m_s2,
+            crate::analyze::human(range_m_s2, "m/s²"),
+        ));
     }
+    Ok(())
 }
 
 /// A flat top is taken for a rail only more than this many steps of the recording's

@@ -185,65 +185,76 @@ pub const MAX_SAMPLES: usize = 40_000_000;
 /// `impact synth` options: one model impact rendered as an accelerometer recording.
 #[derive(clap::Args, Clone, Debug)]
 pub struct SynthArgs {
-    #[command(flatten)]
-    pub model: crate::simulate::ModelArgs,
-    /// Contact law.
-    #[arg(long, value_enum)]
-    pub law: crate::simulate::ModelName,
+    /// Contact law (as `impact simulate --model`).
+    #[arg(long, help_heading = "Model", value_enum, alias = "law")]
+    pub model: crate::simulate::ModelName,
     /// Mass of the body, kg.
-    #[arg(long)]
+    #[arg(short = 'm', long, help_heading = "Model")]
     pub mass: f64,
     /// Approach speed, m/s.
-    #[arg(long)]
+    #[arg(long, help_heading = "Model")]
     pub v0: f64,
+    #[command(flatten)]
+    pub params: crate::simulate::ModelArgs,
     /// Sample rate, Hz.
-    #[arg(long, default_value_t = 500_000.0)]
+    #[arg(
+        short = 'r',
+        long,
+        help_heading = "Recording",
+        default_value_t = 500_000.0
+    )]
     pub rate: f64,
     /// ADC bits.
-    #[arg(long, default_value_t = 12)]
+    #[arg(long, help_heading = "Recording", default_value_t = 12)]
     pub bits: u32,
     /// Full scale, m/s² (codes span ± this).
-    #[arg(long, default_value_t = 800.0)]
+    #[arg(long, help_heading = "Recording", default_value_t = 800.0)]
     pub full_scale: f64,
     /// Noise, RMS codes.
-    #[arg(long, default_value_t = 0.5)]
+    #[arg(long, help_heading = "Recording", default_value_t = 0.5)]
     pub noise: f64,
     /// Offset from mid-scale, codes.
-    #[arg(long, default_value_t = 17.0)]
+    #[arg(long, help_heading = "Recording", default_value_t = 17.0)]
     pub offset: f64,
     /// Drift, codes per second.
-    #[arg(long, default_value_t = 0.0)]
+    #[arg(long, help_heading = "Recording", default_value_t = 0.0)]
     pub drift: f64,
     /// Drop every N-th sample (0: none).
-    #[arg(long, default_value_t = 0)]
+    #[arg(long, help_heading = "Recording", default_value_t = 0)]
     pub drop_every: usize,
     /// Time of first touch, s.
-    #[arg(long, default_value_t = 0.01)]
+    #[arg(long, help_heading = "Recording", default_value_t = 0.01)]
     pub touch: f64,
     /// Recording length, s.
-    #[arg(long, default_value_t = 0.1)]
+    #[arg(long, help_heading = "Recording", default_value_t = 0.1)]
     pub duration: f64,
-    /// The same impact this many times (a train for the real-time emulation), `--every` apart.
-    #[arg(long, default_value_t = 1)]
-    pub repeat: usize,
+    /// Noise seed.
+    #[arg(long, help_heading = "Recording", default_value_t = 1)]
+    pub seed: u64,
+    /// The same impact this many times, `--every` apart (a train for the real-time
+    /// emulation).
+    #[arg(long, help_heading = "Trains", default_value_t = 1, alias = "repeat")]
+    pub impacts: usize,
+    /// Time between the first touches of an `--impacts` train, s.
+    #[arg(long, help_heading = "Trains", default_value_t = 0.08)]
+    pub every: f64,
     /// A bounce train: the body touches at --v0 (dropped from v0²/2g) and bounces under
     /// standard gravity (flights in closed form, each contact at its own speed), this many
     /// contacts in all, fewer if a rebound falls below 1 mm/s or the recording ends.
-    #[arg(long, default_value_t = 1, conflicts_with = "repeat")]
+    #[arg(
+        long,
+        help_heading = "Trains",
+        default_value_t = 1,
+        conflicts_with = "impacts"
+    )]
     pub bounces: u32,
-    /// Time between the first touches of a `--repeat` train, s.
-    #[arg(long, default_value_t = 0.08)]
-    pub every: f64,
-    /// Noise seed.
-    #[arg(long, default_value_t = 1)]
-    pub seed: u64,
 }
 
 /// `impact synth` arguments of the seed-001 bench impact (60 g at 1.3357 m/s into the
 /// two-phase Kelvin–Voigt law matching Table 1's x_m and x_p), shared by the tests and the M4
 /// benchmark.
 pub const SEED_BENCH_ARGS: [&str; 14] = [
-    "--law",
+    "--model",
     "two-phase",
     "--mass",
     "0.06",
@@ -264,7 +275,7 @@ pub const SEED_BENCH_ARGS: [&str; 14] = [
 pub fn synth(args: &SynthArgs) -> Result<Recording, String> {
     let impact = Impact::new(args.mass, args.v0);
     impact.validate().map_err(|e| e.to_string())?;
-    let model = args.model.model(args.law, &impact)?;
+    let model = args.params.model(args.model, &impact)?;
     if !(args.rate.is_finite() && args.rate > 0.0) {
         return Err("--rate: must be finite and > 0".into());
     }
@@ -302,10 +313,10 @@ pub fn synth(args: &SynthArgs) -> Result<Recording, String> {
         return Err("--touch: must lie in [0, --duration)".into());
     }
     let sensor = sensor(args);
-    if args.repeat == 0 || args.repeat > 100_000 {
-        return Err("--repeat: must lie in 1..=100000".into());
+    if args.impacts == 0 || args.impacts > 100_000 {
+        return Err("--impacts: must lie in 1..=100000".into());
     }
-    if args.repeat > 1 && !(args.every.is_finite() && args.every > 0.0) {
+    if args.impacts > 1 && !(args.every.is_finite() && args.every > 0.0) {
         return Err("--every: must be finite and > 0".into());
     }
     if args.bounces == 0 || args.bounces > 10_000 {
@@ -322,7 +333,7 @@ pub fn synth(args: &SynthArgs) -> Result<Recording, String> {
             })
             .collect()
     } else {
-        (0..args.repeat)
+        (0..args.impacts)
             .map(|k| Placed {
                 touch_s: args.touch + k as f64 * args.every,
                 law: &model,

@@ -791,13 +791,36 @@ impl Table {
         }
     }
 
-    /// The channel: the column asked for, or the first one that is not the time column.
+    /// The channel: the column asked for, or the first one that is not the time column (a
+    /// note on stderr names it when there are others to choose from).
     pub fn channel(&self, asked: Option<&ColumnRef>, time: Option<usize>) -> Result<usize, String> {
         match asked {
             Some(c) => self.find(c, "column"),
-            None => (0..self.columns.len())
-                .find(|&c| Some(c) != time)
-                .ok_or_else(|| "no data column besides the time column".to_string()),
+            None => {
+                let data: Vec<usize> = (0..self.columns.len())
+                    .filter(|&c| Some(c) != time)
+                    .collect();
+                let first = *data
+                    .first()
+                    .ok_or_else(|| "no data column besides the time column".to_string())?;
+                if data.len() > 1 {
+                    let name = |c: usize| {
+                        self.headers
+                            .get(c)
+                            .filter(|h| !h.is_empty())
+                            .cloned()
+                            .unwrap_or_else(|| format!("column {c}"))
+                    };
+                    let names: Vec<String> = data.iter().map(|&c| name(c)).collect();
+                    crate::note(&format!(
+                        "analysing {} of {} channels ({}): choose one with --column, or --axes for their resultant",
+                        name(first),
+                        data.len(),
+                        names.join(", ")
+                    ));
+                }
+                Ok(first)
+            }
         }
     }
 

@@ -16,23 +16,23 @@ use crate::simulate::{model_f32, Precision, SimulateArgs};
 #[derive(Args, Clone, Debug, Default)]
 pub struct TargetArgs {
     /// Target mass m2, kg: a body on a spring and damper to ground (free without them).
-    #[arg(long, conflicts_with = "target")]
+    #[arg(long, help_heading = "Target", conflicts_with = "target")]
     pub target_mass: Option<f64>,
     /// Target spring to ground k2, N/m [default: 0, a free body].
-    #[arg(long, requires = "target_mass")]
+    #[arg(long, help_heading = "Target", requires = "target_mass")]
     pub target_stiffness: Option<f64>,
     /// Target damper to ground c2, N s/m [default: 0].
-    #[arg(long, requires = "target_mass")]
+    #[arg(long, help_heading = "Target", requires = "target_mass")]
     pub target_damping: Option<f64>,
     /// A linear target in state-space form, JSON `{"a": [[..]], "b": [..], "c": [[..], [..]],
     /// "d": [0, 0]}`: input the contact force (N), outputs the contact point's displacement (m)
     /// and velocity (m/s), at most 6 states.
-    #[arg(long)]
+    #[arg(long, help_heading = "Target")]
     pub target: Option<PathBuf>,
     /// Draw into this SVG: against a wall the deformation, velocity and force against time and
     /// the force against deformation; on a target the impactor's and target's displacement,
     /// velocity and the contact force over the contact and the ring-down.
-    #[arg(long)]
+    #[arg(short = 'p', long, help_heading = "Output", value_name = "FILE.svg")]
     pub plot: Option<PathBuf>,
 }
 

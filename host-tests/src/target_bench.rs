@@ -9,7 +9,7 @@ use impact_core::{ContactLaw, Error, Impact, Method, Settings};
 
 use crate::precision::Point;
 use crate::simulate::model_f32;
-use crate::stability::{stated_bound, Row};
+use crate::stability::{stated_bound_on_target, Row};
 use crate::target::{narrow, widen};
 
 /// The fields compared: contact time, crush time, deformation, force, both velocities.
@@ -298,7 +298,7 @@ pub fn stability(full: bool) -> Vec<Row> {
                                         &name,
                                         &label,
                                         precision,
-                                        stated_bound(s.method, f32, s.rtol),
+                                        stated_bound_on_target(s.method, f32, s.rtol),
                                     )
                                     .tally(result.ok().map(|o| error(&o, &reference, v0)), &desc);
                                 };

@@ -20,17 +20,19 @@ pub enum SpeedArg {
 /// `--train` options (flattened into `analyze` and `emulate`).
 #[derive(Args, Clone, Debug, Default)]
 pub struct TrainArgs {
+    /// Bounce trains: each bounce's v0 from its flight time or from the previous rebound.
+    ///
     /// Bounce trains: each impact after the first of a drop takes its approach speed from the
     /// flight time since the previous separation (`flight`, vertical flight under gravity
     /// along the sensor's axis, no drag) or from the previous rebound (`rebound`); the first
     /// impact takes --v0, --drop-height or --free-fall. Both speeds are reported.
-    #[arg(long, value_enum)]
+    #[arg(long, help_heading = "Analysis", value_enum)]
     pub train: Option<SpeedArg>,
     /// Gravity along the sensor's axis, m/s² [default: 9.80665].
-    #[arg(long, requires = "train", value_parser = positive_f64)]
+    #[arg(long, help_heading = "Analysis", requires = "train", value_parser = positive_f64)]
     pub gravity: Option<f64>,
     /// A flight longer than this starts a new train (a new drop), s [default: 2].
-    #[arg(long, requires = "train", value_parser = positive_f64)]
+    #[arg(long, help_heading = "Analysis", requires = "train", value_parser = positive_f64)]
     pub max_flight: Option<f64>,
 }
 

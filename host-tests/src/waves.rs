@@ -1,5 +1,5 @@
 //! The board's captured windows put back together from its `wave` and `wave_frame` lines
-//! (firmware/README.md), and written out as recordings `impact analyze` reads again.
+//! (docs/board.md), and written out as recordings `impact analyze` reads again.
 
 use std::collections::{BTreeMap, HashMap};
 use std::path::{Path, PathBuf};

@@ -154,7 +154,7 @@ fn every_other_bundled_recording() {
     emulator_and_log_match_host(&dc, &["--column", "z_g"], false);
     emulator_and_log_match_host(
         &data("impack-water-entry/4mps_sphere_1_40g-DC_9.9-10.6s.csv"),
-        &["--column", "y_g", "--range", "40"],
+        &["--column", "y_g", "--range", "40g"],
         false,
     );
 }
@@ -392,7 +392,7 @@ fn a_bounce_train_gets_the_same_speeds_on_the_board() {
     }
     let (csv, _) = impact(&[
         "synth",
-        "--law",
+        "--model",
         "nonlinear",
         "--mass",
         "0.06",
@@ -449,7 +449,7 @@ fn seed_train(n: usize, every: f64) -> String {
         .into_iter()
         .chain(impact_host::synth::SEED_BENCH_ARGS)
         .chain([
-            "--repeat",
+            "--impacts",
             &n_s,
             "--every",
             &every_s,

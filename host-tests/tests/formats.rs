@@ -271,3 +271,110 @@ fn tdms_channels_give_their_csv_twins_reports() {
         "{err}"
     );
 }
+
+/// The impacts of `impact analyze ARGS --json`: (start, peak, Δv or 0, clipped) each.
+fn impacts_of(args: &[&str]) -> Vec<(f64, f64, f64, bool)> {
+    let mut all = vec!["analyze"];
+    all.extend_from_slice(args);
+    all.push("--json");
+    let (out, _) = impact_ok(&all);
+    let v: serde_json::Value = serde_json::from_str(&out).unwrap();
+    v["impacts"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|i| {
+            (
+                i["start_s"].as_f64().unwrap(),
+                i["peak_acceleration_m_s2"].as_f64().unwrap(),
+                i["delta_v_m_s"].as_f64().unwrap_or(0.0),
+                i["clipped"].as_bool().unwrap(),
+            )
+        })
+        .collect()
+}
+
+/// An enDAQ `.ide` recording read directly gives the reports of its CSV exports (idelib's,
+/// rounded to 5 decimals for the 16 g channel, 4 for the 2000 g one, times to 1 µs): the 16 g
+/// DC z axis (seven bounces, the first three clipped), its three axes together, and the
+/// 2000 g piezo's z axis around the impact (the CSV is a 13.4–15.0 s excerpt, so its levels
+/// come from less of the recording: the impact, not the numbers, is compared there).
+#[test]
+fn an_ide_recording_gives_its_csv_exports_reports() {
+    let data = root().join("data/endaq-high-drop");
+    let ide = data.join("High-Drop.IDE");
+    let ide = ide.to_str().unwrap();
+    let dc = data.join("High-Drop_16g-DC_full.csv");
+    let dc = dc.to_str().unwrap();
+    for (from_ide, from_csv) in [
+        (vec![ide, "--column", "32.2"], vec![dc, "--column", "z_g"]),
+        (
+            vec![ide, "--axes", "32.0,32.1,32.2"],
+            vec![dc, "--axes", "x_g,y_g,z_g"],
+        ),
+    ] {
+        let (a, b) = (impacts_of(&from_ide), impacts_of(&from_csv));
+        assert_eq!(a.len(), 7, "{from_ide:?}: {a:?}");
+        assert_eq!(a.len(), b.len(), "{from_ide:?}");
+        for (x, y) in a.iter().zip(&b) {
+            assert!((x.0 - y.0).abs() < 2e-6, "{from_ide:?}: start {x:?} {y:?}");
+            assert!(
+                (x.1 - y.1).abs() < 1e-4 * y.1.abs(),
+                "{from_ide:?}: peak {x:?} {y:?}"
+            );
+            assert!(
+                (x.2 - y.2).abs() < 1e-4 * y.2.abs().max(1e-3),
+                "{from_ide:?}: Δv {x:?} {y:?}"
+            );
+            assert_eq!(x.3, y.3, "{from_ide:?}: clipped {x:?} {y:?}");
+        }
+    }
+    // The piezo's z axis: the impact at 14.625 s, its peak to 0.1 %.
+    let pe = data.join("High-Drop_2000g-PE_13.4-15.0s.csv");
+    let whole = impacts_of(&[ide, "--column", "Z (2000g)"]);
+    let excerpt = impacts_of(&[pe.to_str().unwrap(), "--column", "z_g"]);
+    let hit = |list: &[(f64, f64, f64, bool)]| {
+        *list
+            .iter()
+            .find(|i| (14.62..14.63).contains(&i.0))
+            .unwrap_or_else(|| panic!("no impact at 14.625 s: {list:?}"))
+    };
+    let (w, e) = (hit(&whole), hit(&excerpt));
+    assert!((w.0 - e.0).abs() < 1e-4, "{w:?} {e:?}");
+    assert!((w.1 - e.1).abs() < 1e-3 * e.1, "{w:?} {e:?}");
+}
+
+/// What no reader takes is named as such, and a subchannel that is no acceleration or force
+/// is refused naming its units.
+#[test]
+fn unsupported_files_and_channels_are_named() {
+    let dir = temp("unsupported");
+    std::fs::create_dir_all(&dir).unwrap();
+    for (name, bytes, want) in [
+        ("sheet.xlsx", b"PK\x03\x04rest".to_vec(), "spreadsheet"),
+        ("old.xls", vec![0xD0, 0xCF, 0x11, 0xE0, 1, 2], "Excel 97"),
+        (
+            "data.mat",
+            b"MATLAB 5.0 MAT-file, Platform".to_vec(),
+            "MATLAB",
+        ),
+        ("data.h5", b"\x89HDF\r\n\x1a\n".to_vec(), "HDF5"),
+        ("blob.bin", vec![1, 0, 2, 0, 3], "binary"),
+    ] {
+        let path = dir.join(name);
+        std::fs::write(&path, bytes).unwrap();
+        let (code, _, err) = impact(&["analyze", path.to_str().unwrap()]);
+        assert_eq!(code, 1, "{name}: {err}");
+        assert!(
+            err.contains("unsupported format") && err.contains(want),
+            "{name}: {err}"
+        );
+    }
+    let ide = root().join("data/endaq-high-drop/High-Drop.IDE");
+    let (code, _, err) = impact(&["analyze", ide.to_str().unwrap(), "--column", "36.1"]);
+    assert_eq!(code, 1, "{err}");
+    assert!(
+        err.contains("°C") && err.contains("not an acceleration"),
+        "{err}"
+    );
+}

@@ -126,15 +126,9 @@ fn fails(args: &[&str], want: &str) -> String {
     r.err
 }
 
+/// Refused: a one-line error (exit 1), or clap's usage error (exit 2), naming `want`.
 fn refused(r: &Run, what: &str, want: &str) {
-    assert!(
-        matches!(r.code, Some(1 | 2)),
-        "{what}: exit {:?}\n{}",
-        r.code,
-        r.out
-    );
-    assert_eq!(r.err.trim().lines().count(), 1, "{what}: {}", r.err);
-    assert!(r.err.contains(want), "{what}: wanted {want:?} in {}", r.err);
+    common::assert_refused(r.code, &r.err, want, &format!("{what}\n{}", r.out));
 }
 
 fn ok(args: &[&str]) -> Run {
@@ -205,7 +199,7 @@ fn synth_memory_follows_the_recording_not_the_contact_time() {
         &["--mass", "1", "--stiffness", "1e-10"],
         &["--mass", "1e30", "--stiffness", "1e-30"],
     ] {
-        let mut args = vec!["synth", "--law", "linear", "--v0", "1"];
+        let mut args = vec!["synth", "--model", "linear", "--v0", "1"];
         args.extend(law);
         args.extend(["--duration", "0.01", "--rate", "1000", "--touch", "0.001"]);
         let r = ok(&args);
@@ -227,7 +221,7 @@ fn a_closed_output_pipe_ends_the_tool_quietly() {
     assert_eq!(r.signal, Some(libc::SIGPIPE), "{:?} {}", r.code, r.err);
     // `impact analyze big.csv --csv | head -1`: the same.
     let big = ok(&strs(&t2(&[
-        "--repeat",
+        "--impacts",
         "400",
         "--every",
         "0.02",
@@ -513,7 +507,7 @@ fn options_are_checked_where_they_are_parsed_naming_themselves() {
 
 #[test]
 fn impact_log_refuses_what_the_firmware_cannot_have_written_by_line() {
-    // A real line from the emulated firmware's format (see firmware/README.md).
+    // A real line from the emulated firmware's format (see docs/board.md).
     let line = "impact index=0 status=complete analysis=full clipped=false flags=0 start_sample=5000 end_sample=17000 start_s=0.01 peak_time_s=0.0100251 peak_acceleration_m_s2=4321.5 peak_force_n=259.29 delta_v_m_s=2.5 duration_s=0.0219 baseline_m_s2=0.2 fwhm_s=0.001 filtered_peak_acceleration_m_s2=none impact_velocity_m_s=1.3357 crush_time_s=0.0218 max_deformation_m=0.0186 rebound_velocity_m_s=1.16 cor=0.87 permanent_deformation_m=0.0182 absorbed_energy_j=none two_phase_kc_n_m=none two_phase_kr_n_m=none two_phase_c_n_s_m=none two_phase_permanent_deformation_m=none two_phase_residual=none nonlinear_k=none nonlinear_c_s_m=none nonlinear_exponent=none nonlinear_residual=none hertz_k=none hertz_residual=none report_latency_s=0.0123";
     let scene = "scene rate_hz=500000 v0_m_s=1.3357 drop_height_m=none two_phase=false nonlinear=false fit_exponent=false hertz=false";
     let set = |field: &str, value: &str| {

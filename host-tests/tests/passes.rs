@@ -144,7 +144,7 @@ fn glitches_flat_tops_and_learned_levels_give_the_whole_files_reports_in_passes(
                 "--mass", "0.06", "--v0", "1", "--srs", "--cfc", "1000", "--train", "flight",
             ],
             vec![],
-            vec!["--range", "200", "--trigger", "5"],
+            vec!["--range", "200g", "--trigger", "5"],
         ] {
             let (passes, whole) = passes_and_whole(&file, &args);
             assert_eq!(passes, whole, "clip {clip:?}, {args:?}");
@@ -390,7 +390,7 @@ fn time_axis_errors_read_the_same_on_every_path() {
             &file,
             "--stream",
             "--range",
-            "10",
+            "10g",
             "--trigger",
             "1",
         ]);

@@ -3,7 +3,7 @@
 
 use std::path::PathBuf;
 
-use impact_host::analyze::{self, AnalysisJson, AnalyzeArgs, Units};
+use impact_host::analyze::{self, AnalysisJson, AnalyzeArgs, Level, Units};
 use impact_host::recording::ColumnRef;
 
 fn signals() -> PathBuf {
@@ -279,7 +279,7 @@ fn afrl_delta_v_is_within_two_percent_of_the_sensor_zero_value() {
 fn endaq_dc_channel_gives_one_report_per_bounce_and_marks_the_clipped_ones() {
     // Free fall 13.62-14.62 s, bounces from 14.62 s, then rest: the z axis (16 g DC) sits
     // flat at its rail (16.03 g) for 5-6 samples in the first three bounces.
-    for range in [None, Some(16.0)] {
+    for range in [None, Some(Level::parse("16g").unwrap())] {
         let a = analyze(AnalyzeArgs {
             column: Some(ColumnRef::Name("z_g".into())),
             range,
@@ -504,7 +504,7 @@ fn a_half_sine_cut_flat_at_the_sensor_range_is_clipped() {
         p
     };
     let cut = write("cut.csv", 16.0);
-    for range in [None, Some(16.0)] {
+    for range in [None, Some(Level::parse("16g").unwrap())] {
         let a = analyze(AnalyzeArgs {
             file: cut.clone(),
             range,
@@ -515,7 +515,7 @@ fn a_half_sine_cut_flat_at_the_sensor_range_is_clipped() {
     }
     // The whole pulse, read by a sensor with range to spare: not clipped.
     let whole = write("whole.csv", f64::INFINITY);
-    for range in [None, Some(50.0)] {
+    for range in [None, Some(Level::parse("50g").unwrap())] {
         let a = analyze(AnalyzeArgs {
             file: whole.clone(),
             range,

@@ -16,7 +16,7 @@ fn tmp(name: &str) -> String {
 }
 
 /// The seed bench's ADC codes (offset binary, 12 bits over ±800 m/s², so the full scale is
-/// 4096 codes) at 500 kS/s.
+/// 4096 codes, 1600 m/s²) at 500 kS/s.
 const LEVELS: [&str; 16] = [
     "--rate",
     "500000",
@@ -25,7 +25,7 @@ const LEVELS: [&str; 16] = [
     "--units",
     "m/s2",
     "--range",
-    "4096",
+    "1600",
     "--trigger",
     "10",
     "--edge",
@@ -40,7 +40,7 @@ const LEVELS: [&str; 16] = [
 /// ±1600 m/s².
 const SEED_CSV_LEVELS: [&str; 10] = [
     "--range",
-    "163",
+    "163g",
     "--trigger",
     "10",
     "--edge",
@@ -195,7 +195,7 @@ fn a_wav_stream_gives_the_whole_files_reports() {
         "--units",
         "kgn",
         "--range",
-        "32767",
+        "32.767kgn",
         "--trigger",
         "20000",
         "--json",
@@ -228,9 +228,9 @@ fn a_wav_stream_gives_the_whole_files_reports() {
 #[test]
 fn npy_streams_give_the_whole_files_reports_in_either_order() {
     let dir = concat!(env!("CARGO_MANIFEST_DIR"), "/fixtures/");
-    for (file, gain) in [
-        ("afrl-test1-int16.npy", "0.001"),
-        ("afrl-test1-float32-fortran.npy", "1"),
+    for (file, gain, range) in [
+        ("afrl-test1-int16.npy", "0.001", "40kgn"),
+        ("afrl-test1-float32-fortran.npy", "1", "40000kgn"),
     ] {
         let path = format!("{dir}{file}");
         for column in ["0", "1"] {
@@ -247,7 +247,7 @@ fn npy_streams_give_the_whole_files_reports_in_either_order() {
                     "--gain",
                     gain,
                     "--range",
-                    "40000",
+                    range,
                     "--trigger",
                     "20000",
                     "--json",
@@ -273,7 +273,7 @@ fn npy_streams_give_the_whole_files_reports_in_either_order() {
         "--rate",
         "1000000",
         "--range",
-        "40000",
+        "40000g",
         "--trigger",
         "20000",
         "--stream",
@@ -456,7 +456,10 @@ fn a_long_csv_file_gives_the_same_reports_and_errors_through_the_parallel_reader
 #[test]
 fn tdms_streams_give_the_whole_files_reports() {
     let tdms = concat!(env!("CARGO_MANIFEST_DIR"), "/fixtures/afrl-test1.tdms");
-    for (column, gain) in [("afrl/bottom_kgn", "1"), ("top_codes", "0.001")] {
+    for (column, gain, range) in [
+        ("afrl/bottom_kgn", "1", "40000kgn"),
+        ("top_codes", "0.001", "40kgn"),
+    ] {
         let args = |tail: &'static str| -> Vec<&str> {
             [
                 "analyze",
@@ -468,7 +471,7 @@ fn tdms_streams_give_the_whole_files_reports() {
                 "--units",
                 "kgn",
                 "--range",
-                "40000",
+                range,
                 "--trigger",
                 "20000",
                 "--json",
@@ -488,7 +491,7 @@ fn tdms_streams_give_the_whole_files_reports() {
         &cut,
         "--stream",
         "--range",
-        "40000",
+        "40000g",
         "--trigger",
         "20000",
     ]);

@@ -20,7 +20,7 @@ struct Synth {
 fn exact(args: &[&str]) -> Vec<(f64, f64)> {
     let s = Synth::parse_from(std::iter::once("synth").chain(args.iter().copied()));
     let impact = impact_core::Impact::new(s.args.mass, s.args.v0);
-    let model = s.args.model.model(s.args.law, &impact).unwrap();
+    let model = s.args.params.model(s.args.model, &impact).unwrap();
     bounce_train(&s.args, &model)
         .unwrap()
         .iter()
@@ -118,7 +118,7 @@ fn train(law: &[&str]) -> String {
 #[test]
 fn a_kelvin_voigt_train_has_a_constant_cor() {
     let verdict = train(&[
-        "--law",
+        "--model",
         "kelvin-voigt",
         "--stiffness",
         "1e4",
@@ -131,7 +131,7 @@ fn a_kelvin_voigt_train_has_a_constant_cor() {
 #[test]
 fn the_nonlinear_laws_cor_falls_with_speed() {
     let verdict = train(&[
-        "--law",
+        "--model",
         "nonlinear",
         "--stiffness",
         "1e4",
@@ -145,7 +145,7 @@ fn the_nonlinear_laws_cor_falls_with_speed() {
 fn without_train_a_bounce_has_no_speed_and_a_long_flight_starts_a_new_train() {
     let args = [
         "synth",
-        "--law",
+        "--model",
         "kelvin-voigt",
         "--mass",
         "0.06",

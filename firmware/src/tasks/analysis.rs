@@ -44,7 +44,7 @@ pub async fn analysis(scene: Scene, mut captures: CaptureReceiver) {
     }
 }
 
-/// The captured window as a `wave` line and its `wave_frame` lines (firmware/README.md),
+/// The captured window as a `wave` line and its `wave_frame` lines (docs/board.md),
 /// before the impact's own line.
 async fn send_waveform(capture: &FwCapture, every: u16) {
     let s = capture.summary();

@@ -1,5 +1,5 @@
 //! Tasks shared by the `stm32` and `emulator` builds, the queues joining them, and the three
-//! priorities they run at (see `firmware/README.md`, "Priorities").
+//! priorities they run at (see `docs/board.md`, "Priorities").
 //!
 //! ```text
 //!  high    sample source ──blocks (zero-copy, 8 deep)──► stream: baseline, trigger,   medium
@@ -39,7 +39,7 @@ pub const PRE_TRIGGER_LEN: usize = 4096;
 
 /// Capture length, samples: 15360 (30.7 ms at 500 kS/s, the seed bench's 26 ms capture with
 /// room). Two captures (60 KiB) and the analysis's f32 workspace (60 KiB, in the CCM RAM) are
-/// the bulk of the board's RAM; see firmware/README.md.
+/// the bulk of the board's RAM; see docs/board.md.
 #[cfg(feature = "stm32")]
 pub const CAPTURE_LEN: usize = 15360;
 

@@ -1,7 +1,7 @@
 //! Reporter task (middle priority, beside the stream): logs the impacts (analysed ones from the analysis task,
 //! skipped ones from the stream task, merged back into index order), the heartbeats and the
 //! summary as defmt lines in a fixed, machine-parseable `name key=value ...` format
-//! (documented in firmware/README.md and parsed back by the host's `impact log` /
+//! (documented in docs/board.md and parsed back by the host's `impact log` /
 //! `impact emulate`), warns when reports stop coming, and hands the end of a finite stream to
 //! the board (which, in the emulator, exits QEMU with the run's status).
 //!

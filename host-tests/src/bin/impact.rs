@@ -10,12 +10,33 @@ use impact_host::{
     target_bench, throughput,
 };
 
+// The examples in the help are commands of docs/user-guide.md, run by its tests.
+const ANALYZE_EXAMPLES: &str = "Examples:
+  impact analyze host-tests/data/afrl-drop-tower/series1_test1_full_100ms.csv
+  impact analyze seed.csv --mass 0.06 --v0 1.3357 --plot seed.svg
+  impact analyze train.csv --mass 0.06 --v0 1.3357 --train flight
+  impact analyze host-tests/data/endaq-high-drop/High-Drop_16g-DC_full.csv --axes x_g,y_g,z_g
+  impact analyze host-tests/data/afrl-drop-tower/series1_test1_full_100ms.csv --srs --json";
+const EMULATE_EXAMPLES: &str = "Examples:
+  impact emulate host-tests/data/afrl-drop-tower/series1_test1_full_100ms.csv --realtime
+  impact emulate seed.csv --mass 0.06 --v0 1.3357 --waveforms --log board.log";
+const SIMULATE_EXAMPLES: &str = "Examples:
+  impact simulate --model hertz --mass 8.419e-3 --v0 2 --radius 6.35e-3 --youngs 200e9 --poisson 0.3
+  impact simulate --model kelvin-voigt --mass 0.06 --v0 1.3357 --stiffness 2e5 --damping 8 --target host-tests/examples/mount.json";
+const SYNTH_EXAMPLES: &str = "Examples:
+  impact synth --model two-phase --mass 0.06 --v0 1.3357 --max-deformation 0.0186 --kr 12376 --permanent 0.0182 --damping 2 -o seed.csv
+  impact synth --model nonlinear --mass 0.06 --v0 1.3357 --stiffness 1e4 --damping 0.5 --bounces 8 --duration 1.5 -o train.csv";
+const LOG_EXAMPLES: &str = "Examples:
+  impact log board.log --csv
+  impact log board.log --plot board.svg";
+
 #[derive(Parser)]
 #[command(
     name = "impact",
     version,
     allow_negative_numbers = true,
-    about = "Live impact monitoring: models, solvers and recorded-signal analysis"
+    about = "Live impact monitoring: models, solvers and recorded-signal analysis",
+    after_help = "Start with `impact analyze FILE`; the user guide is docs/user-guide.md."
 )]
 struct Cli {
     #[command(subcommand)]
@@ -25,23 +46,34 @@ struct Cli {
 #[derive(Subcommand)]
 enum Command {
     /// Solve one impact of a contact model.
-    #[command(allow_negative_numbers = true)]
+    #[command(allow_negative_numbers = true, after_help = SIMULATE_EXAMPLES)]
     Simulate(Box<simulate::SimulateArgs>),
     /// Analyse a recorded signal: one report per impact.
-    #[command(allow_negative_numbers = true)]
+    #[command(allow_negative_numbers = true, after_help = ANALYZE_EXAMPLES)]
     Analyze(Box<analyze::AnalyzeArgs>),
     /// Analyse a recorded signal on the emulated firmware (QEMU): the same output as `analyze`.
-    #[command(allow_negative_numbers = true)]
+    #[command(
+        allow_negative_numbers = true,
+        after_help = EMULATE_EXAMPLES,
+        // The emulator replays a recording it has read whole: no one-pass reading.
+        mut_arg("stream", |a| a.hide(true))
+    )]
     Emulate(Box<emulate::EmulateArgs>),
-    /// Turn a decoded defmt log of the firmware into JSON (default) or CSV.
+    /// Turn the firmware's defmt log into JSON (default) or CSV, its waveforms into figures.
+    #[command(after_help = LOG_EXAMPLES)]
     Log(log::LogArgs),
-    /// Render a model impact as an accelerometer recording (CSV on stdout, raw codes with --raw).
-    #[command(allow_negative_numbers = true)]
+    /// Render a model impact as an accelerometer recording (CSV on stdout or --output, raw
+    /// ADC codes with --raw).
+    #[command(allow_negative_numbers = true, after_help = SYNTH_EXAMPLES)]
     Synth {
         #[command(flatten)]
         args: Box<synth::SynthArgs>,
-        /// Also write the raw ADC codes as little-endian i16 to this file.
-        #[arg(long)]
+        /// Write the CSV (time_s, accel_m_s2) to this file instead of standard output.
+        #[arg(short = 'o', long, help_heading = "Output", value_name = "FILE.csv")]
+        output: Option<PathBuf>,
+        /// Also write the raw ADC codes as little-endian i16 to this file (`impact analyze
+        /// FILE.i16 --rate ...` reads it).
+        #[arg(long, help_heading = "Output", value_name = "FILE.i16")]
         raw: Option<PathBuf>,
     },
     /// Benchmarks.
@@ -135,30 +167,13 @@ fn restore_sigpipe() {
 fn main() -> ExitCode {
     #[cfg(unix)]
     restore_sigpipe();
-    let cli = match Cli::try_parse() {
-        Ok(cli) => cli,
-        Err(e) => {
-            use clap::error::ErrorKind;
-            if matches!(
-                e.kind(),
-                ErrorKind::DisplayHelp
-                    | ErrorKind::DisplayVersion
-                    | ErrorKind::DisplayHelpOnMissingArgumentOrSubcommand
-            ) {
-                let _ = e.print();
-                return ExitCode::SUCCESS;
-            }
-            // One line, naming the parameter.
-            let text = e.to_string();
-            let mut lines = text.lines().map(str::trim).filter(|l| !l.is_empty());
-            let first = lines.next().unwrap_or("error: bad arguments");
-            match lines.next() {
-                Some(detail) if first.ends_with(':') => eprintln!("{first} {detail}"),
-                _ => eprintln!("{first}"),
-            }
-            return ExitCode::from(2);
-        }
-    };
+    // clap's own message on a usage error (the accepted values, the usage line, a hint),
+    // exit status 2; help and version on stdout, status 0.
+    let cli = Cli::parse();
+    // The docs' tests check that every documented command parses (tests/docs.rs).
+    if std::env::var_os("IMPACT_PARSE_ONLY").is_some() {
+        return ExitCode::SUCCESS;
+    }
     let result = run(cli);
     if let Some(bar) = PROGRESS.get() {
         bar.finish_and_clear();
@@ -172,7 +187,12 @@ fn main() -> ExitCode {
         }
     }
     match result {
-        Ok(()) => ExitCode::SUCCESS,
+        Ok(()) => {
+            for note in impact_host::take_notes() {
+                eprintln!("note: {note}");
+            }
+            ExitCode::SUCCESS
+        }
         Err(e) => {
             eprintln!("error: {e}");
             ExitCode::from(1)
@@ -242,19 +262,36 @@ fn run(cli: Cli) -> Result<(), String> {
         }
         Command::Emulate(args) => emulate::emulate(&args)?,
         Command::Log(args) => log::log(&args)?,
-        Command::Synth { args, raw } => {
+        Command::Synth { args, output, raw } => {
+            if let (Some(o), Some(r)) = (&output, &raw) {
+                if o == r {
+                    return Err(format!("--output and --raw are both {}", o.display()));
+                }
+            }
             let rec = synth::synth(&args)?;
             if let Some(path) = raw {
                 let bytes: Vec<u8> = rec.samples.iter().flat_map(|c| c.to_le_bytes()).collect();
                 std::fs::write(&path, bytes).map_err(|e| format!("{}: {e}", path.display()))?;
             }
-            let stdout = std::io::stdout().lock();
-            synth::write_csv(
-                &rec,
-                &args,
-                &mut std::io::BufWriter::with_capacity(1 << 16, stdout),
-            )
-            .map_err(|e| format!("stdout: {e}"))?;
+            match output {
+                Some(path) => {
+                    let file = std::fs::File::create(&path)
+                        .map_err(|e| format!("{}: {e}", path.display()))?;
+                    let mut out = std::io::BufWriter::with_capacity(1 << 16, file);
+                    synth::write_csv(&rec, &args, &mut out)
+                        .and_then(|()| std::io::Write::flush(&mut out))
+                        .map_err(|e| format!("{}: {e}", path.display()))?;
+                }
+                None => {
+                    let stdout = std::io::stdout().lock();
+                    synth::write_csv(
+                        &rec,
+                        &args,
+                        &mut std::io::BufWriter::with_capacity(1 << 16, stdout),
+                    )
+                    .map_err(|e| format!("stdout: {e}"))?;
+                }
+            }
         }
         Command::Bench {
             which: Bench::Realtime(args),
@@ -355,6 +392,12 @@ fn run(cli: Cli) -> Result<(), String> {
                 );
             } else {
                 print!("{}", stability::table(&rows));
+            }
+            let failures = stability::failures(&rows);
+            if failures > 0 {
+                return Err(format!(
+                    "bench stability: {failures} results outside their stated bounds or not finite"
+                ));
             }
         }
         Command::Bench {

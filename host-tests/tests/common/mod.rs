@@ -28,7 +28,7 @@ pub fn impact_ok(args: &[&str]) -> (String, String) {
 #[allow(dead_code)] // not every test file needs it
 pub const SYNTH_T2: [&str; 13] = [
     "synth",
-    "--law",
+    "--model",
     "two-phase",
     "--mass",
     "0.06",
@@ -75,4 +75,17 @@ pub fn peak_memory_mib(stderr: &str) -> f64 {
         .and_then(|v| v.trim_end_matches("kB").trim().parse::<f64>().ok())
         .expect("peak memory printed")
         / 1024.0
+}
+
+/// A refusal: a one-line error naming `want` (exit 1), or clap's usage error (exit 2), which
+/// starts with `error:` and names `want` with the accepted values, the usage and a hint.
+#[allow(dead_code)] // not every test file needs it
+pub fn assert_refused(code: Option<i32>, err: &str, want: &str, what: &str) {
+    assert!(matches!(code, Some(1 | 2)), "{what}: exit {code:?}\n{err}");
+    if code == Some(1) {
+        assert_eq!(err.trim().lines().count(), 1, "{what}: {err}");
+    }
+    assert!(err.starts_with("error: "), "{what}: {err}");
+    assert!(err.contains(want), "{what}: wanted {want:?} in {err}");
+    assert!(!err.contains("panicked"), "{what}: {err}");
 }

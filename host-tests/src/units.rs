@@ -1,0 +1,241 @@
+//! Units of a recorded channel and of the levels given for it: what a header names
+//! (`bottom_kgn`, `x_g`, `table_m_s2`, `force_n`), what `--units` states, and levels written
+//! with or without a unit (`--trigger 5g`, `--range 16g`; a bare number is in m/s²).
+
+use std::fmt;
+
+use clap::ValueEnum;
+use impact_core::solve::bounce::STANDARD_GRAVITY;
+use serde::{Deserialize, Deserializer};
+
+use crate::table::words;
+
+/// Units of a recorded channel.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum, Deserialize)]
+/// Scene files use the command line's spellings (`g`, `m/s2`, `kgn`, `n`).
+pub enum Units {
+    /// Standard gravities (9.80665 m/s²).
+    #[serde(rename = "g", alias = "G")]
+    G,
+    /// m/s².
+    #[value(name = "m/s2")]
+    #[serde(rename = "m/s2", alias = "MS2", alias = "ms2")]
+    MS2,
+    /// Kilo-g (1000 g), as in the AFRL drop-tower data.
+    #[serde(rename = "kgn", alias = "Kgn")]
+    Kgn,
+    /// Force in N (divided by the mass, or by 1 kg if none is given).
+    #[serde(rename = "n", alias = "N")]
+    N,
+}
+
+impl Units {
+    /// m/s² per unit (per N: one over the mass, 1 kg if none is given).
+    pub fn to_m_s2(self, mass_kg: Option<f64>) -> f64 {
+        match self {
+            Units::G => STANDARD_GRAVITY,
+            Units::MS2 => 1.0,
+            Units::Kgn => 1000.0 * STANDARD_GRAVITY,
+            Units::N => 1.0 / mass_kg.unwrap_or(1.0),
+        }
+    }
+
+    /// The unit's name as `--units` spells it.
+    pub fn name(self) -> &'static str {
+        match self {
+            Units::G => "g",
+            Units::MS2 => "m/s2",
+            Units::Kgn => "kgn",
+            Units::N => "n",
+        }
+    }
+
+    /// The unit a column header names in a word after its first (`x_g`, `bottom_kgn`,
+    /// `table_m_s2`, `accel [m/s²]`, `force_n`, `Force (N)`); `None` if it names none.
+    pub fn of_header(header: &str) -> Option<Units> {
+        let h = header.to_lowercase();
+        let w: Vec<&str> = words(&h).skip(1).collect();
+        // m/s², m/s^2, m_s2, ms2, mps2 (as two words or one).
+        let m_s2 = w
+            .windows(2)
+            .any(|p| p[0] == "m" && matches!(p[1], "s2" | "s²" | "s" | "sec2"))
+            || w.iter().any(|x| matches!(*x, "ms2" | "mps2" | "ms²"));
+        if m_s2 {
+            return Some(Units::MS2);
+        }
+        if w.windows(2).any(|p| p[0] == "kg" && p[1] == "n") {
+            return Some(Units::Kgn);
+        }
+        w.iter().rev().find_map(|x| match *x {
+            "g" | "gs" | "gee" => Some(Units::G),
+            "kgn" | "kgs" => Some(Units::Kgn),
+            "n" | "newton" | "newtons" => Some(Units::N),
+            _ => None,
+        })
+    }
+
+    /// The channel's units: the ones stated (`--units` or the scene file), else the ones its
+    /// header names, else g; an error naming both if they disagree.
+    pub fn resolve(stated: Option<Units>, column: &str) -> Result<Units, String> {
+        match (stated, Units::of_header(column)) {
+            (Some(s), Some(h)) if s != h => Err(format!(
+                "--units {} contradicts the column's header {column:?}, which names {}: drop --units or choose another column",
+                s.name(),
+                h.name()
+            )),
+            (Some(s), _) => Ok(s),
+            (None, Some(h)) => Ok(h),
+            (None, None) => Ok(Units::G),
+        }
+    }
+}
+
+/// A level of the channel (`--trigger`, `--edge`, `--range`): a number in m/s², or with a
+/// unit (`5g`, `16 g`, `2kgn`, `490m/s2`, `200n` for a force channel).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Level {
+    pub value: f64,
+    pub units: Units,
+}
+
+impl Level {
+    /// A level in m/s².
+    pub const fn m_s2(value: f64) -> Self {
+        Self {
+            value,
+            units: Units::MS2,
+        }
+    }
+
+    /// The level in m/s² (a force over the mass).
+    pub fn to_m_s2(self, mass_kg: Option<f64>) -> f64 {
+        self.value * self.units.to_m_s2(mass_kg)
+    }
+
+    /// Parses `VALUE[UNIT]`: finite and > 0.
+    pub fn parse(s: &str) -> Result<Level, String> {
+        let s = s.trim();
+        let split = s
+            .find(|c: char| c.is_alphabetic() && c != 'e' && c != 'E')
+            .unwrap_or(s.len());
+        let (number, unit) = s.split_at(split);
+        let value: f64 = number
+            .trim()
+            .parse()
+            .map_err(|_| format!("{s:?} is not a number with an optional unit (5, 5g, 49m/s2)"))?;
+        if !(value.is_finite() && value > 0.0) {
+            return Err("must be finite and > 0".into());
+        }
+        let units = match unit.trim().to_lowercase().as_str() {
+            "" | "m/s2" | "m/s²" | "m/s^2" | "ms2" | "m_s2" => Units::MS2,
+            "g" => Units::G,
+            "kgn" | "kg_n" => Units::Kgn,
+            "n" => Units::N,
+            other => {
+                return Err(format!(
+                    "unit {other:?}: one of m/s2 (the default), g, kgn, n"
+                ))
+            }
+        };
+        Ok(Level { value, units })
+    }
+}
+
+impl fmt::Display for Level {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self.units {
+            Units::MS2 => write!(f, "{} m/s²", self.value),
+            u => write!(f, "{}{}", self.value, u.name()),
+        }
+    }
+}
+
+impl std::str::FromStr for Level {
+    type Err = String;
+    fn from_str(s: &str) -> Result<Self, String> {
+        Level::parse(s)
+    }
+}
+
+/// A level in a scene file: a number (m/s²) or a string with a unit (`"16g"`). (Read through
+/// `serde_json::Value`: a dependency turns on serde_json's `arbitrary_precision`, under which
+/// an untagged enum cannot take a number.)
+impl<'de> Deserialize<'de> for Level {
+    fn deserialize<D: Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+        use serde::de::Error;
+        match serde_json::Value::deserialize(d)? {
+            serde_json::Value::Number(n) => match n.as_f64() {
+                Some(v) if v.is_finite() && v > 0.0 => Ok(Level::m_s2(v)),
+                _ => Err(D::Error::custom(format!("{n}: must be finite and > 0"))),
+            },
+            serde_json::Value::String(s) => Level::parse(&s).map_err(D::Error::custom),
+            other => Err(D::Error::custom(format!(
+                "{other}: a level is a number (m/s²) or a string with its unit (\"16g\")"
+            ))),
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn headers_name_their_units() {
+        for (h, u) in [
+            ("x_g", Some(Units::G)),
+            ("bottom_kgn", Some(Units::Kgn)),
+            ("table_m_s2", Some(Units::MS2)),
+            ("accel [m/s²]", Some(Units::MS2)),
+            ("accel_mps2", Some(Units::MS2)),
+            ("force_n", Some(Units::N)),
+            ("Force (N)", Some(Units::N)),
+            ("top_kg_n", Some(Units::Kgn)),
+            ("response", None),
+            ("g", None),
+            ("test1", None),
+            ("column 2", None),
+        ] {
+            assert_eq!(Units::of_header(h), u, "{h}");
+        }
+    }
+
+    #[test]
+    fn stated_units_must_agree_with_the_header() {
+        assert_eq!(Units::resolve(None, "bottom_kgn"), Ok(Units::Kgn));
+        assert_eq!(
+            Units::resolve(Some(Units::Kgn), "bottom_kgn"),
+            Ok(Units::Kgn)
+        );
+        assert_eq!(Units::resolve(None, "test1"), Ok(Units::G));
+        assert_eq!(Units::resolve(Some(Units::MS2), "test1"), Ok(Units::MS2));
+        let e = Units::resolve(Some(Units::G), "table_m_s2").unwrap_err();
+        assert!(e.contains("--units g") && e.contains("m/s2"), "{e}");
+    }
+
+    #[test]
+    fn scene_files_give_levels_as_numbers_or_with_units() {
+        let l: Level = serde_json::from_str("980.665").unwrap();
+        assert_eq!(l, Level::m_s2(980.665));
+        let l: Level = serde_json::from_str("\"16g\"").unwrap();
+        assert_eq!(l.units, Units::G);
+        assert!(serde_json::from_str::<Level>("-1").is_err());
+        assert!(serde_json::from_str::<Level>("true").is_err());
+    }
+
+    #[test]
+    fn levels_take_an_optional_unit() {
+        assert_eq!(Level::parse("49"), Ok(Level::m_s2(49.0)));
+        assert_eq!(Level::parse("1e3"), Ok(Level::m_s2(1000.0)));
+        let g = Level::parse("5g").unwrap();
+        assert!((g.to_m_s2(None) - 49.03325).abs() < 1e-9);
+        assert_eq!(Level::parse("16 g").unwrap().units, Units::G);
+        assert_eq!(Level::parse("2kgn").unwrap().units, Units::Kgn);
+        assert_eq!(Level::parse("2.5E1m/s2"), Ok(Level::m_s2(25.0)));
+        assert!((Level::parse("200n").unwrap().to_m_s2(Some(2.0)) - 100.0).abs() < 1e-12);
+        assert!(Level::parse("5 furlongs").is_err());
+        assert!(Level::parse("-5g").is_err());
+        assert!(Level::parse("NaN").is_err());
+        assert!(Level::parse("g").is_err());
+    }
+}
