@@ -2,7 +2,7 @@
 # Installs what the project needs beyond a Rust toolchain, idempotently:
 #   - the Cortex-M4F Rust target (thumbv7em-none-eabihf), rustfmt and clippy;
 #   - qemu-system-arm (Debian package) for the emulated firmware;
-#   - arm-none-eabi-size (Debian binutils-arm-none-eabi) to print flash and RAM use.
+#   - arm-none-eabi-objdump (Debian binutils-arm-none-eabi) for `impact bench m4`'s cycle model.
 # With --board, also probe-rs (crates.io `probe-rs-tools`, a few minutes to build) to flash
 # the STM32F4-Discovery and read its defmt log (`cargo fw-run`).
 # Run as root or with sudo available for apt-get.
