@@ -23,6 +23,8 @@ pub const MAX_FIT_POINTS: usize = 2048;
 /// `Workspace::new()` is all zeros, so a `static` one starts in `.bss`.
 pub struct Workspace<const CAP: usize> {
     buf: [f32; CAP],
+    /// The spectra's block statistics and marks.
+    spectrum: crate::signal::spectrum::Scratch,
 }
 
 impl<const CAP: usize> Default for Workspace<CAP> {
@@ -41,7 +43,10 @@ impl<const CAP: usize> Workspace<CAP> {
     pub const fn new() -> Self {
         #[allow(clippy::let_unit_value)]
         let _ = Self::CHECK;
-        Self { buf: [0.0; CAP] }
+        Self {
+            buf: [0.0; CAP],
+            spectrum: crate::signal::spectrum::Scratch::new(),
+        }
     }
 }
 
@@ -117,9 +122,8 @@ pub fn analyse<const CAP: usize>(
 }
 
 /// The window from [`SPECTRUM_LEAD`] samples before the onset to the end of the capture, in
-/// m/s² above the baseline, and its spectra. Not inlined: the spectra's marks (some 4 KiB)
-/// stay out of the kinematics' stack frame, which they would push beyond the M4's short
-/// stack offsets.
+/// m/s² above the baseline, and its spectra (their scratch in the workspace, not on the
+/// stack). Not inlined: its frame stays out of the kinematics'.
 #[inline(never)]
 fn spectrum<const CAP: usize>(
     capture: &Capture<CAP>,
@@ -138,13 +142,18 @@ fn spectrum<const CAP: usize>(
     let skip = (from - s.first_index) as usize;
     let window = samples.get(skip..)?;
     // The whole workspace: the room beyond the window holds the decimated levels' copies.
-    let buf = &mut work.buf;
+    let Workspace { buf, spectrum } = work;
     let len = window.len().min(buf.len());
     for (slot, &x) in buf.iter_mut().zip(window) {
         *slot = deviation.of(x) as f32 * per_count;
     }
-    let mut sp =
-        crate::signal::spectrum::spectrum(buf, len, scene.calibration.sample_rate_hz, settings)?;
+    let mut sp = crate::signal::spectrum::spectrum(
+        buf,
+        len,
+        scene.calibration.sample_rate_hz,
+        settings,
+        spectrum,
+    )?;
     sp.from_sample = from;
     sp.to_sample = from + window.len() as u64;
     Some(sp)

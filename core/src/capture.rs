@@ -48,7 +48,57 @@ pub struct Summary {
     /// bounce train, the bounce's ([`crate::train`]).
     pub v0_m_s: Option<f32>,
     /// The impact continues a bounce train: both measures of its approach speed.
-    pub bounce: Option<Bounce>,
+    pub bounce: BounceSlot,
+}
+
+/// A summary's bounce, all zeros when the impact continues no train: `Option<Bounce>` keeps
+/// `None` in a non-zero tag (the niche of its `Option<f32>`), which would put every static
+/// capture in `.data` (its image in flash, copied at start-up) instead of `.bss`.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct BounceSlot {
+    /// The bounce's number (1 for the first bounce after the train's first impact); 0 for no
+    /// bounce.
+    number: u32,
+    flight_s: f32,
+    v0_flight_m_s: f32,
+    v0_rebound_m_s: f32,
+    has_rebound: bool,
+}
+
+impl BounceSlot {
+    /// No bounce.
+    pub const NONE: Self = Self {
+        number: 0,
+        flight_s: 0.0,
+        v0_flight_m_s: 0.0,
+        v0_rebound_m_s: 0.0,
+        has_rebound: false,
+    };
+
+    /// The bounce kept (a bounce's number is at least 1).
+    pub fn get(&self) -> Option<Bounce> {
+        (self.number > 0).then_some(Bounce {
+            number: self.number,
+            flight_s: self.flight_s,
+            v0_flight_m_s: self.v0_flight_m_s,
+            v0_rebound_m_s: self.has_rebound.then_some(self.v0_rebound_m_s),
+        })
+    }
+}
+
+impl From<Option<Bounce>> for BounceSlot {
+    fn from(b: Option<Bounce>) -> Self {
+        match b {
+            Some(b) => Self {
+                number: b.number.max(1),
+                flight_s: b.flight_s,
+                v0_flight_m_s: b.v0_flight_m_s,
+                v0_rebound_m_s: b.v0_rebound_m_s.unwrap_or(0.0),
+                has_rebound: b.v0_rebound_m_s.is_some(),
+            },
+            None => Self::NONE,
+        }
+    }
 }
 
 impl Summary {
@@ -70,7 +120,7 @@ impl Summary {
         total_c: 0,
         contact_c: None,
         v0_m_s: None,
-        bounce: None,
+        bounce: BounceSlot::NONE,
     };
 }
 
@@ -147,4 +197,30 @@ pub trait Sink<const CAP: usize> {
     /// An impact without a buffer is over: its report has the streaming fields only
     /// (`analysis: skipped`).
     fn skipped(&mut self, report: &ImpactReport);
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn an_empty_summary_has_no_bounce_and_a_bounce_survives_the_slot() {
+        // NONE is the all-zero value (Default): an empty capture is all zeros, so its statics
+        // go to `.bss` (the firmware's memory check reads it off the ELF).
+        assert_eq!(BounceSlot::NONE, BounceSlot::default());
+        assert_eq!(Capture::<64>::new().summary.bounce.get(), None);
+        let b = Bounce {
+            number: 3,
+            flight_s: 0.1,
+            v0_flight_m_s: 0.5,
+            v0_rebound_m_s: None,
+        };
+        assert_eq!(BounceSlot::from(Some(b)).get(), Some(b));
+        let b = Bounce {
+            v0_rebound_m_s: Some(0.4),
+            ..b
+        };
+        assert_eq!(BounceSlot::from(Some(b)).get(), Some(b));
+        assert_eq!(BounceSlot::from(None), BounceSlot::NONE);
+    }
 }

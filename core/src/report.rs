@@ -262,7 +262,7 @@ pub fn streaming(s: &Summary, scene: &Scene) -> ImpactReport {
         filtered_peak_acceleration_m_s2: None,
         kinematics: None,
         fits: Fits::default(),
-        bounce: s.bounce,
+        bounce: s.bounce.get(),
         spectrum: None,
     }
 }

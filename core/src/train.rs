@@ -167,7 +167,7 @@ impl Tracker {
         *self = Tracker {
             separation,
             rebound_m_s: rebound,
-            number: s.bounce.map_or(0, |b| b.number),
+            number: s.bounce.get().map_or(0, |b| b.number),
         };
     }
 }

@@ -460,6 +460,14 @@ struct Rest {
     norm: f32,
 }
 
+impl Rest {
+    const ZERO: Self = Self {
+        sum: 0.0,
+        max: 0.0,
+        norm: 0.0,
+    };
+}
+
 /// Blocks whose statistics a level keeps: 32 768 samples (the board's windows are shorter);
 /// blocks beyond are always computed.
 const STAT_BLOCKS: usize = 128;
@@ -505,6 +513,43 @@ struct State {
 struct Mark {
     start: State,
     bound: [f32; 2],
+}
+
+impl Mark {
+    const ZERO: Self = Self {
+        start: State {
+            w1: 0.0,
+            w2: 0.0,
+            w3: 0.0,
+        },
+        bound: [0.0; 2],
+    };
+}
+
+/// What the spectra need besides the samples: each block's statistics and marks and the
+/// bands' frequencies (some 5 KiB), kept in the analysis's workspace instead of on the stack
+/// (on the board the analysis task runs on the one stack the interrupts share).
+/// `Scratch::new()` is all zeros.
+pub struct Scratch {
+    stats: [Rest; STAT_BLOCKS],
+    marks: [Mark; STAT_BLOCKS],
+    freqs: [f32; MAX_BANDS],
+}
+
+impl Scratch {
+    pub const fn new() -> Self {
+        Self {
+            stats: [Rest::ZERO; STAT_BLOCKS],
+            marks: [Mark::ZERO; STAT_BLOCKS],
+            freqs: [0.0; MAX_BANDS],
+        }
+    }
+}
+
+impl Default for Scratch {
+    fn default() -> Self {
+        Self::new()
+    }
 }
 
 /// Both oscillators of a band in direct form II: one recursion (shared poles), two
@@ -738,10 +783,15 @@ pub fn spectrum(
     len: usize,
     rate_hz: f32,
     settings: &SpectrumSettings,
+    scratch: &mut Scratch,
 ) -> Option<Spectrum> {
     settings.check_parameters().ok()?;
-    let mut freqs = [0.0f32; MAX_BANDS];
-    let n = settings.bands(rate_hz, &mut freqs);
+    let Scratch {
+        stats,
+        marks,
+        freqs,
+    } = scratch;
+    let n = settings.bands(rate_hz, freqs);
     if n == 0 {
         return None;
     }
@@ -759,9 +809,7 @@ pub fn spectrum(
     let mut len = len.min(x.len());
     let mut rate = rate_hz;
     let mut compensated: Option<(f32, core::ops::Range<usize>)> = None;
-    let mut stats = [Rest::default(); STAT_BLOCKS];
     let mut stats_rate = 0.0f32;
-    let mut marks = [Mark::default(); STAT_BLOCKS];
     // From the highest band down, halving the rate whenever a band falls to rate / 64.
     for k in (0..n).rev() {
         let f = freqs.get(k).copied().unwrap_or(0.0);
@@ -785,13 +833,13 @@ pub fn spectrum(
             (_, false) => Input::Plain(x.get(..len).unwrap_or(&[])),
         };
         if stats_rate != rate {
-            rests(input, &mut stats);
+            rests(input, stats);
             stats_rate = rate;
         }
         let (s, p) = band(
             input,
-            &stats,
-            &mut marks,
+            stats,
+            marks,
             f,
             settings.damping,
             rate,
@@ -927,7 +975,7 @@ mod tests {
             let x = half_sine(1000.0, dur, rate, 64);
             let mut buf: Vec<f32> = x.iter().map(|v| *v as f32).collect();
             let len = buf.len();
-            let s = spectrum(&mut buf, len, rate as f32, &SpectrumSettings::new()).unwrap();
+            let s = spectrum(&mut buf, len, rate as f32, &SpectrumSettings::new(), &mut Scratch::new()).unwrap();
             let mut worst: f64 = 0.0;
             let mut freqs = [0.0f64; MAX_BANDS];
             assert_eq!(srs::bands(6, 10.0, rate, &mut freqs), s.bands as usize);

@@ -535,7 +535,7 @@ impl<const PRE: usize> Stream<PRE> {
             total_c: a.total_c,
             contact_c: a.separation.map(|_| a.separation_c - a.pre_onset_c),
             v0_m_s: v0,
-            bounce,
+            bounce: bounce.into(),
         };
         self.train.ended(&summary, &self.scene);
         self.counters.impacts += 1;
