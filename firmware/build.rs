@@ -3,8 +3,10 @@
 //! workspace root's `memory.x`, which includes `board-memory.x` from that path:
 //!
 //! * `stm32` (default): `firmware/stm32/board-memory.x` (STM32F407VG flash and SRAM);
-//! * `emulator`: `firmware/emulator/board-memory.x` (QEMU `mps2-an386`: code RAM at
-//!   0x0000_0000, data RAM at 0x2000_0000);
+//! * `emulator`: `firmware/emulator/board-memory.x` (QEMU `mps2-an386`: the board's
+//!   regions and sizes at the MPS2's addresses);
+//! * `m4-bench` (implies `emulator`): `firmware/m4-bench/board-memory.x`, the emulator's map
+//!   with all 4 MiB of data RAM for statics (the bench holds a whole recording in RAM);
 //! * `panic-check` alone (neither of the above): the STM32F407VG map, for the
 //!   `panic-check` binary (`src/bin/panic_check.rs`).
 //!
@@ -37,7 +39,14 @@ fn main() {
         );
     }
 
-    let memory_dir = manifest_dir.join(if emulator { "emulator" } else { "stm32" });
+    let m4_bench = env::var_os("CARGO_FEATURE_M4_BENCH").is_some();
+    let memory_dir = manifest_dir.join(if m4_bench {
+        "m4-bench"
+    } else if emulator {
+        "emulator"
+    } else {
+        "stm32"
+    });
     let memory_x = memory_dir.join("board-memory.x");
 
     println!("cargo:rustc-link-search={}", memory_dir.display());

@@ -21,6 +21,7 @@
 #![allow(clippy::neg_cmp_op_on_partial_ord)]
 
 pub mod analysis;
+pub mod board;
 pub mod capture;
 pub mod fit;
 pub mod model;

@@ -1,7 +1,8 @@
-//! Stack high-water mark, on both builds: the free RAM between the statics and the current
+//! The RAM start-up leaves to the firmware, on both builds: the CCM section zeroed
+//! ([`zero_ccmram`]), and the stack's high-water mark: the stack region below the current
 //! frame is painted at start-up, and [`peak_bytes`] finds how deep the stack has gone since
 //! (interrupts included: they share the main stack). The heartbeat and the summary report it,
-//! so a board run shows its margin (see docs/board.md for the RAM budget).
+//! so every run shows its margin (see docs/board.md for the RAM budget).
 
 use core::sync::atomic::{AtomicUsize, Ordering};
 
@@ -14,10 +15,26 @@ static BOTTOM: AtomicUsize = AtomicUsize::new(0);
 static TOP: AtomicUsize = AtomicUsize::new(0);
 
 extern "C" {
-    /// Initial stack pointer (cortex-m-rt's link.x: the end of RAM).
+    /// Initial stack pointer: the top of the stack region (board-memory.x).
     static _stack_start: u32;
-    /// Lowest address the stack may reach (cortex-m-rt's link.x: the end of the statics).
+    /// Lowest address the stack may reach: the bottom of the stack region (board-memory.x).
     static _stack_end: u32;
+    /// Start and end of the `.ccmram` section (board-memory.x).
+    static mut __sccmram: u32;
+    static mut __eccmram: u32;
+}
+
+/// Zeroes the `.ccmram` section, which cortex-m-rt neither loads nor zeroes (the statics
+/// there start as the zeros they are declared with). Call once, first thing.
+pub fn zero_ccmram() {
+    // SAFETY: first thing after reset, before anything in `.ccmram` is used: the section is
+    // word-aligned and nothing else touches it yet.
+    unsafe {
+        let start = core::ptr::addr_of_mut!(__sccmram);
+        let end = core::ptr::addr_of_mut!(__eccmram);
+        let words = (end as usize).saturating_sub(start as usize) / 4;
+        core::ptr::write_bytes(start, 0, words);
+    }
 }
 
 fn stack_start() -> usize {
@@ -43,7 +60,9 @@ pub fn paint() {
 }
 
 /// Deepest stack use since [`paint`], in bytes from the initial stack pointer, and whether the
-/// stack reached the statics (every painted word overwritten); `None` if nothing was painted.
+/// stack reached its bottom (every painted word overwritten); `None` if nothing was painted.
+/// Reads the painted words from the bottom up to the first one overwritten: at most the
+/// stack's size (24 KiB, some 6 000 loads), less as the peak grows.
 pub fn peak_bytes() -> Option<(usize, bool)> {
     let (bottom, top) = (BOTTOM.load(Ordering::Relaxed), TOP.load(Ordering::Relaxed));
     if bottom >= top {

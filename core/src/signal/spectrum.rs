@@ -975,7 +975,14 @@ mod tests {
             let x = half_sine(1000.0, dur, rate, 64);
             let mut buf: Vec<f32> = x.iter().map(|v| *v as f32).collect();
             let len = buf.len();
-            let s = spectrum(&mut buf, len, rate as f32, &SpectrumSettings::new(), &mut Scratch::new()).unwrap();
+            let s = spectrum(
+                &mut buf,
+                len,
+                rate as f32,
+                &SpectrumSettings::new(),
+                &mut Scratch::new(),
+            )
+            .unwrap();
             let mut worst: f64 = 0.0;
             let mut freqs = [0.0f64; MAX_BANDS];
             assert_eq!(srs::bands(6, 10.0, rate, &mut freqs), s.bands as usize);

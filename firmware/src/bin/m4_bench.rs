@@ -7,7 +7,7 @@
 //! * `scene key=value ...`: the scene of the next streams, from the board's
 //!   [`scene::BENCH`] with the keys of [`scene::apply`];
 //! * `stream <label>`: the samples file (raw little-endian i16) through the board's
-//!   `Monitor<4096, 15360>` in blocks of [`BLOCK_LEN`], each `push_block` call between
+//!   `impact_core::board::BoardMonitor` in blocks of [`BLOCK_LEN`], each `push_block` call between
 //!   [`bench_begin`] and [`bench_end`]. Prints the kind of every block (`i` idle, `t` the
 //!   trigger fired, `a` inside an impact, `e` an impact ended and was reported, `m` mixed) and,
 //!   in `count` mode, the SysTick time of each kind and of the whole stream;
@@ -55,8 +55,8 @@ use static_cell::ConstStaticCell;
 
 use defmt_semihosting as _;
 
-/// Samples per `push_block` call: the firmware's DMA half-buffer (`tasks::BLOCK_LEN`).
-const BLOCK_LEN: usize = 256;
+/// Samples per `push_block` call: the firmware's DMA half-buffer.
+use impact_core::board::BLOCK_LEN;
 /// Largest samples file, samples.
 const MAX_SAMPLES: usize = 1 << 18;
 /// Largest jobs file, bytes.
@@ -64,7 +64,7 @@ const MAX_JOBS: usize = 16 * 1024;
 /// Calls per `math` job.
 const MATH_CALLS: usize = 1024;
 
-static MONITOR: ConstStaticCell<Monitor<4096, 15360>> =
+static MONITOR: ConstStaticCell<impact_core::board::BoardMonitor> =
     ConstStaticCell::new(Monitor::unconfigured());
 static SAMPLES: ConstStaticCell<[i16; MAX_SAMPLES]> = ConstStaticCell::new([0; MAX_SAMPLES]);
 static RAW: ConstStaticCell<[u8; 2 * MAX_SAMPLES]> = ConstStaticCell::new([0; 2 * MAX_SAMPLES]);
@@ -240,7 +240,7 @@ fn set_scene<'a>(scene: &mut Scene, words: impl Iterator<Item = &'a str>) -> Res
 
 fn stream(
     mode: Mode,
-    monitor: &mut Monitor<4096, 15360>,
+    monitor: &mut impact_core::board::BoardMonitor,
     scene: &Scene,
     samples: &[i16],
     kinds: &mut [u8],

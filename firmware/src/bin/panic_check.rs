@@ -9,7 +9,7 @@
 //! adaptive, f32) on
 //! values the optimizer cannot know: the scene, the models and the impacts go through
 //! `black_box`, the samples and the block lengths are volatile reads of ADC1's data
-//! register. The monitor is the board's `Monitor<4096, 15360>`, with CFC and fits compiled in.
+//! register. The monitor is the board's (`impact_core::board::BoardMonitor`), with CFC and fits compiled in.
 //!
 //! Build: `cargo build --release -p impact-firmware --target thumbv7em-none-eabihf
 //! --no-default-features --features panic-check --bin panic-check`. Nothing runs it.
@@ -45,8 +45,8 @@ fn panic(_: &core::panic::PanicInfo) -> ! {
     unsafe { __pipeline_can_panic() }
 }
 
-/// The board's monitor: 4096-sample pre-trigger ring, 15360-sample capture (the board's CAPTURE_LEN).
-static MONITOR: ConstStaticCell<Monitor<4096, 15360>> =
+/// The board's monitor (its pre-trigger ring and capture length).
+static MONITOR: ConstStaticCell<impact_core::board::BoardMonitor> =
     ConstStaticCell::new(Monitor::unconfigured());
 
 /// STM32F407 ADC1 data register: a source of values the compiler cannot know.
