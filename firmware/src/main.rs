@@ -24,6 +24,8 @@ compile_error!(
 compile_error!("enable one of the features `stm32` (default) or `emulator`");
 
 mod executors;
+mod fault;
+mod logger;
 mod scene;
 mod source;
 mod stack;
@@ -48,6 +50,7 @@ use defmt::{info, unwrap};
 
 #[entry]
 fn main() -> ! {
+    stack::zero_ccmram();
     stack::paint();
     info!(
         "impact-firmware {} up; blocks of {}, pre-trigger {}, {} captures of {} samples",

@@ -7,7 +7,7 @@ use embassy_executor::SendSpawner;
 use embassy_stm32::interrupt::{InterruptExt, Priority};
 use embassy_stm32::{bind_interrupts, dma, interrupt, peripherals, Config, Peripherals};
 use impact_core::Scene;
-use {defmt_rtt as _, panic_probe as _};
+use panic_probe as _;
 
 use crate::executors::{HIGH, LOW, MEDIUM};
 use crate::tasks::stream::Backpressure;
@@ -58,30 +58,74 @@ pub struct Setup {
     p: Peripherals,
 }
 
-extern "C" {
-    /// Start and end of the `.ccmram` section (firmware/stm32/board-memory.x).
-    static mut __sccmram: u32;
-    static mut __eccmram: u32;
-}
-
-/// Brings the chip up at 168 MHz with the flash accelerator on, and zeroes the CCM RAM (the
-/// statics there start as zeros; cortex-m-rt only zeroes `.bss`).
+/// Brings the chip up at 168 MHz with the flash accelerator on, logs why it last reset, and
+/// starts the independent watchdog.
 pub fn init() -> Setup {
-    // SAFETY: first thing after reset, before anything in `.ccmram` is used: the section is
-    // word-aligned and nothing else touches it yet.
-    unsafe {
-        let start = core::ptr::addr_of_mut!(__sccmram);
-        let end = core::ptr::addr_of_mut!(__eccmram);
-        let words = (end as usize).saturating_sub(start as usize) / 4;
-        core::ptr::write_bytes(start, 0, words);
-    }
     let p = embassy_stm32::init(clock_config());
     enable_flash_accelerator();
+    info!("reset reason: {}", reset_reason());
+    start_watchdog();
     Setup {
         scene: crate::scene::BENCH,
         backpressure: Backpressure::Never,
         p,
     }
+}
+
+/// Why the chip last reset (RCC_CSR's flags, then cleared): a watchdog reset means the
+/// firmware stopped: a hang, or a core locked up by a fault it could not stack (an
+/// overflowing stack runs into reserved memory below SRAM).
+fn reset_reason() -> &'static str {
+    use embassy_stm32::pac::RCC;
+    let csr = RCC.csr().read();
+    RCC.csr().modify(|w| w.set_rmvf(true));
+    if csr.wdgrstf() {
+        "independent watchdog (the firmware had stopped: a hang, or a stack overflow that locked up the core)"
+    } else if csr.wwdgrstf() {
+        "window watchdog"
+    } else if csr.sftrstf() {
+        "software (after a fault, see the line before the reset)"
+    } else if csr.lpwrrstf() {
+        "low-power management"
+    } else if csr.borrstf() || csr.porrstf() {
+        "power-on or brown-out"
+    } else if csr.padrstf() {
+        "reset pin (NRST: the button, or the probe flashing)"
+    } else {
+        "unknown"
+    }
+}
+
+/// The independent watchdog's timeout, ms: the stream task feeds it with every block (every
+/// 0.5 ms at 500 kS/s, every 20 ms from the ADXL375), so only a stopped firmware lets it run
+/// out.
+const WATCHDOG_TIMEOUT_MS: u16 = 500;
+
+/// Starts the independent watchdog (LSI, about 32 kHz, divided by 32: ~1 ms a count); it
+/// resets the chip unless [`feed_watchdog`] runs within [`WATCHDOG_TIMEOUT_MS`]. Once
+/// started it cannot be stopped, also not by a debugger halting the core (probe-rs's reset
+/// on the next flashing starts afresh).
+fn start_watchdog() {
+    use embassy_stm32::pac::iwdg::vals::{Key, Pr};
+    use embassy_stm32::pac::IWDG;
+    IWDG.kr().write(|w| w.set_key(Key::ENABLE));
+    IWDG.pr().write(|w| w.set_pr(Pr::DIVIDE_BY32));
+    IWDG.rlr().write(|w| w.set_rl(WATCHDOG_TIMEOUT_MS));
+    IWDG.kr().write(|w| w.set_key(Key::RESET));
+    IWDG.kr().write(|w| w.set_key(Key::START));
+}
+
+/// Reloads the watchdog (the stream task, with each block).
+pub fn feed_watchdog() {
+    use embassy_stm32::pac::iwdg::vals::Key;
+    embassy_stm32::pac::IWDG
+        .kr()
+        .write(|w| w.set_key(Key::RESET));
+}
+
+/// After a fault has been logged: resets the chip (the next start-up logs the reason).
+pub fn fault_exit() -> ! {
+    cortex_m::peripheral::SCB::sys_reset()
 }
 
 /// ART accelerator on: prefetch and the instruction and data caches (RM0090 3.5.2).

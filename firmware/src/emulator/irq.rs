@@ -18,7 +18,9 @@ pub enum Irq {
     Timer0 = 8,
     /// CMSDK timer 1: embassy-time's alarms ([`super::time`]).
     Timer1 = 9,
-    /// The lowest executor: analysis and reporter.
+    /// CMSDK dual timer: the logger's drain ([`super::drain`]).
+    Drain = 10,
+    /// The lowest executor: the analysis.
     Low = 29,
     /// The middle executor: the streaming stage.
     Medium = 30,
@@ -49,6 +51,7 @@ pub fn start_executors() -> (SendSpawner, SendSpawner, SendSpawner) {
     unsafe {
         nvic.set_priority(Irq::Timer0, DEVICE_PRIORITY);
         nvic.set_priority(Irq::Timer1, DEVICE_PRIORITY);
+        nvic.set_priority(Irq::Drain, DEVICE_PRIORITY);
         nvic.set_priority(Irq::High, HIGH_PRIORITY);
         nvic.set_priority(Irq::Medium, MEDIUM_PRIORITY);
         nvic.set_priority(Irq::Low, LOW_PRIORITY);
@@ -65,6 +68,7 @@ unsafe fn DefaultHandler(irqn: i16) {
     match irqn {
         8 => super::dma::on_timer(),
         9 => super::time::on_alarm(),
+        10 => super::drain::on_timer(),
         // SAFETY: each executor's interrupt calls its `on_interrupt` and nothing else does.
         29 => unsafe { LOW.on_interrupt() },
         30 => unsafe { MEDIUM.on_interrupt() },

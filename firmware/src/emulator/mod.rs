@@ -5,6 +5,7 @@
 //! the exit status go to the host through semihosting ([`host`]).
 
 pub mod dma;
+pub mod drain;
 pub mod host;
 pub mod irq;
 pub mod time;
@@ -12,7 +13,6 @@ pub mod timer;
 
 use core::sync::atomic::{AtomicBool, Ordering};
 
-use cortex_m_rt::{exception, ExceptionFrame};
 use defmt::{error, info, unwrap};
 use embassy_executor::SendSpawner;
 use impact_core::Scene;
@@ -22,8 +22,6 @@ use crate::scene::SceneError;
 use crate::tasks::stream::Backpressure;
 
 pub use irq::start_executors;
-
-use defmt_semihosting as _;
 
 /// Longest semihosting command line accepted, bytes.
 const COMMAND_LINE_LEN: usize = 2048;
@@ -139,7 +137,7 @@ pub fn init() -> Setup {
         ConstStaticCell::new([0; COMMAND_LINE_LEN]);
     let Some(buf) = LINE.try_take() else {
         error!("emulator: started twice");
-        host::exit(false)
+        fault_exit()
     };
     let config = match host::command_line(buf)
         .map_err(ConfigError::Host)
@@ -148,10 +146,13 @@ pub fn init() -> Setup {
         Ok(config) => config,
         Err(e) => {
             error!("emulator: bad command line: {}", e);
-            host::exit(false)
+            fault_exit()
         }
     };
     time::init();
+    let lossless = config.pacing == Pacing::Lossless;
+    crate::logger::set_waiting(lossless);
+    drain::init(lossless);
     Setup {
         scene: config.scene,
         backpressure: match config.pacing {
@@ -170,7 +171,7 @@ pub fn spawn_sources(setup: Setup, high: SendSpawner, samples: crate::tasks::Sam
         Ok(file) => file,
         Err(e) => {
             error!("replay: {}", e);
-            host::exit(false)
+            fault_exit()
         }
     };
     match c.pacing {
@@ -196,7 +197,17 @@ pub fn spawn_sources(setup: Setup, high: SendSpawner, samples: crate::tasks::Sam
 /// The stream is over: exit QEMU with status 0 if `success`, else 1. The defmt frames are
 /// already on the host (semihosting writes are synchronous).
 pub fn end_of_stream(success: bool) -> ! {
+    drain::flush();
     host::exit(success)
+}
+
+/// The watchdog is the board's: QEMU stops a locked-up core itself (the run fails).
+pub fn feed_watchdog() {}
+
+/// After a fault has been logged: the run fails.
+pub fn fault_exit() -> ! {
+    drain::flush();
+    host::exit(false)
 }
 
 static PANICKED: AtomicBool = AtomicBool::new(false);
@@ -207,13 +218,6 @@ fn panic(info: &core::panic::PanicInfo) -> ! {
     if !PANICKED.swap(true, Ordering::Relaxed) {
         error!("panic: {}", defmt::Display2Format(info));
     }
-    host::exit(false)
-}
-
-#[exception]
-unsafe fn HardFault(frame: &ExceptionFrame) -> ! {
-    if !PANICKED.swap(true, Ordering::Relaxed) {
-        error!("HardFault at pc={=u32:#010x}", frame.pc());
-    }
+    drain::flush();
     host::exit(false)
 }

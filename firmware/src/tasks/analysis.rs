@@ -11,20 +11,18 @@ use static_cell::ConstStaticCell;
 
 use super::{CaptureReceiver, FwCapture, ANALYSED, CAPTURE_LEN};
 
-/// The analysis's scratch memory (the acceleration of a whole capture, f32). All zeros, so it
-/// starts in `.bss`; on the board it lives in the CCM RAM (`firmware/stm32/board-memory.x`),
-/// which the DMA cannot reach and the analysis does not need it to.
-#[cfg_attr(feature = "stm32", link_section = ".ccmram.workspace")]
+/// The analysis's scratch memory (the acceleration of a whole capture, f32, and the spectra's
+/// block statistics). All zeros; it lives in the CCM RAM (board-memory.x: the STM32F407's, and
+/// the same 64 KiB in the emulator), which the DMA cannot reach and the analysis does not need
+/// it to.
+#[link_section = ".ccmram.workspace"]
 static WORKSPACE: ConstStaticCell<Workspace<CAPTURE_LEN>> = ConstStaticCell::new(Workspace::new());
 
-/// Pause after each waveform frame on the board: 130 bytes a millisecond (130 KB/s) leaves
-/// `probe-rs` time to empty the 4 KiB RTT buffer, where a frame that does not fit would be
-/// dropped (the host counts the missing frame numbers). The emulator's semihosting output
-/// blocks instead, so it sends without pausing.
-#[cfg(feature = "stm32")]
+/// Pause after each waveform frame: 130 bytes a millisecond (130 KB/s) leaves the link time
+/// to empty the 4 KiB RTT buffer (probe-rs on the board, the drain interrupt in the
+/// emulator), where a frame that does not fit would be dropped (the host counts the missing
+/// frame numbers).
 const FRAME_GAP: Option<Duration> = Some(Duration::from_millis(1));
-#[cfg(not(feature = "stm32"))]
-const FRAME_GAP: Option<Duration> = None;
 
 /// Analyses captures until the stream ends (it then waits forever).
 #[embassy_executor::task]
@@ -51,7 +49,8 @@ async fn send_waveform(capture: &FwCapture, every: u16) {
     let samples = capture.samples();
     let frames = waveform::frames(samples.len(), every);
     info!(
-        "wave index={=u32} first_sample={=u64} samples={=u32} every={=u16} frames={=u32} base_sum={=i64} base_n={=i64}",
+        "wave seq={=u32} index={=u32} first_sample={=u64} samples={=u32} every={=u16} frames={=u32} base_sum={=i64} base_n={=i64}",
+        crate::logger::next_seq(),
         s.index,
         s.first_index,
         samples.len() as u32,
@@ -64,7 +63,8 @@ async fn send_waveform(capture: &FwCapture, every: u16) {
     for k in 0..frames {
         let n = waveform::frame(samples, every, k, &mut buf);
         info!(
-            "wave_frame index={=u32} frame={=u32} counts={=[?]}",
+            "wave_frame seq={=u32} index={=u32} frame={=u32} counts={=[?]}",
+            crate::logger::next_seq(),
             s.index,
             k as u32,
             buf.get(..n).unwrap_or(&buf),

@@ -27,27 +27,13 @@ use embassy_sync::zerocopy_channel;
 use impact_core::{Capture, ImpactReport};
 use static_cell::{ConstStaticCell, StaticCell};
 
-/// Samples per block: one DMA half-buffer on the STM32, one emulated DMA transfer in QEMU.
-pub const BLOCK_LEN: usize = 256;
+/// Samples per block, pre-trigger ring and capture length: the board's, in both builds (the
+/// emulator has the board's limits), defined once in `impact_core::board`.
+pub use impact_core::board::{BLOCK_LEN, CAPTURE_LEN, PRE_TRIGGER_LEN};
 
 /// Blocks the sample queue holds before the source starts losing (counting) them:
 /// 8 x 256 samples = 4.1 ms of signal at 500 kS/s.
 pub const SAMPLE_QUEUE_BLOCKS: usize = 8;
-
-/// Pre-trigger ring (and baseline window, and reach of the flank fits), samples: the host's.
-pub const PRE_TRIGGER_LEN: usize = 4096;
-
-/// Capture length, samples: 15360 (30.7 ms at 500 kS/s, the seed bench's 26 ms capture with
-/// room). Two captures (60 KiB) and the analysis's f32 workspace (60 KiB, in the CCM RAM) are
-/// the bulk of the board's RAM; see docs/board.md.
-#[cfg(feature = "stm32")]
-pub const CAPTURE_LEN: usize = 15360;
-
-/// Capture length, samples: the host's (`impact analyze`'s `HostMonitor`), so that emulated
-/// and host reports agree bit for bit even for long impacts (two captures of 256 KiB and a
-/// 512 KiB workspace: the emulator's RAM is QEMU's 4 MiB).
-#[cfg(feature = "emulator")]
-pub const CAPTURE_LEN: usize = 131072;
 
 /// Capture buffers: one being filled by the stream while the other is analysed.
 pub const CAPTURE_SLOTS: usize = 2;
@@ -56,8 +42,9 @@ pub const CAPTURE_SLOTS: usize = 2;
 pub const REPORT_QUEUE_LEN: usize = 2;
 
 /// Skipped-impact reports, heartbeats and the end of the stream the stream task can queue
-/// for the reporter without waiting.
-pub const STREAM_QUEUE_LEN: usize = 8;
+/// for the reporter without waiting (each holds a whole report, ~1 KiB: the board's RAM
+/// counts; a report that finds the queue full is counted, `reports_dropped`).
+pub const STREAM_QUEUE_LEN: usize = 4;
 
 /// One block of samples, in the order the source produced them.
 pub struct Block {

@@ -26,8 +26,9 @@ use super::sampler::{SAMPLE_CLOCK, SOURCE_STATS};
 use super::{StreamEnd, ANALYSED, FROM_STREAM};
 use crate::scene::Opt;
 
-/// Impacts held back while an earlier one is still being analysed.
-const REORDER_LEN: usize = 8;
+/// Impacts held back while an earlier one is still being analysed (~1 KiB each: beyond, the
+/// lowest goes out anyway and the broken order is counted, `reports_out_of_order`).
+const REORDER_LEN: usize = 4;
 
 /// Warn when no report has arrived for this long (heartbeats come once per second of signal).
 const SILENCE_WARNING: Duration = Duration::from_secs(3);
@@ -241,7 +242,8 @@ fn log_impact(r: &ImpactReport) {
     let hz = r.fits.hertz;
     let b = r.bounce;
     info!(
-        "impact index={=u32} status={=str} analysis={=str} clipped={=bool} flags={=u16} start_sample={=u64} end_sample={=u64} start_s={=f64} peak_time_s={=f64} peak_acceleration_m_s2={=f32} peak_force_n={} delta_v_m_s={} duration_s={=f32} baseline_m_s2={=f32} fwhm_s={} filtered_peak_acceleration_m_s2={} impact_velocity_m_s={} crush_time_s={} max_deformation_m={} rebound_velocity_m_s={} cor={} permanent_deformation_m={} absorbed_energy_j={} two_phase_kc_n_m={} two_phase_kr_n_m={} two_phase_c_n_s_m={} two_phase_permanent_deformation_m={} two_phase_residual={} nonlinear_k={} nonlinear_c_s_m={} nonlinear_exponent={} nonlinear_residual={} hertz_k={} hertz_residual={} bounce_number={} flight_s={} v0_flight_m_s={} v0_rebound_m_s={} report_latency_s={}",
+        "impact seq={=u32} index={=u32} status={=str} analysis={=str} clipped={=bool} flags={=u16} start_sample={=u64} end_sample={=u64} start_s={=f64} peak_time_s={=f64} peak_acceleration_m_s2={=f32} peak_force_n={} delta_v_m_s={} duration_s={=f32} baseline_m_s2={=f32} fwhm_s={} filtered_peak_acceleration_m_s2={} impact_velocity_m_s={} crush_time_s={} max_deformation_m={} rebound_velocity_m_s={} cor={} permanent_deformation_m={} absorbed_energy_j={} two_phase_kc_n_m={} two_phase_kr_n_m={} two_phase_c_n_s_m={} two_phase_permanent_deformation_m={} two_phase_residual={} nonlinear_k={} nonlinear_c_s_m={} nonlinear_exponent={} nonlinear_residual={} hertz_k={} hertz_residual={} bounce_number={} flight_s={} v0_flight_m_s={} v0_rebound_m_s={} report_latency_s={}",
+        crate::logger::next_seq(),
         r.index,
         r.status.name(),
         r.analysis.name(),
@@ -289,7 +291,8 @@ fn log_impact(r: &ImpactReport) {
 fn log_spectrum(index: u32, s: &impact_core::report::Spectrum) {
     let n = usize::from(s.bands).min(s.srs_m_s2.len());
     info!(
-        "srs index={=u32} bands={=u8} first_hz={=f32} bands_per_octave={=u8} damping={=f32} from_sample={=u64} to_sample={=u64} half_sine_amplitude_m_s2={} half_sine_duration_s={} srs_m_s2={} pvss_m_s={}",
+        "srs seq={=u32} index={=u32} bands={=u8} first_hz={=f32} bands_per_octave={=u8} damping={=f32} from_sample={=u64} to_sample={=u64} half_sine_amplitude_m_s2={} half_sine_duration_s={} srs_m_s2={} pvss_m_s={}",
+        crate::logger::next_seq(),
         index,
         s.bands,
         s.first_hz,
@@ -318,13 +321,14 @@ impl defmt::Format for List<'_> {
     }
 }
 
-/// Deepest stack use so far and the stack's size, bytes; warns if it reached the statics.
+/// Deepest stack use so far and the stack's size, bytes; an error line if it reached the
+/// bottom of its region (one word more would have faulted).
 fn stack() -> (u32, u32) {
     let size = crate::stack::size_bytes() as u32;
     match crate::stack::peak_bytes() {
-        Some((peak, reached_statics)) => {
-            if reached_statics {
-                error!("stack overflow: the stack reached the statics");
+        Some((peak, reached_bottom)) => {
+            if reached_bottom {
+                error!("stack overflow: the stack reached the bottom of its region");
             }
             (peak as u32, size)
         }
@@ -336,7 +340,8 @@ fn log_heartbeat(h: &Heartbeat) {
     let source = SOURCE_STATS.snapshot();
     let (stack_peak, stack_size) = stack();
     info!(
-        "heartbeat samples={=u64} rate_hz={=f32} blocks={=u32} busy_permille={=u32} overruns={=u32} blocks_lost={=u32} blocks_missing={=u32} samples_lost={=u64} gaps={=u64} source_errors={=u32} impacts={=u64} incomplete={=u64} analyses_skipped={=u64} level_changes={=u64} reports_dropped={=u32} heartbeats_dropped={=u32} armed={=bool} in_impact={=bool} stack_peak_bytes={=u32} stack_size_bytes={=u32}",
+        "heartbeat seq={=u32} samples={=u64} rate_hz={=f32} blocks={=u32} busy_permille={=u32} overruns={=u32} blocks_lost={=u32} blocks_missing={=u32} samples_lost={=u64} gaps={=u64} source_errors={=u32} impacts={=u64} incomplete={=u64} analyses_skipped={=u64} level_changes={=u64} reports_dropped={=u32} heartbeats_dropped={=u32} lines_dropped={=u32} armed={=bool} in_impact={=bool} stack_peak_bytes={=u32} stack_size_bytes={=u32}",
+        crate::logger::next_seq(),
         h.counters.samples,
         h.rate_hz,
         h.tally.blocks,
@@ -353,6 +358,7 @@ fn log_heartbeat(h: &Heartbeat) {
         h.counters.level_changes,
         h.reports_dropped,
         HEARTBEATS_DROPPED.load(Ordering::Relaxed),
+        crate::logger::frames_dropped(),
         h.armed,
         h.in_impact,
         stack_peak,
@@ -375,7 +381,8 @@ fn summarize(h: &Heartbeat, end: StreamEnd, out_of_order: u32, elapsed_ms: u64) 
     }
     let (stack_peak, stack_size) = stack();
     info!(
-        "summary result={=str} end={=str} samples={=u64} rate_hz={=f32} blocks={=u32} impacts={=u64} incomplete={=u64} analyses_skipped={=u64} level_changes={=u64} min={=i16} max={=i16} sum={=i64} samples_lost={=u64} gaps={=u64} blocks_lost={=u32} blocks_missing={=u32} overruns={=u32} source_errors={=u32} reports_dropped={=u32} reports_out_of_order={=u32} heartbeats_dropped={=u32} busy_permille={=u32} elapsed_ms={=u64} stack_peak_bytes={=u32} stack_size_bytes={=u32}",
+        "summary seq={=u32} result={=str} end={=str} samples={=u64} rate_hz={=f32} blocks={=u32} impacts={=u64} incomplete={=u64} analyses_skipped={=u64} level_changes={=u64} min={=i16} max={=i16} sum={=i64} samples_lost={=u64} gaps={=u64} blocks_lost={=u32} blocks_missing={=u32} overruns={=u32} source_errors={=u32} reports_dropped={=u32} reports_out_of_order={=u32} heartbeats_dropped={=u32} lines_dropped={=u32} busy_permille={=u32} elapsed_ms={=u64} stack_peak_bytes={=u32} stack_size_bytes={=u32}",
+        crate::logger::next_seq(),
         if success { "ok" } else { "failed" },
         end_name,
         h.counters.samples,
@@ -397,6 +404,7 @@ fn summarize(h: &Heartbeat, end: StreamEnd, out_of_order: u32, elapsed_ms: u64) 
         h.reports_dropped,
         out_of_order,
         HEARTBEATS_DROPPED.load(Ordering::Relaxed),
+        crate::logger::frames_dropped(),
         h.busy_permille,
         elapsed_ms,
         stack_peak,

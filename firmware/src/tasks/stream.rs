@@ -198,6 +198,8 @@ pub async fn stream(
         // The block is read in its queue slot, which goes back to the source as soon as
         // the stream has seen it.
         let event = samples.receive().await;
+        // Blocks keep coming: the firmware runs (the board's watchdog resets it otherwise).
+        crate::board::feed_watchdog();
         let since = Instant::now();
         let mut dropped = 0u32;
         let end = match event {
