@@ -323,6 +323,10 @@ pub struct AnalysisJson {
     pub samples_lost: u64,
     /// Impacts reported without analysis because no capture buffer was free (likewise).
     pub analyses_skipped: u64,
+    /// Lines the board's logger dropped, and numbered lines missing from its log (`impact
+    /// emulate`, `impact log`; 0 on the host).
+    pub lines_dropped: u64,
+    pub lines_missing: u64,
     /// Whether the time axis was interpolated onto an even grid (`--resample`).
     pub resampled: bool,
     /// Isolated glitches removed before the analysis (an impact containing one is flagged
@@ -891,6 +895,8 @@ const FREE_FALL_G: f64 = 0.5;
 /// The report JSON.
 pub fn to_json(setup: &Setup, reports: &[ImpactReport]) -> AnalysisJson {
     let mut a = AnalysisJson {
+        lines_dropped: 0,
+        lines_missing: 0,
         column: setup.column.clone(),
         units: Some(setup.units.name().to_string()),
         samples: setup.samples,
@@ -1117,7 +1123,7 @@ pub fn human(v: f64, unit: &str) -> String {
 /// A readable table.
 pub fn to_table(a: &AnalysisJson) -> String {
     let mut s = format!(
-        "{}{} samples at {} S/s{}{}{}\n",
+        "{}{} samples at {} S/s{}{}{}{}\n",
         match (&a.column, &a.units) {
             (Some(c), Some(u)) => format!("{c} in {u}: "),
             (Some(c), None) => format!("{c}: "),
@@ -1150,6 +1156,10 @@ pub fn to_table(a: &AnalysisJson) -> String {
             format!("; {} analyses skipped", a.analyses_skipped)
         } else {
             String::new()
+        },
+        match (a.lines_dropped, a.lines_missing) {
+            (0, 0) => String::new(),
+            (d, m) => format!("; {d} LINES DROPPED by the board, {m} missing"),
         },
     );
     if a.resampled {

@@ -31,6 +31,12 @@ pub struct EmulateArgs {
     /// analyses skipped and each report's latency are reported. Default: lossless replay.
     #[arg(long, help_heading = "Emulator")]
     pub realtime: bool,
+    /// With --realtime: the emulated chip's speed, as QEMU's `-icount shift`: each
+    /// instruction takes 2^N ns. 3 (125 M instructions/s) stands for the STM32F407 at
+    /// 168 MHz (1.34 cycles an instruction, `impact bench m4`); 2 is a chip twice as fast,
+    /// 4 one half as fast.
+    #[arg(long, help_heading = "Emulator", requires = "realtime", default_value_t = BOARD_CLOCK_SHIFT, value_parser = clap::value_parser!(u8).range(0..=8))]
+    pub clock_shift: u8,
     /// With --realtime: replay this many times faster than the recording's rate (headroom).
     #[arg(long, help_heading = "Emulator", requires = "realtime", default_value_t = 1.0, value_parser = positive_f32)]
     pub rate_scale: f32,
@@ -57,6 +63,9 @@ pub struct EmulateArgs {
     pub defmt: Option<PathBuf>,
 }
 
+/// The `-icount shift` that stands for the STM32F407 at 168 MHz: 8 ns an instruction.
+pub const BOARD_CLOCK_SHIFT: u8 = 3;
+
 fn positive_f32(s: &str) -> Result<f32, String> {
     match s.parse::<f32>() {
         Ok(v) if v.is_finite() && v > 0.0 => Ok(v),
@@ -70,10 +79,12 @@ pub enum Pacing {
     /// Every sample reaches the firmware and every impact is analysed, at QEMU's own speed.
     Lossless,
     /// An emulated DMA at `rate_scale` times the recording's rate, in instruction-paced
-    /// virtual time. `stall` (tests only): before block `.0` the firmware's sampler
+    /// virtual time: each instruction takes 2^`clock_shift` ns ([`BOARD_CLOCK_SHIFT`]: the
+    /// STM32F407's speed). `stall` (tests only): before block `.0` the firmware's sampler
     /// busy-waits `.1` µs, so the DMA ring overruns as on a board whose sampler is held up.
     RealTime {
         rate_scale: f32,
+        clock_shift: u8,
         stall: Option<(u32, u32)>,
     },
 }
@@ -363,14 +374,21 @@ pub fn run_emulator(
     let mut icount = Vec::new();
     match pacing {
         Pacing::Lossless => config.push_str(",arg=lossless"),
-        Pacing::RealTime { rate_scale, stall } => {
+        Pacing::RealTime {
+            rate_scale,
+            clock_shift,
+            stall,
+        } => {
             config.push_str(&format!(",arg=realtime,arg=rate_scale={rate_scale:e}"));
             if let Some((block, us)) = stall {
                 config.push_str(&format!(",arg=stall={block}:{us}"));
             }
-            // 8 ns of virtual time per instruction; idle time (wfi) skipped, so runs are
-            // deterministic and fast.
-            icount = vec!["-icount", "shift=3,sleep=off"];
+            // 2^shift ns of virtual time per instruction; idle time (wfi) skipped, so runs
+            // are deterministic and fast.
+            icount = vec![
+                "-icount".to_string(),
+                format!("shift={clock_shift},sleep=off"),
+            ];
         }
     }
     for a in scene_args(scene) {
@@ -473,6 +491,7 @@ pub fn emulate(args: &EmulateArgs) -> Result<(), String> {
     let pacing = if args.realtime {
         Pacing::RealTime {
             rate_scale: args.rate_scale,
+            clock_shift: args.clock_shift,
             stall: None,
         }
     } else {
@@ -534,6 +553,11 @@ pub fn emulate(args: &EmulateArgs) -> Result<(), String> {
     let mut json = analyze::to_json(&setup, &log.impacts);
     json.samples_lost = lost;
     json.analyses_skipped = num(summary, "analyses_skipped")?;
+    json.lines_dropped = log.lines_dropped;
+    json.lines_missing = log.lines_missing;
+    for w in &log.warnings {
+        eprintln!("warning: {w}");
+    }
     for (j, latency) in json.impacts.iter_mut().zip(&log.latencies) {
         j.report_latency_s = latency.map(f64::from);
     }

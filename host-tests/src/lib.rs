@@ -12,6 +12,7 @@ pub mod histogram;
 pub mod ide;
 pub mod log;
 pub mod m4;
+pub mod memory;
 pub mod npy;
 pub mod plot;
 pub mod precision;

@@ -73,6 +73,11 @@ pub struct Log {
     pub warnings: Vec<String>,
     /// The captured windows the board sent (`wave` lines, scene `wave_every` > 0).
     pub waveforms: Vec<crate::waves::Waveform>,
+    /// Lines the board's logger dropped (the summary's, else the last heartbeat's
+    /// `lines_dropped`; 0 from firmware that did not count them).
+    pub lines_dropped: u64,
+    /// Data lines whose sequence numbers (`seq`) the log lacks, before the last one it has.
+    pub lines_missing: u64,
 }
 
 /// The `key=value` fields following `marker` (e.g. `"impact "`) in a decoded line, or `None`
@@ -325,6 +330,8 @@ pub struct LogReader {
     /// Line and counters (samples, impacts) of the last heartbeat.
     last_heartbeat: Option<(u64, u64, u64)>,
     summary_line: u64,
+    /// The data lines' sequence numbers seen (`seq`).
+    seqs: Vec<u32>,
 }
 
 impl LogReader {
@@ -333,6 +340,7 @@ impl LogReader {
         let at = |e: String| format!("line {n}: {e}");
         if let Some(m) = fields(line, "impact ") {
             let m = m.map_err(at)?;
+            self.seen(&m).map_err(at)?;
             let r = parse_impact(&m).map_err(at)?;
             check_report(&r).map_err(at)?;
             let latency: Option<f32> = opt(&m, "report_latency_s").map_err(at)?;
@@ -355,6 +363,7 @@ impl LogReader {
             self.impact_lines.push(n);
         } else if let Some(m) = fields(line, "srs ") {
             let m = m.map_err(at)?;
+            self.seen(&m).map_err(at)?;
             let (index, spectrum) = parse_spectrum(&m).map_err(at)?;
             match self.log.impacts.iter_mut().rev().find(|r| r.index == index) {
                 Some(r) if r.spectrum.is_none() => r.spectrum = Some(spectrum),
@@ -366,6 +375,7 @@ impl LogReader {
             }
         } else if let Some(m) = fields(line, "wave_frame ") {
             let m = m.map_err(at)?;
+            self.seen(&m).map_err(at)?;
             let (index, frame, counts) = crate::waves::parse_frame(line, &m).map_err(at)?;
             let w = self
                 .log
@@ -381,6 +391,7 @@ impl LogReader {
             w.add_frame(frame, counts).map_err(at)?;
         } else if let Some(m) = fields(line, "wave ") {
             let m = m.map_err(at)?;
+            self.seen(&m).map_err(at)?;
             let w = crate::waves::Waveform::from_header(&m).map_err(at)?;
             if self.log.waveforms.iter().any(|p| p.index == w.index) {
                 return Err(at(format!(
@@ -391,6 +402,7 @@ impl LogReader {
             self.log.waveforms.push(w);
         } else if let Some(m) = fields(line, "heartbeat ") {
             let m = m.map_err(at)?;
+            self.seen(&m).map_err(at)?;
             let samples: u64 = num(&m, "samples").map_err(at)?;
             let impacts: u64 = num(&m, "impacts").map_err(at)?;
             rate(&m).map_err(at)?;
@@ -406,6 +418,7 @@ impl LogReader {
             self.log.heartbeat = Some(m);
         } else if let Some(m) = fields(line, "summary ") {
             let m = m.map_err(at)?;
+            self.seen(&m).map_err(at)?;
             num::<u64>(&m, "samples").map_err(at)?;
             num::<u64>(&m, "impacts").map_err(at)?;
             rate(&m).map_err(at)?;
@@ -421,14 +434,59 @@ impl LogReader {
         Ok(())
     }
 
+    /// A data line's sequence number (`seq`, absent from firmware that did not number them).
+    fn seen(&mut self, m: &HashMap<String, String>) -> Result<(), String> {
+        if m.contains_key("seq") {
+            self.seqs.push(num(m, "seq")?);
+        }
+        Ok(())
+    }
+
     /// The log, its reports in index order; checks the counts against the summary.
     pub fn finish(mut self) -> Result<Log, String> {
         let printed = self.log.impacts.len() as u64;
+        let state = self.log.summary.as_ref().or(self.log.heartbeat.as_ref());
+        self.log.lines_dropped = match state {
+            Some(m) if m.contains_key("lines_dropped") => num(m, "lines_dropped")?,
+            _ => 0,
+        };
+        self.seqs.sort_unstable();
+        self.seqs.dedup();
+        if let Some(&last) = self.seqs.last() {
+            self.log.lines_missing = u64::from(last) + 1 - self.seqs.len() as u64;
+        }
+        if self.log.lines_missing > 0 || self.log.lines_dropped > 0 {
+            let first: Vec<String> = (0..)
+                .filter(|s| self.seqs.binary_search(s).is_err())
+                .take(5)
+                .map(|s: u32| s.to_string())
+                .collect();
+            self.log.warnings.push(format!(
+                "the board dropped {} lines (its logger's count); {} numbered lines are missing{}",
+                self.log.lines_dropped,
+                self.log.lines_missing,
+                if self.log.lines_missing > 0 {
+                    format!(
+                        " (seq {}{})",
+                        first.join(", "),
+                        if self.log.lines_missing > 5 {
+                            ", …"
+                        } else {
+                            ""
+                        }
+                    )
+                } else {
+                    String::new()
+                }
+            ));
+        }
+        let lost = self.log.lines_dropped + self.log.lines_missing > 0;
         if let Some(m) = &self.log.summary {
             let at = |e: String| format!("line {}: {e}", self.summary_line);
             let counted: u64 = num(m, "impacts").map_err(at)?;
             let dropped: u64 = num(m, "reports_dropped").map_err(at)?;
-            if printed + dropped != counted {
+            // Lines the board dropped (counted) explain missing impact lines.
+            if printed + dropped != counted && !(lost && printed + dropped < counted) {
                 return Err(at(format!(
                     "the summary counts {counted} impacts ({dropped} reports dropped), the log \
                      has {printed} impact lines: lines lost, or two streams mixed"
@@ -632,6 +690,8 @@ pub fn log_json(log: &Log, t0: f64) -> Result<AnalysisJson, String> {
     let mut a = AnalysisJson {
         column: None,
         units: None,
+        lines_dropped: log.lines_dropped,
+        lines_missing: log.lines_missing,
         v0_m_s,
         samples,
         train_speed,

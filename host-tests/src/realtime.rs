@@ -144,6 +144,7 @@ fn train(
         scene,
         Pacing::RealTime {
             rate_scale: 1.0,
+            clock_shift: emulate::BOARD_CLOCK_SHIFT,
             stall: None,
         },
         Duration::from_secs(1200),

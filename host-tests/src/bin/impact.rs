@@ -6,8 +6,8 @@ use std::time::Duration;
 
 use clap::{Parser, Subcommand};
 use impact_host::{
-    analyze, emulate, log, m4, plot, precision, realtime, simulate, soak, stability, synth, target,
-    target_bench, throughput,
+    analyze, emulate, log, m4, memory, plot, precision, realtime, simulate, soak, stability, synth,
+    target, target_bench, throughput,
 };
 
 // The examples in the help are commands of docs/user-guide.md, run by its tests.
@@ -136,6 +136,18 @@ enum Bench {
         /// Samples per block (the firmware hands over DMA halves of 256).
         #[arg(long, default_value_t = 256)]
         block: usize,
+        /// Print JSON.
+        #[arg(long)]
+        json: bool,
+    },
+    /// The firmware's memory budget from its ELF: flash, stack, statics, CCM RAM.
+    Memory {
+        /// The firmware ELF [default: the board's, built with `cargo fw`].
+        #[arg(long)]
+        elf: Option<PathBuf>,
+        /// Its memory map [default: firmware/stm32/board-memory.x].
+        #[arg(long)]
+        map: Option<PathBuf>,
         /// Print JSON.
         #[arg(long)]
         json: bool,
@@ -419,6 +431,26 @@ fn run(cli: Cli) -> Result<(), String> {
                     "soak: {} impacts inserted, {} reported, {} mismatched",
                     r.impacts_inserted, r.impacts_reported, r.mismatched
                 ));
+            }
+        }
+        Command::Bench {
+            which: Bench::Memory { elf, map, json },
+        } => {
+            let (default_elf, default_map) = match (&elf, &map) {
+                (Some(e), Some(m)) => (e.clone(), m.clone()),
+                _ => memory::board_elf()?,
+            };
+            let b = memory::budget(
+                elf.as_deref().unwrap_or(&default_elf),
+                map.as_deref().unwrap_or(&default_map),
+            )?;
+            if json {
+                println!(
+                    "{}",
+                    serde_json::to_string_pretty(&b).map_err(|e| e.to_string())?
+                );
+            } else {
+                print!("{}", memory::table(&b));
             }
         }
         Command::Bench {
