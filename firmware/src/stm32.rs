@@ -84,7 +84,7 @@ fn reset_reason() -> &'static str {
     } else if csr.wwdgrstf() {
         "window watchdog"
     } else if csr.sftrstf() {
-        "software (after a fault, see the line before the reset)"
+        "software (a fault, or a sample stream that ended: see the lines before the reset)"
     } else if csr.lpwrrstf() {
         "low-power management"
     } else if csr.borrstf() || csr.porrstf() {
@@ -103,11 +103,13 @@ const WATCHDOG_TIMEOUT_MS: u16 = 500;
 
 /// Starts the independent watchdog (LSI, about 32 kHz, divided by 32: ~1 ms a count); it
 /// resets the chip unless [`feed_watchdog`] runs within [`WATCHDOG_TIMEOUT_MS`]. Once
-/// started it cannot be stopped, also not by a debugger halting the core (probe-rs's reset
-/// on the next flashing starts afresh).
+/// started it cannot be stopped; its counter is frozen while a debugger halts the core
+/// (DBGMCU_APB1_FZ, as ST's HAL freezes it), so stepping through code does not reset the
+/// board.
 fn start_watchdog() {
     use embassy_stm32::pac::iwdg::vals::{Key, Pr};
-    use embassy_stm32::pac::IWDG;
+    use embassy_stm32::pac::{DBGMCU, IWDG};
+    DBGMCU.apb1fzr().modify(|w| w.set_iwdg(true));
     IWDG.kr().write(|w| w.set_key(Key::ENABLE));
     IWDG.pr().write(|w| w.set_pr(Pr::DIVIDE_BY32));
     IWDG.rlr().write(|w| w.set_rl(WATCHDOG_TIMEOUT_MS));
@@ -199,13 +201,26 @@ pub fn spawn_sources(setup: Setup, high: SendSpawner, samples: crate::tasks::Sam
     }
 }
 
-/// The live sources never end; if one does, log it and keep the reporter's last words.
-pub fn end_of_stream(success: bool) {
-    info!(
-        "sample stream ended (success: {}); sampling has stopped",
-        success
+/// The live sources never end; if one does (it gave up), log it and restart the board.
+pub fn end_of_stream(success: bool) -> ! {
+    // The board's sources never end on their own: a source that gave up (a sensor that
+    // would not come up) is retried by restarting, after a pause that lets the log be read;
+    // the watchdog is fed meanwhile, so the next start-up logs a software reset, not a hang.
+    defmt::error!(
+        "sample stream ended (success: {}); restarting in {} s",
+        success,
+        RESTART_AFTER_S
     );
+    for _ in 0..RESTART_AFTER_S * 10 {
+        feed_watchdog();
+        // 100 ms at 168 MHz.
+        cortex_m::asm::delay(16_800_000);
+    }
+    cortex_m::peripheral::SCB::sys_reset()
 }
+
+/// Seconds from the end of the sample stream to the restart.
+const RESTART_AFTER_S: u32 = 5;
 
 /// 168 MHz SYSCLK from the Discovery board's 8 MHz HSE crystal, as in embassy's stm32f4
 /// examples: 8 MHz / 4 * 168 = 336 MHz VCO; P = /2 -> 168 MHz, Q = /7 -> 48 MHz (USB).

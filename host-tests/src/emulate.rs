@@ -46,6 +46,14 @@ pub struct EmulateArgs {
     #[arg(long, help_heading = "Emulator", num_args = 0..=1, default_missing_value = "1", value_name = "EVERY",
           value_parser = clap::value_parser!(u16).range(1..))]
     pub waveforms: Option<u16>,
+    /// The samples come from an ADXL375 (±200 g, 49 mg per count, 13 bits per axis), as on
+    /// the board built with `--features adxl375`: each axis in the part's counts, its FIFO
+    /// emulated (32 entries and the output registers) and polled every 5 ms by the board's
+    /// ADXL375 source, which computes the axes' resultant and counts what the FIFO overwrote.
+    /// The axes are --axes (or the channel as the x axis), at one of the part's rates
+    /// (3200, 1600, 800, 400, 200 or 100 S/s).
+    #[arg(long, help_heading = "Emulator")]
+    pub adxl375: bool,
     /// Emulator firmware ELF (built with `--no-default-features --features emulator`)
     /// [default: build it with cargo into target/emulator when its sources changed].
     #[arg(long, help_heading = "Emulator")]
@@ -340,11 +348,121 @@ pub struct EmulatorRun {
     pub seconds: f64,
 }
 
-/// Replays `counts` on the emulator firmware `elf` with `scene` and `pacing`; each decoded
+/// What the emulated firmware samples.
+#[derive(Clone, Copy, Debug)]
+pub enum Samples<'a> {
+    /// The ADC's counts (the board's default source).
+    Adc(&'a [i16]),
+    /// An ADXL375's three axes, counts (the board's `adxl375` source), and which of them
+    /// the stream gets: one axis (0, 1, 2) or the resultant (`None`).
+    Adxl375(&'a [[i16; 3]], Option<usize>),
+}
+
+impl Samples<'_> {
+    /// Samples in the stream.
+    pub fn len(&self) -> usize {
+        match self {
+            Samples::Adc(c) => c.len(),
+            Samples::Adxl375(a, _) => a.len(),
+        }
+    }
+
+    /// Whether the stream has no sample.
+    pub fn is_empty(&self) -> bool {
+        self.len() == 0
+    }
+
+    fn bytes(&self) -> Vec<u8> {
+        match self {
+            Samples::Adc(c) => c.iter().flat_map(|c| c.to_le_bytes()).collect(),
+            Samples::Adxl375(a, _) => a
+                .iter()
+                .flat_map(|s| s.iter().flat_map(|c| c.to_le_bytes()))
+                .collect(),
+        }
+    }
+}
+
+/// The ADXL375's scale, m/s² per count: 49 mg per LSB (the firmware's `G_PER_LSB` times
+/// standard gravity, in f32 as there).
+pub const ADXL375_GAIN_M_S2: f32 = 0.049 * 9.806_65;
+
+/// The ADXL375's output data rates, S/s.
+pub const ADXL375_RATES_HZ: [f64; 6] = [3200.0, 1600.0, 800.0, 400.0, 200.0, 100.0];
+
+/// One axis's range on the ADXL375: 13-bit two's complement, counts.
+const ADXL375_AXIS_COUNTS: (i16, i16) = (-4096, 4095);
+
+/// The resultant's rail on the board (the firmware's `CLIP_COUNTS` with the ADXL375): it
+/// reaches 4095 counts whenever an axis is at its rail.
+const ADXL375_CLIP_COUNTS: (i16, i16) = (i16::MIN, 4095);
+
+/// Turns a prepared recording into what an ADXL375 would give: each axis (`setup.axes`, or
+/// the channel as x) in the part's counts, and the setup changed to the board's ADXL375 scene
+/// (scale, rails) with what the board streams as its counts: the resultant of the axes, or
+/// the one channel's axis.
+pub fn adxl375_axes(setup: &mut analyze::Setup) -> Result<Vec<[i16; 3]>, String> {
+    let rate = setup.rate_hz;
+    if !ADXL375_RATES_HZ
+        .iter()
+        .any(|r| ((rate - r) / r).abs() < 1e-3)
+    {
+        return Err(format!(
+            "--adxl375: the ADXL375 samples at 3200, 1600, 800, 400, 200 or 100 S/s; this recording is at {rate} S/s (render one at the part's rate with `impact synth --rate 3200`)"
+        ));
+    }
+    let gain = f64::from(ADXL375_GAIN_M_S2);
+    let count = |a: f64| {
+        (a / gain).round().clamp(
+            f64::from(ADXL375_AXIS_COUNTS.0),
+            f64::from(ADXL375_AXIS_COUNTS.1),
+        ) as i16
+    };
+    let columns: Vec<&[f64]> = if setup.axes.is_empty() {
+        vec![&setup.prepared.accel_m_s2]
+    } else {
+        setup.axes.iter().map(|a| a.accel_m_s2.as_slice()).collect()
+    };
+    let n = setup.prepared.counts.len();
+    let axes: Vec<[i16; 3]> = (0..n)
+        .map(|i| {
+            let mut s = [0i16; 3];
+            for (slot, column) in s.iter_mut().zip(&columns) {
+                *slot = column.get(i).map_or(0, |&a| count(a));
+            }
+            s
+        })
+        .collect();
+    let one_axis = setup.axes.is_empty();
+    setup.prepared.counts = axes
+        .iter()
+        .map(|&[x, y, z]| {
+            if one_axis {
+                x
+            } else {
+                impact_core::signal::resultant::resultant_counts(x, y, z)
+            }
+        })
+        .collect();
+    setup.scene.calibration.gain_m_s2_per_count = ADXL375_GAIN_M_S2;
+    setup.prepared.calibration.gain_m_s2_per_count = ADXL375_GAIN_M_S2;
+    setup.scene.clip_counts = if one_axis {
+        ADXL375_AXIS_COUNTS
+    } else {
+        ADXL375_CLIP_COUNTS
+    };
+    setup
+        .scene
+        .validate()
+        .map_err(|e| format!("--adxl375: {e}"))?;
+    Ok(axes)
+}
+
+/// Replays `samples` on the emulator firmware `elf` with `scene` and `pacing`; each decoded
 /// line is passed to `echo` as it arrives.
 pub fn run_emulator(
     elf: &Path,
-    counts: &[i16],
+    samples: Samples<'_>,
     scene: &Scene,
     pacing: Pacing,
     timeout: Duration,
@@ -367,10 +485,18 @@ pub fn run_emulator(
     );
     let raw_s = raw.0.to_string_lossy().into_owned();
     check_arg("the temporary directory", &raw_s)?;
-    let bytes: Vec<u8> = counts.iter().flat_map(|c| c.to_le_bytes()).collect();
-    std::fs::write(&raw.0, bytes).map_err(|e| format!("{raw_s}: {e}"))?;
+    std::fs::write(&raw.0, samples.bytes()).map_err(|e| format!("{raw_s}: {e}"))?;
 
     let mut config = format!("enable=on,target=native,arg={elf_s},arg={raw_s}");
+    if let Samples::Adxl375(_, axis) = samples {
+        config.push_str(",arg=sensor=adxl375,arg=axis=");
+        config.push_str(match axis {
+            Some(0) => "x",
+            Some(1) => "y",
+            Some(2) => "z",
+            _ => "resultant",
+        });
+    }
     let mut icount = Vec::new();
     match pacing {
         Pacing::Lossless => config.push_str(",arg=lossless"),
@@ -482,6 +608,18 @@ pub fn emulate(args: &EmulateArgs) -> Result<(), String> {
     }
     let mut setup = analyze::setup(a, None)?;
     setup.scene.waveform_every = args.waveforms.unwrap_or(0);
+    let axes = if args.adxl375 {
+        Some(adxl375_axes(&mut setup)?)
+    } else {
+        None
+    };
+    // One channel is the part's x axis, streamed as such (the board's `AXIS = Axis::X`):
+    // kinematics apply; the resultant of --axes has none.
+    let axis = setup.axes.is_empty().then_some(0);
+    let samples = match &axes {
+        Some(axes) => Samples::Adxl375(axes, axis),
+        None => Samples::Adc(&setup.prepared.counts),
+    };
     let elf = match &args.elf {
         Some(p) => p.clone(),
         None => build_firmware()?,
@@ -499,7 +637,7 @@ pub fn emulate(args: &EmulateArgs) -> Result<(), String> {
     };
     let run = run_emulator(
         &elf,
-        &setup.prepared.counts,
+        samples,
         &setup.scene,
         pacing,
         Duration::from_secs(args.timeout),

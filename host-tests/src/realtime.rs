@@ -27,6 +27,10 @@ pub struct RealtimeArgs {
     /// Emulator firmware ELF [default: build it].
     #[arg(long)]
     pub elf: Option<std::path::PathBuf>,
+    /// Virtual time per instruction, 2^N ns: 3 (125 M instructions/s) stands for the
+    /// STM32F407 at 168 MHz; 4 is a chip half as fast (the margin of that estimate).
+    #[arg(long, default_value_t = emulate::BOARD_CLOCK_SHIFT, value_parser = clap::value_parser!(u8).range(0..=8))]
+    pub clock_shift: u8,
 }
 
 /// One bench and pulse shape.
@@ -136,15 +140,16 @@ fn train(
     scene: &Scene,
     n: usize,
     spacing: f64,
+    clock_shift: u8,
 ) -> Result<TrainRun, String> {
     let (samples, _) = counts(case, n, spacing)?;
     let run = emulate::run_emulator(
         elf,
-        &samples,
+        emulate::Samples::Adc(&samples),
         scene,
         Pacing::RealTime {
             rate_scale: 1.0,
-            clock_shift: emulate::BOARD_CLOCK_SHIFT,
+            clock_shift,
             stall: None,
         },
         Duration::from_secs(1200),
@@ -192,7 +197,7 @@ pub fn run(args: &RealtimeArgs) -> Result<Vec<CaseResult>, String> {
             scene.fits = if fits { FitSet::all() } else { FitSet::none() };
             let mut runs = Vec::new();
             for &spacing in case.spacings {
-                let r = train(&elf, &case, &scene, args.impacts, spacing)?;
+                let r = train(&elf, &case, &scene, args.impacts, spacing, args.clock_shift)?;
                 if !args.json {
                     eprintln!(
                         "{} {} fits, {:.1} ms apart: {} of {} reported, lost {}, skipped {}, latency median {} max {}",

@@ -1,11 +1,16 @@
 //! Host tests of the firmware's ADXL375 driver (`firmware/src/source/adxl375.rs`, which only
 //! depends on `embedded-hal-async`): exact SPI traffic against `embedded-hal-mock`, FIFO
-//! behaviour against a small simulated ADXL375, and errors from a failing bus.
+//! behaviour against a small simulated ADXL375, and errors from a failing bus; and the loss
+//! accounting of its polled FIFO (`firmware/src/source/fifo.rs`) against a part whose clock
+//! is off nominal, polled with jitter.
 
-// The driver is included as a module so that it is tested exactly as the firmware builds it.
+// The driver is included as a module so that it is tested exactly as the firmware builds it;
+// so is the FIFO's loss accounting (`source/fifo.rs`), which the board and the emulator share.
 #[path = "../../firmware/src/source/adxl375.rs"]
 #[allow(dead_code)]
 mod adxl375;
+#[path = "../../firmware/src/source/fifo.rs"]
+mod fifo;
 
 use std::collections::VecDeque;
 use std::future::Future;
@@ -406,4 +411,98 @@ fn the_resultant_of_three_axes_is_the_rounded_magnitude() {
         .magnitude(),
         7094
     );
+}
+
+/// A part in stream mode on its own clock (`rate_hz`, its first sample one period after 0),
+/// polled at the given MCU times (µs): each poll reads every entry (at most 33) and the
+/// overrun flag. Returns, per poll, (samples read, overrun flag, samples overwritten since
+/// the previous poll).
+fn polled_part(rate_hz: f64, polls_us: &[u64]) -> Vec<(usize, bool, u64)> {
+    let mut produced = 0u64;
+    let mut waiting = 0u64;
+    let mut out = Vec::new();
+    for &t in polls_us {
+        let due = (t as f64 * 1e-6 * rate_hz).floor() as u64;
+        let new = due - produced;
+        produced = due;
+        waiting += new;
+        let overwritten = waiting.saturating_sub(33);
+        waiting -= overwritten;
+        out.push((waiting as usize, overwritten > 0, overwritten));
+        waiting = 0;
+    }
+    out
+}
+
+/// Poll times every `period_us` from `from_us` with up to ±`jitter_us` of deterministic
+/// jitter, `n` of them.
+fn poll_times(from_us: u64, period_us: u64, jitter_us: u64, n: usize) -> Vec<u64> {
+    let mut state = 0x2545_f491u32;
+    (0..n as u64)
+        .map(|k| {
+            state ^= state << 13;
+            state ^= state >> 17;
+            state ^= state << 5;
+            let j = u64::from(state) % (2 * jitter_us + 1);
+            from_us + k * period_us + j - jitter_us.min(k * period_us + from_us)
+        })
+        .collect()
+}
+
+#[test]
+fn a_part_off_its_nominal_rate_never_makes_a_false_gap() {
+    // 2 % fast and 2 % slow parts, polled every 5 ms ± 0.4 ms for 100 s: no overrun, so
+    // nothing is counted lost (the old estimate, MCU time since the start times the nominal
+    // rate, would have counted 6400 samples lost for the fast part, and hidden as many real
+    // losses for the slow one); the rate is measured to 0.05 %.
+    for rate in [3200.0 * 1.02, 3200.0 * 0.98] {
+        let polls = poll_times(5_000, 5_000, 400, 20_000);
+        let mut counter = fifo::LossCounter::new(3200.0, 0);
+        let mut lost = 0;
+        for (&t, (read, overrun, _)) in polls.iter().zip(polled_part(rate, &polls)) {
+            assert!(!overrun);
+            lost += counter.poll(t, read, overrun);
+        }
+        assert_eq!(lost, 0);
+        let measured = counter.rate_hz();
+        assert!(
+            (measured / rate - 1.0).abs() < 5e-4,
+            "measured {measured} S/s of {rate}"
+        );
+    }
+}
+
+#[test]
+fn an_overrun_is_counted_to_a_sample_at_the_measured_rate() {
+    // A part 1.5 % slow, polled every 5 ms ± 0.4 ms; after 10 s one poll comes 15, 30 or
+    // 300 ms late. The count of what the FIFO overwrote is the truth to within one sample;
+    // with the nominal rate it would be off by 1.5 % of the interval (14 samples at 300 ms).
+    let rate = 3200.0 * 0.985;
+    for late_us in [15_000u64, 30_000, 300_000] {
+        let mut polls = poll_times(5_000, 5_000, 400, 4_000);
+        for t in polls.iter_mut().skip(2_000) {
+            *t += late_us;
+        }
+        let mut counter = fifo::LossCounter::new(3200.0, 0);
+        let (mut lost, mut truth) = (0, 0);
+        for (&t, (read, overrun, overwritten)) in polls.iter().zip(polled_part(rate, &polls)) {
+            lost += counter.poll(t, read, overrun);
+            truth += overwritten;
+        }
+        assert!(truth > 0, "the FIFO overran");
+        assert!(
+            lost.abs_diff(truth) <= 1,
+            "{late_us} us late: counted {lost}, the part overwrote {truth}"
+        );
+    }
+}
+
+#[test]
+fn an_overrun_before_the_rate_is_known_uses_the_nominal_rate_and_counts_at_least_one() {
+    let mut counter = fifo::LossCounter::new(3200.0, 0);
+    // 20 ms after the start: 64 produced, 33 read.
+    assert_eq!(counter.poll(20_000, 33, true), 31);
+    // A flag with nothing missing by the clock still counts one (the part says it lost one).
+    assert_eq!(counter.poll(30_000, 33, true), 1);
+    assert_eq!(counter.rate_hz(), 3200.0);
 }

@@ -14,7 +14,8 @@ use crate::executors::{HIGH, LOW, MEDIUM};
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 #[repr(u16)]
 pub enum Irq {
-    /// CMSDK timer 0: the emulated ADC + DMA ([`super::dma`]).
+    /// CMSDK timer 0: the emulated ADC + DMA ([`super::dma`]), or the emulated ADXL375
+    /// ([`super::adxl375`]).
     Timer0 = 8,
     /// CMSDK timer 1: embassy-time's alarms ([`super::time`]).
     Timer1 = 9,
@@ -66,6 +67,7 @@ pub fn start_executors() -> (SendSpawner, SendSpawner, SendSpawner) {
 #[exception]
 unsafe fn DefaultHandler(irqn: i16) {
     match irqn {
+        8 if super::adxl375::active() => super::adxl375::on_timer(),
         8 => super::dma::on_timer(),
         9 => super::time::on_alarm(),
         10 => super::drain::on_timer(),

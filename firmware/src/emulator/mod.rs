@@ -4,6 +4,7 @@
 //! an emulated DMA paced by the other CMSDK timer in real time ([`dma`]), and defmt frames and
 //! the exit status go to the host through semihosting ([`host`]).
 
+pub mod adxl375;
 pub mod dma;
 pub mod drain;
 pub mod host;
@@ -19,6 +20,7 @@ use impact_core::Scene;
 use static_cell::ConstStaticCell;
 
 use crate::scene::SceneError;
+use crate::source::poll::Axis;
 use crate::tasks::stream::Backpressure;
 
 pub use irq::start_executors;
@@ -28,7 +30,7 @@ const COMMAND_LINE_LEN: usize = 2048;
 
 /// What the semihosting command line asks for:
 /// `<program> <samples-file> [realtime|lossless] [rate_scale=X] [stall=BLOCK:US]
-/// [key=value ...]` (scene keys:
+/// [sensor=adc|adxl375] [axis=x|y|z|resultant] [key=value ...]` (scene keys:
 /// see [`crate::scene::apply`]; unset keys keep the seed bench's values,
 /// [`crate::scene::BENCH`]).
 pub struct Config {
@@ -39,8 +41,13 @@ pub struct Config {
     /// Real time only: the samples come this many times faster than the scene's rate.
     pub rate_scale: f32,
     /// Real time only, fault injection for tests: the sampler busy-waits this long (µs) before
-    /// taking this block, so the emulated DMA laps it as it would a stalled board.
+    /// taking this block (or poll, with the ADXL375), so the emulated DMA (or FIFO) laps it as
+    /// it would on a stalled board.
     pub stall: Option<(u32, u32)>,
+    /// `sensor=adxl375`: the file holds three axes, read through the ADXL375 path.
+    pub adxl375: bool,
+    /// `axis=x|y|z|resultant` (ADXL375 path): what the stream gets of each sample.
+    pub axis: Axis,
     /// The scene the stream runs.
     pub scene: Scene,
 }
@@ -67,6 +74,10 @@ enum ConfigError {
     BadRateScale,
     /// `stall` is not `BLOCK:MICROSECONDS`.
     BadStall,
+    /// `sensor` is not `adc` or `adxl375`.
+    BadSensor,
+    /// `axis` is not `x`, `y`, `z` or `resultant`.
+    BadAxis,
     Scene {
         key: &'static str,
         error: SceneError,
@@ -92,8 +103,26 @@ fn parse(line: &'static str) -> Result<Config, ConfigError> {
     let mut scene = crate::scene::BENCH;
     let mut rate_scale = 1.0f32;
     let mut stall = None;
+    let mut adxl375 = false;
+    let mut axis = Axis::Resultant;
     for arg in line.split(' ') {
         match arg.split_once('=') {
+            Some(("axis", value)) => {
+                axis = match value {
+                    "x" => Axis::X,
+                    "y" => Axis::Y,
+                    "z" => Axis::Z,
+                    "resultant" => Axis::Resultant,
+                    _ => return Err(ConfigError::BadAxis),
+                };
+            }
+            Some(("sensor", value)) => {
+                adxl375 = match value {
+                    "adc" => false,
+                    "adxl375" => true,
+                    _ => return Err(ConfigError::BadSensor),
+                };
+            }
             Some(("stall", value)) => {
                 let (block, us) = value.split_once(':').ok_or(ConfigError::BadStall)?;
                 let parse = |v: &str| v.parse::<u32>().map_err(|_| ConfigError::BadStall);
@@ -117,6 +146,8 @@ fn parse(line: &'static str) -> Result<Config, ConfigError> {
         pacing,
         rate_scale,
         stall,
+        adxl375,
+        axis,
         scene,
     })
 }
@@ -167,7 +198,7 @@ pub fn init() -> Setup {
 pub fn spawn_sources(setup: Setup, high: SendSpawner, samples: crate::tasks::SampleSender) {
     let c = &setup.config;
     let rate = c.scene.calibration.sample_rate_hz;
-    let file = match crate::source::replay::open(c.samples_path, rate) {
+    let file = match crate::source::replay::open(c.samples_path, rate, c.adxl375) {
         Ok(file) => file,
         Err(e) => {
             error!("replay: {}", e);
@@ -180,16 +211,29 @@ pub fn spawn_sources(setup: Setup, high: SendSpawner, samples: crate::tasks::Sam
                 "replay: real time, {=f32} x the recording's rate",
                 c.rate_scale
             );
-            high.spawn(unwrap!(crate::source::replay::realtime(
-                file,
-                rate * c.rate_scale,
-                c.stall,
-                samples
-            )));
+            if c.adxl375 {
+                high.spawn(unwrap!(crate::source::replay::adxl375(
+                    file,
+                    rate * c.rate_scale,
+                    c.axis,
+                    c.stall,
+                    samples
+                )));
+            } else {
+                high.spawn(unwrap!(crate::source::replay::realtime(
+                    file,
+                    rate * c.rate_scale,
+                    c.stall,
+                    samples
+                )));
+            }
         }
         Pacing::Lossless => {
             info!("replay: lossless");
-            high.spawn(unwrap!(crate::source::replay::lossless(file, samples)));
+            let axes = c.adxl375.then_some(c.axis);
+            high.spawn(unwrap!(crate::source::replay::lossless(
+                file, axes, samples
+            )));
         }
     }
 }

@@ -1,26 +1,28 @@
 //! STM32 sample source (feature `adxl375`): an ADXL375 on SPI1 (PA5 SCK, PA6 MISO, PA7 MOSI,
-//! chip select PE7), its FIFO polled every few milliseconds; the three axes' resultant (or
-//! one axis) becomes the samples.
+//! chip select PE7), its FIFO polled every 5 ms by [`super::poll`] (the emulator polls its
+//! emulated ADXL375 with the same code); the three axes' resultant (or one axis) becomes the
+//! samples.
 //!
 //! On the STM32F4-Discovery SPI1 also reaches the on-board LIS3DSH, whose chip select (PE3)
 //! is held high here so it stays off the bus. PE7 is a free pin on the P2 header; any free
 //! GPIO works as the ADXL375's chip select.
 
-use defmt::{error, info, warn, Formatter};
+use defmt::{error, info, Formatter};
 use embassy_stm32::gpio::{Level, Output, Speed};
 use embassy_stm32::mode::Async;
 use embassy_stm32::peripherals::{DMA2_CH2, DMA2_CH3, PA5, PA6, PA7, PE3, PE7, SPI1};
 use embassy_stm32::spi::{self, mode::Master, Spi, MODE_3};
 use embassy_stm32::time::Hertz;
 use embassy_stm32::Peri;
-use embassy_time::{Delay, Duration, Instant, Ticker, Timer};
+use embassy_time::{Delay, Instant, Timer};
 use embedded_hal_bus::spi::ExclusiveDevice;
 
 use super::adxl375::{Adxl375, DataRate, Error, Sample, MAX_FIFO_ENTRIES};
+use super::poll::{self, Axes, Axis, Fifo, Poll, Read, MAX_ENTRIES, POLL_PERIOD};
 use super::SAMPLE_RATE_HZ;
 use crate::stm32::Irqs;
 use crate::tasks::sampler::{BlockSender, SAMPLE_CLOCK, SOURCE_STATS};
-use crate::tasks::{StreamEnd, BLOCK_LEN};
+use crate::tasks::StreamEnd;
 
 /// Output data rate; [`SAMPLE_RATE_HZ`] is set to match.
 const DATA_RATE: DataRate = DataRate::Hz3200;
@@ -32,26 +34,13 @@ const _: () = assert!(DATA_RATE.hz() == SAMPLE_RATE_HZ);
 /// This one gives exactly 84 / 32 = 2.625 MHz (checked at start-up).
 const SPI_CLOCK_HZ: u32 = 2_625_000;
 
-/// FIFO poll period: 5 ms = 16 samples at 3200 Hz, half of the 32-sample FIFO, which gives
-/// another 5 ms of slack before it overruns.
-const POLL_PERIOD: Duration = Duration::from_millis(5);
-
 /// Tries at bringing the sensor up before the source gives up.
 const INIT_ATTEMPTS: u32 = 3;
 
-/// What becomes the sample stream: the resultant of the three axes (crash and drop practice:
-/// the trigger on |a| whatever the direction of the hit), or one axis along the expected
-/// impact direction.
-#[derive(Clone, Copy)]
-#[allow(dead_code)]
-enum Axis {
-    X,
-    Y,
-    Z,
-    Resultant,
-}
-
-const AXIS: Axis = Axis::Resultant;
+/// What becomes the sample stream: the resultant (the trigger on |a| whatever the direction
+/// of the hit; no kinematics, its integral being no velocity change), or the axis along the
+/// impact (kinematics and fits from the bench's approach speed, `scene::BENCH`).
+pub const AXIS: Axis = Axis::Resultant;
 
 /// The SPI device: SPI1 with DMA, chip select by GPIO, embassy-time for the FIFO delays.
 pub type Device = ExclusiveDevice<Spi<'static, Async, Master>, Output<'static>, Delay>;
@@ -126,17 +115,32 @@ fn spi_error_kind(kind: embedded_hal::spi::ErrorKind) -> &'static str {
     }
 }
 
-fn pick(sample: &Sample) -> i16 {
-    match AXIS {
-        Axis::X => sample.x,
-        Axis::Y => sample.y,
-        Axis::Z => sample.z,
-        Axis::Resultant => sample.magnitude(),
+impl Fifo for Sensor {
+    type Error = Error<<Device as embedded_hal::spi::ErrorType>::Error>;
+
+    async fn read(&mut self, out: &mut [Axes; MAX_ENTRIES]) -> Result<Read, Poll<Self::Error>> {
+        let mut samples = [Sample::default(); MAX_FIFO_ENTRIES];
+        // `read_fifo` reads the entry count first.
+        let at = Instant::now();
+        let (samples_read, overrun) = match self.read_fifo(&mut samples).await {
+            Ok(n) => (n, false),
+            Err(Error::FifoOverrun { samples_read }) => (samples_read, true),
+            Err(e) => return Err(Poll::Error(e)),
+        };
+        for (slot, s) in out.iter_mut().zip(samples.iter().take(samples_read)) {
+            *slot = [s.x, s.y, s.z];
+        }
+        Ok(Read {
+            at,
+            samples: samples_read,
+            overrun,
+        })
     }
 }
 
-/// Brings the sensor up, then polls its FIFO forever, one block per [`BLOCK_LEN`] samples.
-/// If the sensor cannot be brought up the stream ends as failed.
+/// Brings the sensor up, then polls its FIFO forever ([`poll::run`]: losses counted against
+/// the sensor's own sample stream, one short block per poll). If the sensor cannot be brought
+/// up the stream ends as failed.
 #[embassy_executor::task]
 pub async fn sampler(mut sensor: Sensor, samples: crate::tasks::SampleSender) {
     let mut sender = BlockSender::new(samples);
@@ -152,59 +156,22 @@ pub async fn sampler(mut sensor: Sensor, samples: crate::tasks::SampleSender) {
         attempt += 1;
         Timer::after_millis(100).await;
     }
+    // Measuring starts with init's last write.
+    let started = Instant::now();
+    SAMPLE_CLOCK.start(SAMPLE_RATE_HZ as f32);
     info!(
         "ADXL375 on SPI1 at {} Hz, polled every {} ms",
         DATA_RATE.hz(),
         POLL_PERIOD.as_millis()
     );
-
-    let mut fifo = [Sample::default(); MAX_FIFO_ENTRIES];
-    let mut block = [0i16; BLOCK_LEN];
-    let mut filled = 0;
-    let mut ticker = Ticker::every(POLL_PERIOD);
-    let started = Instant::now();
-    SAMPLE_CLOCK.start(SAMPLE_RATE_HZ as f32);
-    // Samples read or counted lost since the start.
-    let mut accounted = 0u64;
-    loop {
-        ticker.next().await;
-        let read = match sensor.read_fifo(&mut fifo).await {
-            Ok(n) => n,
-            Err(Error::FifoOverrun { samples_read }) => {
-                let n = SOURCE_STATS.overrun();
-                // The FIFO overwrote what was not read in time: what the data rate should
-                // have given since the start, less what was read (the FIFO has no count of
-                // its own; good to a poll period's jitter).
-                let due = started.elapsed().as_micros() * u64::from(SAMPLE_RATE_HZ) / 1_000_000;
-                let lost = due.saturating_sub(accounted + samples_read as u64);
-                accounted += lost;
-                // The samples before the gap go out first, in a short block; the gap is
-                // announced with the block that holds the samples read after it.
-                if filled > 0 {
-                    let before = block;
-                    sender.publish(filled, |b| *b = before);
-                    filled = 0;
-                }
-                sender.lost(lost.min(u64::from(u32::MAX)) as u32);
-                warn!("ADXL375 FIFO overrun (#{}): {} samples lost", n, lost);
-                samples_read
-            }
-            Err(e) => {
-                let n = SOURCE_STATS.error();
-                warn!("ADXL375 read failed (error #{}): {}", n, e);
-                0
-            }
-        };
-        accounted += read as u64;
-        for sample in fifo.iter().take(read) {
-            if let Some(slot) = block.get_mut(filled) {
-                *slot = pick(sample);
-                filled += 1;
-            }
-            if filled == BLOCK_LEN {
-                sender.publish(BLOCK_LEN, |b| *b = block);
-                filled = 0;
-            }
-        }
-    }
+    poll::run(
+        &mut sensor,
+        &mut sender,
+        AXIS,
+        SAMPLE_RATE_HZ as f32,
+        started,
+    )
+    .await;
+    // The board's sensor never ends.
+    sender.finish(StreamEnd::Failed).await;
 }

@@ -138,40 +138,17 @@ impl Sample {
         }
     }
 
-    /// The resultant `sqrt(x² + y² + z²)`, counts, rounded to the nearest integer (exact
-    /// integer arithmetic: at most `4096 √3 < 7095`, so it fits an `i16`).
+    /// The resultant `sqrt(x² + y² + z²)`, counts, rounded to the nearest integer by exact
+    /// integer arithmetic (`impact_core::signal::resultant`, the host's too; at most
+    /// `4096 √3 < 7095`).
     pub fn magnitude(self) -> i16 {
-        let sq = |v: i16| (i32::from(v) * i32::from(v)) as u32;
-        let n = sq(self.x) + sq(self.y) + sq(self.z);
-        let r = isqrt(n);
-        // Round: up when n lies beyond r² + r (the midpoint (r + ½)² = r² + r + ¼).
-        let r = if n - r * r > r { r + 1 } else { r };
-        r.min(i16::MAX as u32) as i16
+        impact_core::signal::resultant::resultant_counts(self.x, self.y, self.z)
     }
 
     /// The sample in m/s², `[x, y, z]`.
     pub fn to_m_per_s2(self) -> [f32; 3] {
         [self.x, self.y, self.z].map(counts_to_m_per_s2)
     }
-}
-
-/// `floor(sqrt(n))`, digit by digit (16 steps of shifts and compares, no division).
-fn isqrt(n: u32) -> u32 {
-    let (mut rem, mut root) = (n, 0u32);
-    let mut bit = 1u32 << 30;
-    while bit > rem {
-        bit >>= 2;
-    }
-    while bit != 0 {
-        if rem >= root + bit {
-            rem -= root + bit;
-            root = (root >> 1) + bit;
-        } else {
-            root >>= 1;
-        }
-        bit >>= 2;
-    }
-    root
 }
 
 /// Converts counts to m/s² with the typical scale factor.

@@ -18,6 +18,13 @@ pub mod adxl375;
 #[cfg(feature = "emulator")]
 pub mod replay;
 
+// A polled FIFO (the ADXL375's, or its emulation): hardware-free loss accounting (tested on
+// the host) and the polling loop.
+#[cfg(any(feature = "adxl375", feature = "emulator"))]
+pub mod fifo;
+#[cfg(any(feature = "adxl375", feature = "emulator"))]
+pub mod poll;
+
 // Hardware-free (tested on the host); `gate` is its EXTI half.
 #[cfg(feature = "light-gate")]
 pub mod gate;

@@ -8,6 +8,11 @@
 //!   blocks, waiting for room in the queue, so every sample reaches the stream whatever the
 //!   emulator's speed (reproducible runs over recorded signals).
 //!
+//! With `sensor=adxl375` the file holds three-axis samples (i16 triplets, x y z) and goes
+//! through the ADXL375 path instead: in real time an emulated ADXL375
+//! ([`crate::emulator::adxl375`]) polled by the board's own ADXL375 source
+//! ([`crate::source::poll`]), losslessly the same resultant computed block by block.
+//!
 //! Paths cannot contain spaces (semihosting joins the arguments with spaces).
 
 use core::sync::atomic::Ordering;
@@ -15,13 +20,21 @@ use core::sync::atomic::Ordering;
 use defmt::{error, info, warn, Format};
 use embassy_time::{Duration, Instant};
 
+use crate::emulator::adxl375;
 use crate::emulator::dma::{self, Take};
 use crate::emulator::host::{HostError, HostFile};
+use crate::source::poll::{self, Axis};
 use crate::tasks::sampler::{BlockSender, SAMPLE_CLOCK, SOURCE_STATS};
 use crate::tasks::{SampleSender, StreamEnd, BLOCK_LEN};
 
-/// Bytes per sample in the file.
-const SAMPLE_BYTES: usize = 2;
+/// Bytes per sample in the file: one axis, or three (the ADXL375 path).
+pub const fn sample_bytes(axes: bool) -> usize {
+    if axes {
+        6
+    } else {
+        2
+    }
+}
 
 #[derive(Format)]
 pub enum ReplayError {
@@ -38,27 +51,31 @@ impl From<HostError> for ReplayError {
     }
 }
 
-/// Opens the file and checks its length; logs what is replayed.
-pub fn open(path: &str, rate_hz: f32) -> Result<HostFile, ReplayError> {
+/// Opens the file and checks its length (whole samples of one axis, or of three with
+/// `axes`); logs what is replayed.
+pub fn open(path: &str, rate_hz: f32, axes: bool) -> Result<HostFile, ReplayError> {
     let file = HostFile::open(path)?;
     let bytes = file.len_bytes()?;
-    if bytes % SAMPLE_BYTES != 0 {
+    if bytes % sample_bytes(axes) != 0 {
         return Err(ReplayError::OddLength { bytes });
     }
     info!(
-        "replay: {=str}: {} samples at {=f32} S/s",
+        "replay: {=str}: {} samples{=str} at {=f32} S/s",
         path,
-        bytes / SAMPLE_BYTES,
+        bytes / sample_bytes(axes),
+        if axes { " of three axes" } else { "" },
         rate_hz
     );
     Ok(file)
 }
 
-/// Replays the file block by block, waiting for room in the queue, then ends the stream.
+/// Replays the file block by block (with `axes`, three-axis samples, of which the axis
+/// given goes to the stream),
+/// waiting for room in the queue, then ends the stream.
 #[embassy_executor::task]
-pub async fn lossless(file: HostFile, samples: SampleSender) {
+pub async fn lossless(file: HostFile, axes: Option<Axis>, samples: SampleSender) {
     let mut sender = BlockSender::new(samples);
-    let end = match replay_all(&mut sender, file).await {
+    let end = match replay_all(&mut sender, file, axes).await {
         Ok(()) => StreamEnd::Complete,
         Err(e) => {
             SOURCE_STATS.error();
@@ -69,24 +86,37 @@ pub async fn lossless(file: HostFile, samples: SampleSender) {
     sender.finish(end).await;
 }
 
-async fn replay_all(sender: &mut BlockSender, mut file: HostFile) -> Result<(), ReplayError> {
-    let mut raw = [0u8; BLOCK_LEN * SAMPLE_BYTES];
+async fn replay_all(
+    sender: &mut BlockSender,
+    mut file: HostFile,
+    axes: Option<Axis>,
+) -> Result<(), ReplayError> {
+    let width = sample_bytes(axes.is_some());
+    let axis = axes.unwrap_or(Axis::Resultant);
+    let mut raw = [0u8; BLOCK_LEN * 6];
+    let raw = raw.get_mut(..BLOCK_LEN * width).unwrap_or(&mut []);
     loop {
-        let n = file.read_full(&mut raw)?;
+        let n = file.read_full(raw)?;
         if n == 0 {
             return Ok(());
         }
-        // The length was checked to be even; a file that grew meanwhile ends here.
-        if n % SAMPLE_BYTES != 0 {
+        // The length was checked; a file that grew meanwhile ends here.
+        if n % width != 0 {
             return Err(ReplayError::OddLength { bytes: n });
         }
         let bytes = raw.get(..n).unwrap_or(&[]);
         sender
-            .send(n / SAMPLE_BYTES, |block| {
-                for (sample, le) in block.iter_mut().zip(bytes.chunks_exact(SAMPLE_BYTES)) {
-                    if let [lo, hi] = *le {
-                        *sample = i16::from_le_bytes([lo, hi]);
-                    }
+            .send(n / width, |block| {
+                for (sample, le) in block.iter_mut().zip(bytes.chunks_exact(width)) {
+                    *sample = match *le {
+                        [lo, hi] => i16::from_le_bytes([lo, hi]),
+                        [x0, x1, y0, y1, z0, z1] => axis.pick([
+                            i16::from_le_bytes([x0, x1]),
+                            i16::from_le_bytes([y0, y1]),
+                            i16::from_le_bytes([z0, z1]),
+                        ]),
+                        _ => 0,
+                    };
                 }
             })
             .await;
@@ -94,6 +124,39 @@ async fn replay_all(sender: &mut BlockSender, mut file: HostFile) -> Result<(), 
             return Ok(());
         }
     }
+}
+
+/// Starts the emulated ADXL375 on the file at `rate_hz` (the recording's rate times the rate
+/// scale) and polls it with the board's ADXL375 source until the file ends. `stall` (a test's
+/// fault injection): before poll `.0`, busy-wait `.1` µs. Logs what the emulated part
+/// overwrote, the truth the firmware's own count of lost samples can be held to.
+#[embassy_executor::task]
+pub async fn adxl375(
+    file: HostFile,
+    rate_hz: f32,
+    axis: Axis,
+    stall: Option<(u32, u32)>,
+    samples: SampleSender,
+) {
+    let mut sender = BlockSender::new(samples);
+    SAMPLE_CLOCK.start(rate_hz);
+    let started = Instant::now();
+    adxl375::start(file, f64::from(rate_hz));
+    let mut part = adxl375::EmulatedAdxl375 { stall, polls: 0 };
+    poll::run(&mut part, &mut sender, axis, rate_hz, started).await;
+    let (produced, overwritten) = adxl375::counts();
+    info!(
+        "emulated ADXL375: {} samples produced, {} overwritten unread",
+        produced, overwritten
+    );
+    let end = if adxl375::failed() {
+        SOURCE_STATS.error();
+        error!("replay: the host file could not be read");
+        StreamEnd::Failed
+    } else {
+        StreamEnd::Complete
+    };
+    sender.finish(end).await;
 }
 
 /// Starts the emulated DMA on the file at `rate_hz` (the recording's rate times the rate
