@@ -1,7 +1,7 @@
 //! `impact-core`: impact models, solvers, the streaming signal pipeline, metrics and fits.
 //!
 //! `no_std`, allocation-free, and panic-free on any input: bad input gives a typed
-//! [`solve::Error`] or a flagged result.
+//! [`Error`] or a flagged result.
 //!
 //! # Units and sign conventions
 //! SI throughout, and every public field name carries its unit (`_m`, `_s`, `_n`, `_m_s`).
@@ -23,10 +23,12 @@
 pub mod analysis;
 pub mod board;
 pub mod capture;
+pub mod consts;
+pub mod error;
 pub mod fit;
 pub mod model;
 pub mod monitor;
-pub mod motion;
+pub mod numeric;
 pub mod real;
 pub mod report;
 pub mod scene;
@@ -34,17 +36,19 @@ pub mod signal;
 pub mod solve;
 pub mod stream;
 pub mod target;
-pub mod train;
 pub mod waveform;
 
 pub use analysis::{analyse, Workspace};
 pub use capture::{Capture, Sink, Summary};
+pub use error::Error;
 pub use model::{ContactLaw, Model};
+pub use model::{Impact, ImpactOutcome};
 pub use monitor::Monitor;
 pub use real::Real;
+pub use report::Bounce;
 pub use report::{Analysis, ImpactReport, Kinematics, Status};
 pub use scene::{Approach, FitSet, Scene};
+pub use scene::{Train, TrainSpeed};
 pub use signal::Calibration;
-pub use solve::{solve, Error, Impact, ImpactOutcome, Method, Settings};
+pub use solve::{solve, Method, Settings};
 pub use stream::{Counters, Stream};
-pub use train::{Bounce, Train, TrainSpeed};

@@ -4,9 +4,9 @@
 
 use crate::analysis::{analyse, Workspace};
 use crate::capture::{Capture, Sink};
+use crate::error::Error;
 use crate::report::ImpactReport;
 use crate::scene::Scene;
-use crate::solve::Error;
 use crate::stream::{Counters, Stream};
 
 /// Streams samples of one channel through a [`Scene`] and reports every impact in full.

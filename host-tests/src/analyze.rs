@@ -4,10 +4,10 @@ use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 
 use clap::Args;
+use impact_core::consts::STANDARD_GRAVITY;
 use impact_core::monitor::Monitor;
 use impact_core::report::{Fits, Flags};
 use impact_core::signal::cfc::Cfc;
-use impact_core::solve::bounce::STANDARD_GRAVITY;
 use impact_core::{Approach, Calibration, FitSet, ImpactReport, Scene, Status};
 use serde::{Deserialize, Serialize};
 

@@ -7,10 +7,10 @@ use std::io::{BufRead, BufReader, Read};
 use std::path::PathBuf;
 
 use clap::Args;
-use impact_core::analysis::COR_TOLERANCE;
+use impact_core::consts::STANDARD_GRAVITY;
+use impact_core::report::COR_TOLERANCE;
 use impact_core::report::{Bounce, Fits, Flags, HertzFit, NonlinearFit, Spectrum, TwoPhaseFit};
 use impact_core::signal::spectrum::MAX_BANDS;
-use impact_core::solve::bounce::STANDARD_GRAVITY;
 use impact_core::{Analysis, ImpactReport, Kinematics, Status};
 
 use crate::analyze::{self, AnalysisJson};

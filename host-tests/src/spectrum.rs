@@ -176,7 +176,7 @@ pub fn csv_cells(s: Option<&ShockSpectrumJson>) -> String {
 
 /// The table's line for an impact's spectra.
 pub fn table_line(s: &ShockSpectrumJson) -> String {
-    let g = impact_core::solve::bounce::STANDARD_GRAVITY;
+    let g = impact_core::consts::STANDARD_GRAVITY;
     let peak = srs_peak(s).map_or("none".to_string(), |(a, f)| {
         format!(
             "{} ({}) at {}",

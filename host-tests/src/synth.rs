@@ -350,7 +350,8 @@ pub fn bounce_train(
     args: &SynthArgs,
     model: &impact_core::Model<f64>,
 ) -> Result<Vec<impact_core::solve::bounce::Bounce<f64>>, String> {
-    use impact_core::solve::bounce::{Bounces, STANDARD_GRAVITY};
+    use impact_core::consts::STANDARD_GRAVITY;
+    use impact_core::solve::bounce::Bounces;
     let g = STANDARD_GRAVITY;
     let height = args.v0 * args.v0 / (2.0 * g);
     let release = (2.0 * height / g).sqrt();
@@ -395,7 +396,7 @@ pub fn write_csv(rec: &Recording, args: &SynthArgs, out: &mut impl Write) -> std
     let mid = (1u64 << (args.bits - 1)) as f64;
     // The sensor's gain in f64, as the codes were made (the calibration holds it in f32).
     let gain = sensor(args).gain();
-    let g = impact_core::solve::bounce::STANDARD_GRAVITY;
+    let g = impact_core::consts::STANDARD_GRAVITY;
     writeln!(out, "time_s,accel_g")?;
     for (k, &c) in rec.samples.iter().enumerate() {
         writeln!(

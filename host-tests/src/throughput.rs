@@ -348,7 +348,7 @@ fn analyze_files(
     let result = (|| {
         let file = std::fs::File::create(&csv).map_err(|e| format!("{}: {e}", csv.display()))?;
         let mut w = std::io::BufWriter::with_capacity(1 << 20, file);
-        let gain_g = 1600.0 / 4096.0 / impact_core::solve::bounce::STANDARD_GRAVITY;
+        let gain_g = 1600.0 / 4096.0 / impact_core::consts::STANDARD_GRAVITY;
         writeln!(w, "time_s,accel_g").map_err(|e| e.to_string())?;
         for (k, &c) in counts.iter().enumerate() {
             writeln!(

@@ -81,7 +81,7 @@ pub struct BounceJson {
 pub fn bounce_json(r: &ImpactReport) -> Option<BounceJson> {
     let b = r.bounce?;
     let f = |v: f32| v as f64;
-    let tol = impact_core::analysis::COR_TOLERANCE as f64;
+    let tol = impact_core::report::COR_TOLERANCE as f64;
     let cor = |v0: Option<f32>| -> Result<f64, &'static str> {
         let v0 = v0.ok_or("no-rebound")?;
         let dv = r.delta_v_m_s.ok_or("ac-coupled")?;

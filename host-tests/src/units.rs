@@ -5,7 +5,7 @@
 use std::fmt;
 
 use clap::ValueEnum;
-use impact_core::solve::bounce::STANDARD_GRAVITY;
+use impact_core::consts::STANDARD_GRAVITY;
 use serde::{Deserialize, Deserializer};
 
 use crate::table::words;

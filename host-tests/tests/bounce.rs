@@ -1,7 +1,8 @@
 //! Bounce scenes: closed-form flights, one solved contact per bounce.
 
+use impact_core::consts::STANDARD_GRAVITY;
 use impact_core::model::{KelvinVoigt, Linear, Nonlinear};
-use impact_core::solve::bounce::{Bounces, STANDARD_GRAVITY};
+use impact_core::solve::bounce::Bounces;
 use impact_core::{ContactLaw, Impact, Settings};
 
 #[test]

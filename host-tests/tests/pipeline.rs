@@ -319,7 +319,8 @@ fn without_v0_the_pulse_metrics_remain_and_kinematics_are_absent() {
 
 #[test]
 fn bounces_in_one_stream_are_each_reported() {
-    use impact_core::solve::bounce::{Bounces, STANDARD_GRAVITY};
+    use impact_core::consts::STANDARD_GRAVITY;
+    use impact_core::solve::bounce::Bounces;
     let law = KelvinVoigt {
         k: cases::bench_kc(),
         c: 0.5,

@@ -92,7 +92,7 @@ fn train(law: &[&str]) -> String {
                 within(c, cor, 0.01, &what(&format!("COR from {source}")));
             }
             // The flight itself: from the exact rebound, 2 v'/g.
-            let g = impact_core::solve::bounce::STANDARD_GRAVITY;
+            let g = impact_core::consts::STANDARD_GRAVITY;
             within(
                 b["flight_s"].as_f64().unwrap(),
                 2.0 * v0 / g,

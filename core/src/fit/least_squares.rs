@@ -8,7 +8,7 @@ use crate::real::Real;
 fn pow15(x: f32) -> f32 {
     x * <f32 as Real>::sqrt(x)
 }
-use crate::solve::roots::brent_min;
+use crate::numeric::roots::brent_min;
 
 /// Bracket of the nonlinear exponent search.
 const EXPONENT_RANGE: (f64, f64) = (1.0, 2.5);

@@ -1,8 +1,11 @@
 //! Hertz contact of two elastic spheres, `F = K x^(3/2)` (seed 000, Eq. 44–46).
 
-use super::{positive, ContactLaw, Phase};
+use super::closed_form as exact;
+use super::{ContactLaw, Phase};
+use super::{Impact, ImpactOutcome};
+use crate::error::positive;
+use crate::error::Error;
 use crate::real::Real;
-use crate::solve::{exact, Error, Impact, ImpactOutcome};
 
 /// One elastic body at the contact. An infinite radius is a flat wall; an infinite Young's
 /// modulus is a rigid body.

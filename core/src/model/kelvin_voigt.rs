@@ -1,8 +1,11 @@
 //! Linear Kelvin–Voigt spring-damper `F = k x + c v` (seed 001, Eq. 2).
 
-use super::{non_negative, positive, Affine, ContactLaw, Phase};
+use super::closed_form as exact;
+use super::{Affine, ContactLaw, Phase};
+use super::{Impact, ImpactOutcome};
+use crate::error::Error;
+use crate::error::{non_negative, positive};
 use crate::real::Real;
-use crate::solve::{exact, Error, Impact, ImpactOutcome};
 
 /// Spring `k` (N/m) in parallel with a damper `c` (N s/m). Separation is where the force (not
 /// the deformation) returns to zero, so a deformation is left at separation.

@@ -1,8 +1,11 @@
 //! Linear spring `F = k x`: the cheap stand-in for Hertz (seed 000, section 3.2.1).
 
-use super::{positive, Affine, ContactLaw, Hertz, Phase};
+use super::closed_form as exact;
+use super::{Affine, ContactLaw, Hertz, Phase};
+use super::{Impact, ImpactOutcome};
+use crate::error::positive;
+use crate::error::Error;
 use crate::real::Real;
-use crate::solve::{exact, Error, Impact, ImpactOutcome};
 
 /// Linear contact spring, `k` in N/m.
 #[derive(Clone, Copy, Debug, PartialEq)]

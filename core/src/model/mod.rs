@@ -7,20 +7,23 @@
 //! which the force returns to zero. Solvers integrate the smooth `raw_force` and stop at
 //! separation, so the clamp never acts inside a contact.
 
+pub mod closed_form;
 mod hertz;
+mod impact;
 mod kelvin_voigt;
 mod linear;
 mod nonlinear;
 mod two_phase;
 
 pub use hertz::{Body, Hertz};
+pub use impact::{Impact, ImpactOutcome};
 pub use kelvin_voigt::KelvinVoigt;
 pub use linear::Linear;
 pub use nonlinear::Nonlinear;
 pub use two_phase::TwoPhase;
 
+use crate::error::Error;
 use crate::real::Real;
-use crate::solve::{Error, Impact, ImpactOutcome};
 
 /// Which side of the maximum deformation the contact is on.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -92,30 +95,6 @@ pub trait ContactLaw<R: Real> {
     /// The exact or semi-analytic outcome of one impact (closed forms, energy relation plus
     /// quadrature).
     fn exact(&self, impact: &Impact<R>) -> Result<ImpactOutcome<R>, Error>;
-}
-
-/// Checks that a parameter is finite and strictly positive.
-pub(crate) fn positive<R: Real>(value: R, name: &'static str) -> Result<(), Error> {
-    if value.is_finite() && value > R::ZERO {
-        Ok(())
-    } else {
-        Err(Error::InvalidParameter {
-            name,
-            reason: "must be finite and > 0",
-        })
-    }
-}
-
-/// Checks that a parameter is finite and not negative.
-pub(crate) fn non_negative<R: Real>(value: R, name: &'static str) -> Result<(), Error> {
-    if value.is_finite() && value >= R::ZERO {
-        Ok(())
-    } else {
-        Err(Error::InvalidParameter {
-            name,
-            reason: "must be finite and >= 0",
-        })
-    }
 }
 
 /// Any of the contact laws, chosen at run time (host tools, scene files). Firmware that knows

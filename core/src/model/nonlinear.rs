@@ -1,9 +1,12 @@
 //! Nonlinear force `F = k x^n (1 + c v)` (seed 001, Eq. 7 with `n = 1`; `n = 3/2` is the
 //! Hertz-based Hunt–Crossley law).
 
-use super::{non_negative, positive, ContactLaw, Phase};
+use super::closed_form as exact;
+use super::{ContactLaw, Phase};
+use super::{Impact, ImpactOutcome};
+use crate::error::Error;
+use crate::error::{non_negative, positive};
 use crate::real::Real;
-use crate::solve::{exact, Error, Impact, ImpactOutcome};
 
 /// `k` in N/m^n, `c` in s/m, exponent `n >= 1`. Starting from `x = 0, v0 > 0` the factor
 /// `1 + c v` stays positive, so the force vanishes only at `x = 0`: no permanent set.

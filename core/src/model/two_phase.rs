@@ -1,10 +1,13 @@
 //! Two-phase Kelvin–Voigt (seed 001, Eq. 5): undamped compression with `kc`, damped
 //! restitution with `kr` and `c` around a permanent set `x_p`.
 
+use super::closed_form as exact;
 use super::kelvin_voigt::damped_time_scale;
-use super::{non_negative, positive, Affine, ContactLaw, Phase};
+use super::{Affine, ContactLaw, Phase};
+use super::{Impact, ImpactOutcome};
+use crate::error::Error;
+use crate::error::{non_negative, positive};
 use crate::real::Real;
-use crate::solve::{exact, Error, Impact, ImpactOutcome};
 
 /// `F = kc x` while compressing; `F = kr (x - x_p) + c v` after the maximum deformation.
 #[derive(Clone, Copy, Debug, PartialEq)]

@@ -293,6 +293,32 @@ impl<const K: usize> Baseline<K> {
     }
 }
 
+/// A raw sample with one impact's frozen baseline removed, `d = W x - S` (the baseline is the
+/// rational `S / W` counts), in i32: exact, since `W <= 4096` and `|x| <= 2^15` keep `|S|`
+/// below 2^27 and `|d|` below 2^28 (the wrapping operations never wrap); i32 because the FPU
+/// converts it while i64 arithmetic and conversions are longer or soft-float calls on the
+/// Cortex-M4.
+#[derive(Clone, Copy, Debug)]
+pub struct Deviation {
+    w: i32,
+    s: i32,
+}
+
+impl Deviation {
+    /// For the baseline `base_sum / base_n` (`base_n <= 4096`, as the stream's baseline).
+    pub fn new(base_sum: i64, base_n: i64) -> Self {
+        Self {
+            w: base_n as i32,
+            s: base_sum as i32,
+        }
+    }
+
+    #[inline]
+    pub fn of(self, x: i16) -> i32 {
+        (x as i32).wrapping_mul(self.w).wrapping_sub(self.s)
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -5,9 +5,6 @@ use super::{solve, Error, Impact, ImpactOutcome, Settings};
 use crate::model::ContactLaw;
 use crate::real::Real;
 
-/// Standard gravity, m/s².
-pub const STANDARD_GRAVITY: f64 = 9.806_65;
-
 /// One contact of a bounce sequence.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Bounce<R> {
@@ -53,9 +50,9 @@ impl<'a, R: Real, L: ContactLaw<R>> Bounces<'a, R, L> {
         min_rebound_m_s: R,
         max_contacts: u32,
     ) -> Result<Self, Error> {
-        crate::model::positive(drop_height_m, "drop-height")?;
-        crate::model::positive(gravity_m_s2, "gravity")?;
-        crate::model::positive(min_rebound_m_s, "min-rebound")?;
+        crate::error::positive(drop_height_m, "drop-height")?;
+        crate::error::positive(gravity_m_s2, "gravity")?;
+        crate::error::positive(min_rebound_m_s, "min-rebound")?;
         Ok(Self {
             law,
             settings,

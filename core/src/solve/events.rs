@@ -1,9 +1,9 @@
 //! The contact driver shared by the time-stepping solvers: steps from first touch, locates
 //! the maximum deformation, the peak force and separation on each step's interpolant.
 
-use super::roots::{brent, golden_max};
 use super::{Error, Impact, ImpactOutcome};
 use crate::model::{ContactLaw, Phase};
+use crate::numeric::roots::{brent, golden_max};
 use crate::real::Real;
 
 /// Position and velocity at a time, s / m / m/s.

@@ -10,9 +10,10 @@
 //! impact at all); or for the reasons of [`Status`].
 
 use super::level::LevelWatch;
-use super::{Deviation, Stream, FLANK_EDGES};
+use super::{Stream, FLANK_EDGES};
 use crate::capture::{Sink, Summary};
 use crate::report::{self, Status};
+use crate::signal::baseline::Deviation;
 use crate::signal::baseline::{Stats, STRIDE};
 use crate::signal::flank::{crossing, Flank};
 

@@ -16,14 +16,15 @@
 
 mod impact;
 mod level;
+pub mod train;
 
 use crate::capture::Sink;
+use crate::error::Error;
 use crate::report::Status;
 use crate::scene::{Approach, FitSet, Scene};
 use crate::signal::baseline::{Baseline, Stats, STRIDE};
 use crate::signal::ring::Ring;
 use crate::signal::Calibration;
-use crate::solve::Error;
 use impact::Active;
 
 /// Quiet strides in the baseline window (`64 * STRIDE` = 4096 samples).
@@ -37,32 +38,6 @@ const _: () = assert!(BASELINE_SPAN <= 1 << 12);
 /// The flanks are fitted between the edge level and this many times it (or the trigger level,
 /// if lower, so the trigger sample always ends the rising flank).
 const FLANK_EDGES: i64 = 4;
-
-/// A raw sample with one impact's frozen baseline removed, `d = W x - S` (the baseline is the
-/// rational `S / W` counts), in i32: exact, since `W <= 4096` and `|x| <= 2^15` keep `|S|`
-/// below 2^27 and `|d|` below 2^28 (the wrapping operations never wrap); i32 because the FPU
-/// converts it while i64 arithmetic and conversions are longer or soft-float calls on the
-/// Cortex-M4.
-#[derive(Clone, Copy, Debug)]
-pub struct Deviation {
-    w: i32,
-    s: i32,
-}
-
-impl Deviation {
-    /// For the baseline `base_sum / base_n` (`base_n <= 4096`, as the stream's baseline).
-    pub fn new(base_sum: i64, base_n: i64) -> Self {
-        Self {
-            w: base_n as i32,
-            s: base_sum as i32,
-        }
-    }
-
-    #[inline]
-    pub fn of(self, x: i16) -> i32 {
-        (x as i32).wrapping_mul(self.w).wrapping_sub(self.s)
-    }
-}
 
 /// Counters that cannot wrap: 2^64 samples at 2.4 MS/s is 240 000 years.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
@@ -97,7 +72,7 @@ pub struct Stream<const PRE: usize> {
     index: u64,
     v0: Option<f32>,
     /// The previous impact, for bounce trains.
-    train: crate::train::Tracker,
+    train: train::Tracker,
     counters: Counters,
     trigger_counts: f32,
     edge_counts: f32,
@@ -164,7 +139,7 @@ impl<const PRE: usize> Stream<PRE> {
             active: None,
             index: 0,
             v0: None,
-            train: crate::train::Tracker::new(),
+            train: train::Tracker::new(),
             counters: Counters {
                 samples: 0,
                 impacts: 0,
@@ -223,7 +198,7 @@ impl<const PRE: usize> Stream<PRE> {
         self.active = None;
         self.index = 0;
         self.v0 = scene.approach.v0_m_s();
-        self.train = crate::train::Tracker::new();
+        self.train = train::Tracker::new();
         self.counters = Counters::default();
         self.trigger_counts = scene.trigger_m_s2 / gain;
         self.edge_counts = scene.edge_m_s2 / gain;

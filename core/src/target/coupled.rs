@@ -10,12 +10,13 @@
 //! step control sees their error; `x1 = δ + y`, `u1 = δ' + w` are sums, formed where needed.
 
 use super::{at_separation, reduced_mass, Target, TargetOutcome, MAX_STATES};
+use crate::error::Error;
+use crate::model::Impact;
 use crate::model::{ContactLaw, Phase};
+use crate::numeric::roots::{brent, golden_max};
 use crate::real::Real;
 use crate::solve::adaptive::{A2, A3, A4, A5, A6, B, D, E};
 use crate::solve::events::Compensated;
-use crate::solve::roots::{brent, golden_max};
-use crate::solve::{Error, Impact};
 
 /// States: `δ, δ'`, the target's `z`, then `∫ F δ' dt`, `∫ F w dt`, `∫ c2 w² dt`.
 const S: usize = MAX_STATES + 5;

@@ -3,10 +3,11 @@
 
 use super::matrix::{dot, Mat, Vector, DIM};
 use super::{at_separation, reduced_mass, Target, TargetOutcome, MAX_STATES};
+use crate::error::Error;
+use crate::model::Impact;
 use crate::model::{Affine, ContactLaw, Phase};
+use crate::numeric::roots::brent;
 use crate::real::Real;
-use crate::solve::roots::brent;
-use crate::solve::{Error, Impact};
 
 /// Two free bodies: the relative motion is the wall problem of the reduced mass
 /// `μ = m1 m2 / (m1 + m2)`, solved by the law's own exact solution; momentum gives each body's

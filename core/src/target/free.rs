@@ -1,9 +1,9 @@
 //! After separation: the target rings on by itself and the impactor coasts; do they meet again?
 
 use super::{Target, TargetOutcome, MAX_STATES};
+use crate::error::Error;
+use crate::numeric::roots::brent;
 use crate::real::Real;
-use crate::solve::roots::brent;
-use crate::solve::Error;
 
 /// The target's free response after separation and the check of the single-hit assumption.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]

@@ -23,9 +23,12 @@ pub mod matrix;
 
 pub use coupled::Sample;
 
-use crate::model::{positive, ContactLaw};
+use crate::error::positive;
+use crate::error::Error;
+use crate::model::ContactLaw;
+use crate::model::Impact;
 use crate::real::Real;
-use crate::solve::{Error, Impact, Method, Settings};
+use crate::solve::{Method, Settings};
 use matrix::{dot, Mat, Vector, DIM};
 
 /// Most states a target may have.

@@ -1,12 +1,14 @@
 //! What a bench is and which stages of the pipeline it needs; shared by host and firmware.
 
-use crate::model::positive;
+use crate::consts::STANDARD_GRAVITY;
+use crate::error::positive;
+use crate::error::Error;
 use crate::signal::cfc::Cfc;
 use crate::signal::spectrum::SpectrumSettings;
 use crate::signal::Calibration;
-use crate::solve::bounce::STANDARD_GRAVITY;
-use crate::solve::Error;
-use crate::train::Train;
+pub mod train;
+
+pub use train::{Train, TrainSpeed};
 
 /// Heaviest impactor, kg: above any drop weight, and forces and energies stay finite f32.
 pub const MAX_MASS_KG: f32 = 1e6;
@@ -107,7 +109,7 @@ pub struct Scene {
     pub trigger_cfc: Option<Cfc>,
     pub fits: FitSet,
     /// Bounce trains: each impact after the first takes its approach speed from the flight
-    /// since the previous separation or from the previous rebound ([`crate::train`]).
+    /// since the previous separation or from the previous rebound ([`crate::stream::train`]).
     pub train: Option<Train>,
     /// Shock spectra (SRS, PVSS, enveloping half-sine) of each captured impact
     /// ([`crate::signal::spectrum`]).

@@ -5,10 +5,10 @@
 //! ratios near critical, vanishing or huge damping, and the inverse-power endpoint of the
 //! time integrals.
 
-use super::quad::tanh_sinh;
-use super::roots::brent;
-use super::{Error, Impact, ImpactOutcome};
-use crate::model::{Nonlinear, TwoPhase};
+use super::{Impact, ImpactOutcome, Nonlinear, TwoPhase};
+use crate::error::Error;
+use crate::numeric::quad::tanh_sinh;
+use crate::numeric::roots::brent;
 use crate::real::{pow, Real};
 
 fn finite<R: Real>(o: ImpactOutcome<R>) -> Result<ImpactOutcome<R>, Error> {

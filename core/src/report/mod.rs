@@ -1,11 +1,16 @@
 //! The per-impact report: what the streaming stage measured exactly (peak, Δv, times), and,
 //! when the analysis ran, the widths, the kinematics (with the approach speed) and the fits.
 
-use crate::capture::Summary;
+pub mod summary;
+
 pub use crate::fit::{Fits, HertzFit, NonlinearFit, TwoPhaseFit};
 use crate::scene::Scene;
 pub use crate::signal::spectrum::Spectrum;
-pub use crate::train::Bounce;
+pub use summary::{Bounce, BounceSlot, Summary};
+
+/// How far beyond [0, 1] a measured COR may lie before it is taken as wrong, not noisy
+/// ([`Flags::COR_OUT_OF_RANGE`]; a bounce's rebound must lie in `[0, 1 + COR_TOLERANCE]`).
+pub const COR_TOLERANCE: f32 = 0.02;
 
 /// How an impact's capture ended.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]

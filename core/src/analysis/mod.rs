@@ -6,13 +6,12 @@
 //! few thousand points: no per-sample floating point unless a CFC filter is asked for.
 
 use crate::capture::Capture;
-use crate::motion::{self, PointsOut, Scale};
-use crate::report::{self, Analysis, Flags, ImpactReport, Kinematics, Status};
-use crate::scene::Scene;
-use crate::stream::Deviation;
+pub mod motion;
 
-/// How far beyond [0, 1] a measured COR may lie before it is taken as wrong, not noisy.
-pub const COR_TOLERANCE: f32 = 0.02;
+use crate::report::{self, Analysis, Flags, ImpactReport, Kinematics, Status, COR_TOLERANCE};
+use crate::scene::Scene;
+use crate::signal::baseline::Deviation;
+use motion::{PointsOut, Scale};
 
 /// Points the fits see at most: a contact of 12 600 samples (the seed bench at 500 kS/s) is
 /// thinned to every 6th sample, which moves no fitted value beyond its noise.

@@ -18,80 +18,9 @@
 //! approach speed ends the train: the next impact is a first one, with the scene's
 //! [`crate::scene::Approach`].
 
-use crate::capture::Summary;
-use crate::report::{self, Status};
-use crate::scene::Scene;
-
-/// Which measure of a bounce's approach speed the kinematics use.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-#[cfg_attr(feature = "defmt", derive(defmt::Format))]
-pub enum TrainSpeed {
-    /// `g t_flight / 2`: independent for every bounce (the default).
-    Flight,
-    /// The previous impact's rebound: no assumption on gravity or the flight's direction,
-    /// but each bounce inherits the previous one's error.
-    Rebound,
-}
-
-impl TrainSpeed {
-    /// The name options and reports use (`flight`, `rebound`).
-    pub fn name(self) -> &'static str {
-        match self {
-            TrainSpeed::Flight => "flight",
-            TrainSpeed::Rebound => "rebound",
-        }
-    }
-}
-
-/// A scene's bounce-train settings. SI units.
-#[derive(Clone, Copy, Debug, PartialEq)]
-#[cfg_attr(feature = "defmt", derive(defmt::Format))]
-pub struct Train {
-    /// The approach speed the kinematics use for bounces after the first.
-    pub speed: TrainSpeed,
-    /// Gravity along the sensor's axis, m/s² (standard gravity unless the bench says).
-    pub gravity_m_s2: f32,
-    /// A flight longer than this starts a new train, s (default 2 s: a 4.9 m bounce).
-    pub max_flight_s: f32,
-}
-
-impl Train {
-    /// Standard gravity, flights up to 2 s, the kinematics on the flight time.
-    pub const fn new() -> Self {
-        Self {
-            speed: TrainSpeed::Flight,
-            gravity_m_s2: crate::solve::bounce::STANDARD_GRAVITY as f32,
-            max_flight_s: 2.0,
-        }
-    }
-}
-
-impl Default for Train {
-    fn default() -> Self {
-        Self::new()
-    }
-}
-
-/// One bounce of a train (an impact after the first): its approach speed by both measures.
-#[derive(Clone, Copy, Debug, PartialEq)]
-#[cfg_attr(feature = "defmt", derive(defmt::Format))]
-pub struct Bounce {
-    /// 1 for the first bounce after the train's first impact.
-    pub number: u32,
-    /// From the previous separation to this first touch, s.
-    pub flight_s: f32,
-    /// `g t_flight / 2`, m/s.
-    pub v0_flight_m_s: f32,
-    /// The previous impact's rebound, m/s; absent if it had none (no Δv, a COR out of range).
-    pub v0_rebound_m_s: Option<f32>,
-}
-
-impl Bounce {
-    /// The COR with approach speed `v0` given this impact's Δv: `(Δv - v0) / v0`.
-    pub fn cor(v0: f32, delta_v: f32) -> f32 {
-        (delta_v - v0) / v0
-    }
-}
+use crate::report::summary::Summary;
+use crate::report::{self, Bounce, Status, COR_TOLERANCE};
+use crate::scene::{Scene, TrainSpeed};
 
 /// What the stream remembers of the previous impact between two impacts.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -158,9 +87,7 @@ impl Tracker {
                 .map(|dv| dv - v0)
                 .filter(|r| {
                     let cor = r / v0;
-                    cor.is_finite()
-                        && (0.0..=1.0 + crate::analysis::COR_TOLERANCE).contains(&cor)
-                        && *r > 0.0
+                    cor.is_finite() && (0.0..=1.0 + COR_TOLERANCE).contains(&cor) && *r > 0.0
                 }),
             _ => None,
         };
@@ -175,6 +102,7 @@ impl Tracker {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::scene::Train;
     use crate::signal::Calibration;
 
     fn scene() -> Scene {

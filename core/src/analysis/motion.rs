@@ -17,7 +17,7 @@
 //! sums at the few points where a value is needed. Per sample the pass costs two i64
 //! additions (no floating point), which is what makes it cheap on the Cortex-M4.
 
-use crate::stream::Deviation;
+use crate::signal::baseline::Deviation;
 
 /// Longest run the sums may cover, samples (keeps `Q` within i64).
 pub const MAX_SAMPLES: usize = 1 << 17;

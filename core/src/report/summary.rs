@@ -1,0 +1,166 @@
+//! What the streaming stage knows of one impact when it ends (the [`Summary`] it hands over
+//! with the capture), and a bounce of a train ([`Bounce`]).
+
+use super::Status;
+
+/// One bounce of a train (an impact after the first): its approach speed by both measures.
+#[derive(Clone, Copy, Debug, PartialEq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct Bounce {
+    /// 1 for the first bounce after the train's first impact.
+    pub number: u32,
+    /// From the previous separation to this first touch, s.
+    pub flight_s: f32,
+    /// `g t_flight / 2`, m/s.
+    pub v0_flight_m_s: f32,
+    /// The previous impact's rebound, m/s; absent if it had none (no Δv, a COR out of range).
+    pub v0_rebound_m_s: Option<f32>,
+}
+
+impl Bounce {
+    /// The COR with approach speed `v0` given this impact's Δv: `(Δv - v0) / v0`.
+    pub fn cor(v0: f32, delta_v: f32) -> f32 {
+        (delta_v - v0) / v0
+    }
+}
+
+/// What the streaming stage knows of one impact when it ends: positions, and exact integer
+/// sums of the baseline-removed raw counts `d = W x - S` (`S / W` is the frozen baseline).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Summary {
+    /// 0 for the stream's first impact.
+    pub index: u32,
+    pub status: Status,
+    /// A sample reached the scene's rails.
+    pub clipped: bool,
+    /// Stream index of the capture's first sample (the pre-trigger margin before the onset).
+    pub first_index: u64,
+    /// Stream index of the first sample beyond the edge level.
+    pub onset_index: u64,
+    /// First touch relative to `onset_index`, samples (≤ 0): the rising flank extrapolated to
+    /// zero, or the edge crossing.
+    pub touch_offset: f32,
+    /// Stream index of the first sample back within the edge level after the peak, if any.
+    pub separation_index: Option<u64>,
+    /// Separation relative to `separation_index`, samples (the falling flank extrapolated to
+    /// zero, or the edge crossing; between -1 and a few samples).
+    pub separation_offset: f32,
+    /// Stream index just after the impact's last sample (the end of the hold, or the cut).
+    pub end_index: u64,
+    /// Baseline as the rational `base_sum / base_n` counts.
+    pub base_sum: i64,
+    pub base_n: i64,
+    /// The first largest `|d|` and its stream index.
+    pub peak_d: i64,
+    pub peak_index: u64,
+    /// `Σ d` over the whole impact (also beyond a full capture), in `W · counts`.
+    pub total_c: i64,
+    /// `Σ d` over the contact, from the onset to the separation (exclusive), if the signal
+    /// came back.
+    pub contact_c: Option<i64>,
+    /// The approach speed of this impact, m/s: the scene's (or a light gate's), or, in a
+    /// bounce train, the bounce's ([`crate::stream::train`]).
+    pub v0_m_s: Option<f32>,
+    /// The impact continues a bounce train: both measures of its approach speed.
+    pub bounce: BounceSlot,
+}
+
+/// A summary's bounce, all zeros when the impact continues no train: `Option<Bounce>` keeps
+/// `None` in a non-zero tag (the niche of its `Option<f32>`), which would put every static
+/// capture in `.data` (its image in flash, copied at start-up) instead of `.bss`.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct BounceSlot {
+    /// The bounce's number (1 for the first bounce after the train's first impact); 0 for no
+    /// bounce.
+    number: u32,
+    flight_s: f32,
+    v0_flight_m_s: f32,
+    v0_rebound_m_s: f32,
+    has_rebound: bool,
+}
+
+impl BounceSlot {
+    /// No bounce.
+    pub const NONE: Self = Self {
+        number: 0,
+        flight_s: 0.0,
+        v0_flight_m_s: 0.0,
+        v0_rebound_m_s: 0.0,
+        has_rebound: false,
+    };
+
+    /// The bounce kept (a bounce's number is at least 1).
+    pub fn get(&self) -> Option<Bounce> {
+        (self.number > 0).then_some(Bounce {
+            number: self.number,
+            flight_s: self.flight_s,
+            v0_flight_m_s: self.v0_flight_m_s,
+            v0_rebound_m_s: self.has_rebound.then_some(self.v0_rebound_m_s),
+        })
+    }
+}
+
+impl From<Option<Bounce>> for BounceSlot {
+    fn from(b: Option<Bounce>) -> Self {
+        match b {
+            Some(b) => Self {
+                number: b.number.max(1),
+                flight_s: b.flight_s,
+                v0_flight_m_s: b.v0_flight_m_s,
+                v0_rebound_m_s: b.v0_rebound_m_s.unwrap_or(0.0),
+                has_rebound: b.v0_rebound_m_s.is_some(),
+            },
+            None => Self::NONE,
+        }
+    }
+}
+
+impl Summary {
+    /// A placeholder (all zero).
+    pub const EMPTY: Self = Self {
+        index: 0,
+        status: Status::Complete,
+        clipped: false,
+        first_index: 0,
+        onset_index: 0,
+        touch_offset: 0.0,
+        separation_index: None,
+        separation_offset: 0.0,
+        end_index: 0,
+        base_sum: 0,
+        base_n: 0,
+        peak_d: 0,
+        peak_index: 0,
+        total_c: 0,
+        contact_c: None,
+        v0_m_s: None,
+        bounce: BounceSlot::NONE,
+    };
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::capture::Capture;
+
+    #[test]
+    fn an_empty_summary_has_no_bounce_and_a_bounce_survives_the_slot() {
+        // NONE is the all-zero value (Default): an empty capture is all zeros, so its statics
+        // go to `.bss` (the firmware's memory check reads it off the ELF).
+        assert_eq!(BounceSlot::NONE, BounceSlot::default());
+        assert_eq!(Capture::<64>::new().summary().bounce.get(), None);
+        let b = Bounce {
+            number: 3,
+            flight_s: 0.1,
+            v0_flight_m_s: 0.5,
+            v0_rebound_m_s: None,
+        };
+        assert_eq!(BounceSlot::from(Some(b)).get(), Some(b));
+        let b = Bounce {
+            v0_rebound_m_s: Some(0.4),
+            ..b
+        };
+        assert_eq!(BounceSlot::from(Some(b)).get(), Some(b));
+        assert_eq!(BounceSlot::from(None), BounceSlot::NONE);
+    }
+}

@@ -1,0 +1,54 @@
+//! A scene's bounce-train settings: which measure of a bounce's approach speed the
+//! kinematics use, gravity, the longest flight ([`crate::stream::train`] follows a train).
+
+use crate::consts::STANDARD_GRAVITY;
+
+/// Which measure of a bounce's approach speed the kinematics use.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub enum TrainSpeed {
+    /// `g t_flight / 2`: independent for every bounce (the default).
+    Flight,
+    /// The previous impact's rebound: no assumption on gravity or the flight's direction,
+    /// but each bounce inherits the previous one's error.
+    Rebound,
+}
+
+impl TrainSpeed {
+    /// The name options and reports use (`flight`, `rebound`).
+    pub fn name(self) -> &'static str {
+        match self {
+            TrainSpeed::Flight => "flight",
+            TrainSpeed::Rebound => "rebound",
+        }
+    }
+}
+
+/// A scene's bounce-train settings. SI units.
+#[derive(Clone, Copy, Debug, PartialEq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct Train {
+    /// The approach speed the kinematics use for bounces after the first.
+    pub speed: TrainSpeed,
+    /// Gravity along the sensor's axis, m/s² (standard gravity unless the bench says).
+    pub gravity_m_s2: f32,
+    /// A flight longer than this starts a new train, s (default 2 s: a 4.9 m bounce).
+    pub max_flight_s: f32,
+}
+
+impl Train {
+    /// Standard gravity, flights up to 2 s, the kinematics on the flight time.
+    pub const fn new() -> Self {
+        Self {
+            speed: TrainSpeed::Flight,
+            gravity_m_s2: STANDARD_GRAVITY as f32,
+            max_flight_s: 2.0,
+        }
+    }
+}
+
+impl Default for Train {
+    fn default() -> Self {
+        Self::new()
+    }
+}
