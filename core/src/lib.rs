@@ -35,7 +35,7 @@ pub mod scene;
 pub mod signal;
 pub mod solve;
 pub mod stream;
-pub mod target;
+pub mod two_body;
 pub mod waveform;
 
 pub use analysis::{analyse, Workspace};

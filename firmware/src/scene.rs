@@ -22,7 +22,8 @@ const CLIP_COUNTS: (i16, i16) = (0, 4095);
 /// ADXL375: 49 mg per LSB at 3200 S/s.
 #[cfg(feature = "adxl375")]
 const CALIBRATION: Calibration = Calibration {
-    gain_m_s2_per_count: crate::source::adxl375::G_PER_LSB * 9.806_65,
+    gain_m_s2_per_count: crate::source::adxl375::G_PER_LSB
+        * crate::source::adxl375::STANDARD_GRAVITY_M_PER_S2,
     sample_rate_hz: crate::source::SAMPLE_RATE_HZ as f32,
 };
 /// ADXL375: 13-bit two's-complement output per axis (±200 g is about ±4082 counts); the

@@ -385,7 +385,7 @@ impl Samples<'_> {
 
 /// The ADXL375's scale, m/s² per count: 49 mg per LSB (the firmware's `G_PER_LSB` times
 /// standard gravity, in f32 as there).
-pub const ADXL375_GAIN_M_S2: f32 = 0.049 * 9.806_65;
+pub const ADXL375_GAIN_M_S2: f32 = 0.049 * impact_core::consts::STANDARD_GRAVITY as f32;
 
 /// The ADXL375's output data rates, S/s.
 pub const ADXL375_RATES_HZ: [f64; 6] = [3200.0, 1600.0, 800.0, 400.0, 200.0, 100.0];

@@ -3,8 +3,8 @@
 //! limit and bad input.
 
 use impact_core::model::{Hertz, KelvinVoigt, Linear, Model, Nonlinear, TwoPhase};
-use impact_core::target::free::after;
-use impact_core::target::{self, Target, TargetOutcome, MAX_STATES};
+use impact_core::two_body::free::after;
+use impact_core::two_body::{self, Target, TargetOutcome, MAX_STATES};
 use impact_core::{ContactLaw, Error, Impact, Settings};
 
 fn rel(got: f64, want: f64) -> f64 {
@@ -32,7 +32,7 @@ fn on<L: ContactLaw<f64>>(
     t: &Target<f64>,
     s: Settings<f64>,
 ) -> TargetOutcome<f64> {
-    target::solve(law, &Impact::new(m1, v0), t, &s).expect("solved")
+    two_body::solve(law, &Impact::new(m1, v0), t, &s).expect("solved")
 }
 
 /// An independent reference: classic RK4 on `(x1, u1, y, w)` of an impactor on a spring–mass
@@ -328,7 +328,7 @@ fn hertz_on_a_damped_spring_mass_matches_an_independent_integration() {
     }
     // Hertz has no closed form on a sprung target: the exact solver says so.
     let err =
-        target::solve(&hertz(), &Impact::new(m1, v0), &target, &Settings::exact()).unwrap_err();
+        two_body::solve(&hertz(), &Impact::new(m1, v0), &target, &Settings::exact()).unwrap_err();
     assert!(
         matches!(err, Error::InvalidParameter { name: "solver", .. }),
         "{err:?}"
@@ -558,11 +558,11 @@ fn f32_paths_agree_with_f64_within_1e_5() {
             steps: s.steps,
             rtol: s.rtol as f32,
         };
-        let got = target::solve(&law32, &Impact::new(m1 as f32, v0 as f32), &t32, &s32).unwrap();
+        let got = two_body::solve(&law32, &Impact::new(m1 as f32, v0 as f32), &t32, &s32).unwrap();
         let what = format!("{} {:?} f32", law.name(), s.method);
         // The closed form on a sprung target is f64 only, and says so.
         if k2 > 0.0 && law.affine(impact_core::model::Phase::Compression).is_some() {
-            let exact32 = target::solve(
+            let exact32 = two_body::solve(
                 &law32,
                 &Impact::new(m1 as f32, v0 as f32),
                 &t32,
@@ -652,7 +652,7 @@ fn a_target_that_cannot_be_pushed_is_an_error_naming_the_option() {
     }
     // Fixed-step solvers are not offered for targets: an error, not a wall.
     let t = Target::spring_mass(1.0, 1.0, 0.0).unwrap();
-    let err = target::solve(
+    let err = two_body::solve(
         &Linear { k: 1e5 },
         &Impact::new(0.1, 1.0),
         &t,

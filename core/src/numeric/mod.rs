@@ -1,4 +1,5 @@
 //! Numerical building blocks with no physics in them: bracketed roots and minima, quadrature.
 
+pub mod dopri;
 pub mod quad;
 pub mod roots;

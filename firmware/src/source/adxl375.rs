@@ -83,7 +83,7 @@ pub const FIFO_POP_DELAY_NS: u32 = 5_000;
 /// Scale factor, typical: 49 mg per LSB, in g per LSB (20.5 LSB/g).
 pub const G_PER_LSB: f32 = 0.049;
 /// Standard gravity, m/s² per g.
-pub const STANDARD_GRAVITY_M_PER_S2: f32 = 9.806_65;
+pub const STANDARD_GRAVITY_M_PER_S2: f32 = impact_core::consts::STANDARD_GRAVITY as f32;
 
 /// Output data rate (BW_RATE rate code; normal power mode).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]

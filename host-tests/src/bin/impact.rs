@@ -7,7 +7,7 @@ use std::time::Duration;
 use clap::{Parser, Subcommand};
 use impact_host::{
     analyze, emulate, log, m4, memory, plot, precision, realtime, simulate, soak, stability, synth,
-    target, target_bench, throughput,
+    throughput, two_body, two_body_bench,
 };
 
 // The examples in the help are commands of docs/user-guide.md, run by its tests.
@@ -222,7 +222,7 @@ fn run(cli: Cli) -> Result<(), String> {
                 simulate::Outcome::Wall(report) if args.json => println!("{}", json(&report)?),
                 simulate::Outcome::Wall(report) => print!("{}", simulate::table(&report)),
                 simulate::Outcome::Target(report) if args.json => println!("{}", json(&*report)?),
-                simulate::Outcome::Target(report) => print!("{}", target::table(&report)),
+                simulate::Outcome::Target(report) => print!("{}", two_body::table(&report)),
             }
         }
         Command::Analyze(args) => {
@@ -396,7 +396,7 @@ fn run(cli: Cli) -> Result<(), String> {
             which: Bench::Stability { full, json },
         } => {
             let mut rows = stability::run(full);
-            rows.extend(target_bench::stability(full));
+            rows.extend(two_body_bench::stability(full));
             if json {
                 println!(
                     "{}",
@@ -490,7 +490,7 @@ fn run(cli: Cli) -> Result<(), String> {
                 &precision::standard_cases(),
                 Duration::from_millis(budget_ms),
             );
-            points.extend(target_bench::precision(Duration::from_millis(budget_ms)));
+            points.extend(two_body_bench::precision(Duration::from_millis(budget_ms)));
             std::fs::create_dir_all(&out).map_err(|e| format!("{}: {e}", out.display()))?;
             let csv_path = out.join("work-precision.csv");
             std::fs::write(&csv_path, precision::csv(&points))

@@ -4,8 +4,8 @@ use std::path::{Path, PathBuf};
 
 use clap::Args;
 use impact_core::model::Model;
-use impact_core::target::free::{after, target_at, FreeResponse};
-use impact_core::target::{self, Sample, Target, TargetOutcome, MAX_STATES};
+use impact_core::two_body::free::{after, target_at, FreeResponse};
+use impact_core::two_body::{self, Sample, Target, TargetOutcome, MAX_STATES};
 use impact_core::{ContactLaw, Impact, Method, Settings};
 use plotters::prelude::*;
 use serde::{Deserialize, Serialize};
@@ -174,7 +174,7 @@ pub fn narrow(t: &Target<f64>) -> Target<f32> {
         a,
         b,
         c,
-        spring_mass: t.spring_mass.map(|s| target::SpringMass {
+        spring_mass: t.spring_mass.map(|s| two_body::SpringMass {
             mass_kg: s.mass_kg as f32,
             stiffness_n_m: s.stiffness_n_m as f32,
             damping_n_s_m: s.damping_n_s_m as f32,
@@ -230,7 +230,7 @@ pub fn run(args: &SimulateArgs, model: &Model<f64>) -> Result<TargetReport, Stri
         m => Settings::fixed(m, args.steps),
     };
     let outcome = match args.precision {
-        Precision::F64 => target::solve(model, &impact, &t, &settings),
+        Precision::F64 => two_body::solve(model, &impact, &t, &settings),
         Precision::F32 => {
             let s32 = Settings {
                 method: settings.method,
@@ -238,7 +238,7 @@ pub fn run(args: &SimulateArgs, model: &Model<f64>) -> Result<TargetReport, Stri
                 rtol: settings.rtol as f32,
             };
             let impact32 = Impact::new(args.mass as f32, args.v0 as f32);
-            target::solve(&model_f32(model), &impact32, &narrow(&t), &s32).map(|o| widen(&o))
+            two_body::solve(&model_f32(model), &impact32, &narrow(&t), &s32).map(|o| widen(&o))
         }
     }
     .map_err(|e| e.to_string())?;
@@ -377,7 +377,7 @@ fn plot(
     path: &Path,
 ) -> Result<(), String> {
     let mut samples: Vec<Sample<f64>> = Vec::new();
-    target::trajectory(model, impact, t, 1e-10, &mut |s| samples.push(s))
+    two_body::trajectory(model, impact, t, 1e-10, &mut |s| samples.push(s))
         .map_err(|e| e.to_string())?;
     let tc = o.contact_time_s;
     let period = free.ring_frequency_hz.map_or(tc, |f| 1.0 / f);

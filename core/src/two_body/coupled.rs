@@ -13,9 +13,9 @@ use super::{at_separation, reduced_mass, Target, TargetOutcome, MAX_STATES};
 use crate::error::Error;
 use crate::model::Impact;
 use crate::model::{ContactLaw, Phase};
+use crate::numeric::dopri::{self, Dense, E};
 use crate::numeric::roots::{brent, golden_max};
 use crate::real::Real;
-use crate::solve::adaptive::{A2, A3, A4, A5, A6, B, D, E};
 use crate::solve::events::Compensated;
 
 /// States: `δ, δ'`, the target's `z`, then `∫ F δ' dt`, `∫ F w dt`, `∫ c2 w² dt`.
@@ -103,26 +103,6 @@ impl<R: Real, L: ContactLaw<R>> System<'_, R, L> {
     }
 }
 
-/// One accepted step: `rcont1..5` of Hairer's `CONTD5` for every state.
-#[derive(Clone, Copy)]
-struct Dense<R> {
-    t0: R,
-    h: R,
-    r: [Vec<R>; 5],
-}
-
-impl<R: Real> Dense<R> {
-    fn at(&self, th: R) -> Vec<R> {
-        let th1 = R::ONE - th;
-        let r = &self.r;
-        let mut out = [R::ZERO; S];
-        for (i, o) in out.iter_mut().enumerate() {
-            *o = r[0][i] + th * (r[1][i] + th1 * (r[2][i] + th * (r[3][i] + th1 * r[4][i])));
-        }
-        out
-    }
-}
-
 /// One point of a contact's trajectory, SI, impact direction positive.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct Sample<R> {
@@ -148,6 +128,17 @@ pub struct Sample<R> {
 /// for ~15% more steps).
 const STIFF_STEP: f64 = 2.8;
 
+/// The events' rules, which differ from the wall solver's (`solve::events`) and are kept
+/// as they are (changing them changes every two-body result in its last digits): the peak
+/// force is refined by this many golden-section steps within a quarter step of the best of
+/// five samples (`events`: 52 steps between the sampled neighbours);
+const PEAK_ITERATIONS: u32 = 80;
+/// the maximum deformation and separation are Brent roots to this many `EPSILON` of a step
+/// (`events`: 0, to the last bit), and a root the interpolant's ends fail to bracket (by
+/// rounding) falls back to the chord instead of failing; separation is always landed on by a
+/// fresh step from the step's start (`events`: a bounded retake of the adaptive step).
+const ROOT_TOLERANCE_EPS: f64 = 4.0;
+
 /// Samples per accepted step handed to an observer.
 const SAMPLES_PER_STEP: u32 = 8;
 
@@ -161,50 +152,67 @@ fn chord<R: Real>(a: R, b: R, from: R) -> R {
     }
 }
 
-/// One Dormand–Prince step of length `h` from `s` (Kahan carry `carry`, derivative `k1`):
-/// the seven stages, the new state and its carry.
-#[allow(clippy::too_many_arguments)]
-fn dopri<R: Real, L: ContactLaw<R>>(
-    sys: &System<'_, R, L>,
-    s: &Vec<R>,
-    carry: &Vec<R>,
-    k1: &Vec<R>,
-    h: R,
+/// The coupled system under one phase, and how its error is measured: the deformation and
+/// its rate, the impactor, the contact point and the energy integrals, each against
+/// `rtol * max(|y|, floor)`, their RMS; the next step is held inside the stability interval
+/// of the contact's fastest mode ([`STIFF_STEP`]).
+struct Phased<'s, 'a, R, L> {
+    sys: &'s System<'a, R, L>,
     phase: Phase<R>,
-    dim: usize,
-) -> ([Vec<R>; 7], Vec<R>, Vec<R>) {
-    let stage = |coef: &[f64], ks: &[Vec<R>]| -> Vec<R> {
-        let mut y = *s;
-        for (a, k) in coef.iter().zip(ks) {
-            let a = c::<R>(*a) * h;
+    rtol: R,
+    floor_x: R,
+    floor_v: R,
+    floor_e: R,
+}
+
+impl<R: Real, L: ContactLaw<R>> dopri::System<R, S> for Phased<'_, '_, R, L> {
+    fn dim(&self) -> usize {
+        self.sys.n + 5
+    }
+
+    fn rhs(&self, y: &Vec<R>) -> Vec<R> {
+        self.sys.rhs(y, self.phase)
+    }
+
+    fn error_norm(&self, h: R, ks: &[Vec<R>; 7], s: &Vec<R>, y1: &Vec<R>) -> R {
+        let (sys, n, dim) = (self.sys, self.sys.n, self.dim());
+        let mut err = [R::ZERO; S];
+        for (e, k) in E.iter().zip(ks) {
             for i in 0..dim {
-                y[i] += a * k[i];
+                err[i] += c::<R>(*e) * h * k[i];
             }
         }
-        y
-    };
-    let mut ks = [[R::ZERO; S]; 7];
-    ks[0] = *k1;
-    ks[1] = sys.rhs(&stage(&A2, &ks[..1]), phase);
-    ks[2] = sys.rhs(&stage(&A3, &ks[..2]), phase);
-    ks[3] = sys.rhs(&stage(&A4, &ks[..3]), phase);
-    ks[4] = sys.rhs(&stage(&A5, &ks[..4]), phase);
-    ks[5] = sys.rhs(&stage(&A6, &ks[..5]), phase);
-    let mut y1 = *s;
-    let mut carry1 = *carry;
-    for i in 0..dim {
-        let mut dy = R::ZERO;
-        for (b, k) in B.iter().zip(&ks[..6]) {
-            dy += c::<R>(*b) * h * k[i];
+        let (ey, ew) = sys.outputs(&err);
+        let (y0o, w0o) = sys.outputs(s);
+        let (y1o, w1o) = sys.outputs(y1);
+        let (x0, u0) = sys.impactor(s);
+        let (x1, u1) = sys.impactor(y1);
+        let tol = |a: R, b: R, floor: R| self.rtol * a.abs().max(b.abs()).max(floor);
+        let (fx, fv, fe) = (self.floor_x, self.floor_v, self.floor_e);
+        let terms = [
+            err[0] / tol(s[0], y1[0], fx),
+            err[1] / tol(s[1], y1[1], fv),
+            (err[0] + ey) / tol(x0, x1, fx),
+            (err[1] + ew) / tol(u0, u1, fv),
+            ey / tol(y0o, y1o, fx),
+            ew / tol(w0o, w1o, fv),
+            err[2 + n] / tol(s[2 + n], y1[2 + n], fe),
+            err[3 + n] / tol(s[3 + n], y1[3 + n], fe),
+            err[4 + n] / tol(s[4 + n], y1[4 + n], fe),
+        ];
+        let mut sq = R::ZERO;
+        for x in terms {
+            sq += x * x;
         }
-        // Kahan-compensated state.
-        let inc = dy - carry1[i];
-        let sum = y1[i] + inc;
-        carry1[i] = (sum - y1[i]) - inc;
-        y1[i] = sum;
+        (sq / c(9.0)).sqrt()
     }
-    ks[6] = sys.rhs(&y1, phase);
-    (ks, y1, carry1)
+
+    fn max_step(&self, y1: &Vec<R>) -> Option<R> {
+        let rate = self
+            .sys
+            .contact_rate(y1, self.phase, self.floor_x, self.floor_v);
+        Some(c::<R>(STIFF_STEP) / rate)
+    }
 }
 
 /// Solves the contact at relative tolerance `rtol` (at least `8 * EPSILON`).
@@ -226,17 +234,10 @@ pub(super) fn solve_observed<R: Real, L: ContactLaw<R>>(
     rtol: R,
     obs: &mut dyn FnMut(Sample<R>),
 ) -> Result<TargetOutcome<R>, Error> {
-    if !(rtol.is_finite() && rtol > R::ZERO && rtol < R::ONE) {
-        return Err(Error::InvalidParameter {
-            name: "rtol",
-            reason: "must lie in (0, 1)",
-        });
-    }
-    let rtol = rtol.max(c::<R>(8.0) * R::EPSILON);
+    let rtol = dopri::checked_rtol(rtol)?;
     let m1 = impact.mass_kg;
     let v0 = impact.v0_m_s;
     let n = target.n;
-    let dim = n + 5;
     let scale_t = law.time_scale(&Impact::new(reduced_mass(m1, target), v0));
     if !(scale_t.is_finite() && scale_t > R::ZERO) {
         return Err(Error::Unresolved(
@@ -257,8 +258,7 @@ pub(super) fn solve_observed<R: Real, L: ContactLaw<R>>(
     let floor_x = v0 * scale_t * c::<R>(1e-2);
     let floor_v = v0 * c::<R>(1e-2);
     let floor_e = R::HALF * m1 * v0 * v0 * c::<R>(1e-2);
-    let h_min = scale_t * R::EPSILON * c(16.0);
-    let mut h = scale_t * c::<R>(0.05) * rtol.powf(c(0.2));
+    let (mut h, h_min) = dopri::initial_steps(scale_t, rtol);
 
     // At first touch: no deformation, closing at `v0`, the target at rest.
     let mut s: Vec<R> = [R::ZERO; S];
@@ -286,7 +286,7 @@ pub(super) fn solve_observed<R: Real, L: ContactLaw<R>>(
         });
     };
     show(obs, R::ZERO, &s, phase);
-    let show_step = |obs: &mut dyn FnMut(Sample<R>), seg: &Dense<R>, upto: R, ph: Phase<R>| {
+    let show_step = |obs: &mut dyn FnMut(Sample<R>), seg: &Dense<R, S>, upto: R, ph: Phase<R>| {
         for k in 1..=SAMPLES_PER_STEP {
             let th = upto * R::from_u32(k) / R::from_u32(SAMPLES_PER_STEP);
             show(obs, seg.t0 + th * seg.h, &seg.at(th), ph);
@@ -294,85 +294,21 @@ pub(super) fn solve_observed<R: Real, L: ContactLaw<R>>(
     };
 
     for _ in 0..1_000_000u32 {
-        // One accepted step (Dormand–Prince, FSAL), as in `solve::adaptive`.
-        let mut accepted = None;
-        for _attempt in 0..64 {
-            let (ks, y1, carry1) = dopri(&sys, &s, &carry, &k1, h, phase, dim);
-            evals += 6;
-            let mut err = [R::ZERO; S];
-            for (e, k) in E.iter().zip(&ks) {
-                for i in 0..dim {
-                    err[i] += c::<R>(*e) * h * k[i];
-                }
-            }
-            // Error on the deformation and its rate, the impactor, the contact point and the
-            // energy integrals.
-            let (ey, ew) = sys.outputs(&err);
-            let (y0o, w0o) = sys.outputs(&s);
-            let (y1o, w1o) = sys.outputs(&y1);
-            let (x0, u0) = sys.impactor(&s);
-            let (x1, u1) = sys.impactor(&y1);
-            let tol = |a: R, b: R, floor: R| rtol * a.abs().max(b.abs()).max(floor);
-            let terms = [
-                err[0] / tol(s[0], y1[0], floor_x),
-                err[1] / tol(s[1], y1[1], floor_v),
-                (err[0] + ey) / tol(x0, x1, floor_x),
-                (err[1] + ew) / tol(u0, u1, floor_v),
-                ey / tol(y0o, y1o, floor_x),
-                ew / tol(w0o, w1o, floor_v),
-                err[2 + n] / tol(s[2 + n], y1[2 + n], floor_e),
-                err[3 + n] / tol(s[3 + n], y1[3 + n], floor_e),
-                err[4 + n] / tol(s[4 + n], y1[4 + n], floor_e),
-            ];
-            let mut sq = R::ZERO;
-            for x in terms {
-                sq += x * x;
-            }
-            let norm = (sq / c(9.0)).sqrt();
-            let finite = y1[..dim].iter().all(|x| x.is_finite());
-            if !norm.is_finite() || !finite {
-                h *= c(0.2);
-            } else {
-                let factor = if norm == R::ZERO {
-                    c(5.0)
-                } else {
-                    (c::<R>(0.9) * norm.powf(c(-0.2))).max(c(0.2)).min(c(5.0))
-                };
-                if norm <= R::ONE {
-                    let mut r = [[R::ZERO; S]; 5];
-                    for i in 0..dim {
-                        let dy = y1[i] - s[i];
-                        let bspl = h * k1[i] - dy;
-                        r[0][i] = s[i];
-                        r[1][i] = dy;
-                        r[2][i] = bspl;
-                        r[3][i] = dy - h * ks[6][i] - bspl;
-                        let mut d = R::ZERO;
-                        for (dj, k) in D.iter().zip(&ks) {
-                            d += c::<R>(*dj) * k[i];
-                        }
-                        r[4][i] = h * d;
-                    }
-                    accepted = Some((Dense { t0: t.sum, h, r }, y1, carry1, ks[6]));
-                    h *= factor;
-                    // Inside the stability interval for the contact's own fastest mode.
-                    let cap = c::<R>(STIFF_STEP) / sys.contact_rate(&y1, phase, floor_x, floor_v);
-                    if cap > R::ZERO && cap.is_finite() {
-                        h = h.min(cap);
-                    }
-                    break;
-                }
-                h *= factor.min(R::ONE);
-            }
-            if !(h > h_min) {
-                return Err(Error::Unresolved("adaptive step size underflow"));
-            }
-        }
-        let Some((seg, y1, carry1, k_end)) = accepted else {
-            return Err(Error::Unresolved(
-                "adaptive step rejected 64 times in a row",
-            ));
+        // One accepted step (Dormand–Prince, FSAL).
+        let phased = Phased {
+            sys: &sys,
+            phase,
+            rtol,
+            floor_x,
+            floor_v,
+            floor_e,
         };
+        let dopri::Accepted {
+            dense: seg,
+            y1,
+            carry1,
+            k_end,
+        } = dopri::step(&phased, t.sum, &s, &carry, &k1, &mut h, h_min, &mut evals)?;
         let contact_at = |th: R, ph: Phase<R>| sys.contact(&seg.at(th), ph);
         let force = |th: R| contact_at(th, phase).2;
         let rate = |th: R| contact_at(th, phase).1;
@@ -391,7 +327,7 @@ pub(super) fn solve_observed<R: Real, L: ContactLaw<R>>(
         // the step too, where the peak may lie just inside).
         let lo = (best.0 - c(0.25)).max(R::ZERO);
         let hi = (best.0 + c(0.25)).min(R::ONE);
-        let (_, f) = golden_max(force, lo, hi, 80);
+        let (_, f) = golden_max(force, lo, hi, PEAK_ITERATIONS);
         best.1 = best.1.max(f);
         peak = peak.max(best.1);
 
@@ -400,8 +336,14 @@ pub(super) fn solve_observed<R: Real, L: ContactLaw<R>>(
         if rate(R::ZERO) >= R::ZERO && rate(R::ONE) < R::ZERO {
             // Never skipped: if the interpolant's ends disagree with the test (rounding), the
             // chord.
-            let th = brent(rate, R::ZERO, R::ONE, R::EPSILON * c(4.0), &mut evals)
-                .unwrap_or_else(|| chord(rate(R::ZERO), rate(R::ONE), R::ZERO));
+            let th = brent(
+                rate,
+                R::ZERO,
+                R::ONE,
+                R::EPSILON * c(ROOT_TOLERANCE_EPS),
+                &mut evals,
+            )
+            .unwrap_or_else(|| chord(rate(R::ZERO), rate(R::ONE), R::ZERO));
             {
                 let sm = seg.at(th);
                 let (d, _, _) = sys.contact(&sm, phase);
@@ -429,11 +371,19 @@ pub(super) fn solve_observed<R: Real, L: ContactLaw<R>>(
         // Separation: the force returns to zero after the maximum.
         let force = |th: R| contact_at(th, phase).2;
         if first_max && force(R::ONE) <= R::ZERO {
-            let th = brent(force, from, R::ONE, R::EPSILON * c(4.0), &mut evals)
-                .unwrap_or_else(|| chord(force(from), force(R::ONE), from));
+            let th = brent(
+                force,
+                from,
+                R::ONE,
+                R::EPSILON * c(ROOT_TOLERANCE_EPS),
+                &mut evals,
+            )
+            .unwrap_or_else(|| chord(force(from), force(R::ONE), from));
             // Land a step on the separation found on the interpolant: the state there has
             // the step's accuracy, not the interpolant's.
-            let (_, ss, _) = dopri(&sys, &s, &carry, &k1, th * seg.h, phase, dim);
+            // Under the phase now in force (restitution, once the maximum is passed).
+            let phased = Phased { phase, ..phased };
+            let (_, ss, _) = dopri::trial(&phased, &s, &carry, &k1, th * seg.h);
             evals += 6;
             show_step(obs, &seg, th, phase);
             let mut z = [R::ZERO; MAX_STATES];

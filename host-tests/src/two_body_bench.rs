@@ -4,13 +4,13 @@
 use std::time::{Duration, Instant};
 
 use impact_core::model::{Hertz, KelvinVoigt, Linear, Model, TwoPhase};
-use impact_core::target::{self, Target, TargetOutcome};
+use impact_core::two_body::{self, Target, TargetOutcome};
 use impact_core::{ContactLaw, Error, Impact, Method, Settings};
 
 use crate::precision::Point;
 use crate::simulate::model_f32;
 use crate::stability::{stated_bound_on_target, Row};
-use crate::target::{narrow, widen};
+use crate::two_body::{narrow, widen};
 
 /// The fields compared: contact time, crush time, deformation, force, both velocities.
 fn fields(o: &TargetOutcome<f64>) -> [(&'static str, f64); 6] {
@@ -49,8 +49,8 @@ fn reference(
     impact: &Impact<f64>,
     t: &Target<f64>,
 ) -> Option<TargetOutcome<f64>> {
-    target::solve(model, impact, t, &Settings::exact())
-        .or_else(|_| target::solve(model, impact, t, &Settings::adaptive(1e-13)))
+    two_body::solve(model, impact, t, &Settings::exact())
+        .or_else(|_| two_body::solve(model, impact, t, &Settings::adaptive(1e-13)))
         .ok()
 }
 
@@ -125,19 +125,19 @@ pub fn precision(budget: Duration) -> Vec<Point> {
             settings.push(Settings::adaptive(rtol));
         }
         for s in &settings {
-            let Ok(o) = target::solve(&model, &impact, &t, s) else {
+            let Ok(o) = two_body::solve(&model, &impact, &t, s) else {
                 continue;
             };
             // The closed form against Dormand–Prince at 1e-13 (not against itself).
             let (err, field) = match (
                 s.method,
-                target::solve(&model, &impact, &t, &Settings::adaptive(1e-13)),
+                two_body::solve(&model, &impact, &t, &Settings::adaptive(1e-13)),
             ) {
                 (Method::Exact, Ok(tight)) => error(&o, &tight, impact.v0_m_s),
                 _ => error(&o, &reference, impact.v0_m_s),
             };
             let secs = seconds(budget, || {
-                let _ = std::hint::black_box(target::solve(
+                let _ = std::hint::black_box(two_body::solve(
                     std::hint::black_box(&model),
                     &impact,
                     &t,
@@ -162,12 +162,12 @@ pub fn precision(budget: Duration) -> Vec<Point> {
             narrow(&t),
         );
         for s in [Settings::<f32>::exact(), Settings::adaptive(1e-5)] {
-            let Ok(o) = target::solve(&m32, &i32_, &t32, &s) else {
+            let Ok(o) = two_body::solve(&m32, &i32_, &t32, &s) else {
                 continue;
             };
             let (err, field) = error(&widen(&o), &reference, impact.v0_m_s);
             let secs = seconds(budget, || {
-                let _ = std::hint::black_box(target::solve(
+                let _ = std::hint::black_box(two_body::solve(
                     std::hint::black_box(&m32),
                     &i32_,
                     &t32,
@@ -307,14 +307,14 @@ pub fn stability(full: bool) -> Vec<Row> {
                                 if s.method == Method::Exact && !has_exact {
                                     continue;
                                 }
-                                record("f64", false, target::solve(&law, &impact, &t, s));
+                                record("f64", false, two_body::solve(&law, &impact, &t, s));
                                 if s.method == Method::Exact || s.rtol >= 1e-6 {
                                     let s32 = Settings {
                                         method: s.method,
                                         steps: s.steps,
                                         rtol: s.rtol as f32,
                                     };
-                                    let r32 = target::solve(
+                                    let r32 = two_body::solve(
                                         &model_f32(&law),
                                         &Impact::new(m1 as f32, v0 as f32),
                                         &narrow(&t),
