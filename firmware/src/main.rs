@@ -3,9 +3,10 @@
 //!
 //! A sample source fills blocks of samples and queues them for the stream task, which hands
 //! each impact's capture to the analysis task; the reporter logs the reports over defmt (see
-//! [`tasks`]). The three run at three interrupt priorities ([`executors`]), so sampling is never
-//! starved by analysis. The builds differ only in the sample source ([`source`]), the clocks,
-//! the interrupt lines and the embassy-time driver:
+//! [`tasks`], [`queues`]). The three run at three interrupt priorities ([`executors`]), so
+//! sampling is never starved by analysis; `main` below starts them one priority at a time. The
+//! builds differ only in the board ([`board`]: its sample sources, clocks, interrupt lines and
+//! embassy-time driver); the hardware-free half is the `impact_firmware` library:
 //!
 //! * `stm32` (default): the board, brought up at 168 MHz; ADC1 (or, with `adxl375`, an
 //!   ADXL375 on SPI1) samples the sensor; defmt over RTT. `cargo fw` at the workspace root
@@ -23,27 +24,14 @@ compile_error!(
 #[cfg(not(any(feature = "stm32", feature = "emulator")))]
 compile_error!("enable one of the features `stm32` (default) or `emulator`");
 
+mod board;
 mod executors;
 mod fault;
 mod logger;
-mod scene;
+mod queues;
 mod source;
 mod stack;
 mod tasks;
-
-#[cfg(feature = "emulator")]
-mod emulator;
-#[cfg(feature = "stm32")]
-mod stm32;
-
-// The board module: `init` brings the chip up and returns the scene (compiled in on the board,
-// from the command line in the emulator); `start_executors` starts the three priorities;
-// `spawn_sources` starts the sample source (and the light gate) at the highest one;
-// `end_of_stream` is told when a finite stream (the emulator's) is over.
-#[cfg(feature = "emulator")]
-use emulator as board;
-#[cfg(feature = "stm32")]
-use stm32 as board;
 
 use cortex_m_rt::entry;
 use defmt::{info, unwrap};
@@ -55,27 +43,39 @@ fn main() -> ! {
     info!(
         "impact-firmware {} up; blocks of {}, pre-trigger {}, {} captures of {} samples",
         env!("CARGO_PKG_VERSION"),
-        tasks::BLOCK_LEN,
-        tasks::PRE_TRIGGER_LEN,
-        tasks::CAPTURE_SLOTS,
-        tasks::CAPTURE_LEN
+        queues::BLOCK_LEN,
+        queues::PRE_TRIGGER_LEN,
+        queues::CAPTURE_SLOTS,
+        queues::CAPTURE_LEN
     );
     let setup = board::init();
-    let (samples_in, samples_out) = unwrap!(tasks::sample_queue());
-    let (captures_in, captures_out) = unwrap!(tasks::capture_queue());
-    let (high, medium, low) = board::start_executors();
+    let (samples_in, samples_out) = unwrap!(queues::sample_queue());
+    let (captures_in, captures_out) = unwrap!(queues::capture_queue());
+
+    // Low priority: the per-impact analysis (widths, kinematics, CFC, fits, spectra), one
+    // capture at a time; preempted by everything else.
+    let low = board::start_low();
     low.spawn(unwrap!(tasks::analysis::analysis(
         setup.scene,
         captures_out
     )));
-    medium.spawn(unwrap!(tasks::reporter::reporter()));
+
+    // Middle: the streaming stage (baseline, trigger, capture, exact sums; it feeds the
+    // watchdog) and the reporter (defmt lines in index order); preempt the analysis.
+    let medium = board::start_medium();
+    medium.spawn(unwrap!(tasks::reporter::reporter(board::end_of_stream)));
     medium.spawn(unwrap!(tasks::stream::stream(
         setup.scene,
         setup.backpressure,
         samples_out,
-        captures_in
+        captures_in,
+        board::feed_watchdog
     )));
+
+    // High: the sample source (and the light gate), which never waits for anything.
+    let high = board::start_high();
     board::spawn_sources(setup, high, samples_in);
+
     loop {
         cortex_m::asm::wfi();
     }

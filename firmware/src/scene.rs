@@ -2,7 +2,6 @@
 //! command line in the emulator (so that the host can hand over exactly the [`Scene`] that
 //! `impact analyze` builds).
 
-use defmt::{info, Format, Formatter};
 use impact_core::{Approach, Calibration, FitSet, Scene, Train, TrainSpeed};
 
 /// The seed bench's approach speed, m/s (a light gate may override it per impact through
@@ -13,7 +12,7 @@ pub const BENCH_V0_M_S: f32 = 1.3357;
 #[cfg(not(feature = "adxl375"))]
 const CALIBRATION: Calibration = Calibration {
     gain_m_s2_per_count: 1600.0 / 4096.0,
-    sample_rate_hz: crate::source::SAMPLE_RATE_HZ as f32,
+    sample_rate_hz: crate::SAMPLE_RATE_HZ as f32,
 };
 /// ADC rails: codes 0 and 4095 mean the sensor (or the ADC) is saturated.
 #[cfg(not(feature = "adxl375"))]
@@ -22,17 +21,16 @@ const CLIP_COUNTS: (i16, i16) = (0, 4095);
 /// ADXL375: 49 mg per LSB at 3200 S/s.
 #[cfg(feature = "adxl375")]
 const CALIBRATION: Calibration = Calibration {
-    gain_m_s2_per_count: crate::source::adxl375::G_PER_LSB
-        * crate::source::adxl375::STANDARD_GRAVITY_M_PER_S2,
-    sample_rate_hz: crate::source::SAMPLE_RATE_HZ as f32,
+    gain_m_s2_per_count: crate::adxl375::G_PER_LSB * crate::adxl375::STANDARD_GRAVITY_M_PER_S2,
+    sample_rate_hz: crate::SAMPLE_RATE_HZ as f32,
 };
 /// ADXL375: 13-bit two's-complement output per axis (±200 g is about ±4082 counts); the
 /// stream is the resultant (never negative), which reaches 4095 whenever an axis is at its
 /// rail: `clipped` then means an axis may have clipped (conservative: a large hit spread over
 /// axes is marked too, none at a rail is missed).
-/// One axis (`source::accel::AXIS`) has both rails, -4096 and 4095.
+/// One axis (`adxl375::AXIS`) has both rails, -4096 and 4095.
 #[cfg(feature = "adxl375")]
-const CLIP_COUNTS: (i16, i16) = if crate::source::accel::AXIS.is_resultant() {
+const CLIP_COUNTS: (i16, i16) = if crate::adxl375::AXIS.is_resultant() {
     (i16::MIN, 4095)
 } else {
     (-4096, 4095)
@@ -45,9 +43,9 @@ const APPROACH: Approach = Approach::Speed {
 };
 /// ADXL375: the seed bench's approach speed if the stream is the axis along the impact; none
 /// for the resultant, whose integral is no velocity change (the host's `--axes` gives none
-/// either): set `source::accel::AXIS` to that axis for kinematics and fits.
+/// either): set `adxl375::AXIS` to that axis for kinematics and fits.
 #[cfg(feature = "adxl375")]
-const APPROACH: Approach = if crate::source::accel::AXIS.is_resultant() {
+const APPROACH: Approach = if crate::adxl375::AXIS.is_resultant() {
     Approach::Unknown
 } else {
     Approach::Speed {
@@ -96,8 +94,9 @@ pub enum SceneError {
     BadValue,
 }
 
-impl Format for SceneError {
-    fn format(&self, f: Formatter<'_>) {
+#[cfg(target_os = "none")]
+impl defmt::Format for SceneError {
+    fn format(&self, f: defmt::Formatter<'_>) {
         match self {
             SceneError::UnknownKey => defmt::write!(f, "unknown key"),
             SceneError::BadValue => defmt::write!(f, "bad value"),
@@ -231,64 +230,6 @@ pub fn apply(scene: &mut Scene, key: &str, value: &str) -> Result<(), SceneError
         _ => return Err(SceneError::UnknownKey),
     }
     Ok(())
-}
-
-/// `none` or the value, for optional fields in the log lines.
-pub struct Opt<T>(pub Option<T>);
-
-impl Format for Opt<f32> {
-    fn format(&self, f: Formatter<'_>) {
-        match self.0 {
-            Some(v) => defmt::write!(f, "{=f32}", v),
-            None => defmt::write!(f, "none"),
-        }
-    }
-}
-
-impl Format for Opt<u32> {
-    fn format(&self, f: Formatter<'_>) {
-        match self.0 {
-            Some(v) => defmt::write!(f, "{=u32}", v),
-            None => defmt::write!(f, "none"),
-        }
-    }
-}
-
-/// Logs the scene in use as one `scene ...` line (the format is in docs/board.md).
-pub fn log(scene: &Scene) {
-    let (v0, drop_height) = match scene.approach {
-        Approach::Unknown => (None, None),
-        Approach::Speed { v0_m_s } => (Some(v0_m_s), None),
-        Approach::DropHeight { height_m } => (scene.approach.v0_m_s(), Some(height_m)),
-    };
-    let fits = &scene.fits;
-    info!(
-        "scene rate_hz={=f32} gain_m_s2_per_count={=f32} mass_kg={} v0_m_s={} drop_height_m={} trigger_m_s2={=f32} edge_m_s2={=f32} hold_s={=f32} max_impact_s={=f32} settle_s={=f32} clip_low={=i16} clip_high={=i16} cfc={} trigger_cfc={} two_phase={=bool} nonlinear={=bool} fit_exponent={=bool} exponent={=f32} hertz={=bool} train={=str} gravity_m_s2={} max_flight_s={} srs={=bool} wave_every={=u16}",
-        scene.calibration.sample_rate_hz,
-        scene.calibration.gain_m_s2_per_count,
-        Opt(scene.mass_kg),
-        Opt(v0),
-        Opt(drop_height),
-        scene.trigger_m_s2,
-        scene.edge_m_s2,
-        scene.hold_s,
-        scene.max_impact_s,
-        scene.settle_s,
-        scene.clip_counts.0,
-        scene.clip_counts.1,
-        Opt(scene.cfc.map(|c| c.class())),
-        Opt(scene.trigger_cfc.map(|c| c.class())),
-        fits.two_phase,
-        fits.nonlinear,
-        fits.fit_exponent,
-        fits.nonlinear_exponent,
-        fits.hertz,
-        scene.train.map_or("none", |t| t.speed.name()),
-        Opt(scene.train.map(|t| t.gravity_m_s2)),
-        Opt(scene.train.map(|t| t.max_flight_s)),
-        scene.spectrum.is_some(),
-        scene.waveform_every,
-    );
 }
 
 /// Distance between the two light-gate beams, m (feature `light-gate`).

@@ -1,16 +1,12 @@
-//! Host tests of the firmware's ADXL375 driver (`firmware/src/source/adxl375.rs`, which only
+//! Host tests of the firmware's ADXL375 driver (`firmware/src/adxl375.rs`, which only
 //! depends on `embedded-hal-async`): exact SPI traffic against `embedded-hal-mock`, FIFO
 //! behaviour against a small simulated ADXL375, and errors from a failing bus; and the loss
-//! accounting of its polled FIFO (`firmware/src/source/fifo.rs`) against a part whose clock
+//! accounting of its polled FIFO (`firmware/src/fifo.rs`) against a part whose clock
 //! is off nominal, polled with jitter.
 
-// The driver is included as a module so that it is tested exactly as the firmware builds it;
-// so is the FIFO's loss accounting (`source/fifo.rs`), which the board and the emulator share.
-#[path = "../../firmware/src/source/adxl375.rs"]
-#[allow(dead_code)]
-mod adxl375;
-#[path = "../../firmware/src/source/fifo.rs"]
-mod fifo;
+// The driver and the FIFO's loss accounting (shared by the board and the emulator) are the
+// firmware library's, built for the host.
+use impact_firmware::{adxl375, fifo};
 
 use std::collections::VecDeque;
 use std::future::Future;

@@ -1,9 +1,6 @@
 //! The firmware's light-gate speed computation (hardware-free part), on the host.
 
-#[path = "../../firmware/src/source/light_gate.rs"]
-mod light_gate;
-
-use light_gate::{speed_m_s, GateError};
+use impact_firmware::light_gate::{speed_m_s, GateError};
 
 #[test]
 fn speed_from_two_beam_cuts() {
@@ -25,7 +22,7 @@ fn bad_readings_are_refused_not_guessed() {
 
 #[test]
 fn cuts_pair_into_passages_with_their_direction() {
-    use light_gate::{Beam, Pairing, Passage, PAIRING_WINDOW_US};
+    use impact_firmware::light_gate::{Beam, Pairing, Passage, PAIRING_WINDOW_US};
     let mut g = Pairing::new();
     // Toward the barrier: first then second beam.
     assert_eq!(g.cut(Beam::First, 1_000, 0.01), None);

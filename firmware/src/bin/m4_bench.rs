@@ -32,16 +32,8 @@
 #![no_std]
 #![no_main]
 
-#[path = "../emulator/host.rs"]
-mod host;
-// The emulator's scene keys (only `BENCH` and `apply` are used here).
-#[allow(dead_code)]
-#[path = "../scene.rs"]
-mod scene;
-/// The one item of the firmware's `source` module that `scene.rs` reads.
-mod source {
-    include!("../source/rate.rs");
-}
+use impact_firmware::scene;
+use impact_firmware::semihosting as host;
 
 use core::hint::black_box;
 use core::sync::atomic::{AtomicU32, Ordering};

@@ -6,10 +6,10 @@
 
 use defmt::{warn, Format};
 use embassy_time::{Duration, Instant, Ticker};
-use impact_core::signal::resultant::resultant_counts;
+use impact_firmware::adxl375::{Axes, Axis};
 
-use super::fifo::LossCounter;
-use crate::tasks::sampler::{BlockSender, SOURCE_STATS};
+use crate::source::sender::{BlockSender, SOURCE_STATS};
+use impact_firmware::fifo::LossCounter;
 
 /// Most entries one poll can find: the ADXL375's 32-sample FIFO and its output registers.
 pub const MAX_ENTRIES: usize = 33;
@@ -17,39 +17,6 @@ pub const MAX_ENTRIES: usize = 33;
 /// Poll period: 5 ms = 16 samples at 3200 S/s, half the FIFO, leaving as much again before
 /// it overruns; also the longest a sample waits for the stream (report latency).
 pub const POLL_PERIOD: Duration = Duration::from_millis(5);
-
-/// One sample's three axes, counts.
-pub type Axes = [i16; 3];
-
-/// What the stream gets of each sample.
-#[derive(Clone, Copy, PartialEq, Eq, Format)]
-#[allow(dead_code)]
-pub enum Axis {
-    X,
-    Y,
-    Z,
-    /// `sqrt(x² + y² + z²)` (crash and drop practice: the trigger on |a| whatever the
-    /// direction of the hit).
-    Resultant,
-}
-
-impl Axis {
-    /// Whether the stream is the resultant (whose integral is no velocity change).
-    #[allow(dead_code)]
-    pub const fn is_resultant(self) -> bool {
-        matches!(self, Axis::Resultant)
-    }
-
-    /// The stream's sample of one three-axis sample.
-    pub fn pick(self, [x, y, z]: Axes) -> i16 {
-        match self {
-            Axis::X => x,
-            Axis::Y => y,
-            Axis::Z => z,
-            Axis::Resultant => resultant_counts(x, y, z),
-        }
-    }
-}
 
 /// One poll's outcome.
 pub struct Read {

@@ -9,7 +9,7 @@ use impact_core::waveform::{self, FRAME_LEN};
 use impact_core::{analyse, Scene, Workspace};
 use static_cell::ConstStaticCell;
 
-use super::{CaptureReceiver, FwCapture, ANALYSED, CAPTURE_LEN};
+use crate::queues::{CaptureReceiver, FwCapture, ANALYSED, CAPTURE_LEN};
 
 /// The analysis's scratch memory (the acceleration of a whole capture, f32, and the spectra's
 /// block statistics). All zeros; it lives in the CCM RAM (board-memory.x: the STM32F407's, and

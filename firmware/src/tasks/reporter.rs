@@ -20,11 +20,10 @@ use defmt::{error, info, warn};
 use embassy_futures::select::{select3, Either3};
 use embassy_time::{Duration, Instant, Timer};
 use heapless::Vec;
-use impact_core::{Counters, ImpactReport};
+use impact_core::{Approach, ImpactReport, Scene};
 
-use super::sampler::{SAMPLE_CLOCK, SOURCE_STATS};
-use super::{StreamEnd, ANALYSED, FROM_STREAM};
-use crate::scene::Opt;
+use crate::queues::{FromStream, Heartbeat, StreamEnd, ANALYSED, FROM_STREAM};
+use crate::source::sender::{SAMPLE_CLOCK, SOURCE_STATS};
 
 /// Impacts held back while an earlier one is still being analysed (~1 KiB each: beyond, the
 /// lowest goes out anyway and the broken order is counted, `reports_out_of_order`).
@@ -38,80 +37,6 @@ static HEARTBEATS_DROPPED: AtomicU32 = AtomicU32::new(0);
 /// Counts a heartbeat the monitor could not queue (the reporter was behind).
 pub fn count_dropped_heartbeat() {
     HEARTBEATS_DROPPED.fetch_add(1, Ordering::Relaxed);
-}
-
-/// Running totals over the blocks the stream task has received.
-#[derive(Clone, Copy, defmt::Format)]
-pub struct Tally {
-    /// Blocks received.
-    pub blocks: u32,
-    /// Samples received.
-    pub samples: u64,
-    /// Blocks missing from the sequence numbers (lost between source and monitor).
-    pub blocks_missing: u32,
-    /// Smallest sample (i16::MAX before any sample).
-    pub min: i16,
-    /// Largest sample (i16::MIN before any sample).
-    pub max: i16,
-    /// Sum of all samples, a cheap checksum of what arrived.
-    pub sum: i64,
-}
-
-impl Tally {
-    /// Nothing seen yet.
-    pub const fn new() -> Self {
-        Self {
-            blocks: 0,
-            samples: 0,
-            blocks_missing: 0,
-            min: i16::MAX,
-            max: i16::MIN,
-            sum: 0,
-        }
-    }
-}
-
-impl Default for Tally {
-    fn default() -> Self {
-        Self::new()
-    }
-}
-
-/// The stream's state at one instant.
-#[derive(Clone, Copy)]
-pub struct Heartbeat {
-    /// What arrived from the source.
-    pub tally: Tally,
-    /// The streaming stage's counters.
-    pub counters: Counters,
-    /// The scene's sample rate, S/s.
-    pub rate_hz: f32,
-    /// Share of the time spent in the streaming stage, per mille: since the previous heartbeat,
-    /// or over the whole run in the summary.
-    pub busy_permille: u32,
-    /// A baseline has been learned (impacts can be detected).
-    pub armed: bool,
-    /// An impact is being captured.
-    pub in_impact: bool,
-    /// Skipped-impact reports the stream task could not queue.
-    pub reports_dropped: u32,
-}
-
-/// What the stream task tells the reporter.
-// Every queue slot holds the largest variant anyway (no heap to box it into).
-#[allow(clippy::large_enum_variant)]
-pub enum FromStream {
-    /// An impact that found no free capture slot: its streaming fields only.
-    Skipped(ImpactReport),
-    /// Periodic state.
-    Heartbeat(Heartbeat),
-    /// The stream ended.
-    End {
-        /// Final state.
-        last: Heartbeat,
-        /// How the source ended.
-        end: StreamEnd,
-    },
 }
 
 /// Prints impacts in index order: one that arrives before an earlier one (a skipped impact
@@ -196,7 +121,7 @@ impl Order {
 
 /// Logs reports until the end of the stream, then tells the board how it went.
 #[embassy_executor::task]
-pub async fn reporter() {
+pub async fn reporter(end_of_stream: fn(bool) -> !) {
     let started = Instant::now();
     let mut order = Order::new();
     let mut end: Option<(Heartbeat, StreamEnd)> = None;
@@ -228,7 +153,7 @@ pub async fn reporter() {
             ),
         }
     };
-    crate::board::end_of_stream(success);
+    end_of_stream(success);
 }
 
 /// The `impact` line: every field of the report, in its order, kinematics and fits
@@ -414,4 +339,62 @@ fn summarize(h: &Heartbeat, end: StreamEnd, out_of_order: u32, elapsed_ms: u64) 
         error!("run failed (see the summary)");
     }
     success
+}
+
+/// `none` or the value, for optional fields in the log lines.
+pub struct Opt<T>(pub Option<T>);
+
+impl defmt::Format for Opt<f32> {
+    fn format(&self, f: defmt::Formatter<'_>) {
+        match self.0 {
+            Some(v) => defmt::write!(f, "{=f32}", v),
+            None => defmt::write!(f, "none"),
+        }
+    }
+}
+
+impl defmt::Format for Opt<u32> {
+    fn format(&self, f: defmt::Formatter<'_>) {
+        match self.0 {
+            Some(v) => defmt::write!(f, "{=u32}", v),
+            None => defmt::write!(f, "none"),
+        }
+    }
+}
+
+/// Logs the scene in use as one `scene ...` line (the format is in docs/board.md).
+pub fn log_scene(scene: &Scene) {
+    let (v0, drop_height) = match scene.approach {
+        Approach::Unknown => (None, None),
+        Approach::Speed { v0_m_s } => (Some(v0_m_s), None),
+        Approach::DropHeight { height_m } => (scene.approach.v0_m_s(), Some(height_m)),
+    };
+    let fits = &scene.fits;
+    info!(
+        "scene rate_hz={=f32} gain_m_s2_per_count={=f32} mass_kg={} v0_m_s={} drop_height_m={} trigger_m_s2={=f32} edge_m_s2={=f32} hold_s={=f32} max_impact_s={=f32} settle_s={=f32} clip_low={=i16} clip_high={=i16} cfc={} trigger_cfc={} two_phase={=bool} nonlinear={=bool} fit_exponent={=bool} exponent={=f32} hertz={=bool} train={=str} gravity_m_s2={} max_flight_s={} srs={=bool} wave_every={=u16}",
+        scene.calibration.sample_rate_hz,
+        scene.calibration.gain_m_s2_per_count,
+        Opt(scene.mass_kg),
+        Opt(v0),
+        Opt(drop_height),
+        scene.trigger_m_s2,
+        scene.edge_m_s2,
+        scene.hold_s,
+        scene.max_impact_s,
+        scene.settle_s,
+        scene.clip_counts.0,
+        scene.clip_counts.1,
+        Opt(scene.cfc.map(|c| c.class())),
+        Opt(scene.trigger_cfc.map(|c| c.class())),
+        fits.two_phase,
+        fits.nonlinear,
+        fits.fit_exponent,
+        fits.nonlinear_exponent,
+        fits.hertz,
+        scene.train.map_or("none", |t| t.speed.name()),
+        Opt(scene.train.map(|t| t.gravity_m_s2)),
+        Opt(scene.train.map(|t| t.max_flight_s)),
+        scene.spectrum.is_some(),
+        scene.waveform_every,
+    );
 }

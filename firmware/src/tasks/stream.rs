@@ -11,10 +11,9 @@ use embassy_time::Instant;
 use impact_core::{Counters, ImpactReport, Scene, Sink, Stream};
 use static_cell::ConstStaticCell;
 
-use super::reporter::{FromStream, Heartbeat, Tally};
-use super::{
-    CaptureSender, FwCapture, SampleReceiver, SourceEvent, StreamEnd, CAPTURE_LEN, FROM_STREAM,
-    PRE_TRIGGER_LEN,
+use crate::queues::{
+    CaptureSender, FromStream, FwCapture, Heartbeat, SampleReceiver, SourceEvent, StreamEnd, Tally,
+    CAPTURE_LEN, FROM_STREAM, PRE_TRIGGER_LEN,
 };
 
 /// The firmware's streaming stage.
@@ -169,6 +168,7 @@ pub async fn stream(
     backpressure: Backpressure,
     mut samples: SampleReceiver,
     mut captures: CaptureSender,
+    feed_watchdog: fn(),
 ) {
     // A compile-time value in its static: the ring (8 KiB) is never built on the stack. (The
     // placeholder scene is not all zeros, so this one static is in `.data`.)
@@ -189,7 +189,7 @@ pub async fn stream(
             .await;
         return;
     }
-    crate::scene::log(s.scene());
+    super::reporter::log_scene(s.scene());
 
     loop {
         if let Some(v0) = APPROACH_SPEED.try_take() {
@@ -199,7 +199,7 @@ pub async fn stream(
         // the stream has seen it.
         let event = samples.receive().await;
         // Blocks keep coming: the firmware runs (the board's watchdog resets it otherwise).
-        crate::board::feed_watchdog();
+        feed_watchdog();
         let since = Instant::now();
         let mut dropped = 0u32;
         let end = match event {

@@ -1,6 +1,7 @@
 //! The `stm32` board: STM32F4-Discovery (STM32F407VG). Clock tree and flash accelerator, the
-//! executors' interrupt lines, the sample source's peripherals, the light gate; defmt over RTT,
-//! panics through panic-probe.
+//! executors' interrupt lines and priorities, the watchdog and the reset reason; its sample
+//! sources (ADC1 and DMA in [`adc`], or the ADXL375 on SPI1 in `accel`) and the light gate
+//! (`gate`); defmt over RTT, panics through panic-probe.
 
 use defmt::{info, unwrap};
 use embassy_executor::SendSpawner;
@@ -11,6 +12,14 @@ use panic_probe as _;
 
 use crate::executors::{HIGH, LOW, MEDIUM};
 use crate::tasks::stream::Backpressure;
+
+// The board's sample sources (the high-priority tasks): the ADC, or the ADXL375; the light gate.
+#[cfg(feature = "adxl375")]
+pub mod accel;
+#[cfg(not(feature = "adxl375"))]
+pub mod adc;
+#[cfg(feature = "light-gate")]
+pub mod gate;
 
 #[cfg(not(feature = "adxl375"))]
 bind_interrupts!(
@@ -51,7 +60,7 @@ unsafe fn USART6() {
 
 /// What the board hands the tasks.
 pub struct Setup {
-    /// The compiled-in scene ([`crate::scene::BENCH`]).
+    /// The compiled-in scene ([`impact_firmware::scene::BENCH`]).
     pub scene: Scene,
     /// A live source: the stream never waits for the analysis.
     pub backpressure: Backpressure,
@@ -66,7 +75,7 @@ pub fn init() -> Setup {
     info!("reset reason: {}", reset_reason());
     start_watchdog();
     Setup {
-        scene: crate::scene::BENCH,
+        scene: impact_firmware::scene::BENCH,
         backpressure: Backpressure::Never,
         p,
     }
@@ -155,25 +164,34 @@ fn enable_flash_accelerator() {
     });
 }
 
-/// Starts the three executors (high, middle, low) below the device interrupts (DMA, EXTI and
-/// the time driver's timer stay at priority 0).
-pub fn start_executors() -> (SendSpawner, SendSpawner, SendSpawner) {
+// The executors, below the device interrupts (DMA, EXTI and the time driver's timer stay at
+// priority 0), on three lines of peripherals the board does not use.
+
+/// Starts the high executor (the sample source) at NVIC priority 2, on UART4's line.
+pub fn start_high() -> SendSpawner {
     interrupt::UART4.set_priority(Priority::P2);
+    HIGH.start(interrupt::UART4)
+}
+
+/// Starts the middle executor (the stream and the reporter) at priority 3, on UART5's line.
+pub fn start_medium() -> SendSpawner {
     interrupt::UART5.set_priority(Priority::P3);
+    MEDIUM.start(interrupt::UART5)
+}
+
+/// Starts the low executor (the analysis) at priority 4, on USART6's line.
+pub fn start_low() -> SendSpawner {
     interrupt::USART6.set_priority(Priority::P4);
-    let high = HIGH.start(interrupt::UART4);
-    let medium = MEDIUM.start(interrupt::UART5);
-    let low = LOW.start(interrupt::USART6);
-    (high, medium, low)
+    LOW.start(interrupt::USART6)
 }
 
 /// Spawns the sample source (and the light gate) on the high executor.
-pub fn spawn_sources(setup: Setup, high: SendSpawner, samples: crate::tasks::SampleSender) {
+pub fn spawn_sources(setup: Setup, high: SendSpawner, samples: crate::queues::SampleSender) {
     let p = setup.p;
 
     #[cfg(not(feature = "adxl375"))]
     {
-        use crate::source::adc;
+        use super::adc;
         let dma_buf = adc::dma_buffer();
         let sampler =
             adc::AdcSampler::new(p.ADC1, p.PA1, p.DMA2_CH0, p.TIM3, p.TIM2, Irqs, dma_buf);
@@ -182,7 +200,7 @@ pub fn spawn_sources(setup: Setup, high: SendSpawner, samples: crate::tasks::Sam
 
     #[cfg(feature = "adxl375")]
     {
-        use crate::source::accel;
+        use super::accel;
         let pins = accel::Spi1Pins {
             sck: p.PA5,
             mosi: p.PA7,
@@ -196,8 +214,8 @@ pub fn spawn_sources(setup: Setup, high: SendSpawner, samples: crate::tasks::Sam
 
     #[cfg(feature = "light-gate")]
     {
-        let beams = crate::source::gate::Beams::new(p.PB0, p.EXTI0, p.PB1, p.EXTI1);
-        high.spawn(unwrap!(crate::source::gate::light_gate(beams)));
+        let beams = super::gate::Beams::new(p.PB0, p.EXTI0, p.PB1, p.EXTI1);
+        high.spawn(unwrap!(super::gate::light_gate(beams)));
     }
 }
 

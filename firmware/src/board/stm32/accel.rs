@@ -7,7 +7,7 @@
 //! is held high here so it stays off the bus. PE7 is a free pin on the P2 header; any free
 //! GPIO works as the ADXL375's chip select.
 
-use defmt::{error, info, Formatter};
+use defmt::{error, info};
 use embassy_stm32::gpio::{Level, Output, Speed};
 use embassy_stm32::mode::Async;
 use embassy_stm32::peripherals::{DMA2_CH2, DMA2_CH3, PA5, PA6, PA7, PE3, PE7, SPI1};
@@ -17,12 +17,13 @@ use embassy_stm32::Peri;
 use embassy_time::{Delay, Instant, Timer};
 use embedded_hal_bus::spi::ExclusiveDevice;
 
-use super::adxl375::{Adxl375, DataRate, Error, Sample, MAX_FIFO_ENTRIES};
-use super::poll::{self, Axes, Axis, Fifo, Poll, Read, MAX_ENTRIES, POLL_PERIOD};
-use super::SAMPLE_RATE_HZ;
-use crate::stm32::Irqs;
-use crate::tasks::sampler::{BlockSender, SAMPLE_CLOCK, SOURCE_STATS};
-use crate::tasks::StreamEnd;
+use super::Irqs;
+use crate::queues::StreamEnd;
+use crate::source::poll::{self, Fifo, Poll, Read, MAX_ENTRIES, POLL_PERIOD};
+use crate::source::sender::{BlockSender, SAMPLE_CLOCK, SOURCE_STATS};
+use impact_firmware::adxl375::{Adxl375, DataRate, Error, Sample, MAX_FIFO_ENTRIES};
+use impact_firmware::adxl375::{Axes, AXIS};
+use impact_firmware::SAMPLE_RATE_HZ;
 
 /// Output data rate; [`SAMPLE_RATE_HZ`] is set to match.
 const DATA_RATE: DataRate = DataRate::Hz3200;
@@ -36,11 +37,6 @@ const SPI_CLOCK_HZ: u32 = 2_625_000;
 
 /// Tries at bringing the sensor up before the source gives up.
 const INIT_ATTEMPTS: u32 = 3;
-
-/// What becomes the sample stream: the resultant (the trigger on |a| whatever the direction
-/// of the hit; no kinematics, its integral being no velocity change), or the axis along the
-/// impact (kinematics and fits from the bench's approach speed, `scene::BENCH`).
-pub const AXIS: Axis = Axis::Resultant;
 
 /// The SPI device: SPI1 with DMA, chip select by GPIO, embassy-time for the FIFO delays.
 pub type Device = ExclusiveDevice<Spi<'static, Async, Master>, Output<'static>, Delay>;
@@ -90,31 +86,6 @@ pub fn sensor(
     Adxl375::new(device, Delay)
 }
 
-impl<E: embedded_hal::spi::Error> defmt::Format for Error<E> {
-    fn format(&self, f: Formatter) {
-        match self {
-            Error::Spi(e) => defmt::write!(f, "SPI error ({})", spi_error_kind(e.kind())),
-            Error::WrongDeviceId { found } => {
-                defmt::write!(f, "wrong device id {=u8:#04x} (expected 0xe5)", found)
-            }
-            Error::FifoOverrun { samples_read } => {
-                defmt::write!(f, "FIFO overrun ({} samples read after it)", samples_read)
-            }
-        }
-    }
-}
-
-fn spi_error_kind(kind: embedded_hal::spi::ErrorKind) -> &'static str {
-    use embedded_hal::spi::ErrorKind;
-    match kind {
-        ErrorKind::Overrun => "overrun",
-        ErrorKind::ModeFault => "mode fault",
-        ErrorKind::FrameFormat => "frame format",
-        ErrorKind::ChipSelectFault => "chip select fault",
-        _ => "other",
-    }
-}
-
 impl Fifo for Sensor {
     type Error = Error<<Device as embedded_hal::spi::ErrorType>::Error>;
 
@@ -142,7 +113,7 @@ impl Fifo for Sensor {
 /// the sensor's own sample stream, one short block per poll). If the sensor cannot be brought
 /// up the stream ends as failed.
 #[embassy_executor::task]
-pub async fn sampler(mut sensor: Sensor, samples: crate::tasks::SampleSender) {
+pub async fn sampler(mut sensor: Sensor, samples: crate::queues::SampleSender) {
     let mut sender = BlockSender::new(samples);
 
     let mut attempt = 1;

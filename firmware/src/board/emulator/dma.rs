@@ -16,11 +16,11 @@ use embassy_sync::blocking_mutex::raw::CriticalSectionRawMutex;
 use embassy_sync::blocking_mutex::Mutex;
 use embassy_sync::signal::Signal;
 
-use super::host::HostFile;
 use super::irq::Irq;
 use super::time::{counter, CLOCK_HZ};
 use super::timer::CmsdkTimer;
-use crate::tasks::BLOCK_LEN;
+use crate::queues::BLOCK_LEN;
+use impact_firmware::semihosting::HostFile;
 
 /// Blocks in the ring (the board's DMA ring: two halves).
 pub const RING_BLOCKS: u32 = 2;

@@ -8,7 +8,7 @@ use core::sync::atomic::{AtomicU32, Ordering};
 use embassy_sync::blocking_mutex::raw::CriticalSectionRawMutex;
 use embassy_sync::blocking_mutex::Mutex;
 
-use super::{Block, SampleSender, SourceEvent, StreamEnd, BLOCK_LEN};
+use crate::queues::{Block, SampleSender, SourceEvent, StreamEnd, BLOCK_LEN};
 use defmt::{info, warn};
 
 /// A u64 shared between priorities (the Cortex-M4 has no 64-bit atomics).

@@ -24,6 +24,7 @@
 
 use embedded_hal_async::delay::DelayNs;
 use embedded_hal_async::spi::{Operation, SpiDevice};
+use impact_core::signal::resultant::resultant_counts;
 
 /// Register addresses (ADXL375 data sheet, Table 14).
 pub mod reg {
@@ -151,6 +152,44 @@ impl Sample {
     }
 }
 
+/// One sample's three axes, counts.
+pub type Axes = [i16; 3];
+
+/// What the stream gets of each sample.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[cfg_attr(target_os = "none", derive(defmt::Format))]
+pub enum Axis {
+    X,
+    Y,
+    Z,
+    /// `sqrt(x² + y² + z²)` (crash and drop practice: the trigger on |a| whatever the
+    /// direction of the hit).
+    Resultant,
+}
+
+impl Axis {
+    /// Whether the stream is the resultant (whose integral is no velocity change).
+    #[allow(dead_code)]
+    pub const fn is_resultant(self) -> bool {
+        matches!(self, Axis::Resultant)
+    }
+
+    /// The stream's sample of one three-axis sample.
+    pub fn pick(self, [x, y, z]: Axes) -> i16 {
+        match self {
+            Axis::X => x,
+            Axis::Y => y,
+            Axis::Z => z,
+            Axis::Resultant => resultant_counts(x, y, z),
+        }
+    }
+}
+
+/// What becomes the sample stream: the resultant (the trigger on |a| whatever the direction
+/// of the hit; no kinematics, its integral being no velocity change), or the axis along the
+/// impact (kinematics and fits from the bench's approach speed, [`crate::scene::BENCH`]).
+pub const AXIS: Axis = Axis::Resultant;
+
 /// Converts counts to m/s² with the typical scale factor.
 pub fn counts_to_m_per_s2(counts: i16) -> f32 {
     f32::from(counts) * G_PER_LSB * STANDARD_GRAVITY_M_PER_S2
@@ -173,6 +212,33 @@ pub enum Error<E> {
         /// Samples read into the output buffer despite the overrun.
         samples_read: usize,
     },
+}
+
+#[cfg(target_os = "none")]
+impl<E: embedded_hal::spi::Error> defmt::Format for Error<E> {
+    fn format(&self, f: defmt::Formatter) {
+        match self {
+            Error::Spi(e) => defmt::write!(f, "SPI error ({})", spi_error_kind(e.kind())),
+            Error::WrongDeviceId { found } => {
+                defmt::write!(f, "wrong device id {=u8:#04x} (expected 0xe5)", found)
+            }
+            Error::FifoOverrun { samples_read } => {
+                defmt::write!(f, "FIFO overrun ({} samples read after it)", samples_read)
+            }
+        }
+    }
+}
+
+#[cfg(target_os = "none")]
+fn spi_error_kind(kind: embedded_hal::spi::ErrorKind) -> &'static str {
+    use embedded_hal::spi::ErrorKind;
+    match kind {
+        ErrorKind::Overrun => "overrun",
+        ErrorKind::ModeFault => "mode fault",
+        ErrorKind::FrameFormat => "frame format",
+        ErrorKind::ChipSelectFault => "chip select fault",
+        _ => "other",
+    }
 }
 
 /// An ADXL375 on an SPI device (which owns the chip select).

@@ -7,8 +7,8 @@
 pub mod adxl375;
 pub mod dma;
 pub mod drain;
-pub mod host;
 pub mod irq;
+pub mod replay;
 pub mod time;
 pub mod timer;
 
@@ -19,11 +19,12 @@ use embassy_executor::SendSpawner;
 use impact_core::Scene;
 use static_cell::ConstStaticCell;
 
-use crate::scene::SceneError;
-use crate::source::poll::Axis;
 use crate::tasks::stream::Backpressure;
+use impact_firmware::adxl375::Axis;
+use impact_firmware::scene::SceneError;
+use impact_firmware::semihosting as host;
 
-pub use irq::start_executors;
+pub use irq::{start_high, start_low, start_medium};
 
 /// Longest semihosting command line accepted, bytes.
 const COMMAND_LINE_LEN: usize = 2048;
@@ -31,8 +32,8 @@ const COMMAND_LINE_LEN: usize = 2048;
 /// What the semihosting command line asks for:
 /// `<program> <samples-file> [realtime|lossless] [rate_scale=X] [stall=BLOCK:US]
 /// [sensor=adc|adxl375] [axis=x|y|z|resultant] [key=value ...]` (scene keys:
-/// see [`crate::scene::apply`]; unset keys keep the seed bench's values,
-/// [`crate::scene::BENCH`]).
+/// see [`impact_firmware::scene::apply`]; unset keys keep the seed bench's values,
+/// [`impact_firmware::scene::BENCH`]).
 pub struct Config {
     /// Host path of the raw little-endian i16 samples.
     pub samples_path: &'static str,
@@ -100,7 +101,7 @@ fn parse(line: &'static str) -> Result<Config, ConfigError> {
     if positional.next().is_some() {
         return Err(ConfigError::BadPacing);
     }
-    let mut scene = crate::scene::BENCH;
+    let mut scene = impact_firmware::scene::BENCH;
     let mut rate_scale = 1.0f32;
     let mut stall = None;
     let mut adxl375 = false;
@@ -135,7 +136,7 @@ fn parse(line: &'static str) -> Result<Config, ConfigError> {
                     .filter(|x| x.is_finite() && *x > 0.0)
                     .ok_or(ConfigError::BadRateScale)?;
             }
-            Some((key, value)) => crate::scene::apply(&mut scene, key, value)
+            Some((key, value)) => impact_firmware::scene::apply(&mut scene, key, value)
                 .map_err(|error| ConfigError::Scene { key, error })?,
             None => {}
         }
@@ -180,6 +181,7 @@ pub fn init() -> Setup {
             fault_exit()
         }
     };
+    irq::init();
     time::init();
     let lossless = config.pacing == Pacing::Lossless;
     crate::logger::set_waiting(lossless);
@@ -195,10 +197,10 @@ pub fn init() -> Setup {
 }
 
 /// Spawns the sample source on the highest-priority executor.
-pub fn spawn_sources(setup: Setup, high: SendSpawner, samples: crate::tasks::SampleSender) {
+pub fn spawn_sources(setup: Setup, high: SendSpawner, samples: crate::queues::SampleSender) {
     let c = &setup.config;
     let rate = c.scene.calibration.sample_rate_hz;
-    let file = match crate::source::replay::open(c.samples_path, rate, c.adxl375) {
+    let file = match super::replay::open(c.samples_path, rate, c.adxl375) {
         Ok(file) => file,
         Err(e) => {
             error!("replay: {}", e);
@@ -212,7 +214,7 @@ pub fn spawn_sources(setup: Setup, high: SendSpawner, samples: crate::tasks::Sam
                 c.rate_scale
             );
             if c.adxl375 {
-                high.spawn(unwrap!(crate::source::replay::adxl375(
+                high.spawn(unwrap!(super::replay::adxl375(
                     file,
                     rate * c.rate_scale,
                     c.axis,
@@ -220,7 +222,7 @@ pub fn spawn_sources(setup: Setup, high: SendSpawner, samples: crate::tasks::Sam
                     samples
                 )));
             } else {
-                high.spawn(unwrap!(crate::source::replay::realtime(
+                high.spawn(unwrap!(super::replay::realtime(
                     file,
                     rate * c.rate_scale,
                     c.stall,
@@ -231,9 +233,7 @@ pub fn spawn_sources(setup: Setup, high: SendSpawner, samples: crate::tasks::Sam
         Pacing::Lossless => {
             info!("replay: lossless");
             let axes = c.adxl375.then_some(c.axis);
-            high.spawn(unwrap!(crate::source::replay::lossless(
-                file, axes, samples
-            )));
+            high.spawn(unwrap!(super::replay::lossless(file, axes, samples)));
         }
     }
 }

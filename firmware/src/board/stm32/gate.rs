@@ -13,9 +13,9 @@ use embassy_sync::blocking_mutex::raw::CriticalSectionRawMutex;
 use embassy_sync::channel::Channel;
 use embassy_time::Instant;
 
-use super::light_gate::{Beam, Pairing, Passage};
-use crate::scene::LIGHT_GATE_SPACING_M;
 use crate::tasks::stream::APPROACH_SPEED;
+use impact_firmware::light_gate::{Beam, Pairing, Passage};
+use impact_firmware::scene::LIGHT_GATE_SPACING_M;
 
 /// Cuts waiting for the task: (beam, µs since start-up).
 static CUTS: Channel<CriticalSectionRawMutex, (Beam, u64), 4> = Channel::new();

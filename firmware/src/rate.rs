@@ -1,9 +1,10 @@
-// Included by `mod.rs` (and by `src/bin/m4_bench.rs`): the sample rate of the build's source.
+//! The sample rate of the build's source.
 
 /// Nominal sample rate of the build's source, in samples per second.
 ///
-/// ADC: 500 kS/s. See [`adc`] for the limits of the STM32F407's ADC at the 168 MHz clock
-/// tree. The emulator's replay paces at its scene's rate, which defaults to this one.
+/// ADC: 500 kS/s (the limits of the STM32F407's ADC at the 168 MHz clock tree are in
+/// `board/stm32/adc.rs`). The emulator's replay paces at its scene's rate, which defaults to
+/// this one.
 #[cfg(not(feature = "adxl375"))]
 pub const SAMPLE_RATE_HZ: u32 = 500_000;
 

@@ -17,11 +17,12 @@ use embassy_sync::blocking_mutex::raw::CriticalSectionRawMutex;
 use embassy_sync::blocking_mutex::Mutex;
 use embassy_time::{Duration, Instant};
 
-use super::host::{HostError, HostFile};
 use super::irq::Irq;
 use super::time::{counter, CLOCK_HZ};
 use super::timer::CmsdkTimer;
-use crate::source::poll::{Axes, Fifo, Poll, Read, MAX_ENTRIES};
+use crate::source::poll::{Fifo, Poll, Read, MAX_ENTRIES};
+use impact_firmware::adxl375::Axes;
+use impact_firmware::semihosting::{HostError, HostFile};
 
 const TIMER: CmsdkTimer = CmsdkTimer::at(0x4000_0000);
 

@@ -1,6 +1,6 @@
 //! Emulator sample sources: a host file of raw little-endian i16 samples, replayed
 //!
-//! * in real time ([`realtime`]): the emulated DMA ([`crate::emulator::dma`]) writes one block
+//! * in real time ([`realtime`]): the emulated DMA ([`super::dma`]) writes one block
 //!   per block period of virtual time into its ring, and this task, at the highest priority,
 //!   copies the blocks into the sample queue as the board's sampler copies the DMA's halves;
 //!   a ring overrun or a full queue is a counted loss, announced to the stream;
@@ -10,7 +10,7 @@
 //!
 //! With `sensor=adxl375` the file holds three-axis samples (i16 triplets, x y z) and goes
 //! through the ADXL375 path instead: in real time an emulated ADXL375
-//! ([`crate::emulator::adxl375`]) polled by the board's own ADXL375 source
+//! ([`super::adxl375`]) polled by the board's own ADXL375 source
 //! ([`crate::source::poll`]), losslessly the same resultant computed block by block.
 //!
 //! Paths cannot contain spaces (semihosting joins the arguments with spaces).
@@ -20,12 +20,13 @@ use core::sync::atomic::Ordering;
 use defmt::{error, info, warn, Format};
 use embassy_time::{Duration, Instant};
 
-use crate::emulator::adxl375;
-use crate::emulator::dma::{self, Take};
-use crate::emulator::host::{HostError, HostFile};
-use crate::source::poll::{self, Axis};
-use crate::tasks::sampler::{BlockSender, SAMPLE_CLOCK, SOURCE_STATS};
-use crate::tasks::{SampleSender, StreamEnd, BLOCK_LEN};
+use super::adxl375;
+use super::dma::{self, Take};
+use crate::queues::{SampleSender, StreamEnd, BLOCK_LEN};
+use crate::source::poll;
+use crate::source::sender::{BlockSender, SAMPLE_CLOCK, SOURCE_STATS};
+use impact_firmware::adxl375::Axis;
+use impact_firmware::semihosting::{HostError, HostFile};
 
 /// Bytes per sample in the file: one axis, or three (the ADXL375 path).
 pub const fn sample_bytes(axes: bool) -> usize {

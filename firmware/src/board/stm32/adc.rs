@@ -38,10 +38,10 @@ use embassy_sync::signal::Signal;
 use embassy_time::{with_timeout, Duration};
 use static_cell::ConstStaticCell;
 
-use super::SAMPLE_RATE_HZ;
-use crate::stm32::Irqs;
-use crate::tasks::sampler::{BlockSender, SAMPLE_CLOCK, SOURCE_STATS};
-use crate::tasks::BLOCK_LEN;
+use super::Irqs;
+use crate::queues::BLOCK_LEN;
+use crate::source::sender::{BlockSender, SAMPLE_CLOCK, SOURCE_STATS};
+use impact_firmware::SAMPLE_RATE_HZ;
 
 /// DMA ring length in samples: two blocks, so the DMA fills one half while the task reads
 /// the other (half-transfer and transfer-complete interrupts).
@@ -171,7 +171,7 @@ fn clear_adc_overrun() -> bool {
 
 /// Samples forever, one block per DMA half-buffer.
 #[embassy_executor::task]
-pub async fn sampler(mut s: AdcSampler, samples: crate::tasks::SampleSender) {
+pub async fn sampler(mut s: AdcSampler, samples: crate::queues::SampleSender) {
     let mut sender = BlockSender::new(samples);
     let mut half = [0u16; BLOCK_LEN];
     // Conversions taken out of the ring or counted lost (wrapping, like the counter).

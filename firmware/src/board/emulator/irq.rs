@@ -5,7 +5,7 @@
 use cortex_m::interrupt::InterruptNumber;
 use cortex_m::peripheral::NVIC;
 use cortex_m_rt::exception;
-use embassy_executor::SendSpawner;
+use embassy_executor::{InterruptExecutor, SendSpawner};
 
 use crate::executors::{HIGH, LOW, MEDIUM};
 
@@ -44,23 +44,38 @@ const HIGH_PRIORITY: u8 = 0x20;
 const MEDIUM_PRIORITY: u8 = 0x40;
 const LOW_PRIORITY: u8 = 0x60;
 
-/// Sets the priorities and starts the three executors; returns their spawners (high, medium,
-/// low).
-pub fn start_executors() -> (SendSpawner, SendSpawner, SendSpawner) {
+/// Sets the device interrupts' priorities (before any of them is unmasked).
+pub fn init() {
     // SAFETY: priorities are set once, before the interrupts they concern are unmasked.
     let mut nvic = unsafe { cortex_m::Peripherals::steal() }.NVIC;
     unsafe {
         nvic.set_priority(Irq::Timer0, DEVICE_PRIORITY);
         nvic.set_priority(Irq::Timer1, DEVICE_PRIORITY);
         nvic.set_priority(Irq::Drain, DEVICE_PRIORITY);
-        nvic.set_priority(Irq::High, HIGH_PRIORITY);
-        nvic.set_priority(Irq::Medium, MEDIUM_PRIORITY);
-        nvic.set_priority(Irq::Low, LOW_PRIORITY);
     }
-    let high = HIGH.start(Irq::High);
-    let medium = MEDIUM.start(Irq::Medium);
-    let low = LOW.start(Irq::Low);
-    (high, medium, low)
+}
+
+/// Starts an executor on `line` at `priority`.
+fn start(executor: &'static InterruptExecutor, line: Irq, priority: u8) -> SendSpawner {
+    // SAFETY: each line's priority is set once, before its executor starts.
+    let mut nvic = unsafe { cortex_m::Peripherals::steal() }.NVIC;
+    unsafe { nvic.set_priority(line, priority) };
+    executor.start(line)
+}
+
+/// Starts the high executor (the sample source).
+pub fn start_high() -> SendSpawner {
+    start(&HIGH, Irq::High, HIGH_PRIORITY)
+}
+
+/// Starts the middle executor (the stream and the reporter).
+pub fn start_medium() -> SendSpawner {
+    start(&MEDIUM, Irq::Medium, MEDIUM_PRIORITY)
+}
+
+/// Starts the low executor (the analysis).
+pub fn start_low() -> SendSpawner {
+    start(&LOW, Irq::Low, LOW_PRIORITY)
 }
 
 /// Every external interrupt.

@@ -1,0 +1,23 @@
+//! The hardware-free half of the impact monitor firmware (Stabilizer's pattern): what the
+//! firmware's binaries, the host's tests and the benchmarks import as a library, not by
+//! `#[path]` or `include!`. Nothing here touches a peripheral; it builds for the host too,
+//! where the defmt formatting is left out.
+//!
+//! * [`scene`]: the compiled-in bench and the emulator's `key=value` scene parser;
+//! * [`rate`]: the build's sample rate;
+//! * [`adxl375`]: the ADXL375 driver over `embedded-hal-async` (SPI traffic, FIFO, scale);
+//! * [`fifo`]: samples a polled FIFO lost, counted against the sensor's own stream;
+//! * [`light_gate`]: two beams' cuts paired into passages and speeds;
+//! * [`semihosting`] (QEMU builds only): the host's command line, files and exit status.
+
+#![no_std]
+
+pub mod adxl375;
+pub mod fifo;
+pub mod light_gate;
+pub mod rate;
+pub mod scene;
+#[cfg(all(target_os = "none", feature = "emulator"))]
+pub mod semihosting;
+
+pub use rate::SAMPLE_RATE_HZ;
