@@ -966,16 +966,14 @@ pub const SPIKE_REMOVED: &str = "spike-removed";
 
 /// CSV text: one row per impact.
 pub fn to_csv(a: &AnalysisJson) -> String {
-    let mut s = String::from(
-        "index,status,analysis,clipped,flags,start_sample,end_sample,start_s,peak_time_s,peak_acceleration_m_s2,peak_force_n,delta_v_m_s,duration_s,baseline_m_s2,fwhm_s,filtered_peak_acceleration_m_s2,\
-impact_velocity_m_s,crush_time_s,max_deformation_m,rebound_velocity_m_s,cor,permanent_deformation_m,absorbed_energy_j,\
-two_phase_kc_n_m,two_phase_kr_n_m,two_phase_c_n_s_m,two_phase_permanent_deformation_m,two_phase_residual,\
-nonlinear_k,nonlinear_c_s_m,nonlinear_exponent,nonlinear_residual,hertz_k,hertz_residual",
-    );
+    // The report's fields as the firmware's `impact` line names them (one list, in core).
+    let mut s = impact_core::report::FIELDS.join(",");
     // With --train, the bounce columns; with --srs, the spectra's summary columns.
     let with_train = a.train_speed.is_some();
     if with_train {
-        s.push_str(",bounce_number,flight_s,v0_flight_m_s,v0_rebound_m_s,cor_flight,cor_rebound");
+        s.push(',');
+        s.push_str(&impact_core::report::BOUNCE_FIELDS.join(","));
+        s.push_str(",cor_flight,cor_rebound");
     }
     let with_spectrum = a.impacts.iter().any(|i| i.shock_spectrum.is_some());
     // With --axes, the resultant's peak and each axis's peak and Δv (named by its column).
@@ -1002,7 +1000,8 @@ nonlinear_k,nonlinear_c_s_m,nonlinear_exponent,nonlinear_residual,hertz_k,hertz_
         let tp = i.fits.two_phase.as_ref();
         let nl = i.fits.nonlinear.as_ref();
         let hz = i.fits.hertz.as_ref();
-        let cells = [
+        // In the order of `report::FIELDS` (the header above).
+        let cells: [String; impact_core::report::FIELDS.len()] = [
             i.index.to_string(),
             i.status.clone(),
             i.analysis.clone(),

@@ -172,6 +172,11 @@ fn flag(m: &HashMap<String, String>, key: &str) -> Result<bool, String> {
 /// An `impact` line's fields as the core's report (floats parsed at their own width, so the
 /// firmware's shortest round-trip decimals give back its exact bits).
 pub fn parse_impact(m: &HashMap<String, String>) -> Result<ImpactReport, String> {
+    // Every field of the contract first, in its order (`report::FIELDS`): the first missing
+    // one is the error.
+    for key in impact_core::report::FIELDS {
+        get(m, key)?;
+    }
     let status = get(m, "status")?;
     let status = Status::ALL
         .into_iter()

@@ -1,11 +1,13 @@
 //! The per-impact report: what the streaming stage measured exactly (peak, Δv, times), and,
 //! when the analysis ran, the widths, the kinematics (with the approach speed) and the fits.
 
+pub mod fields;
 pub mod summary;
 
 pub use crate::fit::{Fits, HertzFit, NonlinearFit, TwoPhaseFit};
 use crate::scene::Scene;
 pub use crate::signal::spectrum::Spectrum;
+pub use fields::{BOUNCE_FIELDS, FIELDS};
 pub use summary::{Bounce, BounceSlot, Summary};
 
 /// How far beyond [0, 1] a measured COR may lie before it is taken as wrong, not noisy
