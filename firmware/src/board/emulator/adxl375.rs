@@ -17,7 +17,7 @@ use embassy_sync::blocking_mutex::raw::CriticalSectionRawMutex;
 use embassy_sync::blocking_mutex::Mutex;
 use embassy_time::{Duration, Instant};
 
-use super::irq::Irq;
+use super::lines::Irq;
 use super::time::{counter, CLOCK_HZ};
 use super::timer::CmsdkTimer;
 use crate::source::poll::{Fifo, Poll, Read, MAX_ENTRIES};

@@ -16,7 +16,7 @@ use embassy_sync::blocking_mutex::raw::CriticalSectionRawMutex;
 use embassy_sync::blocking_mutex::Mutex;
 use embassy_sync::signal::Signal;
 
-use super::irq::Irq;
+use super::lines::Irq;
 use super::time::{counter, CLOCK_HZ};
 use super::timer::CmsdkTimer;
 use crate::queues::BLOCK_LEN;
@@ -69,7 +69,7 @@ pub fn start(file: HostFile, rate_hz: f64) {
         d.ended = false;
         arm(&d);
     });
-    // SAFETY: the timer's handler is `on_timer`, reached through `irq::dispatch`.
+    // SAFETY: the timer's handler is `on_timer`, reached through `irq::DefaultHandler`.
     unsafe { NVIC::unmask(Irq::Timer0) };
 }
 

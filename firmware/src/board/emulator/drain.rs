@@ -10,7 +10,7 @@ use core::sync::atomic::{AtomicBool, Ordering};
 use cortex_m::peripheral::NVIC;
 use cortex_m_semihosting::hio;
 
-use super::irq::Irq;
+use super::lines::Irq;
 use crate::logger;
 
 /// The dual timer's first timer (QEMU `cmsdk-apb-dualtimer` at 0x4000_2000, on the 25 MHz

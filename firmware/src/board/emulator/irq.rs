@@ -1,5 +1,5 @@
-//! The emulator's interrupts (QEMU `mps2-an386`, 32 external lines, 8 priority bits) and the
-//! three executor priorities. There is no PAC for the MPS2, so every external interrupt goes
+//! The emulator's interrupt priorities, the three executors on their lines, and the dispatch
+//! of every external interrupt (QEMU `mps2-an386`, 32 external lines, 8 priority bits). There is no PAC for the MPS2, so every external interrupt goes
 //! through cortex-m-rt's `DefaultHandler`, which dispatches on the interrupt number.
 
 use cortex_m::interrupt::InterruptNumber;
@@ -7,34 +7,8 @@ use cortex_m::peripheral::NVIC;
 use cortex_m_rt::exception;
 use embassy_executor::{InterruptExecutor, SendSpawner};
 
+use super::lines::Irq;
 use crate::executors::{HIGH, LOW, MEDIUM};
-
-/// The interrupt lines used (the AN386's map, hw/arm/mps2.c): the two CMSDK timers, and three
-/// lines that no device drives (free for the executors, pended by software).
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-#[repr(u16)]
-pub enum Irq {
-    /// CMSDK timer 0: the emulated ADC + DMA ([`super::dma`]), or the emulated ADXL375
-    /// ([`super::adxl375`]).
-    Timer0 = 8,
-    /// CMSDK timer 1: embassy-time's alarms ([`super::time`]).
-    Timer1 = 9,
-    /// CMSDK dual timer: the logger's drain ([`super::drain`]).
-    Drain = 10,
-    /// The lowest executor: the analysis.
-    Low = 29,
-    /// The middle executor: the streaming stage.
-    Medium = 30,
-    /// The highest executor: the sample source.
-    High = 31,
-}
-
-// SAFETY: every value is an interrupt line of the AN386's NVIC (0..32).
-unsafe impl InterruptNumber for Irq {
-    fn number(self) -> u16 {
-        self as u16
-    }
-}
 
 /// NVIC priorities (lower is more urgent; multiples of 0x20 so they behave as on a 3-bit
 /// part): the device interrupts (the DMA's timer, the time driver) above everything, then the

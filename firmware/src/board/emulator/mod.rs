@@ -8,6 +8,7 @@ pub mod adxl375;
 pub mod dma;
 pub mod drain;
 pub mod irq;
+pub mod lines;
 pub mod replay;
 pub mod time;
 pub mod timer;

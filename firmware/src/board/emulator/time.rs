@@ -15,7 +15,7 @@ use embassy_sync::blocking_mutex::Mutex;
 use embassy_time_driver::{Driver, TICK_HZ};
 use embassy_time_queue_utils::Queue;
 
-use super::irq::Irq;
+use super::lines::Irq;
 use super::timer::CmsdkTimer;
 
 /// The clock of the FPGA counter and of the CMSDK timers (SYSCLK_FRQ in QEMU's hw/arm/mps2.c).
@@ -92,7 +92,7 @@ pub fn counter() -> u64 {
 /// Unmasks the alarm interrupt. Call once, before anything waits on a timer.
 pub fn init() {
     ALARM.stop();
-    // SAFETY: the alarm interrupt's handler is `on_alarm`, reached through `irq::dispatch`.
+    // SAFETY: the alarm interrupt's handler is `on_alarm`, reached through `irq::DefaultHandler`.
     unsafe { NVIC::unmask(Irq::Timer1) };
 }
 
