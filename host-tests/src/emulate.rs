@@ -707,9 +707,9 @@ pub fn emulate(args: &EmulateArgs) -> Result<(), String> {
     let text = if a.json {
         serde_json::to_string_pretty(&json).map_err(|e| e.to_string())? + "\n"
     } else if a.csv {
-        analyze::to_csv(&json)
+        crate::report::to_csv(&json)
     } else {
-        analyze::to_table(&json)
+        crate::report::to_table(&json)
     };
     out.write_all(text.as_bytes()).map_err(|e| e.to_string())?;
     if let Some(path) = &a.plot {

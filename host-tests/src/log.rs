@@ -13,7 +13,7 @@ use impact_core::report::{Bounce, Fits, Flags, HertzFit, NonlinearFit, Spectrum,
 use impact_core::signal::spectrum::MAX_BANDS;
 use impact_core::{Analysis, ImpactReport, Kinematics, Status};
 
-use crate::analyze::{self, AnalysisJson};
+use crate::report::AnalysisJson;
 use crate::table::{is_stdin, MAX_LINE_BYTES};
 
 /// `impact log` options.
@@ -661,7 +661,7 @@ pub fn log_json(log: &Log, t0: f64) -> Result<AnalysisJson, String> {
             )
         }
         Some(m) if get(m, "v0_m_s")? != "none" => (
-            Some(analyze::shortest(num::<f32>(m, "v0_m_s")?)),
+            Some(crate::report::fmt::shortest(num::<f32>(m, "v0_m_s")?)),
             Some("v0".to_string()),
         ),
         _ => (None, None),
@@ -715,13 +715,13 @@ pub fn log_json(log: &Log, t0: f64) -> Result<AnalysisJson, String> {
             .iter()
             .zip(&log.latencies)
             .map(|(r, latency)| {
-                let mut j = analyze::impact_json(r, t0, &fits);
+                let mut j = crate::report::impact_json(r, t0, &fits);
                 j.report_latency_s = latency.map(f64::from);
                 j
             })
             .collect(),
     };
-    a.trains = crate::train::trains(&a.impacts);
+    a.trains = crate::report::train::trains(&a.impacts);
     Ok(a)
 }
 
@@ -814,7 +814,7 @@ fn report(args: &LogArgs, reader: LogReader, name: &str) -> Result<(), String> {
         }
     }
     if args.csv {
-        print!("{}", analyze::to_csv(&json));
+        print!("{}", crate::report::to_csv(&json));
     } else {
         println!(
             "{}",

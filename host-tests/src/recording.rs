@@ -151,7 +151,7 @@ pub fn check_time_unit(header: &str, given: Option<TimeUnit>, rate_hz: f64) -> R
     }
     Err(format!(
         "the time column {header:?} names no unit: read in seconds it gives {} S/s, too slow for an impact recording; if it is in ms or µs, give --time-unit ms (or us), or name the column time_ms (time_us)",
-        crate::analyze::sig(rate_hz, 4)
+        crate::report::fmt::sig(rate_hz, 4)
     ))
 }
 

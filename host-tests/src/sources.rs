@@ -4,7 +4,7 @@
 
 use std::io::Read;
 
-use crate::analyze::{self, AnalyzeArgs};
+use crate::analyze::AnalyzeArgs;
 use crate::raw::RawType;
 use crate::recording::Format;
 use crate::table::is_stdin;
@@ -98,7 +98,11 @@ fn values_as_counts<S: Source + ?Sized>(
 ) -> Result<(), String> {
     scratch.clear();
     source.next_values(want, scratch)?;
-    out.extend(scratch.iter().map(|v| analyze::to_count(v * scale, gain)));
+    out.extend(
+        scratch
+            .iter()
+            .map(|v| crate::quantise::to_count(v * scale, gain)),
+    );
     Ok(())
 }
 
@@ -186,7 +190,7 @@ impl Source for RawSource {
             Some(t) if t.0 == (scale, gain) => t,
             _ => {
                 let counts = (0..=u16::MAX)
-                    .map(|c| analyze::to_count(f64::from(c as i16) * scale, gain))
+                    .map(|c| crate::quantise::to_count(f64::from(c as i16) * scale, gain))
                     .collect();
                 ((scale, gain), counts)
             }

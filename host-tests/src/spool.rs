@@ -132,7 +132,7 @@ impl Source for SpoolSource {
         out.extend(
             bytes
                 .chunks_exact(8)
-                .map(|b| crate::analyze::to_count(value(b) * scale, gain)),
+                .map(|b| crate::quantise::to_count(value(b) * scale, gain)),
         );
         Ok(())
     }
@@ -201,7 +201,7 @@ mod tests {
             }
             let want_counts: Vec<i16> = values
                 .iter()
-                .map(|v| crate::analyze::to_count(v * 2.5, 0.01))
+                .map(|v| crate::quantise::to_count(v * 2.5, 0.01))
                 .collect();
             assert_eq!(counts, want_counts);
             assert!(back

@@ -55,7 +55,7 @@ pub fn analyze(
     let trigger = trigger.ok_or(
         "--stream: give --trigger (the level cannot be learned from a recording not yet read)",
     )?;
-    let gain = analyze::gain_for(full_scale);
+    let gain = crate::quantise::gain_for(full_scale);
     let clipping = crate::screen::from_range(full_scale);
     // The head: its noise sets the default edge level, a CSV's first intervals the rate; its
     // readings are checked against the range.
@@ -76,7 +76,10 @@ pub fn analyze(
         Some(&clipping),
         mass,
     )?;
-    let head: Vec<i16> = head.iter().map(|a| analyze::to_count(*a, gain)).collect();
+    let head: Vec<i16> = head
+        .iter()
+        .map(|a| crate::quantise::to_count(*a, gain))
+        .collect();
     let (reports, count, source) = run_monitor(source, head, (scale, gain), scene, Vec::new())?;
     let setup = Setup {
         column: (!column.is_empty()).then_some(column),
@@ -190,7 +193,10 @@ pub fn analyze_in_passes(
     let from = if removals.is_empty() { 0.5 } else { 2.0 / 3.0 };
     let (mut source, scale) = reopen(bar(from, 1.0))?;
     let head = read_head(&mut *source, scale)?;
-    let head = head.iter().map(|a| analyze::to_count(*a, gain)).collect();
+    let head = head
+        .iter()
+        .map(|a| crate::quantise::to_count(*a, gain))
+        .collect();
     let (reports, count, _) = run_monitor(source, head, (scale, gain), scene, removals.clone())?;
     let spikes = removals.iter().map(|r| r.timed(t0, rate_hz)).collect();
     let setup = Setup {
@@ -509,6 +515,6 @@ impl<'a> Patches<'a> {
 
     fn counts(&mut self, block: &mut [i16], gain: f64) {
         let len = block.len();
-        self.each(len, |i, v| block[i] = analyze::to_count(v, gain));
+        self.each(len, |i, v| block[i] = crate::quantise::to_count(v, gain));
     }
 }

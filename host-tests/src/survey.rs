@@ -6,7 +6,8 @@
 //! as it is read: the same code on the same values, so both give the same reports.
 
 use crate::histogram::OrderHistogram;
-use crate::screen::{self, Clipping, FlatTops, Removal, SpikeScan};
+use crate::report::Clipping;
+use crate::screen::{self, FlatTops, Removal, SpikeScan};
 
 /// One pass over a recording (values in m/s²).
 pub struct Survey {
@@ -215,7 +216,7 @@ pub fn levels(
         Some(fs) => Some(screen::from_range(fs)),
         None => s.flat_tops.clone(),
     };
-    let gain = crate::analyze::gain_for(range_m_s2.unwrap_or_else(|| s.peak_m_s2()));
+    let gain = crate::quantise::gain_for(range_m_s2.unwrap_or_else(|| s.peak_m_s2()));
     let (trigger, edge) = trigger_and_edge(s, gain, trigger, edge);
     Ok(Levels {
         clipping,
@@ -236,9 +237,9 @@ pub fn check_range(peak_m_s2: f64, range_m_s2: f64) -> Result<(), String> {
     if peak_m_s2 > RANGE_EXCEEDED * range_m_s2 {
         return Err(format!(
             "--range: the recording reaches {}, {:.1}× the full scale given ({}): a bare --range is in m/s²; give its unit, e.g. --range 16g for a ±16 g sensor",
-            crate::analyze::human(peak_m_s2, "m/s²"),
+            crate::report::fmt::human(peak_m_s2, "m/s²"),
             peak_m_s2 / range_m_s2,
-            crate::analyze::human(range_m_s2, "m/s²"),
+            crate::report::fmt::human(range_m_s2, "m/s²"),
         ));
     }
     Ok(())

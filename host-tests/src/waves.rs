@@ -5,9 +5,9 @@ use std::collections::{BTreeMap, HashMap};
 use std::path::{Path, PathBuf};
 
 use impact_core::waveform::{self, FRAME_LEN};
-use serde::Serialize;
 
 use crate::log::num;
+use crate::report::waveform::WaveformJson;
 
 /// One impact's window as the board sent it.
 #[derive(Clone, Debug)]
@@ -27,18 +27,6 @@ pub struct Waveform {
     pub frames: u32,
     /// Frames received, by number.
     received: BTreeMap<u32, Vec<i16>>,
-}
-
-/// What `impact log` says of the windows it found.
-#[derive(Clone, Debug, Serialize, PartialEq)]
-pub struct WaveformJson {
-    pub index: u32,
-    pub first_sample: u64,
-    pub samples: u32,
-    pub every: u16,
-    pub frames: u32,
-    /// Frames the link dropped (their samples are missing from plots and exports).
-    pub missing_frames: u32,
 }
 
 impl Waveform {

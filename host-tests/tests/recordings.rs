@@ -3,8 +3,9 @@
 
 use std::path::PathBuf;
 
-use impact_host::analyze::{self, AnalysisJson, AnalyzeArgs, Level, Units};
+use impact_host::analyze::{self, AnalyzeArgs, Level, Units};
 use impact_host::recording::ColumnRef;
+use impact_host::report::AnalysisJson;
 
 fn signals() -> PathBuf {
     PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("data")

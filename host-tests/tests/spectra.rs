@@ -5,7 +5,8 @@ use std::collections::HashMap;
 use std::path::PathBuf;
 
 use impact_host::analyze::{self, AnalyzeArgs, Units};
-use impact_host::spectrum::{self, ShockSpectrumJson, SpectrumArgs};
+use impact_host::report::spectrum::{self, ShockSpectrumJson};
+use impact_host::spectrum::SpectrumArgs;
 
 fn root() -> PathBuf {
     PathBuf::from(env!("CARGO_MANIFEST_DIR"))
@@ -30,7 +31,7 @@ fn spectra(args: AnalyzeArgs) -> (ShockSpectrumJson, ShockSpectrumJson, f64) {
     let r = &reports[0];
     let board = spectrum::spectrum_json(r.spectrum.as_ref().expect("the report's spectra"));
     (
-        spectrum::reference_spectrum(&setup, r, &spec),
+        impact_host::spectrum::reference_spectrum(&setup, r, &spec),
         board,
         r.baseline_m_s2 as f64,
     )

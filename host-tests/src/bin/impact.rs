@@ -263,9 +263,9 @@ fn run(cli: Cli) -> Result<(), String> {
                     serde_json::to_string_pretty(&a).map_err(|e| e.to_string())?
                 );
             } else if args.csv {
-                print!("{}", analyze::to_csv(&a));
+                print!("{}", impact_host::report::to_csv(&a));
             } else {
-                print!("{}", analyze::to_table(&a));
+                print!("{}", impact_host::report::to_table(&a));
             }
             if let Some(path) = &args.plot {
                 plot::impacts(&setup.plot_signal(), &reports, path)?;

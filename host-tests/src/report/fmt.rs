@@ -1,0 +1,64 @@
+//! Numbers as a person reads them (the table) and settings in their own precision.
+
+/// `x` with `digits` significant digits, without trailing zeros (`1000000`, `19986.9`, `20`).
+pub fn sig(x: f64, digits: usize) -> String {
+    if x == 0.0 || !x.is_finite() {
+        return format!("{x}");
+    }
+    let decimals = (digits as i32 - 1 - x.abs().log10().floor() as i32).max(0) as usize;
+    let s = format!("{x:.decimals$}");
+    if s.contains('.') {
+        s.trim_end_matches('0').trim_end_matches('.').to_string()
+    } else {
+        s
+    }
+}
+
+/// An f32 setting as the f64 its decimal digits name (`0.05`, not `0.05000000074505806`).
+pub fn shortest(x: f32) -> f64 {
+    x.to_string().parse().unwrap_or(f64::from(x))
+}
+
+/// A quantity as a person reads it: four significant digits, times and lengths with a prefix
+/// that keeps the number in [1, 1000) (`5.521 ms`, `3.275 mm`), other units plain between
+/// 1e-3 and 1e5 and in exponent form beyond (`1.071e5 m/s²`).
+pub fn human(v: f64, unit: &str) -> String {
+    let digits = |x: f64| {
+        if x == 0.0 || !x.is_finite() {
+            return format!("{x}");
+        }
+        let decimals = (3 - x.abs().log10().floor() as i32).clamp(0, 6) as usize;
+        format!("{x:.decimals$}")
+    };
+    let prefixed = |prefixes: &[(f64, &str)]| {
+        let (scale, p) = prefixes
+            .iter()
+            .copied()
+            .find(|(scale, _)| v.abs() * scale >= 1.0)
+            .unwrap_or(*prefixes.last().unwrap());
+        format!("{} {p}", digits(v * scale))
+    };
+    match unit {
+        "s" if v.abs() < 1000.0 => prefixed(&[(1.0, "s"), (1e3, "ms"), (1e6, "µs"), (1e9, "ns")]),
+        "m" if v.abs() < 1000.0 => prefixed(&[(1.0, "m"), (1e3, "mm"), (1e6, "µm"), (1e9, "nm")]),
+        _ if v == 0.0 || (1e-3..1e5).contains(&v.abs()) => format!("{} {unit}", digits(v)),
+        _ => format!("{v:.3e} {unit}"),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::human;
+
+    #[test]
+    fn quantities_read_as_a_person_reads_them() {
+        assert_eq!(human(96.873, "m/s²"), "96.87 m/s²");
+        assert_eq!(human(9.878, "g"), "9.878 g");
+        assert_eq!(human(0.0055215, "s"), "5.522 ms");
+        assert_eq!(human(3.2748e-3, "m"), "3.275 mm");
+        assert_eq!(human(2.5e-7, "s"), "250.0 ns");
+        assert_eq!(human(1.0714e5, "m/s²"), "1.071e5 m/s²");
+        assert_eq!(human(-1.5, "m/s"), "-1.500 m/s");
+        assert_eq!(human(0.0, "J"), "0 J");
+    }
+}

@@ -1,0 +1,291 @@
+//! What the tool reports, and how: the output schema (JSON types with SI field names, why a
+//! field is null) and its renderings (CSV, the table, numbers for people). A leaf above the
+//! core: the pipeline, the firmware's log reader and the commands build these types; nothing
+//! here reads a file or runs the pipeline.
+
+pub mod axes;
+pub mod csv;
+pub mod fmt;
+pub mod screen;
+pub mod spectrum;
+pub mod table;
+pub mod train;
+pub mod waveform;
+
+use std::collections::BTreeMap;
+
+use impact_core::report::{Fits, Flags};
+use impact_core::{FitSet, ImpactReport, Status};
+use serde::Serialize;
+
+pub use csv::to_csv;
+pub use screen::{Clipping, Spike};
+pub use table::to_table;
+
+/// Fits as JSON.
+#[derive(Clone, Debug, Default, Serialize, PartialEq)]
+pub struct FitsJson {
+    pub two_phase: Option<TwoPhaseJson>,
+    pub nonlinear: Option<NonlinearJson>,
+    pub hertz: Option<HertzJson>,
+}
+
+#[derive(Clone, Debug, Serialize, PartialEq)]
+pub struct TwoPhaseJson {
+    pub kc_n_m: f64,
+    pub kr_n_m: f64,
+    pub c_n_s_m: f64,
+    pub permanent_deformation_m: f64,
+    pub residual: f64,
+}
+
+#[derive(Clone, Debug, Serialize, PartialEq)]
+pub struct NonlinearJson {
+    pub k: f64,
+    pub c_s_m: f64,
+    pub exponent: f64,
+    pub residual: f64,
+}
+
+#[derive(Clone, Debug, Serialize, PartialEq)]
+pub struct HertzJson {
+    pub k: f64,
+    pub residual: f64,
+}
+
+/// One impact as JSON (SI field names).
+#[derive(Clone, Debug, Serialize, PartialEq)]
+pub struct ImpactJson {
+    pub index: u32,
+    pub status: String,
+    /// "full", or "skipped" when no capture buffer was free (streaming fields only).
+    pub analysis: String,
+    pub clipped: bool,
+    /// What was found that empties fields ("ac-coupled", "cor-out-of-range", ...).
+    pub flags: Vec<String>,
+    pub start_sample: u64,
+    pub end_sample: u64,
+    pub start_s: f64,
+    pub peak_time_s: f64,
+    pub peak_acceleration_m_s2: f64,
+    pub peak_force_n: Option<f64>,
+    pub delta_v_m_s: Option<f64>,
+    pub duration_s: f64,
+    pub baseline_m_s2: f64,
+    pub fwhm_s: Option<f64>,
+    pub filtered_peak_acceleration_m_s2: Option<f64>,
+    pub impact_velocity_m_s: Option<f64>,
+    pub crush_time_s: Option<f64>,
+    pub max_deformation_m: Option<f64>,
+    pub rebound_velocity_m_s: Option<f64>,
+    pub cor: Option<f64>,
+    pub permanent_deformation_m: Option<f64>,
+    pub absorbed_energy_j: Option<f64>,
+    pub fits: FitsJson,
+    /// Why each absent (null) field is absent: the field's name and the reason.
+    pub null_reasons: BTreeMap<String, String>,
+    /// Real-time emulation only: virtual time from the end of the impact's hold to its
+    /// report, s.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub report_latency_s: Option<f64>,
+    /// With `--srs`: the impact's shock spectra.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub shock_spectrum: Option<crate::report::spectrum::ShockSpectrumJson>,
+    /// With `--axes`: the resultant's peak and each axis's peak and Δv.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub axes: Option<crate::report::axes::AxesJson>,
+    /// A bounce of a train (`--train`): its flight, both approach speeds and their CORs;
+    /// null for a train's first impact and without `--train`.
+    pub bounce: Option<crate::report::train::BounceJson>,
+}
+
+/// The whole analysis as JSON.
+#[derive(Clone, Debug, Serialize, PartialEq)]
+pub struct AnalysisJson {
+    /// The channel analysed (its header; `|x,y,z|` for the resultant of axes), if known, and
+    /// its units (`g`, `m/s2`, `kgn`, `n`): shown in the table (the JSON of a recording read
+    /// through another format or the board's log has the same numbers under other names).
+    #[serde(skip_serializing)]
+    pub column: Option<String>,
+    #[serde(skip_serializing)]
+    pub units: Option<String>,
+    pub samples: u64,
+    pub sample_rate_hz: f64,
+    /// The approach speed of the first impact (from `--v0`, `--drop-height` or a free
+    /// fall), m/s.
+    pub v0_m_s: Option<f64>,
+    /// Where v0 came from: "v0", "drop-height", "free-fall" or null.
+    pub v0_source: Option<String>,
+    /// Free fall measured on the DC channel, s.
+    pub free_fall_s: Option<f64>,
+    /// Samples the source lost (only a real-time run on the firmware loses any).
+    pub samples_lost: u64,
+    /// Impacts reported without analysis because no capture buffer was free (likewise).
+    pub analyses_skipped: u64,
+    /// Lines the board's logger dropped, and numbered lines missing from its log (`impact
+    /// emulate`, `impact log`; 0 on the host).
+    pub lines_dropped: u64,
+    pub lines_missing: u64,
+    /// Whether the time axis was interpolated onto an even grid (`--resample`).
+    pub resampled: bool,
+    /// Isolated glitches removed before the analysis (an impact containing one is flagged
+    /// `spike-removed`).
+    pub spikes_removed: Vec<Spike>,
+    /// The channel's rails: from `--range`, or flat tops found in the recording; null when
+    /// neither is known (then `clipped` means a reading at the i16 rail).
+    pub clipping: Option<Clipping>,
+    /// With `--train`: which speed the bounces' kinematics use ("flight" or "rebound").
+    pub train_speed: Option<String>,
+    pub impacts: Vec<ImpactJson>,
+    /// With `--train`: each train of bounces and its COR against impact speed.
+    pub trains: Vec<crate::report::train::TrainJson>,
+    /// `impact log` / `impact emulate --waveforms`: the captured windows the board sent.
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub waveforms: Vec<crate::report::waveform::WaveformJson>,
+}
+
+fn fits_json(f: &Fits) -> FitsJson {
+    FitsJson {
+        two_phase: f.two_phase.map(|t| TwoPhaseJson {
+            kc_n_m: t.kc_n_m as f64,
+            kr_n_m: t.kr_n_m as f64,
+            c_n_s_m: t.c_n_s_m as f64,
+            permanent_deformation_m: t.permanent_m as f64,
+            residual: t.residual as f64,
+        }),
+        nonlinear: f.nonlinear.map(|t| NonlinearJson {
+            k: t.k as f64,
+            c_s_m: t.c_s_m as f64,
+            exponent: t.n as f64,
+            residual: t.residual as f64,
+        }),
+        hertz: f.hertz.map(|t| HertzJson {
+            k: t.k as f64,
+            residual: t.residual as f64,
+        }),
+    }
+}
+
+/// Why each absent field of `r` is absent; `fits` is what the scene asked for.
+pub fn null_reasons(r: &ImpactReport, fits: &FitSet) -> BTreeMap<String, String> {
+    let mut out = BTreeMap::new();
+    let skipped = r.analysis == impact_core::Analysis::Skipped;
+    let flag = |f: Flags| r.flags.contains(f);
+    let mut put = |field: &str, reason: &str| {
+        out.insert(field.to_string(), reason.to_string());
+    };
+    if r.peak_force_n.is_none() {
+        put("peak_force_n", "no-mass");
+    }
+    if r.delta_v_m_s.is_none() {
+        put("delta_v_m_s", "ac-coupled");
+    }
+    let analysis = |own: Option<&'static str>| {
+        if skipped {
+            "analysis-skipped"
+        } else if flag(Flags::CFC_WINDOW) {
+            "cfc-window"
+        } else {
+            own.unwrap_or("not-found")
+        }
+    };
+    if r.fwhm_s.is_none() {
+        put("fwhm_s", analysis(Some("half-maximum-outside")));
+    }
+    if r.filtered_peak_acceleration_m_s2.is_none() {
+        put("filtered_peak_acceleration_m_s2", analysis(Some("no-cfc")));
+    }
+    // The kinematics: the first reason that applies.
+    let kinematics = if r.kinematics.is_some() {
+        None
+    } else if flag(Flags::NO_APPROACH_SPEED) {
+        Some("no-approach-speed".to_string())
+    } else if skipped {
+        Some("analysis-skipped".to_string())
+    } else if flag(Flags::AC_COUPLED) {
+        Some("ac-coupled".to_string())
+    } else if r.status != Status::Complete {
+        Some(format!("status-{}", r.status.name()))
+    } else if flag(Flags::COR_OUT_OF_RANGE) {
+        Some("cor-out-of-range".to_string())
+    } else if flag(Flags::NO_STOP) {
+        Some("no-stop".to_string())
+    } else {
+        Some("not-found".to_string())
+    };
+    if let Some(why) = &kinematics {
+        for field in [
+            "impact_velocity_m_s",
+            "crush_time_s",
+            "max_deformation_m",
+            "rebound_velocity_m_s",
+            "cor",
+            "permanent_deformation_m",
+            "absorbed_energy_j",
+        ] {
+            put(field, why);
+        }
+    } else if r.kinematics.is_some_and(|k| k.absorbed_energy_j.is_none()) {
+        put("absorbed_energy_j", "no-mass");
+    }
+    for (name, asked, got) in [
+        ("fits.two_phase", fits.two_phase, r.fits.two_phase.is_some()),
+        ("fits.nonlinear", fits.nonlinear, r.fits.nonlinear.is_some()),
+        ("fits.hertz", fits.hertz, r.fits.hertz.is_some()),
+    ] {
+        if !got {
+            let why = match &kinematics {
+                _ if !asked => "not-asked",
+                _ if r.peak_force_n.is_none() => "no-mass",
+                Some(k) => k.as_str(),
+                None => "not-identifiable",
+            };
+            put(name, why);
+        }
+    }
+    out
+}
+
+/// A core report as JSON; times shifted by `t0` (the recording's first time stamp); `fits`
+/// is what the scene asked for (for the reasons of absent fits).
+pub fn impact_json(r: &ImpactReport, t0: f64, fits: &FitSet) -> ImpactJson {
+    let k = r.kinematics;
+    let f = |v: f32| v as f64;
+    ImpactJson {
+        index: r.index,
+        status: r.status.name().into(),
+        analysis: r.analysis.name().into(),
+        clipped: r.clipped,
+        flags: r.flags.names().map(str::to_string).collect(),
+        start_sample: r.start_sample,
+        end_sample: r.end_sample,
+        start_s: t0 + r.start_s,
+        peak_time_s: t0 + r.peak_time_s,
+        peak_acceleration_m_s2: f(r.peak_acceleration_m_s2),
+        peak_force_n: r.peak_force_n.map(f),
+        delta_v_m_s: r.delta_v_m_s.map(f),
+        duration_s: f(r.duration_s),
+        baseline_m_s2: f(r.baseline_m_s2),
+        fwhm_s: r.fwhm_s.map(f),
+        filtered_peak_acceleration_m_s2: r.filtered_peak_acceleration_m_s2.map(f),
+        impact_velocity_m_s: k.map(|k| f(k.impact_velocity_m_s)),
+        crush_time_s: k.map(|k| f(k.crush_time_s)),
+        max_deformation_m: k.map(|k| f(k.max_deformation_m)),
+        rebound_velocity_m_s: k.map(|k| f(k.rebound_velocity_m_s)),
+        cor: k.map(|k| f(k.cor)),
+        permanent_deformation_m: k.map(|k| f(k.permanent_deformation_m)),
+        absorbed_energy_j: k.and_then(|k| k.absorbed_energy_j).map(f),
+        fits: fits_json(&r.fits),
+        null_reasons: null_reasons(r, fits),
+        report_latency_s: None,
+        shock_spectrum: r
+            .spectrum
+            .as_ref()
+            .map(crate::report::spectrum::spectrum_json),
+        bounce: crate::report::train::bounce_json(r),
+        axes: None,
+    }
+}
+
+/// The host's flag on an impact that contained a removed spike.
+pub const SPIKE_REMOVED: &str = "spike-removed";

@@ -1,0 +1,170 @@
+//! The analysis as the table a person reads.
+
+use impact_core::consts::STANDARD_GRAVITY;
+
+use super::fmt::{human, sig};
+use super::AnalysisJson;
+
+/// A readable table.
+pub fn to_table(a: &AnalysisJson) -> String {
+    let mut s = format!(
+        "{}{} samples at {} S/s{}{}{}{}\n",
+        match (&a.column, &a.units) {
+            (Some(c), Some(u)) => format!("{c} in {u}: "),
+            (Some(c), None) => format!("{c}: "),
+            _ => String::new(),
+        },
+        a.samples,
+        sig(a.sample_rate_hz, 6),
+        match (&a.v0_source, a.v0_m_s, a.free_fall_s) {
+            (Some(_), Some(v), Some(t)) => format!(
+                "; v0 {} from {} of free fall",
+                human(v, "m/s"),
+                human(t, "s")
+            ),
+            (Some(src), Some(v), None) => format!(
+                "; v0 {} ({})",
+                human(v, "m/s"),
+                match src.as_str() {
+                    "drop-height" => "from the drop height",
+                    _ => "given",
+                }
+            ),
+            _ => String::new(),
+        },
+        if a.samples_lost > 0 {
+            format!("; {} SAMPLES LOST", a.samples_lost)
+        } else {
+            String::new()
+        },
+        if a.analyses_skipped > 0 {
+            format!("; {} analyses skipped", a.analyses_skipped)
+        } else {
+            String::new()
+        },
+        match (a.lines_dropped, a.lines_missing) {
+            (0, 0) => String::new(),
+            (d, m) => format!("; {d} LINES DROPPED by the board, {m} missing"),
+        },
+    );
+    if a.resampled {
+        s.push_str("time axis resampled onto an even grid (--resample)\n");
+    }
+    if let Some(c) = &a.clipping {
+        let level = |v: Option<f64>| v.map_or("-".to_string(), |v| human(v, "m/s²"));
+        s.push_str(&format!(
+            "rails ({}): {} / {}; a clipped peak is a lower bound (≥)\n",
+            c.from,
+            level(c.low_m_s2),
+            level(c.high_m_s2)
+        ));
+    }
+    for sp in &a.spikes_removed {
+        s.push_str(&format!(
+            "spike removed at {:.6} s (sample {}, {} sample{}, {:.4e} m/s²); --keep-spikes keeps it\n",
+            sp.time_s,
+            sp.sample,
+            sp.samples,
+            if sp.samples == 1 { "" } else { "s" },
+            sp.value_m_s2
+        ));
+    }
+    for i in &a.impacts {
+        s.push_str(&format!(
+            "impact {} [{}{}{}] at {:.6} s: peak {}{} ({}){}, Δv {}, duration {}, FWHM {}\n",
+            i.index,
+            i.status,
+            if i.clipped { ", CLIPPED" } else { "" },
+            if i.analysis == "skipped" {
+                ", analysis skipped"
+            } else {
+                ""
+            },
+            i.start_s,
+            if i.clipped { "≥" } else { "" },
+            human(i.peak_acceleration_m_s2, "m/s²"),
+            human(i.peak_acceleration_m_s2 / STANDARD_GRAVITY, "g"),
+            i.peak_force_n
+                .map_or(String::new(), |f| format!(", force {}", human(f, "N"))),
+            i.delta_v_m_s.map_or_else(
+                || format!("unknown ({})", i.null_reasons["delta_v_m_s"]),
+                |v| human(v, "m/s")
+            ),
+            human(i.duration_s, "s"),
+            i.fwhm_s.map_or_else(
+                || format!("unknown ({})", i.null_reasons["fwhm_s"]),
+                |w| human(w, "s")
+            ),
+        ));
+        // Why the kinematics are missing, unless simply because v0 was not given.
+        if let Some(why) = i
+            .null_reasons
+            .get("cor")
+            .filter(|r| *r != "no-approach-speed")
+        {
+            s.push_str(&format!("    no kinematics: {why}\n"));
+        }
+        if let Some(latency) = i.report_latency_s {
+            s.push_str(&format!(
+                "    reported {:.1} ms after the end of its hold\n",
+                latency * 1e3
+            ));
+        }
+        if let Some(x) = &i.axes {
+            s.push_str(&crate::report::axes::table_line(x));
+        }
+        if let Some(b) = &i.bounce {
+            s.push_str(&crate::report::train::table_line(b));
+        }
+        if let Some(sp) = &i.shock_spectrum {
+            s.push_str(&crate::report::spectrum::table_line(sp));
+        }
+        if let (Some(v0), Some(tm), Some(xm), Some(v1), Some(cor), Some(xp)) = (
+            i.impact_velocity_m_s,
+            i.crush_time_s,
+            i.max_deformation_m,
+            i.rebound_velocity_m_s,
+            i.cor,
+            i.permanent_deformation_m,
+        ) {
+            s.push_str(&format!(
+                "    v0 {}, crush time {}, x_m {}, rebound {}, COR {cor:.4}, x_p {}{}\n",
+                human(v0, "m/s"),
+                human(tm, "s"),
+                human(xm, "m"),
+                human(v1, "m/s"),
+                human(xp, "m"),
+                i.absorbed_energy_j
+                    .map_or(String::new(), |e| format!(", absorbed {}", human(e, "J")))
+            ));
+        }
+        if let Some(t) = &i.fits.two_phase {
+            s.push_str(&format!(
+                "    two-phase: kc {}, kr {}, c {}, x_p {} (residual {:.2} %)\n",
+                human(t.kc_n_m, "N/m"),
+                human(t.kr_n_m, "N/m"),
+                human(t.c_n_s_m, "N s/m"),
+                human(t.permanent_deformation_m, "m"),
+                100.0 * t.residual
+            ));
+        }
+        if let Some(t) = &i.fits.nonlinear {
+            s.push_str(&format!(
+                "    nonlinear: k {} N/m^{:.3}, c {} (residual {:.2} %)\n",
+                human(t.k, "").trim_end(),
+                t.exponent,
+                human(t.c_s_m, "s/m"),
+                100.0 * t.residual
+            ));
+        }
+        if let Some(t) = &i.fits.hertz {
+            s.push_str(&format!(
+                "    hertz: K {} N/m^1.5 (residual {:.2} %)\n",
+                human(t.k, "").trim_end(),
+                100.0 * t.residual
+            ));
+        }
+    }
+    s.push_str(&crate::report::train::table_lines(&a.trains));
+    s
+}
