@@ -9,16 +9,18 @@ use impact_core::signal::cfc::Cfc;
 use impact_core::{Approach, Calibration, FitSet, ImpactReport, Scene};
 use serde::Deserialize;
 
+use crate::io::channel::CsvFormat;
+use crate::io::channel::{time_unit_s, ColumnRef, ReadOptions};
+use crate::io::csv_read::read_table;
+use crate::io::read_recording;
 use crate::parse::positive_f64;
 use crate::quantise::to_count;
-use crate::recording::{read_recording, time_unit_s, ColumnRef, ReadOptions};
 use crate::report::fmt::shortest;
 use crate::report::{impact_json, AnalysisJson, Clipping, Spike, SPIKE_REMOVED};
 use crate::screen;
 use crate::survey::{self, Survey};
-use crate::table::{read_table, CsvFormat};
 
-pub use crate::units::{Level, Units};
+pub use crate::io::units::{Level, Units};
 
 /// A scene file (JSON): every field optional; command-line options override it. Its keys are
 /// the options' names (`mass`, `v0`, `trigger`, ...), in the options' units; the earlier
@@ -94,7 +96,7 @@ pub struct AnalyzeArgs {
     /// The time column's unit [default: the one its header names (`time_ms`, `time [us]`),
     /// else s; a header naming none that read in s gives under 100 S/s is refused].
     #[arg(long, help_heading = "Input", value_enum)]
-    pub time_unit: Option<crate::recording::TimeUnit>,
+    pub time_unit: Option<crate::io::channel::TimeUnit>,
     /// Sample rate, Hz (instead of a time column).
     #[arg(short = 'r', long, help_heading = "Input", value_parser = positive_f64)]
     pub rate: Option<f64>,
@@ -106,7 +108,7 @@ pub struct AnalyzeArgs {
     pub resample: bool,
     /// Field separator: one character, or `tab` [default: tab or `;` if the first lines hold
     /// one, else `,`].
-    #[arg(long, help_heading = "Input", value_parser = crate::table::parse_delimiter)]
+    #[arg(long, help_heading = "Input", value_parser = crate::io::channel::parse_delimiter)]
     pub delimiter: Option<u8>,
     /// Numbers are written with a decimal comma (`0,5`); the delimiter must be another
     /// character.
@@ -117,7 +119,7 @@ pub struct AnalyzeArgs {
     pub raw_channels: Option<usize>,
     /// The sample type of a raw stream without a `.i16`/`.f32` name (standard input).
     #[arg(long, help_heading = "Input", value_enum)]
-    pub raw_type: Option<crate::raw::RawType>,
+    pub raw_type: Option<crate::io::raw::RawType>,
     /// One pass as the recording is read (needs --range and --trigger).
     ///
     /// Analyse the recording (CSV, WAV, .npy, TDMS, raw `.i16`/`.f32`; CSV and raw also
@@ -219,6 +221,27 @@ pub struct AnalyzeArgs {
     pub plot: Option<PathBuf>,
 }
 
+impl AnalyzeArgs {
+    /// What the readers take of the options (they never see the command line).
+    pub fn read_options(&self, progress: Option<fn(f64)>) -> ReadOptions {
+        ReadOptions {
+            column: self.column.clone(),
+            axes: self.axes.clone(),
+            raw_channels: self.raw_channels,
+            raw_type: self.raw_type,
+            time_column: self.time_column.clone(),
+            rate_hz: self.rate,
+            time_unit: self.time_unit,
+            resample: self.resample,
+            format: CsvFormat {
+                delimiter: self.delimiter,
+                decimal_comma: self.decimal_comma,
+            },
+            progress,
+        }
+    }
+}
+
 /// The host's monitor: 4096-sample pre-trigger ring, 2^17-sample capture.
 pub type HostMonitor = Monitor<4096, 131072>;
 
@@ -305,24 +328,7 @@ impl Setup {
 /// Reads the file and builds the scene (v0 from a free fall needs a first pass).
 pub fn setup(args: &AnalyzeArgs, progress: Option<fn(f64)>) -> Result<Setup, String> {
     let file = scene_file(args)?;
-    let ch = read_recording(
-        &args.file,
-        &ReadOptions {
-            column: args.column.clone(),
-            axes: args.axes.clone(),
-            raw_channels: args.raw_channels,
-            time_column: args.time_column.clone(),
-            rate_hz: args.rate,
-            time_unit: args.time_unit,
-            resample: args.resample,
-            format: CsvFormat {
-                delimiter: args.delimiter,
-                decimal_comma: args.decimal_comma,
-            },
-            progress,
-        },
-    )
-    .map_err(|e| e.to_string())?;
+    let ch = read_recording(&args.file, &args.read_options(progress)).map_err(|e| e.to_string())?;
     let column = ch
         .axes
         .first()

@@ -13,8 +13,9 @@ use impact_core::report::{Bounce, Fits, Flags, HertzFit, NonlinearFit, Spectrum,
 use impact_core::signal::spectrum::MAX_BANDS;
 use impact_core::{Analysis, ImpactReport, Kinematics, Status};
 
+use crate::io::channel::is_stdin;
+use crate::io::table::MAX_LINE_BYTES;
 use crate::report::AnalysisJson;
-use crate::table::{is_stdin, MAX_LINE_BYTES};
 
 /// `impact log` options.
 #[derive(Args, Clone, Debug)]
@@ -728,7 +729,7 @@ pub fn log_json(log: &Log, t0: f64) -> Result<AnalysisJson, String> {
 /// `impact log`: a decoded firmware log as JSON (default) or CSV. The file (or stdin, `-`)
 /// is read line by line, each line at most [`MAX_LINE_BYTES`].
 pub fn log(args: &LogArgs) -> Result<(), String> {
-    let name = crate::table::input_name(&args.file);
+    let name = crate::io::channel::input_name(&args.file);
     if let Some(path) = &args.plot {
         let mut inputs = vec![args.file.as_path()];
         inputs.extend(args.elf.as_deref());

@@ -5,23 +5,24 @@
 //! - `impact analyze FILE` on a regular file or standard input ([`analyze_in_passes`]): a
 //!   survey of the whole recording ([`crate::survey`]), then the analysis; the whole-file
 //!   path's reports. A CSV's or standard input's values are kept from the first pass for the
-//!   later ones in a temporary file ([`crate::spool`]), so a CSV is parsed once.
+//!   later ones in a temporary file ([`crate::io::spool`]), so a CSV is parsed once.
 //! - `impact analyze --stream` ([`analyze`]): one pass, with what needs the whole signal given
 //!   (`--range`, `--trigger`) or refused (spike screening is not done; figures, axes, free fall,
 //!   resampling); with the same levels, the same reports (tested).
 //!
 //! The per-sample arithmetic (units, gain, quantisation) is the whole-file path's. A reader
 //! thread reads ahead of the survey or the monitor; a CSV file's plain rows past the head are
-//! parsed in parallel ([`crate::csv_fast`]).
+//! parsed in parallel ([`crate::io::csv_fast`]).
 
 use impact_core::{Calibration, ImpactReport};
 
 use crate::analyze::{self, AnalyzeArgs, HostMonitor, Prepared, Setup};
+use crate::io::channel::{input_name, is_stdin};
+use crate::io::open_source;
+use crate::io::sources::{read_head, Source, CHUNK};
+use crate::io::spool::{Axis, SpoolWriter};
 use crate::screen::Removal;
-use crate::sources::{open_source, read_head, Source, CHUNK};
-use crate::spool::{Axis, SpoolWriter};
 use crate::survey::{self, Survey, Surveyed};
-use crate::table::{input_name, is_stdin};
 
 /// Reads and analyses `args.file` as a stream; the setup (without samples) and the reports.
 /// `progress` (a CSV's fraction read) for a bar on a terminal.
@@ -44,7 +45,7 @@ pub fn analyze(
         return refuse("--resample");
     }
     let file = analyze::scene_file(args)?;
-    let mut source = open_source(args, &name, progress)?;
+    let mut source = open_source(&args.file, &args.read_options(progress), &name)?;
     let column = source.column().to_string();
     let (mass, scale, units) = analyze::mass_and_scale(args, &file, &column)?;
     let full_scale = analyze::full_scale_m_s2(args, &file, mass).ok_or(
@@ -107,7 +108,7 @@ pub fn analyze(
 /// grow with its length, with the whole-file path's rules: a survey of the whole recording
 /// (its median, noise, extremes, flat tops and glitches, [`Survey`]), a second one if
 /// glitches were removed, then the analysis. The later passes read the first's values back
-/// from a spool ([`crate::spool`]: a CSV, standard input) or the file again. The same code
+/// from a spool ([`crate::io::spool`]: a CSV, standard input) or the file again. The same code
 /// as the whole-file path on the same values, so the same reports (tested); only the time
 /// axis is checked against the first intervals' median, as in a stream (the whole-file path
 /// takes the median of all of them).
@@ -141,7 +142,7 @@ pub fn analyze_in_passes(
             stops: stdin.then(|| name.clone()),
         }),
     };
-    let input = open_source(args, &name, bar(0.0, 0.5))?;
+    let input = open_source(&args.file, &args.read_options(bar(0.0, 0.5)), &name)?;
     let column = input.column().to_string();
     let (mass, scale, units) = analyze::mass_and_scale(args, &file, &column)?;
     let full_scale = analyze::full_scale_m_s2(args, &file, mass);
@@ -165,7 +166,10 @@ pub fn analyze_in_passes(
     };
     let reopen = |progress: Option<fn(f64)>| match &spool {
         Some(s) => Ok((s.source(progress)?, 1.0)),
-        None => Ok::<_, String>((open_source(args, &name, progress)?, scale)),
+        None => Ok::<_, String>((
+            open_source(&args.file, &args.read_options(progress), &name)?,
+            scale,
+        )),
     };
     let removals = first.removals.clone();
     let survey = if removals.is_empty() {
@@ -379,11 +383,11 @@ type SurveyPass = (
     Option<Result<SpoolWriter, String>>,
 );
 
-/// Whether the first pass keeps the values for the later ones ([`crate::spool`]): standard
+/// Whether the first pass keeps the values for the later ones ([`crate::io::spool`]): standard
 /// input (read once) and a CSV file (its parse costs more than reading the spool).
 fn spooled(args: &AnalyzeArgs) -> bool {
     is_stdin(&args.file)
-        || crate::recording::Format::of(&args.file, args.raw_type) == crate::recording::Format::Csv
+        || crate::io::Format::of(&args.file, args.raw_type) == crate::io::Format::Csv
 }
 
 /// Runs `fill` on a reader thread a few chunks ahead of `take` (so memory stays bounded),

@@ -4,7 +4,7 @@
 use std::path::PathBuf;
 
 use impact_host::analyze::{self, AnalyzeArgs, Level, Units};
-use impact_host::recording::ColumnRef;
+use impact_host::io::channel::ColumnRef;
 use impact_host::report::AnalysisJson;
 
 fn signals() -> PathBuf {

@@ -6,8 +6,9 @@
 
 use std::path::PathBuf;
 
-use impact_host::recording::{read_csv, ReadOptions};
-use impact_host::table::CsvFormat;
+use impact_host::io::channel::CsvFormat;
+use impact_host::io::channel::ReadOptions;
+use impact_host::io::recording::read_csv;
 use libfuzzer_sys::fuzz_target;
 
 fn path() -> PathBuf {

@@ -8,7 +8,7 @@ use clap::ValueEnum;
 use impact_core::consts::STANDARD_GRAVITY;
 use serde::{Deserialize, Deserializer};
 
-use crate::table::words;
+use crate::io::channel::words;
 
 /// Units of a recorded channel.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum, Deserialize)]

@@ -4,8 +4,8 @@
 
 use std::path::Path;
 
-use crate::recording::{evenly_sampled, numbered_column, Channel, ReadOptions};
-use crate::table::RecordingError;
+use crate::io::channel::RecordingError;
+use crate::io::channel::{evenly_sampled, numbered_column, Channel, ReadOptions};
 
 /// The sample type a raw file's extension names.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]

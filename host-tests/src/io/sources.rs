@@ -4,10 +4,13 @@
 
 use std::io::Read;
 
-use crate::analyze::AnalyzeArgs;
-use crate::raw::RawType;
-use crate::recording::Format;
-use crate::table::is_stdin;
+use std::path::Path;
+
+use super::channel::{check_interval, is_stdin, ReadOptions};
+use super::csv_fast::{Layout, Parsed};
+use super::csv_read::{Handover, HandoverError, Step};
+use super::raw::RawType;
+use super::table::Rows;
 
 /// Samples whose noise sets the default edge level (the whole-file path uses the whole
 /// recording's): the first 65 536.
@@ -15,23 +18,6 @@ pub(crate) const HEAD: usize = 1 << 16;
 
 /// Bytes read at a time.
 pub(crate) const CHUNK: usize = 1 << 16;
-
-/// Opens the reader for the file's format.
-pub(crate) fn open_source(
-    args: &AnalyzeArgs,
-    name: &str,
-    progress: Option<fn(f64)>,
-) -> Result<Box<dyn Source>, String> {
-    Ok(match Format::of(&args.file, args.raw_type) {
-        Format::Raw(kind) => Box::new(RawSource::open(args, kind, name)?),
-        Format::Wav => Box::new(WavSource::open(args, name)?),
-        Format::Npy => Box::new(NpySource::open(args, name)?),
-        Format::Tdms => Box::new(TdmsSource::open(args, name)?),
-        Format::Ide => Box::new(IdeSource::open(args, name)?),
-        Format::Unsupported(what) => return Err(Format::refuse(what, name)),
-        Format::Csv => Box::new(CsvSource::open(args, progress)?),
-    })
-}
 
 /// The first [`HEAD`] values × `scale` (fewer if the input is shorter); then what the head
 /// tells is fixed ([`Source::head_read`]).
@@ -107,7 +93,7 @@ fn values_as_counts<S: Source + ?Sized>(
 }
 
 /// A raw file or stream: the chosen channel of interleaved little-endian frames.
-struct RawSource {
+pub(crate) struct RawSource {
     input: Box<dyn Read + Send>,
     kind: RawType,
     /// Bytes per frame (all channels) and the channel's offset in it.
@@ -125,29 +111,34 @@ struct RawSource {
 }
 
 impl RawSource {
-    fn open(args: &AnalyzeArgs, kind: RawType, name: &str) -> Result<Self, String> {
-        if args.time_column.is_some() {
+    pub(crate) fn open(
+        path: &Path,
+        opts: &ReadOptions,
+        kind: RawType,
+        name: &str,
+    ) -> Result<Self, String> {
+        if opts.time_column.is_some() {
             return Err("--stream: a raw stream has no time column (give --rate)".into());
         }
-        let rate_hz = args
-            .rate
+        let rate_hz = opts
+            .rate_hz
             .ok_or("--stream: a raw stream holds no time: give --rate")?;
         if !(rate_hz.is_finite() && rate_hz > 0.0 && rate_hz <= 1e9) {
             return Err(format!("--rate {rate_hz}: not in (0, 1e9]"));
         }
-        let channels = args.raw_channels.unwrap_or(1);
+        let channels = opts.raw_channels.unwrap_or(1);
         if !(1..=64).contains(&channels) {
             return Err(format!("--raw-channels {channels}: must lie in 1..=64"));
         }
-        let column = crate::recording::numbered_column(
-            args.column.as_ref(),
+        let column = crate::io::channel::numbered_column(
+            opts.column.as_ref(),
             channels,
             &format!("the stream's {channels} interleaved channels"),
         )?;
-        let input: Box<dyn Read + Send> = if is_stdin(&args.file) {
+        let input: Box<dyn Read + Send> = if is_stdin(path) {
             Box::new(std::io::stdin())
         } else {
-            Box::new(std::fs::File::open(&args.file).map_err(|e| format!("{name}: {e}"))?)
+            Box::new(std::fs::File::open(path).map_err(|e| format!("{name}: {e}"))?)
         };
         Ok(Self {
             input,
@@ -255,15 +246,18 @@ impl RawSource {
 }
 
 /// A CSV file or stream: the channel's column, and the time column (or `--rate`), row by
-/// row, with the whole-file reader's checks ([`crate::table::Rows`]).
-struct CsvSource {
-    rows: crate::table::Rows,
+/// row, with the whole-file reader's checks ([`crate::io::table::Rows`]).
+pub(crate) struct CsvSource {
+    /// The sequential reader, handing plain rows past the head to the parallel one.
+    reader: Handover,
+    /// One row's values (reused).
+    row: Vec<f64>,
     name: String,
     channel: usize,
     /// The channel's header; the time column's, and its unit if given.
     column: String,
     time_header: String,
-    time_unit: Option<crate::recording::TimeUnit>,
+    time_unit: Option<crate::io::channel::TimeUnit>,
     /// The time column and its unit, s.
     time: Option<(usize, f64)>,
     /// `--rate`, if given.
@@ -279,30 +273,23 @@ struct CsvSource {
     head_rate: Option<f64>,
     /// The first row's value, read while resolving the columns and not yet handed on.
     pending: Option<f64>,
-    /// A regular file's size (for progress); the parallel fast path once the head is read,
-    /// and rows read since the sequential reader last took over (it hands back after
-    /// [`crate::csv_fast::SEQUENTIAL_ROWS`] rows).
-    size: Option<u64>,
-    fast: Option<crate::csv_fast::FastRows>,
     head_done: bool,
     ended: bool,
     /// The first time that does not increase, and the first uneven interval (reported at
     /// the end, in this order, as the whole-file path does).
     not_increasing: Option<String>,
     uneven: Option<String>,
-    sequential: usize,
-    progress: Option<fn(f64)>,
 }
 
 impl CsvSource {
-    fn open(args: &AnalyzeArgs, progress: Option<fn(f64)>) -> Result<Self, String> {
-        let format = crate::table::CsvFormat {
-            delimiter: args.delimiter,
-            decimal_comma: args.decimal_comma,
+    pub(crate) fn open(path: &Path, opts: &ReadOptions) -> Result<Self, String> {
+        let format = crate::io::channel::CsvFormat {
+            delimiter: opts.format.delimiter,
+            decimal_comma: opts.format.decimal_comma,
         };
-        let mut rows =
-            crate::table::Rows::open(&args.file, &format, progress).map_err(|e| e.to_string())?;
-        let name = crate::table::input_name(&args.file);
+        let mut rows = crate::io::table::Rows::open(path, &format, opts.progress)
+            .map_err(|e| e.to_string())?;
+        let name = crate::io::channel::input_name(path);
         let err = |m: String| format!("{name}: {m}");
         // The first data row gives the columns their number (the header their names).
         let (line, first) = match rows.next_row().map_err(|e| e.to_string())? {
@@ -311,24 +298,24 @@ impl CsvSource {
         };
         let shape = rows.shape();
         let tcol = shape
-            .time_column_unless_rate(args.rate.is_some(), args.time_column.as_ref())
+            .time_column_unless_rate(opts.rate_hz.is_some(), opts.time_column.as_ref())
             .map_err(err)?;
         // (With --rate a time column is not read, but it is no channel either.)
         let time_like = tcol.or_else(|| shape.time_column(None).ok().flatten());
         let channel = shape
-            .channel(args.column.as_ref(), time_like)
+            .channel(opts.column.as_ref(), time_like)
             .map_err(err)?;
         if Some(channel) == tcol {
             return Err(err(format!(
                 "column {channel} is the time column: choose another with --column"
             )));
         }
-        if tcol.is_none() && args.rate.is_none() {
+        if tcol.is_none() && opts.rate_hz.is_none() {
             return Err(err(
                 "no time column found: give --time-column or --rate".into()
             ));
         }
-        if let Some(r) = args.rate {
+        if let Some(r) = opts.rate_hz {
             if !(r.is_finite() && r > 0.0 && r <= 1e9) {
                 return Err(err(format!("rate {r} Hz is not in (0, 1e9]")));
             }
@@ -339,20 +326,21 @@ impl CsvSource {
         let time = tcol.map(|t| {
             (
                 t,
-                crate::recording::time_unit_s(&time_header, args.time_unit),
+                crate::io::channel::time_unit_s(&time_header, opts.time_unit),
             )
         });
-        let size = rows.size();
         let column = shape.headers.get(channel).cloned().unwrap_or_default();
         let mut source = Self {
-            rows,
+            // The head is read row by row; the parallel reader may take over right after it.
+            reader: Handover::new(rows, crate::io::csv_fast::SEQUENTIAL_ROWS, opts.progress),
+            row: Vec::new(),
             name,
             channel,
             column,
             time_header,
-            time_unit: args.time_unit,
+            time_unit: opts.time_unit,
             time,
-            rate_given: args.rate,
+            rate_given: opts.rate_hz,
             t0: None,
             last: 0.0,
             n: 0,
@@ -360,14 +348,10 @@ impl CsvSource {
             median_dt: None,
             head_rate: None,
             pending: None,
-            size,
-            fast: None,
             head_done: false,
             ended: false,
             not_increasing: None,
             uneven: None,
-            sequential: crate::csv_fast::SEQUENTIAL_ROWS,
-            progress,
         };
         source.pending = Some(source.take(line, &first)?);
         Ok(source)
@@ -421,89 +405,83 @@ impl CsvSource {
     /// parallel one); none at a hand-over from one to the other, or at the end (then
     /// `ended` is set).
     fn next_some(&mut self, want: usize, out: &mut Vec<f64>) -> Result<(), String> {
-        // Past the head, plain rows go through the parallel fast path (a file read again
-        // from the row, or a stream's tape played from it).
-        if self.head_done
-            && self.fast.is_none()
-            && self.sequential >= crate::csv_fast::SEQUENTIAL_ROWS
-        {
-            let (byte, line) = self.rows.position();
-            let (delimiter, format) = self.rows.format();
-            let layout = crate::csv_fast::Layout {
-                columns: self.rows.columns,
-                channel: self.channel,
-                time: self.time.map(|(c, _)| c),
+        // Past the head, plain rows go through the parallel reader (a file read again from
+        // the row, or a stream's tape played from it), laid out for the channel and time
+        // columns; its workers check what may still be the first error of its kind: time
+        // going back, then an uneven interval.
+        let (channel, time) = (self.channel, self.time);
+        let increasing = self.rate_given.is_none() && self.not_increasing.is_none();
+        let median_dt = self
+            .median_dt
+            .filter(|_| increasing && self.uneven.is_none());
+        let layout = move |rows: &Rows| {
+            let (delimiter, format) = rows.format();
+            Layout {
+                columns: rows.columns,
+                channel,
+                time: time.map(|(c, _)| c),
                 delimiter,
                 decimal_comma: format.decimal_comma,
-                time_unit_s: self.time.map_or(1.0, |(_, unit)| unit),
-                // The workers check what may still be the first error of its kind: time
-                // going back, then an uneven interval.
-                increasing: self.rate_given.is_none() && self.not_increasing.is_none(),
-                median_dt: self.median_dt.filter(|_| {
-                    self.rate_given.is_none()
-                        && self.not_increasing.is_none()
-                        && self.uneven.is_none()
-                }),
+                time_unit_s: time.map_or(1.0, |(_, unit)| unit),
+                increasing,
+                median_dt,
                 all: false,
-            };
-            let progress = self.progress.zip(self.size);
-            let input = self
-                .rows
-                .input_from(byte)
-                .map_err(|e| format!("{}: {e}", self.name))?;
-            self.fast = Some(crate::csv_fast::FastRows::start(
-                input,
-                (byte, line),
-                layout,
-                progress,
-                self.rows.tape(),
-            ));
-        }
-        if let Some(fast) = &mut self.fast {
-            let Some(chunk) = fast.next_chunk() else {
-                self.fast = None;
-                self.ended = true;
-                return Ok(());
-            };
-            out.reserve(chunk.rows.len());
-            // The first row follows the previous chunk's last: checked here; the others the
-            // worker checked against the row before them.
-            if let Some(&(value, time)) = chunk.rows.first() {
-                out.push(self.take_values(chunk.line, value, time)?);
             }
-            let unit = self.time.map(|(_, unit)| unit);
-            for &(value, time) in chunk.rows.iter().skip(1) {
-                if let Some(unit) = unit {
-                    self.last = time * unit;
-                }
-                out.push(value);
-            }
-            self.n += chunk.rows.len().saturating_sub(1) as u64;
-            if let Some((byte, line)) = chunk.stop {
-                // The sequential reader from the line the fast path could not take.
-                self.fast = None;
-                self.rows = self.rows.resume(byte, line).map_err(|e| e.to_string())?;
-                self.sequential = 0;
-            }
-            return Ok(());
-        }
+        };
         let mut left = want.max(1);
         if let Some(v) = self.pending.take() {
             out.push(v);
             left -= 1;
         }
-        let mut row = Vec::new();
-        for _ in 0..left {
-            let Some((line, _, r)) = self.rows.next_row().map_err(|e| e.to_string())? else {
-                self.ended = true;
-                break;
+        let mut row = std::mem::take(&mut self.row);
+        let mut read = 0;
+        while read < left {
+            // The parallel reader may take over only at the first row of a call.
+            let fast = (self.head_done && read == 0).then_some(&layout as &dyn Fn(&Rows) -> Layout);
+            let step = match self.reader.next(fast) {
+                Ok(step) => step,
+                Err(HandoverError::Input { error, .. }) => {
+                    return Err(format!("{}: {error}", self.name))
+                }
+                Err(HandoverError::Rows(e)) => return Err(e.to_string()),
             };
-            row.clear();
-            row.extend_from_slice(r);
-            let v = self.take(line, &row)?;
-            out.push(v);
-            self.sequential += 1;
+            match step {
+                Step::End => {
+                    self.ended = true;
+                    break;
+                }
+                Step::Chunk(chunk) => {
+                    self.row = row;
+                    return self.take_chunk(chunk, out);
+                }
+                Step::Row((line, _, r)) => {
+                    row.clear();
+                    row.extend_from_slice(r);
+                    let v = self.take(line, &row)?;
+                    out.push(v);
+                    read += 1;
+                }
+            }
         }
+        self.row = row;
+        Ok(())
+    }
+
+    /// A chunk of the parallel reader: the first row follows the previous chunk's last and
+    /// is checked here; the others the worker checked against the row before them.
+    fn take_chunk(&mut self, chunk: Parsed, out: &mut Vec<f64>) -> Result<(), String> {
+        out.reserve(chunk.rows.len());
+        if let Some(&(value, time)) = chunk.rows.first() {
+            out.push(self.take_values(chunk.line, value, time)?);
+        }
+        let unit = self.time.map(|(_, unit)| unit);
+        for &(value, time) in chunk.rows.iter().skip(1) {
+            if let Some(unit) = unit {
+                self.last = time * unit;
+            }
+            out.push(value);
+        }
+        self.n += chunk.rows.len().saturating_sub(1) as u64;
         Ok(())
     }
 }
@@ -544,7 +522,7 @@ impl Source for CsvSource {
             let rate = (self.n - 1) as f64 / (self.last - t0);
             self.head_rate = (rate.is_finite() && rate > 0.0).then_some(rate);
             if let (Some(rate), None) = (self.head_rate, self.rate_given) {
-                crate::recording::check_time_unit(&self.time_header, self.time_unit, rate)
+                crate::io::channel::check_time_unit(&self.time_header, self.time_unit, rate)
                     .map_err(|m| format!("{}: {m}", self.name))?;
             }
         }
@@ -583,25 +561,11 @@ impl Source for CsvSource {
     }
 }
 
-/// An interval `dt` within [`crate::recording::INTERVAL_RANGE`] times the median `median`.
-pub(crate) fn check_interval(dt: f64, median: f64) -> Result<(), String> {
-    let ratio = dt / median;
-    if crate::recording::INTERVAL_RANGE.contains(&ratio) {
-        Ok(())
-    } else {
-        Err(format!(
-            "uneven time axis: {dt:.6e} s since the previous sample, {ratio:.3} times the first \
-             intervals' median {median:.6e} s (a gap or a rate change); give --resample to \
-             interpolate onto an even grid, or cut the file"
-        ))
-    }
-}
-
 /// An `.ide` file's subchannel, read block by block on a thread of its own
-/// ([`crate::ide::Blocks`]), on the recorder's time stamps: the rate from the head's, every
+/// ([`crate::io::ide::Blocks`]), on the recorder's time stamps: the rate from the head's, every
 /// interval checked against the head's median as a CSV's are.
-struct IdeSource {
-    blocks: crate::ide::Blocks,
+pub(crate) struct IdeSource {
+    blocks: crate::io::ide::Blocks,
     name: String,
     column: String,
     /// Values of the current block not yet handed on.
@@ -615,18 +579,18 @@ struct IdeSource {
 }
 
 impl IdeSource {
-    fn open(args: &AnalyzeArgs, name: &str) -> Result<Self, String> {
-        if args.rate.is_some() || args.time_column.is_some() {
+    pub(crate) fn open(path: &Path, opts: &ReadOptions, name: &str) -> Result<Self, String> {
+        if opts.rate_hz.is_some() || opts.time_column.is_some() {
             return Err(format!(
                 "{name}: an .ide file's samples carry their own time stamps: no --rate or --time-column"
             ));
         }
-        let file = crate::ide::IdeFile::open(&args.file).map_err(|e| format!("{name}: {e}"))?;
-        let pick = crate::ide::pick(&file, args.column.as_ref(), &[])
+        let file = crate::io::ide::IdeFile::open(path).map_err(|e| format!("{name}: {e}"))?;
+        let pick = crate::io::ide::pick(&file, opts.column.as_ref(), &[])
             .map_err(|e| format!("{name}: {e}"))?;
         drop(file);
         Ok(Self {
-            blocks: crate::ide::Blocks::start(&args.file, pick.channel, pick.subs[0]),
+            blocks: crate::io::ide::Blocks::start(path, pick.channel, pick.subs[0]),
             name: name.to_string(),
             column: pick.names[0].clone(),
             pending: std::collections::VecDeque::new(),
@@ -724,20 +688,20 @@ impl Source for IdeSource {
     }
 }
 
-/// A WAV file's channel ([`crate::wav::WavChannel`], read as it goes).
-struct WavSource {
-    channel: crate::wav::WavChannel,
+/// A WAV file's channel ([`crate::io::wav::WavChannel`], read as it goes).
+pub(crate) struct WavSource {
+    channel: crate::io::wav::WavChannel,
     name: String,
 }
 
 impl WavSource {
-    fn open(args: &AnalyzeArgs, name: &str) -> Result<Self, String> {
-        if args.rate.is_some() || args.time_column.is_some() {
+    pub(crate) fn open(path: &Path, opts: &ReadOptions, name: &str) -> Result<Self, String> {
+        if opts.rate_hz.is_some() || opts.time_column.is_some() {
             return Err(format!(
                 "{name}: a WAV file gives its own rate: no --rate or --time-column"
             ));
         }
-        let channel = crate::wav::WavChannel::open(&args.file, args.column.as_ref())
+        let channel = crate::io::wav::WavChannel::open(path, opts.column.as_ref())
             .map_err(|e| format!("{name}: {e}"))?;
         Ok(Self {
             channel,
@@ -761,8 +725,8 @@ impl Source for WavSource {
 
 /// An .npy array's column: every `cols`-th element from `column` on (C order), or the
 /// `rows` elements after `column × rows` (Fortran order), as npyz reads them.
-struct NpySource {
-    elements: crate::npy::Elements,
+pub(crate) struct NpySource {
+    elements: crate::io::npy::Elements,
     rows: u64,
     cols: u64,
     column: u64,
@@ -775,22 +739,22 @@ struct NpySource {
 }
 
 impl NpySource {
-    fn open(args: &AnalyzeArgs, name: &str) -> Result<Self, String> {
-        let rate_hz = args
-            .rate
+    pub(crate) fn open(path: &Path, opts: &ReadOptions, name: &str) -> Result<Self, String> {
+        let rate_hz = opts
+            .rate_hz
             .ok_or_else(|| format!("{name}: an .npy array holds no time: give --rate"))?;
         if !(rate_hz.is_finite() && rate_hz > 0.0 && rate_hz <= 1e9) {
             return Err(format!("--rate {rate_hz}: not in (0, 1e9]"));
         }
-        if args.time_column.is_some() {
+        if opts.time_column.is_some() {
             return Err(format!(
                 "{name}: an .npy array has no time column (give --rate)"
             ));
         }
         let (elements, shape, order) =
-            crate::npy::open_elements(&args.file).map_err(|e| format!("{name}: {e}"))?;
-        let (rows, cols, column) =
-            crate::npy::layout(&shape, args.column.as_ref()).map_err(|e| format!("{name}: {e}"))?;
+            crate::io::npy::open_elements(path).map_err(|e| format!("{name}: {e}"))?;
+        let (rows, cols, column) = crate::io::npy::layout(&shape, opts.column.as_ref())
+            .map_err(|e| format!("{name}: {e}"))?;
         let column = column as u64;
         Ok(Self {
             elements,
@@ -845,20 +809,20 @@ impl Source for NpySource {
     }
 }
 
-/// A TDMS file's channel ([`crate::tdms::TdmsStream`], a range at a time).
-struct TdmsSource {
-    stream: crate::tdms::TdmsStream,
+/// A TDMS file's channel ([`crate::io::tdms::TdmsStream`], a range at a time).
+pub(crate) struct TdmsSource {
+    stream: crate::io::tdms::TdmsStream,
     name: String,
 }
 
 impl TdmsSource {
-    fn open(args: &AnalyzeArgs, name: &str) -> Result<Self, String> {
-        if args.time_column.is_some() {
+    pub(crate) fn open(path: &Path, opts: &ReadOptions, name: &str) -> Result<Self, String> {
+        if opts.time_column.is_some() {
             return Err(format!(
                 "{name}: a TDMS file takes --column (group/channel) and --rate only"
             ));
         }
-        let stream = crate::tdms::TdmsStream::open(&args.file, args.column.as_ref(), args.rate)
+        let stream = crate::io::tdms::TdmsStream::open(path, opts.column.as_ref(), opts.rate_hz)
             .map_err(|e| e.to_string())?;
         Ok(Self {
             stream,

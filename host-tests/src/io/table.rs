@@ -1,87 +1,17 @@
 //! Numeric tables from CSV text (a file or stdin), on the `csv` crate: header lines, the
 //! delimiter, decimal commas, quoting and a UTF-8 byte-order mark handled; every size bounded.
 
-use std::fmt;
 use std::fs::File;
 use std::io::{self, BufRead, BufReader, Read};
-use std::path::{Path, PathBuf};
+use std::path::Path;
 use std::sync::Arc;
 
-use crate::tape::Tape;
-
-/// A column chosen by header name or 0-based index.
-#[derive(Clone, Debug, PartialEq, Eq)]
-pub enum ColumnRef {
-    Name(String),
-    Index(usize),
-}
-
-impl std::str::FromStr for ColumnRef {
-    type Err = String;
-    fn from_str(s: &str) -> Result<Self, String> {
-        Ok(match s.parse::<usize>() {
-            Ok(i) => ColumnRef::Index(i),
-            Err(_) => ColumnRef::Name(s.to_string()),
-        })
-    }
-}
-
-/// What went wrong, and where.
-#[derive(Debug)]
-pub struct RecordingError {
-    pub file: PathBuf,
-    pub line: Option<u64>,
-    pub message: String,
-}
-
-impl fmt::Display for RecordingError {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        let file = input_name(&self.file);
-        match self.line {
-            Some(l) => write!(f, "{file}:{l}: {}", self.message),
-            None => write!(f, "{file}: {}", self.message),
-        }
-    }
-}
-
-impl std::error::Error for RecordingError {}
-
-impl RecordingError {
-    /// An error of the file as a whole (no line).
-    fn of(path: &Path, message: String) -> Self {
-        Self {
-            file: path.to_path_buf(),
-            line: None,
-            message,
-        }
-    }
-}
-
-/// An external library's message on one line (some span several, with pointers under a
-/// quoted source).
-pub fn one_line(message: impl std::fmt::Display) -> String {
-    message
-        .to_string()
-        .lines()
-        .map(str::trim)
-        .filter(|l| !l.is_empty())
-        .collect::<Vec<_>>()
-        .join(" ")
-}
-
-/// Whether a path names standard input (`-`).
-pub fn is_stdin(path: &Path) -> bool {
-    path.as_os_str() == "-"
-}
-
-/// How messages name an input: `stdin`, or the path.
-pub fn input_name(path: &Path) -> String {
-    if is_stdin(path) {
-        "stdin".to_string()
-    } else {
-        path.display().to_string()
-    }
-}
+use crate::io::channel::is_stdin;
+use crate::io::channel::words;
+use crate::io::channel::ColumnRef;
+use crate::io::channel::CsvFormat;
+use crate::io::channel::RecordingError;
+use crate::io::tape::Tape;
 
 /// Longest record (line) read, bytes: a file without line breaks (`/dev/zero`) or with an
 /// unclosed quote is an error, not a memory blow-up.
@@ -90,28 +20,6 @@ pub const MAX_LINE_BYTES: usize = 1 << 20;
 /// Largest magnitude a value may have: beyond it no sensor reading or time is meant (and the
 /// f32 sample path would overflow).
 pub const MAX_VALUE: f64 = 1e30;
-
-/// How the text is laid out.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
-pub struct CsvFormat {
-    /// Field separator [default: tab if the first lines hold one, else `;` if they hold one,
-    /// else `,`].
-    pub delimiter: Option<u8>,
-    /// Numbers are written with a decimal comma (`6,77e-1`); the delimiter must then be
-    /// another character.
-    pub decimal_comma: bool,
-}
-
-/// Parses a `--delimiter` value: one ASCII character, or `tab`.
-pub fn parse_delimiter(s: &str) -> Result<u8, String> {
-    match s {
-        "tab" | "\\t" | "\t" => Ok(b'\t'),
-        _ if s.len() == 1 && s.is_ascii() && s != "\"" && s != "\n" && s != "\r" => {
-            Ok(s.as_bytes()[0])
-        }
-        _ => Err("must be one ASCII character other than a quote or line break, or `tab`".into()),
-    }
-}
 
 /// All numeric columns of a CSV file, with the header names.
 #[derive(Clone, Debug, Default)]
@@ -122,7 +30,7 @@ pub struct Table {
     pub first_data_line: u64,
     /// `(row, line)` wherever a data row is not on the line after the previous one (blank
     /// lines or quoted line breaks in between), so rows map back to lines.
-    breaks: Vec<(usize, u64)>,
+    pub(crate) breaks: Vec<(usize, u64)>,
 }
 
 impl Table {
@@ -525,7 +433,7 @@ impl Rows {
         &self.path
     }
 
-    fn err(&self, line: Option<u64>, message: String) -> RecordingError {
+    pub(crate) fn err(&self, line: Option<u64>, message: String) -> RecordingError {
         RecordingError {
             file: self.path.clone(),
             line,
@@ -665,97 +573,6 @@ impl Rows {
     }
 }
 
-/// Reads a whole numeric table ([`Rows`]).
-pub fn read_table(
-    path: &Path,
-    format: &CsvFormat,
-    progress: Option<fn(f64)>,
-) -> Result<Table, RecordingError> {
-    let mut rows = Rows::open(path, format, progress)?;
-    let mut table = Table::default();
-    let mut next_line = 0;
-    let mut n = 0usize;
-    // Plain rows past the first few thousand go through the parallel reader
-    // ([`crate::csv_fast`]; a file read again from the row, or a stream's tape played from
-    // it); any other line through this one, for a while.
-    let size = rows.size();
-    let mut fast: Option<crate::csv_fast::FastRows> = None;
-    let mut sequential = 0usize;
-    loop {
-        if fast.is_none() && sequential >= crate::csv_fast::SEQUENTIAL_ROWS {
-            let (byte, line) = rows.position();
-            let layout = crate::csv_fast::Layout {
-                columns: table.columns.len(),
-                channel: 0,
-                time: None,
-                delimiter: rows.delimiter,
-                decimal_comma: rows.format.decimal_comma,
-                time_unit_s: 1.0,
-                increasing: false,
-                median_dt: None,
-                all: true,
-            };
-            let input = rows
-                .input_from(byte)
-                .map_err(|e| rows.err(Some(line), e.to_string()))?;
-            fast = Some(crate::csv_fast::FastRows::start(
-                input,
-                (byte, line),
-                layout,
-                progress.zip(size),
-                rows.tape(),
-            ));
-        }
-        if let Some(reader) = &mut fast {
-            let Some(chunk) = reader.next_chunk() else {
-                break;
-            };
-            if !chunk.rows.is_empty() && chunk.line != next_line {
-                table.breaks.push((n, chunk.line));
-            }
-            for row in chunk.fields.chunks_exact(table.columns.len().max(1)) {
-                for (c, v) in table.columns.iter_mut().zip(row) {
-                    c.push(*v);
-                }
-            }
-            n += chunk.rows.len();
-            next_line = chunk.line + chunk.rows.len() as u64;
-            if let Some((byte, line)) = chunk.stop {
-                fast = None;
-                rows = rows.resume(byte, line)?;
-                sequential = 0;
-            }
-            continue;
-        }
-        let Some((lineno, breaks, row)) = rows.next_row()? else {
-            break;
-        };
-        sequential += 1;
-        if table.columns.is_empty() {
-            table.columns = vec![Vec::new(); row.len()];
-            table.first_data_line = lineno;
-            next_line = lineno;
-        }
-        if lineno != next_line {
-            table.breaks.push((n, lineno));
-        }
-        next_line = lineno + breaks + 1;
-        for (c, v) in table.columns.iter_mut().zip(row) {
-            c.push(*v);
-        }
-        n += 1;
-    }
-    table.headers = rows.headers;
-    if table.columns.first().is_none_or(|c| c.is_empty()) {
-        return Err(RecordingError {
-            file: path.to_path_buf(),
-            line: None,
-            message: "no data rows".into(),
-        });
-    }
-    Ok(table)
-}
-
 impl Table {
     /// Resolves a column reference.
     pub fn find(&self, c: &ColumnRef, what: &str) -> Result<usize, String> {
@@ -855,15 +672,11 @@ fn looks_like_time(header: &str) -> bool {
     matches!(first, Some("time" | "timestamp" | "times" | "t"))
 }
 
-/// The words of a header (letters, digits, `µ`).
-pub(crate) fn words(h: &str) -> impl Iterator<Item = &str> {
-    h.split(|c: char| !(c.is_alphanumeric() || c == 'µ'))
-        .filter(|w| !w.is_empty())
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::io::channel::parse_delimiter;
+    use crate::io::csv_read::read_table;
 
     /// A stream read row by row holds only what a hand-over may still need: a run of blank
     /// lines or of long rows is released as it is read, not held until rows are counted.

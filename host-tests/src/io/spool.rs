@@ -11,7 +11,7 @@ use std::fs::File;
 use std::io::Write;
 use std::os::unix::fs::FileExt;
 
-use crate::sources::{Source, CHUNK};
+use crate::io::sources::{Source, CHUNK};
 
 /// Values being written to the spool.
 pub struct SpoolWriter {

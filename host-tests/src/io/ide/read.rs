@@ -7,9 +7,10 @@ use std::path::Path;
 use std::sync::mpsc;
 
 use super::IdeFile;
-use crate::recording::{check_time, resample, Channel, ColumnRef, ReadOptions};
-use crate::table::RecordingError;
-use crate::units::Units;
+use crate::io::channel::RecordingError;
+use crate::io::channel::{check_time, Channel, ColumnRef, ReadOptions};
+use crate::io::recording::resample;
+use crate::io::units::Units;
 
 /// True for a `.ide` file name (any case), or a file that starts with an EBML header whose
 /// DocType is `mide`.

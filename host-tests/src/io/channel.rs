@@ -1,0 +1,329 @@
+//! What every reader shares: the channel a recording gives (values, rate, first time), the
+//! options a reader takes, which column is meant, the time axis's units and checks, and
+//! errors that name the file and line. The leaf of `io`: the formats depend on it.
+
+use std::fmt;
+use std::path::{Path, PathBuf};
+
+/// A column chosen by header name or 0-based index.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub enum ColumnRef {
+    Name(String),
+    Index(usize),
+}
+
+impl std::str::FromStr for ColumnRef {
+    type Err = String;
+    fn from_str(s: &str) -> Result<Self, String> {
+        Ok(match s.parse::<usize>() {
+            Ok(i) => ColumnRef::Index(i),
+            Err(_) => ColumnRef::Name(s.to_string()),
+        })
+    }
+}
+
+/// What went wrong, and where.
+#[derive(Debug)]
+pub struct RecordingError {
+    pub file: PathBuf,
+    pub line: Option<u64>,
+    pub message: String,
+}
+
+impl fmt::Display for RecordingError {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        let file = input_name(&self.file);
+        match self.line {
+            Some(l) => write!(f, "{file}:{l}: {}", self.message),
+            None => write!(f, "{file}: {}", self.message),
+        }
+    }
+}
+
+impl std::error::Error for RecordingError {}
+
+impl RecordingError {
+    /// An error of the file as a whole (no line).
+    pub(crate) fn of(path: &Path, message: String) -> Self {
+        Self {
+            file: path.to_path_buf(),
+            line: None,
+            message,
+        }
+    }
+}
+
+/// An external library's message on one line (some span several, with pointers under a
+/// quoted source).
+pub fn one_line(message: impl std::fmt::Display) -> String {
+    message
+        .to_string()
+        .lines()
+        .map(str::trim)
+        .filter(|l| !l.is_empty())
+        .collect::<Vec<_>>()
+        .join(" ")
+}
+
+/// Whether a path names standard input (`-`).
+pub fn is_stdin(path: &Path) -> bool {
+    path.as_os_str() == "-"
+}
+
+/// How messages name an input: `stdin`, or the path.
+pub fn input_name(path: &Path) -> String {
+    if is_stdin(path) {
+        "stdin".to_string()
+    } else {
+        path.display().to_string()
+    }
+}
+
+/// How the text is laid out.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct CsvFormat {
+    /// Field separator [default: tab if the first lines hold one, else `;` if they hold one,
+    /// else `,`].
+    pub delimiter: Option<u8>,
+    /// Numbers are written with a decimal comma (`6,77e-1`); the delimiter must then be
+    /// another character.
+    pub decimal_comma: bool,
+}
+
+/// Parses a `--delimiter` value: one ASCII character, or `tab`.
+pub fn parse_delimiter(s: &str) -> Result<u8, String> {
+    match s {
+        "tab" | "\\t" | "\t" => Ok(b'\t'),
+        _ if s.len() == 1 && s.is_ascii() && s != "\"" && s != "\n" && s != "\r" => {
+            Ok(s.as_bytes()[0])
+        }
+        _ => Err("must be one ASCII character other than a quote or line break, or `tab`".into()),
+    }
+}
+
+/// The words of a header (letters, digits, `µ`).
+pub fn words(h: &str) -> impl Iterator<Item = &str> {
+    h.split(|c: char| !(c.is_alphanumeric() || c == 'µ'))
+        .filter(|w| !w.is_empty())
+}
+
+/// One channel of a recording.
+#[derive(Clone, Debug)]
+pub struct Channel {
+    /// The column's header name (or `column N`).
+    pub name: String,
+    pub values: Vec<f64>,
+    /// Time of each sample, s (from the time column, or `index / rate`).
+    pub time_s: Vec<f64>,
+    /// Mean sample rate, Hz.
+    pub rate_hz: f64,
+    /// Largest deviation of a sample interval from the mean interval, relative.
+    pub jitter: f64,
+    /// Whether the samples were interpolated onto an even grid (`resample`).
+    pub resampled: bool,
+    /// With [`ReadOptions::axes`]: each axis (header name, values on the same time base);
+    /// `values` is then their resultant `sqrt(x² + y² + z²)`.
+    pub axes: Vec<(String, Vec<f64>)>,
+}
+
+/// How to read the file.
+#[derive(Clone, Debug, Default)]
+pub struct ReadOptions {
+    /// The channel [default: the first column that is not the time column].
+    pub column: Option<ColumnRef>,
+    /// Two or three axes read together instead of `column`: the channel is their resultant.
+    pub axes: Vec<ColumnRef>,
+    /// The time column [default: the one column whose header looks like a time, if any].
+    pub time_column: Option<ColumnRef>,
+    /// Sample rate, Hz, when there is no time column (overrides it if both are given).
+    pub rate_hz: Option<f64>,
+    /// Interpolate an uneven time axis onto an even grid at the median interval (instead of
+    /// refusing it).
+    pub resample: bool,
+    /// Delimiter and decimal mark.
+    pub format: CsvFormat,
+    /// Interleaved channels of a raw `.i16`/`.f32` file [default: 1].
+    pub raw_channels: Option<usize>,
+    /// The time column's unit [default: the one its header names, else s].
+    pub time_unit: Option<TimeUnit>,
+    /// The sample type of a raw file without the `.i16`/`.f32` extension.
+    pub raw_type: Option<super::raw::RawType>,
+    /// Called with the fraction of the file read, for progress display.
+    pub progress: Option<fn(f64)>,
+}
+
+/// The 0-based channel `column` asks for among `count` numbered ones (default 0), or the
+/// message naming what the file has (`what`, e.g. "a WAV file's channels").
+pub(crate) fn numbered_column(
+    column: Option<&ColumnRef>,
+    count: usize,
+    what: &str,
+) -> Result<usize, String> {
+    match column {
+        None => Ok(0),
+        Some(ColumnRef::Index(i)) if *i < count => Ok(*i),
+        Some(c) => {
+            let c = match c {
+                ColumnRef::Index(i) => i.to_string(),
+                ColumnRef::Name(n) => n.clone(),
+            };
+            Err(format!(
+                "--column {c}: {what} are numbered 0..{}",
+                count.saturating_sub(1)
+            ))
+        }
+    }
+}
+
+/// A channel of `values` sampled evenly at `rate_hz` from t = 0 (binary formats), or the
+/// message if it has fewer than two samples.
+pub(crate) fn evenly_sampled(
+    name: String,
+    values: Vec<f64>,
+    rate_hz: f64,
+) -> Result<Channel, String> {
+    if values.len() < 2 {
+        return Err(format!("{} samples; at least 2", values.len()));
+    }
+    let time_s = (0..values.len()).map(|k| k as f64 / rate_hz).collect();
+    Ok(Channel {
+        name,
+        values,
+        time_s,
+        rate_hz,
+        jitter: 0.0,
+        resampled: false,
+        axes: Vec::new(),
+    })
+}
+
+/// The unit of a time column (`--time-unit`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
+pub enum TimeUnit {
+    S,
+    Ms,
+    Us,
+    Ns,
+}
+
+impl TimeUnit {
+    /// Seconds per unit.
+    pub fn seconds(self) -> f64 {
+        match self {
+            TimeUnit::S => 1.0,
+            TimeUnit::Ms => 1e-3,
+            TimeUnit::Us => 1e-6,
+            TimeUnit::Ns => 1e-9,
+        }
+    }
+}
+
+/// Seconds per unit of a time column, from a unit word in its header (`timestamp_us`,
+/// `time [ms]`, `time - seconds`); `None` when the header names none.
+pub fn named_time_unit_s(header: &str) -> Option<f64> {
+    let h = header.to_ascii_lowercase();
+    let unit = words(&h).skip(1).find_map(|w| match w {
+        "s" | "sec" | "secs" | "second" | "seconds" => Some(1.0),
+        "ms" | "msec" | "millisecond" | "milliseconds" => Some(1e-3),
+        "us" | "µs" | "usec" | "microsecond" | "microseconds" => Some(1e-6),
+        "ns" | "nsec" | "nanosecond" | "nanoseconds" => Some(1e-9),
+        _ => None,
+    });
+    unit
+}
+
+/// Seconds per unit of a time column: `given` (`--time-unit`), else the one its header names,
+/// else seconds.
+pub fn time_unit_s(header: &str, given: Option<TimeUnit>) -> f64 {
+    given
+        .map(TimeUnit::seconds)
+        .or_else(|| named_time_unit_s(header))
+        .unwrap_or(1.0)
+}
+
+/// The slowest rate an impact recording can have, S/s: a pulse of milliseconds needs many
+/// samples. A time column that names no unit and, read in seconds, gives less was written in
+/// another unit.
+pub const SLOWEST_RATE_HZ: f64 = 100.0;
+
+/// An error with the fix if a time column whose unit is neither named nor given gives a rate
+/// below [`SLOWEST_RATE_HZ`] read in seconds.
+pub fn check_time_unit(header: &str, given: Option<TimeUnit>, rate_hz: f64) -> Result<(), String> {
+    if given.is_some() || named_time_unit_s(header).is_some() || rate_hz >= SLOWEST_RATE_HZ {
+        return Ok(());
+    }
+    Err(format!(
+        "the time column {header:?} names no unit: read in seconds it gives {} S/s, too slow for an impact recording; if it is in ms or µs, give --time-unit ms (or us), or name the column time_ms (time_us)",
+        crate::report::fmt::sig(rate_hz, 4)
+    ))
+}
+
+/// Every sample interval must lie within this range of the median interval, or the time axis
+/// counts as uneven (a gap or a rate change). Jittered time stamps, as enDAQ's, stay within
+/// 0.6..1.25.
+pub(crate) const INTERVAL_RANGE: std::ops::RangeInclusive<f64> = 0.5..=1.5;
+
+/// The intervals whose median every interval is checked against: the first 65 535 (those
+/// among the first 65 536 rows, as a file read in passes or a stream has them at hand).
+pub(crate) const HEAD_INTERVALS: usize = (1 << 16) - 1;
+
+/// Checks a time column: finite, strictly increasing and evenly sampled (every interval within
+/// [`INTERVAL_RANGE`] times the median of the first [`HEAD_INTERVALS`]). Returns `(rate,
+/// jitter)`; with `resample`, uneven intervals are allowed and the rate is the median
+/// interval's (of all of them).
+pub(crate) fn check_time(
+    path: &Path,
+    t: &[f64],
+    resample: bool,
+    at: impl Fn(usize, String) -> RecordingError,
+) -> Result<(f64, f64), RecordingError> {
+    for (i, w) in t.windows(2).enumerate() {
+        if w[1] <= w[0] {
+            return Err(at(
+                i + 1,
+                format!("time {} s does not increase (previous {} s)", w[1], w[0]),
+            ));
+        }
+    }
+    if t.len() < 2 {
+        return Err(RecordingError {
+            file: path.to_path_buf(),
+            line: None,
+            message: "one sample: the rate cannot be told; give --rate".into(),
+        });
+    }
+    let dts: Vec<f64> = t.windows(2).map(|w| w[1] - w[0]).collect();
+    let median_of = |d: &[f64]| {
+        let mut d = d.to_vec();
+        let mid = d.len() / 2;
+        *d.select_nth_unstable_by(mid, f64::total_cmp).1
+    };
+    if !resample {
+        let median = median_of(&dts[..dts.len().min(HEAD_INTERVALS)]);
+        for (i, &dt) in dts.iter().enumerate() {
+            crate::io::channel::check_interval(dt, median).map_err(|m| at(i + 1, m))?;
+        }
+        let dt = (t[t.len() - 1] - t[0]) / (t.len() - 1) as f64;
+        let jitter = t
+            .windows(2)
+            .map(|w| ((w[1] - w[0]) / dt - 1.0).abs())
+            .fold(0.0, f64::max);
+        Ok((1.0 / dt, jitter))
+    } else {
+        Ok((1.0 / median_of(&dts), 0.0))
+    }
+}
+
+/// An interval `dt` within [`crate::io::channel::INTERVAL_RANGE`] times the median `median`.
+pub(crate) fn check_interval(dt: f64, median: f64) -> Result<(), String> {
+    let ratio = dt / median;
+    if crate::io::channel::INTERVAL_RANGE.contains(&ratio) {
+        Ok(())
+    } else {
+        Err(format!(
+            "uneven time axis: {dt:.6e} s since the previous sample, {ratio:.3} times the first \
+             intervals' median {median:.6e} s (a gap or a rate change); give --resample to \
+             interpolate onto an even grid, or cut the file"
+        ))
+    }
+}

@@ -1,0 +1,131 @@
+//! Reading recordings: a CSV (a file or standard input), .ide, .wav, .npy, TDMS or raw
+//! .i16/.f32 file, whole ([`read_recording`]) or a block at a time ([`open_source`]). The
+//! format is found in one place ([`Format`]) and both readers are chosen here, side by side.
+//! Below the pipeline: nothing here knows the command line or the analysis.
+
+pub mod channel;
+pub mod csv_fast;
+pub mod csv_read;
+pub mod ide;
+pub mod npy;
+pub mod raw;
+pub mod recording;
+pub mod sources;
+pub mod spool;
+pub mod table;
+pub mod tape;
+pub mod tdms;
+pub mod units;
+pub mod wav;
+
+use std::path::Path;
+
+pub use channel::{Channel, ColumnRef, CsvFormat, ReadOptions, RecordingError, TimeUnit};
+use sources::Source;
+
+/// A recording's format: by the file's extension ([`crate::io::wav`], [`crate::io::npy`],
+/// [`crate::io::tdms`], [`crate::io::raw`]), or raw if its sample type is given; CSV otherwise.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Format {
+    Raw(raw::RawType),
+    Wav,
+    Npy,
+    Tdms,
+    Ide,
+    Csv,
+    /// A file no reader takes: what it is and what to do instead.
+    Unsupported(&'static str),
+}
+
+impl Format {
+    pub fn of(path: &Path, raw_type: Option<raw::RawType>) -> Self {
+        match raw_type.or_else(|| raw::RawType::of(path)) {
+            Some(kind) => Format::Raw(kind),
+            None if wav::is_wav(path) => Format::Wav,
+            None if npy::is_npy(path) => Format::Npy,
+            None if tdms::is_tdms(path) => Format::Tdms,
+            None if ide::is_ide(path) => Format::Ide,
+            None => match unsupported(path) {
+                Some(what) => Format::Unsupported(what),
+                None => Format::Csv,
+            },
+        }
+    }
+
+    /// The error for a file no reader takes.
+    pub fn refuse(what: &str, name: &str) -> String {
+        format!("{name}: unsupported format: {what}")
+    }
+}
+
+/// What a file that is no CSV is, from its first bytes or its extension (a spreadsheet, a
+/// MATLAB or HDF5 file, an archive, other binary data); `None` for text.
+fn unsupported(path: &Path) -> Option<&'static str> {
+    let mut head = [0u8; 1024];
+    // Only a regular file is sniffed (a pipe's bytes would be gone).
+    let n = match std::fs::metadata(path) {
+        Ok(m) if m.is_file() => std::fs::File::open(path)
+            .and_then(|mut f| std::io::Read::read(&mut f, &mut head))
+            .unwrap_or(0),
+        _ => 0,
+    };
+    let head = &head[..n];
+    let ext = path
+        .extension()
+        .and_then(|e| e.to_str())
+        .map(str::to_ascii_lowercase)
+        .unwrap_or_default();
+    if head.starts_with(b"PK\x03\x04") || matches!(ext.as_str(), "xlsx" | "ods") {
+        Some("a spreadsheet or zip archive (.xlsx, .ods, .zip): save the sheet as CSV")
+    } else if head.starts_with(&[0xD0, 0xCF, 0x11, 0xE0]) || ext == "xls" {
+        Some("an Excel 97 workbook (.xls): save the sheet as CSV")
+    } else if head.starts_with(b"MATLAB") {
+        Some("a MATLAB .mat file: save the channel as CSV or .npy (scipy.io.loadmat, numpy.save)")
+    } else if head.starts_with(b"\x89HDF") || matches!(ext.as_str(), "h5" | "hdf5" | "mat") {
+        Some("an HDF5 file (.h5, MATLAB 7.3 .mat): save the channel as CSV or .npy (h5py, numpy.save)")
+    } else if head.starts_with(&[0x1F, 0x8B]) {
+        Some("a gzip archive: unpack it first")
+    } else if head.starts_with(b"MDF ") || ext == "mf4" {
+        Some("an ASAM MDF file: export the channel as CSV")
+    } else if head.contains(&0) {
+        Some("binary data: for raw samples name the file .i16 or .f32, or give --raw-type")
+    } else {
+        None
+    }
+}
+
+/// Reads one channel and its time base from a CSV file (see [`read_table`]), a WAV file, an
+/// `.npy` array, a TDMS file or a raw `.i16`/`.f32` file ([`Format`]).
+pub fn read_recording(path: &Path, opts: &ReadOptions) -> Result<Channel, RecordingError> {
+    match Format::of(path, opts.raw_type) {
+        Format::Wav => wav::read_wav(path, opts),
+        Format::Npy => npy::read_npy(path, opts),
+        Format::Tdms => tdms::read_tdms(path, opts),
+        Format::Ide => ide::read_ide(path, opts),
+        Format::Unsupported(what) => Err(RecordingError {
+            file: path.to_path_buf(),
+            line: None,
+            message: format!("unsupported format: {what}"),
+        }),
+        Format::Raw(kind) => raw::read_raw(path, kind, opts.raw_channels.unwrap_or(1), opts),
+        Format::Csv => recording::read_csv(path, opts),
+    }
+}
+
+/// Opens the reader for the file's format.
+pub(crate) fn open_source(
+    path: &Path,
+    opts: &ReadOptions,
+    name: &str,
+) -> Result<Box<dyn Source>, String> {
+    use sources::{CsvSource, IdeSource, NpySource, RawSource, TdmsSource, WavSource};
+    Ok(match Format::of(path, opts.raw_type) {
+        Format::Raw(kind) => Box::new(RawSource::open(path, opts, kind, name)?),
+        Format::Wav => Box::new(WavSource::open(path, opts, name)?),
+        Format::Npy => Box::new(NpySource::open(path, opts, name)?),
+        Format::Tdms => Box::new(TdmsSource::open(path, opts, name)?),
+        Format::Ide => Box::new(IdeSource::open(path, opts, name)?),
+        Format::Unsupported(what) => return Err(Format::refuse(what, name)),
+        Format::Csv => Box::new(CsvSource::open(path, opts)?),
+    })
+}
