@@ -119,7 +119,7 @@ pub struct AnalyzeArgs {
     pub raw_channels: Option<usize>,
     /// The sample type of a raw stream without a `.i16`/`.f32` name (standard input).
     #[arg(long, help_heading = "Input", value_enum)]
-    pub raw_type: Option<crate::io::raw::RawType>,
+    pub raw_type: Option<crate::io::channel::RawType>,
     /// One pass as the recording is read (needs --range and --trigger).
     ///
     /// Analyse the recording (CSV, WAV, .npy, TDMS, raw `.i16`/`.f32`; CSV and raw also

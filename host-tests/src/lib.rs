@@ -4,14 +4,12 @@
 pub mod analyze;
 pub mod axes;
 pub mod cases;
+pub mod cli;
 pub mod compare;
-pub mod decode;
-pub mod emulate;
+pub mod firmware_link;
 pub mod histogram;
 pub mod io;
-pub mod log;
 pub mod m4;
-pub mod memory;
 pub mod parse;
 pub mod plot;
 pub mod precision;
@@ -30,7 +28,6 @@ pub mod throughput;
 pub mod train;
 pub mod two_body;
 pub mod two_body_bench;
-pub mod waves;
 
 /// Notes for the user, each once (a file read in passes is opened again for each pass).
 static NOTES: std::sync::Mutex<Vec<String>> = std::sync::Mutex::new(Vec::new());

@@ -634,12 +634,12 @@ fn math_error(f: fn(f32) -> f32, reference: fn(f64) -> f64, range: (f32, f32)) -
 
 /// Builds the bench ELF with cargo (a no-op when up to date).
 fn build() -> Result<PathBuf, String> {
-    crate::emulate::build_firmware_bin("m4-bench", Some("m4-bench"))
+    crate::firmware_link::qemu::build_firmware_bin("m4-bench", Some("m4-bench"))
 }
 
 /// Runs the whole benchmark (about a minute: the trace run dominates).
 pub fn run(args: &M4Args) -> Result<(M4Report, String), String> {
-    crate::emulate::tools_available()?;
+    crate::firmware_link::qemu::tools_available()?;
     let elf = match &args.elf {
         Some(e) => e.clone(),
         None => build()?,
@@ -846,7 +846,7 @@ pub fn run(args: &M4Args) -> Result<(M4Report, String), String> {
                 max_relative_error: err,
             });
         }
-        let firmware = crate::emulate::build_firmware()?;
+        let firmware = crate::firmware_link::qemu::build_firmware()?;
         let firmware_idle = firmware_idle_marginal(&firmware)?;
         let report = M4Report {
             block,

@@ -12,7 +12,7 @@ use impact_core::{Analysis, Approach, Calibration, FitSet, Impact, Scene};
 use serde::Serialize;
 
 use crate::cases;
-use crate::emulate::{self, Pacing};
+use crate::firmware_link::qemu::{self, Pacing};
 use crate::synth::{record, DynLaw, Placed, Sensor};
 
 /// `impact bench realtime` options.
@@ -29,7 +29,7 @@ pub struct RealtimeArgs {
     pub elf: Option<std::path::PathBuf>,
     /// Virtual time per instruction, 2^N ns: 3 (125 M instructions/s) stands for the
     /// STM32F407 at 168 MHz; 4 is a chip half as fast (the margin of that estimate).
-    #[arg(long, default_value_t = emulate::BOARD_CLOCK_SHIFT, value_parser = clap::value_parser!(u8).range(0..=8))]
+    #[arg(long, default_value_t = qemu::BOARD_CLOCK_SHIFT, value_parser = clap::value_parser!(u8).range(0..=8))]
     pub clock_shift: u8,
 }
 
@@ -143,9 +143,9 @@ fn train(
     clock_shift: u8,
 ) -> Result<TrainRun, String> {
     let (samples, _) = counts(case, n, spacing)?;
-    let run = emulate::run_emulator(
+    let run = qemu::run_emulator(
         elf,
-        emulate::Samples::Adc(&samples),
+        qemu::Samples::Adc(&samples),
         scene,
         Pacing::RealTime {
             rate_scale: 1.0,
@@ -155,7 +155,7 @@ fn train(
         Duration::from_secs(1200),
         |_| {},
     )?;
-    let log = crate::log::parse_log(&run.lines.join("\n"))?;
+    let log = crate::firmware_link::log::parse_log(&run.lines.join("\n"))?;
     let summary = log
         .summary
         .as_ref()
@@ -185,10 +185,10 @@ fn train(
 
 /// Runs every case with and without fits.
 pub fn run(args: &RealtimeArgs) -> Result<Vec<CaseResult>, String> {
-    emulate::tools_available()?;
+    qemu::tools_available()?;
     let elf = match &args.elf {
         Some(p) => p.clone(),
-        None => emulate::build_firmware()?,
+        None => qemu::build_firmware()?,
     };
     let mut out = Vec::new();
     for case in cases() {

@@ -73,7 +73,7 @@ fn every_block_names_its_language() {
 fn documented_commands_give_their_shown_output() {
     // The documents run the emulated firmware: QEMU must be there, and the firmware built
     // first (so that no command of the documents says it is building it).
-    if let Err(e) = impact_host::emulate::tools_available() {
+    if let Err(e) = impact_host::firmware_link::qemu::tools_available() {
         assert!(
             std::env::var_os("IMPACT_REQUIRE_EMULATOR").is_none(),
             "{e} (scripts/setup.sh)"
@@ -81,7 +81,7 @@ fn documented_commands_give_their_shown_output() {
         eprintln!("skipped: {e}");
         return;
     }
-    impact_host::emulate::build_firmware().expect("the emulator firmware builds");
+    impact_host::firmware_link::qemu::build_firmware().expect("the emulator firmware builds");
     let sandboxes = std::env::temp_dir().join(format!("impact-docs-{}", std::process::id()));
     let _ = std::fs::remove_dir_all(&sandboxes);
     let cases = trycmd::TestCases::new();

@@ -20,9 +20,9 @@ use common::impact_ok as impact;
 fn firmware() -> Option<PathBuf> {
     static ELF: OnceLock<Result<PathBuf, String>> = OnceLock::new();
     let elf = ELF.get_or_init(|| {
-        impact_host::emulate::tools_available()?;
+        impact_host::firmware_link::qemu::tools_available()?;
         let t = Instant::now();
-        let elf = impact_host::emulate::build_firmware()?;
+        let elf = impact_host::firmware_link::qemu::build_firmware()?;
         eprintln!(
             "emulator firmware ready in {:.1} s",
             t.elapsed().as_secs_f64()
@@ -525,7 +525,7 @@ fn realtime_matches_host(file: &str, extra: &[&str]) -> serde_json::Value {
 /// The board's limits held in a run (its log): no sample lost, no line dropped or missing,
 /// the stack's peak at most 75 % of the stack (the board's: the emulator has its size).
 fn within_board_limits(log: &str) {
-    let parsed = impact_host::log::parse_log(log).unwrap();
+    let parsed = impact_host::firmware_link::log::parse_log(log).unwrap();
     let summary = parsed.summary.as_ref().expect("a summary line");
     let get = |k: &str| -> u64 { summary[k].parse().unwrap() };
     assert_eq!(get("samples_lost"), 0, "{log}");
@@ -597,13 +597,13 @@ fn a_forced_dma_overrun_is_a_counted_gap_and_later_positions_stay_right() {
     assert_eq!(host.len(), 3);
     // The sampler stalls 3 ms at block 30 (15 ms into the stream, inside the first impact):
     // the emulated DMA laps its two-block ring.
-    let run = impact_host::emulate::run_emulator(
+    let run = impact_host::firmware_link::qemu::run_emulator(
         &elf,
-        impact_host::emulate::Samples::Adc(&setup.prepared.counts),
+        impact_host::firmware_link::qemu::Samples::Adc(&setup.prepared.counts),
         &setup.scene,
-        impact_host::emulate::Pacing::RealTime {
+        impact_host::firmware_link::qemu::Pacing::RealTime {
             rate_scale: 1.0,
-            clock_shift: impact_host::emulate::BOARD_CLOCK_SHIFT,
+            clock_shift: impact_host::firmware_link::qemu::BOARD_CLOCK_SHIFT,
             stall: Some((30, 3000)),
         },
         std::time::Duration::from_secs(300),
@@ -611,7 +611,7 @@ fn a_forced_dma_overrun_is_a_counted_gap_and_later_positions_stay_right() {
     )
     .unwrap();
     let text = run.lines.join("\n");
-    let log = impact_host::log::parse_log(&text).unwrap();
+    let log = impact_host::firmware_link::log::parse_log(&text).unwrap();
     let summary = log.summary.as_ref().unwrap();
     let lost: u64 = summary["samples_lost"].parse().unwrap();
     let samples: u64 = summary["samples"].parse().unwrap();
@@ -864,7 +864,7 @@ fn adxl375_host(
         None,
     )
     .unwrap();
-    let axes = impact_host::emulate::adxl375_axes(&mut setup).unwrap();
+    let axes = impact_host::cli::emulate::adxl375_axes(&mut setup).unwrap();
     let host = impact_host::analyze::run(&setup.prepared.counts, &setup.scene).unwrap();
     (setup, axes, host)
 }
@@ -935,13 +935,13 @@ fn an_adxl375_fifo_overrun_is_counted_as_the_part_lost_it() {
     assert_eq!(host.len(), 3);
     // The sampler stalls 23 ms before poll 40 (0.2 s in, between the first two impacts): the
     // 33-entry FIFO (10.3 ms) overruns and the part overwrites what it cannot hold.
-    let run = impact_host::emulate::run_emulator(
+    let run = impact_host::firmware_link::qemu::run_emulator(
         &elf,
-        impact_host::emulate::Samples::Adxl375(&axes, None),
+        impact_host::firmware_link::qemu::Samples::Adxl375(&axes, None),
         &setup.scene,
-        impact_host::emulate::Pacing::RealTime {
+        impact_host::firmware_link::qemu::Pacing::RealTime {
             rate_scale: 1.0,
-            clock_shift: impact_host::emulate::BOARD_CLOCK_SHIFT,
+            clock_shift: impact_host::firmware_link::qemu::BOARD_CLOCK_SHIFT,
             stall: Some((40, 23_000)),
         },
         std::time::Duration::from_secs(300),
@@ -949,7 +949,7 @@ fn an_adxl375_fifo_overrun_is_counted_as_the_part_lost_it() {
     )
     .unwrap();
     let text = run.lines.join("\n");
-    let log = impact_host::log::parse_log(&text).unwrap();
+    let log = impact_host::firmware_link::log::parse_log(&text).unwrap();
     let summary = log.summary.as_ref().unwrap();
     let lost: u64 = summary["samples_lost"].parse().unwrap();
     let samples: u64 = summary["samples"].parse().unwrap();

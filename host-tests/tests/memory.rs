@@ -5,7 +5,7 @@
 
 use std::path::{Path, PathBuf};
 
-use impact_host::memory;
+use impact_host::firmware_link::memory;
 
 fn root() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR"))

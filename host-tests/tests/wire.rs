@@ -71,10 +71,10 @@ fn impact_log_reads_every_field_of_the_contract_and_names_a_missing_one() {
         s.push_str(" report_latency_s=none\n");
         s
     };
-    let log = impact_host::log::parse_log(&line(None)).unwrap();
+    let log = impact_host::firmware_link::log::parse_log(&line(None)).unwrap();
     assert_eq!(log.impacts.len(), 1);
     for k in FIELDS {
-        let err = impact_host::log::parse_log(&line(Some(k))).unwrap_err();
+        let err = impact_host::firmware_link::log::parse_log(&line(Some(k))).unwrap_err();
         assert!(err.contains(k), "without {k}: {err}");
     }
 }

@@ -5,9 +5,11 @@ use std::process::ExitCode;
 use std::time::Duration;
 
 use clap::{Parser, Subcommand};
+use impact_host::cli::{emulate, log};
+use impact_host::firmware_link::memory;
 use impact_host::{
-    analyze, emulate, log, m4, memory, plot, precision, realtime, simulate, soak, stability, synth,
-    throughput, two_body, two_body_bench,
+    analyze, m4, plot, precision, realtime, simulate, soak, stability, synth, throughput, two_body,
+    two_body_bench,
 };
 
 // The examples in the help are commands of docs/user-guide.md, run by its tests.

@@ -147,7 +147,7 @@ pub struct ReadOptions {
     /// The time column's unit [default: the one its header names, else s].
     pub time_unit: Option<TimeUnit>,
     /// The sample type of a raw file without the `.i16`/`.f32` extension.
-    pub raw_type: Option<super::raw::RawType>,
+    pub raw_type: Option<RawType>,
     /// Called with the fraction of the file read, for progress display.
     pub progress: Option<fn(f64)>,
 }
@@ -325,5 +325,24 @@ pub(crate) fn check_interval(dt: f64, median: f64) -> Result<(), String> {
              intervals' median {median:.6e} s (a gap or a rate change); give --resample to \
              interpolate onto an even grid, or cut the file"
         ))
+    }
+}
+
+/// The sample type a raw file's extension names.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
+pub enum RawType {
+    I16,
+    F32,
+}
+
+impl RawType {
+    /// From the extension: `.i16` or `.f32` (any case).
+    pub fn of(path: &Path) -> Option<Self> {
+        let e = path.extension()?.to_str()?.to_ascii_lowercase();
+        match e.as_str() {
+            "i16" => Some(RawType::I16),
+            "f32" => Some(RawType::F32),
+            _ => None,
+        }
     }
 }

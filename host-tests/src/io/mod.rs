@@ -27,7 +27,7 @@ use sources::Source;
 /// [`crate::io::tdms`], [`crate::io::raw`]), or raw if its sample type is given; CSV otherwise.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum Format {
-    Raw(raw::RawType),
+    Raw(channel::RawType),
     Wav,
     Npy,
     Tdms,
@@ -38,8 +38,8 @@ pub enum Format {
 }
 
 impl Format {
-    pub fn of(path: &Path, raw_type: Option<raw::RawType>) -> Self {
-        match raw_type.or_else(|| raw::RawType::of(path)) {
+    pub fn of(path: &Path, raw_type: Option<channel::RawType>) -> Self {
+        match raw_type.or_else(|| channel::RawType::of(path)) {
             Some(kind) => Format::Raw(kind),
             None if wav::is_wav(path) => Format::Wav,
             None if npy::is_npy(path) => Format::Npy,

@@ -4,27 +4,12 @@
 
 use std::path::Path;
 
+use super::channel::RawType;
+
 use crate::io::channel::RecordingError;
 use crate::io::channel::{evenly_sampled, numbered_column, Channel, ReadOptions};
 
-/// The sample type a raw file's extension names.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
-pub enum RawType {
-    I16,
-    F32,
-}
-
 impl RawType {
-    /// From the extension: `.i16` or `.f32` (any case).
-    pub fn of(path: &Path) -> Option<Self> {
-        let e = path.extension()?.to_str()?.to_ascii_lowercase();
-        match e.as_str() {
-            "i16" => Some(RawType::I16),
-            "f32" => Some(RawType::F32),
-            _ => None,
-        }
-    }
-
     /// The values at byte `at` of each `frame`-byte frame of `bytes` (whole frames), handed
     /// to `push`; a float that is not finite stops it: its frame's index and value.
     pub(crate) fn decode(

@@ -6,10 +6,10 @@ use std::io::Read;
 
 use std::path::Path;
 
+use super::channel::RawType;
 use super::channel::{check_interval, is_stdin, ReadOptions};
 use super::csv_fast::{Layout, Parsed};
 use super::csv_read::{Handover, HandoverError, Step};
-use super::raw::RawType;
 use super::table::Rows;
 
 /// Samples whose noise sets the default edge level (the whole-file path uses the whole

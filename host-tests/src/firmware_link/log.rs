@@ -3,59 +3,19 @@
 //! `impact analyze`'s JSON and CSV.
 
 use std::collections::HashMap;
-use std::io::{BufRead, BufReader, Read};
-use std::path::PathBuf;
 
-use clap::Args;
 use impact_core::consts::STANDARD_GRAVITY;
 use impact_core::report::COR_TOLERANCE;
 use impact_core::report::{Bounce, Fits, Flags, HertzFit, NonlinearFit, Spectrum, TwoPhaseFit};
 use impact_core::signal::spectrum::MAX_BANDS;
 use impact_core::{Analysis, ImpactReport, Kinematics, Status};
 
-use crate::io::channel::is_stdin;
-use crate::io::table::MAX_LINE_BYTES;
+use crate::firmware_link::fields::fields;
+use crate::firmware_link::fields::flag;
+use crate::firmware_link::fields::get;
+use crate::firmware_link::fields::num;
+use crate::firmware_link::fields::opt;
 use crate::report::AnalysisJson;
-
-/// `impact log` options.
-#[derive(Args, Clone, Debug)]
-pub struct LogArgs {
-    /// The firmware's decoded defmt log (probe-rs's or defmt-print's text output, `impact
-    /// emulate --log`; `-`: standard input), or with --elf its raw defmt stream.
-    pub file: PathBuf,
-    /// Print one JSON object (the default).
-    #[arg(short = 'j', long, help_heading = "Output", conflicts_with = "csv")]
-    pub json: bool,
-    /// Print one CSV row per impact.
-    #[arg(long, help_heading = "Output")]
-    pub csv: bool,
-    /// Time of the stream's first sample, s (added to start_s and peak_time_s, as
-    /// `impact analyze` adds the recording's first time stamp).
-    #[arg(long, help_heading = "Input", default_value_t = 0.0, value_parser = finite_f64)]
-    pub t0: f64,
-    /// The input is the firmware's raw defmt stream (as QEMU's semihosting, `impact emulate
-    /// --defmt` or an RTT reader saves it), decoded against this ELF (the firmware that wrote
-    /// it) with defmt-decoder.
-    #[arg(long, help_heading = "Input")]
-    pub elf: Option<PathBuf>,
-    /// Draw the impacts from the board's waveforms (the figure of `impact analyze --plot`)
-    /// to this SVG file.
-    #[arg(short = 'p', long, help_heading = "Output", value_name = "FILE.svg")]
-    pub plot: Option<PathBuf>,
-    /// Write each waveform as a recording `impact analyze` reads: `NAME.csv` (time_s,
-    /// accel_m_s2) or `NAME.wav` (16-bit counts, give `--gain`), one file per impact,
-    /// `NAME-<index>.csv`.
-    #[arg(long, help_heading = "Output")]
-    pub export: Option<PathBuf>,
-}
-
-fn finite_f64(s: &str) -> Result<f64, String> {
-    match s.parse::<f64>() {
-        Ok(v) if v.is_finite() => Ok(v),
-        Ok(_) => Err("must be finite".into()),
-        Err(_) => Err("not a number".into()),
-    }
-}
 
 /// What a firmware log says.
 #[derive(Clone, Debug, Default)]
@@ -73,101 +33,12 @@ pub struct Log {
     /// heartbeat counts), by line.
     pub warnings: Vec<String>,
     /// The captured windows the board sent (`wave` lines, scene `wave_every` > 0).
-    pub waveforms: Vec<crate::waves::Waveform>,
+    pub waveforms: Vec<crate::firmware_link::waves::Waveform>,
     /// Lines the board's logger dropped (the summary's, else the last heartbeat's
     /// `lines_dropped`; 0 from firmware that did not count them).
     pub lines_dropped: u64,
     /// Data lines whose sequence numbers (`seq`) the log lacks, before the last one it has.
     pub lines_missing: u64,
-}
-
-/// The `key=value` fields following `marker` (e.g. `"impact "`) in a decoded line, or `None`
-/// if the line is not such a line. Tokens without `=` (decoder decorations) are skipped.
-fn fields(line: &str, marker: &str) -> Option<Result<HashMap<String, String>, String>> {
-    // The marker at the start of the message: at the start of the line or after a space
-    // (defmt-print puts a time stamp and the level first).
-    let at = line
-        .match_indices(marker)
-        .map(|(i, _)| i)
-        .find(|&i| i == 0 || line[..i].ends_with(' '))?;
-    let rest = &line[at + marker.len()..];
-    // The first token must be a field, so that a prose message starting with the same word
-    // is not taken for one.
-    if !rest.split_whitespace().next()?.contains('=') {
-        return None;
-    }
-    let mut map = HashMap::new();
-    for token in rest.split_whitespace() {
-        if let Some((k, v)) = token.split_once('=') {
-            if map.insert(k.to_string(), v.to_string()).is_some() {
-                return Some(Err(format!("field {k} given twice")));
-            }
-        }
-    }
-    Some(Ok(map))
-}
-
-pub(crate) fn get<'a>(m: &'a HashMap<String, String>, key: &str) -> Result<&'a str, String> {
-    m.get(key)
-        .map(String::as_str)
-        .ok_or_else(|| format!("missing field {key}"))
-}
-
-/// A number a log line may hold: integers, and floats that must be finite (an `f32` field
-/// written beyond its range parses to infinity).
-pub(crate) trait Number: std::str::FromStr + std::fmt::Display {
-    fn is_finite(&self) -> bool {
-        true
-    }
-}
-
-impl Number for u8 {}
-impl Number for u16 {}
-impl Number for u32 {}
-impl Number for u64 {}
-impl Number for i64 {}
-impl Number for f32 {
-    fn is_finite(&self) -> bool {
-        f32::is_finite(*self)
-    }
-}
-impl Number for f64 {
-    fn is_finite(&self) -> bool {
-        f64::is_finite(*self)
-    }
-}
-
-/// `key=v` as a number, finite.
-fn parse<T: Number>(key: &str, v: &str) -> Result<T, String> {
-    let x = v
-        .parse::<T>()
-        .map_err(|_| format!("{key}={v}: not a number"))?;
-    if x.is_finite() {
-        Ok(x)
-    } else {
-        Err(format!(
-            "{key}={x}: not finite (a float out of range, or NaN)"
-        ))
-    }
-}
-
-pub(crate) fn num<T: Number>(m: &HashMap<String, String>, key: &str) -> Result<T, String> {
-    parse(key, get(m, key)?)
-}
-
-fn opt<T: Number>(m: &HashMap<String, String>, key: &str) -> Result<Option<T>, String> {
-    match get(m, key)? {
-        "none" => Ok(None),
-        v => parse(key, v).map(Some),
-    }
-}
-
-fn flag(m: &HashMap<String, String>, key: &str) -> Result<bool, String> {
-    match get(m, key)? {
-        "true" => Ok(true),
-        "false" => Ok(false),
-        v => Err(format!("{key}={v}: not true or false")),
-    }
 }
 
 /// An `impact` line's fields as the core's report (floats parsed at their own width, so the
@@ -382,7 +253,8 @@ impl LogReader {
         } else if let Some(m) = fields(line, "wave_frame ") {
             let m = m.map_err(at)?;
             self.seen(&m).map_err(at)?;
-            let (index, frame, counts) = crate::waves::parse_frame(line, &m).map_err(at)?;
+            let (index, frame, counts) =
+                crate::firmware_link::waves::parse_frame(line, &m).map_err(at)?;
             let w = self
                 .log
                 .waveforms
@@ -398,7 +270,7 @@ impl LogReader {
         } else if let Some(m) = fields(line, "wave ") {
             let m = m.map_err(at)?;
             self.seen(&m).map_err(at)?;
-            let w = crate::waves::Waveform::from_header(&m).map_err(at)?;
+            let w = crate::firmware_link::waves::Waveform::from_header(&m).map_err(at)?;
             if self.log.waveforms.iter().any(|p| p.index == w.index) {
                 return Err(at(format!(
                     "wave index={} again: two streams mixed, or a line repeated",
@@ -561,7 +433,7 @@ impl LogReader {
 }
 
 /// A line's `rate_hz`: finite and > 0.
-fn rate(m: &HashMap<String, String>) -> Result<f32, String> {
+pub(crate) fn rate(m: &HashMap<String, String>) -> Result<f32, String> {
     let r: f32 = num(m, "rate_hz")?;
     if r.is_finite() && r > 0.0 {
         Ok(r)
@@ -724,105 +596,6 @@ pub fn log_json(log: &Log, t0: f64) -> Result<AnalysisJson, String> {
     };
     a.trains = crate::report::train::trains(&a.impacts);
     Ok(a)
-}
-
-/// `impact log`: a decoded firmware log as JSON (default) or CSV. The file (or stdin, `-`)
-/// is read line by line, each line at most [`MAX_LINE_BYTES`].
-pub fn log(args: &LogArgs) -> Result<(), String> {
-    let name = crate::io::channel::input_name(&args.file);
-    if let Some(path) = &args.plot {
-        let mut inputs = vec![args.file.as_path()];
-        inputs.extend(args.elf.as_deref());
-        crate::plot::check_output(path, &inputs)?;
-    }
-    let input: Box<dyn Read> = if is_stdin(&args.file) {
-        Box::new(std::io::stdin())
-    } else {
-        Box::new(std::fs::File::open(&args.file).map_err(|e| format!("{name}: {e}"))?)
-    };
-    let mut reader = LogReader::default();
-    if let Some(elf) = &args.elf {
-        let skipped = crate::decode::decode(elf, input, &name, |n, line| {
-            reader
-                .line(n, line)
-                .map_err(|e| format!("{name}: {}", e.replacen("line ", "frame ", 1)))
-        })?;
-        if skipped > 0 {
-            eprintln!("warning: {name}: {skipped} malformed defmt frames skipped (a cut stream)");
-        }
-        return report(args, reader, &name);
-    }
-    let mut input = BufReader::with_capacity(1 << 16, input);
-    let mut buf = Vec::new();
-    for n in 1.. {
-        buf.clear();
-        let read = (&mut input)
-            .take(MAX_LINE_BYTES as u64 + 1)
-            .read_until(b'\n', &mut buf)
-            .map_err(|e| format!("{name}:{n}: {e}"))?;
-        if read == 0 {
-            break;
-        }
-        if buf.len() > MAX_LINE_BYTES {
-            return Err(format!(
-                "{name}:{n}: a line longer than {MAX_LINE_BYTES} bytes: not a decoded defmt log"
-            ));
-        }
-        reader
-            .line(n, String::from_utf8_lossy(&buf).trim_end())
-            .map_err(|e| format!("{name}: {e}"))?;
-    }
-    report(args, reader, &name)
-}
-
-/// The log read: its warnings on stderr, the figure and exports asked for, the JSON or CSV.
-fn report(args: &LogArgs, reader: LogReader, name: &str) -> Result<(), String> {
-    let log = reader.finish().map_err(|e| format!("{name}: {e}"))?;
-    for w in &log.warnings {
-        eprintln!("warning: {name}: {w}");
-    }
-    let json = log_json(&log, args.t0)?;
-    if args.plot.is_some() || args.export.is_some() {
-        let scene = log
-            .scene
-            .as_ref()
-            .ok_or("--plot/--export: the log has no scene line (the rate and the gain)")?;
-        let rate = f64::from(rate(scene)?);
-        let gain = f64::from(num::<f32>(scene, "gain_m_s2_per_count")?);
-        if let Some(path) = &args.plot {
-            if log.waveforms.is_empty() {
-                return Err("--plot: the log has no waveforms (the scene's wave=0)".into());
-            }
-            let mass: Option<f32> = opt(scene, "mass_kg")?;
-            let waves = &log.waveforms;
-            let signal = crate::plot::Signal {
-                rate_hz: rate,
-                mass_kg: mass.map(f64::from),
-                accel_m_s2: Box::new(move |i| {
-                    waves
-                        .iter()
-                        .find_map(|w| w.at_sample(i))
-                        .map(|c| f64::from(c) * gain)
-                }),
-            };
-            crate::plot::impacts(&signal, &log.impacts, path)?;
-            eprintln!("wrote {}", path.display());
-        }
-        if let Some(path) = &args.export {
-            for p in crate::waves::export(&log.waveforms, path, rate, gain)? {
-                eprintln!("wrote {}", p.display());
-            }
-        }
-    }
-    if args.csv {
-        print!("{}", crate::report::to_csv(&json));
-    } else {
-        println!(
-            "{}",
-            serde_json::to_string_pretty(&json).map_err(|e| e.to_string())?
-        );
-    }
-    Ok(())
 }
 
 #[cfg(test)]

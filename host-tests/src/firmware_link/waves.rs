@@ -6,7 +6,7 @@ use std::path::{Path, PathBuf};
 
 use impact_core::waveform::{self, FRAME_LEN};
 
-use crate::log::num;
+use crate::firmware_link::fields::num;
 use crate::report::waveform::WaveformJson;
 
 /// One impact's window as the board sent it.

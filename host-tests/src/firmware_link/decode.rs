@@ -1,6 +1,6 @@
 //! The firmware's raw defmt stream (what QEMU's semihosting or an RTT reader saves) decoded
 //! against its ELF with `defmt-decoder`, the decoder `defmt-print` and `probe-rs` use: one
-//! text line per frame, as `defmt-print` prints it, for [`crate::log::LogReader`].
+//! text line per frame, as `defmt-print` prints it, for [`crate::firmware_link::log::LogReader`].
 
 use std::io::Read;
 use std::path::Path;

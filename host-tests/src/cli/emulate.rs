@@ -1,0 +1,331 @@
+//! `impact emulate FILE [analyze options]`: the recording prepared exactly as `impact analyze`
+//! prepares it (the same i16 counts, the same scene), replayed on the emulated firmware
+//! ([`crate::firmware_link::qemu`]), its `impact ...` lines parsed back into reports, and the
+//! same table, JSON or CSV printed. The log's line format is in `docs/board.md`.
+
+use std::io::Write;
+use std::path::PathBuf;
+use std::time::Duration;
+
+use clap::Args;
+
+use crate::analyze::{self, AnalyzeArgs};
+use crate::firmware_link::fields::{get, num};
+use crate::firmware_link::log::parse_log;
+use crate::firmware_link::qemu::{
+    build_firmware, run_emulator, tools_available, Pacing, Samples, BOARD_CLOCK_SHIFT,
+};
+
+/// `impact emulate` options: `impact analyze`'s, and where the firmware comes from.
+#[derive(Args, Clone, Debug)]
+pub struct EmulateArgs {
+    #[command(flatten)]
+    pub analyze: AnalyzeArgs,
+    /// Real time: QEMU with an instruction-paced clock (`-icount shift=3`, 8 ns of virtual
+    /// time per instruction, standing for the STM32F407 at 168 MHz), the samples written by an
+    /// emulated DMA at the recording's rate whatever the firmware is doing; samples lost,
+    /// analyses skipped and each report's latency are reported. Default: lossless replay.
+    #[arg(long, help_heading = "Emulator")]
+    pub realtime: bool,
+    /// With --realtime: the emulated chip's speed, as QEMU's `-icount shift`: each
+    /// instruction takes 2^N ns. 3 (125 M instructions/s) stands for the STM32F407 at
+    /// 168 MHz (1.34 cycles an instruction, `impact bench m4`); 2 is a chip twice as fast,
+    /// 4 one half as fast.
+    #[arg(long, help_heading = "Emulator", requires = "realtime", default_value_t = BOARD_CLOCK_SHIFT, value_parser = clap::value_parser!(u8).range(0..=8))]
+    pub clock_shift: u8,
+    /// With --realtime: replay this many times faster than the recording's rate (headroom).
+    #[arg(long, help_heading = "Emulator", requires = "realtime", default_value_t = 1.0, value_parser = positive_f32)]
+    pub rate_scale: f32,
+    /// The firmware sends each impact's captured window after its analysis (scene `wave`):
+    /// whole, or the mean of every EVERY samples; checked against the replayed samples, and
+    /// in the JSON's `waveforms`. Keep them with --log, draw them with `impact log --plot`.
+    #[arg(long, help_heading = "Emulator", num_args = 0..=1, default_missing_value = "1", value_name = "EVERY",
+          value_parser = clap::value_parser!(u16).range(1..))]
+    pub waveforms: Option<u16>,
+    /// The samples come from an ADXL375 (±200 g, 49 mg per count, 13 bits per axis), as on
+    /// the board built with `--features adxl375`: each axis in the part's counts, its FIFO
+    /// emulated (32 entries and the output registers) and polled every 5 ms by the board's
+    /// ADXL375 source, which computes the axes' resultant and counts what the FIFO overwrote.
+    /// The axes are --axes (or the channel as the x axis), at one of the part's rates
+    /// (3200, 1600, 800, 400, 200 or 100 S/s).
+    #[arg(long, help_heading = "Emulator")]
+    pub adxl375: bool,
+    /// Emulator firmware ELF (built with `--no-default-features --features emulator`)
+    /// [default: build it with cargo into target/emulator when its sources changed].
+    #[arg(long, help_heading = "Emulator")]
+    pub elf: Option<PathBuf>,
+    /// Stop QEMU after this many seconds.
+    #[arg(long, help_heading = "Emulator", default_value_t = 600)]
+    pub timeout: u64,
+    /// Write the firmware's decoded log (one line per defmt frame, waveform frames included)
+    /// to this file, as `impact log` reads it.
+    #[arg(long, help_heading = "Output", value_name = "FILE")]
+    pub log: Option<PathBuf>,
+    /// Write the firmware's raw defmt stream (as `probe-rs` or an RTT reader saves it) to
+    /// this file: `impact log --elf FIRMWARE FILE` decodes it.
+    #[arg(long, help_heading = "Output", value_name = "FILE", alias = "raw")]
+    pub defmt: Option<PathBuf>,
+}
+
+fn positive_f32(s: &str) -> Result<f32, String> {
+    match s.parse::<f32>() {
+        Ok(v) if v.is_finite() && v > 0.0 => Ok(v),
+        _ => Err(format!("{s}: not a positive number")),
+    }
+}
+
+/// The ADXL375's scale, m/s² per count: 49 mg per LSB (the firmware's `G_PER_LSB` times
+/// standard gravity, in f32 as there).
+pub const ADXL375_GAIN_M_S2: f32 = 0.049 * impact_core::consts::STANDARD_GRAVITY as f32;
+
+/// The ADXL375's output data rates, S/s.
+pub const ADXL375_RATES_HZ: [f64; 6] = [3200.0, 1600.0, 800.0, 400.0, 200.0, 100.0];
+
+/// One axis's range on the ADXL375: 13-bit two's complement, counts.
+const ADXL375_AXIS_COUNTS: (i16, i16) = (-4096, 4095);
+
+/// The resultant's rail on the board (the firmware's `CLIP_COUNTS` with the ADXL375): it
+/// reaches 4095 counts whenever an axis is at its rail.
+const ADXL375_CLIP_COUNTS: (i16, i16) = (i16::MIN, 4095);
+
+/// Turns a prepared recording into what an ADXL375 would give: each axis (`setup.axes`, or
+/// the channel as x) in the part's counts, and the setup changed to the board's ADXL375 scene
+/// (scale, rails) with what the board streams as its counts: the resultant of the axes, or
+/// the one channel's axis.
+pub fn adxl375_axes(setup: &mut analyze::Setup) -> Result<Vec<[i16; 3]>, String> {
+    let rate = setup.rate_hz;
+    if !ADXL375_RATES_HZ
+        .iter()
+        .any(|r| ((rate - r) / r).abs() < 1e-3)
+    {
+        return Err(format!(
+            "--adxl375: the ADXL375 samples at 3200, 1600, 800, 400, 200 or 100 S/s; this recording is at {rate} S/s (render one at the part's rate with `impact synth --rate 3200`)"
+        ));
+    }
+    let gain = f64::from(ADXL375_GAIN_M_S2);
+    let count = |a: f64| {
+        (a / gain).round().clamp(
+            f64::from(ADXL375_AXIS_COUNTS.0),
+            f64::from(ADXL375_AXIS_COUNTS.1),
+        ) as i16
+    };
+    let columns: Vec<&[f64]> = if setup.axes.is_empty() {
+        vec![&setup.prepared.accel_m_s2]
+    } else {
+        setup.axes.iter().map(|a| a.accel_m_s2.as_slice()).collect()
+    };
+    let n = setup.prepared.counts.len();
+    let axes: Vec<[i16; 3]> = (0..n)
+        .map(|i| {
+            let mut s = [0i16; 3];
+            for (slot, column) in s.iter_mut().zip(&columns) {
+                *slot = column.get(i).map_or(0, |&a| count(a));
+            }
+            s
+        })
+        .collect();
+    let one_axis = setup.axes.is_empty();
+    setup.prepared.counts = axes
+        .iter()
+        .map(|&[x, y, z]| {
+            if one_axis {
+                x
+            } else {
+                impact_core::signal::resultant::resultant_counts(x, y, z)
+            }
+        })
+        .collect();
+    setup.scene.calibration.gain_m_s2_per_count = ADXL375_GAIN_M_S2;
+    setup.prepared.calibration.gain_m_s2_per_count = ADXL375_GAIN_M_S2;
+    setup.scene.clip_counts = if one_axis {
+        ADXL375_AXIS_COUNTS
+    } else {
+        ADXL375_CLIP_COUNTS
+    };
+    setup
+        .scene
+        .validate()
+        .map_err(|e| format!("--adxl375: {e}"))?;
+    Ok(axes)
+}
+
+/// `impact emulate`: prints what `impact analyze` would, computed by the emulated firmware.
+pub fn emulate(args: &EmulateArgs) -> Result<(), String> {
+    let a = &args.analyze;
+    // Check the tools before a possibly long build.
+    tools_available()?;
+    if a.stream {
+        return Err(
+            "--stream: the emulator replays a recording it has read whole (impact analyze --stream reads one as it comes)"
+                .into(),
+        );
+    }
+    if let Some(path) = &a.plot {
+        crate::plot::check_output(path, &[a.file.as_path()])?;
+    }
+    let mut setup = analyze::setup(a, None)?;
+    setup.scene.waveform_every = args.waveforms.unwrap_or(0);
+    let axes = if args.adxl375 {
+        Some(adxl375_axes(&mut setup)?)
+    } else {
+        None
+    };
+    // One channel is the part's x axis, streamed as such (the board's `AXIS = Axis::X`):
+    // kinematics apply; the resultant of --axes has none.
+    let axis = setup.axes.is_empty().then_some(0);
+    let samples = match &axes {
+        Some(axes) => Samples::Adxl375(axes, axis),
+        None => Samples::Adc(&setup.prepared.counts),
+    };
+    let elf = match &args.elf {
+        Some(p) => p.clone(),
+        None => build_firmware()?,
+    };
+    // The log goes to stderr when stdout carries JSON or CSV.
+    let to_stderr = a.json || a.csv;
+    let pacing = if args.realtime {
+        Pacing::RealTime {
+            rate_scale: args.rate_scale,
+            clock_shift: args.clock_shift,
+            stall: None,
+        }
+    } else {
+        Pacing::Lossless
+    };
+    let run = run_emulator(
+        &elf,
+        samples,
+        &setup.scene,
+        pacing,
+        Duration::from_secs(args.timeout),
+        move |line| {
+            // The waveform frames are for files (--log), not for the terminal.
+            if line.contains("wave_frame ") {
+                return;
+            }
+            if to_stderr {
+                eprintln!("{line}");
+            } else {
+                println!("{line}");
+            }
+        },
+    )?;
+    if !run.status.success() {
+        return Err(format!(
+            "the emulated firmware failed ({}); see its log above",
+            run.status
+        ));
+    }
+    let text = run.lines.join("\n") + "\n";
+    if let Some(path) = &args.log {
+        std::fs::write(path, &text).map_err(|e| format!("{}: {e}", path.display()))?;
+        eprintln!("wrote {}", path.display());
+    }
+    if let Some(path) = &args.defmt {
+        std::fs::write(path, &run.raw).map_err(|e| format!("{}: {e}", path.display()))?;
+        eprintln!(
+            "wrote {} (decode: impact log --elf {} {})",
+            path.display(),
+            elf.display(),
+            path.display()
+        );
+    }
+    let log = parse_log(&text)?;
+    let summary = log
+        .summary
+        .as_ref()
+        .ok_or("the emulator's log has no summary line")?;
+    let samples: u64 = num(summary, "samples")?;
+    let lost: u64 = num(summary, "samples_lost")?;
+    if samples + lost != setup.prepared.counts.len() as u64 || get(summary, "result")? != "ok" {
+        return Err(format!(
+            "the emulator processed {samples} and lost {lost} of {} samples (result={})",
+            setup.prepared.counts.len(),
+            get(summary, "result")?
+        ));
+    }
+    eprintln!("emulated in {:.2} s", run.seconds);
+    let mut json = analyze::to_json(&setup, &log.impacts);
+    json.samples_lost = lost;
+    json.analyses_skipped = num(summary, "analyses_skipped")?;
+    json.lines_dropped = log.lines_dropped;
+    json.lines_missing = log.lines_missing;
+    for w in &log.warnings {
+        eprintln!("warning: {w}");
+    }
+    for (j, latency) in json.impacts.iter_mut().zip(&log.latencies) {
+        j.report_latency_s = latency.map(f64::from);
+    }
+    if let Some(every) = args.waveforms {
+        check_waveforms(&log, &setup.prepared.counts, every)?;
+        json.waveforms = log.waveforms.iter().map(|w| w.json()).collect();
+    }
+    let mut out = std::io::stdout().lock();
+    let text = if a.json {
+        serde_json::to_string_pretty(&json).map_err(|e| e.to_string())? + "\n"
+    } else if a.csv {
+        crate::report::to_csv(&json)
+    } else {
+        crate::report::to_table(&json)
+    };
+    out.write_all(text.as_bytes()).map_err(|e| e.to_string())?;
+    if let Some(path) = &a.plot {
+        crate::plot::impacts(&setup.plot_signal(), &log.impacts, path)?;
+        eprintln!("wrote {}", path.display());
+    }
+    Ok(())
+}
+
+/// Every analysed impact's window, as the firmware sent it, against the replayed samples
+/// (whole or averaged the same way): equal value for value, or an error naming the first
+/// difference. Prints what it checked.
+pub fn check_waveforms(
+    log: &crate::firmware_link::log::Log,
+    counts: &[i16],
+    every: u16,
+) -> Result<(), String> {
+    let analysed = log
+        .impacts
+        .iter()
+        .filter(|r| r.analysis != impact_core::Analysis::Skipped)
+        .count();
+    if log.waveforms.len() != analysed {
+        return Err(format!(
+            "the firmware sent {} waveforms for {analysed} analysed impacts",
+            log.waveforms.len()
+        ));
+    }
+    let mut frames = 0;
+    for w in &log.waveforms {
+        if w.every != every {
+            return Err(format!(
+                "impact {}: waveform every={}, asked {every}",
+                w.index, w.every
+            ));
+        }
+        let from = usize::try_from(w.first_sample).map_err(|e| e.to_string())?;
+        let window = counts
+            .get(from..from + w.samples as usize)
+            .ok_or_else(|| format!("impact {}: its window lies beyond the recording", w.index))?;
+        let mut expected = [0i16; impact_core::waveform::FRAME_LEN];
+        for k in 0..w.frames as usize {
+            let n = impact_core::waveform::frame(window, every, k, &mut expected);
+            for (j, want) in expected.iter().take(n).enumerate() {
+                let at = k * impact_core::waveform::FRAME_LEN + j;
+                let got = w.value(at);
+                if got != Some(*want) {
+                    return Err(format!(
+                        "impact {}: waveform value {at} is {got:?}, the replayed samples give {want}",
+                        w.index
+                    ));
+                }
+            }
+        }
+        frames += w.frames;
+    }
+    eprintln!(
+        "waveforms: {} windows, {frames} frames, equal to the replayed samples",
+        log.waveforms.len()
+    );
+    Ok(())
+}

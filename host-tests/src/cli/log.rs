@@ -1,0 +1,152 @@
+//! `impact log`: a decoded firmware log (or, with `--elf`, a raw defmt stream) read back,
+//! checked line by line, and turned into `impact analyze`'s JSON and CSV, its figure and its
+//! windows as recordings.
+
+use std::io::{BufRead, BufReader, Read};
+use std::path::PathBuf;
+
+use clap::Args;
+
+use crate::firmware_link::fields::{num, opt};
+use crate::firmware_link::log::{log_json, rate, LogReader};
+use crate::io::channel::is_stdin;
+use crate::io::table::MAX_LINE_BYTES;
+
+/// `impact log` options.
+#[derive(Args, Clone, Debug)]
+pub struct LogArgs {
+    /// The firmware's decoded defmt log (probe-rs's or defmt-print's text output, `impact
+    /// emulate --log`; `-`: standard input), or with --elf its raw defmt stream.
+    pub file: PathBuf,
+    /// Print one JSON object (the default).
+    #[arg(short = 'j', long, help_heading = "Output", conflicts_with = "csv")]
+    pub json: bool,
+    /// Print one CSV row per impact.
+    #[arg(long, help_heading = "Output")]
+    pub csv: bool,
+    /// Time of the stream's first sample, s (added to start_s and peak_time_s, as
+    /// `impact analyze` adds the recording's first time stamp).
+    #[arg(long, help_heading = "Input", default_value_t = 0.0, value_parser = finite_f64)]
+    pub t0: f64,
+    /// The input is the firmware's raw defmt stream (as QEMU's semihosting, `impact emulate
+    /// --defmt` or an RTT reader saves it), decoded against this ELF (the firmware that wrote
+    /// it) with defmt-decoder.
+    #[arg(long, help_heading = "Input")]
+    pub elf: Option<PathBuf>,
+    /// Draw the impacts from the board's waveforms (the figure of `impact analyze --plot`)
+    /// to this SVG file.
+    #[arg(short = 'p', long, help_heading = "Output", value_name = "FILE.svg")]
+    pub plot: Option<PathBuf>,
+    /// Write each waveform as a recording `impact analyze` reads: `NAME.csv` (time_s,
+    /// accel_m_s2) or `NAME.wav` (16-bit counts, give `--gain`), one file per impact,
+    /// `NAME-<index>.csv`.
+    #[arg(long, help_heading = "Output")]
+    pub export: Option<PathBuf>,
+}
+
+fn finite_f64(s: &str) -> Result<f64, String> {
+    match s.parse::<f64>() {
+        Ok(v) if v.is_finite() => Ok(v),
+        Ok(_) => Err("must be finite".into()),
+        Err(_) => Err("not a number".into()),
+    }
+}
+
+/// `impact log`: a decoded firmware log as JSON (default) or CSV. The file (or stdin, `-`)
+/// is read line by line, each line at most [`MAX_LINE_BYTES`].
+pub fn log(args: &LogArgs) -> Result<(), String> {
+    let name = crate::io::channel::input_name(&args.file);
+    if let Some(path) = &args.plot {
+        let mut inputs = vec![args.file.as_path()];
+        inputs.extend(args.elf.as_deref());
+        crate::plot::check_output(path, &inputs)?;
+    }
+    let input: Box<dyn Read> = if is_stdin(&args.file) {
+        Box::new(std::io::stdin())
+    } else {
+        Box::new(std::fs::File::open(&args.file).map_err(|e| format!("{name}: {e}"))?)
+    };
+    let mut reader = LogReader::default();
+    if let Some(elf) = &args.elf {
+        let skipped = crate::firmware_link::decode::decode(elf, input, &name, |n, line| {
+            reader
+                .line(n, line)
+                .map_err(|e| format!("{name}: {}", e.replacen("line ", "frame ", 1)))
+        })?;
+        if skipped > 0 {
+            eprintln!("warning: {name}: {skipped} malformed defmt frames skipped (a cut stream)");
+        }
+        return report(args, reader, &name);
+    }
+    let mut input = BufReader::with_capacity(1 << 16, input);
+    let mut buf = Vec::new();
+    for n in 1.. {
+        buf.clear();
+        let read = (&mut input)
+            .take(MAX_LINE_BYTES as u64 + 1)
+            .read_until(b'\n', &mut buf)
+            .map_err(|e| format!("{name}:{n}: {e}"))?;
+        if read == 0 {
+            break;
+        }
+        if buf.len() > MAX_LINE_BYTES {
+            return Err(format!(
+                "{name}:{n}: a line longer than {MAX_LINE_BYTES} bytes: not a decoded defmt log"
+            ));
+        }
+        reader
+            .line(n, String::from_utf8_lossy(&buf).trim_end())
+            .map_err(|e| format!("{name}: {e}"))?;
+    }
+    report(args, reader, &name)
+}
+
+/// The log read: its warnings on stderr, the figure and exports asked for, the JSON or CSV.
+fn report(args: &LogArgs, reader: LogReader, name: &str) -> Result<(), String> {
+    let log = reader.finish().map_err(|e| format!("{name}: {e}"))?;
+    for w in &log.warnings {
+        eprintln!("warning: {name}: {w}");
+    }
+    let json = log_json(&log, args.t0)?;
+    if args.plot.is_some() || args.export.is_some() {
+        let scene = log
+            .scene
+            .as_ref()
+            .ok_or("--plot/--export: the log has no scene line (the rate and the gain)")?;
+        let rate = f64::from(rate(scene)?);
+        let gain = f64::from(num::<f32>(scene, "gain_m_s2_per_count")?);
+        if let Some(path) = &args.plot {
+            if log.waveforms.is_empty() {
+                return Err("--plot: the log has no waveforms (the scene's wave=0)".into());
+            }
+            let mass: Option<f32> = opt(scene, "mass_kg")?;
+            let waves = &log.waveforms;
+            let signal = crate::plot::Signal {
+                rate_hz: rate,
+                mass_kg: mass.map(f64::from),
+                accel_m_s2: Box::new(move |i| {
+                    waves
+                        .iter()
+                        .find_map(|w| w.at_sample(i))
+                        .map(|c| f64::from(c) * gain)
+                }),
+            };
+            crate::plot::impacts(&signal, &log.impacts, path)?;
+            eprintln!("wrote {}", path.display());
+        }
+        if let Some(path) = &args.export {
+            for p in crate::firmware_link::waves::export(&log.waveforms, path, rate, gain)? {
+                eprintln!("wrote {}", p.display());
+            }
+        }
+    }
+    if args.csv {
+        print!("{}", crate::report::to_csv(&json));
+    } else {
+        println!(
+            "{}",
+            serde_json::to_string_pretty(&json).map_err(|e| e.to_string())?
+        );
+    }
+    Ok(())
+}

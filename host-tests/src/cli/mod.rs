@@ -1,0 +1,5 @@
+//! The subcommands, each with its options, its run and its output (`bin/impact.rs` parses
+//! and dispatches).
+
+pub mod emulate;
+pub mod log;
