@@ -26,7 +26,7 @@ pub mod survey;
 pub mod synth;
 pub mod throughput;
 pub mod train;
-pub mod two_body;
+
 pub mod two_body_bench;
 
 /// Notes for the user, each once (a file read in passes is opened again for each pass).

@@ -2,8 +2,6 @@
 
 use plotters::prelude::*;
 
-use crate::precision::Point;
-
 /// Checks that `path` can take an SVG before any work is done: its directory exists and it is
 /// none of the `inputs` (an analysis never overwrites its recording).
 pub fn check_output(path: &std::path::Path, inputs: &[&std::path::Path]) -> Result<(), String> {
@@ -40,107 +38,27 @@ pub fn check_output(path: &std::path::Path, inputs: &[&std::path::Path]) -> Resu
     Ok(())
 }
 
-/// Draws time per impact (µs) against max relative error, one series per solver, one panel
-/// per model case, into an SVG file.
-pub fn work_precision(points: &[Point], path: &std::path::Path) -> Result<(), String> {
-    let mut cases: Vec<&str> = points.iter().map(|p| p.case.as_str()).collect();
-    cases.dedup();
-    let cols = 2usize;
-    let rows = cases.len().div_ceil(cols).max(1);
-    let root = SVGBackend::new(path, (1100, 380 * rows as u32)).into_drawing_area();
-    root.fill(&WHITE).map_err(|e| e.to_string())?;
-    let panels = root.split_evenly((rows, cols));
-    let solvers = [
-        ("euler", RGBColor(200, 80, 40)),
-        ("verlet", RGBColor(40, 140, 60)),
-        ("rk4", RGBColor(40, 80, 200)),
-        ("adaptive", RGBColor(150, 40, 170)),
-        ("exact", RGBColor(0, 0, 0)),
-    ];
-    for (panel, case) in panels.iter().zip(&cases) {
-        let pts: Vec<&Point> = points
-            .iter()
-            .filter(|p| p.case == *case && p.precision == "f64")
-            .collect();
-        let err = |p: &Point| p.max_relative_error.max(1e-17);
-        let (mut tmin, mut tmax) = (f64::MAX, f64::MIN);
-        for p in &pts {
-            tmin = tmin.min(p.seconds_per_impact * 1e6);
-            tmax = tmax.max(p.seconds_per_impact * 1e6);
-        }
-        let mut chart = ChartBuilder::on(panel)
-            .caption(*case, ("sans-serif", 18))
-            .margin(10)
-            .x_label_area_size(40)
-            .y_label_area_size(60)
-            .build_cartesian_2d(
-                (1e-17f64..1.0f64).log_scale(),
-                ((tmin * 0.5)..(tmax * 2.0)).log_scale(),
-            )
-            .map_err(|e| e.to_string())?;
-        chart
-            .configure_mesh()
-            .x_desc("max relative error")
-            .y_desc("time per impact, µs")
-            .x_label_formatter(&|v| format!("{v:.0e}"))
-            .y_label_formatter(&|v| format!("{v:.2}"))
-            .draw()
-            .map_err(|e| e.to_string())?;
-        for (solver, color) in solvers {
-            let series: Vec<(f64, f64)> = pts
-                .iter()
-                .filter(|p| p.solver == solver)
-                .map(|p| (err(p), p.seconds_per_impact * 1e6))
-                .collect();
-            if series.is_empty() {
-                continue;
-            }
-            chart
-                .draw_series(LineSeries::new(series.clone(), color.stroke_width(2)))
-                .map_err(|e| e.to_string())?
-                .label(solver)
-                .legend(move |(x, y)| {
-                    PathElement::new(vec![(x, y), (x + 20, y)], color.stroke_width(2))
-                });
-            chart
-                .draw_series(
-                    series
-                        .into_iter()
-                        .map(|xy| Circle::new(xy, 3, color.filled())),
-                )
-                .map_err(|e| e.to_string())?;
-        }
-        chart
-            .configure_series_labels()
-            .background_style(WHITE.mix(0.8))
-            .border_style(BLACK)
-            .draw()
-            .map_err(|e| e.to_string())?;
-    }
-    root.present().map_err(|e| e.to_string())
-}
-
 /// A named, coloured series of (time, value) points.
-type Curve = (&'static str, RGBColor, Vec<(f64, f64)>);
+pub(crate) type Curve = (&'static str, RGBColor, Vec<(f64, f64)>);
 
 /// The measured curve: broad and light, so that fits drawn over it stay visible.
-const MEASURED: RGBColor = RGBColor(120, 170, 250);
+pub(crate) const MEASURED: RGBColor = RGBColor(120, 170, 250);
 
 /// One panel: its title, axis labels, the measured series and each model's, whether both
 /// axes are logarithmic, and whether it carries the legend (the first of a row: the colours
 /// are the same in every panel).
-struct Panel<'a> {
-    title: &'a str,
-    x_label: &'a str,
-    measured: Vec<(f64, f64)>,
-    measured_label: &'a str,
-    models: Vec<Curve>,
-    log: bool,
-    legend: bool,
+pub(crate) struct Panel<'a> {
+    pub(crate) title: &'a str,
+    pub(crate) x_label: &'a str,
+    pub(crate) measured: Vec<(f64, f64)>,
+    pub(crate) measured_label: &'a str,
+    pub(crate) models: Vec<Curve>,
+    pub(crate) log: bool,
+    pub(crate) legend: bool,
 }
 
 /// Draws one panel on `area`.
-fn draw_panel(
+pub(crate) fn draw_panel(
     area: &DrawingArea<SVGBackend, plotters::coord::Shift>,
     index: Option<u32>,
     p: &Panel,
@@ -435,69 +353,6 @@ pub fn impacts(
         for (j, p) in panels.iter().enumerate() {
             draw_panel(&rows[k * cols + j], Some(r.index), p)?;
         }
-    }
-    root.present().map_err(|e| e.to_string())
-}
-
-/// `impact simulate --plot` against a wall: each model's deformation, velocity and force
-/// against time and its force against deformation (seed 000's Figs. 17–18 when a Hertz
-/// contact and its linear spring are drawn together).
-pub fn wall_contact(
-    models: &[(crate::simulate::ModelName, impact_core::Model<f64>)],
-    impact: &impact_core::Impact<f64>,
-    path: &std::path::Path,
-) -> Result<(), String> {
-    use crate::simulate::ModelName;
-    use impact_core::solve::trajectory;
-    use impact_core::ContactLaw;
-    const COLOURS: [RGBColor; 3] = [
-        RGBColor(40, 90, 200),
-        RGBColor(200, 60, 40),
-        RGBColor(40, 140, 60),
-    ];
-    let mut curves: [Vec<Curve>; 4] = Default::default();
-    for ((name, model), colour) in models.iter().zip(COLOURS) {
-        let label = match name {
-            ModelName::Hertz => "Hertz",
-            ModelName::Linear => "linear",
-            ModelName::KelvinVoigt => "Kelvin–Voigt",
-            ModelName::TwoPhase => "two-phase",
-            ModelName::Nonlinear => "nonlinear",
-        };
-        let mut s = Vec::new();
-        // 400 points per time scale (a contact lasts a few).
-        let scale = model.time_scale(impact);
-        let dt = (scale / 400.0).max(f64::MIN_POSITIVE);
-        trajectory::sample(model, impact, 1e-10, 0.0, dt, 20_000, |p| s.push(p))
-            .map_err(|e| e.to_string())?;
-        let map = |f: &dyn Fn(&trajectory::Sample<f64>) -> (f64, f64)| {
-            s.iter().map(f).collect::<Vec<_>>()
-        };
-        curves[0].push((label, colour, map(&|p| (p.t_s * 1e3, p.x_m * 1e3))));
-        curves[1].push((label, colour, map(&|p| (p.t_s * 1e3, p.v_m_s))));
-        curves[2].push((label, colour, map(&|p| (p.t_s * 1e3, p.force_n))));
-        curves[3].push((label, colour, map(&|p| (p.x_m * 1e3, p.force_n))));
-    }
-    let root = SVGBackend::new(path, (1600, 360)).into_drawing_area();
-    root.fill(&WHITE).map_err(|e| e.to_string())?;
-    let areas = root.split_evenly((1, 4));
-    let titles = [
-        ("deformation x(t), mm", "time from touch, ms"),
-        ("velocity v(t), m/s", "time from touch, ms"),
-        ("contact force F(t), N", "time from touch, ms"),
-        ("force against deformation F(x), N", "deformation, mm"),
-    ];
-    for (j, (c, (title, x_label))) in curves.into_iter().zip(titles).enumerate() {
-        let p = Panel {
-            title,
-            x_label,
-            measured: Vec::new(),
-            measured_label: "",
-            models: c,
-            log: false,
-            legend: j == 0,
-        };
-        draw_panel(&areas[j], None, &p)?;
     }
     root.present().map_err(|e| e.to_string())
 }

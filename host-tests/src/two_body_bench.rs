@@ -9,8 +9,8 @@ use impact_core::{ContactLaw, Error, Impact, Method, Settings};
 
 use crate::precision::Point;
 use crate::simulate::model_f32;
+use crate::simulate::two_body::{narrow, widen};
 use crate::stability::{stated_bound_on_target, Row};
-use crate::two_body::{narrow, widen};
 
 /// The fields compared: contact time, crush time, deformation, force, both velocities.
 fn fields(o: &TargetOutcome<f64>) -> [(&'static str, f64); 6] {

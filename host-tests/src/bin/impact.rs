@@ -8,7 +8,7 @@ use clap::{Parser, Subcommand};
 use impact_host::cli::{emulate, log};
 use impact_host::firmware_link::memory;
 use impact_host::{
-    analyze, m4, plot, precision, realtime, simulate, soak, stability, synth, throughput, two_body,
+    analyze, m4, plot, precision, realtime, simulate, soak, stability, synth, throughput,
     two_body_bench,
 };
 
@@ -224,7 +224,9 @@ fn run(cli: Cli) -> Result<(), String> {
                 simulate::Outcome::Wall(report) if args.json => println!("{}", json(&report)?),
                 simulate::Outcome::Wall(report) => print!("{}", simulate::table(&report)),
                 simulate::Outcome::Target(report) if args.json => println!("{}", json(&*report)?),
-                simulate::Outcome::Target(report) => print!("{}", two_body::table(&report)),
+                simulate::Outcome::Target(report) => {
+                    print!("{}", simulate::two_body::table(&report))
+                }
             }
         }
         Command::Analyze(args) => {
@@ -498,7 +500,7 @@ fn run(cli: Cli) -> Result<(), String> {
             std::fs::write(&csv_path, precision::csv(&points))
                 .map_err(|e| format!("{}: {e}", csv_path.display()))?;
             let svg_path = out.join("work-precision.svg");
-            plot::work_precision(&points, &svg_path)?;
+            precision::work_precision(&points, &svg_path)?;
             if json {
                 println!(
                     "{}",

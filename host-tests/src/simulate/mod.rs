@@ -1,5 +1,8 @@
 //! `impact simulate`: one model impact from command-line parameters, as a table or JSON.
 
+pub mod figure;
+pub mod two_body;
+
 use std::time::Instant;
 
 use clap::{Args, ValueEnum};
@@ -126,7 +129,7 @@ pub struct SimulateArgs {
     #[arg(short = 'j', long, help_heading = "Output")]
     pub json: bool,
     #[command(flatten)]
-    pub target: crate::two_body::TargetArgs,
+    pub target: two_body::TargetArgs,
     /// With --plot against a wall and --model hertz: the linear spring of the same maximum
     /// deformation on the same axes (seed 000, Figs. 17–18).
     #[arg(long, help_heading = "Output", requires = "plot")]
@@ -292,7 +295,7 @@ fn timed<R: Real>(
 /// What `impact simulate` found: a contact with a wall or with a target.
 pub enum Outcome {
     Wall(SimulateReport),
-    Target(Box<crate::two_body::TargetReport>),
+    Target(Box<two_body::TargetReport>),
 }
 
 /// Runs `impact simulate`, on the target if one is given.
@@ -312,7 +315,7 @@ pub fn run_any(args: &SimulateArgs) -> Result<Outcome, String> {
                     .map_err(|e| e.to_string())?;
                 models.push((ModelName::Linear, Model::Linear(l)));
             }
-            crate::plot::wall_contact(&models, &impact, path)?;
+            figure::wall_contact(&models, &impact, path)?;
             eprintln!("wrote {}", path.display());
         }
         return Ok(Outcome::Wall(report));
@@ -326,7 +329,7 @@ pub fn run_any(args: &SimulateArgs) -> Result<Outcome, String> {
     let impact = Impact::new(args.mass, args.v0);
     impact.validate().map_err(|e| e.to_string())?;
     let model = args.params.model(args.model, &impact)?;
-    crate::two_body::run(args, &model).map(|r| Outcome::Target(Box::new(r)))
+    two_body::run(args, &model).map(|r| Outcome::Target(Box::new(r)))
 }
 
 /// Runs `impact simulate` against a wall.

@@ -10,7 +10,7 @@ use impact_core::{ContactLaw, Impact, Method, Settings};
 use plotters::prelude::*;
 use serde::{Deserialize, Serialize};
 
-use crate::simulate::{model_f32, Precision, SimulateArgs};
+use super::{model_f32, Precision, SimulateArgs};
 
 /// The target the impactor hits instead of a wall (seed 000, section 3.2).
 #[derive(Args, Clone, Debug, Default)]
