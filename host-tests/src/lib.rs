@@ -1,31 +1,24 @@
 //! Host side of the impact monitor: the `impact` tool's building blocks, shared by the
 //! integration tests and the benchmarks.
 
-pub mod analyze;
-pub mod axes;
 pub mod cases;
 pub mod cli;
 pub mod compare;
 pub mod firmware_link;
-pub mod histogram;
 pub mod io;
 pub mod m4;
 pub mod parse;
+pub mod pipeline;
 pub mod plot;
 pub mod precision;
 pub mod quantise;
 pub mod realtime;
 pub mod report;
-pub mod screen;
 pub mod simulate;
 pub mod soak;
-pub mod spectrum;
 pub mod stability;
-pub mod streaming;
-pub mod survey;
 pub mod synth;
 pub mod throughput;
-pub mod train;
 
 pub mod two_body_bench;
 

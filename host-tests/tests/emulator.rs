@@ -583,8 +583,8 @@ fn realtime_twenty_impacts_40_ms_apart_are_all_analysed() {
 fn a_forced_dma_overrun_is_a_counted_gap_and_later_positions_stay_right() {
     let Some(elf) = firmware() else { return };
     let file = seed_train(3, 0.08);
-    let setup = impact_host::analyze::setup(
-        &impact_host::analyze::AnalyzeArgs {
+    let setup = impact_host::pipeline::setup(
+        &impact_host::pipeline::options::AnalyzeArgs {
             file: file.clone().into(),
             mass: Some(0.06),
             v0: Some(1.3357),
@@ -593,7 +593,7 @@ fn a_forced_dma_overrun_is_a_counted_gap_and_later_positions_stay_right() {
         None,
     )
     .unwrap();
-    let host = impact_host::analyze::run(&setup.prepared.counts, &setup.scene).unwrap();
+    let host = impact_host::pipeline::run(&setup.prepared.counts, &setup.scene).unwrap();
     assert_eq!(host.len(), 3);
     // The sampler stalls 3 ms at block 30 (15 ms into the stream, inside the first impact):
     // the emulated DMA laps its two-block ring.
@@ -847,12 +847,12 @@ fn adxl375_train(n: usize, every: f64) -> String {
 fn adxl375_host(
     file: &str,
 ) -> (
-    impact_host::analyze::Setup,
+    impact_host::pipeline::Setup,
     Vec<[i16; 3]>,
     Vec<impact_core::ImpactReport>,
 ) {
-    let mut setup = impact_host::analyze::setup(
-        &impact_host::analyze::AnalyzeArgs {
+    let mut setup = impact_host::pipeline::setup(
+        &impact_host::pipeline::options::AnalyzeArgs {
             file: file.into(),
             axes: ["x_g", "y_g", "z_g"]
                 .iter()
@@ -865,7 +865,7 @@ fn adxl375_host(
     )
     .unwrap();
     let axes = impact_host::cli::emulate::adxl375_axes(&mut setup).unwrap();
-    let host = impact_host::analyze::run(&setup.prepared.counts, &setup.scene).unwrap();
+    let host = impact_host::pipeline::run(&setup.prepared.counts, &setup.scene).unwrap();
     (setup, axes, host)
 }
 

@@ -3,8 +3,8 @@
 
 use std::path::PathBuf;
 
-use impact_host::analyze::{self, AnalyzeArgs, Level, Units};
 use impact_host::io::channel::ColumnRef;
+use impact_host::pipeline::{self, AnalyzeArgs, Level, Units};
 use impact_host::report::AnalysisJson;
 
 fn signals() -> PathBuf {
@@ -12,9 +12,9 @@ fn signals() -> PathBuf {
 }
 
 fn analyze(args: AnalyzeArgs) -> AnalysisJson {
-    let setup = analyze::setup(&args, None).unwrap_or_else(|e| panic!("{e}"));
-    let reports = analyze::run(&setup.prepared.counts, &setup.scene).unwrap();
-    analyze::to_json(&setup, &reports)
+    let setup = pipeline::setup(&args, None).unwrap_or_else(|e| panic!("{e}"));
+    let reports = pipeline::run(&setup.prepared.counts, &setup.scene).unwrap();
+    pipeline::to_json(&setup, &reports)
 }
 
 fn file(rel: &str) -> AnalyzeArgs {

@@ -4,9 +4,9 @@
 use std::collections::HashMap;
 use std::path::PathBuf;
 
-use impact_host::analyze::{self, AnalyzeArgs, Units};
+use impact_host::pipeline::options::SpectrumArgs;
+use impact_host::pipeline::{self, AnalyzeArgs, Units};
 use impact_host::report::spectrum::{self, ShockSpectrumJson};
-use impact_host::spectrum::SpectrumArgs;
 
 fn root() -> PathBuf {
     PathBuf::from(env!("CARGO_MANIFEST_DIR"))
@@ -26,12 +26,12 @@ fn spectra(args: AnalyzeArgs) -> (ShockSpectrumJson, ShockSpectrumJson, f64) {
         spectrum: spec.clone(),
         ..args
     };
-    let setup = analyze::setup(&args, None).unwrap_or_else(|e| panic!("{e}"));
-    let reports = analyze::run(&setup.prepared.counts, &setup.scene).unwrap();
+    let setup = pipeline::setup(&args, None).unwrap_or_else(|e| panic!("{e}"));
+    let reports = pipeline::run(&setup.prepared.counts, &setup.scene).unwrap();
     let r = &reports[0];
     let board = spectrum::spectrum_json(r.spectrum.as_ref().expect("the report's spectra"));
     (
-        impact_host::spectrum::reference_spectrum(&setup, r, &spec),
+        impact_host::pipeline::spectrum::reference_spectrum(&setup, r, &spec),
         board,
         r.baseline_m_s2 as f64,
     )

@@ -5,11 +5,10 @@ use std::process::ExitCode;
 use std::time::Duration;
 
 use clap::{Parser, Subcommand};
-use impact_host::cli::{emulate, log};
+use impact_host::cli::{analyze, emulate, log, progress};
 use impact_host::firmware_link::memory;
 use impact_host::{
-    analyze, m4, plot, precision, realtime, simulate, soak, stability, synth, throughput,
-    two_body_bench,
+    m4, pipeline, precision, realtime, simulate, soak, stability, synth, throughput, two_body_bench,
 };
 
 // The examples in the help are commands of docs/user-guide.md, run by its tests.
@@ -52,7 +51,7 @@ enum Command {
     Simulate(Box<simulate::SimulateArgs>),
     /// Analyse a recorded signal: one report per impact.
     #[command(allow_negative_numbers = true, after_help = ANALYZE_EXAMPLES)]
-    Analyze(Box<analyze::AnalyzeArgs>),
+    Analyze(Box<pipeline::AnalyzeArgs>),
     /// Analyse a recorded signal on the emulated firmware (QEMU): the same output as `analyze`.
     #[command(
         allow_negative_numbers = true,
@@ -189,9 +188,7 @@ fn main() -> ExitCode {
         return ExitCode::SUCCESS;
     }
     let result = run(cli);
-    if let Some(bar) = PROGRESS.get() {
-        bar.finish_and_clear();
-    }
+    progress::finish();
     // For benchmarks and tests: this process's own peak memory (VmHWM: the address space
     // since exec; wait4's ru_maxrss would include the parent's at the fork).
     if std::env::var_os("IMPACT_PEAK_MEMORY").is_some() {
@@ -229,53 +226,7 @@ fn run(cli: Cli) -> Result<(), String> {
                 }
             }
         }
-        Command::Analyze(args) => {
-            let progress = progress_for(&args);
-            if let Some(path) = &args.plot {
-                plot::check_output(path, &[args.file.as_path()])?;
-            }
-            // A regular file or standard input is read in passes in bounded memory, unless
-            // an option needs the whole recording: then a large file gets a note of the
-            // memory it takes (about 40 bytes a row).
-            let in_passes = impact_host::streaming::in_passes(&args);
-            let size = std::fs::metadata(&args.file).map_or(0, |m| m.len());
-            if !args.stream && !in_passes && size > 1 << 30 {
-                eprintln!(
-                    "note: {} is {:.1} GB: read whole (for --plot, --axes, --free-fall or --resample) it takes some {:.0} GB of memory",
-                    args.file.display(),
-                    size as f64 / 1e9,
-                    size as f64 * 2.0 / 1e9
-                );
-            }
-            let (setup, reports) = if args.stream {
-                impact_host::streaming::analyze(&args, progress)?
-            } else if in_passes {
-                impact_host::streaming::analyze_in_passes(&args, progress)?
-            } else {
-                let setup = analyze::setup(&args, progress)?;
-                let reports = analyze::run(&setup.prepared.counts, &setup.scene)?;
-                (setup, reports)
-            };
-            // Before the results: the bar's line cleared.
-            if let Some(bar) = PROGRESS.get() {
-                bar.finish_and_clear();
-            }
-            let a = analyze::to_json(&setup, &reports);
-            if args.json {
-                println!(
-                    "{}",
-                    serde_json::to_string_pretty(&a).map_err(|e| e.to_string())?
-                );
-            } else if args.csv {
-                print!("{}", impact_host::report::to_csv(&a));
-            } else {
-                print!("{}", impact_host::report::to_table(&a));
-            }
-            if let Some(path) = &args.plot {
-                plot::impacts(&setup.plot_signal(), &reports, path)?;
-                eprintln!("wrote {}", path.display());
-            }
-        }
+        Command::Analyze(args) => analyze::run(&args)?,
         Command::Emulate(args) => emulate::emulate(&args)?,
         Command::Log(args) => log::log(&args)?,
         Command::Synth { args, output, raw } => {
@@ -514,32 +465,4 @@ fn run(cli: Cli) -> Result<(), String> {
         }
     }
     Ok(())
-}
-
-/// A progress bar on stderr (indicatif) for a file over 8 MiB when stderr is a terminal.
-fn progress_for(args: &analyze::AnalyzeArgs) -> Option<fn(f64)> {
-    use std::io::IsTerminal;
-    let big = std::fs::metadata(&args.file)
-        .map(|m| m.len() > 8 << 20)
-        .unwrap_or(false);
-    (big && std::io::stderr().is_terminal()).then_some(show_progress as fn(f64))
-}
-
-/// The bar, per mille of the file read (a plain function for the readers' callbacks).
-static PROGRESS: std::sync::OnceLock<indicatif::ProgressBar> = std::sync::OnceLock::new();
-
-fn show_progress(fraction: f64) {
-    let bar = PROGRESS.get_or_init(|| {
-        let bar = indicatif::ProgressBar::new(1000);
-        if let Ok(style) = indicatif::ProgressStyle::with_template(
-            "reading {wide_bar} {percent:>3} % {elapsed} (about {eta} left)",
-        ) {
-            bar.set_style(style);
-        }
-        bar
-    });
-    bar.set_position((fraction.clamp(0.0, 1.0) * 1000.0) as u64);
-    if fraction >= 1.0 {
-        bar.finish_and_clear();
-    }
 }

@@ -9,12 +9,12 @@ use std::time::Duration;
 
 use clap::Args;
 
-use crate::analyze::{self, AnalyzeArgs};
 use crate::firmware_link::fields::{get, num};
 use crate::firmware_link::log::parse_log;
 use crate::firmware_link::qemu::{
     build_firmware, run_emulator, tools_available, Pacing, Samples, BOARD_CLOCK_SHIFT,
 };
+use crate::pipeline::{self, AnalyzeArgs};
 
 /// `impact emulate` options: `impact analyze`'s, and where the firmware comes from.
 #[derive(Args, Clone, Debug)]
@@ -92,7 +92,7 @@ const ADXL375_CLIP_COUNTS: (i16, i16) = (i16::MIN, 4095);
 /// the channel as x) in the part's counts, and the setup changed to the board's ADXL375 scene
 /// (scale, rails) with what the board streams as its counts: the resultant of the axes, or
 /// the one channel's axis.
-pub fn adxl375_axes(setup: &mut analyze::Setup) -> Result<Vec<[i16; 3]>, String> {
+pub fn adxl375_axes(setup: &mut pipeline::Setup) -> Result<Vec<[i16; 3]>, String> {
     let rate = setup.rate_hz;
     if !ADXL375_RATES_HZ
         .iter()
@@ -163,7 +163,7 @@ pub fn emulate(args: &EmulateArgs) -> Result<(), String> {
     if let Some(path) = &a.plot {
         crate::plot::check_output(path, &[a.file.as_path()])?;
     }
-    let mut setup = analyze::setup(a, None)?;
+    let mut setup = pipeline::setup(a, None)?;
     setup.scene.waveform_every = args.waveforms.unwrap_or(0);
     let axes = if args.adxl375 {
         Some(adxl375_axes(&mut setup)?)
@@ -245,7 +245,7 @@ pub fn emulate(args: &EmulateArgs) -> Result<(), String> {
         ));
     }
     eprintln!("emulated in {:.2} s", run.seconds);
-    let mut json = analyze::to_json(&setup, &log.impacts);
+    let mut json = pipeline::to_json(&setup, &log.impacts);
     json.samples_lost = lost;
     json.analyses_skipped = num(summary, "analyses_skipped")?;
     json.lines_dropped = log.lines_dropped;

@@ -1,5 +1,7 @@
 //! The subcommands, each with its options, its run and its output (`bin/impact.rs` parses
 //! and dispatches).
 
+pub mod analyze;
 pub mod emulate;
 pub mod log;
+pub mod progress;

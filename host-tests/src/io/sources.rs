@@ -1,5 +1,5 @@
 //! The readers a recording is taken from a block at a time, one per format (CSV, WAV, .npy,
-//! TDMS, raw), for a file read in passes or a stream ([`crate::streaming`]): values as they
+//! TDMS, raw), for a file read in passes or a stream ([`crate::pipeline::streaming`]): values as they
 //! are read, the rate, the first time, and a CSV's checks as the whole-file path makes them.
 
 use std::io::Read;

@@ -3,7 +3,7 @@
 //! (`.i16`/`.f32`) file, or (CSV, raw) standard input.
 //!
 //! - `impact analyze FILE` on a regular file or standard input ([`analyze_in_passes`]): a
-//!   survey of the whole recording ([`crate::survey`]), then the analysis; the whole-file
+//!   survey of the whole recording ([`crate::pipeline::survey`]), then the analysis; the whole-file
 //!   path's reports. A CSV's or standard input's values are kept from the first pass for the
 //!   later ones in a temporary file ([`crate::io::spool`]), so a CSV is parsed once.
 //! - `impact analyze --stream` ([`analyze`]): one pass, with what needs the whole signal given
@@ -16,13 +16,13 @@
 
 use impact_core::{Calibration, ImpactReport};
 
-use crate::analyze::{self, AnalyzeArgs, HostMonitor, Prepared, Setup};
 use crate::io::channel::{input_name, is_stdin};
 use crate::io::open_source;
 use crate::io::sources::{read_head, Source, CHUNK};
 use crate::io::spool::{Axis, SpoolWriter};
-use crate::screen::Removal;
-use crate::survey::{self, Survey, Surveyed};
+use crate::pipeline::screen::Removal;
+use crate::pipeline::survey::{self, Survey, Surveyed};
+use crate::pipeline::{self, AnalyzeArgs, HostMonitor, Prepared, Setup};
 
 /// Reads and analyses `args.file` as a stream; the setup (without samples) and the reports.
 /// `progress` (a CSV's fraction read) for a bar on a terminal.
@@ -44,20 +44,20 @@ pub fn analyze(
     if args.resample {
         return refuse("--resample");
     }
-    let file = analyze::scene_file(args)?;
+    let file = pipeline::scene_file(args)?;
     let mut source = open_source(&args.file, &args.read_options(progress), &name)?;
     let column = source.column().to_string();
-    let (mass, scale, units) = analyze::mass_and_scale(args, &file, &column)?;
-    let full_scale = analyze::full_scale_m_s2(args, &file, mass).ok_or(
+    let (mass, scale, units) = pipeline::mass_and_scale(args, &file, &column)?;
+    let full_scale = pipeline::full_scale_m_s2(args, &file, mass).ok_or(
         "--stream: give --range (the sensor's full scale sets the quantisation before the \
          recording's extremes are known)",
     )?;
-    let (trigger, edge) = analyze::given_levels(args, &file, mass);
+    let (trigger, edge) = pipeline::given_levels(args, &file, mass);
     let trigger = trigger.ok_or(
         "--stream: give --trigger (the level cannot be learned from a recording not yet read)",
     )?;
     let gain = crate::quantise::gain_for(full_scale);
-    let clipping = crate::screen::from_range(full_scale);
+    let clipping = crate::pipeline::screen::from_range(full_scale);
     // The head: its noise sets the default edge level, a CSV's first intervals the rate; its
     // readings are checked against the range.
     let head = read_head(&mut *source, scale)?;
@@ -68,7 +68,7 @@ pub fn analyze(
         sample_rate_hz: rate_hz as f32,
     };
     let edge = edge.unwrap_or_else(|| survey::default_edge(survey::noise_rms(&head), trigger));
-    let (scene, v0_source) = analyze::build_scene(
+    let (scene, v0_source) = pipeline::build_scene(
         args,
         &file,
         calibration,
@@ -117,7 +117,7 @@ pub fn analyze_in_passes(
     progress: Option<fn(f64)>,
 ) -> Result<(Setup, Vec<ImpactReport>), String> {
     let name = input_name(&args.file);
-    let file = analyze::scene_file(args)?;
+    let file = pipeline::scene_file(args)?;
     // The survey; again with the glitches replaced if there are any (they set the extremes).
     // One bar over the passes: the survey fills its first half, a second survey (if any)
     // the next sixth, the analysis the rest.
@@ -144,8 +144,8 @@ pub fn analyze_in_passes(
     };
     let input = open_source(&args.file, &args.read_options(bar(0.0, 0.5)), &name)?;
     let column = input.column().to_string();
-    let (mass, scale, units) = analyze::mass_and_scale(args, &file, &column)?;
-    let full_scale = analyze::full_scale_m_s2(args, &file, mass);
+    let (mass, scale, units) = pipeline::mass_and_scale(args, &file, &column)?;
+    let full_scale = pipeline::full_scale_m_s2(args, &file, mass);
     let (first, source, spool) = survey_pass(input, scale, &[], !args.keep_spikes, spool)?;
     let axis = Axis {
         rate_hz: source.rate_hz()?,
@@ -178,14 +178,14 @@ pub fn analyze_in_passes(
         let (input, scale) = reopen(bar(0.5, 2.0 / 3.0))?;
         survey_pass(input, scale, &removals, false, None)?.0
     };
-    let (trigger, edge) = analyze::given_levels(args, &file, mass);
+    let (trigger, edge) = pipeline::given_levels(args, &file, mass);
     let levels = survey::levels(&survey, full_scale, trigger, edge)?;
     let gain = levels.gain_m_s2_per_count;
     let calibration = Calibration {
         gain_m_s2_per_count: gain as f32,
         sample_rate_hz: rate_hz as f32,
     };
-    let (scene, v0_source) = analyze::build_scene(
+    let (scene, v0_source) = pipeline::build_scene(
         args,
         &file,
         calibration,
@@ -322,7 +322,7 @@ fn survey_pass(
     if let (Some(name), Some(Err(e))) = (&stops, &spool) {
         return Err(format!("{name}: {e}"));
     }
-    survey.put_shape(crate::survey::Shape::join(flat, spikes));
+    survey.put_shape(crate::pipeline::survey::Shape::join(flat, spikes));
     Ok((survey.finish()?, source, spool))
 }
 

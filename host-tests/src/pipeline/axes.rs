@@ -4,9 +4,9 @@
 
 use impact_core::ImpactReport;
 
+use crate::pipeline::screen;
 use crate::report::axes::{AxesJson, AxisJson};
 use crate::report::Clipping;
-use crate::screen;
 
 /// One axis of a recording, in m/s², and its rails.
 #[derive(Clone, Debug)]
@@ -21,11 +21,11 @@ pub struct Axis {
 
 impl Axis {
     /// An axis with its rails from `full_scale_m_s2` if given, else from its flat tops
-    /// beyond its noise (as the channel's, [`crate::survey`]).
+    /// beyond its noise (as the channel's, [`crate::pipeline::survey`]).
     pub fn new(name: String, accel_m_s2: Vec<f64>, full_scale_m_s2: Option<f64>) -> Self {
         let rails = match full_scale_m_s2 {
             Some(fs) => Some(screen::from_range(fs)),
-            None => crate::survey::Survey::of(&accel_m_s2, false)
+            None => crate::pipeline::survey::Survey::of(&accel_m_s2, false)
                 .ok()
                 .and_then(|s| s.flat_tops),
         };

@@ -3,57 +3,12 @@
 //! (`signal::spectrum`, f32 multirate), as JSON, CSV and a table line; and the host's f64
 //! full-rate reference (`signal::srs`) the tests hold both against.
 
-use clap::Args;
-use impact_core::signal::spectrum::SpectrumSettings;
 use impact_core::signal::srs::{self, Oscillator, Response};
 use impact_core::ImpactReport;
 
-use crate::analyze::Setup;
+use crate::pipeline::options::SpectrumArgs;
+use crate::pipeline::Setup;
 use crate::report::spectrum::ShockSpectrumJson;
-
-/// Shock-spectrum options.
-#[derive(Args, Clone, Debug, Default)]
-pub struct SpectrumArgs {
-    /// Add each impact's SRS (maximax absolute acceleration), PVSS and enveloping half-sine.
-    #[arg(long, help_heading = "Analysis")]
-    pub srs: bool,
-    /// Damping ratio of the oscillators, in [0, 0.5].
-    #[arg(long, help_heading = "Analysis", default_value_t = 0.05, requires = "srs", value_parser = damping)]
-    pub srs_damping: f64,
-    /// Bands per octave: 6 or 12 (centres 1000 × 2^(k/n) Hz).
-    #[arg(long, help_heading = "Analysis", default_value_t = 6, requires = "srs", value_parser = per_octave)]
-    pub srs_bands: u32,
-    /// Lowest band, Hz (the highest is an eighth of the sample rate).
-    #[arg(long, help_heading = "Analysis", default_value_t = 10.0, requires = "srs", value_parser = crate::parse::positive_f64)]
-    pub srs_low: f64,
-}
-
-impl SpectrumArgs {
-    /// The scene's spectrum settings, if asked for.
-    pub fn settings(&self) -> Option<SpectrumSettings> {
-        self.srs.then_some(SpectrumSettings {
-            damping: self.srs_damping as f32,
-            bands_per_octave: self.srs_bands as u8,
-            low_hz: self.srs_low as f32,
-        })
-    }
-}
-
-fn per_octave(s: &str) -> Result<u32, String> {
-    match s {
-        "6" => Ok(6),
-        "12" => Ok(12),
-        _ => Err("must be 6 or 12".into()),
-    }
-}
-
-fn damping(s: &str) -> Result<f64, String> {
-    match s.parse::<f64>() {
-        Ok(v) if (0.0..=0.5).contains(&v) => Ok(v),
-        Ok(_) => Err("must lie in [0, 0.5]".into()),
-        Err(_) => Err("not a number".into()),
-    }
-}
 
 /// Samples before the report's onset included in the window (the pulse's foot): the same
 /// as the board's.

@@ -5,9 +5,9 @@
 //! The whole-file path runs it over the recording in memory, the passes path over the file
 //! as it is read: the same code on the same values, so both give the same reports.
 
-use crate::histogram::OrderHistogram;
+use crate::pipeline::histogram::OrderHistogram;
+use crate::pipeline::screen::{self, FlatTops, Removal, SpikeScan};
 use crate::report::Clipping;
-use crate::screen::{self, FlatTops, Removal, SpikeScan};
 
 /// One pass over a recording (values in m/s²).
 pub struct Survey {

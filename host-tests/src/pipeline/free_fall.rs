@@ -1,0 +1,81 @@
+//! The approach speed from a free fall measured on a DC channel before the impact
+//! (`--free-fall`).
+
+use crate::io::channel::time_unit_s;
+use crate::io::channel::ColumnRef;
+use crate::io::channel::CsvFormat;
+use crate::io::csv_read::read_table;
+use std::path::Path;
+
+/// Free-fall time ending at or before `impact_s`, from a DC accelerometer file in g: the
+/// stretch where |a| < 0.5 g (half way between rest and free fall) that ends within 50 ms
+/// before the impact.
+pub fn free_fall_before(spec: &str, impact_s: f64) -> Result<f64, String> {
+    let (path, column) = match spec.rsplit_once(':') {
+        Some((p, c)) if !p.is_empty() && !c.contains('/') => (
+            p,
+            Some(c.parse::<ColumnRef>().unwrap_or(ColumnRef::Name(c.into()))),
+        ),
+        _ => (spec, None),
+    };
+    let path = Path::new(path);
+    let table = read_table(path, &CsvFormat::default(), None).map_err(|e| e.to_string())?;
+    let tcol = table
+        .time_column(None)
+        .map_err(|e| format!("--free-fall {}: {e}", path.display()))?
+        .ok_or_else(|| format!("--free-fall {}: needs a time column", path.display()))?;
+    let unit = time_unit_s(&table.headers.get(tcol).cloned().unwrap_or_default(), None);
+    let time: Vec<f64> = table.columns[tcol].iter().map(|t| t * unit).collect();
+    let cols: Vec<usize> = match &column {
+        Some(c) => vec![table
+            .find(c, "column")
+            .map_err(|e| format!("--free-fall {}: {e}", path.display()))?],
+        None => (0..table.columns.len()).filter(|&c| c != tcol).collect(),
+    };
+    let mag = |i: usize| {
+        cols.iter()
+            .map(|&c| table.columns[c][i].powi(2))
+            .sum::<f64>()
+            .sqrt()
+    };
+    let end = time
+        .iter()
+        .rposition(|&t| t <= impact_s)
+        .ok_or("--free-fall: the DC channel starts after the impact")?;
+    // The DC channel must run up to the impact: a file that ends before it cannot tell when
+    // the fall ended.
+    let interval = (time[time.len() - 1] - time[0]) / (time.len().max(2) - 1) as f64;
+    if end + 1 == time.len() && impact_s - time[end] > 2.0 * interval {
+        return Err(format!(
+            "--free-fall {}: the DC channel ends at {:.6} s, before the impact at {:.6} s",
+            path.display(),
+            time[end],
+            impact_s
+        ));
+    }
+    // Walk back from the impact to the last free-falling sample, then to the release.
+    let mut i = end;
+    while i > 0 && mag(i) >= FREE_FALL_G && impact_s - time[i] < 0.05 {
+        i -= 1;
+    }
+    if mag(i) >= FREE_FALL_G {
+        return Err(
+            "--free-fall: no free fall (|a| < 0.5 g) within 50 ms before the impact".into(),
+        );
+    }
+    let last = i;
+    while i > 0 && mag(i - 1) < FREE_FALL_G {
+        i -= 1;
+    }
+    let dt = if last > 0 {
+        time[last] - time[last - 1]
+    } else {
+        0.0
+    };
+    // Free fall runs from half a sample before the first quiet sample to the impact.
+    let release = time[i] - dt / 2.0;
+    Ok(impact_s - release)
+}
+
+/// Below this magnitude (g) the DC channel is taken as free-falling.
+const FREE_FALL_G: f64 = 0.5;

@@ -1,0 +1,331 @@
+//! The analysis's options: the command line's (shared by `impact analyze` and `impact
+//! emulate`, in the help's sections), the scene file's, the bounce trains' and the spectra's;
+//! and what the readers take of them ([`AnalyzeArgs::read_options`]).
+
+use std::path::PathBuf;
+
+use clap::{Args, ValueEnum};
+use impact_core::signal::spectrum::SpectrumSettings;
+use impact_core::{Train, TrainSpeed};
+use serde::Deserialize;
+
+use crate::io::channel::{ColumnRef, CsvFormat, ReadOptions};
+pub use crate::io::units::{Level, Units};
+use crate::parse::positive_f64;
+
+/// A scene file (JSON): every field optional; command-line options override it. Its keys are
+/// the options' names (`mass`, `v0`, `trigger`, ...), in the options' units; the earlier
+/// spellings with the unit in the name (`mass_kg`, `v0_m_s`, `trigger_m_s2`, ...) are read too.
+#[derive(Clone, Debug, Default, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct SceneFile {
+    #[serde(alias = "mass_kg")]
+    pub mass: Option<f64>,
+    #[serde(alias = "v0_m_s")]
+    pub v0: Option<f64>,
+    #[serde(alias = "drop_height_m")]
+    pub drop_height: Option<f64>,
+    /// m/s², or a string with a unit (`"5g"`).
+    #[serde(alias = "trigger_m_s2")]
+    pub trigger: Option<Level>,
+    #[serde(alias = "edge_m_s2")]
+    pub edge: Option<Level>,
+    #[serde(alias = "hold_s")]
+    pub hold: Option<f64>,
+    #[serde(alias = "max_impact_s")]
+    pub max_impact: Option<f64>,
+    #[serde(alias = "settle_s")]
+    pub settle: Option<f64>,
+    pub cfc: Option<u32>,
+    pub units: Option<Units>,
+    /// The sensor's full scale (as `--range`): m/s², or a string with a unit (`"16g"`).
+    pub range: Option<Level>,
+    pub invert: Option<bool>,
+    pub fits: Option<FitsFile>,
+}
+
+/// Which fits to run (scene file).
+#[derive(Clone, Debug, Default, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct FitsFile {
+    pub two_phase: Option<bool>,
+    pub nonlinear: Option<bool>,
+    pub fit_exponent: Option<bool>,
+    pub exponent: Option<f64>,
+    pub hertz: Option<bool>,
+}
+
+/// Options shared by `analyze` and `emulate`, in the help's sections.
+#[derive(Args, Clone, Debug, Default)]
+pub struct AnalyzeArgs {
+    /// The recording: CSV (`-`: standard input), .ide, .wav, .npy, .tdms, raw .i16/.f32.
+    ///
+    /// A CSV file (`-`: standard input) with a header line (or lines) and numeric rows; an enDAQ `.ide` file; a WAV file (`.wav`: integer or float PCM); a numpy
+    /// array (`.npy`, with --rate: 1-D, or 2-D samples × channels); an NI TDMS file (`.tdms`);
+    /// a raw little-endian file (`.i16`, `.f32`, with --rate and --raw-channels).
+    pub file: PathBuf,
+    /// The channel: header name or 0-based index.
+    ///
+    /// A header name or 0-based index (a WAV or .npy channel, `group/channel` in
+    /// TDMS, `CH.SUB` or a subchannel's name in an .ide file) [default: the first column that
+    /// is not the time; a note names it when there are others].
+    #[arg(short = 'c', long, help_heading = "Input")]
+    pub column: Option<ColumnRef>,
+    /// Two or three axes (`x_g,y_g,z_g`): the resultant, with each axis's peak and Δv.
+    ///
+    /// Two or three axes (header names or indices, `x_g,y_g,z_g`): the pipeline runs on their
+    /// resultant (the trigger on |a|) and each impact reports every axis's peak and Δv.
+    /// The resultant's integral is not a velocity change, so Δv is per axis (and their
+    /// magnitude) and no approach speed applies.
+    #[arg(long, help_heading = "Input", value_delimiter = ',', conflicts_with_all = ["column", "invert", "v0", "drop_height", "free_fall", "train"])]
+    pub axes: Vec<ColumnRef>,
+    /// The time column [default: the column whose header starts with "time"].
+    #[arg(long, help_heading = "Input")]
+    pub time_column: Option<ColumnRef>,
+    /// The time column's unit [default: named in its header, else s].
+    ///
+    /// The time column's unit [default: the one its header names (`time_ms`, `time [us]`),
+    /// else s; a header naming none that read in s gives under 100 S/s is refused].
+    #[arg(long, help_heading = "Input", value_enum)]
+    pub time_unit: Option<crate::io::channel::TimeUnit>,
+    /// Sample rate, Hz (instead of a time column).
+    #[arg(short = 'r', long, help_heading = "Input", value_parser = positive_f64)]
+    pub rate: Option<f64>,
+    /// Interpolate an uneven time axis onto an even grid [default: refuse it].
+    ///
+    /// Interpolate an uneven time axis (gaps, rate changes) onto an even grid at the median
+    /// interval [default: refuse it, naming the line].
+    #[arg(long, help_heading = "Input", conflicts_with = "rate")]
+    pub resample: bool,
+    /// Field separator: one character, or `tab` [default: tab or `;` if the first lines hold
+    /// one, else `,`].
+    #[arg(long, help_heading = "Input", value_parser = crate::io::channel::parse_delimiter)]
+    pub delimiter: Option<u8>,
+    /// Numbers are written with a decimal comma (`0,5`); the delimiter must be another
+    /// character.
+    #[arg(long, help_heading = "Input")]
+    pub decimal_comma: bool,
+    /// Interleaved channels of a raw `.i16`/`.f32` file [default: 1].
+    #[arg(long, help_heading = "Input")]
+    pub raw_channels: Option<usize>,
+    /// The sample type of a raw stream without a `.i16`/`.f32` name (standard input).
+    #[arg(long, help_heading = "Input", value_enum)]
+    pub raw_type: Option<crate::io::channel::RawType>,
+    /// One pass as the recording is read (needs --range and --trigger).
+    ///
+    /// Analyse the recording (CSV, WAV, .npy, TDMS, raw `.i16`/`.f32`; CSV and raw also
+    /// from standard input) in one pass as it is read, in memory that does not grow with its
+    /// length; needs --range and --trigger (and --rate where the file holds no time); spikes
+    /// are not screened; no --plot, --axes, --free-fall, --resample. Without it a regular
+    /// file or standard input is read in passes (a survey of the whole recording, then the
+    /// analysis), also in bounded memory, with the levels learned and spikes screened; a
+    /// CSV's or standard input's values are kept from the first pass in a temporary file
+    /// (TMPDIR, 8 bytes a sample).
+    #[arg(long, help_heading = "Input")]
+    pub stream: bool,
+    /// Units of the channel [default: named in its header, else g].
+    ///
+    /// Units of the channel [default: the ones its header names (`x_g`, `bottom_kgn`,
+    /// `table_m_s2`, `force_n`), else g; units that contradict the header are refused].
+    #[arg(short = 'u', long, help_heading = "Channel", value_enum)]
+    pub units: Option<Units>,
+    /// Multiply the channel's values by this first (e.g. g per code of a WAV file's integer
+    /// samples) [default: 1].
+    #[arg(long, help_heading = "Channel", value_parser = positive_f64)]
+    pub gain: Option<f64>,
+    /// Negate the channel (by default a positive reading is a deceleration).
+    #[arg(long, help_heading = "Channel")]
+    pub invert: bool,
+    /// The sensor's full scale, in m/s² or with a unit (`16g`): clips at the rails.
+    ///
+    /// The sensor's full scale, in m/s² or with a unit (`16g`, `200kgn`, `500n`): readings at
+    /// the rail mark their impact clipped; a recording beyond twice the range is refused
+    /// [default: flat tops at the recording's extremes, more than 10 steps of its resolution
+    /// from its median, are taken for the rails].
+    #[arg(long, help_heading = "Channel", value_name = "LEVEL")]
+    pub range: Option<Level>,
+    /// Keep isolated glitches (by default removed, listed and flagged).
+    ///
+    /// Keep isolated one- or two-sample spikes that dwarf the rest of the recording (by
+    /// default they are removed, listed, and flag the impact they fall in).
+    #[arg(long, help_heading = "Channel")]
+    pub keep_spikes: bool,
+    /// Mass of the instrumented body, kg.
+    #[arg(short = 'm', long, help_heading = "Bench", value_parser = positive_f64)]
+    pub mass: Option<f64>,
+    /// Approach speed, m/s.
+    #[arg(long, help_heading = "Bench", conflicts_with_all = ["drop_height", "free_fall"], value_parser = positive_f64)]
+    pub v0: Option<f64>,
+    /// Drop height, m: v0 = sqrt(2 g h).
+    #[arg(long, help_heading = "Bench", conflicts_with = "free_fall", value_parser = positive_f64)]
+    pub drop_height: Option<f64>,
+    /// DC accelerometer file (g), optionally `:COLUMN`: v0 = g × free-fall time before the impact.
+    #[arg(long, help_heading = "Bench", value_name = "FILE[:COLUMN]")]
+    pub free_fall: Option<String>,
+    /// Scene file (JSON) with any of these options; options given here override it.
+    ///
+    /// Scene file (JSON, keys as these options: `{"mass": 0.06, "v0": 1.3357, "range":
+    /// "16g"}`); options given here override it.
+    #[arg(long, help_heading = "Bench")]
+    pub scene: Option<PathBuf>,
+    /// Trigger level above the baseline, in m/s² or with a unit (`5g`) [default: from the
+    /// signal's noise].
+    #[arg(long, help_heading = "Detection", value_name = "LEVEL")]
+    pub trigger: Option<Level>,
+    /// Edge level (onset, separation), in m/s² or with a unit [default: a fifth of the
+    /// trigger, at least 3 × the noise].
+    #[arg(long, help_heading = "Detection", value_name = "LEVEL")]
+    pub edge: Option<Level>,
+    /// Quiet time that ends an impact, s [default: 2 ms].
+    #[arg(long, help_heading = "Detection", value_parser = positive_f64)]
+    pub hold: Option<f64>,
+    /// How long a new level must last to be a level change, not an impact, s [default: 50 ms].
+    ///
+    /// How long a flat new level must last to be a level change (a DC channel's free fall
+    /// or rest), not an impact, s [default: 50 ms, at least the hold].
+    #[arg(long, help_heading = "Detection", value_parser = positive_f64)]
+    pub settle: Option<f64>,
+    /// Longest impact, s [default: 1 s].
+    ///
+    /// Longest impact, s: a signal away from its baseline longer is a stuck or drifting
+    /// sensor (`too-long`) [default: 1 s].
+    #[arg(long, help_heading = "Detection", value_parser = positive_f64)]
+    pub max_impact: Option<f64>,
+    /// Causal SAE J211 class on the live trigger path (ignores glitches shorter than the class).
+    #[arg(long, help_heading = "Detection")]
+    pub trigger_cfc: Option<u32>,
+    /// SAE J211 channel frequency class for the captured windows: 60, 180, 600 or 1000.
+    #[arg(long, help_heading = "Analysis")]
+    pub cfc: Option<u32>,
+    #[command(flatten)]
+    pub train: crate::pipeline::options::TrainArgs,
+    #[command(flatten)]
+    pub spectrum: crate::pipeline::options::SpectrumArgs,
+    /// Print one JSON object.
+    #[arg(short = 'j', long, help_heading = "Output", conflicts_with = "csv")]
+    pub json: bool,
+    /// Print one CSV row per impact.
+    #[arg(long, help_heading = "Output")]
+    pub csv: bool,
+    /// Draw acceleration, velocity and deformation with the fitted models into this SVG file.
+    #[arg(short = 'p', long, help_heading = "Output", value_name = "FILE.svg")]
+    pub plot: Option<PathBuf>,
+}
+
+impl AnalyzeArgs {
+    /// What the readers take of the options (they never see the command line).
+    pub fn read_options(&self, progress: Option<fn(f64)>) -> ReadOptions {
+        ReadOptions {
+            column: self.column.clone(),
+            axes: self.axes.clone(),
+            raw_channels: self.raw_channels,
+            raw_type: self.raw_type,
+            time_column: self.time_column.clone(),
+            rate_hz: self.rate,
+            time_unit: self.time_unit,
+            resample: self.resample,
+            format: CsvFormat {
+                delimiter: self.delimiter,
+                decimal_comma: self.decimal_comma,
+            },
+            progress,
+        }
+    }
+}
+
+/// The `--scene` file's settings (all defaults without one).
+pub fn scene_file(args: &AnalyzeArgs) -> Result<SceneFile, String> {
+    let Some(path) = &args.scene else {
+        return Ok(SceneFile::default());
+    };
+    let text = std::fs::read_to_string(path).map_err(|e| format!("{}: {e}", path.display()))?;
+    serde_json::from_str(&text).map_err(|e| format!("{}: {e}", path.display()))
+}
+
+/// Which measure of a bounce's approach speed the kinematics use.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
+pub enum SpeedArg {
+    /// `g t_flight / 2`, from the flight since the previous separation.
+    Flight,
+    /// The previous impact's rebound (`Δv - v0`).
+    Rebound,
+}
+
+/// `--train` options (flattened into `analyze` and `emulate`).
+#[derive(Args, Clone, Debug, Default)]
+pub struct TrainArgs {
+    /// Bounce trains: each bounce's v0 from its flight time or from the previous rebound.
+    ///
+    /// Bounce trains: each impact after the first of a drop takes its approach speed from the
+    /// flight time since the previous separation (`flight`, vertical flight under gravity
+    /// along the sensor's axis, no drag) or from the previous rebound (`rebound`); the first
+    /// impact takes --v0, --drop-height or --free-fall. Both speeds are reported.
+    #[arg(long, help_heading = "Analysis", value_enum)]
+    pub train: Option<SpeedArg>,
+    /// Gravity along the sensor's axis, m/s² [default: 9.80665].
+    #[arg(long, help_heading = "Analysis", requires = "train", value_parser = positive_f64)]
+    pub gravity: Option<f64>,
+    /// A flight longer than this starts a new train (a new drop), s [default: 2].
+    #[arg(long, help_heading = "Analysis", requires = "train", value_parser = positive_f64)]
+    pub max_flight: Option<f64>,
+}
+
+impl TrainArgs {
+    /// The scene's train settings, if asked for.
+    pub fn train(&self) -> Option<Train> {
+        let speed = match self.train? {
+            SpeedArg::Flight => TrainSpeed::Flight,
+            SpeedArg::Rebound => TrainSpeed::Rebound,
+        };
+        let d = Train::new();
+        Some(Train {
+            speed,
+            gravity_m_s2: self.gravity.map_or(d.gravity_m_s2, |g| g as f32),
+            max_flight_s: self.max_flight.map_or(d.max_flight_s, |t| t as f32),
+        })
+    }
+}
+
+/// Shock-spectrum options.
+#[derive(Args, Clone, Debug, Default)]
+pub struct SpectrumArgs {
+    /// Add each impact's SRS (maximax absolute acceleration), PVSS and enveloping half-sine.
+    #[arg(long, help_heading = "Analysis")]
+    pub srs: bool,
+    /// Damping ratio of the oscillators, in [0, 0.5].
+    #[arg(long, help_heading = "Analysis", default_value_t = 0.05, requires = "srs", value_parser = damping)]
+    pub srs_damping: f64,
+    /// Bands per octave: 6 or 12 (centres 1000 × 2^(k/n) Hz).
+    #[arg(long, help_heading = "Analysis", default_value_t = 6, requires = "srs", value_parser = per_octave)]
+    pub srs_bands: u32,
+    /// Lowest band, Hz (the highest is an eighth of the sample rate).
+    #[arg(long, help_heading = "Analysis", default_value_t = 10.0, requires = "srs", value_parser = crate::parse::positive_f64)]
+    pub srs_low: f64,
+}
+
+impl SpectrumArgs {
+    /// The scene's spectrum settings, if asked for.
+    pub fn settings(&self) -> Option<SpectrumSettings> {
+        self.srs.then_some(SpectrumSettings {
+            damping: self.srs_damping as f32,
+            bands_per_octave: self.srs_bands as u8,
+            low_hz: self.srs_low as f32,
+        })
+    }
+}
+
+fn per_octave(s: &str) -> Result<u32, String> {
+    match s {
+        "6" => Ok(6),
+        "12" => Ok(12),
+        _ => Err("must be 6 or 12".into()),
+    }
+}
+
+fn damping(s: &str) -> Result<f64, String> {
+    match s.parse::<f64>() {
+        Ok(v) if (0.0..=0.5).contains(&v) => Ok(v),
+        Ok(_) => Err("must lie in [0, 0.5]".into()),
+        Err(_) => Err("not a number".into()),
+    }
+}
