@@ -115,6 +115,41 @@ pub struct Setup {
 }
 
 impl Setup {
+    /// A setup of `samples` samples at `rate_hz` (the first at `t0`, s) of the channel
+    /// `column` in `units`, analysed with `scene`: no counts or signal kept, no glitches
+    /// removed, no rails known, no axes, not resampled (a whole-file read fills them in).
+    #[allow(clippy::too_many_arguments)]
+    pub fn new(
+        column: String,
+        units: Units,
+        calibration: Calibration,
+        t0: f64,
+        scene: Scene,
+        v0_source: Option<&str>,
+        samples: u64,
+        rate_hz: f64,
+    ) -> Self {
+        Self {
+            column: (!column.is_empty()).then_some(column),
+            units,
+            prepared: Prepared {
+                counts: Vec::new(),
+                calibration,
+                t0,
+                accel_m_s2: Vec::new(),
+            },
+            scene,
+            v0_source: v0_source.map(str::to_string),
+            free_fall_s: None,
+            samples,
+            rate_hz,
+            spikes: Vec::new(),
+            clipping: None,
+            resampled: false,
+            axes: Vec::new(),
+        }
+    }
+
     /// The signal the figure draws: the counts the pipeline analysed times the gain.
     pub fn plot_signal(&self) -> crate::plot::Signal<'_> {
         crate::plot::Signal {
@@ -193,25 +228,22 @@ pub fn setup(args: &AnalyzeArgs, progress: Option<fn(f64)>) -> Result<Setup, Str
         clipping.as_ref(),
         mass,
     )?;
-    let mut setup = Setup {
-        column: Some(ch.name.clone()),
+    let mut setup = Setup::new(
+        ch.name.clone(),
         units,
-        prepared: Prepared {
-            counts,
-            calibration,
-            t0,
-            accel_m_s2: accel,
-        },
+        calibration,
+        t0,
         scene,
-        v0_source: source.map(str::to_string),
-        free_fall_s: None,
-        samples: ch.values.len() as u64,
-        rate_hz: ch.rate_hz,
-        spikes,
-        clipping,
-        resampled: ch.resampled,
-        axes,
-    };
+        source,
+        ch.values.len() as u64,
+        ch.rate_hz,
+    );
+    setup.prepared.counts = counts;
+    setup.prepared.accel_m_s2 = accel;
+    setup.spikes = spikes;
+    setup.clipping = clipping;
+    setup.resampled = ch.resampled;
+    setup.axes = axes;
     if let Some(spec) = &args.free_fall {
         // First pass without v0 to find the first impact, then the free fall before it.
         let first = run(&setup.prepared.counts, &setup.scene)?;
@@ -324,21 +356,55 @@ pub(crate) fn build_scene(
     Ok((scene, source))
 }
 
-/// Runs the core pipeline over the counts (in blocks of 256, as the firmware's DMA halves).
+/// The core's monitor fed blocks of counts: the one analysis loop of every way of reading a
+/// recording (whole, in passes, a stream). Big (the capture buffers are inline): build it
+/// on a thread with a big stack ([`crate::on_big_stack`]).
+pub struct MonitorRun {
+    monitor: HostMonitor,
+    reports: Vec<ImpactReport>,
+    samples: u64,
+}
+
+impl MonitorRun {
+    pub fn new(scene: Scene) -> Result<Self, String> {
+        Ok(Self {
+            monitor: HostMonitor::new(scene).map_err(|e| e.to_string())?,
+            reports: Vec::new(),
+            samples: 0,
+        })
+    }
+
+    /// The next counts, in the board's blocks (any split gives the same reports).
+    pub fn push(&mut self, counts: &[i16]) {
+        let reports = &mut self.reports;
+        for block in counts.chunks(impact_core::board::BLOCK_LEN) {
+            self.monitor
+                .push_block(block, &mut |r: &ImpactReport| reports.push(*r));
+        }
+        self.samples += counts.len() as u64;
+    }
+
+    /// The stream has ended: the reports and the samples seen; an error if the signal never
+    /// gave a baseline.
+    pub fn finish(mut self) -> Result<(Vec<ImpactReport>, u64), String> {
+        let reports = &mut self.reports;
+        self.monitor
+            .finish(&mut |r: &ImpactReport| reports.push(*r));
+        if !self.monitor.is_armed() {
+            return Err("the signal never settled to a baseline (no quiet stretch of 64 samples within the edge level): give --edge".into());
+        }
+        Ok((self.reports, self.samples))
+    }
+}
+
+/// Analyses the counts of a whole recording.
 pub fn run(counts: &[i16], scene: &Scene) -> Result<Vec<ImpactReport>, String> {
     let scene = *scene;
     let counts = counts.to_vec();
-    crate::on_big_stack(move || -> Result<Vec<ImpactReport>, String> {
-        let mut m = HostMonitor::new(scene).map_err(|e| e.to_string())?;
-        let mut out = Vec::new();
-        for block in counts.chunks(256) {
-            m.push_block(block, &mut |r: &ImpactReport| out.push(*r));
-        }
-        m.finish(&mut |r: &ImpactReport| out.push(*r));
-        if !m.is_armed() {
-            return Err("the signal never settled to a baseline (no quiet stretch of 64 samples within the edge level): give --edge".into());
-        }
-        Ok(out)
+    crate::on_big_stack(move || {
+        let mut run = MonitorRun::new(scene)?;
+        run.push(&counts);
+        run.finish().map(|(reports, _)| reports)
     })
 }
 

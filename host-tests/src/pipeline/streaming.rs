@@ -22,7 +22,7 @@ use crate::io::sources::{read_head, Source, CHUNK};
 use crate::io::spool::{Axis, SpoolWriter};
 use crate::pipeline::screen::Removal;
 use crate::pipeline::survey::{self, Survey, Surveyed};
-use crate::pipeline::{self, AnalyzeArgs, HostMonitor, Prepared, Setup};
+use crate::pipeline::{self, AnalyzeArgs, MonitorRun, Setup};
 
 /// Reads and analyses `args.file` as a stream; the setup (without samples) and the reports.
 /// `progress` (a CSV's fraction read) for a bar on a terminal.
@@ -82,25 +82,17 @@ pub fn analyze(
         .map(|a| crate::quantise::to_count(*a, gain))
         .collect();
     let (reports, count, source) = run_monitor(source, head, (scale, gain), scene, Vec::new())?;
-    let setup = Setup {
-        column: (!column.is_empty()).then_some(column),
+    let mut setup = Setup::new(
+        column,
         units,
-        prepared: Prepared {
-            counts: Vec::new(),
-            calibration,
-            t0: source.t0(),
-            accel_m_s2: Vec::new(),
-        },
+        calibration,
+        source.t0(),
         scene,
-        v0_source: v0_source.map(str::to_string),
-        free_fall_s: None,
-        samples: count,
-        rate_hz: source.final_rate_hz(),
-        spikes: Vec::new(),
-        clipping: Some(clipping),
-        resampled: false,
-        axes: Vec::new(),
-    };
+        v0_source,
+        count,
+        source.final_rate_hz(),
+    );
+    setup.clipping = Some(clipping);
     Ok((setup, reports))
 }
 
@@ -203,25 +195,18 @@ pub fn analyze_in_passes(
         .collect();
     let (reports, count, _) = run_monitor(source, head, (scale, gain), scene, removals.clone())?;
     let spikes = removals.iter().map(|r| r.timed(t0, rate_hz)).collect();
-    let setup = Setup {
-        column: (!column.is_empty()).then_some(column),
+    let mut setup = Setup::new(
+        column,
         units,
-        prepared: Prepared {
-            counts: Vec::new(),
-            calibration,
-            t0,
-            accel_m_s2: Vec::new(),
-        },
+        calibration,
+        t0,
         scene,
-        v0_source: v0_source.map(str::to_string),
-        free_fall_s: None,
-        samples: count,
+        v0_source,
+        count,
         rate_hz,
-        spikes,
-        clipping: levels.clipping,
-        resampled: false,
-        axes: Vec::new(),
-    };
+    );
+    setup.spikes = spikes;
+    setup.clipping = levels.clipping;
     Ok((setup, reports))
 }
 
@@ -450,16 +435,11 @@ fn run_monitor(
     removals: Vec<Removal>,
 ) -> Result<Analysed, String> {
     crate::on_big_stack(move || {
-        let mut m = HostMonitor::new(scene).map_err(|e| e.to_string())?;
-        let mut out = Vec::new();
-        let mut total = 0u64;
+        let mut run = MonitorRun::new(scene)?;
         let mut patch = Patches::new(&removals);
         let mut take = |counts: &mut [i16]| {
             patch.counts(counts, gain);
-            for block in counts.chunks(256) {
-                m.push_block(block, &mut |r: &ImpactReport| out.push(*r));
-            }
-            total += counts.len() as u64;
+            run.push(counts);
             Ok(())
         };
         let mut head = head;
@@ -469,11 +449,8 @@ fn run_monitor(
             move |s, scratch, counts| s.next_counts(CHUNK, (scale, gain), scratch, counts),
             take,
         )?;
-        m.finish(&mut |r: &ImpactReport| out.push(*r));
-        if !m.is_armed() {
-            return Err("the signal never settled to a baseline (no quiet stretch of 64 samples within the edge level): give --edge".into());
-        }
-        Ok((out, total, source))
+        let (reports, total) = run.finish()?;
+        Ok((reports, total, source))
     })
 }
 
