@@ -1,26 +1,18 @@
 //! Host side of the impact monitor: the `impact` tool's building blocks, shared by the
 //! integration tests and the benchmarks.
 
-pub mod cases;
+pub mod bench;
 pub mod cli;
-pub mod compare;
 pub mod firmware_link;
 pub mod io;
-pub mod m4;
 pub mod parse;
 pub mod pipeline;
 pub mod plot;
-pub mod precision;
 pub mod quantise;
-pub mod realtime;
 pub mod report;
 pub mod simulate;
-pub mod soak;
-pub mod stability;
 pub mod synth;
-pub mod throughput;
-
-pub mod two_body_bench;
+pub mod testkit;
 
 /// Notes for the user, each once (a file read in passes is opened again for each pass).
 static NOTES: std::sync::Mutex<Vec<String>> = std::sync::Mutex::new(Vec::new());

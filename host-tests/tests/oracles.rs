@@ -2,9 +2,9 @@
 
 use impact_core::model::{Body, Hertz, KelvinVoigt, Linear, Model, Nonlinear, TwoPhase};
 use impact_core::{solve, ContactLaw, Error, Impact, ImpactOutcome, Method, Settings};
-use impact_host::cases::{self, Case};
-use impact_host::compare::{max_relative_error, widen};
 use impact_host::simulate::model_f32;
+use impact_host::testkit::cases::{self, Case};
+use impact_host::testkit::compare::{max_relative_error, widen};
 
 fn rel(got: f64, want: f64) -> f64 {
     ((got - want) / want).abs()

@@ -5,8 +5,8 @@ use impact_core::monitor::Monitor;
 use impact_core::{
     Approach, ContactLaw, FitSet, Impact, ImpactOutcome, ImpactReport, Scene, Status,
 };
-use impact_host::cases;
 use impact_host::synth::{record, DynLaw, Placed, Recording, Sensor};
+use impact_host::testkit::cases;
 
 type Bench = Monitor<4096, 32768>;
 
@@ -670,7 +670,7 @@ fn a_causal_trigger_filter_ignores_a_glitch_but_not_the_impact() {
 #[test]
 fn soak_1e8_samples_1e3_impacts_all_reported() {
     // The documented soak (`impact bench soak`) is 1e9 samples and 1e4 impacts; CI runs a tenth.
-    let r = impact_host::soak::run(100_000_000, 100_000, 500).unwrap();
+    let r = impact_host::bench::soak::run(100_000_000, 100_000, 500).unwrap();
     assert_eq!(r.samples, 100_000_000);
     assert_eq!(r.impacts_inserted, 1000);
     assert_eq!(r.impacts_reported, 1000);

@@ -1,6 +1,6 @@
 //! The stability sweep's bounds (the full table: `impact bench stability --full`).
 
-use impact_host::stability;
+use impact_host::bench::stability;
 
 #[test]
 fn every_result_is_finite_and_within_its_bound_or_reported_unresolved() {
@@ -29,7 +29,7 @@ fn every_result_is_finite_and_within_its_bound_or_reported_unresolved() {
 
 #[test]
 fn targets_from_a_feather_to_a_wall_stay_within_their_bounds() {
-    let rows = impact_host::two_body_bench::stability(false);
+    let rows = impact_host::bench::two_body::stability(false);
     assert!(rows.len() >= 16);
     for r in &rows {
         assert_eq!(r.non_finite, 0, "{r:?}");

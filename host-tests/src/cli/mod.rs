@@ -2,6 +2,9 @@
 //! and dispatches).
 
 pub mod analyze;
+pub mod bench;
 pub mod emulate;
 pub mod log;
 pub mod progress;
+pub mod simulate;
+pub mod synth;

@@ -10,7 +10,7 @@ use impact_core::model::{Body, Hertz, KelvinVoigt, Linear, Model, Nonlinear, Two
 use impact_core::{solve, Error, Impact, ImpactOutcome, Method, Real, Settings};
 use serde::Serialize;
 
-use crate::compare::widen;
+use crate::testkit::compare::widen;
 
 /// The contact laws the tool knows.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]

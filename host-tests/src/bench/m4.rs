@@ -19,8 +19,8 @@ use impact_core::model::{Hertz, KelvinVoigt, Linear, Nonlinear, TwoPhase};
 use impact_core::{solve, Impact, ImpactOutcome, Method, Model, Settings};
 use serde::{Deserialize, Serialize};
 
-use crate::cases::{self, Case};
-use crate::compare;
+use crate::testkit::cases::{self, Case};
+use crate::testkit::compare;
 
 /// CPU clock of the STM32F407 board, Hz.
 pub const BOARD_CLOCK_HZ: f64 = 168e6;
@@ -891,7 +891,7 @@ fn firmware_idle_marginal(firmware: &Path) -> Result<f64, String> {
     let dir = std::env::temp_dir();
     let mut totals = Vec::new();
     for n in [1usize << 17, 1 << 18] {
-        let counts = crate::throughput::impact_stream(n, 0);
+        let counts = crate::bench::throughput::impact_stream(n, 0);
         let raw = dir.join(format!("impact-m4-idle-{}-{n}.i16", std::process::id()));
         let bytes: Vec<u8> = counts.iter().flat_map(|c| c.to_le_bytes()).collect();
         std::fs::write(&raw, bytes).map_err(|e| format!("{}: {e}", raw.display()))?;

@@ -7,10 +7,10 @@ use impact_core::model::{Hertz, KelvinVoigt, Linear, Model, TwoPhase};
 use impact_core::two_body::{self, Target, TargetOutcome};
 use impact_core::{ContactLaw, Error, Impact, Method, Settings};
 
-use crate::precision::Point;
+use crate::bench::precision::Point;
+use crate::bench::stability::{stated_bound_on_target, Row};
 use crate::simulate::model_f32;
 use crate::simulate::two_body::{narrow, widen};
-use crate::stability::{stated_bound_on_target, Row};
 
 /// The fields compared: contact time, crush time, deformation, force, both velocities.
 fn fields(o: &TargetOutcome<f64>) -> [(&'static str, f64); 6] {

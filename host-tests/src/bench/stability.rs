@@ -6,8 +6,8 @@ use impact_core::model::{KelvinVoigt, Linear, Model, Nonlinear, TwoPhase};
 use impact_core::{solve, ContactLaw, Impact, Method, Settings};
 use serde::Serialize;
 
-use crate::compare::{max_relative_error, widen};
 use crate::simulate::model_f32;
+use crate::testkit::compare::{max_relative_error, widen};
 
 /// The bound each solver states, relative to the exact result (largest over the fields).
 pub fn stated_bound(method: Method, f32: bool, rtol: f64) -> f64 {

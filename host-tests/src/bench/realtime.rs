@@ -11,9 +11,9 @@ use impact_core::model::{Linear, TwoPhase};
 use impact_core::{Analysis, Approach, Calibration, FitSet, Impact, Scene};
 use serde::Serialize;
 
-use crate::cases;
 use crate::firmware_link::qemu::{self, Pacing};
 use crate::synth::{record, DynLaw, Placed, Sensor};
+use crate::testkit::cases;
 
 /// `impact bench realtime` options.
 #[derive(Args, Clone, Debug)]

@@ -7,9 +7,9 @@ use serde::Serialize;
 
 use plotters::prelude::*;
 
-use crate::cases::{self, Case};
-use crate::compare::{max_relative_error, widen};
 use crate::simulate::model_f32;
+use crate::testkit::cases::{self, Case};
+use crate::testkit::compare::{max_relative_error, widen};
 
 /// One benchmark point.
 #[derive(Clone, Debug, Serialize)]

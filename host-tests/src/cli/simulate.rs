@@ -1,0 +1,20 @@
+//! `impact simulate`: one impact of a contact model, on a wall or a target, as a table or
+//! JSON.
+
+use crate::simulate::{self, SimulateArgs};
+
+/// Runs `impact simulate`.
+pub fn run(args: &SimulateArgs) -> Result<(), String> {
+    fn json<T: serde::Serialize>(v: &T) -> Result<String, String> {
+        serde_json::to_string(v).map_err(|e| e.to_string())
+    }
+    match simulate::run_any(args)? {
+        simulate::Outcome::Wall(report) if args.json => println!("{}", json(&report)?),
+        simulate::Outcome::Wall(report) => print!("{}", simulate::table(&report)),
+        simulate::Outcome::Target(report) if args.json => println!("{}", json(&*report)?),
+        simulate::Outcome::Target(report) => {
+            print!("{}", simulate::two_body::table(&report))
+        }
+    }
+    Ok(())
+}

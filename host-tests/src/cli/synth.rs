@@ -1,0 +1,58 @@
+//! `impact synth`: a model impact rendered as an accelerometer recording, written as CSV
+//! (standard output or `--output`) and raw ADC codes (`--raw`).
+
+use std::path::PathBuf;
+
+use clap::Args;
+
+use crate::synth;
+
+/// `impact synth` options: the impact and the recording ([`synth::SynthArgs`]), and where
+/// they go.
+#[derive(Args, Debug)]
+pub struct SynthCommand {
+    #[command(flatten)]
+    pub args: Box<synth::SynthArgs>,
+    /// Write the CSV (time_s, accel_m_s2) to this file instead of standard output.
+    #[arg(short = 'o', long, help_heading = "Output", value_name = "FILE.csv")]
+    pub output: Option<PathBuf>,
+    /// Also write the raw ADC codes as little-endian i16 to this file (`impact analyze
+    /// FILE.i16 --rate ...` reads it).
+    #[arg(long, help_heading = "Output", value_name = "FILE.i16")]
+    pub raw: Option<PathBuf>,
+}
+
+/// Runs `impact synth`.
+pub fn run(command: SynthCommand) -> Result<(), String> {
+    let SynthCommand { args, output, raw } = command;
+    if let (Some(o), Some(r)) = (&output, &raw) {
+        if o == r {
+            return Err(format!("--output and --raw are both {}", o.display()));
+        }
+    }
+    let rec = synth::synth(&args)?;
+    if let Some(path) = raw {
+        let bytes: Vec<u8> = rec.samples.iter().flat_map(|c| c.to_le_bytes()).collect();
+        std::fs::write(&path, bytes).map_err(|e| format!("{}: {e}", path.display()))?;
+    }
+    match output {
+        Some(path) => {
+            let file =
+                std::fs::File::create(&path).map_err(|e| format!("{}: {e}", path.display()))?;
+            let mut out = std::io::BufWriter::with_capacity(1 << 16, file);
+            synth::write_csv(&rec, &args, &mut out)
+                .and_then(|()| std::io::Write::flush(&mut out))
+                .map_err(|e| format!("{}: {e}", path.display()))?;
+        }
+        None => {
+            let stdout = std::io::stdout().lock();
+            synth::write_csv(
+                &rec,
+                &args,
+                &mut std::io::BufWriter::with_capacity(1 << 16, stdout),
+            )
+            .map_err(|e| format!("stdout: {e}"))?;
+        }
+    }
+    Ok(())
+}
