@@ -1,0 +1,604 @@
+//! Cost of the core on the Cortex-M4F: runs the `m4-bench` firmware under QEMU (`impact bench m4`).
+//!
+//! Two runs of the same ELF (`firmware/src/bin/m4_bench.rs`):
+//!
+//! * **trace**: `qemu-system-arm -singlestep -d exec,nochain` logs every executed instruction;
+//!   the instructions between the firmware's `bench_begin` and `bench_end` marks are counted
+//!   exactly, per 256-sample `push_block` call, and weighed by the Cortex-M4's cycle timings
+//!   ([`cycles`]) for the estimated cycle count;
+//! * **count**: `-icount shift=0` (one virtual nanosecond per instruction) and SysTick, for the
+//!   regions too long to trace: per-impact fits, f32 solves, maths back-ends. Resolution: one
+//!   SysTick tick, 40 instructions (calibrated on a loop of known length each run).
+
+use std::collections::HashMap;
+use std::path::{Path, PathBuf};
+
+use impact_core::model::{Hertz, KelvinVoigt, Linear, Nonlinear, TwoPhase};
+use impact_core::{solve, Impact, ImpactOutcome, Method, Model, Settings};
+use serde::{Deserialize, Serialize};
+
+use crate::testkit::cases::{self, Case};
+use crate::testkit::compare;
+
+pub mod cycles;
+pub mod disasm;
+pub mod maths;
+pub mod report;
+pub mod trace;
+
+use disasm::disassemble;
+use maths::{host_math, math_error, maths};
+pub use report::{check, table};
+use trace::{profile_text, run_qemu, Region, TraceState};
+
+/// CPU clock of the STM32F407 board, Hz.
+pub const BOARD_CLOCK_HZ: f64 = 168e6;
+/// The seed experiment's sample rate, S/s.
+pub const SEED_RATE_HZ: f64 = 500e3;
+/// The STM32F4 ADC's top rate (12 bits, 2.4 MS/s with one ADC), S/s.
+pub const ADC_TOP_RATE_HZ: f64 = 2.4e6;
+/// Targets of the issue: instructions per sample, idle and inside an impact.
+pub const IDLE_TARGET: f64 = 10.0;
+pub const IMPACT_TARGET: f64 = 60.0;
+/// Per-impact targets (issue "analysis 20x cheaper"), instructions: the report without fits,
+/// the three fits with the exponent fixed together, the nonlinear fit with the exponent
+/// searched, and the board's whole analysis (report and its scene's fits).
+pub const REPORT_TARGET: u64 = 400_000;
+pub const THREE_FITS_TARGET: u64 = 2_000_000;
+pub const EXPONENT_FIT_TARGET: u64 = 3_000_000;
+pub const ANALYSIS_TARGET: u64 = 5_000_000;
+/// The shock spectra of one impact at 1/6 octave (issue: spectra per impact on the board).
+pub const SPECTRUM_TARGET: u64 = 5_000_000;
+/// The scene keys of the spectra the bench measures (SRS and PVSS, 5 %, 1/6 octave from
+/// 10 Hz: 76 bands at 500 kS/s).
+const SPECTRUM_KEYS: &str = "two_phase=0 nonlinear=0 hertz=0 srs=1";
+/// Accuracy the board's solves must reach (relative, every report field).
+pub const BOARD_ACCURACY: f64 = 1e-4;
+
+/// What `impact bench m4` measured.
+#[derive(Clone, Debug, Serialize, Deserialize)]
+pub struct M4Report {
+    /// Samples per `push_block` call (the firmware's DMA half-buffer).
+    pub block: usize,
+    /// Idle path: instructions per sample, everything in `push_block` included.
+    pub idle_instructions_per_sample: f64,
+    /// Inside an impact (capture, sums, end detection): instructions per sample.
+    pub impact_instructions_per_sample: f64,
+    /// Estimated Cortex-M4 cycles per sample, idle and in impact.
+    pub idle_cycles_per_sample: f64,
+    pub impact_cycles_per_sample: f64,
+    /// The worse of the two.
+    pub estimated_cycles_per_sample: f64,
+    /// CPU left for everything else at 500 kS/s and at the ADC's top rate (1 - used/budget).
+    pub headroom_at_500k: f64,
+    pub headroom_at_adc_top_rate: f64,
+    /// Per impact: the trigger (walk back to the onset, pre-trigger replay) and the report
+    /// (metrics and kinematics, no fit), instructions.
+    pub trigger_instructions: u64,
+    pub report_instructions: u64,
+    /// Samples in the measured impact's window.
+    pub impact_samples: u64,
+    /// Per-impact fits on the M4 (the captured impact above), instructions: each one alone
+    /// (the fit points it shares with the others included), and together.
+    pub fits: Vec<FitCost>,
+    /// The board's whole analysis of the impact: the report and its scene's fits (all three,
+    /// the exponent fitted), instructions.
+    #[serde(default)]
+    pub analysis_instructions: u64,
+    /// The shock spectra of the impact (SRS, PVSS, half-sine at 1/6 octave), instructions.
+    #[serde(default)]
+    pub spectrum_instructions: u64,
+    /// One impact of each model with each solver in f32 at [`BOARD_ACCURACY`].
+    pub solves: Vec<SolveCost>,
+    /// Maths back-ends: cost per call on the M4 and error against f64.
+    pub maths: Vec<MathCost>,
+    /// Instructions per SysTick tick in the count run (40 expected).
+    pub instructions_per_tick: f64,
+    /// The whole emulator firmware (sampler, channel, monitor, reporter, executor, SysTick
+    /// time driver), per idle sample: the difference between two idle recordings of 2^17
+    /// and 2^18 samples. Its sampler replays a host file through semihosting, which the
+    /// board's DMA does without the CPU.
+    #[serde(default)]
+    pub firmware_idle_instructions_per_sample: f64,
+}
+
+#[derive(Clone, Debug, Serialize, Deserialize)]
+pub struct FitCost {
+    pub fit: String,
+    pub instructions: u64,
+}
+
+#[derive(Clone, Debug, Serialize, Deserialize)]
+pub struct SolveCost {
+    pub case: String,
+    pub method: String,
+    /// Steps per time scale (fixed steps) or relative tolerance (adaptive); 0 for exact.
+    pub setting: f64,
+    /// Largest relative error of the f32 outcome over the report fields.
+    pub error: f64,
+    pub instructions: u64,
+    /// The M4's outcome has the same bits as the host's f32 solve.
+    pub same_bits_as_host: bool,
+}
+
+#[derive(Clone, Debug, Serialize, Deserialize)]
+pub struct MathCost {
+    pub op: String,
+    pub backend: String,
+    pub instructions_per_call: f64,
+    /// Largest relative error against f64 `libm` over the input range, and in ulp-free terms.
+    pub max_relative_error: f64,
+}
+
+/// Options of `impact bench m4`.
+#[derive(clap::Args, Clone, Debug)]
+pub struct M4Args {
+    /// Print JSON.
+    #[arg(long)]
+    pub json: bool,
+    /// Compare with a stored baseline (JSON from `--json`); fail if an instruction count
+    /// grew by more than 10 %.
+    #[arg(long)]
+    pub check: Option<PathBuf>,
+    /// The bench ELF (default: build it).
+    #[arg(long)]
+    pub elf: Option<PathBuf>,
+    /// Also print where the instructions go (functions, per path).
+    #[arg(long)]
+    pub profile: bool,
+}
+
+/// `key=value` fields of an output line.
+fn fields(line: &str) -> HashMap<&str, &str> {
+    line.split_whitespace()
+        .filter_map(|w| w.split_once('='))
+        .collect()
+}
+
+fn number<T: std::str::FromStr>(m: &HashMap<&str, &str>, key: &str) -> Result<T, String> {
+    m.get(key)
+        .and_then(|v| v.parse().ok())
+        .ok_or_else(|| format!("M4 bench output: no `{key}`"))
+}
+
+/// The seed bench impact (seed 001: 60 g at 1.3357 m/s, two-phase), 40 ms after the start of
+/// a 120 ms recording at 500 kS/s, 12-bit ADC codes.
+pub fn seed_recording() -> Result<Vec<i16>, String> {
+    use clap::Parser;
+    #[derive(Parser)]
+    struct Wrap {
+        #[command(flatten)]
+        synth: crate::synth::SynthArgs,
+    }
+    let args = ["synth"]
+        .into_iter()
+        .chain(crate::synth::SEED_BENCH_ARGS)
+        .chain(["--touch", "0.04", "--duration", "0.12"]);
+    let args = Wrap::try_parse_from(args).map_err(|e| e.to_string())?;
+    Ok(crate::synth::synth(&args.synth)?.samples)
+}
+
+/// The board's scene with the fits switched by `fits` (`key=value` overrides of
+/// `scene::BENCH` in the firmware).
+fn scene_line(fits: &str) -> String {
+    format!("scene {fits}")
+}
+
+const NO_FITS: &str = "two_phase=0 nonlinear=0 hertz=0";
+/// The name of the variant that is the board's scene (all three fits, the exponent fitted).
+const BOARD_FITS: &str = "the board's: all three, n fitted";
+const FIT_VARIANTS: [(&str, &str); 6] = [
+    ("two-phase", "two_phase=1 nonlinear=0 hertz=0"),
+    (
+        "nonlinear (n = 1 fixed)",
+        "two_phase=0 nonlinear=1 fit_exponent=0 hertz=0",
+    ),
+    (
+        "nonlinear (n fitted)",
+        "two_phase=0 nonlinear=1 fit_exponent=1 hertz=0",
+    ),
+    ("hertz", "two_phase=0 nonlinear=0 hertz=1"),
+    (
+        "two-phase + nonlinear (n fixed) + hertz",
+        "two_phase=1 nonlinear=1 fit_exponent=0 hertz=1",
+    ),
+    (BOARD_FITS, "two_phase=1 nonlinear=1 fit_exponent=1 hertz=1"),
+];
+
+/// The f32 model of a case and its parameters as the bench's `solve` job writes them.
+fn f32_model(model: &Model<f64>) -> (Model<f32>, String) {
+    let e = |v: f64| format!("{:e}", v as f32);
+    match *model {
+        Model::Hertz(h) => (
+            Model::Hertz(Hertz { k: h.k as f32 }),
+            format!("hertz {} 0 0 none", e(h.k)),
+        ),
+        Model::Linear(l) => (
+            Model::Linear(Linear { k: l.k as f32 }),
+            format!("linear {} 0 0 none", e(l.k)),
+        ),
+        Model::KelvinVoigt(k) => (
+            Model::KelvinVoigt(KelvinVoigt {
+                k: k.k as f32,
+                c: k.c as f32,
+            }),
+            format!("kelvin-voigt {} {} 0 none", e(k.k), e(k.c)),
+        ),
+        Model::TwoPhase(t) => (
+            Model::TwoPhase(TwoPhase {
+                kc: t.kc as f32,
+                kr: t.kr as f32,
+                c: t.c as f32,
+                permanent_m: t.permanent_m.map(|p| p as f32),
+            }),
+            format!(
+                "two-phase {} {} {} {}",
+                e(t.kc),
+                e(t.kr),
+                e(t.c),
+                t.permanent_m.map_or("none".into(), e)
+            ),
+        ),
+        Model::Nonlinear(n) => (
+            Model::Nonlinear(Nonlinear {
+                k: n.k as f32,
+                c: n.c as f32,
+                n: n.n as f32,
+            }),
+            format!("nonlinear {} {} {} none", e(n.k), e(n.c), e(n.n)),
+        ),
+    }
+}
+
+/// A setting of one solver that reaches [`BOARD_ACCURACY`] in f32 on the host, the cheapest
+/// on a ladder; `None` if none does.
+fn board_setting(
+    model: &Model<f32>,
+    impact: &Impact<f32>,
+    exact: &ImpactOutcome<f64>,
+    method: Method,
+) -> Option<(Settings<f32>, ImpactOutcome<f32>, f64)> {
+    let error = |s: &Settings<f32>| {
+        solve(model, impact, s).ok().map(|o| {
+            let e = compare::max_relative_error(&compare::widen(&o), exact).0;
+            (o, e)
+        })
+    };
+    let ladder: Vec<Settings<f32>> = match method {
+        Method::Exact => vec![Settings::exact()],
+        Method::Adaptive => (4..=14)
+            .map(|k| Settings::adaptive(10f32.powf(-(k as f32) / 2.0)))
+            .collect(),
+        m => (0..=40)
+            .map(|k| Settings::fixed(m, (8.0 * 2f64.powf(k as f64 / 2.0)).round() as u32))
+            .collect(),
+    };
+    ladder.into_iter().find_map(|s| {
+        let (o, e) = error(&s)?;
+        (e <= BOARD_ACCURACY).then_some((s, o, e))
+    })
+}
+
+fn bits(o: &ImpactOutcome<f32>) -> String {
+    [
+        o.max_deformation_m,
+        o.crush_time_s,
+        o.contact_time_s,
+        o.rebound_velocity_m_s,
+        o.peak_force_n,
+        o.permanent_deformation_m,
+    ]
+    .iter()
+    .map(|v| format!("{:08x}", v.to_bits()))
+    .collect::<Vec<_>>()
+    .join(",")
+}
+
+/// Builds the bench ELF with cargo (a no-op when up to date).
+fn build() -> Result<PathBuf, String> {
+    crate::firmware_link::qemu::build_firmware_bin("m4-bench", Some("m4-bench"))
+}
+
+/// Runs the whole benchmark (about a minute: the trace run dominates).
+pub fn run(args: &M4Args) -> Result<(M4Report, String), String> {
+    crate::firmware_link::qemu::tools_available()?;
+    let elf = match &args.elf {
+        Some(e) => e.clone(),
+        None => build()?,
+    };
+    let code = disassemble(&elf)?;
+    let samples = seed_recording()?;
+    let dir = std::env::temp_dir();
+    let nanos = std::time::SystemTime::now()
+        .duration_since(std::time::UNIX_EPOCH)
+        .map_or(0, |d| d.subsec_nanos());
+    let stem = format!("impact-m4-{}-{nanos}", std::process::id());
+    let raw = dir.join(format!("{stem}.i16"));
+    let bytes: Vec<u8> = samples.iter().flat_map(|c| c.to_le_bytes()).collect();
+    std::fs::write(&raw, bytes).map_err(|e| format!("{}: {e}", raw.display()))?;
+    let trace_jobs = dir.join(format!("{stem}-trace.txt"));
+    let count_jobs = dir.join(format!("{stem}-count.txt"));
+    let result = (|| {
+        std::fs::write(
+            &trace_jobs,
+            format!("selftest\n{}\nstream pipeline\n", scene_line(NO_FITS)),
+        )
+        .map_err(|e| e.to_string())?;
+        // Trace run: per-block regions.
+        let mut regions: Vec<Region> = Vec::new();
+        let mut profile: Vec<HashMap<String, u64>> = Vec::new();
+        let mut state = TraceState::default();
+        let mut on_line =
+            |line: &str| state.line(line, &code, &mut regions, &mut profile, args.profile);
+        let out = run_qemu(
+            &elf,
+            &["trace".into(), path_arg(&raw)?, path_arg(&trace_jobs)?],
+            Some(&mut on_line),
+            false,
+        )?;
+        if !out.lines().any(|l| l == "selftest ok") {
+            return Err(format!("the M4 self-test did not pass:\n{out}"));
+        }
+        let kinds: String = out
+            .lines()
+            .filter_map(|l| l.strip_prefix("kinds "))
+            .collect();
+        if kinds.len() != regions.len() {
+            return Err(format!(
+                "trace: {} regions for {} blocks",
+                regions.len(),
+                kinds.len()
+            ));
+        }
+        let stream = out
+            .lines()
+            .find(|l| l.starts_with("stream "))
+            .map(fields)
+            .ok_or("trace run: no stream line")?;
+        let n_samples: usize = number(&stream, "samples")?;
+        let block: usize = number(&stream, "block")?;
+        let reports: u32 = number(&stream, "reports")?;
+        if reports != 1 {
+            return Err(format!("the seed recording gave {reports} reports, not 1"));
+        }
+        let mut per_kind: HashMap<char, (Region, usize, u64)> = HashMap::new();
+        for (k, (kind, r)) in kinds.chars().zip(&regions).enumerate() {
+            let len = block.min(n_samples.saturating_sub(k * block)) as u64;
+            let e = per_kind.entry(kind).or_default();
+            e.0.instructions += r.instructions;
+            e.0.cycles += r.cycles;
+            e.1 += 1;
+            e.2 += len;
+        }
+        let get = |k: char| per_kind.get(&k).copied().unwrap_or_default();
+        let (idle, _, idle_n) = get('i');
+        let (active, _, active_n) = get('a');
+        let (trigger, _, trigger_n) = get('t');
+        let (end, _, end_n) = get('e');
+        if idle_n == 0 || active_n == 0 || trigger_n == 0 || end_n == 0 {
+            return Err(format!("trace: unexpected block kinds {kinds}"));
+        }
+        let per = |r: Region, n: u64| r.instructions as f64 / n as f64;
+        let per_c = |r: Region, n: u64| r.cycles as f64 / n as f64;
+        let idle_ips = per(idle, idle_n);
+        let impact_ips = per(active, active_n);
+        // The trigger and end blocks: their samples at the in-impact rate, the rest per impact.
+        let trigger_instructions =
+            (trigger.instructions as f64 - impact_ips * trigger_n as f64).max(0.0) as u64;
+        let report_instructions =
+            (end.instructions as f64 - impact_ips * end_n as f64).max(0.0) as u64;
+        let idle_cps = per_c(idle, idle_n);
+        let impact_cps = per_c(active, active_n);
+        let worst = idle_cps.max(impact_cps);
+
+        // Count run: fits, solves, maths.
+        let mut jobs = String::new();
+        jobs.push_str(&format!("{}\nstream no-fit\n", scene_line(NO_FITS)));
+        for (i, (_, keys)) in FIT_VARIANTS.iter().enumerate() {
+            jobs.push_str(&format!("{}\nstream fit{i}\n", scene_line(keys)));
+        }
+        jobs.push_str(&format!("{}\nstream srs\n", scene_line(SPECTRUM_KEYS)));
+        let mut solve_rows = Vec::new();
+        for case in solve_cases() {
+            let exact = solve(&case.model, &case.impact, &Settings::exact())
+                .map_err(|e| format!("{}: {e}", case.name))?;
+            let (model, params) = f32_model(&case.model);
+            let impact = Impact::new(case.impact.mass_kg as f32, case.impact.v0_m_s as f32);
+            for method in [
+                Method::Exact,
+                Method::Euler,
+                Method::Verlet,
+                Method::Rk4,
+                Method::Adaptive,
+            ] {
+                let Some((s, o, e)) = board_setting(&model, &impact, &exact, method) else {
+                    continue;
+                };
+                let knob = match method {
+                    Method::Exact => "0".to_string(),
+                    Method::Adaptive => format!("{:e}", s.rtol),
+                    _ => s.steps.to_string(),
+                };
+                let label = format!("s{}", solve_rows.len());
+                // Repeated so that SysTick's 40-instruction resolution stays below 0.1 %
+                // (Euler's solves are millions of instructions already).
+                let reps = if method == Method::Euler { 1 } else { 64 };
+                jobs.push_str(&format!(
+                    "solve {label} {reps} {} {knob} {:e} {:e} {params}\n",
+                    method.name(),
+                    impact.mass_kg,
+                    impact.v0_m_s
+                ));
+                let setting = match method {
+                    Method::Exact => 0.0,
+                    Method::Adaptive => s.rtol as f64,
+                    _ => s.steps as f64,
+                };
+                solve_rows.push((label, case.name, method, setting, e, bits(&o)));
+            }
+        }
+        let mut math_rows = Vec::new();
+        jobs.push_str("math none libm 0 1\n");
+        for (op, reference, range, backends) in maths() {
+            for b in backends {
+                jobs.push_str(&format!("math {op} {b} {:e} {:e}\n", range.0, range.1));
+                let f = host_math(op, b).ok_or("no host maths function")?;
+                math_rows.push((op, *b, math_error(f, reference, range)));
+            }
+        }
+        std::fs::write(&count_jobs, jobs).map_err(|e| e.to_string())?;
+        let out = run_qemu(
+            &elf,
+            &["count".into(), path_arg(&raw)?, path_arg(&count_jobs)?],
+            None,
+            true,
+        )?;
+        let lines: Vec<&str> = out.lines().collect();
+        let find = |prefix: &str| {
+            lines
+                .iter()
+                .find(|l| l.starts_with(prefix))
+                .map(|l| fields(l))
+                .ok_or_else(|| format!("count run: no `{prefix}` line"))
+        };
+        let cal = find("calibrate ")?;
+        let ipt = number::<f64>(&cal, "instructions")? / number::<f64>(&cal, "ticks")?;
+        let ticks_total = |label: &str| -> Result<f64, String> {
+            number::<f64>(&find(&format!("ticks {label} "))?, "total")
+        };
+        let base = ticks_total("no-fit")?;
+        let mut fits = Vec::new();
+        for (i, (name, _)) in FIT_VARIANTS.iter().enumerate() {
+            let s = find(&format!("stream fit{i} "))?;
+            let got: String = number(&s, "fits")?;
+            if !got.contains('1') {
+                return Err(format!("the {name} fit gave no result on the seed impact"));
+            }
+            fits.push(FitCost {
+                fit: name.to_string(),
+                instructions: ((ticks_total(&format!("fit{i}"))? - base) * ipt).max(0.0) as u64,
+            });
+        }
+        let spectrum_instructions = ((ticks_total("srs")? - base) * ipt).max(0.0) as u64;
+        let mut solves = Vec::new();
+        for (label, case, method, setting, error, host_bits) in solve_rows {
+            let s = find(&format!("solve {label} "))?;
+            let ok: u32 = number(&s, "ok")?;
+            let m4_bits = s.get("bits").copied().unwrap_or("");
+            solves.push(SolveCost {
+                case: case.to_string(),
+                method: method.name().to_string(),
+                setting,
+                error,
+                instructions: (number::<f64>(&s, "ticks")? * ipt / number::<f64>(&s, "reps")?)
+                    .round() as u64,
+                same_bits_as_host: ok == 1 && m4_bits == host_bits,
+            });
+        }
+        let loop_ticks = number::<f64>(&find("math none libm ")?, "ticks")?;
+        let mut maths_out = Vec::new();
+        for (op, b, err) in math_rows {
+            let m = find(&format!("math {op} {b} "))?;
+            let calls: f64 = number(&m, "calls")?;
+            let ticks: f64 = number(&m, "ticks")?;
+            maths_out.push(MathCost {
+                op: op.to_string(),
+                backend: b.to_string(),
+                instructions_per_call: ((ticks - loop_ticks) * ipt / calls).max(0.0),
+                max_relative_error: err,
+            });
+        }
+        let firmware = crate::firmware_link::qemu::build_firmware()?;
+        let firmware_idle = firmware_idle_marginal(&firmware)?;
+        let report = M4Report {
+            block,
+            idle_instructions_per_sample: idle_ips,
+            impact_instructions_per_sample: impact_ips,
+            idle_cycles_per_sample: idle_cps,
+            impact_cycles_per_sample: impact_cps,
+            estimated_cycles_per_sample: worst,
+            headroom_at_500k: 1.0 - worst / (BOARD_CLOCK_HZ / SEED_RATE_HZ),
+            headroom_at_adc_top_rate: 1.0 - worst / (BOARD_CLOCK_HZ / ADC_TOP_RATE_HZ),
+            trigger_instructions,
+            report_instructions,
+            impact_samples: trigger_n + active_n + end_n,
+            analysis_instructions: report_instructions
+                + fits
+                    .iter()
+                    .find(|f| f.fit == BOARD_FITS)
+                    .map_or(0, |f| f.instructions),
+            spectrum_instructions,
+            fits,
+            solves,
+            maths: maths_out,
+            instructions_per_tick: ipt,
+            firmware_idle_instructions_per_sample: firmware_idle,
+        };
+        let prof = if args.profile {
+            profile_text(&kinds, &profile)
+        } else {
+            String::new()
+        };
+        Ok((report, prof))
+    })();
+    for f in [&raw, &trace_jobs, &count_jobs] {
+        let _ = std::fs::remove_file(f);
+    }
+    result
+}
+
+/// Instructions the whole emulator firmware executes per idle sample (see
+/// [`M4Report::firmware_idle_instructions_per_sample`]).
+fn firmware_idle_marginal(firmware: &Path) -> Result<f64, String> {
+    let dir = std::env::temp_dir();
+    let mut totals = Vec::new();
+    for n in [1usize << 17, 1 << 18] {
+        let counts = crate::bench::throughput::impact_stream(n, 0);
+        let raw = dir.join(format!("impact-m4-idle-{}-{n}.i16", std::process::id()));
+        let bytes: Vec<u8> = counts.iter().flat_map(|c| c.to_le_bytes()).collect();
+        std::fs::write(&raw, bytes).map_err(|e| format!("{}: {e}", raw.display()))?;
+        let mut lines = 0u64;
+        let mut count = |_: &str| lines += 1;
+        // icount: SysTick (the time driver) then ticks with the instructions, not the wall
+        // clock, so the count is deterministic.
+        let result = run_qemu(
+            firmware,
+            &[path_arg(&raw)?, "lossless".into()],
+            Some(&mut count),
+            true,
+        );
+        let _ = std::fs::remove_file(&raw);
+        result?;
+        totals.push((n, lines));
+    }
+    let (n1, i1) = totals[0];
+    let (n2, i2) = totals[1];
+    Ok(i2.saturating_sub(i1) as f64 / (n2 - n1) as f64)
+}
+
+/// The cases solved on the M4: one per model (the standard set's first of each).
+fn solve_cases() -> Vec<Case> {
+    let mut seen = Vec::new();
+    cases::standard()
+        .into_iter()
+        .filter(|c| {
+            let kind = std::mem::discriminant(&c.model);
+            if seen.contains(&kind) {
+                false
+            } else {
+                seen.push(kind);
+                true
+            }
+        })
+        .collect()
+}
+
+fn path_arg(p: &Path) -> Result<String, String> {
+    let s = p.to_string_lossy().into_owned();
+    if s.contains([' ', ',']) {
+        return Err(format!(
+            "{s}: semihosting cannot pass a path with spaces or commas"
+        ));
+    }
+    Ok(s)
+}
