@@ -1,0 +1,224 @@
+//! A band's first pass: the recursion alone over blocks of [`BLOCK`] samples, each block
+//! marked with a bound on both responses over it, and the blocks' statistics.
+
+use super::*;
+
+/// Samples a band's recursion takes at a time: the largest `|y|` is kept per block, and
+/// only the block that holds it is run again to find the outputs around it.
+pub(super) const BLOCK: usize = 128;
+
+/// A band's input: a level's samples, or (without room for a pre-emphasised copy) the
+/// pre-emphasis of them computed as it goes, `len + 4` outputs.
+#[derive(Clone, Copy)]
+pub(super) enum Input<'a> {
+    Plain(&'a [f32]),
+    Emphasised(&'a [f32]),
+}
+
+impl Input<'_> {
+    pub(super) fn len(&self) -> usize {
+        match self {
+            Input::Plain(x) => x.len(),
+            Input::Emphasised(x) => x.len() + 4,
+        }
+    }
+
+    /// Sample `i` (0 beyond the end).
+    pub(super) fn at(&self, i: usize) -> f32 {
+        match self {
+            Input::Plain(x) => x.get(i).copied().unwrap_or(0.0),
+            Input::Emphasised(x) if i < x.len() + 4 => emphasised(x, i),
+            Input::Emphasised(_) => 0.0,
+        }
+    }
+
+    /// Samples `from..` (at most [`BLOCK`]): the slice itself, or computed into `buf`.
+    pub(super) fn block<'b>(&'b self, from: usize, buf: &'b mut [f32; BLOCK]) -> &'b [f32] {
+        let to = self.len().min(from + BLOCK);
+        match self {
+            Input::Plain(x) => x.get(from..to).unwrap_or(&[]),
+            Input::Emphasised(x) => {
+                let buf = buf.get_mut(..to.saturating_sub(from)).unwrap_or(&mut []);
+                for (k, slot) in buf.iter_mut().enumerate() {
+                    *slot = emphasised(x, from + k);
+                }
+                buf
+            }
+        }
+    }
+}
+
+/// Where one response's largest `|y|` came: its block, the recursion's state at the
+/// block's start and the output before it.
+#[derive(Clone, Copy, Default)]
+pub(super) struct Best {
+    pub(super) value: f32,
+    pub(super) from: usize,
+    pub(super) w1: f32,
+    pub(super) w2: f32,
+    pub(super) before: f32,
+}
+
+/// A bound on one response's `|y|` over a block from the recursion's state at its start.
+/// Over the block the input is the line `u + v m` through its first and last samples plus a
+/// rest `r`; the line alone drives `w` along `α + β m` (the recursion's particular
+/// solution), and the difference `e = w - α - β m` follows the recursion driven by `r`.
+/// With `p` the pole, `z = e1 - p̄ e2` evolves as `z ← p z + r` (`|p| <= 1`), and that part
+/// of `y` is `Re(g z)` for the state at the block's start plus the rest through the impulse
+/// response `h`: so `|y| <= |y_line| + |g| |z| + min(|b0| max|r| + |g| Σ|r|, ‖h‖ ‖r‖)`, with
+/// room for `f32` rounding.
+#[derive(Clone, Copy)]
+pub(super) struct Bound {
+    pub(super) a: [f32; 2],
+    /// `1 / (1 + a1 + a2)`: the recursion's gain at 0 Hz.
+    pub(super) inv_dc: f32,
+    /// The pole's real and imaginary parts.
+    pub(super) re: f32,
+    pub(super) im: f32,
+    /// Per response: the numerator, `|b0|`, `|g|` and the root sum of squares of the
+    /// impulse response's first [`BLOCK`] samples.
+    pub(super) num: [[f32; 3]; 2],
+    pub(super) direct: [f32; 2],
+    pub(super) gain: [f32; 2],
+    pub(super) energy: [f32; 2],
+}
+
+impl Bound {
+    /// The bound's constants for poles `a` and the numerators; `None` unless the poles are a
+    /// complex pair inside or on the unit circle, clear of 1.
+    pub(super) fn new([a1, a2]: [f32; 2], num: [[f32; 3]; 2]) -> Option<Self> {
+        let re = -0.5 * a1;
+        let im2 = a2 - re * re;
+        let dc = 1.0 + a1 + a2;
+        if !(im2 > 0.0 && a2 <= 1.0 && dc > 1e-4) {
+            return None;
+        }
+        let im = crate::real::fpu_sqrt(im2);
+        let gain = num.map(|[b0, b1, b2]| {
+            let (d1, d2) = (b1 - b0 * a1, b2 - b0 * a2);
+            let q = (d1 * re + d2) / im;
+            crate::real::fpu_sqrt(d1 * d1 + q * q)
+        });
+        let direct = num.map(|[b0, _, _]| b0.abs());
+        // The impulse response from rest (rounded up by far more than `f32` loses over it).
+        let energy = num.map(|[b0, b1, b2]| {
+            let (mut w1, mut w2, mut sum) = (0.0f32, 0.0f32, 0.0f32);
+            for k in 0..BLOCK {
+                let w = f32::from(u8::from(k == 0)) - a1 * w1 - a2 * w2;
+                let y = b0 * w + b1 * w1 + b2 * w2;
+                sum += y * y;
+                (w2, w1) = (w1, w);
+            }
+            crate::real::fpu_sqrt(sum) * 1.001
+        });
+        let ok = gain
+            .iter()
+            .chain(&direct)
+            .chain(&energy)
+            .all(|v| v.is_finite());
+        ok.then_some(Self {
+            a: [a1, a2],
+            inv_dc: 1.0 / dc,
+            re,
+            im,
+            num,
+            direct,
+            gain,
+            energy,
+        })
+    }
+
+    /// The largest `|y|` each response can reach over `block` (whose rest about its line
+    /// is `rest`) from state `(w1, w2)`.
+    pub(super) fn over(&self, w1: f32, w2: f32, block: &[f32], rest: Rest) -> [f32; 2] {
+        let (u, v) = line(block);
+        let [a1, a2] = self.a;
+        let beta = v * self.inv_dc;
+        let alpha = (u + beta * (a1 + 2.0 * a2)) * self.inv_dc;
+        let (e1, e2) = (w1 - (alpha - beta), w2 - (alpha - 2.0 * beta));
+        let (zr, zi) = (e1 - self.re * e2, self.im * e2);
+        let z = crate::real::fpu_sqrt(zr * zr + zi * zi);
+        let last = block.len().saturating_sub(1) as f32;
+        // The scale of `w` over the block, for the rounding of the recursion (at most 64
+        // steps of 4 operations) and of the outputs.
+        let scale = w1.abs() + w2.abs() + alpha.abs() + beta.abs() * (last + 2.0);
+        let eps = f32::EPSILON;
+        [0, 1].map(|k| {
+            let [b0, b1, b2] = self.num.get(k).copied().unwrap_or([f32::INFINITY; 3]);
+            let (d, g, h) = (
+                self.direct.get(k).copied().unwrap_or(f32::INFINITY),
+                self.gain.get(k).copied().unwrap_or(f32::INFINITY),
+                self.energy.get(k).copied().unwrap_or(f32::INFINITY),
+            );
+            let sum = b0 + b1 + b2;
+            let shift = beta * (b1 + 2.0 * b2);
+            let (y0, y1) = (
+                (sum * alpha - shift).abs(),
+                (sum * (alpha + beta * last) - shift).abs(),
+            );
+            // A comparison, not `f32::max` (a library call on the M4).
+            let y_line = if y1 > y0 { y1 } else { y0 };
+            let rounding = (g * 512.0 * eps + 8.0 * eps * (b0.abs() + b1.abs() + b2.abs())) * scale;
+            // The rest's part: by the triangle inequality, or by Cauchy–Schwarz.
+            let (by_sum, by_norm) = (d * rest.max + g * rest.sum, h * rest.norm);
+            let forced = if by_norm < by_sum { by_norm } else { by_sum };
+            1.002 * (y_line + g * z + forced) + rounding
+        })
+    }
+}
+
+/// The line `u + v m` through a block's first and last samples.
+pub(super) fn line(block: &[f32]) -> (f32, f32) {
+    match (block.first(), block.last()) {
+        (Some(&u), Some(&l)) if block.len() > 1 => (u, (l - u) / (block.len() - 1) as f32),
+        (Some(&u), _) => (u, 0.0),
+        _ => (0.0, 0.0),
+    }
+}
+
+/// One block's input about its [`line`]: `Σ|r|`, `max|r|` and `sqrt(Σ r²)`.
+#[derive(Clone, Copy, Default)]
+pub(super) struct Rest {
+    pub(super) sum: f32,
+    pub(super) max: f32,
+    pub(super) norm: f32,
+}
+
+impl Rest {
+    pub(super) const ZERO: Self = Self {
+        sum: 0.0,
+        max: 0.0,
+        norm: 0.0,
+    };
+}
+
+/// Blocks whose statistics a level keeps: 32 768 samples (the board's windows are shorter);
+/// blocks beyond are always computed.
+pub(super) const STAT_BLOCKS: usize = 128;
+
+/// Each block's [`Rest`] of a band's input.
+pub(super) fn rests(input: Input, out: &mut [Rest; STAT_BLOCKS]) {
+    let mut buf = [0.0f32; BLOCK];
+    for (k, slot) in out.iter_mut().enumerate() {
+        let from = k * BLOCK;
+        if from >= input.len() {
+            break;
+        }
+        let block = input.block(from, &mut buf);
+        let (u, v) = line(block);
+        let mut s = Rest::default();
+        let mut squares = 0.0f32;
+        for (m, &x) in block.iter().enumerate() {
+            let r = (x - (u + v * m as f32)).abs();
+            s.sum += r;
+            squares += r * r;
+            if r > s.max {
+                s.max = r;
+            }
+        }
+        // Rounded up a little: the sums in `f32`.
+        s.norm = crate::real::fpu_sqrt(squares) * 1.0001;
+        s.sum *= 1.0001;
+        *slot = s;
+    }
+}
