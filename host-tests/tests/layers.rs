@@ -360,8 +360,9 @@ fn the_firmware_library_and_binary_have_no_import_cycle() {
 }
 
 #[test]
-fn the_host_tool_has_no_import_cycle() {
+fn the_host_tool_and_its_readers_have_no_import_cycle() {
     assert_layered("host-tests/src/lib.rs");
+    assert_layered("host-tests/io/src/lib.rs");
     assert_layered("host-tests/src/bin/impact.rs");
 }
 

@@ -3,9 +3,9 @@
 
 use std::path::PathBuf;
 
-use impact_host::io::channel::ColumnRef;
 use impact_host::pipeline::{self, AnalyzeArgs, Level, Units};
 use impact_host::report::AnalysisJson;
+use impact_io::channel::ColumnRef;
 
 fn signals() -> PathBuf {
     PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("data")

@@ -106,7 +106,7 @@ fn a_half_sines_spectra_agree_with_endaq() {
     let (s, board, _) = spectra(AnalyzeArgs {
         file,
         units: Some(Units::MS2),
-        trigger: Some(impact_host::io::units::Level::m_s2(100.0)),
+        trigger: Some(impact_host::pipeline::level::Level::m_s2(100.0)),
         ..Default::default()
     });
     // The input quantised to i16 counts (0.03 m/s² steps) and the residual's largest value

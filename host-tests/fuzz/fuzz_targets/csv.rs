@@ -6,9 +6,9 @@
 
 use std::path::PathBuf;
 
-use impact_host::io::channel::CsvFormat;
-use impact_host::io::channel::ReadOptions;
-use impact_host::io::recording::read_csv;
+use impact_io::channel::CsvFormat;
+use impact_io::channel::ReadOptions;
+use impact_io::recording::read_csv;
 use libfuzzer_sys::fuzz_target;
 
 fn path() -> PathBuf {

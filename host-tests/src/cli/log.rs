@@ -9,8 +9,8 @@ use clap::Args;
 
 use crate::firmware_link::fields::{num, opt};
 use crate::firmware_link::log::{log_json, rate, LogReader};
-use crate::io::channel::is_stdin;
-use crate::io::table::MAX_LINE_BYTES;
+use impact_io::channel::is_stdin;
+use impact_io::table::MAX_LINE_BYTES;
 
 /// `impact log` options.
 #[derive(Args, Clone, Debug)]
@@ -55,7 +55,7 @@ fn finite_f64(s: &str) -> Result<f64, String> {
 /// `impact log`: a decoded firmware log as JSON (default) or CSV. The file (or stdin, `-`)
 /// is read line by line, each line at most [`MAX_LINE_BYTES`].
 pub fn log(args: &LogArgs) -> Result<(), String> {
-    let name = crate::io::channel::input_name(&args.file);
+    let name = impact_io::channel::input_name(&args.file);
     if let Some(path) = &args.plot {
         let mut inputs = vec![args.file.as_path()];
         inputs.extend(args.elf.as_deref());

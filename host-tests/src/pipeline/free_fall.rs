@@ -1,10 +1,10 @@
 //! The approach speed from a free fall measured on a DC channel before the impact
 //! (`--free-fall`).
 
-use crate::io::channel::time_unit_s;
-use crate::io::channel::ColumnRef;
-use crate::io::channel::CsvFormat;
-use crate::io::csv_read::read_table;
+use impact_io::channel::time_unit_s;
+use impact_io::channel::ColumnRef;
+use impact_io::channel::CsvFormat;
+use impact_io::csv_read::read_table;
 use std::path::Path;
 
 /// Free-fall time ending at or before `impact_s`, from a DC accelerometer file in g: the

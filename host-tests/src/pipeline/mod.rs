@@ -1,5 +1,5 @@
 //! A recorded signal through the same core pipeline the firmware runs: the options and the
-//! scene resolved ([`options`], [`build_scene`]), the recording read ([`crate::io`]), surveyed
+//! scene resolved ([`options`], [`build_scene`]), the recording read ([`impact_io`]), surveyed
 //! ([`survey`], [`histogram`]) and screened ([`screen`]), quantised to counts, and analysed
 //! by the core's monitor; whole, in passes or as a stream ([`streaming`]); the three axes'
 //! part ([`axes`]), the free fall ([`free_fall`]) and the spectra's reference ([`spectrum`]).
@@ -7,6 +7,7 @@
 pub mod axes;
 pub mod free_fall;
 pub mod histogram;
+pub mod level;
 pub mod options;
 pub mod screen;
 pub mod spectrum;
@@ -18,11 +19,11 @@ use impact_core::monitor::Monitor;
 use impact_core::signal::cfc::Cfc;
 use impact_core::{Approach, Calibration, FitSet, ImpactReport, Scene};
 
-use crate::io::read_recording;
 use crate::pipeline::free_fall::free_fall_before;
-use crate::quantise::to_count;
 use crate::report::fmt::shortest;
 use crate::report::{impact_json, AnalysisJson, Clipping, Spike, SPIKE_REMOVED};
+use impact_io::quantise::to_count;
+use impact_io::read_recording;
 pub use options::{scene_file, AnalyzeArgs, FitsFile, Level, SceneFile, Units};
 use survey::Survey;
 

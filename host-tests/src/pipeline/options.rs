@@ -9,9 +9,10 @@ use impact_core::signal::spectrum::SpectrumSettings;
 use impact_core::{Train, TrainSpeed};
 use serde::Deserialize;
 
-use crate::io::channel::{ColumnRef, CsvFormat, ReadOptions};
-pub use crate::io::units::{Level, Units};
+pub use super::level::Level;
 use crate::parse::positive_f64;
+use impact_io::channel::{ColumnRef, CsvFormat, ReadOptions};
+pub use impact_io::units::Units;
 
 /// A scene file (JSON): every field optional; command-line options override it. Its keys are
 /// the options' names (`mass`, `v0`, `trigger`, ...), in the options' units; the earlier
@@ -87,7 +88,7 @@ pub struct AnalyzeArgs {
     /// The time column's unit [default: the one its header names (`time_ms`, `time [us]`),
     /// else s; a header naming none that read in s gives under 100 S/s is refused].
     #[arg(long, help_heading = "Input", value_enum)]
-    pub time_unit: Option<crate::io::channel::TimeUnit>,
+    pub time_unit: Option<impact_io::channel::TimeUnit>,
     /// Sample rate, Hz (instead of a time column).
     #[arg(short = 'r', long, help_heading = "Input", value_parser = positive_f64)]
     pub rate: Option<f64>,
@@ -99,7 +100,7 @@ pub struct AnalyzeArgs {
     pub resample: bool,
     /// Field separator: one character, or `tab` [default: tab or `;` if the first lines hold
     /// one, else `,`].
-    #[arg(long, help_heading = "Input", value_parser = crate::io::channel::parse_delimiter)]
+    #[arg(long, help_heading = "Input", value_parser = impact_io::channel::parse_delimiter)]
     pub delimiter: Option<u8>,
     /// Numbers are written with a decimal comma (`0,5`); the delimiter must be another
     /// character.
@@ -110,7 +111,7 @@ pub struct AnalyzeArgs {
     pub raw_channels: Option<usize>,
     /// The sample type of a raw stream without a `.i16`/`.f32` name (standard input).
     #[arg(long, help_heading = "Input", value_enum)]
-    pub raw_type: Option<crate::io::channel::RawType>,
+    pub raw_type: Option<impact_io::channel::RawType>,
     /// One pass as the recording is read (needs --range and --trigger).
     ///
     /// Analyse the recording (CSV, WAV, .npy, TDMS, raw `.i16`/`.f32`; CSV and raw also

@@ -5,24 +5,24 @@
 //! - `impact analyze FILE` on a regular file or standard input ([`analyze_in_passes`]): a
 //!   survey of the whole recording ([`crate::pipeline::survey`]), then the analysis; the whole-file
 //!   path's reports. A CSV's or standard input's values are kept from the first pass for the
-//!   later ones in a temporary file ([`crate::io::spool`]), so a CSV is parsed once.
+//!   later ones in a temporary file ([`impact_io::spool`]), so a CSV is parsed once.
 //! - `impact analyze --stream` ([`analyze`]): one pass, with what needs the whole signal given
 //!   (`--range`, `--trigger`) or refused (spike screening is not done; figures, axes, free fall,
 //!   resampling); with the same levels, the same reports (tested).
 //!
 //! The per-sample arithmetic (units, gain, quantisation) is the whole-file path's. A reader
 //! thread reads ahead of the survey or the monitor; a CSV file's plain rows past the head are
-//! parsed in parallel ([`crate::io::csv_fast`]).
+//! parsed in parallel ([`impact_io::csv_fast`]).
 
 use impact_core::{Calibration, ImpactReport};
 
-use crate::io::channel::{input_name, is_stdin};
-use crate::io::open_source;
-use crate::io::sources::{read_head, Source, CHUNK};
-use crate::io::spool::{Axis, SpoolWriter};
 use crate::pipeline::screen::Removal;
 use crate::pipeline::survey::{self, Survey, Surveyed};
 use crate::pipeline::{self, AnalyzeArgs, MonitorRun, Setup};
+use impact_io::channel::{input_name, is_stdin};
+use impact_io::open_source;
+use impact_io::sources::{read_head, Source, CHUNK};
+use impact_io::spool::{Axis, SpoolWriter};
 
 /// Reads and analyses `args.file` as a stream; the setup (without samples) and the reports.
 /// `progress` (a CSV's fraction read) for a bar on a terminal.
@@ -56,7 +56,7 @@ pub fn analyze(
     let trigger = trigger.ok_or(
         "--stream: give --trigger (the level cannot be learned from a recording not yet read)",
     )?;
-    let gain = crate::quantise::gain_for(full_scale);
+    let gain = impact_io::quantise::gain_for(full_scale);
     let clipping = crate::pipeline::screen::from_range(full_scale);
     // The head: its noise sets the default edge level, a CSV's first intervals the rate; its
     // readings are checked against the range.
@@ -79,7 +79,7 @@ pub fn analyze(
     )?;
     let head: Vec<i16> = head
         .iter()
-        .map(|a| crate::quantise::to_count(*a, gain))
+        .map(|a| impact_io::quantise::to_count(*a, gain))
         .collect();
     let (reports, count, source) = run_monitor(source, head, (scale, gain), scene, Vec::new())?;
     let mut setup = Setup::new(
@@ -100,7 +100,7 @@ pub fn analyze(
 /// grow with its length, with the whole-file path's rules: a survey of the whole recording
 /// (its median, noise, extremes, flat tops and glitches, [`Survey`]), a second one if
 /// glitches were removed, then the analysis. The later passes read the first's values back
-/// from a spool ([`crate::io::spool`]: a CSV, standard input) or the file again. The same code
+/// from a spool ([`impact_io::spool`]: a CSV, standard input) or the file again. The same code
 /// as the whole-file path on the same values, so the same reports (tested); only the time
 /// axis is checked against the first intervals' median, as in a stream (the whole-file path
 /// takes the median of all of them).
@@ -191,7 +191,7 @@ pub fn analyze_in_passes(
     let head = read_head(&mut *source, scale)?;
     let head = head
         .iter()
-        .map(|a| crate::quantise::to_count(*a, gain))
+        .map(|a| impact_io::quantise::to_count(*a, gain))
         .collect();
     let (reports, count, _) = run_monitor(source, head, (scale, gain), scene, removals.clone())?;
     let spikes = removals.iter().map(|r| r.timed(t0, rate_hz)).collect();
@@ -368,11 +368,11 @@ type SurveyPass = (
     Option<Result<SpoolWriter, String>>,
 );
 
-/// Whether the first pass keeps the values for the later ones ([`crate::io::spool`]): standard
+/// Whether the first pass keeps the values for the later ones ([`impact_io::spool`]): standard
 /// input (read once) and a CSV file (its parse costs more than reading the spool).
 fn spooled(args: &AnalyzeArgs) -> bool {
     is_stdin(&args.file)
-        || crate::io::Format::of(&args.file, args.raw_type) == crate::io::Format::Csv
+        || impact_io::Format::of(&args.file, args.raw_type) == impact_io::Format::Csv
 }
 
 /// Runs `fill` on a reader thread a few chunks ahead of `take` (so memory stays bounded),
@@ -496,6 +496,8 @@ impl<'a> Patches<'a> {
 
     fn counts(&mut self, block: &mut [i16], gain: f64) {
         let len = block.len();
-        self.each(len, |i, v| block[i] = crate::quantise::to_count(v, gain));
+        self.each(len, |i, v| {
+            block[i] = impact_io::quantise::to_count(v, gain)
+        });
     }
 }

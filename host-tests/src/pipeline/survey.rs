@@ -216,7 +216,7 @@ pub fn levels(
         Some(fs) => Some(screen::from_range(fs)),
         None => s.flat_tops.clone(),
     };
-    let gain = crate::quantise::gain_for(range_m_s2.unwrap_or_else(|| s.peak_m_s2()));
+    let gain = impact_io::quantise::gain_for(range_m_s2.unwrap_or_else(|| s.peak_m_s2()));
     let (trigger, edge) = trigger_and_edge(s, gain, trigger, edge);
     Ok(Levels {
         clipping,

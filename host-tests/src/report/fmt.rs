@@ -1,18 +1,6 @@
 //! Numbers as a person reads them (the table) and settings in their own precision.
 
-/// `x` with `digits` significant digits, without trailing zeros (`1000000`, `19986.9`, `20`).
-pub fn sig(x: f64, digits: usize) -> String {
-    if x == 0.0 || !x.is_finite() {
-        return format!("{x}");
-    }
-    let decimals = (digits as i32 - 1 - x.abs().log10().floor() as i32).max(0) as usize;
-    let s = format!("{x:.decimals$}");
-    if s.contains('.') {
-        s.trim_end_matches('0').trim_end_matches('.').to_string()
-    } else {
-        s
-    }
-}
+pub use impact_io::channel::sig;
 
 /// An f32 setting as the f64 its decimal digits name (`0.05`, not `0.05000000074505806`).
 pub fn shortest(x: f32) -> f64 {

@@ -8,8 +8,8 @@ use std::path::Path;
 
 use tdms_rs::{DataType, PropertyValue, TdmsChannel, TdmsFile};
 
-use crate::io::channel::{evenly_sampled, Channel, ReadOptions};
-use crate::io::channel::{one_line, ColumnRef, RecordingError};
+use crate::channel::{evenly_sampled, Channel, ReadOptions};
+use crate::channel::{one_line, ColumnRef, RecordingError};
 
 /// True for a `.tdms` file name (any case).
 pub fn is_tdms(path: &Path) -> bool {

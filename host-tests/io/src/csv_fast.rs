@@ -2,7 +2,7 @@
 //! parsed on worker threads and handed on in order. It takes plain rows only (numbers and
 //! delimiters with white space around them, no quotes, no blank lines, the table's number of
 //! fields); at the first line it cannot take plainly it stops, and the sequential reader
-//! ([`crate::io::table::Rows::resume`]) goes on from that line, so every error and edge case
+//! ([`crate::table::Rows::resume`]) goes on from that line, so every error and edge case
 //! reads as in one pass.
 
 use std::collections::BTreeMap;
@@ -11,8 +11,8 @@ use std::sync::mpsc::{sync_channel, Receiver};
 use std::sync::{Arc, Mutex};
 use std::thread::JoinHandle;
 
-use crate::io::table::{is_reading, read_number, MAX_LINE_BYTES};
-use crate::io::tape::Tape;
+use crate::table::{is_reading, read_number, MAX_LINE_BYTES};
+use crate::tape::Tape;
 
 /// Bytes a chunk holds (up to the last line end in them).
 const CHUNK: usize = 1 << 20;
@@ -33,7 +33,7 @@ pub struct Layout {
     pub time_unit_s: f64,
     /// Check that each row's time follows the previous one's...
     pub increasing: bool,
-    /// ...by this median interval within [`crate::io::channel::INTERVAL_RANGE`] (if given).
+    /// ...by this median interval within [`crate::channel::INTERVAL_RANGE`] (if given).
     pub median_dt: Option<f64>,
     /// Keep every field of every row too ([`Parsed::fields`]), for a whole table.
     pub all: bool,
@@ -293,7 +293,7 @@ fn follows(time: f64, last: &mut Option<f64>, layout: &Layout) -> bool {
         t > l
             && layout
                 .median_dt
-                .is_none_or(|m| crate::io::channel::check_interval(t - l, m).is_ok())
+                .is_none_or(|m| crate::channel::check_interval(t - l, m).is_ok())
     });
     *last = Some(t);
     ok

@@ -3,17 +3,17 @@
 
 use std::path::Path;
 
-use crate::io::channel::{
+use crate::channel::{
     check_time, check_time_unit, time_unit_s, Channel, ReadOptions, RecordingError,
 };
-use crate::io::csv_read::read_table;
+use crate::csv_read::read_table;
 
 /// A resampled recording may hold at most this many times the file's samples (a long gap in
 /// a fast recording would otherwise fill the memory with interpolated nothing).
 const MAX_RESAMPLE_GROWTH: usize = 4;
 
 /// Linear interpolation of `(t, v)` onto `t0 + k / rate`.
-pub(crate) fn resample(
+pub fn resample(
     path: &Path,
     t: &[f64],
     v: &[f64],

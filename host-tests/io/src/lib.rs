@@ -1,13 +1,15 @@
 //! Reading recordings: a CSV (a file or standard input), .ide, .wav, .npy, TDMS or raw
 //! .i16/.f32 file, whole ([`read_recording`]) or a block at a time ([`open_source`]). The
 //! format is found in one place ([`Format`]) and both readers are chosen here, side by side.
-//! Below the pipeline: nothing here knows the command line or the analysis.
+//! Below the pipeline, a package of its own (`impact-io`), so that cargo holds the line:
+//! nothing here knows the command line or the analysis.
 
 pub mod channel;
 pub mod csv_fast;
 pub mod csv_read;
 pub mod ide;
 pub mod npy;
+pub mod quantise;
 pub mod raw;
 pub mod recording;
 pub mod sources;
@@ -23,8 +25,8 @@ use std::path::Path;
 pub use channel::{Channel, ColumnRef, CsvFormat, ReadOptions, RecordingError, TimeUnit};
 use sources::Source;
 
-/// A recording's format: by the file's extension ([`crate::io::wav`], [`crate::io::npy`],
-/// [`crate::io::tdms`], [`crate::io::raw`]), or raw if its sample type is given; CSV otherwise.
+/// A recording's format: by the file's extension ([`crate::wav`], [`crate::npy`],
+/// [`crate::tdms`], [`crate::raw`]), or raw if its sample type is given; CSV otherwise.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum Format {
     Raw(channel::RawType),
@@ -113,11 +115,7 @@ pub fn read_recording(path: &Path, opts: &ReadOptions) -> Result<Channel, Record
 }
 
 /// Opens the reader for the file's format.
-pub(crate) fn open_source(
-    path: &Path,
-    opts: &ReadOptions,
-    name: &str,
-) -> Result<Box<dyn Source>, String> {
+pub fn open_source(path: &Path, opts: &ReadOptions, name: &str) -> Result<Box<dyn Source>, String> {
     use sources::{CsvSource, IdeSource, NpySource, RawSource, TdmsSource, WavSource};
     Ok(match Format::of(path, opts.raw_type) {
         Format::Raw(kind) => Box::new(RawSource::open(path, opts, kind, name)?),
@@ -128,4 +126,25 @@ pub(crate) fn open_source(
         Format::Unsupported(what) => return Err(Format::refuse(what, name)),
         Format::Csv => Box::new(CsvSource::open(path, opts)?),
     })
+}
+
+/// Notes for the user, each once (a file read in passes is opened again for each pass).
+static NOTES: std::sync::Mutex<Vec<String>> = std::sync::Mutex::new(Vec::new());
+
+/// Keeps `note: MESSAGE` for stderr: the tool prints its notes after a run that succeeded
+/// ([`take_notes`]), so that an error stays one line.
+pub fn note(message: &str) {
+    if let Ok(mut notes) = NOTES.lock() {
+        if !notes.iter().any(|m| m == message) {
+            notes.push(message.to_string());
+        }
+    }
+}
+
+/// The notes kept so far (and forgets them).
+pub fn take_notes() -> Vec<String> {
+    NOTES
+        .lock()
+        .map(|mut n| std::mem::take(&mut *n))
+        .unwrap_or_default()
 }

@@ -4,8 +4,8 @@
 
 use std::path::Path;
 
-use crate::io::channel::{evenly_sampled, numbered_column, Channel, ReadOptions};
-use crate::io::channel::{one_line, RecordingError};
+use crate::channel::{evenly_sampled, numbered_column, Channel, ReadOptions};
+use crate::channel::{one_line, RecordingError};
 
 /// True for a `.wav` file name (any case).
 pub fn is_wav(path: &Path) -> bool {
@@ -37,10 +37,7 @@ enum Samples {
 
 impl WavChannel {
     /// Opens `path` and chooses the channel `column` (0-based, default 0).
-    pub fn open(
-        path: &Path,
-        column: Option<&crate::io::channel::ColumnRef>,
-    ) -> Result<Self, String> {
+    pub fn open(path: &Path, column: Option<&crate::channel::ColumnRef>) -> Result<Self, String> {
         let reader = hound::WavReader::open(path).map_err(|e| format!("WAV: {}", one_line(e)))?;
         let spec = reader.spec();
         let channels = usize::from(spec.channels);

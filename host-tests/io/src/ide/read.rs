@@ -7,10 +7,10 @@ use std::path::Path;
 use std::sync::mpsc;
 
 use super::IdeFile;
-use crate::io::channel::RecordingError;
-use crate::io::channel::{check_time, Channel, ColumnRef, ReadOptions};
-use crate::io::recording::resample;
-use crate::io::units::Units;
+use crate::channel::RecordingError;
+use crate::channel::{check_time, Channel, ColumnRef, ReadOptions};
+use crate::recording::resample;
+use crate::units::Units;
 
 /// True for a `.ide` file name (any case), or a file that starts with an EBML header whose
 /// DocType is `mide`.

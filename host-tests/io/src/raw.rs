@@ -6,13 +6,13 @@ use std::path::Path;
 
 use super::channel::RawType;
 
-use crate::io::channel::RecordingError;
-use crate::io::channel::{evenly_sampled, numbered_column, Channel, ReadOptions};
+use crate::channel::RecordingError;
+use crate::channel::{evenly_sampled, numbered_column, Channel, ReadOptions};
 
 impl RawType {
     /// The values at byte `at` of each `frame`-byte frame of `bytes` (whole frames), handed
     /// to `push`; a float that is not finite stops it: its frame's index and value.
-    pub(crate) fn decode(
+    pub fn decode(
         self,
         bytes: &[u8],
         frame: usize,
@@ -39,7 +39,7 @@ impl RawType {
         Ok(())
     }
 
-    pub(crate) fn bytes(self) -> usize {
+    pub fn bytes(self) -> usize {
         match self {
             RawType::I16 => 2,
             RawType::F32 => 4,

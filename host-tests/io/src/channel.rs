@@ -44,7 +44,7 @@ impl std::error::Error for RecordingError {}
 
 impl RecordingError {
     /// An error of the file as a whole (no line).
-    pub(crate) fn of(path: &Path, message: String) -> Self {
+    pub fn of(path: &Path, message: String) -> Self {
         Self {
             file: path.to_path_buf(),
             line: None,
@@ -154,7 +154,7 @@ pub struct ReadOptions {
 
 /// The 0-based channel `column` asks for among `count` numbered ones (default 0), or the
 /// message naming what the file has (`what`, e.g. "a WAV file's channels").
-pub(crate) fn numbered_column(
+pub fn numbered_column(
     column: Option<&ColumnRef>,
     count: usize,
     what: &str,
@@ -177,11 +177,7 @@ pub(crate) fn numbered_column(
 
 /// A channel of `values` sampled evenly at `rate_hz` from t = 0 (binary formats), or the
 /// message if it has fewer than two samples.
-pub(crate) fn evenly_sampled(
-    name: String,
-    values: Vec<f64>,
-    rate_hz: f64,
-) -> Result<Channel, String> {
+pub fn evenly_sampled(name: String, values: Vec<f64>, rate_hz: f64) -> Result<Channel, String> {
     if values.len() < 2 {
         return Err(format!("{} samples; at least 2", values.len()));
     }
@@ -198,7 +194,8 @@ pub(crate) fn evenly_sampled(
 }
 
 /// The unit of a time column (`--time-unit`).
-#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[cfg_attr(feature = "cli", derive(clap::ValueEnum))]
 pub enum TimeUnit {
     S,
     Ms,
@@ -254,24 +251,24 @@ pub fn check_time_unit(header: &str, given: Option<TimeUnit>, rate_hz: f64) -> R
     }
     Err(format!(
         "the time column {header:?} names no unit: read in seconds it gives {} S/s, too slow for an impact recording; if it is in ms or µs, give --time-unit ms (or us), or name the column time_ms (time_us)",
-        crate::report::fmt::sig(rate_hz, 4)
+        sig(rate_hz, 4)
     ))
 }
 
 /// Every sample interval must lie within this range of the median interval, or the time axis
 /// counts as uneven (a gap or a rate change). Jittered time stamps, as enDAQ's, stay within
 /// 0.6..1.25.
-pub(crate) const INTERVAL_RANGE: std::ops::RangeInclusive<f64> = 0.5..=1.5;
+pub const INTERVAL_RANGE: std::ops::RangeInclusive<f64> = 0.5..=1.5;
 
 /// The intervals whose median every interval is checked against: the first 65 535 (those
 /// among the first 65 536 rows, as a file read in passes or a stream has them at hand).
-pub(crate) const HEAD_INTERVALS: usize = (1 << 16) - 1;
+pub const HEAD_INTERVALS: usize = (1 << 16) - 1;
 
 /// Checks a time column: finite, strictly increasing and evenly sampled (every interval within
 /// [`INTERVAL_RANGE`] times the median of the first [`HEAD_INTERVALS`]). Returns `(rate,
 /// jitter)`; with `resample`, uneven intervals are allowed and the rate is the median
 /// interval's (of all of them).
-pub(crate) fn check_time(
+pub fn check_time(
     path: &Path,
     t: &[f64],
     resample: bool,
@@ -301,7 +298,7 @@ pub(crate) fn check_time(
     if !resample {
         let median = median_of(&dts[..dts.len().min(HEAD_INTERVALS)]);
         for (i, &dt) in dts.iter().enumerate() {
-            crate::io::channel::check_interval(dt, median).map_err(|m| at(i + 1, m))?;
+            crate::channel::check_interval(dt, median).map_err(|m| at(i + 1, m))?;
         }
         let dt = (t[t.len() - 1] - t[0]) / (t.len() - 1) as f64;
         let jitter = t
@@ -314,10 +311,10 @@ pub(crate) fn check_time(
     }
 }
 
-/// An interval `dt` within [`crate::io::channel::INTERVAL_RANGE`] times the median `median`.
-pub(crate) fn check_interval(dt: f64, median: f64) -> Result<(), String> {
+/// An interval `dt` within [`crate::channel::INTERVAL_RANGE`] times the median `median`.
+pub fn check_interval(dt: f64, median: f64) -> Result<(), String> {
     let ratio = dt / median;
-    if crate::io::channel::INTERVAL_RANGE.contains(&ratio) {
+    if crate::channel::INTERVAL_RANGE.contains(&ratio) {
         Ok(())
     } else {
         Err(format!(
@@ -329,7 +326,8 @@ pub(crate) fn check_interval(dt: f64, median: f64) -> Result<(), String> {
 }
 
 /// The sample type a raw file's extension names.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[cfg_attr(feature = "cli", derive(clap::ValueEnum))]
 pub enum RawType {
     I16,
     F32,
@@ -344,5 +342,19 @@ impl RawType {
             "f32" => Some(RawType::F32),
             _ => None,
         }
+    }
+}
+
+/// `x` with `digits` significant digits, without trailing zeros (`1000000`, `19986.9`, `20`).
+pub fn sig(x: f64, digits: usize) -> String {
+    if x == 0.0 || !x.is_finite() {
+        return format!("{x}");
+    }
+    let decimals = (digits as i32 - 1 - x.abs().log10().floor() as i32).max(0) as usize;
+    let s = format!("{x:.decimals$}");
+    if s.contains('.') {
+        s.trim_end_matches('0').trim_end_matches('.').to_string()
+    } else {
+        s
     }
 }

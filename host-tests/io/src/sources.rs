@@ -1,5 +1,5 @@
 //! The readers a recording is taken from a block at a time, one per format (CSV, WAV, .npy,
-//! TDMS, raw), for a file read in passes or a stream ([`crate::pipeline::streaming`]): values as they
+//! TDMS, raw), for a file read in passes or a stream (`impact_host::pipeline::streaming`): values as they
 //! are read, the rate, the first time, and a CSV's checks as the whole-file path makes them.
 
 use std::io::Read;
@@ -14,14 +14,14 @@ use super::table::Rows;
 
 /// Samples whose noise sets the default edge level (the whole-file path uses the whole
 /// recording's): the first 65 536.
-pub(crate) const HEAD: usize = 1 << 16;
+pub const HEAD: usize = 1 << 16;
 
 /// Bytes read at a time.
-pub(crate) const CHUNK: usize = 1 << 16;
+pub const CHUNK: usize = 1 << 16;
 
 /// The first [`HEAD`] values × `scale` (fewer if the input is shorter); then what the head
 /// tells is fixed ([`Source::head_read`]).
-pub(crate) fn read_head(source: &mut dyn Source, scale: f64) -> Result<Vec<f64>, String> {
+pub fn read_head(source: &mut dyn Source, scale: f64) -> Result<Vec<f64>, String> {
     let mut head = Vec::with_capacity(HEAD);
     while head.len() < HEAD {
         let before = head.len();
@@ -38,7 +38,7 @@ pub(crate) fn read_head(source: &mut dyn Source, scale: f64) -> Result<Vec<f64>,
 }
 
 /// Where the stream's values come from.
-pub(crate) trait Source: Send {
+pub trait Source: Send {
     /// Appends up to about `want` values to `out` (none at the end of the input).
     fn next_values(&mut self, want: usize, out: &mut Vec<f64>) -> Result<(), String>;
     /// Appends up to about `want` values to `out` as counts (`to_count(v × scale, gain)`),
@@ -93,7 +93,7 @@ fn values_as_counts<S: Source + ?Sized>(
 }
 
 /// A raw file or stream: the chosen channel of interleaved little-endian frames.
-pub(crate) struct RawSource {
+pub struct RawSource {
     input: Box<dyn Read + Send>,
     kind: RawType,
     /// Bytes per frame (all channels) and the channel's offset in it.
@@ -111,7 +111,7 @@ pub(crate) struct RawSource {
 }
 
 impl RawSource {
-    pub(crate) fn open(
+    pub fn open(
         path: &Path,
         opts: &ReadOptions,
         kind: RawType,
@@ -130,7 +130,7 @@ impl RawSource {
         if !(1..=64).contains(&channels) {
             return Err(format!("--raw-channels {channels}: must lie in 1..=64"));
         }
-        let column = crate::io::channel::numbered_column(
+        let column = crate::channel::numbered_column(
             opts.column.as_ref(),
             channels,
             &format!("the stream's {channels} interleaved channels"),
@@ -246,8 +246,8 @@ impl RawSource {
 }
 
 /// A CSV file or stream: the channel's column, and the time column (or `--rate`), row by
-/// row, with the whole-file reader's checks ([`crate::io::table::Rows`]).
-pub(crate) struct CsvSource {
+/// row, with the whole-file reader's checks ([`crate::table::Rows`]).
+pub struct CsvSource {
     /// The sequential reader, handing plain rows past the head to the parallel one.
     reader: Handover,
     /// One row's values (reused).
@@ -257,7 +257,7 @@ pub(crate) struct CsvSource {
     /// The channel's header; the time column's, and its unit if given.
     column: String,
     time_header: String,
-    time_unit: Option<crate::io::channel::TimeUnit>,
+    time_unit: Option<crate::channel::TimeUnit>,
     /// The time column and its unit, s.
     time: Option<(usize, f64)>,
     /// `--rate`, if given.
@@ -282,14 +282,14 @@ pub(crate) struct CsvSource {
 }
 
 impl CsvSource {
-    pub(crate) fn open(path: &Path, opts: &ReadOptions) -> Result<Self, String> {
-        let format = crate::io::channel::CsvFormat {
+    pub fn open(path: &Path, opts: &ReadOptions) -> Result<Self, String> {
+        let format = crate::channel::CsvFormat {
             delimiter: opts.format.delimiter,
             decimal_comma: opts.format.decimal_comma,
         };
-        let mut rows = crate::io::table::Rows::open(path, &format, opts.progress)
-            .map_err(|e| e.to_string())?;
-        let name = crate::io::channel::input_name(path);
+        let mut rows =
+            crate::table::Rows::open(path, &format, opts.progress).map_err(|e| e.to_string())?;
+        let name = crate::channel::input_name(path);
         let err = |m: String| format!("{name}: {m}");
         // The first data row gives the columns their number (the header their names).
         let (line, first) = match rows.next_row().map_err(|e| e.to_string())? {
@@ -323,16 +323,11 @@ impl CsvSource {
         let time_header = tcol
             .and_then(|t| shape.headers.get(t).cloned())
             .unwrap_or_default();
-        let time = tcol.map(|t| {
-            (
-                t,
-                crate::io::channel::time_unit_s(&time_header, opts.time_unit),
-            )
-        });
+        let time = tcol.map(|t| (t, crate::channel::time_unit_s(&time_header, opts.time_unit)));
         let column = shape.headers.get(channel).cloned().unwrap_or_default();
         let mut source = Self {
             // The head is read row by row; the parallel reader may take over right after it.
-            reader: Handover::new(rows, crate::io::csv_fast::SEQUENTIAL_ROWS, opts.progress),
+            reader: Handover::new(rows, crate::csv_fast::SEQUENTIAL_ROWS, opts.progress),
             row: Vec::new(),
             name,
             channel,
@@ -522,7 +517,7 @@ impl Source for CsvSource {
             let rate = (self.n - 1) as f64 / (self.last - t0);
             self.head_rate = (rate.is_finite() && rate > 0.0).then_some(rate);
             if let (Some(rate), None) = (self.head_rate, self.rate_given) {
-                crate::io::channel::check_time_unit(&self.time_header, self.time_unit, rate)
+                crate::channel::check_time_unit(&self.time_header, self.time_unit, rate)
                     .map_err(|m| format!("{}: {m}", self.name))?;
             }
         }
@@ -562,10 +557,10 @@ impl Source for CsvSource {
 }
 
 /// An `.ide` file's subchannel, read block by block on a thread of its own
-/// ([`crate::io::ide::Blocks`]), on the recorder's time stamps: the rate from the head's, every
+/// ([`crate::ide::Blocks`]), on the recorder's time stamps: the rate from the head's, every
 /// interval checked against the head's median as a CSV's are.
-pub(crate) struct IdeSource {
-    blocks: crate::io::ide::Blocks,
+pub struct IdeSource {
+    blocks: crate::ide::Blocks,
     name: String,
     column: String,
     /// Values of the current block not yet handed on.
@@ -579,18 +574,18 @@ pub(crate) struct IdeSource {
 }
 
 impl IdeSource {
-    pub(crate) fn open(path: &Path, opts: &ReadOptions, name: &str) -> Result<Self, String> {
+    pub fn open(path: &Path, opts: &ReadOptions, name: &str) -> Result<Self, String> {
         if opts.rate_hz.is_some() || opts.time_column.is_some() {
             return Err(format!(
                 "{name}: an .ide file's samples carry their own time stamps: no --rate or --time-column"
             ));
         }
-        let file = crate::io::ide::IdeFile::open(path).map_err(|e| format!("{name}: {e}"))?;
-        let pick = crate::io::ide::pick(&file, opts.column.as_ref(), &[])
+        let file = crate::ide::IdeFile::open(path).map_err(|e| format!("{name}: {e}"))?;
+        let pick = crate::ide::pick(&file, opts.column.as_ref(), &[])
             .map_err(|e| format!("{name}: {e}"))?;
         drop(file);
         Ok(Self {
-            blocks: crate::io::ide::Blocks::start(path, pick.channel, pick.subs[0]),
+            blocks: crate::ide::Blocks::start(path, pick.channel, pick.subs[0]),
             name: name.to_string(),
             column: pick.names[0].clone(),
             pending: std::collections::VecDeque::new(),
@@ -688,20 +683,20 @@ impl Source for IdeSource {
     }
 }
 
-/// A WAV file's channel ([`crate::io::wav::WavChannel`], read as it goes).
-pub(crate) struct WavSource {
-    channel: crate::io::wav::WavChannel,
+/// A WAV file's channel ([`crate::wav::WavChannel`], read as it goes).
+pub struct WavSource {
+    channel: crate::wav::WavChannel,
     name: String,
 }
 
 impl WavSource {
-    pub(crate) fn open(path: &Path, opts: &ReadOptions, name: &str) -> Result<Self, String> {
+    pub fn open(path: &Path, opts: &ReadOptions, name: &str) -> Result<Self, String> {
         if opts.rate_hz.is_some() || opts.time_column.is_some() {
             return Err(format!(
                 "{name}: a WAV file gives its own rate: no --rate or --time-column"
             ));
         }
-        let channel = crate::io::wav::WavChannel::open(path, opts.column.as_ref())
+        let channel = crate::wav::WavChannel::open(path, opts.column.as_ref())
             .map_err(|e| format!("{name}: {e}"))?;
         Ok(Self {
             channel,
@@ -725,8 +720,8 @@ impl Source for WavSource {
 
 /// An .npy array's column: every `cols`-th element from `column` on (C order), or the
 /// `rows` elements after `column × rows` (Fortran order), as npyz reads them.
-pub(crate) struct NpySource {
-    elements: crate::io::npy::Elements,
+pub struct NpySource {
+    elements: crate::npy::Elements,
     rows: u64,
     cols: u64,
     column: u64,
@@ -739,7 +734,7 @@ pub(crate) struct NpySource {
 }
 
 impl NpySource {
-    pub(crate) fn open(path: &Path, opts: &ReadOptions, name: &str) -> Result<Self, String> {
+    pub fn open(path: &Path, opts: &ReadOptions, name: &str) -> Result<Self, String> {
         let rate_hz = opts
             .rate_hz
             .ok_or_else(|| format!("{name}: an .npy array holds no time: give --rate"))?;
@@ -752,9 +747,9 @@ impl NpySource {
             ));
         }
         let (elements, shape, order) =
-            crate::io::npy::open_elements(path).map_err(|e| format!("{name}: {e}"))?;
-        let (rows, cols, column) = crate::io::npy::layout(&shape, opts.column.as_ref())
-            .map_err(|e| format!("{name}: {e}"))?;
+            crate::npy::open_elements(path).map_err(|e| format!("{name}: {e}"))?;
+        let (rows, cols, column) =
+            crate::npy::layout(&shape, opts.column.as_ref()).map_err(|e| format!("{name}: {e}"))?;
         let column = column as u64;
         Ok(Self {
             elements,
@@ -809,20 +804,20 @@ impl Source for NpySource {
     }
 }
 
-/// A TDMS file's channel ([`crate::io::tdms::TdmsStream`], a range at a time).
-pub(crate) struct TdmsSource {
-    stream: crate::io::tdms::TdmsStream,
+/// A TDMS file's channel ([`crate::tdms::TdmsStream`], a range at a time).
+pub struct TdmsSource {
+    stream: crate::tdms::TdmsStream,
     name: String,
 }
 
 impl TdmsSource {
-    pub(crate) fn open(path: &Path, opts: &ReadOptions, name: &str) -> Result<Self, String> {
+    pub fn open(path: &Path, opts: &ReadOptions, name: &str) -> Result<Self, String> {
         if opts.time_column.is_some() {
             return Err(format!(
                 "{name}: a TDMS file takes --column (group/channel) and --rate only"
             ));
         }
-        let stream = crate::io::tdms::TdmsStream::open(path, opts.column.as_ref(), opts.rate_hz)
+        let stream = crate::tdms::TdmsStream::open(path, opts.column.as_ref(), opts.rate_hz)
             .map_err(|e| e.to_string())?;
         Ok(Self {
             stream,

@@ -6,12 +6,12 @@ use std::io::{self, BufRead, BufReader, Read};
 use std::path::Path;
 use std::sync::Arc;
 
-use crate::io::channel::is_stdin;
-use crate::io::channel::words;
-use crate::io::channel::ColumnRef;
-use crate::io::channel::CsvFormat;
-use crate::io::channel::RecordingError;
-use crate::io::tape::Tape;
+use crate::channel::is_stdin;
+use crate::channel::words;
+use crate::channel::ColumnRef;
+use crate::channel::CsvFormat;
+use crate::channel::RecordingError;
+use crate::tape::Tape;
 
 /// Longest record (line) read, bytes: a file without line breaks (`/dev/zero`) or with an
 /// unclosed quote is an error, not a memory blow-up.
@@ -30,7 +30,7 @@ pub struct Table {
     pub first_data_line: u64,
     /// `(row, line)` wherever a data row is not on the line after the previous one (blank
     /// lines or quoted line breaks in between), so rows map back to lines.
-    pub(crate) breaks: Vec<(usize, u64)>,
+    pub breaks: Vec<(usize, u64)>,
 }
 
 impl Table {
@@ -197,7 +197,7 @@ fn parse_number(field: &[u8]) -> Option<f64> {
 
 /// A trimmed field's number, its decimal commas read as points with `decimal_comma` (through
 /// `scratch`).
-pub(crate) fn read_number(field: &[u8], decimal_comma: bool, scratch: &mut Vec<u8>) -> Option<f64> {
+pub fn read_number(field: &[u8], decimal_comma: bool, scratch: &mut Vec<u8>) -> Option<f64> {
     if decimal_comma && field.contains(&b',') {
         scratch.clear();
         scratch.extend(field.iter().map(|&b| if b == b',' { b'.' } else { b }));
@@ -208,7 +208,7 @@ pub(crate) fn read_number(field: &[u8], decimal_comma: bool, scratch: &mut Vec<u
 }
 
 /// A number a data row may hold: finite, within ±[`MAX_VALUE`].
-pub(crate) fn is_reading(v: f64) -> bool {
+pub fn is_reading(v: f64) -> bool {
     v.is_finite() && v.abs() <= MAX_VALUE
 }
 
@@ -433,7 +433,7 @@ impl Rows {
         &self.path
     }
 
-    pub(crate) fn err(&self, line: Option<u64>, message: String) -> RecordingError {
+    pub fn err(&self, line: Option<u64>, message: String) -> RecordingError {
         RecordingError {
             file: self.path.clone(),
             line,
@@ -675,8 +675,8 @@ fn looks_like_time(header: &str) -> bool {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::io::channel::parse_delimiter;
-    use crate::io::csv_read::read_table;
+    use crate::channel::parse_delimiter;
+    use crate::csv_read::read_table;
 
     /// A stream read row by row holds only what a hand-over may still need: a run of blank
     /// lines or of long rows is released as it is read, not held until rows are counted.

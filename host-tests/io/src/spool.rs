@@ -11,7 +11,7 @@ use std::fs::File;
 use std::io::Write;
 use std::os::unix::fs::FileExt;
 
-use crate::io::sources::{Source, CHUNK};
+use crate::sources::{Source, CHUNK};
 
 /// Values being written to the spool.
 pub struct SpoolWriter {
@@ -70,7 +70,7 @@ pub struct Spool {
 
 impl Spool {
     /// A source of the values from the first, `progress` the fraction read.
-    pub(crate) fn source(&self, progress: Option<fn(f64)>) -> Result<Box<dyn Source>, String> {
+    pub fn source(&self, progress: Option<fn(f64)>) -> Result<Box<dyn Source>, String> {
         let file = self.file.try_clone().map_err(failed)?;
         Ok(Box::new(SpoolSource {
             file,

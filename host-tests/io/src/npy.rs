@@ -5,8 +5,8 @@
 use std::io::BufReader;
 use std::path::Path;
 
-use crate::io::channel::{evenly_sampled, numbered_column, Channel, ColumnRef, ReadOptions};
-use crate::io::channel::{one_line, RecordingError};
+use crate::channel::{evenly_sampled, numbered_column, Channel, ColumnRef, ReadOptions};
+use crate::channel::{one_line, RecordingError};
 
 /// True for a `.npy` file name (any case).
 pub fn is_npy(path: &Path) -> bool {
