@@ -14,6 +14,7 @@ use std::time::Instant;
 
 mod common;
 use common::impact_ok as impact;
+use impact_host::firmware_link::qemu::{Pacing, Samples, BOARD_CLOCK_SHIFT};
 
 /// The emulator firmware, built once for all tests; `None` (and a note on stderr) if the
 /// tools are missing.
@@ -579,6 +580,32 @@ fn realtime_twenty_impacts_40_ms_apart_are_all_analysed() {
     all_analysed_within(&json, 20, 0.05);
 }
 
+/// A real-time run of `samples` with `scene` whose sampler stalls `stall.1` µs before block (or
+/// poll) `stall.0`: the decoded log as text and parsed.
+fn stalled(
+    elf: &std::path::Path,
+    samples: Samples<'_>,
+    scene: &impact_core::Scene,
+    stall: (u32, u32),
+) -> (String, impact_host::firmware_link::log::Log) {
+    let run = impact_host::firmware_link::qemu::run_emulator(
+        elf,
+        samples,
+        scene,
+        Pacing::RealTime {
+            rate_scale: 1.0,
+            clock_shift: BOARD_CLOCK_SHIFT,
+            stall: Some(stall),
+        },
+        std::time::Duration::from_secs(300),
+        |_| {},
+    )
+    .unwrap();
+    let text = run.lines.join("\n");
+    let log = impact_host::firmware_link::log::parse_log(&text).unwrap();
+    (text, log)
+}
+
 #[test]
 fn a_forced_dma_overrun_is_a_counted_gap_and_later_positions_stay_right() {
     let Some(elf) = firmware() else { return };
@@ -597,21 +624,12 @@ fn a_forced_dma_overrun_is_a_counted_gap_and_later_positions_stay_right() {
     assert_eq!(host.len(), 3);
     // The sampler stalls 3 ms at block 30 (15 ms into the stream, inside the first impact):
     // the emulated DMA laps its two-block ring.
-    let run = impact_host::firmware_link::qemu::run_emulator(
+    let (text, log) = stalled(
         &elf,
-        impact_host::firmware_link::qemu::Samples::Adc(&setup.prepared.counts),
+        Samples::Adc(&setup.prepared.counts),
         &setup.scene,
-        impact_host::firmware_link::qemu::Pacing::RealTime {
-            rate_scale: 1.0,
-            clock_shift: impact_host::firmware_link::qemu::BOARD_CLOCK_SHIFT,
-            stall: Some((30, 3000)),
-        },
-        std::time::Duration::from_secs(300),
-        |_| {},
-    )
-    .unwrap();
-    let text = run.lines.join("\n");
-    let log = impact_host::firmware_link::log::parse_log(&text).unwrap();
+        (30, 3000),
+    );
     let summary = log.summary.as_ref().unwrap();
     let lost: u64 = summary["samples_lost"].parse().unwrap();
     let samples: u64 = summary["samples"].parse().unwrap();
@@ -935,21 +953,12 @@ fn an_adxl375_fifo_overrun_is_counted_as_the_part_lost_it() {
     assert_eq!(host.len(), 3);
     // The sampler stalls 23 ms before poll 40 (0.2 s in, between the first two impacts): the
     // 33-entry FIFO (10.3 ms) overruns and the part overwrites what it cannot hold.
-    let run = impact_host::firmware_link::qemu::run_emulator(
+    let (text, log) = stalled(
         &elf,
-        impact_host::firmware_link::qemu::Samples::Adxl375(&axes, None),
+        Samples::Adxl375(&axes, None),
         &setup.scene,
-        impact_host::firmware_link::qemu::Pacing::RealTime {
-            rate_scale: 1.0,
-            clock_shift: impact_host::firmware_link::qemu::BOARD_CLOCK_SHIFT,
-            stall: Some((40, 23_000)),
-        },
-        std::time::Duration::from_secs(300),
-        |_| {},
-    )
-    .unwrap();
-    let text = run.lines.join("\n");
-    let log = impact_host::firmware_link::log::parse_log(&text).unwrap();
+        (40, 23_000),
+    );
     let summary = log.summary.as_ref().unwrap();
     let lost: u64 = summary["samples_lost"].parse().unwrap();
     let samples: u64 = summary["samples"].parse().unwrap();
