@@ -15,7 +15,7 @@ use core::sync::atomic::{AtomicBool, Ordering};
 use cortex_m::peripheral::NVIC;
 use embassy_sync::blocking_mutex::raw::CriticalSectionRawMutex;
 use embassy_sync::blocking_mutex::Mutex;
-use embassy_time::{Duration, Instant};
+use embassy_time::Instant;
 
 use super::lines::Irq;
 use super::time::{counter, CLOCK_HZ};
@@ -182,12 +182,7 @@ impl Fifo for EmulatedAdxl375 {
         if let Some((poll, us)) = self.stall {
             if poll == self.polls {
                 self.stall = None;
-                defmt::warn!(
-                    "emulated ADXL375: stalling the sampler for {} us (fault injection)",
-                    us
-                );
-                let until = Instant::now() + Duration::from_micros(u64::from(us));
-                while Instant::now() < until {}
+                super::stall_sampler(us);
             }
         }
         self.polls += 1;

@@ -246,6 +246,14 @@ pub fn end_of_stream(success: bool) -> ! {
     host::exit(success)
 }
 
+/// Fault injection for the tests: the sampler busy-waits `us` µs, as on a board whose
+/// sampler is held up, while the emulated DMA or FIFO goes on filling.
+pub fn stall_sampler(us: u32) {
+    defmt::warn!("stalling the sampler for {} us (fault injection)", us);
+    let until = embassy_time::Instant::now() + embassy_time::Duration::from_micros(u64::from(us));
+    while embassy_time::Instant::now() < until {}
+}
+
 /// The watchdog is the board's: QEMU stops a locked-up core itself (the run fails).
 pub fn feed_watchdog() {}
 

@@ -17,8 +17,8 @@
 
 use core::sync::atomic::Ordering;
 
-use defmt::{error, info, warn, Format};
-use embassy_time::{Duration, Instant};
+use defmt::{error, info, Format};
+use embassy_time::Instant;
 
 use super::adxl375;
 use super::dma::{self, Take};
@@ -150,14 +150,7 @@ pub async fn adxl375(
         "emulated ADXL375: {} samples produced, {} overwritten unread",
         produced, overwritten
     );
-    let end = if adxl375::failed() {
-        SOURCE_STATS.error();
-        error!("replay: the host file could not be read");
-        StreamEnd::Failed
-    } else {
-        StreamEnd::Complete
-    };
-    sender.finish(end).await;
+    sender.finish(replay_end(adxl375::failed())).await;
 }
 
 /// Starts the emulated DMA on the file at `rate_hz` (the recording's rate times the rate
@@ -180,12 +173,7 @@ pub async fn realtime(
         if let Some((block, us)) = stall {
             if block == next {
                 stall = None;
-                warn!(
-                    "replay: stalling the sampler for {} us (fault injection)",
-                    us
-                );
-                let until = Instant::now() + Duration::from_micros(u64::from(us));
-                while Instant::now() < until {}
+                super::stall_sampler(us);
             }
         }
         match dma::take(next, |block| {
@@ -203,12 +191,18 @@ pub async fn realtime(
             Take::End => break,
         }
     }
-    let end = if dma::FAILED.load(Ordering::Relaxed) {
+    sender
+        .finish(replay_end(dma::FAILED.load(Ordering::Relaxed)))
+        .await;
+}
+
+/// How a real-time replay ended: failed (counted, logged) if its host file could not be read.
+fn replay_end(failed: bool) -> StreamEnd {
+    if failed {
         SOURCE_STATS.error();
         error!("replay: the host file could not be read");
         StreamEnd::Failed
     } else {
         StreamEnd::Complete
-    };
-    sender.finish(end).await;
+    }
 }
