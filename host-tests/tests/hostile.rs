@@ -607,6 +607,18 @@ fn binary_recordings_with_lying_headers_are_refused_in_bounded_memory() {
         &["analyze", f.to_str().unwrap()],
         "lying.tdms: TDMS: byte 36",
     );
+    // TDMS: channels written interleaved (ToC bit 5) are refused, not read as if contiguous
+    // (which gave another channel's values, or no impact at all).
+    let mut tdms = std::fs::read(fixtures.join("afrl-test1.tdms")).unwrap();
+    assert_eq!(tdms[4] & 0b10_1000, 0b00_1000, "the fixture is contiguous, with data");
+    tdms[4] |= 1 << 5;
+    let f = temp("interleaved.tdms", &tdms);
+    for column in ["0", "1"] {
+        fails(
+            &["analyze", f.to_str().unwrap(), "--column", column],
+            "interleaved.tdms: TDMS: byte 0: interleaved channels",
+        );
+    }
     // TDMS: a value count beyond the file.
     let mut tdms = std::fs::read(fixtures.join("afrl-test1.tdms")).unwrap();
     tdms.truncate(2000);

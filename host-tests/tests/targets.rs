@@ -695,3 +695,28 @@ fn a_state_space_spring_mass_is_the_spring_mass() {
         "ring amplitude",
     );
 }
+
+/// A light target on a soft mount (15.9 Hz) thrown off by a steel ball: the state-space form
+/// of the spring–mass scans its free response over its own slowest period (it was scanned for
+/// 100 contact times, 1.2 ms, and reported no recontact and no ringing).
+#[test]
+fn a_state_space_mount_rings_and_is_hit_again_as_its_spring_mass_twin() {
+    let sm = Target::spring_mass(0.001, 10.0, 0.0).unwrap();
+    let ss = Target::state_space(sm.n, sm.a, sm.b, sm.c, [0.0, 0.0]).unwrap();
+    let law = Hertz { k: 1.0e10 };
+    let a = on(&law, 8.419e-3, 2.0, &sm, Settings::adaptive(1e-12));
+    let b = on(&law, 8.419e-3, 2.0, &ss, Settings::adaptive(1e-12));
+    let fa = after(&sm, &a).unwrap();
+    let fb = after(&ss, &b).unwrap();
+    let ra = fa.recontact_s.expect("the spring–mass is hit again");
+    let rb = fb.recontact_s.expect("its state-space twin is hit again");
+    close(rb, ra, 1e-6, "recontact");
+    assert!(fb.checked_until_s >= rb, "{fb:?}");
+    close(
+        fb.ring_frequency_hz.expect("the mount rings"),
+        (10.0f64 / 0.001).sqrt() / (2.0 * std::f64::consts::PI),
+        0.01,
+        "ring frequency",
+    );
+    close(fb.ring_amplitude_m, fa.ring_amplitude_m, 0.003, "ring amplitude");
+}

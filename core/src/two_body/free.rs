@@ -28,13 +28,27 @@ const PER_PERIOD: f64 = 40.0;
 /// Most scan steps.
 const MAX_STEPS: u32 = 400_000;
 
-/// The time after separation up to which recontact is possible or worth looking for, s.
-fn horizon<R: Real>(target: &Target<R>, out: &TargetOutcome<R>) -> R {
+/// The time after separation up to which recontact is possible or worth looking for, s, and
+/// for a state-space target the time after which the scan may stop early (two periods of its
+/// slowest mode: once the impactor has recontacted, or has coasted a full swing beyond the
+/// lowest point the target reached).
+fn horizon<R: Real>(target: &Target<R>, out: &TargetOutcome<R>) -> (R, Option<R>) {
     let tc = out.contact_time_s;
     let base = R::from_f64(20.0) * tc;
     let u1 = -out.rebound_velocity_m_s;
     let Some(s) = target.spring_mass else {
-        return R::from_f64(100.0) * tc;
+        // The slowest mode sets the time scale, as a spring–mass's period does; a singular
+        // A (a free body in state-space form) has none.
+        return match target.a_mat().slowest_rate() {
+            Some(rate) => {
+                let period = R::TWO * R::PI / rate;
+                (
+                    base.max(R::from_f64(1000.0) * period),
+                    Some(R::TWO * period),
+                )
+            }
+            None => (R::from_f64(100.0) * tc, None),
+        };
     };
     if s.stiffness_n_m > R::ZERO {
         let period = R::TWO * R::PI * (s.mass_kg / s.stiffness_n_m).sqrt();
@@ -44,9 +58,9 @@ fn horizon<R: Real>(target: &Target<R>, out: &TargetOutcome<R>) -> R {
             let energy = out.target_energy_j.unwrap_or(R::ZERO);
             let bound = (R::TWO * energy / s.stiffness_n_m).sqrt();
             let gap = out.impactor_displacement_m - out.permanent_deformation_m + bound;
-            base.max(R::TWO * period).max((gap / -u1).min(long))
+            (base.max(R::TWO * period).max((gap / -u1).min(long)), None)
         } else {
-            base.max(long)
+            (base.max(long), None)
         }
     } else if s.damping_n_s_m > R::ZERO {
         // A damped free body stops `m2 w / c2` further on.
@@ -58,9 +72,9 @@ fn horizon<R: Real>(target: &Target<R>, out: &TargetOutcome<R>) -> R {
         } else {
             R::ZERO
         };
-        base.max(R::from_f64(10.0) * tau + R::TWO * closing)
+        (base.max(R::from_f64(10.0) * tau + R::TWO * closing), None)
     } else {
-        base
+        (base, None)
     }
 }
 
@@ -71,7 +85,7 @@ pub fn after<R: Real>(
 ) -> Result<FreeResponse<R>, Error> {
     let n = target.n;
     let a = target.a_mat();
-    let span = horizon(target, out);
+    let (span, settle) = horizon(target, out);
     let tc = out.contact_time_s;
     let mut h = tc / R::from_f64(PER_PERIOD);
     let rate = a.norm_inf();
@@ -105,6 +119,7 @@ pub fn after<R: Real>(
     let mut g_prev = R::ZERO;
     let mut evals = 0u32;
     let mut ys = (R::MAX, -R::MAX);
+    let mut scanned = steps;
     for k in 1..=steps {
         let tau = R::from_u32(k) * h;
         let z1 = phi.apply(&z);
@@ -137,6 +152,12 @@ pub fn after<R: Real>(
         w_prev = w;
         g_prev = g;
         z = z1;
+        if settle.is_some_and(|t| tau >= t)
+            && (recontact.is_some() || x1 + u1 * tau - set < ys.0 - (ys.1 - ys.0))
+        {
+            scanned = k;
+            break;
+        }
     }
     let frequency = match target.spring_mass {
         Some(s) if s.stiffness_n_m > R::ZERO => {
@@ -159,7 +180,7 @@ pub fn after<R: Real>(
     };
     Ok(FreeResponse {
         recontact_s: recontact,
-        checked_until_s: tc + R::from_u32(steps) * h,
+        checked_until_s: tc + R::from_u32(scanned) * h,
         ring_amplitude_m: amplitude,
         ring_frequency_hz: frequency,
     })

@@ -194,6 +194,73 @@ impl<R: Real> Mat<R> {
         p.all_finite().then_some(p)
     }
 
+    /// The inverse by Gauss–Jordan elimination with partial pivoting; `None` if the matrix is
+    /// singular (a pivot below `n` epsilons of its column's largest entry) or not finite.
+    pub fn inverse(&self) -> Option<Self> {
+        let n = self.n;
+        let mut m = *self;
+        let mut inv = Self::identity(n);
+        let scale = m.norm_inf();
+        if !(scale > R::ZERO && scale.is_finite()) {
+            return None;
+        }
+        for col in 0..n {
+            let mut pivot = col;
+            for row in col + 1..n {
+                if m.a[row][col].abs() > m.a[pivot][col].abs() {
+                    pivot = row;
+                }
+            }
+            if !(m.a[pivot][col].abs() > R::from_u32(n as u32) * R::EPSILON * scale) {
+                return None;
+            }
+            m.a.swap(col, pivot);
+            inv.a.swap(col, pivot);
+            let p = m.a[col][col];
+            for j in 0..n {
+                m.a[col][j] = m.a[col][j] / p;
+                inv.a[col][j] = inv.a[col][j] / p;
+            }
+            for row in 0..n {
+                let f = m.a[row][col];
+                if row == col || f == R::ZERO {
+                    continue;
+                }
+                for j in 0..n {
+                    m.a[row][j] -= f * m.a[col][j];
+                    inv.a[row][j] -= f * inv.a[col][j];
+                }
+            }
+        }
+        inv.all_finite().then_some(inv)
+    }
+
+    /// The smallest eigenvalue modulus, 1/s: the slowest mode's rate (a mount's natural
+    /// angular frequency, or the inverse of its slowest time constant). The spectral radius
+    /// of the inverse by Gelfand's formula (`‖B^k‖^(1/k)`, `k = 2^40` by repeated squaring,
+    /// each power normalised); `None` for a singular matrix (a free body: no slowest mode).
+    pub fn slowest_rate(&self) -> Option<R> {
+        let (balanced, _) = self.balance();
+        let b = balanced.inverse()?;
+        let mut norm = b.norm_inf();
+        let mut m = b.scaled(R::ONE / norm);
+        // `norm` is ‖B^(2^j)‖^(1/2^j); each squaring refines it by ‖M²‖^(1/2^(j+1)).
+        for j in 0..40u32 {
+            let sq = m.mul(&m);
+            let f = sq.norm_inf();
+            if !(f > R::ZERO && f.is_finite()) {
+                break;
+            }
+            let mut root = f;
+            for _ in 0..=j {
+                root = root.sqrt();
+            }
+            norm *= root;
+            m = sq.scaled(R::ONE / f);
+        }
+        (norm > R::ZERO && norm.is_finite()).then(|| R::ONE / norm)
+    }
+
     /// True if every entry is finite.
     pub fn all_finite(&self) -> bool {
         self.a
@@ -245,5 +312,41 @@ mod tests {
         }
         assert!(a.exp(f64::NAN).is_none());
         assert!(a.scaled(1e300).exp(1e300).is_none());
+    }
+
+    #[test]
+    fn inverse_and_slowest_rate() {
+        // Two masses on springs (k = 1, 4 and 9 N/m between wall, m1 = 1 kg, m2 = 2 kg, wall).
+        let (k1, k2, k3, m1, m2) = (1.0f64, 4.0, 9.0, 1.0, 2.0);
+        let mut a = Mat::zero(4);
+        a.a[0][2] = 1.0;
+        a.a[1][3] = 1.0;
+        a.a[2][0] = -(k1 + k2) / m1;
+        a.a[2][1] = k2 / m1;
+        a.a[3][0] = k2 / m2;
+        a.a[3][1] = -(k2 + k3) / m2;
+        let inv = a.inverse().unwrap();
+        let id = a.mul(&inv);
+        for i in 0..4 {
+            for j in 0..4 {
+                let want = if i == j { 1.0 } else { 0.0 };
+                assert!((id.a[i][j] - want).abs() < 1e-14, "{i}{j}: {}", id.a[i][j]);
+            }
+        }
+        // Natural frequencies: w^2 the eigenvalues of [[5, -4], [-2, 6.5]].
+        let (tr, det) = (5.0 + 6.5, 5.0 * 6.5 - 8.0);
+        let w_low = ((tr - (tr * tr - 4.0 * det).sqrt()) / 2.0).sqrt();
+        let got = a.slowest_rate().unwrap();
+        assert!((got / w_low - 1.0).abs() < 1e-9, "{got} vs {w_low}");
+        // A damped mode (rate |lambda| = wn) and a badly scaled one (k/m = 1e4).
+        let mut a = Mat::zero(2);
+        a.a[0][1] = 1.0;
+        a.a[1][0] = -1e4;
+        a.a[1][1] = -20.0;
+        assert!((a.slowest_rate().unwrap() / 100.0 - 1.0).abs() < 1e-9);
+        // A free body: singular, no slowest mode.
+        a.a[1][0] = 0.0;
+        assert!(a.inverse().is_none());
+        assert!(a.slowest_rate().is_none());
     }
 }

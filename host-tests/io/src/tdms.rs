@@ -2,7 +2,7 @@
 //! `group/channel` or `channel` (or a 0-based index over the file's channels in order), at the
 //! rate of its waveform properties (`wf_increment`) or `--rate`. Numeric channels of any
 //! integer or float type; DAQmx raw (scaled) data is what the crate reads, and it is not
-//! checked against NI's own files here.
+//! checked against NI's own files here. Segments written interleaved are refused.
 
 use std::path::Path;
 
@@ -106,6 +106,13 @@ fn check_structure(path: &Path) -> Result<(), String> {
         if toc & (1 << 6) != 0 {
             return Err(format!(
                 "byte {seg}: a big-endian segment, which this reader does not read"
+            ));
+        }
+        // Interleaved raw data (1 << 5, with raw data 1 << 3): the crate reads it as if
+        // contiguous, which gives another channel's values or none; refused.
+        if toc & (1 << 5) != 0 && toc & (1 << 3) != 0 {
+            return Err(format!(
+                "byte {seg}: interleaved channels (ToC bit 5), which this reader does not read: write the channels one after the other (npTDMS's default) or export a CSV"
             ));
         }
         // Metadata (1 << 1) or a new object list (1 << 2): the reader parses either.
