@@ -642,3 +642,61 @@ fn binary_recordings_with_lying_headers_are_refused_in_bounded_memory() {
         "lying.npy",
     );
 }
+
+/// A recording that never settles to a baseline within the edge level (noise larger than
+/// `--edge`) has no impact: `analyze` exits 0 with none and a note saying why, as the board
+/// (`impact emulate`) does; an empty recording of any format is refused naming its file.
+#[test]
+fn quiet_or_unsettled_recordings_have_no_impacts_and_empty_ones_name_their_file() {
+    // White noise of 20 m/s² RMS (a deterministic LCG) against --edge 5.5.
+    let mut state = 12345u64;
+    let mut noise = || {
+        let mut s = 0.0;
+        for _ in 0..12 {
+            state = state
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
+            s += (state >> 11) as f64 / (1u64 << 53) as f64;
+        }
+        20.0 * (s - 6.0)
+    };
+    let mut csv = String::from("time_s,accel_m_s2\n");
+    for k in 0..10_000 {
+        csv += &format!("{},{:.4}\n", k as f64 / 1e4, noise());
+    }
+    let f = temp("unsettled.csv", csv.as_bytes());
+    let r = ok(&[
+        "analyze",
+        f.to_str().unwrap(),
+        "--trigger",
+        "27",
+        "--edge",
+        "5.5",
+        "--json",
+    ]);
+    assert_eq!(json(&r.out)["impacts"].as_array().unwrap().len(), 0);
+    assert!(r.err.contains("note: the signal never settled"), "{}", r.err);
+    // Empty recordings: the file's name and what is missing.
+    let wav = {
+        let mut w = b"RIFF".to_vec();
+        w.extend_from_slice(&36u32.to_le_bytes());
+        w.extend_from_slice(b"WAVEfmt ");
+        w.extend_from_slice(&16u32.to_le_bytes());
+        w.extend_from_slice(&1u16.to_le_bytes()); // PCM
+        w.extend_from_slice(&1u16.to_le_bytes()); // one channel
+        w.extend_from_slice(&10_000u32.to_le_bytes());
+        w.extend_from_slice(&20_000u32.to_le_bytes());
+        w.extend_from_slice(&2u16.to_le_bytes());
+        w.extend_from_slice(&16u16.to_le_bytes());
+        w.extend_from_slice(b"data");
+        w.extend_from_slice(&0u32.to_le_bytes());
+        w
+    };
+    let f = temp("empty.wav", &wav);
+    fails(&["analyze", f.to_str().unwrap()], "empty.wav: 0 samples; at least 2");
+    let f = temp("empty.f32", b"");
+    fails(
+        &["analyze", f.to_str().unwrap(), "--rate", "1000"],
+        "empty.f32: 0 samples; at least 2",
+    );
+}

@@ -246,6 +246,9 @@ impl TdmsStream {
                 .collect::<Vec<_>>()
                 .join(", ")
         };
+        if all.is_empty() {
+            return Err(err("TDMS: the file holds no channels".into()));
+        }
         let found = match column {
             None => all.first(),
             Some(ColumnRef::Index(i)) => all.get(*i),

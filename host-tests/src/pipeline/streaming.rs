@@ -139,6 +139,17 @@ pub fn analyze_in_passes(
     let (mass, scale, units) = pipeline::mass_and_scale(args, &file, &column)?;
     let full_scale = pipeline::full_scale_m_s2(args, &file, mass);
     let (first, source, spool) = survey_pass(input, scale, &[], !args.keep_spikes, spool)?;
+    if first.samples < 2 {
+        let channel = if column.is_empty() {
+            String::new()
+        } else {
+            format!("{column}: ")
+        };
+        return Err(format!(
+            "{name}: {channel}{} samples; at least 2",
+            first.samples
+        ));
+    }
     let axis = Axis {
         rate_hz: source.rate_hz()?,
         final_rate_hz: source.final_rate_hz(),
