@@ -378,3 +378,56 @@ fn unsupported_files_and_channels_are_named() {
         "{err}"
     );
 }
+
+/// A time column whose interval grows smoothly by 45 % (every step a hair longer than the
+/// last, far inside the 0.5–1.5× window) is no steady sample clock: taken as an even grid it
+/// put the impact 20 ms late with Δv 5 % low, and the whole-file path, the passes and a
+/// stream disagreed. All three refuse it at the same line; `--resample` gives the file's own
+/// times' answer.
+#[test]
+fn a_drifting_time_axis_is_refused_alike_everywhere_or_resampled() {
+    let n = 8000usize;
+    let (v0, e, width, touch) = (2.0f64, 0.6, 0.002, 0.3);
+    let dv = v0 * (1.0 + e);
+    let peak = dv * std::f64::consts::PI / (2.0 * width);
+    let mut t = 0.0f64;
+    let mut text = String::from("time_s,accel_m_s2\n");
+    for k in 0..n {
+        let a = if (touch..touch + width).contains(&t) {
+            peak * (std::f64::consts::PI * (t - touch) / width).sin()
+        } else {
+            0.0
+        };
+        // A deterministic ±0.5 m/s² dither keeps a noise floor.
+        let dither = 0.5 * (((k * 7919) % 13) as f64 / 6.0 - 1.0);
+        text.push_str(&format!("{t:.9},{:.4}\n", a + dither));
+        t += 50e-6 * (1.0 + 0.45 * k as f64 / (n - 2) as f64);
+    }
+    let path = temp("drifting-time.csv");
+    std::fs::write(&path, text).unwrap();
+    let file = path.to_str().unwrap();
+    let mut errors = Vec::new();
+    for extra in [
+        &["--v0", "2"][..],
+        &["--v0", "2", "--plot", temp("drifting.svg").to_str().unwrap()][..],
+        &["--v0", "2", "--stream", "--range", "4000", "--trigger", "200"][..],
+    ] {
+        let mut args = vec!["analyze", file];
+        args.extend_from_slice(extra);
+        let (code, out, err) = impact(&args);
+        assert_eq!(code, 1, "{extra:?}: {out}");
+        assert!(err.contains("the time axis drifts"), "{extra:?}: {err}");
+        errors.push(err);
+    }
+    assert!(errors.iter().all(|e| *e == errors[0]), "{errors:?}");
+    assert!(errors[0].contains("drifting-time.csv:2050:"), "{}", errors[0]);
+    let (out, _) = impact_ok(&["analyze", file, "--v0", "2", "--resample", "--json"]);
+    let v: serde_json::Value = serde_json::from_str(&out).unwrap();
+    let i = &v["impacts"][0];
+    let start = i["start_s"].as_f64().unwrap();
+    assert!((start - touch).abs() < 1e-4, "{start}");
+    let got = i["delta_v_m_s"].as_f64().unwrap();
+    assert!((got / dv - 1.0).abs() < 0.005, "Δv {got} vs {dv}");
+    let cor = i["cor"].as_f64().unwrap();
+    assert!((cor - e).abs() < 0.005, "COR {cor} vs {e}");
+}

@@ -300,6 +300,10 @@ pub fn check_time(
         for (i, &dt) in dts.iter().enumerate() {
             crate::channel::check_interval(dt, median).map_err(|m| at(i + 1, m))?;
         }
+        let mut drift = Drift::default();
+        for (i, &ti) in t.iter().enumerate() {
+            drift.push(ti).map_err(|m| at(i, m))?;
+        }
         let dt = (t[t.len() - 1] - t[0]) / (t.len() - 1) as f64;
         let jitter = t
             .windows(2)
@@ -308,6 +312,61 @@ pub fn check_time(
         Ok((1.0 / dt, jitter))
     } else {
         Ok((1.0 / median_of(&dts), 0.0))
+    }
+}
+
+/// Intervals per block of the drift check ([`Drift`]).
+pub const DRIFT_BLOCK: u64 = 1024;
+/// Largest difference of a block's mean interval from the first block's (1 %): a sample
+/// clock is steady to parts per million; a time axis whose interval drifts further (each
+/// step may stay well inside [`INTERVAL_RANGE`]) is no even grid, and taking it for one
+/// puts the impacts at the wrong times with the wrong Δv.
+pub const DRIFT_LIMIT: f64 = 0.01;
+
+/// Checks that a time axis keeps its rate: the mean interval of every [`DRIFT_BLOCK`]
+/// intervals against the first block's. Fed the time stamps in order (any split), so the
+/// whole-file path and a stream refuse the same files at the same sample.
+#[derive(Clone, Copy, Debug, Default)]
+pub struct Drift {
+    /// Time stamps taken, and the time at the current block's start.
+    n: u64,
+    block_start_s: f64,
+    /// The first block's mean interval, s.
+    first_dt: Option<f64>,
+}
+
+impl Drift {
+    /// Takes the next time stamp `t` (s; the `n`-th from 0); an error once a block's mean
+    /// interval is more than [`DRIFT_LIMIT`] off the first block's.
+    pub fn push(&mut self, t: f64) -> Result<(), String> {
+        let k = self.n;
+        self.n += 1;
+        if k == 0 {
+            self.block_start_s = t;
+            return Ok(());
+        }
+        if k % DRIFT_BLOCK != 0 {
+            return Ok(());
+        }
+        let mean = (t - self.block_start_s) / DRIFT_BLOCK as f64;
+        self.block_start_s = t;
+        let Some(first) = self.first_dt else {
+            self.first_dt = Some(mean);
+            return Ok(());
+        };
+        let off = mean / first - 1.0;
+        if off.abs() > DRIFT_LIMIT {
+            return Err(format!(
+                "the time axis drifts: the mean interval of samples {}..{k} is {mean:.6e} s, \
+                 {:+.2} % off the first {DRIFT_BLOCK} intervals' {first:.6e} s (more than \
+                 {} %: no steady sample clock); give --resample to interpolate onto an even \
+                 grid, or --rate if the column is wrong",
+                k - DRIFT_BLOCK,
+                100.0 * off,
+                100.0 * DRIFT_LIMIT
+            ));
+        }
+        Ok(())
     }
 }
 

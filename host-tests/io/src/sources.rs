@@ -279,6 +279,9 @@ pub struct CsvSource {
     /// the end, in this order, as the whole-file path does).
     not_increasing: Option<String>,
     uneven: Option<String>,
+    /// The time stamps' drift check, and its first error (reported after those two).
+    drift: crate::channel::Drift,
+    drifting: Option<String>,
 }
 
 impl CsvSource {
@@ -347,6 +350,8 @@ impl CsvSource {
             ended: false,
             not_increasing: None,
             uneven: None,
+            drift: crate::channel::Drift::default(),
+            drifting: None,
         };
         source.pending = Some(source.take(line, &first)?);
         Ok(source)
@@ -363,6 +368,11 @@ impl CsvSource {
     fn take_values(&mut self, line: u64, value: f64, time: f64) -> Result<f64, String> {
         if let Some((_, unit)) = self.time {
             let t = time * unit;
+            if self.rate_given.is_none() && self.drifting.is_none() {
+                if let Err(m) = self.drift.push(t) {
+                    self.drifting = Some(format!("{}:{line}: {m}", self.name));
+                }
+            }
             if self.t0.is_none() {
                 self.t0 = Some(t);
             } else {
@@ -489,7 +499,12 @@ impl Source for CsvSource {
             self.next_some(want, out)?;
         }
         if self.ended {
-            if let Some(e) = self.not_increasing.take().or_else(|| self.uneven.take()) {
+            if let Some(e) = self
+                .not_increasing
+                .take()
+                .or_else(|| self.uneven.take())
+                .or_else(|| self.drifting.take())
+            {
                 return Err(e);
             }
         }
@@ -571,6 +586,7 @@ pub struct IdeSource {
     head_dts: Vec<f64>,
     median_dt: Option<f64>,
     head_rate: Option<f64>,
+    drift: crate::channel::Drift,
 }
 
 impl IdeSource {
@@ -595,6 +611,7 @@ impl IdeSource {
             head_dts: Vec::new(),
             median_dt: None,
             head_rate: None,
+            drift: crate::channel::Drift::default(),
         })
     }
 
@@ -605,6 +622,9 @@ impl IdeSource {
         };
         let (times, values) = block.map_err(|e| format!("{}: {e}", self.name))?;
         for &t in &times {
+            self.drift
+                .push(t)
+                .map_err(|e| format!("{}: sample {}: {e}", self.name, self.n))?;
             if let Some(t0) = self.t0 {
                 let dt = t - self.last;
                 if dt <= 0.0 {
