@@ -530,6 +530,132 @@ fn a_half_sine_cut_flat_at_the_sensor_range_is_clipped() {
     }
 }
 
+/// A noise-free half-sine (no quantum to read from the steps: the smallest step is the
+/// pulse's own) cut flat at 16 g is clipped, and so is a bounce train's: a clipped bounce has
+/// no kinematics and no COR (its Δv is a lower bound, `clipped` the reason), and the bounce
+/// after it has no rebound speed; the unclipped bounces keep theirs.
+#[test]
+fn noise_free_flat_tops_are_clipped_and_a_clipped_bounce_has_no_cor() {
+    let hs = |t: f64, t0: f64, peak: f64, width: f64| {
+        if (t0..t0 + width).contains(&t) {
+            peak * (std::f64::consts::PI * (t - t0) / width).sin()
+        } else {
+            0.0
+        }
+    };
+    let write = |name: &str, a: &dyn Fn(f64) -> f64, n: usize, fs: f64| {
+        let mut s = String::from("time_s,accel_m_s2\n");
+        for i in 0..n {
+            let t = i as f64 / fs;
+            s.push_str(&format!("{t:.9},{:.6}\n", a(t).min(16.0 * G)));
+        }
+        let p = temp_dir().join(name);
+        std::fs::write(&p, s).unwrap();
+        p
+    };
+    let single = write("flat-noise-free.csv", &|t| hs(t, 0.05, 40.0 * G, 0.003), 2000, 2e4);
+    let a = analyze(AnalyzeArgs {
+        file: single,
+        ..Default::default()
+    });
+    assert_eq!(a.impacts.len(), 1, "{:#?}", a.impacts);
+    assert!(a.impacts[0].clipped, "{:#?}", a.impacts[0]);
+    assert!(a.impacts[0].flags.iter().any(|f| f == "clipped"));
+    // A train (COR 0.6, 12 ms contacts, flights 2 v' / g) from 2.2 m/s: the first three
+    // bounces are clipped at 16 g, the rest are not.
+    let (e, width) = (0.6, 0.012);
+    let mut touches = Vec::new();
+    let (mut t0, mut v) = (0.05, 2.2f64);
+    while t0 + width < 1.1 && v > 0.05 {
+        touches.push((t0, v));
+        t0 += width + 2.0 * e * v / G;
+        v *= e;
+    }
+    let train = write(
+        "flat-train.csv",
+        &|t| {
+            touches
+                .iter()
+                .map(|&(t0, v)| hs(t, t0, v * (1.0 + e) * std::f64::consts::PI / (2.0 * width), width))
+                .sum()
+        },
+        24_000,
+        2e4,
+    );
+    let a = analyze(AnalyzeArgs {
+        file: train,
+        v0: Some(2.2),
+        train: impact_host::pipeline::options::TrainArgs {
+            train: Some(impact_host::pipeline::options::SpeedArg::Flight),
+            ..Default::default()
+        },
+        ..Default::default()
+    });
+    assert!(a.impacts.len() >= 6, "{:#?}", a.impacts);
+    for (k, i) in a.impacts.iter().enumerate() {
+        let clipped = k < 3;
+        assert_eq!(i.clipped, clipped, "impact {k}");
+        let bounce = i.bounce.as_ref();
+        if clipped {
+            assert!(i.cor.is_none(), "impact {k}: {:?}", i.cor);
+            assert_eq!(i.null_reasons.get("cor").map(String::as_str), Some("clipped"), "{k}");
+            if let Some(b) = bounce {
+                assert!(b.cor_flight.is_none() && b.cor_rebound.is_none(), "{k}: {b:?}");
+                assert_eq!(b.cor_flight_null_reason.as_deref(), Some("clipped"));
+            }
+        } else {
+            let b = bounce.unwrap_or_else(|| panic!("impact {k} is a bounce"));
+            let cor = b.cor_flight.unwrap_or_else(|| panic!("impact {k}: {b:?}"));
+            assert!((cor - e).abs() < 0.01, "impact {k}: COR {cor}");
+            // The bounce after the last clipped one has no rebound speed to go by.
+            assert_eq!(b.v0_rebound_m_s.is_none(), k == 3, "impact {k}: {b:?}");
+        }
+    }
+}
+
+/// A recording that starts inside an impact (at the peak of a half-sine, or in a ring-down)
+/// reports that part flagged `cut-at-start`, without kinematics; the clean impact after it
+/// is unflagged and whole.
+#[test]
+fn a_recording_that_starts_inside_an_impact_flags_it() {
+    let fs = 5e4;
+    let hs = |t: f64, t0: f64, peak: f64, width: f64| {
+        if (t0..t0 + width).contains(&t) {
+            peak * (std::f64::consts::PI * (t - t0) / width).sin()
+        } else {
+            0.0
+        }
+    };
+    for (name, first) in [
+        ("starts-at-a-peak.csv", &(|t: f64| hs(t, -0.001, 400.0, 0.002)) as &dyn Fn(f64) -> f64),
+        ("starts-in-a-ring.csv", &|t: f64| {
+            300.0 * (-t / 0.003).exp() * (2.0 * std::f64::consts::PI * 2000.0 * t).cos()
+        }),
+    ] {
+        let mut s = String::from("time_s,accel_m_s2\n");
+        for i in 0..10_000 {
+            let t = i as f64 / fs;
+            let dither = 0.05 * ((i * 7919 % 7) as f64 - 3.0);
+            s.push_str(&format!("{t:.6},{:.4}\n", first(t) + hs(t, 0.1, 500.0, 0.002) + dither));
+        }
+        let p = temp_dir().join(name);
+        std::fs::write(&p, s).unwrap();
+        let a = analyze(AnalyzeArgs {
+            file: p,
+            v0: Some(0.3),
+            ..Default::default()
+        });
+        assert_eq!(a.impacts.len(), 2, "{name}: {:#?}", a.impacts);
+        let (cut, clean) = (&a.impacts[0], &a.impacts[1]);
+        assert!(cut.flags.iter().any(|f| f == "cut-at-start"), "{name}: {cut:#?}");
+        assert!(cut.cor.is_none(), "{name}");
+        assert!(!clean.flags.iter().any(|f| f == "cut-at-start"), "{name}: {clean:#?}");
+        let dv = clean.delta_v_m_s.unwrap();
+        let want = 500.0 * 2.0 * 0.002 / std::f64::consts::PI;
+        assert!((dv / want - 1.0).abs() < 0.01, "{name}: Δv {dv} vs {want}");
+    }
+}
+
 /// `scripts/peer_endaq.csv`: case -> quantity -> value (see `scripts/peer_endaq.py`).
 fn peer() -> std::collections::HashMap<String, std::collections::HashMap<String, f64>> {
     let path = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../scripts/peer_endaq.csv");

@@ -233,9 +233,14 @@ fn analyse_kinematics<const CAP: usize>(
         r.flags.insert(Flags::HALF_MAXIMUM_OUTSIDE);
     }
 
-    // Kinematics (and the fit points) need the approach speed and the whole impact.
-    let (Some(v0), Status::Complete, Some(sep_index)) = (s.v0_m_s, s.status, s.separation_index)
-    else {
+    // Kinematics (and the fit points) need the approach speed and the whole, unclipped
+    // impact.
+    let (Some(v0), Status::Complete, Some(sep_index), false) = (
+        s.v0_m_s,
+        s.status,
+        s.separation_index,
+        s.clipped || s.cut_at_start,
+    ) else {
         return r;
     };
     let Some(onset) = s.onset_index.checked_sub(s.first_index).map(|o| o as usize) else {

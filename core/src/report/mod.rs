@@ -110,15 +110,25 @@ impl Flags {
     /// The approach speed is unknown (no `v0`, drop height, free fall or light gate): the
     /// kinematics and the fits are absent.
     pub const NO_APPROACH_SPEED: Flags = Flags(1 << 5);
+    /// The sensor was at its rail during the impact (`clipped`): the peak and Δv are lower
+    /// bounds of the pulse's, so the kinematics, the fits and a bounce's COR are absent.
+    pub const CLIPPED: Flags = Flags(1 << 6);
+    /// The recording starts inside the impact (its first sample already beyond the edge
+    /// level: the tail of an earlier event, or the pulse itself): the onset is not in the
+    /// record, so the start, duration, peak and Δv cover the recorded part only; the
+    /// kinematics and the fits are absent.
+    pub const CUT_AT_START: Flags = Flags(1 << 7);
 
     /// Every flag with its name in the reports.
-    pub const NAMES: [(Flags, &'static str); 6] = [
+    pub const NAMES: [(Flags, &'static str); 8] = [
         (Flags::AC_COUPLED, "ac-coupled"),
         (Flags::COR_OUT_OF_RANGE, "cor-out-of-range"),
         (Flags::NO_STOP, "no-stop"),
         (Flags::HALF_MAXIMUM_OUTSIDE, "half-maximum-outside"),
         (Flags::CFC_WINDOW, "cfc-window"),
         (Flags::NO_APPROACH_SPEED, "no-approach-speed"),
+        (Flags::CLIPPED, "clipped"),
+        (Flags::CUT_AT_START, "cut-at-start"),
     ];
 
     pub const fn empty() -> Self {
@@ -238,6 +248,12 @@ pub fn streaming(s: &Summary, scene: &Scene) -> ImpactReport {
     let mut flags = Flags::empty();
     if s.v0_m_s.is_none() {
         flags.insert(Flags::NO_APPROACH_SPEED);
+    }
+    if s.clipped {
+        flags.insert(Flags::CLIPPED);
+    }
+    if s.cut_at_start {
+        flags.insert(Flags::CUT_AT_START);
     }
     let delta_v = match s.contact_c {
         Some(c) if c != 0 && (s.total_c as f64 / c as f64) < AC_COUPLED_RATIO => {

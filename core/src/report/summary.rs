@@ -33,6 +33,9 @@ pub struct Summary {
     pub status: Status,
     /// A sample reached the scene's rails.
     pub clipped: bool,
+    /// The stream began inside the pulse (its first sample was already beyond the edge
+    /// level): the onset is not in the record.
+    pub cut_at_start: bool,
     /// Stream index of the capture's first sample (the pre-trigger margin before the onset).
     pub first_index: u64,
     /// Stream index of the first sample beyond the edge level.
@@ -121,6 +124,7 @@ impl Summary {
         index: 0,
         status: Status::Complete,
         clipped: false,
+        cut_at_start: false,
         first_index: 0,
         onset_index: 0,
         touch_offset: 0.0,

@@ -52,6 +52,8 @@ pub(super) struct Active {
     /// Samples since `first_index`.
     samples: u64,
     clipped: bool,
+    /// The walk back to the onset reached the stream's first sample still beyond the edge.
+    cut_at_start: bool,
     /// The sink gave a buffer for this impact.
     captured: bool,
     /// The buffer overflowed.
@@ -118,6 +120,7 @@ impl<const PRE: usize> Stream<PRE> {
             }
         }
         let onset_index = self.index - pulse as u64;
+        let cut_at_start = onset_index == 0 && pd(pulse).is_none();
         let touch_offset = match flank.zero(true, -1.0, edge_d as f64) {
             Some(z) => z as f32,
             // The edge crossing between the last sample before the pulse and the onset (the
@@ -176,6 +179,7 @@ impl<const PRE: usize> Stream<PRE> {
             total_c: 0,
             samples: 0,
             clipped: false,
+            cut_at_start,
             captured: capture.is_some(),
             full: false,
             // The walk back reached the gap: the pulse began while samples were lost.
@@ -523,6 +527,7 @@ impl<const PRE: usize> Stream<PRE> {
             index: self.counters.impacts.min(u32::MAX as u64) as u32,
             status,
             clipped: a.clipped,
+            cut_at_start: a.cut_at_start,
             first_index: a.first_index,
             onset_index: a.onset_index,
             touch_offset: a.touch_offset,

@@ -81,8 +81,9 @@ impl Tracker {
             (Status::Complete, Some(i)) => Some(i as f64 + s.separation_offset as f64),
             _ => None,
         };
+        // A clipped impact's Δv is a lower bound: no rebound from it.
         let rebound = match (s.v0_m_s, separation) {
-            (Some(v0), Some(_)) => report::streaming(s, scene)
+            (Some(v0), Some(_)) if !s.clipped => report::streaming(s, scene)
                 .delta_v_m_s
                 .map(|dv| dv - v0)
                 .filter(|r| {

@@ -30,8 +30,8 @@ const MAX_STEPS: u32 = 400_000;
 
 /// The time after separation up to which recontact is possible or worth looking for, s, and
 /// for a state-space target the time after which the scan may stop early (two periods of its
-/// slowest mode: once the impactor has recontacted, or has coasted a full swing beyond the
-/// lowest point the target reached).
+/// slowest mode, and at least 100 contact times: once the impactor has recontacted, or has
+/// coasted a full swing beyond the lowest point the target reached).
 fn horizon<R: Real>(target: &Target<R>, out: &TargetOutcome<R>) -> (R, Option<R>) {
     let tc = out.contact_time_s;
     let base = R::from_f64(20.0) * tc;
@@ -42,10 +42,8 @@ fn horizon<R: Real>(target: &Target<R>, out: &TargetOutcome<R>) -> (R, Option<R>
         return match target.a_mat().slowest_rate() {
             Some(rate) => {
                 let period = R::TWO * R::PI / rate;
-                (
-                    base.max(R::from_f64(1000.0) * period),
-                    Some(R::TWO * period),
-                )
+                let settle = (R::TWO * period).max(R::from_f64(100.0) * tc);
+                (base.max(R::from_f64(1000.0) * period), Some(settle))
             }
             None => (R::from_f64(100.0) * tc, None),
         };
@@ -92,7 +90,11 @@ pub fn after<R: Real>(
     if rate > R::ZERO {
         h = h.min(R::TWO * R::PI / rate / R::from_f64(PER_PERIOD));
     }
-    h = h.max(span / R::from_u32(MAX_STEPS));
+    // A scan that may stop early keeps its resolution and stops at MAX_STEPS at the latest
+    // (`checked_until_s` says where); one that runs to its horizon spreads MAX_STEPS over it.
+    if settle.is_none() {
+        h = h.max(span / R::from_u32(MAX_STEPS));
+    }
     if !(h > R::ZERO && h.is_finite() && span.is_finite()) {
         return Err(Error::Unresolved("free response time scale is not finite"));
     }

@@ -139,6 +139,12 @@ pub fn analyze_in_passes(
     let (mass, scale, units) = pipeline::mass_and_scale(args, &file, &column)?;
     let full_scale = pipeline::full_scale_m_s2(args, &file, mass);
     let (first, source, spool) = survey_pass(input, scale, &[], !args.keep_spikes, spool)?;
+    let axis = Axis {
+        rate_hz: source.rate_hz()?,
+        final_rate_hz: source.final_rate_hz(),
+        t0_s: source.t0(),
+    };
+    let (t0, rate_hz) = (axis.t0_s, axis.final_rate_hz);
     if first.samples < 2 {
         let channel = if column.is_empty() {
             String::new()
@@ -150,12 +156,6 @@ pub fn analyze_in_passes(
             first.samples
         ));
     }
-    let axis = Axis {
-        rate_hz: source.rate_hz()?,
-        final_rate_hz: source.final_rate_hz(),
-        t0_s: source.t0(),
-    };
-    let (t0, rate_hz) = (axis.t0_s, axis.final_rate_hz);
     drop(source);
     // The later passes read the spool if there is one; a file whose spool failed (a full
     // disk) is read again (standard input's failure ended its pass).

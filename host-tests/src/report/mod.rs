@@ -204,6 +204,10 @@ pub fn null_reasons(r: &ImpactReport, fits: &FitSet) -> BTreeMap<String, String>
         Some("analysis-skipped".to_string())
     } else if flag(Flags::AC_COUPLED) {
         Some("ac-coupled".to_string())
+    } else if flag(Flags::CLIPPED) {
+        Some("clipped".to_string())
+    } else if flag(Flags::CUT_AT_START) {
+        Some("cut-at-start".to_string())
     } else if r.status != Status::Complete {
         Some(format!("status-{}", r.status.name()))
     } else if flag(Flags::COR_OUT_OF_RANGE) {

@@ -71,10 +71,15 @@ pub fn to_table(a: &AnalysisJson) -> String {
     }
     for i in &a.impacts {
         s.push_str(&format!(
-            "impact {} [{}{}{}] at {:.6} s: peak {}{} ({}){}, Δv {}, duration {}, FWHM {}\n",
+            "impact {} [{}{}{}{}] at {:.6} s: peak {}{} ({}){}, Δv {}, duration {}, FWHM {}\n",
             i.index,
             i.status,
             if i.clipped { ", CLIPPED" } else { "" },
+            if i.flags.iter().any(|f| f == "cut-at-start") {
+                ", CUT AT START"
+            } else {
+                ""
+            },
             if i.analysis == "skipped" {
                 ", analysis skipped"
             } else {
@@ -88,7 +93,7 @@ pub fn to_table(a: &AnalysisJson) -> String {
                 .map_or(String::new(), |f| format!(", force {}", human(f, "N"))),
             i.delta_v_m_s.map_or_else(
                 || format!("unknown ({})", i.null_reasons["delta_v_m_s"]),
-                |v| human(v, "m/s")
+                |v| format!("{}{}", if i.clipped { "≥" } else { "" }, human(v, "m/s"))
             ),
             human(i.duration_s, "s"),
             i.fwhm_s.map_or_else(

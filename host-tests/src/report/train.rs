@@ -19,7 +19,8 @@ pub struct BounceJson {
     /// The previous impact's rebound, m/s (null: it had none).
     pub v0_rebound_m_s: Option<f64>,
     /// `(Δv - v0) / v0` with each speed; null when it cannot be known, the reason beside:
-    /// `ac-coupled` (no Δv), `no-rebound` (no previous rebound), `cor-out-of-range` (outside
+    /// `clipped` (Δv a lower bound), `ac-coupled` (no Δv), `no-rebound` (no previous rebound,
+    /// or it was clipped), `cor-out-of-range` (outside
     /// core's [-0.02, 1.02]: that speed or the signal is wrong).
     pub cor_flight: Option<f64>,
     #[serde(skip_serializing_if = "Option::is_none")]
@@ -37,6 +38,9 @@ pub fn bounce_json(r: &ImpactReport) -> Option<BounceJson> {
     let f = |v: f32| v as f64;
     let tol = impact_core::report::COR_TOLERANCE as f64;
     let cor = |v0: Option<f32>| -> Result<f64, &'static str> {
+        if r.clipped {
+            return Err("clipped");
+        }
         let v0 = v0.ok_or("no-rebound")?;
         let dv = r.delta_v_m_s.ok_or("ac-coupled")?;
         let c = f(impact_core::Bounce::cor(v0, dv));

@@ -83,7 +83,13 @@ pub struct FlatTops {
     /// A run that has ended, with the exit step to its first next reading, waiting for the
     /// second.
     ended: Option<(Run, f64)>,
+    /// The first [`STEP_SAMPLE`] non-zero steps, to tell whether the smallest is the
+    /// recording's quantum ([`FlatTops::quantum`]).
+    steps: Vec<f64>,
 }
+
+/// Non-zero steps kept to check the resolution against.
+const STEP_SAMPLE: usize = 4096;
 
 impl Default for FlatTops {
     fn default() -> Self {
@@ -94,6 +100,7 @@ impl Default for FlatTops {
             low: None,
             run: None,
             ended: None,
+            steps: Vec::new(),
         }
     }
 }
@@ -106,6 +113,14 @@ impl FlatTops {
         let mut q = self.q;
         if let (Some(p), Some(&first)) = (self.prev[0], block.first()) {
             q = q.min(nonzero((first - p).abs()));
+        }
+        if self.steps.len() < STEP_SAMPLE {
+            let room = STEP_SAMPLE - self.steps.len();
+            let steps = block
+                .windows(2)
+                .map(|w| (w[1] - w[0]).abs())
+                .filter(|d| *d > 0.0 && d.is_finite());
+            self.steps.extend(steps.take(room));
         }
         let mut m = [q; 4];
         let quads = block.len().saturating_sub(1) / 4;
@@ -252,9 +267,35 @@ impl FlatTops {
         }
     }
 
-    /// The recording's resolution so far: its smallest non-zero step (infinite if none).
+    /// The recording's resolution so far: its smallest non-zero step (infinite if none) when
+    /// that is its quantum; 0 when it is not (below).
     pub fn resolution(&self) -> f64 {
-        self.q
+        self.quantum()
+    }
+
+    /// The smallest non-zero step if the recording is quantised by it (nine in ten of the
+    /// first steps are whole multiples of it: an ADC's codes, a CSV's last decimal), else 0:
+    /// a noise-free or smooth recording shows no quantum (its smallest step is the signal's
+    /// own, at a clipped top's entry as likely as anywhere), and then a run of three or more
+    /// equal readings at an extreme, which a smooth peak never holds, is a flat top.
+    fn quantum(&self) -> f64 {
+        let q = self.q;
+        if !q.is_finite() || self.steps.is_empty() {
+            return q;
+        }
+        let whole = self
+            .steps
+            .iter()
+            .filter(|&&d| {
+                let m = d / q;
+                (m - m.round()).abs() <= 1e-3
+            })
+            .count();
+        if 10 * whole >= 9 * self.steps.len() {
+            q
+        } else {
+            0.0
+        }
     }
 
     /// The clipping levels found, `None` if none (or the recording has no non-zero step).
@@ -265,7 +306,7 @@ impl FlatTops {
         if let Some(run) = self.run.take() {
             self.close(run, 0.0);
         }
-        let q = self.q;
+        let q = self.quantum();
         if !q.is_finite() {
             return None;
         }
