@@ -409,8 +409,21 @@ fn a_drifting_time_axis_is_refused_alike_everywhere_or_resampled() {
     let mut errors = Vec::new();
     for extra in [
         &["--v0", "2"][..],
-        &["--v0", "2", "--plot", temp("drifting.svg").to_str().unwrap()][..],
-        &["--v0", "2", "--stream", "--range", "4000", "--trigger", "200"][..],
+        &[
+            "--v0",
+            "2",
+            "--plot",
+            temp("drifting.svg").to_str().unwrap(),
+        ][..],
+        &[
+            "--v0",
+            "2",
+            "--stream",
+            "--range",
+            "4000",
+            "--trigger",
+            "200",
+        ][..],
     ] {
         let mut args = vec!["analyze", file];
         args.extend_from_slice(extra);
@@ -420,7 +433,45 @@ fn a_drifting_time_axis_is_refused_alike_everywhere_or_resampled() {
         errors.push(err);
     }
     assert!(errors.iter().all(|e| *e == errors[0]), "{errors:?}");
-    assert!(errors[0].contains("drifting-time.csv:2050:"), "{}", errors[0]);
+    assert!(
+        errors[0].contains("drifting-time.csv:2050:"),
+        "{}",
+        errors[0]
+    );
+    // Past the head the plain rows are parsed in parallel: a steady clock for 150 000 rows,
+    // then one that slows by 5 % over the next 50 000, is refused at the same line everywhere
+    // (and the parallel reader's rows are checked as the sequential reader's).
+    let mut text = String::from("time_s,accel_m_s2\n");
+    let mut t = 0.0f64;
+    for k in 0..200_000usize {
+        let dither = 0.5 * (((k * 7919) % 13) as f64 / 6.0 - 1.0);
+        text.push_str(&format!("{t:.9},{dither:.4}\n"));
+        let slow = k.saturating_sub(150_000) as f64 / 50_000.0;
+        t += 2e-6 * (1.0 + 0.05 * slow);
+    }
+    let long = temp("drifting-long.csv");
+    std::fs::write(&long, text).unwrap();
+    let long = long.to_str().unwrap();
+    let mut errors = Vec::new();
+    for extra in [
+        &[][..],
+        &["--stream", "--range", "100", "--trigger", "10"][..],
+    ] {
+        let mut args = vec!["analyze", long];
+        args.extend_from_slice(extra);
+        let (code, out, err) = impact(&args);
+        assert_eq!(code, 1, "{extra:?}: {out}");
+        assert!(err.contains("the time axis drifts"), "{extra:?}: {err}");
+        errors.push(err);
+    }
+    assert_eq!(errors[0], errors[1]);
+    let line: u64 = errors[0]
+        .split(':')
+        .nth(2)
+        .and_then(|l| l.trim().parse().ok())
+        .unwrap_or_else(|| panic!("{}", errors[0]));
+    // 1 % slower on average over a block of 1024 intervals: about 10 000 rows in.
+    assert!((155_000..170_000).contains(&line), "{}", errors[0]);
     let (out, _) = impact_ok(&["analyze", file, "--v0", "2", "--resample", "--json"]);
     let v: serde_json::Value = serde_json::from_str(&out).unwrap();
     let i = &v["impacts"][0];

@@ -491,17 +491,26 @@ fn options_are_checked_where_they_are_parsed_naming_themselves() {
         .as_f64()
         .unwrap();
     assert!((v0 - 1.3357).abs() < 1e-4, "{v0}");
-    // A hold too short to see the body stop: the kinematics are null with the reason.
-    let short = json(
-        &ok(&[
-            "analyze", name, "--mass", "0.06", "--v0", "1.3357", "--hold", "1e-5", "--json",
-        ])
-        .out,
-    );
-    let i = &short["impacts"][0];
+    // A hold of 5 samples still holds the whole contact: the kinematics are the default
+    // hold's (they need the contact, not the hold). An impact cut before the body has come
+    // back (`--max-impact` shorter than the contact) has none, with the reason.
+    let run = |extra: &[&str]| {
+        let mut args = vec![
+            "analyze", name, "--mass", "0.06", "--v0", "1.3357", "--json",
+        ];
+        args.extend_from_slice(extra);
+        json(&ok(&args).out)["impacts"][0].clone()
+    };
+    let (short, whole) = (run(&["--hold", "1e-5"]), run(&[]));
+    let cor = short["cor"].as_f64().unwrap_or_else(|| panic!("{short}"));
     assert!(
-        i["cor"].is_null() && i["null_reasons"]["cor"].is_string(),
-        "{i}"
+        (cor / whole["cor"].as_f64().unwrap() - 1.0).abs() < 1e-4,
+        "{short}"
+    );
+    let cut = run(&["--max-impact", "0.002"]);
+    assert!(
+        cut["cor"].is_null() && cut["null_reasons"]["cor"] == "status-too-long",
+        "{cut}"
     );
 }
 
@@ -610,7 +619,11 @@ fn binary_recordings_with_lying_headers_are_refused_in_bounded_memory() {
     // TDMS: channels written interleaved (ToC bit 5) are refused, not read as if contiguous
     // (which gave another channel's values, or no impact at all).
     let mut tdms = std::fs::read(fixtures.join("afrl-test1.tdms")).unwrap();
-    assert_eq!(tdms[4] & 0b10_1000, 0b00_1000, "the fixture is contiguous, with data");
+    assert_eq!(
+        tdms[4] & 0b10_1000,
+        0b00_1000,
+        "the fixture is contiguous, with data"
+    );
     tdms[4] |= 1 << 5;
     let f = temp("interleaved.tdms", &tdms);
     for column in ["0", "1"] {
@@ -675,7 +688,11 @@ fn quiet_or_unsettled_recordings_have_no_impacts_and_empty_ones_name_their_file(
         "--json",
     ]);
     assert_eq!(json(&r.out)["impacts"].as_array().unwrap().len(), 0);
-    assert!(r.err.contains("note: the signal never settled"), "{}", r.err);
+    assert!(
+        r.err.contains("note: the signal never settled"),
+        "{}",
+        r.err
+    );
     // Empty recordings: the file's name and what is missing.
     let wav = {
         let mut w = b"RIFF".to_vec();
@@ -693,7 +710,10 @@ fn quiet_or_unsettled_recordings_have_no_impacts_and_empty_ones_name_their_file(
         w
     };
     let f = temp("empty.wav", &wav);
-    fails(&["analyze", f.to_str().unwrap()], "empty.wav: 0 samples; at least 2");
+    fails(
+        &["analyze", f.to_str().unwrap()],
+        "empty.wav: 0 samples; at least 2",
+    );
     let f = temp("empty.f32", b"");
     fails(
         &["analyze", f.to_str().unwrap(), "--rate", "1000"],

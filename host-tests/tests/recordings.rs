@@ -553,7 +553,12 @@ fn noise_free_flat_tops_are_clipped_and_a_clipped_bounce_has_no_cor() {
         std::fs::write(&p, s).unwrap();
         p
     };
-    let single = write("flat-noise-free.csv", &|t| hs(t, 0.05, 40.0 * G, 0.003), 2000, 2e4);
+    let single = write(
+        "flat-noise-free.csv",
+        &|t| hs(t, 0.05, 40.0 * G, 0.003),
+        2000,
+        2e4,
+    );
     let a = analyze(AnalyzeArgs {
         file: single,
         ..Default::default()
@@ -576,7 +581,14 @@ fn noise_free_flat_tops_are_clipped_and_a_clipped_bounce_has_no_cor() {
         &|t| {
             touches
                 .iter()
-                .map(|&(t0, v)| hs(t, t0, v * (1.0 + e) * std::f64::consts::PI / (2.0 * width), width))
+                .map(|&(t0, v)| {
+                    hs(
+                        t,
+                        t0,
+                        v * (1.0 + e) * std::f64::consts::PI / (2.0 * width),
+                        width,
+                    )
+                })
                 .sum()
         },
         24_000,
@@ -598,9 +610,16 @@ fn noise_free_flat_tops_are_clipped_and_a_clipped_bounce_has_no_cor() {
         let bounce = i.bounce.as_ref();
         if clipped {
             assert!(i.cor.is_none(), "impact {k}: {:?}", i.cor);
-            assert_eq!(i.null_reasons.get("cor").map(String::as_str), Some("clipped"), "{k}");
+            assert_eq!(
+                i.null_reasons.get("cor").map(String::as_str),
+                Some("clipped"),
+                "{k}"
+            );
             if let Some(b) = bounce {
-                assert!(b.cor_flight.is_none() && b.cor_rebound.is_none(), "{k}: {b:?}");
+                assert!(
+                    b.cor_flight.is_none() && b.cor_rebound.is_none(),
+                    "{k}: {b:?}"
+                );
                 assert_eq!(b.cor_flight_null_reason.as_deref(), Some("clipped"));
             }
         } else {
@@ -627,7 +646,10 @@ fn a_recording_that_starts_inside_an_impact_flags_it() {
         }
     };
     for (name, first) in [
-        ("starts-at-a-peak.csv", &(|t: f64| hs(t, -0.001, 400.0, 0.002)) as &dyn Fn(f64) -> f64),
+        (
+            "starts-at-a-peak.csv",
+            &(|t: f64| hs(t, -0.001, 400.0, 0.002)) as &dyn Fn(f64) -> f64,
+        ),
         ("starts-in-a-ring.csv", &|t: f64| {
             300.0 * (-t / 0.003).exp() * (2.0 * std::f64::consts::PI * 2000.0 * t).cos()
         }),
@@ -636,7 +658,10 @@ fn a_recording_that_starts_inside_an_impact_flags_it() {
         for i in 0..10_000 {
             let t = i as f64 / fs;
             let dither = 0.05 * ((i * 7919 % 7) as f64 - 3.0);
-            s.push_str(&format!("{t:.6},{:.4}\n", first(t) + hs(t, 0.1, 500.0, 0.002) + dither));
+            s.push_str(&format!(
+                "{t:.6},{:.4}\n",
+                first(t) + hs(t, 0.1, 500.0, 0.002) + dither
+            ));
         }
         let p = temp_dir().join(name);
         std::fs::write(&p, s).unwrap();
@@ -647,9 +672,15 @@ fn a_recording_that_starts_inside_an_impact_flags_it() {
         });
         assert_eq!(a.impacts.len(), 2, "{name}: {:#?}", a.impacts);
         let (cut, clean) = (&a.impacts[0], &a.impacts[1]);
-        assert!(cut.flags.iter().any(|f| f == "cut-at-start"), "{name}: {cut:#?}");
+        assert!(
+            cut.flags.iter().any(|f| f == "cut-at-start"),
+            "{name}: {cut:#?}"
+        );
         assert!(cut.cor.is_none(), "{name}");
-        assert!(!clean.flags.iter().any(|f| f == "cut-at-start"), "{name}: {clean:#?}");
+        assert!(
+            !clean.flags.iter().any(|f| f == "cut-at-start"),
+            "{name}: {clean:#?}"
+        );
         let dv = clean.delta_v_m_s.unwrap();
         let want = 500.0 * 2.0 * 0.002 / std::f64::consts::PI;
         assert!((dv / want - 1.0).abs() < 0.01, "{name}: Δv {dv} vs {want}");

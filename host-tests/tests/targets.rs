@@ -718,5 +718,10 @@ fn a_state_space_mount_rings_and_is_hit_again_as_its_spring_mass_twin() {
         0.01,
         "ring frequency",
     );
-    close(fb.ring_amplitude_m, fa.ring_amplitude_m, 0.003, "ring amplitude");
+    close(
+        fb.ring_amplitude_m,
+        fa.ring_amplitude_m,
+        0.003,
+        "ring amplitude",
+    );
 }

@@ -246,11 +246,24 @@ fn analyse_kinematics<const CAP: usize>(
     let Some(onset) = s.onset_index.checked_sub(s.first_index).map(|o| o as usize) else {
         return r;
     };
+    // The whole samples between first touch and the onset are the contact's foot (its Δv
+    // counts them, [`Summary::contact_c`]): the integration starts at the first of them.
+    let lead = (libm::floor(-(s.touch_offset as f64)).max(0.0) as usize).min(onset);
+    let onset = onset - lead;
     let fs = scene.calibration.sample_rate_hz as f64;
     let dt = 1.0 / fs;
     // Fractional positions from the onset sample: first touch (<= 0) and separation.
-    let touch = s.touch_offset as f64;
-    let separation = (sep_index - s.onset_index) as f64 + s.separation_offset as f64;
+    let touch = s.touch_offset as f64 + lead as f64;
+    // (A falling foot's zero may lie a little past the hold's end, where the capture stops:
+    // the integration stops at its last sample; a separation sample beyond it is no stop.)
+    let captured = samples.len().saturating_sub(onset + 1) as f64;
+    let first_quiet = (sep_index - s.onset_index) as f64 + lead as f64;
+    let separation = first_quiet + s.separation_offset as f64;
+    let separation = if first_quiet <= captured {
+        separation.min(captured)
+    } else {
+        separation
+    };
     let v0d = v0 as f64;
     let motion_scale = Scale {
         v0: v0d,

@@ -40,8 +40,9 @@ pub struct Summary {
     pub first_index: u64,
     /// Stream index of the first sample beyond the edge level.
     pub onset_index: u64,
-    /// First touch relative to `onset_index`, samples (≤ 0): the rising flank extrapolated to
-    /// zero, or the edge crossing.
+    /// First touch relative to `onset_index`, samples (≤ 0): where the rising flank reaches
+    /// zero force (its foot fitted as a power curve on a captured impact,
+    /// [`crate::signal::power_flank`], else a straight line), or the edge crossing.
     pub touch_offset: f32,
     /// Stream index of the first sample back within the edge level after the peak, if any.
     pub separation_index: Option<u64>,
@@ -59,7 +60,9 @@ pub struct Summary {
     /// `Σ d` over the whole impact (also beyond a full capture), in `W · counts`.
     pub total_c: i64,
     /// `Σ d` over the contact, from the onset to the separation (exclusive), if the signal
-    /// came back.
+    /// came back; for a captured impact also over its feet below the edge level: the whole
+    /// samples from first touch to the onset and from the separation sample to the falling
+    /// flank's zero.
     pub contact_c: Option<i64>,
     /// The approach speed of this impact, m/s: the scene's (or a light gate's), or, in a
     /// bounce train, the bounce's ([`crate::stream::train`]).

@@ -5,6 +5,7 @@ pub mod cfc;
 pub mod copy;
 pub mod flank;
 pub mod integrate;
+pub mod power_flank;
 pub mod resultant;
 pub mod ring;
 pub mod spectrum;

@@ -10,12 +10,14 @@
 //! impact at all); or for the reasons of [`Status`].
 
 use super::level::LevelWatch;
+use super::rise::Rise;
 use super::{Stream, FLANK_EDGES};
 use crate::capture::{Sink, Summary};
 use crate::report::{self, Status};
 use crate::signal::baseline::Deviation;
 use crate::signal::baseline::{Stats, STRIDE};
 use crate::signal::flank::{crossing, Flank};
+use crate::signal::power_flank;
 
 /// The impact being followed.
 pub(super) struct Active {
@@ -25,6 +27,8 @@ pub(super) struct Active {
     trigger_index: u64,
     onset_index: u64,
     touch_offset: f32,
+    /// The earliest first touch relative to the onset (the previous contact's end), samples.
+    touch_floor: f32,
     base_sum: i64,
     base_n: i64,
     /// Edge level in units of `d = W x - S`.
@@ -44,6 +48,15 @@ pub(super) struct Active {
     separation: Option<u64>,
     /// `Σ d` from `first_index` to the separation (exclusive).
     separation_c: i64,
+    /// The separation, its offset and the falling foot's `Σ d` beyond it (where the foot is
+    /// a power curve: [`Stream::fall`], else [`Stream::separation_offset`] and 0), found while
+    /// its flank was still in the ring (a long ring-down after it would push it out).
+    separation_at: Option<(u64, f32, i64)>,
+    /// The rising side, for the foot's fit at the end; the pulse's sign; `Σ d` over the whole
+    /// samples from the straight-line first touch to the onset.
+    rise: Rise,
+    sign: i64,
+    lead_c: i64,
     /// `Σ d` over the samples before the onset.
     pre_onset_c: i64,
     peak_d: i64,
@@ -140,7 +153,18 @@ impl<const PRE: usize> Stream<PRE> {
         };
         // First touch cannot come before the previous contact ended: reports never overlap.
         let earliest = self.last_end as f64 - onset_index as f64;
-        let touch_offset = touch_offset.max(earliest.min(0.0) as f32);
+        let touch_floor = earliest.min(0.0) as f32;
+        let touch_offset = touch_offset.max(touch_floor);
+        // The whole samples from first touch to the onset (its foot below the edge level).
+        let lead = libm::floorf(-touch_offset).max(0.0) as usize;
+        let lead_c: i64 = (pulse..pulse + lead)
+            .map_while(|i| ring.back(i).map(|x| deviation.of(x) as i64))
+            .sum();
+        // The rise so far: the onset to the newest sample.
+        let mut rise = Rise::new();
+        rise.take(0, pulse, pulse as u64, |k| {
+            pd(pulse.saturating_sub(1 + k)).unwrap_or(0)
+        });
         // Capture from `margin` samples before the onset (as far as the ring reaches, and not
         // into the previous impact's window).
         let since_last =
@@ -163,6 +187,7 @@ impl<const PRE: usize> Stream<PRE> {
             trigger_index: self.index,
             onset_index,
             touch_offset,
+            touch_floor,
             base_sum,
             base_n,
             edge_d,
@@ -173,6 +198,10 @@ impl<const PRE: usize> Stream<PRE> {
             returned: false,
             separation: None,
             separation_c: 0,
+            separation_at: None,
+            rise,
+            sign,
+            lead_c,
             pre_onset_c: 0,
             peak_d: 0,
             peak_index: self.index,
@@ -403,6 +432,15 @@ impl<const PRE: usize> Stream<PRE> {
         if matches!(ended, Some(End::NextHit)) {
             a.end_at = Some(a.last_quiet);
         }
+        if !a.rise.done() {
+            let sign = a.sign;
+            a.rise.take(
+                start.saturating_sub(a.onset_index),
+                kept.len(),
+                a.peak_index.saturating_sub(a.onset_index),
+                |k| kept.get(k).map_or(0, |&x| sign * deviation.of(x) as i64),
+            );
+        }
         a.total_c += sum;
         a.separation = separation;
         a.separation_c = separation_c;
@@ -416,6 +454,7 @@ impl<const PRE: usize> Stream<PRE> {
         // The ring keeps following the stream: the separation flank and the next impact's
         // pre-trigger history come from it.
         self.keep(kept);
+        self.locate_separation();
         if too_long {
             self.end(Status::TooLong, sink);
             return (used, None);
@@ -460,6 +499,115 @@ impl<const PRE: usize> Stream<PRE> {
             }
         };
         self.end(status, sink);
+    }
+
+    /// Locates a new separation while its flank is in the ring (just after the samples that
+    /// set it were kept).
+    #[inline(never)]
+    fn locate_separation(&mut self) {
+        let Some(a) = self.active.as_ref() else {
+            return;
+        };
+        let Some(s) = a.separation else {
+            return;
+        };
+        if a.separation_at.is_some_and(|(at, _, _)| at == s) {
+            return;
+        }
+        let (offset, tail, clear) = self
+            .fall(a, s)
+            .unwrap_or_else(|| (self.separation_offset(a, s), 0, None));
+        if clear.is_some() {
+            self.foot_power = clear;
+        }
+        if let Some(a) = self.active.as_mut() {
+            a.separation_at = Some((s, offset, tail));
+        }
+    }
+
+    /// First touch relative to the onset and `Σ d` over the foot before the onset: where the
+    /// rising foot, fitted as a power curve ([`power_flank`]), reaches zero force, else the
+    /// straight line's (`touch_offset`, `lead_c`).
+    fn touch(&mut self, a: &Active) -> (f32, i64) {
+        let line = (a.touch_offset, a.lead_c);
+        let peak = a.peak_d.unsigned_abs() as f32;
+        match self.rise_foot(a) {
+            Some(foot) => {
+                if foot.clear {
+                    self.foot_power = Some(foot.power);
+                }
+                let touch = foot.zero.max(a.touch_floor);
+                let lead = libm::floorf(-touch).max(0.0) as i64;
+                let c = foot.sum(-lead, 0) * peak * a.sign as f32;
+                (touch, c as i64)
+            }
+            None => line,
+        }
+    }
+
+    /// The rising foot (from the rise record) fitted as a power curve, if it is one.
+    fn rise_foot(&self, a: &Active) -> Option<power_flank::Foot> {
+        let peak = a.peak_d.unsigned_abs() as f32;
+        if !(peak > 0.0) {
+            return None;
+        }
+        let top = power_flank::FOOT * peak;
+        let n = a
+            .rise
+            .points()
+            .take_while(|&(_, d)| d as f32 <= top)
+            .count();
+        let stride = n.div_ceil(power_flank::MAX_FOOT_POINTS).max(1);
+        let points = a
+            .rise
+            .points()
+            .take(n)
+            .step_by(stride)
+            .filter(|&(_, d)| d > 0)
+            .map(|(p, d)| (p as f32, d as f32 / peak));
+        let choice = power_flank::Choice::Free {
+            prior: self.foot_power,
+        };
+        power_flank::zero(points, true, -1.0, a.edge_d as f32 / peak, choice)
+    }
+
+    /// The separation relative to `separation` and `Σ d` over the foot beyond it, where the
+    /// falling foot (in the ring) is a power curve: its rising foot's power
+    /// ([`power_flank`]).
+    fn fall(&self, a: &Active, separation: u64) -> Option<(f32, i64, Option<f32>)> {
+        let rise = self.rise_foot(a)?;
+        let deviation = a.deviation();
+        let peak = a.peak_d.unsigned_abs() as f32;
+        let sign: i64 = if a.peak_d >= 0 { 1 } else { -1 };
+        if !(peak > 0.0) {
+            return None;
+        }
+        // `y(k)`: sample `separation - 1 - k` over the peak (the ring ends at `index - 1`).
+        let y = |k: u64| {
+            let back = self.index.checked_sub(separation)?.checked_add(k)?;
+            let x = self.ring.back(usize::try_from(back).ok()?)?;
+            Some((sign * deviation.of(x) as i64) as f32 / peak)
+        };
+        let limit = separation
+            .saturating_sub(a.peak_index + 1)
+            .min(self.ring.len() as u64);
+        // The foot's end to within `step` (at most 256 looks).
+        let step = (limit / 256).max(1);
+        let mut len = 0u64;
+        while len < limit && y(len).is_some_and(|v| v <= power_flank::FOOT) {
+            len += step;
+        }
+        let len = len.min(limit);
+        let stride = len.div_ceil(power_flank::MAX_FOOT_POINTS as u64).max(1);
+        let points = (0..len).step_by(stride as usize).filter_map(|k| {
+            let v = y(k)?;
+            (v > 0.0).then_some((-(k as f32) - 1.0, v))
+        });
+        let choice = power_flank::Choice::Only(rise.power);
+        let foot = power_flank::zero(points, false, 0.0, a.edge_d as f32 / peak, choice)?;
+        let tail = libm::ceilf(foot.zero).max(0.0) as i64;
+        let c = foot.sum(0, tail) * peak * sign as f32;
+        Some((foot.zero, c as i64, rise.clear.then_some(rise.power)))
     }
 
     /// The separation relative to `separation_index`: the falling flank (from the ring)
@@ -520,8 +668,18 @@ impl<const PRE: usize> Stream<PRE> {
         if let Some(f) = self.trigger_filter.as_mut() {
             f.reset(level);
         }
-        let separation_offset = a.separation.map_or(0.0, |s| self.separation_offset(&a, s));
-        let touch = a.onset_index as f64 + a.touch_offset as f64;
+        let separation_offset = a.separation.map_or(0.0, |s| match a.separation_at {
+            Some((at, offset, _)) if at == s => offset,
+            _ => self.separation_offset(&a, s),
+        });
+        // A rising foot that is a power curve puts first touch where it reaches zero force;
+        // the contact's Δv runs from touch to separation, the feet below the edge included.
+        let (touch_offset, lead_c) = self.touch(&a);
+        let tail_c = match a.separation_at {
+            Some((at, _, tail)) if Some(at) == a.separation => tail,
+            _ => 0,
+        };
+        let touch = a.onset_index as f64 + touch_offset as f64;
         let (v0, bounce) = self.train.approach(&self.scene, touch, self.v0);
         let summary = Summary {
             index: self.counters.impacts.min(u32::MAX as u64) as u32,
@@ -530,7 +688,7 @@ impl<const PRE: usize> Stream<PRE> {
             cut_at_start: a.cut_at_start,
             first_index: a.first_index,
             onset_index: a.onset_index,
-            touch_offset: a.touch_offset,
+            touch_offset,
             separation_index: a.separation,
             separation_offset,
             end_index: a.end_at.unwrap_or(self.index),
@@ -539,7 +697,9 @@ impl<const PRE: usize> Stream<PRE> {
             peak_d: a.peak_d,
             peak_index: a.peak_index,
             total_c: a.total_c,
-            contact_c: a.separation.map(|_| a.separation_c - a.pre_onset_c),
+            contact_c: a
+                .separation
+                .map(|_| a.separation_c - a.pre_onset_c + lead_c + tail_c),
             v0_m_s: v0,
             bounce: bounce.into(),
         };

@@ -16,6 +16,7 @@
 
 mod impact;
 mod level;
+mod rise;
 pub mod train;
 
 use crate::capture::Sink;
@@ -91,6 +92,9 @@ pub struct Stream<const PRE: usize> {
     /// Where the last impact's contact ended (its separation, or the end of its window): no
     /// report starts before it.
     last_end: u64,
+    /// The power of the latest foot that showed one clearly ([`crate::signal::power_flank`]):
+    /// the same contact's later, smaller impacts take it where their noise leaves it open.
+    foot_power: Option<f32>,
     /// Where the last impact's window ended: the next capture does not reach back into it.
     window_end: u64,
 }
@@ -159,6 +163,7 @@ impl<const PRE: usize> Stream<PRE> {
             trigger_filter: None,
             gap_end: None,
             last_end: 0,
+            foot_power: None,
             window_end: 0,
         }
     }
@@ -214,6 +219,7 @@ impl<const PRE: usize> Stream<PRE> {
         self.replaying = false;
         self.gap_end = None;
         self.last_end = 0;
+        self.foot_power = None;
         self.window_end = 0;
         // At rest at 0 until the first baseline resets it to the baseline's level.
         self.trigger_filter = scene

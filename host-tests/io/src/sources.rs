@@ -480,9 +480,17 @@ impl CsvSource {
             out.push(self.take_values(chunk.line, value, time)?);
         }
         let unit = self.time.map(|(_, unit)| unit);
-        for &(value, time) in chunk.rows.iter().skip(1) {
+        let drift = self.rate_given.is_none();
+        for (k, &(value, time)) in chunk.rows.iter().enumerate().skip(1) {
             if let Some(unit) = unit {
-                self.last = time * unit;
+                let t = time * unit;
+                self.last = t;
+                if drift && self.drifting.is_none() {
+                    if let Err(m) = self.drift.push(t) {
+                        let line = chunk.line + k as u64;
+                        self.drifting = Some(format!("{}:{line}: {m}", self.name));
+                    }
+                }
             }
             out.push(value);
         }

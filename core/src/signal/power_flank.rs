@@ -1,0 +1,301 @@
+//! Where a flank that is a power curve reaches zero force: `|d| = A |x - x0|^p` fitted over
+//! the pulse's foot (its points from the edge level to [`FOOT`] of the peak), `p` the power
+//! of 1 to 2 that fits best.
+//!
+//! A contact force `k x^n` rises from first touch as `t^n` (the deformation grows as `v0 t`)
+//! and falls to separation the same way, so the straight line [`super::flank`] draws through
+//! a Hertz-like flank (`n = 1.5`) puts touch late and separation early: a bounce's flight
+//! comes out long and its flight-time speed high. Over the foot the curvature stands out of
+//! the noise, where between one and four edge levels it does not.
+
+/// The foot reaches this fraction of the peak.
+pub const FOOT: f32 = 0.3;
+
+/// Most points fitted (evenly spread over the foot): the board fits each power in f32.
+/// `zero` takes at most this many.
+pub const MAX_FOOT_POINTS: usize = 32;
+
+/// Least points for a fit.
+pub const MIN_FOOT_POINTS: usize = 6;
+
+/// The powers tried; 1 is the straight line. Only the laws' own powers (linear, Hertz, and a
+/// square law for foams and felts): a finer grid lets the noise pick between close powers,
+/// and a zero extrapolated a few samples moves by tenths of a millisecond with the power.
+pub const POWERS: [f32; 3] = [1.0, 1.5, 2.0];
+
+/// The largest reading, as a fraction of the peak, a power fit may give at the sample next
+/// to its foot (a larger one is a jump, not a foot).
+pub const JUMP: f32 = 0.02;
+
+/// A fit other than the straight line is taken when its unexplained variance (`1 - R²` of
+/// `|d|^(1/p)` against `x`) is below this fraction of the line's.
+pub const BETTER: f32 = 0.5;
+
+/// The zero of the best power fit to `points` (position in samples, `|d| / peak` in `(0, 1]`)
+/// and its power, if a power above 1 fits clearly better than the line, or `prior` (the power
+/// an earlier foot of the same contact showed clearly) fits no worse than it (else `None`:
+/// the straight-line estimate stands), and it is a flank: rising (`rising`) or falling, its zero
+/// within one point spacing of `outside` (the sample next to the foot, within the edge
+/// level) and no further beyond it than the fitted curve takes to rise to four edge levels, and the fit reading at most `1.5 edge` or
+/// [`JUMP`] at `outside` (`edge` as a fraction of the peak).
+pub fn zero<I>(points: I, rising: bool, outside: f32, edge: f32, choice: Choice) -> Option<Foot>
+where
+    I: Iterator<Item = (f32, f32)>,
+{
+    let mut x = [0.0f32; MAX_FOOT_POINTS];
+    let mut y = [0.0f32; MAX_FOOT_POINTS];
+    let mut n = 0usize;
+    for ((xi, yi), (px, py)) in x.iter_mut().zip(y.iter_mut()).zip(points) {
+        *xi = px;
+        *yi = py;
+        n += 1;
+    }
+    let (x, y) = (x.get(..n)?, y.get(..n)?);
+    fit(x, y, rising, outside, edge, choice)
+}
+
+/// [`zero`] over the points gathered (one copy of the fits in the firmware, whatever the
+/// points' iterator).
+#[inline(never)]
+fn fit(
+    xs: &[f32],
+    ys: &[f32],
+    rising: bool,
+    outside: f32,
+    edge: f32,
+    choice: Choice,
+) -> Option<Foot> {
+    // Each point's |d|^(1/p) for each power, computed once (a cube root and a square root:
+    // the FPU's).
+    let n = xs.len().min(ys.len()).min(MAX_FOOT_POINTS);
+    if n < MIN_FOOT_POINTS {
+        return None;
+    }
+    let mut z = [[0.0f32; MAX_FOOT_POINTS]; 3];
+    let [z1, z15, z2] = &mut z;
+    for (((a, b), c), &py) in z1.iter_mut().zip(z15.iter_mut()).zip(z2.iter_mut()).zip(ys) {
+        let r = cbrt(py);
+        *a = py;
+        *b = r * r;
+        *c = libm::sqrtf(py);
+    }
+    let (x, nf) = (xs.get(..n)?, n as f32);
+    let mean_x = x.iter().sum::<f32>() / nf;
+    // (1 - R², slope, intercept) of |d|^(1/p) against x.
+    let fit = |z: &[f32]| {
+        let z = z.get(..n).unwrap_or(&[]);
+        let mean_z = z.iter().sum::<f32>() / nf;
+        let (mut sxx, mut szz, mut sxz) = (0.0f32, 0.0f32, 0.0f32);
+        for (&xi, &zi) in x.iter().zip(z) {
+            let (dx, dz) = (xi - mean_x, zi - mean_z);
+            sxx += dx * dx;
+            szz += dz * dz;
+            sxz += dx * dz;
+        }
+        let slope = sxz / sxx;
+        (
+            1.0 - sxz * sxz / (sxx * szz),
+            slope,
+            mean_z - slope * mean_x,
+        )
+    };
+    let fits = [fit(&z[0]), fit(&z[1]), fit(&z[2])];
+    let line = fits[0].0;
+    let (k, (unexplained, slope, icept)) = (1..POWERS.len())
+        .zip(fits.iter().skip(1))
+        .map(|(k, f)| (k, *f))
+        .fold((0, (f32::INFINITY, 0.0, 0.0)), |best, c| {
+            if c.1 .0 < best.1 .0 {
+                c
+            } else {
+                best
+            }
+        });
+    let clear = unexplained.is_finite() && line.is_finite() && unexplained < BETTER * line;
+    // The power the same contact showed clearly before (`prior`) wherever it fits at least as
+    // well as the line: a smaller impact's noise may favour another power by chance, and a
+    // zero extrapolated with the wrong one is off by many samples.
+    let (prior, only) = match choice {
+        Choice::Free { prior } => (prior, false),
+        Choice::Only(p) => (Some(p), true),
+    };
+    let prior = POWERS
+        .iter()
+        .position(|&p| Some(p) == prior)
+        .filter(|&j| j > 0)
+        .and_then(|j| fits.get(j).map(|f| (j, *f)))
+        .filter(|(_, f)| f.0.is_finite() && f.0 <= line);
+    let (k, (_, slope, icept), clear) = match prior {
+        Some((j, f)) => (j, f, false),
+        None if clear && !only => (k, (unexplained, slope, icept), true),
+        None => return None,
+    };
+    let x0 = -icept / slope;
+    let span = x
+        .iter()
+        .map(|&xi| libm::fabsf(xi - outside))
+        .fold(0.0f32, f32::max);
+    // At `outside` the fit reads at most 1.5 edge levels, or JUMP of the peak: a flank that
+    // starts with a jump (Kelvin–Voigt's `c v0`) reads more; a power curve fitted over the
+    // foot may read a little more than the edge there when the edge is a tiny part of it.
+    let at = (icept + slope * outside).max(0.0);
+    let at = match k {
+        1 => at * libm::sqrtf(at),
+        _ => at * at,
+    };
+    let below = at <= (1.5 * edge).max(JUMP);
+    // The curve reaches four edge levels at most `(4 edge / FOOT)^(1/p)` of the foot's span
+    // from its zero (less where the deceleration bends it): the zero lies no further beyond
+    // `outside` (a tail the power does not describe, as a damped law's long return, would
+    // put it far out).
+    let reach = match k {
+        1 => {
+            let c = cbrt(4.0 * edge / FOOT);
+            c * c
+        }
+        _ => libm::sqrtf(4.0 * edge / FOOT),
+    } * span
+        + 1.0;
+    let within = if rising {
+        slope > 0.0 && x0 <= outside + 1.0 && x0 >= outside - reach
+    } else {
+        slope < 0.0 && x0 >= outside - 1.0 && x0 <= outside + reach
+    };
+    (below && within && x0.is_finite()).then_some(Foot {
+        zero: x0,
+        power: POWERS.get(k).copied().unwrap_or(1.0),
+        slope,
+        clear,
+    })
+}
+
+/// Which powers a fit may take.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Choice {
+    /// The best (see [`zero`]), or `prior` where it fits no worse than the line.
+    Free { prior: Option<f32> },
+    /// This power only, where it fits no worse than the line (a falling foot takes its
+    /// rising foot's: a damped law's slow return is no power curve, and a foot fitted as
+    /// one there would put separation far out in it).
+    Only(f32),
+}
+
+/// A foot fitted as `|d| / peak = (slope (x - zero))^power` (`slope` negative on a falling
+/// flank, so the base is positive on the pulse's side).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Foot {
+    /// Where the force is zero, samples (in the points' positions).
+    pub zero: f32,
+    pub power: f32,
+    pub slope: f32,
+    /// The power fitted clearly better than the line, with no prior taken.
+    pub clear: bool,
+}
+
+impl Foot {
+    /// The fitted `|d| / peak` at position `x` (0 on the far side of the zero).
+    pub fn at(&self, x: f32) -> f32 {
+        let b = (self.slope * (x - self.zero)).max(0.0);
+        if self.power == 1.5 {
+            b * libm::sqrtf(b)
+        } else if self.power == 2.0 {
+            b * b
+        } else {
+            b
+        }
+    }
+
+    /// `Σ |d| / peak` of the fit over the whole samples from `from` to `to` (exclusive): the
+    /// foot's part of a Δv the samples beyond the edge level leave out.
+    pub fn sum(&self, from: i64, to: i64) -> f32 {
+        (from..to).map(|x| self.at(x as f32)).sum()
+    }
+}
+
+/// The cube root of `y > 0` in f32 alone (libm's goes through f64, which the Cortex-M4's FPU
+/// does not have: ~2000 cycles a call): an exponent-thirding first guess and three Newton
+/// steps, within 2 ulp.
+fn cbrt(y: f32) -> f32 {
+    if !(y > 0.0 && y.is_finite()) {
+        return 0.0;
+    }
+    let mut t = f32::from_bits(y.to_bits() / 3 + 709_958_130);
+    for _ in 0..3 {
+        t = (2.0 * t + y / (t * t)) * (1.0 / 3.0);
+    }
+    t
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// `(x, ((x - x0)/w)^p)` for the samples of the foot after `x0`.
+    fn foot(x0: f32, p: f32, w: f32, rising: bool) -> impl Iterator<Item = (f32, f32)> + Clone {
+        (-60..60)
+            .map(move |k| {
+                let x = k as f32;
+                let u = if rising { x - x0 } else { x0 - x };
+                (x, if u > 0.0 { libm::powf(u / w, p) } else { 0.0 })
+            })
+            .filter(|q| q.1 > 0.02 && q.1 <= FOOT)
+    }
+
+    #[test]
+    fn the_f32_cube_root_is_libms() {
+        for k in 1..2000 {
+            let y = k as f32 * 0.0005;
+            let (got, want) = (cbrt(y), libm::cbrtf(y));
+            assert!((got - want).abs() <= 2.5e-7 * want, "{y}: {got} vs {want}");
+        }
+        assert_eq!(cbrt(0.0), 0.0);
+        assert_eq!(cbrt(f32::NAN), 0.0);
+    }
+
+    #[test]
+    fn a_hertz_foot_extrapolates_to_its_touch_and_a_straight_one_is_left_to_the_line() {
+        for (x0, rising) in [(-3.4f32, true), (2.6, false)] {
+            let pts = foot(x0, 1.5, 40.0, rising);
+            let outside = if rising {
+                pts.clone().map(|q| q.0).fold(f32::MAX, f32::min) - 1.0
+            } else {
+                pts.clone().map(|q| q.0).fold(f32::MIN, f32::max) + 1.0
+            };
+            let f = zero(
+                pts.clone(),
+                rising,
+                outside,
+                0.02,
+                Choice::Free { prior: None },
+            )
+            .unwrap();
+            assert!((f.zero - x0).abs() < 0.05, "{} vs {x0}", f.zero);
+            assert_eq!(f.power, 1.5);
+            for (x, y) in pts {
+                assert!(
+                    (f.at(x) - y).abs() < 2e-3 * y.max(0.05),
+                    "{x}: {} vs {y}",
+                    f.at(x)
+                );
+            }
+        }
+        // A straight foot: the line stands.
+        let pts = foot(-3.4, 1.0, 40.0, true);
+        let outside = pts.clone().map(|q| q.0).fold(f32::MAX, f32::min) - 1.0;
+        assert_eq!(
+            zero(pts, true, outside, 0.02, Choice::Free { prior: None }),
+            None
+        );
+        // Too few points.
+        assert_eq!(
+            zero(
+                [(0.0, 0.1), (1.0, 0.2)].into_iter(),
+                true,
+                -1.0,
+                0.05,
+                Choice::Free { prior: None }
+            ),
+            None
+        );
+    }
+}
