@@ -263,9 +263,18 @@ pub fn impacts(
             }
         }
         let [c_a, c_v, c_x, c_f] = curves;
+        // A Δv the report refuses (a channel that does not hold DC) is not drawn either: no
+        // velocity, deformation or loop from its integral.
+        let refused = r.delta_v_m_s.is_none();
+        if refused {
+            vel.clear();
+            def.clear();
+            loop_.clear();
+        }
         // Without v0 the integrals start from rest: said in the titles; no loop.
         let known = v0.is_some();
         let force_title = match (known, mass.is_some()) {
+            _ if refused => "force against deformation: no Δv (see the report)",
             (false, _) => {
                 loop_.clear();
                 "force against deformation: needs v0"
@@ -273,7 +282,12 @@ pub fn impacts(
             (true, true) => "force against deformation, N",
             (true, false) => "deceleration against deformation, m/s²",
         };
-        let (vel_title, def_title) = if known {
+        let (vel_title, def_title) = if refused {
+            (
+                "velocity: no Δv (see the report)",
+                "deformation: no Δv (see the report)",
+            )
+        } else if known {
             ("velocity, m/s", "deformation, mm")
         } else {
             (

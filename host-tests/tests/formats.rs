@@ -482,3 +482,23 @@ fn a_drifting_time_axis_is_refused_alike_everywhere_or_resampled() {
     let cor = i["cor"].as_f64().unwrap();
     assert!((cor - e).abs() < 0.005, "COR {cor} vs {e}");
 }
+
+/// A plot never draws what the report refuses: the enDAQ piezo channel's impact has no Δv
+/// (`ac-coupled`), so its figure has no velocity, deformation or force loop (it drew a
+/// velocity change of -13 m/s), and says why.
+#[test]
+fn a_plot_draws_no_velocity_the_report_refuses() {
+    let pe = root().join("data/endaq-high-drop/High-Drop_2000g-PE_13.4-15.0s.csv");
+    let svg = temp("piezo.svg");
+    let (_, err) = impact_ok(&[
+        "analyze",
+        pe.to_str().unwrap(),
+        "--column",
+        "z_g",
+        "--plot",
+        svg.to_str().unwrap(),
+    ]);
+    let text = std::fs::read_to_string(&svg).unwrap_or_else(|e| panic!("{e}: {err}"));
+    assert!(text.contains("velocity: no Δv (see the report)"), "{err}");
+    assert!(!text.contains("velocity change from touch"));
+}

@@ -619,7 +619,9 @@ fn every_cfc_class_leaves_onset_and_kinematics_and_pads_its_window_or_says_so() 
                 !r.flags.contains(impact_core::report::Flags::CFC_WINDOW),
                 "CFC {class}"
             );
-            let w = r.fwhm_s.expect("FWHM");
+            // A filter never changes an unfiltered field: the raw width is the raw run's.
+            assert_eq!(r.fwhm_s, raw.fwhm_s, "CFC {class}");
+            let w = r.filtered_fwhm_s.expect("filtered FWHM");
             let w_raw = raw.fwhm_s.unwrap();
             assert!(
                 (w / w_raw - 1.0).abs() < 0.05,
@@ -631,7 +633,8 @@ fn every_cfc_class_leaves_onset_and_kinematics_and_pads_its_window_or_says_so() 
                 r.flags.contains(impact_core::report::Flags::CFC_WINDOW),
                 "CFC {class}"
             );
-            assert!(r.fwhm_s.is_none() && r.filtered_peak_acceleration_m_s2.is_none());
+            assert!(r.filtered_fwhm_s.is_none() && r.filtered_peak_acceleration_m_s2.is_none());
+            assert_eq!(r.fwhm_s, raw.fwhm_s, "CFC {class}");
         }
     }
 }

@@ -176,7 +176,6 @@ fn analyse_kinematics<const CAP: usize>(
     // Peak and width: on the filtered acceleration with a CFC, else on the raw samples (the
     // stream's peak, if the capture holds it).
     let mut filtered: Option<(usize, f32)> = None;
-    let mut cfc_refused = false;
     #[cfg(feature = "cfc")]
     if let Some(class) = scene.cfc {
         let fs = scene.calibration.sample_rate_hz as f64;
@@ -188,7 +187,6 @@ fn analyse_kinematics<const CAP: usize>(
         let after = (s.first_index + n as u64).saturating_sub(contact_end);
         if before < pad || after < pad {
             r.flags.insert(Flags::CFC_WINDOW);
-            cfc_refused = true;
         } else if let (Some(b), Some(a)) = (
             crate::signal::cfc::Biquad::cfc(class, fs),
             work.buf.get_mut(..n),
@@ -200,38 +198,33 @@ fn analyse_kinematics<const CAP: usize>(
             filtered = Some(scan_peak(a));
         }
     }
-    let (peak_i, peak_a) = match filtered {
-        Some((i, v)) => {
-            let a = work.buf.get(..n).unwrap_or(&[]);
-            r.fwhm_s = fwhm(n, |j| a.get(j).map_or(0.0, |v| libm::fabsf(*v)), i)
-                .map(|w| w / scene.calibration.sample_rate_hz);
-            r.filtered_peak_acceleration_m_s2 = Some(v);
-            (i, v)
-        }
-        None => {
-            let (i, v) = match s.peak_index.checked_sub(s.first_index) {
-                Some(i) if (i as usize) < n => (i as usize, r.peak_acceleration_m_s2),
-                // The peak lies beyond a full capture: the captured part's own.
-                _ => (0..n).fold((0, 0.0f32), |best, i| {
-                    let v = raw(i) as f32 * per_count;
-                    if libm::fabsf(v) > libm::fabsf(best.1) {
-                        (i, v)
-                    } else {
-                        best
-                    }
-                }),
-            };
-            if !cfc_refused {
-                r.fwhm_s = fwhm_raw(samples, deviation, per_count, i)
-                    .map(|w| w / scene.calibration.sample_rate_hz);
+    // The filtered peak and its width, with a CFC.
+    if let Some((i, v)) = filtered {
+        let a = work.buf.get(..n).unwrap_or(&[]);
+        r.filtered_fwhm_s = fwhm(n, |j| a.get(j).map_or(0.0, |v| libm::fabsf(*v)), i)
+            .map(|w| w / scene.calibration.sample_rate_hz);
+        r.filtered_peak_acceleration_m_s2 = Some(v);
+    }
+    // The raw peak's width, always: a filter never changes an unfiltered field. (The
+    // stream's peak, if the capture holds it; else the captured part's own.)
+    let (raw_i, raw_a) = match s.peak_index.checked_sub(s.first_index) {
+        Some(i) if (i as usize) < n => (i as usize, r.peak_acceleration_m_s2),
+        _ => (0..n).fold((0, 0.0f32), |best, i| {
+            let v = raw(i) as f32 * per_count;
+            if libm::fabsf(v) > libm::fabsf(best.1) {
+                (i, v)
+            } else {
+                best
             }
-            (i, v)
-        }
+        }),
     };
-    let _ = peak_i;
-    if r.fwhm_s.is_none() && !cfc_refused {
+    r.fwhm_s = fwhm_raw(samples, deviation, per_count, raw_i)
+        .map(|w| w / scene.calibration.sample_rate_hz);
+    if r.fwhm_s.is_none() {
         r.flags.insert(Flags::HALF_MAXIMUM_OUTSIDE);
     }
+    // The fits scale by the peak of the signal they fit.
+    let (_, peak_a) = filtered.unwrap_or((raw_i, raw_a));
 
     // Kinematics (and the fit points) need the approach speed and the whole, unclipped
     // impact.

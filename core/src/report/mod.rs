@@ -102,10 +102,10 @@ impl Flags {
     /// The velocity never reached zero: the approach speed is more than the measured Δv
     /// could stop. The kinematics and the fits are absent.
     pub const NO_STOP: Flags = Flags(1 << 2);
-    /// Half the peak is not reached on both sides inside the capture: no FWHM.
+    /// Half the raw peak is not reached on both sides inside the capture: no FWHM.
     pub const HALF_MAXIMUM_OUTSIDE: Flags = Flags(1 << 3);
     /// The capture holds less signal around the contact than the CFC filter needs to settle
-    /// (SAE J211's padding): the filtered peak and the FWHM are absent.
+    /// (SAE J211's padding): the filtered peak and its FWHM are absent.
     pub const CFC_WINDOW: Flags = Flags(1 << 4);
     /// The approach speed is unknown (no `v0`, drop height, free fall or light gate): the
     /// kinematics and the fits are absent.
@@ -209,10 +209,12 @@ pub struct ImpactReport {
     pub duration_s: f32,
     /// Baseline the pulse was measured from, m/s² (sensor offset).
     pub baseline_m_s2: f32,
-    /// Width at half the peak, s (on the filtered signal with a CFC).
+    /// Width at half the peak of the raw signal, s (a filter never changes it).
     pub fwhm_s: Option<f32>,
     /// Peak of the CFC-filtered signal, m/s² (only with a CFC).
     pub filtered_peak_acceleration_m_s2: Option<f32>,
+    /// Width at half the filtered peak, s (only with a CFC).
+    pub filtered_fwhm_s: Option<f32>,
     pub kinematics: Option<Kinematics>,
     pub fits: Fits,
     /// The impact continues a bounce train (a streaming field): its flight and both measures
@@ -283,6 +285,7 @@ pub fn streaming(s: &Summary, scene: &Scene) -> ImpactReport {
         baseline_m_s2: (s.base_sum as f64 * per_d) as f32,
         fwhm_s: None,
         filtered_peak_acceleration_m_s2: None,
+        filtered_fwhm_s: None,
         kinematics: None,
         fits: Fits::default(),
         bounce: s.bounce.get(),

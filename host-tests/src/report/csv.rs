@@ -56,6 +56,7 @@ pub fn to_csv(a: &AnalysisJson) -> String {
             format!("{:e}", i.baseline_m_s2),
             o(i.fwhm_s),
             o(i.filtered_peak_acceleration_m_s2),
+            o(i.filtered_fwhm_s),
             o(i.impact_velocity_m_s),
             o(i.crush_time_s),
             o(i.max_deformation_m),

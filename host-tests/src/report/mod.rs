@@ -74,6 +74,7 @@ pub struct ImpactJson {
     pub baseline_m_s2: f64,
     pub fwhm_s: Option<f64>,
     pub filtered_peak_acceleration_m_s2: Option<f64>,
+    pub filtered_fwhm_s: Option<f64>,
     pub impact_velocity_m_s: Option<f64>,
     pub crush_time_s: Option<f64>,
     pub max_deformation_m: Option<f64>,
@@ -190,10 +191,24 @@ pub fn null_reasons(r: &ImpactReport, fits: &FitSet) -> BTreeMap<String, String>
         }
     };
     if r.fwhm_s.is_none() {
-        put("fwhm_s", analysis(Some("half-maximum-outside")));
+        // The raw signal's width: a CFC's window does not touch it.
+        let why = if skipped {
+            "analysis-skipped"
+        } else {
+            "half-maximum-outside"
+        };
+        put("fwhm_s", why);
     }
     if r.filtered_peak_acceleration_m_s2.is_none() {
         put("filtered_peak_acceleration_m_s2", analysis(Some("no-cfc")));
+    }
+    if r.filtered_fwhm_s.is_none() {
+        let own = if r.filtered_peak_acceleration_m_s2.is_some() {
+            "half-maximum-outside"
+        } else {
+            "no-cfc"
+        };
+        put("filtered_fwhm_s", analysis(Some(own)));
     }
     // The kinematics: the first reason that applies.
     let kinematics = if r.kinematics.is_some() {
@@ -272,6 +287,7 @@ pub fn impact_json(r: &ImpactReport, t0: f64, fits: &FitSet) -> ImpactJson {
         baseline_m_s2: f(r.baseline_m_s2),
         fwhm_s: r.fwhm_s.map(f),
         filtered_peak_acceleration_m_s2: r.filtered_peak_acceleration_m_s2.map(f),
+        filtered_fwhm_s: r.filtered_fwhm_s.map(f),
         impact_velocity_m_s: k.map(|k| f(k.impact_velocity_m_s)),
         crush_time_s: k.map(|k| f(k.crush_time_s)),
         max_deformation_m: k.map(|k| f(k.max_deformation_m)),

@@ -101,6 +101,24 @@ pub fn to_table(a: &AnalysisJson) -> String {
                 |w| human(w, "s")
             ),
         ));
+        // With a CFC, the filtered peak and width beside the raw ones above.
+        if let Some(p) = i.filtered_peak_acceleration_m_s2 {
+            s.push_str(&format!(
+                "    CFC-filtered: peak {} ({}), FWHM {}\n",
+                human(p, "m/s²"),
+                human(p / STANDARD_GRAVITY, "g"),
+                i.filtered_fwhm_s.map_or_else(
+                    || format!("unknown ({})", i.null_reasons["filtered_fwhm_s"]),
+                    |w| human(w, "s")
+                ),
+            ));
+        } else if let Some(why) = i
+            .null_reasons
+            .get("filtered_peak_acceleration_m_s2")
+            .filter(|r| *r != "no-cfc")
+        {
+            s.push_str(&format!("    CFC-filtered: unknown ({why})\n"));
+        }
         // Why the kinematics are missing, unless simply because v0 was not given.
         if let Some(why) = i
             .null_reasons
