@@ -49,6 +49,9 @@ impl Axis {
 const BASELINE_SAMPLES: usize = 64;
 const BASELINE_GAP: usize = 4;
 
+/// The core's rule for a channel that does not hold DC (`Flags::AC_COUPLED`), per axis.
+const AC_COUPLED_RATIO: f64 = 0.5;
+
 /// The axes over `r`'s window; `axes` are in m/s² on the recording's time base starting at
 /// `t0`, `resultant` their resultant, `rate` the sample rate; `previous_end` is the sample
 /// after the previous impact (0 for the first).
@@ -93,13 +96,19 @@ pub fn impact_axes(
                         best
                     }
                 });
-            let dv = a
-                .get(contact.clone())
-                .unwrap_or(&[])
-                .iter()
-                .map(|v| v - base)
-                .sum::<f64>()
-                / rate;
+            let sum = |r: std::ops::Range<usize>| {
+                a.get(r)
+                    .unwrap_or(&[])
+                    .iter()
+                    .map(|v| v - base)
+                    .sum::<f64>()
+                    / rate
+            };
+            let dv = sum(contact.clone());
+            // As the core judges a single channel: the whole window undoing most of the
+            // contact's Δv is the mark of an axis that does not hold DC (judged below,
+            // against the other axes).
+            let window = sum(onset..end);
             let clipped = a
                 .get(onset..end)
                 .unwrap_or(&[])
@@ -111,15 +120,33 @@ pub fn impact_axes(
                 baseline_m_s2: base,
                 peak_acceleration_m_s2: peak,
                 peak_time_s: t0 + peak_i as f64 / rate,
-                delta_v_m_s: dv,
+                delta_v_m_s: Some(dv),
+                ac_coupled: dv != 0.0 && window / dv < AC_COUPLED_RATIO,
             }
+        })
+        .collect();
+    // A cross axis's Δv near zero is all noise: its ratio says nothing. Judged only where
+    // the axis carries a tenth of the largest axis's Δv.
+    let largest = axes
+        .iter()
+        .filter_map(|a: &AxisJson| a.delta_v_m_s)
+        .fold(0.0f64, |m, v| m.max(v.abs()));
+    let axes: Vec<AxisJson> = axes
+        .into_iter()
+        .map(|mut a| {
+            let dv = a.delta_v_m_s.unwrap_or(0.0);
+            a.ac_coupled &= dv.abs() >= 0.1 * largest;
+            if a.ac_coupled {
+                a.delta_v_m_s = None;
+            }
+            a
         })
         .collect();
     let delta_v_magnitude_m_s = axes
         .iter()
-        .map(|a: &AxisJson| a.delta_v_m_s * a.delta_v_m_s)
-        .sum::<f64>()
-        .sqrt();
+        .map(|a: &AxisJson| a.delta_v_m_s.map(|v| v * v))
+        .sum::<Option<f64>>()
+        .map(f64::sqrt);
     AxesJson {
         resultant_peak_m_s2,
         delta_v_magnitude_m_s,

@@ -458,7 +458,9 @@ pub fn to_json(setup: &Setup, reports: &[ImpactReport]) -> AnalysisJson {
                         setup.prepared.t0,
                     );
                     j.clipped |= x.axes.iter().any(|a| a.clipped);
-                    // ∫|a| dt is no velocity change: the axes give it.
+                    // ∫|a| dt is no velocity change: the axes give it, and judge their own
+                    // coupling (the resultant's window says nothing about it).
+                    j.flags.retain(|f| f != "ac-coupled");
                     j.delta_v_m_s = None;
                     j.null_reasons
                         .insert("delta_v_m_s".into(), "resultant".into());

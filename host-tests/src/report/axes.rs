@@ -13,8 +13,12 @@ pub struct AxisJson {
     pub peak_acceleration_m_s2: f64,
     /// Time of that peak, s.
     pub peak_time_s: f64,
-    /// `Σ (a - baseline) dt` over the contact (first touch to separation), m/s.
-    pub delta_v_m_s: f64,
+    /// `Σ (a - baseline) dt` over the contact (first touch to separation), m/s; null for an
+    /// axis that does not hold DC (`ac_coupled`).
+    pub delta_v_m_s: Option<f64>,
+    /// The axis's whole window (contact and hold) undid more than half its contact's Δv: it
+    /// does not hold DC (judged per axis, as the single channel's `ac-coupled`).
+    pub ac_coupled: bool,
     /// The axis reached its rail inside the impact: its peak and Δv are lower bounds (and
     /// the impact is marked clipped).
     pub clipped: bool,
@@ -26,8 +30,8 @@ pub struct AxesJson {
     /// Largest resultant inside the impact, m/s² (the report's peak is above its baseline).
     pub resultant_peak_m_s2: f64,
     /// `sqrt(Σ Δv_axis²)`, m/s: the size of the velocity change (the report's own Δv is
-    /// null, reason `resultant`: `∫|a| dt` is not one).
-    pub delta_v_magnitude_m_s: f64,
+    /// null, reason `resultant`: `∫|a| dt` is not one); null if an axis's Δv is.
+    pub delta_v_magnitude_m_s: Option<f64>,
     pub axes: Vec<AxisJson>,
 }
 
@@ -43,7 +47,8 @@ pub fn table_line(a: &AxesJson) -> String {
                 x.column,
                 if x.clipped { "≥" } else { "" },
                 h(x.peak_acceleration_m_s2, "m/s²"),
-                h(x.delta_v_m_s, "m/s")
+                x.delta_v_m_s
+                    .map_or_else(|| "unknown (ac-coupled)".to_string(), |v| h(v, "m/s"))
             )
         })
         .collect();
@@ -55,7 +60,8 @@ pub fn table_line(a: &AxesJson) -> String {
             ""
         },
         h(a.resultant_peak_m_s2, "m/s²"),
-        h(a.delta_v_magnitude_m_s, "m/s"),
+        a.delta_v_magnitude_m_s
+            .map_or_else(|| "unknown".to_string(), |v| h(v, "m/s")),
         axes.join(", ")
     )
 }

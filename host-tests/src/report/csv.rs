@@ -100,7 +100,7 @@ pub fn to_csv(a: &AnalysisJson) -> String {
                 s.push(',');
                 s.push_str(&o(axis.map(|a| a.peak_acceleration_m_s2)));
                 s.push(',');
-                s.push_str(&o(axis.map(|a| a.delta_v_m_s)));
+                s.push_str(&o(axis.and_then(|a| a.delta_v_m_s)));
             }
         }
         if with_spectrum {
