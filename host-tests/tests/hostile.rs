@@ -720,3 +720,52 @@ fn quiet_or_unsettled_recordings_have_no_impacts_and_empty_ones_name_their_file(
         "empty.f32: 0 samples; at least 2",
     );
 }
+
+/// Secondary inputs are read up to a stated size: an endless one (`/dev/zero`) as a scene,
+/// a target or an ELF is an error naming the limit at once (a scene grew to 24 GB). And a
+/// negative `--t0` is a value, not an unknown option.
+#[test]
+fn endless_secondary_inputs_are_refused_naming_their_limit() {
+    let csv = base();
+    let f = temp("secondary.csv", csv.as_bytes());
+    let name = f.to_str().unwrap();
+    fails(
+        &["analyze", name, "--scene", "/dev/zero"],
+        "/dev/zero: more than 1024 KiB, larger than any scene file",
+    );
+    fails(
+        &[
+            "simulate",
+            "--model",
+            "hertz",
+            "--mass",
+            "8.419e-3",
+            "--v0",
+            "2",
+            "--radius",
+            "6.35e-3",
+            "--youngs",
+            "200e9",
+            "--poisson",
+            "0.3",
+            "--target",
+            "/dev/zero",
+        ],
+        "--target /dev/zero: more than 1024 KiB, larger than any target file",
+    );
+    fails(
+        &["log", "--elf", "/dev/zero", name],
+        "/dev/zero: more than 262144 KiB, larger than any firmware ELF",
+    );
+    let (_, line) = SAMPLE_LOG;
+    let log = temp("t0.log", format!("{}\n{line}\n", SAMPLE_LOG.0).as_bytes());
+    let r = ok(&["log", log.to_str().unwrap(), "--t0", "-0.5", "--json"]);
+    let start = json(&r.out)["impacts"][0]["start_s"].as_f64().unwrap();
+    assert!((start - (0.01 - 0.5)).abs() < 1e-9, "{start}");
+}
+
+/// A scene line and an impact line in the firmware's format (see docs/board.md).
+const SAMPLE_LOG: (&str, &str) = (
+    "scene rate_hz=500000 v0_m_s=1.3357 drop_height_m=none two_phase=false nonlinear=false fit_exponent=false hertz=false",
+    "impact index=0 status=complete analysis=full clipped=false flags=0 start_sample=5000 end_sample=17000 start_s=0.01 peak_time_s=0.0100251 peak_acceleration_m_s2=4321.5 peak_force_n=259.29 delta_v_m_s=2.5 duration_s=0.0219 baseline_m_s2=0.2 fwhm_s=0.001 filtered_peak_acceleration_m_s2=none filtered_fwhm_s=none impact_velocity_m_s=1.3357 crush_time_s=0.0218 max_deformation_m=0.0186 rebound_velocity_m_s=1.16 cor=0.87 permanent_deformation_m=0.0182 absorbed_energy_j=none two_phase_kc_n_m=none two_phase_kr_n_m=none two_phase_c_n_s_m=none two_phase_permanent_deformation_m=none two_phase_residual=none nonlinear_k=none nonlinear_c_s_m=none nonlinear_exponent=none nonlinear_residual=none hertz_k=none hertz_residual=none report_latency_s=0.0123",
+);

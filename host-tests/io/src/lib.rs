@@ -128,6 +128,25 @@ pub fn open_source(path: &Path, opts: &ReadOptions, name: &str) -> Result<Box<dy
     })
 }
 
+/// Reads a secondary input (a scene, a target, an ELF) of at most `limit` bytes: a larger
+/// one (or an endless one, `/dev/zero`) is an error naming the limit, read no further.
+pub fn read_limited(path: &Path, limit: u64, what: &str) -> Result<Vec<u8>, String> {
+    use std::io::Read;
+    let name = path.display();
+    let file = std::fs::File::open(path).map_err(|e| format!("{name}: {e}"))?;
+    let mut bytes = Vec::new();
+    file.take(limit + 1)
+        .read_to_end(&mut bytes)
+        .map_err(|e| format!("{name}: {e}"))?;
+    if bytes.len() as u64 > limit {
+        return Err(format!(
+            "{name}: more than {} KiB, larger than any {what}",
+            limit / 1024
+        ));
+    }
+    Ok(bytes)
+}
+
 /// Notes for the user, each once (a file read in passes is opened again for each pass).
 static NOTES: std::sync::Mutex<Vec<String>> = std::sync::Mutex::new(Vec::new());
 

@@ -26,7 +26,7 @@ pub struct LogArgs {
     pub csv: bool,
     /// Time of the stream's first sample, s (added to start_s and peak_time_s, as
     /// `impact analyze` adds the recording's first time stamp).
-    #[arg(long, help_heading = "Input", default_value_t = 0.0, value_parser = finite_f64)]
+    #[arg(long, help_heading = "Input", default_value_t = 0.0, value_parser = finite_f64, allow_negative_numbers = true)]
     pub t0: f64,
     /// The input is the firmware's raw defmt stream (as QEMU's semihosting, `impact emulate
     /// --defmt` or an RTT reader saves it), decoded against this ELF (the firmware that wrote

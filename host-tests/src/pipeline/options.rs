@@ -239,8 +239,8 @@ pub fn scene_file(args: &AnalyzeArgs) -> Result<SceneFile, String> {
     let Some(path) = &args.scene else {
         return Ok(SceneFile::default());
     };
-    let text = std::fs::read_to_string(path).map_err(|e| format!("{}: {e}", path.display()))?;
-    serde_json::from_str(&text).map_err(|e| format!("{}: {e}", path.display()))
+    let bytes = impact_io::read_limited(path, 1 << 20, "scene file")?;
+    serde_json::from_slice(&bytes).map_err(|e| format!("{}: {e}", path.display()))
 }
 
 /// Which measure of a bounce's approach speed the kinematics use.

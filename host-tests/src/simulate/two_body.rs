@@ -55,9 +55,10 @@ struct StateSpaceFile {
 
 fn read_state_space(path: &Path) -> Result<Target<f64>, String> {
     let name = path.display();
-    let text = std::fs::read_to_string(path).map_err(|e| format!("--target {name}: {e}"))?;
+    let bytes = impact_io::read_limited(path, 1 << 20, "target file")
+        .map_err(|e| format!("--target {e}"))?;
     let f: StateSpaceFile =
-        serde_json::from_str(&text).map_err(|e| format!("--target {name}: {e}"))?;
+        serde_json::from_slice(&bytes).map_err(|e| format!("--target {name}: {e}"))?;
     let n = f.a.len();
     if n == 0 || n > MAX_STATES {
         return Err(format!(
