@@ -219,8 +219,8 @@ pub struct SynthArgs {
     /// Drift, codes per second.
     #[arg(long, help_heading = "Recording", default_value_t = 0.0)]
     pub drift: f64,
-    /// Drop every N-th sample (0: none).
-    #[arg(long, help_heading = "Recording", default_value_t = 0)]
+    /// Drop every N-th sample (0: none; 1 would drop them all).
+    #[arg(long, help_heading = "Recording", default_value_t = 0, value_parser = drop_every)]
     pub drop_every: usize,
     /// Time of first touch, s.
     #[arg(long, help_heading = "Recording", default_value_t = 0.01)]
@@ -407,4 +407,13 @@ pub fn write_csv(rec: &Recording, args: &SynthArgs, out: &mut impl Write) -> std
         )?;
     }
     out.flush()
+}
+
+/// `--drop-every`: 0 (none) or at least 2 (1 would drop every sample and write no recording).
+fn drop_every(s: &str) -> Result<usize, String> {
+    match s.parse::<usize>() {
+        Ok(1) => Err("1 would drop every sample: give 0 (none) or at least 2".into()),
+        Ok(n) => Ok(n),
+        Err(e) => Err(e.to_string()),
+    }
 }

@@ -757,6 +757,8 @@ fn endless_secondary_inputs_are_refused_naming_their_limit() {
         &["log", "--elf", "/dev/zero", name],
         "/dev/zero: more than 262144 KiB, larger than any firmware ELF",
     );
+    // `synth --drop-every 1` would write a header and no sample.
+    fails(&["synth", "--drop-every", "1"], "--drop-every");
     let (_, line) = SAMPLE_LOG;
     let log = temp("t0.log", format!("{}\n{line}\n", SAMPLE_LOG.0).as_bytes());
     let r = ok(&["log", log.to_str().unwrap(), "--t0", "-0.5", "--json"]);
