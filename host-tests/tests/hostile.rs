@@ -517,8 +517,7 @@ fn options_are_checked_where_they_are_parsed_naming_themselves() {
 #[test]
 fn impact_log_refuses_what_the_firmware_cannot_have_written_by_line() {
     // A real line from the emulated firmware's format (see docs/board.md).
-    let line = "impact index=0 status=complete analysis=full clipped=false flags=0 start_sample=5000 end_sample=17000 start_s=0.01 peak_time_s=0.0100251 peak_acceleration_m_s2=4321.5 peak_force_n=259.29 delta_v_m_s=2.5 duration_s=0.0219 baseline_m_s2=0.2 fwhm_s=0.001 filtered_peak_acceleration_m_s2=none filtered_fwhm_s=none impact_velocity_m_s=1.3357 crush_time_s=0.0218 max_deformation_m=0.0186 rebound_velocity_m_s=1.16 cor=0.87 permanent_deformation_m=0.0182 absorbed_energy_j=none two_phase_kc_n_m=none two_phase_kr_n_m=none two_phase_c_n_s_m=none two_phase_permanent_deformation_m=none two_phase_residual=none nonlinear_k=none nonlinear_c_s_m=none nonlinear_exponent=none nonlinear_residual=none hertz_k=none hertz_residual=none report_latency_s=0.0123";
-    let scene = "scene rate_hz=500000 v0_m_s=1.3357 drop_height_m=none two_phase=false nonlinear=false fit_exponent=false hertz=false";
+    let (scene, line) = SAMPLE_LOG;
     let set = |field: &str, value: &str| {
         let (head, tail) = line.split_once(&format!(" {field}=")).unwrap();
         let rest = tail.split_once(' ').map_or("", |(_, r)| r);
@@ -759,8 +758,8 @@ fn endless_secondary_inputs_are_refused_naming_their_limit() {
     );
     // `synth --drop-every 1` would write a header and no sample.
     fails(&["synth", "--drop-every", "1"], "--drop-every");
-    let (_, line) = SAMPLE_LOG;
-    let log = temp("t0.log", format!("{}\n{line}\n", SAMPLE_LOG.0).as_bytes());
+    let (scene, line) = SAMPLE_LOG;
+    let log = temp("t0.log", format!("{scene}\n{line}\n").as_bytes());
     let r = ok(&["log", log.to_str().unwrap(), "--t0", "-0.5", "--json"]);
     let start = json(&r.out)["impacts"][0]["start_s"].as_f64().unwrap();
     assert!((start - (0.01 - 0.5)).abs() < 1e-9, "{start}");

@@ -227,7 +227,7 @@ pub struct ImpactReport {
 /// A window whose Δv is less than this share of its contact's (the rest undone after
 /// separation) is from an AC-coupled channel. A DC sensor on a body that flies off or rings
 /// keeps most of it (the AFRL drop tower's ringing table: 88 %).
-const AC_COUPLED_RATIO: f64 = 0.5;
+pub const AC_COUPLED_RATIO: f64 = 0.5;
 
 /// Acceleration per unit of `d = W x - S`, m/s², in f32 as the analysis converts samples:
 /// `a = d as f32 * per_count(..)`.

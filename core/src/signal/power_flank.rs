@@ -36,8 +36,9 @@ pub const BETTER: f32 = 0.5;
 /// an earlier foot of the same contact showed clearly) fits no worse than it (else `None`:
 /// the straight-line estimate stands), and it is a flank: rising (`rising`) or falling, its zero
 /// within one point spacing of `outside` (the sample next to the foot, within the edge
-/// level) and no further beyond it than the fitted curve takes to rise to four edge levels, and the fit reading at most `1.5 edge` or
-/// [`JUMP`] at `outside` (`edge` as a fraction of the peak).
+/// level) and no further beyond it than the fitted curve takes to rise to four edge levels,
+/// and the fit reading at most `1.5 edge` or [`JUMP`] at `outside` (`edge` as a fraction of
+/// the peak).
 pub fn zero<I>(points: I, rising: bool, outside: f32, edge: f32, choice: Choice) -> Option<Foot>
 where
     I: Iterator<Item = (f32, f32)>,
@@ -74,10 +75,9 @@ fn fit(
     let mut z = [[0.0f32; MAX_FOOT_POINTS]; 3];
     let [z1, z15, z2] = &mut z;
     for (((a, b), c), &py) in z1.iter_mut().zip(z15.iter_mut()).zip(z2.iter_mut()).zip(ys) {
-        let r = cbrt(py);
         *a = py;
-        *b = r * r;
-        *c = libm::sqrtf(py);
+        *b = root(py, 1.5);
+        *c = root(py, 2.0);
     }
     let (x, nf) = (xs.get(..n)?, n as f32);
     let mean_x = x.iter().sum::<f32>() / nf;
@@ -138,24 +138,14 @@ fn fit(
     // At `outside` the fit reads at most 1.5 edge levels, or JUMP of the peak: a flank that
     // starts with a jump (Kelvin–Voigt's `c v0`) reads more; a power curve fitted over the
     // foot may read a little more than the edge there when the edge is a tiny part of it.
-    let at = (icept + slope * outside).max(0.0);
-    let at = match k {
-        1 => at * libm::sqrtf(at),
-        _ => at * at,
-    };
+    let p = POWERS.get(k).copied().unwrap_or(1.0);
+    let at = power((icept + slope * outside).max(0.0), p);
     let below = at <= (1.5 * edge).max(JUMP);
     // The curve reaches four edge levels at most `(4 edge / FOOT)^(1/p)` of the foot's span
     // from its zero (less where the deceleration bends it): the zero lies no further beyond
     // `outside` (a tail the power does not describe, as a damped law's long return, would
     // put it far out).
-    let reach = match k {
-        1 => {
-            let c = cbrt(4.0 * edge / FOOT);
-            c * c
-        }
-        _ => libm::sqrtf(4.0 * edge / FOOT),
-    } * span
-        + 1.0;
+    let reach = root(4.0 * edge / FOOT, p) * span + 1.0;
     let within = if rising {
         slope > 0.0 && x0 <= outside + 1.0 && x0 >= outside - reach
     } else {
@@ -163,7 +153,7 @@ fn fit(
     };
     (below && within && x0.is_finite()).then_some(Foot {
         zero: x0,
-        power: POWERS.get(k).copied().unwrap_or(1.0),
+        power: p,
         slope,
         clear,
     })
@@ -195,20 +185,36 @@ pub struct Foot {
 impl Foot {
     /// The fitted `|d| / peak` at position `x` (0 on the far side of the zero).
     pub fn at(&self, x: f32) -> f32 {
-        let b = (self.slope * (x - self.zero)).max(0.0);
-        if self.power == 1.5 {
-            b * libm::sqrtf(b)
-        } else if self.power == 2.0 {
-            b * b
-        } else {
-            b
-        }
+        power((self.slope * (x - self.zero)).max(0.0), self.power)
     }
 
     /// `Σ |d| / peak` of the fit over the whole samples from `from` to `to` (exclusive): the
     /// foot's part of a Δv the samples beyond the edge level leave out.
     pub fn sum(&self, from: i64, to: i64) -> f32 {
         (from..to).map(|x| self.at(x as f32)).sum()
+    }
+}
+
+/// `b^p` for the powers of [`POWERS`] (`b >= 0`), by the FPU's square root.
+fn power(b: f32, p: f32) -> f32 {
+    if p == 1.5 {
+        b * libm::sqrtf(b)
+    } else if p == 2.0 {
+        b * b
+    } else {
+        b
+    }
+}
+
+/// `y^(1/p)` for the powers of [`POWERS`] (`y >= 0`): the inverse of [`power`].
+fn root(y: f32, p: f32) -> f32 {
+    if p == 1.5 {
+        let c = cbrt(y);
+        c * c
+    } else if p == 2.0 {
+        libm::sqrtf(y)
+    } else {
+        y
     }
 }
 

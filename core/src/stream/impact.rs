@@ -575,13 +575,11 @@ impl<const PRE: usize> Stream<PRE> {
     /// falling foot (in the ring) is a power curve: its rising foot's power
     /// ([`power_flank`]).
     fn fall(&self, a: &Active, separation: u64) -> Option<(f32, i64, Option<f32>)> {
+        // (None for a zero peak, too.)
         let rise = self.rise_foot(a)?;
         let deviation = a.deviation();
         let peak = a.peak_d.unsigned_abs() as f32;
         let sign: i64 = if a.peak_d >= 0 { 1 } else { -1 };
-        if !(peak > 0.0) {
-            return None;
-        }
         // `y(k)`: sample `separation - 1 - k` over the peak (the ring ends at `index - 1`).
         let y = |k: u64| {
             let back = self.index.checked_sub(separation)?.checked_add(k)?;
@@ -668,17 +666,15 @@ impl<const PRE: usize> Stream<PRE> {
         if let Some(f) = self.trigger_filter.as_mut() {
             f.reset(level);
         }
-        let separation_offset = a.separation.map_or(0.0, |s| match a.separation_at {
-            Some((at, offset, _)) if at == s => offset,
-            _ => self.separation_offset(&a, s),
-        });
+        // The separation located while its flank was in the ring, else from the ring now.
+        let (separation_offset, tail_c) = match (a.separation, a.separation_at) {
+            (Some(s), Some((at, offset, tail))) if at == s => (offset, tail),
+            (Some(s), _) => (self.separation_offset(&a, s), 0),
+            (None, _) => (0.0, 0),
+        };
         // A rising foot that is a power curve puts first touch where it reaches zero force;
         // the contact's Δv runs from touch to separation, the feet below the edge included.
         let (touch_offset, lead_c) = self.touch(&a);
-        let tail_c = match a.separation_at {
-            Some((at, _, tail)) if Some(at) == a.separation => tail,
-            _ => 0,
-        };
         let touch = a.onset_index as f64 + touch_offset as f64;
         let (v0, bounce) = self.train.approach(&self.scene, touch, self.v0);
         let summary = Summary {

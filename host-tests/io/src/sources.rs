@@ -368,11 +368,7 @@ impl CsvSource {
     fn take_values(&mut self, line: u64, value: f64, time: f64) -> Result<f64, String> {
         if let Some((_, unit)) = self.time {
             let t = time * unit;
-            if self.rate_given.is_none() && self.drifting.is_none() {
-                if let Err(m) = self.drift.push(t) {
-                    self.drifting = Some(format!("{}:{line}: {m}", self.name));
-                }
-            }
+            self.check_drift(line, t);
             if self.t0.is_none() {
                 self.t0 = Some(t);
             } else {
@@ -472,6 +468,16 @@ impl CsvSource {
         Ok(())
     }
 
+    /// Feeds the time `t` (s) of `line` to the drift check (not with `--rate`), keeping its
+    /// first error for the end.
+    fn check_drift(&mut self, line: u64, t: f64) {
+        if self.rate_given.is_none() && self.drifting.is_none() {
+            if let Err(m) = self.drift.push(t) {
+                self.drifting = Some(format!("{}:{line}: {m}", self.name));
+            }
+        }
+    }
+
     /// A chunk of the parallel reader: the first row follows the previous chunk's last and
     /// is checked here; the others the worker checked against the row before them.
     fn take_chunk(&mut self, chunk: Parsed, out: &mut Vec<f64>) -> Result<(), String> {
@@ -480,17 +486,11 @@ impl CsvSource {
             out.push(self.take_values(chunk.line, value, time)?);
         }
         let unit = self.time.map(|(_, unit)| unit);
-        let drift = self.rate_given.is_none();
         for (k, &(value, time)) in chunk.rows.iter().enumerate().skip(1) {
             if let Some(unit) = unit {
                 let t = time * unit;
                 self.last = t;
-                if drift && self.drifting.is_none() {
-                    if let Err(m) = self.drift.push(t) {
-                        let line = chunk.line + k as u64;
-                        self.drifting = Some(format!("{}:{line}: {m}", self.name));
-                    }
-                }
+                self.check_drift(chunk.line + k as u64, t);
             }
             out.push(value);
         }

@@ -2,6 +2,7 @@
 //! trigger on |a|, as crash and drop practice report it), and each impact gets every axis's
 //! own peak and Δv over its contact.
 
+use impact_core::report::AC_COUPLED_RATIO;
 use impact_core::ImpactReport;
 
 use crate::pipeline::screen;
@@ -48,9 +49,6 @@ impl Axis {
 /// baseline is a stride of 64.
 const BASELINE_SAMPLES: usize = 64;
 const BASELINE_GAP: usize = 4;
-
-/// The core's rule for a channel that does not hold DC (`Flags::AC_COUPLED`), per axis.
-const AC_COUPLED_RATIO: f64 = 0.5;
 
 /// The axes over `r`'s window; `axes` are in m/s² on the recording's time base starting at
 /// `t0`, `resultant` their resultant, `rate` the sample rate; `previous_end` is the sample
