@@ -4,7 +4,8 @@
 Independent of this repository's code: each recording is read with pandas, its sensor zero
 taken as the median of a quiet stretch named below, its impacts found with
 `endaq.calc.stats.find_peaks` (enDAQ's shock-event finder), the velocity change integrated
-with `endaq.calc.integrate.integrals` over the contact, the width at half maximum by linear interpolation of
+with `endaq.calc.integrate.integrals` over the contact (from 1 % of the peak) and over the
+whole lobe (zero crossing to zero crossing), the width at half maximum by linear interpolation of
 the two half-maximum crossings around the peak (and where a hammer strike crosses zero after
 its peak), and the CFC 1000 peak with an own SAE J211
 filter (two-pole Butterworth run forwards and backwards, J211's corner correction, on
@@ -130,6 +131,25 @@ def pulse(case, s, zero, time_distance, out, cfc=None, delta_v=False, contact=Fa
         window = z.iloc[a : b + 1].to_frame()
         v = endaq.calc.integrate.integrals(window, n=1, zero="start")[1]
         out.append((case, "delta_v_m_s", float(v.iloc[-1, 0])))
+        # The whole lobe: from the zero crossing before the peak to the one after it (each
+        # interpolated linearly between its two samples), the felt's slow compression
+        # included.
+        sign = np.sign(y[i])
+        a = i
+        while a > 0 and sign * y[a - 1] > 0:
+            a -= 1
+        b = i
+        while b < len(y) - 1 and sign * y[b + 1] > 0:
+            b += 1
+        t0 = t[a - 1] + y[a - 1] / (y[a - 1] - y[a]) * (t[a] - t[a - 1])
+        t1 = t[b] + y[b] / (y[b] - y[b + 1]) * (t[b + 1] - t[b])
+        lobe = pd.Series(
+            np.concatenate([[0.0], y[a : b + 1], [0.0]]),
+            index=pd.Index(np.concatenate([[t0], t[a : b + 1], [t1]]), name="time_s"),
+        )
+        v = endaq.calc.integrate.integrals(lobe.to_frame(), n=1, zero="start")[1]
+        out.append((case, "delta_v_lobe_m_s", float(v.iloc[-1, 0])))
+        out.append((case, "lobe_start_s", t0))
     if cfc is not None:
         rate = 1.0 / np.median(np.diff(t))
         f = j211(y, rate, cfc)

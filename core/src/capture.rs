@@ -10,8 +10,8 @@ pub use crate::report::summary::Summary;
 use crate::report::ImpactReport;
 use crate::scene::Scene;
 
-/// One impact's raw samples (up to `CAP` of them, from the pre-trigger margin on) and its
-/// [`Summary`]. `Capture::new()` is all zeros, so a `static` of captures starts in `.bss`.
+/// One impact's raw samples (up to `CAP` of them, from the pre-trigger margin on, with a CFC
+/// also the filter's lead-in before it and its tail after the window) and its [`Summary`]. `Capture::new()` is all zeros, so a `static` of captures starts in `.bss`.
 pub struct Capture<const CAP: usize> {
     samples: [i16; CAP],
     /// Samples held (`<= CAP`).
@@ -35,8 +35,21 @@ impl<const CAP: usize> Capture<CAP> {
         }
     }
 
-    /// The raw samples, from stream index `summary().first_index` on.
+    /// The impact's window (valid once handed over): the raw samples from stream index
+    /// `summary().first_index` to `summary().end_index`, as far as the buffer held them.
+    /// Every unfiltered field is measured over these.
     pub fn samples(&self) -> &[i16] {
+        let s = &self.summary;
+        let lead = s.filter_lead as usize;
+        let window =
+            usize::try_from(s.end_index.saturating_sub(s.first_index)).unwrap_or(usize::MAX);
+        let end = lead.saturating_add(window).min(self.len);
+        self.samples.get(lead..end).unwrap_or(&[])
+    }
+
+    /// Every sample held: the filter's lead-in (`summary().filter_lead` samples), the window
+    /// and the filter's tail after it, from stream index `first_index - filter_lead` on.
+    pub fn held(&self) -> &[i16] {
         self.samples.get(..self.len).unwrap_or(&[])
     }
 
@@ -61,6 +74,21 @@ impl<const CAP: usize> Capture<CAP> {
         crate::signal::copy::copy_samples(free, samples);
         self.len += fits;
         fits
+    }
+
+    /// Drops the first `n` samples held (a filter's lead-in that would crowd out the window).
+    pub(crate) fn drop_front(&mut self, n: usize) {
+        let held = self.samples.get_mut(..self.len).unwrap_or(&mut []);
+        let n = n.min(held.len());
+        // (Written with `get` so the board's build keeps no panic path; rare: once an impact.)
+        for i in n..held.len() {
+            if let Some(x) = held.get(i).copied() {
+                if let Some(slot) = held.get_mut(i - n) {
+                    *slot = x;
+                }
+            }
+        }
+        self.len -= n;
     }
 
     pub(crate) fn set_summary(&mut self, summary: Summary) {

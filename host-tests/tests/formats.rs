@@ -296,7 +296,8 @@ fn impacts_of(args: &[&str]) -> Vec<(f64, f64, f64, bool)> {
 
 /// An enDAQ `.ide` recording read directly gives the reports of its CSV exports (idelib's,
 /// rounded to 5 decimals for the 16 g channel, 4 for the 2000 g one, times to 1 µs): the 16 g
-/// DC z axis (seven bounces, the first three clipped), its three axes together, and the
+/// DC z axis (seven bounces, the first three clipped), its three axes together (the same and
+/// a hit the y axis carries), and the
 /// 2000 g piezo's z axis around the impact (the CSV is a 13.4–15.0 s excerpt, so its levels
 /// come from less of the recording: the impact, not the numbers, is compared there).
 #[test]
@@ -306,18 +307,28 @@ fn an_ide_recording_gives_its_csv_exports_reports() {
     let ide = ide.to_str().unwrap();
     let dc = data.join("High-Drop_16g-DC_full.csv");
     let dc = dc.to_str().unwrap();
-    for (from_ide, from_csv) in [
-        (vec![ide, "--column", "32.2"], vec![dc, "--column", "z_g"]),
+    for (from_ide, from_csv, reports) in [
+        (
+            vec![ide, "--column", "32.2"],
+            vec![dc, "--column", "z_g"],
+            7,
+        ),
         (
             vec![ide, "--axes", "32.0,32.1,32.2"],
             vec![dc, "--axes", "x_g,y_g,z_g"],
+            8,
         ),
     ] {
         let (a, b) = (impacts_of(&from_ide), impacts_of(&from_csv));
-        assert_eq!(a.len(), 7, "{from_ide:?}: {a:?}");
+        assert_eq!(a.len(), reports, "{from_ide:?}: {a:?}");
         assert_eq!(a.len(), b.len(), "{from_ide:?}");
         for (x, y) in a.iter().zip(&b) {
-            assert!((x.0 - y.0).abs() < 2e-6, "{from_ide:?}: start {x:?} {y:?}");
+            // (Within 1 % of the 2.56 ms sample interval: the CSV's rounding moves a level
+            // measured before a bounce, and with it the extrapolated first touch, by as much.)
+            assert!(
+                (x.0 - y.0).abs() < 2.6e-5,
+                "{from_ide:?}: start {x:?} {y:?}"
+            );
             assert!(
                 (x.1 - y.1).abs() < 1e-4 * y.1.abs(),
                 "{from_ide:?}: peak {x:?} {y:?}"

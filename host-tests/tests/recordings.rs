@@ -41,7 +41,9 @@ fn afrl_test1_full_record_gives_exactly_one_impact() {
     // Source: ~150 µs wide pulse, 11-13 kg_n.
     let peak_kgn = i.peak_acceleration_m_s2 / (1000.0 * G);
     assert!((10.5..13.5).contains(&peak_kgn), "{peak_kgn}");
-    assert!((100e-6..400e-6).contains(&i.duration_s), "{}", i.duration_s);
+    // The whole lobe: the felt's slow compression (~230 µs from the baseline to the edge
+    // level) and the pulse itself (~240 µs).
+    assert!((350e-6..550e-6).contains(&i.duration_s), "{}", i.duration_s);
     let fwhm = i.fwhm_s.expect("FWHM");
     assert!((40e-6..100e-6).contains(&fwhm), "{fwhm}");
     let dv = i.delta_v_m_s.expect("Δv");
@@ -312,8 +314,13 @@ fn endaq_dc_channel_gives_one_report_per_bounce_and_marks_the_clipped_ones() {
                 assert!((15.9..16.0).contains(&rail), "{rail}");
             }
         }
-        // Δv of the bounces comes from the DC channel itself (no AC flag).
-        assert!(a.impacts.iter().all(|i| i.delta_v_m_s.is_some()));
+        // Δv of the bounces comes from the DC channel itself (no AC flag); the last one ends
+        // with the body coming to rest (1 g, a level its flight never came back from): it
+        // settles, rolling onto its face the while, and has no Δv.
+        let (last, bounces) = a.impacts.split_last().unwrap();
+        assert!(bounces.iter().all(|i| i.delta_v_m_s.is_some()));
+        assert_eq!(last.status, "settled");
+        assert!(last.flags.iter().any(|f| f == "drift") && last.delta_v_m_s.is_none());
     }
 }
 
@@ -323,16 +330,21 @@ fn endaq_three_axes_give_one_report_per_bounce_with_the_resultants_peak() {
         column: Some(ColumnRef::Name("z_g".into())),
         ..file("endaq-high-drop/High-Drop_16g-DC_full.csv")
     });
-    let a = analyze(AnalyzeArgs {
+    let mut a = analyze(AnalyzeArgs {
         axes: ["x_g", "y_g", "z_g"]
             .map(|c| ColumnRef::Name(c.into()))
             .to_vec(),
         ..file("endaq-high-drop/High-Drop_16g-DC_full.csv")
     });
     // The same seven bounces as the z axis alone, each overlapping its z report (slow
-    // bounces at 390 S/s start a few samples apart).
-    assert_eq!(a.impacts.len(), z.impacts.len());
+    // bounces at 390 S/s start a few samples apart), and the hit at 14.716 s that the y axis
+    // carries (-19.5 m/s² within 4.5 ms).
+    assert_eq!(a.impacts.len(), z.impacts.len() + 1);
     ordered_and_disjoint(&a);
+    let y_hit = a.impacts.remove(1);
+    assert!((y_hit.start_s - 14.716).abs() < 0.002, "{}", y_hit.start_s);
+    let y = &y_hit.axes.as_ref().unwrap().axes[1];
+    assert!((y.peak_acceleration_m_s2 + 19.1).abs() < 1.0, "{y:?}");
     for (r, zr) in a.impacts.iter().zip(&z.impacts) {
         let overlap =
             r.start_s < zr.start_s + zr.duration_s && zr.start_s < r.start_s + r.duration_s;
@@ -755,8 +767,22 @@ fn peer_endaq_and_j211_agree_on_every_recording() {
         };
         let a = analyze(args.clone());
         check(&case, &a, 1e-6);
+        // Δv over the whole lobe, zero crossing to zero crossing (the felt's compression
+        // before the main pulse is deceleration too); on the clean bottom channel the lobe
+        // starts where the peer's does.
         let dv = a.impacts[0].delta_v_m_s.unwrap();
-        agree(&case, "Δv", dv, p(&case, "delta_v_m_s"), 5e-3, 0.0);
+        agree(&case, "Δv", dv, p(&case, "delta_v_lobe_m_s"), 5e-3, 0.0);
+        if col == "bottom_kgn" {
+            let start = a.impacts[0].start_s;
+            agree(
+                &case,
+                "lobe start",
+                start,
+                p(&case, "lobe_start_s"),
+                0.0,
+                2e-6,
+            );
+        }
         let f = with_cfc(&args).impacts[0]
             .filtered_peak_acceleration_m_s2
             .unwrap();

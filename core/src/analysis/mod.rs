@@ -158,6 +158,46 @@ fn spectrum<const CAP: usize>(
     Some(sp)
 }
 
+/// The CFC-filtered acceleration of everything the capture holds, into the workspace, and its
+/// peak within the impact's window (index in the workspace, value); `None` if the filter has
+/// too little signal to settle on either side of the contact (SAE J211's padding) or cannot
+/// run at this rate.
+///
+/// Before the contact the padding is the lead-in the capture holds, or the start of the
+/// recording: there the filter starts at rest on the first sample, as a filter run over the
+/// whole record does. After it, the capture's tail.
+#[cfg(feature = "cfc")]
+fn filter<const CAP: usize>(
+    capture: &Capture<CAP>,
+    scene: &Scene,
+    class: crate::signal::cfc::Cfc,
+    work: &mut Workspace<CAP>,
+) -> Option<(usize, f32)> {
+    let s = capture.summary();
+    let held = capture.held();
+    let pad = class.padding_samples(scene.calibration.sample_rate_hz) as u64;
+    let held_from = s.first_index.saturating_sub(u64::from(s.filter_lead));
+    let before = s.onset_index.saturating_sub(held_from);
+    let contact_end = s.separation_index.unwrap_or(s.end_index);
+    let after = (held_from + held.len() as u64).saturating_sub(contact_end);
+    let from_start = held_from == 0 && !s.cut_at_start;
+    if (before < pad && !from_start) || after < pad {
+        return None;
+    }
+    let b = crate::signal::cfc::Biquad::cfc(class, scene.calibration.sample_rate_hz as f64)?;
+    let a = work.buf.get_mut(..held.len())?;
+    let per_count = report::per_count(scene, s.base_n);
+    let deviation = Deviation::new(s.base_sum, s.base_n);
+    for (slot, &x) in a.iter_mut().zip(held) {
+        *slot = deviation.of(x) as f32 * per_count;
+    }
+    b.phaseless_f32(a);
+    let lead = s.filter_lead as usize;
+    let window = a.get(lead..lead + capture.samples().len()).unwrap_or(&[]);
+    let (i, v) = scan_peak(window);
+    Some((lead + i, v))
+}
+
 /// Everything but the spectra.
 fn analyse_kinematics<const CAP: usize>(
     capture: &Capture<CAP>,
@@ -173,35 +213,22 @@ fn analyse_kinematics<const CAP: usize>(
     let deviation = Deviation::new(s.base_sum, s.base_n);
     let raw = |i: usize| samples.get(i).map_or(0, |&x| deviation.of(x));
 
-    // Peak and width: on the filtered acceleration with a CFC, else on the raw samples (the
-    // stream's peak, if the capture holds it).
+    // With a CFC, the filtered acceleration of everything held (the filter's lead-in, the
+    // window, its tail) in the workspace, and its peak in the window.
+    let filter_lead = s.filter_lead as usize;
     let mut filtered: Option<(usize, f32)> = None;
     #[cfg(feature = "cfc")]
     if let Some(class) = scene.cfc {
-        let fs = scene.calibration.sample_rate_hz as f64;
-        // The filter needs signal to settle on both sides of the contact (J211's padding):
-        // without it, no filtered peak and no width.
-        let pad = class.padding_samples(scene.calibration.sample_rate_hz) as u64;
-        let before = s.onset_index.saturating_sub(s.first_index);
-        let contact_end = s.separation_index.unwrap_or(s.end_index);
-        let after = (s.first_index + n as u64).saturating_sub(contact_end);
-        if before < pad || after < pad {
+        filtered = filter(capture, scene, class, work);
+        if filtered.is_none() {
             r.flags.insert(Flags::CFC_WINDOW);
-        } else if let (Some(b), Some(a)) = (
-            crate::signal::cfc::Biquad::cfc(class, fs),
-            work.buf.get_mut(..n),
-        ) {
-            for (slot, i) in a.iter_mut().zip(0..) {
-                *slot = raw(i) as f32 * per_count;
-            }
-            b.phaseless_f32(a);
-            filtered = Some(scan_peak(a));
         }
     }
     // The filtered peak and its width, with a CFC.
     if let Some((i, v)) = filtered {
-        let a = work.buf.get(..n).unwrap_or(&[]);
-        r.filtered_fwhm_s = fwhm(n, |j| a.get(j).map_or(0.0, |v| libm::fabsf(*v)), i)
+        let held = capture.held().len();
+        let a = work.buf.get(..held).unwrap_or(&[]);
+        r.filtered_fwhm_s = fwhm(held, |j| a.get(j).map_or(0.0, |v| libm::fabsf(*v)), i)
             .map(|w| w / scene.calibration.sample_rate_hz);
         r.filtered_peak_acceleration_m_s2 = Some(v);
     }
@@ -232,7 +259,7 @@ fn analyse_kinematics<const CAP: usize>(
         s.v0_m_s,
         s.status,
         s.separation_index,
-        s.clipped || s.cut_at_start,
+        s.clipped || s.cut_at_start || s.in_previous,
     ) else {
         return r;
     };
@@ -283,11 +310,15 @@ fn analyse_kinematics<const CAP: usize>(
     if points > 0 {
         let f_scale = fit_mass.unwrap_or(0.0) / f_peak;
         // With a CFC the filtered acceleration fills the workspace: point i reads sample
-        // onset + i every >= i, so compacting it forwards in place overwrites nothing unread.
+        // filter_lead + onset + i every >= i, so compacting it forwards in place overwrites
+        // nothing unread.
         for i in 0..points {
             let j = i * every;
             let a = if filtered.is_some() {
-                work.buf.get(onset + j).copied().unwrap_or(0.0)
+                work.buf
+                    .get(filter_lead + onset + j)
+                    .copied()
+                    .unwrap_or(0.0)
             } else {
                 from_onset.get(j).map_or(0, |&x| deviation.of(x)) as f32 * per_count
             };

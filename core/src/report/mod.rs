@@ -118,9 +118,22 @@ impl Flags {
     /// record, so the start, duration, peak and Δv cover the recorded part only; the
     /// kinematics and the fits are absent.
     pub const CUT_AT_START: Flags = Flags(1 << 7);
+    /// The signal settled at another level since the previous impact (a sub-trigger step, an
+    /// orientation change, drift, free fall): the baseline is that level, the one just before
+    /// this impact, not the sensor's zero. Empties no field.
+    pub const LEVEL_CHANGE: Flags = Flags(1 << 8);
+    /// The signal never came back to the baseline and left it more than the settle time
+    /// before the peak: the pulse rode on drift or an orientation change, which the start and
+    /// duration take in. Δv, the kinematics and the fits are absent.
+    pub const DRIFT: Flags = Flags(1 << 9);
+    /// The pulse was already under way where the previous impact's contact ended (the signal
+    /// never came back to the baseline between them): its start is that contact's end, so the
+    /// start, duration and Δv cover only the part after it; the kinematics and the fits are
+    /// absent.
+    pub const IN_PREVIOUS: Flags = Flags(1 << 10);
 
     /// Every flag with its name in the reports.
-    pub const NAMES: [(Flags, &'static str); 8] = [
+    pub const NAMES: [(Flags, &'static str); 11] = [
         (Flags::AC_COUPLED, "ac-coupled"),
         (Flags::COR_OUT_OF_RANGE, "cor-out-of-range"),
         (Flags::NO_STOP, "no-stop"),
@@ -129,6 +142,9 @@ impl Flags {
         (Flags::NO_APPROACH_SPEED, "no-approach-speed"),
         (Flags::CLIPPED, "clipped"),
         (Flags::CUT_AT_START, "cut-at-start"),
+        (Flags::LEVEL_CHANGE, "level-change"),
+        (Flags::DRIFT, "drift"),
+        (Flags::IN_PREVIOUS, "in-previous"),
     ];
 
     pub const fn empty() -> Self {
@@ -257,7 +273,17 @@ pub fn streaming(s: &Summary, scene: &Scene) -> ImpactReport {
     if s.cut_at_start {
         flags.insert(Flags::CUT_AT_START);
     }
+    if s.level_change {
+        flags.insert(Flags::LEVEL_CHANGE);
+    }
+    if s.drift {
+        flags.insert(Flags::DRIFT);
+    }
+    if s.in_previous {
+        flags.insert(Flags::IN_PREVIOUS);
+    }
     let delta_v = match s.contact_c {
+        _ if s.drift => None,
         Some(c) if c != 0 && (s.total_c as f64 / c as f64) < AC_COUPLED_RATIO => {
             flags.insert(Flags::AC_COUPLED);
             None

@@ -36,8 +36,21 @@ pub struct Summary {
     /// The stream began inside the pulse (its first sample was already beyond the edge
     /// level): the onset is not in the record.
     pub cut_at_start: bool,
-    /// Stream index of the capture's first sample (the pre-trigger margin before the onset).
+    /// The signal settled at another level since the previous impact (a step, an orientation
+    /// change, drift, free fall): the baseline is that level, the one just before this impact.
+    pub level_change: bool,
+    /// The signal never came back and the onset came more than the settle time before the
+    /// peak: the pulse rode on drift, which its start, duration and Δv take in.
+    pub drift: bool,
+    /// The pulse was already beyond the edge level where the previous impact's contact ended
+    /// (the signal never came back between them): its start is that contact's end.
+    pub in_previous: bool,
+    /// Stream index of the impact's window's first sample (the pre-trigger margin before the
+    /// onset); every streaming field is measured over the window.
     pub first_index: u64,
+    /// Samples the capture holds before `first_index`: with a CFC, the filter's lead-in (SAE
+    /// J211's padding), which no unfiltered field sees. 0 without a filter.
+    pub filter_lead: u32,
     /// Stream index of the first sample beyond the edge level.
     pub onset_index: u64,
     /// First touch relative to `onset_index`, samples (≤ 0): where the rising flank reaches
@@ -128,7 +141,11 @@ impl Summary {
         status: Status::Complete,
         clipped: false,
         cut_at_start: false,
+        level_change: false,
+        drift: false,
+        in_previous: false,
         first_index: 0,
+        filter_lead: 0,
         onset_index: 0,
         touch_offset: 0.0,
         separation_index: None,

@@ -262,15 +262,7 @@ impl<const K: usize> Baseline<K> {
                 && libm::fabsf(stride_mean - mean) <= band
         };
         if quiet {
-            if self.len == K {
-                self.total -= self.sums[self.head % K] as i64;
-            } else {
-                self.len += 1;
-            }
-            self.sums[self.head % K] = acc;
-            self.total += acc as i64;
-            self.head = (self.head + 1) % K;
-            self.mean = self.window_mean();
+            self.push(acc);
         }
         self.acc = 0;
         self.min = i16::MAX;
@@ -290,6 +282,35 @@ impl<const K: usize> Baseline<K> {
     /// Forgets everything.
     pub fn clear(&mut self) {
         *self = Self::new();
+    }
+
+    /// Starts again from the level `sum / n` (raw counts, `n` a multiple of [`STRIDE`], at most
+    /// `K` strides): the level the signal moved to. The window holds it exactly, as `n / STRIDE`
+    /// strides.
+    pub fn restart_at(&mut self, sum: i64, n: i64) {
+        *self = Self::new();
+        let k = (n / STRIDE as i64).clamp(1, K as i64);
+        let each = sum.checked_div(k).unwrap_or(0);
+        // The remainder goes one count to a stride, so the strides add up to `sum`.
+        let mut extra = sum - each * k;
+        for _ in 0..k {
+            let part = each + extra.signum();
+            extra -= extra.signum();
+            self.push(part.clamp(i32::MIN as i64, i32::MAX as i64) as i32);
+        }
+    }
+
+    /// A stride's sum into the window.
+    fn push(&mut self, acc: i32) {
+        if self.len == K {
+            self.total -= self.sums[self.head % K] as i64;
+        } else {
+            self.len += 1;
+        }
+        self.sums[self.head % K] = acc;
+        self.total += acc as i64;
+        self.head = (self.head + 1) % K;
+        self.mean = self.window_mean();
     }
 }
 
@@ -347,6 +368,18 @@ mod tests {
         // Flat but 3 counts off: its mean is beyond its own noise, so it is not the zero.
         assert!(b.add(&[103; STRIDE], 5.0));
         assert_eq!(b.rational(), (201 * STRIDE as i64, 2 * STRIDE as i64));
+    }
+
+    #[test]
+    fn restarting_at_a_level_keeps_it_exactly() {
+        let mut b = Baseline::<64>::new();
+        b.add(&[5; STRIDE], 2.0);
+        // 3 strides summing to 1000 * 192 + 7 counts: their mean, exactly.
+        b.restart_at(1000 * 192 + 7, 3 * STRIDE as i64);
+        assert_eq!(b.rational(), (1000 * 192 + 7, 3 * STRIDE as i64));
+        b.restart_at(-64 * 3, STRIDE as i64);
+        assert_eq!(b.rational(), (-192, STRIDE as i64));
+        assert_eq!(b.mean(), -3.0);
     }
 
     #[test]

@@ -36,9 +36,23 @@ const BASELINE_SPAN: usize = BASELINE_STRIDES * STRIDE;
 // below 2^28.
 const _: () = assert!(BASELINE_SPAN <= 1 << 12);
 
+/// How far back from the newest sample the flanks are followed and fitted, samples (the
+/// board's pre-trigger ring): a longer ring (the host's, for a filter's lead-in) changes no
+/// streaming field.
+pub const REACH: usize = 4096;
+
 /// The flanks are fitted between the edge level and this many times it (or the trigger level,
 /// if lower, so the trigger sample always ends the rising flank).
 const FLANK_EDGES: i64 = 4;
+
+/// What fired the trigger ([`Stream::onset`]).
+enum Onset {
+    /// A pulse, from the baseline or from the level (`(Σx, n)` of raw counts) the signal
+    /// settled at since.
+    Pulse(Option<(i64, i64)>),
+    /// No pulse: the level (`(Σx, n)`) the baseline moves to.
+    Moved((i64, i64)),
+}
 
 /// Counters that cannot wrap: 2^64 samples at 2.4 MS/s is 240 000 years.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
@@ -97,6 +111,21 @@ pub struct Stream<const PRE: usize> {
     foot_power: Option<f32>,
     /// Where the last impact's window ended: the next capture does not reach back into it.
     window_end: u64,
+    /// With a CFC: samples the filter needs on each side of a contact (SAE J211's padding).
+    /// The capture takes them beyond the impact's window (a lead-in before it, a tail after
+    /// it), so the filter never changes where an impact starts or ends.
+    filter_pad: u32,
+    /// The impact just ended still takes samples into its capture up to this stream index
+    /// (its filter's tail): handed over there, at the next trigger, a gap or the end.
+    tail: Option<u64>,
+    /// A trigger fired while a capture was handed over: the next call starts its impact at
+    /// its first sample (see [`Self::push_to_impact_end`]).
+    trigger_pending: bool,
+    /// A capture was handed over in this call.
+    handed_over: bool,
+    /// The baseline moved to another level (or is being learned again) since the last impact
+    /// started: the next one says so.
+    moved: bool,
 }
 
 impl<const PRE: usize> Stream<PRE> {
@@ -165,6 +194,11 @@ impl<const PRE: usize> Stream<PRE> {
             last_end: 0,
             foot_power: None,
             window_end: 0,
+            filter_pad: 0,
+            tail: None,
+            trigger_pending: false,
+            handed_over: false,
+            moved: false,
         }
     }
 
@@ -180,11 +214,7 @@ impl<const PRE: usize> Stream<PRE> {
                 reason: "hold time at this sample rate must be under half the capture length (shorten the hold or lower the rate)",
             });
         }
-        self.configure(scene)?;
-        // A CFC's padding lengthens the hold only as far as the capture allows (beyond, the
-        // analysis refuses the filter: `cfc-window`).
-        self.hold = self.hold.min((cap / 2 - 1) as u32).max(hold);
-        Ok(())
+        self.configure(scene)
     }
 
     /// As [`Self::configure_for`], without a capture length to check.
@@ -207,12 +237,13 @@ impl<const PRE: usize> Stream<PRE> {
         self.counters = Counters::default();
         self.trigger_counts = scene.trigger_m_s2 / gain;
         self.edge_counts = scene.edge_m_s2 / gain;
-        // With a CFC on the captured windows the filter needs its padding of signal after
-        // the contact (SAE J211): an impact ends after at least that much quiet signal.
-        let pad = scene
+        // With a CFC on the captured windows the filter needs its padding of signal around
+        // the contact (SAE J211): the capture takes it beyond the window (the hold does not
+        // change, nor does anything else the stream decides).
+        self.filter_pad = scene
             .cfc
             .map_or(0, |c| c.padding_samples(scene.calibration.sample_rate_hz));
-        self.hold = scene.samples(scene.hold_s).max(pad);
+        self.hold = scene.samples(scene.hold_s);
         self.settle = scene.samples(scene.settle_s);
         self.max_samples = scene.samples(scene.max_impact_s) as u64;
         self.thresholds = None;
@@ -221,6 +252,10 @@ impl<const PRE: usize> Stream<PRE> {
         self.last_end = 0;
         self.foot_power = None;
         self.window_end = 0;
+        self.tail = None;
+        self.trigger_pending = false;
+        self.handed_over = false;
+        self.moved = false;
         // At rest at 0 until the first baseline resets it to the baseline's level.
         self.trigger_filter = scene
             .trigger_cfc
@@ -270,17 +305,33 @@ impl<const PRE: usize> Stream<PRE> {
         }
     }
 
-    /// As [`Self::push_block`], but returns after the first impact that ends in `block`:
-    /// the number of samples taken (all of them if no impact ended). A caller that must have
-    /// a free capture buffer for every impact (the emulator's lossless replay) waits for one
-    /// between calls; the reports are the same for any split of the stream.
+    /// As [`Self::push_block`], but returns after the first impact that ends in `block`, or
+    /// the first capture handed over (a filter's tail ends after its impact): the number of
+    /// samples taken (all of them if neither happened). A caller that must have a free
+    /// capture buffer for every impact (the emulator's lossless replay) waits for one between
+    /// calls; the reports are the same for any split of the stream.
     pub fn push_to_impact_end<const CAP: usize>(
         &mut self,
         block: &[i16],
         sink: &mut impl Sink<CAP>,
     ) -> usize {
         let mut rest = block;
+        self.handed_over = false;
         while !rest.is_empty() {
+            if self.trigger_pending {
+                // The trigger fired on this sample in the previous call.
+                self.trigger_pending = false;
+                let x = rest.first().copied().unwrap_or(0);
+                match self.onset(x) {
+                    Onset::Pulse(level) => self.pulse(sink, x, level),
+                    // (Not reached: the same samples said "pulse" in the previous call.)
+                    Onset::Moved((sum, n)) => self.move_baseline(sum, n),
+                }
+                continue;
+            }
+            if self.handed_over {
+                break;
+            }
             if self.active.is_some() {
                 let used = self.run_active(rest, sink);
                 rest = rest.get(used..).unwrap_or(&[]);
@@ -295,7 +346,7 @@ impl<const PRE: usize> Stream<PRE> {
             let segment_len = self.baseline.to_stride_end().min(rest.len());
             let (segment, after) = rest.split_at(segment_len);
             if !self.baseline.is_armed() {
-                self.idle(segment);
+                self.idle(segment, sink);
                 rest = after;
                 if self.baseline.is_armed() {
                     let level = self.baseline.mean() as f64;
@@ -329,7 +380,7 @@ impl<const PRE: usize> Stream<PRE> {
                             run += next.len();
                         }
                         let (quiet, after) = rest.split_at(run.min(rest.len()));
-                        self.keep(quiet);
+                        self.keep_idle(quiet, sink);
                         rest = after;
                         continue;
                     }
@@ -344,15 +395,34 @@ impl<const PRE: usize> Stream<PRE> {
             };
             match found {
                 None => {
-                    self.idle(segment);
+                    self.idle(segment, sink);
                     rest = after;
                 }
                 Some(at) => {
                     // `at` lies inside `segment`, a prefix of `rest` (written with `get` so
                     // the target build has no panic path here).
-                    self.idle(rest.get(..at).unwrap_or(&[]));
-                    self.start(sink, rest.get(at).copied().unwrap_or(0));
+                    self.idle(rest.get(..at).unwrap_or(&[]), sink);
                     rest = rest.get(at..).unwrap_or(&[]);
+                    let x = rest.first().copied().unwrap_or(0);
+                    let level = match self.onset(x) {
+                        Onset::Pulse(level) => level,
+                        Onset::Moved((sum, n)) => {
+                            // No pulse: the baseline follows the signal to its new level,
+                            // and the trigger sample is an idle one there.
+                            self.move_baseline(sum, n);
+                            self.idle(rest.get(..1).unwrap_or(&[]), sink);
+                            rest = rest.get(1..).unwrap_or(&[]);
+                            continue;
+                        }
+                    };
+                    if self.tail.is_some() || self.handed_over {
+                        // The previous capture goes first (its tail ends here); the caller
+                        // may wait for a free buffer before this impact starts.
+                        self.hand_over(sink);
+                        self.trigger_pending = true;
+                        break;
+                    }
+                    self.pulse(sink, x, level);
                 }
             }
         }
@@ -370,6 +440,7 @@ impl<const PRE: usize> Stream<PRE> {
         if self.active.is_some() {
             self.end(Status::Gap, sink);
         }
+        self.hand_over(sink);
         self.index += lost;
         self.gap_end = Some(self.index);
         self.counters.samples_lost += lost;
@@ -384,16 +455,56 @@ impl<const PRE: usize> Stream<PRE> {
 
     /// Ends the stream: an impact in progress ends with [`Status::StreamEnded`].
     pub fn finish<const CAP: usize>(&mut self, sink: &mut impl Sink<CAP>) {
+        self.trigger_pending = false;
         if self.active.is_some() {
-            self.end(Status::StreamEnded, sink);
+            self.end_unreturned(Status::StreamEnded, sink);
+        }
+        self.hand_over(sink);
+    }
+
+    /// Idle samples: into the ring and the baseline (and the tail of a capture).
+    #[inline]
+    fn idle<const CAP: usize>(&mut self, samples: &[i16], sink: &mut impl Sink<CAP>) {
+        self.keep_idle(samples, sink);
+        self.learn(&Stats::of(samples));
+    }
+
+    /// Idle samples into the ring and the stream position, and into the tail of the capture
+    /// of the impact that ended last, if it still takes one.
+    #[inline]
+    fn keep_idle<const CAP: usize>(&mut self, samples: &[i16], sink: &mut impl Sink<CAP>) {
+        if let Some(until) = self.tail {
+            self.extend_tail(until, samples, sink);
+        }
+        self.keep(samples);
+    }
+
+    /// The samples up to `until` into the capture whose tail is being taken (before they are
+    /// kept); hands it over once the tail is complete or the capture full.
+    #[cold]
+    #[inline(never)]
+    fn extend_tail<const CAP: usize>(
+        &mut self,
+        until: u64,
+        samples: &[i16],
+        sink: &mut impl Sink<CAP>,
+    ) {
+        let n = usize::try_from(until.saturating_sub(self.index))
+            .unwrap_or(usize::MAX)
+            .min(samples.len());
+        let part = samples.get(..n).unwrap_or(&[]);
+        let full = sink.buffer().is_none_or(|c| c.extend(part) < part.len());
+        if full || n < samples.len() || self.index + n as u64 >= until {
+            self.hand_over(sink);
         }
     }
 
-    /// Idle samples: into the ring and the baseline.
-    #[inline]
-    fn idle(&mut self, samples: &[i16]) {
-        self.keep(samples);
-        self.learn(&Stats::of(samples));
+    /// Hands over the capture whose tail is being taken, if any.
+    pub(super) fn hand_over<const CAP: usize>(&mut self, sink: &mut impl Sink<CAP>) {
+        if self.tail.take().is_some() {
+            sink.captured(&self.scene);
+            self.handed_over = true;
+        }
     }
 
     /// Samples into the ring and the stream position.
@@ -446,12 +557,88 @@ impl<const PRE: usize> Stream<PRE> {
         self.replaying = false;
     }
 
+    /// What fired the trigger at sample `x` (the next one): a pulse, measured from the baseline
+    /// or from the level the signal settled at since ([`Self::level_before`]); or no pulse,
+    /// and the level the baseline moves to. No pulse when the signal crept past the trigger
+    /// level instead of rising through it (it left the edge level on the trigger's side more
+    /// than half the settle time before, or since the stream began: drift, an orientation
+    /// change, a sensor warming; a pulse rises from the edge level to the trigger level
+    /// faster), or when `x` is no further than the trigger level from the level the signal
+    /// settled at.
+    fn onset(&self, x: i16) -> Onset {
+        let level = self.level_before();
+        let last_stride = || {
+            let sum: i64 = (0..STRIDE)
+                .map(|i| self.ring.back(i).map_or(0, i64::from))
+                .sum();
+            (sum, STRIDE as i64)
+        };
+        if let Some((sum, n)) = level {
+            let from_level = x as f32 - sum as f32 / n as f32;
+            if libm::fabsf(from_level) <= self.trigger_counts {
+                return Onset::Moved((sum, n));
+            }
+        }
+        let window = (self.settle as usize / 2)
+            .clamp(2, REACH)
+            .min(self.ring.len());
+        let mean = self.baseline.mean();
+        let edge = self.edge_counts;
+        let above = x as f32 > mean;
+        let crept = window >= 2
+            && self.ring.len() >= STRIDE
+            && (0..window).all(|i| {
+                self.ring.back(i).is_some_and(|y| {
+                    if above {
+                        y as f32 > mean + edge
+                    } else {
+                        (y as f32) < mean - edge
+                    }
+                })
+            });
+        if crept {
+            Onset::Moved(level.unwrap_or_else(last_stride))
+        } else {
+            Onset::Pulse(level)
+        }
+    }
+
+    /// A pulse fired the trigger at `x`: from the level the signal settled at since the
+    /// baseline was learned, if it did (the baseline moves there first), else from the
+    /// baseline.
+    fn pulse<const CAP: usize>(
+        &mut self,
+        sink: &mut impl Sink<CAP>,
+        x: i16,
+        level: Option<(i64, i64)>,
+    ) {
+        if let Some((sum, n)) = level {
+            self.move_baseline(sum, n);
+        }
+        let moved = core::mem::take(&mut self.moved);
+        self.start(sink, x, moved);
+    }
+
+    /// The baseline moves to the level `sum / n` (a level change without a pulse).
+    #[cold]
+    fn move_baseline(&mut self, sum: i64, n: i64) {
+        self.baseline.restart_at(sum, n);
+        self.thresholds = None;
+        self.counters.level_changes += 1;
+        self.moved = true;
+        let level = self.baseline.mean() as f64;
+        if let Some(f) = self.trigger_filter.as_mut() {
+            f.reset(level);
+        }
+    }
+
     /// Forgets the baseline and the history (the level moved, or the sensor is stuck): the
     /// next quiet stride arms the stream again.
     fn relearn_baseline(&mut self) {
         self.ring.clear();
         self.baseline.clear();
         self.thresholds = None;
+        self.moved = true;
     }
 
     /// Trigger thresholds in raw counts around the baseline.

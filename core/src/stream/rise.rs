@@ -1,8 +1,12 @@
-//! The rising side of a pulse, kept in bounded memory for its foot's fit at the end
-//! ([`crate::signal::power_flank`]): every `stride`-th sample from the onset, the stride
-//! doubling whenever the record fills, until the pulse is well past its peak. The pulse's
-//! foot (to 30 % of its peak) is known only once the peak is, long after the pre-trigger
-//! ring has let it go on a slow pulse; the capture may not be there (the board has two).
+//! The flanks of a pulse kept in bounded memory for their feet's fits
+//! ([`crate::signal::power_flank`]): the rising side from the onset until the pulse is well
+//! past its peak (its foot, to 30 % of the peak, is known only once the peak is, long after
+//! the pre-trigger ring has let it go on a slow pulse; the capture may not be there: the
+//! board has two), every `stride`-th sample; the falling side from the latest peak to the
+//! separation, the mean of every `stride` samples. The strides double whenever a record
+//! fills; positions decide everything, so any split of the stream keeps the same points.
+
+use crate::signal::baseline::{Stats, STRIDE};
 
 /// Points kept: the foot of a pulse whose peak is `n` samples after its onset keeps at least
 /// `RISE_POINTS / 4` of them over its first 30 %.
@@ -40,12 +44,24 @@ impl Rise {
         self.done
     }
 
+    /// Where the record closes for a peak at `peak_pos` (from the onset): a quarter of the
+    /// way again past it, and 16 samples more.
+    pub fn closing(peak_pos: u64) -> u64 {
+        peak_pos + peak_pos / 4 + 16
+    }
+
+    /// Closes the record: nothing more is taken.
+    pub fn close(&mut self) {
+        self.done = true;
+    }
+
     /// Takes `n` samples from position `pos0` (from the onset): `d(k)` is sample `k`'s
-    /// deviation signed so the pulse is positive. Then the record closes once the samples
-    /// reach twice the peak's position (`peak_pos`) and 16 more.
+    /// deviation signed so the pulse is positive. The caller closes the record at
+    /// [`Self::closing`] of the peak so far, sample by sample (so any split of the stream
+    /// keeps the same points).
     /// (Not inlined: the in-impact loop it follows keeps its registers.)
     #[inline(never)]
-    pub fn take(&mut self, pos0: u64, n: usize, peak_pos: u64, d: impl Fn(usize) -> i64) {
+    pub fn take(&mut self, pos0: u64, n: usize, d: impl Fn(usize) -> i64) {
         if self.done {
             return;
         }
@@ -87,9 +103,6 @@ impl Rise {
             }
             k += u64::from(self.stride);
         }
-        if pos0 + n as u64 > peak_pos + peak_pos / 4 + 16 {
-            self.done = true;
-        }
     }
 
     /// The points kept, in order: (position from the onset, signed deviation).
@@ -103,18 +116,149 @@ impl Rise {
     }
 }
 
+/// Buckets the falling side keeps: its foot (the last 30 %) keeps about a third of them.
+pub const FALL_POINTS: usize = 64;
+
+/// The falling side of a pulse from its peak, kept in bounded memory for its foot's fit: the
+/// mean of every `stride` samples (the stride doubling, neighbours merged, whenever the record
+/// fills), so a long, slow return is seen whole and with its noise averaged down.
+#[derive(Clone, Copy, Debug)]
+pub struct Fall {
+    stride: u32,
+    /// Complete buckets, and Σd over each (of `stride` samples).
+    len: usize,
+    sums: [i64; FALL_POINTS],
+    /// The bucket being filled: Σd and samples.
+    acc: i64,
+    acc_n: u32,
+}
+
+impl Default for Fall {
+    fn default() -> Self {
+        Self::new()
+    }
+}
+
+impl Fall {
+    pub const fn new() -> Self {
+        Self {
+            stride: 1,
+            len: 0,
+            sums: [0; FALL_POINTS],
+            acc: 0,
+            acc_n: 0,
+        }
+    }
+
+    /// Takes the next raw samples (contiguous, after the peak), measured as `sign (w x - s)`
+    /// (the pulse positive): each bucket's sum from the samples' sum (the stride statistics,
+    /// two samples an instruction on the Cortex-M4).
+    #[inline(never)]
+    pub fn take(&mut self, samples: &[i16], w: i64, s: i64, sign: i64) {
+        let mut rest = samples;
+        while !rest.is_empty() {
+            let room = (self.stride - self.acc_n) as usize;
+            let m = room.min(rest.len()).min(STRIDE);
+            let (part, after) = rest.split_at(m);
+            let st = Stats::of(part);
+            self.acc += sign * (w * i64::from(st.sum) - m as i64 * s);
+            self.acc_n += m as u32;
+            rest = after;
+            if self.acc_n < self.stride {
+                continue;
+            }
+            if self.len == FALL_POINTS {
+                // Merge neighbours: half as many buckets, twice as long.
+                for j in 0..FALL_POINTS / 2 {
+                    let pair = self.sums.get(2 * j).copied().unwrap_or(0)
+                        + self.sums.get(2 * j + 1).copied().unwrap_or(0);
+                    if let Some(slot) = self.sums.get_mut(j) {
+                        *slot = pair;
+                    }
+                }
+                self.len = FALL_POINTS / 2;
+                self.stride = self.stride.saturating_mul(2);
+                // The bucket being filled is now half of a doubled one.
+                continue;
+            }
+            if let Some(slot) = self.sums.get_mut(self.len) {
+                *slot = self.acc;
+                self.len += 1;
+            }
+            self.acc = 0;
+            self.acc_n = 0;
+        }
+    }
+
+    /// Points kept, the bucket being filled included.
+    pub fn len(&self) -> usize {
+        self.len + usize::from(self.acc_n > 0)
+    }
+
+    /// Point `i`: the middle of its bucket (position from the peak) and its mean deviation.
+    pub fn get(&self, i: usize) -> Option<(f32, f32)> {
+        let stride = self.stride as f32;
+        if i < self.len {
+            let sum = *self.sums.get(i)? as f32;
+            Some(((i as f32 + 0.5) * stride - 0.5, sum / stride))
+        } else if i == self.len && self.acc_n > 0 {
+            let n = self.acc_n as f32;
+            Some((i as f32 * stride + (n - 1.0) / 2.0, self.acc as f32 / n))
+        } else {
+            None
+        }
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn the_fall_keeps_bucket_means_and_merges_them_when_full() {
+        // A ramp 1000, 999, ... in pieces of 37: at most FALL_POINTS buckets, each the exact
+        // mean of its samples, spread evenly from the peak.
+        let samples: heapless::Vec<i16, 4096> = (0..4000).map(|k| 1000 - (k / 4) as i16).collect();
+        let mut f = Fall::new();
+        for piece in samples.chunks(37) {
+            f.take(piece, 1, 0, 1);
+        }
+        assert!(f.len() <= FALL_POINTS + 1, "{}", f.len());
+        let (p0, d0) = f.get(0).unwrap();
+        let (p1, _) = f.get(1).unwrap();
+        let stride = (p1 - p0) as usize;
+        assert!(stride.is_power_of_two() && stride * FALL_POINTS >= 4000 / 2);
+        let mean = |from: usize| {
+            samples[from..from + stride]
+                .iter()
+                .map(|&x| x as f32)
+                .sum::<f32>()
+                / stride as f32
+        };
+        assert_eq!(d0, mean(0));
+        assert_eq!(f.get(3).unwrap().1, mean(3 * stride));
+        // The bucket being filled: its samples' mean at their middle.
+        let last = f.len() - 1;
+        let (p, d) = f.get(last).unwrap();
+        let n = 4000 - last * stride;
+        let tail = &samples[last * stride..];
+        assert_eq!(p, last as f32 * stride as f32 + (n as f32 - 1.0) / 2.0);
+        assert!((d - tail.iter().map(|&x| x as f32).sum::<f32>() / n as f32).abs() < 1e-3);
+    }
 
     #[test]
     fn a_long_rise_is_kept_decimated_and_the_record_closes_past_the_peak() {
         let mut r = Rise::new();
         // 10 000 samples in blocks of 256 (d = position), peak at 4000.
         let mut at = 0u64;
-        while at < 10_000 {
-            r.take(at, 256, 4000, |k| (at + k as u64) as i64);
+        let close = Rise::closing(4000);
+        while at < 10_000 && !r.done() {
+            let n = (close + 1).saturating_sub(at).min(256);
+            r.take(at, n as usize, |k| (at + k as u64) as i64);
             at += 256;
+            if at > close {
+                r.close();
+            }
         }
         assert!(r.done());
         let pts: heapless::Vec<(u32, i32), RISE_POINTS> = r.points().collect();
@@ -127,6 +271,6 @@ mod tests {
             assert_eq!(d, p as i32);
         }
         // Past the peak nothing is taken.
-        assert!(pts.last().unwrap().0 <= 2 * 4000 + 16 + 256);
+        assert!(u64::from(pts.last().unwrap().0) <= close);
     }
 }

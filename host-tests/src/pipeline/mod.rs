@@ -58,8 +58,10 @@ pub fn analyze(
     }
 }
 
-/// The host's monitor: 4096-sample pre-trigger ring, 2^17-sample capture.
-pub type HostMonitor = Monitor<4096, 131072>;
+/// The host's monitor: a 2^15-sample ring (the flanks reach back 4096 samples, as on the board;
+/// the rest is history for a CFC's lead-in: CFC 60's 10 ms up to 3.2 MS/s), a 2^17-sample
+/// capture.
+pub type HostMonitor = Monitor<32768, 131072>;
 
 /// A recording turned into raw counts for the core pipeline.
 #[derive(Clone, Debug)]
