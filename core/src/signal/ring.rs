@@ -127,6 +127,19 @@ impl<const N: usize> Ring<N> {
     }
 }
 
+/// Splits the two runs `first`, `second` (one sequence) at position `at`: the runs before it
+/// and the runs from it on.
+pub fn split_runs<'a>(
+    first: &'a [i16],
+    second: &'a [i16],
+    at: usize,
+) -> ([&'a [i16]; 2], [&'a [i16]; 2]) {
+    let (a0, a1) = first.split_at(at.min(first.len()));
+    let rest = at.saturating_sub(first.len());
+    let (b0, b1) = second.split_at(rest.min(second.len()));
+    ([a0, b0], [a1, b1])
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -9,6 +9,8 @@
 //! (rest, free fall: the baseline is learned again, and a level change without a pulse is no
 //! impact at all); or for the reasons of [`Status`].
 
+use super::active::Active;
+use super::feet::{record_fall, OnsetWalk};
 use super::level::LevelWatch;
 use super::rise::{Fall, Rise};
 use super::{Stream, FLANK_EDGES, REACH};
@@ -17,94 +19,6 @@ use crate::report::{self, Status};
 use crate::signal::baseline::Deviation;
 use crate::signal::baseline::{Stats, STRIDE};
 use crate::signal::flank::{crossing, Flank};
-use crate::signal::power_flank;
-
-/// The impact being followed.
-pub(super) struct Active {
-    /// Stream index of the window's first sample.
-    first_index: u64,
-    /// Samples captured before `first_index` (the filter's lead-in).
-    filter_lead: u32,
-    /// Stream index of the sample that fired the trigger.
-    trigger_index: u64,
-    onset_index: u64,
-    touch_offset: f32,
-    /// The earliest first touch relative to the onset (the previous contact's end), samples.
-    touch_floor: f32,
-    base_sum: i64,
-    base_n: i64,
-    /// Edge level in units of `d = W x - S`.
-    edge_d: i64,
-    /// Flank level in units of `d`.
-    flank_d: i64,
-    /// The trigger thresholds in units of `d` (a sample fires when `d > d_hi` or `d < d_lo`).
-    d_hi: i32,
-    d_lo: i32,
-    quiet: u32,
-    /// Since the latest peak, the signal stayed within the edge level for at least an
-    /// eighth of the hold (so a new hit is a new impact, not ringing).
-    returned: bool,
-    /// Stream index of the first sample back within the edge level (or across it, a sign
-    /// flip) after the peak (separation: later ringing does not move it unless it brings a
-    /// new peak).
-    separation: Option<u64>,
-    /// `Σ d` from `first_index` to the separation (exclusive).
-    separation_c: i64,
-    /// The separation, its offset and the falling foot's `Σ d` beyond it (where the foot is
-    /// a power curve: [`Stream::fall`], else [`Stream::separation_offset`] and 0), found while
-    /// its flank was still in the ring (a long ring-down after it would push it out).
-    separation_at: Option<(u64, f32, i64)>,
-    /// The rising side, for the foot's fit at the end; the pulse's sign; `Σ d` over the whole
-    /// samples from the straight-line first touch to the onset.
-    rise: Rise,
-    /// The falling foot: from where the signal last came down through the foot's top after
-    /// the latest peak to the separation (so its fit sees the whole foot, averaged, for any
-    /// split of the stream), and the stream index of its first sample.
-    fall: Fall,
-    fall_start: u64,
-    sign: i64,
-    lead_c: i64,
-    /// `Σ d` over the samples before the onset.
-    pre_onset_c: i64,
-    peak_d: i64,
-    peak_index: u64,
-    total_c: i64,
-    /// Samples since `first_index`.
-    samples: u64,
-    clipped: bool,
-    /// The walk back to the onset reached the stream's first sample still beyond the edge.
-    cut_at_start: bool,
-    /// The baseline moved to another level since the previous impact.
-    level_change: bool,
-    /// The signal did not come back, and the onset came more than the settle time before the
-    /// peak: the pulse rode on drift.
-    drift: bool,
-    /// The rising flank's straight line reaches zero inside the previous impact's contact.
-    line_in_previous: bool,
-    /// The whole lobe before the onset: where it crosses the baseline (relative to the
-    /// onset, samples), its samples and `Σ d` over them.
-    lobe_touch: f32,
-    lobe_len: u32,
-    lobe_c: i64,
-    /// The sink gave a buffer for this impact.
-    captured: bool,
-    /// The buffer overflowed.
-    full: bool,
-    /// The pulse was already under way when the last gap ended: its start is unknown.
-    began_in_gap: bool,
-    /// Stream index just after the latest sample within the edge level.
-    last_quiet: u64,
-    /// Where the impact's window ends if not at the current position (a next hit began
-    /// after the last quiet sample).
-    end_at: Option<u64>,
-    level: LevelWatch,
-}
-
-impl Active {
-    pub(super) fn deviation(&self) -> Deviation {
-        Deviation::new(self.base_sum, self.base_n)
-    }
-}
 
 /// How a run of samples ended the impact.
 enum End {
@@ -117,13 +31,6 @@ enum End {
 }
 
 impl<const PRE: usize> Stream<PRE> {
-    /// Samples the in-impact loop takes at a time (a board's block, or half the ring).
-    const CHUNK: usize = if PRE / 2 < 256 { PRE / 2 } else { 256 };
-    /// How far behind a separation the falling flank is read from the ring: as far as the
-    /// flanks reach and the ring is sure to hold, with the newest sample at most a chunk
-    /// beyond the separation.
-    const LOOKBACK: usize = (if REACH < PRE { REACH } else { PRE }).saturating_sub(Self::CHUNK + 2);
-
     /// The trigger fired at `self.index`: find the onset in the ring, fix the baseline from
     /// the samples before it, fit the rising flank, and replay the pre-trigger samples into
     /// the capture (if the sink has a buffer) and the running sums.
@@ -196,53 +103,16 @@ impl<const PRE: usize> Stream<PRE> {
         let lead_c: i64 = (pulse..pulse + lead)
             .map_while(|i| back(i).map(|x| deviation.of(x) as i64))
             .sum();
-        // The whole lobe: the samples before the onset still on the pulse's side of the
-        // baseline (a pad's or felt's slow compression before the main pulse decelerates the
-        // body too), back to where the signal crosses the baseline.
         let since_last =
             usize::try_from(self.index - self.window_end.min(self.index)).unwrap_or(usize::MAX);
-        let lobe_limit = since_last.min(REACH).saturating_sub(pulse);
-        let mut lobe_len = 0usize;
-        let mut lobe_c = 0i64;
-        while lobe_len < lobe_limit {
-            match pd(pulse + lobe_len) {
-                Some(y) if y > 0 => {
-                    lobe_c += sign * y;
-                    lobe_len += 1;
-                }
-                _ => break,
-            }
-        }
-        // A lobe is a ramp from the baseline up to the edge level, not the signal sitting on
-        // the pulse's side of the baseline (drag, an offset, noise): its newest quarter
-        // averages at least half the edge level, its oldest quarter at most a quarter of it
-        // (three samples or fewer are the crossing itself).
-        let quarter = lobe_len / 4;
-        if lobe_len > 3 {
-            let mean = |from: usize| {
-                let sum: i64 = (from..from + quarter).filter_map(pd).sum();
-                sum.checked_div(quarter as i64).unwrap_or(0)
-            };
-            let (newest, oldest) = (mean(pulse), mean(pulse + lobe_len - quarter));
-            if 2 * newest < edge_d || 4 * oldest > edge_d {
-                lobe_len = 0;
-                lobe_c = 0;
-            }
-        }
-        // Where it crosses the baseline, relative to the onset (between the last sample on the
-        // other side and the lobe's first; at its first if the ring holds nothing older).
-        let first = match lobe_len.checked_sub(1) {
-            Some(i) => pd(pulse + i),
-            None => pulse
-                .checked_sub(1)
-                .map_or(Some(sign * deviation.of(trigger_x) as i64), pd),
-        };
-        let lobe_touch = match (pd(pulse + lobe_len), first) {
-            (Some(y0), Some(y1)) if y1 > y0 => {
-                (crossing(y0 as f64, y1 as f64, 0.0) - 1.0) as f32 - lobe_len as f32
-            }
-            _ => -(lobe_len as f32),
-        };
+        let (lobe_touch, lobe_len, lobe_c) = self.lobe_before(OnsetWalk {
+            pulse,
+            sign,
+            deviation,
+            edge_d,
+            trigger_x,
+            since_last,
+        });
         // The rise so far: the onset to the newest sample.
         let mut rise = Rise::new();
         rise.take(0, pulse, |k| pd(pulse.saturating_sub(1 + k)).unwrap_or(0));
@@ -298,7 +168,7 @@ impl<const PRE: usize> Stream<PRE> {
             drift: false,
             line_in_previous,
             lobe_touch,
-            lobe_len: lobe_len.min(u32::MAX as usize) as u32,
+            lobe_len,
             lobe_c,
             captured: capture.is_some(),
             full: false,
@@ -317,7 +187,7 @@ impl<const PRE: usize> Stream<PRE> {
         let (clip_lo, clip_hi) = self.scene.clip_counts;
         let (older, newer) = self.ring.last(lead + margin);
         // The lead-in into the capture only; the window into the sums too.
-        let (lead_runs, window_runs) = split_runs(older, newer, lead);
+        let (lead_runs, window_runs) = crate::signal::ring::split_runs(older, newer, lead);
         if let Some(c) = capture.as_mut() {
             for run in lead_runs {
                 a.full |= c.extend(run) < run.len();
@@ -369,53 +239,6 @@ impl<const PRE: usize> Stream<PRE> {
         );
         record_fall(&mut a, newer, self.index - newer.len() as u64);
         self.active = Some(a);
-    }
-
-    /// The steady level just before the pulse, if the signal moved away from the baseline
-    /// since it was learned (a step below the trigger, an orientation change, drift): walking
-    /// back from the trigger past the pulse's rise (the strides that are not flat), a run of
-    /// flat strides (each spanning at most twice the edge level) within the edge level of one
-    /// another, beyond the edge level from the baseline, lasting at least the settle time (and
-    /// one stride). `(Σx, n)` over the run, as the baseline's rational; `None` for no such
-    /// run within the flanks' reach.
-    pub(super) fn level_before(&self) -> Option<(i64, i64)> {
-        let edge = self.edge_counts;
-        let mean = self.baseline.mean();
-        // Stride `k` back from the newest sample: Σx, least and greatest sample.
-        let stride = |k: usize| -> Option<(i32, i16, i16)> {
-            let reach = (k + 1) * STRIDE;
-            if reach > REACH.min(self.ring.len()) {
-                return None;
-            }
-            let (older, newer) = self.ring.last(reach);
-            let (runs, _) = split_runs(older, newer, STRIDE);
-            let (a, b) = (Stats::of(runs[0]), Stats::of(runs[1]));
-            Some((a.sum + b.sum, a.min.min(b.min), a.max.max(b.max)))
-        };
-        let flat = |(_, min, max): (i32, i16, i16)| (max as f32 - min as f32) <= 2.0 * edge;
-        let level = |(sum, _, _): (i32, i16, i16)| sum as f32 / STRIDE as f32;
-        let mut k = 0;
-        let first = loop {
-            let st = stride(k)?;
-            if flat(st) {
-                break st;
-            }
-            k += 1;
-        };
-        let at = level(first);
-        if libm::fabsf(at - mean) <= 2.0 * edge {
-            return None;
-        }
-        let (mut sum, mut n) = (0i64, 0i64);
-        let mut varies = false;
-        while let Some(st) = stride(k).filter(|&st| flat(st) && libm::fabsf(level(st) - at) <= edge)
-        {
-            sum += i64::from(st.0);
-            n += STRIDE as i64;
-            varies |= st.2 > st.1;
-            k += 1;
-        }
-        (varies && n >= i64::from(self.settle).max(STRIDE as i64)).then_some((sum, n))
     }
 
     /// Feeds samples to the active impact until it ends; returns how many it used.
@@ -714,181 +537,6 @@ impl<const PRE: usize> Stream<PRE> {
         self.end(status, sink);
     }
 
-    /// Locates a new separation while its flank is in the ring (just after the samples that
-    /// set it were kept).
-    #[inline(never)]
-    fn locate_separation(&mut self) {
-        let Some(a) = self.active.as_ref() else {
-            return;
-        };
-        let Some(s) = a.separation else {
-            return;
-        };
-        if a.separation_at.is_some_and(|(at, _, _)| at == s) {
-            return;
-        }
-        let (offset, tail, clear) = self
-            .fall(a, s)
-            .unwrap_or_else(|| (self.separation_offset(a, s), 0, None));
-        if clear.is_some() {
-            self.foot_power = clear;
-        }
-        if let Some(a) = self.active.as_mut() {
-            a.separation_at = Some((s, offset, tail));
-        }
-    }
-
-    /// First touch relative to the onset and `Σ d` over the foot before the onset: where the
-    /// rising foot, fitted as a power curve ([`power_flank`]), reaches zero force, else the
-    /// straight line's (`touch_offset`, `lead_c`); and whether it lies inside the previous
-    /// impact's contact (then it is that contact's end).
-    fn touch(&mut self, a: &Active) -> (f32, i64, bool) {
-        let line = (a.touch_offset, a.lead_c, a.line_in_previous);
-        let peak = a.peak_d.unsigned_abs() as f32;
-        match self.rise_foot(a) {
-            Some(foot) => {
-                if foot.clear {
-                    self.foot_power = Some(foot.power);
-                }
-                let touch = foot.zero.max(a.touch_floor);
-                let lead = libm::floorf(-touch).max(0.0) as i64;
-                let c = foot.sum(-lead, 0) * peak * a.sign as f32;
-                (touch, c as i64, foot.zero < a.touch_floor)
-            }
-            None => line,
-        }
-    }
-
-    /// First touch where the whole lobe begins, if that is earlier than `touch` (first touch,
-    /// `Σ d` before the onset, inside the previous contact): a slow ramp below the edge
-    /// level before the pulse (a pad or felt compressing) is part of the contact. Not where
-    /// the lobe runs back more than twice the pulse's length above the edge level (the
-    /// signal then sat on the pulse's side of the baseline, not rising to it), nor into the
-    /// previous contact.
-    fn lobe(&self, a: &Active, touch: (f32, i64, bool)) -> (f32, i64, bool) {
-        let above = a
-            .separation
-            .unwrap_or(self.index)
-            .saturating_sub(a.onset_index);
-        let longer = a.lobe_touch < touch.0;
-        let fits = u64::from(a.lobe_len) <= 2 * above && a.lobe_touch >= a.touch_floor;
-        if longer && fits {
-            (a.lobe_touch, a.lobe_c, false)
-        } else {
-            touch
-        }
-    }
-
-    /// The rising foot (from the rise record) fitted as a power curve, if it is one.
-    fn rise_foot(&self, a: &Active) -> Option<power_flank::Foot> {
-        let peak = a.peak_d.unsigned_abs() as f32;
-        if !(peak > 0.0) {
-            return None;
-        }
-        let top = power_flank::FOOT * peak;
-        let n = a
-            .rise
-            .points()
-            .take_while(|&(_, d)| d as f32 <= top)
-            .count();
-        let stride = n.div_ceil(power_flank::MAX_FOOT_POINTS).max(1);
-        let points = a
-            .rise
-            .points()
-            .take(n)
-            .step_by(stride)
-            .filter(|&(_, d)| d > 0)
-            .map(|(p, d)| (p as f32, d as f32 / peak));
-        let choice = power_flank::Choice::Free {
-            prior: self.foot_power,
-        };
-        power_flank::zero(points, true, -1.0, a.edge_d as f32 / peak, choice)
-    }
-
-    /// The separation relative to `separation` and `Σ d` over the foot beyond it, where the
-    /// falling foot (the falling side's record up to the separation) is a power curve: its
-    /// rising foot's power ([`power_flank`]).
-    fn fall(&self, a: &Active, separation: u64) -> Option<(f32, i64, Option<f32>)> {
-        // (None for a zero peak, too.)
-        let rise = self.rise_foot(a)?;
-        let peak = a.peak_d.unsigned_abs() as f32;
-        let sign: i64 = if a.peak_d >= 0 { 1 } else { -1 };
-        // Point `i` of the record: position relative to the separation (negative), and the
-        // deviation over the peak.
-        let point = |i: usize| {
-            let (p, d) = a.fall.get(i)?;
-            let x = a.fall_start as f64 + p as f64 - separation as f64;
-            Some((x as f32, d / peak))
-        };
-        // The foot: the record's last points up to the foot's top.
-        let n = a.fall.len();
-        let len = (0..n)
-            .rev()
-            .take_while(|&i| point(i).is_some_and(|(_, v)| v <= power_flank::FOOT))
-            .count();
-        let stride = len.div_ceil(power_flank::MAX_FOOT_POINTS).max(1);
-        let points = (0..len)
-            .step_by(stride)
-            .filter_map(|j| point(n - 1 - j))
-            .filter(|&(_, v)| v > 0.0);
-        let choice = power_flank::Choice::Only(rise.power);
-        let foot = power_flank::zero(points, false, 0.0, a.edge_d as f32 / peak, choice)?;
-        let tail = libm::ceilf(foot.zero).max(0.0) as i64;
-        let c = foot.sum(0, tail) * peak * sign as f32;
-        Some((foot.zero, c as i64, rise.clear.then_some(rise.power)))
-    }
-
-    /// The separation relative to `separation_index`: the falling flank (from the ring)
-    /// extrapolated to zero, the zero crossing for a sign flip across the whole edge band,
-    /// or the edge crossing between the last sample beyond the edge and the first within it.
-    fn separation_offset(&self, a: &Active, separation: u64) -> f32 {
-        let deviation = a.deviation();
-        // The ring ends at `self.index - 1`: sample `i` is `back(index - 1 - i)`; no further
-        // than the look-back before the separation.
-        let oldest = separation.saturating_sub(1 + Self::LOOKBACK as u64);
-        let d_at = |i: u64| {
-            let back = self.index.checked_sub(1)?.checked_sub(i)?;
-            let x = self
-                .ring
-                .back(usize::try_from(back).ok().filter(|_| i >= oldest)?)?;
-            Some(deviation.of(x) as i64)
-        };
-        let Some(last) = separation.checked_sub(1) else {
-            return 0.0;
-        };
-        // Deviations signed so that the pulse's last sample (beyond the edge) is positive.
-        let sign = if d_at(last).is_some_and(|d| d < 0) {
-            -1
-        } else {
-            1
-        };
-        let pd = |i: u64| d_at(i).map(|d| sign * d);
-        if let (Some(d0), Some(d1)) = (d_at(last), d_at(separation)) {
-            if d1.abs() > a.edge_d && (d0 >= 0) != (d1 >= 0) {
-                // Where the line between the two samples crosses zero.
-                return (d0 as f64 / (d0 - d1) as f64 - 1.0) as f32;
-            }
-        }
-        let mut flank = Flank::default();
-        let mut j = 0u64;
-        while let Some(i) = last.checked_sub(j) {
-            match pd(i) {
-                Some(y) if y <= a.flank_d && flank.add(-(j as i64), y) => j += 1,
-                _ => break,
-            }
-        }
-        // Positions relative to `last`: the first quiet sample is at +1.
-        match flank.zero(false, 1.0, a.edge_d as f64) {
-            Some(z) => (z - 1.0) as f32,
-            None => match (pd(last), pd(separation)) {
-                (Some(y0), Some(y1)) => {
-                    (crossing(y0 as f64, y1 as f64, a.edge_d as f64) - 1.0) as f32
-                }
-                _ => 0.0,
-            },
-        }
-    }
-
     /// Hands the active impact over and returns to idle.
     pub(super) fn end<const CAP: usize>(&mut self, status: Status, sink: &mut impl Sink<CAP>) {
         let Some(a) = self.active.take() else { return };
@@ -968,49 +616,4 @@ impl<const PRE: usize> Stream<PRE> {
             }
         }
     }
-}
-
-/// The falling foot's record takes `run` (its first sample at stream index `at`, after the
-/// latest peak): from just after its last sample above the foot's top (its fraction of the
-/// peak, [`power_flank::FOOT`]) on, where the record starts again. The samples above are
-/// found a stride at a time, from the end, by their extremes.
-fn record_fall(a: &mut Active, run: &[i16], at: u64) {
-    let sign: i64 = if a.peak_d >= 0 { 1 } else { -1 };
-    let (w, s) = (a.base_n, a.base_sum);
-    let top = (power_flank::FOOT * a.peak_d.unsigned_abs() as f32) as i64;
-    let above = |x: i16| sign * (w * i64::from(x) - s) > top;
-    let mut end = run.len();
-    let mut cut = None;
-    while end > 0 {
-        let begin = end.saturating_sub(STRIDE);
-        let chunk = run.get(begin..end).unwrap_or(&[]);
-        let st = Stats::of(chunk);
-        if above(if sign > 0 { st.max } else { st.min }) {
-            cut = chunk.iter().rposition(|&x| above(x)).map(|i| begin + i + 1);
-            break;
-        }
-        end = begin;
-    }
-    let from = match cut {
-        Some(c) => {
-            a.fall = Fall::new();
-            a.fall_start = at + c as u64;
-            c
-        }
-        None => 0,
-    };
-    a.fall.take(run.get(from..).unwrap_or(&[]), w, s, sign);
-}
-
-/// Splits the two runs `first`, `second` (one sequence) at position `at`: the runs before it
-/// and the runs from it on.
-fn split_runs<'a>(
-    first: &'a [i16],
-    second: &'a [i16],
-    at: usize,
-) -> ([&'a [i16]; 2], [&'a [i16]; 2]) {
-    let (a0, a1) = first.split_at(at.min(first.len()));
-    let rest = at.saturating_sub(first.len());
-    let (b0, b1) = second.split_at(rest.min(second.len()));
-    ([a0, b0], [a1, b1])
 }

@@ -14,9 +14,13 @@
 //! (widths, kinematics, filtering, fits) is [`crate::analysis`], run by whoever receives the
 //! capture from the [`Sink`].
 
+mod active;
+mod feet;
 mod impact;
 mod level;
+mod onset;
 mod rise;
+mod tail;
 pub mod train;
 
 use crate::capture::Sink;
@@ -26,7 +30,8 @@ use crate::scene::{Approach, FitSet, Scene};
 use crate::signal::baseline::{Baseline, Stats, STRIDE};
 use crate::signal::ring::Ring;
 use crate::signal::Calibration;
-use impact::Active;
+use active::Active;
+use onset::Onset;
 
 /// Quiet strides in the baseline window (`64 * STRIDE` = 4096 samples).
 const BASELINE_STRIDES: usize = 64;
@@ -44,15 +49,6 @@ pub const REACH: usize = 4096;
 /// The flanks are fitted between the edge level and this many times it (or the trigger level,
 /// if lower, so the trigger sample always ends the rising flank).
 const FLANK_EDGES: i64 = 4;
-
-/// What fired the trigger ([`Stream::onset`]).
-enum Onset {
-    /// A pulse, from the baseline or from the level (`(Σx, n)` of raw counts) the signal
-    /// settled at since.
-    Pulse(Option<(i64, i64)>),
-    /// No pulse: the level (`(Σx, n)`) the baseline moves to.
-    Moved((i64, i64)),
-}
 
 /// Counters that cannot wrap: 2^64 samples at 2.4 MS/s is 240 000 years.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
@@ -129,6 +125,14 @@ pub struct Stream<const PRE: usize> {
 }
 
 impl<const PRE: usize> Stream<PRE> {
+    /// Samples the in-impact loop takes at a time (a board's block, or half the ring).
+    pub(super) const CHUNK: usize = if PRE / 2 < 256 { PRE / 2 } else { 256 };
+    /// How far behind a separation the falling flank is read from the ring: as far as the
+    /// flanks reach and the ring is sure to hold, with the newest sample at most a chunk
+    /// beyond the separation.
+    pub(super) const LOOKBACK: usize =
+        (if REACH < PRE { REACH } else { PRE }).saturating_sub(Self::CHUNK + 2);
+
     /// A stream for `scene`; fails on an invalid scene or ring size.
     pub fn new(scene: Scene) -> Result<Self, Error> {
         let mut s = Self::unconfigured();
@@ -479,34 +483,6 @@ impl<const PRE: usize> Stream<PRE> {
         self.keep(samples);
     }
 
-    /// The samples up to `until` into the capture whose tail is being taken (before they are
-    /// kept); hands it over once the tail is complete or the capture full.
-    #[cold]
-    #[inline(never)]
-    fn extend_tail<const CAP: usize>(
-        &mut self,
-        until: u64,
-        samples: &[i16],
-        sink: &mut impl Sink<CAP>,
-    ) {
-        let n = usize::try_from(until.saturating_sub(self.index))
-            .unwrap_or(usize::MAX)
-            .min(samples.len());
-        let part = samples.get(..n).unwrap_or(&[]);
-        let full = sink.buffer().is_none_or(|c| c.extend(part) < part.len());
-        if full || n < samples.len() || self.index + n as u64 >= until {
-            self.hand_over(sink);
-        }
-    }
-
-    /// Hands over the capture whose tail is being taken, if any.
-    pub(super) fn hand_over<const CAP: usize>(&mut self, sink: &mut impl Sink<CAP>) {
-        if self.tail.take().is_some() {
-            sink.captured(&self.scene);
-            self.handed_over = true;
-        }
-    }
-
     /// Samples into the ring and the stream position.
     #[inline]
     fn keep(&mut self, samples: &[i16]) {
@@ -555,81 +531,6 @@ impl<const PRE: usize> Stream<PRE> {
             k += m;
         }
         self.replaying = false;
-    }
-
-    /// What fired the trigger at sample `x` (the next one): a pulse, measured from the baseline
-    /// or from the level the signal settled at since ([`Self::level_before`]); or no pulse,
-    /// and the level the baseline moves to. No pulse when the signal crept past the trigger
-    /// level instead of rising through it (it left the edge level on the trigger's side more
-    /// than half the settle time before, or since the stream began: drift, an orientation
-    /// change, a sensor warming; a pulse rises from the edge level to the trigger level
-    /// faster), or when `x` is no further than the trigger level from the level the signal
-    /// settled at.
-    fn onset(&self, x: i16) -> Onset {
-        let level = self.level_before();
-        let last_stride = || {
-            let sum: i64 = (0..STRIDE)
-                .map(|i| self.ring.back(i).map_or(0, i64::from))
-                .sum();
-            (sum, STRIDE as i64)
-        };
-        if let Some((sum, n)) = level {
-            let from_level = x as f32 - sum as f32 / n as f32;
-            if libm::fabsf(from_level) <= self.trigger_counts {
-                return Onset::Moved((sum, n));
-            }
-        }
-        let window = (self.settle as usize / 2)
-            .clamp(2, REACH)
-            .min(self.ring.len());
-        let mean = self.baseline.mean();
-        let edge = self.edge_counts;
-        let above = x as f32 > mean;
-        let crept = window >= 2
-            && self.ring.len() >= STRIDE
-            && (0..window).all(|i| {
-                self.ring.back(i).is_some_and(|y| {
-                    if above {
-                        y as f32 > mean + edge
-                    } else {
-                        (y as f32) < mean - edge
-                    }
-                })
-            });
-        if crept {
-            Onset::Moved(level.unwrap_or_else(last_stride))
-        } else {
-            Onset::Pulse(level)
-        }
-    }
-
-    /// A pulse fired the trigger at `x`: from the level the signal settled at since the
-    /// baseline was learned, if it did (the baseline moves there first), else from the
-    /// baseline.
-    fn pulse<const CAP: usize>(
-        &mut self,
-        sink: &mut impl Sink<CAP>,
-        x: i16,
-        level: Option<(i64, i64)>,
-    ) {
-        if let Some((sum, n)) = level {
-            self.move_baseline(sum, n);
-        }
-        let moved = core::mem::take(&mut self.moved);
-        self.start(sink, x, moved);
-    }
-
-    /// The baseline moves to the level `sum / n` (a level change without a pulse).
-    #[cold]
-    fn move_baseline(&mut self, sum: i64, n: i64) {
-        self.baseline.restart_at(sum, n);
-        self.thresholds = None;
-        self.counters.level_changes += 1;
-        self.moved = true;
-        let level = self.baseline.mean() as f64;
-        if let Some(f) = self.trigger_filter.as_mut() {
-            f.reset(level);
-        }
     }
 
     /// Forgets the baseline and the history (the level moved, or the sensor is stuck): the

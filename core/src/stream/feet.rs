@@ -1,0 +1,297 @@
+//! Where the contact begins and ends, as the physics defines them (where the contact force is
+//! zero): the feet of the pulse fitted as power curves ([`power_flank`]), the whole lobe where
+//! a ramp rises into the onset, the falling flank's straight line or edge crossing otherwise;
+//! and the falling foot's record.
+
+use super::active::Active;
+use super::rise::Fall;
+use super::{Stream, REACH};
+use crate::signal::baseline::{Deviation, Stats, STRIDE};
+use crate::signal::flank::{crossing, Flank};
+use crate::signal::power_flank;
+
+/// Where a pulse left the edge level, as the trigger found it: samples from the newest back
+/// to the onset (the walk back), the pulse's sign, the baseline, the edge level (units of
+/// `d`), the trigger sample, and samples since the previous impact's window.
+pub(super) struct OnsetWalk {
+    pub pulse: usize,
+    pub sign: i64,
+    pub deviation: Deviation,
+    pub edge_d: i64,
+    pub trigger_x: i16,
+    pub since_last: usize,
+}
+
+impl<const PRE: usize> Stream<PRE> {
+    /// The whole lobe before the onset: the samples still on the pulse's side of the
+    /// baseline (a pad's or felt's slow compression before the main pulse decelerates the
+    /// body too), back to where the signal crosses it, if they rise in a ramp to the edge
+    /// level. Where it crosses (relative to the onset, samples), its samples and `Σ d` over
+    /// them.
+    pub(super) fn lobe_before(&self, o: OnsetWalk) -> (f32, u32, i64) {
+        let OnsetWalk {
+            pulse,
+            sign,
+            deviation,
+            edge_d,
+            trigger_x,
+            since_last,
+        } = o;
+        let pd = |i: usize| {
+            self.ring
+                .back(i)
+                .filter(|_| i < REACH)
+                .map(|x| sign * deviation.of(x) as i64)
+        };
+        let lobe_limit = since_last.min(REACH).saturating_sub(pulse);
+        let mut lobe_len = 0usize;
+        let mut lobe_c = 0i64;
+        while lobe_len < lobe_limit {
+            match pd(pulse + lobe_len) {
+                Some(y) if y > 0 => {
+                    lobe_c += sign * y;
+                    lobe_len += 1;
+                }
+                _ => break,
+            }
+        }
+        // A lobe is a ramp from the baseline up to the edge level, not the signal sitting on
+        // the pulse's side of the baseline (drag, an offset, noise): its newest quarter
+        // averages at least half the edge level, its oldest quarter at most a quarter of it
+        // (three samples or fewer are the crossing itself).
+        let quarter = lobe_len / 4;
+        if lobe_len > 3 {
+            let mean = |from: usize| {
+                let sum: i64 = (from..from + quarter).filter_map(pd).sum();
+                sum.checked_div(quarter as i64).unwrap_or(0)
+            };
+            let (newest, oldest) = (mean(pulse), mean(pulse + lobe_len - quarter));
+            if 2 * newest < edge_d || 4 * oldest > edge_d {
+                lobe_len = 0;
+                lobe_c = 0;
+            }
+        }
+        // Where it crosses the baseline, relative to the onset (between the last sample on the
+        // other side and the lobe's first; at its first if the ring holds nothing older).
+        let first = match lobe_len.checked_sub(1) {
+            Some(i) => pd(pulse + i),
+            None => pulse
+                .checked_sub(1)
+                .map_or(Some(sign * deviation.of(trigger_x) as i64), pd),
+        };
+        let lobe_touch = match (pd(pulse + lobe_len), first) {
+            (Some(y0), Some(y1)) if y1 > y0 => {
+                (crossing(y0 as f64, y1 as f64, 0.0) - 1.0) as f32 - lobe_len as f32
+            }
+            _ => -(lobe_len as f32),
+        };
+        (lobe_touch, lobe_len.min(u32::MAX as usize) as u32, lobe_c)
+    }
+
+    /// Locates a new separation while its flank is in the ring (just after the samples that
+    /// set it were kept).
+    #[inline(never)]
+    pub(super) fn locate_separation(&mut self) {
+        let Some(a) = self.active.as_ref() else {
+            return;
+        };
+        let Some(s) = a.separation else {
+            return;
+        };
+        if a.separation_at.is_some_and(|(at, _, _)| at == s) {
+            return;
+        }
+        let (offset, tail, clear) = self
+            .fall(a, s)
+            .unwrap_or_else(|| (self.separation_offset(a, s), 0, None));
+        if clear.is_some() {
+            self.foot_power = clear;
+        }
+        if let Some(a) = self.active.as_mut() {
+            a.separation_at = Some((s, offset, tail));
+        }
+    }
+
+    /// First touch relative to the onset and `Σ d` over the foot before the onset: where the
+    /// rising foot, fitted as a power curve ([`power_flank`]), reaches zero force, else the
+    /// straight line's (`touch_offset`, `lead_c`); and whether it lies inside the previous
+    /// impact's contact (then it is that contact's end).
+    pub(super) fn touch(&mut self, a: &Active) -> (f32, i64, bool) {
+        let line = (a.touch_offset, a.lead_c, a.line_in_previous);
+        let peak = a.peak_d.unsigned_abs() as f32;
+        match self.rise_foot(a) {
+            Some(foot) => {
+                if foot.clear {
+                    self.foot_power = Some(foot.power);
+                }
+                let touch = foot.zero.max(a.touch_floor);
+                let lead = libm::floorf(-touch).max(0.0) as i64;
+                let c = foot.sum(-lead, 0) * peak * a.sign as f32;
+                (touch, c as i64, foot.zero < a.touch_floor)
+            }
+            None => line,
+        }
+    }
+
+    /// First touch where the whole lobe begins, if that is earlier than `touch` (first touch,
+    /// `Σ d` before the onset, inside the previous contact): a slow ramp below the edge
+    /// level before the pulse (a pad or felt compressing) is part of the contact. Not where
+    /// the lobe runs back more than twice the pulse's length above the edge level (the
+    /// signal then sat on the pulse's side of the baseline, not rising to it), nor into the
+    /// previous contact.
+    pub(super) fn lobe(&self, a: &Active, touch: (f32, i64, bool)) -> (f32, i64, bool) {
+        let above = a
+            .separation
+            .unwrap_or(self.index)
+            .saturating_sub(a.onset_index);
+        let longer = a.lobe_touch < touch.0;
+        let fits = u64::from(a.lobe_len) <= 2 * above && a.lobe_touch >= a.touch_floor;
+        if longer && fits {
+            (a.lobe_touch, a.lobe_c, false)
+        } else {
+            touch
+        }
+    }
+
+    /// The rising foot (from the rise record) fitted as a power curve, if it is one.
+    pub(super) fn rise_foot(&self, a: &Active) -> Option<power_flank::Foot> {
+        let peak = a.peak_d.unsigned_abs() as f32;
+        if !(peak > 0.0) {
+            return None;
+        }
+        let top = power_flank::FOOT * peak;
+        let n = a
+            .rise
+            .points()
+            .take_while(|&(_, d)| d as f32 <= top)
+            .count();
+        let stride = n.div_ceil(power_flank::MAX_FOOT_POINTS).max(1);
+        let points = a
+            .rise
+            .points()
+            .take(n)
+            .step_by(stride)
+            .filter(|&(_, d)| d > 0)
+            .map(|(p, d)| (p as f32, d as f32 / peak));
+        let choice = power_flank::Choice::Free {
+            prior: self.foot_power,
+        };
+        power_flank::zero(points, true, -1.0, a.edge_d as f32 / peak, choice)
+    }
+
+    /// The separation relative to `separation` and `Σ d` over the foot beyond it, where the
+    /// falling foot (the falling side's record up to the separation) is a power curve: its
+    /// rising foot's power ([`power_flank`]).
+    pub(super) fn fall(&self, a: &Active, separation: u64) -> Option<(f32, i64, Option<f32>)> {
+        // (None for a zero peak, too.)
+        let rise = self.rise_foot(a)?;
+        let peak = a.peak_d.unsigned_abs() as f32;
+        let sign: i64 = if a.peak_d >= 0 { 1 } else { -1 };
+        // Point `i` of the record: position relative to the separation (negative), and the
+        // deviation over the peak.
+        let point = |i: usize| {
+            let (p, d) = a.fall.get(i)?;
+            let x = a.fall_start as f64 + p as f64 - separation as f64;
+            Some((x as f32, d / peak))
+        };
+        // The foot: the record's last points up to the foot's top.
+        let n = a.fall.len();
+        let len = (0..n)
+            .rev()
+            .take_while(|&i| point(i).is_some_and(|(_, v)| v <= power_flank::FOOT))
+            .count();
+        let stride = len.div_ceil(power_flank::MAX_FOOT_POINTS).max(1);
+        let points = (0..len)
+            .step_by(stride)
+            .filter_map(|j| point(n - 1 - j))
+            .filter(|&(_, v)| v > 0.0);
+        let choice = power_flank::Choice::Only(rise.power);
+        let foot = power_flank::zero(points, false, 0.0, a.edge_d as f32 / peak, choice)?;
+        let tail = libm::ceilf(foot.zero).max(0.0) as i64;
+        let c = foot.sum(0, tail) * peak * sign as f32;
+        Some((foot.zero, c as i64, rise.clear.then_some(rise.power)))
+    }
+
+    /// The separation relative to `separation_index`: the falling flank (from the ring)
+    /// extrapolated to zero, the zero crossing for a sign flip across the whole edge band,
+    /// or the edge crossing between the last sample beyond the edge and the first within it.
+    pub(super) fn separation_offset(&self, a: &Active, separation: u64) -> f32 {
+        let deviation = a.deviation();
+        // The ring ends at `self.index - 1`: sample `i` is `back(index - 1 - i)`; no further
+        // than the look-back before the separation.
+        let oldest = separation.saturating_sub(1 + Self::LOOKBACK as u64);
+        let d_at = |i: u64| {
+            let back = self.index.checked_sub(1)?.checked_sub(i)?;
+            let x = self
+                .ring
+                .back(usize::try_from(back).ok().filter(|_| i >= oldest)?)?;
+            Some(deviation.of(x) as i64)
+        };
+        let Some(last) = separation.checked_sub(1) else {
+            return 0.0;
+        };
+        // Deviations signed so that the pulse's last sample (beyond the edge) is positive.
+        let sign = if d_at(last).is_some_and(|d| d < 0) {
+            -1
+        } else {
+            1
+        };
+        let pd = |i: u64| d_at(i).map(|d| sign * d);
+        if let (Some(d0), Some(d1)) = (d_at(last), d_at(separation)) {
+            if d1.abs() > a.edge_d && (d0 >= 0) != (d1 >= 0) {
+                // Where the line between the two samples crosses zero.
+                return (d0 as f64 / (d0 - d1) as f64 - 1.0) as f32;
+            }
+        }
+        let mut flank = Flank::default();
+        let mut j = 0u64;
+        while let Some(i) = last.checked_sub(j) {
+            match pd(i) {
+                Some(y) if y <= a.flank_d && flank.add(-(j as i64), y) => j += 1,
+                _ => break,
+            }
+        }
+        // Positions relative to `last`: the first quiet sample is at +1.
+        match flank.zero(false, 1.0, a.edge_d as f64) {
+            Some(z) => (z - 1.0) as f32,
+            None => match (pd(last), pd(separation)) {
+                (Some(y0), Some(y1)) => {
+                    (crossing(y0 as f64, y1 as f64, a.edge_d as f64) - 1.0) as f32
+                }
+                _ => 0.0,
+            },
+        }
+    }
+}
+
+/// The falling foot's record takes `run` (its first sample at stream index `at`, after the
+/// latest peak): from just after its last sample above the foot's top (its fraction of the
+/// peak, [`power_flank::FOOT`]) on, where the record starts again. The samples above are
+/// found a stride at a time, from the end, by their extremes.
+pub(super) fn record_fall(a: &mut Active, run: &[i16], at: u64) {
+    let sign: i64 = if a.peak_d >= 0 { 1 } else { -1 };
+    let (w, s) = (a.base_n, a.base_sum);
+    let top = (power_flank::FOOT * a.peak_d.unsigned_abs() as f32) as i64;
+    let above = |x: i16| sign * (w * i64::from(x) - s) > top;
+    let mut end = run.len();
+    let mut cut = None;
+    while end > 0 {
+        let begin = end.saturating_sub(STRIDE);
+        let chunk = run.get(begin..end).unwrap_or(&[]);
+        let st = Stats::of(chunk);
+        if above(if sign > 0 { st.max } else { st.min }) {
+            cut = chunk.iter().rposition(|&x| above(x)).map(|i| begin + i + 1);
+            break;
+        }
+        end = begin;
+    }
+    let from = match cut {
+        Some(c) => {
+            a.fall = Fall::new();
+            a.fall_start = at + c as u64;
+            c
+        }
+        None => 0,
+    };
+    a.fall.take(run.get(from..).unwrap_or(&[]), w, s, sign);
+}
