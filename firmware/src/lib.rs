@@ -8,6 +8,7 @@
 //! * [`adxl375`]: the ADXL375 driver over `embedded-hal-async` (SPI traffic, FIFO, scale);
 //! * [`fifo`]: samples a polled FIFO lost, counted against the sensor's own stream;
 //! * [`light_gate`]: two beams' cuts paired into passages and speeds;
+//! * [`ticks`]: deadlines beyond a 32-bit one-shot timer's reach, in several shots;
 //! * [`semihosting`] (QEMU builds only): the host's command line, files and exit status.
 
 #![no_std]
@@ -19,5 +20,6 @@ pub mod rate;
 pub mod scene;
 #[cfg(all(target_os = "none", feature = "emulator"))]
 pub mod semihosting;
+pub mod ticks;
 
 pub use rate::SAMPLE_RATE_HZ;

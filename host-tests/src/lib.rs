@@ -4,6 +4,8 @@
 pub mod bench;
 pub mod cli;
 pub mod firmware_link;
+pub mod interrupt;
+pub mod output;
 pub mod parse;
 pub mod pipeline;
 pub mod plot;

@@ -3,29 +3,13 @@
 use plotters::prelude::*;
 
 /// Checks that `path` can take an SVG before any work is done: its directory exists and it is
-/// none of the `inputs` (an analysis never overwrites its recording).
+/// none of the `inputs` (the same file, a link to one, standard input's file: the output rule
+/// of [`crate::output`]), and it is named `.svg`.
 pub fn check_output(path: &std::path::Path, inputs: &[&std::path::Path]) -> Result<(), String> {
-    let dir = match path.parent() {
-        Some(d) if !d.as_os_str().is_empty() => d,
-        _ => std::path::Path::new("."),
-    };
-    if !dir.is_dir() {
-        return Err(format!(
-            "--plot {}: directory {} does not exist",
-            path.display(),
-            dir.display()
-        ));
-    }
-    if let Ok(out) = path.canonicalize() {
-        for input in inputs {
-            if input.canonicalize().is_ok_and(|i| i == out) {
-                return Err(format!(
-                    "--plot {}: is an input file; it would be overwritten",
-                    path.display()
-                ));
-            }
-        }
-    }
+    let all = inputs
+        .iter()
+        .fold(crate::output::Inputs::new(), |all, i| all.with(i));
+    crate::output::check("--plot", path, &all, None)?;
     let svg = path
         .extension()
         .is_some_and(|e| e.eq_ignore_ascii_case("svg"));
@@ -36,6 +20,22 @@ pub fn check_output(path: &std::path::Path, inputs: &[&std::path::Path]) -> Resu
         ));
     }
     Ok(())
+}
+
+/// Draws a `size` SVG with `draw` and writes it to `path` whole or not at all
+/// ([`crate::output::write`]).
+pub(crate) fn write_svg(
+    path: &std::path::Path,
+    size: (u32, u32),
+    draw: impl FnOnce(&DrawingArea<SVGBackend, plotters::coord::Shift>) -> Result<(), String>,
+) -> Result<(), String> {
+    let mut text = String::new();
+    {
+        let root = SVGBackend::with_string(&mut text, size).into_drawing_area();
+        draw(&root)?;
+        root.present().map_err(|e| e.to_string())?;
+    }
+    crate::output::write(path, text.as_bytes())
 }
 
 /// A named, coloured series of (time, value) points.
@@ -55,6 +55,58 @@ pub(crate) struct Panel<'a> {
     pub(crate) models: Vec<Curve>,
     pub(crate) log: bool,
     pub(crate) legend: bool,
+}
+
+/// A panel's width in pixel columns, at most (its curves are drawn at most twice this many
+/// points each).
+const COLUMNS: usize = 400;
+
+/// `points` as at most about `2 columns` points: where there are more and x only grows (a
+/// curve against time), the least and the greatest y of each of `columns` equal spans of x,
+/// in their order (what a pixel column shows: a window of a million samples draws as it
+/// looks, in a file of a few kB); a curve that turns back in x (a force–deformation loop)
+/// keeps every n-th point, its last one included.
+pub(crate) fn decimate(points: &[(f64, f64)], columns: usize) -> Vec<(f64, f64)> {
+    if points.len() <= 2 * columns || columns == 0 {
+        return points.to_vec();
+    }
+    if points.windows(2).any(|w| w[1].0 < w[0].0) {
+        let every = points.len().div_ceil(2 * columns);
+        let mut out: Vec<(f64, f64)> = points.iter().copied().step_by(every).collect();
+        if (points.len() - 1) % every != 0 {
+            out.push(points[points.len() - 1]);
+        }
+        return out;
+    }
+    let (first, last) = (points[0].0, points[points.len() - 1].0);
+    let span = (last - first) / columns as f64;
+    if !(span.is_finite() && span > 0.0) {
+        return points.to_vec();
+    }
+    let column = |x: f64| (((x - first) / span) as usize).min(columns - 1);
+    let mut out = Vec::with_capacity(2 * columns + 2);
+    let mut k = 0;
+    while k < points.len() {
+        let c = column(points[k].0);
+        let (mut lo, mut hi) = (k, k);
+        let mut j = k;
+        while j < points.len() && column(points[j].0) == c {
+            if points[j].1 < points[lo].1 {
+                lo = j;
+            }
+            if points[j].1 > points[hi].1 {
+                hi = j;
+            }
+            j += 1;
+        }
+        let (a, b) = (lo.min(hi), lo.max(hi));
+        out.push(points[a]);
+        if b != a {
+            out.push(points[b]);
+        }
+        k = j.max(k + 1);
+    }
+    out
 }
 
 /// Draws one panel on `area`.
@@ -98,7 +150,9 @@ pub(crate) fn draw_panel(
             if !p.measured.is_empty() {
                 chart
                     .draw_series(LineSeries::new(
-                        p.measured.iter().copied().filter(|q| finite(q)),
+                        decimate(&p.measured, COLUMNS)
+                            .into_iter()
+                            .filter(|q| finite(q)),
                         MEASURED.stroke_width(4),
                     ))
                     .map_err(|e| e.to_string())?
@@ -111,7 +165,7 @@ pub(crate) fn draw_panel(
                 let c = *color;
                 chart
                     .draw_series(LineSeries::new(
-                        s.iter().copied().filter(|q| finite(q)),
+                        decimate(s, COLUMNS).into_iter().filter(|q| finite(q)),
                         c.stroke_width(2),
                     ))
                     .map_err(|e| e.to_string())?
@@ -159,7 +213,18 @@ pub struct Signal<'a> {
     pub accel_m_s2: Box<dyn Fn(u64) -> Option<f64> + 'a>,
 }
 
-/// Per impact (up to six), as in the seed papers' figures: deceleration, velocity and
+/// Impacts the figure shows at most (a note says so when there are more).
+pub const SHOWN: usize = 6;
+
+/// The samples the figure draws of impact `r` at `rate_hz`: from two before first touch to
+/// four past separation, `(first, count)`.
+pub fn window(r: &impact_core::ImpactReport, rate_hz: f64) -> (u64, u64) {
+    let start = ((r.start_s * rate_hz).floor().max(0.0) as u64).saturating_sub(2);
+    let len = ((f64::from(r.duration_s) * rate_hz).ceil().max(0.0) as u64 + 4).max(4);
+    (start, len)
+}
+
+/// Per impact (up to [`SHOWN`]), as in the seed papers' figures: deceleration, velocity and
 /// deformation against time from touch, the force–deformation loop, with the fitted models
 /// (two-phase, nonlinear, Hertz) simulated from the same touch over the measured curves; with
 /// `--srs`, the SRS and the PVSS (log–log).
@@ -168,24 +233,50 @@ pub fn impacts(
     reports: &[impact_core::ImpactReport],
     path: &std::path::Path,
 ) -> Result<(), String> {
+    let shown: Vec<_> = reports.iter().take(SHOWN).collect();
+    if shown.is_empty() {
+        crate::note(&format!(
+            "--plot {}: no impact to draw, no figure written",
+            path.display()
+        ));
+        return Ok(());
+    }
+    let spectra = shown.iter().any(|r| r.spectrum.is_some());
+    if reports.len() > shown.len() {
+        crate::note(&format!(
+            "--plot: the figure shows the first {} of {} impacts",
+            shown.len(),
+            reports.len()
+        ));
+    }
+    let cols = if spectra { 6 } else { 4 };
+    write_svg(
+        path,
+        (400 * cols as u32, 330 * shown.len() as u32),
+        |root| draw_impacts(root, signal, &shown, cols, spectra),
+    )?;
+    eprintln!("wrote {}", path.display());
+    Ok(())
+}
+
+/// The impacts figure's panels on `root` (see [`impacts`]).
+fn draw_impacts(
+    root: &DrawingArea<SVGBackend, plotters::coord::Shift>,
+    signal: &Signal,
+    shown: &[&impact_core::ImpactReport],
+    cols: usize,
+    spectra: bool,
+) -> Result<(), String> {
     use impact_core::model::{Hertz, Model, Nonlinear, TwoPhase};
     use impact_core::solve::trajectory;
     use impact_core::{ContactLaw, Impact};
-    let shown: Vec<_> = reports.iter().take(6).collect();
-    if shown.is_empty() {
-        return Err("--plot: no impact to draw".into());
-    }
-    let spectra = shown.iter().any(|r| r.spectrum.is_some());
-    let cols = if spectra { 6 } else { 4 };
-    let root =
-        SVGBackend::new(path, (400 * cols as u32, 330 * shown.len() as u32)).into_drawing_area();
     root.fill(&WHITE).map_err(|e| e.to_string())?;
     let rows = root.split_evenly((shown.len(), cols));
     let fs = signal.rate_hz;
     let mass = signal.mass_kg;
     for (k, r) in shown.iter().enumerate() {
-        let start = ((r.start_s * fs).floor() as usize).saturating_sub(2);
-        let len = ((r.duration_s as f64 * fs).ceil() as usize + 4).max(4);
+        let (start, len) = window(r, fs);
+        let (start, len) = (start as usize, len as usize);
         let base = r.baseline_m_s2 as f64;
         let t_ms = |i: usize| (i as f64 / fs - r.start_s) * 1e3;
         let meas: Vec<(f64, f64)> = (start..start + len)
@@ -368,5 +459,5 @@ pub fn impacts(
             draw_panel(&rows[k * cols + j], Some(r.index), p)?;
         }
     }
-    root.present().map_err(|e| e.to_string())
+    Ok(())
 }

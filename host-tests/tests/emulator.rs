@@ -674,6 +674,46 @@ fn synth(name: &str, args: &[&str]) -> String {
     file.to_string_lossy().into_owned()
 }
 
+/// A replay slowed until a block's period (256 s here) is beyond the reach of the emulator's
+/// 32-bit timers (171.8 s at 25 MHz): each block comes at its own deadline, not when the
+/// timer's longest shot runs out, so a report's latency is right across the counter's wraps
+/// (it was 20.6 s here instead of 189 s, and negative at `--rate-scale 1e-6`). About 25 s.
+#[test]
+fn a_replay_slower_than_the_timers_reach_reports_the_right_latency() {
+    let Some(elf) = firmware() else { return };
+    let elf = elf.to_string_lossy().into_owned();
+    let mut args = impact_host::synth::SEED_BENCH_ARGS.to_vec();
+    args.extend(["--rate", "10000", "--touch", "0.005", "--duration", "0.05"]);
+    let file = synth("slow.csv", &args);
+    let (out, log) = impact(&[
+        "emulate",
+        &file,
+        "--json",
+        "--realtime",
+        "--rate-scale",
+        "1e-4",
+        "--elf",
+        &elf,
+        "--mass",
+        "0.06",
+        "--v0",
+        "1.3357",
+    ]);
+    let json: serde_json::Value = serde_json::from_str(&out).unwrap();
+    assert_eq!(json["samples_lost"], 0, "{log}");
+    let impacts = json["impacts"].as_array().unwrap();
+    assert_eq!(impacts.len(), 1, "{log}");
+    // 1 S/s: block b (256 samples) is written at (b + 1) × 256 s; the impact ends in block 1.
+    let end = impacts[0]["end_sample"].as_u64().unwrap();
+    assert!((256..512).contains(&end), "{}", impacts[0]);
+    let latency = impacts[0]["report_latency_s"].as_f64().unwrap();
+    let expected = 512.0 - end as f64;
+    assert!(
+        (latency - expected).abs() < 0.5,
+        "reported {latency} s after its hold, not {expected} s\n{log}"
+    );
+}
+
 #[test]
 fn realtime_runs_of_seconds_lose_nothing_at_500_ks_and_1_ms() {
     if firmware().is_none() {

@@ -418,27 +418,42 @@ fn a_drifting_time_axis_is_refused_alike_everywhere_or_resampled() {
     std::fs::write(&path, text).unwrap();
     let file = path.to_str().unwrap();
     let mut errors = Vec::new();
-    for extra in [
-        &["--v0", "2"][..],
-        &[
-            "--v0",
-            "2",
-            "--plot",
-            temp("drifting.svg").to_str().unwrap(),
-        ][..],
-        &[
-            "--v0",
-            "2",
-            "--stream",
-            "--range",
-            "4000",
-            "--trigger",
-            "200",
-        ][..],
+    // In passes, read whole (as `--axes` reads it), and as a stream.
+    for (extra, whole) in [
+        (&["--v0", "2"][..], false),
+        (&["--v0", "2"][..], true),
+        (
+            &[
+                "--v0",
+                "2",
+                "--stream",
+                "--range",
+                "4000",
+                "--trigger",
+                "200",
+            ][..],
+            false,
+        ),
     ] {
         let mut args = vec!["analyze", file];
         args.extend_from_slice(extra);
-        let (code, out, err) = impact(&args);
+        let out = std::process::Command::new(env!("CARGO_BIN_EXE_impact"))
+            .args(&args)
+            .env(
+                if whole {
+                    "IMPACT_READ_WHOLE"
+                } else {
+                    "IMPACT_UNSET"
+                },
+                "1",
+            )
+            .output()
+            .unwrap();
+        let (code, out, err) = (
+            out.status.code().unwrap_or(-1),
+            String::from_utf8_lossy(&out.stdout).into_owned(),
+            String::from_utf8_lossy(&out.stderr).into_owned(),
+        );
         assert_eq!(code, 1, "{extra:?}: {out}");
         assert!(err.contains("the time axis drifts"), "{extra:?}: {err}");
         errors.push(err);

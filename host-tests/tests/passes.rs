@@ -1,9 +1,9 @@
 //! `impact analyze` on a regular file or standard input reads it in passes (a survey of the
 //! whole recording, a second one if glitches were removed, then the analysis) in memory that
 //! does not grow with its length; a CSV's or standard input's values are kept from the first
-//! pass in a temporary file. The reports equal the whole-file path's (`--plot`, which needs
-//! the whole recording) for every format, with glitches, flat tops and the levels learned
-//! from the recording.
+//! pass in a temporary file. The reports equal the whole-file path's (`IMPACT_READ_WHOLE`, as
+//! `--axes` or `--resample` read it) for every format, with glitches, flat tops and the levels
+//! learned from the recording.
 
 use std::io::Write;
 use std::path::PathBuf;
@@ -27,16 +27,27 @@ fn fixture(name: &str) -> String {
         .into_owned()
 }
 
-/// `impact analyze FILE ARGS --json` read in passes, and read whole (`--plot`).
+/// `impact ARGS` read whole (`IMPACT_READ_WHOLE`): (exit code, stdout, stderr).
+fn whole(args: &[&str]) -> (i32, String, String) {
+    let out = Command::new(env!("CARGO_BIN_EXE_impact"))
+        .args(args)
+        .env("IMPACT_READ_WHOLE", "1")
+        .output()
+        .unwrap();
+    (
+        out.status.code().unwrap_or(-1),
+        String::from_utf8_lossy(&out.stdout).into_owned(),
+        String::from_utf8_lossy(&out.stderr).into_owned(),
+    )
+}
+
+/// `impact analyze FILE ARGS --json` read in passes, and read whole.
 fn passes_and_whole(file: &str, args: &[&str]) -> (String, String) {
-    let run = |extra: &[&str]| {
-        let mut v = vec!["analyze", file, "--json"];
-        v.extend_from_slice(args);
-        v.extend_from_slice(extra);
-        impact_ok(&v).0
-    };
-    let svg = tmp("whole.svg");
-    (run(&[]), run(&["--plot", &svg]))
+    let mut v = vec!["analyze", file, "--json"];
+    v.extend_from_slice(args);
+    let (code, out, err) = whole(&v);
+    assert_eq!(code, 0, "{v:?}: {err}");
+    (impact_ok(&v).0, out)
 }
 
 /// `impact analyze - ARGS --json` with `bytes` on standard input.
@@ -379,12 +390,11 @@ fn time_axis_errors_read_the_same_on_every_path() {
             ":3: time 0 s does not increase",
         ),
     ];
-    let svg = tmp("errors.svg");
     for (name, text, want) in cases {
         let file = tmp(&format!("{name}.csv"));
         std::fs::write(&file, &text).unwrap();
         let passes = common::impact(&["analyze", &file]);
-        let whole = common::impact(&["analyze", &file, "--plot", &svg]);
+        let whole = whole(&["analyze", &file]);
         let stream = common::impact(&[
             "analyze",
             &file,

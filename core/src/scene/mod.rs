@@ -13,6 +13,9 @@ pub use train::{Train, TrainSpeed};
 /// Heaviest impactor, kg: above any drop weight, and forces and energies stay finite f32.
 pub const MAX_MASS_KG: f32 = 1e6;
 
+/// Fastest sample rate, Hz.
+pub const MAX_RATE_HZ: f32 = 1e8;
+
 /// How the approach speed `v0` is known (an accelerometer alone cannot tell it).
 #[derive(Clone, Copy, Debug, PartialEq)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
@@ -153,7 +156,7 @@ impl Scene {
             });
         }
         positive(c.sample_rate_hz, "rate")?;
-        if c.sample_rate_hz > 1e8 {
+        if c.sample_rate_hz > MAX_RATE_HZ {
             return Err(Error::InvalidParameter {
                 name: "rate",
                 reason: "must be at most 100 MHz",
@@ -182,11 +185,7 @@ impl Scene {
             positive(t.max_flight_s, "max-flight")?;
         }
         if let Some(sp) = self.spectrum {
-            sp.check(c.sample_rate_hz)
-                .map_err(|reason| Error::InvalidParameter {
-                    name: "srs",
-                    reason,
-                })?;
+            sp.check(c.sample_rate_hz)?;
         }
         positive(self.trigger_m_s2, "trigger")?;
         positive(self.edge_m_s2, "edge")?;

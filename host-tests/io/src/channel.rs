@@ -244,8 +244,16 @@ pub fn time_unit_s(header: &str, given: Option<TimeUnit>) -> f64 {
 pub const SLOWEST_RATE_HZ: f64 = 100.0;
 
 /// An error with the fix if a time column whose unit is neither named nor given gives a rate
-/// below [`SLOWEST_RATE_HZ`] read in seconds.
+/// below [`SLOWEST_RATE_HZ`] read in seconds, or if any gives a rate beyond
+/// [`crate::limits::RATE_HZ`].
 pub fn check_time_unit(header: &str, given: Option<TimeUnit>, rate_hz: f64) -> Result<(), String> {
+    if !crate::limits::RATE_HZ.contains(rate_hz) {
+        return Err(format!(
+            "the time column {header:?} gives {} S/s: out of range ({}); is its unit right (--time-unit)?",
+            crate::limits::number(rate_hz),
+            crate::limits::RATE_HZ
+        ));
+    }
     if given.is_some() || named_time_unit_s(header).is_some() || rate_hz >= SLOWEST_RATE_HZ {
         return Ok(());
     }

@@ -8,6 +8,7 @@ pub mod channel;
 pub mod csv_fast;
 pub mod csv_read;
 pub mod ide;
+pub mod limits;
 pub mod npy;
 pub mod quantise;
 pub mod raw;

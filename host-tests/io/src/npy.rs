@@ -7,6 +7,7 @@ use std::path::Path;
 
 use crate::channel::{evenly_sampled, numbered_column, Channel, ColumnRef, ReadOptions};
 use crate::channel::{one_line, RecordingError};
+use crate::limits::RATE_HZ;
 
 /// True for a `.npy` file name (any case).
 pub fn is_npy(path: &Path) -> bool {
@@ -96,9 +97,7 @@ pub fn read_npy(path: &Path, opts: &ReadOptions) -> Result<Channel, RecordingErr
     let Some(rate_hz) = opts.rate_hz else {
         return Err(err("an .npy array holds no time: give --rate".into()));
     };
-    if !(rate_hz.is_finite() && rate_hz > 0.0 && rate_hz <= 1e9) {
-        return Err(err(format!("rate {rate_hz} Hz is not in (0, 1e9]")));
-    }
+    RATE_HZ.check_named("--rate", rate_hz).map_err(err)?;
     if opts.time_column.is_some() || opts.resample || !opts.axes.is_empty() {
         return Err(err(
             "an .npy array takes --rate and --column only (no --time-column, --resample, --axes)"

@@ -1,9 +1,10 @@
 //! Readings to the i16 counts the core pipeline takes: the gain that puts a full scale at
 //! 32 000 counts, and rounding that saturates as an ADC does.
 
-/// The gain, m/s² per count, that puts `full_scale_m_s2` at 32 000 counts.
+/// The gain, m/s² per count, that puts `full_scale_m_s2` at 32 000 counts (at least the
+/// smallest full scale, [`crate::limits::LEVEL_M_S2`]: a recording of zeros has one too).
 pub fn gain_for(full_scale_m_s2: f64) -> f64 {
-    full_scale_m_s2.max(1e-30) / 32000.0
+    full_scale_m_s2.max(crate::limits::LEVEL_M_S2.low) / 32000.0
 }
 
 /// One reading in counts (saturating at the i16 rails, as an ADC does).

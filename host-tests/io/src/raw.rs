@@ -8,6 +8,7 @@ use super::channel::RawType;
 
 use crate::channel::RecordingError;
 use crate::channel::{evenly_sampled, numbered_column, Channel, ReadOptions};
+use crate::limits::RATE_HZ;
 
 impl RawType {
     /// The values at byte `at` of each `frame`-byte frame of `bytes` (whole frames), handed
@@ -62,9 +63,7 @@ pub fn read_raw(
     let Some(rate_hz) = opts.rate_hz else {
         return Err(err("a raw file holds no time: give --rate".into()));
     };
-    if !(rate_hz.is_finite() && rate_hz > 0.0 && rate_hz <= 1e9) {
-        return Err(err(format!("rate {rate_hz} Hz is not in (0, 1e9]")));
-    }
+    RATE_HZ.check_named("--rate", rate_hz).map_err(err)?;
     if opts.time_column.is_some() || opts.resample || !opts.axes.is_empty() {
         return Err(err(
             "a raw file takes --rate, --raw-channels and --column only".into(),

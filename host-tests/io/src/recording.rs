@@ -7,6 +7,7 @@ use crate::channel::{
     check_time, check_time_unit, time_unit_s, Channel, ReadOptions, RecordingError,
 };
 use crate::csv_read::read_table;
+use crate::limits::RATE_HZ;
 
 /// A resampled recording may hold at most this many times the file's samples (a long gap in
 /// a fast recording would otherwise fill the memory with interpolated nothing).
@@ -99,9 +100,7 @@ pub fn read_csv(path: &Path, opts: &ReadOptions) -> Result<Channel, RecordingErr
     let unit = |t: usize| time_unit_s(&header(t), opts.time_unit);
     let (rate_hz, time_s, jitter, resampled) = match (opts.rate_hz, tcol) {
         (Some(r), _) => {
-            if !(r.is_finite() && r > 0.0 && r <= 1e9) {
-                return Err(err(format!("rate {r} Hz is not in (0, 1e9]")));
-            }
+            RATE_HZ.check_named("--rate", r).map_err(err)?;
             let t0 = tcol.map_or(0.0, |t| table.columns[t][0] * unit(t));
             let times = (0..len).map(|i| t0 + i as f64 / r).collect();
             (r, times, 0.0, false)

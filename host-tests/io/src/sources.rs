@@ -11,6 +11,7 @@ use super::channel::{check_interval, is_stdin, ReadOptions};
 use super::csv_fast::{Layout, Parsed};
 use super::csv_read::{Handover, HandoverError, Step};
 use super::table::Rows;
+use crate::limits::RATE_HZ;
 
 /// Samples whose noise sets the default edge level (the whole-file path uses the whole
 /// recording's): the first 65 536.
@@ -118,14 +119,14 @@ impl RawSource {
         name: &str,
     ) -> Result<Self, String> {
         if opts.time_column.is_some() {
-            return Err("--stream: a raw stream has no time column (give --rate)".into());
+            return Err(format!(
+                "{name}: a raw file takes --rate, --raw-channels and --column only"
+            ));
         }
         let rate_hz = opts
             .rate_hz
-            .ok_or("--stream: a raw stream holds no time: give --rate")?;
-        if !(rate_hz.is_finite() && rate_hz > 0.0 && rate_hz <= 1e9) {
-            return Err(format!("--rate {rate_hz}: not in (0, 1e9]"));
-        }
+            .ok_or_else(|| format!("{name}: a raw file holds no time: give --rate"))?;
+        RATE_HZ.check_named("--rate", rate_hz)?;
         let channels = opts.raw_channels.unwrap_or(1);
         if !(1..=64).contains(&channels) {
             return Err(format!("--raw-channels {channels}: must lie in 1..=64"));
@@ -319,9 +320,7 @@ impl CsvSource {
             ));
         }
         if let Some(r) = opts.rate_hz {
-            if !(r.is_finite() && r > 0.0 && r <= 1e9) {
-                return Err(err(format!("rate {r} Hz is not in (0, 1e9]")));
-            }
+            RATE_HZ.check_named("--rate", r).map_err(err)?;
         }
         let time_header = tcol
             .and_then(|t| shape.headers.get(t).cloned())
@@ -766,9 +765,7 @@ impl NpySource {
         let rate_hz = opts
             .rate_hz
             .ok_or_else(|| format!("{name}: an .npy array holds no time: give --rate"))?;
-        if !(rate_hz.is_finite() && rate_hz > 0.0 && rate_hz <= 1e9) {
-            return Err(format!("--rate {rate_hz}: not in (0, 1e9]"));
-        }
+        RATE_HZ.check_named("--rate", rate_hz)?;
         if opts.time_column.is_some() {
             return Err(format!(
                 "{name}: an .npy array has no time column (give --rate)"

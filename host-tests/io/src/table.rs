@@ -62,7 +62,9 @@ fn sequential_reader(tape: &Arc<Tape>, byte: u64) -> io::Result<Box<dyn Read + S
 
 /// Counts bytes since the last record end (a line break outside quotes, as `csv-core` reads
 /// quotes: opened at a field's start, `""` inside them an escaped quote) and fails past
-/// [`MAX_LINE_BYTES`]; also reports how many bytes went through, for progress.
+/// [`MAX_LINE_BYTES`], or at the end of the input inside a quote, naming the line where
+/// the record or the quote began ([`RecordLimit::failed_at`]); also reports how many bytes
+/// went through, for progress.
 struct RecordLimit<R> {
     inner: R,
     delimiter: u8,
@@ -70,6 +72,13 @@ struct RecordLimit<R> {
     quote: Quote,
     field_start: bool,
     read: u64,
+    /// Line breaks read so far, and their count where the record (the last line break
+    /// outside quotes) and the open quote began.
+    breaks: u64,
+    record_breaks: u64,
+    quote_breaks: u64,
+    /// Line breaks before the line that failed (counted as `breaks`), once it has.
+    failed_at: Option<u64>,
     /// The last byte read, and whether the input has ended.
     last: u8,
     ended: bool,
@@ -87,6 +96,13 @@ impl<R: Read> Read for RecordLimit<R> {
     fn read(&mut self, buf: &mut [u8]) -> io::Result<usize> {
         let mut n = self.inner.read(buf)?;
         if n == 0 && !self.ended && !buf.is_empty() {
+            if self.quote == Quote::Inside {
+                // (csv would take the rest of the input for one field.)
+                return Err(self.fail(
+                    self.quote_breaks,
+                    "a quote opened on this line is never closed".into(),
+                ));
+            }
             // Every record ends with a line break, so that its line is `csv`'s line count
             // less one (see `read_table`).
             self.ended = true;
@@ -102,8 +118,12 @@ impl<R: Read> Read for RecordLimit<R> {
         let chunk = &buf[..n];
         if self.quote == Quote::Outside && !chunk.contains(&b'"') {
             // The common case, without a byte-by-byte walk: only line breaks matter.
+            self.breaks += chunk.iter().filter(|&&b| b == b'\n').count() as u64;
             match chunk.iter().rposition(|&b| b == b'\n') {
-                Some(p) => self.since_break = n - p - 1,
+                Some(p) => {
+                    self.since_break = n - p - 1;
+                    self.record_breaks = self.breaks;
+                }
                 None => self.since_break += n,
             }
             if let Some(&b) = chunk.last() {
@@ -113,6 +133,7 @@ impl<R: Read> Read for RecordLimit<R> {
             return Ok(n);
         }
         for &b in chunk {
+            self.breaks += u64::from(b == b'\n');
             match self.quote {
                 Quote::Inside => {
                     if b == b'"' {
@@ -132,10 +153,12 @@ impl<R: Read> Read for RecordLimit<R> {
             }
             if b == b'\n' {
                 self.since_break = 0;
+                self.record_breaks = self.breaks;
                 self.field_start = true;
             } else {
                 if b == b'"' && self.field_start {
                     self.quote = Quote::Inside;
+                    self.quote_breaks = self.breaks;
                 }
                 self.field_start = b == self.delimiter || b == b'\r';
                 self.since_break += 1;
@@ -147,15 +170,46 @@ impl<R: Read> Read for RecordLimit<R> {
 }
 
 impl<R> RecordLimit<R> {
-    fn check(&self) -> io::Result<()> {
-        if self.since_break > MAX_LINE_BYTES {
-            Err(io::Error::new(
-                io::ErrorKind::InvalidData,
-                format!("a line longer than {MAX_LINE_BYTES} bytes: not a CSV recording"),
-            ))
-        } else {
-            Ok(())
+    /// The limit over `inner`, read from the start of a line on (its first line's breaks
+    /// counted from 0).
+    fn new(inner: R, delimiter: u8) -> Self {
+        Self {
+            inner,
+            delimiter,
+            since_break: 0,
+            quote: Quote::Outside,
+            field_start: true,
+            read: 0,
+            breaks: 0,
+            record_breaks: 0,
+            quote_breaks: 0,
+            failed_at: None,
+            last: 0,
+            ended: false,
         }
+    }
+
+    fn check(&mut self) -> io::Result<()> {
+        if self.since_break <= MAX_LINE_BYTES {
+            return Ok(());
+        }
+        Err(if self.quote == Quote::Outside {
+            self.fail(
+                self.record_breaks,
+                format!("a line longer than {MAX_LINE_BYTES} bytes: not a CSV recording"),
+            )
+        } else {
+            self.fail(
+                self.quote_breaks,
+                format!("a quote opened on this line is not closed within {MAX_LINE_BYTES} bytes"),
+            )
+        })
+    }
+
+    /// The error of a record that began after `breaks` line breaks.
+    fn fail(&mut self, breaks: u64, message: String) -> io::Error {
+        self.failed_at = Some(breaks);
+        io::Error::new(io::ErrorKind::InvalidData, message)
     }
 }
 
@@ -212,14 +266,20 @@ pub fn is_reading(v: f64) -> bool {
     v.is_finite() && v.abs() <= MAX_VALUE
 }
 
-/// Why a field is not a number, with a hint where the layout suggests one.
+/// Why a field is not a number (its first 64 characters), with a hint where the layout
+/// suggests one.
 fn not_a_number(field: &str, format: &CsvFormat, delimiter: u8) -> String {
-    let hint = if !format.decimal_comma && delimiter != b',' && field.contains(',') {
+    let hint = if field.contains('\u{feff}') {
+        " (a byte-order mark is read only at the start of the file: files joined?)"
+    } else if !format.decimal_comma && delimiter != b',' && field.contains(',') {
         " (decimal commas? give --decimal-comma)"
     } else {
         ""
     };
-    format!("not a number: {field:?}{hint}")
+    match field.char_indices().nth(64) {
+        Some((cut, _)) => format!("not a number: {:?}...{hint}", &field[..cut]),
+        None => format!("not a number: {field:?}{hint}"),
+    }
 }
 
 /// A data row: its line, the number of line breaks it spans (quoted ones and its end), and
@@ -318,16 +378,7 @@ impl Rows {
         size: Option<u64>,
         progress: Option<fn(f64)>,
     ) -> Self {
-        let limited = RecordLimit {
-            inner: input,
-            delimiter,
-            since_break: 0,
-            quote: Quote::Outside,
-            field_start: true,
-            read: 0,
-            last: 0,
-            ended: false,
-        };
+        let limited = RecordLimit::new(input, delimiter);
         let reader = csv::ReaderBuilder::new()
             .has_headers(false)
             .flexible(true)
@@ -370,6 +421,12 @@ impl Rows {
             None => self.input_from(byte),
         }
         .map_err(|e| self.err(Some(line), e.to_string()))?;
+        // `csv` drops a byte-order mark at the start of its input: a line break (a blank
+        // line, skipped) ahead of the line keeps one there in the row, which is refused as
+        // on any line but the first.
+        let ahead = u64::from(byte > 0);
+        let lead: &'static [u8] = if byte > 0 { b"\n" } else { b"" };
+        let input: Box<dyn Read + Send> = Box::new(lead.chain(input));
         let mut rows = Self::build(
             &self.path,
             &self.format,
@@ -383,8 +440,9 @@ impl Rows {
         rows.header_line = self.header_line;
         rows.columns = self.columns;
         rows.first_data_line = self.first_data_line;
-        rows.line_offset = line.saturating_sub(1);
-        rows.skip = byte;
+        // (Less the line break put ahead.)
+        rows.line_offset = line.saturating_sub(1 + ahead);
+        rows.skip = byte - ahead;
         rows.tape = self.tape.clone();
         Ok(rows)
     }
@@ -447,11 +505,15 @@ impl Rows {
             let more = match self.reader.read_byte_record(&mut self.record) {
                 Ok(more) => more,
                 Err(e) => {
-                    // The line being read (lines consumed so far, plus one).
-                    let line = e
-                        .position()
-                        .map_or(self.reader.position().line(), |p| p.line())
-                        + self.line_offset;
+                    // The line where the record (or its open quote) began, if the input
+                    // failed on it; else the line being read (lines consumed so far, plus
+                    // one).
+                    let line = match self.reader.get_ref().failed_at {
+                        Some(breaks) => breaks + 1,
+                        None => e
+                            .position()
+                            .map_or(self.reader.position().line(), |p| p.line()),
+                    } + self.line_offset;
                     let message = match e.into_kind() {
                         csv::ErrorKind::Io(io) => io.to_string(),
                         other => format!("{other:?}"),
@@ -776,10 +838,27 @@ mod tests {
 
     #[test]
     fn an_unclosed_quote_or_endless_line_is_bounded() {
+        // Reported at the line the quote was opened on (the text after it spans many), or
+        // that the long line began on.
         let mut text = String::from("t,a\n0,1\n\"");
         text.push_str(&"1,2\n".repeat(MAX_LINE_BYTES / 4 + 10));
         let e = read(&text, CsvFormat::default()).unwrap_err();
-        assert!(e.contains("a line longer than 1048576 bytes"), "{e}");
+        assert!(
+            e.ends_with(":3: a quote opened on this line is not closed within 1048576 bytes"),
+            "{e}"
+        );
+        let e = read("t,a\n0,1\n\"1,2\n3,4\n", CsvFormat::default()).unwrap_err();
+        assert!(
+            e.ends_with(":3: a quote opened on this line is never closed"),
+            "{e}"
+        );
+        let mut text = String::from("t,a\n0,1\n\n1,");
+        text.push_str(&"2".repeat(MAX_LINE_BYTES + 10));
+        let e = read(&text, CsvFormat::default()).unwrap_err();
+        assert!(
+            e.ends_with(":4: a line longer than 1048576 bytes: not a CSV recording"),
+            "{e}"
+        );
         // A quote inside a field is text, not an opening quote.
         let t = read("t,a 5\" bar\n0,1\n", CsvFormat::default()).unwrap();
         assert_eq!(t.headers, ["t", "a 5\" bar"]);

@@ -10,6 +10,7 @@ use tdms_rs::{DataType, PropertyValue, TdmsChannel, TdmsFile};
 
 use crate::channel::{evenly_sampled, Channel, ReadOptions};
 use crate::channel::{one_line, ColumnRef, RecordingError};
+use crate::limits::RATE_HZ;
 
 /// True for a `.tdms` file name (any case).
 pub fn is_tdms(path: &Path) -> bool {
@@ -282,17 +283,21 @@ impl TdmsStream {
             _ => None,
         };
         let rate_hz = match (rate_hz, increment) {
-            (Some(r), _) => r,
-            (None, Some(dt)) => 1.0 / dt,
+            (Some(r), _) => RATE_HZ.check_named("--rate", r).map_err(err)?,
+            (None, Some(dt)) => {
+                // The interval between samples, s: its limits are the rate's.
+                RATE_HZ
+                    .reciprocal("s")
+                    .check_named(&format!("{name}: wf_increment"), dt)
+                    .map_err(err)?;
+                1.0 / dt
+            }
             (None, None) => {
                 return Err(err(format!(
                     "{name} has no wf_increment property: give --rate"
                 )))
             }
         };
-        if !(rate_hz.is_finite() && rate_hz > 0.0 && rate_hz <= 1e9) {
-            return Err(err(format!("rate {rate_hz} Hz is not in (0, 1e9]")));
-        }
         // A header may claim more values than the file holds: check before allocating.
         let file_bytes = std::fs::metadata(path).map(|m| m.len()).unwrap_or(0);
         let item = match ch.dtype() {

@@ -26,7 +26,7 @@ pub struct WavChannel {
     frames: usize,
     /// Bytes a sample takes in the file.
     sample_bytes: usize,
-    /// Sample rate, Hz (never 0).
+    /// Sample rate, Hz (within [`crate::limits::RATE_HZ`]).
     pub rate_hz: f64,
 }
 
@@ -42,9 +42,8 @@ impl WavChannel {
         let spec = reader.spec();
         let channels = usize::from(spec.channels);
         let column = numbered_column(column, channels, "a WAV file's channels")?;
-        if spec.sample_rate == 0 {
-            return Err("WAV: sample rate 0 in the header".into());
-        }
+        crate::limits::RATE_HZ
+            .check_named("WAV: the header's sample rate", f64::from(spec.sample_rate))?;
         let frames = reader.duration() as usize;
         let samples = match spec.sample_format {
             hound::SampleFormat::Int => Samples::Int(reader.into_samples()),

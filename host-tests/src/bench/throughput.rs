@@ -283,9 +283,7 @@ fn run_child(
         .stderr(std::process::Stdio::piped())
         .spawn()
         .map_err(|e| format!("{}: {e}", exe.display()))?;
-    let pid = child.id() as libc::pid_t;
-    // Reap with wait4 for the child's own peak resident set.
-    let _ = pid;
+    let _child = crate::interrupt::child(child.id());
     let out = child.wait_with_output().map_err(|e| e.to_string())?;
     let seconds = t.elapsed().as_secs_f64();
     let stderr = String::from_utf8_lossy(&out.stderr);
@@ -345,6 +343,7 @@ fn analyze_files(
     let dir = std::env::temp_dir();
     let csv = dir.join(format!("impact-throughput-{}.csv", std::process::id()));
     let raw = dir.join(format!("impact-throughput-{}.i16", std::process::id()));
+    let _temporaries = [&csv, &raw].map(|p| crate::interrupt::temporary(p));
     let result = (|| {
         let file = std::fs::File::create(&csv).map_err(|e| format!("{}: {e}", csv.display()))?;
         let mut w = std::io::BufWriter::with_capacity(1 << 20, file);

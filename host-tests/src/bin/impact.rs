@@ -71,19 +71,10 @@ enum Command {
     },
 }
 
-/// A closed output pipe (`impact … | head -1`) ends the tool quietly, as it does any Unix
-/// filter, instead of panicking in `println!` (Rust ignores SIGPIPE by default).
-#[cfg(unix)]
-fn restore_sigpipe() {
-    // SAFETY: sets the default disposition of one signal before any thread starts.
-    unsafe {
-        libc::signal(libc::SIGPIPE, libc::SIG_DFL);
-    }
-}
-
 fn main() -> ExitCode {
-    #[cfg(unix)]
-    restore_sigpipe();
+    // Ctrl-C and its kin remove temporary files and end QEMU; a closed output pipe
+    // (`impact … | head -1`) ends the tool quietly; a file-size limit is an error.
+    impact_host::interrupt::install();
     // clap's own message on a usage error (the accepted values, the usage line, a hint),
     // exit status 2; help and version on stdout, status 0.
     let cli = Cli::parse();

@@ -160,10 +160,53 @@ pub fn emulate(args: &EmulateArgs) -> Result<(), String> {
                 .into(),
         );
     }
+    // No output over an input (the recording, the scene, the free fall, the firmware).
+    let mut inputs = super::analyze::inputs(a);
+    inputs.extend(args.elf.as_deref());
     if let Some(path) = &a.plot {
-        crate::plot::check_output(path, &[a.file.as_path()])?;
+        crate::plot::check_output(path, &inputs)?;
     }
-    let mut setup = pipeline::setup(a, None)?;
+    let all = inputs
+        .iter()
+        .fold(crate::output::Inputs::new(), |all, i| all.with(i));
+    for (option, path) in [("--log", &args.log), ("--defmt", &args.defmt)] {
+        if let Some(path) = path {
+            crate::output::check(option, path, &all, None)?;
+        }
+    }
+    if args.log.is_some() && args.log == args.defmt {
+        return Err("--log and --defmt: the same file; give each its own".into());
+    }
+    // One channel from a file or standard input is surveyed in passes and its counts written
+    // a block at a time to the file QEMU replays (memory bounded whatever its length); the
+    // ADXL375's axes and the options that need the whole recording read it whole.
+    let streamed = !args.adxl375 && pipeline::streaming::in_passes(a);
+    let counts_file = if streamed {
+        let tmp = tempfile::Builder::new()
+            .prefix("impact-emulate-")
+            .suffix(".i16")
+            .tempfile()
+            .map_err(|e| {
+                format!(
+                    "a temporary file in {}: {e}",
+                    std::env::temp_dir().display()
+                )
+            })?;
+        let guard = crate::interrupt::temporary(tmp.path());
+        Some((tmp, guard))
+    } else {
+        None
+    };
+    let mut setup = match &counts_file {
+        Some((tmp, _)) => {
+            let mut out = std::io::BufWriter::with_capacity(1 << 20, tmp.as_file());
+            pipeline::streaming::counts_file(a, &mut out)?
+        }
+        None => {
+            pipeline::memory_for_whole(&a.file)?;
+            pipeline::setup(a, None)?
+        }
+    };
     setup.scene.waveform_every = args.waveforms.unwrap_or(0);
     let axes = if args.adxl375 {
         Some(adxl375_axes(&mut setup)?)
@@ -173,9 +216,25 @@ pub fn emulate(args: &EmulateArgs) -> Result<(), String> {
     // One channel is the part's x axis, streamed as such (the board's `AXIS = Axis::X`):
     // kinematics apply; the resultant of --axes has none.
     let axis = setup.axes.is_empty().then_some(0);
-    let samples = match &axes {
-        Some(axes) => Samples::Adxl375(axes, axis),
-        None => Samples::Adc(&setup.prepared.counts),
+    let samples = match (&axes, &counts_file) {
+        (Some(axes), _) => Samples::Adxl375(axes, axis),
+        (None, Some((tmp, _))) => Samples::File(tmp.path(), setup.samples),
+        (None, None) => Samples::Adc(&setup.prepared.counts),
+    };
+    let total = samples.len() as u64;
+    // Counts of the replayed stream, `n` from stream index `from`: read back from the file
+    // when the recording was not held.
+    let replayed = |from: u64, n: usize| -> Result<Vec<i16>, String> {
+        match &counts_file {
+            Some((tmp, _)) => read_counts(tmp.path(), from, n),
+            None => setup
+                .prepared
+                .counts
+                .get(usize::try_from(from).unwrap_or(usize::MAX)..)
+                .and_then(|c| c.get(..n))
+                .map(<[i16]>::to_vec)
+                .ok_or_else(|| "beyond the recording".to_string()),
+        }
     };
     let elf = match &args.elf {
         Some(p) => p.clone(),
@@ -218,11 +277,11 @@ pub fn emulate(args: &EmulateArgs) -> Result<(), String> {
     }
     let text = run.lines.join("\n") + "\n";
     if let Some(path) = &args.log {
-        std::fs::write(path, &text).map_err(|e| format!("{}: {e}", path.display()))?;
+        crate::output::write(path, text.as_bytes())?;
         eprintln!("wrote {}", path.display());
     }
     if let Some(path) = &args.defmt {
-        std::fs::write(path, &run.raw).map_err(|e| format!("{}: {e}", path.display()))?;
+        crate::output::write(path, &run.raw)?;
         eprintln!(
             "wrote {} (decode: impact log --elf {} {})",
             path.display(),
@@ -237,10 +296,9 @@ pub fn emulate(args: &EmulateArgs) -> Result<(), String> {
         .ok_or("the emulator's log has no summary line")?;
     let samples: u64 = num(summary, "samples")?;
     let lost: u64 = num(summary, "samples_lost")?;
-    if samples + lost != setup.prepared.counts.len() as u64 || get(summary, "result")? != "ok" {
+    if samples + lost != total || get(summary, "result")? != "ok" {
         return Err(format!(
-            "the emulator processed {samples} and lost {lost} of {} samples (result={})",
-            setup.prepared.counts.len(),
+            "the emulator processed {samples} and lost {lost} of {total} samples (result={})",
             get(summary, "result")?
         ));
     }
@@ -257,7 +315,7 @@ pub fn emulate(args: &EmulateArgs) -> Result<(), String> {
         j.report_latency_s = latency.map(f64::from);
     }
     if let Some(every) = args.waveforms {
-        check_waveforms(&log, &setup.prepared.counts, every)?;
+        check_waveforms(&log, &replayed, every)?;
         json.waveforms = log.waveforms.iter().map(|w| w.json()).collect();
     }
     let mut out = std::io::stdout().lock();
@@ -270,10 +328,35 @@ pub fn emulate(args: &EmulateArgs) -> Result<(), String> {
     };
     out.write_all(text.as_bytes()).map_err(|e| e.to_string())?;
     if let Some(path) = &a.plot {
+        if counts_file.is_some() {
+            // The windows the figure draws, from the replayed counts.
+            let rate = f64::from(setup.scene.calibration.sample_rate_hz);
+            let mut windows = Vec::new();
+            for r in log.impacts.iter().take(crate::plot::SHOWN) {
+                let (from, n) = crate::plot::window(r, rate);
+                let n = n.min(total.saturating_sub(from));
+                windows.push((from, replayed(from, n as usize)?));
+            }
+            setup.windows = windows;
+        }
         crate::plot::impacts(&setup.plot_signal(), &log.impacts, path)?;
-        eprintln!("wrote {}", path.display());
     }
     Ok(())
+}
+
+/// `n` little-endian i16 counts from index `from` of the file at `path`.
+fn read_counts(path: &std::path::Path, from: u64, n: usize) -> Result<Vec<i16>, String> {
+    use std::io::{Read, Seek, SeekFrom};
+    let mut file = std::fs::File::open(path).map_err(|e| format!("{}: {e}", path.display()))?;
+    file.seek(SeekFrom::Start(from * 2))
+        .map_err(|e| format!("{}: {e}", path.display()))?;
+    let mut bytes = vec![0u8; n * 2];
+    file.read_exact(&mut bytes)
+        .map_err(|_| "a window beyond the recording".to_string())?;
+    Ok(bytes
+        .chunks_exact(2)
+        .map(|b| i16::from_le_bytes([b[0], b[1]]))
+        .collect())
 }
 
 /// Every analysed impact's window, as the firmware sent it, against the replayed samples
@@ -281,7 +364,7 @@ pub fn emulate(args: &EmulateArgs) -> Result<(), String> {
 /// difference. Prints what it checked.
 pub fn check_waveforms(
     log: &crate::firmware_link::log::Log,
-    counts: &[i16],
+    replayed: &dyn Fn(u64, usize) -> Result<Vec<i16>, String>,
     every: u16,
 ) -> Result<(), String> {
     let analysed = log
@@ -303,10 +386,9 @@ pub fn check_waveforms(
                 w.index, w.every
             ));
         }
-        let from = usize::try_from(w.first_sample).map_err(|e| e.to_string())?;
-        let window = counts
-            .get(from..from + w.samples as usize)
-            .ok_or_else(|| format!("impact {}: its window lies beyond the recording", w.index))?;
+        let window = replayed(w.first_sample, w.samples as usize)
+            .map_err(|_| format!("impact {}: its window lies beyond the recording", w.index))?;
+        let window = window.as_slice();
         let mut expected = [0i16; impact_core::waveform::FRAME_LEN];
         for k in 0..w.frames as usize {
             let n = impact_core::waveform::frame(window, every, k, &mut expected);

@@ -2,13 +2,14 @@
 //! checked line by line, and turned into `impact analyze`'s JSON and CSV, its figure and its
 //! windows as recordings.
 
-use std::io::{BufRead, BufReader, Read};
+use std::io::{BufRead, BufReader, BufWriter, Read, Write};
 use std::path::PathBuf;
 
 use clap::Args;
 
 use crate::firmware_link::fields::{num, opt};
-use crate::firmware_link::log::{log_json, rate, LogReader};
+use crate::firmware_link::log::{rate, LogReader};
+use crate::firmware_link::log_json::LogJson;
 use impact_io::channel::is_stdin;
 use impact_io::table::MAX_LINE_BYTES;
 
@@ -104,10 +105,21 @@ pub fn log(args: &LogArgs) -> Result<(), String> {
 /// The log read: its warnings on stderr, the figure and exports asked for, the JSON or CSV.
 fn report(args: &LogArgs, reader: LogReader, name: &str) -> Result<(), String> {
     let log = reader.finish().map_err(|e| format!("{name}: {e}"))?;
+    if let (true, [_, second, ..]) = (
+        args.plot.is_some() || args.export.is_some(),
+        log.runs.as_slice(),
+    ) {
+        return Err(format!(
+            "--plot/--export: {name} holds {} runs (the board restarted on line {}): their \
+             sample positions overlap; split the log into runs",
+            log.runs.len(),
+            second.line
+        ));
+    }
     for w in &log.warnings {
         eprintln!("warning: {name}: {w}");
     }
-    let json = log_json(&log, args.t0)?;
+    let json = LogJson::new(&log, args.t0)?;
     if args.plot.is_some() || args.export.is_some() {
         let scene = log
             .scene
@@ -131,22 +143,26 @@ fn report(args: &LogArgs, reader: LogReader, name: &str) -> Result<(), String> {
                         .map(|c| f64::from(c) * gain)
                 }),
             };
+            // (plot::impacts says "wrote PATH".)
             crate::plot::impacts(&signal, &log.impacts, path)?;
-            eprintln!("wrote {}", path.display());
         }
         if let Some(path) = &args.export {
-            for p in crate::firmware_link::waves::export(&log.waveforms, path, rate, gain)? {
+            let inputs = crate::output::Inputs::new()
+                .with(&args.file)
+                .with_some(args.elf.as_deref());
+            for p in crate::firmware_link::waves::export(&log.waveforms, path, &inputs, rate, gain)?
+            {
                 eprintln!("wrote {}", p.display());
             }
         }
     }
+    // Written an impact at a time: a long log's report is never held whole.
+    let mut out = BufWriter::with_capacity(1 << 16, std::io::stdout().lock());
     if args.csv {
-        print!("{}", crate::report::to_csv(&json));
+        crate::report::csv::write_csv(&json.head, json.impacts(), &mut out)
     } else {
-        println!(
-            "{}",
-            serde_json::to_string_pretty(&json).map_err(|e| e.to_string())?
-        );
+        crate::report::write_json(&json.head, json.impacts(), &mut out)
     }
-    Ok(())
+    .and_then(|()| out.flush())
+    .map_err(|e| format!("stdout: {e}"))
 }

@@ -30,19 +30,20 @@ pub fn run(command: SynthCommand) -> Result<(), String> {
             return Err(format!("--output and --raw are both {}", o.display()));
         }
     }
+    let inputs = crate::output::Inputs::new();
+    for (option, path) in [("--output", &output), ("--raw", &raw)] {
+        if let Some(path) = path {
+            crate::output::check(option, path, &inputs, None)?;
+        }
+    }
     let rec = synth::synth(&args)?;
     if let Some(path) = raw {
         let bytes: Vec<u8> = rec.samples.iter().flat_map(|c| c.to_le_bytes()).collect();
-        std::fs::write(&path, bytes).map_err(|e| format!("{}: {e}", path.display()))?;
+        crate::output::write(&path, &bytes)?;
     }
     match output {
         Some(path) => {
-            let file =
-                std::fs::File::create(&path).map_err(|e| format!("{}: {e}", path.display()))?;
-            let mut out = std::io::BufWriter::with_capacity(1 << 16, file);
-            synth::write_csv(&rec, &args, &mut out)
-                .and_then(|()| std::io::Write::flush(&mut out))
-                .map_err(|e| format!("{}: {e}", path.display()))?;
+            crate::output::write_with(&path, |mut out| synth::write_csv(&rec, &args, &mut out))?;
         }
         None => {
             let stdout = std::io::stdout().lock();

@@ -4,8 +4,6 @@
 
 use std::collections::HashMap;
 
-use impact_core::consts::STANDARD_GRAVITY;
-use impact_core::report::COR_TOLERANCE;
 use impact_core::report::{Bounce, Fits, Flags, HertzFit, NonlinearFit, Spectrum, TwoPhaseFit};
 use impact_core::signal::spectrum::MAX_BANDS;
 use impact_core::{Analysis, ImpactReport, Kinematics, Status};
@@ -15,30 +13,54 @@ use crate::firmware_link::fields::flag;
 use crate::firmware_link::fields::get;
 use crate::firmware_link::fields::num;
 use crate::firmware_link::fields::opt;
-use crate::report::AnalysisJson;
+use crate::firmware_link::plausible::{check_plausible, check_report};
 
-/// What a firmware log says.
+/// What a firmware log says. A log can hold several runs of the board: one that resets starts
+/// a new run with a new `scene` line, its impact indices, sample positions and times from 0
+/// again. Every run's impacts are kept, run after run ([`Log::runs`] tells them apart).
 #[derive(Clone, Debug, Default)]
 pub struct Log {
-    /// The `scene` line's fields, if the log has one.
+    /// The `scene` line's fields, if the log has one (every run's scene is the same).
     pub scene: Option<HashMap<String, String>>,
+    /// Every run's impacts, run after run, each run's in index order.
     pub impacts: Vec<ImpactReport>,
     /// Each impact's `report_latency_s` (real-time sources only).
     pub latencies: Vec<Option<f32>>,
-    /// The last `heartbeat` line's fields.
+    /// The last run's last `heartbeat` line's fields.
     pub heartbeat: Option<HashMap<String, String>>,
-    /// The `summary` line's fields (only at the end of a finite stream).
+    /// The last run's `summary` line's fields (only at the end of a finite stream).
     pub summary: Option<HashMap<String, String>>,
     /// What looks wrong without being impossible (e.g. fewer impact lines than the last
-    /// heartbeat counts), by line.
+    /// heartbeat counts), by line; and each restart of the board.
     pub warnings: Vec<String>,
-    /// The captured windows the board sent (`wave` lines, scene `wave_every` > 0).
+    /// The captured windows the board sent (`wave` lines, scene `wave_every` > 0), run after
+    /// run, each run's in index order.
     pub waveforms: Vec<crate::firmware_link::waves::Waveform>,
-    /// Lines the board's logger dropped (the summary's, else the last heartbeat's
-    /// `lines_dropped`; 0 from firmware that did not count them).
+    /// Lines the board's logger dropped (each run's summary's, else its last heartbeat's
+    /// `lines_dropped`, summed; 0 from firmware that did not count them).
     pub lines_dropped: u64,
-    /// Data lines whose sequence numbers (`seq`) the log lacks, before the last one it has.
+    /// Data lines whose sequence numbers (`seq`) the log lacks, before the last one it has
+    /// (each run numbers its lines from 0; summed).
     pub lines_missing: u64,
+    /// The runs, in the order of the log (one for a log without a restart).
+    pub runs: Vec<Run>,
+}
+
+/// One run of the board in a log: from its `scene` line (or the start of the log) to the
+/// next `scene` line.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct Run {
+    /// Line of its `scene` line (0: the log starts within the run, without one).
+    pub line: u64,
+    /// Its impacts and their latencies: `Log::impacts[impacts]`, `Log::latencies[impacts]`.
+    pub impacts: std::ops::Range<usize>,
+    /// Its windows: `Log::waveforms[waveforms]`.
+    pub waveforms: std::ops::Range<usize>,
+    /// Samples its summary (or last heartbeat) counts (0 without either).
+    pub samples: u64,
+    /// Its summary's (or last heartbeat's) `samples_lost` and `analyses_skipped`.
+    pub samples_lost: u64,
+    pub analyses_skipped: u64,
 }
 
 /// An `impact` line's fields as the core's report (floats parsed at their own width, so the
@@ -195,21 +217,52 @@ pub fn parse_log(text: &str) -> Result<Log, String> {
 }
 
 /// A firmware log read line by line, checked as it goes: every number finite and within its
-/// field's range, impact indices unique and increasing (unless the summary counts reports
-/// printed out of order), heartbeat counters never going back, and at the end of a finite
-/// stream as many impact lines as the summary counts. Errors name the line.
+/// field's range (times and lengths within what the stream allows: [`check_plausible`]),
+/// impact indices unique and increasing within a run (unless its summary counts reports
+/// printed out of order), heartbeat counters never going back within a run, and at the end
+/// of a finite stream as many impact lines as the summary counts. A `scene` line after data
+/// lines is a restart of the board: a new run, its indices, times and counters from 0 again
+/// (a note in [`Log::warnings`]); a scene unlike the first is an error. Errors name the line.
+///
+/// Time and memory are linear in the log: what it keeps per impact is its report (and per
+/// window the frames received); an impact is found by its index through a map.
 #[derive(Default)]
 pub struct LogReader {
     log: Log,
-    /// Line of each impact report, in the order read.
-    impact_lines: Vec<u64>,
+    /// The first `scene` line: its number and fields (every later run's must equal them).
+    first_scene: Option<(u64, HashMap<String, String>)>,
+    run: RunReader,
+}
+
+/// What the reader keeps of the run it reads.
+#[derive(Default)]
+struct RunReader {
+    /// Line of the run's `scene` line (0: none).
+    line: u64,
+    /// Whether the run has a `scene` or data line (a `scene` line then starts a new run).
+    started: bool,
+    /// Where its impacts and windows start in the log's lists.
+    first_impact: usize,
+    first_wave: usize,
+    /// Each impact's position in `Log::impacts` and its line, by index.
+    impacts: HashMap<u32, (usize, u64)>,
+    /// Each window's position in `Log::waveforms`, by index.
+    waves: HashMap<u32, usize>,
     /// The first impact whose index did not increase: (line, index, previous index).
     reordered: Option<(u64, u32, u32)>,
-    /// Line and counters (samples, impacts) of the last heartbeat.
+    /// Line and counters (samples, impacts) of the last heartbeat, and its fields.
     last_heartbeat: Option<(u64, u64, u64)>,
+    heartbeat: Option<HashMap<String, String>>,
     summary_line: u64,
+    summary: Option<HashMap<String, String>>,
     /// The data lines' sequence numbers seen (`seq`).
-    seqs: Vec<u32>,
+    seqs: SeqSet,
+    /// Samples per second (the scene's, or the first heartbeat's or summary's), and the
+    /// scene's m/s² per count: what [`check_plausible`] needs.
+    rate_hz: Option<f64>,
+    gain: Option<f64>,
+    /// Impacts read before the run's rate was known (line, position): checked when it is.
+    unchecked: Vec<(u64, usize)>,
 }
 
 impl LogReader {
@@ -225,25 +278,36 @@ impl LogReader {
             if let Some(l) = latency.filter(|&l| l < 0.0) {
                 return Err(at(format!("report_latency_s={l}: not a time >= 0")));
             }
-            if let Some(k) = self.log.impacts.iter().position(|p| p.index == r.index) {
+            let run = &mut self.run;
+            if let Some(rate) = run.rate_hz {
+                check_plausible(&r, rate, run.gain).map_err(at)?;
+            } else {
+                run.unchecked.push((n, self.log.impacts.len()));
+            }
+            if let Some(&(_, first)) = run.impacts.get(&r.index) {
                 return Err(at(format!(
-                    "impact index={} again (first on line {}): two streams mixed, or a line repeated",
-                    r.index, self.impact_lines[k]
+                    "impact index={} again (first on line {first}): two streams mixed, or a line repeated",
+                    r.index
                 )));
             }
-            if let Some(prev) = self.log.impacts.last() {
-                if r.index < prev.index && self.reordered.is_none() {
-                    self.reordered = Some((n, r.index, prev.index));
+            if let Some(prev) = self.log.impacts[run.first_impact..].last() {
+                if r.index < prev.index && run.reordered.is_none() {
+                    run.reordered = Some((n, r.index, prev.index));
                 }
             }
+            run.impacts.insert(r.index, (self.log.impacts.len(), n));
             self.log.impacts.push(r);
             self.log.latencies.push(latency);
-            self.impact_lines.push(n);
         } else if let Some(m) = fields(line, "srs ") {
             let m = m.map_err(at)?;
             self.seen(&m).map_err(at)?;
             let (index, spectrum) = parse_spectrum(&m).map_err(at)?;
-            match self.log.impacts.iter_mut().rev().find(|r| r.index == index) {
+            let r = self
+                .run
+                .impacts
+                .get(&index)
+                .and_then(|&(k, _)| self.log.impacts.get_mut(k));
+            match r {
                 Some(r) if r.spectrum.is_none() => r.spectrum = Some(spectrum),
                 _ => {
                     return Err(at(format!(
@@ -257,11 +321,10 @@ impl LogReader {
             let (index, frame, counts) =
                 crate::firmware_link::waves::parse_frame(line, &m).map_err(at)?;
             let w = self
-                .log
-                .waveforms
-                .iter_mut()
-                .rev()
-                .find(|w| w.index == index)
+                .run
+                .waves
+                .get(&index)
+                .and_then(|&k| self.log.waveforms.get_mut(k))
                 .ok_or_else(|| {
                     at(format!(
                         "wave_frame index={index}: no wave line of that index before it"
@@ -272,96 +335,153 @@ impl LogReader {
             let m = m.map_err(at)?;
             self.seen(&m).map_err(at)?;
             let w = crate::firmware_link::waves::Waveform::from_header(&m).map_err(at)?;
-            if self.log.waveforms.iter().any(|p| p.index == w.index) {
+            if self.run.waves.contains_key(&w.index) {
                 return Err(at(format!(
                     "wave index={} again: two streams mixed, or a line repeated",
                     w.index
                 )));
             }
+            self.run.waves.insert(w.index, self.log.waveforms.len());
             self.log.waveforms.push(w);
         } else if let Some(m) = fields(line, "heartbeat ") {
             let m = m.map_err(at)?;
             self.seen(&m).map_err(at)?;
             let samples: u64 = num(&m, "samples").map_err(at)?;
             let impacts: u64 = num(&m, "impacts").map_err(at)?;
-            rate(&m).map_err(at)?;
-            if let Some((line, s0, i0)) = self.last_heartbeat {
+            let rate = rate(&m).map_err(at)?;
+            if let Some((line, s0, i0)) = self.run.last_heartbeat {
                 if samples < s0 || impacts < i0 {
                     return Err(at(format!(
                         "heartbeat samples={samples} impacts={impacts} after samples={s0} \
-                         impacts={i0} (line {line}): counters never go back within a stream"
+                         impacts={i0} (line {line}): counters never go back within a run"
                     )));
                 }
             }
-            self.last_heartbeat = Some((n, samples, impacts));
-            self.log.heartbeat = Some(m);
+            self.run.last_heartbeat = Some((n, samples, impacts));
+            self.run.heartbeat = Some(m);
+            self.rate_known(rate)?;
         } else if let Some(m) = fields(line, "summary ") {
             let m = m.map_err(at)?;
             self.seen(&m).map_err(at)?;
             num::<u64>(&m, "samples").map_err(at)?;
             num::<u64>(&m, "impacts").map_err(at)?;
-            rate(&m).map_err(at)?;
-            self.summary_line = n;
-            self.log.summary = Some(m);
+            let rate = rate(&m).map_err(at)?;
+            self.run.summary_line = n;
+            self.run.summary = Some(m);
+            self.rate_known(rate)?;
         } else if let Some(m) = fields(line, "scene ") {
             let m = m.map_err(at)?;
-            rate(&m).map_err(at)?;
-            // A restart (a new scene) starts a new stream.
-            *self = LogReader::default();
-            self.log.scene = Some(m);
+            let rate = rate(&m).map_err(at)?;
+            let gain: Option<f32> = match m.get("gain_m_s2_per_count") {
+                Some(_) => Some(num(&m, "gain_m_s2_per_count").map_err(at)?),
+                None => None,
+            };
+            match &self.first_scene {
+                None => self.first_scene = Some((n, m.clone())),
+                Some((first, scene)) => {
+                    if let Some(e) = scene_difference(scene, &m) {
+                        return Err(at(format!(
+                            "a scene unlike line {first}'s ({e}): logs of two benches mixed; \
+                             split the log before line {n}"
+                        )));
+                    }
+                }
+            }
+            if self.run.started {
+                self.end_run()?;
+                self.run = RunReader {
+                    first_impact: self.log.impacts.len(),
+                    first_wave: self.log.waveforms.len(),
+                    ..RunReader::default()
+                };
+                self.log.warnings.push(format!(
+                    "line {n}: the board restarted (a new scene line): run {}'s impact indices, \
+                     sample positions and times start from 0 again (\"run\" in the JSON, the \
+                     CSV's run column)",
+                    self.log.runs.len() + 1
+                ));
+            }
+            self.run.line = n;
+            self.run.started = true;
+            self.run.gain = gain.map(f64::from);
+            self.rate_known(rate)?;
+            self.log.scene.get_or_insert(m);
         }
         Ok(())
     }
 
     /// A data line's sequence number (`seq`, absent from firmware that did not number them).
     fn seen(&mut self, m: &HashMap<String, String>) -> Result<(), String> {
+        self.run.started = true;
         if m.contains_key("seq") {
-            self.seqs.push(num(m, "seq")?);
+            self.run.seqs.insert(num(m, "seq")?);
         }
         Ok(())
     }
 
-    /// The log, its reports in index order; checks the counts against the summary.
-    pub fn finish(mut self) -> Result<Log, String> {
-        let printed = self.log.impacts.len() as u64;
-        let state = self.log.summary.as_ref().or(self.log.heartbeat.as_ref());
-        self.log.lines_dropped = match state {
-            Some(m) if m.contains_key("lines_dropped") => num(m, "lines_dropped")?,
-            _ => 0,
-        };
-        self.seqs.sort_unstable();
-        self.seqs.dedup();
-        if let Some(&last) = self.seqs.last() {
-            self.log.lines_missing = u64::from(last) + 1 - self.seqs.len() as u64;
+    /// The run's sample rate, from its scene or its first heartbeat or summary: the impacts
+    /// read before it are checked now.
+    fn rate_known(&mut self, rate: f32) -> Result<(), String> {
+        let run = &mut self.run;
+        if run.rate_hz.is_some() {
+            return Ok(());
         }
-        if self.log.lines_missing > 0 || self.log.lines_dropped > 0 {
-            let first: Vec<String> = (0..)
-                .filter(|s| self.seqs.binary_search(s).is_err())
-                .take(5)
-                .map(|s: u32| s.to_string())
+        run.rate_hz = Some(f64::from(rate));
+        for (line, k) in std::mem::take(&mut run.unchecked) {
+            check_plausible(&self.log.impacts[k], f64::from(rate), run.gain)
+                .map_err(|e| format!("line {line}: {e}"))?;
+        }
+        Ok(())
+    }
+
+    /// The log, every run's reports in index order; checks each run's counts against its
+    /// summary.
+    pub fn finish(mut self) -> Result<Log, String> {
+        self.end_run()?;
+        Ok(self.log)
+    }
+
+    /// Closes the run read: its counts checked against its summary (or last heartbeat), its
+    /// impacts and windows put in index order, its counters added to the log's.
+    fn end_run(&mut self) -> Result<(), String> {
+        let run = std::mem::take(&mut self.run);
+        let log = &mut self.log;
+        let printed = run.impacts.len() as u64;
+        let state = run.summary.as_ref().or(run.heartbeat.as_ref());
+        let counter = |key: &str| -> Result<u64, String> {
+            match state {
+                Some(m) if m.contains_key(key) => num::<u64>(m, key),
+                _ => Ok(0),
+            }
+        };
+        let lines_dropped = counter("lines_dropped")?;
+        let lines_missing = run.seqs.missing();
+        log.lines_dropped += lines_dropped;
+        log.lines_missing += lines_missing;
+        if lines_missing > 0 || lines_dropped > 0 {
+            let first: Vec<String> = run
+                .seqs
+                .first_missing(5)
+                .iter()
+                .map(u32::to_string)
                 .collect();
-            self.log.warnings.push(format!(
-                "the board dropped {} lines (its logger's count); {} numbered lines are missing{}",
-                self.log.lines_dropped,
-                self.log.lines_missing,
-                if self.log.lines_missing > 0 {
+            log.warnings.push(format!(
+                "the board dropped {lines_dropped} lines (its logger's count); {lines_missing} \
+                 numbered lines are missing{}",
+                if lines_missing > 0 {
                     format!(
                         " (seq {}{})",
                         first.join(", "),
-                        if self.log.lines_missing > 5 {
-                            ", …"
-                        } else {
-                            ""
-                        }
+                        if lines_missing > 5 { ", …" } else { "" }
                     )
                 } else {
                     String::new()
                 }
             ));
         }
-        let lost = self.log.lines_dropped + self.log.lines_missing > 0;
-        if let Some(m) = &self.log.summary {
-            let at = |e: String| format!("line {}: {e}", self.summary_line);
+        let lost = lines_dropped + lines_missing > 0;
+        if let Some(m) = &run.summary {
+            let at = |e: String| format!("line {}: {e}", run.summary_line);
             let counted: u64 = num(m, "impacts").map_err(at)?;
             let dropped: u64 = num(m, "reports_dropped").map_err(at)?;
             // Lines the board dropped (counted) explain missing impact lines.
@@ -371,18 +491,18 @@ impl LogReader {
                      has {printed} impact lines: lines lost, or two streams mixed"
                 )));
             }
-            if let Some(r) = self
-                .log
+            if let Some(index) = run
                 .impacts
-                .iter()
-                .find(|r| u64::from(r.index) >= counted)
+                .keys()
+                .copied()
+                .filter(|&i| u64::from(i) >= counted)
+                .min()
             {
                 return Err(at(format!(
-                    "impact index={} but the summary counts {counted} impacts",
-                    r.index
+                    "impact index={index} but the summary counts {counted} impacts"
                 )));
             }
-            if let Some((line, index, prev)) = self.reordered {
+            if let Some((line, index, prev)) = run.reordered {
                 if num::<u64>(m, "reports_out_of_order").map_err(at)? == 0 {
                     return Err(format!(
                         "line {line}: impact index={index} after index={prev}, and the \
@@ -391,18 +511,17 @@ impl LogReader {
                 }
             }
         } else {
-            if let Some((line, index, prev)) = self.reordered {
+            if let Some((line, index, prev)) = run.reordered {
                 return Err(format!(
                     "line {line}: impact index={index} after index={prev} (the firmware prints \
                      in index order; a reorder is counted only in a summary line)"
                 ));
             }
-            if let (Some((line, _, counted)), Some(m)) = (self.last_heartbeat, &self.log.heartbeat)
-            {
+            if let (Some((line, _, counted)), Some(m)) = (run.last_heartbeat, &run.heartbeat) {
                 let dropped: u64 =
                     num(m, "reports_dropped").map_err(|e| format!("line {line}: {e}"))?;
                 if printed + dropped < counted {
-                    self.log.warnings.push(format!(
+                    log.warnings.push(format!(
                         "line {line}: the heartbeat counts {counted} impacts ({dropped} reports \
                          dropped), the log has {printed} impact lines: a cut log, or lines lost \
                          on the link"
@@ -410,9 +529,11 @@ impl LogReader {
                 }
             }
         }
-        for w in &self.log.waveforms {
+        let waves = &mut log.waveforms[run.first_wave..];
+        waves.sort_by_key(|w| w.index);
+        for w in waves.iter() {
             if w.missing_frames() > 0 {
-                self.log.warnings.push(format!(
+                log.warnings.push(format!(
                     "impact {}: {} of {} waveform frames missing (the link dropped them)",
                     w.index,
                     w.missing_frames(),
@@ -420,16 +541,106 @@ impl LogReader {
                 ));
             }
         }
-        self.log.waveforms.sort_by_key(|w| w.index);
-        let mut both: Vec<_> = self
-            .log
-            .impacts
-            .drain(..)
-            .zip(self.log.latencies.drain(..))
-            .collect();
-        both.sort_by_key(|(r, _)| r.index);
-        (self.log.impacts, self.log.latencies) = both.into_iter().unzip();
-        Ok(self.log)
+        if run.reordered.is_some() {
+            let mut both: Vec<_> = log
+                .impacts
+                .drain(run.first_impact..)
+                .zip(log.latencies.drain(run.first_impact..))
+                .collect();
+            both.sort_by_key(|(r, _)| r.index);
+            for (r, l) in both {
+                log.impacts.push(r);
+                log.latencies.push(l);
+            }
+        }
+        log.runs.push(Run {
+            line: run.line,
+            impacts: run.first_impact..log.impacts.len(),
+            waveforms: run.first_wave..log.waveforms.len(),
+            samples: counter("samples")?,
+            samples_lost: counter("samples_lost")?,
+            analyses_skipped: counter("analyses_skipped")?,
+        });
+        log.heartbeat = run.heartbeat;
+        log.summary = run.summary;
+        Ok(())
+    }
+}
+
+/// The first field (in name order) in which two `scene` lines differ, as `key=new, not old`.
+fn scene_difference(
+    first: &HashMap<String, String>,
+    new: &HashMap<String, String>,
+) -> Option<String> {
+    let mut keys: Vec<&String> = first.keys().chain(new.keys()).collect();
+    keys.sort_unstable();
+    keys.into_iter().find_map(|k| {
+        let (a, b) = (first.get(k), new.get(k));
+        (a != b).then(|| {
+            let show = |v: Option<&String>| v.map_or("absent".to_string(), |v| format!("{k}={v}"));
+            format!("{}, not {}", show(b), show(a))
+        })
+    })
+}
+
+/// The distinct sequence numbers of a run's lines, as runs of consecutive numbers: memory
+/// grows with the gaps, not with the lines.
+#[derive(Default)]
+struct SeqSet {
+    /// First number of each run of consecutive numbers, and its last.
+    spans: std::collections::BTreeMap<u32, u32>,
+    /// Distinct numbers held.
+    len: u64,
+}
+
+impl SeqSet {
+    fn insert(&mut self, s: u32) {
+        let before = self.spans.range(..=s).next_back().map(|(&a, &b)| (a, b));
+        if before.is_some_and(|(_, last)| s <= last) {
+            return;
+        }
+        self.len += 1;
+        let after = s
+            .checked_add(1)
+            .and_then(|next| self.spans.get(&next).map(|&last| (next, last)));
+        match (before, after) {
+            (Some((a, last)), Some((next, end))) if last.checked_add(1) == Some(s) => {
+                self.spans.remove(&next);
+                self.spans.insert(a, end);
+            }
+            (Some((a, last)), _) if last.checked_add(1) == Some(s) => {
+                self.spans.insert(a, s);
+            }
+            (_, Some((next, end))) => {
+                self.spans.remove(&next);
+                self.spans.insert(s, end);
+            }
+            _ => {
+                self.spans.insert(s, s);
+            }
+        }
+    }
+
+    /// Numbers missing before the last one held.
+    fn missing(&self) -> u64 {
+        match self.spans.last_key_value() {
+            Some((_, &last)) => u64::from(last) + 1 - self.len,
+            None => 0,
+        }
+    }
+
+    /// The first `n` numbers missing (before the last one held).
+    fn first_missing(&self, n: usize) -> Vec<u32> {
+        let mut out = Vec::new();
+        let mut next = 0u32;
+        for (&a, &b) in &self.spans {
+            out.extend((next..a).take(n - out.len()));
+            if out.len() == n {
+                break;
+            }
+            next = b.saturating_add(1);
+        }
+        out
     }
 }
 
@@ -441,162 +652,6 @@ pub(crate) fn rate(m: &HashMap<String, String>) -> Result<f32, String> {
     } else {
         Err(format!("rate_hz={r}: not a finite rate > 0"))
     }
-}
-
-/// An impact report's numbers within what the firmware can report (finite already: see
-/// [`Number`]).
-fn check_report(r: &ImpactReport) -> Result<(), String> {
-    fn out_of_range(field: &str, v: impl std::fmt::Display, range: &str) -> Result<(), String> {
-        Err(format!("{field}={v}: out of range (must be {range})"))
-    }
-    let non_negative = |field: &str, v: f64, shown: &dyn std::fmt::Display| {
-        if v < 0.0 {
-            out_of_range(field, shown, ">= 0")
-        } else {
-            Ok(())
-        }
-    };
-    non_negative("start_s", r.start_s, &r.start_s)?;
-    non_negative("peak_time_s", r.peak_time_s, &r.peak_time_s)?;
-    non_negative("duration_s", r.duration_s.into(), &r.duration_s)?;
-    if let Some(w) = r.fwhm_s {
-        non_negative("fwhm_s", w.into(), &w)?;
-    }
-    if r.end_sample < r.start_sample {
-        return Err(format!(
-            "end_sample={} before start_sample={}",
-            r.end_sample, r.start_sample
-        ));
-    }
-    if let Some(k) = &r.kinematics {
-        non_negative("crush_time_s", k.crush_time_s.into(), &k.crush_time_s)?;
-        non_negative(
-            "max_deformation_m",
-            k.max_deformation_m.into(),
-            &k.max_deformation_m,
-        )?;
-        if k.impact_velocity_m_s <= 0.0 {
-            return out_of_range("impact_velocity_m_s", k.impact_velocity_m_s, "> 0");
-        }
-        // The core flags a COR further outside [0, 1] `cor-out-of-range` and leaves it out.
-        if !(-COR_TOLERANCE..=1.0 + COR_TOLERANCE).contains(&k.cor) {
-            return out_of_range(
-                "cor",
-                k.cor,
-                &format!("within [-{COR_TOLERANCE}, {}]", 1.0 + COR_TOLERANCE),
-            );
-        }
-        let x = k.max_deformation_m;
-        if !(-x..=x).contains(&k.permanent_deformation_m) {
-            return out_of_range(
-                "permanent_deformation_m",
-                k.permanent_deformation_m,
-                "within ± max_deformation_m",
-            );
-        }
-    }
-    let residuals = [
-        ("two_phase_residual", r.fits.two_phase.map(|f| f.residual)),
-        ("nonlinear_residual", r.fits.nonlinear.map(|f| f.residual)),
-        ("hertz_residual", r.fits.hertz.map(|f| f.residual)),
-    ];
-    for (field, v) in residuals {
-        if let Some(v) = v {
-            non_negative(field, v.into(), &v)?;
-        }
-    }
-    Ok(())
-}
-
-/// `impact analyze`'s JSON from a log alone: samples from the summary (or the last
-/// heartbeat), the rate from the scene line (or a heartbeat), `v0_source` from the scene line
-/// (a free fall measured on the host cannot be told from a plain `v0`).
-pub fn log_json(log: &Log, t0: f64) -> Result<AnalysisJson, String> {
-    let state = log.summary.as_ref().or(log.heartbeat.as_ref());
-    let samples = match state {
-        Some(m) => num::<u64>(m, "samples")?,
-        None => 0,
-    };
-    let rate = match (&log.scene, state) {
-        (Some(m), _) => num::<f32>(m, "rate_hz")?,
-        (None, Some(m)) => num::<f32>(m, "rate_hz")?,
-        (None, None) => {
-            return Err(
-                "the log has no scene, heartbeat or summary line: sample rate unknown".into(),
-            )
-        }
-    };
-    let (v0_m_s, v0_source) = match &log.scene {
-        Some(m) if get(m, "drop_height_m")? != "none" => {
-            let h = num::<f32>(m, "drop_height_m")?;
-            (
-                Some((2.0 * STANDARD_GRAVITY * f64::from(h)).sqrt()),
-                Some("drop-height".to_string()),
-            )
-        }
-        Some(m) if get(m, "v0_m_s")? != "none" => (
-            Some(crate::report::fmt::shortest(num::<f32>(m, "v0_m_s")?)),
-            Some("v0".to_string()),
-        ),
-        _ => (None, None),
-    };
-    // What the scene asked for (the scene line's flags), for the reasons of absent fits.
-    let asked = |key: &str| -> Result<bool, String> {
-        match &log.scene {
-            Some(m) => flag(m, key),
-            None => Ok(false),
-        }
-    };
-    let fits = impact_core::FitSet {
-        two_phase: asked("two_phase")?,
-        nonlinear: asked("nonlinear")?,
-        fit_exponent: asked("fit_exponent")?,
-        nonlinear_exponent: 1.0,
-        hertz: asked("hertz")?,
-    };
-    let counter = |key: &str| -> Result<u64, String> {
-        match state {
-            Some(m) if m.contains_key(key) => num::<u64>(m, key),
-            _ => Ok(0),
-        }
-    };
-    let train_speed = log
-        .scene
-        .as_ref()
-        .and_then(|m| m.get("train"))
-        .filter(|t| *t != "none")
-        .cloned();
-    let mut a = AnalysisJson {
-        column: None,
-        units: None,
-        lines_dropped: log.lines_dropped,
-        lines_missing: log.lines_missing,
-        v0_m_s,
-        samples,
-        train_speed,
-        trains: Vec::new(),
-        waveforms: log.waveforms.iter().map(|w| w.json()).collect(),
-        sample_rate_hz: rate as f64,
-        v0_source,
-        free_fall_s: None,
-        samples_lost: counter("samples_lost")?,
-        analyses_skipped: counter("analyses_skipped")?,
-        resampled: false,
-        spikes_removed: Vec::new(),
-        clipping: None,
-        impacts: log
-            .impacts
-            .iter()
-            .zip(&log.latencies)
-            .map(|(r, latency)| {
-                let mut j = crate::report::impact_json(r, t0, &fits);
-                j.report_latency_s = latency.map(f64::from);
-                j
-            })
-            .collect(),
-    };
-    a.trains = crate::report::train::trains(&a.impacts);
-    Ok(a)
 }
 
 #[cfg(test)]
@@ -696,6 +751,24 @@ mod tests {
             [0, 5]
         );
         assert!(parse_log(&format!("{five}\n{zero}\n{}\n", summary(0))).is_err());
+    }
+
+    #[test]
+    fn sequence_numbers_are_kept_as_spans_and_the_missing_ones_named() {
+        let mut seqs = SeqSet::default();
+        for s in [0, 1, 2, 5, 4, 9, 2, 7, 3, 10, 8] {
+            seqs.insert(s);
+        }
+        // 0..=5 and 7..=10: 6 missing.
+        assert_eq!(seqs.spans.len(), 2);
+        assert_eq!((seqs.missing(), seqs.first_missing(5)), (1, vec![6]));
+        let mut gaps = SeqSet::default();
+        for s in (1..40).step_by(2) {
+            gaps.insert(s);
+        }
+        assert_eq!(gaps.missing(), 20);
+        assert_eq!(gaps.first_missing(5), [0, 2, 4, 6, 8]);
+        assert_eq!(SeqSet::default().missing(), 0);
     }
 
     #[test]

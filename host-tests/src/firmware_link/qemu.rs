@@ -289,6 +289,10 @@ pub enum Samples<'a> {
     /// An ADXL375's three axes, counts (the board's `adxl375` source), and which of them
     /// the stream gets: one axis (0, 1, 2) or the resultant (`None`).
     Adxl375(&'a [[i16; 3]], Option<usize>),
+    /// The ADC's counts already in a file (little-endian i16) and how many: a recording
+    /// written there a block at a time ([`crate::pipeline::streaming::counts_file`]), never
+    /// held whole.
+    File(&'a Path, u64),
 }
 
 impl Samples<'_> {
@@ -297,6 +301,7 @@ impl Samples<'_> {
         match self {
             Samples::Adc(c) => c.len(),
             Samples::Adxl375(a, _) => a.len(),
+            Samples::File(_, n) => usize::try_from(*n).unwrap_or(usize::MAX),
         }
     }
 
@@ -312,6 +317,7 @@ impl Samples<'_> {
                 .iter()
                 .flat_map(|s| s.iter().flat_map(|c| c.to_le_bytes()))
                 .collect(),
+            Samples::File(..) => Vec::new(),
         }
     }
 }
@@ -338,12 +344,23 @@ pub fn run_emulator(
     let nanos = std::time::SystemTime::now()
         .duration_since(std::time::UNIX_EPOCH)
         .map_or(0, |d| d.subsec_nanos());
-    let raw = TempFile(
-        std::env::temp_dir().join(format!("impact-emulate-{}-{nanos}.i16", std::process::id())),
-    );
-    let raw_s = raw.0.to_string_lossy().into_owned();
+    // The samples in a file QEMU's semihosting reads: the caller's, or one written here and
+    // removed at the end (or on an interrupt).
+    let written;
+    let (raw_path, _guard) = match samples {
+        Samples::File(path, _) => (path.to_path_buf(), None),
+        _ => {
+            let path = std::env::temp_dir()
+                .join(format!("impact-emulate-{}-{nanos}.i16", std::process::id()));
+            let guard = crate::interrupt::temporary(&path);
+            written = TempFile(path.clone());
+            std::fs::write(&written.0, samples.bytes())
+                .map_err(|e| format!("{}: {e}", path.display()))?;
+            (path, Some(guard))
+        }
+    };
+    let raw_s = raw_path.to_string_lossy().into_owned();
     check_arg("the temporary directory", &raw_s)?;
-    std::fs::write(&raw.0, samples.bytes()).map_err(|e| format!("{raw_s}: {e}"))?;
 
     let mut config = format!("enable=on,target=native,arg={elf_s},arg={raw_s}");
     if let Samples::Adxl375(_, axis) = samples {
@@ -392,6 +409,8 @@ pub fn run_emulator(
         .stdout(Stdio::piped())
         .spawn()
         .map_err(|e| format!("qemu-system-arm: {e}"))?;
+    // Ended with the tool on an interrupt.
+    let _child = crate::interrupt::child(qemu.id());
     let Some(frames) = qemu.stdout.take() else {
         let _ = qemu.kill();
         return Err("qemu-system-arm: no stdout".into());

@@ -119,6 +119,7 @@ impl Waveform {
             every: self.every,
             frames: self.frames,
             missing_frames: self.missing_frames(),
+            run: None,
         }
     }
 }
@@ -169,6 +170,7 @@ fn numbered(path: &Path, index: u32) -> PathBuf {
 pub fn export(
     waves: &[Waveform],
     path: &Path,
+    inputs: &crate::output::Inputs,
     rate_hz: f64,
     gain_m_s2_per_count: f64,
 ) -> Result<Vec<PathBuf>, String> {
@@ -184,6 +186,11 @@ pub fn export(
     }
     if waves.is_empty() {
         return Err("--export: the log has no waveforms (the scene's wave=0)".into());
+    }
+    // Every numbered name checked before any is written: none may be an input (`x-0.csv`
+    // read, `--export x.csv` asked).
+    for w in waves {
+        crate::output::check("--export", &numbered(path, w.index), inputs, None)?;
     }
     let mut written = Vec::new();
     for w in waves {
@@ -201,7 +208,7 @@ pub fn export(
                     ));
                 }
             }
-            std::fs::write(&out, text).map_err(|e| format!("{}: {e}", out.display()))?;
+            crate::output::write(&out, text.as_bytes())?;
         } else {
             let rate = rate_hz / every as f64;
             if !(rate.fract() == 0.0 && rate >= 1.0 && rate <= f64::from(u32::MAX)) {
@@ -224,7 +231,9 @@ pub fn export(
                 bits_per_sample: 16,
                 sample_format: hound::SampleFormat::Int,
             };
-            let mut writer = hound::WavWriter::create(&out, spec)
+            // A window is at most a capture: made in memory, written whole.
+            let mut bytes = std::io::Cursor::new(Vec::new());
+            let mut writer = hound::WavWriter::new(&mut bytes, spec)
                 .map_err(|e| format!("{}: {e}", out.display()))?;
             for v in values {
                 writer
@@ -234,6 +243,7 @@ pub fn export(
             writer
                 .finalize()
                 .map_err(|e| format!("{}: {e}", out.display()))?;
+            crate::output::write(&out, bytes.get_ref())?;
         }
         written.push(out);
     }

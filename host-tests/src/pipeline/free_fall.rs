@@ -7,18 +7,25 @@ use impact_io::channel::CsvFormat;
 use impact_io::csv_read::read_table;
 use std::path::Path;
 
+/// The file of a `--free-fall FILE[:COLUMN]` (an input: no output may write over it).
+pub fn file(spec: &str) -> &Path {
+    split(spec).0
+}
+
+/// `FILE[:COLUMN]` split (a colon in a directory name is the file's).
+fn split(spec: &str) -> (&Path, Option<&str>) {
+    match spec.rsplit_once(':') {
+        Some((p, c)) if !p.is_empty() && !c.contains('/') => (Path::new(p), Some(c)),
+        _ => (Path::new(spec), None),
+    }
+}
+
 /// Free-fall time ending at or before `impact_s`, from a DC accelerometer file in g: the
 /// stretch where |a| < 0.5 g (half way between rest and free fall) that ends within 50 ms
 /// before the impact.
 pub fn free_fall_before(spec: &str, impact_s: f64) -> Result<f64, String> {
-    let (path, column) = match spec.rsplit_once(':') {
-        Some((p, c)) if !p.is_empty() && !c.contains('/') => (
-            p,
-            Some(c.parse::<ColumnRef>().unwrap_or(ColumnRef::Name(c.into()))),
-        ),
-        _ => (spec, None),
-    };
-    let path = Path::new(path);
+    let (path, column) = split(spec);
+    let column = column.map(|c| c.parse::<ColumnRef>().unwrap_or(ColumnRef::Name(c.into())));
     let table = read_table(path, &CsvFormat::default(), None).map_err(|e| e.to_string())?;
     let tcol = table
         .time_column(None)

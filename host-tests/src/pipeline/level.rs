@@ -59,9 +59,10 @@ impl Level {
 
 impl fmt::Display for Level {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        let value = impact_io::limits::number(self.value);
         match self.units {
-            Units::MS2 => write!(f, "{} m/s²", self.value),
-            u => write!(f, "{}{}", self.value, u.name()),
+            Units::MS2 => write!(f, "{value} m/s²"),
+            u => write!(f, "{value}{}", u.name()),
         }
     }
 }

@@ -38,14 +38,8 @@ pub fn analyze(
     progress: Option<fn(f64)>,
 ) -> Result<(Setup, Vec<ImpactReport>), String> {
     let in_passes = streaming::in_passes(args);
-    let size = std::fs::metadata(&args.file).map_or(0, |m| m.len());
-    if !args.stream && !in_passes && size > 1 << 30 {
-        eprintln!(
-            "note: {} is {:.1} GB: read whole (for --plot, --axes, --free-fall or --resample) it takes some {:.0} GB of memory",
-            args.file.display(),
-            size as f64 / 1e9,
-            size as f64 * 2.0 / 1e9
-        );
+    if !args.stream && !in_passes {
+        memory_for_whole(&args.file)?;
     }
     if args.stream {
         streaming::analyze(args, progress)
@@ -56,6 +50,41 @@ pub fn analyze(
         let reports = run(&setup.prepared.counts, &setup.scene)?;
         Ok((setup, reports))
     }
+}
+
+/// Checks that a recording read whole (for `--axes`, `--free-fall`, `--resample` or an
+/// ADXL375's axes) finds the memory it takes (its values, the signal and the counts: about
+/// three times a CSV's size, ten times a binary file's): a message naming the need when it
+/// does not (a memory limit), never an abort half way; a note for one over 1 GB.
+pub fn memory_for_whole(file: &std::path::Path) -> Result<(), String> {
+    let size = std::fs::metadata(file).map_or(0, |m| m.len());
+    let binary = matches!(
+        impact_io::Format::of(file, None),
+        impact_io::Format::Raw(_) | impact_io::Format::Wav | impact_io::Format::Npy
+    );
+    let need = size.saturating_mul(if binary { 10 } else { 3 });
+    let gb = |b: u64| b as f64 / 1e9;
+    let mut probe: Vec<u8> = Vec::new();
+    if probe
+        .try_reserve_exact(usize::try_from(need).unwrap_or(usize::MAX))
+        .is_err()
+    {
+        return Err(format!(
+            "{}: read whole (for --axes, --free-fall, --resample, --adxl375) it takes some {:.1} GB of memory, which is not available: analyse it without those options (read in passes, in bounded memory)",
+            file.display(),
+            gb(need)
+        ));
+    }
+    drop(probe);
+    if size > 1 << 30 {
+        eprintln!(
+            "note: {} is {:.1} GB: read whole (for --axes, --free-fall, --resample or --adxl375) it takes some {:.0} GB of memory",
+            file.display(),
+            gb(size),
+            gb(need)
+        );
+    }
+    Ok(())
 }
 
 /// The host's monitor: a 2^15-sample ring (the flanks reach back 4096 samples, as on the board;
@@ -115,6 +144,9 @@ pub struct Setup {
     pub resampled: bool,
     /// With `--axes`: each axis in m/s² and its rails.
     pub axes: Vec<crate::pipeline::axes::Axis>,
+    /// A recording read in passes keeps no counts: the windows `--plot` draws, read in a
+    /// last pass (first sample's stream index, counts).
+    pub windows: Vec<(u64, Vec<i16>)>,
 }
 
 impl Setup {
@@ -150,6 +182,7 @@ impl Setup {
             clipping: None,
             resampled: false,
             axes: Vec::new(),
+            windows: Vec::new(),
         }
     }
 
@@ -160,10 +193,15 @@ impl Setup {
             mass_kg: self.scene.mass_kg.map(f64::from),
             accel_m_s2: Box::new(move |i| {
                 let gain = f64::from(self.scene.calibration.gain_m_s2_per_count);
-                self.prepared
-                    .counts
-                    .get(usize::try_from(i).ok()?)
-                    .map(|&c| f64::from(c) * gain)
+                let count = match self
+                    .windows
+                    .iter()
+                    .find(|(from, w)| i >= *from && i - from < w.len() as u64)
+                {
+                    Some((from, w)) => w.get(usize::try_from(i - from).ok()?),
+                    None => self.prepared.counts.get(usize::try_from(i).ok()?),
+                };
+                count.map(|&c| f64::from(c) * gain)
             }),
         }
     }
@@ -264,20 +302,16 @@ pub fn setup(args: &AnalyzeArgs, progress: Option<fn(f64)>) -> Result<Setup, Str
     Ok(setup)
 }
 
-/// The body's mass (checked) and the factor from the file's values to m/s² (units, `--gain`,
-/// `--invert`), from the options or the scene file; the units are those stated, else those
-/// the channel's header (`column`) names, else g (an error if the two disagree).
+/// The body's mass and the factor from the file's values to m/s² (units, `--gain`,
+/// `--invert`), from the options or the scene file (checked as they were read: the options'
+/// parsers, [`scene_file`]); the units are those stated, else those the channel's header
+/// (`column`) names, else g (an error if the two disagree).
 pub(crate) fn mass_and_scale(
     args: &AnalyzeArgs,
     file: &SceneFile,
     column: &str,
 ) -> Result<(Option<f64>, f64, Units), String> {
     let mass = args.mass.or(file.mass);
-    if let Some(m) = mass {
-        if !(m.is_finite() && m > 0.0) {
-            return Err("--mass: must be finite and > 0".into());
-        }
-    }
     let units = Units::resolve(args.units.or(file.units), column)?;
     let invert = args.invert || file.invert.unwrap_or(false);
     let scale = units.to_m_s2(mass) * args.gain.unwrap_or(1.0) * if invert { -1.0 } else { 1.0 };
@@ -304,7 +338,9 @@ pub(crate) fn build_scene(
             c.high_m_s2.map_or(i16::MAX, |v| to_count(v, gain)),
         );
     }
-    scene.hold_s = args.hold.or(file.hold).unwrap_or(2e-3) as f32;
+    check_times(args, file, f64::from(scene.max_impact_s))?;
+    check_edge(args, file, trigger, edge, mass)?;
+    scene.hold_s = args.hold.or(file.hold).unwrap_or(DEFAULT_HOLD_S) as f32;
     if let Some(m) = args.max_impact.or(file.max_impact) {
         scene.max_impact_s = m as f32;
     }
@@ -314,10 +350,10 @@ pub(crate) fn build_scene(
     };
     scene.mass_kg = mass.map(|m| m as f32);
     scene.cfc = match args.cfc.or(file.cfc) {
-        Some(c) => Some(
-            Cfc::from_class(c)
-                .ok_or_else(|| format!("--cfc: {c} is not one of 60, 180, 600, 1000"))?,
-        ),
+        Some(c) => Some(Cfc::from_class(c).ok_or_else(|| {
+            let name = name_of(args, file, "cfc");
+            format!("{name}: {c} is not one of 60, 180, 600, 1000")
+        })?),
         None => None,
     };
     scene.trigger_cfc = match args.trigger_cfc {
@@ -355,8 +391,132 @@ pub(crate) fn build_scene(
     scene.approach = approach;
     scene.train = args.train.train();
     scene.spectrum = args.spectrum.settings();
-    scene.validate().map_err(|e| e.to_string())?;
+    scene.validate().map_err(|e| match e {
+        // Named as it was given: an option, or the scene file's key.
+        impact_core::Error::InvalidParameter { name, reason } => {
+            format!("{}: {reason}", name_of(args, file, name))
+        }
+        e => e.to_string(),
+    })?;
     Ok((scene, source))
+}
+
+/// The quiet time that ends an impact when none is given, s.
+const DEFAULT_HOLD_S: f64 = 2e-3;
+
+/// How messages name the core's parameter `name` (`hold`, `max-impact`): the scene file's
+/// key if the file gives it and the command line does not, else the option.
+fn name_of(args: &AnalyzeArgs, file: &SceneFile, name: &str) -> String {
+    // (On the command line, and in the file.)
+    let (cli, in_file) = match name {
+        "mass" => (args.mass.is_some(), file.mass.is_some()),
+        "v0" => (args.v0.is_some(), file.v0.is_some()),
+        "drop-height" => (args.drop_height.is_some(), file.drop_height.is_some()),
+        "trigger" => (args.trigger.is_some(), file.trigger.is_some()),
+        "edge" => (args.edge.is_some(), file.edge.is_some()),
+        "hold" => (args.hold.is_some(), file.hold.is_some()),
+        "max-impact" => (args.max_impact.is_some(), file.max_impact.is_some()),
+        "settle" => (args.settle.is_some(), file.settle.is_some()),
+        "cfc" => (args.cfc.is_some(), file.cfc.is_some()),
+        // Only the scene file sets the exponent.
+        "exponent" => (false, true),
+        _ => (true, false),
+    };
+    let key = match name {
+        "exponent" => "fits.exponent".to_string(),
+        _ => name.replace('-', "_"),
+    };
+    let option = format!("--{name}");
+    options::setting_name(args, cli, in_file, &option, &key).unwrap_or(option)
+}
+
+/// One of the times given (or its default), s, and how messages name it: `--hold 0.5`,
+/// `scene.json: max_impact 1e-9`, `the default --hold, 0.002 s`; and whether it was given.
+fn time_given(
+    args: &AnalyzeArgs,
+    file: &SceneFile,
+    name: &str,
+    (cli, in_file): (Option<f64>, Option<f64>),
+    default: f64,
+) -> (f64, String, bool) {
+    match cli.or(in_file) {
+        Some(v) => (
+            v,
+            format!(
+                "{} {}",
+                name_of(args, file, name),
+                impact_io::limits::number(v)
+            ),
+            true,
+        ),
+        None => (
+            default,
+            format!(
+                "the default --{name}, {} s",
+                impact_io::limits::number(default)
+            ),
+            false,
+        ),
+    }
+}
+
+/// The hold at most the longest impact (`default_longest_s` if none is given), the settling
+/// time at least the hold: an error names the time given that breaks it (and the other,
+/// given or its default).
+fn check_times(args: &AnalyzeArgs, file: &SceneFile, default_longest_s: f64) -> Result<(), String> {
+    let (hold, hold_name, hold_given) =
+        time_given(args, file, "hold", (args.hold, file.hold), DEFAULT_HOLD_S);
+    let (longest, longest_name, longest_given) = time_given(
+        args,
+        file,
+        "max-impact",
+        (args.max_impact, file.max_impact),
+        default_longest_s,
+    );
+    if hold > longest {
+        return Err(if longest_given || !hold_given {
+            format!("{longest_name}: shorter than the hold (at least {hold_name})")
+        } else {
+            format!("{hold_name}: longer than the longest impact (at most {longest_name})")
+        });
+    }
+    if let Some(settle) = args.settle.or(file.settle) {
+        if settle < hold {
+            let name = name_of(args, file, "settle");
+            let settle = impact_io::limits::number(settle);
+            return Err(format!(
+                "{name} {settle}: shorter than the hold (at least {hold_name})"
+            ));
+        }
+    }
+    Ok(())
+}
+
+/// An edge level given below the trigger level (given, or learned from the signal).
+fn check_edge(
+    args: &AnalyzeArgs,
+    file: &SceneFile,
+    trigger: f64,
+    edge: f64,
+    mass: Option<f64>,
+) -> Result<(), String> {
+    let Some(level) = args.edge.or(file.edge) else {
+        return Ok(());
+    };
+    if (edge as f32) < (trigger as f32) {
+        return Ok(());
+    }
+    let trigger_name = match (args.trigger, file.trigger) {
+        (Some(t), _) => format!("--trigger {t}"),
+        (None, Some(t)) => format!("the scene file's trigger {t}"),
+        (None, None) => "the trigger level learned from the signal's noise".into(),
+    };
+    Err(format!(
+        "{} {}: not below the trigger level (below {trigger_name}, {})",
+        name_of(args, file, "edge"),
+        options::level_as_given(level, mass),
+        crate::report::fmt::human(trigger, "m/s²"),
+    ))
 }
 
 /// The core's monitor fed blocks of counts: the one analysis loop of every way of reading a

@@ -2,7 +2,7 @@
 //! emulate`, in the help's sections), the scene file's, the bounce trains' and the spectra's;
 //! and what the readers take of them ([`AnalyzeArgs::read_options`]).
 
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 
 use clap::{Args, ValueEnum};
 use impact_core::signal::spectrum::SpectrumSettings;
@@ -10,7 +10,7 @@ use impact_core::{Train, TrainSpeed};
 use serde::Deserialize;
 
 pub use super::level::Level;
-use crate::parse::positive_f64;
+use crate::parse;
 use impact_io::channel::{ColumnRef, CsvFormat, ReadOptions};
 pub use impact_io::units::Units;
 
@@ -90,7 +90,7 @@ pub struct AnalyzeArgs {
     #[arg(long, help_heading = "Input", value_enum)]
     pub time_unit: Option<impact_io::channel::TimeUnit>,
     /// Sample rate, Hz (instead of a time column).
-    #[arg(short = 'r', long, help_heading = "Input", value_parser = positive_f64)]
+    #[arg(short = 'r', long, help_heading = "Input", value_parser = parse::rate_hz)]
     pub rate: Option<f64>,
     /// Interpolate an uneven time axis onto an even grid [default: refuse it].
     ///
@@ -132,7 +132,7 @@ pub struct AnalyzeArgs {
     pub units: Option<Units>,
     /// Multiply the channel's values by this first (e.g. g per code of a WAV file's integer
     /// samples) [default: 1].
-    #[arg(long, help_heading = "Channel", value_parser = positive_f64)]
+    #[arg(long, help_heading = "Channel", value_parser = parse::gain)]
     pub gain: Option<f64>,
     /// Negate the channel (by default a positive reading is a deceleration).
     #[arg(long, help_heading = "Channel")]
@@ -152,13 +152,13 @@ pub struct AnalyzeArgs {
     #[arg(long, help_heading = "Channel")]
     pub keep_spikes: bool,
     /// Mass of the instrumented body, kg.
-    #[arg(short = 'm', long, help_heading = "Bench", value_parser = positive_f64)]
+    #[arg(short = 'm', long, help_heading = "Bench", value_parser = parse::mass_kg)]
     pub mass: Option<f64>,
     /// Approach speed, m/s.
-    #[arg(long, help_heading = "Bench", conflicts_with_all = ["drop_height", "free_fall"], value_parser = positive_f64)]
+    #[arg(long, help_heading = "Bench", conflicts_with_all = ["drop_height", "free_fall"], value_parser = parse::speed_m_s)]
     pub v0: Option<f64>,
     /// Drop height, m: v0 = sqrt(2 g h).
-    #[arg(long, help_heading = "Bench", conflicts_with = "free_fall", value_parser = positive_f64)]
+    #[arg(long, help_heading = "Bench", conflicts_with = "free_fall", value_parser = parse::height_m)]
     pub drop_height: Option<f64>,
     /// DC accelerometer file (g), optionally `:COLUMN`: v0 = g × free-fall time before the impact.
     #[arg(long, help_heading = "Bench", value_name = "FILE[:COLUMN]")]
@@ -178,19 +178,19 @@ pub struct AnalyzeArgs {
     #[arg(long, help_heading = "Detection", value_name = "LEVEL")]
     pub edge: Option<Level>,
     /// Quiet time that ends an impact, s [default: 2 ms].
-    #[arg(long, help_heading = "Detection", value_parser = positive_f64)]
+    #[arg(long, help_heading = "Detection", value_parser = parse::seconds)]
     pub hold: Option<f64>,
     /// How long a new level must last to be a level change, not an impact, s [default: 50 ms].
     ///
     /// How long a flat new level must last to be a level change (a DC channel's free fall
     /// or rest), not an impact, s [default: 50 ms, at least the hold].
-    #[arg(long, help_heading = "Detection", value_parser = positive_f64)]
+    #[arg(long, help_heading = "Detection", value_parser = parse::seconds)]
     pub settle: Option<f64>,
     /// Longest impact, s [default: 1 s].
     ///
     /// Longest impact, s: a signal away from its baseline longer is a stuck or drifting
     /// sensor (`too-long`) [default: 1 s].
-    #[arg(long, help_heading = "Detection", value_parser = positive_f64)]
+    #[arg(long, help_heading = "Detection", value_parser = parse::seconds)]
     pub max_impact: Option<f64>,
     /// Causal SAE J211 class on the live trigger path (ignores glitches shorter than the class).
     #[arg(long, help_heading = "Detection")]
@@ -234,13 +234,97 @@ impl AnalyzeArgs {
     }
 }
 
-/// The `--scene` file's settings (all defaults without one).
+/// The `--scene` file's settings (all defaults without one), each number within its limits
+/// ([`SceneFile::check`]); and the levels given, there or as options ([`check_levels`]).
 pub fn scene_file(args: &AnalyzeArgs) -> Result<SceneFile, String> {
-    let Some(path) = &args.scene else {
-        return Ok(SceneFile::default());
+    let file = match &args.scene {
+        None => SceneFile::default(),
+        Some(path) => {
+            let bytes = impact_io::read_limited(path, 1 << 20, "scene file")?;
+            let file: SceneFile =
+                serde_json::from_slice(&bytes).map_err(|e| format!("{}: {e}", path.display()))?;
+            file.check(path)?;
+            file
+        }
     };
-    let bytes = impact_io::read_limited(path, 1 << 20, "scene file")?;
-    serde_json::from_slice(&bytes).map_err(|e| format!("{}: {e}", path.display()))
+    check_levels(args, &file)?;
+    Ok(file)
+}
+
+/// Each level given (`--trigger`, `--edge`, `--range`, or the scene file's) within
+/// [`parse::LEVEL_M_S2`] once in m/s² (a force over the mass given), named as it was given.
+pub fn check_levels(args: &AnalyzeArgs, file: &SceneFile) -> Result<(), String> {
+    let mass = args.mass.or(file.mass);
+    for (option, key, cli, in_file) in [
+        ("--trigger", "trigger", args.trigger, file.trigger),
+        ("--edge", "edge", args.edge, file.edge),
+        ("--range", "range", args.range, file.range),
+    ] {
+        let (Some(level), Some(name)) = (
+            cli.or(in_file),
+            setting_name(args, cli.is_some(), in_file.is_some(), option, key),
+        ) else {
+            continue;
+        };
+        if !parse::LEVEL_M_S2.contains(level.to_m_s2(mass)) {
+            return Err(format!(
+                "{name} {}: out of range ({})",
+                level_as_given(level, mass),
+                parse::LEVEL_M_S2
+            ));
+        }
+    }
+    Ok(())
+}
+
+/// A level as given, and in m/s² if it was given in another unit: `5g (49.03 m/s²)`.
+pub fn level_as_given(level: Level, mass: Option<f64>) -> String {
+    match level.units {
+        Units::MS2 => level.to_string(),
+        _ => format!(
+            "{level} ({})",
+            crate::report::fmt::human(level.to_m_s2(mass), "m/s²")
+        ),
+    }
+}
+
+impl SceneFile {
+    /// Checks each number against its limits (as the options' are), naming the file and
+    /// the key: `scene.json: hold 1e-300: out of range (between 1e-30 and 1e30 s)`. (The
+    /// levels are checked in m/s², with the mass: [`check_levels`].)
+    pub fn check(&self, path: &Path) -> Result<(), String> {
+        let exponent = self.fits.as_ref().and_then(|f| f.exponent);
+        for (key, value, limits) in [
+            ("mass", self.mass, &parse::MASS_KG),
+            ("v0", self.v0, &parse::SPEED_M_S),
+            ("drop_height", self.drop_height, &parse::HEIGHT_M),
+            ("hold", self.hold, &parse::SECONDS),
+            ("max_impact", self.max_impact, &parse::SECONDS),
+            ("settle", self.settle, &parse::SECONDS),
+            ("fits.exponent", exponent, &parse::EXPONENT),
+        ] {
+            if let Some(v) = value {
+                limits.check_named(&format!("{}: {key}", path.display()), v)?;
+            }
+        }
+        Ok(())
+    }
+}
+
+/// How messages name a setting given on the command line (`option`, `--hold`) or else in the
+/// scene file (`key`: `scene.json: hold`); `None` if neither gives it.
+pub fn setting_name(
+    args: &AnalyzeArgs,
+    on_command_line: bool,
+    in_file: bool,
+    option: &str,
+    key: &str,
+) -> Option<String> {
+    match (&args.scene, on_command_line, in_file) {
+        (_, true, _) => Some(option.to_string()),
+        (Some(path), false, true) => Some(format!("{}: {key}", path.display())),
+        _ => None,
+    }
 }
 
 /// Which measure of a bounce's approach speed the kinematics use.
@@ -264,10 +348,10 @@ pub struct TrainArgs {
     #[arg(long, help_heading = "Analysis", value_enum)]
     pub train: Option<SpeedArg>,
     /// Gravity along the sensor's axis, m/s² [default: 9.80665].
-    #[arg(long, help_heading = "Analysis", requires = "train", value_parser = positive_f64)]
+    #[arg(long, help_heading = "Analysis", requires = "train", value_parser = parse::gravity_m_s2)]
     pub gravity: Option<f64>,
     /// A flight longer than this starts a new train (a new drop), s [default: 2].
-    #[arg(long, help_heading = "Analysis", requires = "train", value_parser = positive_f64)]
+    #[arg(long, help_heading = "Analysis", requires = "train", value_parser = parse::seconds)]
     pub max_flight: Option<f64>,
 }
 
@@ -300,7 +384,7 @@ pub struct SpectrumArgs {
     #[arg(long, help_heading = "Analysis", default_value_t = 6, requires = "srs", value_parser = per_octave)]
     pub srs_bands: u32,
     /// Lowest band, Hz (the highest is an eighth of the sample rate).
-    #[arg(long, help_heading = "Analysis", default_value_t = 10.0, requires = "srs", value_parser = crate::parse::positive_f64)]
+    #[arg(long, help_heading = "Analysis", default_value_t = 10.0, requires = "srs", value_parser = parse::frequency_hz)]
     pub srs_low: f64,
 }
 

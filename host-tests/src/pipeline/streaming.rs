@@ -108,6 +108,27 @@ pub fn analyze_in_passes(
     args: &AnalyzeArgs,
     progress: Option<fn(f64)>,
 ) -> Result<(Setup, Vec<ImpactReport>), String> {
+    in_passes_then(args, progress, Last::Analyse)
+}
+
+/// The recording's counts (little-endian i16, as the board's ADC gives them to the stream),
+/// written to `out` in a last pass after the survey, in bounded memory: what `impact emulate`
+/// replays. The setup says how many (`samples`).
+pub fn counts_file(args: &AnalyzeArgs, out: &mut dyn std::io::Write) -> Result<Setup, String> {
+    in_passes_then(args, None, Last::Counts(out)).map(|(setup, _)| setup)
+}
+
+/// What the last pass does: analyse, or write the counts.
+enum Last<'a> {
+    Analyse,
+    Counts(&'a mut dyn std::io::Write),
+}
+
+fn in_passes_then(
+    args: &AnalyzeArgs,
+    progress: Option<fn(f64)>,
+    last: Last,
+) -> Result<(Setup, Vec<ImpactReport>), String> {
     let name = input_name(&args.file);
     let file = pipeline::scene_file(args)?;
     // The survey; again with the glitches replaced if there are any (they set the extremes).
@@ -204,7 +225,37 @@ pub fn analyze_in_passes(
         .iter()
         .map(|a| impact_io::quantise::to_count(*a, gain))
         .collect();
-    let (reports, count, _) = run_monitor(source, head, (scale, gain), scene, removals.clone())?;
+    let (reports, count) = match last {
+        Last::Analyse => {
+            let (reports, count, _) =
+                run_monitor(source, head, (scale, gain), scene, removals.clone())?;
+            (reports, count)
+        }
+        Last::Counts(out) => (
+            Vec::new(),
+            write_counts(source, head, (scale, gain), removals.clone(), out)?,
+        ),
+    };
+    // The figure's windows: a last pass keeps just them (memory bounded by the impacts
+    // drawn, not the recording).
+    let windows = match &args.plot {
+        Some(_) => {
+            let rate = f64::from(calibration.sample_rate_hz);
+            let spans: Vec<(u64, u64)> = reports
+                .iter()
+                .take(crate::plot::SHOWN)
+                .map(|r| crate::plot::window(r, rate))
+                .collect();
+            let (mut source, scale) = reopen(None)?;
+            let head = read_head(&mut *source, scale)?;
+            let head = head
+                .iter()
+                .map(|a| impact_io::quantise::to_count(*a, gain))
+                .collect();
+            collect_windows(source, head, (scale, gain), removals.clone(), spans)?
+        }
+        None => Vec::new(),
+    };
     let spikes = removals.iter().map(|r| r.timed(t0, rate_hz)).collect();
     let mut setup = Setup::new(
         column,
@@ -218,6 +269,7 @@ pub fn analyze_in_passes(
     );
     setup.spikes = spikes;
     setup.clipping = levels.clipping;
+    setup.windows = windows;
     Ok((setup, reports))
 }
 
@@ -237,11 +289,12 @@ fn in_pass(fraction: f64) {
 
 /// Whether `impact analyze` reads `args.file` in passes ([`analyze_in_passes`]): a regular
 /// file or standard input, without the options that need the whole recording in memory
-/// (figures, axes, free fall, resampling).
+/// (axes, free fall, resampling; a figure takes its windows in a last pass).
 pub fn in_passes(args: &AnalyzeArgs) -> bool {
+    // (`IMPACT_READ_WHOLE` set: read whole, for the tests that compare the two ways.)
     !args.stream
+        && std::env::var_os("IMPACT_READ_WHOLE").is_none()
         && (is_stdin(&args.file) || std::fs::metadata(&args.file).is_ok_and(|m| m.is_file()))
-        && args.plot.is_none()
         && args.axes.is_empty()
         && args.free_fall.is_none()
         && !args.resample
@@ -463,6 +516,75 @@ fn run_monitor(
         let (reports, total) = run.finish()?;
         Ok((reports, total, source))
     })
+}
+
+/// Writes the head's counts and the rest of the source's (at `(scale, gain)`, the `removals`
+/// put in, as the analysis sees them) to `out` as little-endian i16; how many.
+fn write_counts(
+    source: Box<dyn Source>,
+    head: Vec<i16>,
+    (scale, gain): (f64, f64),
+    removals: Vec<Removal>,
+    out: &mut dyn std::io::Write,
+) -> Result<u64, String> {
+    let mut patch = Patches::new(&removals);
+    let mut count = 0u64;
+    let mut bytes = Vec::new();
+    let mut take = |counts: &mut [i16]| {
+        patch.counts(counts, gain);
+        bytes.clear();
+        bytes.extend(counts.iter().flat_map(|c| c.to_le_bytes()));
+        out.write_all(&bytes)
+            .map_err(|e| format!("the recording's counts for the emulator: {e}"))?;
+        count += counts.len() as u64;
+        Ok(())
+    };
+    let mut head = head;
+    take(&mut head)?;
+    read_ahead(
+        source,
+        move |s, scratch, counts| s.next_counts(CHUNK, (scale, gain), scratch, counts),
+        take,
+    )?;
+    out.flush()
+        .map_err(|e| format!("the recording's counts for the emulator: {e}"))?;
+    Ok(count)
+}
+
+/// Reads the head's counts and the rest of the source (as counts at `(scale, gain)`, the
+/// `removals` put in, as the analysis saw them) and keeps the samples of each span `(first,
+/// count)`: the windows a figure draws.
+fn collect_windows(
+    source: Box<dyn Source>,
+    head: Vec<i16>,
+    (scale, gain): (f64, f64),
+    removals: Vec<Removal>,
+    spans: Vec<(u64, u64)>,
+) -> Result<Vec<(u64, Vec<i16>)>, String> {
+    let mut windows: Vec<(u64, Vec<i16>)> =
+        spans.iter().map(|&(from, _)| (from, Vec::new())).collect();
+    let mut patch = Patches::new(&removals);
+    let mut at = 0u64;
+    let mut take = |counts: &mut [i16]| {
+        patch.counts(counts, gain);
+        let end = at + counts.len() as u64;
+        for ((from, w), &(_, len)) in windows.iter_mut().zip(&spans) {
+            let (a, b) = ((*from).max(at), (*from + len).min(end));
+            if a < b {
+                w.extend_from_slice(&counts[(a - at) as usize..(b - at) as usize]);
+            }
+        }
+        at = end;
+        Ok(())
+    };
+    let mut head = head;
+    take(&mut head)?;
+    read_ahead(
+        source,
+        move |s, scratch, counts| s.next_counts(CHUNK, (scale, gain), scratch, counts),
+        take,
+    )?;
+    Ok(windows)
 }
 
 /// What [`run_monitor`] gives: the reports, the samples read and the source.

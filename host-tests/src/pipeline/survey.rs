@@ -209,8 +209,9 @@ pub fn levels(
     trigger: Option<f64>,
     edge: Option<f64>,
 ) -> Result<Levels, String> {
-    if let Some(fs) = range_m_s2 {
-        check_range(s.peak_m_s2(), fs)?;
+    match range_m_s2 {
+        Some(fs) => check_range(s.peak_m_s2(), fs)?,
+        None => check_peak(s.peak_m_s2())?,
     }
     let clipping = match range_m_s2 {
         Some(fs) => Some(screen::from_range(fs)),
@@ -243,6 +244,20 @@ pub fn check_range(peak_m_s2: f64, range_m_s2: f64) -> Result<(), String> {
         ));
     }
     Ok(())
+}
+
+/// An error if `peak_m_s2`, the largest reading's distance from zero and the full scale
+/// when no range is given, is not 0 and not within [`impact_io::limits::LEVEL_M_S2`]: counts
+/// at a smaller full scale would all be 0 (the impacts lost), at a larger one not finite.
+pub fn check_peak(peak_m_s2: f64) -> Result<(), String> {
+    let limits = impact_io::limits::LEVEL_M_S2;
+    if peak_m_s2 == 0.0 || limits.contains(peak_m_s2) {
+        return Ok(());
+    }
+    Err(format!(
+        "the recording reaches {} (its values in their units times --gain): out of range ({limits}); give a --gain that brings it within",
+        crate::report::fmt::human(peak_m_s2, "m/s²"),
+    ))
 }
 
 /// A flat top is taken for a rail only more than this many steps of the recording's

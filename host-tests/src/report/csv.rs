@@ -1,9 +1,25 @@
 //! The analysis as CSV: one row per impact, the contract's fields first (`report::FIELDS`).
 
-use super::AnalysisJson;
+use std::borrow::Borrow;
+use std::io::Write;
+
+use super::{AnalysisJson, ImpactJson};
 
 /// CSV text: one row per impact.
 pub fn to_csv(a: &AnalysisJson) -> String {
+    let mut out = Vec::new();
+    // Writing to a Vec cannot fail.
+    let _ = write_csv(a, a.impacts.iter(), &mut out);
+    String::from_utf8_lossy(&out).into_owned()
+}
+
+/// The CSV of `a` with `impacts` (read twice: the columns, then the rows) in place of
+/// `a.impacts`, written to `out` a row at a time.
+pub fn write_csv<I>(a: &AnalysisJson, impacts: I, out: &mut impl Write) -> std::io::Result<()>
+where
+    I: Iterator + Clone,
+    I::Item: Borrow<ImpactJson>,
+{
     // The report's fields as the firmware's `impact` line names them (one list, in core).
     let mut s = impact_core::report::FIELDS.join(",");
     // With --train, the bounce columns; with --srs, the spectra's summary columns.
@@ -13,15 +29,16 @@ pub fn to_csv(a: &AnalysisJson) -> String {
         s.push_str(&impact_core::report::BOUNCE_FIELDS.join(","));
         s.push_str(",cor_flight,cor_rebound");
     }
-    let with_spectrum = a.impacts.iter().any(|i| i.shock_spectrum.is_some());
+    let with_spectrum = impacts.clone().any(|i| i.borrow().shock_spectrum.is_some());
     // With --axes, the resultant's peak and each axis's peak and Δv (named by its column).
-    let axis_names: Vec<String> = a
-        .impacts
-        .iter()
-        .find_map(|i| i.axes.as_ref())
-        .map(|x| x.axes.iter().map(|a| a.column.clone()).collect())
+    let axis_names: Vec<String> = impacts
+        .clone()
+        .find_map(|i| {
+            let x = i.borrow().axes.as_ref()?;
+            Some(x.axes.iter().map(|a| a.column.clone()).collect())
+        })
         .unwrap_or_default();
-    let with_axes = a.impacts.iter().any(|i| i.axes.is_some());
+    let with_axes = impacts.clone().any(|i| i.borrow().axes.is_some());
     if with_axes {
         s.push_str(",resultant_peak_m_s2");
         for n in &axis_names {
@@ -32,9 +49,17 @@ pub fn to_csv(a: &AnalysisJson) -> String {
         s.push(',');
         s.push_str(crate::report::spectrum::CSV_HEADER);
     }
+    // `impact log` of a log in which the board restarted: each impact's run.
+    let with_run = impacts.clone().any(|i| i.borrow().run.is_some());
+    if with_run {
+        s.push_str(",run");
+    }
     s.push('\n');
+    out.write_all(s.as_bytes())?;
     let o = |v: Option<f64>| v.map_or(String::new(), |v| format!("{v:e}"));
-    for i in &a.impacts {
+    for i in impacts {
+        let i = i.borrow();
+        let mut s = String::new();
         let tp = i.fits.two_phase.as_ref();
         let nl = i.fits.nonlinear.as_ref();
         let hz = i.fits.hertz.as_ref();
@@ -109,7 +134,12 @@ pub fn to_csv(a: &AnalysisJson) -> String {
                 i.shock_spectrum.as_ref(),
             ));
         }
+        if with_run {
+            s.push(',');
+            s.push_str(&i.run.map_or(String::new(), |r| r.to_string()));
+        }
         s.push('\n');
+        out.write_all(s.as_bytes())?;
     }
-    s
+    Ok(())
 }

@@ -98,6 +98,10 @@ pub struct ImpactJson {
     /// A bounce of a train (`--train`): its flight, both approach speeds and their CORs;
     /// null for a train's first impact and without `--train`.
     pub bounce: Option<crate::report::train::BounceJson>,
+    /// `impact log` of a log in which the board restarted: the run the impact is from (1 for
+    /// the first; each run's indices and times start from 0).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub run: Option<u32>,
 }
 
 /// The whole analysis as JSON.
@@ -143,6 +147,46 @@ pub struct AnalysisJson {
     /// `impact log` / `impact emulate --waveforms`: the captured windows the board sent.
     #[serde(skip_serializing_if = "Vec::is_empty")]
     pub waveforms: Vec<crate::report::waveform::WaveformJson>,
+}
+
+/// The JSON of `a` with `impacts` in place of `a.impacts` (which must be empty), written to
+/// `out` an impact at a time: the bytes of `serde_json::to_string_pretty` on the whole, and
+/// a newline. So a long log's report is never held whole, as text or as JSON values.
+pub fn write_json(
+    a: &AnalysisJson,
+    impacts: impl Iterator<Item = ImpactJson>,
+    out: &mut impl std::io::Write,
+) -> std::io::Result<()> {
+    let head = serde_json::to_vec_pretty(a)?;
+    // The top-level key: a nested one is indented further, and a string's quotes are escaped.
+    const KEY: &[u8] = b"\n  \"impacts\": [";
+    let at = head
+        .windows(KEY.len())
+        .position(|w| w == KEY)
+        .map(|k| k + KEY.len())
+        .filter(|&k| head.get(k) == Some(&b']'))
+        .ok_or_else(|| std::io::Error::other("write_json: the impacts are not an empty list"))?;
+    out.write_all(&head[..at])?;
+    let mut any = false;
+    let mut one = Vec::new();
+    for i in impacts {
+        out.write_all(if any { b",\n    " } else { b"\n    " })?;
+        one.clear();
+        serde_json::to_writer_pretty(&mut one, &i)?;
+        // Two levels deeper (a JSON string holds no raw newline).
+        for (k, line) in one.split(|&b| b == b'\n').enumerate() {
+            if k > 0 {
+                out.write_all(b"\n    ")?;
+            }
+            out.write_all(line)?;
+        }
+        any = true;
+    }
+    if any {
+        out.write_all(b"\n  ")?;
+    }
+    out.write_all(&head[at..])?;
+    out.write_all(b"\n")
 }
 
 fn fits_json(f: &Fits) -> FitsJson {
@@ -304,6 +348,7 @@ pub fn impact_json(r: &ImpactReport, t0: f64, fits: &FitSet) -> ImpactJson {
             .map(crate::report::spectrum::spectrum_json),
         bounce: crate::report::train::bounce_json(r),
         axes: None,
+        run: None,
     }
 }
 

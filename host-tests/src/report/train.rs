@@ -106,11 +106,14 @@ pub struct TrainJson {
 }
 
 /// The trains among `impacts` (an impact without a bounce starts one); only trains with a
-/// bounce are listed.
-pub fn trains(impacts: &[ImpactJson]) -> Vec<TrainJson> {
+/// bounce are listed. `impacts`: a slice's, or JSON made one at a time.
+pub fn trains<I: std::borrow::Borrow<ImpactJson>>(
+    impacts: impl IntoIterator<Item = I>,
+) -> Vec<TrainJson> {
     let mut out: Vec<TrainJson> = Vec::new();
     let mut current: Option<TrainJson> = None;
     for i in impacts {
+        let i = i.borrow();
         if i.bounce.is_none() {
             out.extend(current.take().filter(|t| t.impacts.len() > 1));
             current = Some(TrainJson {

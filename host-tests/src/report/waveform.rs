@@ -13,4 +13,7 @@ pub struct WaveformJson {
     pub frames: u32,
     /// Frames the link dropped (their samples are missing from plots and exports).
     pub missing_frames: u32,
+    /// The run the window is from, in a log in which the board restarted (1 for the first).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub run: Option<u32>,
 }

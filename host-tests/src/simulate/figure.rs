@@ -44,26 +44,30 @@ pub fn wall_contact(
         curves[2].push((label, colour, map(&|p| (p.t_s * 1e3, p.force_n))));
         curves[3].push((label, colour, map(&|p| (p.x_m * 1e3, p.force_n))));
     }
-    let root = SVGBackend::new(path, (1600, 360)).into_drawing_area();
-    root.fill(&WHITE).map_err(|e| e.to_string())?;
-    let areas = root.split_evenly((1, 4));
-    let titles = [
-        ("deformation x(t), mm", "time from touch, ms"),
-        ("velocity v(t), m/s", "time from touch, ms"),
-        ("contact force F(t), N", "time from touch, ms"),
-        ("force against deformation F(x), N", "deformation, mm"),
-    ];
-    for (j, (c, (title, x_label))) in curves.into_iter().zip(titles).enumerate() {
-        let p = Panel {
-            title,
-            x_label,
-            measured: Vec::new(),
-            measured_label: "",
-            models: c,
-            log: false,
-            legend: j == 0,
-        };
-        draw_panel(&areas[j], None, &p)?;
+    let mut text = String::new();
+    {
+        let root = SVGBackend::with_string(&mut text, (1600, 360)).into_drawing_area();
+        root.fill(&WHITE).map_err(|e| e.to_string())?;
+        let areas = root.split_evenly((1, 4));
+        let titles = [
+            ("deformation x(t), mm", "time from touch, ms"),
+            ("velocity v(t), m/s", "time from touch, ms"),
+            ("contact force F(t), N", "time from touch, ms"),
+            ("force against deformation F(x), N", "deformation, mm"),
+        ];
+        for (j, (c, (title, x_label))) in curves.into_iter().zip(titles).enumerate() {
+            let p = Panel {
+                title,
+                x_label,
+                measured: Vec::new(),
+                measured_label: "",
+                models: c,
+                log: false,
+                legend: j == 0,
+            };
+            draw_panel(&areas[j], None, &p)?;
+        }
+        root.present().map_err(|e| e.to_string())?;
     }
-    root.present().map_err(|e| e.to_string())
+    crate::output::write(path, text.as_bytes())
 }

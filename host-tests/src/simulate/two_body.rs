@@ -211,10 +211,12 @@ pub fn widen(o: &TargetOutcome<f32>) -> TargetOutcome<f64> {
 
 /// Runs `impact simulate` with a target.
 pub fn run(args: &SimulateArgs, model: &Model<f64>) -> Result<TargetReport, String> {
-    let t = build(&args.target)?;
     if let Some(path) = &args.target.plot {
-        crate::plot::check_output(path, &[])?;
+        // Before the target file is read: a figure never writes over it.
+        let inputs: Vec<_> = args.target.target.iter().map(|p| p.as_path()).collect();
+        crate::plot::check_output(path, &inputs)?;
     }
+    let t = build(&args.target)?;
     let impact = Impact::new(args.mass, args.v0);
     let closed_form = t.is_free_body()
         || model
@@ -400,110 +402,113 @@ fn plot(
             });
         }
     }
-    let root = SVGBackend::new(path, (1300, 900)).into_drawing_area();
-    root.fill(&WHITE).map_err(|e| e.to_string())?;
-    let panels = root.split_evenly((3, 2));
-    let ms = |s: &Sample<f64>| s.t_s * 1e3;
-    let impactor = RGBColor(200, 60, 30);
-    let target_c = RGBColor(30, 90, 200);
-    type Pick = fn(&Sample<f64>) -> f64;
-    let series: [(&str, Pick, Option<Pick>); 3] = [
-        (
-            "displacement, mm (impact direction +)",
-            |s| s.impactor_m * 1e3,
-            Some(|s| s.target_m * 1e3),
-        ),
-        ("velocity, m/s", |s| s.impactor_m_s, Some(|s| s.target_m_s)),
-        ("contact force, N", |s| s.force_n, None),
-    ];
-    // Left: the contact and a little after; right: the whole ring-down.
-    let spans = [(0.0, (1.5 * tc).min(end)), (0.0, end)];
-    for (index, panel) in panels.iter().enumerate() {
-        let (ylabel, first, second) = series[index / 2];
-        let (t0, t1) = spans[index % 2];
-        let shown: Vec<&Sample<f64>> = samples
-            .iter()
-            .filter(|s| s.t_s <= t1 * (1.0 + 1e-12))
-            .collect();
-        let (mut lo, mut hi) = (f64::MAX, f64::MIN);
-        for s in &shown {
-            for v in [Some(first(s)), second.map(|g| g(s))].into_iter().flatten() {
-                lo = lo.min(v);
-                hi = hi.max(v);
-            }
-        }
-        let pad = 0.05 * (hi - lo).max(1e-12);
-        let title = match index {
-            0 => format!(
-                "{} on a target: the contact, {:.4} ms, COR {:.4}",
-                model.name(),
-                tc * 1e3,
-                o.cor
+    let mut text = String::new();
+    {
+        let root = SVGBackend::with_string(&mut text, (1300, 900)).into_drawing_area();
+        root.fill(&WHITE).map_err(|e| e.to_string())?;
+        let panels = root.split_evenly((3, 2));
+        let ms = |s: &Sample<f64>| s.t_s * 1e3;
+        let impactor = RGBColor(200, 60, 30);
+        let target_c = RGBColor(30, 90, 200);
+        type Pick = fn(&Sample<f64>) -> f64;
+        let series: [(&str, Pick, Option<Pick>); 3] = [
+            (
+                "displacement, mm (impact direction +)",
+                |s| s.impactor_m * 1e3,
+                Some(|s| s.target_m * 1e3),
             ),
-            1 => match free.recontact_s {
-                Some(r) => format!("after separation: recontact at {:.4} ms", r * 1e3),
-                None => format!(
-                    "after separation: the target rings{}, no recontact",
-                    free.ring_frequency_hz
-                        .map_or(String::new(), |f| format!(" at {f:.4} Hz"))
+            ("velocity, m/s", |s| s.impactor_m_s, Some(|s| s.target_m_s)),
+            ("contact force, N", |s| s.force_n, None),
+        ];
+        // Left: the contact and a little after; right: the whole ring-down.
+        let spans = [(0.0, (1.5 * tc).min(end)), (0.0, end)];
+        for (index, panel) in panels.iter().enumerate() {
+            let (ylabel, first, second) = series[index / 2];
+            let (t0, t1) = spans[index % 2];
+            let shown: Vec<&Sample<f64>> = samples
+                .iter()
+                .filter(|s| s.t_s <= t1 * (1.0 + 1e-12))
+                .collect();
+            let (mut lo, mut hi) = (f64::MAX, f64::MIN);
+            for s in &shown {
+                for v in [Some(first(s)), second.map(|g| g(s))].into_iter().flatten() {
+                    lo = lo.min(v);
+                    hi = hi.max(v);
+                }
+            }
+            let pad = 0.05 * (hi - lo).max(1e-12);
+            let title = match index {
+                0 => format!(
+                    "{} on a target: the contact, {:.4} ms, COR {:.4}",
+                    model.name(),
+                    tc * 1e3,
+                    o.cor
                 ),
-            },
-            _ => String::new(),
-        };
-        let mut chart = ChartBuilder::on(panel)
-            .caption(title, ("sans-serif", 17))
-            .margin(10)
-            .x_label_area_size(40)
-            .y_label_area_size(70)
-            .build_cartesian_2d(t0 * 1e3..t1 * 1e3, (lo - pad)..(hi + pad))
-            .map_err(|e| e.to_string())?;
-        chart
-            .configure_mesh()
-            .x_desc("time from first touch, ms")
-            .y_desc(ylabel)
-            .draw()
-            .map_err(|e| e.to_string())?;
-        let name1 = if second.is_some() {
-            "impactor"
-        } else {
-            "contact force"
-        };
-        chart
-            .draw_series(LineSeries::new(
-                shown.iter().map(|s| (ms(s), first(s))),
-                impactor.stroke_width(2),
-            ))
-            .map_err(|e| e.to_string())?
-            .label(name1)
-            .legend(move |(x, y)| {
-                PathElement::new(vec![(x, y), (x + 20, y)], impactor.stroke_width(2))
-            });
-        if let Some(g) = second {
+                1 => match free.recontact_s {
+                    Some(r) => format!("after separation: recontact at {:.4} ms", r * 1e3),
+                    None => format!(
+                        "after separation: the target rings{}, no recontact",
+                        free.ring_frequency_hz
+                            .map_or(String::new(), |f| format!(" at {f:.4} Hz"))
+                    ),
+                },
+                _ => String::new(),
+            };
+            let mut chart = ChartBuilder::on(panel)
+                .caption(title, ("sans-serif", 17))
+                .margin(10)
+                .x_label_area_size(40)
+                .y_label_area_size(70)
+                .build_cartesian_2d(t0 * 1e3..t1 * 1e3, (lo - pad)..(hi + pad))
+                .map_err(|e| e.to_string())?;
+            chart
+                .configure_mesh()
+                .x_desc("time from first touch, ms")
+                .y_desc(ylabel)
+                .draw()
+                .map_err(|e| e.to_string())?;
+            let name1 = if second.is_some() {
+                "impactor"
+            } else {
+                "contact force"
+            };
             chart
                 .draw_series(LineSeries::new(
-                    shown.iter().map(|s| (ms(s), g(s))),
-                    target_c.stroke_width(2),
+                    shown.iter().map(|s| (ms(s), first(s))),
+                    impactor.stroke_width(2),
                 ))
                 .map_err(|e| e.to_string())?
-                .label("target (contact point)")
+                .label(name1)
                 .legend(move |(x, y)| {
-                    PathElement::new(vec![(x, y), (x + 20, y)], target_c.stroke_width(2))
+                    PathElement::new(vec![(x, y), (x + 20, y)], impactor.stroke_width(2))
                 });
+            if let Some(g) = second {
+                chart
+                    .draw_series(LineSeries::new(
+                        shown.iter().map(|s| (ms(s), g(s))),
+                        target_c.stroke_width(2),
+                    ))
+                    .map_err(|e| e.to_string())?
+                    .label("target (contact point)")
+                    .legend(move |(x, y)| {
+                        PathElement::new(vec![(x, y), (x + 20, y)], target_c.stroke_width(2))
+                    });
+            }
+            let sep = vec![(tc * 1e3, lo - pad), (tc * 1e3, hi + pad)];
+            chart
+                .draw_series(std::iter::once(PathElement::new(sep, BLACK.mix(0.4))))
+                .map_err(|e| e.to_string())?
+                .label("separation")
+                .legend(|(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], BLACK.mix(0.4)));
+            chart
+                .configure_series_labels()
+                .background_style(WHITE.mix(0.8))
+                .border_style(BLACK)
+                .position(SeriesLabelPosition::UpperRight)
+                .draw()
+                .map_err(|e| e.to_string())?;
         }
-        let sep = vec![(tc * 1e3, lo - pad), (tc * 1e3, hi + pad)];
-        chart
-            .draw_series(std::iter::once(PathElement::new(sep, BLACK.mix(0.4))))
-            .map_err(|e| e.to_string())?
-            .label("separation")
-            .legend(|(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], BLACK.mix(0.4)));
-        chart
-            .configure_series_labels()
-            .background_style(WHITE.mix(0.8))
-            .border_style(BLACK)
-            .position(SeriesLabelPosition::UpperRight)
-            .draw()
-            .map_err(|e| e.to_string())?;
+        root.present().map_err(|e| e.to_string())?;
     }
-    root.present()
-        .map_err(|e| format!("--plot {}: {e}", path.display()))
+    crate::output::write(path, text.as_bytes())
 }

@@ -21,6 +21,7 @@
 //! for the samples around it.
 
 use super::srs::{self};
+use crate::error::Error;
 
 mod band;
 mod bound;
@@ -76,25 +77,30 @@ impl SpectrumSettings {
         n
     }
 
-    /// Checks the settings at `rate_hz`: a reason if they cannot be computed.
-    pub fn check(&self, rate_hz: f32) -> Result<(), &'static str> {
+    /// Checks the settings at `rate_hz`, naming the one that cannot be computed
+    /// (`srs-damping`, `srs-bands`, `srs-low`).
+    pub fn check(&self, rate_hz: f32) -> Result<(), Error> {
         self.check_parameters()?;
         if self.bands(rate_hz, &mut [0.0; MAX_BANDS]) == 0 {
-            return Err("no band between the lowest band and rate / 8, or more than 96 bands");
+            return Err(Error::InvalidParameter {
+                name: "srs-low",
+                reason: "no band between it and rate / 8, or more than 96 (below rate / 8 by at most 16 octaves at 6 bands per octave, 8 at 12)",
+            });
         }
         Ok(())
     }
 
     /// Damping, bands per octave and lowest band, whatever the rate.
-    fn check_parameters(&self) -> Result<(), &'static str> {
+    fn check_parameters(&self) -> Result<(), Error> {
+        let invalid = |name, reason| Err(Error::InvalidParameter { name, reason });
         if !(self.damping >= 0.0 && self.damping <= 0.5) {
-            return Err("damping must lie in [0, 0.5]");
+            return invalid("srs-damping", "must lie in [0, 0.5]");
         }
         if !matches!(self.bands_per_octave, 6 | 12) {
-            return Err("bands per octave must be 6 or 12");
+            return invalid("srs-bands", "must be 6 or 12");
         }
         if !(self.low_hz > 0.0 && self.low_hz.is_finite()) {
-            return Err("lowest band must be finite and > 0");
+            return invalid("srs-low", "must be finite and > 0");
         }
         Ok(())
     }

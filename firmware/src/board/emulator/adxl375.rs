@@ -23,6 +23,7 @@ use super::timer::CmsdkTimer;
 use crate::source::poll::{Fifo, Poll, Read, MAX_ENTRIES};
 use impact_firmware::adxl375::Axes;
 use impact_firmware::semihosting::{HostError, HostFile};
+use impact_firmware::ticks;
 
 const TIMER: CmsdkTimer = CmsdkTimer::at(0x4000_0000);
 
@@ -48,6 +49,8 @@ struct Sensor {
     /// Counter ticks at sample 0's deadline, and per sample.
     start: u64,
     period: f64,
+    /// The timer's shot is a step toward the next deadline, beyond its reach (171.8 s).
+    stepping: bool,
 }
 
 static SENSOR: Mutex<CriticalSectionRawMutex, RefCell<Sensor>> = Mutex::new(RefCell::new(Sensor {
@@ -64,6 +67,7 @@ static SENSOR: Mutex<CriticalSectionRawMutex, RefCell<Sensor>> = Mutex::new(RefC
     ended: false,
     start: 0,
     period: 1.0,
+    stepping: false,
 }));
 
 /// Timer 0 drives the emulated ADXL375 instead of the emulated DMA.
@@ -99,18 +103,23 @@ pub fn start(file: HostFile, rate_hz: f64) {
         s.file = Some(file);
         s.period = CLOCK_HZ as f64 / rate_hz;
         s.start = counter();
-        arm(&s);
+        arm(&mut s);
     });
     // SAFETY: the timer's handler is `on_timer`, reached through `irq::DefaultHandler`.
     unsafe { NVIC::unmask(Irq::Timer0) };
 }
 
-fn arm(s: &Sensor) {
-    let deadline = s.start + ((s.produced + 1) as f64 * s.period) as u64;
-    let delay = deadline
-        .saturating_sub(counter())
-        .clamp(1, u64::from(u32::MAX));
-    TIMER.one_shot(delay as u32);
+/// The next sample's deadline, counter ticks.
+fn deadline(s: &Sensor) -> u64 {
+    s.start + ((s.produced + 1) as f64 * s.period) as u64
+}
+
+/// Arms the timer for the next sample's deadline (at once if it has passed; a step toward
+/// it if it is beyond the timer's reach).
+fn arm(s: &mut Sensor) {
+    let (ticks, reaches) = ticks::shot(deadline(s), counter(), u32::MAX);
+    s.stepping = !reaches;
+    TIMER.one_shot(ticks);
 }
 
 /// Refills the read-ahead from the file; false at its end (or on an error).
@@ -136,12 +145,17 @@ fn refill(s: &mut Sensor) -> bool {
     n > 0
 }
 
-/// The timer's interrupt: the part produces its next sample.
+/// The timer's interrupt: the part produces its next sample (or, after a step toward a
+/// deadline beyond the timer's reach, the next shot is armed).
 pub fn on_timer() {
     TIMER.clear();
     critical_section::with(|cs| {
         let mut s = SENSOR.borrow(cs).borrow_mut();
         if s.ended {
+            return;
+        }
+        if s.stepping {
+            arm(&mut s);
             return;
         }
         if s.chunk_next == s.chunk_len && !refill(&mut s) {
@@ -164,7 +178,7 @@ pub fn on_timer() {
         }
         s.len += 1;
         s.produced += 1;
-        arm(&s);
+        arm(&mut s);
     });
 }
 

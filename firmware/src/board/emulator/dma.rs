@@ -21,6 +21,7 @@ use super::time::{counter, CLOCK_HZ};
 use super::timer::CmsdkTimer;
 use crate::queues::BLOCK_LEN;
 use impact_firmware::semihosting::HostFile;
+use impact_firmware::ticks;
 
 /// Blocks in the ring (the board's DMA ring: two halves).
 pub const RING_BLOCKS: u32 = 2;
@@ -38,6 +39,9 @@ struct Dma {
     /// Counter ticks at block 0's deadline, and per block.
     start: u64,
     period: f64,
+    /// The timer's shot is a step toward the next deadline, beyond its reach (171.8 s: a
+    /// block period of a replay slowed below 1.5 S/s).
+    stepping: bool,
 }
 
 static DMA: Mutex<CriticalSectionRawMutex, RefCell<Dma>> = Mutex::new(RefCell::new(Dma {
@@ -48,6 +52,7 @@ static DMA: Mutex<CriticalSectionRawMutex, RefCell<Dma>> = Mutex::new(RefCell::n
     ended: false,
     start: 0,
     period: 1.0,
+    stepping: false,
 }));
 
 /// A block was written (or the file ended).
@@ -67,27 +72,36 @@ pub fn start(file: HostFile, rate_hz: f64) {
         d.start = counter();
         d.written = 0;
         d.ended = false;
-        arm(&d);
+        arm(&mut d);
     });
     // SAFETY: the timer's handler is `on_timer`, reached through `irq::DefaultHandler`.
     unsafe { NVIC::unmask(Irq::Timer0) };
 }
 
-/// Arms the timer for the next block's deadline.
-fn arm(d: &Dma) {
-    let deadline = d.start + (f64::from(d.written + 1) * d.period) as u64;
-    let delay = deadline
-        .saturating_sub(counter())
-        .clamp(1, u64::from(u32::MAX));
-    TIMER.one_shot(delay as u32);
+/// The next block's deadline, counter ticks.
+fn deadline(d: &Dma) -> u64 {
+    d.start + (f64::from(d.written + 1) * d.period) as u64
 }
 
-/// The timer's interrupt: the next block arrives.
+/// Arms the timer for the next block's deadline (at once if it has passed; a step toward it
+/// if it is beyond the timer's reach).
+fn arm(d: &mut Dma) {
+    let (ticks, reaches) = ticks::shot(deadline(d), counter(), u32::MAX);
+    d.stepping = !reaches;
+    TIMER.one_shot(ticks);
+}
+
+/// The timer's interrupt: the next block arrives (or, after a step toward a deadline beyond
+/// the timer's reach, the next shot is armed).
 pub fn on_timer() {
     TIMER.clear();
     critical_section::with(|cs| {
         let mut d = DMA.borrow(cs).borrow_mut();
         if d.ended {
+            return;
+        }
+        if d.stepping {
+            arm(&mut d);
             return;
         }
         let slot = (d.written % RING_BLOCKS) as usize;
@@ -117,7 +131,7 @@ pub fn on_timer() {
                 d.ended = true;
                 d.file = None;
             } else {
-                arm(&d);
+                arm(&mut d);
             }
         }
     });

@@ -28,7 +28,8 @@ const FPGAIO_COUNTER: *const u32 = 0x4002_8018 as *const u32;
 const ALARM: CmsdkTimer = CmsdkTimer::at(0x4000_1000);
 
 /// Longest one-shot delay, counter ticks: well under half the counter's wrap, so the
-/// interrupt handler extends the counter to 64 bits at least twice per wrap.
+/// interrupt handler extends the counter to 64 bits at least twice per wrap (the alarm stays
+/// armed with no timer waiting: [`State::arm`]).
 const MAX_DELAY: u64 = 1 << 31;
 
 const CYCLES_PER_TICK: u64 = CLOCK_HZ / TICK_HZ;
@@ -57,12 +58,10 @@ impl State {
         (self.wraps << 32) | u64::from(now)
     }
 
-    /// Arms the alarm for `at` (embassy ticks; `u64::MAX`: none).
+    /// Arms the alarm for `at` (embassy ticks; `u64::MAX`: none, and the alarm comes after
+    /// `MAX_DELAY` all the same, so that the counter is read twice per wrap whoever else reads
+    /// it: a slowed replay's DMA may not for longer than a wrap).
     fn arm(&mut self, at: u64) {
-        if at == u64::MAX {
-            ALARM.stop();
-            return;
-        }
         let now = self.counter();
         let delay = at
             .saturating_mul(CYCLES_PER_TICK)

@@ -318,6 +318,7 @@ pub fn run(args: &M4Args) -> Result<(M4Report, String), String> {
     std::fs::write(&raw, bytes).map_err(|e| format!("{}: {e}", raw.display()))?;
     let trace_jobs = dir.join(format!("{stem}-trace.txt"));
     let count_jobs = dir.join(format!("{stem}-count.txt"));
+    let _temporaries = [&raw, &trace_jobs, &count_jobs].map(|p| crate::interrupt::temporary(p));
     let result = (|| {
         std::fs::write(
             &trace_jobs,
@@ -555,6 +556,7 @@ fn firmware_idle_marginal(firmware: &Path) -> Result<f64, String> {
     for n in [1usize << 17, 1 << 18] {
         let counts = crate::bench::throughput::impact_stream(n, 0);
         let raw = dir.join(format!("impact-m4-idle-{}-{n}.i16", std::process::id()));
+        let _raw = crate::interrupt::temporary(&raw);
         let bytes: Vec<u8> = counts.iter().flat_map(|c| c.to_le_bytes()).collect();
         std::fs::write(&raw, bytes).map_err(|e| format!("{}: {e}", raw.display()))?;
         let mut lines = 0u64;

@@ -27,6 +27,7 @@ pub(super) fn run_qemu(
 ) -> Result<String, String> {
     let dir = std::env::temp_dir().join(format!("impact-m4-{}", std::process::id()));
     std::fs::create_dir_all(&dir).map_err(|e| format!("{}: {e}", dir.display()))?;
+    let _dir = crate::interrupt::temporary(&dir);
     let mut cmd = Command::new("qemu-system-arm");
     cmd.args([
         "-machine",
@@ -51,8 +52,16 @@ pub(super) fn run_qemu(
         cmd.args(["-icount", "shift=0"]);
     }
     let fifo = dir.join("trace.fifo");
+    // Removed, and QEMU ended, on an interrupt.
+    let _fifo = crate::interrupt::temporary(&fifo);
     let result = match trace {
-        None => cmd.output().map_err(|e| format!("qemu-system-arm: {e}")),
+        None => cmd
+            .spawn()
+            .and_then(|child| {
+                let _child = crate::interrupt::child(child.id());
+                child.wait_with_output()
+            })
+            .map_err(|e| format!("qemu-system-arm: {e}")),
         Some(on_line) => {
             let _ = std::fs::remove_file(&fifo);
             let status = Command::new("mkfifo")
@@ -65,6 +74,7 @@ pub(super) fn run_qemu(
             cmd.args(["-singlestep", "-d", "exec,nochain", "-D"])
                 .arg(&fifo);
             let child = cmd.spawn().map_err(|e| format!("qemu-system-arm: {e}"))?;
+            let _child = crate::interrupt::child(child.id());
             // QEMU opens the log when it starts; the FIFO blocks until then.
             let file =
                 std::fs::File::open(&fifo).map_err(|e| format!("{}: {e}", fifo.display()))?;

@@ -1,0 +1,240 @@
+//! The one output rule: a file the tool writes is never one of its inputs, and it appears
+//! whole or not at all.
+//!
+//! Every output (a figure, a log, a defmt stream, an exported window, a synthesised
+//! recording) is checked against the command's inputs before any work: the same file, a hard
+//! or symbolic link to it, or the file standard input is read from is refused. It is then
+//! written to a temporary file beside it, renamed into place once complete: a reader never
+//! sees half a file, two writers cannot interleave (the last rename wins), and an error or an
+//! interrupt leaves nothing behind (the temporary file is registered with
+//! [`crate::interrupt`], which removes it on Ctrl-C).
+
+use std::io::Write;
+use std::path::{Path, PathBuf};
+
+/// The files a command reads: the recording, a scene, a free-fall recording, a target, an
+/// ELF, a log; `-` is standard input.
+#[derive(Clone, Debug, Default)]
+pub struct Inputs {
+    paths: Vec<PathBuf>,
+}
+
+impl Inputs {
+    pub fn new() -> Self {
+        Self::default()
+    }
+
+    /// One more input (`-` for standard input).
+    pub fn with(mut self, path: &Path) -> Self {
+        self.paths.push(path.to_path_buf());
+        self
+    }
+
+    /// One more input if there is one.
+    pub fn with_some(self, path: Option<&Path>) -> Self {
+        match path {
+            Some(p) => self.with(p),
+            None => self,
+        }
+    }
+}
+
+/// The file's identity (device and inode), following symbolic links; `None` if it does not
+/// exist.
+#[cfg(unix)]
+fn identity(path: &Path) -> Option<(u64, u64)> {
+    use std::os::unix::fs::MetadataExt;
+    std::fs::metadata(path).ok().map(|m| (m.dev(), m.ino()))
+}
+
+/// Standard input's file (a redirection `< FILE`), if it is one.
+#[cfg(unix)]
+fn stdin_identity() -> Option<(u64, u64)> {
+    use std::os::unix::fs::MetadataExt;
+    use std::os::unix::io::AsFd;
+    let fd = std::io::stdin().as_fd().try_clone_to_owned().ok()?;
+    let file = std::fs::File::from(fd);
+    file.metadata().ok().map(|m| (m.dev(), m.ino()))
+}
+
+#[cfg(not(unix))]
+fn identity(path: &Path) -> Option<(u64, u64)> {
+    let _ = path.canonicalize().ok()?;
+    None
+}
+
+#[cfg(not(unix))]
+fn stdin_identity() -> Option<(u64, u64)> {
+    None
+}
+
+/// Checks, before any work, that `path` (the value of `option`) can take an output: its
+/// directory exists, it is no directory itself, and it is none of the `inputs` (the same file,
+/// a link to one, standard input's file). `extension`, if given, is the one the output must
+/// have (`svg`).
+pub fn check(
+    option: &str,
+    path: &Path,
+    inputs: &Inputs,
+    extension: Option<&str>,
+) -> Result<(), String> {
+    let shown = path.display();
+    let dir = directory(path);
+    if !dir.is_dir() {
+        return Err(format!(
+            "{option} {shown}: directory {} does not exist",
+            dir.display()
+        ));
+    }
+    if path.is_dir() {
+        return Err(format!("{option} {shown}: is a directory"));
+    }
+    if let Some(out) = identity(path) {
+        for input in &inputs.paths {
+            let same = if input.as_os_str() == "-" {
+                stdin_identity() == Some(out)
+            } else {
+                identity(input) == Some(out)
+            };
+            if same {
+                let what = if input.as_os_str() == "-" {
+                    "the input file read on standard input".to_string()
+                } else {
+                    format!("the input file {}", input.display())
+                };
+                return Err(format!(
+                    "{option} {shown}: is {what}; it would be overwritten (write to another file)"
+                ));
+            }
+        }
+    }
+    // Without a file yet, its name may still be an input's (not created yet) only by a
+    // dangling link: the comparison by name covers it.
+    if identity(path).is_none() {
+        if let Ok(target) = std::fs::read_link(path) {
+            let target = dir.join(target);
+            if inputs.paths.contains(&target) {
+                return Err(format!(
+                    "{option} {shown}: links to an input; it would be overwritten"
+                ));
+            }
+        }
+    }
+    if let Some(ext) = extension {
+        let ok = path
+            .extension()
+            .is_some_and(|e| e.eq_ignore_ascii_case(ext));
+        if !ok {
+            return Err(format!(
+                "{option} {shown}: the output is {}: name the file .{ext}",
+                ext.to_uppercase()
+            ));
+        }
+    }
+    Ok(())
+}
+
+/// The directory `path` is in (`.` for a bare name).
+fn directory(path: &Path) -> &Path {
+    match path.parent() {
+        Some(d) if !d.as_os_str().is_empty() => d,
+        _ => Path::new("."),
+    }
+}
+
+/// Writes `bytes` to `path`, whole or not at all (see the module).
+pub fn write(path: &Path, bytes: &[u8]) -> Result<(), String> {
+    write_with(path, |w| w.write_all(bytes))
+}
+
+/// Writes `path` through `fill`, whole or not at all: into a temporary file beside it,
+/// renamed into place once `fill` and the flush succeed; on an error (a full disk, a file
+/// size limit) the temporary file is removed and the error names `path`.
+pub fn write_with(
+    path: &Path,
+    fill: impl FnOnce(&mut dyn Write) -> std::io::Result<()>,
+) -> Result<(), String> {
+    let shown = path.display();
+    let name = path
+        .file_name()
+        .map_or_else(|| "output".into(), |n| n.to_string_lossy().into_owned());
+    let tmp = tempfile::Builder::new()
+        .prefix(&format!(".{name}."))
+        .suffix(".part")
+        .tempfile_in(directory(path))
+        .map_err(|e| format!("{shown}: {e}"))?;
+    let guard = crate::interrupt::temporary(tmp.path());
+    {
+        let mut w = std::io::BufWriter::new(tmp.as_file());
+        fill(&mut w).map_err(|e| format!("{shown}: {e}"))?;
+        w.flush().map_err(|e| format!("{shown}: {e}"))?;
+    }
+    // A new file's usual permissions (the temporary one is private).
+    #[cfg(unix)]
+    {
+        use std::os::unix::fs::PermissionsExt;
+        let mode = std::fs::Permissions::from_mode(0o644);
+        std::fs::set_permissions(tmp.path(), mode).map_err(|e| format!("{shown}: {e}"))?;
+    }
+    tmp.persist(path)
+        .map_err(|e| format!("{shown}: {}", e.error))?;
+    drop(guard);
+    Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn dir() -> PathBuf {
+        let d = std::env::temp_dir().join(format!("impact-output-{}", std::process::id()));
+        std::fs::create_dir_all(&d).unwrap();
+        d
+    }
+
+    #[test]
+    fn an_input_a_link_to_it_or_its_hard_link_is_refused() {
+        let d = dir();
+        let input = d.join("in.csv");
+        std::fs::write(&input, "a\n").unwrap();
+        let inputs = Inputs::new().with(&input);
+        assert!(check("--plot", &input, &inputs, None).is_err());
+        let hard = d.join("hard.svg");
+        let _ = std::fs::remove_file(&hard);
+        std::fs::hard_link(&input, &hard).unwrap();
+        let e = check("--plot", &hard, &inputs, Some("svg")).unwrap_err();
+        assert!(e.contains("would be overwritten"), "{e}");
+        #[cfg(unix)]
+        {
+            let soft = d.join("soft.svg");
+            let _ = std::fs::remove_file(&soft);
+            std::os::unix::fs::symlink(&input, &soft).unwrap();
+            assert!(check("--plot", &soft, &inputs, Some("svg")).is_err());
+        }
+        assert!(check("--plot", &d.join("new.svg"), &inputs, Some("svg")).is_ok());
+        assert!(check("--plot", &d.join("new.png"), &inputs, Some("svg")).is_err());
+        assert!(check("--plot", &d.join("nowhere/x.svg"), &inputs, None).is_err());
+    }
+
+    #[test]
+    fn a_write_is_whole_or_leaves_nothing() {
+        let d = dir();
+        let out = d.join("whole.txt");
+        write(&out, b"complete\n").unwrap();
+        assert_eq!(std::fs::read(&out).unwrap(), b"complete\n");
+        // A failing writer: the old file stays, no temporary file is left.
+        let e = write_with(&out, |w| {
+            w.write_all(b"half")?;
+            Err(std::io::Error::other("disk full"))
+        })
+        .unwrap_err();
+        assert!(e.contains("whole.txt") && e.contains("disk full"), "{e}");
+        assert_eq!(std::fs::read(&out).unwrap(), b"complete\n");
+        let left: Vec<_> = std::fs::read_dir(&d)
+            .unwrap()
+            .filter_map(|e| e.ok())
+            .filter(|e| e.file_name().to_string_lossy().ends_with(".part"))
+            .collect();
+        assert!(left.is_empty(), "{left:?}");
+    }
+}

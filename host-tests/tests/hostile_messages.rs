@@ -1,0 +1,359 @@
+//! Hostile input, round three: messages that were false or named the wrong option. Each
+//! refusal names what was given (the option, the scene file's key, the file's property or
+//! line) and what is accepted; a value that would have been lost silently is refused.
+
+use std::path::PathBuf;
+use std::process::{Command, Stdio};
+
+mod common;
+use common::{assert_refused, impact};
+
+/// A file of `bytes` in this run's temporary directory.
+fn temp(name: &str, bytes: &[u8]) -> PathBuf {
+    let dir = std::env::temp_dir().join(format!("impact-messages-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let p = dir.join(name);
+    std::fs::write(&p, bytes).unwrap();
+    p
+}
+
+/// Read whole (`IMPACT_READ_WHOLE`, as `--axes` or `--resample` read a recording) where the
+/// arguments hold this word, in passes elsewhere.
+const WHOLE: &str = "(read whole)";
+
+/// `impact ARGS` is refused with a message holding every one of `want` and none of `not`:
+/// the message.
+fn refused(args: &[&str], want: &[&str], not: &[&str]) -> String {
+    let whole = args.contains(&WHOLE);
+    let args: Vec<&str> = args.iter().copied().filter(|a| *a != WHOLE).collect();
+    let args = args.as_slice();
+    let (code, out, err) = if whole {
+        let out = Command::new(env!("CARGO_BIN_EXE_impact"))
+            .args(args)
+            .env("IMPACT_READ_WHOLE", "1")
+            .output()
+            .expect("runs");
+        (
+            out.status.code().unwrap_or(-1),
+            String::from_utf8_lossy(&out.stdout).into_owned(),
+            String::from_utf8_lossy(&out.stderr).into_owned(),
+        )
+    } else {
+        impact(args)
+    };
+    let what = format!("impact {}\n{out}", args.join(" "));
+    assert_refused(Some(code), &err, want[0], &what);
+    for w in want {
+        assert!(err.contains(w), "{what}: wanted {w:?} in {err}");
+    }
+    for n in not {
+        assert!(!err.contains(n), "{what}: {n:?} in {err}");
+    }
+    err
+}
+
+/// `impact analyze - ARGS` with `file` on standard input: (exit code, stderr).
+fn analyze_stdin(file: &PathBuf, args: &[&str]) -> (i32, String) {
+    let out = Command::new(env!("CARGO_BIN_EXE_impact"))
+        .args(["analyze", "-"])
+        .args(args)
+        .stdin(Stdio::from(std::fs::File::open(file).unwrap()))
+        .output()
+        .expect("runs");
+    (
+        out.status.code().unwrap_or(-1),
+        String::from_utf8_lossy(&out.stderr).into_owned(),
+    )
+}
+
+/// The hostile-input issue's `T2` recording (one 55.6 g impact), as a file.
+fn t2() -> PathBuf {
+    temp("t2.csv", common::synth_t2().as_bytes())
+}
+
+#[test]
+fn values_the_core_cannot_hold_are_out_of_range_not_infinite() {
+    // Finite and > 0, but beyond the f32 the core takes: each option names its limits.
+    let t2 = t2();
+    let t2 = t2.to_str().unwrap();
+    for (args, option, limits) in [
+        (
+            &["--mass", "1e300"][..],
+            "--mass",
+            "between 1e-30 and 1e6 kg",
+        ),
+        (&["--mass", "1e-300"], "--mass", "between 1e-30 and 1e6 kg"),
+        (&["--rate", "1e-300"], "--rate", "between 1e-30 and 1e8 Hz"),
+        (
+            &["--train", "flight", "--gravity", "1e300"],
+            "--gravity",
+            "between 1e-30 and 1e30 m/s²",
+        ),
+        (
+            &["--train", "flight", "--max-flight", "1e-300"],
+            "--max-flight",
+            "between 1e-30 and 1e30 s",
+        ),
+        (&["--hold", "1e-300"], "--hold", "between 1e-30 and 1e30 s"),
+        (&["--v0", "1e300"], "--v0", "between 1e-30 and 1e30 m/s"),
+        (
+            &["--trigger", "1e300"],
+            "--trigger 1e300 m/s²",
+            "between 1e-30 and 1e30 m/s²",
+        ),
+        (
+            &["--trigger", "1e30g"],
+            "--trigger 1e30g (9.807e30 m/s²)",
+            "between 1e-30 and 1e30 m/s²",
+        ),
+        (
+            &["--srs", "--srs-low", "1e-300"],
+            "--srs-low",
+            "between 1e-30 and 1e30 Hz",
+        ),
+        (
+            &["--range", "1e300"],
+            "--range 1e300 m/s²",
+            "between 1e-30 and 1e30 m/s²",
+        ),
+        (
+            &["--range", "1e-300"],
+            "--range 1e-300 m/s²",
+            "between 1e-30 and 1e30 m/s²",
+        ),
+        // Dropped the impact silently: every reading under one count.
+        (&["--gain", "1e-40"], "--gain", "between 1e-30 and 1e30"),
+    ] {
+        let mut all = vec!["analyze", t2];
+        all.extend_from_slice(args);
+        let err = refused(
+            &all,
+            &[option, &format!("out of range ({limits}")],
+            &["finite", "--gain:", "--clip", "--srs:"],
+        );
+        assert!(!err.contains("1000000000"), "{err}");
+    }
+    // The lowest band below the rate's reach names --srs-low, not --srs.
+    refused(
+        &["analyze", t2, "--srs", "--srs-low", "1e-20"],
+        &["--srs-low: no band between it and rate / 8"],
+        &["--srs:"],
+    );
+    // A recording of zeros with a range of 1e-300 named an option that does not exist.
+    let zeros: String = std::iter::once("time_s,accel_g\n".to_string())
+        .chain((0..2000).map(|i| format!("{:.6},0\n", i as f64 * 2e-6)))
+        .collect();
+    let zeros = temp("zeros.csv", zeros.as_bytes());
+    refused(
+        &["analyze", zeros.to_str().unwrap(), "--range", "1e-300"],
+        &["--range 1e-300 m/s²: out of range"],
+        &["--clip"],
+    );
+}
+
+#[test]
+fn readings_too_small_or_large_for_the_counts_are_refused_not_lost() {
+    // Readings of 1e-5 g times --gain 1e-30 are below the smallest full scale: every count
+    // would be 0 and the impact lost.
+    let tiny: String = std::iter::once("time_s,accel_g\n".to_string())
+        .chain((0..2000).map(|i| {
+            let v = if (1000..1010).contains(&i) { 1e-5 } else { 0.0 };
+            format!("{:.6},{v}\n", i as f64 * 1e-5)
+        }))
+        .collect();
+    let tiny = temp("tiny.csv", tiny.as_bytes());
+    let t2 = t2();
+    for (file, gain) in [(&tiny, "1e-30"), (&t2, "1e30")] {
+        refused(
+            &["analyze", file.to_str().unwrap(), "--gain", gain],
+            &[
+                "the recording reaches",
+                "out of range (between 1e-30 and 1e30 m/s²)",
+                "--gain",
+            ],
+            &["--gain: must be finite"],
+        );
+    }
+}
+
+#[test]
+fn scene_files_are_named_with_their_keys() {
+    let t2 = t2();
+    let t2 = t2.to_str().unwrap();
+    for (name, json, want) in [
+        (
+            "hold.json",
+            r#"{"hold": 1e-300}"#,
+            "hold.json: hold 1e-300: out of range (between 1e-30 and 1e30 s)",
+        ),
+        (
+            "max_impact.json",
+            r#"{"max_impact": 1e-9}"#,
+            "max_impact.json: max_impact 1e-9: shorter than the hold (at least the default --hold, 0.002 s)",
+        ),
+        (
+            "mass.json",
+            r#"{"mass": 1e300}"#,
+            "mass.json: mass 1e300: out of range (between 1e-30 and 1e6 kg)",
+        ),
+        (
+            "trigger.json",
+            r#"{"trigger": "1e30g"}"#,
+            "trigger.json: trigger 1e30g (9.807e30 m/s²): out of range",
+        ),
+        (
+            "edge.json",
+            r#"{"edge": "100g", "trigger": "5g"}"#,
+            "edge.json: edge 100g (980.7 m/s²): not below the trigger level (below the scene file's trigger 5g, 49.03 m/s²)",
+        ),
+        (
+            "cfc.json",
+            r#"{"cfc": 7}"#,
+            "cfc.json: cfc: 7 is not one of 60, 180, 600, 1000",
+        ),
+        (
+            "exponent.json",
+            r#"{"fits": {"exponent": 7}}"#,
+            "exponent.json: fits.exponent 7: out of range (between 1 and 4)",
+        ),
+    ] {
+        let scene = temp(name, json.as_bytes());
+        refused(
+            &["analyze", t2, "--scene", scene.to_str().unwrap()],
+            &[want],
+            // (Not blamed on an option.)
+            &["error: --"],
+        );
+    }
+    // On the command line the same checks name the options.
+    refused(
+        &["analyze", t2, "--hold", "5"],
+        &["--hold 5: longer than the longest impact (at most the default --max-impact, 1 s)"],
+        &[],
+    );
+    refused(
+        &["analyze", t2, "--hold", "0.5", "--settle", "0.1"],
+        &["--settle 0.1: shorter than the hold (at least --hold 0.5)"],
+        &[],
+    );
+}
+
+#[test]
+fn a_rate_from_a_file_names_the_file_and_its_property() {
+    let fixtures = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("fixtures");
+    let mut tdms = std::fs::read(fixtures.join("afrl-test1.tdms")).unwrap();
+    // Every wf_increment (a double after its name and type code) 1e300 s.
+    let mut at = 0;
+    while let Some(p) = tdms[at..].windows(12).position(|w| w == b"wf_increment") {
+        let value = at + p + 12 + 4;
+        tdms[value..value + 8].copy_from_slice(&1e300f64.to_le_bytes());
+        at = value + 8;
+    }
+    assert!(at > 0, "the fixture has a wf_increment");
+    let tdms = temp("increment.tdms", &tdms);
+    let tdms = tdms.to_str().unwrap();
+    for extra in [
+        &[][..],
+        &[WHOLE],
+        &["--stream", "--range", "16000g", "--trigger", "5g"],
+    ] {
+        let mut args = vec!["analyze", tdms];
+        args.extend_from_slice(extra);
+        refused(
+            &args,
+            &["increment.tdms: afrl/bottom_kgn: wf_increment 1e300: out of range (between 1e-8 and 1e30 s)"],
+            &["--rate"],
+        );
+    }
+    // A time column at 1 GS/s (nanoseconds named seconds).
+    let fast: String = std::iter::once("time_s,accel_g\n".to_string())
+        .chain((0..2000).map(|i| format!("{:.12},0\n", i as f64 * 1e-9)))
+        .collect();
+    let fast = temp("fast.csv", fast.as_bytes());
+    refused(
+        &["analyze", fast.to_str().unwrap()],
+        &["fast.csv: the time column \"time_s\" gives 1e9 S/s: out of range (between 1e-30 and 1e8 Hz)"],
+        &["--rate:"],
+    );
+}
+
+#[test]
+fn a_raw_file_without_a_rate_asks_for_rate_not_stream() {
+    let zeros = vec![0u8; 4096];
+    for name in ["codes.i16", "values.f32"] {
+        let raw = temp(name, &zeros);
+        let raw = raw.to_str().unwrap();
+        for extra in [
+            &[][..],
+            &[WHOLE],
+            &["--stream", "--range", "16g", "--trigger", "5g"],
+        ] {
+            let mut args = vec!["analyze", raw];
+            args.extend_from_slice(extra);
+            refused(
+                &args,
+                &[&format!("{name}: a raw file holds no time: give --rate")],
+                &["--stream:"],
+            );
+        }
+        refused(
+            &["analyze", raw, "--time-column", "0"],
+            &[&format!(
+                "{name}: a raw file takes --rate, --raw-channels and --column only"
+            )],
+            &["--stream:"],
+        );
+    }
+}
+
+/// A CSV of `rows` rows of a 500 kS/s time column and zeros, with `line` (1-based, the header
+/// is line 1) changed by `change`, then `after` more rows.
+fn csv_with(rows: usize, change: impl Fn(String) -> String, after: usize) -> Vec<u8> {
+    let mut text = String::from("time_s,accel_g\n");
+    for i in 0..rows + after {
+        let row = format!("{:.6},0\n", i as f64 * 2e-6);
+        text.push_str(&if i == rows { change(row) } else { row });
+    }
+    text.into_bytes()
+}
+
+#[test]
+fn an_unclosed_quote_is_reported_where_it_was_opened() {
+    // Past the sequential reader's head (the parallel one stops at the quote and hands over)
+    // and within it; the quoted text runs past the longest line, or to the end of the file.
+    for (rows, after, want) in [
+        (100_000, 120_000, "not closed within 1048576 bytes"),
+        (100, 120_000, "not closed within 1048576 bytes"),
+        (100_000, 1000, "never closed"),
+    ] {
+        let line = rows + 2;
+        let csv = temp(
+            &format!("quote-{rows}-{after}.csv"),
+            &csv_with(rows, |row| format!("\"{row}"), after),
+        );
+        let want = format!(":{line}: a quote opened on this line is {want}");
+        refused(&["analyze", csv.to_str().unwrap()], &[&want], &[]);
+        refused(&["analyze", csv.to_str().unwrap(), WHOLE], &[&want], &[]);
+        let (code, err) = analyze_stdin(&csv, &[]);
+        assert_refused(Some(code), &err, &format!("stdin{want}"), "stdin");
+    }
+}
+
+#[test]
+fn a_byte_order_mark_after_the_first_line_is_refused_on_every_line() {
+    for rows in [100, 100_000] {
+        let line = rows + 2;
+        let csv = temp(
+            &format!("bom-{rows}.csv"),
+            &csv_with(rows, |row| format!("\u{feff}{row}"), 2000),
+        );
+        let want = format!(":{line}: not a number: \"\\u{{feff}}");
+        for extra in [&[][..], &[WHOLE]] {
+            let mut args = vec!["analyze", csv.to_str().unwrap()];
+            args.extend_from_slice(extra);
+            refused(&args, &[&want, "a byte-order mark"], &[]);
+        }
+        let (code, err) = analyze_stdin(&csv, &[]);
+        assert_refused(Some(code), &err, &format!("stdin{want}"), "stdin");
+    }
+}
