@@ -2,7 +2,8 @@
 # Installs what the project needs beyond a Rust toolchain, idempotently:
 #   - the Cortex-M4F Rust target (thumbv7em-none-eabihf), rustfmt and clippy;
 #   - qemu-system-arm (Debian package) for the emulated firmware;
-#   - arm-none-eabi-objdump (Debian binutils-arm-none-eabi) for `impact bench m4`'s cycle model.
+#   - arm-none-eabi-objdump (Debian binutils-arm-none-eabi) for `impact bench m4`'s cycle model;
+#   - chromium (Debian package) for the HTML report's test in a real headless browser.
 # With --board, also probe-rs (crates.io `probe-rs-tools`, a few minutes to build) to flash
 # the STM32F4-Discovery and read its defmt log (`cargo fw-run`).
 # Run as root or with sudo available for apt-get.
@@ -20,6 +21,7 @@ done
 need_apt=()
 command -v qemu-system-arm >/dev/null || need_apt+=(qemu-system-arm)
 command -v arm-none-eabi-size >/dev/null || need_apt+=(binutils-arm-none-eabi)
+command -v chromium >/dev/null || need_apt+=(chromium)
 if [[ ${#need_apt[@]} -gt 0 ]]; then
   sudo=""; [[ $(id -u) == 0 ]] || sudo="sudo"
   $sudo apt-get update -qq

@@ -50,7 +50,8 @@ cargo fw
 step "host tests (the documented commands, the emulated firmware against the host, real time)"
 # tests/emulator.rs compares the emulated firmware with the host bit for bit; the tools were
 # installed above, so a missing one is an error here, not a skip.
-IMPACT_REQUIRE_EMULATOR=1 cargo test --workspace --exclude impact-firmware "${HOST[@]}"
+# tests/report.rs loads the HTML report in headless Chromium, also installed above.
+IMPACT_REQUIRE_EMULATOR=1 IMPACT_REQUIRE_BROWSER=1 cargo test --workspace --exclude impact-firmware "${HOST[@]}"
 
 step "M4 instruction counts (QEMU, exact) against the stored baseline: fails on a > 10 % regression"
 # Also checks the hand-written M4 routines against their portable versions and every f32

@@ -34,6 +34,7 @@ pub mod report;
 pub mod scene;
 pub mod signal;
 pub mod solve;
+pub mod spec;
 pub mod stream;
 pub mod two_body;
 pub mod waveform;

@@ -16,14 +16,18 @@ use core::sync::atomic::{AtomicBool, AtomicU32, AtomicUsize, Ordering};
 /// The RTT up-buffer, bytes (one byte of it always stays free).
 pub const BUFFER_LEN: usize = 4096;
 
-/// Staging slots: frames being written at once (a low-priority line preempted by a middle one
-/// preempted by a high one).
-const SLOTS: usize = 3;
+/// Staging slots of the longest frames: the two outer depths (a low-priority line preempted by
+/// a middle one, the reporter's, which prints the longest lines).
+const SLOTS: usize = 2;
 
 /// A staging slot, bytes: the longest frame with room. An `srs` line of the most bands the
 /// analysis computes (96) is ~1.6 KB: each of its 192 values costs 8 bytes (the `{=f32}`
 /// write and the comma's), the fields before them ~60.
 const SLOT_LEN: usize = 1664;
+
+/// The innermost slot, bytes: a high-priority line preempting both (the sample source's
+/// warnings and notes, a few numbers each; a longer frame there is dropped and counted).
+const INNER_SLOT_LEN: usize = 512;
 
 /// RTT mode bits (`flags`): the target never blocks (probe-rs may set blocking mode on
 /// attach; this logger drops and counts regardless).
@@ -82,32 +86,38 @@ static _SEGGER_RTT: Header = Header {
     },
 };
 
-/// One frame being encoded.
-struct Slot {
+/// One frame being encoded (`B`: its bytes, `[u8; N]` in a static, `[u8]` in use).
+struct Slot<B: ?Sized = [u8]> {
     encoder: defmt::Encoder,
     len: usize,
     /// The frame outgrew the slot: it will be dropped.
     overflow: bool,
-    bytes: [u8; SLOT_LEN],
+    bytes: B,
 }
 
-impl Slot {
+impl<const N: usize> Slot<[u8; N]> {
     const fn new() -> Self {
         Self {
             encoder: defmt::Encoder::new(),
             len: 0,
             overflow: false,
-            bytes: [0; SLOT_LEN],
+            bytes: [0; N],
         }
     }
 }
 
-struct Slots([UnsafeCell<Slot>; SLOTS]);
+struct Slots(
+    [UnsafeCell<Slot<[u8; SLOT_LEN]>>; SLOTS],
+    UnsafeCell<Slot<[u8; INNER_SLOT_LEN]>>,
+);
 
 // SAFETY: slot `k` is used only by the context at preemption depth `k` (see `Logger`).
 unsafe impl Sync for Slots {}
 
-static STAGING: Slots = Slots([const { UnsafeCell::new(Slot::new()) }; SLOTS]);
+static STAGING: Slots = Slots(
+    [const { UnsafeCell::new(Slot::new()) }; SLOTS],
+    UnsafeCell::new(Slot::new()),
+);
 
 /// Frames under way: acquire takes the slot at this depth, release gives it back. Contexts
 /// nest strictly (an interrupt returns before the code it preempted goes on), so the slot of
@@ -139,7 +149,11 @@ pub fn set_waiting(wait: bool) {
 
 fn slot(depth: usize) -> Option<&'static mut Slot> {
     // SAFETY: only the context at `depth` uses this slot while it holds it (see `DEPTH`).
-    STAGING.0.get(depth).map(|s| unsafe { &mut *s.get() })
+    match STAGING.0.get(depth) {
+        Some(s) => Some(unsafe { &mut *s.get() }),
+        None if depth == SLOTS => Some(unsafe { &mut *STAGING.1.get() }),
+        None => None,
+    }
 }
 
 /// Copies a finished frame into the buffer, whole, or drops it (counted); with
@@ -275,7 +289,7 @@ unsafe impl defmt::Logger for Logger {
 
 /// Appends `b` to a slot's frame (its fields apart: the encoder borrows the slot meanwhile);
 /// a frame that outgrows the slot is marked for dropping.
-fn push(bytes: &mut [u8; SLOT_LEN], len: &mut usize, overflow: &mut bool, b: &[u8]) {
+fn push(bytes: &mut [u8], len: &mut usize, overflow: &mut bool, b: &[u8]) {
     let end = *len + b.len();
     match bytes.get_mut(*len..end) {
         Some(room) => {

@@ -80,6 +80,7 @@ pub const BENCH: Scene = Scene {
     },
     train: None,
     spectrum: None,
+    spec: None,
     // The captured windows stay on the board (`wave=1` in the emulator sends them).
     waveform_every: 0,
 };
@@ -124,6 +125,10 @@ impl defmt::Format for SceneError {
 /// | `gravity`, `max_flight` | the train's gravity, m/s², and longest flight, s |
 /// | `srs` | `0` or `1`: shock spectra per impact |
 /// | `srs_damping`, `srs_bands`, `srs_low` | damping ratio, bands per octave (6, 12), lowest band, Hz |
+/// | `spec` | judge each impact against a specified pulse: `half-sine`, `sawtooth`, `trapezoid` or `none` |
+/// | `spec_peak`, `spec_duration` | its peak, m/s², and duration, s |
+/// | `spec_band`, `spec_outside`, `spec_slack`, `spec_dv`, `spec_before`, `spec_after`, `spec_watch` | its tolerances ([`impact_core::spec::Tolerance`]) |
+/// | `spec_rise`, `spec_fall` | a trapezoid's ramps, × the duration (after `spec=trapezoid`) |
 /// | `wave` | send each captured window: `0` not, `1` whole, `N` the mean of every `N` samples |
 ///
 /// Floats are parsed by `core`'s correctly rounded parser, so the shortest round-trip decimal
@@ -225,6 +230,58 @@ pub fn apply(scene: &mut Scene, key: &str, value: &str) -> Result<(), SceneError
                 _ => t.max_flight_s = float(value)?,
             }
             scene.train = Some(t);
+        }
+        "spec" => {
+            use impact_core::spec::{Shape, Spec, Tolerance};
+            let shape = match value {
+                "none" => {
+                    scene.spec = None;
+                    return Ok(());
+                }
+                "half-sine" => Shape::HalfSine,
+                "sawtooth" => Shape::Sawtooth,
+                "trapezoid" => Shape::Trapezoid {
+                    rise: 0.1,
+                    fall: 0.1,
+                },
+                _ => return Err(SceneError::BadValue),
+            };
+            // The numbers follow in their own keys (the scene is validated once complete).
+            scene.spec = Some(Spec {
+                shape,
+                peak_m_s2: 0.0,
+                duration_s: 0.0,
+                tolerance: Tolerance {
+                    band: 0.0,
+                    outside: 0.0,
+                    slack: 0.0,
+                    delta_v: 0.0,
+                    before: 0.0,
+                    after: 0.0,
+                    watch: 0.0,
+                },
+            });
+        }
+        k if k.starts_with("spec_") => {
+            use impact_core::spec::Shape;
+            let mut spec = scene.spec.ok_or(SceneError::BadValue)?;
+            let v = float(value)?;
+            let t = &mut spec.tolerance;
+            match (k, &mut spec.shape) {
+                ("spec_peak", _) => spec.peak_m_s2 = v,
+                ("spec_duration", _) => spec.duration_s = v,
+                ("spec_band", _) => t.band = v,
+                ("spec_outside", _) => t.outside = v,
+                ("spec_slack", _) => t.slack = v,
+                ("spec_dv", _) => t.delta_v = v,
+                ("spec_before", _) => t.before = v,
+                ("spec_after", _) => t.after = v,
+                ("spec_watch", _) => t.watch = v,
+                ("spec_rise", Shape::Trapezoid { rise, .. }) => *rise = v,
+                ("spec_fall", Shape::Trapezoid { fall, .. }) => *fall = v,
+                _ => return Err(SceneError::UnknownKey),
+            }
+            scene.spec = Some(spec);
         }
         "wave" => scene.waveform_every = value.parse::<u16>().map_err(|_| SceneError::BadValue)?,
         _ => return Err(SceneError::UnknownKey),

@@ -1034,3 +1034,48 @@ fn an_adxl375_fifo_overrun_is_counted_as_the_part_lost_it() {
         assert_eq!(r.status, impact_core::Status::Complete);
     }
 }
+
+/// Verdicts against a specified pulse (`--spec`): the emulated board's equal the host's bit
+/// for bit (a pass; a fail by the band and by Δv; a window the capture cannot hold), and
+/// `impact log` reads the board's `spec` lines back to the same verdicts.
+#[test]
+fn spec_verdicts_on_the_board_are_the_hosts() {
+    let Some(elf) = firmware() else { return };
+    let elf = elf.to_string_lossy().into_owned();
+    for (name, peak_g, spec) in [
+        ("pass", 50.0, "half-sine,50g,11ms"),
+        ("fail", 65.0, "half-sine,50g,11ms,standard=mil-std-810h"),
+        ("window", 50.0, "half-sine,50g,1s"),
+    ] {
+        // A half-sine of `peak_g` over 11 ms at 50 kS/s, from 50 ms.
+        let mut csv = String::from("time_s,accel_g\n");
+        for k in 0..10_000u32 {
+            let t = f64::from(k) / 50_000.0 - 0.05;
+            let a = if (0.0..0.011).contains(&t) {
+                peak_g * (std::f64::consts::PI * t / 0.011).sin()
+            } else {
+                0.0
+            };
+            let noise = 0.02 * f64::from(k % 7) / 7.0;
+            csv.push_str(&format!("{:.6},{:.5}\n", t + 0.05, a + noise));
+        }
+        let file = tmp(&format!("spec-{name}.csv"));
+        std::fs::write(&file, csv).unwrap();
+        let file = file.to_string_lossy().into_owned();
+        let (host, _) = impact(&["analyze", &file, "--spec", spec, "--json"]);
+        let (emulated, log) = impact(&["emulate", &file, "--spec", spec, "--json", "--elf", &elf]);
+        assert_eq!(emulated, host, "{name}\n--- emulator log ---\n{log}");
+        let host: serde_json::Value = serde_json::from_str(&host).unwrap();
+        let verdict = &host["impacts"][0]["spec"];
+        match name {
+            "pass" => assert_eq!(verdict["pass"], true, "{verdict}"),
+            "fail" => assert_eq!(verdict["pass"], false, "{verdict}"),
+            _ => assert!(verdict.is_null(), "{verdict}"),
+        }
+        let log_file = tmp(&format!("spec-{name}.log"));
+        std::fs::write(&log_file, &log).unwrap();
+        let (from_log, _) = impact(&["log", &log_file.to_string_lossy()]);
+        let from_log: serde_json::Value = serde_json::from_str(&from_log).unwrap();
+        assert_eq!(from_log["impacts"], host["impacts"], "{name}: impact log");
+    }
+}

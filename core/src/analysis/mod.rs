@@ -117,7 +117,37 @@ pub fn analyse<const CAP: usize>(
     if let Some(settings) = scene.spectrum {
         r.spectrum = spectrum(capture, scene, &settings, work);
     }
+    if let Some(spec) = scene.spec {
+        r.verdict = Some(verdict(capture, scene, &spec, &r));
+    }
     r
+}
+
+/// The impact judged against the scene's specified pulse ([`crate::spec::verdict`]) on every
+/// sample the capture holds (its padding around the window included), in m/s² above the
+/// baseline in the direction of the impact's peak.
+#[inline(never)]
+fn verdict<const CAP: usize>(
+    capture: &Capture<CAP>,
+    scene: &Scene,
+    spec: &crate::spec::Spec,
+    r: &ImpactReport,
+) -> Result<crate::spec::verdict::Verdict, crate::spec::verdict::Missing> {
+    let s = capture.summary();
+    let samples = capture.held();
+    let first = s.first_index.saturating_sub(u64::from(s.filter_lead));
+    let per_count = report::per_count(scene, s.base_n);
+    let deviation = Deviation::new(s.base_sum, s.base_n);
+    let sign = if r.peak_acceleration_m_s2 < 0.0 {
+        -1.0
+    } else {
+        1.0
+    };
+    let a = |i: u64| {
+        let k = usize::try_from(i.checked_sub(first)?).ok()?;
+        Some(sign * deviation.of(*samples.get(k)?) as f32 * per_count)
+    };
+    crate::spec::verdict::judge(a, scene.calibration.sample_rate_hz, spec, s.peak_index)
 }
 
 /// The window from [`SPECTRUM_LEAD`] samples before the onset to the end of the capture, in

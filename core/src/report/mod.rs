@@ -238,6 +238,9 @@ pub struct ImpactReport {
     pub bounce: Option<Bounce>,
     /// Shock spectra of the impact's window (an analysis field, when the scene asks).
     pub spectrum: Option<Spectrum>,
+    /// The verdict against the scene's specified pulse (an analysis field, when the scene
+    /// asks), or why there is none.
+    pub verdict: Option<Result<crate::spec::verdict::Verdict, crate::spec::verdict::Missing>>,
 }
 
 /// A window whose Δv is less than this share of its contact's (the rest undone after
@@ -316,5 +319,6 @@ pub fn streaming(s: &Summary, scene: &Scene) -> ImpactReport {
         fits: Fits::default(),
         bounce: s.bounce.get(),
         spectrum: None,
+        verdict: None,
     }
 }

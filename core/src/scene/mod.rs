@@ -117,6 +117,8 @@ pub struct Scene {
     /// Shock spectra (SRS, PVSS, enveloping half-sine) of each captured impact
     /// ([`crate::signal::spectrum`]).
     pub spectrum: Option<SpectrumSettings>,
+    /// A specified shock pulse each captured impact is judged against ([`crate::spec`]).
+    pub spec: Option<crate::spec::Spec>,
     /// Send each captured window off the board after its analysis ([`crate::waveform`]):
     /// 0 not, 1 whole, `N` the mean of every `N` samples.
     pub waveform_every: u16,
@@ -142,6 +144,7 @@ impl Scene {
             fits: FitSet::none(),
             train: None,
             spectrum: None,
+            spec: None,
             waveform_every: 0,
         }
     }
@@ -186,6 +189,9 @@ impl Scene {
         }
         if let Some(sp) = self.spectrum {
             sp.check(c.sample_rate_hz)?;
+        }
+        if let Some(spec) = self.spec {
+            spec.validate()?;
         }
         positive(self.trigger_m_s2, "trigger")?;
         positive(self.edge_m_s2, "edge")?;

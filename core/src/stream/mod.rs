@@ -107,9 +107,10 @@ pub struct Stream<const PRE: usize> {
     foot_power: Option<f32>,
     /// Where the last impact's window ended: the next capture does not reach back into it.
     window_end: u64,
-    /// With a CFC: samples the filter needs on each side of a contact (SAE J211's padding).
+    /// With a CFC: samples the filter needs on each side of a contact (SAE J211's padding);
+    /// with a specified pulse, the window its verdict watches (the larger of the two).
     /// The capture takes them beyond the impact's window (a lead-in before it, a tail after
-    /// it), so the filter never changes where an impact starts or ends.
+    /// it), so neither ever changes where an impact starts or ends.
     filter_pad: u32,
     /// The impact just ended still takes samples into its capture up to this stream index
     /// (its filter's tail): handed over there, at the next trigger, a gap or the end.
@@ -162,6 +163,7 @@ impl<const PRE: usize> Stream<PRE> {
                 trigger_cfc: None,
                 train: None,
                 spectrum: None,
+                spec: None,
                 waveform_every: 0,
                 fits: FitSet {
                     two_phase: false,
@@ -244,9 +246,12 @@ impl<const PRE: usize> Stream<PRE> {
         // With a CFC on the captured windows the filter needs its padding of signal around
         // the contact (SAE J211): the capture takes it beyond the window (the hold does not
         // change, nor does anything else the stream decides).
+        // A specified pulse's verdict watches its window around the pulse: the same padding.
+        let rate = scene.calibration.sample_rate_hz;
         self.filter_pad = scene
             .cfc
-            .map_or(0, |c| c.padding_samples(scene.calibration.sample_rate_hz));
+            .map_or(0, |c| c.padding_samples(rate))
+            .max(scene.spec.map_or(0, |s| s.padding_samples(rate)));
         self.hold = scene.samples(scene.hold_s);
         self.settle = scene.samples(scene.settle_s);
         self.max_samples = scene.samples(scene.max_impact_s) as u64;

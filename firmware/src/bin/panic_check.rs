@@ -78,6 +78,23 @@ fn scene() -> Scene {
         fits: FitSet::all(),
         train: Some(impact_core::Train::new()),
         spectrum: Some(impact_core::signal::spectrum::SpectrumSettings::new()),
+        spec: Some(impact_core::spec::Spec {
+            shape: impact_core::spec::Shape::Trapezoid {
+                rise: 0.1,
+                fall: 0.1,
+            },
+            peak_m_s2: 500.0,
+            duration_s: 0.011,
+            tolerance: impact_core::spec::Tolerance {
+                band: 0.2,
+                outside: 0.2,
+                slack: 0.1,
+                delta_v: 0.15,
+                before: 0.4,
+                after: 0.1,
+                watch: 1.1,
+            },
+        }),
         waveform_every: 1,
     })
 }

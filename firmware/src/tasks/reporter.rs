@@ -81,6 +81,9 @@ impl Order {
         if let Some(s) = &r.spectrum {
             log_spectrum(r.index, s);
         }
+        if let Some(v) = &r.verdict {
+            log_verdict(r.index, v);
+        }
         self.printed += 1;
         if r.index >= self.next {
             self.next = r.index.wrapping_add(1);
@@ -231,6 +234,36 @@ fn log_spectrum(index: u32, s: &impact_core::report::Spectrum) {
         List(&s.srs_m_s2[..n]),
         List(&s.pvss_m_s[..n]),
     );
+}
+
+/// The `spec` line after an impact's line when the scene specifies a pulse: its verdict (times
+/// in s from the stream's first sample), or why there is none.
+fn log_verdict(
+    index: u32,
+    v: &Result<impact_core::spec::verdict::Verdict, impact_core::spec::verdict::Missing>,
+) {
+    match v {
+        Ok(v) => info!(
+            "spec seq={=u32} index={=u32} pass={=bool} band_pass={=bool} delta_v_pass={=bool} margin={=f32} worst_s={=f64} worst_m_s2={=f32} limit_m_s2={=f32} delta_v_m_s={=f32} start_s={=f64}",
+            crate::logger::next_seq(),
+            index,
+            v.pass,
+            v.band_pass,
+            v.delta_v_pass,
+            v.margin,
+            v.worst_s,
+            v.worst_m_s2,
+            v.limit_m_s2,
+            v.delta_v_m_s,
+            v.start_s,
+        ),
+        Err(m) => info!(
+            "spec seq={=u32} index={=u32} pass=none reason={=str}",
+            crate::logger::next_seq(),
+            index,
+            m.name(),
+        ),
+    }
 }
 
 /// Values separated by commas, no spaces (one `key=value` token).

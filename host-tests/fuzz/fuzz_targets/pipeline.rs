@@ -121,6 +121,22 @@ fn scene(b: &mut Bytes) -> (Scene, bool) {
             bands_per_octave: if stage_byte & 8 != 0 { 12 } else { 6 },
             ..SpectrumSettings::new()
         }),
+        // A specified half-sine of the trigger's tenfold over a hold's time (a verdict per
+        // impact, judged or not).
+        spec: (stage_byte & 0x40 != 0).then(|| impact_core::spec::Spec {
+            shape: impact_core::spec::Shape::HalfSine,
+            peak_m_s2: 10.0 * trigger_counts * g,
+            duration_s: hold_samples as f32 / rate,
+            tolerance: impact_core::spec::Tolerance {
+                band: 0.2,
+                outside: 0.2,
+                slack: 0.1,
+                delta_v: 0.15,
+                before: 0.4,
+                after: 0.1,
+                watch: 1.1,
+            },
+        }),
         waveform_every: u16::from(stage_byte >> 4),
     };
     (scene, !raw)
@@ -152,6 +168,13 @@ fn finite(r: &ImpactReport) -> bool {
     }
     if let Some(s) = &r.spectrum {
         ok &= s.srs_m_s2.iter().chain(&s.pvss_m_s).all(|v| v.is_finite());
+    }
+    if let Some(Ok(v)) = &r.verdict {
+        ok &= [v.margin, v.worst_m_s2, v.limit_m_s2, v.delta_v_m_s]
+            .iter()
+            .all(|x| x.is_finite())
+            && v.start_s.is_finite()
+            && v.worst_s.is_finite();
     }
     ok
 }

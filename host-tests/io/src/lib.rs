@@ -154,11 +154,38 @@ static NOTES: std::sync::Mutex<Vec<String>> = std::sync::Mutex::new(Vec::new());
 /// Keeps `note: MESSAGE` for stderr: the tool prints its notes after a run that succeeded
 /// ([`take_notes`]), so that an error stays one line.
 pub fn note(message: &str) {
+    let own = OWN_NOTES.with(|own| match own.borrow_mut().as_mut() {
+        Some(notes) => {
+            if !notes.iter().any(|m| m == message) {
+                notes.push(message.to_string());
+            }
+            true
+        }
+        None => false,
+    });
+    if own {
+        return;
+    }
     if let Ok(mut notes) = NOTES.lock() {
         if !notes.iter().any(|m| m == message) {
             notes.push(message.to_string());
         }
     }
+}
+
+std::thread_local! {
+    /// The notes of an analysis that keeps its own ([`with_own_notes`]).
+    static OWN_NOTES: std::cell::RefCell<Option<Vec<String>>> =
+        const { std::cell::RefCell::new(None) };
+}
+
+/// Runs `f` with the notes it gives on this thread kept apart (a series' recordings,
+/// analysed side by side, each with its own notes), and returns them with its result.
+pub fn with_own_notes<R>(f: impl FnOnce() -> R) -> (R, Vec<String>) {
+    OWN_NOTES.with(|own| *own.borrow_mut() = Some(Vec::new()));
+    let r = f();
+    let notes = OWN_NOTES.with(|own| own.borrow_mut().take());
+    (r, notes.unwrap_or_default())
 }
 
 /// The notes kept so far (and forgets them).

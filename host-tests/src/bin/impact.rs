@@ -6,7 +6,7 @@ use std::process::ExitCode;
 
 use clap::{Parser, Subcommand};
 use impact_host::cli::{self, progress};
-use impact_host::{pipeline, simulate};
+use impact_host::simulate;
 
 // The examples in the help are commands of docs/user-guide.md, run by its tests.
 const ANALYZE_EXAMPLES: &str = "Examples:
@@ -14,7 +14,8 @@ const ANALYZE_EXAMPLES: &str = "Examples:
   impact analyze seed.csv --mass 0.06 --v0 1.3357 --plot seed.svg
   impact analyze train.csv --mass 0.06 --v0 1.3357 --train flight
   impact analyze host-tests/data/endaq-high-drop/High-Drop_16g-DC_full.csv --axes x_g,y_g,z_g
-  impact analyze host-tests/data/afrl-drop-tower/series1_test1_full_100ms.csv --srs --json";
+  impact analyze host-tests/data/afrl-drop-tower/series1_test1_full_100ms.csv --srs --json
+  impact analyze host-tests/data/afrl-drop-tower/accel_5.csv --channels 1,2,3,4,5 --units kgn";
 const EMULATE_EXAMPLES: &str = "Examples:
   impact emulate host-tests/data/afrl-drop-tower/series1_test1_full_100ms.csv --realtime
   impact emulate seed.csv --mass 0.06 --v0 1.3357 --waveforms --log board.log";
@@ -24,6 +25,8 @@ const SIMULATE_EXAMPLES: &str = "Examples:
 const SYNTH_EXAMPLES: &str = "Examples:
   impact synth --model two-phase --mass 0.06 --v0 1.3357 --max-deformation 0.0186 --kr 12376 --permanent 0.0182 --damping 2 -o seed.csv
   impact synth --model nonlinear --mass 0.06 --v0 1.3357 --stiffness 1e4 --damping 0.5 --bounces 8 --duration 1.5 -o train.csv";
+const REPORT_EXAMPLES: &str = "Examples:
+  impact report host-tests/data/afrl-drop-tower/accel_5.csv --channels 1,2,3,4,5 --units kgn --spec half-sine,11000g,0.1ms --html afrl.html";
 const LOG_EXAMPLES: &str = "Examples:
   impact log board.log --csv
   impact log board.log --plot board.svg";
@@ -48,7 +51,7 @@ enum Command {
     Simulate(Box<simulate::SimulateArgs>),
     /// Analyse a recorded signal: one report per impact.
     #[command(allow_negative_numbers = true, after_help = ANALYZE_EXAMPLES)]
-    Analyze(Box<pipeline::AnalyzeArgs>),
+    Analyze(Box<cli::analyze::AnalyzeCommand>),
     /// Analyse a recorded signal on the emulated firmware (QEMU): the same output as `analyze`.
     #[command(
         allow_negative_numbers = true,
@@ -57,6 +60,17 @@ enum Command {
         mut_arg("stream", |a| a.hide(true))
     )]
     Emulate(Box<cli::emulate::EmulateArgs>),
+    /// Analyse recordings into one self-contained HTML report (settings, the series' table and
+    /// statistics, every pulse drawn with the specification's band).
+    #[command(
+        allow_negative_numbers = true,
+        after_help = REPORT_EXAMPLES,
+        // The report is the output: analyze's own outputs are refused here.
+        mut_arg("json", |a| a.hide(true)),
+        mut_arg("csv", |a| a.hide(true)),
+        mut_arg("plot", |a| a.hide(true))
+    )]
+    Report(Box<cli::html::ReportArgs>),
     /// Turn the firmware's defmt log into JSON (default) or CSV, its waveforms into figures.
     #[command(after_help = LOG_EXAMPLES)]
     Log(cli::log::LogArgs),
@@ -112,6 +126,7 @@ fn run(cli: Cli) -> Result<(), String> {
         Command::Analyze(args) => cli::analyze::run(&args),
         Command::Emulate(args) => cli::emulate::emulate(&args),
         Command::Log(args) => cli::log::log(&args),
+        Command::Report(args) => cli::html::run(&args),
         Command::Synth(command) => cli::synth::run(command),
         Command::Bench { which } => cli::bench::run(which),
     }

@@ -1,8 +1,42 @@
-//! `impact analyze FILE`: a recording through the pipeline ([`crate::pipeline::analyze`]),
-//! printed as the table, JSON or CSV, and drawn (`--plot`).
+//! `impact analyze FILE…`: a recording through the pipeline ([`crate::pipeline::analyze`]),
+//! printed as the table, JSON or CSV, and drawn (`--plot`); several recordings or channels
+//! are a test series ([`super::series`]).
 
+use std::path::PathBuf;
+
+use impact_io::channel::ColumnRef;
+
+use super::series;
 use crate::pipeline::{self, AnalyzeArgs};
 use crate::{plot, report};
+
+/// `impact analyze`'s command line: one recording's options, and the series' recordings.
+#[derive(clap::Args, Clone, Debug)]
+pub struct AnalyzeCommand {
+    #[command(flatten)]
+    pub args: AnalyzeArgs,
+    /// More recordings: a test series.
+    ///
+    /// More recordings, folders (their recordings, by name) or quoted patterns
+    /// (`'runs/*.csv'`): a test series, each analysed with the same options, in parallel;
+    /// one row per impact with its file and channel, and each metric's statistics across
+    /// the series (mean, sample standard deviation, coefficient of variation, min, max).
+    #[arg(value_name = "MORE")]
+    pub more: Vec<PathBuf>,
+    /// A series over channels: each file analysed once per channel (`1,2,3,4,5`).
+    ///
+    /// A series over channels: each file analysed once per channel (header names or 0-based
+    /// indices, comma-separated: `accel 1,accel 2` or `1,2,3,4,5`), as if each were given
+    /// with --column.
+    #[arg(
+        long,
+        value_delimiter = ',',
+        value_name = "LIST",
+        conflicts_with_all = ["column", "axes"],
+        help_heading = "Input"
+    )]
+    pub channels: Vec<ColumnRef>,
+}
 
 /// The files an analysis reads (no output may write over one): the recording, the scene
 /// file, the free-fall recording.
@@ -14,7 +48,13 @@ pub fn inputs(args: &AnalyzeArgs) -> Vec<&std::path::Path> {
 }
 
 /// Runs `impact analyze`.
-pub fn run(args: &AnalyzeArgs) -> Result<(), String> {
+pub fn run(cmd: &AnalyzeCommand) -> Result<(), String> {
+    let mut files = vec![cmd.args.file.clone()];
+    files.extend(cmd.more.iter().cloned());
+    if series::is_series(&files, &cmd.channels) {
+        return run_series(cmd, &files);
+    }
+    let args = &cmd.args;
     let progress = super::progress::progress_for(&args.file);
     if let Some(path) = &args.plot {
         plot::check_output(path, &inputs(args))?;
@@ -37,4 +77,48 @@ pub fn run(args: &AnalyzeArgs) -> Result<(), String> {
         plot::impacts(&setup.plot_signal(), &reports, path)?;
     }
     Ok(())
+}
+
+/// A test series: every recording analysed, the rows and statistics printed, each
+/// recording's notes named by it; exit status 1 if one failed (its error in the output).
+fn run_series(cmd: &AnalyzeCommand, files: &[PathBuf]) -> Result<(), String> {
+    let args = &cmd.args;
+    if args.plot.is_some() {
+        return Err(
+            "--plot draws one recording: give one file and one channel (draw a series' \
+             recordings one call each)"
+                .into(),
+        );
+    }
+    let entries = series::entries(files, &cmd.channels, args.column.as_ref())?;
+    let results = series::analyze(args, &entries);
+    for e in &results {
+        for n in &e.notes {
+            eprintln!("note: {}", series::failure(e, n));
+        }
+    }
+    if args.json {
+        println!(
+            "{}",
+            serde_json::to_string_pretty(&series::to_json(&results)).map_err(|e| e.to_string())?
+        );
+    } else if args.csv {
+        print!("{}", series::to_csv(&results));
+    } else {
+        print!("{}", series::to_table(&results));
+    }
+    let failed: Vec<&series::EntryJson> = results.iter().filter(|e| e.error.is_some()).collect();
+    match failed.as_slice() {
+        [] => Ok(()),
+        [one] => Err(format!(
+            "1 of {} recordings failed: {}",
+            results.len(),
+            series::failure(one, one.error.as_deref().unwrap_or_default())
+        )),
+        many => Err(format!(
+            "{} of {} recordings failed (each named in the output)",
+            many.len(),
+            results.len()
+        )),
+    }
 }

@@ -4,7 +4,10 @@
 pub mod analyze;
 pub mod bench;
 pub mod emulate;
+pub mod html;
 pub mod log;
 pub mod progress;
+pub mod pulse;
+pub mod series;
 pub mod simulate;
 pub mod synth;

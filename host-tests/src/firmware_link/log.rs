@@ -160,7 +160,45 @@ pub fn parse_impact(m: &HashMap<String, String>) -> Result<ImpactReport, String>
         },
         bounce,
         spectrum: None,
+        verdict: None,
     })
+}
+
+/// A `spec` line: the verdict of the impact with its `index`, or why there is none.
+fn parse_verdict(
+    m: &HashMap<String, String>,
+) -> Result<
+    (
+        u32,
+        Result<impact_core::spec::verdict::Verdict, impact_core::spec::verdict::Missing>,
+    ),
+    String,
+> {
+    use impact_core::spec::verdict::{Missing, Verdict};
+    let index = num::<u32>(m, "index")?;
+    if get(m, "pass")? == "none" {
+        let missing = match get(m, "reason")? {
+            "spec-window" => Missing::Window,
+            "spec-resolution" => Missing::Resolution,
+            "spec-overflow" => Missing::Overflow,
+            other => return Err(format!("reason={other}: not a reason a verdict is missing")),
+        };
+        return Ok((index, Err(missing)));
+    }
+    Ok((
+        index,
+        Ok(Verdict {
+            pass: flag(m, "pass")?,
+            band_pass: flag(m, "band_pass")?,
+            delta_v_pass: flag(m, "delta_v_pass")?,
+            margin: num::<f32>(m, "margin")?,
+            worst_s: num::<f64>(m, "worst_s")?,
+            worst_m_s2: num::<f32>(m, "worst_m_s2")?,
+            limit_m_s2: num::<f32>(m, "limit_m_s2")?,
+            delta_v_m_s: num::<f32>(m, "delta_v_m_s")?,
+            start_s: num::<f64>(m, "start_s")?,
+        }),
+    ))
 }
 
 /// An `srs` line: the spectra of the impact with its `index`.
@@ -266,6 +304,26 @@ struct RunReader {
 }
 
 impl LogReader {
+    /// Sets what a `what` line (`srs`, `spec`) adds to this run's impact `index` (`set` gives
+    /// `None` if the impact has it already: a second such line).
+    fn attach(
+        &mut self,
+        index: u32,
+        what: &str,
+        set: impl FnOnce(&mut ImpactReport) -> Option<()>,
+    ) -> Result<(), String> {
+        self.run
+            .impacts
+            .get(&index)
+            .and_then(|&(k, _)| self.log.impacts.get_mut(k))
+            .and_then(set)
+            .ok_or_else(|| {
+                format!(
+                    "{what} index={index}: no impact line of that index before it, or a second {what} line"
+                )
+            })
+    }
+
     /// Reads line `n` (1-based).
     pub fn line(&mut self, n: u64, line: &str) -> Result<(), String> {
         let at = |e: String| format!("line {n}: {e}");
@@ -302,19 +360,18 @@ impl LogReader {
             let m = m.map_err(at)?;
             self.seen(&m).map_err(at)?;
             let (index, spectrum) = parse_spectrum(&m).map_err(at)?;
-            let r = self
-                .run
-                .impacts
-                .get(&index)
-                .and_then(|&(k, _)| self.log.impacts.get_mut(k));
-            match r {
-                Some(r) if r.spectrum.is_none() => r.spectrum = Some(spectrum),
-                _ => {
-                    return Err(at(format!(
-                        "srs index={index}: no impact line of that index before it, or a second srs line"
-                    )))
-                }
-            }
+            self.attach(index, "srs", |r| {
+                r.spectrum.is_none().then(|| r.spectrum = Some(spectrum))
+            })
+            .map_err(at)?;
+        } else if let Some(m) = fields(line, "spec ") {
+            let m = m.map_err(at)?;
+            self.seen(&m).map_err(at)?;
+            let (index, verdict) = parse_verdict(&m).map_err(at)?;
+            self.attach(index, "spec", |r| {
+                r.verdict.is_none().then(|| r.verdict = Some(verdict))
+            })
+            .map_err(at)?;
         } else if let Some(m) = fields(line, "wave_frame ") {
             let m = m.map_err(at)?;
             self.seen(&m).map_err(at)?;

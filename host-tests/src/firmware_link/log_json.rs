@@ -88,6 +88,8 @@ impl<'a> LogJson<'a> {
             v0_m_s,
             samples: total(|r| r.samples),
             train_speed,
+            // The board's spec lines give each impact's verdict; the pulse is the scene's.
+            spec: None,
             trains: Vec::new(),
             waveforms: (log.waveforms.iter().enumerate())
                 .map(|(k, w)| {

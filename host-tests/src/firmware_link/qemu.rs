@@ -81,6 +81,27 @@ pub fn scene_args(scene: &Scene) -> Vec<String> {
             format!("max_flight={}", f(t.max_flight_s)),
         ]),
     }
+    if let Some(spec) = scene.spec {
+        let t = spec.tolerance;
+        args.push(format!("spec={}", spec.shape.name()));
+        if let impact_core::spec::Shape::Trapezoid { rise, fall } = spec.shape {
+            args.extend([
+                format!("spec_rise={}", f(rise)),
+                format!("spec_fall={}", f(fall)),
+            ]);
+        }
+        args.extend([
+            format!("spec_peak={}", f(spec.peak_m_s2)),
+            format!("spec_duration={}", f(spec.duration_s)),
+            format!("spec_band={}", f(t.band)),
+            format!("spec_outside={}", f(t.outside)),
+            format!("spec_slack={}", f(t.slack)),
+            format!("spec_dv={}", f(t.delta_v)),
+            format!("spec_before={}", f(t.before)),
+            format!("spec_after={}", f(t.after)),
+            format!("spec_watch={}", f(t.watch)),
+        ]);
+    }
     args.push(format!("wave={}", scene.waveform_every));
     args
 }

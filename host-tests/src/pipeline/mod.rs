@@ -10,6 +10,7 @@ pub mod histogram;
 pub mod level;
 pub mod options;
 pub mod screen;
+pub mod spec;
 pub mod spectrum;
 pub mod streaming;
 pub mod survey;
@@ -391,6 +392,7 @@ pub(crate) fn build_scene(
     scene.approach = approach;
     scene.train = args.train.train();
     scene.spectrum = args.spectrum.settings();
+    scene.spec = args.spec.map(|s| s.spec);
     scene.validate().map_err(|e| match e {
         // Named as it was given: an option, or the scene file's key.
         impact_core::Error::InvalidParameter { name, reason } => {
@@ -599,6 +601,11 @@ pub fn to_json(setup: &Setup, reports: &[ImpactReport]) -> AnalysisJson {
         spikes_removed: setup.spikes.clone(),
         clipping: setup.clipping.clone(),
         train_speed: setup.scene.train.map(|t| t.speed.name().to_string()),
+        spec: setup
+            .scene
+            .spec
+            .as_ref()
+            .map(crate::report::spec::spec_json),
         trains: Vec::new(),
         waveforms: Vec::new(),
         impacts: reports

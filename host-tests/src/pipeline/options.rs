@@ -202,6 +202,16 @@ pub struct AnalyzeArgs {
     pub train: crate::pipeline::options::TrainArgs,
     #[command(flatten)]
     pub spectrum: crate::pipeline::options::SpectrumArgs,
+    /// Judge each impact against a specified pulse: `half-sine,50g,11ms`.
+    ///
+    /// Judge each impact against a specified shock pulse: SHAPE,PEAK,DURATION
+    /// (`half-sine`, `sawtooth` (terminal-peak) or `trapezoid`; `50g` or `490m/s2`; `11ms`),
+    /// then KEY=VALUE: `standard=` iec-60068-2-27 (the default), mil-std-810h or
+    /// mil-std-202h, whose tolerance band and velocity-change tolerance apply, or any
+    /// tolerance by hand (`band`, `outside`, `slack`, `dv`, `before`, `after`, `watch`; a
+    /// trapezoid's `rise`, `fall`). Every number and its source: docs/standards.md.
+    #[arg(long, help_heading = "Analysis", value_name = "SHAPE,PEAK,DURATION", value_parser = crate::pipeline::spec::parse)]
+    pub spec: Option<crate::pipeline::spec::SpecArg>,
     /// Print one JSON object.
     #[arg(short = 'j', long, help_heading = "Output", conflicts_with = "csv")]
     pub json: bool,

@@ -3,6 +3,7 @@
 use std::borrow::Borrow;
 use std::io::Write;
 
+use super::fmt::number;
 use super::{AnalysisJson, ImpactJson};
 
 /// CSV text: one row per impact.
@@ -49,6 +50,11 @@ where
         s.push(',');
         s.push_str(crate::report::spectrum::CSV_HEADER);
     }
+    // With --spec: each impact's verdict (empty cells when it could not be judged).
+    let with_spec = impacts.clone().any(|i| i.borrow().spec.is_some());
+    if with_spec {
+        s.push_str(",spec_pass,spec_band_pass,spec_delta_v_pass,spec_margin,spec_worst_time_s,spec_worst_m_s2,spec_limit_m_s2,spec_delta_v_m_s,spec_nominal_start_s");
+    }
     // `impact log` of a log in which the board restarted: each impact's run.
     let with_run = impacts.clone().any(|i| i.borrow().run.is_some());
     if with_run {
@@ -56,7 +62,7 @@ where
     }
     s.push('\n');
     out.write_all(s.as_bytes())?;
-    let o = |v: Option<f64>| v.map_or(String::new(), |v| format!("{v:e}"));
+    let o = |v: Option<f64>| v.map_or(String::new(), number);
     for i in impacts {
         let i = i.borrow();
         let mut s = String::new();
@@ -72,13 +78,13 @@ where
             i.flags.join(";"),
             i.start_sample.to_string(),
             i.end_sample.to_string(),
-            format!("{:e}", i.start_s),
-            format!("{:e}", i.peak_time_s),
-            format!("{:e}", i.peak_acceleration_m_s2),
+            number(i.start_s),
+            number(i.peak_time_s),
+            number(i.peak_acceleration_m_s2),
             o(i.peak_force_n),
             o(i.delta_v_m_s),
-            format!("{:e}", i.duration_s),
-            format!("{:e}", i.baseline_m_s2),
+            number(i.duration_s),
+            number(i.baseline_m_s2),
             o(i.fwhm_s),
             o(i.filtered_peak_acceleration_m_s2),
             o(i.filtered_fwhm_s),
@@ -133,6 +139,26 @@ where
             s.push_str(&crate::report::spectrum::csv_cells(
                 i.shock_spectrum.as_ref(),
             ));
+        }
+        if with_spec {
+            let v = i.spec.as_ref().and_then(|v| v.as_ref());
+            let b = |f: fn(&crate::report::spec::VerdictJson) -> bool| {
+                v.map_or(String::new(), |v| f(v).to_string())
+            };
+            for cell in [
+                b(|v| v.pass),
+                b(|v| v.band_pass),
+                b(|v| v.delta_v_pass),
+                o(v.map(|v| v.margin)),
+                o(v.map(|v| v.worst_time_s)),
+                o(v.map(|v| v.worst_m_s2)),
+                o(v.map(|v| v.limit_m_s2)),
+                o(v.map(|v| v.delta_v_m_s)),
+                o(v.map(|v| v.nominal_start_s)),
+            ] {
+                s.push(',');
+                s.push_str(&cell);
+            }
         }
         if with_run {
             s.push(',');

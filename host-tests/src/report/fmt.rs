@@ -34,9 +34,23 @@ pub fn human(v: f64, unit: &str) -> String {
     }
 }
 
+/// A number as a CSV cell, in the digits it holds: an f32 field (the core's) in the shortest
+/// digits that give it back (`7.569964`, not `7.5699639320373535e0`), any other in an f64's;
+/// plain between 1e-4 and 1e7, in exponent form beyond (`1.5e-7`).
+pub fn number(v: f64) -> String {
+    let f = v as f32;
+    let plain = v == 0.0 || (1e-4..1e7).contains(&v.abs());
+    match (f64::from(f) == v, plain) {
+        (true, true) => format!("{f}"),
+        (true, false) => format!("{f:e}"),
+        (false, true) => format!("{v}"),
+        (false, false) => format!("{v:e}"),
+    }
+}
+
 #[cfg(test)]
 mod tests {
-    use super::human;
+    use super::{human, number};
 
     #[test]
     fn quantities_read_as_a_person_reads_them() {
@@ -48,5 +62,18 @@ mod tests {
         assert_eq!(human(1.0714e5, "m/s²"), "1.071e5 m/s²");
         assert_eq!(human(-1.5, "m/s"), "-1.500 m/s");
         assert_eq!(human(0.0, "J"), "0 J");
+    }
+
+    #[test]
+    fn numbers_keep_the_digits_they_hold() {
+        assert_eq!(number(f64::from(7.569964f32)), "7.569964");
+        assert_eq!(number(f64::from(1.5e-7f32)), "1.5e-7");
+        assert_eq!(number(f64::from(30579.8f32)), "30579.8");
+        assert_eq!(number(0.005002401375770569), "0.005002401375770569");
+        assert_eq!(number(0.0), "0");
+        // The digits read back to the same f32.
+        for x in [0.1f32, 1.0 / 3.0, 9.80665, 2.0e-5, 123456.79, 3.4e38] {
+            assert_eq!(number(f64::from(x)).parse::<f32>().unwrap(), x);
+        }
     }
 }

@@ -7,7 +7,9 @@ pub mod axes;
 pub mod csv;
 pub mod fmt;
 pub mod screen;
+pub mod spec;
 pub mod spectrum;
+pub mod statistics;
 pub mod table;
 pub mod train;
 pub mod waveform;
@@ -54,7 +56,7 @@ pub struct HertzJson {
 }
 
 /// One impact as JSON (SI field names).
-#[derive(Clone, Debug, Serialize, PartialEq)]
+#[derive(Clone, Debug, Default, Serialize, PartialEq)]
 pub struct ImpactJson {
     pub index: u32,
     pub status: String,
@@ -102,6 +104,10 @@ pub struct ImpactJson {
     /// the first; each run's indices and times start from 0).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub run: Option<u32>,
+    /// With `--spec`: the verdict against the specified pulse (null, with its reason in
+    /// `null_reasons.spec`, when the capture cannot show it).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub spec: Option<Option<crate::report::spec::VerdictJson>>,
 }
 
 /// The whole analysis as JSON.
@@ -141,6 +147,10 @@ pub struct AnalysisJson {
     pub clipping: Option<Clipping>,
     /// With `--train`: which speed the bounces' kinematics use ("flight" or "rebound").
     pub train_speed: Option<String>,
+    /// With `--spec`: the specified pulse and its tolerances (each impact's verdict is its
+    /// `spec`).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub spec: Option<crate::report::spec::SpecJson>,
     pub impacts: Vec<ImpactJson>,
     /// With `--train`: each train of bounces and its COR against impact speed.
     pub trains: Vec<crate::report::train::TrainJson>,
@@ -224,6 +234,9 @@ pub fn null_reasons(r: &ImpactReport, fits: &FitSet) -> BTreeMap<String, String>
     }
     if r.delta_v_m_s.is_none() {
         put("delta_v_m_s", "ac-coupled");
+    }
+    if let Some(Err(m)) = r.verdict {
+        put("spec", m.name());
     }
     let analysis = |own: Option<&'static str>| {
         if skipped {
@@ -349,6 +362,10 @@ pub fn impact_json(r: &ImpactReport, t0: f64, fits: &FitSet) -> ImpactJson {
         bounce: crate::report::train::bounce_json(r),
         axes: None,
         run: None,
+        spec: r
+            .verdict
+            .as_ref()
+            .map(|v| crate::report::spec::verdict_json(v, t0)),
     }
 }
 

@@ -59,7 +59,7 @@ pub const CSV_HEADER: &str =
 
 /// An impact's cells under [`CSV_HEADER`] (empty without spectra).
 pub fn csv_cells(s: Option<&ShockSpectrumJson>) -> String {
-    let o = |v: Option<f64>| v.map_or(String::new(), |v| format!("{v:e}"));
+    let o = |v: Option<f64>| v.map_or(String::new(), crate::report::fmt::number);
     let peak = s.and_then(srs_peak);
     [
         o(peak.map(|p| p.0)),

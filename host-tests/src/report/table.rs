@@ -59,6 +59,9 @@ pub fn to_table(a: &AnalysisJson) -> String {
             level(c.high_m_s2)
         ));
     }
+    if let Some(spec) = &a.spec {
+        s.push_str(&crate::report::spec::table_head(spec));
+    }
     for sp in &a.spikes_removed {
         s.push_str(&format!(
             "spike removed at {:.6} s (sample {}, {} sample{}, {:.4e} m/s²); --keep-spikes keeps it\n",
@@ -141,6 +144,12 @@ pub fn to_table(a: &AnalysisJson) -> String {
         }
         if let Some(sp) = &i.shock_spectrum {
             s.push_str(&crate::report::spectrum::table_line(sp));
+        }
+        if let Some(v) = &i.spec {
+            s.push_str(&crate::report::spec::table_line(
+                v.as_ref(),
+                i.null_reasons.get("spec"),
+            ));
         }
         if let (Some(v0), Some(tm), Some(xm), Some(v1), Some(cor), Some(xp)) = (
             i.impact_velocity_m_s,

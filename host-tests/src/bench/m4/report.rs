@@ -49,6 +49,11 @@ pub fn table(r: &M4Report) -> String {
         r.spectrum_instructions,
         r.spectrum_instructions as f64 / 125e6 * 1e3,
     ));
+    s.push_str(&format!(
+        "  verdict against a specified pulse (3 ms half-sine, IEC 60068-2-27): {} instructions ({:.1} ms at 125 M instructions/s)\n",
+        r.spec_instructions,
+        r.spec_instructions as f64 / 125e6 * 1e3,
+    ));
     for (name, now, target) in targets(r) {
         s.push_str(&format!(
             "  target: {name:<40} {now:>10} <= {target:>9}: {}\n",
@@ -121,6 +126,11 @@ pub fn check(r: &M4Report, baseline: &M4Report) -> Result<String, String> {
             "shock spectra instructions".into(),
             r.spectrum_instructions as f64,
             baseline.spectrum_instructions as f64,
+        ),
+        (
+            "spec verdict instructions".into(),
+            r.spec_instructions as f64,
+            baseline.spec_instructions as f64,
         ),
     ];
     for f in &r.fits {
@@ -210,6 +220,11 @@ fn targets(r: &M4Report) -> Vec<(&'static str, u64, u64)> {
             r.spectrum_instructions,
             SPECTRUM_TARGET,
         ),
+        (
+            "a verdict against a specified pulse",
+            r.spec_instructions,
+            SPEC_TARGET,
+        ),
     ]
 }
 
@@ -232,6 +247,7 @@ mod tests {
             impact_samples: 100,
             analysis_instructions: 2000,
             spectrum_instructions: 3000,
+            spec_instructions: 3000,
             fits: vec![],
             solves: vec![SolveCost {
                 case: "c".into(),

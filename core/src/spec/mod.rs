@@ -1,0 +1,226 @@
+//! A specified shock pulse (half-sine, terminal-peak sawtooth, trapezoid of a peak and a
+//! duration) and the tolerances it is judged with: the band the measured acceleration must lie
+//! within, and the velocity change's. The verdict of a captured impact is [`verdict`].
+//!
+//! The band follows the figures of the shock-test standards (IEC 60068-2-27, MIL-STD-810
+//! Method 516, MIL-STD-202 Method 213; the numbers of each preset and their sources are in
+//! docs/standards.md): within the pulse the nominal acceleration ± `band` × the peak, widened
+//! in time by `slack` × the duration on each side (the peak may come that much early or late,
+//! a sawtooth's drop takes that long); before and after it, within ± `outside` × the peak.
+//! The nominal pulse is placed where the measured one fits best (the standards: "any measured
+//! pulse which can be contained between the boundaries" is a nominal pulse).
+
+pub mod verdict;
+
+use crate::error::Error;
+
+/// A nominal pulse's shape.
+#[derive(Clone, Copy, Debug, PartialEq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub enum Shape {
+    /// `A sin(π t / D)`.
+    HalfSine,
+    /// Terminal-peak (final-peak) sawtooth: `A t / D`, then down to 0.
+    Sawtooth,
+    /// A linear rise over `rise` × D, flat at A, a linear fall over `fall` × D.
+    Trapezoid { rise: f32, fall: f32 },
+}
+
+impl Shape {
+    /// The name a specification uses (`half-sine`, `sawtooth`, `trapezoid`).
+    pub fn name(self) -> &'static str {
+        match self {
+            Shape::HalfSine => "half-sine",
+            Shape::Sawtooth => "sawtooth",
+            Shape::Trapezoid { .. } => "trapezoid",
+        }
+    }
+
+    /// The nominal acceleration over the peak at `u` = time / duration (0 outside `[0, 1]`).
+    pub fn at(self, u: f32) -> f32 {
+        if !(0.0..=1.0).contains(&u) {
+            return 0.0;
+        }
+        match self {
+            Shape::HalfSine => libm::sinf(core::f32::consts::PI * u),
+            Shape::Sawtooth => u,
+            Shape::Trapezoid { rise, fall } => {
+                if u < rise {
+                    u / rise
+                } else if u > 1.0 - fall {
+                    (1.0 - u) / fall
+                } else {
+                    1.0
+                }
+            }
+        }
+    }
+
+    /// The nominal velocity change over the peak times the duration (the shape's area).
+    pub fn area(self) -> f32 {
+        match self {
+            Shape::HalfSine => 2.0 / core::f32::consts::PI,
+            Shape::Sawtooth => 0.5,
+            Shape::Trapezoid { rise, fall } => 1.0 - (rise + fall) / 2.0,
+        }
+    }
+
+    /// Where the nominal pulse peaks, over the duration (a trapezoid: the middle of its top).
+    pub fn peak_at(self) -> f32 {
+        match self {
+            Shape::HalfSine => 0.5,
+            Shape::Sawtooth => 1.0,
+            Shape::Trapezoid { rise, fall } => (rise + 1.0 - fall) / 2.0,
+        }
+    }
+}
+
+/// How far a measured pulse may stray from the nominal one, as fractions of its peak and
+/// duration.
+#[derive(Clone, Copy, Debug, PartialEq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct Tolerance {
+    /// Within the pulse: the nominal ± this × the peak.
+    pub band: f32,
+    /// Before and after the pulse: within ± this × the peak.
+    pub outside: f32,
+    /// The band's widening in time on each side, × the duration.
+    pub slack: f32,
+    /// The velocity change within ± this × the nominal one.
+    pub delta_v: f32,
+    /// The velocity change is integrated from this × D before the nominal pulse to `after` ×
+    /// D after it; the band is watched from `before` × D before it to `watch` × D after it.
+    pub before: f32,
+    pub after: f32,
+    pub watch: f32,
+}
+
+/// A specified pulse and its tolerances.
+#[derive(Clone, Copy, Debug, PartialEq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct Spec {
+    pub shape: Shape,
+    /// Nominal peak, m/s² (deceleration positive, as the reports).
+    pub peak_m_s2: f32,
+    /// Nominal duration, s.
+    pub duration_s: f32,
+    pub tolerance: Tolerance,
+}
+
+impl Spec {
+    /// Checks every value: a finite positive peak and duration, fractions in their ranges.
+    pub fn validate(&self) -> Result<(), Error> {
+        let invalid = |name, reason| Err(Error::InvalidParameter { name, reason });
+        let t = &self.tolerance;
+        if !(self.peak_m_s2.is_finite() && self.peak_m_s2 > 0.0) {
+            return invalid("spec-peak", "must be finite and > 0");
+        }
+        if !(self.duration_s.is_finite() && self.duration_s > 0.0) {
+            return invalid("spec-duration", "must be finite and > 0");
+        }
+        if let Shape::Trapezoid { rise, fall } = self.shape {
+            if !(rise > 0.0 && fall > 0.0 && rise + fall <= 1.0) {
+                return invalid(
+                    "spec-shape",
+                    "a trapezoid's rise and fall are > 0 and at most the duration together",
+                );
+            }
+        }
+        let fraction = |v: f32| v.is_finite() && (0.0..=1.0).contains(&v);
+        if !(fraction(t.band) && fraction(t.outside) && fraction(t.slack) && fraction(t.delta_v)) {
+            return invalid(
+                "spec-tolerance",
+                "band, outside, slack and delta_v are fractions in [0, 1]",
+            );
+        }
+        let span = |v: f32| v.is_finite() && (0.0..=10.0).contains(&v);
+        if !(span(t.before) && span(t.after) && span(t.watch) && t.watch >= t.after) {
+            return invalid(
+                "spec-window",
+                "before, after and watch are 0 to 10 durations, watch at least after",
+            );
+        }
+        Ok(())
+    }
+
+    /// Samples the verdict needs held on either side of the contact at `rate_hz`: the watched
+    /// window's reach beyond the nominal pulse, and half a duration for the placement.
+    pub fn padding_samples(&self, rate_hz: f32) -> u32 {
+        let t = &self.tolerance;
+        let reach = (t.before + 1.0).max(t.watch.max(t.after)) + 0.5;
+        let n = libm::ceilf(reach * self.duration_s * rate_hz);
+        if n.is_finite() && n < u32::MAX as f32 {
+            n as u32
+        } else {
+            u32::MAX
+        }
+    }
+
+    /// The nominal velocity change, m/s.
+    pub fn delta_v_m_s(&self) -> f32 {
+        self.peak_m_s2 * self.duration_s * self.shape.area()
+    }
+
+    /// The band at `u` = time from the nominal pulse's start / duration, over the peak: the
+    /// least and the greatest acceptable acceleration.
+    pub fn band_at(&self, u: f32) -> (f32, f32) {
+        self.band_with(|u| self.shape.at(u), u)
+    }
+
+    /// [`Self::band_at`] with the nominal shape given by `at` (over the peak, at `u` in
+    /// `[0, 1]`): the verdict's tabulated shape ([`Nominal`]).
+    pub fn band_with(&self, at: impl Fn(f32) -> f32, u: f32) -> (f32, f32) {
+        let t = &self.tolerance;
+        let (a, b) = (u - t.slack, u + t.slack);
+        if b < 0.0 || a > 1.0 {
+            return (-t.outside, t.outside);
+        }
+        // The nominal's extremes over [u - slack, u + slack] (its shapes rise then fall: the
+        // ends, and the peak where it lies inside).
+        let ends = [at(a.max(0.0)), at(b.min(1.0))];
+        let p = self.shape.peak_at();
+        let hi = if (a..=b).contains(&p) {
+            1.0
+        } else {
+            ends[0].max(ends[1])
+        };
+        // Past either end of the pulse the nominal is 0 there: the lower limit is 0's.
+        let lo = if a < 0.0 || b > 1.0 {
+            0.0
+        } else {
+            ends[0].min(ends[1])
+        };
+        ((lo - t.band).max(-t.outside.max(t.band)), hi + t.band)
+    }
+}
+
+/// Points of the tabulated nominal shape ([`Nominal`]), past the first.
+pub const NOMINAL_POINTS: usize = 256;
+
+/// A shape tabulated over its duration and read by linear interpolation: the verdict's
+/// thousands of band look-ups cost a multiply-add each instead of a sine (off the exact shape
+/// by at most 2e-5 of the peak, a thousandth of any band).
+pub struct Nominal {
+    table: [f32; NOMINAL_POINTS + 1],
+}
+
+impl Nominal {
+    pub fn new(shape: Shape) -> Self {
+        let mut table = [0.0; NOMINAL_POINTS + 1];
+        for (k, v) in table.iter_mut().enumerate() {
+            *v = shape.at(k as f32 / NOMINAL_POINTS as f32);
+        }
+        Self { table }
+    }
+
+    /// The shape at `u` in `[0, 1]` (clamped).
+    pub fn at(&self, u: f32) -> f32 {
+        let x = u.clamp(0.0, 1.0) * NOMINAL_POINTS as f32;
+        let k = (x as usize).min(NOMINAL_POINTS - 1);
+        let f = x - k as f32;
+        match (self.table.get(k), self.table.get(k + 1)) {
+            (Some(&y0), Some(&y1)) => y0 + f * (y1 - y0),
+            _ => 0.0,
+        }
+    }
+}

@@ -1,0 +1,323 @@
+//! A captured impact judged against a specified pulse: the nominal pulse placed where the
+//! measured one fits its band best, the worst excursion there, and the velocity change over the
+//! standards' window against its tolerance.
+//!
+//! The placement is a search over the nominal pulse's start, within half a duration of where
+//! its peak meets the measured peak, for the least worst excursion: first on the signal's
+//! extremes in [`BUCKETS`] spans against the band on the same grid (at most 129 starts of
+//! 128 comparisons), then over every sample for 17 starts around the best one.
+
+use super::{Nominal, Spec};
+
+/// Spans the signal is summarised in for the search (its least and greatest value each).
+pub const BUCKETS: usize = 128;
+
+/// The verdict of one impact.
+#[derive(Clone, Copy, Debug, PartialEq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct Verdict {
+    /// Within the band and the velocity tolerance.
+    pub pass: bool,
+    pub band_pass: bool,
+    pub delta_v_pass: bool,
+    /// The nominal pulse's start, s from the stream's first sample.
+    pub start_s: f64,
+    /// The worst excursion: how far beyond its limit (negative: inside), over the peak.
+    pub margin: f32,
+    /// Where (s from the stream's first sample), and the acceleration there and its limit,
+    /// m/s².
+    pub worst_s: f64,
+    pub worst_m_s2: f32,
+    pub limit_m_s2: f32,
+    /// The velocity change over the standards' window, m/s.
+    pub delta_v_m_s: f32,
+}
+
+/// Why there is no verdict.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub enum Missing {
+    /// The capture does not hold the window the verdict watches (the nominal duration is
+    /// too long for the capture at this rate, or the impact lies at its edge).
+    Window,
+    /// The nominal duration is shorter than 4 samples at this rate.
+    Resolution,
+    /// A number of the verdict is beyond f32 (the scene's gain or peak out of any real range).
+    Overflow,
+}
+
+impl Missing {
+    /// The reason's name in the reports.
+    pub fn name(self) -> &'static str {
+        match self {
+            Missing::Window => "spec-window",
+            Missing::Resolution => "spec-resolution",
+            Missing::Overflow => "spec-overflow",
+        }
+    }
+}
+
+/// Whether a placement of worst excursion `worst` is better than the best so far, the
+/// placements tried nearest first: one that passes (the standards: a pulse that "can be
+/// contained" in the band complies) over one that fails, and among failing ones the least
+/// excursion; among passing ones the nearest stays.
+fn better(worst: f32, best: f32) -> bool {
+    match (worst <= 0.0, best <= 0.0) {
+        (true, false) => true,
+        (false, false) => worst < best,
+        _ => false,
+    }
+}
+
+/// Judges the acceleration `a(i)` (m/s² in the pulse's direction, stream index `i`; `None`
+/// outside what is held) at `rate_hz` against `spec`, the measured peak at stream index
+/// `peak_index`. Written for the FPU: positions in f32 samples from the first sample watched
+/// (`base`), the shape tabulated, f64 only for the velocity change's sum.
+pub fn judge(
+    a: impl Fn(u64) -> Option<f32>,
+    rate_hz: f32,
+    spec: &Spec,
+    peak_index: u64,
+) -> Result<Verdict, Missing> {
+    let t = &spec.tolerance;
+    let d = spec.duration_s * rate_hz; // samples
+    if !(d >= 4.0) {
+        return Err(Missing::Resolution);
+    }
+    let peak = spec.peak_m_s2;
+    let nominal = Nominal::new(spec.shape);
+    let band = |u: f32| spec.band_with(|u| nominal.at(u), u);
+    // The start where the nominal peak meets the measured one; the search half a duration
+    // either way; the span the signal must cover for any of them, from `base` (its first
+    // sample) over `span` samples.
+    let lead = t.before * d;
+    let reach = spec.shape.peak_at() * d + d / 2.0 + lead;
+    let base = peak_index
+        .checked_sub(libm::ceilf(reach) as u64)
+        .ok_or(Missing::Window)?;
+    let guess = peak_index as f32 - spec.shape.peak_at() * d - base as f32; // from base
+    let from = guess - d / 2.0 - lead; // >= 0
+    let to = guess + d / 2.0 + (1.0 + t.watch.max(t.after)) * d;
+    let span = libm::ceilf(to) as u32 + 1;
+    // The signal's extremes in BUCKETS spans of `w` samples from `base`.
+    let w = span as f32 / BUCKETS as f32;
+    let mut ext = [(f32::INFINITY, f32::NEG_INFINITY); BUCKETS];
+    for k in 0..span {
+        let v = a(base + u64::from(k)).ok_or(Missing::Window)?;
+        let j = (k as usize * BUCKETS / span as usize).min(BUCKETS - 1);
+        if let Some(e) = ext.get_mut(j) {
+            e.0 = e.0.min(v);
+            e.1 = e.1.max(v);
+        }
+    }
+    // The band over bucket j of a nominal pulse starting at bucket `s`'s start plus `lead`:
+    // the loosest limits over the bucket's two ends (a bucket's extremes inside them is
+    // necessary for its samples to lie inside: the search finds where the pulse can fit, the
+    // exact pass below says whether it does). The band is watched from `before` × D before
+    // the pulse to `watch` × D after it.
+    let watched = (((lead + (1.0 + t.watch) * d) / w) as usize).min(BUCKETS);
+    let mut limits = [(0.0f32, 0.0f32); BUCKETS];
+    for (j, l) in limits.iter_mut().enumerate().take(watched) {
+        let u = |j: f32| (j * w - lead) / d;
+        let (b0, b1) = (band(u(j as f32)), band(u(j as f32 + 1.0)));
+        *l = (b0.0.min(b1.0) * peak, b0.1.max(b1.1) * peak);
+    }
+    // The start in whole buckets: nearest the peak-aligned one (`centre`) among those that
+    // may pass, else of least worst excursion ([`better`]).
+    let first = libm::ceilf(from / w) as usize;
+    let steps = ((d / w) as usize).min(BUCKETS);
+    let centre = libm::roundf((guess - lead) / w) as usize;
+    let mut best = (centre, f32::INFINITY);
+    for k in 0..=2 * steps {
+        // centre, centre + 1, centre - 1, centre + 2, …
+        let offset = k.div_ceil(2);
+        let Some(s) = (if k % 2 == 1 {
+            Some(centre + offset)
+        } else {
+            centre.checked_sub(offset)
+        })
+        .filter(|&s| (first..=first + steps).contains(&s)) else {
+            continue;
+        };
+        let mut worst = f32::NEG_INFINITY;
+        for (&(lo, hi), &(lower, upper)) in ext.iter().skip(s).zip(limits.iter().take(watched)) {
+            worst = worst.max(hi - upper).max(lower - lo);
+        }
+        if better(worst, best.1) {
+            best = (s, worst);
+        }
+    }
+    // Every sample, for the coarse start and then, halving the step from half a bucket down
+    // to an eighth (at least a sample), a step either way of the best so far: the worst
+    // excursion at the best of them. The first start that passes is the one (the nearest);
+    // a start whose excursion so far already exceeds the best's is left there (it cannot be
+    // better), after a look at the best's worst sample first.
+    let coarse = best.0 as f32 * w + lead;
+    let mut fine = (coarse, f32::INFINITY, 0u32, 0.0f32, 0.0f32);
+    let try_start = |start: f32, fine: &mut (f32, f32, u32, f32, f32)| -> Result<(), Missing> {
+        let k0 = libm::ceilf((start - lead).max(0.0)) as u32;
+        let k1 = (libm::floorf(start + (1.0 + t.watch) * d) as u32).min(span - 1);
+        let excursion = |k: u32| -> Result<(f32, f32, f32), Missing> {
+            let v = a(base + u64::from(k)).ok_or(Missing::Window)?;
+            let (lo, hi) = band((k as f32 - start) / d);
+            let (lo, hi) = (lo * peak, hi * peak);
+            Ok(if v - hi >= lo - v {
+                (v - hi, v, hi)
+            } else {
+                (lo - v, v, lo)
+            })
+        };
+        if fine.1.is_finite() && (k0..=k1).contains(&fine.2) && excursion(fine.2)?.0 > fine.1 {
+            return Ok(());
+        }
+        let (mut worst, mut worst_k, mut worst_v, mut limit) =
+            (f32::NEG_INFINITY, 0u32, 0.0f32, 0.0f32);
+        for k in k0..=k1 {
+            if worst > fine.1 {
+                return Ok(());
+            }
+            let (over, v, lim) = excursion(k)?;
+            if over > worst {
+                (worst, worst_k, worst_v, limit) = (over, k, v, lim);
+            }
+        }
+        if better(worst, fine.1) {
+            *fine = (start, worst, worst_k, worst_v, limit);
+        }
+        Ok(())
+    };
+    try_start(coarse, &mut fine)?;
+    let mut step = w / 2.0;
+    while fine.1 > 0.0 {
+        let around = fine.0;
+        try_start(around - step, &mut fine)?;
+        if fine.1 > 0.0 {
+            try_start(around + step, &mut fine)?;
+        }
+        if step <= 1.0 || step <= w / 8.0 {
+            break;
+        }
+        step = (step / 2.0).max(1.0);
+    }
+    let (start, worst, worst_k, worst_v, limit) = fine;
+    // The velocity change from `before` × D before the pulse to `after` × D after it.
+    let k0 = libm::ceilf((start - lead).max(0.0)) as u32;
+    let k1 = (libm::floorf(start + (1.0 + t.after) * d) as u32).min(span - 1);
+    // Compensated f32 sums (Kahan): an f64's accuracy at the FPU's speed.
+    let (mut sum, mut carry) = (0.0f32, 0.0f32);
+    for k in k0..=k1 {
+        let y = a(base + u64::from(k)).ok_or(Missing::Window)? - carry;
+        let next = sum + y;
+        carry = (next - sum) - y;
+        sum = next;
+    }
+    let delta_v = sum / rate_hz;
+    let nominal_dv = spec.delta_v_m_s();
+    let band_pass = worst <= 0.0;
+    let delta_v_pass = libm::fabsf(delta_v - nominal_dv) <= t.delta_v * nominal_dv;
+    let seconds = |k: f64| (base as f64 + k) / f64::from(rate_hz);
+    let margin = worst / peak;
+    if ![margin, worst_v, limit, delta_v]
+        .iter()
+        .all(|x| x.is_finite())
+    {
+        return Err(Missing::Overflow);
+    }
+    Ok(Verdict {
+        pass: band_pass && delta_v_pass,
+        band_pass,
+        delta_v_pass,
+        start_s: seconds(f64::from(start)),
+        margin,
+        worst_s: seconds(f64::from(worst_k)),
+        worst_m_s2: worst_v,
+        limit_m_s2: limit,
+        delta_v_m_s: delta_v,
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::spec::{Shape, Tolerance};
+
+    fn spec(shape: Shape) -> Spec {
+        Spec {
+            shape,
+            peak_m_s2: 500.0,
+            duration_s: 0.011,
+            tolerance: Tolerance {
+                band: 0.2,
+                outside: 0.2,
+                slack: 0.0,
+                delta_v: 0.15,
+                before: 0.4,
+                after: 0.1,
+                watch: 1.5,
+            },
+        }
+    }
+
+    /// A pulse of `shape` scaled by `gain` in time and amplitude, at 50 kS/s, its start at
+    /// sample 2000 (and `glitch` added at a sample).
+    fn judge_pulse(shape: Shape, peak: f32, dur: f32, glitch: Option<(u64, f32)>) -> Verdict {
+        let rate = 50_000.0f32;
+        let start = 2000.0;
+        let a = |i: u64| {
+            let u = (i as f32 - start) / (dur * rate);
+            let g = glitch.filter(|g| g.0 == i).map_or(0.0, |g| g.1);
+            Some(peak * shape.at(u) + g)
+        };
+        let peak_index = (start + shape.peak_at() * dur * rate) as u64;
+        let held = |i: u64| (i < 10_000).then(|| a(i)).flatten();
+        judge(
+            held,
+            rate,
+            &spec(shape),
+            peak_index.min(2000 + (dur * rate) as u64 - 1),
+        )
+        .unwrap()
+    }
+
+    #[test]
+    fn a_nominal_pulse_passes_and_its_delta_v_is_the_nominal_one() {
+        for shape in [
+            Shape::HalfSine,
+            Shape::Sawtooth,
+            Shape::Trapezoid {
+                rise: 0.1,
+                fall: 0.1,
+            },
+        ] {
+            let v = judge_pulse(shape, 500.0, 0.011, None);
+            assert!(v.pass, "{shape:?}: {v:?}");
+            let want = spec(shape).delta_v_m_s();
+            assert!(
+                (v.delta_v_m_s / want - 1.0).abs() < 0.01,
+                "{shape:?}: {v:?}"
+            );
+            assert!(
+                (v.start_s * 50_000.0 - 2000.0).abs() < 10.0,
+                "{shape:?}: {v:?}"
+            );
+        }
+    }
+
+    #[test]
+    fn a_pulse_too_high_or_too_short_fails_by_its_margin() {
+        // 30 % high: beyond the ±20 % band by 10 % of the peak.
+        let v = judge_pulse(Shape::HalfSine, 650.0, 0.011, None);
+        assert!(!v.band_pass, "{v:?}");
+        assert!((v.margin - 0.1).abs() < 0.01, "{v:?}");
+        // Half as long: its Δv is half the nominal one.
+        let v = judge_pulse(Shape::HalfSine, 500.0, 0.0055, None);
+        assert!(!v.pass && !v.delta_v_pass, "{v:?}");
+        // A spike after the pulse beyond ±20 %: the band fails there.
+        let v = judge_pulse(Shape::HalfSine, 500.0, 0.011, Some((2800, 150.0)));
+        assert!(
+            !v.band_pass && (v.worst_s * 50_000.0 - 2800.0).abs() < 1e-6,
+            "{v:?}"
+        );
+        assert!((v.margin - 0.1).abs() < 0.01, "{v:?}");
+    }
+}

@@ -1,0 +1,223 @@
+//! `impact report … --html FILE`: one self-contained HTML file (no network, no script) a test
+//! engineer can hand in: the settings and provenance, the series table and statistics, and
+//! every impact's pulse drawn with the nominal pulse and its tolerance band when a
+//! specification is given.
+
+use std::fmt::Write as _;
+use std::path::PathBuf;
+
+use impact_core::consts::STANDARD_GRAVITY;
+
+use super::analyze::AnalyzeCommand;
+use super::pulse::{esc, MAX_FIGURES};
+use super::series::{self, EntryJson};
+use crate::report::fmt::human;
+
+/// `impact report`'s command line: the analysis's (one or more recordings), and the file.
+#[derive(clap::Args, Clone, Debug)]
+pub struct ReportArgs {
+    #[command(flatten)]
+    pub analyze: AnalyzeCommand,
+    /// The report: one self-contained HTML file (its figures inline).
+    #[arg(long, value_name = "FILE.html", help_heading = "Output")]
+    pub html: PathBuf,
+}
+
+/// Runs `impact report`.
+pub fn run(args: &ReportArgs) -> Result<(), String> {
+    let cmd = &args.analyze;
+    let a = &cmd.args;
+    if a.plot.is_some() || a.json || a.csv {
+        return Err(
+            "--plot, --json, --csv: `impact analyze` writes those; the report is --html".into(),
+        );
+    }
+    let mut files = vec![a.file.clone()];
+    files.extend(cmd.more.iter().cloned());
+    let entries = series::entries(&files, &cmd.channels, a.column.as_ref())?;
+    let mut inputs = crate::output::Inputs::new();
+    for e in &entries {
+        inputs = inputs.with(&e.file);
+    }
+    let inputs = inputs
+        .with_some(a.scene.as_deref())
+        .with_some(a.free_fall.as_deref().map(crate::pipeline::free_fall::file));
+    crate::output::check("--html", &args.html, &inputs, Some("html"))?;
+    let results = series::analyze_drawn(a, &entries);
+    let page = page(cmd, &results);
+    crate::output::write(&args.html, page.as_bytes())?;
+    for e in &results {
+        for n in &e.notes {
+            eprintln!("note: {}", series::failure(e, n));
+        }
+    }
+    eprintln!("wrote {}", args.html.display());
+    let failed = results.iter().filter(|e| e.error.is_some()).count();
+    if failed > 0 {
+        return Err(format!(
+            "{failed} of {} recordings failed (each named in the report)",
+            results.len()
+        ));
+    }
+    Ok(())
+}
+
+const STYLE: &str = "body{font-family:system-ui,sans-serif;margin:2em;color:#222;max-width:1100px}\
+h1{font-size:1.5em}h2{font-size:1.2em;margin-top:2em;border-bottom:1px solid #ccc}\
+table{border-collapse:collapse;font-size:.85em;margin:.5em 0}\
+td,th{border:1px solid #ccc;padding:.2em .5em;text-align:right}th{background:#f3f3f3}\
+td.l,th.l{text-align:left}.pass{color:#080;font-weight:bold}.fail{color:#b00;font-weight:bold}\
+.figure{display:inline-block;margin:.5em;vertical-align:top}dl{display:grid;grid-template-columns:max-content auto;gap:.2em 1em}\
+dt{font-weight:bold}";
+
+fn page(cmd: &AnalyzeCommand, results: &[EntryJson]) -> String {
+    let json = series::to_json(results);
+    let a = &cmd.args;
+    let mut h = String::new();
+    let _ = write!(
+        h,
+        "<!DOCTYPE html>\n<html lang=\"en\"><head><meta charset=\"utf-8\"><title>Impact report</title><style>{STYLE}</style></head><body>\n<h1>Impact report: {} recording{}, {} impact{}</h1>\n",
+        json.recordings,
+        if json.recordings == 1 { "" } else { "s" },
+        json.impacts,
+        if json.impacts == 1 { "" } else { "s" },
+    );
+    // Settings and provenance.
+    h.push_str("<h2>Settings and provenance</h2><dl>");
+    let mut dd = |k: &str, v: &str| {
+        let _ = write!(h, "<dt>{}</dt><dd>{}</dd>", esc(k), esc(v));
+    };
+    dd("tool", &format!("impact {}", env!("CARGO_PKG_VERSION")));
+    dd("command", &std::env::args().collect::<Vec<_>>().join(" "));
+    for e in results {
+        let size =
+            std::fs::metadata(&e.file).map_or(String::new(), |m| format!(", {} bytes", m.len()));
+        let rate = e.analysis.as_ref().map_or(String::new(), |a| {
+            format!(
+                ", {} samples at {} S/s",
+                a.samples,
+                crate::report::fmt::sig(a.sample_rate_hz, 6)
+            )
+        });
+        dd(
+            "recording",
+            &format!("{} [{}]{size}{rate}", e.file, e.channel),
+        );
+    }
+    dd(
+        "filter",
+        &a.cfc.map_or("none (raw signal)".into(), |c| {
+            format!("CFC {c} (SAE J211) on the captured windows")
+        }),
+    );
+    if let Some(s) = results
+        .iter()
+        .find_map(|e| e.analysis.as_ref()?.spec.clone())
+    {
+        dd(
+            "specification",
+            crate::report::spec::table_head(&s)
+                .trim_end()
+                .trim_start_matches("spec: "),
+        );
+    }
+    h.push_str("</dl>\n");
+    // The series table.
+    h.push_str("<h2>Impacts</h2><table><tr><th class=\"l\">file</th><th class=\"l\">channel</th><th>#</th><th>start</th><th>peak (g)</th><th>peak (m/s²)</th><th>Δv</th><th>duration</th><th>FWHM</th><th>COR</th><th class=\"l\">status</th><th class=\"l\">verdict</th></tr>\n");
+    for (e, i) in series::impacts(results) {
+        let o = |v: Option<f64>, u: &str| {
+            v.map_or("—".into(), |v| human(v, u).trim_end().to_string())
+        };
+        let verdict = match &i.spec {
+            Some(Some(v)) if v.pass => "<span class=\"pass\">PASS</span>".to_string(),
+            Some(Some(v)) => format!(
+                "<span class=\"fail\">FAIL</span> ({:+.1} % of the peak)",
+                100.0 * v.margin
+            ),
+            Some(None) => format!(
+                "not judged ({})",
+                esc(i.null_reasons.get("spec").map_or("", String::as_str))
+            ),
+            None => "—".into(),
+        };
+        let _ = writeln!(
+            h,
+            "<tr><td class=\"l\">{}</td><td class=\"l\">{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td class=\"l\">{}</td><td class=\"l\">{verdict}</td></tr>",
+            esc(&e.file),
+            esc(&e.channel),
+            i.index,
+            human(i.start_s, "s"),
+            human(i.peak_acceleration_m_s2 / STANDARD_GRAVITY, "g").trim_end_matches(" g"),
+            human(i.peak_acceleration_m_s2, "m/s²").trim_end_matches(" m/s²"),
+            o(i.delta_v_m_s, "m/s"),
+            human(i.duration_s, "s"),
+            o(i.fwhm_s, "s"),
+            o(i.cor, ""),
+            esc(&std::iter::once(i.status.as_str()).chain(i.flags.iter().map(String::as_str)).collect::<Vec<_>>().join(" ")),
+        );
+    }
+    h.push_str("</table>\n");
+    for e in results {
+        if let Some(err) = &e.error {
+            let _ = writeln!(
+                h,
+                "<p class=\"fail\">FAILED {}</p>",
+                esc(&series::failure(e, err))
+            );
+        }
+    }
+    if let Some(r) = &json.spec {
+        let _ = writeln!(
+            h,
+            "<p><b>Specification:</b> {} of {} judged impacts pass{}{}.</p>",
+            r.passed,
+            r.judged,
+            r.pass_rate
+                .map_or(String::new(), |p| format!(" ({:.1} %)", 100.0 * p)),
+            if r.not_judged > 0 {
+                format!("; {} not judged", r.not_judged)
+            } else {
+                String::new()
+            }
+        );
+    }
+    if !json.statistics.is_empty() {
+        h.push_str("<h2>Statistics across the series</h2><p>sd: sample standard deviation; CV: sd / |mean|.</p><table><tr><th class=\"l\">metric</th><th>n</th><th>mean</th><th>sd</th><th>CV</th><th>min</th><th>max</th></tr>\n");
+        for st in &json.statistics {
+            let u = crate::report::statistics::METRICS
+                .iter()
+                .find(|(m, _, _)| *m == st.metric)
+                .map_or("", |(_, u, _)| u);
+            let q = |v: f64| human(v, u).trim_end().to_string();
+            let _ = writeln!(
+                h,
+                "<tr><td class=\"l\">{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td></tr>",
+                st.metric,
+                st.n,
+                q(st.mean),
+                st.sd.map_or("—".into(), q),
+                st.cv.map_or("—".into(), |c| format!("{:.2} %", 100.0 * c)),
+                q(st.min),
+                q(st.max)
+            );
+        }
+        h.push_str("</table>\n");
+    }
+    // The pulses.
+    h.push_str("<h2>Pulses</h2>\n");
+    let drawn: usize = results.iter().map(|e| e.figures.len()).sum();
+    let total = json.impacts;
+    if drawn < total {
+        let _ = writeln!(
+            h,
+            "<p>The first {drawn} of {total} impacts are drawn (at most {MAX_FIGURES}); the table has them all.</p>"
+        );
+    }
+    for e in results {
+        for f in &e.figures {
+            let _ = writeln!(h, "<div class=\"figure\">{f}</div>");
+        }
+    }
+    h.push_str("</body></html>\n");
+    h
+}

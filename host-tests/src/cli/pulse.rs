@@ -1,0 +1,264 @@
+//! An impact's pulse as an inline SVG for the HTML report: the measured acceleration in g
+//! above its baseline (min/max per column), with a specification's nominal pulse and band
+//! where its verdict placed them.
+
+use std::fmt::Write as _;
+
+use impact_core::consts::STANDARD_GRAVITY;
+use impact_core::spec::Spec;
+
+use crate::report::fmt::human;
+
+/// The largest number of impacts drawn (each figure is a few kB; the table has them all).
+pub const MAX_FIGURES: usize = 200;
+
+/// Text for HTML (the report and its figures).
+pub fn esc(s: &str) -> String {
+    s.replace('&', "&amp;")
+        .replace('<', "&lt;")
+        .replace('>', "&gt;")
+        .replace('"', "&quot;")
+}
+
+/// A pulse drawn: `(t_s, a_m_s2)` min/max pairs per pixel column over the window from
+/// `from_s`, the title, and the specification's nominal pulse and band placed at `start_s`.
+pub struct Pulse<'a> {
+    pub title: String,
+    /// Per column: time (s) and the least and greatest acceleration there (m/s²).
+    pub columns: Vec<(f64, f64, f64)>,
+    pub spec: Option<(&'a Spec, f64)>,
+}
+
+/// Ticks at 1, 2 or 5 × 10^k covering `[lo, hi]`, about `n` of them.
+fn ticks(lo: f64, hi: f64, n: usize) -> Vec<f64> {
+    let span = (hi - lo).abs().max(f64::MIN_POSITIVE);
+    let raw = span / n as f64;
+    let mag = 10f64.powf(raw.log10().floor());
+    let step = [1.0, 2.0, 5.0, 10.0]
+        .iter()
+        .map(|m| m * mag)
+        .find(|s| *s >= raw)
+        .unwrap_or(10.0 * mag);
+    let mut t = (lo / step).ceil() * step;
+    let mut out = Vec::new();
+    while t <= hi + step * 1e-9 && out.len() < 50 {
+        out.push(if t.abs() < step * 1e-9 { 0.0 } else { t });
+        t += step;
+    }
+    out
+}
+
+/// A tick's label: as few digits as the step needs.
+fn label(v: f64, step: f64) -> String {
+    let decimals = (-step.log10().floor()).max(0.0) as usize;
+    format!("{v:.decimals$}")
+}
+
+/// The pulse as an inline SVG: acceleration in g against time in ms from the window's start,
+/// the measured signal as a min/max band per column, the band and the nominal pulse dashed.
+pub fn svg(p: &Pulse) -> String {
+    const W: f64 = 520.0;
+    const H: f64 = 300.0;
+    const L: f64 = 58.0;
+    const R: f64 = 12.0;
+    const T: f64 = 30.0;
+    const B: f64 = 42.0;
+    let Some(&(t_first, _, _)) = p.columns.first() else {
+        return String::new();
+    };
+    let t_last = p.columns.last().map_or(t_first, |c| c.0);
+    let g = STANDARD_GRAVITY;
+    // The band and the nominal pulse, in (t, lo, hi, nominal) over the window.
+    let band: Vec<(f64, f64, f64, f64)> = match p.spec {
+        Some((spec, start)) => (0..=200)
+            .map(|k| {
+                let t = t_first + (t_last - t_first) * f64::from(k) / 200.0;
+                let u = ((t - start) / f64::from(spec.duration_s)) as f32;
+                let (lo, hi) = spec.band_at(u);
+                let peak = f64::from(spec.peak_m_s2);
+                (
+                    t,
+                    f64::from(lo) * peak,
+                    f64::from(hi) * peak,
+                    f64::from(spec.shape.at(u)) * peak,
+                )
+            })
+            .collect(),
+        None => Vec::new(),
+    };
+    let (mut y_lo, mut y_hi) = p
+        .columns
+        .iter()
+        .fold((0.0f64, 0.0f64), |(lo, hi), c| (lo.min(c.1), hi.max(c.2)));
+    for b in &band {
+        y_lo = y_lo.min(b.1);
+        y_hi = y_hi.max(b.2);
+    }
+    let pad = 0.05 * (y_hi - y_lo).max(1e-9);
+    let (y_lo, y_hi) = (y_lo - pad, y_hi + pad);
+    let x = |t: f64| L + (t - t_first) / (t_last - t_first).max(1e-12) * (W - L - R);
+    let y = |a: f64| T + (y_hi - a) / (y_hi - y_lo) * (H - T - B);
+    let mut s = String::new();
+    let _ = write!(
+        s,
+        "<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"{W}\" height=\"{H}\" viewBox=\"0 0 {W} {H}\" font-family=\"sans-serif\" font-size=\"11\"><title>{}</title><rect width=\"{W}\" height=\"{H}\" fill=\"white\"/>",
+        esc(&p.title)
+    );
+    let _ = write!(s, "<text x=\"{}\" y=\"16\" text-anchor=\"middle\" font-size=\"12\" font-weight=\"bold\">{}</text>", W / 2.0, esc(&p.title));
+    // Grid and ticks: time in ms from the window's start, acceleration in g.
+    let span_ms = (t_last - t_first) * 1e3;
+    let xt = ticks(0.0, span_ms, 6);
+    let xstep = xt.get(1).zip(xt.first()).map_or(1.0, |(b, a)| b - a);
+    for v in &xt {
+        let px = x(t_first + v * 1e-3);
+        let _ = write!(s, "<line x1=\"{px:.1}\" y1=\"{T}\" x2=\"{px:.1}\" y2=\"{}\" stroke=\"#eee\"/><text x=\"{px:.1}\" y=\"{}\" text-anchor=\"middle\">{}</text>", H - B, H - B + 14.0, label(*v, xstep));
+    }
+    let yt = ticks(y_lo / g, y_hi / g, 6);
+    let ystep = yt.get(1).zip(yt.first()).map_or(1.0, |(b, a)| b - a);
+    for v in &yt {
+        let py = y(v * g);
+        let _ = write!(s, "<line x1=\"{L}\" y1=\"{py:.1}\" x2=\"{}\" y2=\"{py:.1}\" stroke=\"#eee\"/><text x=\"{}\" y=\"{:.1}\" text-anchor=\"end\">{}</text>", W - R, L - 4.0, py + 4.0, label(*v, ystep));
+    }
+    let _ = write!(
+        s,
+        "<rect x=\"{L}\" y=\"{T}\" width=\"{}\" height=\"{}\" fill=\"none\" stroke=\"#999\"/>",
+        W - L - R,
+        H - T - B
+    );
+    let _ = write!(
+        s,
+        "<text x=\"{}\" y=\"{}\" text-anchor=\"middle\">time from {:.3} ms (ms)</text>",
+        (L + W - R) / 2.0,
+        H - 8.0,
+        t_first * 1e3
+    );
+    let _ = write!(s, "<text transform=\"translate(14 {}) rotate(-90)\" text-anchor=\"middle\">acceleration (g)</text>", (T + H - B) / 2.0);
+    // The band (shaded between its limits) and the nominal pulse (dashed).
+    if !band.is_empty() {
+        let mut d = String::new();
+        for (k, b) in band.iter().enumerate() {
+            let _ = write!(
+                d,
+                "{}{:.1},{:.1}",
+                if k == 0 { "M" } else { " L" },
+                x(b.0),
+                y(b.2)
+            );
+        }
+        for b in band.iter().rev() {
+            let _ = write!(d, " L{:.1},{:.1}", x(b.0), y(b.1));
+        }
+        let _ = write!(s, "<path d=\"{d} Z\" fill=\"#4a90d9\" fill-opacity=\"0.15\" stroke=\"#4a90d9\" stroke-width=\"0.8\"/>");
+        let pts: Vec<String> = band
+            .iter()
+            .map(|b| format!("{:.1},{:.1}", x(b.0), y(b.3)))
+            .collect();
+        let _ = write!(
+            s,
+            "<polyline points=\"{}\" fill=\"none\" stroke=\"#4a90d9\" stroke-dasharray=\"5 3\"/>",
+            pts.join(" ")
+        );
+    }
+    // The measured signal: each column's extremes joined.
+    let mut d = String::new();
+    for (k, c) in p.columns.iter().enumerate() {
+        let _ = write!(
+            d,
+            "{}{:.1},{:.1} L{:.1},{:.1}",
+            if k == 0 { "M" } else { " L" },
+            x(c.0),
+            y(c.1),
+            x(c.0),
+            y(c.2)
+        );
+    }
+    let _ = write!(
+        s,
+        "<path d=\"{d}\" fill=\"none\" stroke=\"#c0392b\" stroke-width=\"1.2\"/>"
+    );
+    // The legend.
+    let _ = write!(s, "<g transform=\"translate({} {})\"><line x1=\"0\" y1=\"0\" x2=\"18\" y2=\"0\" stroke=\"#c0392b\" stroke-width=\"1.5\"/><text x=\"22\" y=\"4\">measured</text>", W - R - 150.0, T + 12.0);
+    if !band.is_empty() {
+        s.push_str("<line x1=\"0\" y1=\"14\" x2=\"18\" y2=\"14\" stroke=\"#4a90d9\" stroke-dasharray=\"5 3\"/><text x=\"22\" y=\"18\">nominal, tolerance band</text>");
+    }
+    s.push_str("</g></svg>");
+    s
+}
+
+/// Columns a pulse is drawn in (each its samples' least and greatest value).
+const COLUMNS: u64 = 400;
+
+/// Impact `r` of the recording `signal` reads drawn (`spec`: the scene's): above its baseline, in the direction of its peak;
+/// with a verdict, over the window it watched with the nominal pulse and band where it was
+/// placed, else from a quarter of its duration before it to a quarter after.
+pub fn pulse_svg(
+    signal: &crate::plot::Signal,
+    spec: Option<&Spec>,
+    r: &impact_core::ImpactReport,
+    title: String,
+) -> String {
+    let rate = signal.rate_hz;
+    let (from_s, to_s, placed) = match (spec, &r.verdict) {
+        (Some(spec), Some(Ok(v))) => {
+            let d = f64::from(spec.duration_s);
+            let t = spec.tolerance;
+            (
+                v.start_s - f64::from(t.before) * d,
+                v.start_s + f64::from(1.0 + t.watch) * d,
+                Some((spec, v.start_s)),
+            )
+        }
+        _ => {
+            let d = f64::from(r.duration_s);
+            (r.start_s - 0.25 * d, r.start_s + 1.25 * d, None)
+        }
+    };
+    let sign = if r.peak_acceleration_m_s2 < 0.0 {
+        -1.0
+    } else {
+        1.0
+    };
+    let base = f64::from(r.baseline_m_s2);
+    let i0 = (from_s * rate).floor().max(0.0) as u64;
+    let i1 = ((to_s * rate).ceil().max(0.0) as u64).max(i0 + 1);
+    let n = i1 - i0;
+    let cols = COLUMNS.min(n);
+    let columns = (0..cols)
+        .filter_map(|c| {
+            let (a, b) = (i0 + c * n / cols, i0 + (c + 1) * n / cols);
+            let (lo, hi) = (a..b.max(a + 1))
+                .filter_map(|i| (signal.accel_m_s2)(i))
+                .map(|v| sign * (v - base))
+                .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), v| {
+                    (lo.min(v), hi.max(v))
+                });
+            (lo <= hi).then_some((a as f64 / rate, lo, hi))
+        })
+        .collect();
+    svg(&Pulse {
+        title: format!(
+            "{title}: peak {}",
+            human(f64::from(r.peak_acceleration_m_s2) / STANDARD_GRAVITY, "g")
+        ),
+        columns,
+        spec: placed,
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn ticks_are_round_numbers_covering_the_range() {
+        assert_eq!(ticks(0.0, 10.0, 5), [0.0, 2.0, 4.0, 6.0, 8.0, 10.0]);
+        assert_eq!(ticks(-3.0, 12.0, 6), [0.0, 5.0, 10.0]);
+        assert_eq!(
+            ticks(-3.0, 12.0, 10),
+            [-2.0, 0.0, 2.0, 4.0, 6.0, 8.0, 10.0, 12.0]
+        );
+        assert_eq!(label(0.25, 0.05), "0.25");
+        assert_eq!(label(12000.0, 2000.0), "12000");
+        assert_eq!(esc("a<b&\"c\""), "a&lt;b&amp;&quot;c&quot;");
+    }
+}

@@ -1,0 +1,488 @@
+//! A test series: several recordings (files, folders, patterns) and channels analysed in one
+//! call, in parallel; one row per impact with its file and channel, and each metric's
+//! statistics across the series.
+
+use std::path::{Path, PathBuf};
+use std::sync::atomic::{AtomicUsize, Ordering};
+
+use impact_core::consts::STANDARD_GRAVITY;
+use impact_io::channel::ColumnRef;
+use serde::Serialize;
+
+use crate::pipeline::{self, AnalyzeArgs};
+use crate::report::fmt::human;
+use crate::report::statistics::{pass_rate, statistics, PassRate, Statistic, METRICS};
+use crate::report::{AnalysisJson, ImpactJson};
+
+/// The extensions of the recordings a folder contributes (as `impact analyze` reads them).
+pub const RECORDING_EXTENSIONS: [&str; 7] = ["csv", "ide", "wav", "npy", "tdms", "i16", "f32"];
+
+/// One recording of a series: a file and its channel (`None`: the file's default).
+#[derive(Clone, Debug)]
+pub struct Entry {
+    pub file: PathBuf,
+    pub column: Option<ColumnRef>,
+}
+
+impl Entry {
+    /// The channel as the table and the CSV name it (empty: the file's default).
+    pub fn channel(&self) -> String {
+        match &self.column {
+            Some(ColumnRef::Name(n)) => n.clone(),
+            Some(ColumnRef::Index(i)) => i.to_string(),
+            None => String::new(),
+        }
+    }
+}
+
+/// Whether `path` is a pattern (`*`, `?`, `[`) rather than a file name.
+fn is_pattern(path: &Path) -> bool {
+    path.to_string_lossy().contains(['*', '?', '['])
+}
+
+/// Whether `files` and `channels` make a series rather than one recording: more than one
+/// file, a folder, a pattern, or a list of channels.
+pub fn is_series(files: &[PathBuf], channels: &[ColumnRef]) -> bool {
+    files.len() > 1 || !channels.is_empty() || files.iter().any(|f| f.is_dir() || is_pattern(f))
+}
+
+/// The series' recordings, in the order given: each file (a folder: its recordings by name;
+/// a pattern: its matches by name) with each of `channels` (none: `column`, or the file's
+/// default). A file given twice is analysed twice; a folder or pattern that holds no
+/// recording, and standard input, are errors.
+pub fn entries(
+    files: &[PathBuf],
+    channels: &[ColumnRef],
+    column: Option<&ColumnRef>,
+) -> Result<Vec<Entry>, String> {
+    let mut paths = Vec::new();
+    for f in files {
+        if f.as_os_str() == "-" {
+            return Err(
+                "a series reads files: standard input (-) can be one recording only".into(),
+            );
+        }
+        if f.is_dir() {
+            let mut found: Vec<PathBuf> = std::fs::read_dir(f)
+                .map_err(|e| format!("{}: {e}", f.display()))?
+                .filter_map(|e| e.ok().map(|e| e.path()))
+                .filter(|p| p.is_file() && is_recording(p))
+                .collect();
+            found.sort();
+            if found.is_empty() {
+                return Err(format!(
+                    "{}: a folder with no recordings (files ending .{})",
+                    f.display(),
+                    RECORDING_EXTENSIONS.join(", .")
+                ));
+            }
+            paths.extend(found);
+        } else if is_pattern(f) && !f.exists() {
+            let pattern = f.to_string_lossy();
+            let mut found: Vec<PathBuf> = glob::glob(&pattern)
+                .map_err(|e| format!("{pattern}: not a pattern ({e})"))?
+                .filter_map(Result::ok)
+                .filter(|p| p.is_file())
+                .collect();
+            found.sort();
+            if found.is_empty() {
+                return Err(format!("{pattern}: no file matches"));
+            }
+            paths.extend(found);
+        } else {
+            paths.push(f.clone());
+        }
+    }
+    let columns: Vec<Option<ColumnRef>> = if channels.is_empty() {
+        vec![column.cloned()]
+    } else {
+        channels.iter().cloned().map(Some).collect()
+    };
+    Ok(paths
+        .into_iter()
+        .flat_map(|file| {
+            columns.iter().map(move |column| Entry {
+                file: file.clone(),
+                column: column.clone(),
+            })
+        })
+        .collect())
+}
+
+fn is_recording(path: &Path) -> bool {
+    let hidden = path
+        .file_name()
+        .is_some_and(|n| n.to_string_lossy().starts_with('.'));
+    let ext = path
+        .extension()
+        .map(|e| e.to_string_lossy().to_ascii_lowercase())
+        .unwrap_or_default();
+    !hidden && RECORDING_EXTENSIONS.contains(&ext.as_str())
+}
+
+/// One recording's analysis, or why it failed, with the notes it gave.
+#[derive(Debug, Serialize)]
+pub struct EntryJson {
+    pub file: String,
+    pub channel: String,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub error: Option<String>,
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub notes: Vec<String>,
+    #[serde(flatten, skip_serializing_if = "Option::is_none")]
+    pub analysis: Option<AnalysisJson>,
+    /// With [`analyze_drawn`]: each impact's pulse as an inline SVG (the report's).
+    #[serde(skip)]
+    pub figures: Vec<String>,
+}
+
+/// Analyses every entry with `args` (its file and channel replaced), on as many threads as
+/// the machine has cores (at most one per entry), in the entries' order. Each analysis
+/// reads its file as `impact analyze` does, so memory is bounded by the threads' analyses.
+pub fn analyze(args: &AnalyzeArgs, entries: &[Entry]) -> Vec<EntryJson> {
+    analyze_all(args, entries, false)
+}
+
+/// As [`analyze`], each impact's pulse drawn as well (`impact report`).
+pub fn analyze_drawn(args: &AnalyzeArgs, entries: &[Entry]) -> Vec<EntryJson> {
+    analyze_all(args, entries, true)
+}
+
+fn analyze_all(args: &AnalyzeArgs, entries: &[Entry], draw: bool) -> Vec<EntryJson> {
+    let next = AtomicUsize::new(0);
+    let workers = std::thread::available_parallelism()
+        .map_or(1, |n| n.get())
+        .min(entries.len())
+        .max(1);
+    let mut done: Vec<(usize, EntryJson)> = std::thread::scope(|scope| {
+        let handles: Vec<_> = (0..workers)
+            .map(|_| {
+                scope.spawn(|| {
+                    let mut mine = Vec::new();
+                    loop {
+                        let k = next.fetch_add(1, Ordering::Relaxed);
+                        let Some(entry) = entries.get(k) else { break };
+                        mine.push((k, analyze_one(args, entry, draw)));
+                    }
+                    mine
+                })
+            })
+            .collect();
+        handles
+            .into_iter()
+            .flat_map(|h| {
+                h.join().unwrap_or_else(|_| {
+                    // A panicking analysis is a bug; its entries are reported, not lost.
+                    Vec::new()
+                })
+            })
+            .collect()
+    });
+    done.sort_by_key(|(k, _)| *k);
+    // An entry whose thread panicked is missing: named as failed.
+    let mut out = Vec::with_capacity(entries.len());
+    let mut done = done.into_iter().peekable();
+    for (k, entry) in entries.iter().enumerate() {
+        match done.next_if(|(j, _)| *j == k) {
+            Some((_, json)) => out.push(json),
+            None => out.push(EntryJson {
+                file: entry.file.display().to_string(),
+                channel: entry.channel(),
+                error: Some("the analysis stopped on an internal error (please report it)".into()),
+                notes: Vec::new(),
+                analysis: None,
+                figures: Vec::new(),
+            }),
+        }
+    }
+    out
+}
+
+fn analyze_one(args: &AnalyzeArgs, entry: &Entry, draw: bool) -> EntryJson {
+    let mut a = args.clone();
+    a.file = entry.file.clone();
+    a.column = entry.column.clone();
+    // A figure reads its windows in a last pass when the recording is read in passes.
+    if draw {
+        a.plot = Some(std::path::PathBuf::from("report.svg"));
+    }
+    let title = |r: &impact_core::ImpactReport, channel: &str| {
+        format!(
+            "{} [{channel}] impact {}{}",
+            entry.file.file_name().map_or_else(
+                || entry.file.display().to_string(),
+                |n| n.to_string_lossy().into_owned()
+            ),
+            r.index,
+            args.cfc.map_or(String::new(), |c| format!(", CFC {c}"))
+        )
+    };
+    let (result, notes) = impact_io::with_own_notes(|| {
+        pipeline::analyze(&a, None).map(|(setup, reports)| {
+            let json = pipeline::to_json(&setup, &reports);
+            // As the table names it: as given, else as the file's default resolved.
+            let channel = match (&entry.column, json.column.clone()) {
+                (None, Some(resolved)) => resolved,
+                _ => entry.channel(),
+            };
+            let figures = if draw {
+                reports
+                    .iter()
+                    .take(super::pulse::MAX_FIGURES)
+                    .map(|r| {
+                        super::pulse::pulse_svg(
+                            &setup.plot_signal(),
+                            setup.scene.spec.as_ref(),
+                            r,
+                            title(r, &channel),
+                        )
+                    })
+                    // A recording read in passes holds only the first impacts' windows.
+                    .filter(|svg| !svg.is_empty())
+                    .collect()
+            } else {
+                Vec::new()
+            };
+            (json, figures)
+        })
+    });
+    let (analysis, figures, error) = match result {
+        Ok((j, f)) => (Some(j), f, None),
+        Err(e) => (None, Vec::new(), Some(e)),
+    };
+    EntryJson {
+        file: entry.file.display().to_string(),
+        // As given (the series' own names); the file's default as it resolved.
+        channel: match (
+            &entry.column,
+            analysis.as_ref().and_then(|a| a.column.clone()),
+        ) {
+            (None, Some(resolved)) => resolved,
+            _ => entry.channel(),
+        },
+        error,
+        notes,
+        analysis,
+        figures,
+    }
+}
+
+/// The series as JSON: every recording's analysis (or its error), then the statistics.
+#[derive(Debug, Serialize)]
+pub struct SeriesJson<'a> {
+    pub recordings: usize,
+    pub failed: usize,
+    pub impacts: usize,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub spec: Option<PassRate>,
+    pub statistics: Vec<Statistic>,
+    pub entries: &'a [EntryJson],
+}
+
+/// Every impact of the series with its entry, in order.
+pub fn impacts(entries: &[EntryJson]) -> impl Iterator<Item = (&EntryJson, &ImpactJson)> + Clone {
+    entries.iter().flat_map(|e| {
+        e.analysis
+            .iter()
+            .flat_map(move |a| a.impacts.iter().map(move |i| (e, i)))
+    })
+}
+
+pub fn to_json(entries: &[EntryJson]) -> SeriesJson<'_> {
+    SeriesJson {
+        recordings: entries.len(),
+        failed: entries.iter().filter(|e| e.error.is_some()).count(),
+        impacts: impacts(entries).count(),
+        spec: pass_rate(impacts(entries).map(|(_, i)| i)),
+        statistics: statistics(impacts(entries).map(|(_, i)| i)),
+        entries,
+    }
+}
+
+/// A CSV cell: quoted when it holds a comma, a quote or a line break.
+fn cell(s: &str) -> String {
+    if s.contains([',', '"', '\n', '\r']) {
+        format!("\"{}\"", s.replace('"', "\"\""))
+    } else {
+        s.to_string()
+    }
+}
+
+/// The series as CSV: `analyze --csv`'s columns with `file` and `channel` first and
+/// `peak_acceleration_g` last, one row per impact of every recording.
+pub fn to_csv(entries: &[EntryJson]) -> String {
+    let Some(first) = entries.iter().find_map(|e| e.analysis.as_ref()) else {
+        return "file,channel\n".into();
+    };
+    let mut body = Vec::new();
+    // Writing to a Vec cannot fail.
+    let _ = crate::report::csv::write_csv(first, impacts(entries).map(|(_, i)| i), &mut body);
+    let body = String::from_utf8_lossy(&body);
+    let mut lines = body.lines();
+    let mut out = format!(
+        "file,channel,{},peak_acceleration_g\n",
+        lines.next().unwrap_or_default()
+    );
+    for ((e, i), line) in impacts(entries).zip(lines) {
+        out.push_str(&format!(
+            "{},{},{line},{}\n",
+            cell(&e.file),
+            cell(&e.channel),
+            // In the f32 digits of the peak it comes from.
+            crate::report::fmt::number(f64::from(
+                (i.peak_acceleration_m_s2 / STANDARD_GRAVITY) as f32
+            ))
+        ));
+    }
+    out
+}
+
+/// The series as a person reads it: a row per impact, then the statistics, then the
+/// recordings that failed.
+pub fn to_table(entries: &[EntryJson]) -> String {
+    let json = to_json(entries);
+    let mut s = format!(
+        "series: {} recordings, {} impacts{}\n",
+        json.recordings,
+        json.impacts,
+        if json.failed > 0 {
+            format!(", {} FAILED", json.failed)
+        } else {
+            String::new()
+        }
+    );
+    let rows: Vec<[String; 10]> = impacts(entries)
+        .map(|(e, i)| {
+            let o = |v: Option<f64>, unit: &str| {
+                v.map_or("-".to_string(), |v| human(v, unit).trim_end().to_string())
+            };
+            [
+                e.file.clone(),
+                e.channel.clone(),
+                i.index.to_string(),
+                human(i.start_s, "s"),
+                human(i.peak_acceleration_m_s2 / STANDARD_GRAVITY, "g"),
+                human(i.peak_acceleration_m_s2, "m/s²"),
+                o(i.delta_v_m_s, "m/s"),
+                human(i.duration_s, "s"),
+                o(i.cor, ""),
+                {
+                    let verdict = match &i.spec {
+                        Some(Some(v)) if v.pass => " PASS",
+                        Some(Some(_)) => " FAIL",
+                        Some(None) => " not-judged",
+                        None => "",
+                    };
+                    if i.flags.is_empty() {
+                        format!("{}{verdict}", i.status)
+                    } else {
+                        format!("{} {}{verdict}", i.status, i.flags.join(","))
+                    }
+                },
+            ]
+        })
+        .collect();
+    let head = [
+        "file", "channel", "#", "start", "peak", "peak", "Δv", "duration", "COR", "status",
+    ];
+    s.push_str(&columns(&head, &rows));
+    if let Some(r) = &json.spec {
+        s.push_str(&format!(
+            "\nspec: {} of {} judged impacts pass{}{}\n",
+            r.passed,
+            r.judged,
+            r.pass_rate
+                .map_or(String::new(), |p| format!(" ({:.1} %)", 100.0 * p)),
+            if r.not_judged > 0 {
+                format!("; {} NOT JUDGED (see each impact's reason)", r.not_judged)
+            } else {
+                String::new()
+            }
+        ));
+    }
+    if !json.statistics.is_empty() {
+        s.push_str("\nstatistics (sd: sample standard deviation; CV: sd / |mean|)\n");
+        let unit_of = |m: &str| {
+            METRICS
+                .iter()
+                .find(|(name, _, _)| *name == m)
+                .map_or("", |(_, u, _)| u)
+        };
+        let rows: Vec<[String; 7]> = json
+            .statistics
+            .iter()
+            .map(|st| {
+                let u = unit_of(st.metric);
+                let q = |v: f64| human(v, u).trim_end().to_string();
+                [
+                    st.metric.to_string(),
+                    st.n.to_string(),
+                    q(st.mean),
+                    st.sd.map_or("-".into(), q),
+                    st.cv.map_or("-".into(), |c| format!("{:.2} %", 100.0 * c)),
+                    q(st.min),
+                    q(st.max),
+                ]
+            })
+            .collect();
+        s.push_str(&columns(
+            &["metric", "n", "mean", "sd", "CV", "min", "max"],
+            &rows,
+        ));
+    }
+    for e in entries {
+        if let Some(err) = &e.error {
+            s.push_str(&format!("FAILED {}\n", failure(e, err)));
+        }
+    }
+    s
+}
+
+/// A recording's failure as one line: its file, its channel if given, the error (which may
+/// name the file already).
+pub fn failure(e: &EntryJson, err: &str) -> String {
+    let err = err.strip_prefix(&format!("{}: ", e.file)).unwrap_or(err);
+    if e.channel.is_empty() {
+        format!("{}: {err}", e.file)
+    } else {
+        format!("{} channel {}: {err}", e.file, e.channel)
+    }
+}
+
+/// Left-aligned columns two spaces apart.
+fn columns<const N: usize>(head: &[&str; N], rows: &[[String; N]]) -> String {
+    let mut widths = head.map(|h| h.chars().count());
+    for r in rows {
+        for (w, c) in widths.iter_mut().zip(r) {
+            *w = (*w).max(c.chars().count());
+        }
+    }
+    let line = |cells: &mut dyn Iterator<Item = &str>| {
+        let mut l = String::new();
+        for (k, (c, w)) in cells.zip(widths).enumerate() {
+            if k > 0 {
+                l.push_str("  ");
+            }
+            l.push_str(c);
+            l.extend(std::iter::repeat_n(' ', w - c.chars().count()));
+        }
+        l.trim_end().to_string() + "\n"
+    };
+    let mut s = line(&mut head.iter().copied());
+    for r in rows {
+        s.push_str(&line(&mut r.iter().map(String::as_str)));
+    }
+    s
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_cell_with_a_comma_is_quoted() {
+        assert_eq!(cell("a,b.csv"), "\"a,b.csv\"");
+        assert_eq!(cell("say \"x\""), "\"say \"\"x\"\"\"");
+        assert_eq!(cell("plain"), "plain");
+    }
+}

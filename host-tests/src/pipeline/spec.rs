@@ -1,0 +1,189 @@
+//! `--spec SHAPE,PEAK,DURATION[,KEY=VALUE…]`: the specified shock pulse each impact is judged
+//! against, with the tolerances of a standard (`standard=`) or the user's own. Every number of
+//! every preset and its source: docs/standards.md.
+
+use impact_core::consts::STANDARD_GRAVITY;
+use impact_core::spec::{Shape, Spec};
+
+use crate::standards::STANDARDS;
+
+/// A parsed `--spec`: the pulse with its tolerances, and the standard they start from
+/// (`custom` once a tolerance is set by hand).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct SpecArg {
+    pub spec: Spec,
+    pub standard: &'static str,
+}
+
+/// An acceleration with an optional unit: `50g`, `490.3m/s2` (m/s² without one).
+fn acceleration(s: &str) -> Result<f32, String> {
+    let t = s.trim();
+    let (num, scale) = if let Some(n) = t.strip_suffix('g') {
+        (n, STANDARD_GRAVITY)
+    } else {
+        let n = ["m/s2", "m/s²", "m/s^2"]
+            .iter()
+            .find_map(|u| t.strip_suffix(u))
+            .unwrap_or(t);
+        (n, 1.0)
+    };
+    let v: f64 = num
+        .trim()
+        .parse()
+        .map_err(|_| format!("peak {s:?}: not a number with an optional unit (50g, 490m/s2)"))?;
+    let v = v * scale;
+    if !(v.is_finite() && (1e-30..=1e30).contains(&v)) {
+        return Err(format!("peak {s:?}: must be between 1e-30 and 1e30 m/s²"));
+    }
+    Ok(v as f32)
+}
+
+/// A duration with an optional unit: `11ms`, `500us`, `0.011` (s without one).
+fn duration(s: &str) -> Result<f32, String> {
+    let t = s.trim();
+    let (num, scale) = [("ms", 1e-3), ("us", 1e-6), ("µs", 1e-6), ("s", 1.0)]
+        .iter()
+        .find_map(|(u, k)| t.strip_suffix(u).map(|n| (n, *k)))
+        .unwrap_or((t, 1.0));
+    let v: f64 = num
+        .trim()
+        .parse()
+        .map_err(|_| format!("duration {s:?}: not a number with an optional unit (11ms, 0.011)"))?;
+    let v = v * scale;
+    if !(v.is_finite() && (1e-30..=1e30).contains(&v)) {
+        return Err(format!("duration {s:?}: must be between 1e-30 and 1e30 s"));
+    }
+    Ok(v as f32)
+}
+
+/// Parses `--spec`: `SHAPE,PEAK,DURATION` (`half-sine`, `sawtooth` or `trapezoid`; `50g`;
+/// `11ms`), then `KEY=VALUE`s: `standard=` (the tolerances' source, [`STANDARDS`]), and any
+/// tolerance by hand: `band`, `outside`, `slack`, `dv`, `before`, `after`, `watch` (fractions of
+/// the peak or of the duration), a trapezoid's `rise` and `fall`.
+pub fn parse(s: &str) -> Result<SpecArg, String> {
+    let mut parts = s.split(',').map(str::trim);
+    let shape_name = parts.next().unwrap_or_default();
+    let (Some(peak), Some(dur)) = (parts.next(), parts.next()) else {
+        return Err("SHAPE,PEAK,DURATION (half-sine,50g,11ms), then KEY=VALUE tolerances".into());
+    };
+    let peak_m_s2 = acceleration(peak)?;
+    let duration_s = duration(dur)?;
+    let mut pairs = Vec::new();
+    for p in parts {
+        let (k, v) = p
+            .split_once('=')
+            .ok_or_else(|| format!("{p:?}: KEY=VALUE (standard=, band=, dv=, …)"))?;
+        pairs.push((k.trim(), v.trim()));
+    }
+    let standard = match pairs.iter().find(|(k, _)| *k == "standard") {
+        Some((_, name)) => STANDARDS.iter().find(|s| s.name == *name).ok_or_else(|| {
+            format!(
+                "standard={name}: one of {}",
+                STANDARDS.map(|s| s.name).join(", ")
+            )
+        })?,
+        None => &STANDARDS[0],
+    };
+    let mut t = standard.tolerance;
+    let (mut rise, mut fall) = (standard.ramp, standard.ramp);
+    let mut custom = false;
+    for (k, v) in pairs {
+        if k == "standard" {
+            continue;
+        }
+        let x: f32 = v
+            .parse()
+            .ok()
+            .filter(|x: &f32| x.is_finite())
+            .ok_or_else(|| format!("{k}={v}: not a number"))?;
+        let slot = match k {
+            "band" => &mut t.band,
+            "outside" => &mut t.outside,
+            "slack" => &mut t.slack,
+            "dv" => &mut t.delta_v,
+            "before" => &mut t.before,
+            "after" => &mut t.after,
+            "watch" => &mut t.watch,
+            "rise" if shape_name == "trapezoid" => &mut rise,
+            "fall" if shape_name == "trapezoid" => &mut fall,
+            _ => {
+                return Err(format!(
+                    "{k}: one of standard, band, outside, slack, dv, before, after, watch{}",
+                    if shape_name == "trapezoid" {
+                        ", rise, fall"
+                    } else {
+                        " (rise, fall: a trapezoid's)"
+                    }
+                ))
+            }
+        };
+        *slot = x;
+        custom |= !matches!(k, "rise" | "fall");
+    }
+    let shape = match shape_name {
+        "half-sine" => Shape::HalfSine,
+        "sawtooth" => Shape::Sawtooth,
+        "trapezoid" => Shape::Trapezoid { rise, fall },
+        other => {
+            return Err(format!(
+                "shape {other:?}: one of half-sine, sawtooth (terminal-peak), trapezoid"
+            ))
+        }
+    };
+    let spec = Spec {
+        shape,
+        peak_m_s2,
+        duration_s,
+        tolerance: t,
+    };
+    spec.validate().map_err(|e| match e {
+        impact_core::Error::InvalidParameter { name, reason } => format!("{name}: {reason}"),
+        e => e.to_string(),
+    })?;
+    Ok(SpecArg {
+        spec,
+        standard: if custom { "custom" } else { standard.name },
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_spec_reads_with_units_and_a_standards_tolerances() {
+        let a = parse("half-sine,50g,11ms").unwrap();
+        assert_eq!(a.standard, "iec-60068-2-27");
+        assert_eq!(a.spec.shape, Shape::HalfSine);
+        assert!((a.spec.peak_m_s2 - 490.3325).abs() < 1e-3);
+        assert!((a.spec.duration_s - 0.011).abs() < 1e-9);
+        assert_eq!(a.spec.tolerance.delta_v, 0.15);
+        let b = parse("sawtooth, 300m/s2, 0.006, standard=mil-std-810h").unwrap();
+        assert_eq!(
+            (b.standard, b.spec.tolerance.delta_v),
+            ("mil-std-810h", 0.1)
+        );
+        let c = parse("trapezoid,100g,6ms,rise=0.2,fall=0.05,dv=0.2").unwrap();
+        assert_eq!(c.standard, "custom");
+        assert_eq!(
+            c.spec.shape,
+            Shape::Trapezoid {
+                rise: 0.2,
+                fall: 0.05
+            }
+        );
+        for (bad, want) in [
+            ("half-sine", "SHAPE,PEAK,DURATION"),
+            ("square,50g,11ms", "shape \"square\""),
+            ("half-sine,50q,11ms", "peak \"50q\""),
+            ("half-sine,50g,-1ms", "duration \"-1ms\": must be"),
+            ("half-sine,50g,11ms,standard=iso", "standard=iso: one of"),
+            ("half-sine,50g,11ms,band=2", "spec-tolerance"),
+            ("half-sine,50g,11ms,rise=0.1", "rise: one of"),
+            ("half-sine,50g,11ms,dv", "KEY=VALUE"),
+        ] {
+            let e = parse(bad).unwrap_err();
+            assert!(e.contains(want), "{bad}: {e}");
+        }
+    }
+}

@@ -1,0 +1,144 @@
+//! The verdicts against `--spec` as JSON: the specified pulse and its tolerances once, each
+//! impact's verdict (null with its reason when it cannot be judged).
+
+use impact_core::spec::verdict::{Missing, Verdict};
+use impact_core::spec::{Shape, Spec};
+use serde::Serialize;
+
+use super::fmt::shortest;
+
+/// The specified pulse and the tolerances it is judged with (fractions of the peak, or of
+/// the duration for the windows and the slack).
+#[derive(Clone, Debug, Serialize, PartialEq)]
+pub struct SpecJson {
+    pub shape: &'static str,
+    /// A trapezoid's rise and fall, × the duration.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub rise: Option<f64>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub fall: Option<f64>,
+    pub peak_m_s2: f64,
+    pub duration_s: f64,
+    pub nominal_delta_v_m_s: f64,
+    /// The standard the tolerances are from (`custom`: set by hand); docs/standards.md.
+    pub standard: String,
+    pub band: f64,
+    pub outside: f64,
+    pub slack: f64,
+    pub delta_v_tolerance: f64,
+    pub before: f64,
+    pub after: f64,
+    pub watch: f64,
+}
+
+/// `spec` as JSON; its standard is the preset whose tolerances it has, else `custom`.
+pub fn spec_json(spec: &Spec) -> SpecJson {
+    let t = spec.tolerance;
+    let standard = crate::standards::STANDARDS
+        .iter()
+        .find(|s| s.tolerance == t)
+        .map_or("custom", |s| s.name);
+    let (rise, fall) = match spec.shape {
+        Shape::Trapezoid { rise, fall } => (Some(shortest(rise)), Some(shortest(fall))),
+        _ => (None, None),
+    };
+    SpecJson {
+        shape: spec.shape.name(),
+        rise,
+        fall,
+        peak_m_s2: shortest(spec.peak_m_s2),
+        duration_s: shortest(spec.duration_s),
+        nominal_delta_v_m_s: f64::from(spec.delta_v_m_s()),
+        standard: standard.to_string(),
+        band: shortest(t.band),
+        outside: shortest(t.outside),
+        slack: shortest(t.slack),
+        delta_v_tolerance: shortest(t.delta_v),
+        before: shortest(t.before),
+        after: shortest(t.after),
+        watch: shortest(t.watch),
+    }
+}
+
+/// One impact's verdict: pass only if every sample in the watched window lies within the band
+/// around the nominal pulse placed where it fits best (`nominal_start_s`) and the velocity
+/// change over the standards' window is within its tolerance. `margin` is the worst
+/// excursion beyond its limit over the nominal peak (negative: inside, by that much).
+#[derive(Clone, Debug, Serialize, PartialEq)]
+pub struct VerdictJson {
+    pub pass: bool,
+    pub band_pass: bool,
+    pub delta_v_pass: bool,
+    pub margin: f64,
+    pub worst_time_s: f64,
+    pub worst_m_s2: f64,
+    pub limit_m_s2: f64,
+    pub delta_v_m_s: f64,
+    pub nominal_start_s: f64,
+}
+
+/// The verdict as JSON, times from `t0`; `None` (null) if it could not be judged.
+pub fn verdict_json(v: &Result<Verdict, Missing>, t0: f64) -> Option<VerdictJson> {
+    let v = v.as_ref().ok()?;
+    Some(VerdictJson {
+        pass: v.pass,
+        band_pass: v.band_pass,
+        delta_v_pass: v.delta_v_pass,
+        margin: f64::from(v.margin),
+        worst_time_s: t0 + v.worst_s,
+        worst_m_s2: f64::from(v.worst_m_s2),
+        limit_m_s2: f64::from(v.limit_m_s2),
+        delta_v_m_s: f64::from(v.delta_v_m_s),
+        nominal_start_s: t0 + v.start_s,
+    })
+}
+
+/// The table's line for the specified pulse (before the impacts).
+pub fn table_head(s: &SpecJson) -> String {
+    use super::fmt::human;
+    format!(
+        "spec: {} {} ({}), {}; {} tolerances: band ±{:.0} % of the peak (±{:.0} % outside), Δv {} ±{:.0} % over −{}D…+{}D\n",
+        s.shape,
+        human(s.peak_m_s2 / impact_core::consts::STANDARD_GRAVITY, "g"),
+        human(s.peak_m_s2, "m/s²"),
+        human(s.duration_s, "s"),
+        crate::standards::title(&s.standard),
+        100.0 * s.band,
+        100.0 * s.outside,
+        human(s.nominal_delta_v_m_s, "m/s"),
+        100.0 * s.delta_v_tolerance,
+        s.before,
+        s.after,
+    )
+}
+
+/// The table's line for an impact's verdict.
+pub fn table_line(v: Option<&VerdictJson>, why: Option<&String>) -> String {
+    use super::fmt::human;
+    let Some(v) = v else {
+        return format!(
+            "    spec: not judged ({})\n",
+            why.map_or("unknown", String::as_str)
+        );
+    };
+    format!(
+        "    spec: {}: band {} (worst {} at {:.6} s, limit {}: {} {:.1} % of the peak), Δv {} {}\n",
+        if v.pass { "PASS" } else { "FAIL" },
+        if v.band_pass { "within" } else { "EXCEEDED" },
+        human(v.worst_m_s2, "m/s²"),
+        v.worst_time_s,
+        human(v.limit_m_s2, "m/s²"),
+        if v.margin <= 0.0 {
+            "inside by"
+        } else {
+            "beyond by"
+        },
+        100.0 * v.margin.abs(),
+        human(v.delta_v_m_s, "m/s"),
+        if v.delta_v_pass {
+            "within"
+        } else {
+            "OUTSIDE its tolerance"
+        },
+    )
+}

@@ -1,0 +1,182 @@
+//! A metric's statistics across a series of impacts (n, mean, sample standard deviation,
+//! coefficient of variation, min, max) and the pass rate against a specification.
+
+use impact_core::consts::STANDARD_GRAVITY;
+use serde::Serialize;
+
+use super::ImpactJson;
+
+/// A metric across the series: its values' count, mean, sample standard deviation,
+/// coefficient of variation (sd / |mean|), least and greatest. `sd` and `cv` are null with a
+/// reason when they cannot be known (one value; a mean of zero).
+#[derive(Clone, Debug, Serialize, PartialEq)]
+pub struct Statistic {
+    pub metric: &'static str,
+    pub n: usize,
+    pub mean: f64,
+    pub sd: Option<f64>,
+    pub cv: Option<f64>,
+    pub min: f64,
+    pub max: f64,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub null_reason: Option<&'static str>,
+}
+
+/// The metrics the statistics cover, with their units (for the table), and how each is read
+/// off an impact.
+type Metric = (&'static str, &'static str, fn(&ImpactJson) -> Option<f64>);
+pub const METRICS: [Metric; 13] = [
+    ("peak_acceleration_m_s2", "m/s²", |i| {
+        Some(i.peak_acceleration_m_s2)
+    }),
+    ("peak_acceleration_g", "g", |i| {
+        Some(i.peak_acceleration_m_s2 / STANDARD_GRAVITY)
+    }),
+    ("filtered_peak_acceleration_m_s2", "m/s²", |i| {
+        i.filtered_peak_acceleration_m_s2
+    }),
+    ("peak_force_n", "N", |i| i.peak_force_n),
+    ("delta_v_m_s", "m/s", |i| i.delta_v_m_s),
+    ("duration_s", "s", |i| Some(i.duration_s)),
+    ("fwhm_s", "s", |i| i.fwhm_s),
+    ("crush_time_s", "s", |i| i.crush_time_s),
+    ("max_deformation_m", "m", |i| i.max_deformation_m),
+    ("permanent_deformation_m", "m", |i| {
+        i.permanent_deformation_m
+    }),
+    ("rebound_velocity_m_s", "m/s", |i| i.rebound_velocity_m_s),
+    ("cor", "", |i| i.cor),
+    ("absorbed_energy_j", "J", |i| i.absorbed_energy_j),
+];
+
+/// Each metric's statistics over `impacts` (a metric no impact has is left out). Sums in f64
+/// with the mean taken out first (two passes), so a series of nearly equal values keeps its
+/// spread.
+pub fn statistics<'a>(impacts: impl Iterator<Item = &'a ImpactJson> + Clone) -> Vec<Statistic> {
+    METRICS
+        .iter()
+        .filter_map(|(metric, _, read)| {
+            let values = impacts.clone().filter_map(read).filter(|v| v.is_finite());
+            let n = values.clone().count();
+            if n == 0 {
+                return None;
+            }
+            let mean = values.clone().sum::<f64>() / n as f64;
+            let (min, max) = values
+                .clone()
+                .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), v| {
+                    (lo.min(v), hi.max(v))
+                });
+            let (sd, cv, null_reason) = if n < 2 {
+                (None, None, Some("one value: no spread"))
+            } else {
+                let ss: f64 = values.map(|v| (v - mean) * (v - mean)).sum();
+                let sd = (ss / (n - 1) as f64).sqrt();
+                if mean == 0.0 {
+                    (
+                        Some(sd),
+                        None,
+                        Some("mean zero: no coefficient of variation"),
+                    )
+                } else {
+                    (Some(sd), Some(sd / mean.abs()), None)
+                }
+            };
+            Some(Statistic {
+                metric,
+                n,
+                mean,
+                sd,
+                cv,
+                min,
+                max,
+                null_reason,
+            })
+        })
+        .collect()
+}
+
+/// With `--spec`: how many of the series' impacts were judged and passed.
+#[derive(Clone, Debug, Serialize, PartialEq)]
+pub struct PassRate {
+    pub judged: usize,
+    pub passed: usize,
+    /// Impacts the capture could not judge (each with its reason).
+    pub not_judged: usize,
+    /// `passed / judged`; null when none was judged.
+    pub pass_rate: Option<f64>,
+}
+
+/// The pass rate of `impacts` against `--spec`, `None` without one.
+pub fn pass_rate<'a>(impacts: impl Iterator<Item = &'a ImpactJson>) -> Option<PassRate> {
+    let mut rate = PassRate {
+        judged: 0,
+        passed: 0,
+        not_judged: 0,
+        pass_rate: None,
+    };
+    let mut asked = false;
+    for v in impacts.filter_map(|i| i.spec.as_ref()) {
+        asked = true;
+        match v {
+            Some(v) => {
+                rate.judged += 1;
+                rate.passed += usize::from(v.pass);
+            }
+            None => rate.not_judged += 1,
+        }
+    }
+    rate.pass_rate = (rate.judged > 0).then(|| rate.passed as f64 / rate.judged as f64);
+    asked.then_some(rate)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn impact(peak: f64, cor: Option<f64>) -> ImpactJson {
+        ImpactJson {
+            peak_acceleration_m_s2: peak,
+            cor,
+            ..Default::default()
+        }
+    }
+
+    #[test]
+    fn statistics_are_the_textbook_ones_and_unknowns_are_null() {
+        let impacts = [
+            impact(2.0, Some(0.5)),
+            impact(4.0, None),
+            impact(4.0, None),
+            impact(4.0, None),
+            impact(5.0, None),
+            impact(5.0, None),
+            impact(7.0, None),
+            impact(9.0, None),
+        ];
+        let st = statistics(impacts.iter());
+        let peak = &st[0];
+        assert_eq!(peak.metric, "peak_acceleration_m_s2");
+        assert_eq!((peak.n, peak.mean, peak.min, peak.max), (8, 5.0, 2.0, 9.0));
+        // Σ(x - 5)² = 32, over n - 1 = 7.
+        let sd = (32.0f64 / 7.0).sqrt();
+        assert!((peak.sd.unwrap() - sd).abs() < 1e-12);
+        assert!((peak.cv.unwrap() - sd / 5.0).abs() < 1e-12);
+        let cor = st.iter().find(|s| s.metric == "cor").unwrap();
+        assert_eq!((cor.n, cor.mean, cor.sd, cor.cv), (1, 0.5, None, None));
+        assert_eq!(cor.null_reason, Some("one value: no spread"));
+        assert!(
+            st.iter().all(|s| s.metric != "delta_v_m_s"),
+            "no impact has one"
+        );
+    }
+
+    #[test]
+    fn nearly_equal_values_keep_their_spread() {
+        let impacts: Vec<ImpactJson> = (0..1000)
+            .map(|k| impact(1e8 + if k % 2 == 0 { 1.0 } else { -1.0 }, None))
+            .collect();
+        let st = statistics(impacts.iter());
+        assert!((st[0].sd.unwrap() - (1000.0f64 / 999.0).sqrt()).abs() < 1e-9);
+    }
+}

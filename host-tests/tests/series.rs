@@ -1,0 +1,266 @@
+//! A test series (`impact analyze FILE… --channels LIST`): the five AFRL repeats in one call
+//! give the reports of five single analyses and the textbook statistics of their metrics;
+//! folders and patterns expand to their recordings; a recording that fails is named, the
+//! others still reported, the exit status 1.
+
+use std::path::{Path, PathBuf};
+
+mod common;
+use common::{impact, impact_ok};
+
+fn data(rel: &str) -> String {
+    format!("{}/data/{rel}", env!("CARGO_MANIFEST_DIR"))
+}
+
+fn dir(name: &str) -> PathBuf {
+    let d = PathBuf::from(env!("CARGO_TARGET_TMPDIR"))
+        .join(format!("series-{}-{name}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&d);
+    std::fs::create_dir_all(&d).unwrap();
+    d
+}
+
+fn json(text: &str) -> serde_json::Value {
+    serde_json::from_str(text).unwrap_or_else(|e| panic!("{e}: {text}"))
+}
+
+/// The five repeats of AFRL's bottom accelerometer (columns 1 to 5 of `accel_5.csv`, kg_n).
+#[test]
+fn the_five_afrl_repeats_are_five_analyses_and_their_statistics() {
+    let file = data("afrl-drop-tower/accel_5.csv");
+    let (out, _) = impact_ok(&[
+        "analyze",
+        &file,
+        "--channels",
+        "1,2,3,4,5",
+        "--units",
+        "kgn",
+        "--json",
+    ]);
+    let series = json(&out);
+    assert_eq!(series["recordings"], 5);
+    assert_eq!(series["failed"], 0);
+    let entries = series["entries"].as_array().unwrap();
+    let mut peaks = Vec::new();
+    let mut delta_vs = Vec::new();
+    for (k, e) in entries.iter().enumerate() {
+        let column = (k + 1).to_string();
+        assert_eq!(e["channel"], column.as_str());
+        assert_eq!(e["file"], file.as_str());
+        // Each entry is the single analysis of its channel, field for field.
+        let (single, _) = impact_ok(&[
+            "analyze", &file, "--column", &column, "--units", "kgn", "--json",
+        ]);
+        let single = json(&single);
+        assert_eq!(e["impacts"], single["impacts"], "channel {column}");
+        assert_eq!(e["samples"], single["samples"]);
+        let i = &single["impacts"][0];
+        peaks.push(i["peak_acceleration_m_s2"].as_f64().unwrap());
+        delta_vs.push(i["delta_v_m_s"].as_f64().unwrap());
+    }
+    // The statistics, computed here from the single analyses.
+    let stat = |metric: &str| {
+        series["statistics"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .find(|s| s["metric"] == metric)
+            .unwrap_or_else(|| panic!("no {metric}"))
+            .clone()
+    };
+    for (metric, values) in [
+        ("peak_acceleration_m_s2", &peaks),
+        ("delta_v_m_s", &delta_vs),
+    ] {
+        let n = values.len() as f64;
+        let mean = values.iter().sum::<f64>() / n;
+        let sd = (values.iter().map(|v| (v - mean).powi(2)).sum::<f64>() / (n - 1.0)).sqrt();
+        let s = stat(metric);
+        assert_eq!(s["n"], 5);
+        let close =
+            |a: &serde_json::Value, b: f64| (a.as_f64().unwrap() - b).abs() <= 1e-12 * b.abs();
+        assert!(close(&s["mean"], mean), "{metric}: {s}");
+        assert!(close(&s["sd"], sd), "{metric}: {s}");
+        assert!(close(&s["cv"], sd / mean), "{metric}: {s}");
+        let min = values.iter().copied().fold(f64::INFINITY, f64::min);
+        let max = values.iter().copied().fold(f64::NEG_INFINITY, f64::max);
+        assert_eq!(
+            (s["min"].as_f64(), s["max"].as_f64()),
+            (Some(min), Some(max))
+        );
+    }
+    // The peaks in g, the same statistics divided by standard gravity.
+    let g = stat("peak_acceleration_g");
+    let m = stat("peak_acceleration_m_s2");
+    assert!(
+        (g["mean"].as_f64().unwrap() * 9.80665 / m["mean"].as_f64().unwrap() - 1.0).abs() < 1e-12
+    );
+    // No approach speed: no COR anywhere, so no COR statistic.
+    assert!(series["statistics"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .all(|s| s["metric"] != "cor"));
+
+    // The table: a row per impact and the statistics.
+    let (table, _) = impact_ok(&[
+        "analyze",
+        &file,
+        "--channels",
+        "1,2,3,4,5",
+        "--units",
+        "kgn",
+    ]);
+    assert!(
+        table.starts_with("series: 5 recordings, 5 impacts\n"),
+        "{table}"
+    );
+    assert!(table.contains("\nstatistics ("), "{table}");
+    assert!(
+        table
+            .lines()
+            .any(|l| l.starts_with("delta_v_m_s ") && l.contains(" 5 ")),
+        "{table}"
+    );
+
+    // The CSV: file and channel first, the peak in g last, engineering digits.
+    let (csv, _) = impact_ok(&[
+        "analyze",
+        &file,
+        "--channels",
+        "1,2,3,4,5",
+        "--units",
+        "kgn",
+        "--csv",
+    ]);
+    let mut rows = csv.lines().map(|l| l.split(',').collect::<Vec<_>>());
+    let header = rows.next().unwrap();
+    assert_eq!(&header[..3], ["file", "channel", "index"]);
+    assert_eq!(*header.last().unwrap(), "peak_acceleration_g");
+    let col = |name: &str| header.iter().position(|h| *h == name).unwrap();
+    let rows: Vec<Vec<&str>> = rows.collect();
+    assert_eq!(rows.len(), 5);
+    for (k, r) in rows.iter().enumerate() {
+        assert_eq!(r.len(), header.len());
+        assert_eq!(r[1], (k + 1).to_string());
+        let peak: f32 = r[col("peak_acceleration_m_s2")].parse().unwrap();
+        assert_eq!(f64::from(peak), peaks[k], "the f32 read back exactly");
+        assert!(
+            r[col("peak_acceleration_m_s2")].len() <= 10,
+            "{}",
+            r[col("peak_acceleration_m_s2")]
+        );
+        let g: f64 = r[col("peak_acceleration_g")].parse().unwrap();
+        assert!((g * 9.80665 / peaks[k] - 1.0).abs() < 1e-6);
+    }
+}
+
+/// A folder gives its recordings by name (other files and hidden ones left out); a quoted
+/// pattern its matches; a failing recording is named and the others still reported.
+#[test]
+fn folders_and_patterns_expand_and_a_failure_is_named() {
+    let d = dir("folder");
+    let seed = common::synth_t2();
+    for name in ["b.csv", "a.csv"] {
+        std::fs::write(d.join(name), &seed).unwrap();
+    }
+    std::fs::write(d.join("notes.txt"), "not a recording").unwrap();
+    std::fs::write(d.join(".hidden.csv"), "not one either").unwrap();
+    let s = |p: &Path| p.to_string_lossy().into_owned();
+    let files = |out: &str| -> Vec<String> {
+        json(out)["entries"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .map(|e| {
+                e["file"]
+                    .as_str()
+                    .unwrap()
+                    .rsplit('/')
+                    .next()
+                    .unwrap()
+                    .to_string()
+            })
+            .collect()
+    };
+    let kin = ["--mass", "0.06", "--v0", "1.3357", "--json"];
+    let mut args = vec!["analyze".to_string(), s(&d)];
+    args.extend(kin.iter().map(|a| a.to_string()));
+    let args: Vec<&str> = args.iter().map(String::as_str).collect();
+    let (out, _) = impact_ok(&args);
+    assert_eq!(files(&out), ["a.csv", "b.csv"]);
+    let pattern = s(&d.join("?.csv"));
+    let mut args = vec!["analyze", &pattern];
+    args.extend(kin);
+    let (out, _) = impact_ok(&args);
+    assert_eq!(files(&out), ["a.csv", "b.csv"]);
+    let series = json(&out);
+    let cor = series["statistics"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .find(|s| s["metric"] == "cor")
+        .unwrap()
+        .clone();
+    assert_eq!(cor["n"], 2);
+    assert_eq!(cor["sd"], 0.0, "the same recording twice");
+
+    // One bad recording among good ones: reported, named, exit 1.
+    let bad = d.join("bad.csv");
+    std::fs::write(&bad, "time_s,accel_g\n").unwrap();
+    let a = s(&d.join("a.csv"));
+    let bad = s(&bad);
+    let mut args = vec!["analyze", &a, &bad];
+    args.extend(kin);
+    let (code, out, err) = impact(&args);
+    assert_eq!(code, 1, "{err}");
+    let series = json(&out);
+    assert_eq!(
+        (series["recordings"].as_u64(), series["failed"].as_u64()),
+        (Some(2), Some(1))
+    );
+    assert_eq!(series["entries"][0]["impacts"].as_array().unwrap().len(), 1);
+    assert!(
+        series["entries"][1]["error"]
+            .as_str()
+            .unwrap()
+            .contains("no data rows"),
+        "{out}"
+    );
+    assert!(
+        err.contains(&format!("1 of 2 recordings failed: {bad}: ")),
+        "{err}"
+    );
+
+    // Nothing to analyse, standard input, a figure of many: refused before any work.
+    let empty = dir("empty");
+    for (args, want) in [
+        (
+            vec!["analyze".to_string(), s(&empty)],
+            "a folder with no recordings",
+        ),
+        (
+            vec!["analyze".into(), s(&empty.join("*.csv"))],
+            "no file matches",
+        ),
+        (
+            vec!["analyze".into(), a.clone(), "-".into()],
+            "standard input (-) can be one recording only",
+        ),
+        (
+            vec![
+                "analyze".into(),
+                a.clone(),
+                a.clone(),
+                "--plot".into(),
+                s(&d.join("x.svg")),
+            ],
+            "--plot draws one recording",
+        ),
+    ] {
+        let args: Vec<&str> = args.iter().map(String::as_str).collect();
+        let (code, _, err) = impact(&args);
+        common::assert_refused(Some(code), &err, want, &args.join(" "));
+    }
+    assert!(!d.join("x.svg").exists());
+}
