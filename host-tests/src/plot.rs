@@ -211,7 +211,12 @@ pub struct Signal<'a> {
     pub mass_kg: Option<f64>,
     /// Acceleration of stream sample `i`, m/s² (`None` where it is not known).
     pub accel_m_s2: Box<dyn Fn(u64) -> Option<f64> + 'a>,
+    /// The figure's title: what was drawn (file, channel, filter).
+    pub title: String,
 }
+
+/// The height of the figure's title band, px.
+const TITLE_HEIGHT: u32 = 36;
 
 /// Impacts the figure shows at most (a note says so when there are more).
 pub const SHOWN: usize = 6;
@@ -252,8 +257,18 @@ pub fn impacts(
     let cols = if spectra { 6 } else { 4 };
     write_svg(
         path,
-        (400 * cols as u32, 330 * shown.len() as u32),
-        |root| draw_impacts(root, signal, &shown, cols, spectra),
+        (400 * cols as u32, 330 * shown.len() as u32 + TITLE_HEIGHT),
+        |root| {
+            root.fill(&WHITE).map_err(|e| e.to_string())?;
+            let (head, body) = root.split_vertically(TITLE_HEIGHT);
+            head.draw(&Text::new(
+                signal.title.clone(),
+                (12, 10),
+                ("sans-serif", 18).into_font().style(FontStyle::Bold),
+            ))
+            .map_err(|e| e.to_string())?;
+            draw_impacts(&body, signal, &shown, cols, spectra)
+        },
     )?;
     eprintln!("wrote {}", path.display());
     Ok(())

@@ -67,8 +67,12 @@ fn analyze_stdin(file: &PathBuf, args: &[&str]) -> (i32, String) {
 }
 
 /// The hostile-input issue's `T2` recording (one 55.6 g impact), as a file.
+/// The T2 recording, written once (the tests run in parallel: rewriting it while another
+/// test reads it made that one flaky).
 fn t2() -> PathBuf {
-    temp("t2.csv", common::synth_t2().as_bytes())
+    static T2: std::sync::OnceLock<PathBuf> = std::sync::OnceLock::new();
+    T2.get_or_init(|| temp("t2.csv", common::synth_t2().as_bytes()))
+        .clone()
 }
 
 #[test]

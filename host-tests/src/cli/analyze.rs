@@ -74,7 +74,14 @@ pub fn run(cmd: &AnalyzeCommand) -> Result<(), String> {
         print!("{}", report::to_table(&a));
     }
     if let Some(path) = &args.plot {
-        plot::impacts(&setup.plot_signal(), &reports, path)?;
+        let mut signal = setup.plot_signal();
+        // Titled with the recording it is drawn from.
+        let name = args.file.file_name().map_or_else(
+            || args.file.display().to_string(),
+            |n| n.to_string_lossy().into_owned(),
+        );
+        signal.title = format!("{name}, {}", signal.title);
+        plot::impacts(&signal, &reports, path)?;
     }
     Ok(())
 }

@@ -339,7 +339,14 @@ pub fn emulate(args: &EmulateArgs) -> Result<(), String> {
             }
             setup.windows = windows;
         }
-        crate::plot::impacts(&setup.plot_signal(), &log.impacts, path)?;
+        let mut signal = setup.plot_signal();
+        let file = &args.analyze.file;
+        let name = file.file_name().map_or_else(
+            || file.display().to_string(),
+            |n| n.to_string_lossy().into_owned(),
+        );
+        signal.title = format!("{name} on the emulated board, {}", signal.title);
+        crate::plot::impacts(&signal, &log.impacts, path)?;
     }
     Ok(())
 }

@@ -134,6 +134,7 @@ fn report(args: &LogArgs, reader: LogReader, name: &str) -> Result<(), String> {
             let mass: Option<f32> = opt(scene, "mass_kg")?;
             let waves = &log.waveforms;
             let signal = crate::plot::Signal {
+                title: format!("{name}: the board's captured windows, m/s² above the baseline"),
                 rate_hz: rate,
                 mass_kg: mass.map(f64::from),
                 accel_m_s2: Box::new(move |i| {

@@ -190,6 +190,15 @@ impl Setup {
     /// The signal the figure draws: the counts the pipeline analysed times the gain.
     pub fn plot_signal(&self) -> crate::plot::Signal<'_> {
         crate::plot::Signal {
+            title: format!(
+                "{}{}: {}",
+                self.column.as_deref().unwrap_or("acceleration"),
+                self.scene.cfc.map_or(String::new(), |c| format!(
+                    ", CFC {} on the windows",
+                    c.class()
+                )),
+                "raw signal above its baseline, m/s²"
+            ),
             rate_hz: f64::from(self.scene.calibration.sample_rate_hz),
             mass_kg: self.scene.mass_kg.map(f64::from),
             accel_m_s2: Box::new(move |i| {
