@@ -270,8 +270,8 @@ fn waveforms_off_the_board_draw_the_same_figure() {
         std::fs::read_to_string(&board_svg).unwrap(),
     );
     // The same panels; the titles say what each was drawn from.
-    let (a_title, a) = untitled(&a);
-    let (b_title, b) = untitled(&b);
+    let (a_title, a) = common::untitled(&a);
+    let (b_title, b) = common::untitled(&b);
     assert!(
         a_title.contains("raw signal above its baseline"),
         "{a_title}"
@@ -680,13 +680,6 @@ fn synth(name: &str, args: &[&str]) -> String {
     let file = tmp(name);
     std::fs::write(&file, csv).unwrap();
     file.to_string_lossy().into_owned()
-}
-
-/// A figure's title (its first text) and the figure without it.
-fn untitled(svg: &str) -> (String, String) {
-    let i = svg.find("<text").expect("a title");
-    let j = i + svg[i..].find("</text>").expect("its end") + "</text>".len();
-    (svg[i..j].to_string(), format!("{}{}", &svg[..i], &svg[j..]))
 }
 
 /// A replay slowed until a block's period (256 s here) is beyond the reach of the emulator's

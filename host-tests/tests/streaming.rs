@@ -411,8 +411,8 @@ fn a_long_csv_file_gives_the_same_reports_and_errors_through_the_parallel_reader
     assert_eq!(piped.1, whole.1, "{}", piped.2);
     // (Titled with what was read: `-` or the file's name.)
     assert_eq!(
-        untitled(&std::fs::read_to_string(&piped_svg).unwrap()),
-        untitled(&std::fs::read_to_string(&svg).unwrap())
+        common::untitled(&std::fs::read_to_string(&piped_svg).unwrap()).1,
+        common::untitled(&std::fs::read_to_string(&svg).unwrap()).1
     );
 
     // A text field and a gap, far past the head: the whole-file reader's message and line.
@@ -500,11 +500,4 @@ fn tdms_streams_give_the_whole_files_reports() {
         code != 0 && err.contains("cut.tdms") && err.trim().lines().count() == 1,
         "{err}"
     );
-}
-
-/// A figure without its title (its first text: the input's name).
-fn untitled(svg: &str) -> String {
-    let i = svg.find("<text").expect("a title");
-    let j = i + svg[i..].find("</text>").expect("its end") + "</text>".len();
-    format!("{}{}", &svg[..i], &svg[j..])
 }

@@ -33,6 +33,15 @@ impl Entry {
             None => String::new(),
         }
     }
+
+    /// The channel as the table, the JSON and the figures name it: as given (the series' own
+    /// names), else the file's default as it `resolved`.
+    pub fn shown_channel(&self, resolved: Option<&str>) -> String {
+        match (&self.column, resolved) {
+            (None, Some(resolved)) => resolved.to_string(),
+            _ => self.channel(),
+        }
+    }
 }
 
 /// Whether `path` is a pattern (`*`, `?`, `[`) rather than a file name.
@@ -220,11 +229,7 @@ fn analyze_one(args: &AnalyzeArgs, entry: &Entry, draw: bool) -> EntryJson {
     let (result, notes) = impact_io::with_own_notes(|| {
         pipeline::analyze(&a, None).map(|(setup, reports)| {
             let json = pipeline::to_json(&setup, &reports);
-            // As the table names it: as given, else as the file's default resolved.
-            let channel = match (&entry.column, json.column.clone()) {
-                (None, Some(resolved)) => resolved,
-                _ => entry.channel(),
-            };
+            let channel = entry.shown_channel(json.column.as_deref());
             let figures = if draw {
                 reports
                     .iter()
@@ -252,14 +257,7 @@ fn analyze_one(args: &AnalyzeArgs, entry: &Entry, draw: bool) -> EntryJson {
     };
     EntryJson {
         file: entry.file.display().to_string(),
-        // As given (the series' own names); the file's default as it resolved.
-        channel: match (
-            &entry.column,
-            analysis.as_ref().and_then(|a| a.column.clone()),
-        ) {
-            (None, Some(resolved)) => resolved,
-            _ => entry.channel(),
-        },
+        channel: entry.shown_channel(analysis.as_ref().and_then(|a| a.column.as_deref())),
         error,
         notes,
         analysis,

@@ -500,19 +500,10 @@ fn run_monitor(
 ) -> Result<Analysed, String> {
     crate::on_big_stack(move || {
         let mut run = MonitorRun::new(scene)?;
-        let mut patch = Patches::new(&removals);
-        let mut take = |counts: &mut [i16]| {
-            patch.counts(counts, gain);
+        let source = for_each_count(source, head, (scale, gain), &removals, |counts| {
             run.push(counts);
             Ok(())
-        };
-        let mut head = head;
-        take(&mut head)?;
-        let source = read_ahead(
-            source,
-            move |s, scratch, counts| s.next_counts(CHUNK, (scale, gain), scratch, counts),
-            take,
-        )?;
+        })?;
         let (reports, total) = run.finish()?;
         Ok((reports, total, source))
     })
@@ -527,25 +518,16 @@ fn write_counts(
     removals: Vec<Removal>,
     out: &mut dyn std::io::Write,
 ) -> Result<u64, String> {
-    let mut patch = Patches::new(&removals);
     let mut count = 0u64;
     let mut bytes = Vec::new();
-    let mut take = |counts: &mut [i16]| {
-        patch.counts(counts, gain);
+    for_each_count(source, head, (scale, gain), &removals, |counts| {
         bytes.clear();
         bytes.extend(counts.iter().flat_map(|c| c.to_le_bytes()));
         out.write_all(&bytes)
             .map_err(|e| format!("the recording's counts for the emulator: {e}"))?;
         count += counts.len() as u64;
         Ok(())
-    };
-    let mut head = head;
-    take(&mut head)?;
-    read_ahead(
-        source,
-        move |s, scratch, counts| s.next_counts(CHUNK, (scale, gain), scratch, counts),
-        take,
-    )?;
+    })?;
     out.flush()
         .map_err(|e| format!("the recording's counts for the emulator: {e}"))?;
     Ok(count)
@@ -563,10 +545,8 @@ fn collect_windows(
 ) -> Result<Vec<(u64, Vec<i16>)>, String> {
     let mut windows: Vec<(u64, Vec<i16>)> =
         spans.iter().map(|&(from, _)| (from, Vec::new())).collect();
-    let mut patch = Patches::new(&removals);
     let mut at = 0u64;
-    let mut take = |counts: &mut [i16]| {
-        patch.counts(counts, gain);
+    for_each_count(source, head, (scale, gain), &removals, |counts| {
         let end = at + counts.len() as u64;
         for ((from, w), &(_, len)) in windows.iter_mut().zip(&spans) {
             let (a, b) = ((*from).max(at), (*from + len).min(end));
@@ -576,15 +556,30 @@ fn collect_windows(
         }
         at = end;
         Ok(())
+    })?;
+    Ok(windows)
+}
+
+/// Hands `take` the head's counts, then the rest of the source's a chunk at a time (as counts
+/// at `(scale, gain)`, the `removals` put in: as the analysis sees them); the source.
+fn for_each_count(
+    source: Box<dyn Source>,
+    mut head: Vec<i16>,
+    (scale, gain): (f64, f64),
+    removals: &[Removal],
+    mut take: impl FnMut(&[i16]) -> Result<(), String>,
+) -> Result<Box<dyn Source>, String> {
+    let mut patch = Patches::new(removals);
+    let mut patched = |counts: &mut [i16]| {
+        patch.counts(counts, gain);
+        take(counts)
     };
-    let mut head = head;
-    take(&mut head)?;
+    patched(&mut head)?;
     read_ahead(
         source,
         move |s, scratch, counts| s.next_counts(CHUNK, (scale, gain), scratch, counts),
-        take,
-    )?;
-    Ok(windows)
+        patched,
+    )
 }
 
 /// What [`run_monitor`] gives: the reports, the samples read and the source.

@@ -89,3 +89,11 @@ pub fn assert_refused(code: Option<i32>, err: &str, want: &str, what: &str) {
     assert!(err.contains(want), "{what}: wanted {want:?} in {err}");
     assert!(!err.contains("panicked"), "{what}: {err}");
 }
+
+/// A figure's title (its first text) and the figure without it.
+#[allow(dead_code)] // not every test file needs it
+pub fn untitled(svg: &str) -> (String, String) {
+    let i = svg.find("<text").expect("a title");
+    let j = i + svg[i..].find("</text>").expect("its end") + "</text>".len();
+    (svg[i..j].to_string(), format!("{}{}", &svg[..i], &svg[j..]))
+}
