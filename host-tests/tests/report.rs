@@ -8,6 +8,7 @@ use std::path::{Path, PathBuf};
 use std::process::Command;
 
 mod common;
+use common::browser::chromium;
 use common::{impact, impact_ok};
 
 fn dir() -> PathBuf {
@@ -92,25 +93,6 @@ fn the_report_is_one_self_contained_page_with_every_pulse() {
         "would be overwritten",
         "--html onto an input",
     );
-}
-
-/// The browser, if there is one: `None` to skip (unless `IMPACT_REQUIRE_BROWSER` is set).
-fn chromium() -> Option<&'static str> {
-    for name in ["chromium", "chromium-browser", "google-chrome"] {
-        if Command::new(name)
-            .arg("--version")
-            .output()
-            .is_ok_and(|o| o.status.success())
-        {
-            return Some(name);
-        }
-    }
-    assert!(
-        std::env::var_os("IMPACT_REQUIRE_BROWSER").is_none(),
-        "no chromium: scripts/setup.sh installs it"
-    );
-    eprintln!("skipped: no chromium (scripts/setup.sh installs it)");
-    None
 }
 
 #[test]

@@ -27,6 +27,10 @@ const SYNTH_EXAMPLES: &str = "Examples:
   impact synth --model nonlinear --mass 0.06 --v0 1.3357 --stiffness 1e4 --damping 0.5 --bounces 8 --duration 1.5 -o train.csv";
 const REPORT_EXAMPLES: &str = "Examples:
   impact report host-tests/data/afrl-drop-tower/accel_5.csv --channels 1,2,3,4,5 --units kgn --spec half-sine,11000g,0.1ms --html afrl.html";
+const WATCH_EXAMPLES: &str = "Examples:
+  impact emulate seed.csv --mass 0.06 --v0 1.3357 --realtime --waveforms 8 | impact watch
+  impact watch board.log --spec half-sine,100g,3ms
+  impact watch board.log --terminal --once";
 const LOG_EXAMPLES: &str = "Examples:
   impact log board.log --csv
   impact log board.log --plot board.svg";
@@ -74,6 +78,10 @@ enum Command {
     /// Turn the firmware's defmt log into JSON (default) or CSV, its waveforms into figures.
     #[command(after_help = LOG_EXAMPLES)]
     Log(cli::log::LogArgs),
+    /// Watch the board live: its log as it arrives (a pipe, a growing file) shown on a local
+    /// web page (or in the terminal), every line kept in a session file.
+    #[command(after_help = WATCH_EXAMPLES)]
+    Watch(Box<cli::watch::WatchArgs>),
     /// Render a model impact as an accelerometer recording (CSV on stdout or --output, raw
     /// ADC codes with --raw).
     #[command(allow_negative_numbers = true, after_help = SYNTH_EXAMPLES)]
@@ -127,6 +135,7 @@ fn run(cli: Cli) -> Result<(), String> {
         Command::Emulate(args) => cli::emulate::emulate(&args),
         Command::Log(args) => cli::log::log(&args),
         Command::Report(args) => cli::html::run(&args),
+        Command::Watch(args) => cli::watch::run(&args),
         Command::Synth(command) => cli::synth::run(command),
         Command::Bench { which } => cli::bench::run(which),
     }

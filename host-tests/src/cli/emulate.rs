@@ -242,6 +242,7 @@ pub fn emulate(args: &EmulateArgs) -> Result<(), String> {
     };
     // The log goes to stderr when stdout carries JSON or CSV.
     let to_stderr = a.json || a.csv;
+    let stdout_terminal = std::io::IsTerminal::is_terminal(&std::io::stdout());
     let pacing = if args.realtime {
         Pacing::RealTime {
             rate_scale: args.rate_scale,
@@ -258,8 +259,9 @@ pub fn emulate(args: &EmulateArgs) -> Result<(), String> {
         pacing,
         Duration::from_secs(args.timeout),
         move |line| {
-            // The waveform frames are for files (--log), not for the terminal.
-            if line.contains("wave_frame ") {
+            // The waveform frames are for files (--log) and pipes (`| impact watch`), not
+            // for the terminal.
+            if line.contains("wave_frame ") && (to_stderr || stdout_terminal) {
                 return;
             }
             if to_stderr {

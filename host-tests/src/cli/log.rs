@@ -79,6 +79,13 @@ pub fn log(args: &LogArgs) -> Result<(), String> {
         }
         return report(args, reader, &name);
     }
+    read_text(input, &name, &mut reader)?;
+    report(args, reader, &name)
+}
+
+/// Reads the decoded log `input` (called `name` in errors) line by line into `reader`, each
+/// line at most [`MAX_LINE_BYTES`].
+fn read_text(input: impl Read, name: &str, reader: &mut LogReader) -> Result<(), String> {
     let mut input = BufReader::with_capacity(1 << 16, input);
     let mut buf = Vec::new();
     for n in 1.. {
@@ -99,7 +106,24 @@ pub fn log(args: &LogArgs) -> Result<(), String> {
             .line(n, String::from_utf8_lossy(&buf).trim_end())
             .map_err(|e| format!("{name}: {e}"))?;
     }
-    report(args, reader, &name)
+    Ok(())
+}
+
+/// The decoded log at `path` (`impact watch`'s session file) as `impact log`'s JSON, or CSV,
+/// written to `out`.
+pub fn export(path: &std::path::Path, csv: bool, out: &mut impl Write) -> Result<(), String> {
+    let name = path.display().to_string();
+    let file = std::fs::File::open(path).map_err(|e| format!("{name}: {e}"))?;
+    let mut reader = LogReader::default();
+    read_text(file, &name, &mut reader)?;
+    let log = reader.finish().map_err(|e| format!("{name}: {e}"))?;
+    let json = LogJson::new(&log, 0.0)?;
+    if csv {
+        crate::report::csv::write_csv(&json.head, json.impacts(), out)
+    } else {
+        crate::report::write_json(&json.head, json.impacts(), out)
+    }
+    .map_err(|e| format!("{name}: {e}"))
 }
 
 /// The log read: its warnings on stderr, the figure and exports asked for, the JSON or CSV.

@@ -11,3 +11,4 @@ pub mod pulse;
 pub mod series;
 pub mod simulate;
 pub mod synth;
+pub mod watch;

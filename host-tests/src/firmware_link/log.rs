@@ -165,7 +165,7 @@ pub fn parse_impact(m: &HashMap<String, String>) -> Result<ImpactReport, String>
 }
 
 /// A `spec` line: the verdict of the impact with its `index`, or why there is none.
-fn parse_verdict(
+pub(crate) fn parse_verdict(
     m: &HashMap<String, String>,
 ) -> Result<
     (
@@ -202,7 +202,7 @@ fn parse_verdict(
 }
 
 /// An `srs` line: the spectra of the impact with its `index`.
-fn parse_spectrum(m: &HashMap<String, String>) -> Result<(u32, Spectrum), String> {
+pub(crate) fn parse_spectrum(m: &HashMap<String, String>) -> Result<(u32, Spectrum), String> {
     let list = |key: &str| -> Result<Vec<f32>, String> {
         get(m, key)?
             .split(',')

@@ -96,6 +96,67 @@ pub fn statistics<'a>(impacts: impl Iterator<Item = &'a ImpactJson> + Clone) -> 
         .collect()
 }
 
+/// A metric's statistics kept as values arrive, in constant memory (Welford's update), for a
+/// session whose impacts are not all kept (`impact watch`): the same numbers as
+/// [`statistics`] to rounding.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct Running {
+    n: usize,
+    mean: f64,
+    /// Σ (x − mean)² so far.
+    m2: f64,
+    min: f64,
+    max: f64,
+}
+
+impl Running {
+    /// Takes `v` (a value that is not finite is not a measurement and is left out).
+    pub fn add(&mut self, v: f64) {
+        if !v.is_finite() {
+            return;
+        }
+        self.n += 1;
+        if self.n == 1 {
+            (self.min, self.max) = (v, v);
+        }
+        let d = v - self.mean;
+        self.mean += d / self.n as f64;
+        self.m2 += d * (v - self.mean);
+        (self.min, self.max) = (self.min.min(v), self.max.max(v));
+    }
+
+    /// The statistics so far under `metric`'s name; `None` before the first value.
+    pub fn statistic(&self, metric: &'static str) -> Option<Statistic> {
+        if self.n == 0 {
+            return None;
+        }
+        let (sd, cv, null_reason) = if self.n < 2 {
+            (None, None, Some("one value: no spread"))
+        } else {
+            let sd = (self.m2.max(0.0) / (self.n - 1) as f64).sqrt();
+            if self.mean == 0.0 {
+                (
+                    Some(sd),
+                    None,
+                    Some("mean zero: no coefficient of variation"),
+                )
+            } else {
+                (Some(sd), Some(sd / self.mean.abs()), None)
+            }
+        };
+        Some(Statistic {
+            metric,
+            n: self.n,
+            mean: self.mean,
+            sd,
+            cv,
+            min: self.min,
+            max: self.max,
+            null_reason,
+        })
+    }
+}
+
 /// With `--spec`: how many of the series' impacts were judged and passed.
 #[derive(Clone, Debug, Serialize, PartialEq)]
 pub struct PassRate {
@@ -168,6 +229,32 @@ mod tests {
         assert!(
             st.iter().all(|s| s.metric != "delta_v_m_s"),
             "no impact has one"
+        );
+    }
+
+    #[test]
+    fn running_statistics_are_the_two_pass_ones() {
+        let values = [2.0, 4.0, 4.0, 4.0, 5.0, 5.0, 7.0, 9.0, 1e8 + 1.0, 1e8 - 1.0];
+        let impacts: Vec<ImpactJson> = values.iter().map(|&v| impact(v, None)).collect();
+        let two_pass = &statistics(impacts.iter())[0];
+        let mut running = Running::default();
+        assert_eq!(running.statistic("peak_acceleration_m_s2"), None);
+        for v in values {
+            running.add(v);
+        }
+        running.add(f64::NAN);
+        let r = running.statistic("peak_acceleration_m_s2").unwrap();
+        assert_eq!(
+            (r.n, r.min, r.max),
+            (two_pass.n, two_pass.min, two_pass.max)
+        );
+        assert!((r.mean - two_pass.mean).abs() <= 1e-9 * two_pass.mean.abs());
+        assert!((r.sd.unwrap() - two_pass.sd.unwrap()).abs() <= 1e-9 * two_pass.sd.unwrap());
+        let mut one = Running::default();
+        one.add(3.0);
+        assert_eq!(
+            one.statistic("cor").unwrap().null_reason,
+            Some("one value: no spread")
         );
     }
 

@@ -2,6 +2,9 @@
 
 use std::process::Command;
 
+pub mod board_log;
+pub mod browser;
+
 /// Runs `impact ARGS`: (exit code, stdout, stderr).
 pub fn impact(args: &[&str]) -> (i32, String, String) {
     let out = Command::new(env!("CARGO_BIN_EXE_impact"))

@@ -1,0 +1,280 @@
+//! `impact watch`'s web server: the page, its event stream (Server-Sent Events), the
+//! session's exports. Four GET routes on localhost, each connection on its own thread; a
+//! page too slow for the stream loses events (counted and shown), never holds up the board's
+//! input.
+
+use std::collections::VecDeque;
+use std::io::{BufRead, BufReader, Read, Write};
+use std::net::{TcpListener, TcpStream};
+use std::path::PathBuf;
+use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
+use std::sync::mpsc::{sync_channel, Receiver, RecvTimeoutError, SyncSender, TrySendError};
+use std::sync::{Arc, Mutex, MutexGuard};
+use std::time::Duration;
+
+use serde_json::Value;
+
+use super::session::Session;
+
+/// The page (HTML, CSS and script in one file: no network).
+const PAGE: &str = include_str!("page.html");
+/// Events a page may have queued before it loses the next ones.
+const QUEUE: usize = 512;
+/// Receipts kept (the newest) for `/receipts`.
+const RECEIPTS: usize = 4096;
+/// The longest request head read, bytes.
+const MAX_HEAD: usize = 8192;
+
+/// A page's event stream.
+struct Client {
+    tx: SyncSender<Arc<str>>,
+    dropped: Arc<AtomicU64>,
+    /// Whether it lost events since its last snapshot (the next tick sends it a new one).
+    stale: Arc<AtomicBool>,
+}
+
+/// The session and the pages watching it.
+pub struct Hub {
+    session: Mutex<Session>,
+    clients: Mutex<Vec<Client>>,
+    /// What the pages said they drew (`/receipt?…`), with the time it arrived (Unix ms).
+    receipts: Mutex<VecDeque<String>>,
+    /// The session file (the whole log as it arrived), for the exports.
+    session_file: PathBuf,
+    /// Whether the server is bound to a loopback address (then only `Host: localhost` or a
+    /// loopback address is served, so a web page elsewhere cannot read the session).
+    loopback: bool,
+}
+
+/// A lock that a panicked thread left poisoned is still the session's.
+fn lock<T>(m: &Mutex<T>) -> MutexGuard<'_, T> {
+    m.lock().unwrap_or_else(std::sync::PoisonError::into_inner)
+}
+
+/// Unix time, ms.
+pub fn now_ms() -> u64 {
+    std::time::SystemTime::now()
+        .duration_since(std::time::UNIX_EPOCH)
+        .map_or(0, |d| d.as_millis() as u64)
+}
+
+impl Hub {
+    pub fn new(session: Session, session_file: PathBuf, loopback: bool) -> Self {
+        Self {
+            session: Mutex::new(session),
+            clients: Mutex::new(Vec::new()),
+            receipts: Mutex::new(VecDeque::new()),
+            session_file,
+            loopback,
+        }
+    }
+
+    /// Runs `f` on the session and sends the events it returns to every page.
+    pub fn with(&self, f: impl FnOnce(&mut Session) -> Vec<Value>) -> Vec<Value> {
+        let mut session = lock(&self.session);
+        let events = f(&mut session);
+        // Sent under the session's lock, so a page connecting meanwhile gets its snapshot
+        // first and then every later event, none twice.
+        let mut clients = lock(&self.clients);
+        for e in &events {
+            let text: Arc<str> = format!("data: {e}\n\n").into();
+            clients.retain(|c| send(c, text.clone()));
+        }
+        events
+    }
+
+    /// How long since the last heartbeat, ms (`None` before the first or after the end).
+    pub fn silent_for(&self, now_ms: u64) -> Option<u64> {
+        lock(&self.session).silent_for(now_ms)
+    }
+
+    /// Sends each page the clock event (with the events it lost), and a page that lost
+    /// events a new snapshot once it has room for one: it shows the session as it is again.
+    pub fn tick(&self) {
+        let session = lock(&self.session);
+        let now = now_ms();
+        let mut clients = lock(&self.clients);
+        let mut snapshot: Option<Arc<str>> = None;
+        clients.retain(|c| {
+            if c.stale.load(Ordering::Relaxed) {
+                let s = snapshot
+                    .get_or_insert_with(|| format!("data: {}\n\n", session.snapshot(now)).into());
+                match c.tx.try_send(s.clone()) {
+                    Ok(()) => c.stale.store(false, Ordering::Relaxed),
+                    Err(TrySendError::Full(_)) => {}
+                    Err(TrySendError::Disconnected(_)) => return false,
+                }
+            }
+            let tick = session.tick(now, c.dropped.load(Ordering::Relaxed));
+            send(c, format!("data: {tick}\n\n").into())
+        });
+    }
+
+    /// A new page's stream: the snapshot first.
+    fn subscribe(&self) -> Receiver<Arc<str>> {
+        let session = lock(&self.session);
+        let (tx, rx) = sync_channel(QUEUE);
+        let snapshot = session.snapshot(now_ms());
+        let client = Client {
+            tx,
+            dropped: Arc::new(AtomicU64::new(0)),
+            stale: Arc::new(AtomicBool::new(false)),
+        };
+        if send(&client, format!("data: {snapshot}\n\n").into()) {
+            lock(&self.clients).push(client);
+        }
+        rx
+    }
+}
+
+/// Queues `text` for a page; false once the page is gone.
+fn send(c: &Client, text: Arc<str>) -> bool {
+    match c.tx.try_send(text) {
+        Ok(()) => true,
+        Err(TrySendError::Full(_)) => {
+            c.dropped.fetch_add(1, Ordering::Relaxed);
+            c.stale.store(true, Ordering::Relaxed);
+            true
+        }
+        Err(TrySendError::Disconnected(_)) => false,
+    }
+}
+
+/// Serves `hub` on `listener` until the process ends.
+pub fn serve(listener: TcpListener, hub: Arc<Hub>) {
+    for stream in listener.incoming().flatten() {
+        let hub = hub.clone();
+        std::thread::spawn(move || {
+            let _ = connection(stream, &hub);
+        });
+    }
+}
+
+/// One request on `stream`.
+fn connection(stream: TcpStream, hub: &Hub) -> std::io::Result<()> {
+    stream.set_read_timeout(Some(Duration::from_secs(10)))?;
+    let mut reader = BufReader::new(stream.try_clone()?);
+    let (mut head, mut line) = (Vec::new(), String::new());
+    let mut size = 0;
+    loop {
+        line.clear();
+        let n = (&mut reader).take(MAX_HEAD as u64).read_line(&mut line)?;
+        size += n;
+        if n == 0 || line == "\r\n" || line == "\n" || size > MAX_HEAD {
+            break;
+        }
+        head.push(line.trim_end().to_string());
+    }
+    let mut out = stream;
+    let request = head.first().cloned().unwrap_or_default();
+    let mut parts = request.split(' ');
+    let (method, target) = (parts.next().unwrap_or(""), parts.next().unwrap_or(""));
+    if hub.loopback {
+        let host = head
+            .iter()
+            .find_map(|h| {
+                let (k, v) = h.split_once(':')?;
+                k.eq_ignore_ascii_case("host").then(|| v.trim().to_string())
+            })
+            .unwrap_or_default();
+        let name = host.rsplit_once(':').map_or(host.as_str(), |(h, _)| h);
+        if !matches!(name, "localhost" | "127.0.0.1" | "[::1]") {
+            return respond(&mut out, "403 Forbidden", "text/plain", b"not this host\n");
+        }
+    }
+    if method != "GET" {
+        return respond(
+            &mut out,
+            "405 Method Not Allowed",
+            "text/plain",
+            b"GET only\n",
+        );
+    }
+    let (path, query) = target.split_once('?').unwrap_or((target, ""));
+    match path {
+        "/" => respond(
+            &mut out,
+            "200 OK",
+            "text/html; charset=utf-8",
+            PAGE.as_bytes(),
+        ),
+        "/events" => events(&mut out, hub),
+        "/state.json" => {
+            let s = lock(&hub.session).snapshot(now_ms()).to_string();
+            respond(&mut out, "200 OK", "application/json", s.as_bytes())
+        }
+        "/session.json" | "/session.csv" => {
+            let csv = path.ends_with("csv");
+            let mut body = Vec::new();
+            match crate::cli::log::export(&hub.session_file, csv, &mut body) {
+                Ok(()) => respond(
+                    &mut out,
+                    "200 OK",
+                    if csv { "text/csv" } else { "application/json" },
+                    &body,
+                ),
+                Err(e) => respond(
+                    &mut out,
+                    "500 Internal Server Error",
+                    "text/plain; charset=utf-8",
+                    format!("the session file could not be exported: {e}\n").as_bytes(),
+                ),
+            }
+        }
+        "/receipt" => {
+            let mut r = lock(&hub.receipts);
+            if r.len() == RECEIPTS {
+                r.pop_front();
+            }
+            r.push_back(format!("arrived_unix_ms={}&{query}", now_ms()));
+            drop(r);
+            write!(out, "HTTP/1.1 204 No Content\r\nConnection: close\r\n\r\n")
+        }
+        "/receipts" => {
+            let text: String = lock(&hub.receipts)
+                .iter()
+                .map(|r| format!("{r}\n"))
+                .collect();
+            respond(&mut out, "200 OK", "text/plain", text.as_bytes())
+        }
+        _ => respond(&mut out, "404 Not Found", "text/plain", b"not found\n"),
+    }
+}
+
+fn respond(out: &mut TcpStream, status: &str, kind: &str, body: &[u8]) -> std::io::Result<()> {
+    write!(
+        out,
+        "HTTP/1.1 {status}\r\nContent-Type: {kind}\r\nContent-Length: {}\r\nCache-Control: no-store\r\nConnection: close\r\n\r\n",
+        body.len()
+    )?;
+    out.write_all(body)?;
+    out.flush()
+}
+
+/// The event stream: the snapshot, then every event as it comes; a comment every 15 s keeps
+/// an idle connection open through proxies.
+fn events(out: &mut TcpStream, hub: &Hub) -> std::io::Result<()> {
+    write!(
+        out,
+        "HTTP/1.1 200 OK\r\nContent-Type: text/event-stream\r\nCache-Control: no-store\r\nConnection: keep-alive\r\n\r\nretry: 1000\n\n"
+    )?;
+    out.flush()?;
+    let rx = hub.subscribe();
+    loop {
+        match rx.recv_timeout(Duration::from_secs(15)) {
+            Ok(text) => {
+                out.write_all(text.as_bytes())?;
+                // Whatever else is queued goes in the same write.
+                while let Ok(more) = rx.try_recv() {
+                    out.write_all(more.as_bytes())?;
+                }
+                out.flush()?;
+            }
+            Err(RecvTimeoutError::Timeout) => {
+                out.write_all(b": idle\n\n")?;
+                out.flush()?;
+            }
+            Err(RecvTimeoutError::Disconnected) => return Ok(()),
+        }
+    }
+}

@@ -1,0 +1,629 @@
+//! `impact watch`'s session: the board's lines turned into the live view's events (JSON, the
+//! protocol the page reads), keeping only what the view shows: the last impacts, the trend,
+//! running statistics, the board's health. Memory does not grow with the session.
+
+use std::collections::{HashMap, VecDeque};
+
+use impact_core::consts::STANDARD_GRAVITY;
+use impact_core::spec::Spec;
+use impact_core::ImpactReport;
+use serde_json::{json, Map, Value};
+
+use crate::firmware_link::fields::{fields, get, num};
+use crate::firmware_link::log::{parse_impact, parse_spectrum, parse_verdict, rate};
+use crate::firmware_link::plausible::check_report;
+use crate::firmware_link::waves::{parse_frame, Waveform};
+use crate::report::statistics::Running;
+
+/// Impacts kept with their pulses (the newest; the page's "last impact" and its table start).
+pub const LAST: usize = 50;
+/// Trend points kept (the newest).
+pub const TREND: usize = 2000;
+/// Runs kept (the newest): a board that resets all day.
+pub const RUNS: usize = 100;
+/// How long an impact line waits for its `srs` and `spec` lines before it is shown, ms.
+pub const HOLD_MS: u64 = 100;
+/// A board is silent when its last heartbeat (one a second) is older than this, ms: within
+/// two heartbeats.
+pub const SILENT_MS: u64 = 2500;
+/// Points a pulse is drawn with at most (min/max of 200 columns).
+const PULSE_COLUMNS: usize = 200;
+
+/// The metrics the trend and the statistics follow: name, label, read off an impact event.
+const METRICS: [(&str, &str); 4] = [
+    ("peak_g", "peak, g"),
+    ("delta_v_m_s", "Δv, m/s"),
+    ("duration_s", "duration, s"),
+    ("cor", "COR"),
+];
+
+/// One impact on the trend (kept small: the session keeps [`TREND`] of them).
+#[derive(Clone, Copy, Debug, serde::Serialize)]
+struct TrendPoint {
+    run: u32,
+    index: u32,
+    received_unix_ms: u64,
+    peak_g: Option<f64>,
+    delta_v_m_s: Option<f64>,
+    duration_s: Option<f64>,
+    cor: Option<f64>,
+    pass: Option<bool>,
+}
+
+/// An impact line waiting for its `srs` and `spec` lines.
+struct Pending {
+    received_ms: u64,
+    report: ImpactReport,
+    latency_s: Option<f32>,
+    /// The captured window the board sent before it, if it is this impact's.
+    wave: Option<Waveform>,
+}
+
+/// What the session knows and shows.
+pub struct Session {
+    spec: Option<Spec>,
+    head: Map<String, Value>,
+    run: u32,
+    /// Whether the current run has had a data line (a `scene` line then is a restart).
+    started: bool,
+    rate_hz: Option<f64>,
+    gain: Option<f64>,
+    /// The window being received (only the newest is kept).
+    wave: Option<Waveform>,
+    pending: Option<Pending>,
+    impacts: VecDeque<Value>,
+    trend: VecDeque<TrendPoint>,
+    runs: VecDeque<Value>,
+    stats: [Running; 4],
+    /// Judged and passed, judged, not judged.
+    passed: usize,
+    judged: usize,
+    not_judged: usize,
+    health: Option<Value>,
+    ended: Option<Value>,
+    /// Lines read, and when the last one and the last heartbeat came (Unix ms).
+    pub lines: u64,
+    last_line_ms: Option<u64>,
+    last_heartbeat_ms: Option<u64>,
+    /// Lines that looked like the board's but could not be read, and the last one's error.
+    pub bad_lines: u64,
+    last_error: Option<String>,
+}
+
+impl Session {
+    /// A session reading `source` into `session_file`, its impacts judged against `spec`
+    /// (`spec_text` says which) when given.
+    pub fn new(source: &str, session_file: &str, spec: Option<(Spec, String)>) -> Self {
+        let mut head = Map::new();
+        head.insert(
+            "tool".into(),
+            json!(format!("impact {}", env!("CARGO_PKG_VERSION"))),
+        );
+        head.insert("source".into(), json!(source));
+        head.insert("session_file".into(), json!(session_file));
+        head.insert(
+            "spec".into(),
+            spec.as_ref().map_or(Value::Null, |(s, text)| {
+                json!({
+                    "text": text,
+                    "shape": s.shape.name(),
+                    "peak_g": f64::from(s.peak_m_s2) / STANDARD_GRAVITY,
+                    "duration_s": f64::from(s.duration_s),
+                })
+            }),
+        );
+        Self {
+            spec: spec.map(|(s, _)| s),
+            head,
+            run: 1,
+            started: false,
+            rate_hz: None,
+            gain: None,
+            wave: None,
+            pending: None,
+            impacts: VecDeque::new(),
+            trend: VecDeque::new(),
+            runs: VecDeque::new(),
+            stats: Default::default(),
+            passed: 0,
+            judged: 0,
+            not_judged: 0,
+            health: None,
+            ended: None,
+            lines: 0,
+            last_line_ms: None,
+            last_heartbeat_ms: None,
+            bad_lines: 0,
+            last_error: None,
+        }
+    }
+
+    /// Reads line `n` of the input, received at `now_ms` (Unix ms); returns the events it
+    /// makes. A line that is not the board's is passed over; one that is but cannot be read
+    /// is counted and reported as a `warning` event, and the session goes on.
+    pub fn line(&mut self, n: u64, line: &str, now_ms: u64) -> Vec<Value> {
+        self.lines += 1;
+        self.last_line_ms = Some(now_ms);
+        let mut events = Vec::new();
+        if let Err(e) = self.read(line, now_ms, &mut events) {
+            self.bad_lines += 1;
+            let text = format!("line {n}: {e}");
+            self.last_error = Some(text.clone());
+            events.push(json!({"type": "warning", "text": text}));
+        }
+        events
+    }
+
+    fn read(&mut self, line: &str, now_ms: u64, events: &mut Vec<Value>) -> Result<(), String> {
+        // An impact's `srs` and `spec` lines (and a window's frames) follow it; any other
+        // data line shows the waiting impact first.
+        if let Some(m) = fields(line, "srs ") {
+            let (index, spectrum) = parse_spectrum(&m?)?;
+            if let Some(p) = self.pending.as_mut().filter(|p| p.report.index == index) {
+                p.report.spectrum = Some(spectrum);
+            }
+            return Ok(());
+        }
+        if let Some(m) = fields(line, "spec ") {
+            let (index, verdict) = parse_verdict(&m?)?;
+            if let Some(p) = self.pending.as_mut().filter(|p| p.report.index == index) {
+                p.report.verdict = Some(verdict);
+                // The last line of its impact.
+                self.show(events);
+            }
+            return Ok(());
+        }
+        if let Some(m) = fields(line, "wave_frame ") {
+            let (index, frame, counts) = parse_frame(line, &m?)?;
+            if let Some(w) = self.wave.as_mut().filter(|w| w.index == index) {
+                w.add_frame(frame, counts)?;
+            }
+            return Ok(());
+        }
+        let data = ["impact ", "wave ", "heartbeat ", "summary ", "scene "]
+            .iter()
+            .find_map(|marker| fields(line, marker).map(|m| (*marker, m)));
+        let Some((marker, m)) = data else {
+            return Ok(());
+        };
+        self.show(events);
+        let m = m?;
+        match marker {
+            "impact " => {
+                let report = parse_impact(&m)?;
+                check_report(&report)?;
+                let latency_s = crate::firmware_link::fields::opt(&m, "report_latency_s")?;
+                let wave = self.wave.take().filter(|w| w.index == report.index);
+                self.started = true;
+                self.pending = Some(Pending {
+                    received_ms: now_ms,
+                    report,
+                    latency_s,
+                    wave,
+                });
+            }
+            "wave " => {
+                self.started = true;
+                self.wave = Some(Waveform::from_header(&m)?);
+            }
+            "heartbeat " => {
+                self.started = true;
+                self.last_heartbeat_ms = Some(now_ms);
+                let h = self.health(&m, now_ms)?;
+                self.health = Some(h.clone());
+                events.push(tagged("health", h));
+            }
+            "summary " => {
+                let h = self.health(&m, now_ms)?;
+                self.health = Some(h.clone());
+                events.push(tagged("health", h));
+                let end = json!({"result": get(&m, "result")?, "received_unix_ms": now_ms});
+                self.ended = Some(end.clone());
+                events.push(tagged("end", end));
+            }
+            _ => {
+                // A scene: the board (re)started.
+                let rate_hz = f64::from(rate(&m)?);
+                if self.started {
+                    self.run += 1;
+                    self.started = false;
+                    self.wave = None;
+                    self.ended = None;
+                }
+                self.rate_hz = Some(rate_hz);
+                self.gain = m
+                    .get("gain_m_s2_per_count")
+                    .and_then(|g| g.parse::<f64>().ok())
+                    .filter(|g| g.is_finite());
+                let scene: Map<String, Value> = m
+                    .iter()
+                    .map(|(k, v)| {
+                        let value = v
+                            .parse::<f64>()
+                            .ok()
+                            .filter(|x| x.is_finite())
+                            .map_or_else(|| json!(v), |x| json!(x));
+                        (k.clone(), value)
+                    })
+                    .collect();
+                let run = json!({"run": self.run, "received_unix_ms": now_ms, "scene": scene});
+                if self.runs.back().is_some_and(|r| r["run"] == self.run) {
+                    self.runs.pop_back();
+                }
+                push_bounded(&mut self.runs, run.clone(), RUNS);
+                events.push(tagged("run", run));
+            }
+        }
+        Ok(())
+    }
+
+    /// Shows the waiting impact if it has waited [`HOLD_MS`] by `now_ms`.
+    pub fn flush(&mut self, now_ms: u64) -> Vec<Value> {
+        let mut events = Vec::new();
+        if self
+            .pending
+            .as_ref()
+            .is_some_and(|p| now_ms >= p.received_ms + HOLD_MS)
+        {
+            self.show(&mut events);
+        }
+        events
+    }
+
+    /// Shows the waiting impact (if any): its event, the trend point, the statistics.
+    fn show(&mut self, events: &mut Vec<Value>) {
+        let Some(p) = self.pending.take() else {
+            return;
+        };
+        let event = self.impact(&p);
+        let number = |k: &str| event[k].as_f64();
+        for (k, (name, _)) in METRICS.iter().enumerate() {
+            if let Some(v) = number(name) {
+                self.stats[k].add(v);
+            }
+        }
+        let pass = event["verdict"]["pass"].as_bool();
+        match &p.report.verdict {
+            Some(Ok(v)) => {
+                self.judged += 1;
+                self.passed += usize::from(v.pass);
+            }
+            Some(Err(_)) => self.not_judged += 1,
+            None => {}
+        }
+        let point = TrendPoint {
+            run: self.run,
+            index: p.report.index,
+            received_unix_ms: p.received_ms,
+            peak_g: number("peak_g"),
+            delta_v_m_s: number("delta_v_m_s"),
+            duration_s: number("duration_s"),
+            cor: number("cor"),
+            pass,
+        };
+        push_bounded(&mut self.trend, point, TREND);
+        push_bounded(&mut self.impacts, event.clone(), LAST);
+        events.push(tagged("impact", event));
+        events.push(tagged("stats", self.stats()));
+    }
+
+    /// An impact's event: its numbers, verdict and pulse.
+    fn impact(&self, p: &Pending) -> Value {
+        let r = &p.report;
+        let j = crate::report::impact_json(r, 0.0, &impact_core::FitSet::default());
+        let g = STANDARD_GRAVITY;
+        let verdict = r.verdict.as_ref().map(|v| match v {
+            Ok(v) => json!({
+                "pass": v.pass, "reason": null, "band_pass": v.band_pass,
+                "delta_v_pass": v.delta_v_pass, "margin": f64::from(v.margin),
+                "margin_g": self.spec.map(|s| -f64::from(v.margin) * f64::from(s.peak_m_s2) / g),
+                "worst_s": v.worst_s - r.start_s,
+                "worst_g": f64::from(v.worst_m_s2) / g, "limit_g": f64::from(v.limit_m_s2) / g,
+                "delta_v_m_s": f64::from(v.delta_v_m_s),
+            }),
+            Err(missing) => json!({"pass": null, "reason": missing.name()}),
+        });
+        json!({
+            "run": self.run, "index": r.index, "received_unix_ms": p.received_ms,
+            "start_s": j.start_s, "status": j.status, "analysis": j.analysis,
+            "flags": j.flags, "clipped": j.clipped,
+            "peak_g": j.peak_acceleration_m_s2 / g, "peak_m_s2": j.peak_acceleration_m_s2,
+            "peak_force_n": j.peak_force_n, "delta_v_m_s": j.delta_v_m_s,
+            "duration_s": j.duration_s, "cor": j.cor,
+            "impact_velocity_m_s": j.impact_velocity_m_s,
+            "rebound_velocity_m_s": j.rebound_velocity_m_s, "crush_time_s": j.crush_time_s,
+            "max_deformation_m": j.max_deformation_m,
+            "report_latency_s": p.latency_s.map(f64::from),
+            "verdict": verdict,
+            "pulse": self.pulse(p),
+        })
+    }
+
+    /// The pulse drawn: the board's window when it sent one, else a half-sine sketch from
+    /// the reported peak and duration; in g above the baseline (deceleration positive),
+    /// against time from first touch; with the spec's nominal pulse and band where its
+    /// verdict placed them.
+    fn pulse(&self, p: &Pending) -> Value {
+        let r = &p.report;
+        let g = STANDARD_GRAVITY;
+        let touch = r.start_s;
+        let placed = match (&self.spec, &r.verdict) {
+            (Some(spec), Some(Ok(v))) => Some((spec, v.start_s)),
+            _ => None,
+        };
+        let (from_s, to_s) = match placed {
+            Some((spec, start)) => {
+                let d = f64::from(spec.duration_s);
+                let t = spec.tolerance;
+                (
+                    start - f64::from(t.before) * d,
+                    start + f64::from(1.0 + t.watch) * d,
+                )
+            }
+            None => {
+                let d = f64::from(r.duration_s);
+                (touch - 0.25 * d, touch + 1.25 * d)
+            }
+        };
+        let sign = if r.peak_acceleration_m_s2 < 0.0 {
+            -1.0
+        } else {
+            1.0
+        };
+        let peak_g = f64::from(r.peak_acceleration_m_s2.abs()) / g;
+        let measured = match (&p.wave, self.rate_hz, self.gain) {
+            (Some(w), Some(rate), Some(gain)) => {
+                let every = f64::from(w.every);
+                let base = f64::from(r.baseline_m_s2);
+                let points: Vec<(f64, f64)> = (0..w.values())
+                    .filter_map(|k| {
+                        // The value is the mean of `every` samples: at their middle.
+                        let t =
+                            (w.first_sample as f64 + k as f64 * every + (every - 1.0) / 2.0) / rate;
+                        let c = w.value(k)?;
+                        ((from_s..=to_s).contains(&t))
+                            .then(|| (t - touch, sign * (f64::from(c) * gain - base) / g))
+                    })
+                    .collect();
+                (!points.is_empty())
+                    .then(|| ("waveform", crate::plot::decimate(&points, PULSE_COLUMNS)))
+            }
+            _ => None,
+        };
+        let (source, points) = measured.unwrap_or_else(|| {
+            let d = f64::from(r.duration_s);
+            let mut pts = vec![(from_s - touch, 0.0)];
+            pts.extend((0..=100).map(|k| {
+                let u = f64::from(k) / 100.0;
+                (u * d, peak_g * (std::f64::consts::PI * u).sin())
+            }));
+            pts.push((to_s - touch, 0.0));
+            ("numbers", pts)
+        });
+        let band = placed.map(|(spec, start)| {
+            let d = f64::from(spec.duration_s);
+            let peak = f64::from(spec.peak_m_s2) / g;
+            let (mut t, mut lo, mut hi, mut nominal) = (vec![], vec![], vec![], vec![]);
+            for k in 0..=200 {
+                let at = from_s + (to_s - from_s) * f64::from(k) / 200.0;
+                let u = ((at - start) / d) as f32;
+                let (l, h) = spec.band_at(u);
+                t.push(at - touch);
+                lo.push(f64::from(l) * peak);
+                hi.push(f64::from(h) * peak);
+                nominal.push(f64::from(spec.shape.at(u)) * peak);
+            }
+            json!({"t_s": t, "nominal_g": nominal, "lower_g": lo, "upper_g": hi})
+        });
+        json!({
+            "source": source,
+            "t_s": points.iter().map(|q| q.0).collect::<Vec<_>>(),
+            "g": points.iter().map(|q| q.1).collect::<Vec<_>>(),
+            "band": band,
+        })
+    }
+
+    /// The board's health from a heartbeat's (or the summary's) counters.
+    fn health(&self, m: &HashMap<String, String>, now_ms: u64) -> Result<Value, String> {
+        let n = |k: &str| num::<u64>(m, k);
+        let samples = n("samples")?;
+        let rate_hz = f64::from(rate(m)?);
+        let busy = m
+            .get("busy_permille")
+            .and_then(|b| b.parse::<f64>().ok())
+            .map(|b| b / 1000.0);
+        let optional = |k: &str| m.get(k).and_then(|v| v.parse::<u64>().ok());
+        Ok(json!({
+            "run": self.run, "received_unix_ms": now_ms,
+            "board_time_s": samples as f64 / rate_hz, "samples": samples,
+            "samples_lost": n("samples_lost")?, "gaps": optional("gaps"),
+            "lines_dropped": optional("lines_dropped"),
+            "analyses_skipped": optional("analyses_skipped"),
+            "reports_dropped": optional("reports_dropped"),
+            "stack_peak_bytes": optional("stack_peak_bytes"),
+            "stack_size_bytes": optional("stack_size_bytes"),
+            "busy_share": busy, "impacts": n("impacts")?,
+        }))
+    }
+
+    /// The statistics so far (the series statistics' definitions, kept running).
+    fn stats(&self) -> Value {
+        let metrics: Vec<Value> = METRICS
+            .iter()
+            .zip(&self.stats)
+            .map(|((name, label), running)| match running.statistic(name) {
+                Some(s) => json!({
+                    "name": name, "label": label, "n": s.n, "mean": s.mean, "sd": s.sd,
+                    "cv": s.cv, "min": s.min, "max": s.max,
+                }),
+                None => json!({"name": name, "label": label, "n": 0}),
+            })
+            .collect();
+        let asked = self.judged + self.not_judged > 0;
+        json!({
+            "metrics": metrics,
+            "pass_rate": asked.then(|| json!({
+                "passed": self.passed, "judged": self.judged, "not_judged": self.not_judged,
+            })),
+        })
+    }
+
+    /// Everything the page shows, for a page that (re)connects.
+    pub fn snapshot(&self, now_ms: u64) -> Value {
+        let mut s = self.head.clone();
+        s.insert("type".into(), json!("snapshot"));
+        s.insert("runs".into(), json!(self.runs));
+        s.insert("impacts".into(), json!(self.impacts));
+        s.insert("trend".into(), json!(self.trend));
+        s.insert("stats".into(), self.stats());
+        s.insert("health".into(), json!(self.health));
+        s.insert("ended".into(), json!(self.ended));
+        s.insert("now_unix_ms".into(), json!(now_ms));
+        Value::Object(s)
+    }
+
+    /// How long since the last heartbeat, ms (`None` before the first, and once the stream
+    /// ended).
+    pub fn silent_for(&self, now_ms: u64) -> Option<u64> {
+        if self.ended.is_some() {
+            return None;
+        }
+        self.last_heartbeat_ms.map(|t| now_ms.saturating_sub(t))
+    }
+
+    /// The clock event: when the last line and the last heartbeat came.
+    pub fn tick(&self, now_ms: u64, dropped_events: u64) -> Value {
+        json!({
+            "type": "tick", "now_unix_ms": now_ms, "last_line_unix_ms": self.last_line_ms,
+            "last_heartbeat_unix_ms": self.last_heartbeat_ms, "lines": self.lines,
+            "dropped_events": dropped_events, "bad_lines": self.bad_lines,
+            "last_error": self.last_error,
+        })
+    }
+
+    /// The input ended (a closed pipe, the end of a file not followed): an `end` event
+    /// unless the board's summary said so already.
+    pub fn input_ended(&mut self, now_ms: u64) -> Vec<Value> {
+        let mut events = Vec::new();
+        self.show(&mut events);
+        if self.ended.is_none() {
+            let end = json!({"result": "input-closed", "received_unix_ms": now_ms});
+            self.ended = Some(end.clone());
+            events.push(tagged("end", end));
+        }
+        events
+    }
+}
+
+/// `value` (an object) with its event `type` first.
+fn tagged(kind: &str, value: Value) -> Value {
+    let mut m = Map::new();
+    m.insert("type".into(), json!(kind));
+    if let Value::Object(o) = value {
+        m.extend(o);
+    }
+    Value::Object(m)
+}
+
+fn push_bounded<T>(q: &mut VecDeque<T>, v: T, cap: usize) {
+    if q.len() == cap {
+        q.pop_front();
+    }
+    q.push_back(v);
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    const SCENE: &str = "0.001409 INFO scene rate_hz=500000.0 gain_m_s2_per_count=0.004467775 mass_kg=0.06 v0_m_s=1.3357 drop_height_m=none trigger_m_s2=6.816018 edge_m_s2=1.3632036 hold_s=0.002 max_impact_s=1.0 settle_s=0.05 clip_low=-32768 clip_high=32767 cfc=none trigger_cfc=none two_phase=true nonlinear=true fit_exponent=true exponent=1.0 hertz=true train=none gravity_m_s2=none max_flight_s=none srs=false wave_every=0";
+    const HEARTBEAT: &str = "1.002161 INFO heartbeat seq=198 samples=500224 rate_hz=500000.0 blocks=1954 busy_permille=115 overruns=0 blocks_lost=0 blocks_missing=0 samples_lost=3 gaps=1 source_errors=0 impacts=7 incomplete=7 analyses_skipped=0 level_changes=0 reports_dropped=0 heartbeats_dropped=0 lines_dropped=0 armed=true in_impact=false stack_peak_bytes=12784 stack_size_bytes=24576";
+
+    /// Impact `index`'s line (the emulated board's, its index and place changed).
+    fn impact(index: u32) -> String {
+        let start = 5180 + 100_000 * u64::from(index);
+        format!("0.131031 INFO impact seq={} index={index} status=complete analysis=full clipped=false flags=0 start_sample={start} end_sample={} start_s={} peak_time_s={} peak_acceleration_m_s2=136.32632 peak_force_n=8.17958 delta_v_m_s=2.255874 duration_s=0.034259174 baseline_m_s2=6.6424823 fwhm_s=0.016056484 filtered_peak_acceleration_m_s2=none filtered_fwhm_s=none impact_velocity_m_s=none crush_time_s=none max_deformation_m=none rebound_velocity_m_s=none cor=none permanent_deformation_m=none absorbed_energy_j=none two_phase_kc_n_m=none two_phase_kr_n_m=none two_phase_c_n_s_m=none two_phase_permanent_deformation_m=none two_phase_residual=none nonlinear_k=none nonlinear_c_s_m=none nonlinear_exponent=none nonlinear_residual=none hertz_k=none hertz_residual=none bounce_number=none flight_s=none v0_flight_m_s=none v0_rebound_m_s=none report_latency_s=0.084117",
+            2 * index, start + 17_540, start as f64 / 5e5, (start + 5692) as f64 / 5e5)
+    }
+
+    fn spec(index: u32, pass: bool) -> String {
+        format!("0.131106 INFO spec seq={} index={index} pass={pass} band_pass={pass} delta_v_pass=true margin=-0.1 worst_s=0.01983 worst_m_s2=131.63962 limit_m_s2=140.0 delta_v_m_s=2.25 start_s=0.0101", 2 * index + 1)
+    }
+
+    fn kinds(events: &[Value]) -> Vec<&str> {
+        events.iter().map(|e| e["type"].as_str().unwrap()).collect()
+    }
+
+    #[test]
+    fn an_impact_is_shown_with_its_verdict_or_after_waiting_for_it() {
+        let mut s = Session::new("board.log", "s.log", None);
+        assert_eq!(kinds(&s.line(1, SCENE, 0)), ["run"]);
+        // Its spec line is its last: shown then, with the verdict.
+        assert!(s.line(2, &impact(0), 10).is_empty());
+        let shown = s.line(3, &spec(0, true), 12);
+        assert_eq!(kinds(&shown), ["impact", "stats"]);
+        let e = &shown[0];
+        assert_eq!((e["run"].as_u64(), e["index"].as_u64()), (Some(1), Some(0)));
+        assert!((e["peak_g"].as_f64().unwrap() - 136.32632 / STANDARD_GRAVITY).abs() < 1e-5);
+        assert_eq!(e["verdict"]["pass"], true);
+        assert_eq!(e["cor"], Value::Null);
+        // No window sent: the pulse is a sketch, and says so.
+        assert_eq!(e["pulse"]["source"], "numbers");
+        assert_eq!(e["received_unix_ms"], 10);
+        // Without a spec line: shown once it waited HOLD_MS, or at the next data line.
+        assert!(s.line(4, &impact(1), 100).is_empty());
+        assert!(s.flush(100 + HOLD_MS - 1).is_empty());
+        assert_eq!(kinds(&s.flush(100 + HOLD_MS)), ["impact", "stats"]);
+        s.line(5, &impact(2), 300);
+        assert_eq!(
+            kinds(&s.line(6, HEARTBEAT, 301)),
+            ["impact", "stats", "health"]
+        );
+        let snap = s.snapshot(400);
+        assert_eq!(snap["impacts"].as_array().unwrap().len(), 3);
+        assert_eq!(snap["stats"]["metrics"][0]["n"], 3);
+        assert_eq!(snap["stats"]["pass_rate"]["judged"], 1);
+        assert_eq!(snap["health"]["samples_lost"], 3);
+        assert_eq!(s.silent_for(2901), Some(2600));
+    }
+
+    #[test]
+    fn a_restart_starts_a_run_and_a_bad_line_is_a_warning() {
+        let mut s = Session::new("board.log", "s.log", None);
+        s.line(1, SCENE, 0);
+        s.line(2, &impact(0), 1);
+        // A cut line: the impact before it is shown, the line counted and said.
+        let bad = s.line(3, "INFO impact seq=9 index=1 status=complete", 2);
+        assert_eq!(kinds(&bad), ["impact", "stats", "warning"]);
+        assert!(bad[2]["text"].as_str().unwrap().starts_with("line 3: "));
+        assert_eq!(s.bad_lines, 1);
+        let restart = s.line(4, SCENE, 3);
+        assert_eq!(kinds(&restart), ["run"]);
+        assert_eq!(restart[0]["run"], 2);
+        s.line(5, &impact(0), 4);
+        let end = s.input_ended(5);
+        assert_eq!(kinds(&end), ["impact", "stats", "end"]);
+        assert_eq!(
+            (end[0]["run"].as_u64(), end[2]["result"].as_str()),
+            (Some(2), Some("input-closed"))
+        );
+        // Prose that merely starts like a data line is not the board's.
+        assert!(s.line(6, "impact of the day: none", 6).is_empty());
+        assert_eq!(s.bad_lines, 1);
+    }
+
+    #[test]
+    fn a_long_session_keeps_what_it_shows_only() {
+        let mut s = Session::new("board.log", "s.log", None);
+        s.line(1, SCENE, 0);
+        for k in 0..3000 {
+            s.line(2 + u64::from(k), &impact(k), u64::from(k));
+        }
+        s.input_ended(5000);
+        let snap = s.snapshot(5000);
+        assert_eq!(snap["impacts"].as_array().unwrap().len(), LAST);
+        assert_eq!(snap["trend"].as_array().unwrap().len(), TREND);
+        assert_eq!(snap["trend"][TREND - 1]["index"], 2999);
+        assert_eq!(snap["stats"]["metrics"][0]["n"], 3000);
+    }
+}

@@ -1,0 +1,569 @@
+//! `impact watch`: the board's log shown live. The terminal view prints every impact and the
+//! health; 10 000 impacts go through the web view in flat memory with a page that never reads
+//! (it loses events, the board's input is never held up, the session file has every line);
+//! and a real-time emulated train, watched in a real headless browser (Chromium from the
+//! distribution's packages), shows every impact with its numbers and pulse within a second of
+//! its line and the board's silence within two heartbeats.
+
+use std::io::{BufRead, BufReader, Read, Write};
+use std::net::TcpStream;
+use std::path::PathBuf;
+use std::process::{Child, ChildStdin, Command, Stdio};
+use std::time::{Duration, Instant};
+
+mod common;
+use common::board_log::{heartbeat, impact_line, summary, SCENE};
+
+fn tmp(name: &str) -> PathBuf {
+    let p = PathBuf::from(env!("CARGO_TARGET_TMPDIR"))
+        .join(format!("watch-{}-{name}", std::process::id()));
+    let _ = std::fs::remove_file(&p);
+    p
+}
+
+/// A running `impact watch` (killed when dropped), its standard input and its address.
+struct Watch {
+    child: Child,
+    stdin: Option<ChildStdin>,
+    addr: String,
+}
+
+impl Watch {
+    fn start(session: &PathBuf, extra: &[&str]) -> Self {
+        let mut child = Command::new(env!("CARGO_BIN_EXE_impact"))
+            .args(["watch", "-", "--listen", "127.0.0.1:0", "--session"])
+            .arg(session)
+            .args(extra)
+            .stdin(Stdio::piped())
+            .stdout(Stdio::null())
+            .stderr(Stdio::piped())
+            .spawn()
+            .unwrap();
+        let mut err = BufReader::new(child.stderr.take().unwrap());
+        let mut first = String::new();
+        err.read_line(&mut first).unwrap();
+        // The rest of stderr drained, so the tool never waits on it.
+        std::thread::spawn(move || std::io::copy(&mut err, &mut std::io::sink()));
+        let addr = first
+            .split("http://")
+            .nth(1)
+            .and_then(|r| r.split('/').next())
+            .unwrap_or_else(|| panic!("no address in {first:?}"))
+            .to_string();
+        Self {
+            stdin: child.stdin.take(),
+            child,
+            addr,
+        }
+    }
+
+    fn send(&mut self, line: &str) {
+        let stdin = self.stdin.as_mut().unwrap();
+        writeln!(stdin, "{line}").unwrap();
+    }
+
+    /// GET `path`: the body.
+    fn get(&self, path: &str) -> String {
+        let mut s = TcpStream::connect(&self.addr).unwrap();
+        write!(
+            s,
+            "GET {path} HTTP/1.1\r\nHost: {}\r\nConnection: close\r\n\r\n",
+            self.addr
+        )
+        .unwrap();
+        let mut text = String::new();
+        s.read_to_string(&mut text).unwrap();
+        text.split_once("\r\n\r\n")
+            .map(|(_, b)| b.to_string())
+            .unwrap_or_default()
+    }
+
+    fn state(&self) -> serde_json::Value {
+        serde_json::from_str(&self.get("/state.json")).unwrap()
+    }
+
+    /// Waits (at most `secs`) until `done` holds for the state.
+    fn wait(
+        &self,
+        secs: u64,
+        what: &str,
+        done: impl Fn(&serde_json::Value) -> bool,
+    ) -> serde_json::Value {
+        let t = Instant::now();
+        loop {
+            let s = self.state();
+            if done(&s) {
+                return s;
+            }
+            assert!(
+                t.elapsed() < Duration::from_secs(secs),
+                "{what}: not within {secs} s"
+            );
+            std::thread::sleep(Duration::from_millis(50));
+        }
+    }
+
+    /// The tool's resident memory, KiB.
+    fn rss_kib(&self) -> u64 {
+        let status = std::fs::read_to_string(format!("/proc/{}/status", self.child.id())).unwrap();
+        status
+            .lines()
+            .find_map(|l| l.strip_prefix("VmRSS:"))
+            .and_then(|v| v.trim().trim_end_matches("kB").trim().parse().ok())
+            .unwrap()
+    }
+}
+
+impl Drop for Watch {
+    fn drop(&mut self) {
+        let _ = self.child.kill();
+        let _ = self.child.wait();
+    }
+}
+
+/// A log of `impacts` impacts (a heartbeat every 12), the board restarting after `restart`
+/// of them when given, and its summary.
+fn board_log(impacts: u64, restart: Option<u64>) -> Vec<String> {
+    let mut lines = vec![SCENE.to_string()];
+    let (mut seq, mut index) = (0, 0);
+    for i in 0..impacts {
+        if Some(i) == restart {
+            lines.push(SCENE.to_string());
+            (seq, index) = (0, 0);
+        }
+        lines.push(impact_line(seq, index, None));
+        seq += 1;
+        index += 1;
+        if index % 12 == 0 {
+            lines.push(heartbeat(seq, 40_000 * index, index));
+            seq += 1;
+        }
+    }
+    lines.push(summary(seq, 40_000 * index, index));
+    lines
+}
+
+#[test]
+fn the_terminal_view_prints_every_impact_and_the_health() {
+    let session = tmp("terminal.log");
+    let log = board_log(30, Some(20));
+    let text = log.join("\n") + "\n";
+    let mut child = Command::new(env!("CARGO_BIN_EXE_impact"))
+        .args(["watch", "--terminal", "--session"])
+        .arg(&session)
+        .stdin(Stdio::piped())
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    child
+        .stdin
+        .take()
+        .unwrap()
+        .write_all(text.as_bytes())
+        .unwrap();
+    let out = child.wait_with_output().unwrap();
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let impacts: Vec<&str> = stdout.lines().filter(|l| l.contains(" impact ")).collect();
+    assert_eq!(impacts.len(), 30, "{stdout}");
+    assert!(impacts[0].starts_with("run 1 impact    0  t 0.01017 s  peak 9.878 g  Δv 1.507 m/s  duration 25.26 ms  COR 0.1285"), "{}", impacts[0]);
+    assert!(
+        impacts[29].starts_with("run 2 impact    9 "),
+        "{}",
+        impacts[29]
+    );
+    assert!(stdout.contains("── the board restarted: run 2 ──"));
+    assert!(
+        stdout.contains("board 0.96 s: 12 impacts, samples lost 0"),
+        "{stdout}"
+    );
+    assert!(stdout.ends_with("── the stream ended: ok ──\n"), "{stdout}");
+    // The session file is the input, every line.
+    assert_eq!(std::fs::read_to_string(&session).unwrap(), text);
+    // It is never overwritten.
+    let again = Command::new(env!("CARGO_BIN_EXE_impact"))
+        .args(["watch", "--terminal", "--session"])
+        .arg(&session)
+        .stdin(Stdio::null())
+        .output()
+        .unwrap();
+    assert!(!again.status.success());
+    assert!(String::from_utf8_lossy(&again.stderr).contains("never overwritten"));
+}
+
+/// 10 000 impacts as fast as a pipe takes them, a page connected that never reads its
+/// stream: the tool's memory after 10 000 is what it was after 2000 (the view keeps the
+/// last 50 impacts and 2000 trend points; statistics run), the session file has every line,
+/// and the exports read it back whole.
+#[cfg(target_os = "linux")]
+#[test]
+fn ten_thousand_impacts_keep_memory_flat_and_a_slow_page_never_holds_up_the_board() {
+    let session = tmp("10k.log");
+    let mut w = Watch::start(&session, &[]);
+    // A page that connects and never reads.
+    let mut stuck = TcpStream::connect(&w.addr).unwrap();
+    write!(stuck, "GET /events HTTP/1.1\r\nHost: localhost\r\n\r\n").unwrap();
+    let log = board_log(10_000, None);
+    // (The trend is full from 2000 impacts on.)
+    let (first, rest) = log.split_at(1 + 2000 + 2000 / 12);
+    for l in first {
+        w.send(l);
+    }
+    w.wait(30, "2000 impacts", |s| {
+        s["stats"]["metrics"][0]["n"] == 2000
+    });
+    let rss_2k = w.rss_kib();
+    let t = Instant::now();
+    for l in rest {
+        w.send(l);
+    }
+    let s = w.wait(60, "10 000 impacts", |s| s["ended"]["result"] == "ok");
+    let fed = t.elapsed();
+    let rss_10k = w.rss_kib();
+    eprintln!("impact watch: RSS {rss_2k} KiB after 2000 impacts, {rss_10k} KiB after 10 000 ({:.2} s for 8000)", fed.as_secs_f64());
+    assert!(
+        rss_10k < rss_2k + 2048,
+        "memory grew from {rss_2k} to {rss_10k} KiB"
+    );
+    assert_eq!(s["stats"]["metrics"][0]["n"], 10_000);
+    assert_eq!(s["impacts"].as_array().unwrap().len(), 50);
+    assert_eq!(s["trend"].as_array().unwrap().len(), 2000);
+    assert_eq!(s["impacts"][49]["index"], 9999);
+    let kept = std::fs::read_to_string(&session).unwrap();
+    assert_eq!(kept, log.join("\n") + "\n");
+    let csv = w.get("/session.csv");
+    assert_eq!(
+        csv.lines().count(),
+        10_001,
+        "{}",
+        &csv[..csv.len().min(500)]
+    );
+    drop(stuck);
+}
+
+/// The receipts the page sent (`/receipts`): each a map of its query's fields.
+fn receipts(w: &Watch) -> Vec<std::collections::HashMap<String, String>> {
+    w.get("/receipts")
+        .lines()
+        .map(|l| {
+            l.split('&')
+                .filter_map(|kv| kv.split_once('='))
+                .map(|(k, v)| (k.to_string(), percent_decode(v)))
+                .collect()
+        })
+        .collect()
+}
+
+fn percent_decode(s: &str) -> String {
+    let b = s.as_bytes();
+    let mut out = Vec::with_capacity(b.len());
+    let mut k = 0;
+    while k < b.len() {
+        match b[k] {
+            b'%' if k + 2 < b.len() => {
+                let hex = std::str::from_utf8(&b[k + 1..k + 3]).unwrap_or("");
+                match u8::from_str_radix(hex, 16) {
+                    Ok(v) => {
+                        out.push(v);
+                        k += 3;
+                        continue;
+                    }
+                    Err(_) => out.push(b'%'),
+                }
+            }
+            b'+' => out.push(b' '),
+            c => out.push(c),
+        }
+        k += 1;
+    }
+    String::from_utf8_lossy(&out).into_owned()
+}
+
+/// A number as the page shows it: four significant digits, no exponent.
+fn shown(x: f64) -> String {
+    let digits = 3 - x.abs().log10().floor() as i32;
+    let r = format!("{:.*}", digits.max(0) as usize, x);
+    // The rounding may carry into a fifth digit (9.9996 → 10.000): one decimal fewer then.
+    let r2: f64 = r.parse().unwrap();
+    let digits2 = 3 - r2.abs().log10().floor() as i32;
+    format!("{:.*}", digits2.max(0) as usize, r2)
+}
+
+/// A real-time emulated train piped into the view, watched by headless Chromium: every
+/// impact's row (its numbers) and its pulse (the board's window) are on the page within a
+/// second of its line reaching the tool, and when the board falls silent (the lines stop, no
+/// summary) the health panel says so within two heartbeats.
+#[test]
+fn an_emulated_train_shows_live_in_a_headless_browser() {
+    let Some(browser) = common::browser::chromium() else {
+        return;
+    };
+    if let Err(e) = impact_host::firmware_link::qemu::tools_available() {
+        assert!(std::env::var_os("IMPACT_REQUIRE_EMULATOR").is_none(), "{e}");
+        eprintln!("SKIPPED: {e}");
+        return;
+    }
+    let train = tmp("train.csv");
+    common::impact_ok(&[
+        "synth",
+        "--model",
+        "nonlinear",
+        "--mass",
+        "0.06",
+        "--v0",
+        "1.3357",
+        "--stiffness",
+        "1e5",
+        "--damping",
+        "0.5",
+        "--bounces",
+        "8",
+        "--duration",
+        "1.5",
+        "-o",
+        train.to_str().unwrap(),
+    ]);
+    // 2.4 ms bounces from 81 g down: the 60 g ones pass, the others fail.
+    let spec = "half-sine,60g,2.45ms";
+    let mut w = Watch::start(&tmp("live.log"), &["--spec", spec]);
+    let profile = tmp("profile");
+    let mut page = Command::new(browser)
+        .args([
+            "--headless",
+            "--no-sandbox",
+            "--disable-gpu",
+            "--remote-debugging-port=0",
+            "--window-size=1400,1000",
+            &format!("--user-data-dir={}", profile.display()),
+            &format!("http://{}/", w.addr),
+        ])
+        .stdout(Stdio::null())
+        .stderr(Stdio::null())
+        .spawn()
+        .unwrap();
+    struct Kill<'a>(&'a mut Child);
+    impl Drop for Kill<'_> {
+        fn drop(&mut self) {
+            let _ = self.0.kill();
+            let _ = self.0.wait();
+        }
+    }
+    let _page = Kill(&mut page);
+    // The page is up when it reports its first health state (waiting for a heartbeat).
+    let t = Instant::now();
+    while !receipts(&w)
+        .iter()
+        .any(|r| r.get("kind").is_some_and(|k| k == "health"))
+    {
+        assert!(
+            t.elapsed() < Duration::from_secs(30),
+            "the page never connected"
+        );
+        std::thread::sleep(Duration::from_millis(100));
+    }
+    // The emulated board's lines, forwarded as they come; its summary held back, so the
+    // board falls silent instead of ending.
+    let mut emulate = Command::new(env!("CARGO_BIN_EXE_impact"))
+        .args(["emulate"])
+        .arg(&train)
+        .args([
+            "--realtime",
+            "--mass",
+            "0.06",
+            "--v0",
+            "1.3357",
+            "--waveforms",
+            "8",
+            "--spec",
+            spec,
+        ])
+        .stdout(Stdio::piped())
+        .stderr(Stdio::null())
+        .spawn()
+        .unwrap();
+    let mut indices = Vec::new();
+    let mut last_heartbeat = None;
+    for line in BufReader::new(emulate.stdout.take().unwrap()).lines() {
+        let line = line.unwrap();
+        if line.contains(" summary ") {
+            break;
+        }
+        if line.contains(" heartbeat ") {
+            last_heartbeat = Some(Instant::now());
+        }
+        if let Some(i) = line.split(" impact seq=").nth(1) {
+            let index: u32 = i
+                .split(" index=")
+                .nth(1)
+                .unwrap()
+                .split(' ')
+                .next()
+                .unwrap()
+                .parse()
+                .unwrap();
+            indices.push(index);
+        }
+        w.send(&line);
+    }
+    let _ = emulate.wait();
+    let last_heartbeat = last_heartbeat.expect("the board sent heartbeats");
+    assert!(indices.len() >= 6, "{indices:?}");
+    // Silence shown within two heartbeats (2.5 s) and the page's clock (0.5 s).
+    let silent = loop {
+        let r = receipts(&w);
+        if r.iter()
+            .any(|r| r.get("state").is_some_and(|s| s == "SILENT"))
+        {
+            break last_heartbeat.elapsed();
+        }
+        assert!(
+            last_heartbeat.elapsed() < Duration::from_secs(10),
+            "no SILENT state: {r:?}"
+        );
+        std::thread::sleep(Duration::from_millis(50));
+    };
+    let state = w.state();
+    let r = receipts(&w);
+    eprintln!(
+        "silent shown {:.2} s after the last heartbeat",
+        silent.as_secs_f64()
+    );
+    assert!(silent <= Duration::from_millis(3500), "{silent:?}");
+    for index in &indices {
+        let event = state["impacts"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .find(|e| e["index"] == *index)
+            .unwrap();
+        let received = event["received_unix_ms"].as_u64().unwrap();
+        let receipt = r
+            .iter()
+            .find(|r| {
+                r.get("kind").is_some_and(|k| k == "impact")
+                    && r.get("index").is_some_and(|i| i == &index.to_string())
+            })
+            .unwrap_or_else(|| panic!("impact {index} never shown: {r:?}"));
+        let shown_ms: u64 = receipt["shown_unix_ms"].parse().unwrap();
+        let delay = shown_ms.saturating_sub(received);
+        eprintln!(
+            "impact {index}: shown {delay} ms after its line: {}",
+            receipt["row"]
+        );
+        assert!(
+            delay <= 1000,
+            "impact {index} shown {delay} ms after its line"
+        );
+        // Its numbers, and its pulse drawn from the board's window.
+        // The row's cells: run, index, board time, peak g, Δv, duration ms, COR, verdict, …
+        let row = &receipt["row"];
+        let cells: Vec<&str> = row.split(" | ").collect();
+        assert_eq!(cells[..2], ["1".to_string(), index.to_string()], "{row}");
+        for (cell, field, scale) in [
+            (3, "peak_g", 1.0),
+            (4, "delta_v_m_s", 1.0),
+            (5, "duration_s", 1e3),
+        ] {
+            let want = shown(event[field].as_f64().unwrap() * scale);
+            assert_eq!(cells[cell], want, "impact {index}: {field} in {row:?}");
+        }
+        let verdict = if event["verdict"]["pass"] == true {
+            "PASS"
+        } else {
+            "FAIL"
+        };
+        assert_eq!(cells[7], verdict, "{row}");
+        assert_eq!(event["pulse"]["source"], "waveform");
+        let points: usize = receipt["pulse_points"].parse().unwrap();
+        assert!(points > 100, "impact {index}: {points} points drawn");
+    }
+}
+
+/// A log file another program writes is followed as it grows: impacts appended after the
+/// tool started are shown.
+#[test]
+fn a_growing_log_file_is_followed() {
+    let file = tmp("growing.log");
+    let log = board_log(6, None);
+    let (head, tail) = log.split_at(4);
+    std::fs::write(&file, head.join("\n") + "\n").unwrap();
+    let mut child = Command::new(env!("CARGO_BIN_EXE_impact"))
+        .args(["watch", "--terminal", "--session"])
+        .arg(tmp("growing-session.log"))
+        .arg(&file)
+        .stdout(Stdio::piped())
+        .stderr(Stdio::null())
+        .spawn()
+        .unwrap();
+    let mut out = BufReader::new(child.stdout.take().unwrap());
+    let mut seen = Vec::new();
+    let mut appended = false;
+    let t = Instant::now();
+    while seen.len() < 6 {
+        let mut line = String::new();
+        if out.read_line(&mut line).unwrap() == 0 {
+            break;
+        }
+        if line.contains(" impact ") {
+            seen.push(line);
+        }
+        if seen.len() == 3 && !appended {
+            let mut f = std::fs::OpenOptions::new()
+                .append(true)
+                .open(&file)
+                .unwrap();
+            f.write_all((tail.join("\n") + "\n").as_bytes()).unwrap();
+            appended = true;
+        }
+        assert!(t.elapsed() < Duration::from_secs(20), "{seen:?}");
+    }
+    let _ = child.kill();
+    let _ = child.wait();
+    assert_eq!(seen.len(), 6, "{seen:?}");
+    assert!(seen[5].starts_with("run 1 impact    5 "), "{}", seen[5]);
+}
+
+/// The firmware's raw defmt stream, decoded against its ELF as it arrives.
+#[test]
+fn a_raw_defmt_stream_is_decoded_live() {
+    if let Err(e) = impact_host::firmware_link::qemu::tools_available() {
+        assert!(std::env::var_os("IMPACT_REQUIRE_EMULATOR").is_none(), "{e}");
+        eprintln!("SKIPPED: {e}");
+        return;
+    }
+    let elf = impact_host::firmware_link::qemu::build_firmware().unwrap();
+    let seed = tmp("seed.csv");
+    let raw = tmp("seed.defmt");
+    std::fs::write(&seed, common::synth_t2()).unwrap();
+    common::impact_ok(&[
+        "emulate",
+        seed.to_str().unwrap(),
+        "--mass",
+        "0.06",
+        "--v0",
+        "1.3357",
+        "--elf",
+        elf.to_str().unwrap(),
+        "--defmt",
+        raw.to_str().unwrap(),
+    ]);
+    let (out, _) = common::impact_ok(&[
+        "watch",
+        raw.to_str().unwrap(),
+        "--elf",
+        elf.to_str().unwrap(),
+        "--terminal",
+        "--once",
+        "--session",
+        tmp("raw-session.log").to_str().unwrap(),
+    ]);
+    let impacts: Vec<&str> = out.lines().filter(|l| l.contains(" impact ")).collect();
+    assert_eq!(impacts.len(), 1, "{out}");
+    assert!(impacts[0].contains("peak 55.6"), "{out}");
+    assert!(out.ends_with("── the stream ended: ok ──\n"), "{out}");
+}
