@@ -7,6 +7,7 @@ use std::fmt::Write as _;
 use impact_core::consts::STANDARD_GRAVITY;
 use impact_core::spec::Spec;
 
+use crate::plot::ticks::tick;
 use crate::report::fmt::human;
 
 /// The largest number of impacts drawn (each figure is a few kB; the table has them all).
@@ -54,13 +55,14 @@ fn label(v: f64, step: f64) -> String {
     format!("{v:.decimals$}")
 }
 
-/// The pulse as an inline SVG: acceleration in g against time in ms from the window's start,
-/// the measured signal as a min/max band per column, the band and the nominal pulse dashed.
+/// The pulse as an inline SVG: acceleration in g (left; m/s² on the right) against time in ms
+/// from the window's start, the measured signal as a min/max band per column, the band and
+/// the nominal pulse dashed.
 pub fn svg(p: &Pulse) -> String {
-    const W: f64 = 520.0;
+    const W: f64 = 580.0;
     const H: f64 = 300.0;
     const L: f64 = 58.0;
-    const R: f64 = 12.0;
+    const R: f64 = 62.0;
     const T: f64 = 30.0;
     const B: f64 = 42.0;
     let Some(&(t_first, _, _)) = p.columns.first() else {
@@ -119,6 +121,12 @@ pub fn svg(p: &Pulse) -> String {
         let py = y(v * g);
         let _ = write!(s, "<line x1=\"{L}\" y1=\"{py:.1}\" x2=\"{}\" y2=\"{py:.1}\" stroke=\"#eee\"/><text x=\"{}\" y=\"{:.1}\" text-anchor=\"end\">{}</text>", W - R, L - 4.0, py + 4.0, label(*v, ystep));
     }
+    // The same range in m/s² on the right.
+    let yt = ticks(y_lo, y_hi, 6);
+    for v in &yt {
+        let py = y(*v);
+        let _ = write!(s, "<line x1=\"{}\" y1=\"{py:.1}\" x2=\"{}\" y2=\"{py:.1}\" stroke=\"#999\"/><text x=\"{}\" y=\"{:.1}\">{}</text>", W - R, W - R + 4.0, W - R + 6.0, py + 4.0, tick(*v));
+    }
     let _ = write!(
         s,
         "<rect x=\"{L}\" y=\"{T}\" width=\"{}\" height=\"{}\" fill=\"none\" stroke=\"#999\"/>",
@@ -133,6 +141,7 @@ pub fn svg(p: &Pulse) -> String {
         t_first * 1e3
     );
     let _ = write!(s, "<text transform=\"translate(14 {}) rotate(-90)\" text-anchor=\"middle\">acceleration (g)</text>", (T + H - B) / 2.0);
+    let _ = write!(s, "<text transform=\"translate({} {}) rotate(90)\" text-anchor=\"middle\">acceleration (m/s²)</text>", W - 12.0, (T + H - B) / 2.0);
     // The band (shaded between its limits) and the nominal pulse (dashed).
     if !band.is_empty() {
         let mut d = String::new();
@@ -176,10 +185,28 @@ pub fn svg(p: &Pulse) -> String {
         s,
         "<path d=\"{d}\" fill=\"none\" stroke=\"#c0392b\" stroke-width=\"1.2\"/>"
     );
-    // The legend.
-    let _ = write!(s, "<g transform=\"translate({} {})\"><line x1=\"0\" y1=\"0\" x2=\"18\" y2=\"0\" stroke=\"#c0392b\" stroke-width=\"1.5\"/><text x=\"22\" y=\"4\">measured</text>", W - R - 150.0, T + 12.0);
+    // The legend, on white, in the upper right corner.
+    let mut entries = vec![("stroke=\"#c0392b\" stroke-width=\"1.5\"", "measured")];
     if !band.is_empty() {
-        s.push_str("<line x1=\"0\" y1=\"14\" x2=\"18\" y2=\"14\" stroke=\"#4a90d9\" stroke-dasharray=\"5 3\"/><text x=\"22\" y=\"18\">nominal, tolerance band</text>");
+        entries.push((
+            "stroke=\"#4a90d9\" stroke-dasharray=\"5 3\"",
+            "nominal, tolerance band",
+        ));
+    }
+    let _ = write!(
+        s,
+        "<g transform=\"translate({} {})\"><rect x=\"-4\" y=\"-8\" width=\"162\" height=\"{}\" fill=\"white\" fill-opacity=\"0.85\" stroke=\"#ccc\"/>",
+        W - R - 164.0,
+        T + 11.0,
+        14 * entries.len() + 2
+    );
+    for (k, (stroke, text)) in entries.iter().enumerate() {
+        let y = 14 * k;
+        let _ = write!(
+            s,
+            "<line x1=\"0\" y1=\"{y}\" x2=\"18\" y2=\"{y}\" {stroke}/><text x=\"22\" y=\"{}\">{text}</text>",
+            y + 4
+        );
     }
     s.push_str("</g></svg>");
     s
@@ -260,5 +287,26 @@ mod tests {
         assert_eq!(label(0.25, 0.05), "0.25");
         assert_eq!(label(12000.0, 2000.0), "12000");
         assert_eq!(esc("a<b&\"c\""), "a&lt;b&amp;&quot;c&quot;");
+    }
+
+    #[test]
+    fn the_pulse_is_in_g_with_m_s2_on_the_right() {
+        // A 10 g step: g ticks 0–10 on the left, m/s² 0–100 on the right.
+        let g = STANDARD_GRAVITY;
+        let s = svg(&Pulse {
+            title: "step".into(),
+            columns: (0..100)
+                .map(|k| (f64::from(k) * 1e-5, 0.0, 10.0 * g))
+                .collect(),
+            spec: None,
+        });
+        for want in [
+            ">acceleration (g)</text>",
+            ">acceleration (m/s²)</text>",
+            ">10</text>",
+            ">100</text>",
+        ] {
+            assert!(s.contains(want), "{want} missing");
+        }
     }
 }

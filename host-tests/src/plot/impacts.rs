@@ -208,12 +208,13 @@ fn draw_impacts(
         };
         let mut panels = vec![
             Panel {
-                title: "deceleration, m/s²",
+                title: "deceleration, m/s² (left) and g (right)",
                 x_label: "time from touch, ms",
                 measured: meas,
                 measured_label: "measured",
                 models: c_a,
                 log: false,
+                g_axis: true,
                 legend: true,
             },
             Panel {
@@ -223,6 +224,7 @@ fn draw_impacts(
                 measured_label: "measured",
                 models: c_v,
                 log: false,
+                g_axis: false,
                 legend: false,
             },
             Panel {
@@ -232,6 +234,7 @@ fn draw_impacts(
                 measured_label: "measured",
                 models: c_x,
                 log: false,
+                g_axis: false,
                 legend: false,
             },
             Panel {
@@ -241,6 +244,7 @@ fn draw_impacts(
                 measured_label: "measured",
                 models: c_f,
                 log: false,
+                g_axis: false,
                 legend: false,
             },
         ];
@@ -257,12 +261,13 @@ fn draw_impacts(
                 None => (Vec::new(), Vec::new()),
             };
             panels.push(Panel {
-                title: "SRS (maximax), m/s²",
+                title: "SRS (maximax), m/s² (left) and g (right)",
                 x_label: "natural frequency, Hz",
                 measured: srs,
                 measured_label: "SRS",
                 models: Vec::new(),
                 log: true,
+                g_axis: true,
                 legend: false,
             });
             panels.push(Panel {
@@ -272,6 +277,7 @@ fn draw_impacts(
                 measured_label: "PVSS",
                 models: Vec::new(),
                 log: true,
+                g_axis: false,
                 legend: false,
             });
         }

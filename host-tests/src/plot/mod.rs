@@ -7,6 +7,7 @@ pub(crate) mod ticks;
 pub use impacts::{impacts, window, Signal, SHOWN};
 use ticks::tick;
 
+use impact_core::consts::STANDARD_GRAVITY;
 use plotters::prelude::*;
 
 /// Checks that `path` can take an SVG before any work is done: its directory exists and it is
@@ -36,13 +37,22 @@ pub(crate) fn write_svg(
     size: (u32, u32),
     draw: impl FnOnce(&DrawingArea<SVGBackend, plotters::coord::Shift>) -> Result<(), String>,
 ) -> Result<(), String> {
+    let text = svg_text(size, draw)?;
+    crate::output::write(path, text.as_bytes())
+}
+
+/// A `size` SVG drawn with `draw`, as text.
+pub(crate) fn svg_text(
+    size: (u32, u32),
+    draw: impl FnOnce(&DrawingArea<SVGBackend, plotters::coord::Shift>) -> Result<(), String>,
+) -> Result<String, String> {
     let mut text = String::new();
     {
         let root = SVGBackend::with_string(&mut text, size).into_drawing_area();
         draw(&root)?;
         root.present().map_err(|e| e.to_string())?;
     }
-    crate::output::write(path, text.as_bytes())
+    Ok(text)
 }
 
 /// A named, coloured series of (time, value) points.
@@ -52,8 +62,9 @@ pub(crate) type Curve = (&'static str, RGBColor, Vec<(f64, f64)>);
 pub(crate) const MEASURED: RGBColor = RGBColor(120, 170, 250);
 
 /// One panel: its title, axis labels, the measured series and each model's, whether both
-/// axes are logarithmic, and whether it carries the legend (the first of a row: the colours
-/// are the same in every panel).
+/// axes are logarithmic, whether its values (m/s²) get a second axis in g on the right, and
+/// whether it carries the legend (the first of a row: the colours are the same in every
+/// panel).
 pub(crate) struct Panel<'a> {
     pub(crate) title: &'a str,
     pub(crate) x_label: &'a str,
@@ -61,6 +72,8 @@ pub(crate) struct Panel<'a> {
     pub(crate) measured_label: &'a str,
     pub(crate) models: Vec<Curve>,
     pub(crate) log: bool,
+    /// The values are m/s²: the same range in g on a second axis on the right.
+    pub(crate) g_axis: bool,
     pub(crate) legend: bool,
 }
 
@@ -145,19 +158,21 @@ pub(crate) fn draw_panel(
         .caption(caption, ("sans-serif", 15))
         .margin(8)
         .x_label_area_size(30)
-        .y_label_area_size(60);
-    macro_rules! finish {
-        ($chart:expr) => {{
-            let mut chart = $chart;
-            chart
+        .y_label_area_size(60)
+        .right_y_label_area_size(if p.g_axis { 60 } else { 0 });
+    // The measured curve and each model's on `chart`, the mesh, the legend.
+    macro_rules! curves {
+        ($chart:ident) => {{
+            $chart
                 .configure_mesh()
                 .x_desc(p.x_label)
+                .y_desc(if p.g_axis { "m/s²" } else { "" })
                 .x_label_formatter(&|v| tick(*v))
                 .y_label_formatter(&|v| tick(*v))
                 .draw()
                 .map_err(|e| e.to_string())?;
             if !p.measured.is_empty() {
-                chart
+                $chart
                     .draw_series(LineSeries::new(
                         decimate(&p.measured, COLUMNS)
                             .into_iter()
@@ -172,7 +187,7 @@ pub(crate) fn draw_panel(
             }
             for (name, color, s) in &p.models {
                 let c = *color;
-                chart
+                $chart
                     .draw_series(LineSeries::new(
                         decimate(s, COLUMNS).into_iter().filter(|q| finite(q)),
                         c.stroke_width(2),
@@ -184,7 +199,7 @@ pub(crate) fn draw_panel(
                     });
             }
             if p.legend {
-                chart
+                $chart
                     .configure_series_labels()
                     .position(SeriesLabelPosition::UpperRight)
                     .background_style(WHITE.mix(0.85))
@@ -194,18 +209,122 @@ pub(crate) fn draw_panel(
             }
         }};
     }
+    // The chart on ranges `x` and `y` (in m/s² with the g axis: `y_g` is the same range in g).
+    macro_rules! chart {
+        ($x:expr, $y:expr, $y_g:expr) => {{
+            let mut chart = builder
+                .build_cartesian_2d($x, $y)
+                .map_err(|e| e.to_string())?;
+            if p.g_axis {
+                let mut chart = chart.set_secondary_coord($x, $y_g);
+                chart
+                    .configure_secondary_axes()
+                    .y_desc("g")
+                    .y_label_formatter(&|v| tick(*v))
+                    .draw()
+                    .map_err(|e| e.to_string())?;
+                curves!(chart);
+            } else {
+                curves!(chart);
+            }
+        }};
+    }
+    let g = STANDARD_GRAVITY;
     if p.log {
-        finish!(builder
-            .build_cartesian_2d(
-                (x0..x1.max(x0 * 1.01)).log_scale(),
-                (y0 * 0.8..(y1 * 1.25).max(y0 * 1.01)).log_scale()
-            )
-            .map_err(|e| e.to_string())?);
+        let (y0, y1) = (y0 * 0.8, (y1 * 1.25).max(y0 * 1.01));
+        chart!(
+            (x0..x1.max(x0 * 1.01)).log_scale(),
+            (y0..y1).log_scale(),
+            (y0 / g..y1 / g).log_scale()
+        );
     } else {
         let pad = (y1 - y0).abs().max(1e-12) * 0.08;
-        finish!(builder
-            .build_cartesian_2d(x0..x1.max(x0 + 1e-9), (y0 - pad)..(y1 + pad))
-            .map_err(|e| e.to_string())?);
+        let (y0, y1) = (y0 - pad, y1 + pad);
+        chart!(x0..x1.max(x0 + 1e-9), y0..y1, y0 / g..y1 / g);
     }
     Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The labels of an SVG's `<text>` elements placed in `xs` × `ys`, top to bottom.
+    pub(super) fn labels_in(
+        svg: &str,
+        xs: std::ops::Range<f64>,
+        ys: std::ops::Range<f64>,
+    ) -> Vec<String> {
+        let mut out: Vec<(f64, String)> = Vec::new();
+        for t in svg.split("<text").skip(1) {
+            let attr = |name: &str| -> Option<f64> {
+                let key = format!(" {name}=\"");
+                let rest = &t[t.find(&key)? + key.len()..];
+                rest[..rest.find('"')?].parse().ok()
+            };
+            let (Some(x), Some(y)) = (attr("x"), attr("y")) else {
+                continue;
+            };
+            let text = &t[t.find('>').unwrap() + 1..t.find("</text>").unwrap()];
+            if xs.contains(&x) && ys.contains(&y) {
+                out.push((y, text.trim().to_string()));
+            }
+        }
+        out.sort_by(|a, b| a.0.total_cmp(&b.0));
+        out.into_iter().map(|(_, t)| t).collect()
+    }
+
+    /// A 400 × 300 panel of `measured` drawn alone, as SVG text.
+    pub(super) fn panel_svg(measured: Vec<(f64, f64)>, log: bool, g_axis: bool) -> String {
+        svg_text((400, 300), |root| {
+            root.fill(&WHITE).map_err(|e| e.to_string())?;
+            draw_panel(
+                root,
+                None,
+                &Panel {
+                    title: "test",
+                    x_label: "x",
+                    measured,
+                    measured_label: "measured",
+                    models: Vec::new(),
+                    log,
+                    g_axis,
+                    legend: false,
+                },
+            )
+        })
+        .unwrap()
+    }
+
+    #[test]
+    fn the_g_axis_is_the_same_range_divided_by_standard_gravity() {
+        // 0 to 10 g.
+        let svg = panel_svg(
+            (0..=100)
+                .map(|k| (f64::from(k), f64::from(k) / 10.0 * STANDARD_GRAVITY))
+                .collect(),
+            false,
+            true,
+        );
+        // Right of the plot area (the 60 px label area's ticks): whole g.
+        let right = labels_in(&svg, 335.0..400.0, 0.0..300.0);
+        let g: Vec<&str> = right
+            .iter()
+            .map(String::as_str)
+            .filter(|t| *t != "g")
+            .collect();
+        assert_eq!(
+            g,
+            ["10", "9", "8", "7", "6", "5", "4", "3", "2", "1", "0"],
+            "{right:?}"
+        );
+        // Each axis named by its unit.
+        assert!(right.iter().any(|t| t == "g"), "{right:?}");
+        assert!(labels_in(&svg, 0.0..60.0, 0.0..300.0)
+            .iter()
+            .any(|t| t == "m/s²"));
+        // Without it, no labels on the right.
+        let svg = panel_svg(vec![(0.0, 0.0), (1.0, 98.0)], false, false);
+        assert!(labels_in(&svg, 345.0..400.0, 0.0..250.0).is_empty());
+    }
 }

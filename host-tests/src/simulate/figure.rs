@@ -63,6 +63,7 @@ pub fn wall_contact(
                 measured_label: "",
                 models: c,
                 log: false,
+                g_axis: false,
                 legend: j == 0,
             };
             draw_panel(&areas[j], None, &p)?;
