@@ -133,8 +133,17 @@ fn report(args: &LogArgs, reader: LogReader, name: &str) -> Result<(), String> {
             }
             let mass: Option<f32> = opt(scene, "mass_kg")?;
             let waves = &log.waveforms;
+            // The board sends the impact's window only: not the samples around it that its
+            // CFC filtered.
+            let cfc = scene.get("cfc").filter(|c| c.as_str() != "none");
             let signal = crate::plot::Signal {
-                title: format!("{name}: the board's captured windows, m/s² above the baseline"),
+                title: format!(
+                    "{name}: the board's captured windows, m/s² above the baseline{}",
+                    cfc.map_or(String::new(), |c| format!(
+                        " (raw: the windows hold too little for its CFC {c} trace)"
+                    ))
+                ),
+                cfc: None,
                 rate_hz: rate,
                 mass_kg: mass.map(f64::from),
                 accel_m_s2: Box::new(move |i| {

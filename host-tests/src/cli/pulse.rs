@@ -22,11 +22,14 @@ pub fn esc(s: &str) -> String {
 }
 
 /// A pulse drawn: `(t_s, a_m_s2)` min/max pairs per pixel column over the window from
-/// `from_s`, the title, and the specification's nominal pulse and band placed at `start_s`.
+/// `from_s`, the title, the CFC-filtered trace's, and the specification's nominal pulse and
+/// band placed at `start_s`.
 pub struct Pulse<'a> {
     pub title: String,
     /// Per column: time (s) and the least and greatest acceleration there (m/s²).
     pub columns: Vec<(f64, f64, f64)>,
+    /// The CFC-filtered signal's columns, likewise, and its legend (`CFC 1000`).
+    pub filtered: Option<(String, Vec<(f64, f64, f64)>)>,
     pub spec: Option<(&'a Spec, f64)>,
 }
 
@@ -91,14 +94,41 @@ pub fn svg(p: &Pulse) -> String {
     let (mut y_lo, mut y_hi) = p
         .columns
         .iter()
+        .chain(p.filtered.iter().flat_map(|f| f.1.iter()))
         .fold((0.0f64, 0.0f64), |(lo, hi), c| (lo.min(c.1), hi.max(c.2)));
     for b in &band {
         y_lo = y_lo.min(b.1);
         y_hi = y_hi.max(b.2);
     }
     let pad = 0.05 * (y_hi - y_lo).max(1e-9);
-    let (y_lo, y_hi) = (y_lo - pad, y_hi + pad);
+    let (y_lo, mut y_hi) = (y_lo - pad, y_hi + pad);
     let x = |t: f64| L + (t - t_first) / (t_last - t_first).max(1e-12) * (W - L - R);
+    // The legend: in the upper right corner, or the left, whichever the curves leave free;
+    // else the right, with the range raised until they pass below it.
+    let entries = 1 + usize::from(p.filtered.is_some()) + usize::from(!band.is_empty());
+    let legend_px = 14.0 * entries as f64 + 8.0;
+    let highest = |from_px: f64, to_px: f64| {
+        let within = |t: f64| (from_px..=to_px).contains(&x(t));
+        p.columns
+            .iter()
+            .chain(p.filtered.iter().flat_map(|f| f.1.iter()))
+            .filter(|c| within(c.0))
+            .map(|c| c.2)
+            .chain(band.iter().filter(|b| within(b.0)).map(|b| b.2))
+            .fold(f64::NEG_INFINITY, f64::max)
+    };
+    let free = |top: f64| (y_hi - top) / (y_hi - y_lo) * (H - T - B) > legend_px;
+    let (right, left) = (W - R - 168.0, L + 4.0);
+    let right_top = highest(right, W - R);
+    let legend_x = if free(right_top) {
+        right
+    } else if free(highest(left, left + 168.0)) {
+        left
+    } else {
+        let f = legend_px / (H - T - B);
+        y_hi = (right_top - f * y_lo) / (1.0 - f);
+        right
+    };
     let y = |a: f64| T + (y_hi - a) / (y_hi - y_lo) * (H - T - B);
     let mut s = String::new();
     let _ = write!(
@@ -168,25 +198,42 @@ pub fn svg(p: &Pulse) -> String {
             pts.join(" ")
         );
     }
-    // The measured signal: each column's extremes joined.
-    let mut d = String::new();
-    for (k, c) in p.columns.iter().enumerate() {
-        let _ = write!(
-            d,
-            "{}{:.1},{:.1} L{:.1},{:.1}",
-            if k == 0 { "M" } else { " L" },
-            x(c.0),
-            y(c.1),
-            x(c.0),
-            y(c.2)
-        );
-    }
+    // The measured signal, and the filtered one: each column's extremes joined.
+    let path = |columns: &[(f64, f64, f64)]| {
+        let mut d = String::new();
+        for (k, c) in columns.iter().enumerate() {
+            let _ = write!(
+                d,
+                "{}{:.1},{:.1} L{:.1},{:.1}",
+                if k == 0 { "M" } else { " L" },
+                x(c.0),
+                y(c.1),
+                x(c.0),
+                y(c.2)
+            );
+        }
+        d
+    };
     let _ = write!(
         s,
-        "<path d=\"{d}\" fill=\"none\" stroke=\"#c0392b\" stroke-width=\"1.2\"/>"
+        "<path d=\"{}\" fill=\"none\" stroke=\"{RAW}\" stroke-width=\"1.2\"/>",
+        path(&p.columns)
     );
-    // The legend, on white, in the upper right corner.
-    let mut entries = vec![("stroke=\"#c0392b\" stroke-width=\"1.5\"", "measured")];
+    if let Some((_, f)) = &p.filtered {
+        let _ = write!(
+            s,
+            "<path d=\"{}\" fill=\"none\" stroke=\"{FILTERED}\" stroke-width=\"1.8\"/>",
+            path(f)
+        );
+    }
+    // The legend, on white.
+    let raw_stroke = format!("stroke=\"{RAW}\" stroke-width=\"1.5\"");
+    let filtered_stroke = format!("stroke=\"{FILTERED}\" stroke-width=\"1.8\"");
+    let mut entries = vec![(raw_stroke.as_str(), "measured")];
+    if let Some((label, _)) = &p.filtered {
+        entries[0].1 = "raw";
+        entries.push((filtered_stroke.as_str(), label.as_str()));
+    }
     if !band.is_empty() {
         entries.push((
             "stroke=\"#4a90d9\" stroke-dasharray=\"5 3\"",
@@ -196,7 +243,7 @@ pub fn svg(p: &Pulse) -> String {
     let _ = write!(
         s,
         "<g transform=\"translate({} {})\"><rect x=\"-4\" y=\"-8\" width=\"162\" height=\"{}\" fill=\"white\" fill-opacity=\"0.85\" stroke=\"#ccc\"/>",
-        W - R - 164.0,
+        legend_x + 4.0,
         T + 11.0,
         14 * entries.len() + 2
     );
@@ -211,6 +258,12 @@ pub fn svg(p: &Pulse) -> String {
     s.push_str("</g></svg>");
     s
 }
+
+/// The raw signal's colour.
+const RAW: &str = "#c0392b";
+
+/// The CFC-filtered signal's colour: dark, over the raw one.
+const FILTERED: &str = "#192d78";
 
 /// Columns a pulse is drawn in (each its samples' least and greatest value).
 const COLUMNS: u64 = 400;
@@ -250,24 +303,48 @@ pub fn pulse_svg(
     let i1 = ((to_s * rate).ceil().max(0.0) as u64).max(i0 + 1);
     let n = i1 - i0;
     let cols = COLUMNS.min(n);
-    let columns = (0..cols)
-        .filter_map(|c| {
-            let (a, b) = (i0 + c * n / cols, i0 + (c + 1) * n / cols);
-            let (lo, hi) = (a..b.max(a + 1))
-                .filter_map(|i| (signal.accel_m_s2)(i))
-                .map(|v| sign * (v - base))
-                .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), v| {
-                    (lo.min(v), hi.max(v))
+    // Each column's least and greatest value of `a` (m/s² above the baseline, by sample), in
+    // the direction of the peak.
+    let columns = |a: &dyn Fn(u64) -> Option<f64>| -> Vec<(f64, f64, f64)> {
+        (0..cols)
+            .filter_map(|c| {
+                let (from, to) = (i0 + c * n / cols, i0 + (c + 1) * n / cols);
+                let (lo, hi) = (from..to.max(from + 1))
+                    .filter_map(a)
+                    .map(|v| sign * v)
+                    .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), v| {
+                        (lo.min(v), hi.max(v))
+                    });
+                (lo <= hi).then_some((from as f64 / rate, lo, hi))
+            })
+            .collect()
+    };
+    let raw = columns(&|i| Some((signal.accel_m_s2)(i)? - base));
+    let g = |a: f32| human(f64::from(a) / STANDARD_GRAVITY, "g");
+    let mut peak = format!("peak {}", g(r.peak_acceleration_m_s2));
+    let mut filtered = None;
+    if let Some((class, _)) = signal.cfc {
+        let class = class.class();
+        match (
+            crate::plot::filtered(signal, r),
+            r.filtered_peak_acceleration_m_s2,
+        ) {
+            (Some((first, values)), Some(f)) => {
+                let trace = columns(&|i| {
+                    values
+                        .get(usize::try_from(i.checked_sub(first)?).ok()?)
+                        .copied()
                 });
-            (lo <= hi).then_some((a as f64 / rate, lo, hi))
-        })
-        .collect();
+                peak = format!("{peak} raw, {} CFC {class}", g(f));
+                filtered = Some((format!("CFC {class}"), trace));
+            }
+            _ => peak = format!("{peak} raw (CFC {class}: not drawn)"),
+        }
+    }
     svg(&Pulse {
-        title: format!(
-            "{title}: peak {}",
-            human(f64::from(r.peak_acceleration_m_s2) / STANDARD_GRAVITY, "g")
-        ),
-        columns,
+        title: format!("{title}: {peak}"),
+        columns: raw,
+        filtered,
         spec: placed,
     })
 }

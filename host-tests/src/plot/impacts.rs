@@ -2,22 +2,23 @@
 //! deceleration, velocity, deformation and force–deformation loop with the fitted models,
 //! and with `--srs` the SRS and PVSS.
 
+use impact_core::signal::cfc::Cfc;
 use plotters::prelude::*;
 
+use super::signal::{window, Signal};
 use super::{draw_panel, write_svg, Curve, Panel};
 
-/// What the impact figure draws from: the signal the pipeline analysed (the counts times
-/// the gain, so that `impact analyze` and `impact log` on the board's waveforms draw the
-/// same), at the scene's rate.
-pub struct Signal<'a> {
-    /// Sample rate, Hz (the scene's, an `f32`).
-    pub rate_hz: f64,
-    /// The body's mass, kg, if known.
-    pub mass_kg: Option<f64>,
-    /// Acceleration of stream sample `i`, m/s² (`None` where it is not known).
-    pub accel_m_s2: Box<dyn Fn(u64) -> Option<f64> + 'a>,
-    /// The figure's title: what was drawn (file, channel, filter).
-    pub title: String,
+/// The CFC-filtered trace's colour: dark, over the light raw one.
+const CFC_TRACE: RGBColor = RGBColor(25, 45, 120);
+
+/// A CFC trace's legend.
+fn cfc_label(class: Cfc) -> &'static str {
+    match class {
+        Cfc::Cfc60 => "CFC 60",
+        Cfc::Cfc180 => "CFC 180",
+        Cfc::Cfc600 => "CFC 600",
+        Cfc::Cfc1000 => "CFC 1000",
+    }
 }
 
 /// The height of the figure's title band, px.
@@ -25,14 +26,6 @@ const TITLE_HEIGHT: u32 = 36;
 
 /// Impacts the figure shows at most (a note says so when there are more).
 pub const SHOWN: usize = 6;
-
-/// The samples the figure draws of impact `r` at `rate_hz`: from two before first touch to
-/// four past separation, `(first, count)`.
-pub fn window(r: &impact_core::ImpactReport, rate_hz: f64) -> (u64, u64) {
-    let start = ((r.start_s * rate_hz).floor().max(0.0) as u64).saturating_sub(2);
-    let len = ((f64::from(r.duration_s) * rate_hz).ceil().max(0.0) as u64 + 4).max(4);
-    (start, len)
-}
 
 /// Per impact (up to [`SHOWN`]), as in the seed papers' figures: deceleration, velocity and
 /// deformation against time from touch, the force–deformation loop, with the fitted models
@@ -173,7 +166,32 @@ fn draw_impacts(
                 }
             }
         }
-        let [c_a, c_v, c_x, c_f] = curves;
+        let [mut c_a, c_v, c_x, c_f] = curves;
+        // With a CFC, its trace over the raw one (the analysis's filter on the samples it
+        // filtered), or the title says it is not drawn.
+        let mut decel_title = "deceleration, m/s² (left) and g (right)".to_string();
+        if let Some((class, _)) = signal.cfc {
+            match super::filtered(signal, r) {
+                Some((first, values)) => {
+                    let trace = (start..start + len)
+                        .filter_map(|i| {
+                            let v = values
+                                .get(usize::try_from((i as u64).checked_sub(first)?).ok()?)?;
+                            Some((t_ms(i), *v))
+                        })
+                        .collect();
+                    c_a.insert(0, (cfc_label(class), CFC_TRACE, trace));
+                }
+                None => {
+                    decel_title = format!("deceleration, m/s², g: CFC {} not drawn", class.class());
+                }
+            }
+        }
+        let raw_label = if c_a.first().is_some_and(|c| c.1 == CFC_TRACE) {
+            "raw"
+        } else {
+            "measured"
+        };
         // A Δv the report refuses (a channel that does not hold DC) is not drawn either: no
         // velocity, deformation or loop from its integral.
         let refused = r.delta_v_m_s.is_none();
@@ -208,10 +226,10 @@ fn draw_impacts(
         };
         let mut panels = vec![
             Panel {
-                title: "deceleration, m/s² (left) and g (right)",
+                title: &decel_title,
                 x_label: "time from touch, ms",
                 measured: meas,
-                measured_label: "measured",
+                measured_label: raw_label,
                 models: c_a,
                 log: false,
                 g_axis: true,

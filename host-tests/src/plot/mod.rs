@@ -1,10 +1,13 @@
 //! The figures' primitives: the output checked and written, panels of curves drawn with
-//! plotters; the impacts figure ([`impacts`]) and the tick labels ([`ticks`]).
+//! plotters; the impacts figure ([`impacts`]), what it draws from ([`signal`]) and the tick
+//! labels ([`ticks`]).
 
 mod impacts;
+mod signal;
 pub(crate) mod ticks;
 
-pub use impacts::{impacts, window, Signal, SHOWN};
+pub use impacts::{impacts, SHOWN};
+pub use signal::{filtered, read_window, window, Signal};
 use ticks::tick;
 
 use impact_core::consts::STANDARD_GRAVITY;
