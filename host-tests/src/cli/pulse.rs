@@ -375,6 +375,7 @@ mod tests {
             columns: (0..100)
                 .map(|k| (f64::from(k) * 1e-5, 0.0, 10.0 * g))
                 .collect(),
+            filtered: None,
             spec: None,
         });
         for want in [
