@@ -7,7 +7,7 @@ use std::fmt::Write as _;
 use impact_core::consts::STANDARD_GRAVITY;
 use impact_core::spec::Spec;
 
-use crate::plot::ticks::tick;
+use crate::plot::ticks::{linear_ticks, tick};
 use crate::report::fmt::human;
 
 /// The largest number of impacts drawn (each figure is a few kB; the table has them all).
@@ -31,25 +31,6 @@ pub struct Pulse<'a> {
     /// The CFC-filtered signal's columns, likewise, and its legend (`CFC 1000`).
     pub filtered: Option<(String, Vec<(f64, f64, f64)>)>,
     pub spec: Option<(&'a Spec, f64)>,
-}
-
-/// Ticks at 1, 2 or 5 × 10^k covering `[lo, hi]`, about `n` of them.
-fn ticks(lo: f64, hi: f64, n: usize) -> Vec<f64> {
-    let span = (hi - lo).abs().max(f64::MIN_POSITIVE);
-    let raw = span / n as f64;
-    let mag = 10f64.powf(raw.log10().floor());
-    let step = [1.0, 2.0, 5.0, 10.0]
-        .iter()
-        .map(|m| m * mag)
-        .find(|s| *s >= raw)
-        .unwrap_or(10.0 * mag);
-    let mut t = (lo / step).ceil() * step;
-    let mut out = Vec::new();
-    while t <= hi + step * 1e-9 && out.len() < 50 {
-        out.push(if t.abs() < step * 1e-9 { 0.0 } else { t });
-        t += step;
-    }
-    out
 }
 
 /// A tick's label: as few digits as the step needs.
@@ -139,20 +120,20 @@ pub fn svg(p: &Pulse) -> String {
     let _ = write!(s, "<text x=\"{}\" y=\"16\" text-anchor=\"middle\" font-size=\"12\" font-weight=\"bold\">{}</text>", W / 2.0, esc(&p.title));
     // Grid and ticks: time in ms from the window's start, acceleration in g.
     let span_ms = (t_last - t_first) * 1e3;
-    let xt = ticks(0.0, span_ms, 6);
+    let xt = linear_ticks(0.0, span_ms, 6);
     let xstep = xt.get(1).zip(xt.first()).map_or(1.0, |(b, a)| b - a);
     for v in &xt {
         let px = x(t_first + v * 1e-3);
         let _ = write!(s, "<line x1=\"{px:.1}\" y1=\"{T}\" x2=\"{px:.1}\" y2=\"{}\" stroke=\"#eee\"/><text x=\"{px:.1}\" y=\"{}\" text-anchor=\"middle\">{}</text>", H - B, H - B + 14.0, label(*v, xstep));
     }
-    let yt = ticks(y_lo / g, y_hi / g, 6);
+    let yt = linear_ticks(y_lo / g, y_hi / g, 6);
     let ystep = yt.get(1).zip(yt.first()).map_or(1.0, |(b, a)| b - a);
     for v in &yt {
         let py = y(v * g);
         let _ = write!(s, "<line x1=\"{L}\" y1=\"{py:.1}\" x2=\"{}\" y2=\"{py:.1}\" stroke=\"#eee\"/><text x=\"{}\" y=\"{:.1}\" text-anchor=\"end\">{}</text>", W - R, L - 4.0, py + 4.0, label(*v, ystep));
     }
     // The same range in m/s² on the right.
-    let yt = ticks(y_lo, y_hi, 6);
+    let yt = linear_ticks(y_lo, y_hi, 6);
     for v in &yt {
         let py = y(*v);
         let _ = write!(s, "<line x1=\"{}\" y1=\"{py:.1}\" x2=\"{}\" y2=\"{py:.1}\" stroke=\"#999\"/><text x=\"{}\" y=\"{:.1}\">{}</text>", W - R, W - R + 4.0, W - R + 6.0, py + 4.0, tick(*v));
@@ -355,10 +336,10 @@ mod tests {
 
     #[test]
     fn ticks_are_round_numbers_covering_the_range() {
-        assert_eq!(ticks(0.0, 10.0, 5), [0.0, 2.0, 4.0, 6.0, 8.0, 10.0]);
-        assert_eq!(ticks(-3.0, 12.0, 6), [0.0, 5.0, 10.0]);
+        assert_eq!(linear_ticks(0.0, 10.0, 5), [0.0, 2.0, 4.0, 6.0, 8.0, 10.0]);
+        assert_eq!(linear_ticks(-3.0, 12.0, 6), [0.0, 5.0, 10.0]);
         assert_eq!(
-            ticks(-3.0, 12.0, 10),
+            linear_ticks(-3.0, 12.0, 10),
             [-2.0, 0.0, 2.0, 4.0, 6.0, 8.0, 10.0, 12.0]
         );
         assert_eq!(label(0.25, 0.05), "0.25");

@@ -8,7 +8,7 @@ pub(crate) mod ticks;
 
 pub use impacts::{impacts, SHOWN};
 pub use signal::{filtered, read_window, window, Signal};
-use ticks::tick;
+use ticks::{log_tick, log_ticks, tick};
 
 use impact_core::consts::STANDARD_GRAVITY;
 use plotters::prelude::*;
@@ -138,6 +138,7 @@ pub(crate) fn draw_panel(
     index: Option<u32>,
     p: &Panel,
 ) -> Result<(), String> {
+    let label = if p.log { log_tick } else { tick };
     let finite =
         |q: &(f64, f64)| q.0.is_finite() && q.1.is_finite() && (!p.log || (q.0 > 0.0 && q.1 > 0.0));
     let all = p
@@ -166,14 +167,15 @@ pub(crate) fn draw_panel(
     // The measured curve and each model's on `chart`, the mesh, the legend.
     macro_rules! curves {
         ($chart:ident) => {{
-            $chart
-                .configure_mesh()
-                .x_desc(p.x_label)
-                .y_desc(if p.g_axis { "m/s²" } else { "" })
-                .x_label_formatter(&|v| tick(*v))
-                .y_label_formatter(&|v| tick(*v))
-                .draw()
-                .map_err(|e| e.to_string())?;
+            let format = |v: &f64| label(*v);
+            let mut mesh = $chart.configure_mesh();
+            mesh.x_desc(p.x_label)
+                .x_label_formatter(&format)
+                .y_label_formatter(&format);
+            if p.g_axis {
+                mesh.y_desc("m/s²");
+            }
+            mesh.draw().map_err(|e| e.to_string())?;
             if !p.measured.is_empty() {
                 $chart
                     .draw_series(LineSeries::new(
@@ -223,7 +225,7 @@ pub(crate) fn draw_panel(
                 chart
                     .configure_secondary_axes()
                     .y_desc("g")
-                    .y_label_formatter(&|v| tick(*v))
+                    .y_label_formatter(&|v| label(*v))
                     .draw()
                     .map_err(|e| e.to_string())?;
                 curves!(chart);
@@ -234,11 +236,24 @@ pub(crate) fn draw_panel(
     }
     let g = STANDARD_GRAVITY;
     if p.log {
-        let (y0, y1) = (y0 * 0.8, (y1 * 1.25).max(y0 * 1.01));
+        // Each axis's decades numbered, never crowding (ticks::log_ticks), over the plot
+        // area's size (the area less its margins, caption and label areas).
+        let (w, h) = area.dim_in_pixel();
+        let width = f64::from(w) - 76.0 - if p.g_axis { 60.0 } else { 0.0 };
+        let height = f64::from(h) - 71.0;
+        let axis = |lo: f64, hi: f64, length: f64, spacing: f64| {
+            let (labelled, light) = log_ticks(lo, hi, length, spacing);
+            (lo..hi)
+                .log_scale()
+                .with_key_points(labelled)
+                .with_light_points(light)
+        };
+        let (x1, y0, y1) = (x1.max(x0 * 1.01), y0 * 0.8, (y1 * 1.25).max(y0 * 1.01));
+        // Labels 40 px apart across (`100k` is some 25 px wide), 16 px up (a line).
         chart!(
-            (x0..x1.max(x0 * 1.01)).log_scale(),
-            (y0..y1).log_scale(),
-            (y0 / g..y1 / g).log_scale()
+            axis(x0, x1, width, 40.0),
+            axis(y0, y1, height, 16.0),
+            axis(y0 / g, y1 / g, height, 16.0)
         );
     } else {
         let pad = (y1 - y0).abs().max(1e-12) * 0.08;
@@ -252,13 +267,14 @@ pub(crate) fn draw_panel(
 mod tests {
     use super::*;
 
-    /// The labels of an SVG's `<text>` elements placed in `xs` × `ys`, top to bottom.
+    /// The labels of an SVG's `<text>` elements placed in `xs` × `ys`, top to bottom, then
+    /// left to right.
     pub(super) fn labels_in(
         svg: &str,
         xs: std::ops::Range<f64>,
         ys: std::ops::Range<f64>,
     ) -> Vec<String> {
-        let mut out: Vec<(f64, String)> = Vec::new();
+        let mut out: Vec<(f64, f64, String)> = Vec::new();
         for t in svg.split("<text").skip(1) {
             let attr = |name: &str| -> Option<f64> {
                 let key = format!(" {name}=\"");
@@ -270,11 +286,11 @@ mod tests {
             };
             let text = &t[t.find('>').unwrap() + 1..t.find("</text>").unwrap()];
             if xs.contains(&x) && ys.contains(&y) {
-                out.push((y, text.trim().to_string()));
+                out.push((y, x, text.trim().to_string()));
             }
         }
-        out.sort_by(|a, b| a.0.total_cmp(&b.0));
-        out.into_iter().map(|(_, t)| t).collect()
+        out.sort_by(|a, b| a.0.total_cmp(&b.0).then(a.1.total_cmp(&b.1)));
+        out.into_iter().map(|(_, _, t)| t).collect()
     }
 
     /// A 400 × 300 panel of `measured` drawn alone, as SVG text.
@@ -329,5 +345,41 @@ mod tests {
         // Without it, no labels on the right.
         let svg = panel_svg(vec![(0.0, 0.0), (1.0, 98.0)], false, false);
         assert!(labels_in(&svg, 345.0..400.0, 0.0..250.0).is_empty());
+    }
+
+    #[test]
+    fn log_panels_number_their_decades() {
+        // 10 Hz to 100 kHz, 100 to 1M m/s².
+        let spectrum: Vec<(f64, f64)> = (0..=40)
+            .map(|k| {
+                let f = 10f64.powf(1.0 + f64::from(k) / 10.0);
+                (f, 10.0 * f)
+            })
+            .collect();
+        let svg = panel_svg(spectrum, true, true);
+        // Under the plot area: the decades of frequency.
+        let x = labels_in(&svg, 60.0..340.0, 262.0..285.0);
+        assert_eq!(x, ["10", "100", "1k", "10k", "100k"], "{x:?}");
+        // Left: m/s², right: g, each decade (80 to 1.25M m/s² is 8.2 to 127k g).
+        let left = labels_in(&svg, 0.0..68.0, 30.0..262.0);
+        let left: Vec<&str> = left
+            .iter()
+            .map(String::as_str)
+            .filter(|t| *t != "m/s²")
+            .collect();
+        assert_eq!(left, ["1M", "100k", "10k", "1k", "100"], "{left:?}");
+        let right = labels_in(&svg, 330.0..400.0, 30.0..262.0);
+        let right: Vec<&str> = right
+            .iter()
+            .map(String::as_str)
+            .filter(|t| *t != "g")
+            .collect();
+        assert_eq!(right, ["100k", "10k", "1k", "100", "10"], "{right:?}");
+        // A short band: 2 and 5 times the decade too.
+        let svg = panel_svg(vec![(150.0, 3.0), (900.0, 20.0)], true, false);
+        let x = labels_in(&svg, 60.0..400.0, 262.0..285.0);
+        assert_eq!(x, ["200", "400", "600", "800"], "{x:?}");
+        let y = labels_in(&svg, 0.0..68.0, 30.0..262.0);
+        assert_eq!(y, ["20", "10", "5"], "{y:?}");
     }
 }
