@@ -140,3 +140,98 @@ fn with_a_cfc_the_figures_draw_the_raw_and_the_filtered_signal_and_say_so() {
     assert_eq!(page.matches(">CFC 1000</text>").count(), 2, "the legends");
     assert_eq!(page.matches(">raw</text>").count(), 2);
 }
+
+/// A PNG's size and its RGBA pixels.
+fn decode(bytes: &[u8]) -> ((u32, u32), Vec<u8>) {
+    let mut reader = png::Decoder::new(std::io::Cursor::new(bytes))
+        .read_info()
+        .unwrap();
+    let mut pixels = vec![0; reader.output_buffer_size().unwrap()];
+    let info = reader.next_frame(&mut pixels).unwrap();
+    assert_eq!(info.color_type, png::ColorType::Rgba);
+    pixels.truncate(info.buffer_size());
+    ((info.width, info.height), pixels)
+}
+
+/// The share of the pixels in rows `rows` that are dark (text, axes, curves).
+fn dark(size: (u32, u32), pixels: &[u8], rows: std::ops::Range<u32>) -> f64 {
+    let w = size.0 as usize;
+    let px = |k: usize| &pixels[4 * k..4 * k + 4];
+    let n = rows.clone().count() * w;
+    let dark = rows
+        .flat_map(|y| (0..w).map(move |x| y as usize * w + x))
+        .filter(|&k| px(k)[..3].iter().all(|&c| c < 100) && px(k)[3] > 200)
+        .count();
+    dark as f64 / n as f64
+}
+
+#[test]
+fn plot_png_is_the_figure_rasterised_the_same_on_any_machine() {
+    let d = dir();
+    let f = data("afrl-drop-tower/series1_test1_full_100ms.csv");
+    let draw = |name: &str| {
+        let out = d.join(name);
+        let (_, err) = impact_ok(&[
+            "analyze",
+            f.to_str().unwrap(),
+            "--column",
+            "1",
+            "--srs",
+            "--plot",
+            out.to_str().unwrap(),
+        ]);
+        assert!(err.contains(&format!("wrote {}", out.display())), "{err}");
+        std::fs::read(&out).unwrap()
+    };
+    let png = draw("figure.png");
+    assert_eq!(&png[..8], b"\x89PNG\r\n\x1a\n", "the PNG signature");
+    // The SVG's size: six panels of 400 px across, one impact of 330 px and the title's 36.
+    let svg = String::from_utf8(draw("figure.svg")).unwrap();
+    assert!(
+        svg.starts_with("<svg width=\"2400\" height=\"366\""),
+        "{}",
+        &svg[..80]
+    );
+    let (size, pixels) = decode(&png);
+    assert_eq!(size, (2400, 366));
+    // Not blank: opaque, a white background, and dark pixels where the title's text is (the
+    // embedded font drew it) and over the panels (axes, labels).
+    assert!(pixels.chunks(4).all(|p| p[3] == 255), "transparent pixels");
+    let title = dark(size, &pixels, 8..30);
+    let panels = dark(size, &pixels, 40..366);
+    assert!(
+        title > 0.005 && panels > 0.005,
+        "title {title}, panels {panels}"
+    );
+    assert!(
+        title < 0.5 && panels < 0.5,
+        "title {title}, panels {panels}"
+    );
+    // The same bytes every time (no system font, no clock in the file).
+    assert_eq!(draw("again.png"), png);
+    // The extension chooses, whatever its case; other names are refused, naming the two.
+    assert_eq!(&draw("upper.PNG")[..8], b"\x89PNG\r\n\x1a\n");
+    let (code, _, err) = common::impact(&[
+        "analyze",
+        f.to_str().unwrap(),
+        "--plot",
+        d.join("figure.jpg").to_str().unwrap(),
+    ]);
+    assert_eq!(code, 1);
+    assert!(err.contains(".svg or .png"), "{err}");
+    assert!(!d.join("figure.jpg").exists());
+    // The output rules hold for a PNG: never over an input (a link to one included).
+    let input = d.join("input.png");
+    std::fs::copy(&f, &input).unwrap();
+    let (code, _, err) = common::impact(&[
+        "analyze",
+        input.to_str().unwrap(),
+        "--column",
+        "1",
+        "--plot",
+        input.to_str().unwrap(),
+    ]);
+    assert_eq!(code, 1);
+    assert!(err.contains("would be overwritten"), "{err}");
+    assert_eq!(std::fs::read(&input).unwrap(), std::fs::read(&f).unwrap());
+}

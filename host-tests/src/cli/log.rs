@@ -35,8 +35,8 @@ pub struct LogArgs {
     #[arg(long, help_heading = "Input")]
     pub elf: Option<PathBuf>,
     /// Draw the impacts from the board's waveforms (the figure of `impact analyze --plot`)
-    /// to this SVG file.
-    #[arg(short = 'p', long, help_heading = "Output", value_name = "FILE.svg")]
+    /// to this SVG or PNG file (by its extension).
+    #[arg(short = 'p', long, help_heading = "Output", value_name = "FILE")]
     pub plot: Option<PathBuf>,
     /// Write each waveform as a recording `impact analyze` reads: `NAME.csv` (time_s,
     /// accel_m_s2) or `NAME.wav` (16-bit counts, give `--gain`), one file per impact,

@@ -1,8 +1,9 @@
-//! The figures' primitives: the output checked and written, panels of curves drawn with
-//! plotters; the impacts figure ([`impacts`]), what it draws from ([`signal`]) and the tick
+//! The figures' primitives: the output checked and written (SVG, or PNG: [`png`]), panels of
+//! curves drawn with plotters; the impacts figure ([`impacts`]), what it draws from ([`signal`]) and the tick
 //! labels ([`ticks`]).
 
 mod impacts;
+mod png;
 mod signal;
 pub(crate) mod ticks;
 
@@ -13,35 +14,52 @@ use ticks::{log_tick, log_ticks, tick};
 use impact_core::consts::STANDARD_GRAVITY;
 use plotters::prelude::*;
 
-/// Checks that `path` can take an SVG before any work is done: its directory exists and it is
-/// none of the `inputs` (the same file, a link to one, standard input's file: the output rule
-/// of [`crate::output`]), and it is named `.svg`.
+/// The figures' formats, by the file's extension.
+const FORMATS: [&str; 2] = ["svg", "png"];
+
+/// Checks that `path` can take a figure before any work is done: its directory exists and it
+/// is none of the `inputs` (the same file, a link to one, standard input's file: the output
+/// rule of [`crate::output`]), and it is named `.svg` or `.png` (the format).
 pub fn check_output(path: &std::path::Path, inputs: &[&std::path::Path]) -> Result<(), String> {
     let all = inputs
         .iter()
         .fold(crate::output::Inputs::new(), |all, i| all.with(i));
     crate::output::check("--plot", path, &all, None)?;
-    let svg = path
-        .extension()
-        .is_some_and(|e| e.eq_ignore_ascii_case("svg"));
-    if !svg {
+    if format(path).is_none() {
         return Err(format!(
-            "--plot {}: the figure is SVG: name the file .svg (rsvg-convert FILE.svg -o FILE.png makes a PNG of it)",
+            "--plot {}: the figure is SVG or PNG: name the file .svg or .png",
             path.display()
         ));
     }
     Ok(())
 }
 
-/// Draws a `size` SVG with `draw` and writes it to `path` whole or not at all
-/// ([`crate::output::write`]).
+/// The figure's format for `path` (`svg` or `png`, whatever the case of its extension).
+fn format(path: &std::path::Path) -> Option<&'static str> {
+    let ext = path.extension()?.to_str()?;
+    FORMATS.into_iter().find(|f| ext.eq_ignore_ascii_case(f))
+}
+
+/// Draws a `size` SVG with `draw` and writes it to `path` ([`write_figure`]).
 pub(crate) fn write_svg(
     path: &std::path::Path,
     size: (u32, u32),
     draw: impl FnOnce(&DrawingArea<SVGBackend, plotters::coord::Shift>) -> Result<(), String>,
 ) -> Result<(), String> {
-    let text = svg_text(size, draw)?;
-    crate::output::write(path, text.as_bytes())
+    write_figure(path, &svg_text(size, draw)?)
+}
+
+/// Writes the figure `svg` to `path` whole or not at all ([`crate::output::write`]): as it is
+/// to a `.svg`, rasterised ([`png::from_svg`]) to a `.png`.
+pub(crate) fn write_figure(path: &std::path::Path, svg: &str) -> Result<(), String> {
+    match format(path) {
+        Some("png") => crate::output::write(path, &png::from_svg(svg)?),
+        Some(_) => crate::output::write(path, svg.as_bytes()),
+        None => Err(format!(
+            "--plot {}: name the figure .svg or .png",
+            path.display()
+        )),
+    }
 }
 
 /// A `size` SVG drawn with `draw`, as text.

@@ -70,5 +70,5 @@ pub fn wall_contact(
         }
         root.present().map_err(|e| e.to_string())?;
     }
-    crate::output::write(path, text.as_bytes())
+    crate::plot::write_figure(path, &text)
 }
