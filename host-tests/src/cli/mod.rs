@@ -10,4 +10,5 @@ pub mod progress;
 pub mod pulse;
 pub mod series;
 pub mod simulate;
+pub mod srs_required;
 pub mod synth;

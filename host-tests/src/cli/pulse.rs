@@ -43,10 +43,10 @@ fn label(v: f64, step: f64) -> String {
 /// from the window's start, the measured signal as a min/max band per column, the band and
 /// the nominal pulse dashed.
 pub fn svg(p: &Pulse) -> String {
-    const W: f64 = 580.0;
+    const W: f64 = 530.0;
     const H: f64 = 300.0;
-    const L: f64 = 58.0;
-    const R: f64 = 62.0;
+    const L: f64 = 54.0;
+    const R: f64 = 56.0;
     const T: f64 = 30.0;
     const B: f64 = 42.0;
     let Some(&(t_first, _, _)) = p.columns.first() else {

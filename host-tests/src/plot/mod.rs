@@ -92,6 +92,8 @@ pub(crate) struct Panel<'a> {
     pub(crate) measured: Vec<(f64, f64)>,
     pub(crate) measured_label: &'a str,
     pub(crate) models: Vec<Curve>,
+    /// Curves drawn dashed, thin (a tolerance's limits).
+    pub(crate) dashed: Vec<Curve>,
     pub(crate) log: bool,
     /// The values are m/s²: the same range in g on a second axis on the right.
     pub(crate) g_axis: bool,
@@ -162,7 +164,7 @@ pub(crate) fn draw_panel(
     let all = p
         .measured
         .iter()
-        .chain(p.models.iter().flat_map(|c| c.2.iter()))
+        .chain(p.models.iter().chain(&p.dashed).flat_map(|c| c.2.iter()))
         .filter(|q| finite(q));
     let (mut x0, mut x1, mut y0, mut y1) = (f64::MAX, f64::MIN, f64::MAX, f64::MIN);
     for q in all {
@@ -171,6 +173,19 @@ pub(crate) fn draw_panel(
     if x0 > x1 {
         (x0, x1, y0, y1) = (0.0, 1.0, 0.0, 1.0);
     }
+    // The axes' ranges: a log axis a little beyond the curves, a linear one padded by 8 %.
+    let (x1, y0, y1) = if p.log {
+        (x1.max(x0 * 1.01), y0 * 0.8, (y1 * 1.25).max(y0 * 1.01))
+    } else {
+        let pad = (y1 - y0).abs().max(1e-12) * 0.08;
+        (x1.max(x0 + 1e-9), y0 - pad, y1 + pad)
+    };
+    let (w, h) = area.dim_in_pixel();
+    // The plot area's size: the area less its margins, caption and label areas.
+    let width = f64::from(w) - 76.0 - if p.g_axis { 60.0 } else { 0.0 };
+    let height = f64::from(h) - 71.0;
+    let entries = usize::from(!p.measured.is_empty()) + p.models.len() + p.dashed.len();
+    let corner = legend_corner(p, (x0, x1, y0, y1), (width, height), entries);
     let caption = match index {
         Some(i) => format!("impact {i} — {}", p.title),
         None => p.title.to_string(),
@@ -221,10 +236,30 @@ pub(crate) fn draw_panel(
                         PathElement::new(vec![(x, y), (x + 18, y)], c.stroke_width(2))
                     });
             }
+            for (name, color, s) in &p.dashed {
+                let c = *color;
+                $chart
+                    .draw_series(DashedLineSeries::new(
+                        decimate(s, COLUMNS).into_iter().filter(|q| finite(q)),
+                        6,
+                        4,
+                        c.stroke_width(1),
+                    ))
+                    .map_err(|e| e.to_string())?
+                    .label(*name)
+                    .legend(move |(x, y)| {
+                        plotters::element::DashedPathElement::new(
+                            vec![(x, y), (x + 18, y)],
+                            5,
+                            3,
+                            c.stroke_width(1),
+                        )
+                    });
+            }
             if p.legend {
                 $chart
                     .configure_series_labels()
-                    .position(SeriesLabelPosition::UpperRight)
+                    .position(corner)
                     .background_style(WHITE.mix(0.85))
                     .border_style(BLACK)
                     .draw()
@@ -254,11 +289,7 @@ pub(crate) fn draw_panel(
     }
     let g = STANDARD_GRAVITY;
     if p.log {
-        // Each axis's decades numbered, never crowding (ticks::log_ticks), over the plot
-        // area's size (the area less its margins, caption and label areas).
-        let (w, h) = area.dim_in_pixel();
-        let width = f64::from(w) - 76.0 - if p.g_axis { 60.0 } else { 0.0 };
-        let height = f64::from(h) - 71.0;
+        // Each axis's decades numbered, never crowding (ticks::log_ticks).
         let axis = |lo: f64, hi: f64, length: f64, spacing: f64| {
             let (labelled, light) = log_ticks(lo, hi, length, spacing);
             (lo..hi)
@@ -266,7 +297,6 @@ pub(crate) fn draw_panel(
                 .with_key_points(labelled)
                 .with_light_points(light)
         };
-        let (x1, y0, y1) = (x1.max(x0 * 1.01), y0 * 0.8, (y1 * 1.25).max(y0 * 1.01));
         // Labels 40 px apart across (`100k` is some 25 px wide), 16 px up (a line).
         chart!(
             axis(x0, x1, width, 40.0),
@@ -274,11 +304,78 @@ pub(crate) fn draw_panel(
             axis(y0 / g, y1 / g, height, 16.0)
         );
     } else {
-        let pad = (y1 - y0).abs().max(1e-12) * 0.08;
-        let (y0, y1) = (y0 - pad, y1 + pad);
-        chart!(x0..x1.max(x0 + 1e-9), y0..y1, y0 / g..y1 / g);
+        chart!(x0..x1, y0..y1, y0 / g..y1 / g);
     }
     Ok(())
+}
+
+/// The corner of `p`'s plot area (its axes' `ranges`, `size` in px) where a legend of
+/// `entries` lines covers the fewest points of its curves: upper right unless another corner
+/// is emptier.
+fn legend_corner(
+    p: &Panel,
+    (x0, x1, y0, y1): (f64, f64, f64, f64),
+    (width, height): (f64, f64),
+    entries: usize,
+) -> SeriesLabelPosition {
+    // Where a value lies across an axis, 0 to 1.
+    let unit = |v: f64, lo: f64, hi: f64| {
+        if p.log {
+            (v / lo).ln() / (hi / lo).ln()
+        } else {
+            (v - lo) / (hi - lo)
+        }
+    };
+    // The legend's box: some 150 px wide, 19 px a line, as a share of the plot area.
+    let (w, h) = (
+        (150.0 / width).min(0.9),
+        ((19.0 * entries as f64 + 12.0) / height).min(0.9),
+    );
+    let corners = [
+        (
+            SeriesLabelPosition::UpperRight,
+            1.0 - w..=1.0,
+            1.0 - h..=1.0,
+        ),
+        (SeriesLabelPosition::LowerRight, 1.0 - w..=1.0, 0.0..=h),
+        (SeriesLabelPosition::UpperLeft, 0.0..=w, 1.0 - h..=1.0),
+        (SeriesLabelPosition::LowerLeft, 0.0..=w, 0.0..=h),
+    ];
+    // Every curve's points across the plot area; a curve of few points (a required SRS's
+    // breakpoints) 16 to each straight piece, so that one crossing a corner is seen there.
+    let mut points: Vec<(f64, f64)> = Vec::new();
+    for curve in std::iter::once(&p.measured).chain(p.models.iter().chain(&p.dashed).map(|c| &c.2))
+    {
+        let across: Vec<(f64, f64)> = curve
+            .iter()
+            .map(|q| (unit(q.0, x0, x1), unit(q.1, y0, y1)))
+            .filter(|q| q.0.is_finite() && q.1.is_finite())
+            .collect();
+        if across.len() < 200 {
+            for w in across.windows(2) {
+                points.extend((0..16).map(|k| {
+                    let t = f64::from(k) / 16.0;
+                    (
+                        w[0].0 + t * (w[1].0 - w[0].0),
+                        w[0].1 + t * (w[1].1 - w[0].1),
+                    )
+                }));
+            }
+            points.extend(across.last());
+        } else {
+            points.extend(across);
+        }
+    }
+    let covered = |xs: &std::ops::RangeInclusive<f64>, ys: &std::ops::RangeInclusive<f64>| {
+        points
+            .iter()
+            .filter(|q| xs.contains(&q.0) && ys.contains(&q.1))
+            .count()
+    };
+    corners
+        .into_iter()
+        .min_by_key(|(_, xs, ys)| covered(xs, ys))
+        .map_or(SeriesLabelPosition::UpperRight, |c| c.0)
 }
 
 #[cfg(test)]
@@ -324,6 +421,7 @@ mod tests {
                     measured,
                     measured_label: "measured",
                     models: Vec::new(),
+                    dashed: Vec::new(),
                     log,
                     g_axis,
                     legend: false,

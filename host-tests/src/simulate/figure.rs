@@ -62,6 +62,7 @@ pub fn wall_contact(
                 measured: Vec::new(),
                 measured_label: "",
                 models: c,
+                dashed: Vec::new(),
                 log: false,
                 g_axis: false,
                 legend: j == 0,
