@@ -21,15 +21,17 @@ pub fn esc(s: &str) -> String {
         .replace('"', "&quot;")
 }
 
+/// A pixel column of a pulse: time (s) and the least and greatest acceleration there (m/s²).
+pub type Column = (f64, f64, f64);
+
 /// A pulse drawn: `(t_s, a_m_s2)` min/max pairs per pixel column over the window from
 /// `from_s`, the title, the CFC-filtered trace's, and the specification's nominal pulse and
 /// band placed at `start_s`.
 pub struct Pulse<'a> {
     pub title: String,
-    /// Per column: time (s) and the least and greatest acceleration there (m/s²).
-    pub columns: Vec<(f64, f64, f64)>,
+    pub columns: Vec<Column>,
     /// The CFC-filtered signal's columns, likewise, and its legend (`CFC 1000`).
-    pub filtered: Option<(String, Vec<(f64, f64, f64)>)>,
+    pub filtered: Option<(String, Vec<Column>)>,
     pub spec: Option<(&'a Spec, f64)>,
 }
 
@@ -180,7 +182,7 @@ pub fn svg(p: &Pulse) -> String {
         );
     }
     // The measured signal, and the filtered one: each column's extremes joined.
-    let path = |columns: &[(f64, f64, f64)]| {
+    let path = |columns: &[Column]| {
         let mut d = String::new();
         for (k, c) in columns.iter().enumerate() {
             let _ = write!(
@@ -286,7 +288,7 @@ pub fn pulse_svg(
     let cols = COLUMNS.min(n);
     // Each column's least and greatest value of `a` (m/s² above the baseline, by sample), in
     // the direction of the peak.
-    let columns = |a: &dyn Fn(u64) -> Option<f64>| -> Vec<(f64, f64, f64)> {
+    let columns = |a: &dyn Fn(u64) -> Option<f64>| -> Vec<Column> {
         (0..cols)
             .filter_map(|c| {
                 let (from, to) = (i0 + c * n / cols, i0 + (c + 1) * n / cols);
