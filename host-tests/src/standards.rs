@@ -1,5 +1,6 @@
-//! The shock-test standards whose tolerances `--spec` applies (`standard=`), each number as
-//! docs/standards.md gives it with its source.
+//! The shock-test standards whose tolerances `--spec` applies (`standard=`), and the SRS
+//! tolerance `impact report --srs-required` judges by, each number as docs/standards.md gives
+//! it with its source.
 
 use impact_core::spec::Tolerance;
 
@@ -67,3 +68,10 @@ pub fn title(name: &str) -> &str {
         .find(|s| s.name == name)
         .map_or(name, |s| s.title)
 }
+
+/// The SRS tolerance of MIL-STD-810H Method 516.8 (docs/standards.md gives its source): the
+/// measured SRS within −1.5 dB and +3 dB of the required one, dB (20 log10 of the ratio).
+pub const SRS_TOLERANCE_DB: (f64, f64) = (-1.5, 3.0);
+
+/// Where [`SRS_TOLERANCE_DB`] comes from, as the report names it.
+pub const SRS_TOLERANCE_SOURCE: &str = "MIL-STD-810H Method 516.8";

@@ -232,11 +232,12 @@ fn a_time_column_without_a_unit_that_implies_a_crawl_is_refused_with_the_fix() {
 }
 
 #[test]
-fn plot_writes_svg_or_refuses() {
-    let png = temp("x.png");
-    let png = png.to_str().unwrap();
+fn plot_writes_svg_or_png_or_refuses() {
+    // (A PNG's contents: tests/figures.rs.)
+    let pdf = temp("x.pdf");
+    let pdf = pdf.to_str().unwrap();
     for args in [
-        vec!["analyze", &afrl(), "--plot", png],
+        vec!["analyze", &afrl(), "--plot", pdf],
         vec![
             "simulate",
             "--model",
@@ -248,13 +249,16 @@ fn plot_writes_svg_or_refuses() {
             "--stiffness",
             "1e6",
             "--plot",
-            png,
+            pdf,
         ],
     ] {
         let (code, _, err) = impact(&args);
         assert_eq!(code, 1, "{args:?}: {err}");
-        assert!(err.contains("SVG") && err.contains(".svg"), "{err}");
-        assert!(!std::path::Path::new(png).exists(), "{png} was written");
+        assert!(
+            err.contains("SVG or PNG") && err.contains(".svg or .png"),
+            "{err}"
+        );
+        assert!(!std::path::Path::new(pdf).exists(), "{pdf} was written");
     }
 }
 

@@ -2,7 +2,8 @@
 //! self-contained page (no network, no script), checked as written and in a real headless
 //! browser (Chromium from the distribution's packages: `scripts/setup.sh` installs it; with
 //! `IMPACT_REQUIRE_BROWSER` set a missing browser is an error, not a skip): the page loads,
-//! every figure is there, and its screenshot is a full, non-blank image.
+//! every figure is there, and its screenshot is a full, non-blank image. A required SRS: each
+//! impact's SRS judged against it and drawn over it.
 
 use std::path::{Path, PathBuf};
 use std::process::Command;
@@ -93,6 +94,154 @@ fn the_report_is_one_self_contained_page_with_every_pulse() {
         "would be overwritten",
         "--html onto an input",
     );
+}
+
+/// Channel `channel`'s SRS (Hz, m/s²) as `impact analyze --srs --json` gives it.
+fn measured_srs(channel: &str) -> Vec<(f64, f64)> {
+    let (json, _) = impact_ok(&[
+        "analyze",
+        &afrl(),
+        "--column",
+        channel,
+        "--units",
+        "kgn",
+        "--srs",
+        "--json",
+    ]);
+    let j: serde_json::Value = serde_json::from_str(&json).unwrap();
+    let sp = &j["impacts"][0]["shock_spectrum"];
+    let values = |k: &str| -> Vec<f64> {
+        sp[k]
+            .as_array()
+            .unwrap()
+            .iter()
+            .map(|v| v.as_f64().unwrap())
+            .collect()
+    };
+    values("frequency_hz")
+        .into_iter()
+        .zip(values("srs_m_s2"))
+        .collect()
+}
+
+/// The report of channels 1 and 2 against the required SRS in `csv`: the page, or the error.
+fn report_against(d: &Path, name: &str, csv: &str) -> Result<String, String> {
+    let required = d.join(format!("{name}.csv"));
+    std::fs::write(&required, csv).unwrap();
+    let html = d.join(format!("{name}.html"));
+    let (code, _, err) = impact(&[
+        "report",
+        &afrl(),
+        "--channels",
+        "1,2",
+        "--units",
+        "kgn",
+        "--srs-required",
+        required.to_str().unwrap(),
+        "--html",
+        html.to_str().unwrap(),
+    ]);
+    if code == 0 {
+        Ok(std::fs::read_to_string(&html).unwrap())
+    } else {
+        Err(err)
+    }
+}
+
+#[test]
+fn a_required_srs_judges_and_draws_each_impact_s_srs() {
+    let d = dir();
+    // Channel 1's own SRS lowered by 2 dB, in m/s² and in g: its SRS lies 2 dB above it at
+    // every natural frequency (within −1.5/+3 dB); lowered by 4 dB, 4 dB above (beyond +3).
+    let srs = measured_srs("1");
+    let required = |db: f64, g: bool| {
+        let k = 10f64.powf(-db / 20.0) / if g { 9.80665 } else { 1.0 };
+        let unit = if g {
+            "acceleration_g"
+        } else {
+            "acceleration_m_s2"
+        };
+        let rows: String = srs
+            .iter()
+            .map(|(f, a)| format!("{f},{}\n", a * k))
+            .collect();
+        format!("frequency_hz,{unit}\n{rows}")
+    };
+    for g in [false, true] {
+        let page = report_against(&d, "within", &required(2.0, g)).unwrap();
+        // No --srs given: the required SRS implies it.
+        assert!(page.contains("SRS within −1.5/+3 dB of required</th>"));
+        assert!(page.contains("MIL-STD-810H Method 516.8"));
+        let cells: Vec<&str> = page
+            .match_indices("worst at ")
+            .map(|(k, _)| &page[k - 8..k + 40])
+            .collect();
+        assert_eq!(cells.len(), 2, "{cells:?}");
+        assert!(
+            cells[0].contains("yes, worst at") && cells[0].contains(", +2.00 dB<"),
+            "{cells:?}"
+        );
+        // Two pulses, two spectra over the required one with its limits dashed.
+        assert_eq!(page.matches("<svg").count(), 4);
+        assert_eq!(page.matches("−1.5 dB\n</text>").count(), 2);
+        assert!(page.contains("impact 0: SRS, m/s² (left), g (right)"));
+    }
+    let page = report_against(&d, "beyond", &required(4.0, false)).unwrap();
+    assert!(page.contains("class=\"l fail\">no, worst at "), "the cell");
+    assert!(page.contains(", +4.00 dB</td>"));
+    // Breakpoints outside the spectrum's band: nothing to compare.
+    let page =
+        report_against(&d, "elsewhere", "frequency_hz,acceleration_g\n1,10\n5,10\n").unwrap();
+    assert_eq!(
+        page.matches("not compared (no natural frequency in both)")
+            .count(),
+        2
+    );
+    // A file that is no required SRS is refused, naming what is wrong.
+    for (csv, want) in [
+        (
+            "f,a\n1,2\n",
+            "needs the columns frequency_hz and acceleration_m_s2",
+        ),
+        (
+            "frequency_hz,acceleration_g\n100,1\n50,1\n",
+            "line 3: frequency_hz 50 does not increase",
+        ),
+        (
+            "frequency_hz,acceleration_g\n100,1\n200,-1\n",
+            "line 3: acceleration_g \"-1\" is not a positive number",
+        ),
+        (
+            "frequency_hz,acceleration_g\n100,1\n",
+            "at least two breakpoints",
+        ),
+    ] {
+        let err = report_against(&d, "bad", csv).unwrap_err();
+        assert!(
+            err.contains("--srs-required") && err.contains(want),
+            "{err}"
+        );
+    }
+    // The report never writes over it.
+    let required = d.join("kept.csv");
+    std::fs::write(&required, required_text()).unwrap();
+    let (code, _, err) = impact(&[
+        "report",
+        &afrl(),
+        "--channels",
+        "1",
+        "--srs-required",
+        required.to_str().unwrap(),
+        "--html",
+        required.to_str().unwrap(),
+    ]);
+    common::assert_refused(Some(code), &err, "would be overwritten", "--html onto it");
+    assert_eq!(std::fs::read_to_string(&required).unwrap(), required_text());
+}
+
+/// A required SRS (+6 dB/octave to 2 kHz, flat to 50 kHz).
+fn required_text() -> &'static str {
+    "frequency_hz,acceleration_g\n100,400\n2000,8000\n50000,8000\n"
 }
 
 #[test]

@@ -257,6 +257,16 @@ impl Scene {
         Ok(())
     }
 
+    /// Samples a capture holds beyond the impact's contact on either side, as far as the
+    /// signal reaches: the CFC's padding (SAE J211) or the specified pulse's verdict's,
+    /// whichever is longer; 0 with neither.
+    pub fn padding_samples(&self) -> u32 {
+        let rate = self.calibration.sample_rate_hz;
+        self.cfc
+            .map_or(0, |c| c.padding_samples(rate))
+            .max(self.spec.map_or(0, |s| s.padding_samples(rate)))
+    }
+
     /// Samples in `seconds`, at least 1.
     pub fn samples(&self, seconds: f32) -> u32 {
         let n = seconds * self.calibration.sample_rate_hz;

@@ -247,11 +247,7 @@ impl<const PRE: usize> Stream<PRE> {
         // the contact (SAE J211): the capture takes it beyond the window (the hold does not
         // change, nor does anything else the stream decides).
         // A specified pulse's verdict watches its window around the pulse: the same padding.
-        let rate = scene.calibration.sample_rate_hz;
-        self.filter_pad = scene
-            .cfc
-            .map_or(0, |c| c.padding_samples(rate))
-            .max(scene.spec.map_or(0, |s| s.padding_samples(rate)));
+        self.filter_pad = scene.padding_samples();
         self.hold = scene.samples(scene.hold_s);
         self.settle = scene.samples(scene.settle_s);
         self.max_samples = scene.samples(scene.max_impact_s) as u64;

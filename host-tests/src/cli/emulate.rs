@@ -333,9 +333,10 @@ pub fn emulate(args: &EmulateArgs) -> Result<(), String> {
         if counts_file.is_some() {
             // The windows the figure draws, from the replayed counts.
             let rate = f64::from(setup.scene.calibration.sample_rate_hz);
+            let padding = u64::from(setup.scene.padding_samples());
             let mut windows = Vec::new();
             for r in log.impacts.iter().take(crate::plot::SHOWN) {
-                let (from, n) = crate::plot::window(r, rate);
+                let (from, n) = crate::plot::read_window(r, rate, padding);
                 let n = n.min(total.saturating_sub(from));
                 windows.push((from, replayed(from, n as usize)?));
             }

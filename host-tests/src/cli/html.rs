@@ -11,6 +11,7 @@ use impact_core::consts::STANDARD_GRAVITY;
 use super::analyze::AnalyzeCommand;
 use super::pulse::{esc, MAX_FIGURES};
 use super::series::{self, EntryJson};
+use super::srs_required::{self, RequiredSrs};
 use crate::report::fmt::human;
 
 /// `impact report`'s command line: the analysis's (one or more recordings), and the file.
@@ -21,6 +22,15 @@ pub struct ReportArgs {
     /// The report: one self-contained HTML file (its figures inline).
     #[arg(long, value_name = "FILE.html", help_heading = "Output")]
     pub html: PathBuf,
+    /// A required SRS each impact's SRS is judged against (implies --srs).
+    ///
+    /// A required SRS: a CSV with the columns frequency_hz and acceleration_m_s2 (or
+    /// acceleration_g), straight between its breakpoints on log–log axes. Each impact's SRS is
+    /// drawn over it with MIL-STD-810H Method 516.8's tolerance (−1.5 dB, +3 dB) dashed, and
+    /// the table says whether it lies within at every natural frequency both have. Implies
+    /// --srs.
+    #[arg(long, value_name = "FILE.csv", help_heading = "Output")]
+    pub srs_required: Option<PathBuf>,
 }
 
 /// Runs `impact report`.
@@ -41,10 +51,19 @@ pub fn run(args: &ReportArgs) -> Result<(), String> {
     }
     let inputs = inputs
         .with_some(a.scene.as_deref())
-        .with_some(a.free_fall.as_deref().map(crate::pipeline::free_fall::file));
+        .with_some(a.free_fall.as_deref().map(crate::pipeline::free_fall::file))
+        .with_some(args.srs_required.as_deref());
     crate::output::check("--html", &args.html, &inputs, Some("html"))?;
-    let results = series::analyze_drawn(a, &entries);
-    let page = page(cmd, &results);
+    let required = args
+        .srs_required
+        .as_deref()
+        .map(RequiredSrs::read)
+        .transpose()?;
+    // A required SRS needs the measured one.
+    let mut a = a.clone();
+    a.spectrum.srs |= required.is_some();
+    let results = series::analyze_drawn(&a, &entries);
+    let page = page(cmd, &results, required.as_ref());
     crate::output::write(&args.html, page.as_bytes())?;
     for e in &results {
         for n in &e.notes {
@@ -70,7 +89,7 @@ td.l,th.l{text-align:left}.pass{color:#080;font-weight:bold}.fail{color:#b00;fon
 .figure{display:inline-block;margin:.5em;vertical-align:top}dl{display:grid;grid-template-columns:max-content auto;gap:.2em 1em}\
 dt{font-weight:bold}";
 
-fn page(cmd: &AnalyzeCommand, results: &[EntryJson]) -> String {
+fn page(cmd: &AnalyzeCommand, results: &[EntryJson], required: Option<&RequiredSrs>) -> String {
     let json = series::to_json(results);
     let a = &cmd.args;
     let mut h = String::new();
@@ -110,6 +129,21 @@ fn page(cmd: &AnalyzeCommand, results: &[EntryJson]) -> String {
             format!("CFC {c} (SAE J211) on the captured windows")
         }),
     );
+    if let Some(r) = required {
+        let (first, last) = (r.points()[0].0, r.points()[r.points().len() - 1].0);
+        let (low, high) = crate::standards::SRS_TOLERANCE_DB;
+        dd(
+            "required SRS",
+            &format!(
+                "{}: {} breakpoints, {} to {}; tolerance {low:+} dB, {high:+} dB ({})",
+                r.file,
+                r.points().len(),
+                human(first, "Hz").trim_end(),
+                human(last, "Hz").trim_end(),
+                crate::standards::SRS_TOLERANCE_SOURCE,
+            ),
+        );
+    }
     if let Some(s) = results
         .iter()
         .find_map(|e| e.analysis.as_ref()?.spec.clone())
@@ -123,7 +157,11 @@ fn page(cmd: &AnalyzeCommand, results: &[EntryJson]) -> String {
     }
     h.push_str("</dl>\n");
     // The series table.
-    h.push_str("<h2>Impacts</h2><table><tr><th class=\"l\">file</th><th class=\"l\">channel</th><th>#</th><th>start</th><th>peak (g)</th><th>peak (m/s²)</th><th>Δv</th><th>duration</th><th>FWHM</th><th>COR</th><th class=\"l\">status</th><th class=\"l\">verdict</th></tr>\n");
+    h.push_str("<h2>Impacts</h2><table><tr><th class=\"l\">file</th><th class=\"l\">channel</th><th>#</th><th>start</th><th>peak (g)</th><th>peak (m/s²)</th><th>Δv</th><th>duration</th><th>FWHM</th><th>COR</th><th class=\"l\">status</th><th class=\"l\">verdict</th>");
+    if required.is_some() {
+        h.push_str("<th class=\"l\">SRS within −1.5/+3 dB of required</th>");
+    }
+    h.push_str("</tr>\n");
     for (e, i) in series::impacts(results) {
         let o = |v: Option<f64>, u: &str| {
             v.map_or("—".into(), |v| human(v, u).trim_end().to_string())
@@ -155,6 +193,26 @@ fn page(cmd: &AnalyzeCommand, results: &[EntryJson]) -> String {
             o(i.cor, ""),
             esc(&std::iter::once(i.status.as_str()).chain(i.flags.iter().map(String::as_str)).collect::<Vec<_>>().join(" ")),
         );
+        if let Some(r) = required {
+            let cell = match &i.shock_spectrum {
+                Some(sp) => {
+                    let c = srs_required::compare(r, &sp.frequency_hz, &sp.srs_m_s2);
+                    let class = match c {
+                        Some(c) if c.within => " pass",
+                        Some(_) => " fail",
+                        None => "",
+                    };
+                    format!(
+                        "<td class=\"l{class}\">{}</td>",
+                        esc(&srs_required::cell(c.as_ref()))
+                    )
+                }
+                None => "<td class=\"l\">no SRS (see its status)</td>".to_string(),
+            };
+            // The row's last cell, before its end.
+            h.truncate(h.len() - "</tr>\n".len());
+            let _ = writeln!(h, "{cell}</tr>");
+        }
     }
     h.push_str("</table>\n");
     for e in results {
@@ -218,6 +276,55 @@ fn page(cmd: &AnalyzeCommand, results: &[EntryJson]) -> String {
             let _ = writeln!(h, "<div class=\"figure\">{f}</div>");
         }
     }
+    if let Some(r) = required {
+        spectra(&mut h, results, r);
+    }
     h.push_str("</body></html>\n");
     h
+}
+
+/// The section of each impact's SRS drawn over the required one (at most [`MAX_FIGURES`]).
+fn spectra(h: &mut String, results: &[EntryJson], required: &RequiredSrs) {
+    h.push_str("<h2>Shock response spectra against the required SRS</h2>\n");
+    let (low, high) = crate::standards::SRS_TOLERANCE_DB;
+    let _ = writeln!(
+        h,
+        "<p>Each impact's SRS (maximax absolute acceleration) over the required SRS of {}, its tolerance ({low:+} dB, {high:+} dB, {}) dashed.</p>",
+        esc(&required.file),
+        crate::standards::SRS_TOLERANCE_SOURCE
+    );
+    let mut drawn = 0;
+    for (e, i) in series::impacts(results) {
+        let Some(sp) = &i.shock_spectrum else {
+            continue;
+        };
+        if drawn == MAX_FIGURES {
+            let _ = writeln!(
+                h,
+                "<p>The first {MAX_FIGURES} spectra are drawn; the table judges them all.</p>"
+            );
+            break;
+        }
+        let name = std::path::Path::new(&e.file)
+            .file_name()
+            .map_or_else(|| e.file.clone(), |n| n.to_string_lossy().into_owned());
+        let title = format!(
+            "{name} [{}] impact {}: SRS, m/s² (left), g (right)",
+            e.channel, i.index
+        );
+        match srs_required::svg(&title, &sp.frequency_hz, &sp.srs_m_s2, required) {
+            Ok(svg) => {
+                let _ = writeln!(h, "<div class=\"figure\">{svg}</div>");
+                drawn += 1;
+            }
+            Err(err) => {
+                let _ = writeln!(
+                    h,
+                    "<p class=\"fail\">{}: not drawn: {}</p>",
+                    esc(&title),
+                    esc(&err)
+                );
+            }
+        }
+    }
 }

@@ -35,8 +35,8 @@ pub struct LogArgs {
     #[arg(long, help_heading = "Input")]
     pub elf: Option<PathBuf>,
     /// Draw the impacts from the board's waveforms (the figure of `impact analyze --plot`)
-    /// to this SVG file.
-    #[arg(short = 'p', long, help_heading = "Output", value_name = "FILE.svg")]
+    /// to this SVG or PNG file (by its extension).
+    #[arg(short = 'p', long, help_heading = "Output", value_name = "FILE")]
     pub plot: Option<PathBuf>,
     /// Write each waveform as a recording `impact analyze` reads: `NAME.csv` (time_s,
     /// accel_m_s2) or `NAME.wav` (16-bit counts, give `--gain`), one file per impact,
@@ -157,8 +157,17 @@ fn report(args: &LogArgs, reader: LogReader, name: &str) -> Result<(), String> {
             }
             let mass: Option<f32> = opt(scene, "mass_kg")?;
             let waves = &log.waveforms;
+            // The board sends the impact's window only: not the samples around it that its
+            // CFC filtered.
+            let cfc = scene.get("cfc").filter(|c| c.as_str() != "none");
             let signal = crate::plot::Signal {
-                title: format!("{name}: the board's captured windows, m/s² above the baseline"),
+                title: format!(
+                    "{name}: the board's captured windows, m/s² above the baseline{}",
+                    cfc.map_or(String::new(), |c| format!(
+                        " (raw: the windows hold too little for its CFC {c} trace)"
+                    ))
+                ),
+                cfc: None,
                 rate_hz: rate,
                 mass_kg: mass.map(f64::from),
                 accel_m_s2: Box::new(move |i| {

@@ -10,5 +10,6 @@ pub mod progress;
 pub mod pulse;
 pub mod series;
 pub mod simulate;
+pub mod srs_required;
 pub mod synth;
 pub mod watch;

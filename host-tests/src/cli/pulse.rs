@@ -7,6 +7,7 @@ use std::fmt::Write as _;
 use impact_core::consts::STANDARD_GRAVITY;
 use impact_core::spec::Spec;
 
+use crate::plot::ticks::{linear_ticks, tick};
 use crate::report::fmt::human;
 
 /// The largest number of impacts drawn (each figure is a few kB; the table has them all).
@@ -20,32 +21,18 @@ pub fn esc(s: &str) -> String {
         .replace('"', "&quot;")
 }
 
+/// A pixel column of a pulse: time (s) and the least and greatest acceleration there (m/s²).
+pub type Column = (f64, f64, f64);
+
 /// A pulse drawn: `(t_s, a_m_s2)` min/max pairs per pixel column over the window from
-/// `from_s`, the title, and the specification's nominal pulse and band placed at `start_s`.
+/// `from_s`, the title, the CFC-filtered trace's, and the specification's nominal pulse and
+/// band placed at `start_s`.
 pub struct Pulse<'a> {
     pub title: String,
-    /// Per column: time (s) and the least and greatest acceleration there (m/s²).
-    pub columns: Vec<(f64, f64, f64)>,
+    pub columns: Vec<Column>,
+    /// The CFC-filtered signal's columns, likewise, and its legend (`CFC 1000`).
+    pub filtered: Option<(String, Vec<Column>)>,
     pub spec: Option<(&'a Spec, f64)>,
-}
-
-/// Ticks at 1, 2 or 5 × 10^k covering `[lo, hi]`, about `n` of them.
-fn ticks(lo: f64, hi: f64, n: usize) -> Vec<f64> {
-    let span = (hi - lo).abs().max(f64::MIN_POSITIVE);
-    let raw = span / n as f64;
-    let mag = 10f64.powf(raw.log10().floor());
-    let step = [1.0, 2.0, 5.0, 10.0]
-        .iter()
-        .map(|m| m * mag)
-        .find(|s| *s >= raw)
-        .unwrap_or(10.0 * mag);
-    let mut t = (lo / step).ceil() * step;
-    let mut out = Vec::new();
-    while t <= hi + step * 1e-9 && out.len() < 50 {
-        out.push(if t.abs() < step * 1e-9 { 0.0 } else { t });
-        t += step;
-    }
-    out
 }
 
 /// A tick's label: as few digits as the step needs.
@@ -54,13 +41,14 @@ fn label(v: f64, step: f64) -> String {
     format!("{v:.decimals$}")
 }
 
-/// The pulse as an inline SVG: acceleration in g against time in ms from the window's start,
-/// the measured signal as a min/max band per column, the band and the nominal pulse dashed.
+/// The pulse as an inline SVG: acceleration in g (left; m/s² on the right) against time in ms
+/// from the window's start, the measured signal as a min/max band per column, the band and
+/// the nominal pulse dashed.
 pub fn svg(p: &Pulse) -> String {
-    const W: f64 = 520.0;
+    const W: f64 = 530.0;
     const H: f64 = 300.0;
-    const L: f64 = 58.0;
-    const R: f64 = 12.0;
+    const L: f64 = 54.0;
+    const R: f64 = 56.0;
     const T: f64 = 30.0;
     const B: f64 = 42.0;
     let Some(&(t_first, _, _)) = p.columns.first() else {
@@ -89,14 +77,41 @@ pub fn svg(p: &Pulse) -> String {
     let (mut y_lo, mut y_hi) = p
         .columns
         .iter()
+        .chain(p.filtered.iter().flat_map(|f| f.1.iter()))
         .fold((0.0f64, 0.0f64), |(lo, hi), c| (lo.min(c.1), hi.max(c.2)));
     for b in &band {
         y_lo = y_lo.min(b.1);
         y_hi = y_hi.max(b.2);
     }
     let pad = 0.05 * (y_hi - y_lo).max(1e-9);
-    let (y_lo, y_hi) = (y_lo - pad, y_hi + pad);
+    let (y_lo, mut y_hi) = (y_lo - pad, y_hi + pad);
     let x = |t: f64| L + (t - t_first) / (t_last - t_first).max(1e-12) * (W - L - R);
+    // The legend: in the upper right corner, or the left, whichever the curves leave free;
+    // else the right, with the range raised until they pass below it.
+    let entries = 1 + usize::from(p.filtered.is_some()) + usize::from(!band.is_empty());
+    let legend_px = 14.0 * entries as f64 + 8.0;
+    let highest = |from_px: f64, to_px: f64| {
+        let within = |t: f64| (from_px..=to_px).contains(&x(t));
+        p.columns
+            .iter()
+            .chain(p.filtered.iter().flat_map(|f| f.1.iter()))
+            .filter(|c| within(c.0))
+            .map(|c| c.2)
+            .chain(band.iter().filter(|b| within(b.0)).map(|b| b.2))
+            .fold(f64::NEG_INFINITY, f64::max)
+    };
+    let free = |top: f64| (y_hi - top) / (y_hi - y_lo) * (H - T - B) > legend_px;
+    let (right, left) = (W - R - 168.0, L + 4.0);
+    let right_top = highest(right, W - R);
+    let legend_x = if free(right_top) {
+        right
+    } else if free(highest(left, left + 168.0)) {
+        left
+    } else {
+        let f = legend_px / (H - T - B);
+        y_hi = (right_top - f * y_lo) / (1.0 - f);
+        right
+    };
     let y = |a: f64| T + (y_hi - a) / (y_hi - y_lo) * (H - T - B);
     let mut s = String::new();
     let _ = write!(
@@ -107,17 +122,23 @@ pub fn svg(p: &Pulse) -> String {
     let _ = write!(s, "<text x=\"{}\" y=\"16\" text-anchor=\"middle\" font-size=\"12\" font-weight=\"bold\">{}</text>", W / 2.0, esc(&p.title));
     // Grid and ticks: time in ms from the window's start, acceleration in g.
     let span_ms = (t_last - t_first) * 1e3;
-    let xt = ticks(0.0, span_ms, 6);
+    let xt = linear_ticks(0.0, span_ms, 6);
     let xstep = xt.get(1).zip(xt.first()).map_or(1.0, |(b, a)| b - a);
     for v in &xt {
         let px = x(t_first + v * 1e-3);
         let _ = write!(s, "<line x1=\"{px:.1}\" y1=\"{T}\" x2=\"{px:.1}\" y2=\"{}\" stroke=\"#eee\"/><text x=\"{px:.1}\" y=\"{}\" text-anchor=\"middle\">{}</text>", H - B, H - B + 14.0, label(*v, xstep));
     }
-    let yt = ticks(y_lo / g, y_hi / g, 6);
+    let yt = linear_ticks(y_lo / g, y_hi / g, 6);
     let ystep = yt.get(1).zip(yt.first()).map_or(1.0, |(b, a)| b - a);
     for v in &yt {
         let py = y(v * g);
         let _ = write!(s, "<line x1=\"{L}\" y1=\"{py:.1}\" x2=\"{}\" y2=\"{py:.1}\" stroke=\"#eee\"/><text x=\"{}\" y=\"{:.1}\" text-anchor=\"end\">{}</text>", W - R, L - 4.0, py + 4.0, label(*v, ystep));
+    }
+    // The same range in m/s² on the right.
+    let yt = linear_ticks(y_lo, y_hi, 6);
+    for v in &yt {
+        let py = y(*v);
+        let _ = write!(s, "<line x1=\"{}\" y1=\"{py:.1}\" x2=\"{}\" y2=\"{py:.1}\" stroke=\"#999\"/><text x=\"{}\" y=\"{:.1}\">{}</text>", W - R, W - R + 4.0, W - R + 6.0, py + 4.0, tick(*v));
     }
     let _ = write!(
         s,
@@ -133,6 +154,7 @@ pub fn svg(p: &Pulse) -> String {
         t_first * 1e3
     );
     let _ = write!(s, "<text transform=\"translate(14 {}) rotate(-90)\" text-anchor=\"middle\">acceleration (g)</text>", (T + H - B) / 2.0);
+    let _ = write!(s, "<text transform=\"translate({} {}) rotate(90)\" text-anchor=\"middle\">acceleration (m/s²)</text>", W - 12.0, (T + H - B) / 2.0);
     // The band (shaded between its limits) and the nominal pulse (dashed).
     if !band.is_empty() {
         let mut d = String::new();
@@ -159,31 +181,72 @@ pub fn svg(p: &Pulse) -> String {
             pts.join(" ")
         );
     }
-    // The measured signal: each column's extremes joined.
-    let mut d = String::new();
-    for (k, c) in p.columns.iter().enumerate() {
+    // The measured signal, and the filtered one: each column's extremes joined.
+    let path = |columns: &[Column]| {
+        let mut d = String::new();
+        for (k, c) in columns.iter().enumerate() {
+            let _ = write!(
+                d,
+                "{}{:.1},{:.1} L{:.1},{:.1}",
+                if k == 0 { "M" } else { " L" },
+                x(c.0),
+                y(c.1),
+                x(c.0),
+                y(c.2)
+            );
+        }
+        d
+    };
+    let _ = write!(
+        s,
+        "<path d=\"{}\" fill=\"none\" stroke=\"{RAW}\" stroke-width=\"1.2\"/>",
+        path(&p.columns)
+    );
+    if let Some((_, f)) = &p.filtered {
         let _ = write!(
-            d,
-            "{}{:.1},{:.1} L{:.1},{:.1}",
-            if k == 0 { "M" } else { " L" },
-            x(c.0),
-            y(c.1),
-            x(c.0),
-            y(c.2)
+            s,
+            "<path d=\"{}\" fill=\"none\" stroke=\"{FILTERED}\" stroke-width=\"1.8\"/>",
+            path(f)
         );
+    }
+    // The legend, on white.
+    let raw_stroke = format!("stroke=\"{RAW}\" stroke-width=\"1.5\"");
+    let filtered_stroke = format!("stroke=\"{FILTERED}\" stroke-width=\"1.8\"");
+    let mut entries = vec![(raw_stroke.as_str(), "measured")];
+    if let Some((label, _)) = &p.filtered {
+        entries[0].1 = "raw";
+        entries.push((filtered_stroke.as_str(), label.as_str()));
+    }
+    if !band.is_empty() {
+        entries.push((
+            "stroke=\"#4a90d9\" stroke-dasharray=\"5 3\"",
+            "nominal, tolerance band",
+        ));
     }
     let _ = write!(
         s,
-        "<path d=\"{d}\" fill=\"none\" stroke=\"#c0392b\" stroke-width=\"1.2\"/>"
+        "<g transform=\"translate({} {})\"><rect x=\"-4\" y=\"-8\" width=\"162\" height=\"{}\" fill=\"white\" fill-opacity=\"0.85\" stroke=\"#ccc\"/>",
+        legend_x + 4.0,
+        T + 11.0,
+        14 * entries.len() + 2
     );
-    // The legend.
-    let _ = write!(s, "<g transform=\"translate({} {})\"><line x1=\"0\" y1=\"0\" x2=\"18\" y2=\"0\" stroke=\"#c0392b\" stroke-width=\"1.5\"/><text x=\"22\" y=\"4\">measured</text>", W - R - 150.0, T + 12.0);
-    if !band.is_empty() {
-        s.push_str("<line x1=\"0\" y1=\"14\" x2=\"18\" y2=\"14\" stroke=\"#4a90d9\" stroke-dasharray=\"5 3\"/><text x=\"22\" y=\"18\">nominal, tolerance band</text>");
+    for (k, (stroke, text)) in entries.iter().enumerate() {
+        let y = 14 * k;
+        let _ = write!(
+            s,
+            "<line x1=\"0\" y1=\"{y}\" x2=\"18\" y2=\"{y}\" {stroke}/><text x=\"22\" y=\"{}\">{text}</text>",
+            y + 4
+        );
     }
     s.push_str("</g></svg>");
     s
 }
+
+/// The raw signal's colour.
+const RAW: &str = "#c0392b";
+
+/// The CFC-filtered signal's colour: dark, over the raw one.
+const FILTERED: &str = "#192d78";
 
 /// Columns a pulse is drawn in (each its samples' least and greatest value).
 const COLUMNS: u64 = 400;
@@ -223,24 +286,48 @@ pub fn pulse_svg(
     let i1 = ((to_s * rate).ceil().max(0.0) as u64).max(i0 + 1);
     let n = i1 - i0;
     let cols = COLUMNS.min(n);
-    let columns = (0..cols)
-        .filter_map(|c| {
-            let (a, b) = (i0 + c * n / cols, i0 + (c + 1) * n / cols);
-            let (lo, hi) = (a..b.max(a + 1))
-                .filter_map(|i| (signal.accel_m_s2)(i))
-                .map(|v| sign * (v - base))
-                .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), v| {
-                    (lo.min(v), hi.max(v))
+    // Each column's least and greatest value of `a` (m/s² above the baseline, by sample), in
+    // the direction of the peak.
+    let columns = |a: &dyn Fn(u64) -> Option<f64>| -> Vec<Column> {
+        (0..cols)
+            .filter_map(|c| {
+                let (from, to) = (i0 + c * n / cols, i0 + (c + 1) * n / cols);
+                let (lo, hi) = (from..to.max(from + 1))
+                    .filter_map(a)
+                    .map(|v| sign * v)
+                    .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), v| {
+                        (lo.min(v), hi.max(v))
+                    });
+                (lo <= hi).then_some((from as f64 / rate, lo, hi))
+            })
+            .collect()
+    };
+    let raw = columns(&|i| Some((signal.accel_m_s2)(i)? - base));
+    let g = |a: f32| human(f64::from(a) / STANDARD_GRAVITY, "g");
+    let mut peak = format!("peak {}", g(r.peak_acceleration_m_s2));
+    let mut filtered = None;
+    if let Some((class, _)) = signal.cfc {
+        let class = class.class();
+        match (
+            crate::plot::filtered(signal, r),
+            r.filtered_peak_acceleration_m_s2,
+        ) {
+            (Some((first, values)), Some(f)) => {
+                let trace = columns(&|i| {
+                    values
+                        .get(usize::try_from(i.checked_sub(first)?).ok()?)
+                        .copied()
                 });
-            (lo <= hi).then_some((a as f64 / rate, lo, hi))
-        })
-        .collect();
+                peak = format!("{peak} raw, {} CFC {class}", g(f));
+                filtered = Some((format!("CFC {class}"), trace));
+            }
+            _ => peak = format!("{peak} raw (CFC {class}: not drawn)"),
+        }
+    }
     svg(&Pulse {
-        title: format!(
-            "{title}: peak {}",
-            human(f64::from(r.peak_acceleration_m_s2) / STANDARD_GRAVITY, "g")
-        ),
-        columns,
+        title: format!("{title}: {peak}"),
+        columns: raw,
+        filtered,
         spec: placed,
     })
 }
@@ -251,14 +338,36 @@ mod tests {
 
     #[test]
     fn ticks_are_round_numbers_covering_the_range() {
-        assert_eq!(ticks(0.0, 10.0, 5), [0.0, 2.0, 4.0, 6.0, 8.0, 10.0]);
-        assert_eq!(ticks(-3.0, 12.0, 6), [0.0, 5.0, 10.0]);
+        assert_eq!(linear_ticks(0.0, 10.0, 5), [0.0, 2.0, 4.0, 6.0, 8.0, 10.0]);
+        assert_eq!(linear_ticks(-3.0, 12.0, 6), [0.0, 5.0, 10.0]);
         assert_eq!(
-            ticks(-3.0, 12.0, 10),
+            linear_ticks(-3.0, 12.0, 10),
             [-2.0, 0.0, 2.0, 4.0, 6.0, 8.0, 10.0, 12.0]
         );
         assert_eq!(label(0.25, 0.05), "0.25");
         assert_eq!(label(12000.0, 2000.0), "12000");
         assert_eq!(esc("a<b&\"c\""), "a&lt;b&amp;&quot;c&quot;");
+    }
+
+    #[test]
+    fn the_pulse_is_in_g_with_m_s2_on_the_right() {
+        // A 10 g step: g ticks 0–10 on the left, m/s² 0–100 on the right.
+        let g = STANDARD_GRAVITY;
+        let s = svg(&Pulse {
+            title: "step".into(),
+            columns: (0..100)
+                .map(|k| (f64::from(k) * 1e-5, 0.0, 10.0 * g))
+                .collect(),
+            filtered: None,
+            spec: None,
+        });
+        for want in [
+            ">acceleration (g)</text>",
+            ">acceleration (m/s²)</text>",
+            ">10</text>",
+            ">100</text>",
+        ] {
+            assert!(s.contains(want), "{want} missing");
+        }
     }
 }

@@ -217,13 +217,12 @@ fn analyze_one(args: &AnalyzeArgs, entry: &Entry, draw: bool) -> EntryJson {
     }
     let title = |r: &impact_core::ImpactReport, channel: &str| {
         format!(
-            "{} [{channel}] impact {}{}",
+            "{} [{channel}] impact {}",
             entry.file.file_name().map_or_else(
                 || entry.file.display().to_string(),
                 |n| n.to_string_lossy().into_owned()
             ),
             r.index,
-            args.cfc.map_or(String::new(), |c| format!(", CFC {c}"))
         )
     };
     let (result, notes) = impact_io::with_own_notes(|| {

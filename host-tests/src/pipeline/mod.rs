@@ -191,14 +191,17 @@ impl Setup {
     pub fn plot_signal(&self) -> crate::plot::Signal<'_> {
         crate::plot::Signal {
             title: format!(
-                "{}{}: {}",
+                "{}: raw signal above its baseline, m/s²{}",
                 self.column.as_deref().unwrap_or("acceleration"),
                 self.scene.cfc.map_or(String::new(), |c| format!(
-                    ", CFC {} on the windows",
+                    "; CFC {} (SAE J211, phaseless) over the deceleration",
                     c.class()
                 )),
-                "raw signal above its baseline, m/s²"
             ),
+            cfc: self
+                .scene
+                .cfc
+                .map(|c| (c, u64::from(self.scene.padding_samples()))),
             rate_hz: f64::from(self.scene.calibration.sample_rate_hz),
             mass_kg: self.scene.mass_kg.map(f64::from),
             accel_m_s2: Box::new(move |i| {

@@ -218,8 +218,9 @@ pub struct AnalyzeArgs {
     /// Print one CSV row per impact.
     #[arg(long, help_heading = "Output")]
     pub csv: bool,
-    /// Draw acceleration, velocity and deformation with the fitted models into this SVG file.
-    #[arg(short = 'p', long, help_heading = "Output", value_name = "FILE.svg")]
+    /// Draw acceleration, velocity and deformation with the fitted models into this SVG or PNG
+    /// file (by its extension).
+    #[arg(short = 'p', long, help_heading = "Output", value_name = "FILE")]
     pub plot: Option<PathBuf>,
 }
 

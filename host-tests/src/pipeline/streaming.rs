@@ -241,10 +241,11 @@ fn in_passes_then(
     let windows = match &args.plot {
         Some(_) => {
             let rate = f64::from(calibration.sample_rate_hz);
+            let padding = u64::from(scene.padding_samples());
             let spans: Vec<(u64, u64)> = reports
                 .iter()
                 .take(crate::plot::SHOWN)
-                .map(|r| crate::plot::window(r, rate))
+                .map(|r| crate::plot::read_window(r, rate, padding))
                 .collect();
             let (mut source, scale) = reopen(None)?;
             let head = read_head(&mut *source, scale)?;

@@ -62,12 +62,14 @@ pub fn wall_contact(
                 measured: Vec::new(),
                 measured_label: "",
                 models: c,
+                dashed: Vec::new(),
                 log: false,
+                g_axis: false,
                 legend: j == 0,
             };
             draw_panel(&areas[j], None, &p)?;
         }
         root.present().map_err(|e| e.to_string())?;
     }
-    crate::output::write(path, text.as_bytes())
+    crate::plot::write_figure(path, &text)
 }

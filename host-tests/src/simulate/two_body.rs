@@ -29,10 +29,10 @@ pub struct TargetArgs {
     /// and velocity (m/s), at most 6 states.
     #[arg(long, help_heading = "Target")]
     pub target: Option<PathBuf>,
-    /// Draw into this SVG: against a wall the deformation, velocity and force against time and
+    /// Draw into this SVG or PNG (by its extension): against a wall the deformation, velocity and force against time and
     /// the force against deformation; on a target the impactor's and target's displacement,
     /// velocity and the contact force over the contact and the ring-down.
-    #[arg(short = 'p', long, help_heading = "Output", value_name = "FILE.svg")]
+    #[arg(short = 'p', long, help_heading = "Output", value_name = "FILE")]
     pub plot: Option<PathBuf>,
 }
 
@@ -510,5 +510,5 @@ fn plot(
         }
         root.present().map_err(|e| e.to_string())?;
     }
-    crate::output::write(path, text.as_bytes())
+    crate::plot::write_figure(path, &text)
 }

@@ -1,0 +1,260 @@
+//! The required SRS of `impact report --srs-required FILE`: read from a CSV, each impact's
+//! measured SRS judged against it within MIL-STD-810H's −1.5/+3 dB, and drawn over it.
+
+use std::path::Path;
+
+use impact_core::consts::STANDARD_GRAVITY;
+use plotters::prelude::*;
+
+use crate::plot::{draw_panel, svg_text, Panel};
+use crate::report::fmt::human;
+use crate::standards::SRS_TOLERANCE_DB;
+
+/// Breakpoints a required SRS may have at most (a specification has a handful).
+const MAX_POINTS: usize = 10_000;
+
+/// A required SRS: its breakpoints (natural frequency, Hz; acceleration, m/s²), the
+/// frequencies increasing, straight between them on log–log axes (a constant dB/octave slope).
+pub struct RequiredSrs {
+    /// The file, as given.
+    pub file: String,
+    points: Vec<(f64, f64)>,
+}
+
+impl RequiredSrs {
+    /// Reads a CSV with a header naming `frequency_hz` and `acceleration_m_s2` or
+    /// `acceleration_g` (other columns ignored): at least two rows, frequencies increasing,
+    /// every value a positive number.
+    pub fn read(path: &Path) -> Result<Self, String> {
+        let file = path.display().to_string();
+        let err = |what: String| format!("--srs-required {file}: {what}");
+        let mut reader = csv::ReaderBuilder::new()
+            .trim(csv::Trim::All)
+            .from_path(path)
+            .map_err(|e| err(e.to_string()))?;
+        let header = reader.headers().map_err(|e| err(e.to_string()))?.clone();
+        let column = |name: &str| header.iter().position(|h| h.eq_ignore_ascii_case(name));
+        let (Some(f_col), acceleration) = (
+            column("frequency_hz"),
+            column("acceleration_m_s2")
+                .map(|c| (c, 1.0))
+                .or_else(|| column("acceleration_g").map(|c| (c, STANDARD_GRAVITY))),
+        ) else {
+            return Err(err(format!(
+                "needs the columns frequency_hz and acceleration_m_s2 (or acceleration_g); its header is {:?}",
+                header.iter().collect::<Vec<_>>().join(",")
+            )));
+        };
+        let Some((a_col, scale)) = acceleration else {
+            return Err(err(
+                "needs a column acceleration_m_s2 (or acceleration_g)".into()
+            ));
+        };
+        let mut points: Vec<(f64, f64)> = Vec::new();
+        for row in reader.records() {
+            let row = row.map_err(|e| err(e.to_string()))?;
+            let line = row.position().map_or(0, csv::Position::line);
+            let value = |col: usize, name: &str| -> Result<f64, String> {
+                let text = row.get(col).unwrap_or("");
+                match text.parse::<f64>() {
+                    Ok(v) if v.is_finite() && v > 0.0 => Ok(v),
+                    _ => Err(err(format!(
+                        "line {line}: {name} {text:?} is not a positive number"
+                    ))),
+                }
+            };
+            let f = value(f_col, "frequency_hz")?;
+            let a = value(a_col, &header[a_col])? * scale;
+            if let Some(&(last, _)) = points.last() {
+                if f <= last {
+                    return Err(err(format!(
+                        "line {line}: frequency_hz {f} does not increase (after {last})"
+                    )));
+                }
+            }
+            if points.len() == MAX_POINTS {
+                return Err(err(format!("more than {MAX_POINTS} breakpoints")));
+            }
+            points.push((f, a));
+        }
+        if points.len() < 2 {
+            return Err(err("needs at least two breakpoints".into()));
+        }
+        Ok(Self { file, points })
+    }
+
+    /// The breakpoints: (natural frequency, Hz; acceleration, m/s²).
+    pub fn points(&self) -> &[(f64, f64)] {
+        &self.points
+    }
+
+    /// The required acceleration at `f_hz`, m/s² (log–log between the breakpoints); `None`
+    /// outside them.
+    pub fn at(&self, f_hz: f64) -> Option<f64> {
+        let (first, last) = (self.points[0].0, self.points[self.points.len() - 1].0);
+        // A hair of slack: band centres computed as 1000 × 2^(k/n) are not always the
+        // literal a file gives.
+        let f = if (f_hz - first).abs() <= first * 1e-9 {
+            first
+        } else if (f_hz - last).abs() <= last * 1e-9 {
+            last
+        } else {
+            f_hz
+        };
+        if !(first..=last).contains(&f) {
+            return None;
+        }
+        let k = self
+            .points
+            .windows(2)
+            .position(|w| f <= w[1].0)
+            .unwrap_or(self.points.len() - 2);
+        let ((f0, a0), (f1, a1)) = (self.points[k], self.points[k + 1]);
+        let u = (f / f0).ln() / (f1 / f0).ln();
+        Some(a0 * (a1 / a0).powf(u))
+    }
+}
+
+/// A measured SRS against the required one over the natural frequencies both have.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Comparison {
+    /// Within [`SRS_TOLERANCE_DB`] at every one of them.
+    pub within: bool,
+    /// Where the measured SRS is nearest to a limit, or furthest beyond one, Hz.
+    pub worst_hz: f64,
+    /// The measured SRS there over the required, dB.
+    pub worst_db: f64,
+    /// The natural frequencies compared.
+    pub compared: usize,
+}
+
+/// The measured SRS (`srs_m_s2` at `frequency_hz`) against `required` at every natural
+/// frequency where both are defined (a measured value positive and finite, the frequency
+/// within the required breakpoints); `None` where there is none.
+pub fn compare(
+    required: &RequiredSrs,
+    frequency_hz: &[f64],
+    srs_m_s2: &[f64],
+) -> Option<Comparison> {
+    let (low, high) = SRS_TOLERANCE_DB;
+    // Beyond the nearer limit, dB (negative: inside by that much).
+    let excess = |db: f64| (db - high).max(low - db);
+    let mut worst: Option<Comparison> = None;
+    for (&f, &a) in frequency_hz.iter().zip(srs_m_s2) {
+        let Some(r) = required.at(f) else { continue };
+        if !(a.is_finite() && a > 0.0) {
+            continue;
+        }
+        let db = 20.0 * (a / r).log10();
+        let compared = worst.map_or(0, |w| w.compared) + 1;
+        let within = worst.is_none_or(|w| w.within) && excess(db) <= 0.0;
+        worst = Some(match worst {
+            Some(w) if excess(w.worst_db) >= excess(db) => Comparison {
+                within,
+                compared,
+                ..w
+            },
+            _ => Comparison {
+                within,
+                worst_hz: f,
+                worst_db: db,
+                compared,
+            },
+        });
+    }
+    worst
+}
+
+/// The report's cell: `yes, worst at 1250 Hz, +2.10 dB` (or `no, …`), or why not compared.
+pub fn cell(c: Option<&Comparison>) -> String {
+    match c {
+        Some(c) => format!(
+            "{}, worst at {}, {:+.2} dB",
+            if c.within { "yes" } else { "no" },
+            human(c.worst_hz, "Hz").trim_end(),
+            c.worst_db
+        ),
+        None => "not compared (no natural frequency in both)".into(),
+    }
+}
+
+/// The measured SRS and the required one with its tolerance's limits dashed, log–log in m/s²
+/// (g on the right), titled `title`: an inline SVG for the report.
+pub fn svg(
+    title: &str,
+    frequency_hz: &[f64],
+    srs_m_s2: &[f64],
+    required: &RequiredSrs,
+) -> Result<String, String> {
+    let (low, high) = SRS_TOLERANCE_DB;
+    let scaled = |db: f64| -> Vec<(f64, f64)> {
+        let k = 10f64.powf(db / 20.0);
+        required.points.iter().map(|&(f, a)| (f, a * k)).collect()
+    };
+    const REQUIRED: RGBColor = RGBColor(30, 30, 30);
+    const LIMIT: RGBColor = RGBColor(110, 110, 110);
+    let panel = Panel {
+        title,
+        x_label: "natural frequency, Hz",
+        measured: frequency_hz
+            .iter()
+            .copied()
+            .zip(srs_m_s2.iter().copied())
+            .collect(),
+        measured_label: "measured SRS",
+        models: vec![("required", REQUIRED, scaled(0.0))],
+        dashed: vec![
+            ("+3 dB", LIMIT, scaled(high)),
+            ("−1.5 dB", LIMIT, scaled(low)),
+        ],
+        log: true,
+        g_axis: true,
+        legend: true,
+    };
+    svg_text((530, 340), |root| {
+        root.fill(&WHITE).map_err(|e| e.to_string())?;
+        draw_panel(root, None, &panel)
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn required(points: &[(f64, f64)]) -> RequiredSrs {
+        RequiredSrs {
+            file: "test.csv".into(),
+            points: points.to_vec(),
+        }
+    }
+
+    #[test]
+    fn the_required_srs_is_straight_on_log_log_axes_between_breakpoints() {
+        // +6 dB/octave from 100 Hz to 1 kHz, flat to 10 kHz.
+        let r = required(&[(100.0, 10.0), (1000.0, 100.0), (10_000.0, 100.0)]);
+        assert_eq!(r.at(99.0), None);
+        assert_eq!(r.at(10_001.0), None);
+        assert!((r.at(316.227_766).unwrap() - 31.622_776_6).abs() < 1e-6);
+        assert!((r.at(5000.0).unwrap() - 100.0).abs() < 1e-9);
+        assert_eq!(r.at(100.000_000_01), Some(10.0));
+    }
+
+    #[test]
+    fn a_measured_srs_is_within_the_tolerance_or_named_where_it_is_worst() {
+        let r = required(&[(100.0, 100.0), (1000.0, 100.0)]);
+        let db = |d: f64| 100.0 * 10f64.powf(d / 20.0);
+        // Inside: the nearest a limit is +2.5 dB at 400 Hz; 50 Hz and 2 kHz not compared.
+        let f = [50.0, 100.0, 200.0, 400.0, 800.0, 2000.0];
+        let c = compare(&r, &f, &[1.0, db(0.0), db(-1.0), db(2.5), db(0.5), 1.0]).unwrap();
+        assert!(c.within && c.worst_hz == 400.0 && c.compared == 4, "{c:?}");
+        assert!((c.worst_db - 2.5).abs() < 1e-9);
+        assert_eq!(cell(Some(&c)), "yes, worst at 400.0 Hz, +2.50 dB");
+        // Outside: −2 dB at 200 Hz is beyond −1.5 dB by more than +3.4 dB is beyond +3.
+        let c = compare(&r, &f, &[1.0, db(3.4), db(-2.0), db(0.0), db(0.0), 1.0]).unwrap();
+        assert!(!c.within && c.worst_hz == 200.0, "{c:?}");
+        assert_eq!(cell(Some(&c)), "no, worst at 200.0 Hz, -2.00 dB");
+        // Nothing in common.
+        assert_eq!(compare(&r, &[20.0, 5000.0], &[1.0, 1.0]), None);
+        assert!(cell(None).starts_with("not compared"));
+    }
+}

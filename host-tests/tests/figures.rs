@@ -1,0 +1,237 @@
+//! The figures as a user sees them: the CFC trace drawn is the analysis's own filter, the
+//! g axis, the log axes' decades, the PNG.
+
+use std::path::PathBuf;
+
+use impact_host::pipeline::{self, AnalyzeArgs};
+use impact_io::channel::ColumnRef;
+
+mod common;
+use common::impact_ok;
+
+fn dir() -> PathBuf {
+    let d =
+        PathBuf::from(env!("CARGO_TARGET_TMPDIR")).join(format!("figures-{}", std::process::id()));
+    std::fs::create_dir_all(&d).unwrap();
+    d
+}
+
+fn data(rel: &str) -> PathBuf {
+    PathBuf::from(env!("CARGO_MANIFEST_DIR"))
+        .join("data")
+        .join(rel)
+}
+
+/// The analysis's CFC-filtered peak, as the report has it: the trace drawn reaches it (to the
+/// rounding of its f32 input) in the impact's window, read in passes and whole.
+#[test]
+fn the_cfc_trace_drawn_is_the_analysis_s_filter() {
+    let mut compared = 0;
+    for (rel, column) in [
+        ("afrl-drop-tower/series1_test1_full_100ms.csv", 1),
+        ("afrl-drop-tower/accel_5.csv", 3),
+        ("endaq-high-drop/High-Drop_2000g-PE_13.4-15.0s.csv", 1),
+        ("impack-water-entry/4mps_sphere_1_100g-PR_9.9-10.6s.csv", 1),
+        ("pyfrf-impact-hammer/measurement_1.csv", 1),
+    ] {
+        for class in [60, 180, 600, 1000] {
+            // Read in passes (the figure's windows kept) and whole.
+            for whole in [false, true] {
+                let args = AnalyzeArgs {
+                    file: data(rel),
+                    column: Some(ColumnRef::Index(column)),
+                    cfc: Some(class),
+                    plot: Some(PathBuf::from("unused.svg")),
+                    ..Default::default()
+                };
+                let analysed = if whole {
+                    pipeline::setup(&args, None).and_then(|setup| {
+                        let reports = pipeline::run(&setup.prepared.counts, &setup.scene)?;
+                        Ok((setup, reports))
+                    })
+                } else {
+                    pipeline::analyze(&args, None)
+                };
+                // (A rate too low for the class is refused as a whole.)
+                let Ok((setup, reports)) = analysed else {
+                    continue;
+                };
+                let signal = setup.plot_signal();
+                for r in reports.iter().take(impact_host::plot::SHOWN) {
+                    let Some(want) = r.filtered_peak_acceleration_m_s2 else {
+                        assert!(impact_host::plot::filtered(&signal, r).is_none());
+                        continue;
+                    };
+                    let (first, trace) = impact_host::plot::filtered(&signal, r)
+                        .unwrap_or_else(|| panic!("{rel} CFC {class}: no trace"));
+                    // The trace's peak over the impact's window (from its onset: the window
+                    // starts a little before, where the filtered signal is smaller).
+                    let from = usize::try_from(r.start_sample - first).unwrap();
+                    let to = usize::try_from(r.end_sample - first).unwrap();
+                    let got = trace[from..to]
+                        .iter()
+                        .copied()
+                        .max_by(|a, b| a.abs().total_cmp(&b.abs()))
+                        .unwrap();
+                    let err = (got - f64::from(want)).abs() / f64::from(want).abs();
+                    assert!(
+                        err < 2e-5,
+                        "{rel} CFC {class} (whole: {whole}) impact {}: drawn {got}, reported {want}",
+                        r.index
+                    );
+                    compared += 1;
+                }
+            }
+        }
+    }
+    assert!(compared >= 20, "{compared}");
+}
+
+#[test]
+fn with_a_cfc_the_figures_draw_the_raw_and_the_filtered_signal_and_say_so() {
+    let d = dir();
+    let f = data("afrl-drop-tower/accel_5.csv");
+    let svg = d.join("cfc.svg");
+    impact_ok(&[
+        "analyze",
+        f.to_str().unwrap(),
+        "--column",
+        "1",
+        "--cfc",
+        "1000",
+        "--plot",
+        svg.to_str().unwrap(),
+    ]);
+    let drawn = std::fs::read_to_string(&svg).unwrap();
+    for want in [
+        "raw signal above its baseline, m/s²; CFC 1000 (SAE J211, phaseless) over the deceleration",
+        ">\nraw\n</text>",
+        ">\nCFC 1000\n</text>",
+    ] {
+        assert!(drawn.contains(want), "{want} missing from the figure");
+    }
+    // Without a CFC: the measured signal alone.
+    impact_ok(&[
+        "analyze",
+        f.to_str().unwrap(),
+        "--column",
+        "1",
+        "--plot",
+        svg.to_str().unwrap(),
+    ]);
+    let drawn = std::fs::read_to_string(&svg).unwrap();
+    assert!(!drawn.contains("CFC") && drawn.contains(">\nmeasured\n</text>"));
+    // The report's pulses: both peaks in the title, both traces in the legend.
+    let html = d.join("cfc.html");
+    impact_ok(&[
+        "report",
+        f.to_str().unwrap(),
+        "--channels",
+        "1,2",
+        "--units",
+        "kgn",
+        "--cfc",
+        "1000",
+        "--html",
+        html.to_str().unwrap(),
+    ]);
+    let page = std::fs::read_to_string(&html).unwrap();
+    assert_eq!(page.matches("g CFC 1000</text>").count(), 2, "the titles");
+    assert_eq!(page.matches(">CFC 1000</text>").count(), 2, "the legends");
+    assert_eq!(page.matches(">raw</text>").count(), 2);
+}
+
+/// A PNG's size and its RGBA pixels.
+fn decode(bytes: &[u8]) -> ((u32, u32), Vec<u8>) {
+    let mut reader = png::Decoder::new(std::io::Cursor::new(bytes))
+        .read_info()
+        .unwrap();
+    let mut pixels = vec![0; reader.output_buffer_size().unwrap()];
+    let info = reader.next_frame(&mut pixels).unwrap();
+    assert_eq!(info.color_type, png::ColorType::Rgba);
+    pixels.truncate(info.buffer_size());
+    ((info.width, info.height), pixels)
+}
+
+/// The share of the pixels in rows `rows` that are dark (text, axes, curves).
+fn dark(size: (u32, u32), pixels: &[u8], rows: std::ops::Range<u32>) -> f64 {
+    let w = size.0 as usize;
+    let px = |k: usize| &pixels[4 * k..4 * k + 4];
+    let n = rows.clone().count() * w;
+    let dark = rows
+        .flat_map(|y| (0..w).map(move |x| y as usize * w + x))
+        .filter(|&k| px(k)[..3].iter().all(|&c| c < 100) && px(k)[3] > 200)
+        .count();
+    dark as f64 / n as f64
+}
+
+#[test]
+fn plot_png_is_the_figure_rasterised_the_same_on_any_machine() {
+    let d = dir();
+    let f = data("afrl-drop-tower/series1_test1_full_100ms.csv");
+    let draw = |name: &str| {
+        let out = d.join(name);
+        let (_, err) = impact_ok(&[
+            "analyze",
+            f.to_str().unwrap(),
+            "--column",
+            "1",
+            "--srs",
+            "--plot",
+            out.to_str().unwrap(),
+        ]);
+        assert!(err.contains(&format!("wrote {}", out.display())), "{err}");
+        std::fs::read(&out).unwrap()
+    };
+    let png = draw("figure.png");
+    assert_eq!(&png[..8], b"\x89PNG\r\n\x1a\n", "the PNG signature");
+    // The SVG's size: six panels of 400 px across, one impact of 330 px and the title's 36.
+    let svg = String::from_utf8(draw("figure.svg")).unwrap();
+    assert!(
+        svg.starts_with("<svg width=\"2400\" height=\"366\""),
+        "{}",
+        &svg[..80]
+    );
+    let (size, pixels) = decode(&png);
+    assert_eq!(size, (2400, 366));
+    // Not blank: opaque, a white background, and dark pixels where the title's text is (the
+    // embedded font drew it) and over the panels (axes, labels).
+    assert!(pixels.chunks(4).all(|p| p[3] == 255), "transparent pixels");
+    let title = dark(size, &pixels, 8..30);
+    let panels = dark(size, &pixels, 40..366);
+    assert!(
+        title > 0.005 && panels > 0.005,
+        "title {title}, panels {panels}"
+    );
+    assert!(
+        title < 0.5 && panels < 0.5,
+        "title {title}, panels {panels}"
+    );
+    // The same bytes every time (no system font, no clock in the file).
+    assert_eq!(draw("again.png"), png);
+    // The extension chooses, whatever its case; other names are refused, naming the two.
+    assert_eq!(&draw("upper.PNG")[..8], b"\x89PNG\r\n\x1a\n");
+    let (code, _, err) = common::impact(&[
+        "analyze",
+        f.to_str().unwrap(),
+        "--plot",
+        d.join("figure.jpg").to_str().unwrap(),
+    ]);
+    assert_eq!(code, 1);
+    assert!(err.contains(".svg or .png"), "{err}");
+    assert!(!d.join("figure.jpg").exists());
+    // The output rules hold for a PNG: never over an input (a link to one included).
+    let input = d.join("input.png");
+    std::fs::copy(&f, &input).unwrap();
+    let (code, _, err) = common::impact(&[
+        "analyze",
+        input.to_str().unwrap(),
+        "--column",
+        "1",
+        "--plot",
+        input.to_str().unwrap(),
+    ]);
+    assert_eq!(code, 1);
+    assert!(err.contains("would be overwritten"), "{err}");
+    assert_eq!(std::fs::read(&input).unwrap(), std::fs::read(&f).unwrap());
+}
