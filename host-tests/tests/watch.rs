@@ -540,6 +540,25 @@ fn an_emulated_train_shows_live_in_a_headless_browser() {
         let points: usize = receipt["pulse_points"].parse().unwrap();
         assert!(points > 100, "impact {index}: {points} points drawn");
     }
+    // The page's exports: the session as JSON and as the HTML report, every pulse drawn from
+    // the board's windows with the band.
+    let json: serde_json::Value = serde_json::from_str(&w.get("/session.json")).unwrap();
+    assert_eq!(json["impacts"].as_array().unwrap().len(), indices.len());
+    let report = w.get("/report.html");
+    assert!(report.starts_with("<!DOCTYPE html>"), "{report}");
+    assert_eq!(report.matches("<svg").count(), indices.len());
+    assert_eq!(
+        report.matches("nominal, tolerance band").count(),
+        indices.len()
+    );
+    let passed = state["stats"]["pass_rate"]["passed"].as_u64().unwrap();
+    assert!(
+        report.contains(&format!(
+            "{passed} of {} judged impacts pass",
+            indices.len()
+        )),
+        "{report}"
+    );
 }
 
 /// A log file another program writes is followed as it grows: impacts appended after the

@@ -63,7 +63,7 @@ pub fn run(args: &ReportArgs) -> Result<(), String> {
     let mut a = a.clone();
     a.spectrum.srs |= required.is_some();
     let results = series::analyze_drawn(&a, &entries);
-    let page = page(cmd, &results, required.as_ref());
+    let page = page(a.cfc, &results, required.as_ref());
     crate::output::write(&args.html, page.as_bytes())?;
     for e in &results {
         for n in &e.notes {
@@ -89,9 +89,9 @@ td.l,th.l{text-align:left}.pass{color:#080;font-weight:bold}.fail{color:#b00;fon
 .figure{display:inline-block;margin:.5em;vertical-align:top}dl{display:grid;grid-template-columns:max-content auto;gap:.2em 1em}\
 dt{font-weight:bold}";
 
-fn page(cmd: &AnalyzeCommand, results: &[EntryJson], required: Option<&RequiredSrs>) -> String {
+/// The page: `results` analysed with the windows' filter `cfc`, against `required`.
+fn page(cfc: Option<u32>, results: &[EntryJson], required: Option<&RequiredSrs>) -> String {
     let json = series::to_json(results);
-    let a = &cmd.args;
     let mut h = String::new();
     let _ = write!(
         h,
@@ -125,7 +125,7 @@ fn page(cmd: &AnalyzeCommand, results: &[EntryJson], required: Option<&RequiredS
     }
     dd(
         "filter",
-        &a.cfc.map_or("none (raw signal)".into(), |c| {
+        &cfc.map_or("none (raw signal)".into(), |c| {
             format!("CFC {c} (SAE J211) on the captured windows")
         }),
     );
@@ -327,4 +327,61 @@ fn spectra(h: &mut String, results: &[EntryJson], required: &RequiredSrs) {
             }
         }
     }
+}
+
+/// The report of a board's log (`impact watch`'s session file, exported from its page): the
+/// log's impacts as `impact log` reads them, each pulse drawn from the window the board sent
+/// (its run's), with `spec`'s band where its verdict placed it.
+pub fn log_report(
+    path: &std::path::Path,
+    spec: Option<&impact_core::spec::Spec>,
+) -> Result<String, String> {
+    use crate::firmware_link::fields::{num, opt};
+    let name = path.display().to_string();
+    let log = crate::cli::log::read_log(path)?;
+    let mut analysis = crate::firmware_link::log_json::log_json(&log, 0.0)?;
+    analysis.spec = spec.map(crate::report::spec::spec_json);
+    let mut figures = Vec::new();
+    if let Some(scene) = &log.scene {
+        let rate = f64::from(crate::firmware_link::log::rate(scene)?);
+        let gain = f64::from(num::<f32>(scene, "gain_m_s2_per_count")?);
+        let mass: Option<f32> = opt(scene, "mass_kg")?;
+        for (k, run) in log.runs.iter().enumerate() {
+            let waves = &log.waveforms[run.waveforms.clone()];
+            for r in &log.impacts[run.impacts.clone()] {
+                if figures.len() == MAX_FIGURES || !waves.iter().any(|w| w.index == r.index) {
+                    continue;
+                }
+                // (The board's windows hold no filter padding: no CFC trace.)
+                let signal = crate::plot::Signal {
+                    title: String::new(),
+                    cfc: None,
+                    rate_hz: rate,
+                    mass_kg: mass.map(f64::from),
+                    accel_m_s2: Box::new(move |i| {
+                        waves
+                            .iter()
+                            .find(|w| w.index == r.index)
+                            .and_then(|w| w.at_sample(i))
+                            .map(|c| f64::from(c) * gain)
+                    }),
+                };
+                let title = if log.runs.len() > 1 {
+                    format!("run {} impact {}", k + 1, r.index)
+                } else {
+                    format!("impact {}", r.index)
+                };
+                figures.push(crate::cli::pulse::pulse_svg(&signal, spec, r, title));
+            }
+        }
+    }
+    let entry = EntryJson {
+        file: name,
+        channel: "the board".into(),
+        error: None,
+        notes: log.warnings.clone(),
+        analysis: Some(analysis),
+        figures,
+    };
+    Ok(page(None, std::slice::from_ref(&entry), None))
 }

@@ -109,14 +109,20 @@ fn read_text(input: impl Read, name: &str, reader: &mut LogReader) -> Result<(),
     Ok(())
 }
 
-/// The decoded log at `path` (`impact watch`'s session file) as `impact log`'s JSON, or CSV,
-/// written to `out`.
-pub fn export(path: &std::path::Path, csv: bool, out: &mut impl Write) -> Result<(), String> {
+/// The decoded log at `path` (`impact watch`'s session file), read and checked.
+pub fn read_log(path: &std::path::Path) -> Result<crate::firmware_link::log::Log, String> {
     let name = path.display().to_string();
     let file = std::fs::File::open(path).map_err(|e| format!("{name}: {e}"))?;
     let mut reader = LogReader::default();
     read_text(file, &name, &mut reader)?;
-    let log = reader.finish().map_err(|e| format!("{name}: {e}"))?;
+    reader.finish().map_err(|e| format!("{name}: {e}"))
+}
+
+/// The decoded log at `path` (`impact watch`'s session file) as `impact log`'s JSON, or CSV,
+/// written to `out`.
+pub fn export(path: &std::path::Path, csv: bool, out: &mut impl Write) -> Result<(), String> {
+    let name = path.display().to_string();
+    let log = read_log(path)?;
     let json = LogJson::new(&log, 0.0)?;
     if csv {
         crate::report::csv::write_csv(&json.head, json.impacts(), out)

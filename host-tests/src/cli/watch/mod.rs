@@ -153,12 +153,13 @@ pub fn run(args: &WatchArgs) -> Result<(), String> {
             )
         })?;
     let mut log = std::io::BufWriter::new(file);
+    let spec_only = spec.as_ref().map(|(s, _)| *s);
     let session = Session::new(&name, &session_path.display().to_string(), spec);
     let loopback = listener
         .as_ref()
         .and_then(|l| l.local_addr().ok())
         .is_some_and(|a| a.ip().is_loopback());
-    let hub = Arc::new(Hub::new(session, session_path.clone(), loopback));
+    let hub = Arc::new(Hub::new(session, session_path.clone(), spec_only, loopback));
     let terminal = args.terminal;
     if let Some(l) = listener {
         let addr = l.local_addr().map_err(|e| e.to_string())?;

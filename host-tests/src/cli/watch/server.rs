@@ -41,6 +41,8 @@ pub struct Hub {
     receipts: Mutex<VecDeque<String>>,
     /// The session file (the whole log as it arrived), for the exports.
     session_file: PathBuf,
+    /// The pulse the board judges, for the report's bands.
+    spec: Option<impact_core::spec::Spec>,
     /// Whether the server is bound to a loopback address (then only `Host: localhost` or a
     /// loopback address is served, so a web page elsewhere cannot read the session).
     loopback: bool,
@@ -59,8 +61,14 @@ pub fn now_ms() -> u64 {
 }
 
 impl Hub {
-    pub fn new(session: Session, session_file: PathBuf, loopback: bool) -> Self {
+    pub fn new(
+        session: Session,
+        session_file: PathBuf,
+        spec: Option<impact_core::spec::Spec>,
+        loopback: bool,
+    ) -> Self {
         Self {
+            spec,
             session: Mutex::new(session),
             clients: Mutex::new(Vec::new()),
             receipts: Mutex::new(VecDeque::new()),
@@ -218,6 +226,22 @@ fn connection(stream: TcpStream, hub: &Hub) -> std::io::Result<()> {
                     "500 Internal Server Error",
                     "text/plain; charset=utf-8",
                     format!("the session file could not be exported: {e}\n").as_bytes(),
+                ),
+            }
+        }
+        "/report.html" => {
+            match crate::cli::html::log_report(&hub.session_file, hub.spec.as_ref()) {
+                Ok(page) => respond(
+                    &mut out,
+                    "200 OK",
+                    "text/html; charset=utf-8",
+                    page.as_bytes(),
+                ),
+                Err(e) => respond(
+                    &mut out,
+                    "500 Internal Server Error",
+                    "text/plain; charset=utf-8",
+                    format!("the session file could not be reported: {e}\n").as_bytes(),
                 ),
             }
         }
