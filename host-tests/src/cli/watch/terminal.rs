@@ -114,9 +114,10 @@ fn health(e: &Value) -> Option<String> {
         _ => String::new(),
     };
     Some(format!(
-        "board {} s: {} impacts, samples lost {}, gaps {}, lines dropped {}, analyses skipped {}, reports dropped {}{stack}, busy {} %",
+        "board {} s: {} impact{}, samples lost {}, gaps {}, lines dropped {}, analyses skipped {}, reports dropped {}{stack}, busy {} %",
         n(&e["board_time_s"], 1.0),
         e["impacts"],
+        if e["impacts"] == 1 { "" } else { "s" },
         e["samples_lost"],
         e["gaps"],
         e["lines_dropped"],
