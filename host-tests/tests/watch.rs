@@ -197,9 +197,10 @@ fn the_terminal_view_prints_every_impact_and_the_health() {
 }
 
 /// 10 000 impacts as fast as a pipe takes them, a page connected that never reads its
-/// stream: the tool's memory after 10 000 is what it was after 2000 (the view keeps the
-/// last 50 impacts and 2000 trend points; statistics run), the session file has every line,
-/// and the exports read it back whole.
+/// stream (and a real one when there is a browser): the tool's memory after 10 000 is what it
+/// was after 2000, within 4 MiB (the view keeps the last 50 impacts and 2000 trend points, the
+/// statistics run, each page's queue holds 128 events; kept per impact, 8000 impacts' events
+/// would be 30 MB); the session file has every line, and the exports read it back whole.
 #[cfg(target_os = "linux")]
 #[test]
 fn ten_thousand_impacts_keep_memory_flat_and_a_slow_page_never_holds_up_the_board() {
@@ -232,7 +233,7 @@ fn ten_thousand_impacts_keep_memory_flat_and_a_slow_page_never_holds_up_the_boar
     let rss_10k = w.rss_kib();
     eprintln!("impact watch: RSS {rss_2k} KiB after 2000 impacts, {rss_10k} KiB after 10 000 ({:.2} s for 8000)", fed.as_secs_f64());
     assert!(
-        rss_10k < rss_2k + 2048,
+        rss_10k < rss_2k + 4096,
         "memory grew from {rss_2k} to {rss_10k} KiB"
     );
     assert_eq!(s["stats"]["metrics"][0]["n"], 10_000);

@@ -167,10 +167,22 @@ pub fn run(args: &WatchArgs) -> Result<(), String> {
             "impact watch: http://{addr}/ (session file {})",
             session_path.display()
         );
+        if !loopback {
+            eprintln!(
+                "impact watch: --listen {addr} is not a loopback address: anyone who can reach \
+                 it sees the session"
+            );
+        }
         let h = hub.clone();
         std::thread::spawn(move || server::serve(l, h));
     } else {
         eprintln!("impact watch: session file {}", session_path.display());
+    }
+    if stdin && std::io::IsTerminal::is_terminal(&std::io::stdin()) {
+        eprintln!(
+            "impact watch: reading the board's log from standard input: pipe it in \
+             (cargo fw-run | impact watch), or name a log file"
+        );
     }
     // The clock: impacts that waited for their srs/spec lines shown, pages told the time, a
     // silent board said in the terminal.

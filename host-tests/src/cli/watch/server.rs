@@ -19,7 +19,7 @@ use super::session::Session;
 /// The page (HTML, CSS and script in one file: no network).
 const PAGE: &str = include_str!("page.html");
 /// Events a page may have queued before it loses the next ones.
-const QUEUE: usize = 512;
+const QUEUE: usize = 128;
 /// Receipts kept (the newest) for `/receipts`.
 const RECEIPTS: usize = 4096;
 /// The longest request head read, bytes.
