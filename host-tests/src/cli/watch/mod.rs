@@ -84,7 +84,7 @@ impl Read for Follow {
                 self.at += n as u64;
                 return Ok(n);
             }
-            std::thread::sleep(Duration::from_millis(100));
+            std::thread::sleep(Duration::from_millis(50));
             if self.file.metadata()?.len() < self.at {
                 use std::io::Seek;
                 self.at = self.file.seek(std::io::SeekFrom::Start(0))?;

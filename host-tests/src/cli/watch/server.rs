@@ -24,13 +24,23 @@ const QUEUE: usize = 128;
 const RECEIPTS: usize = 4096;
 /// The longest request head read, bytes.
 const MAX_HEAD: usize = 8192;
+/// Connections served at once at most (a page holds two or three).
+const MAX_CONNECTIONS: usize = 64;
+/// How long a request head may take to arrive, and a write to a peer that stopped reading.
+const TIMEOUT: Duration = Duration::from_secs(10);
+/// The marker a stale page's queue carries in place of its snapshot: its writer builds the
+/// snapshot when it comes to it (so a page that never drains costs nothing).
+const RESYNC: &str = "";
 
 /// A page's event stream.
 struct Client {
     tx: SyncSender<Arc<str>>,
     dropped: Arc<AtomicU64>,
-    /// Whether it lost events since its last snapshot (the next tick sends it a new one).
+    /// Whether it lost events since its last snapshot: it is sent none until its writer has
+    /// sent it a new snapshot (the tick queues the marker, [`RESYNC`], once there is room).
     stale: Arc<AtomicBool>,
+    /// Whether the marker is queued.
+    resync: Arc<AtomicBool>,
 }
 
 /// The session and the pages watching it.
@@ -46,6 +56,8 @@ pub struct Hub {
     /// Whether the server is bound to a loopback address (then only `Host: localhost` or a
     /// loopback address is served, so a web page elsewhere cannot read the session).
     loopback: bool,
+    /// Connections open.
+    connections: std::sync::atomic::AtomicUsize,
 }
 
 /// A lock that a panicked thread left poisoned is still the session's.
@@ -74,6 +86,7 @@ impl Hub {
             receipts: Mutex::new(VecDeque::new()),
             session_file,
             loopback,
+            connections: std::sync::atomic::AtomicUsize::new(0),
         }
     }
 
@@ -86,7 +99,7 @@ impl Hub {
         let mut clients = lock(&self.clients);
         for e in &events {
             let text: Arc<str> = format!("data: {e}\n\n").into();
-            clients.retain(|c| send(c, text.clone()));
+            clients.retain(|c| c.stale.load(Ordering::Relaxed) || send(c, text.clone()));
         }
         events
     }
@@ -96,30 +109,47 @@ impl Hub {
         lock(&self.session).silent_for(now_ms)
     }
 
-    /// Sends each page the clock event (with the events it lost), and a page that lost
-    /// events a new snapshot once it has room for one: it shows the session as it is again.
+    /// Sends each page the clock event (with the events it lost); a page that lost events
+    /// gets the marker for a new snapshot once it has room for it, then nothing until its
+    /// writer has sent the snapshot: it shows the session as it is again.
     pub fn tick(&self) {
         let session = lock(&self.session);
         let now = now_ms();
         let mut clients = lock(&self.clients);
-        let mut snapshot: Option<Arc<str>> = None;
         clients.retain(|c| {
-            if c.stale.load(Ordering::Relaxed) {
-                let s = snapshot
-                    .get_or_insert_with(|| format!("data: {}\n\n", session.snapshot(now)).into());
-                match c.tx.try_send(s.clone()) {
-                    Ok(()) => c.stale.store(false, Ordering::Relaxed),
-                    Err(TrySendError::Full(_)) => {}
-                    Err(TrySendError::Disconnected(_)) => return false,
+            let text: Arc<str> = if c.stale.load(Ordering::Relaxed) {
+                if c.resync.load(Ordering::Relaxed) {
+                    return true;
                 }
+                RESYNC.into()
+            } else {
+                let tick = session.tick(now, c.dropped.load(Ordering::Relaxed));
+                format!("data: {tick}\n\n").into()
+            };
+            match c.tx.try_send(text.clone()) {
+                Ok(()) => {
+                    if text.is_empty() {
+                        c.resync.store(true, Ordering::Relaxed);
+                    }
+                    true
+                }
+                Err(TrySendError::Full(_)) => true,
+                Err(TrySendError::Disconnected(_)) => false,
             }
-            let tick = session.tick(now, c.dropped.load(Ordering::Relaxed));
-            send(c, format!("data: {tick}\n\n").into())
         });
     }
 
-    /// A new page's stream: the snapshot first.
-    fn subscribe(&self) -> Receiver<Arc<str>> {
+    /// A stale page's snapshot, made when its writer reaches the marker: under the session's
+    /// lock, so the events after it are the ones sent after it.
+    fn resynced(&self, stale: &AtomicBool, resync: &AtomicBool) -> String {
+        let session = lock(&self.session);
+        stale.store(false, Ordering::Relaxed);
+        resync.store(false, Ordering::Relaxed);
+        format!("data: {}\n\n", session.snapshot(now_ms()))
+    }
+
+    /// A new page's stream (the snapshot first) and its stale and marker flags.
+    fn subscribe(&self) -> (Receiver<Arc<str>>, Arc<AtomicBool>, Arc<AtomicBool>) {
         let session = lock(&self.session);
         let (tx, rx) = sync_channel(QUEUE);
         let snapshot = session.snapshot(now_ms());
@@ -127,11 +157,13 @@ impl Hub {
             tx,
             dropped: Arc::new(AtomicU64::new(0)),
             stale: Arc::new(AtomicBool::new(false)),
+            resync: Arc::new(AtomicBool::new(false)),
         };
+        let flags = (client.stale.clone(), client.resync.clone());
         if send(&client, format!("data: {snapshot}\n\n").into()) {
             lock(&self.clients).push(client);
         }
-        rx
+        (rx, flags.0, flags.1)
     }
 }
 
@@ -148,28 +180,57 @@ fn send(c: &Client, text: Arc<str>) -> bool {
     }
 }
 
-/// Serves `hub` on `listener` until the process ends.
+/// Serves `hub` on `listener` until the process ends; at most [`MAX_CONNECTIONS`] at once (one
+/// more is closed at once).
 pub fn serve(listener: TcpListener, hub: Arc<Hub>) {
-    for stream in listener.incoming().flatten() {
+    for stream in listener.incoming() {
+        let Ok(stream) = stream else {
+            // Out of file descriptors, say: wait rather than spin.
+            std::thread::sleep(Duration::from_millis(100));
+            continue;
+        };
+        if hub.connections.fetch_add(1, Ordering::Relaxed) >= MAX_CONNECTIONS {
+            hub.connections.fetch_sub(1, Ordering::Relaxed);
+            continue;
+        }
         let hub = hub.clone();
         std::thread::spawn(move || {
             let _ = connection(stream, &hub);
+            hub.connections.fetch_sub(1, Ordering::Relaxed);
         });
     }
 }
 
+/// Whether `host` (a Host header: a name or address, then perhaps a port) is this machine.
+fn local_host(host: &str) -> bool {
+    let name = match host.strip_prefix('[') {
+        Some(rest) => rest.split(']').next().unwrap_or(""),
+        None => host.split(':').next().unwrap_or(""),
+    };
+    name.eq_ignore_ascii_case("localhost")
+        || name
+            .parse::<std::net::IpAddr>()
+            .is_ok_and(|ip| ip.is_loopback())
+}
+
 /// One request on `stream`.
 fn connection(stream: TcpStream, hub: &Hub) -> std::io::Result<()> {
-    stream.set_read_timeout(Some(Duration::from_secs(10)))?;
+    stream.set_read_timeout(Some(TIMEOUT))?;
+    stream.set_write_timeout(Some(TIMEOUT))?;
+    stream.set_nodelay(true)?;
     let mut reader = BufReader::new(stream.try_clone()?);
     let (mut head, mut line) = (Vec::new(), String::new());
     let mut size = 0;
+    let started = std::time::Instant::now();
     loop {
         line.clear();
         let n = (&mut reader).take(MAX_HEAD as u64).read_line(&mut line)?;
         size += n;
         if n == 0 || line == "\r\n" || line == "\n" || size > MAX_HEAD {
             break;
+        }
+        if started.elapsed() > TIMEOUT {
+            return Ok(());
         }
         head.push(line.trim_end().to_string());
     }
@@ -185,8 +246,7 @@ fn connection(stream: TcpStream, hub: &Hub) -> std::io::Result<()> {
                 k.eq_ignore_ascii_case("host").then(|| v.trim().to_string())
             })
             .unwrap_or_default();
-        let name = host.rsplit_once(':').map_or(host.as_str(), |(h, _)| h);
-        if !matches!(name, "localhost" | "127.0.0.1" | "[::1]") {
+        if !local_host(&host) {
             return respond(&mut out, "403 Forbidden", "text/plain", b"not this host\n");
         }
     }
@@ -283,14 +343,18 @@ fn events(out: &mut TcpStream, hub: &Hub) -> std::io::Result<()> {
         "HTTP/1.1 200 OK\r\nContent-Type: text/event-stream\r\nCache-Control: no-store\r\nConnection: keep-alive\r\n\r\nretry: 1000\n\n"
     )?;
     out.flush()?;
-    let rx = hub.subscribe();
+    let (rx, stale, resync) = hub.subscribe();
     loop {
         match rx.recv_timeout(Duration::from_secs(15)) {
             Ok(text) => {
-                out.write_all(text.as_bytes())?;
-                // Whatever else is queued goes in the same write.
-                while let Ok(more) = rx.try_recv() {
-                    out.write_all(more.as_bytes())?;
+                let mut pending = Some(text);
+                // Whatever else is queued goes out in the same flush.
+                while let Some(text) = pending.take().or_else(|| rx.try_recv().ok()) {
+                    if text.is_empty() {
+                        out.write_all(hub.resynced(&stale, &resync).as_bytes())?;
+                    } else {
+                        out.write_all(text.as_bytes())?;
+                    }
                 }
                 out.flush()?;
             }

@@ -21,8 +21,14 @@ pub const LAST: usize = 50;
 pub const TREND: usize = 2000;
 /// Runs kept (the newest): a board that resets all day.
 pub const RUNS: usize = 100;
-/// How long an impact line waits for its `srs` and `spec` lines before it is shown, ms.
-pub const HOLD_MS: u64 = 100;
+/// How long an impact line waits for its `srs` and `spec` lines before it is shown, ms (they
+/// follow it at once from the board's reporter; the wait covers a file followed in 50 ms
+/// polls and a link's hiccups).
+pub const HOLD_MS: u64 = 300;
+/// The longest window (`wave` line) read: a capture (15 104 samples) with room to spare.
+const MAX_WAVE_SAMPLES: u32 = 1 << 16;
+/// The longest text kept of a line's error or a scene's value, bytes.
+const MAX_TEXT: usize = 200;
 /// A board is silent when its last heartbeat (one a second) is older than this, ms: within
 /// two heartbeats.
 pub const SILENT_MS: u64 = 2500;
@@ -147,7 +153,7 @@ impl Session {
         let mut events = Vec::new();
         if let Err(e) = self.read(line, now_ms, &mut events) {
             self.bad_lines += 1;
-            let text = format!("line {n}: {e}");
+            let text = format!("line {n}: {}", cut(&e));
             self.last_error = Some(text.clone());
             events.push(json!({"type": "warning", "text": text}));
         }
@@ -159,17 +165,21 @@ impl Session {
         // data line shows the waiting impact first.
         if let Some(m) = fields(line, "srs ") {
             let (index, spectrum) = parse_spectrum(&m?)?;
-            if let Some(p) = self.pending.as_mut().filter(|p| p.report.index == index) {
-                p.report.spectrum = Some(spectrum);
+            match self.pending.as_mut().filter(|p| p.report.index == index) {
+                Some(p) => p.report.spectrum = Some(spectrum),
+                None => return Err(late("srs", index)),
             }
             return Ok(());
         }
         if let Some(m) = fields(line, "spec ") {
             let (index, verdict) = parse_verdict(&m?)?;
-            if let Some(p) = self.pending.as_mut().filter(|p| p.report.index == index) {
-                p.report.verdict = Some(verdict);
-                // The last line of its impact.
-                self.show(events);
+            match self.pending.as_mut().filter(|p| p.report.index == index) {
+                Some(p) => {
+                    p.report.verdict = Some(verdict);
+                    // The last line of its impact.
+                    self.show(events);
+                }
+                None => return Err(late("spec", index)),
             }
             return Ok(());
         }
@@ -204,7 +214,14 @@ impl Session {
             }
             "wave " => {
                 self.started = true;
-                self.wave = Some(Waveform::from_header(&m)?);
+                let w = Waveform::from_header(&m)?;
+                if w.samples > MAX_WAVE_SAMPLES {
+                    return Err(format!(
+                        "samples={}: a window of the board holds at most {MAX_WAVE_SAMPLES}",
+                        w.samples
+                    ));
+                }
+                self.wave = Some(w);
             }
             "heartbeat " => {
                 self.started = true;
@@ -222,14 +239,15 @@ impl Session {
                 events.push(tagged("end", end));
             }
             _ => {
-                // A scene: the board (re)started.
+                // A scene: the board (re)started (as `impact log` counts runs: any scene line
+                // after the first line of the board's is a restart).
                 let rate_hz = f64::from(rate(&m)?);
                 if self.started {
                     self.run += 1;
-                    self.started = false;
                     self.wave = None;
                     self.ended = None;
                 }
+                self.started = true;
                 self.rate_hz = Some(rate_hz);
                 self.gain = m
                     .get("gain_m_s2_per_count")
@@ -237,13 +255,15 @@ impl Session {
                     .filter(|g| g.is_finite());
                 let scene: Map<String, Value> = m
                     .iter()
+                    .take(64)
+                    .map(|(k, v)| (cut(k), cut(v)))
                     .map(|(k, v)| {
                         let value = v
                             .parse::<f64>()
                             .ok()
                             .filter(|x| x.is_finite())
                             .map_or_else(|| json!(v), |x| json!(x));
-                        (k.clone(), value)
+                        (k, value)
                     })
                     .collect();
                 let run = json!({"run": self.run, "received_unix_ms": now_ms, "scene": scene});
@@ -513,6 +533,26 @@ impl Session {
         }
         events
     }
+}
+
+/// The error of a `what` line (`srs`, `spec`) whose impact was shown already (or never came).
+fn late(what: &str, index: u32) -> String {
+    format!(
+        "{what} index={index}: after its impact was shown (or without its impact line): not \
+         on the page; the session file has it (impact log reads it)"
+    )
+}
+
+/// `text`, at most [`MAX_TEXT`] bytes of it (cut at a character's boundary, marked).
+fn cut(text: &str) -> String {
+    if text.len() <= MAX_TEXT {
+        return text.to_string();
+    }
+    let mut end = MAX_TEXT;
+    while !text.is_char_boundary(end) {
+        end -= 1;
+    }
+    format!("{}…", &text[..end])
 }
 
 /// `value` (an object) with its event `type` first.

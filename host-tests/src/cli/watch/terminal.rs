@@ -110,7 +110,10 @@ fn health(e: &Value) -> Option<String> {
         e["stack_peak_bytes"].as_u64(),
         e["stack_size_bytes"].as_u64(),
     ) {
-        (Some(p), Some(s)) if s > 0 => format!(", stack {p} of {s} B ({} %)", 100 * p / s),
+        (Some(p), Some(s)) if s > 0 => format!(
+            ", stack {p} of {s} B ({:.0} %)",
+            100.0 * p as f64 / s as f64
+        ),
         _ => String::new(),
     };
     Some(format!(
