@@ -115,6 +115,17 @@ pub fn install() {
     }));
 }
 
+/// An error that is a closed output pipe (`impact … | head`: EPIPE reached the write before
+/// the signal's handler ended the run) ends the run as the signal would: quietly, by SIGPIPE,
+/// after the cleanup. Any other error returns.
+pub fn closed_pipe(error: &str) {
+    #[cfg(unix)]
+    if error.contains("Broken pipe") {
+        clean_up();
+        die_of(libc::SIGPIPE);
+    }
+}
+
 /// Ends the process by `sig` with its default action, as if it had not been caught (the
 /// status a shell and a parent expect of an interrupted or cut-off tool).
 #[cfg(unix)]

@@ -122,6 +122,7 @@ fn main() -> ExitCode {
             ExitCode::SUCCESS
         }
         Err(e) => {
+            impact_host::interrupt::closed_pipe(&e);
             eprintln!("error: {e}");
             ExitCode::from(1)
         }
