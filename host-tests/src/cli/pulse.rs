@@ -57,21 +57,8 @@ pub fn svg(p: &Pulse) -> String {
     let t_last = p.columns.last().map_or(t_first, |c| c.0);
     let g = STANDARD_GRAVITY;
     // The band and the nominal pulse, in (t, lo, hi, nominal) over the window.
-    let band: Vec<(f64, f64, f64, f64)> = match p.spec {
-        Some((spec, start)) => (0..=200)
-            .map(|k| {
-                let t = t_first + (t_last - t_first) * f64::from(k) / 200.0;
-                let u = ((t - start) / f64::from(spec.duration_s)) as f32;
-                let (lo, hi) = spec.band_at(u);
-                let peak = f64::from(spec.peak_m_s2);
-                (
-                    t,
-                    f64::from(lo) * peak,
-                    f64::from(hi) * peak,
-                    f64::from(spec.shape.at(u)) * peak,
-                )
-            })
-            .collect(),
+    let band = match p.spec {
+        Some((spec, start)) => band(spec, start, t_first, t_last),
         None => Vec::new(),
     };
     let (mut y_lo, mut y_hi) = p
@@ -248,20 +235,36 @@ const RAW: &str = "#c0392b";
 /// The CFC-filtered signal's colour: dark, over the raw one.
 const FILTERED: &str = "#192d78";
 
-/// Columns a pulse is drawn in (each its samples' least and greatest value).
-const COLUMNS: u64 = 400;
+/// A point of a tolerance band: `(t_s, lower, upper, nominal)`, the last three in m/s².
+pub type BandPoint = (f64, f64, f64, f64);
 
-/// Impact `r` of the recording `signal` reads drawn (`spec`: the scene's): above its baseline, in the direction of its peak;
-/// with a verdict, over the window it watched with the nominal pulse and band where it was
-/// placed, else from a quarter of its duration before it to a quarter after.
-pub fn pulse_svg(
-    signal: &crate::plot::Signal,
-    spec: Option<&Spec>,
+/// `spec`'s tolerance band and nominal pulse placed at `start_s`, at 201 times over
+/// `[from_s, to_s]` (s from the stream's start).
+pub fn band(spec: &Spec, start_s: f64, from_s: f64, to_s: f64) -> Vec<BandPoint> {
+    let peak = f64::from(spec.peak_m_s2);
+    (0..=200)
+        .map(|k| {
+            let t = from_s + (to_s - from_s) * f64::from(k) / 200.0;
+            let u = ((t - start_s) / f64::from(spec.duration_s)) as f32;
+            let (lo, hi) = spec.band_at(u);
+            (
+                t,
+                f64::from(lo) * peak,
+                f64::from(hi) * peak,
+                f64::from(spec.shape.at(u)) * peak,
+            )
+        })
+        .collect()
+}
+
+/// Where impact `r`'s pulse is drawn, s from the stream's start: with a verdict against
+/// `spec`, over the window it watched, with where it placed the nominal pulse; else from a
+/// quarter of its duration before first touch to a quarter after.
+pub fn window<'a>(
+    spec: Option<&'a Spec>,
     r: &impact_core::ImpactReport,
-    title: String,
-) -> String {
-    let rate = signal.rate_hz;
-    let (from_s, to_s, placed) = match (spec, &r.verdict) {
+) -> (f64, f64, Option<(&'a Spec, f64)>) {
+    match (spec, &r.verdict) {
         (Some(spec), Some(Ok(v))) => {
             let d = f64::from(spec.duration_s);
             let t = spec.tolerance;
@@ -275,7 +278,23 @@ pub fn pulse_svg(
             let d = f64::from(r.duration_s);
             (r.start_s - 0.25 * d, r.start_s + 1.25 * d, None)
         }
-    };
+    }
+}
+
+/// Columns a pulse is drawn in (each its samples' least and greatest value).
+const COLUMNS: u64 = 400;
+
+/// Impact `r` of the recording `signal` reads drawn (`spec`: the scene's): above its baseline, in the direction of its peak;
+/// with a verdict, over the window it watched with the nominal pulse and band where it was
+/// placed, else from a quarter of its duration before it to a quarter after.
+pub fn pulse_svg(
+    signal: &crate::plot::Signal,
+    spec: Option<&Spec>,
+    r: &impact_core::ImpactReport,
+    title: String,
+) -> String {
+    let rate = signal.rate_hz;
+    let (from_s, to_s, placed) = window(spec, r);
     let sign = if r.peak_acceleration_m_s2 < 0.0 {
         -1.0
     } else {

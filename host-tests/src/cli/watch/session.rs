@@ -367,24 +367,7 @@ impl Session {
         let r = &p.report;
         let g = STANDARD_GRAVITY;
         let touch = r.start_s;
-        let placed = match (&self.spec, &r.verdict) {
-            (Some(spec), Some(Ok(v))) => Some((spec, v.start_s)),
-            _ => None,
-        };
-        let (from_s, to_s) = match placed {
-            Some((spec, start)) => {
-                let d = f64::from(spec.duration_s);
-                let t = spec.tolerance;
-                (
-                    start - f64::from(t.before) * d,
-                    start + f64::from(1.0 + t.watch) * d,
-                )
-            }
-            None => {
-                let d = f64::from(r.duration_s);
-                (touch - 0.25 * d, touch + 1.25 * d)
-            }
-        };
+        let (from_s, to_s, placed) = crate::cli::pulse::window(self.spec.as_ref(), r);
         let sign = if r.peak_acceleration_m_s2 < 0.0 {
             -1.0
         } else {
@@ -421,19 +404,16 @@ impl Session {
             ("numbers", pts)
         });
         let band = placed.map(|(spec, start)| {
-            let d = f64::from(spec.duration_s);
-            let peak = f64::from(spec.peak_m_s2) / g;
-            let (mut t, mut lo, mut hi, mut nominal) = (vec![], vec![], vec![], vec![]);
-            for k in 0..=200 {
-                let at = from_s + (to_s - from_s) * f64::from(k) / 200.0;
-                let u = ((at - start) / d) as f32;
-                let (l, h) = spec.band_at(u);
-                t.push(at - touch);
-                lo.push(f64::from(l) * peak);
-                hi.push(f64::from(h) * peak);
-                nominal.push(f64::from(spec.shape.at(u)) * peak);
-            }
-            json!({"t_s": t, "nominal_g": nominal, "lower_g": lo, "upper_g": hi})
+            let band = crate::cli::pulse::band(spec, start, from_s, to_s);
+            let column = |f: &dyn Fn(&crate::cli::pulse::BandPoint) -> f64| -> Vec<f64> {
+                band.iter().map(f).collect()
+            };
+            json!({
+                "t_s": column(&|b| b.0 - touch),
+                "nominal_g": column(&|b| b.3 / g),
+                "lower_g": column(&|b| b.1 / g),
+                "upper_g": column(&|b| b.2 / g),
+            })
         });
         json!({
             "source": source,
