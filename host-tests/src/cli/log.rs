@@ -83,9 +83,15 @@ pub fn log(args: &LogArgs) -> Result<(), String> {
     report(args, reader, &name)
 }
 
-/// Reads the decoded log `input` (called `name` in errors) line by line into `reader`, each
-/// line at most [`MAX_LINE_BYTES`].
-fn read_text(input: impl Read, name: &str, reader: &mut LogReader) -> Result<(), String> {
+/// Reads `input` (called `name` in errors) line by line: `on_line` gets each line's number
+/// (from 1), its text, and whether it was cut: a line is at most [`MAX_LINE_BYTES`] with its
+/// newline; of a longer one `on_line` gets the first [`MAX_LINE_BYTES`] bytes (it may end the
+/// reading there) and the rest is passed over, never held.
+pub fn for_each_line(
+    input: impl Read,
+    name: &str,
+    mut on_line: impl FnMut(u64, &str, bool) -> Result<(), String>,
+) -> Result<(), String> {
     let mut input = BufReader::with_capacity(1 << 16, input);
     let mut buf = Vec::new();
     for n in 1.. {
@@ -97,16 +103,30 @@ fn read_text(input: impl Read, name: &str, reader: &mut LogReader) -> Result<(),
         if read == 0 {
             break;
         }
-        if buf.len() > MAX_LINE_BYTES {
+        let cut = buf.len() > MAX_LINE_BYTES;
+        let rest = cut && buf.last() != Some(&b'\n');
+        buf.truncate(MAX_LINE_BYTES);
+        on_line(n, String::from_utf8_lossy(&buf).trim_end(), cut)?;
+        if rest {
+            input
+                .skip_until(b'\n')
+                .map_err(|e| format!("{name}:{n}: {e}"))?;
+        }
+    }
+    Ok(())
+}
+
+/// Reads the decoded log `input` (called `name` in errors) line by line into `reader`; a line
+/// longer than [`MAX_LINE_BYTES`] is an error.
+fn read_text(input: impl Read, name: &str, reader: &mut LogReader) -> Result<(), String> {
+    for_each_line(input, name, |n, line, cut| {
+        if cut {
             return Err(format!(
                 "{name}:{n}: a line longer than {MAX_LINE_BYTES} bytes: not a decoded defmt log"
             ));
         }
-        reader
-            .line(n, String::from_utf8_lossy(&buf).trim_end())
-            .map_err(|e| format!("{name}: {e}"))?;
-    }
-    Ok(())
+        reader.line(n, line).map_err(|e| format!("{name}: {e}"))
+    })
 }
 
 /// The decoded log at `path` (`impact watch`'s session file), read and checked.

@@ -6,7 +6,7 @@ pub mod server;
 pub mod session;
 mod terminal;
 
-use std::io::{BufRead, BufReader, Read, Write};
+use std::io::{Read, Write};
 use std::net::TcpListener;
 use std::path::PathBuf;
 use std::sync::Arc;
@@ -226,7 +226,12 @@ pub fn run(args: &WatchArgs) -> Result<(), String> {
                 eprintln!("warning: {name}: {skipped} malformed defmt frames skipped");
             }
         }
-        None => read_lines(source, &name, &mut on_line)?,
+        None => crate::cli::log::for_each_line(source, &name, |n, line, cut| {
+            if cut {
+                eprintln!("warning: {name}:{n}: a line longer than {MAX_LINE_BYTES} bytes, cut");
+            }
+            on_line(n, line)
+        })?,
     }
     let events = hub.with(|s| s.input_ended(now_ms()));
     if terminal {
@@ -237,34 +242,4 @@ pub fn run(args: &WatchArgs) -> Result<(), String> {
     loop {
         std::thread::park();
     }
-}
-
-/// Reads `input` line by line (each at most [`MAX_LINE_BYTES`]; a longer one is cut there and
-/// the rest passed over).
-fn read_lines(
-    input: impl Read,
-    name: &str,
-    on_line: &mut impl FnMut(u64, &str) -> Result<(), String>,
-) -> Result<(), String> {
-    let mut input = BufReader::with_capacity(1 << 16, input);
-    let mut buf = Vec::new();
-    for n in 1.. {
-        buf.clear();
-        let read = (&mut input)
-            .take(MAX_LINE_BYTES as u64)
-            .read_until(b'\n', &mut buf)
-            .map_err(|e| format!("{name}:{n}: {e}"))?;
-        if read == 0 {
-            break;
-        }
-        if buf.last() != Some(&b'\n') && buf.len() == MAX_LINE_BYTES {
-            eprintln!("warning: {name}:{n}: a line longer than {MAX_LINE_BYTES} bytes, cut");
-            // The rest passed over, never held.
-            input
-                .skip_until(b'\n')
-                .map_err(|e| format!("{name}:{n}: {e}"))?;
-        }
-        on_line(n, String::from_utf8_lossy(&buf).trim_end())?;
-    }
-    Ok(())
 }
