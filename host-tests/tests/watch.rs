@@ -24,7 +24,7 @@ fn tmp(name: &str) -> PathBuf {
 
 /// A running `impact watch` (killed when dropped), its standard input and its address.
 struct Watch {
-    child: Child,
+    process: Ended,
     stdin: Option<ChildStdin>,
     addr: String,
 }
@@ -53,7 +53,11 @@ impl Watch {
             .to_string();
         Self {
             stdin: child.stdin.take(),
-            child,
+            process: Ended {
+                child,
+                group: false,
+                signal: libc::SIGKILL,
+            },
             addr,
         }
     }
@@ -106,19 +110,13 @@ impl Watch {
 
     /// The tool's resident memory, KiB.
     fn rss_kib(&self) -> u64 {
-        let status = std::fs::read_to_string(format!("/proc/{}/status", self.child.id())).unwrap();
+        let status =
+            std::fs::read_to_string(format!("/proc/{}/status", self.process.child.id())).unwrap();
         status
             .lines()
             .find_map(|l| l.strip_prefix("VmRSS:"))
             .and_then(|v| v.trim().trim_end_matches("kB").trim().parse().ok())
             .unwrap()
-    }
-}
-
-impl Drop for Watch {
-    fn drop(&mut self) {
-        let _ = self.child.kill();
-        let _ = self.child.wait();
     }
 }
 
@@ -212,7 +210,7 @@ fn ten_thousand_impacts_keep_memory_flat_and_a_slow_page_never_holds_up_the_boar
     let mut stuck = TcpStream::connect(&w.addr).unwrap();
     write!(stuck, "GET /events HTTP/1.1\r\nHost: localhost\r\n\r\n").unwrap();
     // And a real page, when there is a browser: it keeps up with the end of the session.
-    let browser = common::browser::chromium().map(|b| Browser::open(b, &w.addr, "10k"));
+    let browser = common::browser::chromium().map(|b| open_browser(b, &w.addr, "10k"));
     if browser.is_some() {
         wait_for_page(&w);
     }
@@ -292,43 +290,33 @@ fn ten_thousand_impacts_keep_memory_flat_and_a_slow_page_never_holds_up_the_boar
     drop(stuck);
 }
 
-/// A headless Chromium on the view's page (killed when dropped).
-struct Browser(Child);
-
-impl Browser {
-    fn open(browser: &str, addr: &str, name: &str) -> Self {
-        use std::os::unix::process::CommandExt;
-        let child = Command::new(browser)
-            // Its own process group: its renderers and helpers end with it.
-            .process_group(0)
-            .args([
-                "--headless",
-                "--no-sandbox",
-                "--disable-gpu",
-                "--remote-debugging-port=0",
-                "--window-size=1400,1000",
-                "--enable-precise-memory-info",
-                &format!(
-                    "--user-data-dir={}",
-                    tmp(&format!("profile-{name}")).display()
-                ),
-                &format!("http://{addr}/"),
-            ])
-            .stdout(Stdio::null())
-            .stderr(Stdio::null())
-            .spawn()
-            .unwrap();
-        Self(child)
-    }
-}
-
-impl Drop for Browser {
-    fn drop(&mut self) {
-        // SAFETY: kill(2) on the browser's own process group.
-        unsafe {
-            libc::kill(-(self.0.id() as i32), libc::SIGKILL);
-        }
-        let _ = self.0.wait();
+/// A headless Chromium on the view's page (killed with its process group when dropped).
+fn open_browser(browser: &str, addr: &str, name: &str) -> Ended {
+    use std::os::unix::process::CommandExt;
+    let child = Command::new(browser)
+        // Its own process group: its renderers and helpers end with it.
+        .process_group(0)
+        .args([
+            "--headless",
+            "--no-sandbox",
+            "--disable-gpu",
+            "--remote-debugging-port=0",
+            "--window-size=1400,1000",
+            "--enable-precise-memory-info",
+            &format!(
+                "--user-data-dir={}",
+                tmp(&format!("profile-{name}")).display()
+            ),
+            &format!("http://{addr}/"),
+        ])
+        .stdout(Stdio::null())
+        .stderr(Stdio::null())
+        .spawn()
+        .unwrap();
+    Ended {
+        child,
+        group: true,
+        signal: libc::SIGKILL,
     }
 }
 
@@ -432,7 +420,7 @@ fn an_emulated_train_shows_live_in_a_headless_browser() {
     // 2.4 ms bounces from 81 g down: the 60 g ones pass, the others fail.
     let spec = "half-sine,60g,2.45ms";
     let mut w = Watch::start(&tmp("live.log"), &["--spec", spec]);
-    let _page = Browser::open(browser, &w.addr, "live");
+    let _page = open_browser(browser, &w.addr, "live");
     wait_for_page(&w);
     // The emulated board's lines, forwarded as they come; its summary held back, so the
     // board falls silent instead of ending.
@@ -456,7 +444,12 @@ fn an_emulated_train_shows_live_in_a_headless_browser() {
         .unwrap();
     let lines = BufReader::new(emulate.stdout.take().unwrap()).lines();
     // Ended (with its QEMU) however the test ends.
-    let _emulate = KillOnDrop(emulate);
+    // (SIGTERM: it ends its QEMU too.)
+    let _emulate = Ended {
+        child: emulate,
+        group: false,
+        signal: libc::SIGTERM,
+    };
     let mut indices = Vec::new();
     let mut last_heartbeat = None;
     for line in lines {
@@ -665,16 +658,21 @@ fn a_raw_defmt_stream_is_decoded_live() {
     assert!(out.ends_with("── the stream ended: ok ──\n"), "{out}");
 }
 
-/// A child `impact` ended when dropped (a panicking test leaves none behind): SIGTERM, on
-/// which it ends its QEMU too.
-struct KillOnDrop(Child);
+/// A child process signalled and reaped when dropped (a panicking test leaves none behind):
+/// the process itself, or with `group` its whole process group (a browser's renderers).
+struct Ended {
+    child: Child,
+    group: bool,
+    signal: i32,
+}
 
-impl Drop for KillOnDrop {
+impl Drop for Ended {
     fn drop(&mut self) {
-        // SAFETY: kill(2) on our own child.
+        let pid = self.child.id() as i32;
+        // SAFETY: kill(2) on our own child, or on the process group it leads.
         unsafe {
-            libc::kill(self.0.id() as i32, libc::SIGTERM);
+            libc::kill(if self.group { -pid } else { pid }, self.signal);
         }
-        let _ = self.0.wait();
+        let _ = self.child.wait();
     }
 }
