@@ -129,6 +129,7 @@ impl defmt::Format for SceneError {
 /// | `spec_peak`, `spec_duration` | its peak, m/s², and duration, s |
 /// | `spec_band`, `spec_outside`, `spec_slack`, `spec_dv`, `spec_before`, `spec_after`, `spec_watch` | its tolerances ([`impact_core::spec::Tolerance`]) |
 /// | `spec_rise`, `spec_fall` | a trapezoid's ramps, × the duration (after `spec=trapezoid`) |
+/// | `spec_table` | emulator only, not here: a file of the user's band ([`impact_core::spec::Spec::band`]), read by the emulator board; on the STM32 set `band: Some(&BAND)` of a `static` table in [`BENCH`]'s spec (docs/standards.md) |
 /// | `wave` | send each captured window: `0` not, `1` whole, `N` the mean of every `N` samples |
 ///
 /// Floats are parsed by `core`'s correctly rounded parser, so the shortest round-trip decimal
@@ -260,6 +261,7 @@ pub fn apply(scene: &mut Scene, key: &str, value: &str) -> Result<(), SceneError
                     after: 0.0,
                     watch: 0.0,
                 },
+                band: None,
             });
         }
         k if k.starts_with("spec_") => {

@@ -1044,16 +1044,23 @@ fn an_adxl375_fifo_overrun_is_counted_as_the_part_lost_it() {
 }
 
 /// Verdicts against a specified pulse (`--spec`): the emulated board's equal the host's bit
-/// for bit (a pass; a fail by the band and by Δv; a window the capture cannot hold), and
+/// for bit (a pass; a fail by the band and by Δv; a window the capture cannot hold; a fail by
+/// a user's band from a file), and
 /// `impact log` reads the board's `spec` lines back to the same verdicts.
 #[test]
 fn spec_verdicts_on_the_board_are_the_hosts() {
     let Some(elf) = firmware() else { return };
     let elf = elf.to_string_lossy().into_owned();
+    // A user's band from a file (at most 55 g at the top): the board reads the host's rows.
+    let band = format!(
+        "half-sine,50g,11ms,band-file={}/../docs/bands/half-sine-50g-11ms.csv",
+        env!("CARGO_MANIFEST_DIR")
+    );
     for (name, peak_g, spec) in [
         ("pass", 50.0, "half-sine,50g,11ms"),
         ("fail", 65.0, "half-sine,50g,11ms,standard=mil-std-810h"),
         ("window", 50.0, "half-sine,50g,1s"),
+        ("band", 57.0, band.as_str()),
     ] {
         // A half-sine of `peak_g` over 11 ms at 50 kS/s, from 50 ms.
         let mut csv = String::from("time_s,accel_g\n");
@@ -1078,6 +1085,14 @@ fn spec_verdicts_on_the_board_are_the_hosts() {
         match name {
             "pass" => assert_eq!(verdict["pass"], true, "{verdict}"),
             "fail" => assert_eq!(verdict["pass"], false, "{verdict}"),
+            "band" => assert_eq!(
+                (
+                    verdict["band_pass"].as_bool(),
+                    verdict["delta_v_pass"].as_bool()
+                ),
+                (Some(false), Some(true)),
+                "{verdict}"
+            ),
             _ => assert!(verdict.is_null(), "{verdict}"),
         }
         let log_file = tmp(&format!("spec-{name}.log"));

@@ -246,3 +246,89 @@ fn the_afrl_drop_tower_pulse_fails_in_its_ringing() {
     let lobe = f(&i["delta_v_m_s"]);
     assert!(dv < lobe && dv / lobe > 0.94, "{dv} vs {lobe}");
 }
+
+/// A user's band from a file (`band-file=`, docs/bands/half-sine-50g-11ms.csv: at most 55 g
+/// at the top): the nominal pulse passes; one 14 % high, which IEC's ±20 % passes, fails at
+/// its peak by 2 g (4 % of the peak) with its Δv within tolerance. The JSON holds the band
+/// judged, and a band that cannot be one is refused naming the file and the fault.
+#[test]
+fn a_users_band_from_a_file_judges_as_written() {
+    let band = concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/../docs/bands/half-sine-50g-11ms.csv"
+    );
+    let spec = format!("half-sine,50g,11ms,band-file={band}");
+    let file = recording("band-nominal", half_sine(50.0, 0.011));
+    let (i, j) = judged(&file, &spec);
+    assert_eq!(i["spec"]["pass"], true, "{}", i["spec"]);
+    let s = &j["spec"];
+    assert_eq!(s["standard"], "custom", "{s}");
+    let rows = s["band_table"].as_array().unwrap();
+    assert_eq!(rows.len(), 9, "{s}");
+    assert!((f(&rows[4]["upper_over_peak"]) - 1.1).abs() < 1e-6, "{s}");
+    assert!(
+        (f(&rows[4]["time_over_duration"]) - 0.5).abs() < 1e-6,
+        "{s}"
+    );
+    let file = recording("band-high", half_sine(57.0, 0.011));
+    let (iec, _) = judged(&file, "half-sine,50g,11ms");
+    assert_eq!(iec["spec"]["pass"], true, "{}", iec["spec"]);
+    let (i, _) = judged(&file, &spec);
+    let v = &i["spec"];
+    assert_eq!(
+        (v["band_pass"].as_bool(), v["delta_v_pass"].as_bool()),
+        (Some(false), Some(true)),
+        "{v}"
+    );
+    assert!((f(&v["margin"]) - 0.04).abs() < 0.002, "{v}");
+    assert!((f(&v["limit_m_s2"]) - 55.0 * 9.80665).abs() < 0.1, "{v}");
+    assert!((f(&v["worst_time_s"]) - 0.0555).abs() < 0.0003, "{v}");
+    // The table names the band.
+    let (table, _) = impact_ok(&["analyze", &file, "--spec", &spec]);
+    assert!(table.contains("the user's band of 9 rows"), "{table}");
+    // Bands that cannot be one.
+    let dir = std::path::PathBuf::from(env!("CARGO_TARGET_TMPDIR"));
+    for (name, body, want) in [
+        ("header", "t,lo,hi\n0,-1,1\n1,-1,1\n", "needs a time column"),
+        // Limits in m/s² given in g: the nominal peak lies above them.
+        (
+            "units",
+            "time_s,lower_m_s2,upper_m_s2\n0,-10,10\n0.0055,40,55\n0.011,-10,10\n",
+            "the nominal pulse lies outside the band",
+        ),
+        (
+            "back",
+            "time_s,lower_g,upper_g\n0,-10,10\n-0.001,-10,10\n",
+            "line 3: the time goes back",
+        ),
+        (
+            "text",
+            "time_s,lower_g,upper_g\n0,-10,ten\n",
+            "line 2: upper_g \"ten\" is not a number",
+        ),
+        (
+            "one",
+            "time_s,lower_g,upper_g\n0,-10,10\n",
+            "at least two rows",
+        ),
+        ("missing", "", "No such file"),
+    ] {
+        let path = dir.join(format!("band-{}-{name}.csv", std::process::id()));
+        if name != "missing" {
+            std::fs::write(&path, body).unwrap();
+        }
+        let spec = format!("half-sine,50g,11ms,band-file={}", path.display());
+        let (code, _, err) = impact(&["analyze", &file, "--spec", &spec]);
+        common::assert_refused(Some(code), &err, want, name);
+        assert!(err.contains("band-file="), "{name}: {err}");
+    }
+    let mut long = String::from("time_s,lower_g,upper_g\n");
+    for k in 0..65 {
+        long.push_str(&format!("{},-100,100\n", f64::from(k) * 0.0002));
+    }
+    let path = dir.join(format!("band-{}-long.csv", std::process::id()));
+    std::fs::write(&path, long).unwrap();
+    let spec = format!("half-sine,50g,11ms,band-file={}", path.display());
+    let (code, _, err) = impact(&["analyze", &file, "--spec", &spec]);
+    common::assert_refused(Some(code), &err, "more than 64 rows", "long");
+}

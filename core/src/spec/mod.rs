@@ -9,6 +9,10 @@
 //! a sawtooth's drop takes that long); before and after it, within ± `outside` × the peak.
 //! The nominal pulse is placed where the measured one fits best (the standards: "any measured
 //! pulse which can be contained between the boundaries" is a nominal pulse).
+//!
+//! A user's own band ([`Spec::band`], a table of [`BandPoint`]s read by linear interpolation)
+//! replaces the band and slack; `outside` still applies before its first row and after its
+//! last.
 
 pub mod verdict;
 
@@ -105,6 +109,48 @@ pub struct Spec {
     /// Nominal duration, s.
     pub duration_s: f32,
     pub tolerance: Tolerance,
+    /// A user's band instead of the tolerance's `band` and `slack` (at most
+    /// [`MAX_BAND_POINTS`] rows, their times non-decreasing; two rows at one time are a step,
+    /// the looser limits holding at that instant). On the board a `static` table.
+    pub band: Option<&'static [BandPoint]>,
+}
+
+/// One row of a user's band: at `u` = time from the nominal pulse's start / duration, the least
+/// and the greatest acceptable acceleration, over the peak.
+#[derive(Clone, Copy, Debug, PartialEq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct BandPoint {
+    pub u: f32,
+    pub lower: f32,
+    pub upper: f32,
+}
+
+/// Most rows of a user's band ([`Spec::band`]).
+pub const MAX_BAND_POINTS: usize = 64;
+
+/// The band `points` at `u` (linear between rows, the looser limits at a step), `None` before
+/// the first row or after the last. `points` is a valid band ([`Spec::validate`]).
+fn table_at(points: &[BandPoint], u: f32) -> Option<(f32, f32)> {
+    let (first, last) = (points.first()?, points.last()?);
+    if !(u >= first.u && u <= last.u) {
+        return None;
+    }
+    // The first row at or after u; it exists since u <= last.u.
+    let i = points.partition_point(|p| p.u < u);
+    let p = points.get(i)?;
+    if p.u == u {
+        // A step: its second row, if any, is the next.
+        return Some(match points.get(i + 1).filter(|q| q.u == u) {
+            Some(q) => (p.lower.min(q.lower), p.upper.max(q.upper)),
+            None => (p.lower, p.upper),
+        });
+    }
+    let q = points.get(i.checked_sub(1)?)?;
+    let f = (u - q.u) / (p.u - q.u);
+    Some((
+        q.lower + f * (p.lower - q.lower),
+        q.upper + f * (p.upper - q.upper),
+    ))
 }
 
 impl Spec {
@@ -140,6 +186,52 @@ impl Spec {
                 "before, after and watch are 0 to 10 durations, watch at least after",
             );
         }
+        if let Some(points) = self.band {
+            self.validate_band(points)?;
+        }
+        Ok(())
+    }
+
+    /// A user's band: 2 to [`MAX_BAND_POINTS`] finite rows within the watched reach (−10 to
+    /// 11 durations, 10 peaks), times non-decreasing with at most two rows at one, each lower
+    /// limit at most its upper one, and the nominal pulse inside at every row (a band it
+    /// cannot pass is a mistake, most often of units).
+    fn validate_band(&self, points: &[BandPoint]) -> Result<(), Error> {
+        let invalid = |reason| {
+            Err(Error::InvalidParameter {
+                name: "spec-band-table",
+                reason,
+            })
+        };
+        if !(2..=MAX_BAND_POINTS).contains(&points.len()) {
+            return invalid("2 to 64 rows");
+        }
+        for p in points {
+            let fine = |v: f32, r: f32| v.is_finite() && (-r..=r).contains(&v);
+            if !(fine(p.u + 0.5, 10.5) && fine(p.lower, 10.0) && fine(p.upper, 10.0)) {
+                return invalid("times from -10 to 11 durations, limits within ±10 peaks");
+            }
+            if p.lower > p.upper {
+                return invalid("a lower limit above its upper one");
+            }
+        }
+        if points.windows(2).any(|w| matches!(w, [a, b] if a.u > b.u)) {
+            return invalid("times must not decrease");
+        }
+        if points
+            .windows(3)
+            .any(|w| matches!(w, [a, _, c] if a.u == c.u))
+        {
+            return invalid("at most two rows at one time (a step)");
+        }
+        for p in points {
+            let nominal = self.shape.at(p.u);
+            let inside =
+                table_at(points, p.u).is_some_and(|(lo, hi)| lo <= nominal && nominal <= hi);
+            if !inside {
+                return invalid("the nominal pulse lies outside the band at a row");
+            }
+        }
         Ok(())
     }
 
@@ -171,6 +263,9 @@ impl Spec {
     /// `[0, 1]`): the verdict's tabulated shape ([`Nominal`]).
     pub fn band_with(&self, at: impl Fn(f32) -> f32, u: f32) -> (f32, f32) {
         let t = &self.tolerance;
+        if let Some(points) = self.band {
+            return table_at(points, u).unwrap_or((-t.outside, t.outside));
+        }
         let (a, b) = (u - t.slack, u + t.slack);
         if b < 0.0 || a > 1.0 {
             return (-t.outside, t.outside);
@@ -192,6 +287,20 @@ impl Spec {
         };
         ((lo - t.band).max(-t.outside.max(t.band)), hi + t.band)
     }
+}
+
+/// The loosest limits of `spec`'s band over `[u0, u1]` (`u0 <= u1`), the nominal shape given
+/// by `at`: a user's band at both ends, at its rows between them and `outside` where the
+/// span leaves the table; otherwise the band at both ends (the verdict's coarse search).
+pub fn band_over(spec: &Spec, at: impl Fn(f32) -> f32, u0: f32, u1: f32) -> (f32, f32) {
+    let (a, b) = (spec.band_with(&at, u0), spec.band_with(&at, u1));
+    let (mut lo, mut hi) = (a.0.min(b.0), a.1.max(b.1));
+    if let Some(points) = spec.band {
+        for p in points.iter().filter(|p| p.u > u0 && p.u < u1) {
+            (lo, hi) = (lo.min(p.lower), hi.max(p.upper));
+        }
+    }
+    (lo, hi)
 }
 
 /// Points of the tabulated nominal shape ([`Nominal`]), past the first.

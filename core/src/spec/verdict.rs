@@ -7,7 +7,7 @@
 //! extremes in [`BUCKETS`] spans against the band on the same grid (at most 129 starts of
 //! 128 comparisons), then over every sample for 17 starts around the best one.
 
-use super::{Nominal, Spec};
+use super::{band_over, Nominal, Spec};
 
 /// Spans the signal is summarised in for the search (its least and greatest value each).
 pub const BUCKETS: usize = 128;
@@ -111,7 +111,7 @@ pub fn judge(
         }
     }
     // The band over bucket j of a nominal pulse starting at bucket `s`'s start plus `lead`:
-    // the loosest limits over the bucket's two ends (a bucket's extremes inside them is
+    // the loosest limits over the bucket's two ends and a user band's rows between them (a bucket's extremes inside them is
     // necessary for its samples to lie inside: the search finds where the pulse can fit, the
     // exact pass below says whether it does). The band is watched from `before` × D before
     // the pulse to `watch` × D after it.
@@ -119,8 +119,8 @@ pub fn judge(
     let mut limits = [(0.0f32, 0.0f32); BUCKETS];
     for (j, l) in limits.iter_mut().enumerate().take(watched) {
         let u = |j: f32| (j * w - lead) / d;
-        let (b0, b1) = (band(u(j as f32)), band(u(j as f32 + 1.0)));
-        *l = (b0.0.min(b1.0) * peak, b0.1.max(b1.1) * peak);
+        let (lo, hi) = band_over(spec, |u| nominal.at(u), u(j as f32), u(j as f32 + 1.0));
+        *l = (lo * peak, hi * peak);
     }
     // The start in whole buckets: nearest the peak-aligned one (`centre`) among those that
     // may pass, else of least worst excursion ([`better`]).
@@ -239,7 +239,7 @@ pub fn judge(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::spec::{Shape, Tolerance};
+    use crate::spec::{BandPoint, Shape, Tolerance};
 
     fn spec(shape: Shape) -> Spec {
         Spec {
@@ -255,12 +255,19 @@ mod tests {
                 after: 0.1,
                 watch: 1.5,
             },
+            band: None,
         }
     }
 
     /// A pulse of `shape` scaled by `gain` in time and amplitude, at 50 kS/s, its start at
     /// sample 2000 (and `glitch` added at a sample).
     fn judge_pulse(shape: Shape, peak: f32, dur: f32, glitch: Option<(u64, f32)>) -> Verdict {
+        judge_against(&spec(shape), peak, dur, glitch)
+    }
+
+    /// [`judge_pulse`] against `spec`, its shape's pulse measured.
+    fn judge_against(spec: &Spec, peak: f32, dur: f32, glitch: Option<(u64, f32)>) -> Verdict {
+        let shape = spec.shape;
         let rate = 50_000.0f32;
         let start = 2000.0;
         let a = |i: u64| {
@@ -273,7 +280,7 @@ mod tests {
         judge(
             held,
             rate,
-            &spec(shape),
+            spec,
             peak_index.min(2000 + (dur * rate) as u64 - 1),
         )
         .unwrap()
@@ -319,5 +326,193 @@ mod tests {
             "{v:?}"
         );
         assert!((v.margin - 0.1).abs() < 0.01, "{v:?}");
+    }
+
+    /// `spec(shape)`'s band as a user's table: from `before` to `watch` around the pulse, and
+    /// the standard band at `n` + 1 rows over it (a step where the nominal ends at its peak).
+    fn tabulated(shape: Shape, n: usize) -> Spec {
+        extern crate std;
+        let s = spec(shape);
+        let mut rows = std::vec![BandPoint {
+            u: -0.4,
+            lower: -0.2,
+            upper: 0.2,
+        }];
+        for k in 0..=n {
+            let u = k as f32 / n as f32;
+            let (lower, upper) = s.band_at(u);
+            rows.push(BandPoint { u, lower, upper });
+        }
+        rows.push(BandPoint {
+            u: 1.0,
+            lower: -0.2,
+            upper: 0.2,
+        });
+        rows.push(BandPoint {
+            u: 1.5,
+            lower: -0.2,
+            upper: 0.2,
+        });
+        let t = Spec {
+            band: Some(rows.leak()),
+            ..s
+        };
+        t.validate().unwrap();
+        t
+    }
+
+    #[test]
+    fn a_users_table_of_the_standard_band_judges_as_the_standard_band() {
+        for shape in [Shape::HalfSine, Shape::Sawtooth] {
+            let table = tabulated(shape, 60);
+            for (peak, dur, glitch) in [
+                (500.0, 0.011, None),
+                (650.0, 0.011, None),
+                (500.0, 0.0055, None),
+                (500.0, 0.011, Some((2800, 150.0))),
+                (560.0, 0.012, None),
+            ] {
+                let (a, b) = (
+                    judge_pulse(shape, peak, dur, glitch),
+                    judge_against(&table, peak, dur, glitch),
+                );
+                // The table is the band to within its chords' sag (sin over 1/60: 3.4e-4).
+                assert_eq!((a.band_pass, a.delta_v_pass), (b.band_pass, b.delta_v_pass));
+                assert!(
+                    (a.margin - b.margin).abs() < 2e-3,
+                    "{shape:?} {peak}: {a:?} {b:?}"
+                );
+            }
+        }
+    }
+
+    #[test]
+    fn a_users_narrow_band_fails_by_its_own_margin() {
+        // The standard band, but at most 1.05 × the peak from 0.3 to 0.7 of the pulse: a
+        // half-sine 10 % high fails there by 5 % (the standard band passes it).
+        extern crate std;
+        let s = spec(Shape::HalfSine);
+        let rows = std::vec![
+            BandPoint {
+                u: -0.4,
+                lower: -0.2,
+                upper: 0.2
+            },
+            BandPoint {
+                u: 0.0,
+                lower: -0.2,
+                upper: 0.2
+            },
+            BandPoint {
+                u: 0.3,
+                lower: 0.6,
+                upper: 1.05
+            },
+            BandPoint {
+                u: 0.7,
+                lower: 0.6,
+                upper: 1.05
+            },
+            BandPoint {
+                u: 1.0,
+                lower: -0.2,
+                upper: 0.2
+            },
+            BandPoint {
+                u: 1.5,
+                lower: -0.2,
+                upper: 0.2
+            },
+        ];
+        let narrow = Spec {
+            band: Some(rows.leak()),
+            ..s
+        };
+        narrow.validate().unwrap();
+        assert!(judge_pulse(Shape::HalfSine, 550.0, 0.011, None).band_pass);
+        let v = judge_against(&narrow, 550.0, 0.011, None);
+        assert!(!v.band_pass, "{v:?}");
+        assert!((v.margin - 0.05).abs() < 2e-3, "{v:?}");
+        assert!((v.limit_m_s2 - 525.0).abs() < 0.5, "{v:?}");
+        // The nominal pulse passes it.
+        assert!(judge_against(&narrow, 500.0, 0.011, None).pass);
+    }
+
+    #[test]
+    fn a_users_band_reads_between_its_rows_and_its_steps() {
+        extern crate std;
+        let rows: &'static [BandPoint] = std::vec![
+            BandPoint {
+                u: 0.0,
+                lower: 0.1,
+                upper: 0.2
+            },
+            BandPoint {
+                u: 0.5,
+                lower: 0.4,
+                upper: 0.7
+            },
+            BandPoint {
+                u: 1.0,
+                lower: 0.8,
+                upper: 1.2
+            },
+            BandPoint {
+                u: 1.0,
+                lower: -0.2,
+                upper: 0.2
+            },
+            BandPoint {
+                u: 1.2,
+                lower: -0.2,
+                upper: 0.2
+            },
+        ]
+        .leak();
+        let s = Spec {
+            shape: Shape::Sawtooth,
+            band: Some(rows),
+            ..spec(Shape::Sawtooth)
+        };
+        // The sawtooth starts at 0: below the first row's 0.1.
+        assert!(s.validate().is_err());
+        let t = Spec {
+            tolerance: Tolerance {
+                outside: 0.3,
+                ..s.tolerance
+            },
+            band: Some(&rows[1..]),
+            ..s
+        };
+        t.validate().unwrap();
+        let (lo, hi) = t.band_at(0.75);
+        assert!(
+            (lo - 0.6).abs() < 1e-6 && (hi - 0.95).abs() < 1e-6,
+            "{lo} {hi}"
+        );
+        assert_eq!(t.band_at(1.0), (-0.2, 1.2)); // the step: the looser limits
+        assert_eq!(t.band_at(1.1), (-0.2, 0.2));
+        assert_eq!(t.band_at(0.4), (-0.3, 0.3)); // before the table: `outside`
+        assert_eq!(t.band_at(1.3), (-0.3, 0.3));
+        let bad = |rows: std::vec::Vec<BandPoint>| {
+            Spec {
+                band: Some(rows.leak()),
+                ..t
+            }
+            .validate()
+            .is_err()
+        };
+        let p = |u, lower, upper| BandPoint { u, lower, upper };
+        assert!(bad(std::vec![p(0.5, 0.0, 1.0)])); // one row
+        assert!(bad(std::vec![p(0.6, 0.0, 1.0), p(0.5, 0.0, 1.0)])); // back in time
+        assert!(bad(std::vec![p(0.5, 0.0, 1.0); 3])); // three rows at one time
+        assert!(bad(std::vec![p(0.5, 1.0, 0.0), p(0.6, 0.0, 1.0)])); // lower above upper
+        assert!(bad(std::vec![p(0.5, 0.0, f32::NAN), p(0.6, 0.0, 1.0)]));
+        assert!(bad((0..65)
+            .map(|k| p(k as f32 / 64.0, -1.0, 2.0))
+            .collect()));
+        assert!(!bad((0..64)
+            .map(|k| p(k as f32 / 63.0, -1.0, 2.0))
+            .collect()));
     }
 }

@@ -5,7 +5,8 @@
 //! `<program> <trace|count> <samples-file> <jobs-file>`; the jobs file holds one job per line:
 //!
 //! * `scene key=value ...`: the scene of the next streams, from the board's
-//!   [`scene::BENCH`] with the keys of [`scene::apply`];
+//!   [`scene::BENCH`] with the keys of [`scene::apply`], and `spec_rows=U:LOWER:UPPER;…` a
+//!   user's band for its spec (one per run);
 //! * `stream <label>`: the samples file (raw little-endian i16) through the board's
 //!   `impact_core::board::BoardMonitor` in blocks of [`BLOCK_LEN`], each `push_block` call between
 //!   [`bench_begin`] and [`bench_end`]. Prints the kind of every block (`i` idle, `t` the
@@ -42,6 +43,7 @@ use cortex_m::peripheral::syst::SystClkSource;
 use cortex_m_rt::{entry, exception};
 use cortex_m_semihosting::hprintln;
 use impact_core::model::{Hertz, KelvinVoigt, Linear, Nonlinear, TwoPhase};
+use impact_core::spec::{BandPoint, MAX_BAND_POINTS};
 use impact_core::{solve, Impact, ImpactReport, Method, Model, Monitor, Scene, Settings};
 use static_cell::ConstStaticCell;
 
@@ -223,11 +225,51 @@ fn calibrate() {
 
 fn set_scene<'a>(scene: &mut Scene, words: impl Iterator<Item = &'a str>) -> Result<(), ()> {
     *scene = scene::BENCH;
+    let mut rows = None;
     for kv in words {
         let (k, v) = kv.split_once('=').ok_or(())?;
+        if k == "spec_rows" {
+            rows = Some(v);
+            continue;
+        }
         scene::apply(scene, k, v).map_err(|_| ())?;
     }
+    if let Some(text) = rows {
+        let spec = scene.spec.as_mut().ok_or(())?;
+        spec.band = Some(band_rows(text)?);
+    }
     Ok(())
+}
+
+/// A user's band (`spec_rows=U:LOWER:UPPER;…`, [`impact_core::spec::Spec::band`]) in the
+/// bench's one static table: one band per run.
+fn band_rows(text: &str) -> Result<&'static [BandPoint], ()> {
+    const EMPTY: BandPoint = BandPoint {
+        u: 0.0,
+        lower: 0.0,
+        upper: 0.0,
+    };
+    static BAND: ConstStaticCell<[BandPoint; MAX_BAND_POINTS]> =
+        ConstStaticCell::new([EMPTY; MAX_BAND_POINTS]);
+    let rows = BAND
+        .try_take()
+        .ok_or_else(|| hprintln!("error one spec_rows per run"))?;
+    let mut n = 0;
+    for row in text.split(';') {
+        let mut f = row.split(':').map(|x| x.parse::<f32>().map_err(|_| ()));
+        let (Some(u), Some(lower), Some(upper), None) = (f.next(), f.next(), f.next(), f.next())
+        else {
+            return Err(());
+        };
+        *rows.get_mut(n).ok_or(())? = BandPoint {
+            u: u?,
+            lower: lower?,
+            upper: upper?,
+        };
+        n += 1;
+    }
+    let rows: &'static [BandPoint; MAX_BAND_POINTS] = rows;
+    rows.get(..n).ok_or(())
 }
 
 fn stream(

@@ -57,6 +57,33 @@ fn unknown() -> u32 {
     unsafe { core::ptr::read_volatile(ADC1_DR) }
 }
 
+/// A user's band (`spec.band`), so that its look-ups are linked and checked too.
+static BAND: [impact_core::spec::BandPoint; 4] = {
+    use impact_core::spec::BandPoint;
+    [
+        BandPoint {
+            u: -0.4,
+            lower: -0.2,
+            upper: 0.2,
+        },
+        BandPoint {
+            u: 0.0,
+            lower: -0.2,
+            upper: 0.4,
+        },
+        BandPoint {
+            u: 1.0,
+            lower: -0.2,
+            upper: 1.2,
+        },
+        BandPoint {
+            u: 1.1,
+            lower: -0.2,
+            upper: 0.2,
+        },
+    ]
+};
+
 /// A scene like the board's, with the CFC filters and every fit on; `black_box` makes every
 /// field unknown, so all variants and values are possible.
 fn scene() -> Scene {
@@ -94,6 +121,7 @@ fn scene() -> Scene {
                 after: 0.1,
                 watch: 1.1,
             },
+            band: Some(&BAND),
         }),
         waveform_every: 1,
     })

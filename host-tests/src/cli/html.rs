@@ -154,6 +154,21 @@ fn page(cfc: Option<u32>, results: &[EntryJson], required: Option<&RequiredSrs>)
                 .trim_end()
                 .trim_start_matches("spec: "),
         );
+        if let Some(rows) = &s.band_table {
+            let rows: Vec<String> = rows
+                .iter()
+                .map(|r| {
+                    format!(
+                        "{}D: {}…{}",
+                        r.time_over_duration, r.lower_over_peak, r.upper_over_peak
+                    )
+                })
+                .collect();
+            dd(
+                "user's band (time from the nominal start: lower…upper limit, × the peak)",
+                &rows.join("; "),
+            );
+        }
     }
     h.push_str("</dl>\n");
     // The series table.

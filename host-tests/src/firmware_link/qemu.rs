@@ -413,6 +413,31 @@ pub fn run_emulator(
             ];
         }
     }
+    // A user's band in a file of its rows' f32 bits (the board's own table is a `static`).
+    let band_written;
+    let _band_guard = match scene.spec.and_then(|s| s.band) {
+        Some(rows) => {
+            let path = std::env::temp_dir().join(format!(
+                "impact-emulate-{}-{nanos}.band",
+                std::process::id()
+            ));
+            let guard = crate::interrupt::temporary(&path);
+            band_written = TempFile(path.clone());
+            let bytes: Vec<u8> = rows
+                .iter()
+                .flat_map(|p| [p.u, p.lower, p.upper])
+                .flat_map(f32::to_le_bytes)
+                .collect();
+            std::fs::write(&band_written.0, bytes)
+                .map_err(|e| format!("{}: {e}", path.display()))?;
+            let s = path.to_string_lossy().into_owned();
+            check_arg("the temporary directory", &s)?;
+            config.push_str(",arg=spec_table=");
+            config.push_str(&s);
+            Some(guard)
+        }
+        None => None,
+    };
     for a in scene_args(scene) {
         check_arg("a scene argument", &a)?;
         config.push_str(",arg=");

@@ -5,6 +5,7 @@
 //! part ([`axes`]), the free fall ([`free_fall`]) and the spectra's reference ([`spectrum`]).
 
 pub mod axes;
+pub mod band_file;
 pub mod free_fall;
 pub mod histogram;
 pub mod level;

@@ -2,8 +2,12 @@
 //! against, with the tolerances of a standard (`standard=`) or the user's own. Every number of
 //! every preset and its source: docs/standards.md.
 
+use std::path::Path;
+
 use impact_core::consts::STANDARD_GRAVITY;
 use impact_core::spec::{Shape, Spec};
+
+use super::band_file;
 
 use crate::standards::STANDARDS;
 
@@ -59,7 +63,8 @@ fn duration(s: &str) -> Result<f32, String> {
 /// Parses `--spec`: `SHAPE,PEAK,DURATION` (`half-sine`, `sawtooth` or `trapezoid`; `50g`;
 /// `11ms`), then `KEY=VALUE`s: `standard=` (the tolerances' source, [`STANDARDS`]), and any
 /// tolerance by hand: `band`, `outside`, `slack`, `dv`, `before`, `after`, `watch` (fractions of
-/// the peak or of the duration), a trapezoid's `rise` and `fall`.
+/// the peak or of the duration), a trapezoid's `rise` and `fall`; `band-file=` a user's band
+/// (a CSV, [`band_file::read`]) instead of `band` and `slack`, watched at least over its rows.
 pub fn parse(s: &str) -> Result<SpecArg, String> {
     let mut parts = s.split(',').map(str::trim);
     let shape_name = parts.next().unwrap_or_default();
@@ -87,8 +92,13 @@ pub fn parse(s: &str) -> Result<SpecArg, String> {
     let mut t = standard.tolerance;
     let (mut rise, mut fall) = (standard.ramp, standard.ramp);
     let mut custom = false;
+    let mut band_path = None;
     for (k, v) in pairs {
         if k == "standard" {
+            continue;
+        }
+        if k == "band-file" {
+            band_path = Some(v);
             continue;
         }
         let x: f32 = v
@@ -108,13 +118,13 @@ pub fn parse(s: &str) -> Result<SpecArg, String> {
             "fall" if shape_name == "trapezoid" => &mut fall,
             _ => {
                 return Err(format!(
-                    "{k}: one of standard, band, outside, slack, dv, before, after, watch{}",
-                    if shape_name == "trapezoid" {
-                        ", rise, fall"
-                    } else {
-                        " (rise, fall: a trapezoid's)"
-                    }
-                ))
+                "{k}: one of standard, band-file, band, outside, slack, dv, before, after, watch{}",
+                if shape_name == "trapezoid" {
+                    ", rise, fall"
+                } else {
+                    " (rise, fall: a trapezoid's)"
+                }
+            ))
             }
         };
         *slot = x;
@@ -130,16 +140,30 @@ pub fn parse(s: &str) -> Result<SpecArg, String> {
             ))
         }
     };
-    let spec = Spec {
+    let mut spec = Spec {
         shape,
         peak_m_s2,
         duration_s,
         tolerance: t,
+        band: None,
     };
-    spec.validate().map_err(|e| match e {
+    let invalid = |e| match e {
         impact_core::Error::InvalidParameter { name, reason } => format!("{name}: {reason}"),
         e => e.to_string(),
-    })?;
+    };
+    spec.validate().map_err(invalid)?;
+    if let Some(path) = band_path {
+        let rows = band_file::read(Path::new(path), &spec)?;
+        // The band is watched at least over the table.
+        if let (Some(first), Some(last)) = (rows.first(), rows.last()) {
+            spec.tolerance.before = spec.tolerance.before.max(-first.u);
+            spec.tolerance.watch = spec.tolerance.watch.max(last.u - 1.0);
+        }
+        spec.band = Some(rows);
+        spec.validate()
+            .map_err(|e| format!("band-file={path}: {}", invalid(e)))?;
+        custom = true;
+    }
     Ok(SpecArg {
         spec,
         standard: if custom { "custom" } else { standard.name },

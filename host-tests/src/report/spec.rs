@@ -29,6 +29,19 @@ pub struct SpecJson {
     pub before: f64,
     pub after: f64,
     pub watch: f64,
+    /// A user's band (`band-file=`) in place of `band` and `slack`: its rows, over the
+    /// duration and the peak.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub band_table: Option<Vec<BandRowJson>>,
+}
+
+/// A row of a user's band: at this time from the nominal pulse's start over the duration,
+/// the least and the greatest acceptable acceleration over the peak.
+#[derive(Clone, Debug, Serialize, PartialEq)]
+pub struct BandRowJson {
+    pub time_over_duration: f64,
+    pub lower_over_peak: f64,
+    pub upper_over_peak: f64,
 }
 
 /// `spec` as JSON; its standard is the preset whose tolerances it has, else `custom`.
@@ -36,7 +49,7 @@ pub fn spec_json(spec: &Spec) -> SpecJson {
     let t = spec.tolerance;
     let standard = crate::standards::STANDARDS
         .iter()
-        .find(|s| s.tolerance == t)
+        .find(|s| s.tolerance == t && spec.band.is_none())
         .map_or("custom", |s| s.name);
     let (rise, fall) = match spec.shape {
         Shape::Trapezoid { rise, fall } => (Some(shortest(rise)), Some(shortest(fall))),
@@ -57,6 +70,15 @@ pub fn spec_json(spec: &Spec) -> SpecJson {
         before: shortest(t.before),
         after: shortest(t.after),
         watch: shortest(t.watch),
+        band_table: spec.band.map(|rows| {
+            rows.iter()
+                .map(|r| BandRowJson {
+                    time_over_duration: shortest(r.u),
+                    lower_over_peak: shortest(r.lower),
+                    upper_over_peak: shortest(r.upper),
+                })
+                .collect()
+        }),
     }
 }
 
@@ -96,15 +118,25 @@ pub fn verdict_json(v: &Result<Verdict, Missing>, t0: f64) -> Option<VerdictJson
 /// The table's line for the specified pulse (before the impacts).
 pub fn table_head(s: &SpecJson) -> String {
     use super::fmt::human;
+    let band = match &s.band_table {
+        Some(rows) => format!(
+            "the user's band of {} rows (±{:.0} % beyond it)",
+            rows.len(),
+            100.0 * s.outside
+        ),
+        None => format!(
+            "band ±{:.0} % of the peak (±{:.0} % outside)",
+            100.0 * s.band,
+            100.0 * s.outside
+        ),
+    };
     format!(
-        "spec: {} {} ({}), {}; {} tolerances: band ±{:.0} % of the peak (±{:.0} % outside), Δv {} ±{:.0} % over −{}D…+{}D\n",
+        "spec: {} {} ({}), {}; {} tolerances: {band}, Δv {} ±{:.0} % over −{}D…+{}D\n",
         s.shape,
         human(s.peak_m_s2 / impact_core::consts::STANDARD_GRAVITY, "g"),
         human(s.peak_m_s2, "m/s²"),
         human(s.duration_s, "s"),
         crate::standards::title(&s.standard),
-        100.0 * s.band,
-        100.0 * s.outside,
         human(s.nominal_delta_v_m_s, "m/s"),
         100.0 * s.delta_v_tolerance,
         s.before,

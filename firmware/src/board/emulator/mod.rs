@@ -17,6 +17,7 @@ use core::sync::atomic::{AtomicBool, Ordering};
 
 use defmt::{error, info, unwrap};
 use embassy_executor::SendSpawner;
+use impact_core::spec::{BandPoint, MAX_BAND_POINTS};
 use impact_core::Scene;
 use static_cell::ConstStaticCell;
 
@@ -32,7 +33,7 @@ const COMMAND_LINE_LEN: usize = 2048;
 
 /// What the semihosting command line asks for:
 /// `<program> <samples-file> [realtime|lossless] [rate_scale=X] [stall=BLOCK:US]
-/// [sensor=adc|adxl375] [axis=x|y|z|resultant] [key=value ...]` (scene keys:
+/// [sensor=adc|adxl375] [axis=x|y|z|resultant] [spec_table=PATH] [key=value ...]` (scene keys:
 /// see [`impact_firmware::scene::apply`]; unset keys keep the seed bench's values,
 /// [`impact_firmware::scene::BENCH`]).
 pub struct Config {
@@ -84,8 +85,46 @@ enum ConfigError {
         key: &'static str,
         error: SceneError,
     },
+    /// `spec_table` is given without a `spec`, or its file is not whole rows of three
+    /// little-endian f32s, at most `MAX_BAND_POINTS` of them.
+    BadBandTable,
     /// The scene does not validate (or does not fit the monitor's buffers).
     Invalid(impact_core::Error),
+}
+
+/// Reads a user's tolerance band (`spec_table=PATH`, [`impact_core::spec::Spec::band`]): rows
+/// of three little-endian f32s (time over the duration, lower and upper limit over the peak),
+/// as `impact` writes them, so that the board judges with the host's very bits. On the STM32
+/// the band is a `static` table in flash instead; here it takes 768 bytes of RAM.
+fn read_band(path: &str) -> Result<&'static [BandPoint], ConfigError> {
+    const EMPTY: BandPoint = BandPoint {
+        u: 0.0,
+        lower: 0.0,
+        upper: 0.0,
+    };
+    static BAND: ConstStaticCell<[BandPoint; MAX_BAND_POINTS]> =
+        ConstStaticCell::new([EMPTY; MAX_BAND_POINTS]);
+    let rows = BAND.try_take().ok_or(ConfigError::BadBandTable)?;
+    let mut file = host::HostFile::open(path).map_err(ConfigError::Host)?;
+    let mut n = 0;
+    loop {
+        let mut row = [0u8; 12];
+        match file.read_full(&mut row).map_err(ConfigError::Host)? {
+            0 => break,
+            12 => {}
+            _ => return Err(ConfigError::BadBandTable),
+        }
+        let mut f = row
+            .chunks_exact(4)
+            .map(|b| f32::from_le_bytes([b[0], b[1], b[2], b[3]]));
+        let (Some(u), Some(lower), Some(upper)) = (f.next(), f.next(), f.next()) else {
+            return Err(ConfigError::BadBandTable);
+        };
+        *rows.get_mut(n).ok_or(ConfigError::BadBandTable)? = BandPoint { u, lower, upper };
+        n += 1;
+    }
+    let rows: &'static [BandPoint; MAX_BAND_POINTS] = rows;
+    rows.get(..n).ok_or(ConfigError::BadBandTable)
 }
 
 fn parse(line: &'static str) -> Result<Config, ConfigError> {
@@ -107,6 +146,7 @@ fn parse(line: &'static str) -> Result<Config, ConfigError> {
     let mut stall = None;
     let mut adxl375 = false;
     let mut axis = Axis::Resultant;
+    let mut band_path = None;
     for arg in line.split(' ') {
         match arg.split_once('=') {
             Some(("axis", value)) => {
@@ -137,10 +177,15 @@ fn parse(line: &'static str) -> Result<Config, ConfigError> {
                     .filter(|x| x.is_finite() && *x > 0.0)
                     .ok_or(ConfigError::BadRateScale)?;
             }
+            Some(("spec_table", path)) => band_path = Some(path),
             Some((key, value)) => impact_firmware::scene::apply(&mut scene, key, value)
                 .map_err(|error| ConfigError::Scene { key, error })?,
             None => {}
         }
+    }
+    if let Some(path) = band_path {
+        let spec = scene.spec.as_mut().ok_or(ConfigError::BadBandTable)?;
+        spec.band = Some(read_band(path)?);
     }
     scene.validate().map_err(ConfigError::Invalid)?;
     Ok(Config {

@@ -59,6 +59,9 @@ pub const SPEC_TARGET: u64 = 5_000_000;
 /// peak with IEC 60068-2-27's tolerances (at 500 kS/s its watched window, 1.5k samples
 /// each side of the pulse, fits the board's capture; the seed's 25 ms contact fails it).
 const SPEC_KEYS: &str = "two_phase=0 nonlinear=0 hertz=0 spec=half-sine spec_peak=96.9 spec_duration=0.003 spec_band=0.2 spec_outside=0.2 spec_slack=0.1 spec_dv=0.15 spec_before=0.4 spec_after=0.1 spec_watch=1.1";
+/// The same verdict with a user's band ([`impact_core::spec::Spec::band`]): the example
+/// band of docs/bands/half-sine-50g-11ms.csv over D and A (9 rows).
+const SPEC_BAND_KEYS: &str = "spec_rows=-0.4:-0.2:0.2;0:-0.2:0.2;0.2:-0.2:0.8;0.35:0.4:1.1;0.5:0.8:1.1;0.65:0.4:1.1;0.8:-0.2:0.8;1:-0.2:0.2;1.5:-0.2:0.2";
 /// Accuracy the board's solves must reach (relative, every report field).
 pub const BOARD_ACCURACY: f64 = 1e-4;
 
@@ -98,6 +101,9 @@ pub struct M4Report {
     /// The verdict of the impact against a specified pulse ([`SPEC_KEYS`]), instructions.
     #[serde(default)]
     pub spec_instructions: u64,
+    /// The same verdict with a user's band of 9 rows instead of the standard's, instructions.
+    #[serde(default)]
+    pub spec_band_instructions: u64,
     /// One impact of each model with each solver in f32 at [`BOARD_ACCURACY`].
     pub solves: Vec<SolveCost>,
     /// Maths back-ends: cost per call on the M4 and error against f64.
@@ -410,6 +416,10 @@ pub fn run(args: &M4Args) -> Result<(M4Report, String), String> {
         }
         jobs.push_str(&format!("{}\nstream srs\n", scene_line(SPECTRUM_KEYS)));
         jobs.push_str(&format!("{}\nstream spec\n", scene_line(SPEC_KEYS)));
+        jobs.push_str(&format!(
+            "{}\nstream spec-band\n",
+            scene_line(&format!("{SPEC_KEYS} {SPEC_BAND_KEYS}"))
+        ));
         let mut solve_rows = Vec::new();
         for case in solve_cases() {
             let exact = solve(&case.model, &case.impact, &Settings::exact())
@@ -493,6 +503,7 @@ pub fn run(args: &M4Args) -> Result<(M4Report, String), String> {
         }
         let spectrum_instructions = ((ticks_total("srs")? - base) * ipt).max(0.0) as u64;
         let spec_instructions = ((ticks_total("spec")? - base) * ipt).max(0.0) as u64;
+        let spec_band_instructions = ((ticks_total("spec-band")? - base) * ipt).max(0.0) as u64;
         let mut solves = Vec::new();
         for (label, case, method, setting, error, host_bits) in solve_rows {
             let s = find(&format!("solve {label} "))?;
@@ -542,6 +553,7 @@ pub fn run(args: &M4Args) -> Result<(M4Report, String), String> {
                     .map_or(0, |f| f.instructions),
             spectrum_instructions,
             spec_instructions,
+            spec_band_instructions,
             fits,
             solves,
             maths: maths_out,

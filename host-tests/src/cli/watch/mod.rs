@@ -110,7 +110,9 @@ pub fn run(args: &WatchArgs) -> Result<(), String> {
                 ),
                 crate::report::fmt::sig(f64::from(a.spec.duration_s) * 1e3, 4),
                 crate::standards::title(a.standard),
-            );
+            ) + &a.spec.band.map_or(String::new(), |rows| {
+                format!(", the user's band ({} rows)", rows.len())
+            });
             Some((a.spec, text))
         }
         None => None,
