@@ -160,8 +160,11 @@ fn every_impact_command_in_the_docs_parses() {
                         .unwrap_or_default(),
                     _ => continue,
                 };
+                // From the workspace's root, as the docs' paths are written (a file an
+                // option reads while it is parsed, `--spec …,band-file=`, must be found).
                 let out = std::process::Command::new(env!("CARGO_BIN_EXE_impact"))
                     .args(&args)
+                    .current_dir(concat!(env!("CARGO_MANIFEST_DIR"), "/.."))
                     .env("IMPACT_PARSE_ONLY", "1")
                     .output()
                     .unwrap();

@@ -283,9 +283,15 @@ fn a_users_band_from_a_file_judges_as_written() {
     assert!((f(&v["margin"]) - 0.04).abs() < 0.002, "{v}");
     assert!((f(&v["limit_m_s2"]) - 55.0 * 9.80665).abs() < 0.1, "{v}");
     assert!((f(&v["worst_time_s"]) - 0.0555).abs() < 0.0003, "{v}");
-    // The table names the band.
+    // The table names the band; the report lists its rows.
     let (table, _) = impact_ok(&["analyze", &file, "--spec", &spec]);
     assert!(table.contains("the user's band of 9 rows"), "{table}");
+    let html = std::path::PathBuf::from(env!("CARGO_TARGET_TMPDIR"))
+        .join(format!("band-{}.html", std::process::id()));
+    let html_s = html.to_string_lossy().into_owned();
+    impact_ok(&["report", &file, "--spec", &spec, "--html", &html_s]);
+    let page = std::fs::read_to_string(&html).unwrap();
+    assert!(page.contains("0.35D: 0.4…1.1; 0.5D: 0.8…1.1"), "{page}");
     // Bands that cannot be one.
     let dir = std::path::PathBuf::from(env!("CARGO_TARGET_TMPDIR"));
     for (name, body, want) in [

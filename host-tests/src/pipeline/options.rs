@@ -209,7 +209,8 @@ pub struct AnalyzeArgs {
     /// then KEY=VALUE: `standard=` iec-60068-2-27 (the default), mil-std-810h or
     /// mil-std-202h, whose tolerance band and velocity-change tolerance apply, or any
     /// tolerance by hand (`band`, `outside`, `slack`, `dv`, `before`, `after`, `watch`; a
-    /// trapezoid's `rise`, `fall`). Every number and its source: docs/standards.md.
+    /// trapezoid's `rise`, `fall`), or `band-file=` a CSV of your own band (time_s,
+    /// lower_g, upper_g; up to 64 rows). Every number and its source: docs/standards.md.
     #[arg(long, help_heading = "Analysis", value_name = "SHAPE,PEAK,DURATION", value_parser = crate::pipeline::spec::parse)]
     pub spec: Option<crate::pipeline::spec::SpecArg>,
     /// Print one JSON object.
