@@ -136,11 +136,44 @@ fn scene(b: &mut Bytes) -> (Scene, bool) {
                 after: 0.1,
                 watch: 1.1,
             },
+            band: (fit_byte & 32 != 0).then_some(&BAND[..]),
         }),
         waveform_every: u16::from(stage_byte >> 4),
     };
     (scene, !raw)
 }
+
+/// A user's band for the specified half-sine (`spec.band`), judged in place of IEC's.
+static BAND: [impact_core::spec::BandPoint; 5] = {
+    use impact_core::spec::BandPoint;
+    [
+        BandPoint {
+            u: -0.4,
+            lower: -0.2,
+            upper: 0.2,
+        },
+        BandPoint {
+            u: 0.0,
+            lower: -0.2,
+            upper: 0.3,
+        },
+        BandPoint {
+            u: 0.5,
+            lower: 0.7,
+            upper: 1.2,
+        },
+        BandPoint {
+            u: 1.0,
+            lower: -0.2,
+            upper: 0.3,
+        },
+        BandPoint {
+            u: 1.1,
+            lower: -0.2,
+            upper: 0.2,
+        },
+    ]
+};
 
 fn finite(r: &ImpactReport) -> bool {
     let mut ok = r.start_s.is_finite()
