@@ -300,7 +300,7 @@ fn a_users_band_from_a_file_judges_as_written() {
         (
             "units",
             "time_s,lower_m_s2,upper_m_s2\n0,-10,10\n0.0055,40,55\n0.011,-10,10\n",
-            "the nominal pulse lies outside the band",
+            "line 3: the nominal pulse (490.332 m/s²) lies outside the band (40…55 m/s²)",
         ),
         (
             "back",
