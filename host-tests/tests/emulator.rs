@@ -292,6 +292,18 @@ fn waveforms_off_the_board_draw_the_same_figure() {
     assert!(err.contains("malformed defmt frames skipped"), "{err}");
     let j: serde_json::Value = serde_json::from_str(&json).unwrap();
     assert_eq!(j["waveforms"][0]["missing_frames"], 1, "{err}");
+    // A stream in which no frame ends (the decoded text, 2 MiB of it, given with --elf) is
+    // refused once 1 MiB is held, not buffered whole.
+    let text = std::fs::read(&log).unwrap();
+    let long_text = path("text-as-raw.log");
+    std::fs::write(&long_text, text.repeat((2 << 20) / text.len() + 1)).unwrap();
+    let out = std::process::Command::new(env!("CARGO_BIN_EXE_impact"))
+        .args(["log", "--elf", &elf, &long_text])
+        .output()
+        .unwrap();
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(1), "{err}");
+    assert!(err.contains("no defmt frame ends in 1 MiB"), "{err}");
 
     // The exported window, analysed again: the same impact, its baseline learned from the
     // window's pre-trigger part alone (so within 1e-3; the deformation, a double integral

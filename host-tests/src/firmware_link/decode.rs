@@ -7,6 +7,11 @@ use std::path::Path;
 
 use defmt_decoder::{DecodeError, Table};
 
+/// The most bytes a stream may hold without a frame ending: the firmware's frames are a few
+/// KiB at most (a `wave` line's chunk, the logger's staging); anything longer is no defmt
+/// stream, and the decoder would hold it all.
+const MAX_FRAME_BYTES: usize = 1 << 20;
+
 /// Decodes `input` against the ELF at `elf`, handing each frame's text line to `on_line`
 /// (numbered from 1); returns how many malformed frames were skipped (a stream cut by a
 /// dropped link recovers at the next frame with the `rzcobs` encoding), or an error naming
@@ -24,15 +29,26 @@ pub fn decode(
     let mut decoder = table.new_stream_decoder();
     let mut buf = vec![0u8; 1 << 16];
     let (mut frames, mut skipped) = (0u64, 0u64);
+    // Bytes received since a frame last ended (decoded or skipped): the decoder holds them.
+    let mut pending = 0usize;
     loop {
         let n = input.read(&mut buf).map_err(|e| format!("{name}: {e}"))?;
         if n == 0 {
             break;
         }
+        pending += n;
+        if pending > MAX_FRAME_BYTES {
+            return Err(format!(
+                "{name}: no defmt frame ends in {} MiB: not this firmware's raw defmt stream \
+                 (text lines are read without --elf)",
+                MAX_FRAME_BYTES >> 20
+            ));
+        }
         decoder.received(&buf[..n]);
         loop {
             match decoder.decode() {
                 Ok(frame) => {
+                    pending = 0;
                     frames += 1;
                     let line = match (frame.display_timestamp(), frame.level()) {
                         (Some(t), Some(l)) => {
@@ -44,7 +60,10 @@ pub fn decode(
                     on_line(frames, &line)?;
                 }
                 Err(DecodeError::UnexpectedEof) => break,
-                Err(DecodeError::Malformed) if table.encoding().can_recover() => skipped += 1,
+                Err(DecodeError::Malformed) if table.encoding().can_recover() => {
+                    pending = 0;
+                    skipped += 1
+                }
                 Err(DecodeError::Malformed) => {
                     return Err(format!(
                         "{name}: frame {}: malformed, and this encoding cannot recover: not this firmware's stream",
