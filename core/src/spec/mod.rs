@@ -192,10 +192,11 @@ impl Spec {
         Ok(())
     }
 
-    /// A user's band: 2 to [`MAX_BAND_POINTS`] finite rows within the watched reach (−10 to
-    /// 11 durations, 10 peaks), times non-decreasing with at most two rows at one, each lower
-    /// limit at most its upper one, and the nominal pulse inside at every row (a band it
-    /// cannot pass is a mistake, most often of units).
+    /// A user's band: 2 to [`MAX_BAND_POINTS`] finite rows (−10 to 11 durations, 10 peaks)
+    /// within the watched window (`before` × D before the pulse to `watch` × D after it),
+    /// times non-decreasing with at most two rows at one, each lower limit at most its upper
+    /// one, and the nominal pulse inside at every row (a band it cannot pass is a mistake,
+    /// most often of units).
     fn validate_band(&self, points: &[BandPoint]) -> Result<(), Error> {
         let invalid = |reason| {
             Err(Error::InvalidParameter {
@@ -223,6 +224,13 @@ impl Spec {
             .any(|w| matches!(w, [a, _, c] if a.u == c.u))
         {
             return invalid("at most two rows at one time (a step)");
+        }
+        // Every row is watched: a row beyond the window would be silently unused.
+        let t = &self.tolerance;
+        let first = points.first().map_or(0.0, |p| p.u);
+        let last = points.last().map_or(0.0, |p| p.u);
+        if first < -t.before || last > 1.0 + t.watch {
+            return invalid("rows beyond the watched window: widen before and watch to them");
         }
         for p in points {
             let nominal = self.shape.at(p.u);

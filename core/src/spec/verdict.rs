@@ -514,5 +514,9 @@ mod tests {
         assert!(!bad((0..64)
             .map(|k| p(k as f32 / 63.0, -1.0, 2.0))
             .collect()));
+        // Rows beyond the watched window (0.4 D before, 1.5 D after).
+        assert!(bad(std::vec![p(-0.5, -1.0, 1.0), p(1.0, -1.0, 1.0)]));
+        assert!(bad(std::vec![p(0.0, -1.0, 1.0), p(2.6, -1.0, 1.0)]));
+        assert!(!bad(std::vec![p(-0.4, -1.0, 1.0), p(2.5, -1.0, 1.0)]));
     }
 }
