@@ -1064,15 +1064,26 @@ fn spec_verdicts_on_the_board_are_the_hosts() {
     let Some(elf) = firmware() else { return };
     let elf = elf.to_string_lossy().into_owned();
     // A user's band from a file (at most 55 g at the top): the board reads the host's rows.
+    // And one over D and A that reaches back to −0.6 D (the band's window widened, Δv's
+    // not) with a step at the pulse's end.
     let band = format!(
         "half-sine,50g,11ms,band-file={}/../docs/bands/half-sine-50g-11ms.csv",
         env!("CARGO_MANIFEST_DIR")
     );
+    let step_file = tmp("spec-step-band.csv");
+    std::fs::write(
+        &step_file,
+        "time_over_duration,lower_over_peak,upper_over_peak\n-0.6,-0.1,0.1\n0,-0.2,0.2\n\
+         0.25,0.5,0.95\n0.5,0.8,1.15\n0.75,0.5,0.95\n1,-0.2,0.3\n1,-0.15,0.15\n1.3,-0.15,0.15\n",
+    )
+    .unwrap();
+    let step = format!("half-sine,50g,11ms,band-file={}", step_file.display());
     for (name, peak_g, spec) in [
         ("pass", 50.0, "half-sine,50g,11ms"),
         ("fail", 65.0, "half-sine,50g,11ms,standard=mil-std-810h"),
         ("window", 50.0, "half-sine,50g,1s"),
         ("band", 57.0, band.as_str()),
+        ("step", 57.0, step.as_str()),
     ] {
         // A half-sine of `peak_g` over 11 ms at 50 kS/s, from 50 ms.
         let mut csv = String::from("time_s,accel_g\n");
@@ -1097,7 +1108,7 @@ fn spec_verdicts_on_the_board_are_the_hosts() {
         match name {
             "pass" => assert_eq!(verdict["pass"], true, "{verdict}"),
             "fail" => assert_eq!(verdict["pass"], false, "{verdict}"),
-            "band" => assert_eq!(
+            "band" | "step" => assert_eq!(
                 (
                     verdict["band_pass"].as_bool(),
                     verdict["delta_v_pass"].as_bool()

@@ -165,3 +165,91 @@ proptest! {
         }
     }
 }
+
+/// A row of a user's band with any f32 bits at all, or one in a plausible range.
+fn band_row() -> impl Strategy<Value = impact_core::spec::BandPoint> {
+    let value = prop_oneof![
+        4 => -3.0f32..3.0,
+        1 => any::<f32>(),
+        1 => Just(f32::NAN),
+    ];
+    (value.clone(), value.clone(), value)
+        .prop_map(|(u, lower, upper)| impact_core::spec::BandPoint { u, lower, upper })
+}
+
+/// A half-sine spec of `peak` m/s² over 11 ms with IEC's tolerances and the user's `rows`.
+fn band_spec(peak: f64, rows: Vec<impact_core::spec::BandPoint>) -> impact_core::spec::Spec {
+    use impact_core::spec::{Shape, Spec, Tolerance};
+    Spec {
+        shape: Shape::HalfSine,
+        peak_m_s2: peak as f32,
+        duration_s: 0.011,
+        tolerance: Tolerance {
+            band: 0.2,
+            outside: 0.2,
+            slack: 0.1,
+            delta_v: 0.15,
+            before: 0.4,
+            after: 0.1,
+            watch: 1.5,
+        },
+        band: Some(Box::leak(rows.into_boxed_slice())),
+    }
+}
+
+/// The half-sine of `spec` itself at 50 kS/s, starting at sample 15 000 (held to 40 000).
+fn nominal_pulse(spec: &impact_core::spec::Spec) -> impl Fn(u64) -> Option<f32> + '_ {
+    move |i| (i < 40_000).then(|| spec.peak_m_s2 * spec.shape.at((i as f32 - 15_000.0) / 550.0))
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(256))]
+
+    /// A user's band of any rows (any bits, sorted or not) never panics: refused, or every
+    /// look-up finite and ordered, and the verdict of a pulse against it finite.
+    #[test]
+    fn any_users_band_is_refused_or_finite(mut rows in prop::collection::vec(band_row(), 0..70), sort in any::<bool>(), peak in log_uniform(1.0, 1e4), us in prop::collection::vec(-20.0f32..20.0, 8)) {
+        use impact_core::spec::verdict;
+        if sort {
+            rows.sort_by(|a, b| a.u.total_cmp(&b.u));
+        }
+        let spec = band_spec(peak, rows);
+        if spec.validate().is_err() {
+            return Ok(());
+        }
+        for &u in &us {
+            let (lo, hi) = spec.band_at(u);
+            prop_assert!(lo.is_finite() && hi.is_finite() && lo <= hi, "{u}: {lo} {hi}");
+        }
+        match verdict::judge(nominal_pulse(&spec), 50_000.0, &spec, 15_275) {
+            Ok(v) => prop_assert!(v.margin.is_finite() && v.delta_v_m_s.is_finite(), "{v:?}"),
+            Err(e) => prop_assert!(e == verdict::Missing::Window, "{e:?}"),
+        }
+    }
+
+    /// Any band around the nominal pulse (rows every 0.1 D from −0.4 D to 1.5 D, each limit
+    /// 0.2 to 3 peaks from the nominal: its chords within 0.012 of the sine) is valid, and the
+    /// nominal pulse itself passes it.
+    #[test]
+    fn the_nominal_pulse_passes_any_band_around_it(widths in prop::collection::vec((0.2f32..3.0, 0.2f32..3.0), 20), peak in log_uniform(1.0, 1e4)) {
+        use impact_core::spec::{verdict, BandPoint, Shape};
+        let rows: Vec<BandPoint> = widths
+            .iter()
+            .enumerate()
+            .map(|(k, &(below, above))| {
+                let u = -0.4 + 0.1 * k as f32;
+                let at = Shape::HalfSine.at(u);
+                BandPoint { u, lower: at - below, upper: at + above }
+            })
+            .collect();
+        let spec = band_spec(peak, rows);
+        prop_assert!(spec.validate().is_ok(), "{:?}", spec.validate());
+        let v = verdict::judge(nominal_pulse(&spec), 50_000.0, &spec, 15_275).unwrap();
+        prop_assert!(v.band_pass, "{v:?}");
+        let narrowest = widths.iter().map(|&(a, b)| a.min(b)).fold(f32::INFINITY, f32::min);
+        // The first placement that passes is kept (up to a coarse bucket, 0.03 D, from the
+        // best): the margin is the narrowest width less the sine's slope over that (π × 0.03)
+        // and the chords'.
+        prop_assert!(v.margin <= -(narrowest.min(0.2) - 0.11), "{v:?}: narrowest {narrowest}");
+    }
+}

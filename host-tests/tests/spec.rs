@@ -291,7 +291,11 @@ fn a_users_band_from_a_file_judges_as_written() {
     let html_s = html.to_string_lossy().into_owned();
     impact_ok(&["report", &file, "--spec", &spec, "--html", &html_s]);
     let page = std::fs::read_to_string(&html).unwrap();
-    assert!(page.contains("0.35D: 0.4…1.1; 0.5D: 0.8…1.1"), "{page}");
+    assert!(
+        page.contains("9 rows (time from the nominal start")
+            && page.contains("0.35D: 0.4…1.1; 0.5D: 0.8…1.1"),
+        "{page}"
+    );
     // Bands that cannot be one.
     let dir = std::path::PathBuf::from(env!("CARGO_TARGET_TMPDIR"));
     for (name, body, want) in [
@@ -300,7 +304,7 @@ fn a_users_band_from_a_file_judges_as_written() {
         (
             "units",
             "time_s,lower_m_s2,upper_m_s2\n0,-10,10\n0.0055,40,55\n0.011,-10,10\n",
-            "line 3: the nominal pulse (490.332 m/s²) lies outside the band (40…55 m/s²)",
+            "line 3, at time_s = 0.0055: the nominal pulse (490.332 m/s²) lies outside the band (40…55 m/s²)",
         ),
         (
             "back",
@@ -316,6 +320,24 @@ fn a_users_band_from_a_file_judges_as_written() {
             "one",
             "time_s,lower_g,upper_g\n0,-10,10\n",
             "at least two rows",
+        ),
+        // CRLF, comments between rows, a blank line, names in any case, an extra column: the
+        // lines still counted as an editor does; the sine above the chord between two rows.
+        (
+            "crlf",
+            "# c\r\ntime_over_duration,LOWER_OVER_PEAK,upper_over_peak,note\r\n\r\n0,-0.2,0.2,a\r\n# mid\r\n0.5,0.8,1.05,b\r\n1,-0.2,0.2,c\r\n",
+            "between lines 4 and 6, at time_over_duration = 0.",
+        ),
+        // A step whose second row leaves the nominal peak outside.
+        (
+            "step",
+            "time_over_duration,lower_over_peak,upper_over_peak\n0,-0.2,0.2\n0.5,0.8,1.2\n0.5,-0.2,0.2\n1,-0.2,0.2\n",
+            "line 4, at time_over_duration = 0.5: the nominal pulse (1 × the peak) lies outside the band (-0.2…0.2 × the peak)",
+        ),
+        (
+            "third",
+            "time_s,lower_g,upper_g\n0,-10,10\n0,-10,10\n0,-10,10\n",
+            "line 4: a third row at one time",
         ),
         ("missing", "", "No such file"),
     ] {
@@ -336,5 +358,33 @@ fn a_users_band_from_a_file_judges_as_written() {
     std::fs::write(&path, long).unwrap();
     let spec = format!("half-sine,50g,11ms,band-file={}", path.display());
     let (code, _, err) = impact(&["analyze", &file, "--spec", &spec]);
-    common::assert_refused(Some(code), &err, "more than 64 rows", "long");
+    common::assert_refused(Some(code), &err, "line 66: more than 64 rows", "long");
+    // The same band over D and A, in a CRLF file: the same verdict.
+    let normalised = dir.join(format!("band-{}-normalised.csv", std::process::id()));
+    std::fs::write(
+        &normalised,
+        "time_over_duration,lower_over_peak,upper_over_peak\r\n-0.4,-0.2,0.2\r\n0,-0.2,0.2\r\n\
+         0.2,-0.2,0.8\r\n0.35,0.4,1.1\r\n0.5,0.8,1.1\r\n0.65,0.4,1.1\r\n0.8,-0.2,0.8\r\n\
+         1,-0.2,0.2\r\n1.5,-0.2,0.2\r\n",
+    )
+    .unwrap();
+    let normalised_spec = format!("half-sine,50g,11ms,band-file={}", normalised.display());
+    let (j, _) = judged(&file, &normalised_spec);
+    assert!(
+        (f(&j["spec"]["margin"]) - f(&v["margin"])).abs() < 1e-6,
+        "{} vs {v}",
+        j["spec"]
+    );
+    // No output over the band file.
+    let (code, _, err) = impact(&[
+        "emulate",
+        &file,
+        "--spec",
+        &normalised_spec,
+        "--log",
+        &normalised.to_string_lossy(),
+    ]);
+    common::assert_refused(Some(code), &err, "--log", "over the band");
+    let kept = std::fs::read_to_string(&normalised).unwrap();
+    assert!(kept.starts_with("time_over_duration"), "{kept}");
 }

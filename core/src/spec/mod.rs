@@ -128,13 +128,23 @@ pub struct BandPoint {
 /// Most rows of a user's band ([`Spec::band`]).
 pub const MAX_BAND_POINTS: usize = 64;
 
+/// Durations within which a time counts as on a user's band's first or last row (a few f32
+/// ulps at 10 durations).
+const END_SLACK: f32 = 4e-6;
+
+/// Points over the pulse, and over a user's band's span, at which the nominal pulse must lie
+/// within the band ([`Spec::band_misses_nominal`]), past the first.
+const NOMINAL_CHECKS: usize = 256;
+
 /// The band `points` at `u` (linear between rows, the looser limits at a step), `None` before
 /// the first row or after the last. `points` is a valid band ([`Spec::validate`]).
 fn table_at(points: &[BandPoint], u: f32) -> Option<(f32, f32)> {
     let (first, last) = (points.first()?, points.last()?);
-    if !(u >= first.u && u <= last.u) {
+    if !(u >= first.u - END_SLACK && u <= last.u + END_SLACK) {
         return None;
     }
+    // A sample's time over D, computed in f32, can miss an end row by an ulp or two.
+    let u = u.clamp(first.u, last.u);
     // The first row at or after u; it exists since u <= last.u.
     let i = points.partition_point(|p| p.u < u);
     let p = points.get(i)?;
@@ -192,11 +202,10 @@ impl Spec {
         Ok(())
     }
 
-    /// A user's band: 2 to [`MAX_BAND_POINTS`] finite rows (−10 to 11 durations, 10 peaks)
-    /// within the watched window (`before` × D before the pulse to `watch` × D after it),
-    /// times non-decreasing with at most two rows at one, each lower limit at most its upper
-    /// one, and the nominal pulse inside at every row (a band it cannot pass is a mistake,
-    /// most often of units).
+    /// A user's band: 2 to [`MAX_BAND_POINTS`] finite rows (−10 to 11 durations, limits
+    /// within 10 peaks), times non-decreasing with at most two rows at one, each lower limit
+    /// at most its upper one, and the nominal pulse inside it ([`Self::band_misses_nominal`]:
+    /// a band it cannot pass is a mistake, most often of units).
     fn validate_band(&self, points: &[BandPoint]) -> Result<(), Error> {
         let invalid = |reason| {
             Err(Error::InvalidParameter {
@@ -209,7 +218,7 @@ impl Spec {
         }
         for p in points {
             let fine = |v: f32, r: f32| v.is_finite() && (-r..=r).contains(&v);
-            if !(fine(p.u + 0.5, 10.5) && fine(p.lower, 10.0) && fine(p.upper, 10.0)) {
+            if !(fine(p.u - 0.5, 10.5) && fine(p.lower, 10.0) && fine(p.upper, 10.0)) {
                 return invalid("times from -10 to 11 durations, limits within ±10 peaks");
             }
             if p.lower > p.upper {
@@ -225,29 +234,60 @@ impl Spec {
         {
             return invalid("at most two rows at one time (a step)");
         }
-        // Every row is watched: a row beyond the window would be silently unused.
-        let t = &self.tolerance;
-        let first = points.first().map_or(0.0, |p| p.u);
-        let last = points.last().map_or(0.0, |p| p.u);
-        if first < -t.before || last > 1.0 + t.watch {
-            return invalid("rows beyond the watched window: widen before and watch to them");
-        }
-        for p in points {
-            let nominal = self.shape.at(p.u);
-            let inside =
-                table_at(points, p.u).is_some_and(|(lo, hi)| lo <= nominal && nominal <= hi);
-            if !inside {
-                return invalid("the nominal pulse lies outside the band at a row");
-            }
+        if self.band_misses_nominal().is_some() {
+            return invalid("the nominal pulse lies outside the band");
         }
         Ok(())
+    }
+
+    /// Where the nominal pulse lies outside a user's band, time over D (`None`: nowhere, or
+    /// no user's band): each side of every step against its own row, then
+    /// [`NOMINAL_CHECKS`] + 1 points over the pulse and as many over the band's span. The
+    /// band's rows must be in order ([`Self::validate`] checks that first).
+    pub fn band_misses_nominal(&self) -> Option<f32> {
+        let points = self.band?;
+        let (first, last) = (points.first()?.u, points.last()?.u);
+        let outside = |v: f32, lo: f32, hi: f32| !(lo <= v && v <= hi);
+        for w in points.windows(2) {
+            if let [a, b] = w {
+                if a.u == b.u {
+                    // The nominal just before and just after the step (0 outside the pulse).
+                    let before = if a.u > 0.0 { self.shape.at(a.u) } else { 0.0 };
+                    let after = if a.u < 1.0 { self.shape.at(a.u) } else { 0.0 };
+                    if outside(before, a.lower, a.upper) || outside(after, b.lower, b.upper) {
+                        return Some(a.u);
+                    }
+                }
+            }
+        }
+        let rows = points.iter().map(|p| p.u);
+        let grid = |a: f32, b: f32| {
+            (0..=NOMINAL_CHECKS).map(move |k| a + (b - a) * k as f32 / NOMINAL_CHECKS as f32)
+        };
+        rows.chain(grid(0.0, 1.0))
+            .chain(grid(first, last))
+            .find(|&u| {
+                let v = self.shape.at(u);
+                table_at(points, u).is_some_and(|(lo, hi)| outside(v, lo, hi))
+            })
+    }
+
+    /// The band's watched window, durations before the nominal pulse and after it: the
+    /// tolerance's `before` and `watch`, widened to a user's band's first and last rows (every
+    /// row is watched). The velocity change keeps its own window (`before`, `after`).
+    pub fn watched(&self) -> (f32, f32) {
+        let t = &self.tolerance;
+        match self.band.and_then(|b| Some((b.first()?.u, b.last()?.u))) {
+            Some((first, last)) => (t.before.max(-first), t.watch.max(last - 1.0)),
+            None => (t.before, t.watch),
+        }
     }
 
     /// Samples the verdict needs held on either side of the contact at `rate_hz`: the watched
     /// window's reach beyond the nominal pulse, and half a duration for the placement.
     pub fn padding_samples(&self, rate_hz: f32) -> u32 {
-        let t = &self.tolerance;
-        let reach = (t.before + 1.0).max(t.watch.max(t.after)) + 0.5;
+        let (before, watch) = self.watched();
+        let reach = (before + 1.0).max(watch.max(self.tolerance.after)) + 0.5;
         let n = libm::ceilf(reach * self.duration_s * rate_hz);
         if n.is_finite() && n < u32::MAX as f32 {
             n as u32

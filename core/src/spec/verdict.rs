@@ -90,14 +90,16 @@ pub fn judge(
     // The start where the nominal peak meets the measured one; the search half a duration
     // either way; the span the signal must cover for any of them, from `base` (its first
     // sample) over `span` samples.
-    let lead = t.before * d;
+    // The band's watched window (a user's band widens it to its rows), × D.
+    let (before, watch) = spec.watched();
+    let lead = before * d;
     let reach = spec.shape.peak_at() * d + d / 2.0 + lead;
     let base = peak_index
         .checked_sub(libm::ceilf(reach) as u64)
         .ok_or(Missing::Window)?;
     let guess = peak_index as f32 - spec.shape.peak_at() * d - base as f32; // from base
     let from = guess - d / 2.0 - lead; // >= 0
-    let to = guess + d / 2.0 + (1.0 + t.watch.max(t.after)) * d;
+    let to = guess + d / 2.0 + (1.0 + watch.max(t.after)) * d;
     let span = libm::ceilf(to) as u32 + 1;
     // The signal's extremes in BUCKETS spans of `w` samples from `base`.
     let w = span as f32 / BUCKETS as f32;
@@ -111,11 +113,11 @@ pub fn judge(
         }
     }
     // The band over bucket j of a nominal pulse starting at bucket `s`'s start plus `lead`:
-    // the loosest limits over the bucket's two ends and a user band's rows between them (a bucket's extremes inside them is
-    // necessary for its samples to lie inside: the search finds where the pulse can fit, the
-    // exact pass below says whether it does). The band is watched from `before` × D before
-    // the pulse to `watch` × D after it.
-    let watched = (((lead + (1.0 + t.watch) * d) / w) as usize).min(BUCKETS);
+    // the loosest limits over the bucket's two ends and a user's band's rows between them (a
+    // bucket's extremes inside them is necessary for its samples to lie inside: the search
+    // finds where the pulse can fit, the exact pass below says whether it does). The band is
+    // watched from `before` × D before the pulse to `watch` × D after it.
+    let watched = (((lead + (1.0 + watch) * d) / w) as usize).min(BUCKETS);
     let mut limits = [(0.0f32, 0.0f32); BUCKETS];
     for (j, l) in limits.iter_mut().enumerate().take(watched) {
         let u = |j: f32| (j * w - lead) / d;
@@ -156,7 +158,7 @@ pub fn judge(
     let mut fine = (coarse, f32::INFINITY, 0u32, 0.0f32, 0.0f32);
     let try_start = |start: f32, fine: &mut (f32, f32, u32, f32, f32)| -> Result<(), Missing> {
         let k0 = libm::ceilf((start - lead).max(0.0)) as u32;
-        let k1 = (libm::floorf(start + (1.0 + t.watch) * d) as u32).min(span - 1);
+        let k1 = (libm::floorf(start + (1.0 + watch) * d) as u32).min(span - 1);
         let excursion = |k: u32| -> Result<(f32, f32, f32), Missing> {
             let v = a(base + u64::from(k)).ok_or(Missing::Window)?;
             let (lo, hi) = band((k as f32 - start) / d);
@@ -201,7 +203,7 @@ pub fn judge(
     }
     let (start, worst, worst_k, worst_v, limit) = fine;
     // The velocity change from `before` × D before the pulse to `after` × D after it.
-    let k0 = libm::ceilf((start - lead).max(0.0)) as u32;
+    let k0 = libm::ceilf((start - t.before * d).max(0.0)) as u32;
     let k1 = (libm::floorf(start + (1.0 + t.after) * d) as u32).min(span - 1);
     // Compensated f32 sums (Kahan): an f64's accuracy at the FPU's speed.
     let (mut sum, mut carry) = (0.0f32, 0.0f32);
@@ -514,9 +516,130 @@ mod tests {
         assert!(!bad((0..64)
             .map(|k| p(k as f32 / 63.0, -1.0, 2.0))
             .collect()));
-        // Rows beyond the watched window (0.4 D before, 1.5 D after).
-        assert!(bad(std::vec![p(-0.5, -1.0, 1.0), p(1.0, -1.0, 1.0)]));
-        assert!(bad(std::vec![p(0.0, -1.0, 1.0), p(2.6, -1.0, 1.0)]));
-        assert!(!bad(std::vec![p(-0.4, -1.0, 1.0), p(2.5, -1.0, 1.0)]));
+        // Times from -10 to 11 durations.
+        assert!(!bad(std::vec![p(-10.0, -1.0, 1.0), p(11.0, -1.0, 1.0)]));
+        assert!(bad(std::vec![p(-10.5, -1.0, 1.0), p(1.0, -1.0, 1.0)]));
+        assert!(bad(std::vec![p(0.0, -1.0, 1.0), p(11.5, -1.0, 1.0)]));
+        // The band is watched over its rows: the window widened to them, not beyond 10 D.
+        let wide = Spec {
+            band: Some(std::vec![p(-2.0, -1.0, 1.0), p(4.0, -1.0, 2.0)].leak()),
+            ..t
+        };
+        assert_eq!(wide.watched(), (2.0, 3.0));
+        assert_eq!(t.watched(), (0.4, 1.5));
+        // A band the nominal pulse cannot pass between its rows or on one side of a step.
+        let sine = |rows: std::vec::Vec<BandPoint>| Spec {
+            shape: Shape::HalfSine,
+            band: Some(rows.leak()),
+            ..spec(Shape::HalfSine)
+        };
+        let flat = sine(std::vec![p(0.0, -0.2, 0.2), p(1.0, -0.2, 0.2)]);
+        assert!(flat.band_misses_nominal().is_some() && flat.validate().is_err());
+        let chord = sine(std::vec![
+            p(0.0, -0.2, 0.2),
+            p(0.5, 0.8, 1.1),
+            p(1.0, -0.2, 0.2)
+        ]);
+        let u = chord.band_misses_nominal().unwrap(); // the sine above the chord to 1.1
+        assert!((0.0..0.5).contains(&u) || (0.5..1.0).contains(&u), "{u}");
+        let step = sine(std::vec![
+            p(0.0, -0.2, 0.2),
+            p(0.5, 0.8, 1.2),
+            p(0.5, -0.2, 0.2),
+            p(1.0, -0.2, 0.2),
+        ]);
+        assert_eq!(step.band_misses_nominal(), Some(0.5));
+        let fine = sine(std::vec![
+            p(0.0, -0.2, 0.2),
+            p(0.25, 0.5, 0.95),
+            p(0.5, 0.8, 1.2),
+            p(0.75, 0.5, 0.95),
+            p(1.0, -0.2, 0.2),
+        ]);
+        assert_eq!(fine.band_misses_nominal(), None);
+        fine.validate().unwrap();
+    }
+
+    #[test]
+    fn a_users_band_at_its_ends_and_over_spans() {
+        extern crate std;
+        let p = |u, lower, upper| BandPoint { u, lower, upper };
+        let rows: &'static [BandPoint] = std::vec![
+            p(0.0, -0.5, 0.5),
+            p(0.0, -0.3, 0.3),
+            p(0.5, 0.0, 2.0),
+            p(1.0, -0.3, 0.3),
+            p(1.0, -0.1, 0.1),
+        ]
+        .leak();
+        let s = Spec {
+            shape: Shape::Sawtooth,
+            band: Some(rows),
+            ..spec(Shape::Sawtooth)
+        };
+        // Steps at both ends: the looser rows' limits at the instant; `outside` (0.2) beyond.
+        assert_eq!(s.band_at(0.0), (-0.5, 0.5));
+        assert_eq!(s.band_at(1.0), (-0.3, 0.3));
+        assert_eq!(s.band_at(-0.01), (-0.2, 0.2));
+        assert_eq!(s.band_at(1.01), (-0.2, 0.2));
+        // On an interior row, and an ulp or two off an end row, the row.
+        assert_eq!(s.band_at(0.5), (0.0, 2.0));
+        assert_eq!(s.band_at(1.0 + 2e-7), (-0.3, 0.3));
+        assert_eq!(s.band_at(-1e-7), (-0.5, 0.5));
+        // Over a span: the loosest of its ends and of the rows inside it.
+        let at = |u| s.shape.at(u);
+        let (lo, hi) = super::band_over(&s, at, 0.4, 0.6);
+        assert!((lo + 0.06).abs() < 1e-6 && hi == 2.0, "{lo} {hi}"); // 0.4's lower, the row's upper
+        let (lo, hi) = super::band_over(&s, at, -0.1, 0.1);
+        assert!(lo == -0.5 && (hi - 0.64).abs() < 1e-5, "{lo} {hi}"); // the step's, 0.1's
+        let (lo, hi) = super::band_over(&s, at, 0.9, 1.5);
+        assert!(lo == -0.3 && (hi - 0.64).abs() < 1e-5, "{lo} {hi}"); // the step's, 0.9's
+    }
+
+    /// A user's band that reaches further back than `before` widens the band's window, not
+    /// the velocity change's: a slow pre-pulse dip before −0.4 D leaves Δv as it is.
+    #[test]
+    fn a_wide_users_band_leaves_the_delta_v_window_alone() {
+        extern crate std;
+        let shape = Shape::HalfSine;
+        let s = spec(shape);
+        let p = |u, lower, upper| BandPoint { u, lower, upper };
+        let wide = Spec {
+            band: Some(
+                std::vec![
+                    p(-2.0, -0.2, 0.2),
+                    p(0.0, -0.2, 0.2),
+                    p(0.25, 0.5, 0.95),
+                    p(0.5, 0.8, 1.2),
+                    p(0.75, 0.5, 0.95),
+                    p(1.0, -0.2, 0.2),
+                    p(1.5, -0.2, 0.2),
+                ]
+                .leak(),
+            ),
+            ..s
+        };
+        wide.validate().unwrap();
+        let rate = 50_000.0f32;
+        let d = 0.011 * rate;
+        let a = |i: u64| {
+            let u = (i as f32 - 3000.0) / d;
+            let dip = if (-1.5..-0.5).contains(&u) {
+                -60.0
+            } else {
+                0.0
+            };
+            (i < 12_000).then_some(500.0 * shape.at(u) + dip)
+        };
+        let peak = (3000.0 + 0.5 * d) as u64;
+        let (narrow, wide) = (
+            judge(a, rate, &s, peak).unwrap(),
+            judge(a, rate, &wide, peak).unwrap(),
+        );
+        assert!(
+            (wide.delta_v_m_s / narrow.delta_v_m_s - 1.0).abs() < 1e-3,
+            "{narrow:?} {wide:?}"
+        );
+        assert!(wide.delta_v_pass && wide.band_pass, "{wide:?}");
     }
 }

@@ -136,7 +136,7 @@ fn scene(b: &mut Bytes) -> (Scene, bool) {
                 after: 0.1,
                 watch: 1.1,
             },
-            band: (fit_byte & 32 != 0).then_some(&BAND[..]),
+            band: (cfc_byte & 0x80 != 0).then_some(&BAND[..]),
         }),
         waveform_every: u16::from(stage_byte >> 4),
     };

@@ -39,11 +39,12 @@ pub struct AnalyzeCommand {
 }
 
 /// The files an analysis reads (no output may write over one): the recording, the scene
-/// file, the free-fall recording.
+/// file, the free-fall recording, the user's band (`--spec …,band-file=`).
 pub fn inputs(args: &AnalyzeArgs) -> Vec<&std::path::Path> {
     let mut inputs = vec![args.file.as_path()];
     inputs.extend(args.scene.as_deref());
     inputs.extend(args.free_fall.as_deref().map(pipeline::free_fall::file));
+    inputs.extend(args.spec.and_then(|s| s.band_file));
     inputs
 }
 

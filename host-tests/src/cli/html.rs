@@ -52,7 +52,8 @@ pub fn run(args: &ReportArgs) -> Result<(), String> {
     let inputs = inputs
         .with_some(a.scene.as_deref())
         .with_some(a.free_fall.as_deref().map(crate::pipeline::free_fall::file))
-        .with_some(args.srs_required.as_deref());
+        .with_some(args.srs_required.as_deref())
+        .with_some(a.spec.and_then(|s| s.band_file));
     crate::output::check("--html", &args.html, &inputs, Some("html"))?;
     let required = args
         .srs_required
@@ -165,8 +166,12 @@ fn page(cfc: Option<u32>, results: &[EntryJson], required: Option<&RequiredSrs>)
                 })
                 .collect();
             dd(
-                "user's band (time from the nominal start: lower…upper limit, × the peak)",
-                &rows.join("; "),
+                "user's band",
+                &format!(
+                    "{} rows (time from the nominal start: lower…upper limit, × the peak): {}",
+                    rows.len(),
+                    rows.join("; ")
+                ),
             );
         }
     }

@@ -239,22 +239,47 @@ const FILTERED: &str = "#192d78";
 pub type BandPoint = (f64, f64, f64, f64);
 
 /// `spec`'s tolerance band and nominal pulse placed at `start_s`, at 201 times over
-/// `[from_s, to_s]` (s from the stream's start).
+/// `[from_s, to_s]` (s from the stream's start); a user's band also at each of its rows, with
+/// the row's own limits (a step's two rows one after the other, and `outside` on the far side
+/// of its first and last rows), so that its corners and steps are drawn as judged.
 pub fn band(spec: &Spec, start_s: f64, from_s: f64, to_s: f64) -> Vec<BandPoint> {
     let peak = f64::from(spec.peak_m_s2);
-    (0..=200)
-        .map(|k| {
-            let t = from_s + (to_s - from_s) * f64::from(k) / 200.0;
-            let u = ((t - start_s) / f64::from(spec.duration_s)) as f32;
-            let (lo, hi) = spec.band_at(u);
-            (
-                t,
-                f64::from(lo) * peak,
-                f64::from(hi) * peak,
-                f64::from(spec.shape.at(u)) * peak,
-            )
-        })
-        .collect()
+    let duration = f64::from(spec.duration_s);
+    let u_at = |t: f64| ((t - start_s) / duration) as f32;
+    let point = |t: f64, (lo, hi): (f32, f32)| {
+        (
+            t,
+            f64::from(lo) * peak,
+            f64::from(hi) * peak,
+            f64::from(spec.shape.at(u_at(t))) * peak,
+        )
+    };
+    let grid = (0..=200).map(|k| from_s + (to_s - from_s) * f64::from(k) / 200.0);
+    let Some(rows) = spec.band else {
+        return grid.map(|t| point(t, spec.band_at(u_at(t)))).collect();
+    };
+    let outside = (-spec.tolerance.outside, spec.tolerance.outside);
+    let row_t = |u: f32| start_s + f64::from(u) * duration;
+    let mut points: Vec<BandPoint> = grid
+        .filter(|&t| rows.iter().all(|r| row_t(r.u) != t))
+        .map(|t| point(t, spec.band_at(u_at(t))))
+        .collect();
+    for (k, r) in rows.iter().enumerate() {
+        let t = row_t(r.u);
+        if !(from_s..=to_s).contains(&t) {
+            continue;
+        }
+        if k == 0 {
+            points.push(point(t, outside));
+        }
+        points.push(point(t, (r.lower, r.upper)));
+        if k + 1 == rows.len() {
+            points.push(point(t, outside));
+        }
+    }
+    // In time; at one time, in the order pushed (the grid's first, then the rows').
+    points.sort_by(|a, b| a.0.total_cmp(&b.0));
+    points
 }
 
 /// Where impact `r`'s pulse is drawn, s from the stream's start: with a verdict against
@@ -267,10 +292,10 @@ pub fn window<'a>(
     match (spec, &r.verdict) {
         (Some(spec), Some(Ok(v))) => {
             let d = f64::from(spec.duration_s);
-            let t = spec.tolerance;
+            let (before, watch) = spec.watched();
             (
-                v.start_s - f64::from(t.before) * d,
-                v.start_s + f64::from(1.0 + t.watch) * d,
+                v.start_s - f64::from(before) * d,
+                v.start_s + f64::from(1.0 + watch) * d,
                 Some((spec, v.start_s)),
             )
         }

@@ -11,14 +11,22 @@ use impact_core::spec::{BandPoint, Spec, MAX_BAND_POINTS};
 /// Largest band file read, bytes (64 rows take a few KiB; anything far beyond is not a band).
 const MAX_FILE_BYTES: u64 = 1 << 20;
 
-/// Reads a band: a CSV (`#` starts a comment line) whose header names a time column —
-/// `time_s` (s from the nominal pulse's start) or `time_over_duration` — and a lower and an
-/// upper limit in one unit: `lower_m_s2`/`upper_m_s2`, `lower_g`/`upper_g` or
-/// `lower_over_peak`/`upper_over_peak`; other columns are ignored. At most
-/// [`MAX_BAND_POINTS`] rows (the board holds them), times non-decreasing (two rows at one
-/// time are a step); linear between rows; the nominal pulse inside at every row. The rows
-/// come over `spec`'s duration and peak, kept for the run (the verdict reads a `'static`
-/// table, as the board's is).
+/// The limits' units a band file may use: the column suffix, the unit's name, and m/s² per unit
+/// (`None`: over the peak).
+const UNITS: [(&str, &str, Option<f64>); 3] = [
+    ("m_s2", " m/s²", Some(1.0)),
+    ("g", " g", Some(STANDARD_GRAVITY)),
+    ("over_peak", " × the peak", None),
+];
+
+/// Reads a band: a CSV (lines starting with `#` and blank lines skipped, LF or CRLF) whose
+/// header names a time column — `time_s` (s from the nominal pulse's start) or
+/// `time_over_duration` — and a lower and an upper limit in one unit: `lower_m_s2`/`upper_m_s2`,
+/// `lower_g`/`upper_g` or `lower_over_peak`/`upper_over_peak` (names in any case; other
+/// columns ignored). At most [`MAX_BAND_POINTS`] rows (the board holds them), times
+/// non-decreasing (two rows at one time are a step); linear between rows; the nominal pulse
+/// inside. The rows come over `spec`'s duration and peak, kept for the run (the verdict reads
+/// a `'static` table, as the board's is). Every refusal names the file and its line.
 pub fn read(path: &Path, spec: &Spec) -> Result<&'static [BandPoint], String> {
     let err = |what: String| format!("band-file={}: {what}", path.display());
     let mut bytes = Vec::new();
@@ -30,59 +38,62 @@ pub fn read(path: &Path, spec: &Spec) -> Result<&'static [BandPoint], String> {
             "larger than {MAX_FILE_BYTES} bytes: not a band"
         )));
     }
-    let mut reader = csv::ReaderBuilder::new()
-        .trim(csv::Trim::All)
-        .comment(Some(b'#'))
-        .from_reader(bytes.as_slice());
-    let header = reader.headers().map_err(|e| err(e.to_string()))?.clone();
+    let text = String::from_utf8(bytes).map_err(|_| err("not UTF-8 text".into()))?;
+    // (line number, fields) of every line that is not blank or a comment.
+    let mut lines = text.lines().enumerate().filter_map(|(i, line)| {
+        let line = line.trim();
+        (!line.is_empty() && !line.starts_with('#')).then(|| {
+            let fields: Vec<&str> = line
+                .split(',')
+                .map(|f| f.trim().trim_matches('"'))
+                .collect();
+            (i + 1, fields)
+        })
+    });
+    let Some((_, header)) = lines.next() else {
+        return Err(err("empty: needs a header and at least two rows".into()));
+    };
     let column = |name: &str| header.iter().position(|h| h.eq_ignore_ascii_case(name));
     let peak = f64::from(spec.peak_m_s2);
     let duration = f64::from(spec.duration_s);
     let time = column("time_s")
         .map(|c| (c, 1.0 / duration))
         .or_else(|| column("time_over_duration").map(|c| (c, 1.0)));
-    let limits = [
-        ("m_s2", 1.0 / peak),
-        ("g", STANDARD_GRAVITY / peak),
-        ("over_peak", 1.0),
-    ]
-    .into_iter()
-    .find_map(|(unit, scale)| {
+    let limits = UNITS.iter().find_map(|&(suffix, unit, scale)| {
         Some((
-            column(&format!("lower_{unit}"))?,
-            column(&format!("upper_{unit}"))?,
-            scale,
+            column(&format!("lower_{suffix}"))?,
+            column(&format!("upper_{suffix}"))?,
+            unit,
+            scale.map_or(1.0, |s| s / peak),
         ))
     });
-    let (Some((t_col, t_scale)), Some((lo_col, hi_col, scale))) = (time, limits) else {
+    let (Some((t_col, t_scale)), Some((lo_col, hi_col, unit, scale))) = (time, limits) else {
         return Err(err(format!(
             "needs a time column (time_s or time_over_duration) and the limits in one unit \
              (lower_m_s2 and upper_m_s2, lower_g and upper_g, or lower_over_peak and \
              upper_over_peak); its header is {:?}",
-            header.iter().collect::<Vec<_>>().join(",")
+            header.join(",")
         )));
     };
-    let mut rows = Vec::new();
-    let mut lines = Vec::new();
-    for record in reader.records() {
-        let record = record.map_err(|e| err(e.to_string()))?;
-        let line = record.position().map_or(0, csv::Position::line);
+    let mut rows: Vec<BandPoint> = Vec::new();
+    let mut numbers = Vec::new();
+    for (line, fields) in lines {
         let value = |col: usize| -> Result<f64, String> {
-            let text = record.get(col).unwrap_or("");
+            let text = fields.get(col).copied().unwrap_or("");
             text.parse::<f64>()
                 .ok()
                 .filter(|v| v.is_finite())
                 .ok_or_else(|| {
                     err(format!(
                         "line {line}: {} {text:?} is not a number",
-                        &header[col]
+                        header[col]
                     ))
                 })
         };
         if rows.len() == MAX_BAND_POINTS {
             return Err(err(format!(
-                "more than {MAX_BAND_POINTS} rows (the board holds {MAX_BAND_POINTS}): \
-                 keep the band's corners"
+                "line {line}: more than {MAX_BAND_POINTS} rows (the board holds \
+                 {MAX_BAND_POINTS}): keep the band's corners"
             )));
         }
         let row = BandPoint {
@@ -90,47 +101,77 @@ pub fn read(path: &Path, spec: &Spec) -> Result<&'static [BandPoint], String> {
             lower: (value(lo_col)? * scale) as f32,
             upper: (value(hi_col)? * scale) as f32,
         };
-        if let Some(last) = rows.last().map(|r: &BandPoint| r.u) {
-            if row.u < last {
-                return Err(err(format!("line {line}: the time goes back")));
+        let fault = match rows.as_slice() {
+            [.., a] if row.u < a.u => Some("the time goes back"),
+            [.., a, b] if a.u == row.u && b.u == row.u => {
+                Some("a third row at one time (two are a step)")
             }
-        }
-        if row.lower > row.upper {
-            return Err(err(format!(
-                "line {line}: the lower limit is above the upper"
-            )));
+            _ if row.lower > row.upper => Some("the lower limit is above the upper"),
+            _ if !(-10.0..=11.0).contains(&row.u) => {
+                Some("beyond −10 to 11 durations from the nominal pulse's start")
+            }
+            _ if row.lower.abs() > 10.0 || row.upper.abs() > 10.0 => {
+                Some("a limit beyond ±10 times the peak")
+            }
+            _ => None,
+        };
+        if let Some(fault) = fault {
+            return Err(err(format!("line {line}: {fault}")));
         }
         rows.push(row);
-        lines.push(line);
+        numbers.push(line);
     }
     if rows.len() < 2 {
         return Err(err("needs at least two rows".into()));
     }
-    // The nominal pulse inside the band at every row (the core refuses it otherwise; here
-    // the row is named, in the file's units).
     let rows: &'static [BandPoint] = Box::leak(rows.into_boxed_slice());
     let with_band = Spec {
         band: Some(rows),
         ..*spec
     };
-    for (row, line) in rows.iter().zip(&lines) {
-        let (lo, hi) = with_band.band_at(row.u);
-        let nominal = spec.shape.at(row.u);
-        if !(lo <= nominal && nominal <= hi) {
-            let unit = match header[lo_col].to_ascii_lowercase().as_str() {
-                "lower_m_s2" => " m/s²",
-                "lower_g" => " g",
-                _ => " × the peak",
+    if let Some(u) = with_band.band_misses_nominal() {
+        // Name the row (at a step, the side the nominal misses) or the rows around the miss,
+        // in the file's units.
+        let at = rows.partition_point(|r| r.u < u);
+        let on = |k: usize| rows.get(k).is_some_and(|r| r.u == u);
+        let (what, nominal, (lo, hi)) = if on(at) {
+            let (k, nominal) = if on(at + 1) {
+                let before = if u > 0.0 { spec.shape.at(u) } else { 0.0 };
+                let after = if u < 1.0 { spec.shape.at(u) } else { 0.0 };
+                if (rows[at].lower..=rows[at].upper).contains(&before) {
+                    (at + 1, after)
+                } else {
+                    (at, before)
+                }
+            } else {
+                (at, spec.shape.at(u))
             };
-            let v = |v: f32| crate::report::fmt::sig(f64::from(v) / scale, 6);
-            return Err(err(format!(
-                "line {line}: the nominal pulse ({}{unit}) lies outside the band ({}…{}{unit}) \
-                 there: are the limits in the column's unit?",
-                v(nominal),
-                v(lo),
-                v(hi),
-            )));
-        }
+            (
+                format!("line {}", numbers[k]),
+                nominal,
+                (rows[k].lower, rows[k].upper),
+            )
+        } else {
+            let (b, a) = (
+                numbers[at.saturating_sub(1)],
+                numbers[at.min(rows.len() - 1)],
+            );
+            (
+                format!("between lines {b} and {a}"),
+                spec.shape.at(u),
+                with_band.band_at(u),
+            )
+        };
+        let v = |v: f32| crate::report::fmt::sig(f64::from(v) / scale, 6);
+        return Err(err(format!(
+            "{what}, at {} = {}: the nominal pulse ({}{unit}) lies outside the band \
+             ({}…{}{unit}): are the limits in the column's unit?",
+            header[t_col],
+            crate::report::fmt::sig(f64::from(u) / t_scale, 6),
+            v(nominal),
+            v(lo),
+            v(hi),
+        )));
     }
     Ok(rows)
 }

@@ -2,7 +2,7 @@
 //! against, with the tolerances of a standard (`standard=`) or the user's own. Every number of
 //! every preset and its source: docs/standards.md.
 
-use std::path::Path;
+use std::path::{Path, PathBuf};
 
 use impact_core::consts::STANDARD_GRAVITY;
 use impact_core::spec::{Shape, Spec};
@@ -17,6 +17,8 @@ use crate::standards::STANDARDS;
 pub struct SpecArg {
     pub spec: Spec,
     pub standard: &'static str,
+    /// The user's band's file (`band-file=`): an input, which no output may overwrite.
+    pub band_file: Option<&'static Path>,
 }
 
 /// An acceleration with an optional unit: `50g`, `490.3m/s2` (m/s² without one).
@@ -64,7 +66,7 @@ fn duration(s: &str) -> Result<f32, String> {
 /// `11ms`), then `KEY=VALUE`s: `standard=` (the tolerances' source, [`STANDARDS`]), and any
 /// tolerance by hand: `band`, `outside`, `slack`, `dv`, `before`, `after`, `watch` (fractions of
 /// the peak or of the duration), a trapezoid's `rise` and `fall`; `band-file=` a user's band
-/// (a CSV, [`band_file::read`]) instead of `band` and `slack`, watched at least over its rows.
+/// (a CSV, [`band_file::read`]) instead of `band` and `slack`.
 pub fn parse(s: &str) -> Result<SpecArg, String> {
     let mut parts = s.split(',').map(str::trim);
     let shape_name = parts.next().unwrap_or_default();
@@ -152,21 +154,19 @@ pub fn parse(s: &str) -> Result<SpecArg, String> {
         e => e.to_string(),
     };
     spec.validate().map_err(invalid)?;
+    let mut band_source = None;
     if let Some(path) = band_path {
-        let rows = band_file::read(Path::new(path), &spec)?;
-        // The band is watched at least over the table.
-        if let (Some(first), Some(last)) = (rows.first(), rows.last()) {
-            spec.tolerance.before = spec.tolerance.before.max(-first.u);
-            spec.tolerance.watch = spec.tolerance.watch.max(last.u - 1.0);
-        }
-        spec.band = Some(rows);
+        // The band is watched over its rows (`Spec::watched`); Δv keeps its window.
+        spec.band = Some(band_file::read(Path::new(path), &spec)?);
         spec.validate()
             .map_err(|e| format!("band-file={path}: {}", invalid(e)))?;
         custom = true;
+        band_source = Some(&*Box::leak(PathBuf::from(path).into_boxed_path()));
     }
     Ok(SpecArg {
         spec,
         standard: if custom { "custom" } else { standard.name },
+        band_file: band_source,
     })
 }
 

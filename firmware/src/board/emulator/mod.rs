@@ -116,7 +116,8 @@ fn read_band(path: &str) -> Result<&'static [BandPoint], ConfigError> {
         }
         let mut f = row
             .chunks_exact(4)
-            .map(|b| f32::from_le_bytes([b[0], b[1], b[2], b[3]]));
+            .filter_map(|b| <[u8; 4]>::try_from(b).ok())
+            .map(f32::from_le_bytes);
         let (Some(u), Some(lower), Some(upper)) = (f.next(), f.next(), f.next()) else {
             return Err(ConfigError::BadBandTable);
         };

@@ -113,15 +113,17 @@ pub fn run(args: &WatchArgs) -> Result<(), String> {
             ) + &a.spec.band.map_or(String::new(), |rows| {
                 format!(", the user's band ({} rows)", rows.len())
             });
-            Some((a.spec, text))
+            Some((a.spec, text, a.band_file))
         }
         None => None,
     };
     let session_path = args.session.clone().unwrap_or_else(default_session);
     let inputs = crate::output::Inputs::new()
         .with(&input)
-        .with_some(args.elf.as_deref());
+        .with_some(args.elf.as_deref())
+        .with_some(spec.as_ref().and_then(|s| s.2));
     crate::output::check("--session", &session_path, &inputs, None)?;
+    let spec = spec.map(|(spec, text, _)| (spec, text));
     let source: Box<dyn Read + Send> = if stdin {
         Box::new(std::io::stdin())
     } else {
