@@ -140,11 +140,16 @@ const NOMINAL_CHECKS: usize = 256;
 /// the first row or after the last. `points` is a valid band ([`Spec::validate`]).
 fn table_at(points: &[BandPoint], u: f32) -> Option<(f32, f32)> {
     let (first, last) = (points.first()?, points.last()?);
-    if !(u >= first.u - END_SLACK && u <= last.u + END_SLACK) {
-        return None;
-    }
     // A sample's time over D, computed in f32, can miss an end row by an ulp or two.
-    let u = u.clamp(first.u, last.u);
+    let u = if u >= first.u && u <= last.u {
+        u
+    } else if u < first.u && u >= first.u - END_SLACK {
+        first.u
+    } else if u > last.u && u <= last.u + END_SLACK {
+        last.u
+    } else {
+        return None;
+    };
     // The first row at or after u; it exists since u <= last.u.
     let i = points.partition_point(|p| p.u < u);
     let p = points.get(i)?;
