@@ -125,6 +125,15 @@ pub struct BandPoint {
     pub upper: f32,
 }
 
+impl BandPoint {
+    /// A row of zeros: the filler of a table read at start-up.
+    pub const ZERO: Self = Self {
+        u: 0.0,
+        lower: 0.0,
+        upper: 0.0,
+    };
+}
+
 /// Most rows of a user's band ([`Spec::band`]).
 pub const MAX_BAND_POINTS: usize = 64;
 

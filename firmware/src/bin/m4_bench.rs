@@ -244,13 +244,8 @@ fn set_scene<'a>(scene: &mut Scene, words: impl Iterator<Item = &'a str>) -> Res
 /// A user's band (`spec_rows=U:LOWER:UPPER;…`, [`impact_core::spec::Spec::band`]) in the
 /// bench's one static table: one band per run.
 fn band_rows(text: &str) -> Result<&'static [BandPoint], ()> {
-    const EMPTY: BandPoint = BandPoint {
-        u: 0.0,
-        lower: 0.0,
-        upper: 0.0,
-    };
     static BAND: ConstStaticCell<[BandPoint; MAX_BAND_POINTS]> =
-        ConstStaticCell::new([EMPTY; MAX_BAND_POINTS]);
+        ConstStaticCell::new([BandPoint::ZERO; MAX_BAND_POINTS]);
     let rows = BAND
         .try_take()
         .ok_or_else(|| hprintln!("error one spec_rows per run"))?;

@@ -97,13 +97,8 @@ enum ConfigError {
 /// as `impact` writes them, so that the board judges with the host's very bits. On the STM32
 /// the band is a `static` table in flash instead; here it takes 768 bytes of RAM.
 fn read_band(path: &str) -> Result<&'static [BandPoint], ConfigError> {
-    const EMPTY: BandPoint = BandPoint {
-        u: 0.0,
-        lower: 0.0,
-        upper: 0.0,
-    };
     static BAND: ConstStaticCell<[BandPoint; MAX_BAND_POINTS]> =
-        ConstStaticCell::new([EMPTY; MAX_BAND_POINTS]);
+        ConstStaticCell::new([BandPoint::ZERO; MAX_BAND_POINTS]);
     let rows = BAND.try_take().ok_or(ConfigError::BadBandTable)?;
     let mut file = host::HostFile::open(path).map_err(ConfigError::Host)?;
     let mut n = 0;
