@@ -11,6 +11,7 @@ pub mod pipeline;
 pub mod plot;
 pub mod report;
 pub mod simulate;
+pub mod small_csv;
 pub mod standards;
 pub mod synth;
 pub mod testkit;

@@ -759,6 +759,26 @@ fn endless_secondary_inputs_are_refused_naming_their_limit() {
         &["log", "--elf", "/dev/zero", name],
         "/dev/zero: more than 262144 KiB, larger than any firmware ELF",
     );
+    fails(
+        &[
+            "report",
+            name,
+            "--srs-required",
+            "/dev/zero",
+            "--html",
+            &f.with_file_name("secondary-out.html").to_string_lossy(),
+        ],
+        "--srs-required /dev/zero: more than 1024 KiB, larger than any required SRS",
+    );
+    fails(
+        &[
+            "analyze",
+            name,
+            "--spec",
+            "half-sine,50g,11ms,band-file=/dev/zero",
+        ],
+        "band-file=/dev/zero: more than 1024 KiB, larger than any band file",
+    );
     // `synth --drop-every 1` would write a header and no sample.
     fails(&["synth", "--drop-every", "1"], "--drop-every");
     let (scene, line) = SAMPLE_LOG;

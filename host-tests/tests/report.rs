@@ -215,6 +215,11 @@ fn a_required_srs_judges_and_draws_each_impact_s_srs() {
             "frequency_hz,acceleration_g\n100,1\n",
             "at least two breakpoints",
         ),
+        // CRLF and a comment between rows: lines counted as an editor counts them.
+        (
+            "# spec 7\r\nfrequency_hz,acceleration_g\r\n100,1\r\n# x\r\n50,1\r\n",
+            "line 5: frequency_hz 50 does not increase",
+        ),
     ] {
         let err = report_against(&d, "bad", csv).unwrap_err();
         assert!(

@@ -8,6 +8,7 @@ use plotters::prelude::*;
 
 use crate::plot::{draw_panel, svg_text, Panel};
 use crate::report::fmt::human;
+use crate::small_csv::SmallCsv;
 use crate::standards::SRS_TOLERANCE_DB;
 
 /// Breakpoints a required SRS may have at most (a specification has a handful).
@@ -22,18 +23,16 @@ pub struct RequiredSrs {
 }
 
 impl RequiredSrs {
-    /// Reads a CSV with a header naming `frequency_hz` and `acceleration_m_s2` or
-    /// `acceleration_g` (other columns ignored): at least two rows, frequencies increasing,
-    /// every value a positive number.
+    /// Reads a small CSV ([`SmallCsv`]: `#` comments, LF or CRLF, at most 1 MiB) with a
+    /// header naming `frequency_hz` and `acceleration_m_s2` or `acceleration_g` (in any case;
+    /// other columns ignored): at least two rows, frequencies increasing, every value a
+    /// positive number.
     pub fn read(path: &Path) -> Result<Self, String> {
         let file = path.display().to_string();
         let err = |what: String| format!("--srs-required {file}: {what}");
-        let mut reader = csv::ReaderBuilder::new()
-            .trim(csv::Trim::All)
-            .from_path(path)
-            .map_err(|e| err(e.to_string()))?;
-        let header = reader.headers().map_err(|e| err(e.to_string()))?.clone();
-        let column = |name: &str| header.iter().position(|h| h.eq_ignore_ascii_case(name));
+        let csv = SmallCsv::read(path, "required SRS").map_err(&err)?;
+        let header = &csv.header;
+        let column = |name: &str| csv.column(name);
         let (Some(f_col), acceleration) = (
             column("frequency_hz"),
             column("acceleration_m_s2")
@@ -42,7 +41,7 @@ impl RequiredSrs {
         ) else {
             return Err(err(format!(
                 "needs the columns frequency_hz and acceleration_m_s2 (or acceleration_g); its header is {:?}",
-                header.iter().collect::<Vec<_>>().join(",")
+                header.join(",")
             )));
         };
         let Some((a_col, scale)) = acceleration else {
@@ -51,11 +50,9 @@ impl RequiredSrs {
             ));
         };
         let mut points: Vec<(f64, f64)> = Vec::new();
-        for row in reader.records() {
-            let row = row.map_err(|e| err(e.to_string()))?;
-            let line = row.position().map_or(0, csv::Position::line);
+        for (line, row) in &csv.rows {
             let value = |col: usize, name: &str| -> Result<f64, String> {
-                let text = row.get(col).unwrap_or("");
+                let text = row.get(col).map_or("", String::as_str);
                 match text.parse::<f64>() {
                     Ok(v) if v.is_finite() && v > 0.0 => Ok(v),
                     _ => Err(err(format!(

@@ -2,14 +2,12 @@
 //! core's verdict interpolates ([`impact_core::spec::BandPoint`]), over the spec's duration
 //! and peak.
 
-use std::io::Read;
 use std::path::Path;
 
 use impact_core::consts::STANDARD_GRAVITY;
 use impact_core::spec::{BandPoint, Spec, MAX_BAND_POINTS};
 
-/// Largest band file read, bytes (64 rows take a few KiB; anything far beyond is not a band).
-const MAX_FILE_BYTES: u64 = 1 << 20;
+use crate::small_csv::SmallCsv;
 
 /// The limits' units a band file may use: the column suffix, the unit's name, and m/s² per unit
 /// (`None`: over the peak).
@@ -19,7 +17,7 @@ const UNITS: [(&str, &str, Option<f64>); 3] = [
     ("over_peak", " × the peak", None),
 ];
 
-/// Reads a band: a CSV (lines starting with `#` and blank lines skipped, LF or CRLF) whose
+/// Reads a band: a small CSV ([`SmallCsv`]: `#` comments, LF or CRLF, at most 1 MiB) whose
 /// header names a time column — `time_s` (s from the nominal pulse's start) or
 /// `time_over_duration` — and a lower and an upper limit in one unit: `lower_m_s2`/`upper_m_s2`,
 /// `lower_g`/`upper_g` or `lower_over_peak`/`upper_over_peak` (names in any case; other
@@ -29,31 +27,9 @@ const UNITS: [(&str, &str, Option<f64>); 3] = [
 /// a `'static` table, as the board's is). Every refusal names the file and its line.
 pub fn read(path: &Path, spec: &Spec) -> Result<&'static [BandPoint], String> {
     let err = |what: String| format!("band-file={}: {what}", path.display());
-    let mut bytes = Vec::new();
-    std::fs::File::open(path)
-        .and_then(|f| f.take(MAX_FILE_BYTES + 1).read_to_end(&mut bytes))
-        .map_err(|e| err(e.to_string()))?;
-    if bytes.len() as u64 > MAX_FILE_BYTES {
-        return Err(err(format!(
-            "larger than {MAX_FILE_BYTES} bytes: not a band"
-        )));
-    }
-    let text = String::from_utf8(bytes).map_err(|_| err("not UTF-8 text".into()))?;
-    // (line number, fields) of every line that is not blank or a comment.
-    let mut lines = text.lines().enumerate().filter_map(|(i, line)| {
-        let line = line.trim();
-        (!line.is_empty() && !line.starts_with('#')).then(|| {
-            let fields: Vec<&str> = line
-                .split(',')
-                .map(|f| f.trim().trim_matches('"'))
-                .collect();
-            (i + 1, fields)
-        })
-    });
-    let Some((_, header)) = lines.next() else {
-        return Err(err("empty: needs a header and at least two rows".into()));
-    };
-    let column = |name: &str| header.iter().position(|h| h.eq_ignore_ascii_case(name));
+    let csv = SmallCsv::read(path, "band file").map_err(&err)?;
+    let header = &csv.header;
+    let column = |name: &str| csv.column(name);
     let peak = f64::from(spec.peak_m_s2);
     let duration = f64::from(spec.duration_s);
     let time = column("time_s")
@@ -77,9 +53,10 @@ pub fn read(path: &Path, spec: &Spec) -> Result<&'static [BandPoint], String> {
     };
     let mut rows: Vec<BandPoint> = Vec::new();
     let mut numbers = Vec::new();
-    for (line, fields) in lines {
+    for (line, fields) in &csv.rows {
+        let line = *line;
         let value = |col: usize| -> Result<f64, String> {
-            let text = fields.get(col).copied().unwrap_or("");
+            let text = fields.get(col).map_or("", String::as_str);
             text.parse::<f64>()
                 .ok()
                 .filter(|v| v.is_finite())
