@@ -145,6 +145,44 @@ const END_SLACK: f32 = 4e-6;
 /// within the band ([`Spec::band_misses_nominal`]), past the first.
 const NOMINAL_CHECKS: usize = 256;
 
+/// Where the nominal pulse lies outside a user's band ([`Spec::band_misses_nominal`]).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct NominalMiss {
+    /// Time over D.
+    pub u: f32,
+    /// The row whose limits it misses (at a step, the side's own row), or `None` between
+    /// rows.
+    pub row: Option<usize>,
+    /// The nominal pulse there and the limits it misses, over the peak.
+    pub nominal: f32,
+    pub lower: f32,
+    pub upper: f32,
+}
+
+/// A user's band's first faulty row (its index) and what is wrong with it: a time not
+/// finite or beyond −10 to 11 durations, a limit not finite or beyond ±10 peaks, the lower
+/// limit above the upper, a time before the previous row's, a third row at one time.
+pub fn band_row_fault(points: &[BandPoint]) -> Option<(usize, &'static str)> {
+    points.iter().enumerate().find_map(|(k, p)| {
+        let fine = |v: f32, r: f32| v.is_finite() && (-r..=r).contains(&v);
+        let before = |n: usize| k.checked_sub(n).and_then(|i| points.get(i));
+        let fault = if !fine(p.u - 0.5, 10.5) {
+            "beyond −10 to 11 durations from the nominal pulse's start"
+        } else if !(fine(p.lower, 10.0) && fine(p.upper, 10.0)) {
+            "a limit beyond ±10 times the peak"
+        } else if p.lower > p.upper {
+            "the lower limit is above the upper"
+        } else if before(1).is_some_and(|a| p.u < a.u) {
+            "the time goes back"
+        } else if before(2).is_some_and(|a| a.u == p.u) {
+            "a third row at one time (two are a step)"
+        } else {
+            return None;
+        };
+        Some((k, fault))
+    })
+}
+
 /// The band `points` at `u` (linear between rows, the looser limits at a step), `None` before
 /// the first row or after the last. `points` is a valid band ([`Spec::validate`]).
 fn table_at(points: &[BandPoint], u: f32) -> Option<(f32, f32)> {
@@ -216,10 +254,9 @@ impl Spec {
         Ok(())
     }
 
-    /// A user's band: 2 to [`MAX_BAND_POINTS`] finite rows (−10 to 11 durations, limits
-    /// within 10 peaks), times non-decreasing with at most two rows at one, each lower limit
-    /// at most its upper one, and the nominal pulse inside it ([`Self::band_misses_nominal`]:
-    /// a band it cannot pass is a mistake, most often of units).
+    /// A user's band: 2 to [`MAX_BAND_POINTS`] rows, none faulty ([`band_row_fault`]), and
+    /// the nominal pulse inside it ([`Self::band_misses_nominal`]: a band it cannot pass is a
+    /// mistake, most often of units).
     fn validate_band(&self, points: &[BandPoint]) -> Result<(), Error> {
         let invalid = |reason| {
             Err(Error::InvalidParameter {
@@ -230,23 +267,8 @@ impl Spec {
         if !(2..=MAX_BAND_POINTS).contains(&points.len()) {
             return invalid("2 to 64 rows");
         }
-        for p in points {
-            let fine = |v: f32, r: f32| v.is_finite() && (-r..=r).contains(&v);
-            if !(fine(p.u - 0.5, 10.5) && fine(p.lower, 10.0) && fine(p.upper, 10.0)) {
-                return invalid("times from -10 to 11 durations, limits within ±10 peaks");
-            }
-            if p.lower > p.upper {
-                return invalid("a lower limit above its upper one");
-            }
-        }
-        if points.windows(2).any(|w| matches!(w, [a, b] if a.u > b.u)) {
-            return invalid("times must not decrease");
-        }
-        if points
-            .windows(3)
-            .any(|w| matches!(w, [a, _, c] if a.u == c.u))
-        {
-            return invalid("at most two rows at one time (a step)");
+        if let Some((_, reason)) = band_row_fault(points) {
+            return invalid(reason);
         }
         if self.band_misses_nominal().is_some() {
             return invalid("the nominal pulse lies outside the band");
@@ -254,36 +276,50 @@ impl Spec {
         Ok(())
     }
 
-    /// Where the nominal pulse lies outside a user's band, time over D (`None`: nowhere, or
-    /// no user's band): each side of every step against its own row, then
+    /// Where the nominal pulse lies outside a user's band, if anywhere (`None` too without a
+    /// user's band): each side of every step against its own row, every row, then
     /// [`NOMINAL_CHECKS`] + 1 points over the pulse and as many over the band's span. The
-    /// band's rows must be in order ([`Self::validate`] checks that first).
-    pub fn band_misses_nominal(&self) -> Option<f32> {
+    /// band's rows must be in order ([`band_row_fault`] finds none).
+    pub fn band_misses_nominal(&self) -> Option<NominalMiss> {
         let points = self.band?;
         let (first, last) = (points.first()?.u, points.last()?.u);
-        let outside = |v: f32, lo: f32, hi: f32| !(lo <= v && v <= hi);
-        for w in points.windows(2) {
-            if let [a, b] = w {
-                if a.u == b.u {
-                    // The nominal just before and just after the step (0 outside the pulse).
-                    let before = if a.u > 0.0 { self.shape.at(a.u) } else { 0.0 };
-                    let after = if a.u < 1.0 { self.shape.at(a.u) } else { 0.0 };
-                    if outside(before, a.lower, a.upper) || outside(after, b.lower, b.upper) {
-                        return Some(a.u);
-                    }
-                }
-            }
-        }
-        let rows = points.iter().map(|p| p.u);
-        let grid = |a: f32, b: f32| {
-            (0..=NOMINAL_CHECKS).map(move |k| a + (b - a) * k as f32 / NOMINAL_CHECKS as f32)
-        };
-        rows.chain(grid(0.0, 1.0))
-            .chain(grid(first, last))
-            .find(|&u| {
-                let v = self.shape.at(u);
-                table_at(points, u).is_some_and(|(lo, hi)| outside(v, lo, hi))
+        let miss = |u: f32, row: Option<usize>, nominal: f32, (lower, upper): (f32, f32)| {
+            (!(lower <= nominal && nominal <= upper)).then_some(NominalMiss {
+                u,
+                row,
+                nominal,
+                lower,
+                upper,
             })
+        };
+        // A step: the nominal just before it against its first row, just after it against
+        // its second (0 outside the pulse).
+        let steps = points.windows(2).enumerate().find_map(|(k, w)| match w {
+            [a, b] if a.u == b.u => {
+                let before = if a.u > 0.0 { self.shape.at(a.u) } else { 0.0 };
+                let after = if a.u < 1.0 { self.shape.at(a.u) } else { 0.0 };
+                miss(a.u, Some(k), before, (a.lower, a.upper))
+                    .or_else(|| miss(a.u, Some(k + 1), after, (b.lower, b.upper)))
+            }
+            _ => None,
+        });
+        // Every row (at a step the looser limits, each side's own checked above).
+        let rows = || {
+            points
+                .iter()
+                .enumerate()
+                .find_map(|(k, p)| miss(p.u, Some(k), self.shape.at(p.u), table_at(points, p.u)?))
+        };
+        let grid = |a: f32, b: f32| {
+            (0..=NOMINAL_CHECKS).find_map(move |k| {
+                let u = a + (b - a) * k as f32 / NOMINAL_CHECKS as f32;
+                miss(u, None, self.shape.at(u), table_at(points, u)?)
+            })
+        };
+        steps
+            .or_else(rows)
+            .or_else(|| grid(0.0, 1.0))
+            .or_else(|| grid(first, last))
     }
 
     /// The band's watched window, durations before the nominal pulse and after it: the

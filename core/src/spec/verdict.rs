@@ -540,7 +540,7 @@ mod tests {
             p(0.5, 0.8, 1.1),
             p(1.0, -0.2, 0.2)
         ]);
-        let u = chord.band_misses_nominal().unwrap(); // the sine above the chord to 1.1
+        let u = chord.band_misses_nominal().unwrap().u; // the sine above the chord to 1.1
         assert!((0.0..0.5).contains(&u) || (0.5..1.0).contains(&u), "{u}");
         let step = sine(std::vec![
             p(0.0, -0.2, 0.2),
@@ -548,7 +548,9 @@ mod tests {
             p(0.5, -0.2, 0.2),
             p(1.0, -0.2, 0.2),
         ]);
-        assert_eq!(step.band_misses_nominal(), Some(0.5));
+        let miss = step.band_misses_nominal();
+        assert_eq!(miss.map(|m| m.u), Some(0.5));
+        assert_eq!(miss.and_then(|m| m.row), Some(2)); // the step's second row
         let fine = sine(std::vec![
             p(0.0, -0.2, 0.2),
             p(0.25, 0.5, 0.95),

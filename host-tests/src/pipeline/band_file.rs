@@ -73,30 +73,16 @@ pub fn read(path: &Path, spec: &Spec) -> Result<&'static [BandPoint], String> {
                  {MAX_BAND_POINTS}): keep the band's corners"
             )));
         }
-        let row = BandPoint {
+        rows.push(BandPoint {
             u: (value(t_col)? * t_scale) as f32,
             lower: (value(lo_col)? * scale) as f32,
             upper: (value(hi_col)? * scale) as f32,
-        };
-        let fault = match rows.as_slice() {
-            [.., a] if row.u < a.u => Some("the time goes back"),
-            [.., a, b] if a.u == row.u && b.u == row.u => {
-                Some("a third row at one time (two are a step)")
-            }
-            _ if row.lower > row.upper => Some("the lower limit is above the upper"),
-            _ if !(-10.0..=11.0).contains(&row.u) => {
-                Some("beyond −10 to 11 durations from the nominal pulse's start")
-            }
-            _ if row.lower.abs() > 10.0 || row.upper.abs() > 10.0 => {
-                Some("a limit beyond ±10 times the peak")
-            }
-            _ => None,
-        };
-        if let Some(fault) = fault {
-            return Err(err(format!("line {line}: {fault}")));
-        }
-        rows.push(row);
+        });
         numbers.push(line);
+    }
+    // The core's own checks, each fault named at its line.
+    if let Some((k, fault)) = impact_core::spec::band_row_fault(&rows) {
+        return Err(err(format!("line {}: {fault}", numbers[k])));
     }
     if rows.len() < 2 {
         return Err(err("needs at least two rows".into()));
@@ -106,48 +92,28 @@ pub fn read(path: &Path, spec: &Spec) -> Result<&'static [BandPoint], String> {
         band: Some(rows),
         ..*spec
     };
-    if let Some(u) = with_band.band_misses_nominal() {
-        // Name the row (at a step, the side the nominal misses) or the rows around the miss,
-        // in the file's units.
-        let at = rows.partition_point(|r| r.u < u);
-        let on = |k: usize| rows.get(k).is_some_and(|r| r.u == u);
-        let (what, nominal, (lo, hi)) = if on(at) {
-            let (k, nominal) = if on(at + 1) {
-                let before = if u > 0.0 { spec.shape.at(u) } else { 0.0 };
-                let after = if u < 1.0 { spec.shape.at(u) } else { 0.0 };
-                if (rows[at].lower..=rows[at].upper).contains(&before) {
-                    (at + 1, after)
-                } else {
-                    (at, before)
-                }
-            } else {
-                (at, spec.shape.at(u))
-            };
-            (
-                format!("line {}", numbers[k]),
-                nominal,
-                (rows[k].lower, rows[k].upper),
-            )
-        } else {
-            let (b, a) = (
-                numbers[at.saturating_sub(1)],
-                numbers[at.min(rows.len() - 1)],
-            );
-            (
-                format!("between lines {b} and {a}"),
-                spec.shape.at(u),
-                with_band.band_at(u),
-            )
+    if let Some(m) = with_band.band_misses_nominal() {
+        // The row it misses (at a step, the side's own), or the rows around the miss.
+        let what = match m.row {
+            Some(k) => format!("line {}", numbers[k]),
+            None => {
+                let after = rows.partition_point(|r| r.u < m.u);
+                format!(
+                    "between lines {} and {}",
+                    numbers[after.saturating_sub(1)],
+                    numbers[after.min(rows.len() - 1)]
+                )
+            }
         };
         let v = |v: f32| crate::report::fmt::sig(f64::from(v) / scale, 6);
         return Err(err(format!(
             "{what}, at {} = {}: the nominal pulse ({}{unit}) lies outside the band \
              ({}…{}{unit}): are the limits in the column's unit?",
             header[t_col],
-            crate::report::fmt::sig(f64::from(u) / t_scale, 6),
-            v(nominal),
-            v(lo),
-            v(hi),
+            crate::report::fmt::sig(f64::from(m.u) / t_scale, 6),
+            v(m.nominal),
+            v(m.lower),
+            v(m.upper),
         )));
     }
     Ok(rows)
