@@ -2,7 +2,11 @@
 //! command line in the emulator (so that the host can hand over exactly the [`Scene`] that
 //! `impact analyze` builds).
 
+#[cfg(target_os = "none")]
+use impact_core::spec::{BandPoint, MAX_BAND_POINTS};
 use impact_core::{Approach, Calibration, FitSet, Scene, Train, TrainSpeed};
+#[cfg(target_os = "none")]
+use static_cell::ConstStaticCell;
 
 /// The seed bench's approach speed, m/s (a light gate may override it per impact through
 /// [`crate::tasks::monitor::APPROACH_SPEED`]).
@@ -84,6 +88,38 @@ pub const BENCH: Scene = Scene {
     // The captured windows stay on the board (`wave=1` in the emulator sends them).
     waveform_every: 0,
 };
+
+/// Why [`band_table`] gave no table.
+#[cfg(target_os = "none")]
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum BandTableError<E> {
+    /// The table was taken already: one band per run.
+    Taken,
+    /// More than [`MAX_BAND_POINTS`] rows.
+    TooManyRows,
+    /// A row could not be read.
+    Row(E),
+}
+
+/// A user's band read at start-up (the emulator's `spec_table`, the M4 bench's `spec_rows`),
+/// in the one static table a scene's spec can borrow ([`impact_core::spec::Spec::band`]; on
+/// the STM32 the band is a `static` in flash instead). The table takes 768 bytes of RAM where
+/// this is called; a second call is refused.
+#[cfg(target_os = "none")]
+pub fn band_table<E>(
+    rows: impl IntoIterator<Item = Result<BandPoint, E>>,
+) -> Result<&'static [BandPoint], BandTableError<E>> {
+    static TABLE: ConstStaticCell<[BandPoint; MAX_BAND_POINTS]> =
+        ConstStaticCell::new([BandPoint::ZERO; MAX_BAND_POINTS]);
+    let table = TABLE.try_take().ok_or(BandTableError::Taken)?;
+    let mut n = 0;
+    for row in rows {
+        *table.get_mut(n).ok_or(BandTableError::TooManyRows)? = row.map_err(BandTableError::Row)?;
+        n += 1;
+    }
+    let table: &'static [BandPoint; MAX_BAND_POINTS] = table;
+    table.get(..n).ok_or(BandTableError::TooManyRows)
+}
 
 /// Why a `key=value` scene argument was refused.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]

@@ -43,7 +43,7 @@ use cortex_m::peripheral::syst::SystClkSource;
 use cortex_m_rt::{entry, exception};
 use cortex_m_semihosting::hprintln;
 use impact_core::model::{Hertz, KelvinVoigt, Linear, Nonlinear, TwoPhase};
-use impact_core::spec::{BandPoint, MAX_BAND_POINTS};
+use impact_core::spec::BandPoint;
 use impact_core::{solve, Impact, ImpactReport, Method, Model, Monitor, Scene, Settings};
 use static_cell::ConstStaticCell;
 
@@ -242,29 +242,24 @@ fn set_scene<'a>(scene: &mut Scene, words: impl Iterator<Item = &'a str>) -> Res
 }
 
 /// A user's band (`spec_rows=U:LOWER:UPPER;…`, [`impact_core::spec::Spec::band`]) in the
-/// bench's one static table: one band per run.
+/// firmware's one static band table ([`scene::band_table`]): one band per run.
 fn band_rows(text: &str) -> Result<&'static [BandPoint], ()> {
-    static BAND: ConstStaticCell<[BandPoint; MAX_BAND_POINTS]> =
-        ConstStaticCell::new([BandPoint::ZERO; MAX_BAND_POINTS]);
-    let rows = BAND
-        .try_take()
-        .ok_or_else(|| hprintln!("error one spec_rows per run"))?;
-    let mut n = 0;
-    for row in text.split(';') {
+    let rows = text.split(';').map(|row| {
         let mut f = row.split(':').map(|x| x.parse::<f32>().map_err(|_| ()));
-        let (Some(u), Some(lower), Some(upper), None) = (f.next(), f.next(), f.next(), f.next())
-        else {
-            return Err(());
-        };
-        *rows.get_mut(n).ok_or(())? = BandPoint {
-            u: u?,
-            lower: lower?,
-            upper: upper?,
-        };
-        n += 1;
-    }
-    let rows: &'static [BandPoint; MAX_BAND_POINTS] = rows;
-    rows.get(..n).ok_or(())
+        match (f.next(), f.next(), f.next(), f.next()) {
+            (Some(u), Some(lower), Some(upper), None) => Ok(BandPoint {
+                u: u?,
+                lower: lower?,
+                upper: upper?,
+            }),
+            _ => Err(()),
+        }
+    });
+    scene::band_table(rows).map_err(|e| {
+        if e == scene::BandTableError::Taken {
+            hprintln!("error one spec_rows per run");
+        }
+    })
 }
 
 fn stream(

@@ -17,13 +17,13 @@ use core::sync::atomic::{AtomicBool, Ordering};
 
 use defmt::{error, info, unwrap};
 use embassy_executor::SendSpawner;
-use impact_core::spec::{BandPoint, MAX_BAND_POINTS};
+use impact_core::spec::BandPoint;
 use impact_core::Scene;
 use static_cell::ConstStaticCell;
 
 use crate::tasks::stream::Backpressure;
 use impact_firmware::adxl375::Axis;
-use impact_firmware::scene::SceneError;
+use impact_firmware::scene::{BandTableError, SceneError};
 use impact_firmware::semihosting as host;
 
 pub use irq::{start_high, start_low, start_medium};
@@ -94,33 +94,32 @@ enum ConfigError {
 
 /// Reads a user's tolerance band (`spec_table=PATH`, [`impact_core::spec::Spec::band`]): rows
 /// of three little-endian f32s (time over the duration, lower and upper limit over the peak),
-/// as `impact` writes them, so that the board judges with the host's very bits. On the STM32
-/// the band is a `static` table in flash instead; here it takes 768 bytes of RAM.
+/// as `impact` writes them, so that the board judges with the host's very bits
+/// ([`impact_firmware::scene::band_table`]).
 fn read_band(path: &str) -> Result<&'static [BandPoint], ConfigError> {
-    static BAND: ConstStaticCell<[BandPoint; MAX_BAND_POINTS]> =
-        ConstStaticCell::new([BandPoint::ZERO; MAX_BAND_POINTS]);
-    let rows = BAND.try_take().ok_or(ConfigError::BadBandTable)?;
     let mut file = host::HostFile::open(path).map_err(ConfigError::Host)?;
-    let mut n = 0;
-    loop {
+    let rows = core::iter::from_fn(|| {
         let mut row = [0u8; 12];
-        match file.read_full(&mut row).map_err(ConfigError::Host)? {
-            0 => break,
-            12 => {}
-            _ => return Err(ConfigError::BadBandTable),
+        match file.read_full(&mut row) {
+            Ok(0) => None,
+            Ok(12) => {
+                let mut f = row
+                    .chunks_exact(4)
+                    .filter_map(|b| <[u8; 4]>::try_from(b).ok())
+                    .map(f32::from_le_bytes);
+                Some(match (f.next(), f.next(), f.next()) {
+                    (Some(u), Some(lower), Some(upper)) => Ok(BandPoint { u, lower, upper }),
+                    _ => Err(ConfigError::BadBandTable),
+                })
+            }
+            Ok(_) => Some(Err(ConfigError::BadBandTable)),
+            Err(e) => Some(Err(ConfigError::Host(e))),
         }
-        let mut f = row
-            .chunks_exact(4)
-            .filter_map(|b| <[u8; 4]>::try_from(b).ok())
-            .map(f32::from_le_bytes);
-        let (Some(u), Some(lower), Some(upper)) = (f.next(), f.next(), f.next()) else {
-            return Err(ConfigError::BadBandTable);
-        };
-        *rows.get_mut(n).ok_or(ConfigError::BadBandTable)? = BandPoint { u, lower, upper };
-        n += 1;
-    }
-    let rows: &'static [BandPoint; MAX_BAND_POINTS] = rows;
-    rows.get(..n).ok_or(ConfigError::BadBandTable)
+    });
+    impact_firmware::scene::band_table(rows).map_err(|e| match e {
+        BandTableError::Row(e) => e,
+        _ => ConfigError::BadBandTable,
+    })
 }
 
 fn parse(line: &'static str) -> Result<Config, ConfigError> {
