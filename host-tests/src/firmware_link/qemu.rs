@@ -282,12 +282,32 @@ impl<R: std::io::Read> std::io::Read for Tee<R> {
     }
 }
 
-/// Removes a file when dropped.
-struct TempFile(PathBuf);
+/// A file written for QEMU's semihosting to read: removed when dropped, and on an interrupt
+/// while it lives.
+struct TempFile {
+    path: PathBuf,
+    _guard: crate::interrupt::FileGuard,
+}
+
+impl TempFile {
+    /// Writes `bytes` to `impact-emulate-PID-NANOS.EXT` in the temporary directory.
+    fn write(ext: &str, nanos: u32, bytes: &[u8]) -> Result<Self, String> {
+        let path = std::env::temp_dir().join(format!(
+            "impact-emulate-{}-{nanos}.{ext}",
+            std::process::id()
+        ));
+        let file = Self {
+            _guard: crate::interrupt::temporary(&path),
+            path,
+        };
+        std::fs::write(&file.path, bytes).map_err(|e| format!("{}: {e}", file.path.display()))?;
+        Ok(file)
+    }
+}
 
 impl Drop for TempFile {
     fn drop(&mut self) {
-        let _ = std::fs::remove_file(&self.0);
+        let _ = std::fs::remove_file(&self.path);
     }
 }
 
@@ -368,16 +388,11 @@ pub fn run_emulator(
     // The samples in a file QEMU's semihosting reads: the caller's, or one written here and
     // removed at the end (or on an interrupt).
     let written;
-    let (raw_path, _guard) = match samples {
-        Samples::File(path, _) => (path.to_path_buf(), None),
+    let raw_path = match samples {
+        Samples::File(path, _) => path.to_path_buf(),
         _ => {
-            let path = std::env::temp_dir()
-                .join(format!("impact-emulate-{}-{nanos}.i16", std::process::id()));
-            let guard = crate::interrupt::temporary(&path);
-            written = TempFile(path.clone());
-            std::fs::write(&written.0, samples.bytes())
-                .map_err(|e| format!("{}: {e}", path.display()))?;
-            (path, Some(guard))
+            written = TempFile::write("i16", nanos, &samples.bytes())?;
+            written.path.clone()
         }
     };
     let raw_s = raw_path.to_string_lossy().into_owned();
@@ -414,30 +429,23 @@ pub fn run_emulator(
         }
     }
     // A user's band in a file of its rows' f32 bits (the board's own table is a `static`).
-    let band_written;
-    let _band_guard = match scene.spec.and_then(|s| s.band) {
+    let band_file = match scene.spec.and_then(|s| s.band) {
         Some(rows) => {
-            let path = std::env::temp_dir().join(format!(
-                "impact-emulate-{}-{nanos}.band",
-                std::process::id()
-            ));
-            let guard = crate::interrupt::temporary(&path);
-            band_written = TempFile(path.clone());
             let bytes: Vec<u8> = rows
                 .iter()
                 .flat_map(|p| [p.u, p.lower, p.upper])
                 .flat_map(f32::to_le_bytes)
                 .collect();
-            std::fs::write(&band_written.0, bytes)
-                .map_err(|e| format!("{}: {e}", path.display()))?;
-            let s = path.to_string_lossy().into_owned();
-            check_arg("the temporary directory", &s)?;
-            config.push_str(",arg=spec_table=");
-            config.push_str(&s);
-            Some(guard)
+            Some(TempFile::write("band", nanos, &bytes)?)
         }
         None => None,
     };
+    if let Some(file) = &band_file {
+        let s = file.path.to_string_lossy().into_owned();
+        check_arg("the temporary directory", &s)?;
+        config.push_str(",arg=spec_table=");
+        config.push_str(&s);
+    }
     for a in scene_args(scene) {
         check_arg("a scene argument", &a)?;
         config.push_str(",arg=");

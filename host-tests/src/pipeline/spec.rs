@@ -119,14 +119,15 @@ pub fn parse(s: &str) -> Result<SpecArg, String> {
             "rise" if shape_name == "trapezoid" => &mut rise,
             "fall" if shape_name == "trapezoid" => &mut fall,
             _ => {
+                let keys = "standard, band-file, band, outside, slack, dv, before, after, watch";
                 return Err(format!(
-                "{k}: one of standard, band-file, band, outside, slack, dv, before, after, watch{}",
-                if shape_name == "trapezoid" {
-                    ", rise, fall"
-                } else {
-                    " (rise, fall: a trapezoid's)"
-                }
-            ))
+                    "{k}: one of {keys}{}",
+                    if shape_name == "trapezoid" {
+                        ", rise, fall"
+                    } else {
+                        " (rise, fall: a trapezoid's)"
+                    }
+                ));
             }
         };
         *slot = x;

@@ -98,32 +98,32 @@ pub fn run(args: &WatchArgs) -> Result<(), String> {
     let input = args.input.clone().unwrap_or_else(|| PathBuf::from("-"));
     let stdin = impact_io::channel::is_stdin(&input);
     let name = impact_io::channel::input_name(&input);
-    let spec = match &args.spec {
-        Some(s) => {
-            let a = crate::pipeline::spec::parse(s)?;
-            let text = format!(
-                "{} {} g {} ms, {}",
-                a.spec.shape.name(),
-                crate::report::fmt::sig(
-                    f64::from(a.spec.peak_m_s2) / impact_core::consts::STANDARD_GRAVITY,
-                    4
-                ),
-                crate::report::fmt::sig(f64::from(a.spec.duration_s) * 1e3, 4),
-                crate::standards::title(a.standard),
-            ) + &a.spec.band.map_or(String::new(), |rows| {
-                format!(", the user's band ({} rows)", rows.len())
-            });
-            Some((a.spec, text, a.band_file))
-        }
-        None => None,
-    };
+    let parsed = args
+        .spec
+        .as_deref()
+        .map(crate::pipeline::spec::parse)
+        .transpose()?;
+    let spec = parsed.map(|a| {
+        let text = format!(
+            "{} {} g {} ms, {}",
+            a.spec.shape.name(),
+            crate::report::fmt::sig(
+                f64::from(a.spec.peak_m_s2) / impact_core::consts::STANDARD_GRAVITY,
+                4
+            ),
+            crate::report::fmt::sig(f64::from(a.spec.duration_s) * 1e3, 4),
+            crate::standards::title(a.standard),
+        ) + &a.spec.band.map_or(String::new(), |rows| {
+            format!(", the user's band ({} rows)", rows.len())
+        });
+        (a.spec, text)
+    });
     let session_path = args.session.clone().unwrap_or_else(default_session);
     let inputs = crate::output::Inputs::new()
         .with(&input)
         .with_some(args.elf.as_deref())
-        .with_some(spec.as_ref().and_then(|s| s.2));
+        .with_some(parsed.and_then(|a| a.band_file));
     crate::output::check("--session", &session_path, &inputs, None)?;
-    let spec = spec.map(|(spec, text, _)| (spec, text));
     let source: Box<dyn Read + Send> = if stdin {
         Box::new(std::io::stdin())
     } else {
