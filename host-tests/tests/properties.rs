@@ -179,20 +179,12 @@ fn band_row() -> impl Strategy<Value = impact_core::spec::BandPoint> {
 
 /// A half-sine spec of `peak` m/s² over 11 ms with IEC's tolerances and the user's `rows`.
 fn band_spec(peak: f64, rows: Vec<impact_core::spec::BandPoint>) -> impact_core::spec::Spec {
-    use impact_core::spec::{Shape, Spec, Tolerance};
+    use impact_core::spec::{Shape, Spec};
     Spec {
         shape: Shape::HalfSine,
         peak_m_s2: peak as f32,
         duration_s: 0.011,
-        tolerance: Tolerance {
-            band: 0.2,
-            outside: 0.2,
-            slack: 0.1,
-            delta_v: 0.15,
-            before: 0.4,
-            after: 0.1,
-            watch: 1.5,
-        },
+        tolerance: impact_host::standards::STANDARDS[0].tolerance,
         band: Some(Box::leak(rows.into_boxed_slice())),
     }
 }
