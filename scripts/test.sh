@@ -53,6 +53,9 @@ step "host tests (the documented commands, the emulated firmware against the hos
 # tests/report.rs loads the HTML report in headless Chromium, also installed above.
 IMPACT_REQUIRE_EMULATOR=1 IMPACT_REQUIRE_BROWSER=1 cargo test --workspace --exclude impact-firmware "${HOST[@]}"
 
+step "golden outputs: the tool's outputs on scripts/golden.sh's commands, byte for byte (host-tests/golden)"
+scripts/golden.sh --check
+
 step "M4 instruction counts (QEMU, exact) against the stored baseline: fails on a > 10 % regression"
 # Also checks the hand-written M4 routines against their portable versions and every f32
 # solve on the M4 against the host's, bit for bit. Refresh the baseline after an intended
