@@ -58,6 +58,7 @@ normalise() {
     -e 's/^\[[0-9.:, ]+\]/[T]/' \
     -e 's/^[0-9]+\.[0-9]+ (TRACE|DEBUG|INFO|WARN|ERROR) /T \1 /' \
     -e 's/(busy )[0-9.]+ %/\1T %/g' \
+    -e '/^building the QEMU firmware/d' \
     "$1"
 }
 

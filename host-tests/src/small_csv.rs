@@ -1,6 +1,7 @@
 //! Small CSV files a user writes by hand (a tolerance band, a required SRS): read whole up to
-//! 1 MiB, lines numbered as an editor numbers them (LF or CRLF), `#` comment lines and blank
-//! lines skipped, fields split on commas and trimmed (surrounding quotes dropped).
+//! 1 MiB, lines numbered as an editor numbers them (LF or CRLF), a byte-order mark (Excel's
+//! "CSV UTF-8") dropped, `#` comment lines and blank lines skipped, each line's fields read by
+//! the `csv` crate (a quoted `"a,b"` is one field) and trimmed.
 
 use std::path::Path;
 
@@ -14,29 +15,50 @@ pub struct SmallCsv {
     pub rows: Vec<(usize, Vec<String>)>,
 }
 
+/// Why a small CSV could not be read. Its text is the bare reason: the caller names the
+/// option and the file.
+#[derive(Debug, thiserror::Error)]
+pub enum SmallCsvError {
+    #[error("{0}")]
+    Io(#[from] std::io::Error),
+    #[error("more than {} KiB, larger than any {what}", MAX_BYTES / 1024)]
+    TooLarge { what: &'static str },
+    #[error("not UTF-8 text")]
+    NotUtf8,
+    #[error("empty: no header")]
+    NoHeader,
+    #[error("line {line}: {source}")]
+    Line { line: usize, source: csv::Error },
+}
+
 impl SmallCsv {
-    /// Reads `path` (`what` names the kind of file in the size error). Errors are the bare
-    /// reason, for the caller to prefix with the option and file.
-    pub fn read(path: &Path, what: &str) -> Result<Self, String> {
-        let bytes = impact_io::read_limited(path, MAX_BYTES, what).map_err(|e| {
-            // read_limited names the file; the caller does too.
-            e.strip_prefix(&format!("{}: ", path.display()))
-                .unwrap_or(&e)
-                .to_string()
-        })?;
-        let text = String::from_utf8(bytes).map_err(|_| "not UTF-8 text".to_string())?;
-        let mut lines = text.lines().enumerate().filter_map(|(i, line)| {
+    /// Reads `path` (`what` names the kind of file in the size error).
+    pub fn read(path: &Path, what: &'static str) -> Result<Self, SmallCsvError> {
+        use std::io::Read;
+        let mut bytes = Vec::new();
+        std::fs::File::open(path)?
+            .take(MAX_BYTES + 1)
+            .read_to_end(&mut bytes)?;
+        if bytes.len() as u64 > MAX_BYTES {
+            return Err(SmallCsvError::TooLarge { what });
+        }
+        let text = String::from_utf8(bytes).map_err(|_| SmallCsvError::NotUtf8)?;
+        let text = text.strip_prefix('\u{feff}').unwrap_or(&text);
+        let mut lines = Vec::new();
+        for (i, line) in text.lines().enumerate() {
             let line = line.trim();
-            (!line.is_empty() && !line.starts_with('#')).then(|| {
-                let fields = line
-                    .split(',')
-                    .map(|f| f.trim().trim_matches('"').to_string())
-                    .collect();
-                (i + 1, fields)
-            })
-        });
+            if line.is_empty() || line.starts_with('#') {
+                continue;
+            }
+            let fields = fields(line).map_err(|source| SmallCsvError::Line {
+                line: i + 1,
+                source,
+            })?;
+            lines.push((i + 1, fields));
+        }
+        let mut lines = lines.into_iter();
         let Some((_, header)) = lines.next() else {
-            return Err("empty: no header".into());
+            return Err(SmallCsvError::NoHeader);
         };
         Ok(Self {
             header,
@@ -52,18 +74,37 @@ impl SmallCsv {
     }
 }
 
+/// One line's fields, as the `csv` crate reads them (quotes around a field, `""` inside
+/// one), each trimmed; a field quoted after a space (`3, "4"`, which the crate keeps as
+/// written) unquoted too.
+fn fields(line: &str) -> Result<Vec<String>, csv::Error> {
+    let mut reader = csv::ReaderBuilder::new()
+        .has_headers(false)
+        .flexible(true)
+        .trim(csv::Trim::All)
+        .from_reader(line.as_bytes());
+    let mut record = csv::StringRecord::new();
+    reader.read_record(&mut record)?;
+    Ok(record
+        .iter()
+        .map(|f| match f.strip_prefix('"').and_then(|f| f.strip_suffix('"')) {
+            Some(inner) => inner.replace("\"\"", "\""),
+            None => f.to_string(),
+        })
+        .collect())
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
 
     #[test]
     fn lines_are_numbered_as_an_editor_numbers_them() {
-        let dir = std::env::temp_dir().join(format!("small-csv-{}", std::process::id()));
-        std::fs::create_dir_all(&dir).unwrap();
-        let path = dir.join("t.csv");
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("t.csv");
         std::fs::write(
             &path,
-            "# a\r\n\"Time_S\", x \r\n\r\n1,2\r\n# b\r\n3 , \"4\"\r\n",
+            "\u{feff}# a\r\n\"Time_S\", x \r\n\r\n1,2\r\n# b\r\n3 , \"4\"\r\n\"5,6\",7\n",
         )
         .unwrap();
         let t = SmallCsv::read(&path, "table").unwrap();
@@ -73,13 +114,19 @@ mod tests {
             t.rows,
             [
                 (4, vec!["1".to_string(), "2".into()]),
-                (6, vec!["3".into(), "4".into()])
+                (6, vec!["3".into(), "4".into()]),
+                (7, vec!["5,6".into(), "7".into()])
             ]
         );
         std::fs::write(&path, "# only\n\n").unwrap();
-        assert!(SmallCsv::read(&path, "table")
-            .unwrap_err()
-            .contains("no header"));
-        let _ = std::fs::remove_dir_all(&dir);
+        assert!(matches!(
+            SmallCsv::read(&path, "table"),
+            Err(SmallCsvError::NoHeader)
+        ));
+        std::fs::write(&path, "\u{feff}frequency_hz\n").unwrap();
+        assert_eq!(
+            SmallCsv::read(&path, "table").unwrap().header,
+            ["frequency_hz"]
+        );
     }
 }

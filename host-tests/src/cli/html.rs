@@ -3,15 +3,16 @@
 //! every impact's pulse drawn with the nominal pulse and its tolerance band when a
 //! specification is given.
 
-use std::fmt::Write as _;
 use std::path::PathBuf;
 
 use impact_core::consts::STANDARD_GRAVITY;
 
 use super::analyze::AnalyzeCommand;
-use super::pulse::{esc, MAX_FIGURES};
+use super::pulse::MAX_FIGURES;
 use super::series::{self, EntryJson};
 use super::srs_required::{self, RequiredSrs};
+use crate::html;
+use crate::html::Html;
 use crate::report::fmt::human;
 
 /// `impact report`'s command line: the analysis's (one or more recordings), and the file.
@@ -65,7 +66,7 @@ pub fn run(args: &ReportArgs) -> Result<(), String> {
     a.spectrum.srs |= required.is_some();
     let results = series::analyze_drawn(&a, &entries);
     let page = page(a.cfc, &results, required.as_ref());
-    crate::output::write(&args.html, page.as_bytes())?;
+    crate::output::write(&args.html, page.as_str().as_bytes())?;
     for e in &results {
         for n in &e.notes {
             eprintln!("note: {}", series::failure(e, n));
@@ -91,22 +92,99 @@ td.l,th.l{text-align:left}.pass{color:#080;font-weight:bold}.fail{color:#b00;fon
 dt{font-weight:bold}";
 
 /// The page: `results` analysed with the windows' filter `cfc`, against `required`.
-fn page(cfc: Option<u32>, results: &[EntryJson], required: Option<&RequiredSrs>) -> String {
+fn page(cfc: Option<u32>, results: &[EntryJson], required: Option<&RequiredSrs>) -> Html {
     let json = series::to_json(results);
-    let mut h = String::new();
-    let _ = write!(
+    let mut h = Html::new();
+    h.raw("<!DOCTYPE html>\n<html lang=\"en\"><head><meta charset=\"utf-8\"><title>Impact report</title><style>")
+        .raw(STYLE)
+        .raw("</style></head><body>\n");
+    html!(
         h,
-        "<!DOCTYPE html>\n<html lang=\"en\"><head><meta charset=\"utf-8\"><title>Impact report</title><style>{STYLE}</style></head><body>\n<h1>Impact report: {} recording{}, {} impact{}</h1>\n",
+        "<h1>Impact report: {} recording{}, {} impact{}</h1>\n",
         json.recordings,
         if json.recordings == 1 { "" } else { "s" },
         json.impacts,
         if json.impacts == 1 { "" } else { "s" },
     );
-    // Settings and provenance.
-    h.push_str("<h2>Settings and provenance</h2><dl>");
-    let mut dd = |k: &str, v: &str| {
-        let _ = write!(h, "<dt>{}</dt><dd>{}</dd>", esc(k), esc(v));
-    };
+    provenance(&mut h, cfc, results, required);
+    impacts_table(&mut h, results, required);
+    for e in results {
+        if let Some(err) = &e.error {
+            html!(h, "<p class=\"fail\">FAILED {}</p>\n", series::failure(e, err));
+        }
+    }
+    if let Some(r) = &json.spec {
+        html!(
+            h,
+            "<p><b>Specification:</b> {} of {} judged impacts pass{}{}.</p>\n",
+            r.passed,
+            r.judged,
+            r.pass_rate
+                .map_or(String::new(), |p| format!(" ({:.1} %)", 100.0 * p)),
+            if r.not_judged > 0 {
+                format!("; {} not judged", r.not_judged)
+            } else {
+                String::new()
+            }
+        );
+    }
+    if !json.statistics.is_empty() {
+        h.raw("<h2>Statistics across the series</h2><p>sd: sample standard deviation; CV: sd / |mean|.</p><table><tr><th class=\"l\">metric</th><th>n</th><th>mean</th><th>sd</th><th>CV</th><th>min</th><th>max</th></tr>\n");
+        for st in &json.statistics {
+            let u = crate::report::statistics::METRICS
+                .iter()
+                .find(|(m, _, _)| *m == st.metric)
+                .map_or("", |(_, u, _)| u);
+            let q = |v: f64| human(v, u).trim_end().to_string();
+            html!(
+                h,
+                "<tr><td class=\"l\">{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td></tr>\n",
+                st.metric,
+                st.n,
+                q(st.mean),
+                st.sd.map_or("—".into(), q),
+                st.cv.map_or("—".into(), |c| format!("{:.2} %", 100.0 * c)),
+                q(st.min),
+                q(st.max)
+            );
+        }
+        h.raw("</table>\n");
+    }
+    // The pulses.
+    h.raw("<h2>Pulses</h2>\n");
+    let drawn: usize = results.iter().map(|e| e.figures.len()).sum();
+    let total = json.impacts;
+    if drawn < total {
+        html!(
+            h,
+            "<p>The first {} of {} impacts are drawn (at most {}); the table has them all.</p>\n",
+            drawn,
+            total,
+            MAX_FIGURES
+        );
+    }
+    for e in results {
+        for f in &e.figures {
+            html!(h, "<div class=\"figure\">{}</div>\n", f);
+        }
+    }
+    if let Some(r) = required {
+        spectra(&mut h, results, r);
+    }
+    h.raw("</body></html>\n");
+    h
+}
+
+/// The settings and provenance: the tool, the command, each recording, the filter, the
+/// required SRS and the specification.
+fn provenance(
+    h: &mut Html,
+    cfc: Option<u32>,
+    results: &[EntryJson],
+    required: Option<&RequiredSrs>,
+) {
+    h.raw("<h2>Settings and provenance</h2><dl>");
+    let mut dd = |k: &str, v: &str| html!(h, "<dt>{}</dt><dd>{}</dd>", k, v);
     dd("tool", &format!("impact {}", env!("CARGO_PKG_VERSION")));
     dd("command", &std::env::args().collect::<Vec<_>>().join(" "));
     for e in results {
@@ -175,34 +253,44 @@ fn page(cfc: Option<u32>, results: &[EntryJson], required: Option<&RequiredSrs>)
             );
         }
     }
-    h.push_str("</dl>\n");
-    // The series table.
-    h.push_str("<h2>Impacts</h2><table><tr><th class=\"l\">file</th><th class=\"l\">channel</th><th>#</th><th>start</th><th>peak (g)</th><th>peak (m/s²)</th><th>Δv</th><th>duration</th><th>FWHM</th><th>COR</th><th class=\"l\">status</th><th class=\"l\">verdict</th>");
+    h.raw("</dl>\n");
+}
+
+/// The series table: a row per impact, with the required SRS's column when there is one.
+fn impacts_table(h: &mut Html, results: &[EntryJson], required: Option<&RequiredSrs>) {
+    h.raw("<h2>Impacts</h2><table><tr><th class=\"l\">file</th><th class=\"l\">channel</th><th>#</th><th>start</th><th>peak (g)</th><th>peak (m/s²)</th><th>Δv</th><th>duration</th><th>FWHM</th><th>COR</th><th class=\"l\">status</th><th class=\"l\">verdict</th>");
     if required.is_some() {
-        h.push_str("<th class=\"l\">SRS within −1.5/+3 dB of required</th>");
+        h.raw("<th class=\"l\">SRS within −1.5/+3 dB of required</th>");
     }
-    h.push_str("</tr>\n");
+    h.raw("</tr>\n");
     for (e, i) in series::impacts(results) {
         let o = |v: Option<f64>, u: &str| {
             v.map_or("—".into(), |v| human(v, u).trim_end().to_string())
         };
-        let verdict = match &i.spec {
-            Some(Some(v)) if v.pass => "<span class=\"pass\">PASS</span>".to_string(),
-            Some(Some(v)) => format!(
+        let mut verdict = Html::new();
+        match &i.spec {
+            Some(Some(v)) if v.pass => {
+                verdict.raw("<span class=\"pass\">PASS</span>");
+            }
+            Some(Some(v)) => html!(
+                verdict,
                 "<span class=\"fail\">FAIL</span> ({:+.1} % of the peak)",
                 100.0 * v.margin
             ),
-            Some(None) => format!(
+            Some(None) => html!(
+                verdict,
                 "not judged ({})",
-                esc(i.null_reasons.get("spec").map_or("", String::as_str))
+                i.null_reasons.get("spec").map_or("", String::as_str)
             ),
-            None => "—".into(),
-        };
-        let _ = writeln!(
+            None => {
+                verdict.raw("—");
+            }
+        }
+        html!(
             h,
-            "<tr><td class=\"l\">{}</td><td class=\"l\">{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td class=\"l\">{}</td><td class=\"l\">{verdict}</td></tr>",
-            esc(&e.file),
-            esc(&e.channel),
+            "<tr><td class=\"l\">{}</td><td class=\"l\">{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td class=\"l\">{}</td><td class=\"l\">{}</td>",
+            e.file,
+            e.channel,
             i.index,
             human(i.start_s, "s"),
             human(i.peak_acceleration_m_s2 / STANDARD_GRAVITY, "g").trim_end_matches(" g"),
@@ -211,10 +299,11 @@ fn page(cfc: Option<u32>, results: &[EntryJson], required: Option<&RequiredSrs>)
             human(i.duration_s, "s"),
             o(i.fwhm_s, "s"),
             o(i.cor, ""),
-            esc(&std::iter::once(i.status.as_str()).chain(i.flags.iter().map(String::as_str)).collect::<Vec<_>>().join(" ")),
+            std::iter::once(i.status.as_str()).chain(i.flags.iter().map(String::as_str)).collect::<Vec<_>>().join(" "),
+            verdict,
         );
         if let Some(r) = required {
-            let cell = match &i.shock_spectrum {
+            match &i.shock_spectrum {
                 Some(sp) => {
                     let c = srs_required::compare(r, &sp.frequency_hz, &sp.srs_m_s2);
                     let class = match c {
@@ -222,95 +311,33 @@ fn page(cfc: Option<u32>, results: &[EntryJson], required: Option<&RequiredSrs>)
                         Some(_) => " fail",
                         None => "",
                     };
-                    format!(
-                        "<td class=\"l{class}\">{}</td>",
-                        esc(&srs_required::cell(c.as_ref()))
-                    )
+                    html!(
+                        h,
+                        "<td class=\"l{}\">{}</td>",
+                        class,
+                        srs_required::cell(c.as_ref())
+                    );
                 }
-                None => "<td class=\"l\">no SRS (see its status)</td>".to_string(),
-            };
-            // The row's last cell, before its end.
-            h.truncate(h.len() - "</tr>\n".len());
-            let _ = writeln!(h, "{cell}</tr>");
-        }
-    }
-    h.push_str("</table>\n");
-    for e in results {
-        if let Some(err) = &e.error {
-            let _ = writeln!(
-                h,
-                "<p class=\"fail\">FAILED {}</p>",
-                esc(&series::failure(e, err))
-            );
-        }
-    }
-    if let Some(r) = &json.spec {
-        let _ = writeln!(
-            h,
-            "<p><b>Specification:</b> {} of {} judged impacts pass{}{}.</p>",
-            r.passed,
-            r.judged,
-            r.pass_rate
-                .map_or(String::new(), |p| format!(" ({:.1} %)", 100.0 * p)),
-            if r.not_judged > 0 {
-                format!("; {} not judged", r.not_judged)
-            } else {
-                String::new()
+                None => {
+                    h.raw("<td class=\"l\">no SRS (see its status)</td>");
+                }
             }
-        );
-    }
-    if !json.statistics.is_empty() {
-        h.push_str("<h2>Statistics across the series</h2><p>sd: sample standard deviation; CV: sd / |mean|.</p><table><tr><th class=\"l\">metric</th><th>n</th><th>mean</th><th>sd</th><th>CV</th><th>min</th><th>max</th></tr>\n");
-        for st in &json.statistics {
-            let u = crate::report::statistics::METRICS
-                .iter()
-                .find(|(m, _, _)| *m == st.metric)
-                .map_or("", |(_, u, _)| u);
-            let q = |v: f64| human(v, u).trim_end().to_string();
-            let _ = writeln!(
-                h,
-                "<tr><td class=\"l\">{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td></tr>",
-                st.metric,
-                st.n,
-                q(st.mean),
-                st.sd.map_or("—".into(), q),
-                st.cv.map_or("—".into(), |c| format!("{:.2} %", 100.0 * c)),
-                q(st.min),
-                q(st.max)
-            );
         }
-        h.push_str("</table>\n");
+        h.raw("</tr>\n");
     }
-    // The pulses.
-    h.push_str("<h2>Pulses</h2>\n");
-    let drawn: usize = results.iter().map(|e| e.figures.len()).sum();
-    let total = json.impacts;
-    if drawn < total {
-        let _ = writeln!(
-            h,
-            "<p>The first {drawn} of {total} impacts are drawn (at most {MAX_FIGURES}); the table has them all.</p>"
-        );
-    }
-    for e in results {
-        for f in &e.figures {
-            let _ = writeln!(h, "<div class=\"figure\">{f}</div>");
-        }
-    }
-    if let Some(r) = required {
-        spectra(&mut h, results, r);
-    }
-    h.push_str("</body></html>\n");
-    h
+    h.raw("</table>\n");
 }
 
 /// The section of each impact's SRS drawn over the required one (at most [`MAX_FIGURES`]).
-fn spectra(h: &mut String, results: &[EntryJson], required: &RequiredSrs) {
-    h.push_str("<h2>Shock response spectra against the required SRS</h2>\n");
+fn spectra(h: &mut Html, results: &[EntryJson], required: &RequiredSrs) {
+    h.raw("<h2>Shock response spectra against the required SRS</h2>\n");
     let (low, high) = crate::standards::SRS_TOLERANCE_DB;
-    let _ = writeln!(
+    html!(
         h,
-        "<p>Each impact's SRS (maximax absolute acceleration) over the required SRS of {}, its tolerance ({low:+} dB, {high:+} dB, {}) dashed.</p>",
-        esc(&required.file),
+        "<p>Each impact's SRS (maximax absolute acceleration) over the required SRS of {}, its tolerance ({:+} dB, {:+} dB, {}) dashed.</p>\n",
+        required.file,
+        low,
+        high,
         crate::standards::SRS_TOLERANCE_SOURCE
     );
     let mut drawn = 0;
@@ -319,9 +346,10 @@ fn spectra(h: &mut String, results: &[EntryJson], required: &RequiredSrs) {
             continue;
         };
         if drawn == MAX_FIGURES {
-            let _ = writeln!(
+            html!(
                 h,
-                "<p>The first {MAX_FIGURES} spectra are drawn; the table judges them all.</p>"
+                "<p>The first {} spectra are drawn; the table judges them all.</p>\n",
+                MAX_FIGURES
             );
             break;
         }
@@ -334,16 +362,11 @@ fn spectra(h: &mut String, results: &[EntryJson], required: &RequiredSrs) {
         );
         match srs_required::svg(&title, &sp.frequency_hz, &sp.srs_m_s2, required) {
             Ok(svg) => {
-                let _ = writeln!(h, "<div class=\"figure\">{svg}</div>");
+                html!(h, "<div class=\"figure\">{}</div>\n", svg);
                 drawn += 1;
             }
             Err(err) => {
-                let _ = writeln!(
-                    h,
-                    "<p class=\"fail\">{}: not drawn: {}</p>",
-                    esc(&title),
-                    esc(&err)
-                );
+                html!(h, "<p class=\"fail\">{}: not drawn: {}</p>\n", title, err);
             }
         }
     }
@@ -403,5 +426,5 @@ pub fn log_report(
         analysis: Some(analysis),
         figures,
     };
-    Ok(page(None, std::slice::from_ref(&entry), None))
+    Ok(page(None, std::slice::from_ref(&entry), None).into_string())
 }

@@ -2,24 +2,16 @@
 //! above its baseline (min/max per column), with a specification's nominal pulse and band
 //! where its verdict placed them.
 
-use std::fmt::Write as _;
-
 use impact_core::consts::STANDARD_GRAVITY;
 use impact_core::spec::Spec;
 
+use crate::html;
+use crate::html::Html;
 use crate::plot::ticks::{linear_ticks, tick};
 use crate::report::fmt::human;
 
 /// The largest number of impacts drawn (each figure is a few kB; the table has them all).
 pub const MAX_FIGURES: usize = 200;
-
-/// Text for HTML (the report and its figures).
-pub fn esc(s: &str) -> String {
-    s.replace('&', "&amp;")
-        .replace('<', "&lt;")
-        .replace('>', "&gt;")
-        .replace('"', "&quot;")
-}
 
 /// A pixel column of a pulse: time (s) and the least and greatest acceleration there (m/s²).
 pub type Column = (f64, f64, f64);
@@ -44,7 +36,7 @@ fn label(v: f64, step: f64) -> String {
 /// The pulse as an inline SVG: acceleration in g (left; m/s² on the right) against time in ms
 /// from the window's start, the measured signal as a min/max band per column, the band and
 /// the nominal pulse dashed.
-pub fn svg(p: &Pulse) -> String {
+pub fn svg(p: &Pulse) -> Html {
     const W: f64 = 530.0;
     const H: f64 = 300.0;
     const L: f64 = 54.0;
@@ -52,7 +44,7 @@ pub fn svg(p: &Pulse) -> String {
     const T: f64 = 30.0;
     const B: f64 = 42.0;
     let Some(&(t_first, _, _)) = p.columns.first() else {
-        return String::new();
+        return Html::new();
     };
     let t_last = p.columns.last().map_or(t_first, |c| c.0);
     let g = STANDARD_GRAVITY;
@@ -100,53 +92,55 @@ pub fn svg(p: &Pulse) -> String {
         right
     };
     let y = |a: f64| T + (y_hi - a) / (y_hi - y_lo) * (H - T - B);
-    let mut s = String::new();
-    let _ = write!(
+    let mut s = Html::new();
+    html!(
         s,
-        "<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"{W}\" height=\"{H}\" viewBox=\"0 0 {W} {H}\" font-family=\"sans-serif\" font-size=\"11\"><title>{}</title><rect width=\"{W}\" height=\"{H}\" fill=\"white\"/>",
-        esc(&p.title)
+        "<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"{}\" height=\"{}\" viewBox=\"0 0 {} {}\" font-family=\"sans-serif\" font-size=\"11\"><title>{}</title><rect width=\"{}\" height=\"{}\" fill=\"white\"/>",
+        W, H, W, H, p.title, W, H
     );
-    let _ = write!(s, "<text x=\"{}\" y=\"16\" text-anchor=\"middle\" font-size=\"12\" font-weight=\"bold\">{}</text>", W / 2.0, esc(&p.title));
+    html!(s, "<text x=\"{}\" y=\"16\" text-anchor=\"middle\" font-size=\"12\" font-weight=\"bold\">{}</text>", W / 2.0, p.title);
     // Grid and ticks: time in ms from the window's start, acceleration in g.
     let span_ms = (t_last - t_first) * 1e3;
     let xt = linear_ticks(0.0, span_ms, 6);
     let xstep = xt.get(1).zip(xt.first()).map_or(1.0, |(b, a)| b - a);
     for v in &xt {
         let px = x(t_first + v * 1e-3);
-        let _ = write!(s, "<line x1=\"{px:.1}\" y1=\"{T}\" x2=\"{px:.1}\" y2=\"{}\" stroke=\"#eee\"/><text x=\"{px:.1}\" y=\"{}\" text-anchor=\"middle\">{}</text>", H - B, H - B + 14.0, label(*v, xstep));
+        html!(s, "<line x1=\"{:.1}\" y1=\"{}\" x2=\"{:.1}\" y2=\"{}\" stroke=\"#eee\"/><text x=\"{:.1}\" y=\"{}\" text-anchor=\"middle\">{}</text>", px, T, px, H - B, px, H - B + 14.0, label(*v, xstep));
     }
     let yt = linear_ticks(y_lo / g, y_hi / g, 6);
     let ystep = yt.get(1).zip(yt.first()).map_or(1.0, |(b, a)| b - a);
     for v in &yt {
         let py = y(v * g);
-        let _ = write!(s, "<line x1=\"{L}\" y1=\"{py:.1}\" x2=\"{}\" y2=\"{py:.1}\" stroke=\"#eee\"/><text x=\"{}\" y=\"{:.1}\" text-anchor=\"end\">{}</text>", W - R, L - 4.0, py + 4.0, label(*v, ystep));
+        html!(s, "<line x1=\"{}\" y1=\"{:.1}\" x2=\"{}\" y2=\"{:.1}\" stroke=\"#eee\"/><text x=\"{}\" y=\"{:.1}\" text-anchor=\"end\">{}</text>", L, py, W - R, py, L - 4.0, py + 4.0, label(*v, ystep));
     }
     // The same range in m/s² on the right.
     let yt = linear_ticks(y_lo, y_hi, 6);
     for v in &yt {
         let py = y(*v);
-        let _ = write!(s, "<line x1=\"{}\" y1=\"{py:.1}\" x2=\"{}\" y2=\"{py:.1}\" stroke=\"#999\"/><text x=\"{}\" y=\"{:.1}\">{}</text>", W - R, W - R + 4.0, W - R + 6.0, py + 4.0, tick(*v));
+        html!(s, "<line x1=\"{}\" y1=\"{:.1}\" x2=\"{}\" y2=\"{:.1}\" stroke=\"#999\"/><text x=\"{}\" y=\"{:.1}\">{}</text>", W - R, py, W - R + 4.0, py, W - R + 6.0, py + 4.0, tick(*v));
     }
-    let _ = write!(
+    html!(
         s,
-        "<rect x=\"{L}\" y=\"{T}\" width=\"{}\" height=\"{}\" fill=\"none\" stroke=\"#999\"/>",
+        "<rect x=\"{}\" y=\"{}\" width=\"{}\" height=\"{}\" fill=\"none\" stroke=\"#999\"/>",
+        L,
+        T,
         W - L - R,
         H - T - B
     );
-    let _ = write!(
+    html!(
         s,
         "<text x=\"{}\" y=\"{}\" text-anchor=\"middle\">time from {:.3} ms (ms)</text>",
         (L + W - R) / 2.0,
         H - 8.0,
         t_first * 1e3
     );
-    let _ = write!(s, "<text transform=\"translate(14 {}) rotate(-90)\" text-anchor=\"middle\">acceleration (g)</text>", (T + H - B) / 2.0);
-    let _ = write!(s, "<text transform=\"translate({} {}) rotate(90)\" text-anchor=\"middle\">acceleration (m/s²)</text>", W - 12.0, (T + H - B) / 2.0);
+    html!(s, "<text transform=\"translate(14 {}) rotate(-90)\" text-anchor=\"middle\">acceleration (g)</text>", (T + H - B) / 2.0);
+    html!(s, "<text transform=\"translate({} {}) rotate(90)\" text-anchor=\"middle\">acceleration (m/s²)</text>", W - 12.0, (T + H - B) / 2.0);
     // The band (shaded between its limits) and the nominal pulse (dashed).
     if !band.is_empty() {
-        let mut d = String::new();
+        let mut d = Html::new();
         for (k, b) in band.iter().enumerate() {
-            let _ = write!(
+            html!(
                 d,
                 "{}{:.1},{:.1}",
                 if k == 0 { "M" } else { " L" },
@@ -155,24 +149,30 @@ pub fn svg(p: &Pulse) -> String {
             );
         }
         for b in band.iter().rev() {
-            let _ = write!(d, " L{:.1},{:.1}", x(b.0), y(b.1));
+            html!(d, " L{:.1},{:.1}", x(b.0), y(b.1));
         }
-        let _ = write!(s, "<path d=\"{d} Z\" fill=\"#4a90d9\" fill-opacity=\"0.15\" stroke=\"#4a90d9\" stroke-width=\"0.8\"/>");
-        let pts: Vec<String> = band
-            .iter()
-            .map(|b| format!("{:.1},{:.1}", x(b.0), y(b.3)))
-            .collect();
-        let _ = write!(
+        html!(s, "<path d=\"{} Z\" fill=\"#4a90d9\" fill-opacity=\"0.15\" stroke=\"#4a90d9\" stroke-width=\"0.8\"/>", d);
+        let mut pts = Html::new();
+        for (k, b) in band.iter().enumerate() {
+            html!(
+                pts,
+                "{}{:.1},{:.1}",
+                if k == 0 { "" } else { " " },
+                x(b.0),
+                y(b.3)
+            );
+        }
+        html!(
             s,
             "<polyline points=\"{}\" fill=\"none\" stroke=\"#4a90d9\" stroke-dasharray=\"5 3\"/>",
-            pts.join(" ")
+            pts
         );
     }
     // The measured signal, and the filtered one: each column's extremes joined.
     let path = |columns: &[Column]| {
-        let mut d = String::new();
+        let mut d = Html::new();
         for (k, c) in columns.iter().enumerate() {
-            let _ = write!(
+            html!(
                 d,
                 "{}{:.1},{:.1} L{:.1},{:.1}",
                 if k == 0 { "M" } else { " L" },
@@ -184,33 +184,36 @@ pub fn svg(p: &Pulse) -> String {
         }
         d
     };
-    let _ = write!(
+    html!(
         s,
-        "<path d=\"{}\" fill=\"none\" stroke=\"{RAW}\" stroke-width=\"1.2\"/>",
-        path(&p.columns)
+        "<path d=\"{}\" fill=\"none\" stroke=\"{}\" stroke-width=\"1.2\"/>",
+        path(&p.columns),
+        RAW
     );
     if let Some((_, f)) = &p.filtered {
-        let _ = write!(
+        html!(
             s,
-            "<path d=\"{}\" fill=\"none\" stroke=\"{FILTERED}\" stroke-width=\"1.8\"/>",
-            path(f)
+            "<path d=\"{}\" fill=\"none\" stroke=\"{}\" stroke-width=\"1.8\"/>",
+            path(f),
+            FILTERED
         );
     }
-    // The legend, on white.
-    let raw_stroke = format!("stroke=\"{RAW}\" stroke-width=\"1.5\"");
-    let filtered_stroke = format!("stroke=\"{FILTERED}\" stroke-width=\"1.8\"");
-    let mut entries = vec![(raw_stroke.as_str(), "measured")];
+    // The legend, on white: each entry's stroke (markup) and its text.
+    let mut raw_stroke = Html::new();
+    html!(raw_stroke, "stroke=\"{}\" stroke-width=\"1.5\"", RAW);
+    let mut entries = vec![(raw_stroke, "measured")];
     if let Some((label, _)) = &p.filtered {
         entries[0].1 = "raw";
-        entries.push((filtered_stroke.as_str(), label.as_str()));
+        let mut filtered_stroke = Html::new();
+        html!(filtered_stroke, "stroke=\"{}\" stroke-width=\"1.8\"", FILTERED);
+        entries.push((filtered_stroke, label.as_str()));
     }
     if !band.is_empty() {
-        entries.push((
-            "stroke=\"#4a90d9\" stroke-dasharray=\"5 3\"",
-            "nominal, tolerance band",
-        ));
+        let mut dashed = Html::new();
+        dashed.raw("stroke=\"#4a90d9\" stroke-dasharray=\"5 3\"");
+        entries.push((dashed, "nominal, tolerance band"));
     }
-    let _ = write!(
+    html!(
         s,
         "<g transform=\"translate({} {})\"><rect x=\"-4\" y=\"-8\" width=\"162\" height=\"{}\" fill=\"white\" fill-opacity=\"0.85\" stroke=\"#ccc\"/>",
         legend_x + 4.0,
@@ -219,13 +222,17 @@ pub fn svg(p: &Pulse) -> String {
     );
     for (k, (stroke, text)) in entries.iter().enumerate() {
         let y = 14 * k;
-        let _ = write!(
+        html!(
             s,
-            "<line x1=\"0\" y1=\"{y}\" x2=\"18\" y2=\"{y}\" {stroke}/><text x=\"22\" y=\"{}\">{text}</text>",
-            y + 4
+            "<line x1=\"0\" y1=\"{}\" x2=\"18\" y2=\"{}\" {}/><text x=\"22\" y=\"{}\">{}</text>",
+            y,
+            y,
+            stroke,
+            y + 4,
+            text
         );
     }
-    s.push_str("</g></svg>");
+    s.raw("</g></svg>");
     s
 }
 
@@ -317,7 +324,7 @@ pub fn pulse_svg(
     spec: Option<&Spec>,
     r: &impact_core::ImpactReport,
     title: String,
-) -> String {
+) -> Html {
     let rate = signal.rate_hz;
     let (from_s, to_s, placed) = window(spec, r);
     let sign = if r.peak_acceleration_m_s2 < 0.0 {
@@ -390,7 +397,6 @@ mod tests {
         );
         assert_eq!(label(0.25, 0.05), "0.25");
         assert_eq!(label(12000.0, 2000.0), "12000");
-        assert_eq!(esc("a<b&\"c\""), "a&lt;b&amp;&quot;c&quot;");
     }
 
     #[test]
@@ -411,7 +417,7 @@ mod tests {
             ">10</text>",
             ">100</text>",
         ] {
-            assert!(s.contains(want), "{want} missing");
+            assert!(s.as_str().contains(want), "{want} missing");
         }
     }
 }

@@ -142,7 +142,7 @@ pub struct EntryJson {
     pub analysis: Option<AnalysisJson>,
     /// With [`analyze_drawn`]: each impact's pulse as an inline SVG (the report's).
     #[serde(skip)]
-    pub figures: Vec<String>,
+    pub figures: Vec<crate::html::Html>,
 }
 
 /// Analyses every entry with `args` (its file and channel replaced), on as many threads as
@@ -296,42 +296,32 @@ pub fn to_json(entries: &[EntryJson]) -> SeriesJson<'_> {
     }
 }
 
-/// A CSV cell: quoted when it holds a comma, a quote or a line break.
-fn cell(s: &str) -> String {
-    if s.contains([',', '"', '\n', '\r']) {
-        format!("\"{}\"", s.replace('"', "\"\""))
-    } else {
-        s.to_string()
-    }
-}
-
 /// The series as CSV: `analyze --csv`'s columns with `file` and `channel` first and
 /// `peak_acceleration_g` last, one row per impact of every recording.
 pub fn to_csv(entries: &[EntryJson]) -> String {
     let Some(first) = entries.iter().find_map(|e| e.analysis.as_ref()) else {
         return "file,channel\n".into();
     };
-    let mut body = Vec::new();
+    let columns = crate::report::csv::Columns::of(first, impacts(entries).map(|(_, i)| i));
+    let mut w = crate::report::csv::writer(Vec::new());
+    let mut header = vec!["file".to_string(), "channel".to_string()];
+    header.extend(columns.header());
+    header.push("peak_acceleration_g".into());
     // Writing to a Vec cannot fail.
-    let _ = crate::report::csv::write_csv(first, impacts(entries).map(|(_, i)| i), &mut body);
-    let body = String::from_utf8_lossy(&body);
-    let mut lines = body.lines();
-    let mut out = format!(
-        "file,channel,{},peak_acceleration_g\n",
-        lines.next().unwrap_or_default()
-    );
-    for ((e, i), line) in impacts(entries).zip(lines) {
-        out.push_str(&format!(
-            "{},{},{line},{}\n",
-            cell(&e.file),
-            cell(&e.channel),
-            // In the f32 digits of the peak it comes from.
-            crate::report::fmt::number(f64::from(
-                (i.peak_acceleration_m_s2 / STANDARD_GRAVITY) as f32
-            ))
-        ));
+    let _ = w.write_record(&header);
+    for (e, i) in impacts(entries) {
+        let mut row = vec![
+            crate::report::csv::text(&e.file),
+            crate::report::csv::text(&e.channel),
+        ];
+        row.extend(columns.row(i));
+        // In the f32 digits of the peak it comes from.
+        row.push(crate::report::fmt::number(f64::from(
+            (i.peak_acceleration_m_s2 / STANDARD_GRAVITY) as f32,
+        )));
+        let _ = w.write_record(&row);
     }
-    out
+    String::from_utf8_lossy(&w.into_inner().unwrap_or_default()).into_owned()
 }
 
 /// The series as a person reads it: a row per impact, then the statistics, then the
@@ -470,16 +460,4 @@ fn columns<const N: usize>(head: &[&str; N], rows: &[[String; N]]) -> String {
         s.push_str(&line(&mut r.iter().map(String::as_str)));
     }
     s
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn a_cell_with_a_comma_is_quoted() {
-        assert_eq!(cell("a,b.csv"), "\"a,b.csv\"");
-        assert_eq!(cell("say \"x\""), "\"say \"\"x\"\"\"");
-        assert_eq!(cell("plain"), "plain");
-    }
 }

@@ -6,7 +6,7 @@ use std::path::Path;
 use impact_core::consts::STANDARD_GRAVITY;
 use plotters::prelude::*;
 
-use crate::plot::{draw_panel, svg_text, Panel};
+use crate::plot::{draw_panel, svg_html, Panel};
 use crate::report::fmt::human;
 use crate::small_csv::SmallCsv;
 use crate::standards::SRS_TOLERANCE_DB;
@@ -30,7 +30,7 @@ impl RequiredSrs {
     pub fn read(path: &Path) -> Result<Self, String> {
         let file = path.display().to_string();
         let err = |what: String| format!("--srs-required {file}: {what}");
-        let csv = SmallCsv::read(path, "required SRS").map_err(&err)?;
+        let csv = SmallCsv::read(path, "required SRS").map_err(|e| err(e.to_string()))?;
         let header = &csv.header;
         let column = |name: &str| csv.column(name);
         let (Some(f_col), acceleration) = (
@@ -182,7 +182,7 @@ pub fn svg(
     frequency_hz: &[f64],
     srs_m_s2: &[f64],
     required: &RequiredSrs,
-) -> Result<String, String> {
+) -> Result<crate::html::Html, String> {
     let (low, high) = SRS_TOLERANCE_DB;
     let scaled = |db: f64| -> Vec<(f64, f64)> {
         let k = 10f64.powf(db / 20.0);
@@ -208,7 +208,7 @@ pub fn svg(
         g_axis: true,
         legend: true,
     };
-    svg_text((530, 340), |root| {
+    svg_html((530, 340), |root| {
         root.fill(&WHITE).map_err(|e| e.to_string())?;
         draw_panel(root, None, &panel)
     })

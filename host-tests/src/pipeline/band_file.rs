@@ -27,7 +27,7 @@ const UNITS: [(&str, &str, Option<f64>); 3] = [
 /// a `'static` table, as the board's is). Every refusal names the file and its line.
 pub fn read(path: &Path, spec: &Spec) -> Result<&'static [BandPoint], String> {
     let err = |what: String| format!("band-file={}: {what}", path.display());
-    let csv = SmallCsv::read(path, "band file").map_err(&err)?;
+    let csv = SmallCsv::read(path, "band file").map_err(|e| err(e.to_string()))?;
     let header = &csv.header;
     let column = |name: &str| csv.column(name);
     let peak = f64::from(spec.peak_m_s2);

@@ -76,6 +76,14 @@ pub(crate) fn svg_text(
     Ok(text)
 }
 
+/// A `size` SVG drawn with `draw`, as markup for a page (plotters escapes its text).
+pub(crate) fn svg_html(
+    size: (u32, u32),
+    draw: impl FnOnce(&DrawingArea<SVGBackend, plotters::coord::Shift>) -> Result<(), String>,
+) -> Result<crate::html::Html, String> {
+    svg_text(size, draw).map(crate::html::Html::from_plotters)
+}
+
 /// A named, coloured series of (time, value) points.
 pub(crate) type Curve = (&'static str, RGBColor, Vec<(f64, f64)>);
 

@@ -54,11 +54,15 @@ pub fn srs_peak(s: &ShockSpectrumJson) -> Option<(f64, f64)> {
 }
 
 /// The CSV columns `impact analyze --csv --srs` adds.
-pub const CSV_HEADER: &str =
-    "srs_peak_m_s2,srs_peak_frequency_hz,half_sine_amplitude_m_s2,half_sine_duration_s";
+pub const CSV_COLUMNS: [&str; 4] = [
+    "srs_peak_m_s2",
+    "srs_peak_frequency_hz",
+    "half_sine_amplitude_m_s2",
+    "half_sine_duration_s",
+];
 
-/// An impact's cells under [`CSV_HEADER`] (empty without spectra).
-pub fn csv_cells(s: Option<&ShockSpectrumJson>) -> String {
+/// An impact's cells under [`CSV_COLUMNS`] (empty without spectra).
+pub fn csv_cells(s: Option<&ShockSpectrumJson>) -> [String; 4] {
     let o = |v: Option<f64>| v.map_or(String::new(), crate::report::fmt::number);
     let peak = s.and_then(srs_peak);
     [
@@ -67,7 +71,6 @@ pub fn csv_cells(s: Option<&ShockSpectrumJson>) -> String {
         o(s.and_then(|s| s.half_sine_amplitude_m_s2)),
         o(s.and_then(|s| s.half_sine_duration_s)),
     ]
-    .join(",")
 }
 
 /// The table's line for an impact's spectra.
