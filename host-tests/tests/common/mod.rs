@@ -100,3 +100,37 @@ pub fn untitled(svg: &str) -> (String, String) {
     let j = i + svg[i..].find("</text>").expect("its end") + "</text>".len();
     (svg[i..j].to_string(), format!("{}{}", &svg[..i], &svg[j..]))
 }
+
+/// A scratch folder for a test's files, removed when it drops (also when the test fails).
+#[allow(dead_code)] // not every test file needs it
+pub struct Scratch(tempfile::TempDir);
+
+#[allow(dead_code)] // not every test file needs it
+impl Scratch {
+    /// A new, empty folder (under TMPDIR).
+    pub fn new() -> Self {
+        Self(
+            tempfile::Builder::new()
+                .prefix("impact-test-")
+                .tempdir()
+                .expect("a temporary folder"),
+        )
+    }
+
+    /// The folder.
+    pub fn path(&self) -> &std::path::Path {
+        self.0.path()
+    }
+
+    /// `name` in the folder (not written).
+    pub fn join(&self, name: &str) -> std::path::PathBuf {
+        self.0.path().join(name)
+    }
+
+    /// `name` in the folder, written with `bytes`.
+    pub fn file(&self, name: &str, bytes: impl AsRef<[u8]>) -> std::path::PathBuf {
+        let path = self.join(name);
+        std::fs::write(&path, bytes).expect("a scratch file written");
+        path
+    }
+}
