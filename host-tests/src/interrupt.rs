@@ -97,33 +97,27 @@ pub fn install() {
             die_of(sig);
         }
     });
-    // Writing to a closed pipe fails with EPIPE (the signal no longer kills the tool): a
-    // print that panics on it ends the run quietly, after the same cleanup.
-    let default = std::panic::take_hook();
-    std::panic::set_hook(Box::new(move |info| {
-        let text = info
-            .payload()
-            .downcast_ref::<String>()
-            .map(String::as_str)
-            .or_else(|| info.payload().downcast_ref::<&str>().copied())
-            .unwrap_or("");
-        if text.contains("Broken pipe") {
-            clean_up();
-            die_of(SIGPIPE);
-        }
-        default(info);
-    }));
 }
 
-/// An error that is a closed output pipe (`impact … | head`: EPIPE reached the write before
-/// the signal's handler ended the run) ends the run as the signal would: quietly, by SIGPIPE,
-/// after the cleanup. Any other error returns.
-pub fn closed_pipe(error: &str) {
+/// A write to standard output failed with `error`: a closed pipe (`impact … | head`: EPIPE
+/// reached the write before the signal's handler ended the run) ends the run as the signal
+/// would, quietly, by SIGPIPE, after the cleanup; any other error is returned.
+pub fn closed_pipe(error: std::io::Error) -> std::io::Error {
     #[cfg(unix)]
-    if error.contains("Broken pipe") {
+    if error.kind() == std::io::ErrorKind::BrokenPipe {
         clean_up();
         die_of(libc::SIGPIPE);
     }
+    error
+}
+
+/// Standard output could not be written (`error`, not a closed pipe): the run ends with the
+/// message and status 1, after the cleanup (where `println!` would panic).
+pub fn stdout_failed(error: std::io::Error) -> ! {
+    let error = closed_pipe(error);
+    clean_up();
+    eprintln!("error: stdout: {error}");
+    std::process::exit(1)
 }
 
 /// Ends the process by `sig` with its default action, as if it had not been caught (the

@@ -182,6 +182,49 @@ pub fn write_with(
     Ok(())
 }
 
+/// Standard output, locked: a write that finds the pipe closed ends the run as SIGPIPE would
+/// ([`crate::interrupt::closed_pipe`], found by its `io::ErrorKind`); any other error is
+/// returned to the caller.
+pub fn stdout() -> Stdout {
+    Stdout(std::io::stdout().lock())
+}
+
+/// See [`stdout`].
+pub struct Stdout(std::io::StdoutLock<'static>);
+
+impl Write for Stdout {
+    fn write(&mut self, buf: &[u8]) -> std::io::Result<usize> {
+        self.0.write(buf).map_err(crate::interrupt::closed_pipe)
+    }
+
+    fn flush(&mut self) -> std::io::Result<()> {
+        self.0.flush().map_err(crate::interrupt::closed_pipe)
+    }
+}
+
+/// `print!` through [`stdout`]: a closed pipe ends the run as SIGPIPE would; another write
+/// error ends it with a message ([`crate::interrupt::stdout_failed`]), where `print!` panics.
+#[macro_export]
+macro_rules! out {
+    ($($arg:tt)*) => {{
+        use std::io::Write as _;
+        if let Err(e) = write!($crate::output::stdout(), $($arg)*) {
+            $crate::interrupt::stdout_failed(e);
+        }
+    }};
+}
+
+/// `println!` through [`stdout`], as [`out!`](crate::out!).
+#[macro_export]
+macro_rules! outln {
+    ($($arg:tt)*) => {{
+        use std::io::Write as _;
+        if let Err(e) = writeln!($crate::output::stdout(), $($arg)*) {
+            $crate::interrupt::stdout_failed(e);
+        }
+    }};
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -122,7 +122,6 @@ fn main() -> ExitCode {
             ExitCode::SUCCESS
         }
         Err(e) => {
-            impact_host::interrupt::closed_pipe(&e);
             eprintln!("error: {e}");
             ExitCode::from(1)
         }

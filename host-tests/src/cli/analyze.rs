@@ -65,14 +65,14 @@ pub fn run(cmd: &AnalyzeCommand) -> Result<(), String> {
     super::progress::finish();
     let a = pipeline::to_json(&setup, &reports);
     if args.json {
-        println!(
+        crate::outln!(
             "{}",
             serde_json::to_string_pretty(&a).map_err(|e| e.to_string())?
         );
     } else if args.csv {
-        print!("{}", report::to_csv(&a));
+        crate::out!("{}", report::to_csv(&a));
     } else {
-        print!("{}", report::to_table(&a));
+        crate::out!("{}", report::to_table(&a));
     }
     if let Some(path) = &args.plot {
         let mut signal = setup.plot_signal();
@@ -106,14 +106,14 @@ fn run_series(cmd: &AnalyzeCommand, files: &[PathBuf]) -> Result<(), String> {
         }
     }
     if args.json {
-        println!(
+        crate::outln!(
             "{}",
             serde_json::to_string_pretty(&series::to_json(&results)).map_err(|e| e.to_string())?
         );
     } else if args.csv {
-        print!("{}", series::to_csv(&results));
+        crate::out!("{}", series::to_csv(&results));
     } else {
-        print!("{}", series::to_table(&results));
+        crate::out!("{}", series::to_table(&results));
     }
     let failed: Vec<&series::EntryJson> = results.iter().filter(|e| e.error.is_some()).collect();
     match failed.as_slice() {

@@ -98,23 +98,23 @@ pub fn run(which: Bench) -> Result<(), String> {
         Bench::Realtime(args) => {
             let results = realtime::run(&args)?;
             if args.json {
-                println!(
+                crate::outln!(
                     "{}",
                     serde_json::to_string_pretty(&results).map_err(|e| e.to_string())?
                 );
             } else {
-                print!("{}", realtime::table(&results));
+                crate::out!("{}", realtime::table(&results));
             }
         }
         Bench::M4(args) => {
             let (report, profile) = m4::run(&args)?;
             if args.json {
-                println!(
+                crate::outln!(
                     "{}",
                     serde_json::to_string_pretty(&report).map_err(|e| e.to_string())?
                 );
             } else {
-                print!("{}", m4::table(&report));
+                crate::out!("{}", m4::table(&report));
             }
             if !profile.is_empty() {
                 eprint!("{profile}");
@@ -138,22 +138,22 @@ pub fn run(which: Bench) -> Result<(), String> {
             let exe = std::env::current_exe().map_err(|e| e.to_string())?;
             let r = throughput::throughput(samples, impacts, block, csv_rows, &exe)?;
             if json {
-                println!(
+                crate::outln!(
                     "{}",
                     serde_json::to_string_pretty(&r).map_err(|e| e.to_string())?
                 );
             } else {
-                println!(
+                crate::outln!(
                     "pipeline: {} samples, {} impacts (all reported) in {:.3} s on one core: {:.3e} samples/s best of 3, {:.3e} median (target 1e9)",
                     r.samples, r.impacts_reported, r.seconds, r.samples_per_second, r.median_samples_per_second
                 );
                 let a = &r.analyze;
-                println!(
+                crate::outln!(
                     "impact analyze: {} rows ({:.0} MB CSV), {} impacts in {:.2} s: {:.3e} rows/s, {:.0} MB/s, peak memory {:.0} MiB",
                     a.rows, a.bytes as f64 / 1e6, a.impacts_reported, a.seconds, a.rows_per_second, a.megabytes_per_second, a.peak_rss_mib
                 );
                 for f in &r.formats {
-                    println!(
+                    crate::outln!(
                         "  {:<3} {:<6} {:>5.0} MB in {:>5.2} s: {:>5.0} MB/s, {:.3e} samples/s, peak memory {:>4.0} MiB",
                         f.format,
                         f.path,
@@ -165,12 +165,15 @@ pub fn run(which: Bench) -> Result<(), String> {
                     );
                 }
                 if r.peers.is_empty() {
-                    println!("  peers: none (python3 with pandas and numpy not found)");
+                    crate::outln!("  peers: none (python3 with pandas and numpy not found)");
                 }
                 for p in &r.peers {
-                    println!(
+                    crate::outln!(
                         "  peer {} on the {}: {:.2} s, {:.0} MB/s (reading only)",
-                        p.tool, p.format, p.seconds, p.megabytes_per_second
+                        p.tool,
+                        p.format,
+                        p.seconds,
+                        p.megabytes_per_second
                     );
                 }
             }
@@ -179,12 +182,12 @@ pub fn run(which: Bench) -> Result<(), String> {
             let mut rows = stability::run(full);
             rows.extend(two_body::stability(full));
             if json {
-                println!(
+                crate::outln!(
                     "{}",
                     serde_json::to_string_pretty(&rows).map_err(|e| e.to_string())?
                 );
             } else {
-                print!("{}", stability::table(&rows));
+                crate::out!("{}", stability::table(&rows));
             }
             let failures = stability::failures(&rows);
             if failures > 0 {
@@ -199,7 +202,7 @@ pub fn run(which: Bench) -> Result<(), String> {
             pulse,
         } => {
             let r = soak::run(samples, spacing, pulse)?;
-            println!(
+            crate::outln!(
                 "{}",
                 serde_json::to_string_pretty(&r).map_err(|e| e.to_string())?
             );
@@ -221,35 +224,36 @@ pub fn run(which: Bench) -> Result<(), String> {
                 map.as_deref().unwrap_or(&default_map),
             )?;
             if json {
-                println!(
+                crate::outln!(
                     "{}",
                     serde_json::to_string_pretty(&b).map_err(|e| e.to_string())?
                 );
             } else {
-                print!("{}", memory::table(&b));
+                crate::out!("{}", memory::table(&b));
             }
         }
         Bench::Pipeline { block, json } => {
             let c = throughput::measure(block)?;
             if json {
-                println!(
+                crate::outln!(
                     "{}",
                     serde_json::to_string_pretty(&c).map_err(|e| e.to_string())?
                 );
             } else {
-                println!(
+                crate::outln!(
                     "streaming pipeline on this host, blocks of {} samples:",
                     c.block
                 );
-                println!(
+                crate::outln!(
                     "  idle                {:8.2} ns/sample ({:.3e} samples/s)",
-                    c.idle_ns_per_sample, c.idle_samples_per_second
+                    c.idle_ns_per_sample,
+                    c.idle_samples_per_second
                 );
-                println!(
+                crate::outln!(
                     "  inside an impact    {:8.2} ns/sample (report included)",
                     c.impact_ns_per_sample
                 );
-                println!("  fits                {:8.1} µs/impact (8000 samples; two-phase, nonlinear with n, Hertz)", c.fits_us_per_impact);
+                crate::outln!("  fits                {:8.1} µs/impact (8000 samples; two-phase, nonlinear with n, Hertz)", c.fits_us_per_impact);
             }
         }
         Bench::Precision {
@@ -269,14 +273,14 @@ pub fn run(which: Bench) -> Result<(), String> {
             let svg_path = out.join("work-precision.svg");
             precision::work_precision(&points, &svg_path)?;
             if json {
-                println!(
+                crate::outln!(
                     "{}",
                     serde_json::to_string_pretty(&points).map_err(|e| e.to_string())?
                 );
             } else {
-                print!("{}", precision::table(&points));
-                print!("{}", precision::summary(&points, 1e-9));
-                println!("wrote {} and {}", csv_path.display(), svg_path.display());
+                crate::out!("{}", precision::table(&points));
+                crate::out!("{}", precision::summary(&points, 1e-9));
+                crate::outln!("wrote {} and {}", csv_path.display(), svg_path.display());
             }
         }
     }

@@ -267,7 +267,7 @@ pub fn emulate(args: &EmulateArgs) -> Result<(), String> {
             if to_stderr {
                 eprintln!("{line}");
             } else {
-                println!("{line}");
+                crate::outln!("{line}");
             }
         },
     )?;
@@ -320,7 +320,7 @@ pub fn emulate(args: &EmulateArgs) -> Result<(), String> {
         check_waveforms(&log, &replayed, every)?;
         json.waveforms = log.waveforms.iter().map(|w| w.json()).collect();
     }
-    let mut out = std::io::stdout().lock();
+    let mut out = crate::output::stdout();
     let text = if a.json {
         serde_json::to_string_pretty(&json).map_err(|e| e.to_string())? + "\n"
     } else if a.csv {

@@ -217,7 +217,7 @@ fn report(args: &LogArgs, reader: LogReader, name: &str) -> Result<(), String> {
         }
     }
     // Written an impact at a time: a long log's report is never held whole.
-    let mut out = BufWriter::with_capacity(1 << 16, std::io::stdout().lock());
+    let mut out = BufWriter::with_capacity(1 << 16, crate::output::stdout());
     if args.csv {
         crate::report::csv::write_csv(&json.head, json.impacts(), &mut out)
     } else {

@@ -9,11 +9,11 @@ pub fn run(args: &SimulateArgs) -> Result<(), String> {
         serde_json::to_string(v).map_err(|e| e.to_string())
     }
     match simulate::run_any(args)? {
-        simulate::Outcome::Wall(report) if args.json => println!("{}", json(&report)?),
-        simulate::Outcome::Wall(report) => print!("{}", simulate::table(&report)),
-        simulate::Outcome::Target(report) if args.json => println!("{}", json(&*report)?),
+        simulate::Outcome::Wall(report) if args.json => crate::outln!("{}", json(&report)?),
+        simulate::Outcome::Wall(report) => crate::out!("{}", simulate::table(&report)),
+        simulate::Outcome::Target(report) if args.json => crate::outln!("{}", json(&*report)?),
         simulate::Outcome::Target(report) => {
-            print!("{}", simulate::two_body::table(&report))
+            crate::out!("{}", simulate::two_body::table(&report))
         }
     }
     Ok(())

@@ -46,7 +46,7 @@ pub fn run(command: SynthCommand) -> Result<(), String> {
             crate::output::write_with(&path, |mut out| synth::write_csv(&rec, &args, &mut out))?;
         }
         None => {
-            let stdout = std::io::stdout().lock();
+            let stdout = crate::output::stdout();
             synth::write_csv(
                 &rec,
                 &args,

@@ -17,7 +17,7 @@ fn n(v: &Value, scale: f64) -> String {
 
 /// Prints `events` as text on stdout (warnings on stderr).
 pub fn print(events: &[Value]) {
-    let mut out = std::io::stdout().lock();
+    let mut out = crate::output::stdout();
     for e in events {
         let line = match e["type"].as_str() {
             Some("impact") => Some(impact(e)),
@@ -133,10 +133,10 @@ fn health(e: &Value) -> Option<String> {
 /// Says that the board went silent (`Some(ms)` since its last heartbeat) or came back.
 pub fn silence(quiet_ms: Option<u64>) {
     match quiet_ms {
-        Some(ms) => println!(
+        Some(ms) => crate::outln!(
             "── no heartbeat for {} s: the board is silent or its link is lost ──",
             crate::report::fmt::sig(ms as f64 / 1e3, 2)
         ),
-        None => println!("── heartbeats again ──"),
+        None => crate::outln!("── heartbeats again ──"),
     }
 }
