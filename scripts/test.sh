@@ -41,6 +41,14 @@ cargo clippy --release -p impact-firmware --target thumbv7em-none-eabihf --no-de
 cargo clippy --release -p impact-firmware --target thumbv7em-none-eabihf --no-default-features --features panic-check --bin panic-check -- -D warnings
 cargo clippy --release -p impact-firmware --target thumbv7em-none-eabihf --no-default-features --features m4-bench --bin m4-bench -- -D warnings
 
+step "cargo doc: every crate's docs (private items too) build without a warning, links resolved"
+# Private items are documented (the docs are for the next engineer), so a link to one is fine.
+export RUSTDOCFLAGS="-D warnings --document-private-items -A rustdoc::private-intra-doc-links"
+cargo doc --no-deps "${HOST[@]}" -p impact-core -p impact-io -p impact-host
+cargo doc --no-deps --release -p impact-firmware --target thumbv7em-none-eabihf
+cargo doc --no-deps --release -p impact-firmware --target thumbv7em-none-eabihf --no-default-features --features emulator
+unset RUSTDOCFLAGS
+
 step "firmware: no reachable panic in the pipeline (links only if none survives optimization)"
 cargo build --release -p impact-firmware --target thumbv7em-none-eabihf --no-default-features --features panic-check --bin panic-check
 

@@ -9,7 +9,7 @@
 //! * [`fifo`]: samples a polled FIFO lost, counted against the sensor's own stream;
 //! * [`light_gate`]: two beams' cuts paired into passages and speeds;
 //! * [`ticks`]: deadlines beyond a 32-bit one-shot timer's reach, in several shots;
-//! * [`semihosting`] (QEMU builds only): the host's command line, files and exit status.
+//! * `semihosting` (QEMU builds only): the host's command line, files and exit status.
 
 #![no_std]
 

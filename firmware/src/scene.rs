@@ -9,7 +9,7 @@ use impact_core::{Approach, Calibration, FitSet, Scene, Train, TrainSpeed};
 use static_cell::ConstStaticCell;
 
 /// The seed bench's approach speed, m/s (a light gate may override it per impact through
-/// [`crate::tasks::monitor::APPROACH_SPEED`]).
+/// the firmware binary's `tasks::stream::APPROACH_SPEED`).
 pub const BENCH_V0_M_S: f32 = 1.3357;
 
 /// ADC: 12 bits over ±800 m/s², so 1600 / 4096 m/s² per count (exact in binary).

@@ -2,7 +2,7 @@
 //! signal if the scene asks for a filter), and, when the approach speed is known, the
 //! kinematics (crush time, deformations, COR) and the model fits. Runs once per impact,
 //! wherever the capture was handed (inline on the host, in a low-priority task on the
-//! firmware), in one integer pass over the capture ([`crate::motion`]) plus the fits over a
+//! firmware), in one integer pass over the capture ([`motion`]) plus the fits over a
 //! few thousand points: no per-sample floating point unless a CFC filter is asked for.
 
 use crate::capture::Capture;

@@ -1,7 +1,7 @@
 //! Per-impact model identification from the measured force–deformation loop.
 //!
 //! The fits take the loop as [`Points`] (deformation, velocity and force at evenly spaced
-//! points of the contact, in scaled units; [`crate::motion`] integrates them once per impact)
+//! points of the contact, in scaled units; [`crate::analysis::motion`] integrates them once per impact)
 //! and return their own result types; the report assembles them. Linear least squares in the
 //! scaled variables `X = x / x_m`, `V = v / v0`, `F = m a / F_peak`, the products in f32 (the
 //! Cortex-M4's FPU) and their sums to f64 accuracy ([`sums`]): two-phase Kelvin–Voigt

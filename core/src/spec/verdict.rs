@@ -261,7 +261,7 @@ mod tests {
         }
     }
 
-    /// A pulse of `shape` scaled by `gain` in time and amplitude, at 50 kS/s, its start at
+    /// A pulse of `shape` of `peak` (m/s²) and `dur` (s), at 50 kS/s, its start at
     /// sample 2000 (and `glitch` added at a sample).
     fn judge_pulse(shape: Shape, peak: f32, dur: f32, glitch: Option<(u64, f32)>) -> Verdict {
         judge_against(&spec(shape), peak, dur, glitch)

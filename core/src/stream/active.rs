@@ -37,7 +37,7 @@ pub(super) struct Active {
     /// `Σ d` from `first_index` to the separation (exclusive).
     pub(super) separation_c: i64,
     /// The separation, its offset and the falling foot's `Σ d` beyond it (where the foot is
-    /// a power curve: [`Stream::fall`], else [`Stream::separation_offset`] and 0), found while
+    /// a power curve: [`super::Stream::fall`], else [`super::Stream::separation_offset`] and 0), found while
     /// its flank was still in the ring (a long ring-down after it would push it out).
     pub(super) separation_at: Option<(u64, f32, i64)>,
     /// The rising side, for the foot's fit at the end; the pulse's sign; `Σ d` over the whole

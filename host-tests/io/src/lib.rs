@@ -97,7 +97,7 @@ fn unsupported(path: &Path) -> Option<&'static str> {
     }
 }
 
-/// Reads one channel and its time base from a CSV file (see [`read_table`]), a WAV file, an
+/// Reads one channel and its time base from a CSV file (see [`csv_read::read_table`]), a WAV file, an
 /// `.npy` array, a TDMS file or a raw `.i16`/`.f32` file ([`Format`]).
 pub fn read_recording(path: &Path, opts: &ReadOptions) -> Result<Channel, RecordingError> {
     match Format::of(path, opts.raw_type) {

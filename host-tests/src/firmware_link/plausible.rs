@@ -7,7 +7,7 @@ use impact_core::report::COR_TOLERANCE;
 use impact_core::ImpactReport;
 
 /// An impact report's numbers within what the firmware can report (finite already: see
-/// [`Number`]).
+/// [`crate::firmware_link::fields::num`]).
 pub(crate) fn check_report(r: &ImpactReport) -> Result<(), String> {
     fn out_of_range(field: &str, v: impl std::fmt::Display, range: &str) -> Result<(), String> {
         Err(format!("{field}={v}: out of range (must be {range})"))

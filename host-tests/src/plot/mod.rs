@@ -1,5 +1,5 @@
 //! The figures' primitives: the output checked and written (SVG, or PNG: [`png`]), panels of
-//! curves drawn with plotters; the impacts figure ([`impacts`]), what it draws from ([`signal`]) and the tick
+//! curves drawn with plotters; the impacts figure ([`mod@impacts`]), what it draws from ([`signal`]) and the tick
 //! labels ([`ticks`]).
 
 mod impacts;

@@ -176,7 +176,7 @@ pub(super) fn line(block: &[f32]) -> (f32, f32) {
     }
 }
 
-/// One block's input about its [`line`]: `Σ|r|`, `max|r|` and `sqrt(Σ r²)`.
+/// One block's input about its [`fn@line`]: `Σ|r|`, `max|r|` and `sqrt(Σ r²)`.
 #[derive(Clone, Copy, Default)]
 pub(super) struct Rest {
     pub(super) sum: f32,

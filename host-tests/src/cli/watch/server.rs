@@ -1,7 +1,8 @@
 //! `impact watch`'s web server: the page, its event stream (Server-Sent Events), the
-//! session's exports. Four GET routes on localhost, each connection on its own thread; a
-//! page too slow for the stream loses events (counted and shown), never holds up the board's
-//! input.
+//! session's exports. Eight GET routes on localhost (`/`, `/events`, `/state.json`,
+//! `/session.json`, `/session.csv`, `/report.html`, `/receipt`, `/receipts`), each connection
+//! on its own thread; a page too slow for the stream loses events (counted and shown), never
+//! holds up the board's input.
 
 use std::collections::VecDeque;
 use std::io::{BufRead, BufReader, Read, Write};
