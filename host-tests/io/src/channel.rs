@@ -282,12 +282,19 @@ pub fn check_time(
     resample: bool,
     at: impl Fn(usize, String) -> RecordingError,
 ) -> Result<(f64, f64), RecordingError> {
-    for (i, w) in t.windows(2).enumerate() {
-        if w[1] <= w[0] {
-            return Err(at(
-                i + 1,
-                format!("time {} s does not increase (previous {} s)", w[1], w[0]),
-            ));
+    // One pass: time going back is the first error, then one sample, then the first uneven
+    // interval (against the head's median), then drift.
+    let mut axis = crate::time_axis::TimeAxis::new(true);
+    let (mut uneven, mut drift) = (None, None);
+    for (k, &tk) in t.iter().enumerate() {
+        let f = axis.push(tk, k as u64);
+        if let Some(e) = f.not_increasing {
+            return Err(at(k, e.to_string()));
+        }
+        uneven = uneven.or(f.uneven.map(|e| (k as u64, e)));
+        drift = drift.or(f.drift.map(|e| (k, e)));
+        if k == HEAD_INTERVALS {
+            uneven = uneven.or(axis.close_head());
         }
     }
     if t.len() < 2 {
@@ -297,30 +304,23 @@ pub fn check_time(
             message: "one sample: the rate cannot be told; give --rate".into(),
         });
     }
-    let dts: Vec<f64> = t.windows(2).map(|w| w[1] - w[0]).collect();
-    let median_of = |d: &[f64]| {
-        let mut d = d.to_vec();
-        let mid = d.len() / 2;
-        *d.select_nth_unstable_by(mid, f64::total_cmp).1
-    };
-    if !resample {
-        let median = median_of(&dts[..dts.len().min(HEAD_INTERVALS)]);
-        for (i, &dt) in dts.iter().enumerate() {
-            crate::channel::check_interval(dt, median).map_err(|m| at(i + 1, m))?;
-        }
-        let mut drift = Drift::default();
-        for (i, &ti) in t.iter().enumerate() {
-            drift.push(ti).map_err(|m| at(i, m))?;
-        }
-        let dt = (t[t.len() - 1] - t[0]) / (t.len() - 1) as f64;
-        let jitter = t
-            .windows(2)
-            .map(|w| ((w[1] - w[0]) / dt - 1.0).abs())
-            .fold(0.0, f64::max);
-        Ok((1.0 / dt, jitter))
-    } else {
-        Ok((1.0 / median_of(&dts), 0.0))
+    if resample {
+        let mut dts: Vec<f64> = t.windows(2).map(|w| w[1] - w[0]).collect();
+        let median = crate::time_axis::median(&mut dts).unwrap_or(f64::NAN);
+        return Ok((1.0 / median, 0.0));
     }
+    if let Some((k, e)) = uneven.or_else(|| axis.close_head()) {
+        return Err(at(k as usize, e.to_string()));
+    }
+    if let Some((k, e)) = drift {
+        return Err(at(k, e.to_string()));
+    }
+    let dt = (t[t.len() - 1] - t[0]) / (t.len() - 1) as f64;
+    let jitter = t
+        .windows(2)
+        .map(|w| ((w[1] - w[0]) / dt - 1.0).abs())
+        .fold(0.0, f64::max);
+    Ok((axis.rate_hz().unwrap_or(1.0 / dt), jitter))
 }
 
 /// Intervals per block of the drift check ([`Drift`]).
@@ -344,9 +344,9 @@ pub struct Drift {
 }
 
 impl Drift {
-    /// Takes the next time stamp `t` (s; the `n`-th from 0); an error once a block's mean
+    /// Takes the next time stamp `t` (s; the `n`-th from 0); a fault once a block's mean
     /// interval is more than [`DRIFT_LIMIT`] off the first block's.
-    pub fn push(&mut self, t: f64) -> Result<(), String> {
+    pub fn push(&mut self, t: f64) -> Result<(), DriftFault> {
         let k = self.n;
         self.n += 1;
         if k == 0 {
@@ -362,33 +362,40 @@ impl Drift {
             self.first_dt = Some(mean);
             return Ok(());
         };
-        let off = mean / first - 1.0;
-        if off.abs() > DRIFT_LIMIT {
-            return Err(format!(
-                "the time axis drifts: the mean interval of samples {}..{k} is {mean:.6e} s, \
-                 {:+.2} % off the first {DRIFT_BLOCK} intervals' {first:.6e} s (more than \
-                 {} %: no steady sample clock); give --resample to interpolate onto an even \
-                 grid, or --rate if the column is wrong",
-                k - DRIFT_BLOCK,
-                100.0 * off,
-                100.0 * DRIFT_LIMIT
-            ));
+        if (mean / first - 1.0).abs() > DRIFT_LIMIT {
+            return Err(DriftFault {
+                block_end: k,
+                mean_dt: mean,
+                first_dt: first,
+            });
         }
         Ok(())
     }
 }
 
-/// An interval `dt` within [`crate::channel::INTERVAL_RANGE`] times the median `median`.
-pub fn check_interval(dt: f64, median: f64) -> Result<(), String> {
-    let ratio = dt / median;
-    if crate::channel::INTERVAL_RANGE.contains(&ratio) {
-        Ok(())
-    } else {
-        Err(format!(
-            "uneven time axis: {dt:.6e} s since the previous sample, {ratio:.3} times the first \
-             intervals' median {median:.6e} s (a gap or a rate change); give --resample to \
-             interpolate onto an even grid, or cut the file"
-        ))
+/// A block of intervals whose mean is more than [`DRIFT_LIMIT`] off the first block's.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct DriftFault {
+    /// The block's last sample (its first is [`DRIFT_BLOCK`] before).
+    pub block_end: u64,
+    /// The block's mean interval and the first block's, s.
+    pub mean_dt: f64,
+    pub first_dt: f64,
+}
+
+impl fmt::Display for DriftFault {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        let (k, mean, first) = (self.block_end, self.mean_dt, self.first_dt);
+        write!(
+            f,
+            "the time axis drifts: the mean interval of samples {}..{k} is {mean:.6e} s, \
+             {:+.2} % off the first {DRIFT_BLOCK} intervals' {first:.6e} s (more than \
+             {} %: no steady sample clock); give --resample to interpolate onto an even \
+             grid, or --rate if the column is wrong",
+            k - DRIFT_BLOCK,
+            100.0 * (mean / first - 1.0),
+            100.0 * DRIFT_LIMIT
+        )
     }
 }
 

@@ -293,7 +293,7 @@ fn follows(time: f64, last: &mut Option<f64>, layout: &Layout) -> bool {
         t > l
             && layout
                 .median_dt
-                .is_none_or(|m| crate::channel::check_interval(t - l, m).is_ok())
+                .is_none_or(|m| crate::time_axis::check_interval(t - l, m).is_ok())
     });
     *last = Some(t);
     ok

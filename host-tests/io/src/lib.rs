@@ -18,6 +18,7 @@ pub mod spool;
 pub mod table;
 pub mod tape;
 pub mod tdms;
+pub mod time_axis;
 pub mod units;
 pub mod wav;
 

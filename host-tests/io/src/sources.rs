@@ -7,10 +7,11 @@ use std::io::Read;
 use std::path::Path;
 
 use super::channel::RawType;
-use super::channel::{check_interval, is_stdin, ReadOptions};
+use super::channel::{is_stdin, ReadOptions};
 use super::csv_fast::{Layout, Parsed};
 use super::csv_read::{Handover, HandoverError, Step};
 use super::table::Rows;
+use super::time_axis::TimeAxis;
 use crate::limits::RATE_HZ;
 
 /// Samples whose noise sets the default edge level (the whole-file path uses the whole
@@ -263,14 +264,9 @@ pub struct CsvSource {
     time: Option<(usize, f64)>,
     /// `--rate`, if given.
     rate_given: Option<f64>,
-    /// The first time and the latest one, s; the rows read.
-    t0: Option<f64>,
-    last: f64,
-    n: u64,
-    /// The head's intervals and the lines they end on, then their median and the head's
+    /// The time axis (the rows read; without a time column, only counted), and the head's
     /// mean rate.
-    head_dts: Vec<(f64, u64)>,
-    median_dt: Option<f64>,
+    axis: TimeAxis,
     head_rate: Option<f64>,
     /// The first row's value, read while resolving the columns and not yet handed on.
     pending: Option<f64>,
@@ -280,8 +276,7 @@ pub struct CsvSource {
     /// the end, in this order, as the whole-file path does).
     not_increasing: Option<String>,
     uneven: Option<String>,
-    /// The time stamps' drift check, and its first error (reported after those two).
-    drift: crate::channel::Drift,
+    /// The time stamps' drift check's first error (reported after those two).
     drifting: Option<String>,
 }
 
@@ -338,18 +333,13 @@ impl CsvSource {
             time_unit: opts.time_unit,
             time,
             rate_given: opts.rate_hz,
-            t0: None,
-            last: 0.0,
-            n: 0,
-            head_dts: Vec::new(),
-            median_dt: None,
+            axis: TimeAxis::new(opts.rate_hz.is_none()),
             head_rate: None,
             pending: None,
             head_done: false,
             ended: false,
             not_increasing: None,
             uneven: None,
-            drift: crate::channel::Drift::default(),
             drifting: None,
         };
         source.pending = Some(source.take(line, &first)?);
@@ -365,37 +355,26 @@ impl CsvSource {
 
     /// [`CsvSource::take`] of a row's channel value and time column's value.
     fn take_values(&mut self, line: u64, value: f64, time: f64) -> Result<f64, String> {
-        if let Some((_, unit)) = self.time {
-            let t = time * unit;
-            self.check_drift(line, t);
-            if self.t0.is_none() {
-                self.t0 = Some(t);
-            } else {
-                // Errors wait for the end, as in the whole-file path: a value that is not a
-                // number anywhere comes first, then time going back, then an uneven interval
-                // (the first of each).
-                let at = |m: String| format!("{}:{line}: {m}", self.name);
-                let dt = t - self.last;
-                // With --rate the column gives only the first time, as in the whole-file path.
-                if self.rate_given.is_some() {
-                } else if t <= self.last {
-                    let m = format!("time {t} s does not increase (previous {} s)", self.last);
-                    self.not_increasing.get_or_insert_with(|| at(m));
-                } else {
-                    match self.median_dt {
-                        None if !self.head_done => self.head_dts.push((dt, line)),
-                        None => {}
-                        Some(m) => {
-                            if let Err(e) = check_interval(dt, m) {
-                                self.uneven.get_or_insert_with(|| at(e));
-                            }
-                        }
-                    }
-                }
-            }
-            self.last = t;
+        let Some((_, unit)) = self.time else {
+            self.axis.count(1);
+            return Ok(value);
+        };
+        // Errors wait for the end, as in the whole-file path: a value that is not a number
+        // anywhere comes first, then time going back, then an uneven interval, then drift
+        // (the first of each). With --rate the column gives only the first time, as in the
+        // whole-file path (the axis does not check it).
+        let faults = self.axis.push(time * unit, line);
+        let name = &self.name;
+        let at = |m: &dyn std::fmt::Display| format!("{name}:{line}: {m}");
+        if let Some(e) = faults.drift {
+            self.drifting.get_or_insert_with(|| at(&e));
         }
-        self.n += 1;
+        if let Some(e) = faults.not_increasing {
+            self.not_increasing.get_or_insert_with(|| at(&e));
+        }
+        if let Some(e) = faults.uneven {
+            self.uneven.get_or_insert_with(|| at(&e));
+        }
         Ok(value)
     }
 }
@@ -412,7 +391,8 @@ impl CsvSource {
         let (channel, time) = (self.channel, self.time);
         let increasing = self.rate_given.is_none() && self.not_increasing.is_none();
         let median_dt = self
-            .median_dt
+            .axis
+            .median_dt()
             .filter(|_| increasing && self.uneven.is_none());
         let layout = move |rows: &Rows| {
             let (delimiter, format) = rows.format();
@@ -467,16 +447,6 @@ impl CsvSource {
         Ok(())
     }
 
-    /// Feeds the time `t` (s) of `line` to the drift check (not with `--rate`), keeping its
-    /// first error for the end.
-    fn check_drift(&mut self, line: u64, t: f64) {
-        if self.rate_given.is_none() && self.drifting.is_none() {
-            if let Err(m) = self.drift.push(t) {
-                self.drifting = Some(format!("{}:{line}: {m}", self.name));
-            }
-        }
-    }
-
     /// A chunk of the parallel reader: the first row follows the previous chunk's last and
     /// is checked here; the others the worker checked against the row before them.
     fn take_chunk(&mut self, chunk: Parsed, out: &mut Vec<f64>) -> Result<(), String> {
@@ -484,16 +454,23 @@ impl CsvSource {
         if let Some(&(value, time)) = chunk.rows.first() {
             out.push(self.take_values(chunk.line, value, time)?);
         }
-        let unit = self.time.map(|(_, unit)| unit);
-        for (k, &(value, time)) in chunk.rows.iter().enumerate().skip(1) {
-            if let Some(unit) = unit {
-                let t = time * unit;
-                self.last = t;
-                self.check_drift(chunk.line + k as u64, t);
+        let rest = chunk.rows.iter().enumerate().skip(1);
+        match self.time.map(|(_, unit)| unit) {
+            Some(unit) => {
+                for (k, &(value, time)) in rest {
+                    if let Some(e) = self.axis.push_checked(time * unit) {
+                        let line = chunk.line + k as u64;
+                        self.drifting
+                            .get_or_insert_with(|| format!("{}:{line}: {e}", self.name));
+                    }
+                    out.push(value);
+                }
             }
-            out.push(value);
+            None => {
+                out.extend(rest.map(|(_, &(value, _))| value));
+                self.axis.count(chunk.rows.len().saturating_sub(1) as u64);
+            }
         }
-        self.n += chunk.rows.len().saturating_sub(1) as u64;
         Ok(())
     }
 }
@@ -520,24 +497,14 @@ impl Source for CsvSource {
 
     fn head_read(&mut self) -> Result<(), String> {
         self.head_done = true;
-        let dts = std::mem::take(&mut self.head_dts);
-        if !dts.is_empty() {
-            let mut sorted: Vec<f64> = dts.iter().map(|d| d.0).collect();
-            let mid = sorted.len() / 2;
-            let median = *sorted.select_nth_unstable_by(mid, f64::total_cmp).1;
-            // The head's intervals against their median, as every later one.
-            for (dt, line) in dts {
-                if let Err(m) = check_interval(dt, median) {
-                    self.uneven
-                        .get_or_insert_with(|| format!("{}:{line}: {m}", self.name));
-                }
-            }
-            self.median_dt = Some(median);
+        // The head's intervals against their median, as every later one.
+        if let Some((line, e)) = self.axis.close_head() {
+            self.uneven
+                .get_or_insert_with(|| format!("{}:{line}: {e}", self.name));
         }
-        if let Some(t0) = self.t0 {
+        if self.time.is_some() {
             // (None if time went back: `rate_hz` then gives that error.)
-            let rate = (self.n - 1) as f64 / (self.last - t0);
-            self.head_rate = (rate.is_finite() && rate > 0.0).then_some(rate);
+            self.head_rate = self.axis.rate_hz();
             if let (Some(rate), None) = (self.head_rate, self.rate_given) {
                 crate::channel::check_time_unit(&self.time_header, self.time_unit, rate)
                     .map_err(|m| format!("{}: {m}", self.name))?;
@@ -562,15 +529,15 @@ impl Source for CsvSource {
     }
 
     fn final_rate_hz(&self) -> f64 {
-        match (self.rate_given, self.t0) {
+        match (self.rate_given, self.axis.rate_hz()) {
             (Some(r), _) => r,
-            (None, Some(t0)) if self.n > 1 => 1.0 / ((self.last - t0) / (self.n - 1) as f64),
+            (None, Some(r)) => r,
             _ => self.head_rate.unwrap_or(0.0),
         }
     }
 
     fn t0(&self) -> f64 {
-        self.t0.unwrap_or(0.0)
+        self.axis.t0()
     }
 
     fn column(&self) -> &str {
@@ -587,13 +554,8 @@ pub struct IdeSource {
     column: String,
     /// Values of the current block not yet handed on.
     pending: std::collections::VecDeque<f64>,
-    t0: Option<f64>,
-    last: f64,
-    n: u64,
-    head_dts: Vec<f64>,
-    median_dt: Option<f64>,
+    axis: TimeAxis,
     head_rate: Option<f64>,
-    drift: crate::channel::Drift,
 }
 
 impl IdeSource {
@@ -612,13 +574,8 @@ impl IdeSource {
             name: name.to_string(),
             column: pick.names[0].clone(),
             pending: std::collections::VecDeque::new(),
-            t0: None,
-            last: 0.0,
-            n: 0,
-            head_dts: Vec::new(),
-            median_dt: None,
+            axis: TimeAxis::new(true),
             head_rate: None,
-            drift: crate::channel::Drift::default(),
         })
     }
 
@@ -629,28 +586,20 @@ impl IdeSource {
         };
         let (times, values) = block.map_err(|e| format!("{}: {e}", self.name))?;
         for &t in &times {
-            self.drift
-                .push(t)
-                .map_err(|e| format!("{}: sample {}: {e}", self.name, self.n))?;
-            if let Some(t0) = self.t0 {
-                let dt = t - self.last;
-                if dt <= 0.0 {
-                    return Err(format!(
-                        "{}: sample {}: time {t} s does not increase (previous {} s)",
-                        self.name, self.n, self.last
-                    ));
-                }
-                match self.median_dt {
-                    Some(m) => check_interval(dt, m)
-                        .map_err(|e| format!("{}: sample {}: {e}", self.name, self.n))?,
-                    None => self.head_dts.push(dt),
-                }
-                let _ = t0;
-            } else {
-                self.t0 = Some(t);
+            // The first fault stops the read: drift, then time going back, then an uneven
+            // interval.
+            let n = self.axis.samples();
+            let f = self.axis.push(t, n);
+            let fault: Option<&dyn std::fmt::Display> =
+                match (&f.drift, &f.not_increasing, &f.uneven) {
+                    (Some(e), _, _) => Some(e),
+                    (None, Some(e), _) => Some(e),
+                    (None, None, Some(e)) => Some(e),
+                    (None, None, None) => None,
+                };
+            if let Some(e) = fault {
+                return Err(format!("{}: sample {n}: {e}", self.name));
             }
-            self.last = t;
-            self.n += 1;
         }
         self.pending.extend(values);
         Ok(true)
@@ -668,24 +617,17 @@ impl Source for IdeSource {
     }
 
     fn head_read(&mut self) -> Result<(), String> {
-        if self.head_dts.is_empty() {
+        if let Some((n, e)) = self.axis.close_head() {
+            return Err(format!("{}: sample {n}: {e}", self.name));
+        }
+        if self.axis.median_dt().is_none() {
             return Err(format!(
                 "{}: {} samples: the rate cannot be told",
-                self.name, self.n
+                self.name,
+                self.axis.samples()
             ));
         }
-        let mut d = self.head_dts.clone();
-        let mid = d.len() / 2;
-        let median = *d.select_nth_unstable_by(mid, f64::total_cmp).1;
-        for (i, &dt) in self.head_dts.iter().enumerate() {
-            check_interval(dt, median)
-                .map_err(|e| format!("{}: sample {}: {e}", self.name, i + 1))?;
-        }
-        self.median_dt = Some(median);
-        self.head_rate = self
-            .t0
-            .map(|t0| (self.head_dts.len()) as f64 / (self.last - t0))
-            .filter(|r| r.is_finite() && *r > 0.0);
+        self.head_rate = self.axis.rate_hz();
         Ok(())
     }
 
@@ -695,14 +637,11 @@ impl Source for IdeSource {
     }
 
     fn final_rate_hz(&self) -> f64 {
-        match self.t0 {
-            Some(t0) if self.n > 1 => (self.n - 1) as f64 / (self.last - t0),
-            _ => self.head_rate.unwrap_or(0.0),
-        }
+        self.axis.rate_hz().or(self.head_rate).unwrap_or(0.0)
     }
 
     fn t0(&self) -> f64 {
-        self.t0.unwrap_or(0.0)
+        self.axis.t0()
     }
 
     fn column(&self) -> &str {

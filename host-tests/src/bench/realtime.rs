@@ -129,11 +129,6 @@ fn counts(case: &Case, n: usize, spacing: f64) -> Result<(Vec<i16>, Calibration)
     Ok((rec.samples, rec.calibration))
 }
 
-fn median(v: &mut [f64]) -> Option<f64> {
-    v.sort_by(f64::total_cmp);
-    v.get(v.len() / 2).copied()
-}
-
 fn train(
     elf: &Path,
     case: &Case,
@@ -178,7 +173,7 @@ fn train(
             .iter()
             .filter(|r| r.analysis == Analysis::Skipped)
             .count() as u64,
-        latency_median_s: median(&mut latencies),
+        latency_median_s: impact_io::time_axis::median(&mut latencies),
         latency_max_s: max,
     })
 }

@@ -42,9 +42,7 @@ mod tests {
     }
 
     fn median(x: &[f64]) -> f64 {
-        let mut v = x.to_vec();
-        let mid = v.len() / 2;
-        *v.select_nth_unstable_by(mid, f64::total_cmp).1
+        impact_io::time_axis::median(&mut x.to_vec()).unwrap_or(f64::NAN)
     }
 
     fn remove(x: &mut [f64]) -> Vec<Spike> {
