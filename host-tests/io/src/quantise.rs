@@ -7,6 +7,35 @@ pub fn gain_for(full_scale_m_s2: f64) -> f64 {
     full_scale_m_s2.max(crate::limits::LEVEL_M_S2.low) / 32000.0
 }
 
+/// A file's values to the core's counts: times `scale` (the units, `--gain` and `--invert`)
+/// to m/s², then over `gain` (m/s² per count) to counts, saturating as an ADC does.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Quantiser {
+    /// File value to m/s².
+    pub scale: f64,
+    /// m/s² per count.
+    pub gain: f64,
+}
+
+impl Quantiser {
+    /// A file value's count.
+    #[inline]
+    pub fn count(&self, value: f64) -> i16 {
+        to_count(value * self.scale, self.gain)
+    }
+
+    /// A reading already in m/s² (a head read at `scale`), in counts.
+    #[inline]
+    pub fn count_m_s2(&self, a_m_s2: f64) -> i16 {
+        to_count(a_m_s2, self.gain)
+    }
+
+    /// Readings already in m/s², in counts.
+    pub fn counts_m_s2(&self, a_m_s2: &[f64]) -> Vec<i16> {
+        a_m_s2.iter().map(|&a| self.count_m_s2(a)).collect()
+    }
+}
+
 /// One reading in counts (saturating at the i16 rails, as an ADC does).
 pub fn to_count(v: f64, gain: f64) -> i16 {
     round_to_i16(v / gain)

@@ -10,6 +10,7 @@ use super::channel::RawType;
 use super::channel::{is_stdin, ReadOptions};
 use super::csv_fast::{Layout, Parsed};
 use super::csv_read::{Handover, HandoverError, Step};
+use super::quantise::Quantiser;
 use super::table::Rows;
 use super::time_axis::TimeAxis;
 use crate::limits::RATE_HZ;
@@ -48,11 +49,11 @@ pub trait Source: Send {
     fn next_counts(
         &mut self,
         want: usize,
-        (scale, gain): (f64, f64),
+        q: Quantiser,
         scratch: &mut Vec<f64>,
         out: &mut Vec<i16>,
     ) -> Result<(), String> {
-        values_as_counts(self, want, (scale, gain), scratch, out)
+        values_as_counts(self, want, q, scratch, out)
     }
     /// The head has been read: what it tells (a CSV's rate) is fixed, and checked.
     fn head_read(&mut self) -> Result<(), String> {
@@ -80,17 +81,13 @@ pub trait Source: Send {
 fn values_as_counts<S: Source + ?Sized>(
     source: &mut S,
     want: usize,
-    (scale, gain): (f64, f64),
+    q: Quantiser,
     scratch: &mut Vec<f64>,
     out: &mut Vec<i16>,
 ) -> Result<(), String> {
     scratch.clear();
     source.next_values(want, scratch)?;
-    out.extend(
-        scratch
-            .iter()
-            .map(|v| crate::quantise::to_count(v * scale, gain)),
-    );
+    out.extend(scratch.iter().map(|&v| q.count(v)));
     Ok(())
 }
 
@@ -108,8 +105,8 @@ pub struct RawSource {
     read: u64,
     name: String,
     rate_hz: f64,
-    /// For 16-bit codes: each code's count at `(scale, gain)`.
-    table: Option<((f64, f64), Vec<i16>)>,
+    /// For 16-bit codes: each code's count under the quantiser.
+    table: Option<(Quantiser, Vec<i16>)>,
 }
 
 impl RawSource {
@@ -172,21 +169,21 @@ impl Source for RawSource {
     fn next_counts(
         &mut self,
         want: usize,
-        (scale, gain): (f64, f64),
+        q: Quantiser,
         scratch: &mut Vec<f64>,
         out: &mut Vec<i16>,
     ) -> Result<(), String> {
         if self.kind != RawType::I16 {
-            return values_as_counts(self, want, (scale, gain), scratch, out);
+            return values_as_counts(self, want, q, scratch, out);
         }
         let table = match self.table.take() {
-            Some(t) if t.0 == (scale, gain) => t,
-            _ => {
-                let counts = (0..=u16::MAX)
-                    .map(|c| crate::quantise::to_count(f64::from(c as i16) * scale, gain))
-                    .collect();
-                ((scale, gain), counts)
-            }
+            Some(t) if t.0 == q => t,
+            _ => (
+                q,
+                (0..=u16::MAX)
+                    .map(|c| q.count(f64::from(c as i16)))
+                    .collect(),
+            ),
         };
         let (frame, at) = (self.frame, self.at);
         let result = self.next_with(want, |bytes| {

@@ -123,17 +123,13 @@ impl Source for SpoolSource {
     fn next_counts(
         &mut self,
         want: usize,
-        (scale, gain): (f64, f64),
+        q: crate::quantise::Quantiser,
         _scratch: &mut Vec<f64>,
         out: &mut Vec<i16>,
     ) -> Result<(), String> {
         // (As `values_as_counts`, without the values' round trip through memory.)
         let bytes = self.next_bytes(want)?;
-        out.extend(
-            bytes
-                .chunks_exact(8)
-                .map(|b| crate::quantise::to_count(value(b) * scale, gain)),
-        );
+        out.extend(bytes.chunks_exact(8).map(|b| q.count(value(b))));
         Ok(())
     }
 
@@ -193,8 +189,16 @@ mod tests {
             let (mut counts, mut scratch) = (Vec::new(), Vec::new());
             loop {
                 let before = counts.len();
-                s.next_counts(want, (2.5, 0.01), &mut scratch, &mut counts)
-                    .unwrap();
+                s.next_counts(
+                    want,
+                    crate::quantise::Quantiser {
+                        scale: 2.5,
+                        gain: 0.01,
+                    },
+                    &mut scratch,
+                    &mut counts,
+                )
+                .unwrap();
                 if counts.len() == before {
                     break;
                 }

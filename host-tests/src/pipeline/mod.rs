@@ -151,32 +151,48 @@ pub struct Setup {
     pub windows: Vec<(u64, Vec<i16>)>,
 }
 
+/// What was read of a recording, however it was read: its channel, units, time base and
+/// length.
+pub struct Reading {
+    /// The channel's header (empty where the format names none) and its units.
+    pub column: String,
+    pub units: Units,
+    /// Time of the first sample, s; the samples; the rate, S/s.
+    pub t0: f64,
+    pub samples: u64,
+    pub rate_hz: f64,
+}
+
+/// The scene resolved from the options and the scene file ([`build_scene`]), and where its
+/// approach speed came from (`v0`, `drop-height`; none without one).
+pub struct Resolved {
+    pub scene: Scene,
+    pub v0_source: Option<&'static str>,
+}
+
 impl Setup {
-    /// A setup of `samples` samples at `rate_hz` (the first at `t0`, s) of the channel
-    /// `column` in `units`, analysed with `scene`: no counts or signal kept, no glitches
-    /// removed, no rails known, no axes, not resampled (a whole-file read fills them in).
-    #[allow(clippy::too_many_arguments)]
-    pub fn new(
-        column: String,
-        units: Units,
-        calibration: Calibration,
-        t0: f64,
-        scene: Scene,
-        v0_source: Option<&str>,
-        samples: u64,
-        rate_hz: f64,
-    ) -> Self {
+    /// The setup of `reading` analysed with `resolved`'s scene (its calibration the
+    /// scene's): no counts or signal kept, no glitches removed, no rails known, no axes, not
+    /// resampled (a whole-file read fills them in).
+    pub fn new(reading: Reading, resolved: Resolved) -> Self {
+        let Reading {
+            column,
+            units,
+            t0,
+            samples,
+            rate_hz,
+        } = reading;
         Self {
             column: (!column.is_empty()).then_some(column),
             units,
             prepared: Prepared {
                 counts: Vec::new(),
-                calibration,
+                calibration: resolved.scene.calibration,
                 t0,
                 accel_m_s2: Vec::new(),
             },
-            scene,
-            v0_source: v0_source.map(str::to_string),
+            scene: resolved.scene,
+            v0_source: resolved.v0_source.map(str::to_string),
             free_fall_s: None,
             samples,
             rate_hz,
@@ -274,7 +290,7 @@ pub fn setup(args: &AnalyzeArgs, progress: Option<fn(f64)>) -> Result<Setup, Str
         .map(|v| to_count(*v, levels.gain_m_s2_per_count))
         .collect();
     let (trigger, edge) = (levels.trigger_m_s2, levels.edge_m_s2);
-    let (scene, source) = build_scene(
+    let resolved = build_scene(
         args,
         &file,
         calibration,
@@ -283,16 +299,14 @@ pub fn setup(args: &AnalyzeArgs, progress: Option<fn(f64)>) -> Result<Setup, Str
         clipping.as_ref(),
         mass,
     )?;
-    let mut setup = Setup::new(
-        ch.name.clone(),
+    let reading = Reading {
+        column: ch.name.clone(),
         units,
-        calibration,
         t0,
-        scene,
-        source,
-        ch.values.len() as u64,
-        ch.rate_hz,
-    );
+        samples: ch.values.len() as u64,
+        rate_hz: ch.rate_hz,
+    };
+    let mut setup = Setup::new(reading, resolved);
     setup.prepared.counts = counts;
     setup.prepared.accel_m_s2 = accel;
     setup.spikes = spikes;
@@ -342,7 +356,7 @@ pub(crate) fn build_scene(
     edge: f64,
     clipping: Option<&Clipping>,
     mass: Option<f64>,
-) -> Result<(Scene, Option<&'static str>), String> {
+) -> Result<Resolved, String> {
     let mut scene = Scene::new(calibration, trigger as f32);
     scene.edge_m_s2 = edge as f32;
     if let Some(c) = clipping {
@@ -413,7 +427,10 @@ pub(crate) fn build_scene(
         }
         e => e.to_string(),
     })?;
-    Ok((scene, source))
+    Ok(Resolved {
+        scene,
+        v0_source: source,
+    })
 }
 
 /// The quiet time that ends an impact when none is given, s.

@@ -18,9 +18,10 @@ use impact_core::{Calibration, ImpactReport};
 
 use crate::pipeline::screen::Removal;
 use crate::pipeline::survey::{self, Survey, Surveyed};
-use crate::pipeline::{self, AnalyzeArgs, MonitorRun, Setup};
+use crate::pipeline::{self, AnalyzeArgs, MonitorRun, Reading, Setup};
 use impact_io::channel::{input_name, is_stdin};
 use impact_io::open_source;
+use impact_io::quantise::Quantiser;
 use impact_io::sources::{read_head, Source, CHUNK};
 use impact_io::spool::{Axis, SpoolWriter};
 
@@ -68,7 +69,7 @@ pub fn analyze(
         sample_rate_hz: rate_hz as f32,
     };
     let edge = edge.unwrap_or_else(|| survey::default_edge(survey::noise_rms(&head), trigger));
-    let (scene, v0_source) = pipeline::build_scene(
+    let resolved = pipeline::build_scene(
         args,
         &file,
         calibration,
@@ -77,23 +78,18 @@ pub fn analyze(
         Some(&clipping),
         mass,
     )?;
-    let head: Vec<i16> = head
-        .iter()
-        .map(|a| impact_io::quantise::to_count(*a, gain))
-        .collect();
-    let (reports, count, source) = run_monitor(source, head, (scale, gain), scene, Vec::new())?;
-    let mut setup = Setup::new(
+    let q = Quantiser { scale, gain };
+    let run = run_monitor(source, q.counts_m_s2(&head), q, resolved.scene, Vec::new())?;
+    let reading = Reading {
         column,
         units,
-        calibration,
-        source.t0(),
-        scene,
-        v0_source,
-        count,
-        source.final_rate_hz(),
-    );
+        t0: run.source.t0(),
+        samples: run.samples,
+        rate_hz: run.source.final_rate_hz(),
+    };
+    let mut setup = Setup::new(reading, resolved);
     setup.clipping = Some(clipping);
-    Ok((setup, reports))
+    Ok((setup, run.reports))
 }
 
 /// Reads and analyses a regular file or standard input in passes, in memory that does not
@@ -143,23 +139,16 @@ fn in_passes_then(
         })
     };
     // (The spool first: standard input without one is refused before it is read.)
-    let stdin = is_stdin(&args.file);
-    let spool = match spooled(args).then(SpoolWriter::new).transpose() {
-        Err(e) if stdin => return Err(format!("stdin: {e}")),
-        Err(e) => {
-            eprintln!("note: {e}: {name} is read again for each pass");
-            None
-        }
-        Ok(writer) => writer.map(|writer| Spooling {
-            writer,
-            stops: stdin.then(|| name.clone()),
-        }),
-    };
+    let spool = Spooling::for_input(args, &name)?;
     let input = open_source(&args.file, &args.read_options(bar(0.0, 0.5)), &name)?;
     let column = input.column().to_string();
     let (mass, scale, units) = pipeline::mass_and_scale(args, &file, &column)?;
     let full_scale = pipeline::full_scale_m_s2(args, &file, mass);
-    let (first, source, spool) = survey_pass(input, scale, &[], !args.keep_spikes, spool)?;
+    let SurveyPass {
+        survey: first,
+        source,
+        spool,
+    } = survey_pass(input, scale, &[], !args.keep_spikes, spool)?;
     let axis = Axis {
         rate_hz: source.rate_hz()?,
         final_rate_hz: source.final_rate_hz(),
@@ -200,7 +189,7 @@ fn in_passes_then(
         first
     } else {
         let (input, scale) = reopen(bar(0.5, 2.0 / 3.0))?;
-        survey_pass(input, scale, &removals, false, None)?.0
+        survey_pass(input, scale, &removals, false, None)?.survey
     };
     let (trigger, edge) = pipeline::given_levels(args, &file, mass);
     let levels = survey::levels(&survey, full_scale, trigger, edge)?;
@@ -209,7 +198,7 @@ fn in_passes_then(
         gain_m_s2_per_count: gain as f32,
         sample_rate_hz: rate_hz as f32,
     };
-    let (scene, v0_source) = pipeline::build_scene(
+    let resolved = pipeline::build_scene(
         args,
         &file,
         calibration,
@@ -219,59 +208,66 @@ fn in_passes_then(
         mass,
     )?;
     let from = if removals.is_empty() { 0.5 } else { 2.0 / 3.0 };
-    let (mut source, scale) = reopen(bar(from, 1.0))?;
-    let head = read_head(&mut *source, scale)?;
-    let head = head
-        .iter()
-        .map(|a| impact_io::quantise::to_count(*a, gain))
-        .collect();
-    let (reports, count) = match last {
+    let (source, scale) = reopen(bar(from, 1.0))?;
+    let q = Quantiser { scale, gain };
+    let (source, head) = head_counts(source, q)?;
+    let (reports, samples) = match last {
         Last::Analyse => {
-            let (reports, count, _) =
-                run_monitor(source, head, (scale, gain), scene, removals.clone())?;
-            (reports, count)
+            let run = run_monitor(source, head, q, resolved.scene, removals.clone())?;
+            (run.reports, run.samples)
         }
         Last::Counts(out) => (
             Vec::new(),
-            write_counts(source, head, (scale, gain), removals.clone(), out)?,
+            write_counts(source, head, q, removals.clone(), out)?,
         ),
     };
     // The figure's windows: a last pass keeps just them (memory bounded by the impacts
     // drawn, not the recording).
     let windows = match &args.plot {
         Some(_) => {
-            let rate = f64::from(calibration.sample_rate_hz);
-            let padding = u64::from(scene.padding_samples());
-            let spans: Vec<(u64, u64)> = reports
-                .iter()
-                .take(crate::plot::SHOWN)
-                .map(|r| crate::plot::read_window(r, rate, padding))
-                .collect();
-            let (mut source, scale) = reopen(None)?;
-            let head = read_head(&mut *source, scale)?;
-            let head = head
-                .iter()
-                .map(|a| impact_io::quantise::to_count(*a, gain))
-                .collect();
-            collect_windows(source, head, (scale, gain), removals.clone(), spans)?
+            let (source, scale) = reopen(None)?;
+            let spans = figure_spans(&reports, &resolved.scene);
+            let q = Quantiser { scale, gain };
+            let (source, head) = head_counts(source, q)?;
+            collect_windows(source, head, q, removals.clone(), spans)?
         }
         None => Vec::new(),
     };
     let spikes = removals.iter().map(|r| r.timed(t0, rate_hz)).collect();
-    let mut setup = Setup::new(
+    let reading = Reading {
         column,
         units,
-        calibration,
         t0,
-        scene,
-        v0_source,
-        count,
+        samples,
         rate_hz,
-    );
+    };
+    let mut setup = Setup::new(reading, resolved);
     setup.spikes = spikes;
     setup.clipping = levels.clipping;
     setup.windows = windows;
     Ok((setup, reports))
+}
+
+/// The spans `(first sample, samples)` of the impacts a figure draws (with the scene's
+/// filter padding).
+fn figure_spans(reports: &[ImpactReport], scene: &impact_core::Scene) -> Vec<(u64, u64)> {
+    let rate = f64::from(scene.calibration.sample_rate_hz);
+    let padding = u64::from(scene.padding_samples());
+    reports
+        .iter()
+        .take(crate::plot::SHOWN)
+        .map(|r| crate::plot::read_window(r, rate, padding))
+        .collect()
+}
+
+/// The head of `source` (its values at `q`'s scale, in m/s²: what [`read_head`] reads) in
+/// counts.
+fn head_counts(
+    mut source: Box<dyn Source>,
+    q: Quantiser,
+) -> Result<(Box<dyn Source>, Vec<i16>), String> {
+    let head = read_head(&mut *source, q.scale)?;
+    Ok((source, q.counts_m_s2(&head)))
 }
 
 /// The caller's progress bar, and the span of it (from, to) the current pass fills.
@@ -373,7 +369,11 @@ fn survey_pass(
         return Err(format!("{name}: {e}"));
     }
     survey.put_shape(crate::pipeline::survey::Shape::join(flat, spikes));
-    Ok((survey.finish()?, source, spool))
+    Ok(SurveyPass {
+        survey: survey.finish()?,
+        source,
+        spool,
+    })
 }
 
 /// A scan on a thread of its own, given a copy of each block in order (the copies go back to
@@ -425,13 +425,33 @@ struct Spooling {
     stops: Option<String>,
 }
 
+impl Spooling {
+    /// The spool `args.file` (named `name`) is read into, if it gets one ([`spooled`]): a
+    /// spool that cannot be made is an error for standard input (read once), a note for a
+    /// file (read again for each pass).
+    fn for_input(args: &AnalyzeArgs, name: &str) -> Result<Option<Self>, String> {
+        let stdin = is_stdin(&args.file);
+        match spooled(args).then(SpoolWriter::new).transpose() {
+            Err(e) if stdin => Err(format!("stdin: {e}")),
+            Err(e) => {
+                eprintln!("note: {e}: {name} is read again for each pass");
+                Ok(None)
+            }
+            Ok(writer) => Ok(writer.map(|writer| Spooling {
+                writer,
+                stops: stdin.then(|| name.to_string()),
+            })),
+        }
+    }
+}
+
 /// What [`survey_pass`] gives: the survey, the source read and the spool written (or why
 /// it failed).
-type SurveyPass = (
-    Surveyed,
-    Box<dyn Source>,
-    Option<Result<SpoolWriter, String>>,
-);
+struct SurveyPass {
+    survey: Surveyed,
+    source: Box<dyn Source>,
+    spool: Option<Result<SpoolWriter, String>>,
+}
 
 /// Whether the first pass keeps the values for the later ones ([`impact_io::spool`]): standard
 /// input (read once) and a CSV file (its parse costs more than reading the spool).
@@ -490,38 +510,42 @@ fn read_ahead<T: Send + 'static>(
     }
 }
 
-/// Runs the monitor over the head's counts and the rest of the source (as counts at
-/// `(scale, gain)`, the `removals` put in); the reports, the samples read and the source.
+/// Runs the monitor over the head's counts and the rest of the source (as counts under
+/// `q`, the `removals` put in); the reports, the samples read and the source.
 fn run_monitor(
     source: Box<dyn Source>,
     head: Vec<i16>,
-    (scale, gain): (f64, f64),
+    q: Quantiser,
     scene: impact_core::Scene,
     removals: Vec<Removal>,
 ) -> Result<Analysed, String> {
     crate::on_big_stack(move || {
         let mut run = MonitorRun::new(scene)?;
-        let source = for_each_count(source, head, (scale, gain), &removals, |counts| {
+        let source = for_each_count(source, head, q, &removals, |counts| {
             run.push(counts);
             Ok(())
         })?;
-        let (reports, total) = run.finish()?;
-        Ok((reports, total, source))
+        let (reports, samples) = run.finish()?;
+        Ok(Analysed {
+            reports,
+            samples,
+            source,
+        })
     })
 }
 
-/// Writes the head's counts and the rest of the source's (at `(scale, gain)`, the `removals`
-/// put in, as the analysis sees them) to `out` as little-endian i16; how many.
+/// Writes the head's counts and the rest of the source's (under `q`, the `removals` put
+/// in, as the analysis sees them) to `out` as little-endian i16; how many.
 fn write_counts(
     source: Box<dyn Source>,
     head: Vec<i16>,
-    (scale, gain): (f64, f64),
+    q: Quantiser,
     removals: Vec<Removal>,
     out: &mut dyn std::io::Write,
 ) -> Result<u64, String> {
     let mut count = 0u64;
     let mut bytes = Vec::new();
-    for_each_count(source, head, (scale, gain), &removals, |counts| {
+    for_each_count(source, head, q, &removals, |counts| {
         bytes.clear();
         bytes.extend(counts.iter().flat_map(|c| c.to_le_bytes()));
         out.write_all(&bytes)
@@ -534,20 +558,20 @@ fn write_counts(
     Ok(count)
 }
 
-/// Reads the head's counts and the rest of the source (as counts at `(scale, gain)`, the
-/// `removals` put in, as the analysis saw them) and keeps the samples of each span `(first,
-/// count)`: the windows a figure draws.
+/// Reads the head's counts and the rest of the source (as counts under `q`, the `removals`
+/// put in, as the analysis saw them) and keeps the samples of each span `(first, count)`:
+/// the windows a figure draws.
 fn collect_windows(
     source: Box<dyn Source>,
     head: Vec<i16>,
-    (scale, gain): (f64, f64),
+    q: Quantiser,
     removals: Vec<Removal>,
     spans: Vec<(u64, u64)>,
 ) -> Result<Vec<(u64, Vec<i16>)>, String> {
     let mut windows: Vec<(u64, Vec<i16>)> =
         spans.iter().map(|&(from, _)| (from, Vec::new())).collect();
     let mut at = 0u64;
-    for_each_count(source, head, (scale, gain), &removals, |counts| {
+    for_each_count(source, head, q, &removals, |counts| {
         let end = at + counts.len() as u64;
         for ((from, w), &(_, len)) in windows.iter_mut().zip(&spans) {
             let (a, b) = ((*from).max(at), (*from + len).min(end));
@@ -562,29 +586,33 @@ fn collect_windows(
 }
 
 /// Hands `take` the head's counts, then the rest of the source's a chunk at a time (as counts
-/// at `(scale, gain)`, the `removals` put in: as the analysis sees them); the source.
+/// under `q`, the `removals` put in: as the analysis sees them); the source.
 fn for_each_count(
     source: Box<dyn Source>,
     mut head: Vec<i16>,
-    (scale, gain): (f64, f64),
+    q: Quantiser,
     removals: &[Removal],
     mut take: impl FnMut(&[i16]) -> Result<(), String>,
 ) -> Result<Box<dyn Source>, String> {
     let mut patch = Patches::new(removals);
     let mut patched = |counts: &mut [i16]| {
-        patch.counts(counts, gain);
+        patch.counts(counts, q);
         take(counts)
     };
     patched(&mut head)?;
     read_ahead(
         source,
-        move |s, scratch, counts| s.next_counts(CHUNK, (scale, gain), scratch, counts),
+        move |s, scratch, counts| s.next_counts(CHUNK, q, scratch, counts),
         patched,
     )
 }
 
 /// What [`run_monitor`] gives: the reports, the samples read and the source.
-type Analysed = (Vec<ImpactReport>, u64, Box<dyn Source>);
+struct Analysed {
+    reports: Vec<ImpactReport>,
+    samples: u64,
+    source: Box<dyn Source>,
+}
 
 /// Puts removed glitches' straight lines into a stream's blocks as they pass.
 struct Patches<'a> {
@@ -623,10 +651,8 @@ impl<'a> Patches<'a> {
         self.each(len, |i, v| block[i] = v);
     }
 
-    fn counts(&mut self, block: &mut [i16], gain: f64) {
+    fn counts(&mut self, block: &mut [i16], q: Quantiser) {
         let len = block.len();
-        self.each(len, |i, v| {
-            block[i] = impact_io::quantise::to_count(v, gain)
-        });
+        self.each(len, |i, v| block[i] = q.count_m_s2(v));
     }
 }
