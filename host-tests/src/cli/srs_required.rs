@@ -191,7 +191,7 @@ pub fn svg(
     const REQUIRED: RGBColor = RGBColor(30, 30, 30);
     const LIMIT: RGBColor = RGBColor(110, 110, 110);
     let panel = Panel {
-        title,
+        title: title.into(),
         x_label: "natural frequency, Hz",
         measured: frequency_hz
             .iter()

@@ -72,7 +72,7 @@ pub fn impacts(
     Ok(())
 }
 
-/// The impacts figure's panels on `root` (see [`impacts`]).
+/// The impacts figure's panels on `root` (see [`impacts`]): a row per impact.
 fn draw_impacts(
     root: &DrawingArea<SVGBackend, plotters::coord::Shift>,
     signal: &Signal,
@@ -80,234 +80,301 @@ fn draw_impacts(
     cols: usize,
     spectra: bool,
 ) -> Result<(), String> {
-    use impact_core::model::{Hertz, Model, Nonlinear, TwoPhase};
-    use impact_core::solve::trajectory;
-    use impact_core::{ContactLaw, Impact};
     root.fill(&WHITE).map_err(|e| e.to_string())?;
     let rows = root.split_evenly((shown.len(), cols));
-    let fs = signal.rate_hz;
-    let mass = signal.mass_kg;
     for (k, r) in shown.iter().enumerate() {
-        let (start, len) = window(r, fs);
-        let (start, len) = (start as usize, len as usize);
-        let base = r.baseline_m_s2 as f64;
-        let t_ms = |i: usize| (i as f64 / fs - r.start_s) * 1e3;
-        let meas: Vec<(f64, f64)> = (start..start + len)
-            .map_while(|i| Some((t_ms(i), (signal.accel_m_s2)(i as u64)? - base)))
-            .collect();
-        let v0 = r.kinematics.map(|k| k.impact_velocity_m_s as f64);
-        // Velocity and deformation by integration from the touch.
-        let (mut v, mut x) = (v0.unwrap_or(0.0), 0.0);
-        let (mut vel, mut def, mut loop_) = (Vec::new(), Vec::new(), Vec::new());
-        for (t, acc) in &meas {
-            if *t >= 0.0 {
-                let v1 = v - acc / fs;
-                x += (v + v1) / 2.0 / fs;
-                v = v1;
-            }
-            vel.push((*t, v));
-            def.push((*t, x * 1e3));
-            if *t >= 0.0 {
-                loop_.push((x * 1e3, acc * mass.unwrap_or(1.0)));
-            }
-        }
-        // Fitted models, simulated from the same touch.
-        let mut models: Vec<(&'static str, RGBColor, Model<f64>)> = Vec::new();
-        if let Some(f) = r.fits.two_phase {
-            models.push((
-                "two-phase fit",
-                RGBColor(200, 60, 40),
-                Model::TwoPhase(TwoPhase {
-                    kc: f.kc_n_m as f64,
-                    kr: f.kr_n_m as f64,
-                    c: (f.c_n_s_m as f64).max(0.0),
-                    permanent_m: Some((f.permanent_m as f64).max(0.0)),
-                }),
-            ));
-        }
-        if let Some(f) = r.fits.nonlinear {
-            models.push((
-                "nonlinear fit",
-                RGBColor(40, 140, 60),
-                Model::Nonlinear(Nonlinear {
-                    k: f.k as f64,
-                    c: (f.c_s_m as f64).max(0.0),
-                    n: f.n as f64,
-                }),
-            ));
-        }
-        if let Some(f) = r.fits.hertz {
-            models.push((
-                "Hertz fit",
-                RGBColor(150, 60, 170),
-                Model::Hertz(Hertz { k: f.k as f64 }),
-            ));
-        }
-        // Each model's a(t), v(t), x(t) and F(x), over a few times the window at most.
-        let mut curves: [Vec<Curve>; 4] = Default::default();
-        if let (Some(v0), Some(m)) = (v0, mass) {
-            let impact = Impact::new(m, v0);
-            let points = 4 * meas.len() as u64 + 1024;
-            for (name, color, model) in models {
-                let mut s = Vec::new();
-                if model.validate().is_ok()
-                    && trajectory::sample(&model, &impact, 1e-8, 0.0, 1.0 / fs, points, |p| {
-                        s.push(p)
-                    })
-                    .is_ok()
-                {
-                    let map = |f: &dyn Fn(&trajectory::Sample<f64>) -> (f64, f64)| {
-                        s.iter().map(f).collect::<Vec<_>>()
-                    };
-                    curves[0].push((name, color, map(&|p| (p.t_s * 1e3, p.force_n / m))));
-                    curves[1].push((name, color, map(&|p| (p.t_s * 1e3, p.v_m_s))));
-                    curves[2].push((name, color, map(&|p| (p.t_s * 1e3, p.x_m * 1e3))));
-                    curves[3].push((name, color, map(&|p| (p.x_m * 1e3, p.force_n))));
-                }
-            }
-        }
-        let [mut c_a, c_v, c_x, c_f] = curves;
-        // With a CFC, its trace over the raw one (the analysis's filter on the samples it
-        // filtered), or the title says it is not drawn.
-        let mut decel_title = "deceleration, m/s² (left) and g (right)".to_string();
-        if let Some((class, _)) = signal.cfc {
-            match super::filtered(signal, r) {
-                Some((first, values)) => {
-                    let trace = (start..start + len)
-                        .filter_map(|i| {
-                            let v = values
-                                .get(usize::try_from((i as u64).checked_sub(first)?).ok()?)?;
-                            Some((t_ms(i), *v))
-                        })
-                        .collect();
-                    c_a.insert(0, (cfc_label(class), CFC_TRACE, trace));
-                }
-                None => {
-                    decel_title = format!("deceleration, m/s², g: CFC {} not drawn", class.class());
-                }
-            }
-        }
-        let raw_label = if c_a.first().is_some_and(|c| c.1 == CFC_TRACE) {
-            "raw"
-        } else {
-            "measured"
-        };
-        // A Δv the report refuses (a channel that does not hold DC) is not drawn either: no
-        // velocity, deformation or loop from its integral.
-        let refused = r.delta_v_m_s.is_none();
-        if refused {
-            vel.clear();
-            def.clear();
-            loop_.clear();
-        }
-        // Without v0 the integrals start from rest: said in the titles; no loop.
-        let known = v0.is_some();
-        let force_title = match (known, mass.is_some()) {
-            _ if refused => "force against deformation: no Δv (see the report)",
-            (false, _) => {
-                loop_.clear();
-                "force against deformation: needs v0"
-            }
-            (true, true) => "force against deformation, N",
-            (true, false) => "deceleration against deformation, m/s²",
-        };
-        let (vel_title, def_title) = if refused {
-            (
-                "velocity: no Δv (see the report)",
-                "deformation: no Δv (see the report)",
-            )
-        } else if known {
-            ("velocity, m/s", "deformation, mm")
-        } else {
-            (
-                "velocity change from touch, m/s (no v0)",
-                "displacement from touch, mm (no v0)",
-            )
-        };
-        let mut panels = vec![
-            Panel {
-                title: &decel_title,
-                x_label: "time from touch, ms",
-                measured: meas,
-                measured_label: raw_label,
-                models: c_a,
-                dashed: Vec::new(),
-                log: false,
-                g_axis: true,
-                legend: true,
-            },
-            Panel {
-                title: vel_title,
-                x_label: "time from touch, ms",
-                measured: vel,
-                measured_label: "measured",
-                models: c_v,
-                dashed: Vec::new(),
-                log: false,
-                g_axis: false,
-                legend: false,
-            },
-            Panel {
-                title: def_title,
-                x_label: "time from touch, ms",
-                measured: def,
-                measured_label: "measured",
-                models: c_x,
-                dashed: Vec::new(),
-                log: false,
-                g_axis: false,
-                legend: false,
-            },
-            Panel {
-                title: force_title,
-                x_label: "deformation, mm",
-                measured: loop_,
-                measured_label: "measured",
-                models: c_f,
-                dashed: Vec::new(),
-                log: false,
-                g_axis: false,
-                legend: false,
-            },
-        ];
+        let mut panels = kinematics_panels(signal, r);
         if spectra {
-            let (srs, pvss) = match &r.spectrum {
-                Some(sp) => {
-                    let n = usize::from(sp.bands);
-                    let f = |i: usize| sp.frequency_hz(i);
-                    (
-                        (0..n).map(|i| (f(i), sp.srs_m_s2[i] as f64)).collect(),
-                        (0..n).map(|i| (f(i), sp.pvss_m_s[i] as f64)).collect(),
-                    )
-                }
-                None => (Vec::new(), Vec::new()),
-            };
-            panels.push(Panel {
-                title: "SRS (maximax), m/s² (left) and g (right)",
-                x_label: "natural frequency, Hz",
-                measured: srs,
-                measured_label: "SRS",
-                models: Vec::new(),
-                dashed: Vec::new(),
-                log: true,
-                g_axis: true,
-                legend: false,
-            });
-            panels.push(Panel {
-                title: "pseudo-velocity shock spectrum, m/s",
-                x_label: "natural frequency, Hz",
-                measured: pvss,
-                measured_label: "PVSS",
-                models: Vec::new(),
-                dashed: Vec::new(),
-                log: true,
-                g_axis: false,
-                legend: false,
-            });
+            panels.extend(spectrum_panels(r));
         }
         for (j, p) in panels.iter().enumerate() {
             draw_panel(&rows[k * cols + j], Some(r.index), p)?;
         }
     }
     Ok(())
+}
+
+/// What an impact's window shows, measured: the deceleration above the baseline, and from
+/// the touch on the velocity, deformation and the force (or deceleration) against the
+/// deformation, integrated from v0 (from rest without it). Times in ms from the touch.
+struct Measured {
+    accel: Vec<(f64, f64)>,
+    velocity: Vec<(f64, f64)>,
+    deformation_mm: Vec<(f64, f64)>,
+    force_loop: Vec<(f64, f64)>,
+}
+
+impl Measured {
+    fn of(signal: &Signal, r: &impact_core::ImpactReport) -> Self {
+        let fs = signal.rate_hz;
+        let (start, len) = window(r, fs);
+        let (start, len) = (start as usize, len as usize);
+        let base = r.baseline_m_s2 as f64;
+        let t_ms = |i: usize| (i as f64 / fs - r.start_s) * 1e3;
+        let accel: Vec<(f64, f64)> = (start..start + len)
+            .map_while(|i| Some((t_ms(i), (signal.accel_m_s2)(i as u64)? - base)))
+            .collect();
+        let v0 = r.kinematics.map(|k| k.impact_velocity_m_s as f64);
+        // Velocity and deformation by integration from the touch.
+        let (mut v, mut x) = (v0.unwrap_or(0.0), 0.0);
+        let (mut velocity, mut deformation_mm, mut force_loop) =
+            (Vec::new(), Vec::new(), Vec::new());
+        for (t, acc) in &accel {
+            if *t >= 0.0 {
+                let v1 = v - acc / fs;
+                x += (v + v1) / 2.0 / fs;
+                v = v1;
+            }
+            velocity.push((*t, v));
+            deformation_mm.push((*t, x * 1e3));
+            if *t >= 0.0 {
+                force_loop.push((x * 1e3, acc * signal.mass_kg.unwrap_or(1.0)));
+            }
+        }
+        Self {
+            accel,
+            velocity,
+            deformation_mm,
+            force_loop,
+        }
+    }
+}
+
+/// The fitted models of `r` with their legends and colours.
+fn fitted_models(
+    r: &impact_core::ImpactReport,
+) -> Vec<(&'static str, RGBColor, impact_core::model::Model<f64>)> {
+    use impact_core::model::{Hertz, Model, Nonlinear, TwoPhase};
+    let mut models = Vec::new();
+    if let Some(f) = r.fits.two_phase {
+        models.push((
+            "two-phase fit",
+            RGBColor(200, 60, 40),
+            Model::TwoPhase(TwoPhase {
+                kc: f.kc_n_m as f64,
+                kr: f.kr_n_m as f64,
+                c: (f.c_n_s_m as f64).max(0.0),
+                permanent_m: Some((f.permanent_m as f64).max(0.0)),
+            }),
+        ));
+    }
+    if let Some(f) = r.fits.nonlinear {
+        models.push((
+            "nonlinear fit",
+            RGBColor(40, 140, 60),
+            Model::Nonlinear(Nonlinear {
+                k: f.k as f64,
+                c: (f.c_s_m as f64).max(0.0),
+                n: f.n as f64,
+            }),
+        ));
+    }
+    if let Some(f) = r.fits.hertz {
+        models.push((
+            "Hertz fit",
+            RGBColor(150, 60, 170),
+            Model::Hertz(Hertz { k: f.k as f64 }),
+        ));
+    }
+    models
+}
+
+/// Each fitted model simulated from the same touch (with v0 and the mass): its a(t), v(t),
+/// x(t) and F(x), over `points` samples at `fs` at most.
+fn model_curves(
+    r: &impact_core::ImpactReport,
+    v0: Option<f64>,
+    mass: Option<f64>,
+    fs: f64,
+    points: u64,
+) -> [Vec<Curve>; 4] {
+    use impact_core::solve::trajectory;
+    use impact_core::{ContactLaw, Impact};
+    let mut curves: [Vec<Curve>; 4] = Default::default();
+    let (Some(v0), Some(m)) = (v0, mass) else {
+        return curves;
+    };
+    let impact = Impact::new(m, v0);
+    for (name, color, model) in fitted_models(r) {
+        let mut s = Vec::new();
+        if model.validate().is_ok()
+            && trajectory::sample(&model, &impact, 1e-8, 0.0, 1.0 / fs, points, |p| s.push(p))
+                .is_ok()
+        {
+            let map = |f: &dyn Fn(&trajectory::Sample<f64>) -> (f64, f64)| {
+                s.iter().map(f).collect::<Vec<_>>()
+            };
+            curves[0].push((name, color, map(&|p| (p.t_s * 1e3, p.force_n / m))));
+            curves[1].push((name, color, map(&|p| (p.t_s * 1e3, p.v_m_s))));
+            curves[2].push((name, color, map(&|p| (p.t_s * 1e3, p.x_m * 1e3))));
+            curves[3].push((name, color, map(&|p| (p.x_m * 1e3, p.force_n))));
+        }
+    }
+    curves
+}
+
+/// With a CFC, its trace over the raw one (the analysis's filter on the samples it
+/// filtered) put first in `curves`; else, or where it cannot be drawn, the deceleration
+/// panel's title saying so.
+fn cfc_trace(signal: &Signal, r: &impact_core::ImpactReport, curves: &mut Vec<Curve>) -> String {
+    let title = "deceleration, m/s² (left) and g (right)".to_string();
+    let Some((class, _)) = signal.cfc else {
+        return title;
+    };
+    let fs = signal.rate_hz;
+    let (start, len) = window(r, fs);
+    let (start, len) = (start as usize, len as usize);
+    let t_ms = |i: usize| (i as f64 / fs - r.start_s) * 1e3;
+    match super::filtered(signal, r) {
+        Some((first, values)) => {
+            let trace = (start..start + len)
+                .filter_map(|i| {
+                    let v = values.get(usize::try_from((i as u64).checked_sub(first)?).ok()?)?;
+                    Some((t_ms(i), *v))
+                })
+                .collect();
+            curves.insert(0, (cfc_label(class), CFC_TRACE, trace));
+            title
+        }
+        None => format!("deceleration, m/s², g: CFC {} not drawn", class.class()),
+    }
+}
+
+/// The four kinematic panels of impact `r`: deceleration, velocity, deformation, and force
+/// against deformation, measured with the fitted models over them.
+fn kinematics_panels<'a>(signal: &Signal, r: &impact_core::ImpactReport) -> Vec<Panel<'a>> {
+    let Measured {
+        accel,
+        mut velocity,
+        mut deformation_mm,
+        mut force_loop,
+    } = Measured::of(signal, r);
+    let v0 = r.kinematics.map(|k| k.impact_velocity_m_s as f64);
+    let points = 4 * accel.len() as u64 + 1024;
+    let [mut c_a, c_v, c_x, c_f] = model_curves(r, v0, signal.mass_kg, signal.rate_hz, points);
+    let decel_title = cfc_trace(signal, r, &mut c_a);
+    let raw_label = if c_a.first().is_some_and(|c| c.1 == CFC_TRACE) {
+        "raw"
+    } else {
+        "measured"
+    };
+    // A Δv the report refuses (a channel that does not hold DC) is not drawn either: no
+    // velocity, deformation or loop from its integral.
+    let refused = r.delta_v_m_s.is_none();
+    if refused {
+        velocity.clear();
+        deformation_mm.clear();
+        force_loop.clear();
+    }
+    // Without v0 the integrals start from rest: said in the titles; no loop.
+    let known = v0.is_some();
+    let force_title = match (known, signal.mass_kg.is_some()) {
+        _ if refused => "force against deformation: no Δv (see the report)",
+        (false, _) => {
+            force_loop.clear();
+            "force against deformation: needs v0"
+        }
+        (true, true) => "force against deformation, N",
+        (true, false) => "deceleration against deformation, m/s²",
+    };
+    let (vel_title, def_title) = if refused {
+        (
+            "velocity: no Δv (see the report)",
+            "deformation: no Δv (see the report)",
+        )
+    } else if known {
+        ("velocity, m/s", "deformation, mm")
+    } else {
+        (
+            "velocity change from touch, m/s (no v0)",
+            "displacement from touch, mm (no v0)",
+        )
+    };
+    let panel = |title, x_label, measured, models, g_axis, legend| Panel {
+        title,
+        x_label,
+        measured,
+        measured_label: "measured",
+        models,
+        dashed: Vec::new(),
+        log: false,
+        g_axis,
+        legend,
+    };
+    vec![
+        Panel {
+            measured_label: raw_label,
+            ..panel(
+                decel_title.into(),
+                "time from touch, ms",
+                accel,
+                c_a,
+                true,
+                true,
+            )
+        },
+        panel(
+            vel_title.into(),
+            "time from touch, ms",
+            velocity,
+            c_v,
+            false,
+            false,
+        ),
+        panel(
+            def_title.into(),
+            "time from touch, ms",
+            deformation_mm,
+            c_x,
+            false,
+            false,
+        ),
+        panel(
+            force_title.into(),
+            "deformation, mm",
+            force_loop,
+            c_f,
+            false,
+            false,
+        ),
+    ]
+}
+
+/// The SRS and PVSS panels of impact `r` (empty where it has no spectra).
+fn spectrum_panels<'a>(r: &impact_core::ImpactReport) -> [Panel<'a>; 2] {
+    let (srs, pvss) = match &r.spectrum {
+        Some(sp) => {
+            let n = usize::from(sp.bands);
+            let f = |i: usize| sp.frequency_hz(i);
+            (
+                (0..n).map(|i| (f(i), sp.srs_m_s2[i] as f64)).collect(),
+                (0..n).map(|i| (f(i), sp.pvss_m_s[i] as f64)).collect(),
+            )
+        }
+        None => (Vec::new(), Vec::new()),
+    };
+    [
+        Panel {
+            title: "SRS (maximax), m/s² (left) and g (right)".into(),
+            x_label: "natural frequency, Hz",
+            measured: srs,
+            measured_label: "SRS",
+            models: Vec::new(),
+            dashed: Vec::new(),
+            log: true,
+            g_axis: true,
+            legend: false,
+        },
+        Panel {
+            title: "pseudo-velocity shock spectrum, m/s".into(),
+            x_label: "natural frequency, Hz",
+            measured: pvss,
+            measured_label: "PVSS",
+            models: Vec::new(),
+            dashed: Vec::new(),
+            log: true,
+            g_axis: false,
+            legend: false,
+        },
+    ]
 }

@@ -95,7 +95,7 @@ pub(crate) const MEASURED: RGBColor = RGBColor(120, 170, 250);
 /// whether it carries the legend (the first of a row: the colours are the same in every
 /// panel).
 pub(crate) struct Panel<'a> {
-    pub(crate) title: &'a str,
+    pub(crate) title: std::borrow::Cow<'a, str>,
     pub(crate) x_label: &'a str,
     pub(crate) measured: Vec<(f64, f64)>,
     pub(crate) measured_label: &'a str,
@@ -424,7 +424,7 @@ mod tests {
                 root,
                 None,
                 &Panel {
-                    title: "test",
+                    title: "test".into(),
                     x_label: "x",
                     measured,
                     measured_label: "measured",

@@ -57,7 +57,7 @@ pub fn wall_contact(
         ];
         for (j, (c, (title, x_label))) in curves.into_iter().zip(titles).enumerate() {
             let p = Panel {
-                title,
+                title: title.into(),
                 x_label,
                 measured: Vec::new(),
                 measured_label: "",
