@@ -127,10 +127,23 @@ impl Scratch {
         self.0.path().join(name)
     }
 
+    /// `name` in the folder (not written), as a string: a command-line argument.
+    pub fn join_str(&self, name: &str) -> String {
+        self.join(name).to_str().expect("a UTF-8 path").to_string()
+    }
+
     /// `name` in the folder, written with `bytes`.
     pub fn file(&self, name: &str, bytes: impl AsRef<[u8]>) -> std::path::PathBuf {
         let path = self.join(name);
         std::fs::write(&path, bytes).expect("a scratch file written");
+        path
+    }
+
+    /// `name` in the folder, written with `text`: its path as a string (a command-line
+    /// argument).
+    pub fn text(&self, name: &str, text: &str) -> String {
+        let path = self.join_str(name);
+        std::fs::write(&path, text).expect("a scratch file written");
         path
     }
 }
