@@ -7,7 +7,7 @@ mod common;
 
 use std::path::PathBuf;
 
-use common::{impact, impact_ok, Scratch};
+use common::{assert_refused_file, impact, impact_ok, Scratch};
 
 fn root() -> PathBuf {
     PathBuf::from(env!("CARGO_MANIFEST_DIR"))
@@ -110,12 +110,7 @@ fn malformed_wav_files_are_one_line_errors_naming_file_and_frame() {
         let mut args = vec!["analyze", file.to_str().unwrap()];
         args.extend(extra.iter().copied());
         let (code, _, err) = impact(&args);
-        assert_ne!(code, 0, "{args:?}");
-        assert!(
-            err.contains(want) && err.contains(file.file_name().unwrap().to_str().unwrap()),
-            "{args:?}: {err}"
-        );
-        assert_eq!(err.trim().lines().count(), 1, "{err}");
+        assert_refused_file(Some(code), &err, want, file, &format!("{args:?}"));
     }
 }
 
@@ -168,12 +163,7 @@ fn malformed_npy_files_are_one_line_errors_naming_the_file() {
         let mut args = vec!["analyze", file.to_str().unwrap()];
         args.extend(extra.iter().copied());
         let (code, _, err) = impact(&args);
-        assert_ne!(code, 0, "{args:?}");
-        assert!(
-            err.contains(want) && err.contains(file.file_name().unwrap().to_str().unwrap()),
-            "{args:?}: {err}"
-        );
-        assert_eq!(err.trim().lines().count(), 1, "{err}");
+        assert_refused_file(Some(code), &err, want, file, &format!("{args:?}"));
     }
 }
 
