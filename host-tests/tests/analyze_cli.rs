@@ -1,19 +1,7 @@
 //! `impact analyze` from the command line: output formats and one-line errors on bad input.
 
-use std::io::Write;
 mod common;
-use common::impact;
-
-fn temp_csv(name: &str, text: &str) -> std::path::PathBuf {
-    let dir = std::env::temp_dir().join(format!("impact-cli-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
-    let p = dir.join(name);
-    std::fs::File::create(&p)
-        .unwrap()
-        .write_all(text.as_bytes())
-        .unwrap();
-    p
-}
+use common::{impact, Scratch};
 
 fn afrl() -> String {
     concat!(
@@ -69,6 +57,7 @@ fn json_csv_and_table_agree() {
 
 #[test]
 fn with_mass_and_v0_the_kinematics_and_fits_appear_and_a_plot_is_drawn() {
+    let scratch = Scratch::new();
     let (code, csv, err) = impact(&[
         "synth",
         "--model",
@@ -83,7 +72,7 @@ fn with_mass_and_v0_the_kinematics_and_fits_appear_and_a_plot_is_drawn() {
         "1.3357",
     ]);
     assert_eq!(code, 0, "{err}");
-    let f = temp_csv("bench.csv", &csv);
+    let f = scratch.file("bench.csv", &csv);
     let svg = f.with_extension("svg");
     let (code, out, err) = impact(&[
         "analyze",
@@ -132,6 +121,7 @@ fn with_mass_and_v0_the_kinematics_and_fits_appear_and_a_plot_is_drawn() {
 
 #[test]
 fn malformed_input_is_one_line_naming_file_and_line() {
+    let scratch = Scratch::new();
     let cases: [(&str, &str, &[&str], &str); 8] = [
         ("nan.csv", "time_s,a\n0,1\n1e-6,NaN\n", &[], ":3:"),
         ("text.csv", "time_s,a\n0,1\n1e-6,abc\n2e-6,1\n", &[], ":3:"),
@@ -148,7 +138,7 @@ fn malformed_input_is_one_line_naming_file_and_line() {
         ("one-line.csv", "time_s,a\n0,1\n", &[], "one sample"),
     ];
     for (name, text, extra, want) in cases {
-        let f = temp_csv(name, text);
+        let f = scratch.file(name, text);
         let mut args = vec!["analyze", f.to_str().unwrap()];
         args.extend_from_slice(extra);
         let (code, _, err) = impact(&args);
@@ -188,10 +178,11 @@ fn kilohertz(n: usize, time: impl Fn(usize) -> f64) -> String {
 
 #[test]
 fn an_uneven_time_axis_is_an_error_naming_the_line_unless_resampled() {
+    let scratch = Scratch::new();
     // A gap of 1000 s after row 300 (file line 302), and ten leading rows 10 ms apart.
-    let gap = temp_csv(
+    let gap = scratch.file(
         "gap.csv",
-        &kilohertz(600, |i| {
+        kilohertz(600, |i| {
             i as f64 * 1e-3 + if i >= 300 { 1000.0 } else { 0.0 }
         }),
     );
@@ -207,9 +198,9 @@ fn an_uneven_time_axis_is_an_error_naming_the_line_unless_resampled() {
     assert_ne!(code, 0);
     assert!(err.contains("cut the file"), "{err}");
 
-    let lead = temp_csv(
+    let lead = scratch.file(
         "lead.csv",
-        &kilohertz(600, |i| {
+        kilohertz(600, |i| {
             if i < 10 {
                 (i as f64 - 10.0) * 1e-2
             } else {
@@ -236,6 +227,7 @@ fn an_uneven_time_axis_is_an_error_naming_the_line_unless_resampled() {
 
 #[test]
 fn an_ambiguous_time_column_names_the_candidates_and_units_are_read_from_the_header() {
+    let scratch = Scratch::new();
     let even = kilohertz(400, |i| i as f64 * 1e-3);
     let both: String = even
         .lines()
@@ -249,7 +241,7 @@ fn an_ambiguous_time_column_names_the_candidates_and_units_are_read_from_the_hea
             }
         })
         .collect();
-    let f = temp_csv("two-times.csv", &both);
+    let f = scratch.file("two-times.csv", &both);
     let (code, _, err) = impact(&["analyze", f.to_str().unwrap()]);
     assert_ne!(code, 0);
     assert_eq!(err.trim().lines().count(), 1, "{err}");
@@ -281,6 +273,7 @@ fn an_ambiguous_time_column_names_the_candidates_and_units_are_read_from_the_hea
 
 #[test]
 fn a_free_fall_file_must_reach_the_impact() {
+    let scratch = Scratch::new();
     let dir = concat!(env!("CARGO_MANIFEST_DIR"), "/data/endaq-high-drop");
     let dc = std::fs::read_to_string(format!("{dir}/High-Drop_16g-DC_full.csv")).unwrap();
     // The DC channel cut at 4.6 s, 10 s before the impact (at rest, before the release).
@@ -295,7 +288,7 @@ fn a_free_fall_file_must_reach_the_impact() {
         })
         .map(|l| format!("{l}\n"))
         .collect();
-    let f = temp_csv("short-dc.csv", &short);
+    let f = scratch.file("short-dc.csv", &short);
     let (code, _, err) = impact(&[
         "analyze",
         &format!("{dir}/High-Drop_2000g-PE_13.4-15.0s.csv"),

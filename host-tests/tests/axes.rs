@@ -3,7 +3,7 @@
 
 mod common;
 
-use common::{impact_ok, synth_t2};
+use common::{impact_ok, synth_t2, Scratch};
 use serde_json::Value;
 
 #[test]
@@ -16,11 +16,11 @@ fn a_pulse_split_over_axes_gives_each_its_share() {
         let a: f64 = a.parse().unwrap();
         three.push_str(&format!("{t},{:.9e},{:.9e},0\n", a * c, a * s));
     }
-    let dir = std::env::temp_dir().join(format!("impact-axes-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
-    let (f1, f3) = (dir.join("one.csv"), dir.join("three.csv"));
-    std::fs::write(&f1, &one).unwrap();
-    std::fs::write(&f3, &three).unwrap();
+    let scratch = Scratch::new();
+    let (f1, f3) = (
+        scratch.file("one.csv", &one),
+        scratch.file("three.csv", &three),
+    );
     let json = |args: &[&str]| -> Value {
         let mut a = vec!["analyze"];
         a.extend_from_slice(args);
@@ -81,5 +81,4 @@ fn a_pulse_split_over_axes_gives_each_its_share() {
         assert_ne!(code, 0);
         assert!(err.contains("--axes"), "{err}");
     }
-    std::fs::remove_dir_all(&dir).ok();
 }

@@ -6,15 +6,7 @@
 
 mod common;
 
-use std::path::PathBuf;
-
-use common::{impact, impact_ok};
-
-fn temp(name: &str) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("impact-conventions-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
-    dir.join(name)
-}
+use common::{impact, impact_ok, Scratch};
 
 fn afrl() -> String {
     concat!(
@@ -25,7 +17,7 @@ fn afrl() -> String {
 }
 
 /// A recording at 10 kHz: a half-sine of `peak` at 0.1 s, in a CSV with `header`.
-fn pulse_csv(name: &str, header: &str, peak: f64, dt: f64) -> String {
+fn pulse_csv(scratch: &Scratch, name: &str, header: &str, peak: f64, dt: f64) -> String {
     let mut s = format!("{header}\n");
     for k in 0..4000 {
         let t = k as f64 * 1e-4;
@@ -36,9 +28,7 @@ fn pulse_csv(name: &str, header: &str, peak: f64, dt: f64) -> String {
         };
         s.push_str(&format!("{:.7},{v}\n", k as f64 * dt));
     }
-    let p = temp(name);
-    std::fs::write(&p, s).unwrap();
-    p.to_string_lossy().into_owned()
+    scratch.text(name, &s)
 }
 
 fn json(args: &[&str]) -> serde_json::Value {
@@ -61,8 +51,9 @@ fn a_usage_error_is_claps_message_with_the_accepted_values() {
 
 #[test]
 fn earlier_spellings_still_work_but_are_not_offered() {
-    let out = temp("alias.csv");
-    let out = out.to_str().unwrap();
+    let scratch = Scratch::new();
+    let out = scratch.join_str("alias.csv");
+    let out = out.as_str();
     let new = impact_ok(&[
         "synth",
         "--model",
@@ -153,18 +144,15 @@ fn levels_take_their_unit_and_a_bare_number_is_m_s2() {
 #[test]
 fn the_scene_file_uses_the_options_names_and_reads_the_earlier_ones() {
     let f = afrl();
-    let new = temp("new.json");
-    std::fs::write(
-        &new,
+    let scratch = Scratch::new();
+    let new = scratch.file(
+        "new.json",
         r#"{"trigger": "500g", "edge": 980.665, "hold": 0.003}"#,
-    )
-    .unwrap();
-    let old = temp("old.json");
-    std::fs::write(
-        &old,
+    );
+    let old = scratch.file(
+        "old.json",
         r#"{"trigger_m_s2": 4903.325, "edge_m_s2": 980.665, "hold_s": 0.003}"#,
-    )
-    .unwrap();
+    );
     let a = json(&["analyze", &f, "--scene", new.to_str().unwrap()]);
     let b = json(&["analyze", &f, "--scene", old.to_str().unwrap()]);
     assert_eq!(a, b);
@@ -183,9 +171,10 @@ fn the_scene_file_uses_the_options_names_and_reads_the_earlier_ones() {
 
 #[test]
 fn units_come_from_the_header_and_must_agree_with_units_given() {
+    let scratch = Scratch::new();
     // The same pulse written in m/s² under a header that says so, and in g under a bare one.
-    let si = pulse_csv("si.csv", "time_s,table_m_s2", 490.3325, 1e-4);
-    let g = pulse_csv("g.csv", "time_s,table", 50.0, 1e-4);
+    let si = pulse_csv(&scratch, "si.csv", "time_s,table_m_s2", 490.3325, 1e-4);
+    let g = pulse_csv(&scratch, "g.csv", "time_s,table", 50.0, 1e-4);
     let a = json(&["analyze", &si]);
     let b = json(&["analyze", &g]);
     let peak = |v: &serde_json::Value| v["impacts"][0]["peak_acceleration_m_s2"].as_f64().unwrap();
@@ -210,8 +199,9 @@ fn units_come_from_the_header_and_must_agree_with_units_given() {
 
 #[test]
 fn a_time_column_without_a_unit_that_implies_a_crawl_is_refused_with_the_fix() {
+    let scratch = Scratch::new();
     // Written in ms (0.1 ms apart) under a bare `time`: 10 S/s if read in seconds.
-    let ms = pulse_csv("ms.csv", "time,accel_g", 50.0, 0.1);
+    let ms = pulse_csv(&scratch, "ms.csv", "time,accel_g", 50.0, 0.1);
     for extra in [
         &[][..],
         &["--stream", "--range", "100g", "--trigger", "5g"][..],
@@ -227,15 +217,16 @@ fn a_time_column_without_a_unit_that_implies_a_crawl_is_refused_with_the_fix() {
     }
     let fixed = json(&["analyze", &ms, "--time-unit", "ms"]);
     assert_eq!(fixed["sample_rate_hz"].as_f64().unwrap().round(), 10000.0);
-    let named = pulse_csv("named.csv", "time_ms,accel_g", 50.0, 0.1);
+    let named = pulse_csv(&scratch, "named.csv", "time_ms,accel_g", 50.0, 0.1);
     assert_eq!(json(&["analyze", &named]), fixed);
 }
 
 #[test]
 fn plot_writes_svg_or_png_or_refuses() {
     // (A PNG's contents: tests/figures.rs.)
-    let pdf = temp("x.pdf");
-    let pdf = pdf.to_str().unwrap();
+    let scratch = Scratch::new();
+    let pdf = scratch.join_str("x.pdf");
+    let pdf = pdf.as_str();
     for args in [
         vec!["analyze", &afrl(), "--plot", pdf],
         vec![

@@ -13,6 +13,9 @@
 
 use std::path::{Path, PathBuf};
 
+mod common;
+use common::Scratch;
+
 fn root() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR"))
         .parent()
@@ -82,8 +85,7 @@ fn documented_commands_give_their_shown_output() {
         return;
     }
     impact_host::firmware_link::qemu::build_firmware().expect("the emulator firmware builds");
-    let sandboxes = std::env::temp_dir().join(format!("impact-docs-{}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&sandboxes);
+    let sandboxes = Scratch::new();
     let cases = trycmd::TestCases::new();
     cases.register_bin("impact", PathBuf::from(env!("CARGO_BIN_EXE_impact")));
     // Every run says the same: no progress bar, no colour.
@@ -115,7 +117,6 @@ fn documented_commands_give_their_shown_output() {
             std::fs::copy(copy, doc).unwrap();
         }
     }
-    let _ = std::fs::remove_dir_all(&sandboxes);
 }
 
 #[test]

@@ -13,7 +13,7 @@ use std::sync::OnceLock;
 use std::time::Instant;
 
 mod common;
-use common::impact_ok as impact;
+use common::{impact_ok as impact, Scratch};
 use impact_host::firmware_link::qemu::{Pacing, Samples, BOARD_CLOCK_SHIFT};
 
 /// The emulator firmware, built once for all tests; `None` (and a note on stderr) if the
@@ -46,10 +46,6 @@ fn firmware() -> Option<PathBuf> {
         }
         Err(e) => panic!("{e}"),
     }
-}
-
-fn tmp(name: &str) -> PathBuf {
-    PathBuf::from(env!("CARGO_TARGET_TMPDIR")).join(format!("{}-{name}", std::process::id()))
 }
 
 /// `impact emulate` against `impact analyze` on `file` with `options`, and `impact log` on
@@ -95,12 +91,10 @@ fn emulator_and_log_match_host(file: &str, options: &[&str], log_too: bool) {
     }
 
     // The decoded log alone gives the same JSON and CSV (both files start at t = 0).
-    // One file per comparison: the tests run in parallel.
-    static RUNS: std::sync::atomic::AtomicUsize = std::sync::atomic::AtomicUsize::new(0);
-    let run_id = RUNS.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
-    let log_file = tmp(&format!("emulator-{run_id}.log"));
-    std::fs::write(&log_file, &log).unwrap();
-    let log_path = log_file.to_string_lossy().into_owned();
+    // One folder per comparison: the tests run in parallel.
+    let scratch = Scratch::new();
+    let log_path = scratch.join_str("emulator.log");
+    std::fs::write(&log_path, &log).unwrap();
     let (from_log, _) = impact(&["log", &log_path]);
     assert_eq!(from_log, host, "impact log differs from impact analyze");
     let (csv_host, _) = run(with("analyze", &["--csv"]));
@@ -162,6 +156,7 @@ fn every_other_bundled_recording() {
 
 #[test]
 fn a_spiked_recording_is_screened_the_same_way() {
+    let scratch = Scratch::new();
     if firmware().is_none() {
         return;
     }
@@ -181,7 +176,7 @@ fn a_spiked_recording_is_screened_the_same_way() {
             }
         })
         .collect();
-    let file = tmp("spiked-afrl.csv");
+    let file = scratch.join("spiked-afrl.csv");
     std::fs::write(&file, spiked).unwrap();
     // (Not `impact log`: a log cannot know what the host removed.)
     emulator_and_log_match_host(&file.to_string_lossy(), &["--units", "kgn"], false);
@@ -189,6 +184,7 @@ fn a_spiked_recording_is_screened_the_same_way() {
 
 #[test]
 fn seed_001_bench_impact_with_kinematics_and_fits() {
+    let scratch = Scratch::new();
     if firmware().is_none() {
         return;
     }
@@ -197,7 +193,7 @@ fn seed_001_bench_impact_with_kinematics_and_fits() {
         .chain(impact_host::synth::SEED_BENCH_ARGS)
         .collect();
     let (csv, _) = impact(&args);
-    let file = tmp("seed-001.csv");
+    let file = scratch.join("seed-001.csv");
     std::fs::write(&file, csv).unwrap();
     let file = file.to_string_lossy().into_owned();
     emulator_matches_host(&file, &["--mass", "0.06", "--v0", "1.3357"]);
@@ -219,6 +215,7 @@ fn seed_001_bench_impact_with_kinematics_and_fits() {
 /// exported window analyses again to the same impact; a dropped frame is counted.
 #[test]
 fn waveforms_off_the_board_draw_the_same_figure() {
+    let scratch = Scratch::new();
     let Some(elf) = firmware() else { return };
     let elf = elf.to_string_lossy().into_owned();
     let args: Vec<&str> = ["synth"]
@@ -226,10 +223,10 @@ fn waveforms_off_the_board_draw_the_same_figure() {
         .chain(impact_host::synth::SEED_BENCH_ARGS)
         .collect();
     let (csv, _) = impact(&args);
-    let file = tmp("waves-seed.csv");
+    let file = scratch.join("waves-seed.csv");
     std::fs::write(&file, csv).unwrap();
     let file = file.to_string_lossy().into_owned();
-    let path = |name: &str| tmp(name).to_string_lossy().into_owned();
+    let path = |name: &str| scratch.join(name).to_string_lossy().into_owned();
     let body = ["--mass", "0.06", "--v0", "1.3357"];
     let with = |head: &[&str], tail: &[&str]| -> Vec<String> {
         head.iter()
@@ -409,6 +406,7 @@ fn three_axes_give_the_same_reports_on_the_board() {
 
 #[test]
 fn a_bounce_train_gets_the_same_speeds_on_the_board() {
+    let scratch = Scratch::new();
     if firmware().is_none() {
         return;
     }
@@ -429,7 +427,7 @@ fn a_bounce_train_gets_the_same_speeds_on_the_board() {
         "--duration",
         "1.2",
     ]);
-    let file = tmp("bounce-train.csv");
+    let file = scratch.join("bounce-train.csv");
     std::fs::write(&file, csv).unwrap();
     let file = file.to_string_lossy().into_owned();
     for speed in ["flight", "rebound"] {
@@ -463,8 +461,8 @@ const STREAMING_FIELDS: [&str; 12] = [
     "baseline_m_s2",
 ];
 
-/// A train of `n` seed-bench impacts `every` seconds apart, as a CSV file.
-fn seed_train(n: usize, every: f64) -> String {
+/// A train of `n` seed-bench impacts `every` seconds apart, as a CSV file in `scratch`.
+fn seed_train(scratch: &Scratch, n: usize, every: f64) -> String {
     let (n_s, every_s) = (n.to_string(), every.to_string());
     let duration = (0.01 + n as f64 * every).to_string();
     let args: Vec<&str> = ["synth"]
@@ -480,9 +478,7 @@ fn seed_train(n: usize, every: f64) -> String {
         ])
         .collect();
     let (csv, _) = impact(&args);
-    let file = tmp(&format!("train-{n}-{every}.csv"));
-    std::fs::write(&file, csv).unwrap();
-    file.to_string_lossy().into_owned()
+    scratch.text(&format!("train-{n}-{every}.csv"), &csv)
 }
 
 /// `impact emulate --realtime` on a seed-bench train: nothing lost, one report per impact,
@@ -580,10 +576,11 @@ fn all_analysed_within(json: &serde_json::Value, impacts: usize, latency_s: f64)
 
 #[test]
 fn realtime_five_impacts_80_ms_apart_lose_nothing() {
+    let scratch = Scratch::new();
     if firmware().is_none() {
         return;
     }
-    let file = seed_train(5, 0.08);
+    let file = seed_train(&scratch, 5, 0.08);
     let json = realtime_matches_host(&file, &[]);
     all_analysed_within(&json, 5, 0.05);
     // Half as much time again between blocks is still enough.
@@ -593,10 +590,11 @@ fn realtime_five_impacts_80_ms_apart_lose_nothing() {
 
 #[test]
 fn realtime_twenty_impacts_40_ms_apart_are_all_analysed() {
+    let scratch = Scratch::new();
     if firmware().is_none() {
         return;
     }
-    let file = seed_train(20, 0.04);
+    let file = seed_train(&scratch, 20, 0.04);
     let json = realtime_matches_host(&file, &[]);
     all_analysed_within(&json, 20, 0.05);
 }
@@ -629,8 +627,9 @@ fn stalled(
 
 #[test]
 fn a_forced_dma_overrun_is_a_counted_gap_and_later_positions_stay_right() {
+    let scratch = Scratch::new();
     let Some(elf) = firmware() else { return };
-    let file = seed_train(3, 0.08);
+    let file = seed_train(&scratch, 3, 0.08);
     let setup = impact_host::pipeline::setup(
         &impact_host::pipeline::options::AnalyzeArgs {
             file: file.clone().into(),
@@ -684,14 +683,12 @@ fn a_forced_dma_overrun_is_a_counted_gap_and_later_positions_stay_right() {
     }
 }
 
-/// A synthetic recording from `impact synth ARGS`, as a CSV file.
-fn synth(name: &str, args: &[&str]) -> String {
+/// A synthetic recording from `impact synth ARGS`, as a CSV file in `scratch`.
+fn synth(scratch: &Scratch, name: &str, args: &[&str]) -> String {
     let mut all = vec!["synth"];
     all.extend_from_slice(args);
     let (csv, _) = impact(&all);
-    let file = tmp(name);
-    std::fs::write(&file, csv).unwrap();
-    file.to_string_lossy().into_owned()
+    scratch.text(name, &csv)
 }
 
 /// A replay slowed until a block's period (256 s here) is beyond the reach of the emulator's
@@ -700,11 +697,12 @@ fn synth(name: &str, args: &[&str]) -> String {
 /// (it was 20.6 s here instead of 189 s, and negative at `--rate-scale 1e-6`). About 25 s.
 #[test]
 fn a_replay_slower_than_the_timers_reach_reports_the_right_latency() {
+    let scratch = Scratch::new();
     let Some(elf) = firmware() else { return };
     let elf = elf.to_string_lossy().into_owned();
     let mut args = impact_host::synth::SEED_BENCH_ARGS.to_vec();
     args.extend(["--rate", "10000", "--touch", "0.005", "--duration", "0.05"]);
-    let file = synth("slow.csv", &args);
+    let file = synth(&scratch, "slow.csv", &args);
     let (out, log) = impact(&[
         "emulate",
         &file,
@@ -736,16 +734,18 @@ fn a_replay_slower_than_the_timers_reach_reports_the_right_latency() {
 
 #[test]
 fn realtime_runs_of_seconds_lose_nothing_at_500_ks_and_1_ms() {
+    let scratch = Scratch::new();
     if firmware().is_none() {
         return;
     }
     // 2.57 s of seed-bench impacts 80 ms apart (the heartbeat comes twice): every one fully
     // analysed within 50 ms, nothing lost or dropped, the stack within its margin.
-    let file = seed_train(32, 0.08);
+    let file = seed_train(&scratch, 32, 0.08);
     let json = realtime_matches_host(&file, &[]);
     all_analysed_within(&json, 32, 0.05);
     // 5 s at 1 MS/s: 199 AFRL-like pulses (150 µs, ~15 kg_n) 25 ms apart, with the fits.
     let file = synth(
+        &scratch,
         "afrl-like-5s.csv",
         &[
             "--model",
@@ -789,11 +789,12 @@ fn realtime_runs_of_seconds_lose_nothing_at_500_ks_and_1_ms() {
 
 #[test]
 fn realtime_spectra_and_a_bounce_train_to_10_ms_flights_lose_nothing() {
+    let scratch = Scratch::new();
     let Some(elf) = firmware() else { return };
     let elf = elf.to_string_lossy().into_owned();
     // Five seed impacts with their shock spectra (4.8 M instructions each, at the lowest
     // priority): nothing lost, the stack within its margin.
-    let file = seed_train(5, 0.08);
+    let file = seed_train(&scratch, 5, 0.08);
     let (out, log) = impact(&[
         "emulate",
         &file,
@@ -830,7 +831,7 @@ fn realtime_spectra_and_a_bounce_train_to_10_ms_flights_lose_nothing() {
     ];
     let mut args: Vec<&str> = train.to_vec();
     args.extend(["--duration", "3"]);
-    let long = synth("bounces-long.csv", &args);
+    let long = synth(&scratch, "bounces-long.csv", &args);
     let (out, _) = impact(&["analyze", &long, "--json", "--mass", "0.06", "--v0", "0.5"]);
     let v: serde_json::Value = serde_json::from_str(&out).unwrap();
     let impacts = v["impacts"].as_array().unwrap();
@@ -839,7 +840,7 @@ fn realtime_spectra_and_a_bounce_train_to_10_ms_flights_lose_nothing() {
     let duration = format!("{:.4}", end + 0.02);
     let mut args: Vec<&str> = train.to_vec();
     args.extend(["--duration", &duration]);
-    let file = synth("bounces.csv", &args);
+    let file = synth(&scratch, "bounces.csv", &args);
     let (out, log) = impact(&[
         "emulate",
         &file,
@@ -890,7 +891,7 @@ fn realtime_spectra_and_a_bounce_train_to_10_ms_flights_lose_nothing() {
 
 /// A three-axis recording at the ADXL375's 3200 S/s: `n` seed-bench impacts `every` s apart
 /// from 0.1 s on, the pulse along the unit vector (0.6, 0.48, 0.64); returns the CSV's path.
-fn adxl375_train(n: usize, every: f64) -> String {
+fn adxl375_train(scratch: &Scratch, n: usize, every: f64) -> String {
     let (n_s, every_s) = (n.to_string(), every.to_string());
     let duration = (0.1 + n as f64 * every).to_string();
     let args: Vec<&str> = ["synth"]
@@ -916,9 +917,7 @@ fn adxl375_train(n: usize, every: f64) -> String {
         let a: f64 = a.parse().unwrap();
         out.push_str(&format!("{t},{},{},{}\n", 0.6 * a, 0.48 * a, 0.64 * a));
     }
-    let file = tmp(&format!("adxl375-{n}-{every}.csv"));
-    std::fs::write(&file, out).unwrap();
-    file.to_string_lossy().into_owned()
+    scratch.text(&format!("adxl375-{n}-{every}.csv"), &out)
 }
 
 /// The host's own analysis of what an ADXL375 gives for `file`'s three axes (the resultant
@@ -950,17 +949,18 @@ fn adxl375_host(
 
 #[test]
 fn the_adxl375_path_in_real_time_loses_nothing_and_reports_within_20_ms() {
+    let scratch = Scratch::new();
     let Some(elf) = firmware() else { return };
     let elf = elf.to_string_lossy().into_owned();
     // 2.7 s of three-axis seed impacts at 3200 S/s through the emulated part's FIFO, polled
     // by the board's ADXL375 source: nothing lost or dropped, every impact analysed and
     // reported within 20 ms of its hold (blocks of one poll, 5 ms), the board's stack.
-    let file = adxl375_train(8, 0.325);
+    let file = adxl375_train(&scratch, 8, 0.325);
     let (args, opts) = (
         ["emulate", &file, "--axes", "x_g,y_g,z_g", "--adxl375"],
         ["--mass", "0.06", "--json", "--elf", &elf],
     );
-    let log_file = tmp("adxl375-realtime.log");
+    let log_file = scratch.join("adxl375-realtime.log");
     let log_path = log_file.to_string_lossy().into_owned();
     let mut realtime: Vec<&str> = args.into_iter().chain(opts).collect();
     realtime.extend(["--realtime", "--log", &log_path]);
@@ -1008,8 +1008,9 @@ fn the_adxl375_path_in_real_time_loses_nothing_and_reports_within_20_ms() {
 
 #[test]
 fn an_adxl375_fifo_overrun_is_counted_as_the_part_lost_it() {
+    let scratch = Scratch::new();
     let Some(elf) = firmware() else { return };
-    let file = adxl375_train(3, 0.3);
+    let file = adxl375_train(&scratch, 3, 0.3);
     let (setup, axes, host) = adxl375_host(&file);
     assert_eq!(host.len(), 3);
     // The sampler stalls 23 ms before poll 40 (0.2 s in, between the first two impacts): the
@@ -1061,6 +1062,7 @@ fn an_adxl375_fifo_overrun_is_counted_as_the_part_lost_it() {
 /// `impact log` reads the board's `spec` lines back to the same verdicts.
 #[test]
 fn spec_verdicts_on_the_board_are_the_hosts() {
+    let scratch = Scratch::new();
     let Some(elf) = firmware() else { return };
     let elf = elf.to_string_lossy().into_owned();
     // A user's band from a file (at most 55 g at the top): the board reads the host's rows.
@@ -1070,7 +1072,7 @@ fn spec_verdicts_on_the_board_are_the_hosts() {
         "half-sine,50g,11ms,band-file={}/../docs/bands/half-sine-50g-11ms.csv",
         env!("CARGO_MANIFEST_DIR")
     );
-    let step_file = tmp("spec-step-band.csv");
+    let step_file = scratch.join("spec-step-band.csv");
     std::fs::write(
         &step_file,
         "time_over_duration,lower_over_peak,upper_over_peak\n-0.6,-0.1,0.1\n0,-0.2,0.2\n\
@@ -1097,7 +1099,7 @@ fn spec_verdicts_on_the_board_are_the_hosts() {
             let noise = 0.02 * f64::from(k % 7) / 7.0;
             csv.push_str(&format!("{:.6},{:.5}\n", t + 0.05, a + noise));
         }
-        let file = tmp(&format!("spec-{name}.csv"));
+        let file = scratch.join(&format!("spec-{name}.csv"));
         std::fs::write(&file, csv).unwrap();
         let file = file.to_string_lossy().into_owned();
         let (host, _) = impact(&["analyze", &file, "--spec", spec, "--json"]);
@@ -1118,7 +1120,7 @@ fn spec_verdicts_on_the_board_are_the_hosts() {
             ),
             _ => assert!(verdict.is_null(), "{verdict}"),
         }
-        let log_file = tmp(&format!("spec-{name}.log"));
+        let log_file = scratch.join(&format!("spec-{name}.log"));
         std::fs::write(&log_file, &log).unwrap();
         let (from_log, _) = impact(&["log", &log_file.to_string_lossy()]);
         let from_log: serde_json::Value = serde_json::from_str(&from_log).unwrap();

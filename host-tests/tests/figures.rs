@@ -7,14 +7,7 @@ use impact_host::pipeline::{self, AnalyzeArgs};
 use impact_io::channel::ColumnRef;
 
 mod common;
-use common::impact_ok;
-
-fn dir() -> PathBuf {
-    let d =
-        PathBuf::from(env!("CARGO_TARGET_TMPDIR")).join(format!("figures-{}", std::process::id()));
-    std::fs::create_dir_all(&d).unwrap();
-    d
-}
+use common::{impact_ok, Scratch};
 
 fn data(rel: &str) -> PathBuf {
     PathBuf::from(env!("CARGO_MANIFEST_DIR"))
@@ -89,7 +82,8 @@ fn the_cfc_trace_drawn_is_the_analysis_s_filter() {
 
 #[test]
 fn with_a_cfc_the_figures_draw_the_raw_and_the_filtered_signal_and_say_so() {
-    let d = dir();
+    let scratch = Scratch::new();
+    let d = scratch.path();
     let f = data("afrl-drop-tower/accel_5.csv");
     let svg = d.join("cfc.svg");
     impact_ok(&[
@@ -167,7 +161,8 @@ fn dark(size: (u32, u32), pixels: &[u8], rows: std::ops::Range<u32>) -> f64 {
 
 #[test]
 fn plot_png_is_the_figure_rasterised_the_same_on_any_machine() {
-    let d = dir();
+    let scratch = Scratch::new();
+    let d = scratch.path();
     let f = data("afrl-drop-tower/series1_test1_full_100ms.csv");
     let draw = |name: &str| {
         let out = d.join(name);

@@ -9,6 +9,9 @@ use std::os::unix::fs::PermissionsExt;
 use std::path::{Path, PathBuf};
 use std::process::Command;
 
+mod common;
+use common::Scratch;
+
 fn root() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR"))
         .parent()
@@ -58,18 +61,16 @@ fn fw_run_flashes_the_monitor_through_probe_rs() {
         eprintln!("skipped: the thumbv7em-none-eabihf target is not installed");
         return;
     }
-    let dir = std::env::temp_dir().join(format!("impact-flash-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
-    let calls = dir.join("calls");
-    let stand_in = dir.join("probe-rs");
-    std::fs::write(
-        &stand_in,
+    let scratch = Scratch::new();
+    let dir = scratch.path();
+    let calls = scratch.join("calls");
+    let stand_in = scratch.file(
+        "probe-rs",
         format!(
             "#!/bin/sh\necho \"$@\" >> {}\necho 'Error: No connected probes were found.' >&2\nexit 1\n",
             calls.display()
         ),
-    )
-    .unwrap();
+    );
     std::fs::set_permissions(&stand_in, std::fs::Permissions::from_mode(0o755)).unwrap();
 
     for (where_, args) in [
@@ -77,7 +78,7 @@ fn fw_run_flashes_the_monitor_through_probe_rs() {
         (root().join("firmware"), vec!["run", "--release"]),
     ] {
         let _ = std::fs::remove_file(&calls);
-        let (ok, err) = cargo(&where_, &args, Some(&dir));
+        let (ok, err) = cargo(&where_, &args, Some(dir));
         assert!(!ok, "{args:?} succeeded without a board");
         assert!(
             err.contains("No connected probes were found"),

@@ -7,7 +7,7 @@ mod common;
 
 use std::path::PathBuf;
 
-use common::{impact, impact_ok};
+use common::{assert_refused_file, impact, impact_ok, Scratch};
 
 fn root() -> PathBuf {
     PathBuf::from(env!("CARGO_MANIFEST_DIR"))
@@ -33,21 +33,13 @@ fn rows(first: usize, count: usize) -> Vec<(f64, f64)> {
         .collect()
 }
 
-fn temp(name: &str) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("impact-formats-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
-    dir.join(name)
-}
-
 /// A CSV of `values` at 1 MS/s from t = 0.
-fn twin(name: &str, values: impl Iterator<Item = String>) -> PathBuf {
+fn twin(scratch: &Scratch, name: &str, values: impl Iterator<Item = String>) -> PathBuf {
     let mut text = String::from("time_s,value\n");
     for (k, v) in values.enumerate() {
         text.push_str(&format!("{:.6},{v}\n", k as f64 * 1e-6));
     }
-    let path = temp(name);
-    std::fs::write(&path, text).unwrap();
-    path
+    scratch.file(name, text)
 }
 
 fn json(file: &std::path::Path, extra: &[&str]) -> String {
@@ -64,12 +56,14 @@ fn json(file: &std::path::Path, extra: &[&str]) -> String {
 
 #[test]
 fn integer_wav_channels_give_their_csv_twins_reports() {
+    let scratch = Scratch::new();
     let wav = root().join("fixtures/afrl-test1-int16.wav");
     let rows = source_rows();
     // The codes the fixture holds: round half to even of kg_n × 1000 (Python's round).
     let code = |v: f64| ((v * 1000.0).round_ties_even() as i64).to_string();
     for (channel, pick) in [(0, 0usize), (1, 1)] {
         let csv = twin(
+            &scratch,
             &format!("int16-{channel}.csv"),
             rows.iter().map(|r| code(if pick == 0 { r.0 } else { r.1 })),
         );
@@ -85,9 +79,11 @@ fn integer_wav_channels_give_their_csv_twins_reports() {
 
 #[test]
 fn float_wav_gives_its_csv_twins_report() {
+    let scratch = Scratch::new();
     let wav = root().join("fixtures/afrl-test1-float32.wav");
     // The fixture's float32 values exactly (as f64 decimals that give them back).
     let csv = twin(
+        &scratch,
         "float32.csv",
         source_rows()
             .iter()
@@ -99,11 +95,10 @@ fn float_wav_gives_its_csv_twins_report() {
 #[test]
 fn malformed_wav_files_are_one_line_errors_naming_file_and_frame() {
     let good = std::fs::read(root().join("fixtures/afrl-test1-int16.wav")).unwrap();
-    let cut = temp("cut.wav");
+    let scratch = Scratch::new();
     // Cut in the middle of the data: the header announces more frames than the file holds.
-    std::fs::write(&cut, &good[..good.len() / 2 + 1]).unwrap();
-    let garbage = temp("garbage.wav");
-    std::fs::write(&garbage, b"RIFF\x10\x00\x00\x00WAVEjunkjunkjunk").unwrap();
+    let cut = scratch.file("cut.wav", &good[..good.len() / 2 + 1]);
+    let garbage = scratch.file("garbage.wav", b"RIFF\x10\x00\x00\x00WAVEjunkjunkjunk");
     let wav = root().join("fixtures/afrl-test1-int16.wav");
     for (file, extra, want) in [
         (&cut, vec![], "frame"),
@@ -115,17 +110,13 @@ fn malformed_wav_files_are_one_line_errors_naming_file_and_frame() {
         let mut args = vec!["analyze", file.to_str().unwrap()];
         args.extend(extra.iter().copied());
         let (code, _, err) = impact(&args);
-        assert_ne!(code, 0, "{args:?}");
-        assert!(
-            err.contains(want) && err.contains(file.file_name().unwrap().to_str().unwrap()),
-            "{args:?}: {err}"
-        );
-        assert_eq!(err.trim().lines().count(), 1, "{err}");
+        assert_refused_file(Some(code), &err, want, file, &format!("{args:?}"));
     }
 }
 
 #[test]
 fn npy_arrays_in_either_order_give_their_csv_twins_reports() {
+    let scratch = Scratch::new();
     let rows = rows(8000, 10_000);
     let code = |v: f64| ((v * 1000.0).round_ties_even() as i64).to_string();
     let ints = root().join("fixtures/afrl-test1-int16.npy");
@@ -134,6 +125,7 @@ fn npy_arrays_in_either_order_give_their_csv_twins_reports() {
         let pick = |r: &(f64, f64)| if column == 0 { r.0 } else { r.1 };
         let c = column.to_string();
         let csv = twin(
+            &scratch,
             &format!("npy-int16-{column}.csv"),
             rows.iter().map(|r| code(pick(r))),
         );
@@ -143,6 +135,7 @@ fn npy_arrays_in_either_order_give_their_csv_twins_reports() {
             "int16 column {column}"
         );
         let csv = twin(
+            &scratch,
             &format!("npy-f32-{column}.csv"),
             rows.iter().map(|r| format!("{}", pick(r) as f32 as f64)),
         );
@@ -157,10 +150,9 @@ fn npy_arrays_in_either_order_give_their_csv_twins_reports() {
 #[test]
 fn malformed_npy_files_are_one_line_errors_naming_the_file() {
     let good = std::fs::read(root().join("fixtures/afrl-test1-int16.npy")).unwrap();
-    let cut = temp("cut.npy");
-    std::fs::write(&cut, &good[..good.len() / 2]).unwrap();
-    let garbage = temp("garbage.npy");
-    std::fs::write(&garbage, b"\x93NUMPY\x01\x00junk").unwrap();
+    let scratch = Scratch::new();
+    let cut = scratch.file("cut.npy", &good[..good.len() / 2]);
+    let garbage = scratch.file("garbage.npy", b"\x93NUMPY\x01\x00junk");
     let npy = root().join("fixtures/afrl-test1-int16.npy");
     for (file, extra, want) in [
         (&cut, vec!["--rate", "1e6"], "npy"),
@@ -171,17 +163,13 @@ fn malformed_npy_files_are_one_line_errors_naming_the_file() {
         let mut args = vec!["analyze", file.to_str().unwrap()];
         args.extend(extra.iter().copied());
         let (code, _, err) = impact(&args);
-        assert_ne!(code, 0, "{args:?}");
-        assert!(
-            err.contains(want) && err.contains(file.file_name().unwrap().to_str().unwrap()),
-            "{args:?}: {err}"
-        );
-        assert_eq!(err.trim().lines().count(), 1, "{err}");
+        assert_refused_file(Some(code), &err, want, file, &format!("{args:?}"));
     }
 }
 
 #[test]
 fn raw_files_give_their_csv_twins_reports() {
+    let scratch = Scratch::new();
     let rows = rows(8000, 10_000);
     let code = |v: f64| ((v * 1000.0).round_ties_even() as i64).to_string();
     let ints = root().join("fixtures/afrl-test1-2ch.i16");
@@ -189,6 +177,7 @@ fn raw_files_give_their_csv_twins_reports() {
         let pick = |r: &(f64, f64)| if column == 0 { r.0 } else { r.1 };
         let c = column.to_string();
         let csv = twin(
+            &scratch,
             &format!("raw-i16-{column}.csv"),
             rows.iter().map(|r| code(pick(r))),
         );
@@ -211,6 +200,7 @@ fn raw_files_give_their_csv_twins_reports() {
         );
     }
     let csv = twin(
+        &scratch,
         "raw-f32.csv",
         rows.iter().map(|r| format!("{}", r.0 as f32 as f64)),
     );
@@ -220,8 +210,7 @@ fn raw_files_give_their_csv_twins_reports() {
     );
     // A file that is not whole frames names the byte where the last one starts.
     let good = std::fs::read(&ints).unwrap();
-    let cut = temp("cut.i16");
-    std::fs::write(&cut, &good[..good.len() - 3]).unwrap();
+    let cut = scratch.file("cut.i16", &good[..good.len() - 3]);
     let (code, _, err) = impact(&[
         "analyze",
         cut.to_str().unwrap(),
@@ -242,17 +231,22 @@ fn raw_files_give_their_csv_twins_reports() {
 
 #[test]
 fn tdms_channels_give_their_csv_twins_reports() {
+    let scratch = Scratch::new();
     let rows = rows(8000, 10_000);
     let tdms = root().join("fixtures/afrl-test1.tdms");
     // float64 kg_n at the wf_increment's rate, by its full name.
-    let csv = twin("tdms-bottom.csv", rows.iter().map(|r| format!("{}", r.0)));
+    let csv = twin(
+        &scratch,
+        "tdms-bottom.csv",
+        rows.iter().map(|r| format!("{}", r.0)),
+    );
     assert_eq!(
         json(&tdms, &["--column", "afrl/bottom_kgn"]),
         json(&csv, &[])
     );
     // int16 codes, by the channel's own name.
     let code = |v: f64| ((v * 1000.0).round_ties_even() as i64).to_string();
-    let csv = twin("tdms-top.csv", rows.iter().map(|r| code(r.1)));
+    let csv = twin(&scratch, "tdms-top.csv", rows.iter().map(|r| code(r.1)));
     assert_eq!(
         json(&tdms, &["--column", "top_codes", "--gain", "0.001"]),
         json(&csv, &["--gain", "0.001"])
@@ -262,8 +256,7 @@ fn tdms_channels_give_their_csv_twins_reports() {
     assert_ne!(code, 0);
     assert!(err.contains("afrl/bottom_kgn, afrl/top_codes"), "{err}");
     let good = std::fs::read(&tdms).unwrap();
-    let cut = temp("cut.tdms");
-    std::fs::write(&cut, &good[..good.len() / 3]).unwrap();
+    let cut = scratch.file("cut.tdms", &good[..good.len() / 3]);
     let (code, _, err) = impact(&["analyze", cut.to_str().unwrap()]);
     assert_ne!(code, 0);
     assert!(
@@ -359,8 +352,7 @@ fn an_ide_recording_gives_its_csv_exports_reports() {
 /// is refused naming its units.
 #[test]
 fn unsupported_files_and_channels_are_named() {
-    let dir = temp("unsupported");
-    std::fs::create_dir_all(&dir).unwrap();
+    let scratch = Scratch::new();
     for (name, bytes, want) in [
         ("sheet.xlsx", b"PK\x03\x04rest".to_vec(), "spreadsheet"),
         ("old.xls", vec![0xD0, 0xCF, 0x11, 0xE0, 1, 2], "Excel 97"),
@@ -372,8 +364,7 @@ fn unsupported_files_and_channels_are_named() {
         ("data.h5", b"\x89HDF\r\n\x1a\n".to_vec(), "HDF5"),
         ("blob.bin", vec![1, 0, 2, 0, 3], "binary"),
     ] {
-        let path = dir.join(name);
-        std::fs::write(&path, bytes).unwrap();
+        let path = scratch.file(name, bytes);
         let (code, _, err) = impact(&["analyze", path.to_str().unwrap()]);
         assert_eq!(code, 1, "{name}: {err}");
         assert!(
@@ -397,6 +388,7 @@ fn unsupported_files_and_channels_are_named() {
 /// times' answer.
 #[test]
 fn a_drifting_time_axis_is_refused_alike_everywhere_or_resampled() {
+    let scratch = Scratch::new();
     let n = 8000usize;
     let (v0, e, width, touch) = (2.0f64, 0.6, 0.002, 0.3);
     let dv = v0 * (1.0 + e);
@@ -414,8 +406,7 @@ fn a_drifting_time_axis_is_refused_alike_everywhere_or_resampled() {
         text.push_str(&format!("{t:.9},{:.4}\n", a + dither));
         t += 50e-6 * (1.0 + 0.45 * k as f64 / (n - 2) as f64);
     }
-    let path = temp("drifting-time.csv");
-    std::fs::write(&path, text).unwrap();
+    let path = scratch.file("drifting-time.csv", text);
     let file = path.to_str().unwrap();
     let mut errors = Vec::new();
     // In passes, read whole (as `--axes` reads it), and as a stream.
@@ -475,8 +466,7 @@ fn a_drifting_time_axis_is_refused_alike_everywhere_or_resampled() {
         let slow = k.saturating_sub(150_000) as f64 / 50_000.0;
         t += 2e-6 * (1.0 + 0.05 * slow);
     }
-    let long = temp("drifting-long.csv");
-    std::fs::write(&long, text).unwrap();
+    let long = scratch.file("drifting-long.csv", text);
     let long = long.to_str().unwrap();
     let mut errors = Vec::new();
     for extra in [
@@ -515,7 +505,8 @@ fn a_drifting_time_axis_is_refused_alike_everywhere_or_resampled() {
 #[test]
 fn a_plot_draws_no_velocity_the_report_refuses() {
     let pe = root().join("data/endaq-high-drop/High-Drop_2000g-PE_13.4-15.0s.csv");
-    let svg = temp("piezo.svg");
+    let scratch = Scratch::new();
+    let svg = scratch.join("piezo.svg");
     let (_, err) = impact_ok(&[
         "analyze",
         pe.to_str().unwrap(),

@@ -11,7 +11,7 @@ use std::process::{Child, Command, Stdio};
 use std::time::{Duration, Instant};
 
 mod common;
-use common::SYNTH_T2 as T2;
+use common::{Scratch, SYNTH_T2 as T2};
 
 /// Address space each `impact` process may map: far below what the cases used to take
 /// (2.5–12 GB), far above what a bounded run needs.
@@ -137,14 +137,6 @@ fn ok(args: &[&str]) -> Run {
     r
 }
 
-fn temp(name: &str, bytes: &[u8]) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("impact-hostile-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
-    let p = dir.join(name);
-    std::fs::write(&p, bytes).unwrap();
-    p
-}
-
 fn t2(extra: &[&str]) -> Vec<String> {
     T2.iter().chain(extra).map(|s| s.to_string()).collect()
 }
@@ -209,6 +201,7 @@ fn synth_memory_follows_the_recording_not_the_contact_time() {
 
 #[test]
 fn a_closed_output_pipe_ends_the_tool_quietly() {
+    let scratch = Scratch::new();
     // `impact synth … | head -1`: the next write after the reader left gets SIGPIPE (the usual
     // status of a pipeline's writer), not a panic.
     let args = strs(&t2(&["--duration", "2"])).join(" ");
@@ -231,7 +224,7 @@ fn a_closed_output_pipe_ends_the_tool_quietly() {
         "50000",
     ])))
     .out;
-    let f = temp("big.csv", big.as_bytes());
+    let f = scratch.file("big.csv", big.as_bytes());
     let mut child = spawn(&["analyze", f.to_str().unwrap(), "--csv"], Stdio::null());
     let mut first = String::new();
     BufReader::new(child.stdout.take().unwrap())
@@ -249,14 +242,12 @@ fn a_closed_output_pipe_ends_the_tool_quietly() {
 
 #[test]
 fn endless_or_blocking_inputs_end_in_bounded_memory() {
+    let scratch = Scratch::new();
     // No line break at all: an error after a bounded read.
     fails(&["analyze", "/dev/zero"], "/dev/zero:1: a line longer than");
     fails(&["log", "/dev/zero"], "/dev/zero:1: a line longer than");
     // A FIFO is opened once: the tool reads what the writer sends and ends when it closes.
-    let dir = std::env::temp_dir().join(format!("impact-fifo-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
-    let fifo = dir.join("stream.csv");
-    let _ = std::fs::remove_file(&fifo);
+    let fifo = scratch.join("stream.csv");
     let path = std::ffi::CString::new(fifo.to_str().unwrap()).unwrap();
     // SAFETY: a valid NUL-terminated path.
     assert_eq!(unsafe { libc::mkfifo(path.as_ptr(), 0o600) }, 0);
@@ -281,7 +272,7 @@ fn endless_or_blocking_inputs_end_in_bounded_memory() {
     // An unclosed quote does not swallow the rest of the file into one field.
     let mut text = b"time_s,a_g\n0,1\n\"".to_vec();
     text.extend(b"0.001,2\n".repeat(200_000));
-    let f = temp("open-quote.csv", &text);
+    let f = scratch.file("open-quote.csv", &text);
     fails(
         &["analyze", f.to_str().unwrap()],
         "open-quote.csv:3: a quote opened on this line is not closed",
@@ -309,6 +300,7 @@ fn the_exact_solvers_refuse_results_that_underflow() {
 
 #[test]
 fn values_no_sensor_gives_are_the_files_line() {
+    let scratch = Scratch::new();
     let csv = base();
     for (v, line) in [
         ("1e38", 1002),
@@ -321,7 +313,7 @@ fn values_no_sensor_gives_are_the_files_line() {
             &format!("\n0.002000000,{v}\n0.002000001,"),
             1,
         );
-        let f = temp(&format!("value-{v}.csv"), text.as_bytes());
+        let f = scratch.file(&format!("value-{v}.csv"), text.as_bytes());
         let err = fails(
             &["analyze", f.to_str().unwrap(), "--csv"],
             &format!(":{line}:"),
@@ -335,7 +327,7 @@ fn values_no_sensor_gives_are_the_files_line() {
     let mut text = String::from("time_s,a_g\n");
     text.push_str(&"NaN,NaN\n".repeat(1000));
     text.push_str("0.001,1\n0.002,2\n");
-    let f = temp("nan-lead.csv", text.as_bytes());
+    let f = scratch.file("nan-lead.csv", text.as_bytes());
     fails(
         &["analyze", f.to_str().unwrap()],
         "nan-lead.csv:2: value is NaN",
@@ -344,13 +336,14 @@ fn values_no_sensor_gives_are_the_files_line() {
 
 #[test]
 fn csv_layouts_are_read_right_or_refused_with_a_hint() {
+    let scratch = Scratch::new();
     let csv = base();
-    let f = temp("plain.csv", csv.as_bytes());
+    let f = scratch.file("plain.csv", csv.as_bytes());
     let reference = json(&ok(&["analyze", f.to_str().unwrap(), "--json"]).out)["impacts"].clone();
     let peak = reference[0]["peak_acceleration_m_s2"].as_f64().unwrap();
     assert!((peak - 546.0).abs() < 1.0, "{peak}");
     let same = |name: &str, text: String, extra: &[&str]| {
-        let f = temp(name, text.as_bytes());
+        let f = scratch.file(name, text.as_bytes());
         let mut args = vec!["analyze", f.to_str().unwrap(), "--json"];
         args.extend(extra);
         let r = ok(&args);
@@ -379,7 +372,7 @@ fn csv_layouts_are_read_right_or_refused_with_a_hint() {
         comma.clone(),
         &["--decimal-comma", "--delimiter", ";"],
     );
-    let f = temp("comma.csv", comma.as_bytes());
+    let f = scratch.file("comma.csv", comma.as_bytes());
     fails(
         &["analyze", f.to_str().unwrap()],
         "comma.csv:2: not a number: \"0,000000000\" (decimal commas? give --decimal-comma)",
@@ -403,7 +396,7 @@ fn csv_layouts_are_read_right_or_refused_with_a_hint() {
                 .map(|l| l.split(',').nth(1).unwrap().replace('.', ",") + "\n"),
         )
         .collect();
-    let f = temp("one-column.csv", one.as_bytes());
+    let f = scratch.file("one-column.csv", one.as_bytes());
     fails(
         &["analyze", f.to_str().unwrap(), "--rate", "500000"],
         "one-column.csv:2: 2 fields, but the header (line 1) has 1",
@@ -423,12 +416,12 @@ fn csv_layouts_are_read_right_or_refused_with_a_hint() {
         .unwrap();
     assert!((p - peak).abs() < 1e-3, "{p}");
     // Ragged rows against the header and against the first row.
-    let f = temp("ragged.csv", b"time_s,a_g\n0,1,2\n");
+    let f = scratch.file("ragged.csv", b"time_s,a_g\n0,1,2\n");
     fails(
         &["analyze", f.to_str().unwrap()],
         "ragged.csv:2: 3 fields, but the header",
     );
-    let f = temp("ragged2.csv", b"time_s,a_g\n0,1\n1e-6,2,3\n");
+    let f = scratch.file("ragged2.csv", b"time_s,a_g\n0,1\n1e-6,2,3\n");
     fails(
         &["analyze", f.to_str().unwrap()],
         "ragged2.csv:3: 3 fields, expected 2",
@@ -438,8 +431,9 @@ fn csv_layouts_are_read_right_or_refused_with_a_hint() {
 
 #[test]
 fn options_are_checked_where_they_are_parsed_naming_themselves() {
+    let scratch = Scratch::new();
     let csv = base();
-    let f = temp("options.csv", csv.as_bytes());
+    let f = scratch.file("options.csv", csv.as_bytes());
     let name = f.to_str().unwrap();
     for (extra, want) in [
         (&["--mass", "NaN"][..], "--mass"),
@@ -470,7 +464,7 @@ fn options_are_checked_where_they_are_parsed_naming_themselves() {
     );
     // A scene file spells units as the command line does; a drop height given on the command
     // line replaces the scene's v0.
-    let scene = temp(
+    let scene = scratch.file(
         "scene.json",
         br#"{"mass_kg": 0.06, "v0_m_s": 5.0, "units": "g"}"#,
     );
@@ -519,6 +513,7 @@ fn options_are_checked_where_they_are_parsed_naming_themselves() {
 
 #[test]
 fn impact_log_refuses_what_the_firmware_cannot_have_written_by_line() {
+    let scratch = Scratch::new();
     // A real line from the emulated firmware's format (see docs/board.md).
     let (scene, line) = SAMPLE_LOG;
     let set = |field: &str, value: &str| {
@@ -526,7 +521,7 @@ fn impact_log_refuses_what_the_firmware_cannot_have_written_by_line() {
         let rest = tail.split_once(' ').map_or("", |(_, r)| r);
         format!("{head} {field}={value} {rest}")
     };
-    let log = |name: &str, text: String| temp(name, text.as_bytes());
+    let log = |name: &str, text: String| scratch.file(name, text.as_bytes());
     let good = log("good.log", format!("{scene}\n{line}\n"));
     let r = ok(&["log", good.to_str().unwrap(), "--csv"]);
     assert_eq!(r.out.lines().count(), 2, "{}", r.out);
@@ -609,11 +604,12 @@ fn impact_log_refuses_what_the_firmware_cannot_have_written_by_line() {
 
 #[test]
 fn binary_recordings_with_lying_headers_are_refused_in_bounded_memory() {
+    let scratch = Scratch::new();
     let fixtures = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("fixtures");
     // TDMS: the first object path claims 4 GiB (the reader would allocate it).
     let mut tdms = std::fs::read(fixtures.join("afrl-test1.tdms")).unwrap();
     tdms[32..36].copy_from_slice(&u32::MAX.to_le_bytes());
-    let f = temp("lying.tdms", &tdms);
+    let f = scratch.file("lying.tdms", &tdms);
     fails(
         &["analyze", f.to_str().unwrap()],
         "lying.tdms: TDMS: byte 36",
@@ -627,7 +623,7 @@ fn binary_recordings_with_lying_headers_are_refused_in_bounded_memory() {
         "the fixture is contiguous, with data"
     );
     tdms[4] |= 1 << 5;
-    let f = temp("interleaved.tdms", &tdms);
+    let f = scratch.file("interleaved.tdms", &tdms);
     for column in ["0", "1"] {
         fails(
             &["analyze", f.to_str().unwrap(), "--column", column],
@@ -637,7 +633,7 @@ fn binary_recordings_with_lying_headers_are_refused_in_bounded_memory() {
     // TDMS: a value count beyond the file.
     let mut tdms = std::fs::read(fixtures.join("afrl-test1.tdms")).unwrap();
     tdms.truncate(2000);
-    let f = temp("short.tdms", &tdms);
+    let f = scratch.file("short.tdms", &tdms);
     fails(&["analyze", f.to_str().unwrap()], "short.tdms");
     // WAV: a header announcing 2^31 frames of a file that holds a few.
     let mut wav = std::fs::read(fixtures.join("afrl-test1-int16.wav")).unwrap();
@@ -645,13 +641,13 @@ fn binary_recordings_with_lying_headers_are_refused_in_bounded_memory() {
     let len = wav.len();
     wav[40..44].copy_from_slice(&(u32::MAX - 3).to_le_bytes());
     wav[4..8].copy_from_slice(&((len - 8) as u32).to_le_bytes());
-    let f = temp("lying.wav", &wav);
+    let f = scratch.file("lying.wav", &wav);
     fails(&["analyze", f.to_str().unwrap()], "lying.wav");
     // .npy: a shape of 2^40 rows.
     let mut npy = std::fs::read(fixtures.join("afrl-test1-int16.npy")).unwrap();
     let at = npy.windows(10).position(|w| w == b"(10000, 2)").unwrap();
     npy[at..at + 10].copy_from_slice(b"(99999, 2)");
-    let f = temp("lying.npy", &npy);
+    let f = scratch.file("lying.npy", &npy);
     fails(
         &["analyze", f.to_str().unwrap(), "--rate", "1e6"],
         "lying.npy",
@@ -663,6 +659,7 @@ fn binary_recordings_with_lying_headers_are_refused_in_bounded_memory() {
 /// (`impact emulate`) does; an empty recording of any format is refused naming its file.
 #[test]
 fn quiet_or_unsettled_recordings_have_no_impacts_and_empty_ones_name_their_file() {
+    let scratch = Scratch::new();
     // White noise of 20 m/s² RMS (a deterministic LCG) against --edge 5.5.
     let mut state = 12345u64;
     let mut noise = || {
@@ -679,7 +676,7 @@ fn quiet_or_unsettled_recordings_have_no_impacts_and_empty_ones_name_their_file(
     for k in 0..10_000 {
         csv += &format!("{},{:.4}\n", k as f64 / 1e4, noise());
     }
-    let f = temp("unsettled.csv", csv.as_bytes());
+    let f = scratch.file("unsettled.csv", csv.as_bytes());
     let r = ok(&[
         "analyze",
         f.to_str().unwrap(),
@@ -711,12 +708,12 @@ fn quiet_or_unsettled_recordings_have_no_impacts_and_empty_ones_name_their_file(
         w.extend_from_slice(&0u32.to_le_bytes());
         w
     };
-    let f = temp("empty.wav", &wav);
+    let f = scratch.file("empty.wav", &wav);
     fails(
         &["analyze", f.to_str().unwrap()],
         "empty.wav: 0 samples; at least 2",
     );
-    let f = temp("empty.f32", b"");
+    let f = scratch.file("empty.f32", b"");
     fails(
         &["analyze", f.to_str().unwrap(), "--rate", "1000"],
         "empty.f32: 0 samples; at least 2",
@@ -728,8 +725,9 @@ fn quiet_or_unsettled_recordings_have_no_impacts_and_empty_ones_name_their_file(
 /// negative `--t0` is a value, not an unknown option.
 #[test]
 fn endless_secondary_inputs_are_refused_naming_their_limit() {
+    let scratch = Scratch::new();
     let csv = base();
-    let f = temp("secondary.csv", csv.as_bytes());
+    let f = scratch.file("secondary.csv", csv.as_bytes());
     let name = f.to_str().unwrap();
     fails(
         &["analyze", name, "--scene", "/dev/zero"],
@@ -782,7 +780,7 @@ fn endless_secondary_inputs_are_refused_naming_their_limit() {
     // `synth --drop-every 1` would write a header and no sample.
     fails(&["synth", "--drop-every", "1"], "--drop-every");
     let (scene, line) = SAMPLE_LOG;
-    let log = temp("t0.log", format!("{scene}\n{line}\n").as_bytes());
+    let log = scratch.file("t0.log", format!("{scene}\n{line}\n").as_bytes());
     let r = ok(&["log", log.to_str().unwrap(), "--t0", "-0.5", "--json"]);
     let start = json(&r.out)["impacts"][0]["start_s"].as_f64().unwrap();
     assert!((start - (0.01 - 0.5)).abs() < 1e-9, "{start}");

@@ -6,16 +6,7 @@ use std::path::PathBuf;
 use std::process::{Command, Stdio};
 
 mod common;
-use common::{assert_refused, impact};
-
-/// A file of `bytes` in this run's temporary directory.
-fn temp(name: &str, bytes: &[u8]) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("impact-messages-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
-    let p = dir.join(name);
-    std::fs::write(&p, bytes).unwrap();
-    p
-}
+use common::{assert_refused, impact, Scratch};
 
 /// Read whole (`IMPACT_READ_WHOLE`, as `--axes` or `--resample` read a recording) where the
 /// arguments hold this word, in passes elsewhere.
@@ -66,19 +57,18 @@ fn analyze_stdin(file: &PathBuf, args: &[&str]) -> (i32, String) {
     )
 }
 
-/// The hostile-input issue's `T2` recording (one 55.6 g impact), as a file.
-/// The T2 recording, written once (the tests run in parallel: rewriting it while another
-/// test reads it made that one flaky).
-fn t2() -> PathBuf {
-    static T2: std::sync::OnceLock<PathBuf> = std::sync::OnceLock::new();
-    T2.get_or_init(|| temp("t2.csv", common::synth_t2().as_bytes()))
-        .clone()
+/// The hostile-input issue's `T2` recording (one 55.6 g impact), as a file in the test's own
+/// scratch folder (the tests run in parallel: one file rewritten while another test read it
+/// made that one flaky).
+fn t2(scratch: &Scratch) -> PathBuf {
+    scratch.file("t2.csv", common::synth_t2())
 }
 
 #[test]
 fn values_the_core_cannot_hold_are_out_of_range_not_infinite() {
+    let scratch = Scratch::new();
     // Finite and > 0, but beyond the f32 the core takes: each option names its limits.
-    let t2 = t2();
+    let t2 = t2(&scratch);
     let t2 = t2.to_str().unwrap();
     for (args, option, limits) in [
         (
@@ -147,7 +137,7 @@ fn values_the_core_cannot_hold_are_out_of_range_not_infinite() {
     let zeros: String = std::iter::once("time_s,accel_g\n".to_string())
         .chain((0..2000).map(|i| format!("{:.6},0\n", i as f64 * 2e-6)))
         .collect();
-    let zeros = temp("zeros.csv", zeros.as_bytes());
+    let zeros = scratch.file("zeros.csv", zeros.as_bytes());
     refused(
         &["analyze", zeros.to_str().unwrap(), "--range", "1e-300"],
         &["--range 1e-300 m/s²: out of range"],
@@ -157,6 +147,7 @@ fn values_the_core_cannot_hold_are_out_of_range_not_infinite() {
 
 #[test]
 fn readings_too_small_or_large_for_the_counts_are_refused_not_lost() {
+    let scratch = Scratch::new();
     // Readings of 1e-5 g times --gain 1e-30 are below the smallest full scale: every count
     // would be 0 and the impact lost.
     let tiny: String = std::iter::once("time_s,accel_g\n".to_string())
@@ -165,8 +156,8 @@ fn readings_too_small_or_large_for_the_counts_are_refused_not_lost() {
             format!("{:.6},{v}\n", i as f64 * 1e-5)
         }))
         .collect();
-    let tiny = temp("tiny.csv", tiny.as_bytes());
-    let t2 = t2();
+    let tiny = scratch.file("tiny.csv", tiny.as_bytes());
+    let t2 = t2(&scratch);
     for (file, gain) in [(&tiny, "1e-30"), (&t2, "1e30")] {
         refused(
             &["analyze", file.to_str().unwrap(), "--gain", gain],
@@ -182,7 +173,8 @@ fn readings_too_small_or_large_for_the_counts_are_refused_not_lost() {
 
 #[test]
 fn scene_files_are_named_with_their_keys() {
-    let t2 = t2();
+    let scratch = Scratch::new();
+    let t2 = t2(&scratch);
     let t2 = t2.to_str().unwrap();
     for (name, json, want) in [
         (
@@ -221,7 +213,7 @@ fn scene_files_are_named_with_their_keys() {
             "exponent.json: fits.exponent 7: out of range (between 1 and 4)",
         ),
     ] {
-        let scene = temp(name, json.as_bytes());
+        let scene = scratch.file(name, json.as_bytes());
         refused(
             &["analyze", t2, "--scene", scene.to_str().unwrap()],
             &[want],
@@ -244,6 +236,7 @@ fn scene_files_are_named_with_their_keys() {
 
 #[test]
 fn a_rate_from_a_file_names_the_file_and_its_property() {
+    let scratch = Scratch::new();
     let fixtures = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("fixtures");
     let mut tdms = std::fs::read(fixtures.join("afrl-test1.tdms")).unwrap();
     // Every wf_increment (a double after its name and type code) 1e300 s.
@@ -254,7 +247,7 @@ fn a_rate_from_a_file_names_the_file_and_its_property() {
         at = value + 8;
     }
     assert!(at > 0, "the fixture has a wf_increment");
-    let tdms = temp("increment.tdms", &tdms);
+    let tdms = scratch.file("increment.tdms", &tdms);
     let tdms = tdms.to_str().unwrap();
     for extra in [
         &[][..],
@@ -273,7 +266,7 @@ fn a_rate_from_a_file_names_the_file_and_its_property() {
     let fast: String = std::iter::once("time_s,accel_g\n".to_string())
         .chain((0..2000).map(|i| format!("{:.12},0\n", i as f64 * 1e-9)))
         .collect();
-    let fast = temp("fast.csv", fast.as_bytes());
+    let fast = scratch.file("fast.csv", fast.as_bytes());
     refused(
         &["analyze", fast.to_str().unwrap()],
         &["fast.csv: the time column \"time_s\" gives 1e9 S/s: out of range (between 1e-30 and 1e8 Hz)"],
@@ -283,9 +276,10 @@ fn a_rate_from_a_file_names_the_file_and_its_property() {
 
 #[test]
 fn a_raw_file_without_a_rate_asks_for_rate_not_stream() {
+    let scratch = Scratch::new();
     let zeros = vec![0u8; 4096];
     for name in ["codes.i16", "values.f32"] {
-        let raw = temp(name, &zeros);
+        let raw = scratch.file(name, &zeros);
         let raw = raw.to_str().unwrap();
         for extra in [
             &[][..],
@@ -323,6 +317,7 @@ fn csv_with(rows: usize, change: impl Fn(String) -> String, after: usize) -> Vec
 
 #[test]
 fn an_unclosed_quote_is_reported_where_it_was_opened() {
+    let scratch = Scratch::new();
     // Past the sequential reader's head (the parallel one stops at the quote and hands over)
     // and within it; the quoted text runs past the longest line, or to the end of the file.
     for (rows, after, want) in [
@@ -331,9 +326,9 @@ fn an_unclosed_quote_is_reported_where_it_was_opened() {
         (100_000, 1000, "never closed"),
     ] {
         let line = rows + 2;
-        let csv = temp(
+        let csv = scratch.file(
             &format!("quote-{rows}-{after}.csv"),
-            &csv_with(rows, |row| format!("\"{row}"), after),
+            csv_with(rows, |row| format!("\"{row}"), after),
         );
         let want = format!(":{line}: a quote opened on this line is {want}");
         refused(&["analyze", csv.to_str().unwrap()], &[&want], &[]);
@@ -345,11 +340,12 @@ fn an_unclosed_quote_is_reported_where_it_was_opened() {
 
 #[test]
 fn a_byte_order_mark_after_the_first_line_is_refused_on_every_line() {
+    let scratch = Scratch::new();
     for rows in [100, 100_000] {
         let line = rows + 2;
-        let csv = temp(
+        let csv = scratch.file(
             &format!("bom-{rows}.csv"),
-            &csv_with(rows, |row| format!("\u{feff}{row}"), 2000),
+            csv_with(rows, |row| format!("\u{feff}{row}"), 2000),
         );
         let want = format!(":{line}: not a number: \"\\u{{feff}}");
         for extra in [&[][..], &[WHOLE]] {

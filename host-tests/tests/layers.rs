@@ -14,6 +14,9 @@ use std::path::{Path, PathBuf};
 
 use syn::visit::Visit;
 
+mod common;
+use common::Scratch;
+
 /// A module: its path from the crate root (empty for the root) and its file.
 struct Module {
     path: Vec<String>,
@@ -369,14 +372,12 @@ fn the_host_tool_and_its_readers_have_no_import_cycle() {
 #[test]
 fn a_cycle_is_found() {
     // The check itself: two sibling modules that use each other.
-    let dir = std::env::temp_dir().join(format!("impact-layers-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
-    std::fs::write(dir.join("lib.rs"), "mod a;\nmod b;\nmod c;\n").unwrap();
-    std::fs::write(dir.join("a.rs"), "use crate::b::X;\npub struct Y;\n").unwrap();
-    std::fs::write(dir.join("b.rs"), "pub struct X(crate::a::Y);\n").unwrap();
-    std::fs::write(dir.join("c.rs"), "fn f() { super::a::Y; }\n").unwrap();
-    let found = cycles(&dir.join("lib.rs"));
-    std::fs::remove_dir_all(&dir).unwrap();
+    let scratch = Scratch::new();
+    let lib = scratch.file("lib.rs", "mod a;\nmod b;\nmod c;\n");
+    scratch.file("a.rs", "use crate::b::X;\npub struct Y;\n");
+    scratch.file("b.rs", "pub struct X(crate::a::Y);\n");
+    scratch.file("c.rs", "fn f() { super::a::Y; }\n");
+    let found = cycles(&lib);
     assert_eq!(
         found,
         vec![("crate".to_string(), vec!["a".into(), "b".into()])]

@@ -3,30 +3,28 @@
 //! `impact analyze`'s pipeline with its default levels.
 
 use std::f64::consts::PI;
-use std::path::PathBuf;
 
 use impact_host::pipeline::{self, AnalyzeArgs};
 use impact_host::report::AnalysisJson;
+
+mod common;
+use common::Scratch;
 
 const RATE: f64 = 20_000.0;
 
 /// Writes `a` (m/s², one sample every 1/RATE s) as a CSV and analyses it.
 fn analyze(name: &str, a: &[f64]) -> AnalysisJson {
-    let dir = std::env::temp_dir().join(format!("impact-levels-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
-    let path: PathBuf = dir.join(format!("{name}.csv"));
+    let scratch = Scratch::new();
     let mut text = String::from("time_s,accel_m_s2\n");
     for (i, v) in a.iter().enumerate() {
         text.push_str(&format!("{:.6},{v:.4}\n", i as f64 / RATE));
     }
-    std::fs::write(&path, text).unwrap();
     let args = AnalyzeArgs {
-        file: path.clone(),
+        file: scratch.file(&format!("{name}.csv"), text),
         ..Default::default()
     };
     let setup = pipeline::setup(&args, None).unwrap_or_else(|e| panic!("{e}"));
     let reports = pipeline::run(&setup.prepared.counts, &setup.scene).unwrap();
-    let _ = std::fs::remove_file(&path);
     pipeline::to_json(&setup, &reports)
 }
 

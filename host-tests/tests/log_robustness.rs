@@ -7,14 +7,7 @@ use std::process::{Command, Stdio};
 
 mod common;
 use common::board_log::{heartbeat, impact_line, summary, SCENE};
-use common::{assert_refused, impact, peak_memory_mib};
-
-fn temp(name: &str, text: &str) -> String {
-    let p = std::path::PathBuf::from(env!("CARGO_TARGET_TMPDIR"))
-        .join(format!("log-robustness-{}-{name}", std::process::id()));
-    std::fs::write(&p, text).unwrap();
-    p.to_string_lossy().into_owned()
-}
+use common::{assert_refused, impact, peak_memory_mib, Scratch};
 
 fn json(text: &str) -> serde_json::Value {
     serde_json::from_str(text).unwrap_or_else(|e| panic!("{e}: {text}"))
@@ -92,6 +85,7 @@ fn a_long_log_is_read_in_bounded_memory() {
 /// its own heartbeat and summary.
 #[test]
 fn a_restarted_board_gives_every_runs_impacts_each_with_its_run() {
+    let scratch = Scratch::new();
     let text = [
         SCENE.to_string(),
         impact_line(0, 0, None),
@@ -102,7 +96,7 @@ fn a_restarted_board_gives_every_runs_impacts_each_with_its_run() {
         summary(1, 50_000, 1),
     ]
     .join("\n");
-    let log = temp("restart.log", &text);
+    let log = scratch.text("restart.log", &text);
     let (code, out, err) = impact(&["log", &log]);
     assert_eq!(code, 0, "{err}");
     assert!(
@@ -128,10 +122,10 @@ fn a_restarted_board_gives_every_runs_impacts_each_with_its_run() {
         .collect();
     assert_eq!(runs, ["1", "1", "2"]);
     // A figure or windows of two runs would overlap: refused, naming the restart.
-    let (code, _, err) = impact(&["log", &log, "--plot", &temp("restart.svg", "")]);
+    let (code, _, err) = impact(&["log", &log, "--plot", &scratch.text("restart.svg", "")]);
     assert_refused(Some(code), &err, "the board restarted on line 5", "--plot");
     // A log of one run is unchanged: no run field, no run column.
-    let one = temp(
+    let one = scratch.text(
         "one-run.log",
         &text.lines().take(4).collect::<Vec<_>>().join("\n"),
     );
@@ -144,7 +138,7 @@ fn a_restarted_board_gives_every_runs_impacts_each_with_its_run() {
         &summary(1, 50_000, 1),
         &format!("{}\n{}", impact_line(1, 1, None), summary(2, 50_000, 1)),
     );
-    let log = temp("restart-count.log", &text);
+    let log = scratch.text("restart-count.log", &text);
     let (code, _, err) = impact(&["log", &log]);
     assert_refused(
         Some(code),
@@ -158,9 +152,10 @@ fn a_restarted_board_gives_every_runs_impacts_each_with_its_run() {
 /// naming both lines and the field.
 #[test]
 fn a_scene_unlike_the_first_is_refused_naming_both_lines() {
+    let scratch = Scratch::new();
     let other = SCENE.replace("rate_hz=500000.0", "rate_hz=1000.0");
     let text = [SCENE, &impact_line(0, 0, None), &other].join("\n");
-    let log = temp("two-scenes.log", &text);
+    let log = scratch.text("two-scenes.log", &text);
     let (code, _, err) = impact(&["log", &log]);
     assert_refused(
         Some(code),
@@ -175,6 +170,7 @@ fn a_scene_unlike_the_first_is_refused_naming_both_lines() {
 /// ending there, a width at most a capture, the deformation within reach of the impact speed.
 #[test]
 fn absurd_times_and_lengths_are_refused_naming_line_and_field() {
+    let scratch = Scratch::new();
     // The impact ends at sample 18618 (37.2 ms); a capture is 30.2 ms at 500 kS/s.
     for (field, value, want) in [
         (
@@ -220,7 +216,7 @@ fn absurd_times_and_lengths_are_refused_naming_line_and_field() {
         ),
     ] {
         let text = [SCENE, &impact_line(0, 0, Some((field, value)))].join("\n");
-        let log = temp(&format!("{field}-{value}.log"), &text);
+        let log = scratch.text(&format!("{field}-{value}.log"), &text);
         let (code, _, err) = impact(&["log", &log]);
         assert_refused(Some(code), &err, want, &format!("{field}={value}"));
         assert!(err.contains(&format!("{log}: line 2: ")), "{err}");
@@ -232,7 +228,7 @@ fn absurd_times_and_lengths_are_refused_naming_line_and_field() {
         heartbeat(1, 500_000, 1),
     ]
     .join("\n");
-    let log = temp("no-scene.log", &text);
+    let log = scratch.text("no-scene.log", &text);
     let (code, _, err) = impact(&["log", &log]);
     assert_refused(
         Some(code),
@@ -242,6 +238,6 @@ fn absurd_times_and_lengths_are_refused_naming_line_and_field() {
     );
     // The genuine line is read.
     let text = [SCENE, &impact_line(0, 0, None)].join("\n");
-    let (code, _, err) = impact(&["log", &temp("genuine.log", &text)]);
+    let (code, _, err) = impact(&["log", &scratch.text("genuine.log", &text)]);
     assert_eq!(code, 0, "{err}");
 }

@@ -3,18 +3,11 @@
 //! emulator in memory that does not grow with the recording; a file-size limit an error, not
 //! a kill; an interrupt leaves no temporary file and no QEMU behind.
 
-use std::path::{Path, PathBuf};
+use std::path::Path;
 use std::process::{Command, Stdio};
 
 mod common;
-use common::impact_ok;
-
-fn dir(name: &str) -> PathBuf {
-    let d = PathBuf::from(env!("CARGO_TARGET_TMPDIR"))
-        .join(format!("outputs-{}-{name}", std::process::id()));
-    std::fs::create_dir_all(&d).unwrap();
-    d
-}
+use common::{impact_ok, Scratch};
 
 fn s(p: &Path) -> &str {
     p.to_str().unwrap()
@@ -62,16 +55,15 @@ fn refused(args: &[&str], stdin: Option<&Path>, want: &str, inputs: &[&Path]) {
 
 #[test]
 fn no_output_writes_over_an_input_whatever_the_path() {
-    let d = dir("inputs");
+    let scratch = Scratch::new();
+    let d = scratch.path();
     let csv = d.join("seed.csv");
     seed(&csv);
     let scene = d.join("scene.json");
     std::fs::write(&scene, r#"{"mass": 0.06, "v0": 1.3357}"#).unwrap();
     let hard = d.join("hard.svg");
-    let _ = std::fs::remove_file(&hard);
     std::fs::hard_link(&csv, &hard).unwrap();
     let soft = d.join("soft.svg");
-    let _ = std::fs::remove_file(&soft);
     std::os::unix::fs::symlink(&csv, &soft).unwrap();
     // The scene file written as a figure (named .svg: the name is no protection).
     let scene_svg = d.join("scene.svg");
@@ -182,7 +174,8 @@ fn no_output_writes_over_an_input_whatever_the_path() {
 
 #[test]
 fn two_writers_of_one_figure_leave_one_whole_figure() {
-    let d = dir("writers");
+    let scratch = Scratch::new();
+    let d = scratch.path();
     let csv = d.join("seed.csv");
     seed(&csv);
     let svg = d.join("both.svg");
@@ -209,7 +202,7 @@ fn two_writers_of_one_figure_leave_one_whole_figure() {
         let text = std::fs::read_to_string(&svg).unwrap();
         assert!(text.starts_with("<svg") && text.trim_end().ends_with("</svg>"));
     }
-    let left: Vec<_> = std::fs::read_dir(&d)
+    let left: Vec<_> = std::fs::read_dir(d)
         .unwrap()
         .filter_map(|e| e.ok())
         .filter(|e| e.file_name().to_string_lossy().ends_with(".part"))
@@ -235,7 +228,8 @@ fn the_figure_and_the_emulator_hold_no_whole_recording() {
     // 2^23 samples (16 MB of i16; held whole with its values, some 200 MB): the figure
     // reads its windows in a last pass, the emulator gets the counts through a file written a
     // block at a time. Both give the reports of the analysis in passes.
-    let d = dir("memory");
+    let scratch = Scratch::new();
+    let d = scratch.path();
     let big = d.join("big.i16");
     raw(&big, 1 << 23);
     let svg = d.join("big.svg");
@@ -272,7 +266,8 @@ fn the_figure_and_the_emulator_hold_no_whole_recording() {
 fn a_file_size_limit_is_a_message_never_a_kill() {
     // `ulimit -f`: the spool of a CSV's values (a temporary file) and a figure exceed it.
     use std::os::unix::process::CommandExt;
-    let d = dir("fsize");
+    let scratch = Scratch::new();
+    let d = scratch.path();
     let csv = d.join("seed.csv");
     seed(&csv);
     let run = |args: &[&str]| {
@@ -313,7 +308,7 @@ fn a_file_size_limit_is_a_message_never_a_kill() {
         "{err}"
     );
     assert!(!svg.exists());
-    assert!(std::fs::read_dir(&d).unwrap().all(|e| !e
+    assert!(std::fs::read_dir(d).unwrap().all(|e| !e
         .unwrap()
         .file_name()
         .to_string_lossy()
@@ -326,10 +321,10 @@ fn an_interrupt_removes_the_temporary_files_and_ends_qemu() {
         assert!(std::env::var_os("IMPACT_REQUIRE_EMULATOR").is_none());
         return;
     }
-    let d = dir("interrupt");
+    let scratch = Scratch::new();
+    let d = scratch.path();
     let tmp = d.join("tmp");
-    let _ = std::fs::remove_dir_all(&tmp);
-    std::fs::create_dir_all(&tmp).unwrap();
+    std::fs::create_dir(&tmp).unwrap();
     let big = d.join("long.i16");
     raw(&big, 1 << 23);
     // Real time at a tenth of the rate: 168 s of emulation; interrupted after two.

@@ -10,14 +10,7 @@ use std::path::PathBuf;
 use std::process::{Command, Stdio};
 
 mod common;
-use common::impact_ok;
-
-fn tmp(name: &str) -> String {
-    PathBuf::from(env!("CARGO_TARGET_TMPDIR"))
-        .join(format!("{}-passes-{name}", std::process::id()))
-        .to_string_lossy()
-        .into_owned()
-}
+use common::{impact_ok, Scratch};
 
 fn fixture(name: &str) -> String {
     PathBuf::from(env!("CARGO_MANIFEST_DIR"))
@@ -144,10 +137,10 @@ fn glitched_csv(clip_g: Option<f64>) -> String {
 
 #[test]
 fn glitches_flat_tops_and_learned_levels_give_the_whole_files_reports_in_passes() {
+    let scratch = Scratch::new();
     for clip in [None, Some(30.0)] {
         let csv = glitched_csv(clip);
-        let file = tmp(&format!("glitched-{}.csv", clip.is_some()));
-        std::fs::write(&file, &csv).unwrap();
+        let file = scratch.text(&format!("glitched-{}.csv", clip.is_some()), &csv);
         for args in [
             vec!["--mass", "0.06", "--v0", "1.3357"],
             vec!["--mass", "0.06", "--keep-spikes"],
@@ -180,6 +173,7 @@ fn glitches_flat_tops_and_learned_levels_give_the_whole_files_reports_in_passes(
 /// field quoted) reads on to the end.
 #[test]
 fn quoted_rows_past_the_head_are_all_read() {
+    let scratch = Scratch::new();
     let mut csv = String::from("time_s,accel_g\n");
     for k in 0..100_000u32 {
         let v = if (50_000..50_200).contains(&k) {
@@ -189,8 +183,7 @@ fn quoted_rows_past_the_head_are_all_read() {
         };
         csv.push_str(&format!("\"{:.5}\",\"{v:.4}\"\n", f64::from(k) * 1e-5));
     }
-    let file = tmp("quoted.csv");
-    std::fs::write(&file, &csv).unwrap();
+    let file = scratch.text("quoted.csv", &csv);
     let (passes, whole) = passes_and_whole(&file, &[]);
     assert_eq!(passes, whole);
     assert_eq!(from_stdin(csv.into_bytes(), &[]), whole);
@@ -201,12 +194,13 @@ fn quoted_rows_past_the_head_are_all_read() {
 
 #[test]
 fn a_file_too_long_to_hold_whole_is_analysed_in_passes_in_bounded_memory() {
+    let scratch = Scratch::new();
     // 2^26 samples of raw i16 (128 MB; read whole, some 2.7 GB): one 2 ms impact every
     // 2^21 samples on ±1 count of noise, and one glitch far above them all.
     const PERIOD: usize = 1 << 21;
     const PERIODS: usize = 32;
     let pattern = common::impact_period(PERIOD, 0);
-    let file = tmp("long.i16");
+    let file = scratch.join_str("long.i16");
     {
         let mut f = std::io::BufWriter::new(std::fs::File::create(&file).unwrap());
         for p in 0..PERIODS {
@@ -274,10 +268,10 @@ fn a_file_too_long_to_hold_whole_is_analysed_in_passes_in_bounded_memory() {
 /// input, which cannot be, is a one-line error that names the directory.
 #[test]
 fn without_a_temporary_file_a_file_is_read_again_and_stdin_is_refused() {
+    let scratch = Scratch::new();
     let csv = glitched_csv(None);
-    let file = tmp("no-spool.csv");
-    std::fs::write(&file, &csv).unwrap();
-    let missing = tmp("no-such-directory");
+    let file = scratch.text("no-spool.csv", &csv);
+    let missing = scratch.join_str("no-such-directory");
     let run = |tmpdir: &str, input: &str| {
         Command::new(env!("CARGO_BIN_EXE_impact"))
             .args(["analyze", input, "--json", "--mass", "0.06"])
@@ -340,6 +334,7 @@ fn without_a_temporary_file_a_file_is_read_again_and_stdin_is_refused() {
 /// interval (the first of each), every interval against the first intervals' median.
 #[test]
 fn time_axis_errors_read_the_same_on_every_path() {
+    let scratch = Scratch::new();
     let csv = |rows: usize, time: &dyn Fn(usize) -> f64, bad: Option<usize>| {
         let mut s = String::from("time_s,accel_g\n");
         for k in 0..rows {
@@ -391,8 +386,7 @@ fn time_axis_errors_read_the_same_on_every_path() {
         ),
     ];
     for (name, text, want) in cases {
-        let file = tmp(&format!("{name}.csv"));
-        std::fs::write(&file, &text).unwrap();
+        let file = scratch.text(&format!("{name}.csv"), &text);
         let passes = common::impact(&["analyze", &file]);
         let whole = whole(&["analyze", &file]);
         let stream = common::impact(&[
@@ -430,7 +424,7 @@ fn time_axis_errors_read_the_same_on_every_path() {
         }
     }
     // With --rate the time column gives only the first time (its drift is not checked).
-    let file = tmp("drift-rate.csv");
+    let file = scratch.join_str("drift-rate.csv");
     let text = csv(200_000, &drift, None);
     std::fs::write(&file, &text).unwrap();
     let rate = ["--rate", "100000", "--time-column", "time_s"];

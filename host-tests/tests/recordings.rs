@@ -7,6 +7,9 @@ use impact_host::pipeline::{self, AnalyzeArgs, Level, Units};
 use impact_host::report::AnalysisJson;
 use impact_io::channel::ColumnRef;
 
+mod common;
+use common::Scratch;
+
 fn signals() -> PathBuf {
     PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("data")
 }
@@ -381,14 +384,14 @@ fn endaq_three_axes_give_one_report_per_bounce_with_the_resultants_peak() {
     assert!(a.impacts[0].axes.as_ref().unwrap().axes[2].clipped);
 }
 
-fn temp_dir() -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("impact-recordings-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
-    dir
-}
-
-/// A copy of a bundled recording with `change(row, line)` applied to each data row.
-fn copy_with(rel: &str, name: &str, change: impl Fn(usize, &str) -> String) -> PathBuf {
+/// A copy of a bundled recording with `change(row, line)` applied to each data row, in
+/// `scratch`.
+fn copy_with(
+    scratch: &Scratch,
+    rel: &str,
+    name: &str,
+    change: impl Fn(usize, &str) -> String,
+) -> PathBuf {
     let text = std::fs::read_to_string(signals().join(rel)).unwrap();
     let mut out = String::new();
     for (i, l) in text.lines().enumerate() {
@@ -399,9 +402,7 @@ fn copy_with(rel: &str, name: &str, change: impl Fn(usize, &str) -> String) -> P
         });
         out.push('\n');
     }
-    let p = temp_dir().join(name);
-    std::fs::write(&p, out).unwrap();
-    p
+    scratch.file(name, out)
 }
 
 /// Replaces field `col` of a CSV line.
@@ -413,6 +414,7 @@ fn set_field(line: &str, col: usize, value: &str) -> String {
 
 #[test]
 fn a_spiked_copy_reports_the_same_real_impact() {
+    let scratch = Scratch::new();
     // One 220 kg_n sample in the AFRL record (20x its real 11 kg_n pulse), after the impact
     // and before it; a 1e4 g sample and a two-sample -5e3 g glitch in the water entry (real
     // slam 63 g). A glitch after the impacts leaves them bit for bit as in the clean file; one
@@ -455,12 +457,15 @@ fn a_spiked_copy_reports_the_same_real_impact() {
             file: signals().join(rel),
             ..args.clone()
         });
-        let path = copy_with(rel, &format!("spiked-{n}.csv"), |row, line| {
-            match spikes.iter().find(|(r, _)| *r == row) {
+        let path = copy_with(
+            &scratch,
+            rel,
+            &format!("spiked-{n}.csv"),
+            |row, line| match spikes.iter().find(|(r, _)| *r == row) {
                 Some((_, v)) => set_field(line, col, v),
                 None => line.to_string(),
-            }
-        });
+            },
+        );
         let spiked = analyze(AnalyzeArgs {
             file: path.clone(),
             ..args.clone()
@@ -498,6 +503,7 @@ fn a_spiked_copy_reports_the_same_real_impact() {
 
 #[test]
 fn a_half_sine_cut_flat_at_the_sensor_range_is_clipped() {
+    let scratch = Scratch::new();
     // A 40 g, 8.81 ms half-sine at 100 kS/s read by a 16 g sensor: flat at 16 g for ~650
     // samples (quantised to 0.01 g, with a little noise).
     let write = |name: &str, cut: f64| {
@@ -512,9 +518,7 @@ fn a_half_sine_cut_flat_at_the_sensor_range_is_clipped() {
             let noise = 0.01 * ((i * 7919 % 5) as f64 - 2.0);
             s.push_str(&format!("{t:.6},{:.2}\n", (a + noise).min(cut)));
         }
-        let p = temp_dir().join(name);
-        std::fs::write(&p, s).unwrap();
-        p
+        scratch.file(name, s)
     };
     let cut = write("cut.csv", 16.0);
     for range in [None, Some(Level::parse("16g").unwrap())] {
@@ -548,6 +552,7 @@ fn a_half_sine_cut_flat_at_the_sensor_range_is_clipped() {
 /// after it has no rebound speed; the unclipped bounces keep theirs.
 #[test]
 fn noise_free_flat_tops_are_clipped_and_a_clipped_bounce_has_no_cor() {
+    let scratch = Scratch::new();
     let hs = |t: f64, t0: f64, peak: f64, width: f64| {
         if (t0..t0 + width).contains(&t) {
             peak * (std::f64::consts::PI * (t - t0) / width).sin()
@@ -561,9 +566,7 @@ fn noise_free_flat_tops_are_clipped_and_a_clipped_bounce_has_no_cor() {
             let t = i as f64 / fs;
             s.push_str(&format!("{t:.9},{:.6}\n", a(t).min(16.0 * G)));
         }
-        let p = temp_dir().join(name);
-        std::fs::write(&p, s).unwrap();
-        p
+        scratch.file(name, s)
     };
     let single = write(
         "flat-noise-free.csv",
@@ -649,6 +652,7 @@ fn noise_free_flat_tops_are_clipped_and_a_clipped_bounce_has_no_cor() {
 /// is unflagged and whole.
 #[test]
 fn a_recording_that_starts_inside_an_impact_flags_it() {
+    let scratch = Scratch::new();
     let fs = 5e4;
     let hs = |t: f64, t0: f64, peak: f64, width: f64| {
         if (t0..t0 + width).contains(&t) {
@@ -675,10 +679,8 @@ fn a_recording_that_starts_inside_an_impact_flags_it() {
                 first(t) + hs(t, 0.1, 500.0, 0.002) + dither
             ));
         }
-        let p = temp_dir().join(name);
-        std::fs::write(&p, s).unwrap();
         let a = analyze(AnalyzeArgs {
-            file: p,
+            file: scratch.file(name, s),
             v0: Some(0.3),
             ..Default::default()
         });

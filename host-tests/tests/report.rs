@@ -5,19 +5,12 @@
 //! every figure is there, and its screenshot is a full, non-blank image. A required SRS: each
 //! impact's SRS judged against it and drawn over it.
 
-use std::path::{Path, PathBuf};
+use std::path::Path;
 use std::process::Command;
 
 mod common;
 use common::browser::chromium;
-use common::{impact, impact_ok};
-
-fn dir() -> PathBuf {
-    let d =
-        PathBuf::from(env!("CARGO_TARGET_TMPDIR")).join(format!("report-{}", std::process::id()));
-    std::fs::create_dir_all(&d).unwrap();
-    d
-}
+use common::{impact, impact_ok, Scratch};
 
 fn afrl() -> String {
     format!(
@@ -46,7 +39,8 @@ fn write_report(html: &Path) -> String {
 
 #[test]
 fn the_report_is_one_self_contained_page_with_every_pulse() {
-    let html_path = dir().join("afrl.html");
+    let scratch = Scratch::new();
+    let html_path = scratch.join("afrl.html");
     let page = write_report(&html_path);
     assert!(page.starts_with("<!DOCTYPE html>"));
     // Self-contained: nothing fetched, nothing run.
@@ -150,7 +144,8 @@ fn report_against(d: &Path, name: &str, csv: &str) -> Result<String, String> {
 
 #[test]
 fn a_required_srs_judges_and_draws_each_impact_s_srs() {
-    let d = dir();
+    let scratch = Scratch::new();
+    let d = scratch.path();
     // Channel 1's own SRS lowered by 2 dB, in m/s² and in g: its SRS lies 2 dB above it at
     // every natural frequency (within −1.5/+3 dB); lowered by 4 dB, 4 dB above (beyond +3).
     let srs = measured_srs("1");
@@ -168,7 +163,7 @@ fn a_required_srs_judges_and_draws_each_impact_s_srs() {
         format!("frequency_hz,{unit}\n{rows}")
     };
     for g in [false, true] {
-        let page = report_against(&d, "within", &required(2.0, g)).unwrap();
+        let page = report_against(d, "within", &required(2.0, g)).unwrap();
         // No --srs given: the required SRS implies it.
         assert!(page.contains("SRS within −1.5/+3 dB of required</th>"));
         assert!(page.contains("MIL-STD-810H Method 516.8"));
@@ -186,12 +181,11 @@ fn a_required_srs_judges_and_draws_each_impact_s_srs() {
         assert_eq!(page.matches("−1.5 dB\n</text>").count(), 2);
         assert!(page.contains("impact 0: SRS, m/s² (left), g (right)"));
     }
-    let page = report_against(&d, "beyond", &required(4.0, false)).unwrap();
+    let page = report_against(d, "beyond", &required(4.0, false)).unwrap();
     assert!(page.contains("class=\"l fail\">no, worst at "), "the cell");
     assert!(page.contains(", +4.00 dB</td>"));
     // Breakpoints outside the spectrum's band: nothing to compare.
-    let page =
-        report_against(&d, "elsewhere", "frequency_hz,acceleration_g\n1,10\n5,10\n").unwrap();
+    let page = report_against(d, "elsewhere", "frequency_hz,acceleration_g\n1,10\n5,10\n").unwrap();
     assert_eq!(
         page.matches("not compared (no natural frequency in both)")
             .count(),
@@ -221,7 +215,7 @@ fn a_required_srs_judges_and_draws_each_impact_s_srs() {
             "line 5: frequency_hz 50 does not increase",
         ),
     ] {
-        let err = report_against(&d, "bad", csv).unwrap_err();
+        let err = report_against(d, "bad", csv).unwrap_err();
         assert!(
             err.contains("--srs-required") && err.contains(want),
             "{err}"
@@ -252,7 +246,8 @@ fn required_text() -> &'static str {
 #[test]
 fn the_report_loads_in_a_headless_browser_with_every_figure() {
     let Some(browser) = chromium() else { return };
-    let d = dir();
+    let scratch = Scratch::new();
+    let d = scratch.path();
     let html = d.join("browser.html");
     write_report(&html);
     let url = format!("file://{}", html.display());

@@ -3,21 +3,13 @@
 //! folders and patterns expand to their recordings; a recording that fails is named, the
 //! others still reported, the exit status 1.
 
-use std::path::{Path, PathBuf};
+use std::path::Path;
 
 mod common;
-use common::{impact, impact_ok};
+use common::{impact, impact_ok, Scratch};
 
 fn data(rel: &str) -> String {
     format!("{}/data/{rel}", env!("CARGO_MANIFEST_DIR"))
-}
-
-fn dir(name: &str) -> PathBuf {
-    let d = PathBuf::from(env!("CARGO_TARGET_TMPDIR"))
-        .join(format!("series-{}-{name}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&d);
-    std::fs::create_dir_all(&d).unwrap();
-    d
 }
 
 fn json(text: &str) -> serde_json::Value {
@@ -159,7 +151,8 @@ fn the_five_afrl_repeats_are_five_analyses_and_their_statistics() {
 /// pattern its matches; a failing recording is named and the others still reported.
 #[test]
 fn folders_and_patterns_expand_and_a_failure_is_named() {
-    let d = dir("folder");
+    let folder = Scratch::new();
+    let d = folder.path();
     let seed = common::synth_t2();
     for name in ["b.csv", "a.csv"] {
         std::fs::write(d.join(name), &seed).unwrap();
@@ -184,7 +177,7 @@ fn folders_and_patterns_expand_and_a_failure_is_named() {
             .collect()
     };
     let kin = ["--mass", "0.06", "--v0", "1.3357", "--json"];
-    let mut args = vec!["analyze".to_string(), s(&d)];
+    let mut args = vec!["analyze".to_string(), s(d)];
     args.extend(kin.iter().map(|a| a.to_string()));
     let args: Vec<&str> = args.iter().map(String::as_str).collect();
     let (out, _) = impact_ok(&args);
@@ -233,10 +226,11 @@ fn folders_and_patterns_expand_and_a_failure_is_named() {
     );
 
     // Nothing to analyse, standard input, a figure of many: refused before any work.
-    let empty = dir("empty");
+    let nothing = Scratch::new();
+    let empty = nothing.path();
     for (args, want) in [
         (
-            vec!["analyze".to_string(), s(&empty)],
+            vec!["analyze".to_string(), s(empty)],
             "a folder with no recordings",
         ),
         (

@@ -1,7 +1,7 @@
 //! The `impact` command line: `simulate` output and errors.
 
 mod common;
-use common::impact;
+use common::{impact, Scratch};
 
 fn json(args: &[&str]) -> serde_json::Value {
     let (code, out, err) = impact(args);
@@ -192,9 +192,8 @@ fn simulate_repeat_adds_seconds_per_impact() {
 
 #[test]
 fn simulate_plot_draws_a_hertz_contact_and_its_linear_spring() {
-    let dir = std::env::temp_dir().join(format!("impact-sim-plot-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
-    let svg = dir.join("hertz.svg");
+    let scratch = Scratch::new();
+    let svg = scratch.join("hertz.svg");
     let hertz = [
         "simulate",
         "--model",
@@ -243,7 +242,6 @@ fn simulate_plot_draws_a_hertz_contact_and_its_linear_spring() {
     ]);
     assert_ne!(code, 0);
     assert!(err.contains("--with-linear"), "{err}");
-    std::fs::remove_dir_all(&dir).ok();
 }
 
 #[test]
@@ -479,10 +477,8 @@ fn simulate_on_a_target_reports_the_two_bodies_and_the_ring_down() {
     assert_eq!(v["recontact"], false);
     assert!(v["recontact_time_s"].is_null() && v["null_reasons"]["recontact_time_s"].is_string());
     // A state-space target file is the same spring–mass; its energy is null with a reason.
-    let dir = std::env::temp_dir().join(format!("impact-target-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
-    let file = dir.join("mount.json");
-    std::fs::write(&file, r#"{"a": [[0, 1], [-133333.333333333333, -40]], "b": [0, 3.33333333333333333], "c": [[1, 0], [0, 1]], "d": [0, 0]}"#).unwrap();
+    let scratch = Scratch::new();
+    let file = scratch.file("mount.json", r#"{"a": [[0, 1], [-133333.333333333333, -40]], "b": [0, 3.33333333333333333], "c": [[1, 0], [0, 1]], "d": [0, 0]}"#);
     let s = json(&[
         "simulate",
         "--model",
@@ -503,7 +499,7 @@ fn simulate_on_a_target_reports_the_two_bodies_and_the_ring_down() {
     assert!(s["target_energy_j"].is_null() && s["null_reasons"]["target_energy_j"].is_string());
     assert!(s["target_work_j"].as_f64().unwrap() > 0.0);
     // --plot draws an SVG.
-    let svg = dir.join("t.svg");
+    let svg = scratch.join("t.svg");
     let (code, _, err) = impact(&[
         "simulate",
         "--model",
@@ -529,26 +525,19 @@ fn simulate_on_a_target_reports_the_two_bodies_and_the_ring_down() {
 
 #[test]
 fn a_target_that_cannot_be_pushed_is_a_one_line_error_naming_the_option() {
-    let dir = std::env::temp_dir().join(format!("impact-target-bad-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
-    let unstable = dir.join("unstable.json");
-    std::fs::write(
-        &unstable,
+    let scratch = Scratch::new();
+    let unstable = scratch.file(
+        "unstable.json",
         r#"{"a": [[0, 1], [-1e4, 1]], "b": [0, 1], "c": [[1, 0], [0, 1]]}"#,
-    )
-    .unwrap();
-    let ragged = dir.join("ragged.json");
-    std::fs::write(
-        &ragged,
+    );
+    let ragged = scratch.file(
+        "ragged.json",
         r#"{"a": [[0, 1], [-1e4]], "b": [0, 1], "c": [[1, 0], [0, 1]]}"#,
-    )
-    .unwrap();
-    let nan = dir.join("nan.json");
-    std::fs::write(
-        &nan,
+    );
+    let nan = scratch.file(
+        "nan.json",
         r#"{"a": [[0, 1], [NaN, 0]], "b": [0, 1], "c": [[1, 0], [0, 1]]}"#,
-    )
-    .unwrap();
+    );
     let law = [
         "simulate",
         "--model",

@@ -4,11 +4,11 @@
 //! table rings after the pulse). The emulated board's verdicts: `tests/emulator.rs`.
 
 mod common;
-use common::{impact, impact_ok};
+use common::{impact, impact_ok, Scratch};
 
 /// A recording at 50 kS/s, in g: `pulse(t)` (t from the pulse's start at 50 ms, s) over 200 ms,
-/// with ±0.02 g of deterministic noise.
-fn recording(name: &str, pulse: impl Fn(f64) -> f64) -> String {
+/// with ±0.02 g of deterministic noise, written to `name`.csv in `scratch`: its path.
+fn recording(scratch: &Scratch, name: &str, pulse: impl Fn(f64) -> f64) -> String {
     let rate = 50_000.0;
     let mut csv = String::from("time_s,accel_g\n");
     for k in 0..10_000u32 {
@@ -16,10 +16,7 @@ fn recording(name: &str, pulse: impl Fn(f64) -> f64) -> String {
         let noise = 0.02 * (((k.wrapping_mul(2_654_435_761) >> 16) % 1000) as f64 / 500.0 - 1.0);
         csv.push_str(&format!("{t:.6},{:.5}\n", pulse(t - 0.05) + noise));
     }
-    let p = std::path::PathBuf::from(env!("CARGO_TARGET_TMPDIR"))
-        .join(format!("spec-{}-{name}.csv", std::process::id()));
-    std::fs::write(&p, csv).unwrap();
-    p.to_string_lossy().into_owned()
+    scratch.text(&format!("{name}.csv"), &csv)
 }
 
 /// A half-sine of `peak` g lasting `d` s.
@@ -54,6 +51,7 @@ fn f(v: &serde_json::Value) -> f64 {
 
 #[test]
 fn nominal_pulses_pass_with_the_nominal_delta_v() {
+    let scratch = Scratch::new();
     let g = 9.80665;
     for (name, spec, pulse) in [
         (
@@ -85,7 +83,7 @@ fn nominal_pulses_pass_with_the_nominal_delta_v() {
             }),
         ),
     ] {
-        let file = recording(name, pulse);
+        let file = recording(&scratch, name, pulse);
         let (i, j) = judged(&file, spec);
         let v = &i["spec"];
         assert_eq!(v["pass"], true, "{name}: {v}");
@@ -124,8 +122,9 @@ fn spec_peak_g(spec: &str) -> f64 {
 
 #[test]
 fn pulses_off_the_specification_fail_by_their_margin() {
+    let scratch = Scratch::new();
     // 30 % high: beyond the +20 % band by 10 % of the peak, at the peak; Δv 30 % high.
-    let file = recording("high", half_sine(65.0, 0.011));
+    let file = recording(&scratch, "high", half_sine(65.0, 0.011));
     let (i, _) = judged(&file, "half-sine,50g,11ms");
     let v = &i["spec"];
     assert_eq!(
@@ -141,14 +140,14 @@ fn pulses_off_the_specification_fail_by_their_margin() {
     assert_eq!(v["delta_v_pass"], false, "{v}");
     // Within the band's ±20 % but 14 % high in Δv: passes IEC's ±15 %, fails MIL-STD-810H's
     // ±10 %.
-    let file = recording("dv", half_sine(57.0, 0.011));
+    let file = recording(&scratch, "dv", half_sine(57.0, 0.011));
     let (iec, _) = judged(&file, "half-sine,50g,11ms");
     assert_eq!(iec["spec"]["pass"], true, "{}", iec["spec"]);
     let (mil, _) = judged(&file, "half-sine,50g,11ms,standard=mil-std-810h");
     assert_eq!(mil["spec"]["band_pass"], true, "{}", mil["spec"]);
     assert_eq!(mil["spec"]["delta_v_pass"], false, "{}", mil["spec"]);
     // Half as long: Δv half the nominal one, and the band fails where the nominal is high.
-    let file = recording("short", half_sine(50.0, 0.0055));
+    let file = recording(&scratch, "short", half_sine(50.0, 0.0055));
     let (i, _) = judged(&file, "half-sine,50g,11ms");
     assert_eq!(i["spec"]["pass"], false);
     assert_eq!(i["spec"]["delta_v_pass"], false);
@@ -156,7 +155,7 @@ fn pulses_off_the_specification_fail_by_their_margin() {
     // 10 % of the peak. With the trigger above it (it is no impact of its own: one that is
     // ends the first one's capture inside its watched window, which is then not judged).
     let pulse = half_sine(50.0, 0.011);
-    let file = recording("spike", move |t| {
+    let file = recording(&scratch, "spike", move |t| {
         pulse(t)
             + if (0.019..0.01902).contains(&t) {
                 15.0
@@ -202,7 +201,8 @@ fn pulses_off_the_specification_fail_by_their_margin() {
 /// 2.5 s around it) is not judged: the verdict is null with its reason, never a guess.
 #[test]
 fn a_window_the_capture_cannot_hold_is_null_with_its_reason() {
-    let file = recording("long", half_sine(50.0, 0.011));
+    let scratch = Scratch::new();
+    let file = recording(&scratch, "long", half_sine(50.0, 0.011));
     let (i, _) = judged(&file, "half-sine,50g,1s");
     assert!(i["spec"].is_null(), "{}", i["spec"]);
     assert_eq!(i["null_reasons"]["spec"], "spec-window");
@@ -253,12 +253,13 @@ fn the_afrl_drop_tower_pulse_fails_in_its_ringing() {
 /// judged, and a band that cannot be one is refused naming the file and the fault.
 #[test]
 fn a_users_band_from_a_file_judges_as_written() {
+    let scratch = Scratch::new();
     let band = concat!(
         env!("CARGO_MANIFEST_DIR"),
         "/../docs/bands/half-sine-50g-11ms.csv"
     );
     let spec = format!("half-sine,50g,11ms,band-file={band}");
-    let file = recording("band-nominal", half_sine(50.0, 0.011));
+    let file = recording(&scratch, "band-nominal", half_sine(50.0, 0.011));
     let (i, j) = judged(&file, &spec);
     assert_eq!(i["spec"]["pass"], true, "{}", i["spec"]);
     let s = &j["spec"];
@@ -270,7 +271,7 @@ fn a_users_band_from_a_file_judges_as_written() {
         (f(&rows[4]["time_over_duration"]) - 0.5).abs() < 1e-6,
         "{s}"
     );
-    let file = recording("band-high", half_sine(57.0, 0.011));
+    let file = recording(&scratch, "band-high", half_sine(57.0, 0.011));
     let (iec, _) = judged(&file, "half-sine,50g,11ms");
     assert_eq!(iec["spec"]["pass"], true, "{}", iec["spec"]);
     let (i, _) = judged(&file, &spec);
@@ -286,8 +287,7 @@ fn a_users_band_from_a_file_judges_as_written() {
     // The table names the band; the report lists its rows.
     let (table, _) = impact_ok(&["analyze", &file, "--spec", &spec]);
     assert!(table.contains("the user's band of 9 rows"), "{table}");
-    let html = std::path::PathBuf::from(env!("CARGO_TARGET_TMPDIR"))
-        .join(format!("band-{}.html", std::process::id()));
+    let html = scratch.join("band.html");
     let html_s = html.to_string_lossy().into_owned();
     impact_ok(&["report", &file, "--spec", &spec, "--html", &html_s]);
     let page = std::fs::read_to_string(&html).unwrap();
@@ -297,7 +297,6 @@ fn a_users_band_from_a_file_judges_as_written() {
         "{page}"
     );
     // Bands that cannot be one.
-    let dir = std::path::PathBuf::from(env!("CARGO_TARGET_TMPDIR"));
     for (name, body, want) in [
         ("header", "t,lo,hi\n0,-1,1\n1,-1,1\n", "needs a time column"),
         // Limits in m/s² given in g: the nominal peak lies above them.
@@ -341,7 +340,7 @@ fn a_users_band_from_a_file_judges_as_written() {
         ),
         ("missing", "", "No such file"),
     ] {
-        let path = dir.join(format!("band-{}-{name}.csv", std::process::id()));
+        let path = scratch.join(&format!("band-{name}.csv"));
         if name != "missing" {
             std::fs::write(&path, body).unwrap();
         }
@@ -354,20 +353,17 @@ fn a_users_band_from_a_file_judges_as_written() {
     for k in 0..65 {
         long.push_str(&format!("{},-100,100\n", f64::from(k) * 0.0002));
     }
-    let path = dir.join(format!("band-{}-long.csv", std::process::id()));
-    std::fs::write(&path, long).unwrap();
+    let path = scratch.file("band-long.csv", long);
     let spec = format!("half-sine,50g,11ms,band-file={}", path.display());
     let (code, _, err) = impact(&["analyze", &file, "--spec", &spec]);
     common::assert_refused(Some(code), &err, "line 66: more than 64 rows", "long");
     // The same band over D and A, in a CRLF file: the same verdict.
-    let normalised = dir.join(format!("band-{}-normalised.csv", std::process::id()));
-    std::fs::write(
-        &normalised,
+    let normalised = scratch.file(
+        "band-normalised.csv",
         "time_over_duration,lower_over_peak,upper_over_peak\r\n-0.4,-0.2,0.2\r\n0,-0.2,0.2\r\n\
          0.2,-0.2,0.8\r\n0.35,0.4,1.1\r\n0.5,0.8,1.1\r\n0.65,0.4,1.1\r\n0.8,-0.2,0.8\r\n\
          1,-0.2,0.2\r\n1.5,-0.2,0.2\r\n",
-    )
-    .unwrap();
+    );
     let normalised_spec = format!("half-sine,50g,11ms,band-file={}", normalised.display());
     let (j, _) = judged(&file, &normalised_spec);
     assert!(

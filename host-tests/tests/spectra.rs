@@ -8,6 +8,9 @@ use impact_host::pipeline::options::SpectrumArgs;
 use impact_host::pipeline::{self, AnalyzeArgs, Units};
 use impact_host::report::spectrum::{self, ShockSpectrumJson};
 
+mod common;
+use common::Scratch;
+
 fn root() -> PathBuf {
     PathBuf::from(env!("CARGO_MANIFEST_DIR"))
 }
@@ -99,12 +102,9 @@ fn a_half_sines_spectra_agree_with_endaq() {
         };
         text.push_str(&format!("{:.6},{a:.9e}\n", k as f64 * 1e-6));
     }
-    let dir = std::env::temp_dir().join(format!("impact-srs-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
-    let file = dir.join("half-sine.csv");
-    std::fs::write(&file, text).unwrap();
+    let scratch = Scratch::new();
     let (s, board, _) = spectra(AnalyzeArgs {
-        file,
+        file: scratch.file("half-sine.csv", text),
         units: Some(Units::MS2),
         trigger: Some(impact_host::pipeline::level::Level::m_s2(100.0)),
         ..Default::default()

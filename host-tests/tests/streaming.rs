@@ -6,14 +6,7 @@ use std::io::Write;
 use std::process::{Command, Stdio};
 
 mod common;
-use common::impact_ok as impact;
-
-fn tmp(name: &str) -> String {
-    std::path::PathBuf::from(env!("CARGO_TARGET_TMPDIR"))
-        .join(format!("{}-{name}", std::process::id()))
-        .to_string_lossy()
-        .into_owned()
-}
+use common::{impact_ok as impact, Scratch};
 
 /// The seed bench's ADC codes (offset binary, 12 bits over ±800 m/s², so the full scale is
 /// 4096 codes, 1600 m/s²) at 500 kS/s.
@@ -53,7 +46,8 @@ const SEED_CSV_LEVELS: [&str; 10] = [
 
 #[test]
 fn a_raw_stream_gives_the_whole_files_reports() {
-    let raw = tmp("seed.i16");
+    let scratch = Scratch::new();
+    let raw = scratch.join_str("seed.i16");
     let args: Vec<&str> = ["synth", "--raw", &raw]
         .into_iter()
         .chain(impact_host::synth::SEED_BENCH_ARGS)
@@ -100,16 +94,19 @@ fn a_raw_stream_gives_the_whole_files_reports() {
     let (code, _, err) = common::impact(&["analyze", &raw, "--stream", "--rate", "500000"]);
     assert!(code != 0 && err.contains("--range"), "{err}");
     let (code, _, err) = common::impact(
-        &with(&["analyze", &raw], &["--stream", "--plot", &tmp("x.svg")])
-            .iter()
-            .map(String::as_str)
-            .collect::<Vec<_>>(),
+        &with(
+            &["analyze", &raw],
+            &["--stream", "--plot", &scratch.join_str("x.svg")],
+        )
+        .iter()
+        .map(String::as_str)
+        .collect::<Vec<_>>(),
     );
     assert!(
         code != 0 && err.contains("--plot needs the whole recording"),
         "{err}"
     );
-    let odd = tmp("odd.i16");
+    let odd = scratch.join_str("odd.i16");
     std::fs::write(&odd, &std::fs::read(&raw).unwrap()[..1001]).unwrap();
     let (code, _, err) = common::impact(
         &with(&["analyze", &odd], &["--stream"])
@@ -125,14 +122,14 @@ fn a_raw_stream_gives_the_whole_files_reports() {
 
 #[test]
 fn a_csv_stream_gives_the_whole_files_reports() {
+    let scratch = Scratch::new();
     let (csv, _) = impact(
         &["synth"]
             .into_iter()
             .chain(impact_host::synth::SEED_BENCH_ARGS)
             .collect::<Vec<_>>(),
     );
-    let file = tmp("seed.csv");
-    std::fs::write(&file, &csv).unwrap();
+    let file = scratch.text("seed.csv", &csv);
     let levels = SEED_CSV_LEVELS;
     let args = |head: &[&str], tail: &[&str]| -> Vec<String> {
         head.iter()
@@ -172,8 +169,7 @@ fn a_csv_stream_gives_the_whole_files_reports() {
         .map(|l| l.to_owned().leak() as &str)
         .collect();
     lines.remove(30_000);
-    let gap = tmp("gap.csv");
-    std::fs::write(&gap, lines.join("\n")).unwrap();
+    let gap = scratch.text("gap.csv", &lines.join("\n"));
     let (code, _, err) = common::impact(
         &args(&["analyze", &gap], &["--stream"])
             .iter()
@@ -188,6 +184,7 @@ fn a_csv_stream_gives_the_whole_files_reports() {
 
 #[test]
 fn a_wav_stream_gives_the_whole_files_reports() {
+    let scratch = Scratch::new();
     let wav = concat!(env!("CARGO_MANIFEST_DIR"), "/fixtures/afrl-test1-int16.wav");
     let levels = [
         "--gain",
@@ -213,7 +210,7 @@ fn a_wav_stream_gives_the_whole_files_reports() {
     assert_eq!(streamed, whole);
     assert!(whole.contains("peak_acceleration_m_s2"), "{whole}");
     // Cut in the middle of the data: an error naming the frame, as the whole-file reader's.
-    let cut = tmp("cut.wav");
+    let cut = scratch.join_str("cut.wav");
     let bytes = std::fs::read(wav).unwrap();
     std::fs::write(&cut, &bytes[..bytes.len() / 2 + 1]).unwrap();
     let args: Vec<&str> = ["analyze", &cut, "--stream"]
@@ -227,6 +224,7 @@ fn a_wav_stream_gives_the_whole_files_reports() {
 
 #[test]
 fn npy_streams_give_the_whole_files_reports_in_either_order() {
+    let scratch = Scratch::new();
     let dir = concat!(env!("CARGO_MANIFEST_DIR"), "/fixtures/");
     for (file, gain, range) in [
         ("afrl-test1-int16.npy", "0.001", "40kgn"),
@@ -265,7 +263,7 @@ fn npy_streams_give_the_whole_files_reports_in_either_order() {
     }
     // A file cut short: an error naming where its data ends.
     let bytes = std::fs::read(format!("{dir}afrl-test1-int16.npy")).unwrap();
-    let cut = tmp("cut.npy");
+    let cut = scratch.join_str("cut.npy");
     std::fs::write(&cut, &bytes[..bytes.len() - 1000]).unwrap();
     let (code, _, err) = common::impact(&[
         "analyze",
@@ -323,6 +321,7 @@ fn a_stream_longer_than_memory_is_analysed_in_bounded_memory() {
 /// read as in one pass: the same reports as the whole-file path, the same messages and lines.
 #[test]
 fn a_long_csv_file_gives_the_same_reports_and_errors_through_the_parallel_reader() {
+    let scratch = Scratch::new();
     let (csv, _) = impact(
         &["synth"]
             .into_iter()
@@ -341,11 +340,7 @@ fn a_long_csv_file_gives_the_same_reports_and_errors_through_the_parallel_reader
             .collect();
         common::impact(&v)
     };
-    let write = |name: &str, lines: &[String]| {
-        let path = tmp(name);
-        std::fs::write(&path, lines.join("\n") + "\n").unwrap();
-        path
-    };
+    let write = |name: &str, lines: &[String]| scratch.text(name, &(lines.join("\n") + "\n"));
     // Through a pipe on standard input (which cannot be read twice: the readers hand it
     // over on a tape).
     let run_stdin = |file: &str, tail: &[&str]| {
@@ -374,7 +369,7 @@ fn a_long_csv_file_gives_the_same_reports_and_errors_through_the_parallel_reader
     };
     let plain = write("long.csv", &lines);
     // The whole-file path (`--plot` holds the recording).
-    let svg = tmp("long.svg");
+    let svg = scratch.join_str("long.svg");
     let whole = run(&plain, &["--json", "--keep-spikes", "--plot", &svg]);
     assert_eq!(whole.0, 0, "{}", whole.2);
     assert_eq!(run_stdin(&plain, &["--json", "--keep-spikes"]).1, whole.1);
@@ -406,7 +401,7 @@ fn a_long_csv_file_gives_the_same_reports_and_errors_through_the_parallel_reader
     assert_eq!(run(&odd, &["--json", "--keep-spikes"]).1, whole.1);
     assert_eq!(run(&odd, &["--json", "--stream"]).1, whole.1);
     // The whole-file path from the pipe draws the same figure.
-    let piped_svg = tmp("long-piped.svg");
+    let piped_svg = scratch.join_str("long-piped.svg");
     let piped = run_stdin(&odd, &["--json", "--keep-spikes", "--plot", &piped_svg]);
     assert_eq!(piped.1, whole.1, "{}", piped.2);
     // (Titled with what was read: `-` or the file's name.)
@@ -456,6 +451,7 @@ fn a_long_csv_file_gives_the_same_reports_and_errors_through_the_parallel_reader
 /// a file cut short is one line naming it.
 #[test]
 fn tdms_streams_give_the_whole_files_reports() {
+    let scratch = Scratch::new();
     let tdms = concat!(env!("CARGO_MANIFEST_DIR"), "/fixtures/afrl-test1.tdms");
     for (column, gain, range) in [
         ("afrl/bottom_kgn", "1", "40000kgn"),
@@ -485,7 +481,7 @@ fn tdms_streams_give_the_whole_files_reports() {
         assert!(whole.contains("peak_time_s"), "{column}: no impact");
     }
     let bytes = std::fs::read(tdms).unwrap();
-    let cut = tmp("cut.tdms");
+    let cut = scratch.join_str("cut.tdms");
     std::fs::write(&cut, &bytes[..bytes.len() / 3]).unwrap();
     let (code, _, err) = common::impact(&[
         "analyze",

@@ -6,7 +6,7 @@
 mod common;
 
 use clap::Parser;
-use common::impact_ok;
+use common::{impact_ok, Scratch};
 use impact_host::synth::{bounce_train, SynthArgs};
 use serde_json::Value;
 
@@ -57,17 +57,11 @@ fn train(law: &[&str]) -> String {
     args.extend_from_slice(&["--duration", "2"]);
     let exact = exact(&args);
     assert_eq!(exact.len(), 8);
-    let dir = std::env::temp_dir().join(format!(
-        "impact-train-{}-{}",
-        std::process::id(),
-        law.join("_")
-    ));
-    std::fs::create_dir_all(&dir).unwrap();
-    let csv = dir.join("train.csv");
+    let scratch = Scratch::new();
     let synth: Vec<&str> = std::iter::once("synth")
         .chain(args.iter().copied())
         .collect();
-    std::fs::write(&csv, impact_ok(&synth).0).unwrap();
+    let csv = scratch.file("train.csv", impact_ok(&synth).0);
     let mut verdicts = Vec::new();
     for speed in ["flight", "rebound"] {
         let a = analyse(&csv, speed);
@@ -114,7 +108,6 @@ fn train(law: &[&str]) -> String {
                 .to_string(),
         );
     }
-    std::fs::remove_dir_all(&dir).ok();
     assert_eq!(verdicts[0], verdicts[1], "both sources tell the same");
     verdicts.remove(0)
 }
@@ -164,10 +157,8 @@ fn without_train_a_bounce_has_no_speed_and_a_long_flight_starts_a_new_train() {
         "--duration",
         "0.6",
     ];
-    let dir = std::env::temp_dir().join(format!("impact-train-flight-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
-    let csv = dir.join("train.csv");
-    std::fs::write(&csv, impact_ok(&args).0).unwrap();
+    let scratch = Scratch::new();
+    let csv = scratch.file("train.csv", impact_ok(&args).0);
     let path = csv.to_str().unwrap();
     // Without --train every impact takes --v0 (a horizontal bench's repeated impacts).
     let (out, _) = impact_ok(&["analyze", path, "--v0", "1.3357", "--json"]);
@@ -205,7 +196,6 @@ fn without_train_a_bounce_has_no_speed_and_a_long_flight_starts_a_new_train() {
     assert!(impacts[1]["impact_velocity_m_s"].as_f64().unwrap() > 1.0);
     assert!(impacts[1]["bounce"]["v0_rebound_m_s"].is_null());
     assert!(impacts[2]["bounce"]["v0_rebound_m_s"].as_f64().is_some());
-    std::fs::remove_dir_all(&dir).ok();
 }
 
 /// A soft Hunt–Crossley contact (`k x^1.5 (1 + c v)`: 36–45 ms contacts, as long as half the

@@ -13,14 +13,7 @@ use std::time::{Duration, Instant};
 
 mod common;
 use common::board_log::{heartbeat, impact_line, summary, SCENE};
-
-fn tmp(name: &str) -> PathBuf {
-    let p = PathBuf::from(env!("CARGO_TARGET_TMPDIR"))
-        .join(format!("watch-{}-{name}", std::process::id()));
-    let _ = std::fs::remove_file(&p);
-    let _ = std::fs::remove_dir_all(&p);
-    p
-}
+use common::Scratch;
 
 /// A running `impact watch` (killed when dropped), its standard input and its address.
 struct Watch {
@@ -144,7 +137,8 @@ fn board_log(impacts: u64, restart: Option<u64>) -> Vec<String> {
 
 #[test]
 fn the_terminal_view_prints_every_impact_and_the_health() {
-    let session = tmp("terminal.log");
+    let scratch = Scratch::new();
+    let session = scratch.join("terminal.log");
     let log = board_log(30, Some(20));
     let text = log.join("\n") + "\n";
     let mut child = Command::new(env!("CARGO_BIN_EXE_impact"))
@@ -204,13 +198,14 @@ fn the_terminal_view_prints_every_impact_and_the_health() {
 #[cfg(target_os = "linux")]
 #[test]
 fn ten_thousand_impacts_keep_memory_flat_and_a_slow_page_never_holds_up_the_board() {
-    let session = tmp("10k.log");
+    let scratch = Scratch::new();
+    let session = scratch.join("10k.log");
     let mut w = Watch::start(&session, &[]);
     // A page that connects and never reads.
     let mut stuck = TcpStream::connect(&w.addr).unwrap();
     write!(stuck, "GET /events HTTP/1.1\r\nHost: localhost\r\n\r\n").unwrap();
     // And a real page, when there is a browser: it keeps up with the end of the session.
-    let browser = common::browser::chromium().map(|b| open_browser(b, &w.addr, "10k"));
+    let browser = common::browser::chromium().map(|b| open_browser(b, &w.addr, &scratch, "10k"));
     if browser.is_some() {
         wait_for_page(&w);
     }
@@ -290,8 +285,9 @@ fn ten_thousand_impacts_keep_memory_flat_and_a_slow_page_never_holds_up_the_boar
     drop(stuck);
 }
 
-/// A headless Chromium on the view's page (killed with its process group when dropped).
-fn open_browser(browser: &str, addr: &str, name: &str) -> Ended {
+/// A headless Chromium on the view's page (killed with its process group when dropped), its
+/// profile in `scratch`.
+fn open_browser(browser: &str, addr: &str, scratch: &Scratch, name: &str) -> Ended {
     use std::os::unix::process::CommandExt;
     let child = Command::new(browser)
         // Its own process group: its renderers and helpers end with it.
@@ -305,7 +301,7 @@ fn open_browser(browser: &str, addr: &str, name: &str) -> Ended {
             "--enable-precise-memory-info",
             &format!(
                 "--user-data-dir={}",
-                tmp(&format!("profile-{name}")).display()
+                scratch.join(&format!("profile-{name}")).display()
             ),
             &format!("http://{addr}/"),
         ])
@@ -389,6 +385,7 @@ fn shown(x: f64) -> String {
 /// summary) the health panel says so within two heartbeats.
 #[test]
 fn an_emulated_train_shows_live_in_a_headless_browser() {
+    let scratch = Scratch::new();
     let Some(browser) = common::browser::chromium() else {
         return;
     };
@@ -397,7 +394,7 @@ fn an_emulated_train_shows_live_in_a_headless_browser() {
         eprintln!("SKIPPED: {e}");
         return;
     }
-    let train = tmp("train.csv");
+    let train = scratch.join("train.csv");
     common::impact_ok(&[
         "synth",
         "--model",
@@ -419,8 +416,8 @@ fn an_emulated_train_shows_live_in_a_headless_browser() {
     ]);
     // 2.4 ms bounces from 81 g down: the 60 g ones pass, the others fail.
     let spec = "half-sine,60g,2.45ms";
-    let mut w = Watch::start(&tmp("live.log"), &["--spec", spec]);
-    let _page = open_browser(browser, &w.addr, "live");
+    let mut w = Watch::start(&scratch.join("live.log"), &["--spec", spec]);
+    let _page = open_browser(browser, &w.addr, &scratch, "live");
     wait_for_page(&w);
     // The emulated board's lines, forwarded as they come; its summary held back, so the
     // board falls silent instead of ending.
@@ -570,13 +567,14 @@ fn an_emulated_train_shows_live_in_a_headless_browser() {
 /// tool started are shown.
 #[test]
 fn a_growing_log_file_is_followed() {
-    let file = tmp("growing.log");
+    let scratch = Scratch::new();
+    let file = scratch.join("growing.log");
     let log = board_log(6, None);
     let (head, tail) = log.split_at(4);
     std::fs::write(&file, head.join("\n") + "\n").unwrap();
     let mut child = Command::new(env!("CARGO_BIN_EXE_impact"))
         .args(["watch", "--terminal", "--session"])
-        .arg(tmp("growing-session.log"))
+        .arg(scratch.join("growing-session.log"))
         .arg(&file)
         .stdout(Stdio::piped())
         .stderr(Stdio::null())
@@ -621,14 +619,15 @@ fn a_growing_log_file_is_followed() {
 /// The firmware's raw defmt stream, decoded against its ELF as it arrives.
 #[test]
 fn a_raw_defmt_stream_is_decoded_live() {
+    let scratch = Scratch::new();
     if let Err(e) = impact_host::firmware_link::qemu::tools_available() {
         assert!(std::env::var_os("IMPACT_REQUIRE_EMULATOR").is_none(), "{e}");
         eprintln!("SKIPPED: {e}");
         return;
     }
     let elf = impact_host::firmware_link::qemu::build_firmware().unwrap();
-    let seed = tmp("seed.csv");
-    let raw = tmp("seed.defmt");
+    let seed = scratch.join("seed.csv");
+    let raw = scratch.join("seed.defmt");
     std::fs::write(&seed, common::synth_t2()).unwrap();
     common::impact_ok(&[
         "emulate",
@@ -650,7 +649,7 @@ fn a_raw_defmt_stream_is_decoded_live() {
         "--terminal",
         "--once",
         "--session",
-        tmp("raw-session.log").to_str().unwrap(),
+        scratch.join("raw-session.log").to_str().unwrap(),
     ]);
     let impacts: Vec<&str> = out.lines().filter(|l| l.contains(" impact ")).collect();
     assert_eq!(impacts.len(), 1, "{out}");

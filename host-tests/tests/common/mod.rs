@@ -93,6 +93,28 @@ pub fn assert_refused(code: Option<i32>, err: &str, want: &str, what: &str) {
     assert!(!err.contains("panicked"), "{what}: {err}");
 }
 
+/// A refusal of a file: [`assert_refused`], on one line whatever the exit code (a usage
+/// error included), and naming the file (its name, where the message shows its path).
+#[allow(dead_code)] // not every test file needs it
+pub fn assert_refused_file(
+    code: Option<i32>,
+    err: &str,
+    want: &str,
+    file: &std::path::Path,
+    what: &str,
+) {
+    assert_refused(code, err, want, what);
+    assert_eq!(err.trim().lines().count(), 1, "{what}: {err}");
+    let name = file
+        .file_name()
+        .and_then(|n| n.to_str())
+        .expect("a file name");
+    assert!(
+        err.contains(name),
+        "{what}: wanted the file {name:?} in {err}"
+    );
+}
+
 /// A figure's title (its first text) and the figure without it.
 #[allow(dead_code)] // not every test file needs it
 pub fn untitled(svg: &str) -> (String, String) {
@@ -127,10 +149,23 @@ impl Scratch {
         self.0.path().join(name)
     }
 
+    /// `name` in the folder (not written), as a string: a command-line argument.
+    pub fn join_str(&self, name: &str) -> String {
+        self.join(name).to_str().expect("a UTF-8 path").to_string()
+    }
+
     /// `name` in the folder, written with `bytes`.
     pub fn file(&self, name: &str, bytes: impl AsRef<[u8]>) -> std::path::PathBuf {
         let path = self.join(name);
         std::fs::write(&path, bytes).expect("a scratch file written");
+        path
+    }
+
+    /// `name` in the folder, written with `text`: its path as a string (a command-line
+    /// argument).
+    pub fn text(&self, name: &str, text: &str) -> String {
+        let path = self.join_str(name);
+        std::fs::write(&path, text).expect("a scratch file written");
         path
     }
 }
