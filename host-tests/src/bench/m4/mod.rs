@@ -323,254 +323,358 @@ pub fn run(args: &M4Args) -> Result<(M4Report, String), String> {
         None => build()?,
     };
     let code = disassemble(&elf)?;
+    let files = BenchFiles::new()?;
     let samples = seed_recording()?;
-    let dir = std::env::temp_dir();
-    let nanos = std::time::SystemTime::now()
-        .duration_since(std::time::UNIX_EPOCH)
-        .map_or(0, |d| d.subsec_nanos());
-    let stem = format!("impact-m4-{}-{nanos}", std::process::id());
-    let raw = dir.join(format!("{stem}.i16"));
     let bytes: Vec<u8> = samples.iter().flat_map(|c| c.to_le_bytes()).collect();
-    std::fs::write(&raw, bytes).map_err(|e| format!("{}: {e}", raw.display()))?;
-    let trace_jobs = dir.join(format!("{stem}-trace.txt"));
-    let count_jobs = dir.join(format!("{stem}-count.txt"));
-    let _temporaries = [&raw, &trace_jobs, &count_jobs].map(|p| crate::interrupt::temporary(p));
-    let result = (|| {
-        std::fs::write(
-            &trace_jobs,
-            format!("selftest\n{}\nstream pipeline\n", scene_line(NO_FITS)),
-        )
-        .map_err(|e| e.to_string())?;
-        // Trace run: per-block regions.
-        let mut regions: Vec<Region> = Vec::new();
-        let mut profile: Vec<HashMap<String, u64>> = Vec::new();
-        let mut state = TraceState::default();
-        let mut on_line =
-            |line: &str| state.line(line, &code, &mut regions, &mut profile, args.profile);
-        let out = run_qemu(
-            &elf,
-            &["trace".into(), path_arg(&raw)?, path_arg(&trace_jobs)?],
-            Some(&mut on_line),
-            false,
-        )?;
-        if !out.lines().any(|l| l == "selftest ok") {
-            return Err(format!("the M4 self-test did not pass:\n{out}"));
-        }
-        let kinds: String = out
-            .lines()
-            .filter_map(|l| l.strip_prefix("kinds "))
-            .collect();
-        if kinds.len() != regions.len() {
-            return Err(format!(
-                "trace: {} regions for {} blocks",
-                regions.len(),
-                kinds.len()
-            ));
-        }
-        let stream = out
-            .lines()
-            .find(|l| l.starts_with("stream "))
-            .map(fields)
-            .ok_or("trace run: no stream line")?;
-        let n_samples: usize = number(&stream, "samples")?;
-        let block: usize = number(&stream, "block")?;
-        let reports: u32 = number(&stream, "reports")?;
-        if reports != 1 {
-            return Err(format!("the seed recording gave {reports} reports, not 1"));
-        }
-        let mut per_kind: HashMap<char, (Region, usize, u64)> = HashMap::new();
-        for (k, (kind, r)) in kinds.chars().zip(&regions).enumerate() {
-            let len = block.min(n_samples.saturating_sub(k * block)) as u64;
-            let e = per_kind.entry(kind).or_default();
-            e.0.instructions += r.instructions;
-            e.0.cycles += r.cycles;
-            e.1 += 1;
-            e.2 += len;
-        }
-        let get = |k: char| per_kind.get(&k).copied().unwrap_or_default();
-        let (idle, _, idle_n) = get('i');
-        let (active, _, active_n) = get('a');
-        let (trigger, _, trigger_n) = get('t');
-        let (end, _, end_n) = get('e');
-        if idle_n == 0 || active_n == 0 || trigger_n == 0 || end_n == 0 {
-            return Err(format!("trace: unexpected block kinds {kinds}"));
-        }
-        let per = |r: Region, n: u64| r.instructions as f64 / n as f64;
-        let per_c = |r: Region, n: u64| r.cycles as f64 / n as f64;
-        let idle_ips = per(idle, idle_n);
-        let impact_ips = per(active, active_n);
-        // The trigger and end blocks: their samples at the in-impact rate, the rest per impact.
-        let trigger_instructions =
-            (trigger.instructions as f64 - impact_ips * trigger_n as f64).max(0.0) as u64;
-        let report_instructions =
-            (end.instructions as f64 - impact_ips * end_n as f64).max(0.0) as u64;
-        let idle_cps = per_c(idle, idle_n);
-        let impact_cps = per_c(active, active_n);
-        let worst = idle_cps.max(impact_cps);
-
-        // Count run: fits, solves, maths.
-        let mut jobs = String::new();
-        jobs.push_str(&format!("{}\nstream no-fit\n", scene_line(NO_FITS)));
-        for (i, (_, keys)) in FIT_VARIANTS.iter().enumerate() {
-            jobs.push_str(&format!("{}\nstream fit{i}\n", scene_line(keys)));
-        }
-        jobs.push_str(&format!("{}\nstream srs\n", scene_line(SPECTRUM_KEYS)));
-        jobs.push_str(&format!("{}\nstream spec\n", scene_line(SPEC_KEYS)));
-        jobs.push_str(&format!(
-            "{}\nstream spec-band\n",
-            scene_line(&format!("{SPEC_KEYS} {SPEC_BAND_KEYS}"))
-        ));
-        let mut solve_rows = Vec::new();
-        for case in solve_cases() {
-            let exact = solve(&case.model, &case.impact, &Settings::exact())
-                .map_err(|e| format!("{}: {e}", case.name))?;
-            let (model, params) = f32_model(&case.model);
-            let impact = Impact::new(case.impact.mass_kg as f32, case.impact.v0_m_s as f32);
-            for method in [
-                Method::Exact,
-                Method::Euler,
-                Method::Verlet,
-                Method::Rk4,
-                Method::Adaptive,
-            ] {
-                let Some((s, o, e)) = board_setting(&model, &impact, &exact, method) else {
-                    continue;
-                };
-                let knob = match method {
-                    Method::Exact => "0".to_string(),
-                    Method::Adaptive => format!("{:e}", s.rtol),
-                    _ => s.steps.to_string(),
-                };
-                let label = format!("s{}", solve_rows.len());
-                // Repeated so that SysTick's 40-instruction resolution stays below 0.1 %
-                // (Euler's solves are millions of instructions already).
-                let reps = if method == Method::Euler { 1 } else { 64 };
-                jobs.push_str(&format!(
-                    "solve {label} {reps} {} {knob} {:e} {:e} {params}\n",
-                    method.name(),
-                    impact.mass_kg,
-                    impact.v0_m_s
-                ));
-                let setting = match method {
-                    Method::Exact => 0.0,
-                    Method::Adaptive => s.rtol as f64,
-                    _ => s.steps as f64,
-                };
-                solve_rows.push((label, case.name, method, setting, e, bits(&o)));
-            }
-        }
-        let mut math_rows = Vec::new();
-        jobs.push_str("math none libm 0 1\n");
-        for (op, reference, range, backends) in maths() {
-            for b in backends {
-                jobs.push_str(&format!("math {op} {b} {:e} {:e}\n", range.0, range.1));
-                let f = host_math(op, b).ok_or("no host maths function")?;
-                math_rows.push((op, *b, math_error(f, reference, range)));
-            }
-        }
-        std::fs::write(&count_jobs, jobs).map_err(|e| e.to_string())?;
-        let out = run_qemu(
-            &elf,
-            &["count".into(), path_arg(&raw)?, path_arg(&count_jobs)?],
-            None,
-            true,
-        )?;
-        let lines: Vec<&str> = out.lines().collect();
-        let find = |prefix: &str| {
-            lines
+    std::fs::write(&files.raw, bytes).map_err(|e| format!("{}: {e}", files.raw.display()))?;
+    let streaming = trace_run(&elf, &code, &files, args.profile)?;
+    let counted = count_run(&elf, &files)?;
+    let firmware = crate::firmware_link::qemu::build_firmware()?;
+    let firmware_idle = firmware_idle_marginal(&firmware)?;
+    let s = &streaming;
+    let worst = s.idle_cps.max(s.impact_cps);
+    let report = M4Report {
+        block: s.block,
+        idle_instructions_per_sample: s.idle_ips,
+        impact_instructions_per_sample: s.impact_ips,
+        idle_cycles_per_sample: s.idle_cps,
+        impact_cycles_per_sample: s.impact_cps,
+        estimated_cycles_per_sample: worst,
+        headroom_at_500k: 1.0 - worst / (BOARD_CLOCK_HZ / SEED_RATE_HZ),
+        headroom_at_adc_top_rate: 1.0 - worst / (BOARD_CLOCK_HZ / ADC_TOP_RATE_HZ),
+        trigger_instructions: s.trigger_instructions,
+        report_instructions: s.report_instructions,
+        impact_samples: s.impact_samples,
+        analysis_instructions: s.report_instructions
+            + counted
+                .fits
                 .iter()
-                .find(|l| l.starts_with(prefix))
-                .map(|l| fields(l))
-                .ok_or_else(|| format!("count run: no `{prefix}` line"))
-        };
-        let cal = find("calibrate ")?;
-        let ipt = number::<f64>(&cal, "instructions")? / number::<f64>(&cal, "ticks")?;
-        let ticks_total = |label: &str| -> Result<f64, String> {
-            number::<f64>(&find(&format!("ticks {label} "))?, "total")
-        };
-        let base = ticks_total("no-fit")?;
-        let mut fits = Vec::new();
-        for (i, (name, _)) in FIT_VARIANTS.iter().enumerate() {
-            let s = find(&format!("stream fit{i} "))?;
-            let got: String = number(&s, "fits")?;
-            if !got.contains('1') {
-                return Err(format!("the {name} fit gave no result on the seed impact"));
-            }
-            fits.push(FitCost {
-                fit: name.to_string(),
-                instructions: ((ticks_total(&format!("fit{i}"))? - base) * ipt).max(0.0) as u64,
-            });
-        }
-        let spectrum_instructions = ((ticks_total("srs")? - base) * ipt).max(0.0) as u64;
-        let spec_instructions = ((ticks_total("spec")? - base) * ipt).max(0.0) as u64;
-        let spec_band_instructions = ((ticks_total("spec-band")? - base) * ipt).max(0.0) as u64;
-        let mut solves = Vec::new();
-        for (label, case, method, setting, error, host_bits) in solve_rows {
-            let s = find(&format!("solve {label} "))?;
-            let ok: u32 = number(&s, "ok")?;
-            let m4_bits = s.get("bits").copied().unwrap_or("");
-            solves.push(SolveCost {
-                case: case.to_string(),
-                method: method.name().to_string(),
-                setting,
-                error,
-                instructions: (number::<f64>(&s, "ticks")? * ipt / number::<f64>(&s, "reps")?)
-                    .round() as u64,
-                same_bits_as_host: ok == 1 && m4_bits == host_bits,
-            });
-        }
-        let loop_ticks = number::<f64>(&find("math none libm ")?, "ticks")?;
-        let mut maths_out = Vec::new();
-        for (op, b, err) in math_rows {
-            let m = find(&format!("math {op} {b} "))?;
-            let calls: f64 = number(&m, "calls")?;
-            let ticks: f64 = number(&m, "ticks")?;
-            maths_out.push(MathCost {
-                op: op.to_string(),
-                backend: b.to_string(),
-                instructions_per_call: ((ticks - loop_ticks) * ipt / calls).max(0.0),
-                max_relative_error: err,
-            });
-        }
-        let firmware = crate::firmware_link::qemu::build_firmware()?;
-        let firmware_idle = firmware_idle_marginal(&firmware)?;
-        let report = M4Report {
-            block,
-            idle_instructions_per_sample: idle_ips,
-            impact_instructions_per_sample: impact_ips,
-            idle_cycles_per_sample: idle_cps,
-            impact_cycles_per_sample: impact_cps,
-            estimated_cycles_per_sample: worst,
-            headroom_at_500k: 1.0 - worst / (BOARD_CLOCK_HZ / SEED_RATE_HZ),
-            headroom_at_adc_top_rate: 1.0 - worst / (BOARD_CLOCK_HZ / ADC_TOP_RATE_HZ),
-            trigger_instructions,
-            report_instructions,
-            impact_samples: trigger_n + active_n + end_n,
-            analysis_instructions: report_instructions
-                + fits
-                    .iter()
-                    .find(|f| f.fit == BOARD_FITS)
-                    .map_or(0, |f| f.instructions),
-            spectrum_instructions,
-            spec_instructions,
-            spec_band_instructions,
-            fits,
-            solves,
-            maths: maths_out,
-            instructions_per_tick: ipt,
-            firmware_idle_instructions_per_sample: firmware_idle,
-        };
-        let prof = if args.profile {
-            profile_text(&kinds, &profile)
-        } else {
-            String::new()
-        };
-        Ok((report, prof))
-    })();
-    for f in [&raw, &trace_jobs, &count_jobs] {
-        let _ = std::fs::remove_file(f);
+                .find(|f| f.fit == BOARD_FITS)
+                .map_or(0, |f| f.instructions),
+        spectrum_instructions: counted.spectrum_instructions,
+        spec_instructions: counted.spec_instructions,
+        spec_band_instructions: counted.spec_band_instructions,
+        fits: counted.fits,
+        solves: counted.solves,
+        maths: counted.maths,
+        instructions_per_tick: counted.instructions_per_tick,
+        firmware_idle_instructions_per_sample: firmware_idle,
+    };
+    let prof = if args.profile {
+        profile_text(&s.kinds, &s.profile)
+    } else {
+        String::new()
+    };
+    Ok((report, prof))
+}
+
+/// The bench's temporary files (the seed recording's counts, the two runs' job lists),
+/// removed when dropped or on an interrupt.
+struct BenchFiles {
+    raw: PathBuf,
+    trace_jobs: PathBuf,
+    count_jobs: PathBuf,
+    _guards: [crate::interrupt::FileGuard; 3],
+}
+
+impl BenchFiles {
+    fn new() -> Result<Self, String> {
+        let dir = std::env::temp_dir();
+        let nanos = std::time::SystemTime::now()
+            .duration_since(std::time::UNIX_EPOCH)
+            .map_or(0, |d| d.subsec_nanos());
+        let stem = format!("impact-m4-{}-{nanos}", std::process::id());
+        let raw = dir.join(format!("{stem}.i16"));
+        let trace_jobs = dir.join(format!("{stem}-trace.txt"));
+        let count_jobs = dir.join(format!("{stem}-count.txt"));
+        let _guards = [&raw, &trace_jobs, &count_jobs].map(|p| crate::interrupt::temporary(p));
+        Ok(Self {
+            raw,
+            trace_jobs,
+            count_jobs,
+            _guards,
+        })
     }
-    result
+}
+
+impl Drop for BenchFiles {
+    fn drop(&mut self) {
+        for f in [&self.raw, &self.trace_jobs, &self.count_jobs] {
+            let _ = std::fs::remove_file(f);
+        }
+    }
+}
+
+/// What the trace run measured of the streaming path: per sample idle and in an impact
+/// (instructions and estimated cycles), the trigger's and the report's own cost, the block
+/// size, the impact's samples; each block's kind and (with `--profile`) its per-function
+/// profile.
+struct Streaming {
+    block: usize,
+    idle_ips: f64,
+    impact_ips: f64,
+    idle_cps: f64,
+    impact_cps: f64,
+    trigger_instructions: u64,
+    report_instructions: u64,
+    impact_samples: u64,
+    kinds: String,
+    profile: Vec<HashMap<String, u64>>,
+}
+
+/// The trace run: every block's instructions counted exactly, then averaged by the block's
+/// kind (idle, trigger, in the impact, end).
+fn trace_run(
+    elf: &Path,
+    code: &disasm::Code,
+    files: &BenchFiles,
+    profiling: bool,
+) -> Result<Streaming, String> {
+    std::fs::write(
+        &files.trace_jobs,
+        format!("selftest\n{}\nstream pipeline\n", scene_line(NO_FITS)),
+    )
+    .map_err(|e| e.to_string())?;
+    // Per-block regions.
+    let mut regions: Vec<Region> = Vec::new();
+    let mut profile: Vec<HashMap<String, u64>> = Vec::new();
+    let mut state = TraceState::default();
+    let mut on_line = |line: &str| state.line(line, code, &mut regions, &mut profile, profiling);
+    let out = run_qemu(
+        elf,
+        &[
+            "trace".into(),
+            path_arg(&files.raw)?,
+            path_arg(&files.trace_jobs)?,
+        ],
+        Some(&mut on_line),
+        false,
+    )?;
+    if !out.lines().any(|l| l == "selftest ok") {
+        return Err(format!("the M4 self-test did not pass:\n{out}"));
+    }
+    let kinds: String = out
+        .lines()
+        .filter_map(|l| l.strip_prefix("kinds "))
+        .collect();
+    if kinds.len() != regions.len() {
+        return Err(format!(
+            "trace: {} regions for {} blocks",
+            regions.len(),
+            kinds.len()
+        ));
+    }
+    let stream = out
+        .lines()
+        .find(|l| l.starts_with("stream "))
+        .map(fields)
+        .ok_or("trace run: no stream line")?;
+    let n_samples: usize = number(&stream, "samples")?;
+    let block: usize = number(&stream, "block")?;
+    let reports: u32 = number(&stream, "reports")?;
+    if reports != 1 {
+        return Err(format!("the seed recording gave {reports} reports, not 1"));
+    }
+    let mut per_kind: HashMap<char, (Region, usize, u64)> = HashMap::new();
+    for (k, (kind, r)) in kinds.chars().zip(&regions).enumerate() {
+        let len = block.min(n_samples.saturating_sub(k * block)) as u64;
+        let e = per_kind.entry(kind).or_default();
+        e.0.instructions += r.instructions;
+        e.0.cycles += r.cycles;
+        e.1 += 1;
+        e.2 += len;
+    }
+    let get = |k: char| per_kind.get(&k).copied().unwrap_or_default();
+    let (idle, _, idle_n) = get('i');
+    let (active, _, active_n) = get('a');
+    let (trigger, _, trigger_n) = get('t');
+    let (end, _, end_n) = get('e');
+    if idle_n == 0 || active_n == 0 || trigger_n == 0 || end_n == 0 {
+        return Err(format!("trace: unexpected block kinds {kinds}"));
+    }
+    let per = |r: Region, n: u64| r.instructions as f64 / n as f64;
+    let per_c = |r: Region, n: u64| r.cycles as f64 / n as f64;
+    let impact_ips = per(active, active_n);
+    // The trigger and end blocks: their samples at the in-impact rate, the rest per impact.
+    let own = |r: Region, n: u64| (r.instructions as f64 - impact_ips * n as f64).max(0.0) as u64;
+    Ok(Streaming {
+        block,
+        idle_ips: per(idle, idle_n),
+        impact_ips,
+        idle_cps: per_c(idle, idle_n),
+        impact_cps: per_c(active, active_n),
+        trigger_instructions: own(trigger, trigger_n),
+        report_instructions: own(end, end_n),
+        impact_samples: trigger_n + active_n + end_n,
+        kinds,
+        profile,
+    })
+}
+
+/// What the count run measured: each fit variant's, the spectra's and the verdicts' cost per
+/// impact, the f32 solves and the maths back-ends, and SysTick's instructions per tick.
+struct Counted {
+    fits: Vec<FitCost>,
+    spectrum_instructions: u64,
+    spec_instructions: u64,
+    spec_band_instructions: u64,
+    solves: Vec<SolveCost>,
+    maths: Vec<MathCost>,
+    instructions_per_tick: f64,
+}
+
+/// A solve the count run times: its label in the jobs, the case, the method, its setting,
+/// the host's error and the host's result bits.
+type SolveJob = (String, &'static str, Method, f64, f64, String);
+
+/// A maths back-end the count run times: the operation, the back-end and its host error.
+type MathJob = (&'static str, &'static str, f64);
+
+/// The count run's jobs: the stream with each fit variant, the spectra and the verdicts; the
+/// f32 solves of every case and method the board would use; each maths back-end.
+fn count_jobs() -> Result<(String, Vec<SolveJob>, Vec<MathJob>), String> {
+    let mut jobs = String::new();
+    jobs.push_str(&format!("{}\nstream no-fit\n", scene_line(NO_FITS)));
+    for (i, (_, keys)) in FIT_VARIANTS.iter().enumerate() {
+        jobs.push_str(&format!("{}\nstream fit{i}\n", scene_line(keys)));
+    }
+    jobs.push_str(&format!("{}\nstream srs\n", scene_line(SPECTRUM_KEYS)));
+    jobs.push_str(&format!("{}\nstream spec\n", scene_line(SPEC_KEYS)));
+    jobs.push_str(&format!(
+        "{}\nstream spec-band\n",
+        scene_line(&format!("{SPEC_KEYS} {SPEC_BAND_KEYS}"))
+    ));
+    let mut solve_rows = Vec::new();
+    for case in solve_cases() {
+        let exact = solve(&case.model, &case.impact, &Settings::exact())
+            .map_err(|e| format!("{}: {e}", case.name))?;
+        let (model, params) = f32_model(&case.model);
+        let impact = Impact::new(case.impact.mass_kg as f32, case.impact.v0_m_s as f32);
+        for method in [
+            Method::Exact,
+            Method::Euler,
+            Method::Verlet,
+            Method::Rk4,
+            Method::Adaptive,
+        ] {
+            let Some((s, o, e)) = board_setting(&model, &impact, &exact, method) else {
+                continue;
+            };
+            let knob = match method {
+                Method::Exact => "0".to_string(),
+                Method::Adaptive => format!("{:e}", s.rtol),
+                _ => s.steps.to_string(),
+            };
+            let label = format!("s{}", solve_rows.len());
+            // Repeated so that SysTick's 40-instruction resolution stays below 0.1 %
+            // (Euler's solves are millions of instructions already).
+            let reps = if method == Method::Euler { 1 } else { 64 };
+            jobs.push_str(&format!(
+                "solve {label} {reps} {} {knob} {:e} {:e} {params}\n",
+                method.name(),
+                impact.mass_kg,
+                impact.v0_m_s
+            ));
+            let setting = match method {
+                Method::Exact => 0.0,
+                Method::Adaptive => s.rtol as f64,
+                _ => s.steps as f64,
+            };
+            solve_rows.push((label, case.name, method, setting, e, bits(&o)));
+        }
+    }
+    let mut math_rows = Vec::new();
+    jobs.push_str("math none libm 0 1\n");
+    for (op, reference, range, backends) in maths() {
+        for b in backends {
+            jobs.push_str(&format!("math {op} {b} {:e} {:e}\n", range.0, range.1));
+            let f = host_math(op, b).ok_or("no host maths function")?;
+            math_rows.push((op, *b, math_error(f, reference, range)));
+        }
+    }
+    Ok((jobs, solve_rows, math_rows))
+}
+
+/// The count run ([`count_jobs`] under `-icount`, timed by SysTick, calibrated each run).
+fn count_run(elf: &Path, files: &BenchFiles) -> Result<Counted, String> {
+    let (jobs, solve_rows, math_rows) = count_jobs()?;
+    std::fs::write(&files.count_jobs, jobs).map_err(|e| e.to_string())?;
+    let out = run_qemu(
+        elf,
+        &[
+            "count".into(),
+            path_arg(&files.raw)?,
+            path_arg(&files.count_jobs)?,
+        ],
+        None,
+        true,
+    )?;
+    let lines: Vec<&str> = out.lines().collect();
+    let find = |prefix: &str| {
+        lines
+            .iter()
+            .find(|l| l.starts_with(prefix))
+            .map(|l| fields(l))
+            .ok_or_else(|| format!("count run: no `{prefix}` line"))
+    };
+    let cal = find("calibrate ")?;
+    let ipt = number::<f64>(&cal, "instructions")? / number::<f64>(&cal, "ticks")?;
+    let ticks_total = |label: &str| -> Result<f64, String> {
+        number::<f64>(&find(&format!("ticks {label} "))?, "total")
+    };
+    let base = ticks_total("no-fit")?;
+    let over_base = |label: &str| -> Result<u64, String> {
+        Ok(((ticks_total(label)? - base) * ipt).max(0.0) as u64)
+    };
+    let mut fits = Vec::new();
+    for (i, (name, _)) in FIT_VARIANTS.iter().enumerate() {
+        let s = find(&format!("stream fit{i} "))?;
+        let got: String = number(&s, "fits")?;
+        if !got.contains('1') {
+            return Err(format!("the {name} fit gave no result on the seed impact"));
+        }
+        fits.push(FitCost {
+            fit: name.to_string(),
+            instructions: over_base(&format!("fit{i}"))?,
+        });
+    }
+    let mut solves = Vec::new();
+    for (label, case, method, setting, error, host_bits) in solve_rows {
+        let s = find(&format!("solve {label} "))?;
+        let ok: u32 = number(&s, "ok")?;
+        let m4_bits = s.get("bits").copied().unwrap_or("");
+        solves.push(SolveCost {
+            case: case.to_string(),
+            method: method.name().to_string(),
+            setting,
+            error,
+            instructions: (number::<f64>(&s, "ticks")? * ipt / number::<f64>(&s, "reps")?).round()
+                as u64,
+            same_bits_as_host: ok == 1 && m4_bits == host_bits,
+        });
+    }
+    let loop_ticks = number::<f64>(&find("math none libm ")?, "ticks")?;
+    let mut maths = Vec::new();
+    for (op, b, err) in math_rows {
+        let m = find(&format!("math {op} {b} "))?;
+        let calls: f64 = number(&m, "calls")?;
+        let ticks: f64 = number(&m, "ticks")?;
+        maths.push(MathCost {
+            op: op.to_string(),
+            backend: b.to_string(),
+            instructions_per_call: ((ticks - loop_ticks) * ipt / calls).max(0.0),
+            max_relative_error: err,
+        });
+    }
+    Ok(Counted {
+        fits,
+        spectrum_instructions: over_base("srs")?,
+        spec_instructions: over_base("spec")?,
+        spec_band_instructions: over_base("spec-band")?,
+        solves,
+        maths,
+        instructions_per_tick: ipt,
+    })
 }
 
 /// Instructions the whole emulator firmware executes per idle sample (see
