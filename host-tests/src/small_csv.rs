@@ -87,10 +87,12 @@ fn fields(line: &str) -> Result<Vec<String>, csv::Error> {
     reader.read_record(&mut record)?;
     Ok(record
         .iter()
-        .map(|f| match f.strip_prefix('"').and_then(|f| f.strip_suffix('"')) {
-            Some(inner) => inner.replace("\"\"", "\""),
-            None => f.to_string(),
-        })
+        .map(
+            |f| match f.strip_prefix('"').and_then(|f| f.strip_suffix('"')) {
+                Some(inner) => inner.replace("\"\"", "\""),
+                None => f.to_string(),
+            },
+        )
         .collect())
 }
 

@@ -110,7 +110,11 @@ fn page(cfc: Option<u32>, results: &[EntryJson], required: Option<&RequiredSrs>)
     impacts_table(&mut h, results, required);
     for e in results {
         if let Some(err) = &e.error {
-            html!(h, "<p class=\"fail\">FAILED {}</p>\n", series::failure(e, err));
+            html!(
+                h,
+                "<p class=\"fail\">FAILED {}</p>\n",
+                series::failure(e, err)
+            );
         }
     }
     if let Some(r) = &json.spec {

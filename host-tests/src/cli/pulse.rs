@@ -205,7 +205,11 @@ pub fn svg(p: &Pulse) -> Html {
     if let Some((label, _)) = &p.filtered {
         entries[0].1 = "raw";
         let mut filtered_stroke = Html::new();
-        html!(filtered_stroke, "stroke=\"{}\" stroke-width=\"1.8\"", FILTERED);
+        html!(
+            filtered_stroke,
+            "stroke=\"{}\" stroke-width=\"1.8\"",
+            FILTERED
+        );
         entries.push((filtered_stroke, label.as_str()));
     }
     if !band.is_empty() {

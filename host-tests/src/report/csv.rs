@@ -82,7 +82,11 @@ impl Columns {
             .map(|f| f.to_string())
             .collect();
         if self.train {
-            h.extend(impact_core::report::BOUNCE_FIELDS.iter().map(|f| f.to_string()));
+            h.extend(
+                impact_core::report::BOUNCE_FIELDS
+                    .iter()
+                    .map(|f| f.to_string()),
+            );
             h.extend(["cor_flight".into(), "cor_rebound".into()]);
         }
         // The resultant's peak and each axis's peak and Δv (named by its column).
@@ -94,7 +98,11 @@ impl Columns {
             }
         }
         if self.spectrum {
-            h.extend(crate::report::spectrum::CSV_COLUMNS.iter().map(|c| c.to_string()));
+            h.extend(
+                crate::report::spectrum::CSV_COLUMNS
+                    .iter()
+                    .map(|c| c.to_string()),
+            );
         }
         // Each impact's verdict (empty cells when it could not be judged).
         if self.spec {
@@ -185,7 +193,9 @@ impl Columns {
             }
         }
         if self.spectrum {
-            row.extend(crate::report::spectrum::csv_cells(i.shock_spectrum.as_ref()));
+            row.extend(crate::report::spectrum::csv_cells(
+                i.shock_spectrum.as_ref(),
+            ));
         }
         if self.spec {
             let v = i.spec.as_ref().and_then(|v| v.as_ref());
@@ -234,7 +244,14 @@ mod tests {
     #[test]
     fn a_cell_is_quoted_where_it_must_be_and_no_name_is_a_formula() {
         let mut w = writer(Vec::new());
-        for cell in ["a,b.csv", "say \"x\"", "plain", "=cmd|' /C calc'!A0", "-2+3", "@SUM(1)"] {
+        for cell in [
+            "a,b.csv",
+            "say \"x\"",
+            "plain",
+            "=cmd|' /C calc'!A0",
+            "-2+3",
+            "@SUM(1)",
+        ] {
             w.write_record([text(cell), "1.5".into()]).unwrap();
         }
         let out = String::from_utf8(w.into_inner().unwrap()).unwrap();
