@@ -201,7 +201,7 @@ impl Session {
         match marker {
             "impact " => {
                 let report = parse_impact(&m)?;
-                check_report(&report)?;
+                check_report(&report).map_err(|e| e.to_string())?;
                 let latency_s = crate::firmware_link::fields::opt(&m, "report_latency_s")?;
                 let wave = self.wave.take().filter(|w| w.index == report.index);
                 self.started = true;

@@ -334,14 +334,14 @@ impl LogReader {
             let m = m.map_err(at)?;
             self.seen(&m).map_err(at)?;
             let r = parse_impact(&m).map_err(at)?;
-            check_report(&r).map_err(at)?;
+            check_report(&r).map_err(|e| at(e.to_string()))?;
             let latency: Option<f32> = opt(&m, "report_latency_s").map_err(at)?;
             if let Some(l) = latency.filter(|&l| l < 0.0) {
                 return Err(at(format!("report_latency_s={l}: not a time >= 0")));
             }
             let run = &mut self.run;
             if let Some(rate) = run.rate_hz {
-                check_plausible(&r, rate, run.gain).map_err(at)?;
+                check_plausible(&r, rate, run.gain).map_err(|e| at(e.to_string()))?;
             } else {
                 run.unchecked.push((n, self.log.impacts.len()));
             }
