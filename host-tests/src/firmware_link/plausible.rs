@@ -105,7 +105,7 @@ impl std::fmt::Display for Range {
 }
 
 /// An impact report's numbers within what the firmware can report (finite already: see
-/// [`crate::firmware_link::fields::Number`]).
+/// [`crate::firmware_link::line::Number`]).
 pub(crate) fn check_report(r: &ImpactReport) -> Result<(), Implausible> {
     let out_of_range = |field, value: Value, range| {
         Err(Implausible::OutOfRange {

@@ -1,21 +1,24 @@
-//! `impact log`: a decoded firmware log (the `scene`, `impact`, `heartbeat` and `summary`
-//! lines of `docs/board.md`) read back, checked line by line, and turned into
-//! `impact analyze`'s JSON and CSV.
+//! `impact log`: a decoded firmware log (the lines of docs/board.md, read by
+//! [`crate::firmware_link::line`]) read back, checked line by line, and turned into `impact
+//! analyze`'s JSON and CSV.
 
+mod error;
+mod run;
 mod seq;
+
+pub use error::{LogError, LogErrorKind};
 
 use std::collections::HashMap;
 
-use impact_core::report::{Bounce, Fits, Flags, HertzFit, NonlinearFit, Spectrum, TwoPhaseFit};
-use impact_core::signal::spectrum::MAX_BANDS;
-use impact_core::{Analysis, ImpactReport, Kinematics, Status};
+use impact_core::ImpactReport;
 
-use crate::firmware_link::fields::fields;
-use crate::firmware_link::fields::flag;
-use crate::firmware_link::fields::get;
-use crate::firmware_link::fields::num;
-use crate::firmware_link::fields::opt;
-use crate::firmware_link::plausible::{check_plausible, check_report};
+use crate::firmware_link::line::{
+    self, FieldError, Fields, HeartbeatLine, ImpactLine, LineKind, SceneLine, SpecLine, SrsLine,
+    SummaryLine, WaveFrameLine, WaveLine,
+};
+use crate::firmware_link::plausible::check_plausible;
+use crate::firmware_link::waves::Waveform;
+use error::At;
 use seq::SeqSet;
 
 /// What a firmware log says. A log can hold several runs of the board: one that resets starts
@@ -23,22 +26,22 @@ use seq::SeqSet;
 /// again. Every run's impacts are kept, run after run ([`Log::runs`] tells them apart).
 #[derive(Clone, Debug, Default)]
 pub struct Log {
-    /// The `scene` line's fields, if the log has one (every run's scene is the same).
-    pub scene: Option<HashMap<String, String>>,
+    /// The `scene` line, if the log has one (every run's scene is the same).
+    pub scene: Option<SceneLine>,
     /// Every run's impacts, run after run, each run's in index order.
     pub impacts: Vec<ImpactReport>,
     /// Each impact's `report_latency_s` (real-time sources only).
     pub latencies: Vec<Option<f32>>,
-    /// The last run's last `heartbeat` line's fields.
-    pub heartbeat: Option<HashMap<String, String>>,
-    /// The last run's `summary` line's fields (only at the end of a finite stream).
-    pub summary: Option<HashMap<String, String>>,
+    /// The last run's last `heartbeat` line.
+    pub heartbeat: Option<HeartbeatLine>,
+    /// The last run's `summary` line (only at the end of a finite stream).
+    pub summary: Option<SummaryLine>,
     /// What looks wrong without being impossible (e.g. fewer impact lines than the last
     /// heartbeat counts), by line; and each restart of the board.
     pub warnings: Vec<String>,
     /// The captured windows the board sent (`wave` lines, scene `wave_every` > 0), run after
     /// run, each run's in index order.
-    pub waveforms: Vec<crate::firmware_link::waves::Waveform>,
+    pub waveforms: Vec<Waveform>,
     /// Lines the board's logger dropped (each run's summary's, else its last heartbeat's
     /// `lines_dropped`, summed; 0 from firmware that did not count them).
     pub lines_dropped: u64,
@@ -66,190 +69,9 @@ pub struct Run {
     pub analyses_skipped: u64,
 }
 
-/// An `impact` line's fields as the core's report (floats parsed at their own width, so the
-/// firmware's shortest round-trip decimals give back its exact bits).
-pub fn parse_impact(m: &HashMap<String, String>) -> Result<ImpactReport, String> {
-    // Every field of the contract first, in its order (`report::FIELDS`): the first missing
-    // one is the error.
-    for key in impact_core::report::FIELDS {
-        get(m, key)?;
-    }
-    let status = get(m, "status")?;
-    let status = Status::ALL
-        .into_iter()
-        .find(|s| s.name() == status)
-        .ok_or_else(|| format!("status={status}: unknown status"))?;
-    let analysis = get(m, "analysis")?;
-    let analysis = [Analysis::Full, Analysis::Skipped]
-        .into_iter()
-        .find(|a| a.name() == analysis)
-        .ok_or_else(|| format!("analysis={analysis}: not full or skipped"))?;
-    let kinematics = match opt::<f32>(m, "impact_velocity_m_s")? {
-        None => None,
-        Some(v0) => Some(Kinematics {
-            impact_velocity_m_s: v0,
-            crush_time_s: num(m, "crush_time_s")?,
-            max_deformation_m: num(m, "max_deformation_m")?,
-            rebound_velocity_m_s: num(m, "rebound_velocity_m_s")?,
-            cor: num(m, "cor")?,
-            permanent_deformation_m: num(m, "permanent_deformation_m")?,
-            absorbed_energy_j: opt(m, "absorbed_energy_j")?,
-        }),
-    };
-    let two_phase = match opt::<f32>(m, "two_phase_kc_n_m")? {
-        None => None,
-        Some(kc) => Some(TwoPhaseFit {
-            kc_n_m: kc,
-            kr_n_m: num(m, "two_phase_kr_n_m")?,
-            c_n_s_m: num(m, "two_phase_c_n_s_m")?,
-            permanent_m: num(m, "two_phase_permanent_deformation_m")?,
-            residual: num(m, "two_phase_residual")?,
-        }),
-    };
-    let nonlinear = match opt::<f32>(m, "nonlinear_k")? {
-        None => None,
-        Some(k) => Some(NonlinearFit {
-            k,
-            c_s_m: num(m, "nonlinear_c_s_m")?,
-            n: num(m, "nonlinear_exponent")?,
-            residual: num(m, "nonlinear_residual")?,
-        }),
-    };
-    let hertz = match opt::<f32>(m, "hertz_k")? {
-        None => None,
-        Some(k) => Some(HertzFit {
-            k,
-            residual: num(m, "hertz_residual")?,
-        }),
-    };
-    // Firmware before bounce trains wrote no bounce fields: absent means none.
-    let bounce = match m
-        .contains_key("bounce_number")
-        .then(|| opt::<u32>(m, "bounce_number"))
-        .transpose()?
-        .flatten()
-    {
-        None => None,
-        Some(number) => Some(Bounce {
-            number,
-            flight_s: num(m, "flight_s")?,
-            v0_flight_m_s: num(m, "v0_flight_m_s")?,
-            v0_rebound_m_s: opt(m, "v0_rebound_m_s")?,
-        }),
-    };
-    Ok(ImpactReport {
-        index: num(m, "index")?,
-        status,
-        analysis,
-        clipped: flag(m, "clipped")?,
-        flags: Flags(num(m, "flags")?),
-        start_sample: num(m, "start_sample")?,
-        end_sample: num(m, "end_sample")?,
-        start_s: num(m, "start_s")?,
-        peak_time_s: num(m, "peak_time_s")?,
-        peak_acceleration_m_s2: num(m, "peak_acceleration_m_s2")?,
-        peak_force_n: opt(m, "peak_force_n")?,
-        delta_v_m_s: opt(m, "delta_v_m_s")?,
-        duration_s: num(m, "duration_s")?,
-        baseline_m_s2: num(m, "baseline_m_s2")?,
-        fwhm_s: opt(m, "fwhm_s")?,
-        filtered_peak_acceleration_m_s2: opt(m, "filtered_peak_acceleration_m_s2")?,
-        filtered_fwhm_s: opt(m, "filtered_fwhm_s")?,
-        kinematics,
-        fits: Fits {
-            two_phase,
-            nonlinear,
-            hertz,
-        },
-        bounce,
-        spectrum: None,
-        verdict: None,
-    })
-}
-
-/// A `spec` line: the verdict of the impact with its `index`, or why there is none.
-pub(crate) fn parse_verdict(
-    m: &HashMap<String, String>,
-) -> Result<
-    (
-        u32,
-        Result<impact_core::spec::verdict::Verdict, impact_core::spec::verdict::Missing>,
-    ),
-    String,
-> {
-    use impact_core::spec::verdict::{Missing, Verdict};
-    let index = num::<u32>(m, "index")?;
-    if get(m, "pass")? == "none" {
-        let missing = match get(m, "reason")? {
-            "spec-window" => Missing::Window,
-            "spec-resolution" => Missing::Resolution,
-            "spec-overflow" => Missing::Overflow,
-            other => return Err(format!("reason={other}: not a reason a verdict is missing")),
-        };
-        return Ok((index, Err(missing)));
-    }
-    Ok((
-        index,
-        Ok(Verdict {
-            pass: flag(m, "pass")?,
-            band_pass: flag(m, "band_pass")?,
-            delta_v_pass: flag(m, "delta_v_pass")?,
-            margin: num::<f32>(m, "margin")?,
-            worst_s: num::<f64>(m, "worst_s")?,
-            worst_m_s2: num::<f32>(m, "worst_m_s2")?,
-            limit_m_s2: num::<f32>(m, "limit_m_s2")?,
-            delta_v_m_s: num::<f32>(m, "delta_v_m_s")?,
-            start_s: num::<f64>(m, "start_s")?,
-        }),
-    ))
-}
-
-/// An `srs` line: the spectra of the impact with its `index`.
-pub(crate) fn parse_spectrum(m: &HashMap<String, String>) -> Result<(u32, Spectrum), String> {
-    let list = |key: &str| -> Result<Vec<f32>, String> {
-        get(m, key)?
-            .split(',')
-            .map(|v| match v.parse::<f32>() {
-                Ok(x) if x.is_finite() && x >= 0.0 => Ok(x),
-                _ => Err(format!("{key}: {v} is not a finite value >= 0")),
-            })
-            .collect()
-    };
-    let bands: u8 = num(m, "bands")?;
-    let (srs, pvss) = (list("srs_m_s2")?, list("pvss_m_s")?);
-    let n = usize::from(bands);
-    if n == 0 || n > MAX_BANDS || srs.len() != n || pvss.len() != n {
-        return Err(format!(
-            "bands={bands} with {} SRS and {} PVSS values",
-            srs.len(),
-            pvss.len()
-        ));
-    }
-    let mut s = Spectrum {
-        bands,
-        first_hz: num(m, "first_hz")?,
-        bands_per_octave: num(m, "bands_per_octave")?,
-        damping: num(m, "damping")?,
-        srs_m_s2: [0.0; MAX_BANDS],
-        pvss_m_s: [0.0; MAX_BANDS],
-        half_sine: match (
-            opt::<f32>(m, "half_sine_amplitude_m_s2")?,
-            opt::<f32>(m, "half_sine_duration_s")?,
-        ) {
-            (Some(a), Some(d)) => Some((a, d)),
-            _ => None,
-        },
-        from_sample: num(m, "from_sample")?,
-        to_sample: num(m, "to_sample")?,
-    };
-    s.srs_m_s2[..n].copy_from_slice(&srs);
-    s.pvss_m_s[..n].copy_from_slice(&pvss);
-    Ok((num(m, "index")?, s))
-}
-
 /// Parses a decoded firmware log (any other lines are ignored), checking what it reads (see
 /// [`LogReader`]).
-pub fn parse_log(text: &str) -> Result<Log, String> {
+pub fn parse_log(text: &str) -> Result<Log, LogError> {
     let mut reader = LogReader::default();
     for (n, line) in text.lines().enumerate() {
         reader.line(n as u64 + 1, line)?;
@@ -270,8 +92,8 @@ pub fn parse_log(text: &str) -> Result<Log, String> {
 #[derive(Default)]
 pub struct LogReader {
     log: Log,
-    /// The first `scene` line: its number and fields (every later run's must equal them).
-    first_scene: Option<(u64, HashMap<String, String>)>,
+    /// Line of the first `scene` line (`Log::scene`: every later run's must equal it).
+    first_scene: u64,
     run: RunReader,
 }
 
@@ -291,11 +113,10 @@ struct RunReader {
     waves: HashMap<u32, usize>,
     /// The first impact whose index did not increase: (line, index, previous index).
     reordered: Option<(u64, u32, u32)>,
-    /// Line and counters (samples, impacts) of the last heartbeat, and its fields.
-    last_heartbeat: Option<(u64, u64, u64)>,
-    heartbeat: Option<HashMap<String, String>>,
-    summary_line: u64,
-    summary: Option<HashMap<String, String>>,
+    /// The last heartbeat and its line.
+    heartbeat: Option<(u64, HeartbeatLine)>,
+    /// The summary and its line.
+    summary: Option<(u64, SummaryLine)>,
     /// The data lines' sequence numbers seen (`seq`).
     seqs: SeqSet,
     /// Samples per second (the scene's, or the first heartbeat's or summary's), and the
@@ -307,355 +128,219 @@ struct RunReader {
 }
 
 impl LogReader {
-    /// Sets what a `what` line (`srs`, `spec`) adds to this run's impact `index` (`set` gives
+    /// Reads line `n` (1-based).
+    pub fn line(&mut self, n: u64, text: &str) -> Result<(), LogError> {
+        let Some((kind, fields)) = line::find(text, &LineKind::ALL) else {
+            return Ok(());
+        };
+        let fields = fields.at(n)?;
+        if kind.is_data() {
+            self.seen(&fields).at(n)?;
+        }
+        match kind {
+            LineKind::Impact => self.impact(n, &fields),
+            LineKind::Srs => self.srs(n, &fields),
+            LineKind::Spec => self.spec(n, &fields),
+            LineKind::WaveFrame => self.wave_frame(n, text, &fields),
+            LineKind::Wave => self.wave(n, &fields),
+            LineKind::Heartbeat => self.heartbeat(n, fields),
+            LineKind::Summary => self.summary(n, fields),
+            LineKind::Scene => self.scene(n, fields),
+        }
+    }
+
+    /// The log, every run's reports in index order; checks each run's counts against its
+    /// summary.
+    pub fn finish(mut self) -> Result<Log, LogError> {
+        self.end_run()?;
+        Ok(self.log)
+    }
+
+    /// A data line's sequence number (`seq`, absent from firmware that did not number them).
+    fn seen(&mut self, f: &Fields) -> Result<(), FieldError> {
+        self.run.started = true;
+        if let Some(seq) = f.given("seq")? {
+            self.run.seqs.insert(seq);
+        }
+        Ok(())
+    }
+
+    fn impact(&mut self, n: u64, f: &Fields) -> Result<(), LogError> {
+        let ImpactLine {
+            report: r,
+            report_latency_s: latency,
+        } = ImpactLine::parse(f).at(n)?;
+        if let Some(value) = latency.filter(|&l| l < 0.0) {
+            return Err(LogError::at(n, LogErrorKind::NegativeLatency { value }));
+        }
+        let run = &mut self.run;
+        if let Some(rate) = run.rate_hz {
+            check_plausible(&r, rate, run.gain).at(n)?;
+        } else {
+            run.unchecked.push((n, self.log.impacts.len()));
+        }
+        if let Some(&(_, first)) = run.impacts.get(&r.index) {
+            let index = r.index;
+            return Err(LogError::at(n, LogErrorKind::ImpactAgain { index, first }));
+        }
+        if let Some(prev) = self.log.impacts[run.first_impact..].last() {
+            if r.index < prev.index && run.reordered.is_none() {
+                run.reordered = Some((n, r.index, prev.index));
+            }
+        }
+        run.impacts.insert(r.index, (self.log.impacts.len(), n));
+        self.log.impacts.push(r);
+        self.log.latencies.push(latency);
+        Ok(())
+    }
+
+    fn srs(&mut self, n: u64, f: &Fields) -> Result<(), LogError> {
+        let SrsLine { index, spectrum } = SrsLine::parse(f).at(n)?;
+        self.attach(index, LineKind::Srs, |r| {
+            r.spectrum.is_none().then(|| r.spectrum = Some(spectrum))
+        })
+        .at(n)
+    }
+
+    fn spec(&mut self, n: u64, f: &Fields) -> Result<(), LogError> {
+        let SpecLine { index, verdict } = SpecLine::parse(f).at(n)?;
+        self.attach(index, LineKind::Spec, |r| {
+            r.verdict.is_none().then(|| r.verdict = Some(verdict))
+        })
+        .at(n)
+    }
+
+    /// Sets what a `kind` line (`srs`, `spec`) adds to this run's impact `index` (`set` gives
     /// `None` if the impact has it already: a second such line).
     fn attach(
         &mut self,
         index: u32,
-        what: &str,
+        kind: LineKind,
         set: impl FnOnce(&mut ImpactReport) -> Option<()>,
-    ) -> Result<(), String> {
+    ) -> Result<(), LogErrorKind> {
         self.run
             .impacts
             .get(&index)
             .and_then(|&(k, _)| self.log.impacts.get_mut(k))
             .and_then(set)
-            .ok_or_else(|| {
-                format!(
-                    "{what} index={index}: no impact line of that index before it, or a second {what} line"
-                )
-            })
+            .ok_or(LogErrorKind::NoImpactFor { kind, index })
     }
 
-    /// Reads line `n` (1-based).
-    pub fn line(&mut self, n: u64, line: &str) -> Result<(), String> {
-        let at = |e: String| format!("line {n}: {e}");
-        if let Some(m) = fields(line, "impact ") {
-            let m = m.map_err(at)?;
-            self.seen(&m).map_err(at)?;
-            let r = parse_impact(&m).map_err(at)?;
-            check_report(&r).map_err(|e| at(e.to_string()))?;
-            let latency: Option<f32> = opt(&m, "report_latency_s").map_err(at)?;
-            if let Some(l) = latency.filter(|&l| l < 0.0) {
-                return Err(at(format!("report_latency_s={l}: not a time >= 0")));
-            }
-            let run = &mut self.run;
-            if let Some(rate) = run.rate_hz {
-                check_plausible(&r, rate, run.gain).map_err(|e| at(e.to_string()))?;
-            } else {
-                run.unchecked.push((n, self.log.impacts.len()));
-            }
-            if let Some(&(_, first)) = run.impacts.get(&r.index) {
-                return Err(at(format!(
-                    "impact index={} again (first on line {first}): two streams mixed, or a line repeated",
-                    r.index
-                )));
-            }
-            if let Some(prev) = self.log.impacts[run.first_impact..].last() {
-                if r.index < prev.index && run.reordered.is_none() {
-                    run.reordered = Some((n, r.index, prev.index));
-                }
-            }
-            run.impacts.insert(r.index, (self.log.impacts.len(), n));
-            self.log.impacts.push(r);
-            self.log.latencies.push(latency);
-        } else if let Some(m) = fields(line, "srs ") {
-            let m = m.map_err(at)?;
-            self.seen(&m).map_err(at)?;
-            let (index, spectrum) = parse_spectrum(&m).map_err(at)?;
-            self.attach(index, "srs", |r| {
-                r.spectrum.is_none().then(|| r.spectrum = Some(spectrum))
-            })
-            .map_err(at)?;
-        } else if let Some(m) = fields(line, "spec ") {
-            let m = m.map_err(at)?;
-            self.seen(&m).map_err(at)?;
-            let (index, verdict) = parse_verdict(&m).map_err(at)?;
-            self.attach(index, "spec", |r| {
-                r.verdict.is_none().then(|| r.verdict = Some(verdict))
-            })
-            .map_err(at)?;
-        } else if let Some(m) = fields(line, "wave_frame ") {
-            let m = m.map_err(at)?;
-            self.seen(&m).map_err(at)?;
-            let (index, frame, counts) =
-                crate::firmware_link::waves::parse_frame(line, &m).map_err(at)?;
-            let w = self
-                .run
-                .waves
-                .get(&index)
-                .and_then(|&k| self.log.waveforms.get_mut(k))
-                .ok_or_else(|| {
-                    at(format!(
-                        "wave_frame index={index}: no wave line of that index before it"
-                    ))
-                })?;
-            w.add_frame(frame, counts).map_err(at)?;
-        } else if let Some(m) = fields(line, "wave ") {
-            let m = m.map_err(at)?;
-            self.seen(&m).map_err(at)?;
-            let w = crate::firmware_link::waves::Waveform::from_header(&m).map_err(at)?;
-            if self.run.waves.contains_key(&w.index) {
-                return Err(at(format!(
-                    "wave index={} again: two streams mixed, or a line repeated",
-                    w.index
-                )));
-            }
-            self.run.waves.insert(w.index, self.log.waveforms.len());
-            self.log.waveforms.push(w);
-        } else if let Some(m) = fields(line, "heartbeat ") {
-            let m = m.map_err(at)?;
-            self.seen(&m).map_err(at)?;
-            let samples: u64 = num(&m, "samples").map_err(at)?;
-            let impacts: u64 = num(&m, "impacts").map_err(at)?;
-            let rate = rate(&m).map_err(at)?;
-            if let Some((line, s0, i0)) = self.run.last_heartbeat {
-                if samples < s0 || impacts < i0 {
-                    return Err(at(format!(
-                        "heartbeat samples={samples} impacts={impacts} after samples={s0} \
-                         impacts={i0} (line {line}): counters never go back within a run"
-                    )));
-                }
-            }
-            self.run.last_heartbeat = Some((n, samples, impacts));
-            self.run.heartbeat = Some(m);
-            self.rate_known(rate)?;
-        } else if let Some(m) = fields(line, "summary ") {
-            let m = m.map_err(at)?;
-            self.seen(&m).map_err(at)?;
-            num::<u64>(&m, "samples").map_err(at)?;
-            num::<u64>(&m, "impacts").map_err(at)?;
-            let rate = rate(&m).map_err(at)?;
-            self.run.summary_line = n;
-            self.run.summary = Some(m);
-            self.rate_known(rate)?;
-        } else if let Some(m) = fields(line, "scene ") {
-            let m = m.map_err(at)?;
-            let rate = rate(&m).map_err(at)?;
-            let gain: Option<f32> = match m.get("gain_m_s2_per_count") {
-                Some(_) => Some(num(&m, "gain_m_s2_per_count").map_err(at)?),
-                None => None,
-            };
-            match &self.first_scene {
-                None => self.first_scene = Some((n, m.clone())),
-                Some((first, scene)) => {
-                    if let Some(e) = scene_difference(scene, &m) {
-                        return Err(at(format!(
-                            "a scene unlike line {first}'s ({e}): logs of two benches mixed; \
-                             split the log before line {n}"
-                        )));
-                    }
-                }
-            }
-            if self.run.started {
-                self.end_run()?;
-                self.run = RunReader {
-                    first_impact: self.log.impacts.len(),
-                    first_wave: self.log.waveforms.len(),
-                    ..RunReader::default()
-                };
-                self.log.warnings.push(format!(
-                    "line {n}: the board restarted (a new scene line): run {}'s impact indices, \
-                     sample positions and times start from 0 again (\"run\" in the JSON, the \
-                     CSV's run column)",
-                    self.log.runs.len() + 1
-                ));
-            }
-            self.run.line = n;
-            self.run.started = true;
-            self.run.gain = gain.map(f64::from);
-            self.rate_known(rate)?;
-            self.log.scene.get_or_insert(m);
+    fn wave_frame(&mut self, n: u64, text: &str, f: &Fields) -> Result<(), LogError> {
+        let WaveFrameLine {
+            index,
+            frame,
+            counts,
+        } = WaveFrameLine::parse(text, f).at(n)?;
+        let w = self
+            .run
+            .waves
+            .get(&index)
+            .and_then(|&k| self.log.waveforms.get_mut(k))
+            .ok_or(LogErrorKind::NoWaveFor { index })
+            .at(n)?;
+        w.add_frame(frame, counts).at(n)
+    }
+
+    fn wave(&mut self, n: u64, f: &Fields) -> Result<(), LogError> {
+        let w = Waveform::new(WaveLine::parse(f).at(n)?);
+        if self.run.waves.contains_key(&w.index) {
+            let index = w.index;
+            return Err(LogError::at(n, LogErrorKind::WaveAgain { index }));
         }
+        self.run.waves.insert(w.index, self.log.waveforms.len());
+        self.log.waveforms.push(w);
         Ok(())
     }
 
-    /// A data line's sequence number (`seq`, absent from firmware that did not number them).
-    fn seen(&mut self, m: &HashMap<String, String>) -> Result<(), String> {
-        self.run.started = true;
-        if m.contains_key("seq") {
-            self.run.seqs.insert(num(m, "seq")?);
+    fn heartbeat(&mut self, n: u64, fields: Fields) -> Result<(), LogError> {
+        let h = HeartbeatLine::parse(fields).at(n)?;
+        if let Some((line, before)) = &self.run.heartbeat {
+            if h.samples < before.samples || h.impacts < before.impacts {
+                let back = LogErrorKind::CountersBack {
+                    samples: h.samples,
+                    impacts: h.impacts,
+                    samples_before: before.samples,
+                    impacts_before: before.impacts,
+                    line: *line,
+                };
+                return Err(LogError::at(n, back));
+            }
         }
+        let rate = h.rate_hz;
+        self.run.heartbeat = Some((n, h));
+        self.rate_known(rate)
+    }
+
+    fn summary(&mut self, n: u64, fields: Fields) -> Result<(), LogError> {
+        let s = SummaryLine::parse(fields).at(n)?;
+        let rate = s.rate_hz;
+        self.run.summary = Some((n, s));
+        self.rate_known(rate)
+    }
+
+    /// A scene: the first one kept, a later one equal to it (a restart of the board after
+    /// data lines: a new run).
+    fn scene(&mut self, n: u64, fields: Fields) -> Result<(), LogError> {
+        let scene = SceneLine::parse(fields).at(n)?;
+        if let Some(difference) = self.log.scene.as_ref().and_then(|s| s.difference(&scene)) {
+            let unlike = LogErrorKind::SceneUnlike {
+                first: self.first_scene,
+                difference,
+                line: n,
+            };
+            return Err(LogError::at(n, unlike));
+        }
+        if self.run.started {
+            self.restart(n)?;
+        }
+        self.run.line = n;
+        self.run.started = true;
+        self.run.gain = scene.gain_m_s2_per_count.map(f64::from);
+        let rate = scene.rate_hz;
+        if self.log.scene.is_none() {
+            self.first_scene = n;
+            self.log.scene = Some(scene);
+        }
+        self.rate_known(rate)
+    }
+
+    /// The board restarted on line `n`: the run read ends, a new one starts.
+    fn restart(&mut self, n: u64) -> Result<(), LogError> {
+        self.end_run()?;
+        self.run = RunReader {
+            first_impact: self.log.impacts.len(),
+            first_wave: self.log.waveforms.len(),
+            ..RunReader::default()
+        };
+        self.log.warnings.push(format!(
+            "line {n}: the board restarted (a new scene line): run {}'s impact indices, \
+             sample positions and times start from 0 again (\"run\" in the JSON, the \
+             CSV's run column)",
+            self.log.runs.len() + 1
+        ));
         Ok(())
     }
 
     /// The run's sample rate, from its scene or its first heartbeat or summary: the impacts
     /// read before it are checked now.
-    fn rate_known(&mut self, rate: f32) -> Result<(), String> {
+    fn rate_known(&mut self, rate: f32) -> Result<(), LogError> {
         let run = &mut self.run;
         if run.rate_hz.is_some() {
             return Ok(());
         }
         run.rate_hz = Some(f64::from(rate));
         for (line, k) in std::mem::take(&mut run.unchecked) {
-            check_plausible(&self.log.impacts[k], f64::from(rate), run.gain)
-                .map_err(|e| format!("line {line}: {e}"))?;
+            check_plausible(&self.log.impacts[k], f64::from(rate), run.gain).at(line)?;
         }
         Ok(())
-    }
-
-    /// The log, every run's reports in index order; checks each run's counts against its
-    /// summary.
-    pub fn finish(mut self) -> Result<Log, String> {
-        self.end_run()?;
-        Ok(self.log)
-    }
-
-    /// Closes the run read: its counts checked against its summary (or last heartbeat), its
-    /// impacts and windows put in index order, its counters added to the log's.
-    fn end_run(&mut self) -> Result<(), String> {
-        let run = std::mem::take(&mut self.run);
-        let log = &mut self.log;
-        let printed = run.impacts.len() as u64;
-        let state = run.summary.as_ref().or(run.heartbeat.as_ref());
-        let counter = |key: &str| -> Result<u64, String> {
-            match state {
-                Some(m) if m.contains_key(key) => num::<u64>(m, key),
-                _ => Ok(0),
-            }
-        };
-        let lines_dropped = counter("lines_dropped")?;
-        let lines_missing = run.seqs.missing();
-        log.lines_dropped += lines_dropped;
-        log.lines_missing += lines_missing;
-        if lines_missing > 0 || lines_dropped > 0 {
-            let first: Vec<String> = run
-                .seqs
-                .first_missing(5)
-                .iter()
-                .map(u32::to_string)
-                .collect();
-            log.warnings.push(format!(
-                "the board dropped {lines_dropped} lines (its logger's count); {lines_missing} \
-                 numbered lines are missing{}",
-                if lines_missing > 0 {
-                    format!(
-                        " (seq {}{})",
-                        first.join(", "),
-                        if lines_missing > 5 { ", …" } else { "" }
-                    )
-                } else {
-                    String::new()
-                }
-            ));
-        }
-        let lost = lines_dropped + lines_missing > 0;
-        if let Some(m) = &run.summary {
-            let at = |e: String| format!("line {}: {e}", run.summary_line);
-            let counted: u64 = num(m, "impacts").map_err(at)?;
-            let dropped: u64 = num(m, "reports_dropped").map_err(at)?;
-            // Lines the board dropped (counted) explain missing impact lines.
-            if printed + dropped != counted && !(lost && printed + dropped < counted) {
-                return Err(at(format!(
-                    "the summary counts {counted} impacts ({dropped} reports dropped), the log \
-                     has {printed} impact lines: lines lost, or two streams mixed"
-                )));
-            }
-            if let Some(index) = run
-                .impacts
-                .keys()
-                .copied()
-                .filter(|&i| u64::from(i) >= counted)
-                .min()
-            {
-                return Err(at(format!(
-                    "impact index={index} but the summary counts {counted} impacts"
-                )));
-            }
-            if let Some((line, index, prev)) = run.reordered {
-                if num::<u64>(m, "reports_out_of_order").map_err(at)? == 0 {
-                    return Err(format!(
-                        "line {line}: impact index={index} after index={prev}, and the \
-                         summary counts no report out of order"
-                    ));
-                }
-            }
-        } else {
-            if let Some((line, index, prev)) = run.reordered {
-                return Err(format!(
-                    "line {line}: impact index={index} after index={prev} (the firmware prints \
-                     in index order; a reorder is counted only in a summary line)"
-                ));
-            }
-            if let (Some((line, _, counted)), Some(m)) = (run.last_heartbeat, &run.heartbeat) {
-                let dropped: u64 =
-                    num(m, "reports_dropped").map_err(|e| format!("line {line}: {e}"))?;
-                if printed + dropped < counted {
-                    log.warnings.push(format!(
-                        "line {line}: the heartbeat counts {counted} impacts ({dropped} reports \
-                         dropped), the log has {printed} impact lines: a cut log, or lines lost \
-                         on the link"
-                    ));
-                }
-            }
-        }
-        let waves = &mut log.waveforms[run.first_wave..];
-        waves.sort_by_key(|w| w.index);
-        for w in waves.iter() {
-            if w.missing_frames() > 0 {
-                log.warnings.push(format!(
-                    "impact {}: {} of {} waveform frames missing (the link dropped them)",
-                    w.index,
-                    w.missing_frames(),
-                    w.frames
-                ));
-            }
-        }
-        if run.reordered.is_some() {
-            let mut both: Vec<_> = log
-                .impacts
-                .drain(run.first_impact..)
-                .zip(log.latencies.drain(run.first_impact..))
-                .collect();
-            both.sort_by_key(|(r, _)| r.index);
-            for (r, l) in both {
-                log.impacts.push(r);
-                log.latencies.push(l);
-            }
-        }
-        log.runs.push(Run {
-            line: run.line,
-            impacts: run.first_impact..log.impacts.len(),
-            waveforms: run.first_wave..log.waveforms.len(),
-            samples: counter("samples")?,
-            samples_lost: counter("samples_lost")?,
-            analyses_skipped: counter("analyses_skipped")?,
-        });
-        log.heartbeat = run.heartbeat;
-        log.summary = run.summary;
-        Ok(())
-    }
-}
-
-/// The first field (in name order) in which two `scene` lines differ, as `key=new, not old`.
-fn scene_difference(
-    first: &HashMap<String, String>,
-    new: &HashMap<String, String>,
-) -> Option<String> {
-    let mut keys: Vec<&String> = first.keys().chain(new.keys()).collect();
-    keys.sort_unstable();
-    keys.into_iter().find_map(|k| {
-        let (a, b) = (first.get(k), new.get(k));
-        (a != b).then(|| {
-            let show = |v: Option<&String>| v.map_or("absent".to_string(), |v| format!("{k}={v}"));
-            format!("{}, not {}", show(b), show(a))
-        })
-    })
-}
-
-/// A line's `rate_hz`: finite and > 0.
-pub(crate) fn rate(m: &HashMap<String, String>) -> Result<f32, String> {
-    let r: f32 = num(m, "rate_hz")?;
-    if r.is_finite() && r > 0.0 {
-        Ok(r)
-    } else {
-        Err(format!("rate_hz={r}: not a finite rate > 0"))
     }
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
+    use impact_core::Status;
 
     const LINE: &str = "0.013931 INFO  impact index=0 status=complete analysis=full clipped=false flags=0 start_sample=5000 end_sample=17000 start_s=0.01 peak_time_s=0.0100251 peak_acceleration_m_s2=4321.5 peak_force_n=259.29 delta_v_m_s=2.5 duration_s=0.0219 baseline_m_s2=0.2 fwhm_s=0.001 filtered_peak_acceleration_m_s2=none filtered_fwhm_s=none impact_velocity_m_s=1.3357 crush_time_s=0.0218 max_deformation_m=0.0186 rebound_velocity_m_s=1.16 cor=0.87 permanent_deformation_m=0.0182 absorbed_energy_j=none two_phase_kc_n_m=none two_phase_kr_n_m=none two_phase_c_n_s_m=none two_phase_permanent_deformation_m=none two_phase_residual=none nonlinear_k=1e6 nonlinear_c_s_m=0.5 nonlinear_exponent=1.2 nonlinear_residual=0.01 hertz_k=none hertz_residual=none report_latency_s=0.0123";
 
@@ -681,7 +366,8 @@ mod tests {
     fn a_missing_field_is_an_error_naming_it() {
         let line = LINE.replace(" fwhm_s=0.001", "");
         let e = parse_log(&line).unwrap_err();
-        assert!(e.contains("line 1") && e.contains("fwhm_s"), "{e}");
+        assert_eq!(e.line, Some(1));
+        assert!(e.to_string().contains("fwhm_s"), "{e}");
     }
 
     #[test]
@@ -712,7 +398,7 @@ mod tests {
             ("report_latency_s", "-1", "report_latency_s=-1"),
         ] {
             let text = format!("noise\n{}\n", with(field, value));
-            let e = parse_log(&text).unwrap_err();
+            let e = parse_log(&text).unwrap_err().to_string();
             assert!(
                 e.starts_with("line 2: ") && e.contains(says),
                 "{field}={value}: {e}"
@@ -721,21 +407,29 @@ mod tests {
         let scene = "scene rate_hz=NaN\n";
         assert!(parse_log(scene)
             .unwrap_err()
+            .to_string()
             .contains("line 1: rate_hz=NaN"));
         let beat = "heartbeat samples=5 impacts=0 rate_hz=-5 reports_dropped=0\n";
-        assert!(parse_log(beat).unwrap_err().contains("rate_hz=-5"));
+        assert!(parse_log(beat)
+            .unwrap_err()
+            .to_string()
+            .contains("rate_hz=-5"));
     }
 
     #[test]
     fn indices_must_be_unique_and_increasing() {
         let zero = with("index", "0");
-        let e = parse_log(&format!("{zero}\n{zero}\n{zero}\n")).unwrap_err();
+        let e = parse_log(&format!("{zero}\n{zero}\n{zero}\n"))
+            .unwrap_err()
+            .to_string();
         assert!(
             e.starts_with("line 2: impact index=0 again (first on line 1)"),
             "{e}"
         );
         let five = with("index", "5");
-        let e = parse_log(&format!("{five}\n{zero}\n")).unwrap_err();
+        let e = parse_log(&format!("{five}\n{zero}\n"))
+            .unwrap_err()
+            .to_string();
         assert!(e.starts_with("line 2: impact index=0 after index=5"), "{e}");
         // The firmware's summary can own up to a reorder.
         let summary = |out_of_order: u32| {
@@ -751,7 +445,6 @@ mod tests {
         );
         assert!(parse_log(&format!("{five}\n{zero}\n{}\n", summary(0))).is_err());
     }
-
     #[test]
     fn counts_are_checked_against_the_heartbeat_and_summary() {
         let lines: String = (0..3)
@@ -765,11 +458,15 @@ mod tests {
         // The end of a stream: the summary's count must match.
         let summary =
             "summary samples=9 impacts=7 rate_hz=1000 reports_dropped=0 reports_out_of_order=0";
-        let e = parse_log(&format!("{lines}{summary}\n")).unwrap_err();
+        let e = parse_log(&format!("{lines}{summary}\n"))
+            .unwrap_err()
+            .to_string();
         assert!(e.starts_with("line 4: the summary counts 7 impacts"), "{e}");
         // Counters never go back.
         let back = "heartbeat samples=4 impacts=7 rate_hz=1000 reports_dropped=0";
-        let e = parse_log(&format!("{beat}\n{back}\n")).unwrap_err();
+        let e = parse_log(&format!("{beat}\n{back}\n"))
+            .unwrap_err()
+            .to_string();
         assert!(e.starts_with("line 2: heartbeat samples=4"), "{e}");
     }
 }
