@@ -167,3 +167,41 @@ pub fn rate(fields: &Fields) -> Result<f32, LineError> {
         Err(LineError::Rate { value })
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_line_is_the_first_kind_tried_whose_name_starts_a_message() {
+        let line = "0.1 INFO heartbeat seq=3 samples=10 note=srs x";
+        let (kind, fields) = find(line, &LineKind::ALL).unwrap();
+        assert_eq!(kind, LineKind::Heartbeat);
+        assert_eq!(fields.unwrap().get("samples"), Some("10"));
+        // A name inside a word, or followed by prose, is not a line.
+        assert!(find("INFO impact_firmware::tasks @ x=1", &LineKind::ALL).is_none());
+        assert!(find("WARN summary of nothing", &LineKind::ALL).is_none());
+        // The order tried decides between two names in one line.
+        let both = "srs index=1 wave index=2";
+        assert_eq!(find(both, &LineKind::ALL).unwrap().0, LineKind::Srs);
+        let waves_first = [LineKind::Wave, LineKind::Srs];
+        assert_eq!(find(both, &waves_first).unwrap().0, LineKind::Wave);
+        // A key given twice is the line's error.
+        let twice = find("spec index=1 index=2", &LineKind::ALL).unwrap().1;
+        assert_eq!(twice.unwrap_err().to_string(), "field index given twice");
+    }
+
+    #[test]
+    fn a_rate_is_finite_and_positive() {
+        let rate_of = |v: &str| rate(&Fields::parse(&format!("rate_hz={v}")).unwrap());
+        assert_eq!(rate_of("500000.0"), Ok(500000.0));
+        assert_eq!(
+            rate_of("-5").unwrap_err().to_string(),
+            "rate_hz=-5: not a finite rate > 0"
+        );
+        assert_eq!(
+            rate_of("1e39").unwrap_err().to_string(),
+            "rate_hz=inf: not finite (a float out of range, or NaN)"
+        );
+    }
+}

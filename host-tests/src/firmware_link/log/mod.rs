@@ -366,8 +366,17 @@ mod tests {
     fn a_missing_field_is_an_error_naming_it() {
         let line = LINE.replace(" fwhm_s=0.001", "");
         let e = parse_log(&line).unwrap_err();
-        assert_eq!(e.line, Some(1));
-        assert!(e.to_string().contains("fwhm_s"), "{e}");
+        let missing = FieldError::Missing { field: "fwhm_s" };
+        assert_eq!(e, LogError::at(1, missing));
+        assert_eq!(e.to_string(), "line 1: missing field fwhm_s");
+        // A bad number names the field and the text.
+        let e = parse_log(&with("flags", "x1")).unwrap_err();
+        let bad = FieldError::NotANumber {
+            field: "flags",
+            text: "x1".into(),
+        };
+        assert_eq!(e, LogError::at(1, bad));
+        assert_eq!(e.to_string(), "line 1: flags=x1: not a number");
     }
 
     #[test]
