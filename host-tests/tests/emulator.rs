@@ -14,6 +14,7 @@ use std::time::Instant;
 
 mod common;
 use common::{impact_ok as impact, Scratch};
+use impact_host::firmware_link::line::Counter;
 use impact_host::firmware_link::qemu::{Pacing, Samples, BOARD_CLOCK_SHIFT};
 
 /// The emulator firmware, built once for all tests; `None` (and a note on stderr) if the
@@ -545,11 +546,11 @@ fn realtime_matches_host(file: &str, extra: &[&str]) -> serde_json::Value {
 fn within_board_limits(log: &str) {
     let parsed = impact_host::firmware_link::log::parse_log(log).unwrap();
     let summary = parsed.summary.as_ref().expect("a summary line");
-    let get = |k: &str| -> u64 { summary[k].parse().unwrap() };
-    assert_eq!(get("samples_lost"), 0, "{log}");
-    assert_eq!(get("lines_dropped"), 0, "{log}");
+    let get = |c: Counter| -> u64 { summary.state.counter(c).unwrap() };
+    assert_eq!(get(Counter::SamplesLost), 0, "{log}");
+    assert_eq!(get(Counter::LinesDropped), 0, "{log}");
     assert_eq!(parsed.lines_missing, 0, "{log}");
-    let (peak, size) = (get("stack_peak_bytes"), get("stack_size_bytes"));
+    let (peak, size) = (get(Counter::StackPeakBytes), get(Counter::StackSizeBytes));
     assert_eq!(size, 24 * 1024, "the emulator's stack is the board's");
     assert!(
         peak * 4 <= size * 3,
@@ -651,13 +652,13 @@ fn a_forced_dma_overrun_is_a_counted_gap_and_later_positions_stay_right() {
         (30, 3000),
     );
     let summary = log.summary.as_ref().unwrap();
-    let lost: u64 = summary["samples_lost"].parse().unwrap();
-    let samples: u64 = summary["samples"].parse().unwrap();
+    let lost = summary.state.counter(Counter::SamplesLost).unwrap();
+    let samples = summary.samples;
     assert!(
         lost >= 256 && lost % 256 == 0,
         "whole blocks lost: {lost}\n{text}"
     );
-    assert_eq!(summary["gaps"], "1");
+    assert_eq!(summary.state.counter(Counter::Gaps), Ok(1));
     assert_eq!(samples + lost, setup.prepared.counts.len() as u64);
     let cut: Vec<_> = log
         .impacts
@@ -1022,8 +1023,8 @@ fn an_adxl375_fifo_overrun_is_counted_as_the_part_lost_it() {
         (40, 23_000),
     );
     let summary = log.summary.as_ref().unwrap();
-    let lost: u64 = summary["samples_lost"].parse().unwrap();
-    let samples: u64 = summary["samples"].parse().unwrap();
+    let lost = summary.state.counter(Counter::SamplesLost).unwrap();
+    let samples = summary.samples;
     let overwritten: u64 = text
         .lines()
         .find_map(|l| {
@@ -1038,7 +1039,7 @@ fn an_adxl375_fifo_overrun_is_counted_as_the_part_lost_it() {
         lost.abs_diff(overwritten) <= 1,
         "counted {lost}, the part overwrote {overwritten}\n{text}"
     );
-    assert_eq!(summary["overruns"], "1");
+    assert_eq!(summary.state.counter(Counter::Overruns), Ok(1));
     assert_eq!(samples + lost, axes.len() as u64 + lost - overwritten);
     // Every impact is where the host finds it, to the sample (the loss was between them;
     // its Δv differs in the last digits, its baseline's window holding the gap).

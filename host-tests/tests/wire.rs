@@ -74,7 +74,9 @@ fn impact_log_reads_every_field_of_the_contract_and_names_a_missing_one() {
     let log = impact_host::firmware_link::log::parse_log(&line(None)).unwrap();
     assert_eq!(log.impacts.len(), 1);
     for k in FIELDS {
-        let err = impact_host::firmware_link::log::parse_log(&line(Some(k))).unwrap_err();
+        let err = impact_host::firmware_link::log::parse_log(&line(Some(k)))
+            .unwrap_err()
+            .to_string();
         assert!(err.contains(k), "without {k}: {err}");
     }
 }

@@ -263,14 +263,9 @@ pub fn check_time_unit(header: &str, given: Option<TimeUnit>, rate_hz: f64) -> R
     ))
 }
 
-/// Every sample interval must lie within this range of the median interval, or the time axis
-/// counts as uneven (a gap or a rate change). Jittered time stamps, as enDAQ's, stay within
-/// 0.6..1.25.
-pub const INTERVAL_RANGE: std::ops::RangeInclusive<f64> = 0.5..=1.5;
-
-/// The intervals whose median every interval is checked against: the first 65 535 (those
-/// among the first 65 536 rows, as a file read in passes or a stream has them at hand).
-pub const HEAD_INTERVALS: usize = (1 << 16) - 1;
+pub use crate::time_axis::{
+    Drift, DriftFault, DRIFT_BLOCK, DRIFT_LIMIT, HEAD_INTERVALS, INTERVAL_RANGE,
+};
 
 /// Checks a time column: finite, strictly increasing and evenly sampled (every interval within
 /// [`INTERVAL_RANGE`] times the median of the first [`HEAD_INTERVALS`]). Returns `(rate,
@@ -321,82 +316,6 @@ pub fn check_time(
         .map(|w| ((w[1] - w[0]) / dt - 1.0).abs())
         .fold(0.0, f64::max);
     Ok((axis.rate_hz().unwrap_or(1.0 / dt), jitter))
-}
-
-/// Intervals per block of the drift check ([`Drift`]).
-pub const DRIFT_BLOCK: u64 = 1024;
-/// Largest difference of a block's mean interval from the first block's (1 %): a sample
-/// clock is steady to parts per million; a time axis whose interval drifts further (each
-/// step may stay well inside [`INTERVAL_RANGE`]) is no even grid, and taking it for one
-/// puts the impacts at the wrong times with the wrong Δv.
-pub const DRIFT_LIMIT: f64 = 0.01;
-
-/// Checks that a time axis keeps its rate: the mean interval of every [`DRIFT_BLOCK`]
-/// intervals against the first block's. Fed the time stamps in order (any split), so the
-/// whole-file path and a stream refuse the same files at the same sample.
-#[derive(Clone, Copy, Debug, Default)]
-pub struct Drift {
-    /// Time stamps taken, and the time at the current block's start.
-    n: u64,
-    block_start_s: f64,
-    /// The first block's mean interval, s.
-    first_dt: Option<f64>,
-}
-
-impl Drift {
-    /// Takes the next time stamp `t` (s; the `n`-th from 0); a fault once a block's mean
-    /// interval is more than [`DRIFT_LIMIT`] off the first block's.
-    pub fn push(&mut self, t: f64) -> Result<(), DriftFault> {
-        let k = self.n;
-        self.n += 1;
-        if k == 0 {
-            self.block_start_s = t;
-            return Ok(());
-        }
-        if k % DRIFT_BLOCK != 0 {
-            return Ok(());
-        }
-        let mean = (t - self.block_start_s) / DRIFT_BLOCK as f64;
-        self.block_start_s = t;
-        let Some(first) = self.first_dt else {
-            self.first_dt = Some(mean);
-            return Ok(());
-        };
-        if (mean / first - 1.0).abs() > DRIFT_LIMIT {
-            return Err(DriftFault {
-                block_end: k,
-                mean_dt: mean,
-                first_dt: first,
-            });
-        }
-        Ok(())
-    }
-}
-
-/// A block of intervals whose mean is more than [`DRIFT_LIMIT`] off the first block's.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct DriftFault {
-    /// The block's last sample (its first is [`DRIFT_BLOCK`] before).
-    pub block_end: u64,
-    /// The block's mean interval and the first block's, s.
-    pub mean_dt: f64,
-    pub first_dt: f64,
-}
-
-impl fmt::Display for DriftFault {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        let (k, mean, first) = (self.block_end, self.mean_dt, self.first_dt);
-        write!(
-            f,
-            "the time axis drifts: the mean interval of samples {}..{k} is {mean:.6e} s, \
-             {:+.2} % off the first {DRIFT_BLOCK} intervals' {first:.6e} s (more than \
-             {} %: no steady sample clock); give --resample to interpolate onto an even \
-             grid, or --rate if the column is wrong",
-            k - DRIFT_BLOCK,
-            100.0 * (mean / first - 1.0),
-            100.0 * DRIFT_LIMIT
-        )
-    }
 }
 
 /// The sample type a raw file's extension names.

@@ -11,6 +11,7 @@ use impact_core::model::{Linear, TwoPhase};
 use impact_core::{Analysis, Approach, Calibration, FitSet, Impact, Scene};
 use serde::Serialize;
 
+use crate::firmware_link::line::Counter;
 use crate::firmware_link::qemu::{self, Pacing};
 use crate::synth::{record, DynLaw, Placed, Sensor};
 use crate::testkit::cases;
@@ -150,16 +151,14 @@ fn train(
         Duration::from_secs(1200),
         |_| {},
     )?;
-    let log = crate::firmware_link::log::parse_log(&run.lines.join("\n"))?;
+    let log =
+        crate::firmware_link::log::parse_log(&run.lines.join("\n")).map_err(|e| e.to_string())?;
     let summary = log
         .summary
         .as_ref()
         .ok_or("the emulator's log has no summary line")?;
-    let get = |k: &str| -> Result<u64, String> {
-        summary
-            .get(k)
-            .and_then(|v| v.parse().ok())
-            .ok_or(format!("summary: no {k}"))
+    let get = |c: Counter| -> Result<u64, String> {
+        (summary.state.readable(c)).ok_or(format!("summary: no {}", c.name()))
     };
     let mut latencies: Vec<f64> = log.latencies.iter().flatten().map(|&l| l as f64).collect();
     let max = latencies.iter().copied().reduce(f64::max);
@@ -167,7 +166,7 @@ fn train(
         spacing_s: spacing,
         impacts: n,
         reports: log.impacts.len(),
-        samples_lost: get("samples_lost")?,
+        samples_lost: get(Counter::SamplesLost)?,
         analyses_skipped: log
             .impacts
             .iter()

@@ -9,7 +9,7 @@ use std::time::Duration;
 
 use clap::Args;
 
-use crate::firmware_link::fields::{get, num};
+use crate::firmware_link::line::Counter;
 use crate::firmware_link::log::parse_log;
 use crate::firmware_link::qemu::{
     build_firmware, run_emulator, tools_available, Pacing, Samples, BOARD_CLOCK_SHIFT,
@@ -291,23 +291,28 @@ pub fn emulate(args: &EmulateArgs) -> Result<(), String> {
             path.display()
         );
     }
-    let log = parse_log(&text)?;
+    let log = parse_log(&text).map_err(|e| e.to_string())?;
     let summary = log
         .summary
         .as_ref()
         .ok_or("the emulator's log has no summary line")?;
-    let samples: u64 = num(summary, "samples")?;
-    let lost: u64 = num(summary, "samples_lost")?;
-    if samples + lost != total || get(summary, "result")? != "ok" {
+    let state = &summary.state;
+    let samples = summary.samples;
+    let lost = state
+        .counter(Counter::SamplesLost)
+        .map_err(|e| e.to_string())?;
+    let result = state.result().map_err(|e| e.to_string())?;
+    if samples + lost != total || result != "ok" {
         return Err(format!(
-            "the emulator processed {samples} and lost {lost} of {total} samples (result={})",
-            get(summary, "result")?
+            "the emulator processed {samples} and lost {lost} of {total} samples (result={result})"
         ));
     }
     eprintln!("emulated in {:.2} s", run.seconds);
     let mut json = pipeline::to_json(&setup, &log.impacts);
     json.samples_lost = lost;
-    json.analyses_skipped = num(summary, "analyses_skipped")?;
+    json.analyses_skipped = state
+        .counter(Counter::AnalysesSkipped)
+        .map_err(|e| e.to_string())?;
     json.lines_dropped = log.lines_dropped;
     json.lines_missing = log.lines_missing;
     for w in &log.warnings {

@@ -383,16 +383,16 @@ pub fn log_report(
     path: &std::path::Path,
     spec: Option<&impact_core::spec::Spec>,
 ) -> Result<String, String> {
-    use crate::firmware_link::fields::{num, opt};
     let name = path.display().to_string();
     let log = crate::cli::log::read_log(path)?;
-    let mut analysis = crate::firmware_link::log_json::log_json(&log, 0.0)?;
+    let mut analysis =
+        crate::firmware_link::log_json::log_json(&log, 0.0).map_err(|e| e.to_string())?;
     analysis.spec = spec.map(crate::report::spec::spec_json);
     let mut figures = Vec::new();
     if let Some(scene) = &log.scene {
-        let rate = f64::from(crate::firmware_link::log::rate(scene)?);
-        let gain = f64::from(num::<f32>(scene, "gain_m_s2_per_count")?);
-        let mass: Option<f32> = opt(scene, "mass_kg")?;
+        let rate = f64::from(scene.rate_hz);
+        let gain = f64::from(scene.gain().map_err(|e| e.to_string())?);
+        let mass = scene.mass_kg().map_err(|e| e.to_string())?;
         for (k, run) in log.runs.iter().enumerate() {
             let waves = &log.waveforms[run.waveforms.clone()];
             for r in &log.impacts[run.impacts.clone()] {

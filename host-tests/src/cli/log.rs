@@ -7,8 +7,7 @@ use std::path::PathBuf;
 
 use clap::Args;
 
-use crate::firmware_link::fields::{num, opt};
-use crate::firmware_link::log::{rate, LogReader};
+use crate::firmware_link::log::LogReader;
 use crate::firmware_link::log_json::LogJson;
 use impact_io::channel::is_stdin;
 use impact_io::table::MAX_LINE_BYTES;
@@ -72,7 +71,7 @@ pub fn log(args: &LogArgs) -> Result<(), String> {
         let skipped = crate::firmware_link::decode::decode(elf, input, &name, |n, line| {
             reader
                 .line(n, line)
-                .map_err(|e| format!("{name}: {}", e.replacen("line ", "frame ", 1)))
+                .map_err(|e| format!("{name}: {}", e.to_string().replacen("line ", "frame ", 1)))
         })?;
         if skipped > 0 {
             eprintln!("warning: {name}: {skipped} malformed defmt frames skipped (a cut stream)");
@@ -143,7 +142,7 @@ pub fn read_log(path: &std::path::Path) -> Result<crate::firmware_link::log::Log
 pub fn export(path: &std::path::Path, csv: bool, out: &mut impl Write) -> Result<(), String> {
     let name = path.display().to_string();
     let log = read_log(path)?;
-    let json = LogJson::new(&log, 0.0)?;
+    let json = LogJson::new(&log, 0.0).map_err(|e| e.to_string())?;
     if csv {
         crate::report::csv::write_csv(&json.head, json.impacts(), out)
     } else {
@@ -169,23 +168,23 @@ fn report(args: &LogArgs, reader: LogReader, name: &str) -> Result<(), String> {
     for w in &log.warnings {
         eprintln!("warning: {name}: {w}");
     }
-    let json = LogJson::new(&log, args.t0)?;
+    let json = LogJson::new(&log, args.t0).map_err(|e| e.to_string())?;
     if args.plot.is_some() || args.export.is_some() {
         let scene = log
             .scene
             .as_ref()
             .ok_or("--plot/--export: the log has no scene line (the rate and the gain)")?;
-        let rate = f64::from(rate(scene)?);
-        let gain = f64::from(num::<f32>(scene, "gain_m_s2_per_count")?);
+        let rate = f64::from(scene.rate_hz);
+        let gain = f64::from(scene.gain().map_err(|e| e.to_string())?);
         if let Some(path) = &args.plot {
             if log.waveforms.is_empty() {
                 return Err("--plot: the log has no waveforms (the scene's wave=0)".into());
             }
-            let mass: Option<f32> = opt(scene, "mass_kg")?;
+            let mass = scene.mass_kg().map_err(|e| e.to_string())?;
             let waves = &log.waveforms;
             // The board sends the impact's window only: not the samples around it that its
             // CFC filtered.
-            let cfc = scene.get("cfc").filter(|c| c.as_str() != "none");
+            let cfc = scene.cfc();
             let signal = crate::plot::Signal {
                 title: format!(
                     "{name}: the board's captured windows, m/s² above the baseline{}",

@@ -2,12 +2,12 @@
 
 use impact_core::consts::STANDARD_GRAVITY;
 
-use crate::firmware_link::fields::{flag, get, num};
-use crate::firmware_link::log::{Log, Run};
+use crate::firmware_link::line::{FieldError, SceneLine};
+use crate::firmware_link::log::{Log, LogError, LogErrorKind, Run};
 use crate::report::{AnalysisJson, ImpactJson};
 
 /// `impact analyze`'s JSON from a log alone (see [`LogJson`]).
-pub fn log_json(log: &Log, t0: f64) -> Result<AnalysisJson, String> {
+pub fn log_json(log: &Log, t0: f64) -> Result<AnalysisJson, LogError> {
     let json = LogJson::new(log, t0)?;
     let mut a = json.head.clone();
     a.impacts = json.impacts().collect();
@@ -28,51 +28,18 @@ pub struct LogJson<'a> {
 }
 
 impl<'a> LogJson<'a> {
-    pub fn new(log: &'a Log, t0: f64) -> Result<Self, String> {
-        let state = log.summary.as_ref().or(log.heartbeat.as_ref());
-        let rate = match (&log.scene, state) {
-            (Some(m), _) => num::<f32>(m, "rate_hz")?,
-            (None, Some(m)) => num::<f32>(m, "rate_hz")?,
-            (None, None) => {
-                return Err(
-                    "the log has no scene, heartbeat or summary line: sample rate unknown".into(),
-                )
-            }
+    pub fn new(log: &'a Log, t0: f64) -> Result<Self, LogError> {
+        let state_rate =
+            (log.summary.as_ref().map(|s| s.rate_hz)).or(log.heartbeat.as_ref().map(|h| h.rate_hz));
+        let rate = match (&log.scene, state_rate) {
+            (Some(scene), _) => scene.rate_hz,
+            (None, Some(rate)) => rate,
+            (None, None) => return Err(LogError::whole(LogErrorKind::NoRate)),
         };
-        let (v0_m_s, v0_source) = match &log.scene {
-            Some(m) if get(m, "drop_height_m")? != "none" => {
-                let h = num::<f32>(m, "drop_height_m")?;
-                (
-                    Some((2.0 * STANDARD_GRAVITY * f64::from(h)).sqrt()),
-                    Some("drop-height".to_string()),
-                )
-            }
-            Some(m) if get(m, "v0_m_s")? != "none" => (
-                Some(crate::report::fmt::shortest(num::<f32>(m, "v0_m_s")?)),
-                Some("v0".to_string()),
-            ),
-            _ => (None, None),
-        };
-        // What the scene asked for (the scene line's flags), for the reasons of absent fits.
-        let asked = |key: &str| -> Result<bool, String> {
-            match &log.scene {
-                Some(m) => flag(m, key),
-                None => Ok(false),
-            }
-        };
-        let fits = impact_core::FitSet {
-            two_phase: asked("two_phase")?,
-            nonlinear: asked("nonlinear")?,
-            fit_exponent: asked("fit_exponent")?,
-            nonlinear_exponent: 1.0,
-            hertz: asked("hertz")?,
-        };
-        let train_speed = log
-            .scene
-            .as_ref()
-            .and_then(|m| m.get("train"))
-            .filter(|t| *t != "none")
-            .cloned();
+        let scene = log.scene.as_ref();
+        let (v0_m_s, v0_source) = approach(scene).map_err(LogError::whole)?;
+        let fits = asked(scene).map_err(LogError::whole)?;
+        let train_speed = scene.and_then(SceneLine::train).map(str::to_string);
         let total = |f: fn(&Run) -> u64| log.runs.iter().map(f).sum::<u64>();
         // The run of each impact and window (1-based), with more than one run.
         let runs = log.runs.len() > 1;
@@ -129,4 +96,35 @@ impl<'a> LogJson<'a> {
             j
         })
     }
+}
+
+/// The approach speed the scene gives, m/s, and where it comes from (`drop-height`, `v0`).
+fn approach(scene: Option<&SceneLine>) -> Result<(Option<f64>, Option<String>), FieldError> {
+    let Some(scene) = scene else {
+        return Ok((None, None));
+    };
+    if let Some(h) = scene.drop_height_m()? {
+        let v0 = (2.0 * STANDARD_GRAVITY * f64::from(h)).sqrt();
+        return Ok((Some(v0), Some("drop-height".to_string())));
+    }
+    Ok(match scene.v0_m_s()? {
+        Some(v0) => (
+            Some(crate::report::fmt::shortest(v0)),
+            Some("v0".to_string()),
+        ),
+        None => (None, None),
+    })
+}
+
+/// The fits the scene asked for (the scene line's flags; none without one), for the reasons
+/// of absent fits.
+fn asked(scene: Option<&SceneLine>) -> Result<impact_core::FitSet, FieldError> {
+    let asked = |flag: fn(&SceneLine) -> Result<bool, FieldError>| scene.map_or(Ok(false), flag);
+    Ok(impact_core::FitSet {
+        two_phase: asked(SceneLine::two_phase)?,
+        nonlinear: asked(SceneLine::nonlinear)?,
+        fit_exponent: asked(SceneLine::fit_exponent)?,
+        nonlinear_exponent: 1.0,
+        hertz: asked(SceneLine::hertz)?,
+    })
 }

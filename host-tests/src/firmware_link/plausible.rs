@@ -6,56 +6,148 @@ use impact_core::board::CAPTURE_LEN;
 use impact_core::report::COR_TOLERANCE;
 use impact_core::ImpactReport;
 
-/// An impact report's numbers within what the firmware can report (finite already: see
-/// [`crate::firmware_link::fields::num`]).
-pub(crate) fn check_report(r: &ImpactReport) -> Result<(), String> {
-    fn out_of_range(field: &str, v: impl std::fmt::Display, range: &str) -> Result<(), String> {
-        Err(format!("{field}={v}: out of range (must be {range})"))
+/// A report's number that no firmware or stream gives.
+#[derive(Clone, Debug, PartialEq, thiserror::Error)]
+pub enum Implausible {
+    /// Beyond what the firmware can report.
+    #[error("{field}={value}: out of range (must be {range})")]
+    OutOfRange {
+        field: &'static str,
+        value: Value,
+        range: Range,
+    },
+    #[error("end_sample={end} before start_sample={start}")]
+    EndBeforeStart { start: u64, end: u64 },
+    /// Beyond what the impact's stream allows (`limit`: s, or m for a `_m` field).
+    #[error(
+        "{field}={}: implausible (at most {}: {why})",
+        .value.shown(),
+        crate::report::fmt::human(*.limit, if .field.ends_with("_m") { "m" } else { "s" })
+    )]
+    Beyond {
+        field: &'static str,
+        value: Value,
+        limit: f64,
+        why: &'static str,
+    },
+}
+
+/// A field's value at its width.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Value {
+    F32(f32),
+    F64(f64),
+}
+
+impl From<f32> for Value {
+    fn from(v: f32) -> Self {
+        Value::F32(v)
     }
-    let non_negative = |field: &str, v: f64, shown: &dyn std::fmt::Display| {
-        if v < 0.0 {
-            out_of_range(field, shown, ">= 0")
+}
+
+impl From<f64> for Value {
+    fn from(v: f64) -> Self {
+        Value::F64(v)
+    }
+}
+
+impl Value {
+    fn f64(self) -> f64 {
+        match self {
+            Value::F32(v) => v.into(),
+            Value::F64(v) => v,
+        }
+    }
+
+    /// As read (`0.1`, `86400`), or in exponent form when huge or tiny (`1e30`).
+    fn shown(self) -> String {
+        let x = self.f64();
+        let exponent = x != 0.0 && !(1e-4..1e6).contains(&x.abs());
+        match (self, exponent) {
+            (Value::F32(v), true) => format!("{v:e}"),
+            (Value::F64(v), true) => format!("{v:e}"),
+            (Value::F32(v), false) => v.to_string(),
+            (Value::F64(v), false) => v.to_string(),
+        }
+    }
+}
+
+/// As read.
+impl std::fmt::Display for Value {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            Value::F32(v) => v.fmt(f),
+            Value::F64(v) => v.fmt(f),
+        }
+    }
+}
+
+/// The range a report's field must lie in.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Range {
+    NonNegative,
+    Positive,
+    /// A COR within [`COR_TOLERANCE`] of [0, 1].
+    Cor,
+    /// Within ± the maximum deformation.
+    WithinMaxDeformation,
+}
+
+impl std::fmt::Display for Range {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            Range::NonNegative => f.write_str(">= 0"),
+            Range::Positive => f.write_str("> 0"),
+            Range::Cor => write!(f, "within [-{COR_TOLERANCE}, {}]", 1.0 + COR_TOLERANCE),
+            Range::WithinMaxDeformation => f.write_str("within ± max_deformation_m"),
+        }
+    }
+}
+
+/// An impact report's numbers within what the firmware can report (finite already: see
+/// [`crate::firmware_link::line::Number`]).
+pub(crate) fn check_report(r: &ImpactReport) -> Result<(), Implausible> {
+    let out_of_range = |field, value: Value, range| {
+        Err(Implausible::OutOfRange {
+            field,
+            value,
+            range,
+        })
+    };
+    let non_negative = |field, value: Value| {
+        if value.f64() < 0.0 {
+            out_of_range(field, value, Range::NonNegative)
         } else {
             Ok(())
         }
     };
-    non_negative("start_s", r.start_s, &r.start_s)?;
-    non_negative("peak_time_s", r.peak_time_s, &r.peak_time_s)?;
-    non_negative("duration_s", r.duration_s.into(), &r.duration_s)?;
+    non_negative("start_s", r.start_s.into())?;
+    non_negative("peak_time_s", r.peak_time_s.into())?;
+    non_negative("duration_s", r.duration_s.into())?;
     if let Some(w) = r.fwhm_s {
-        non_negative("fwhm_s", w.into(), &w)?;
+        non_negative("fwhm_s", w.into())?;
     }
     if r.end_sample < r.start_sample {
-        return Err(format!(
-            "end_sample={} before start_sample={}",
-            r.end_sample, r.start_sample
-        ));
+        return Err(Implausible::EndBeforeStart {
+            start: r.start_sample,
+            end: r.end_sample,
+        });
     }
     if let Some(k) = &r.kinematics {
-        non_negative("crush_time_s", k.crush_time_s.into(), &k.crush_time_s)?;
-        non_negative(
-            "max_deformation_m",
-            k.max_deformation_m.into(),
-            &k.max_deformation_m,
-        )?;
+        non_negative("crush_time_s", k.crush_time_s.into())?;
+        non_negative("max_deformation_m", k.max_deformation_m.into())?;
         if k.impact_velocity_m_s <= 0.0 {
-            return out_of_range("impact_velocity_m_s", k.impact_velocity_m_s, "> 0");
+            let v = k.impact_velocity_m_s.into();
+            return out_of_range("impact_velocity_m_s", v, Range::Positive);
         }
         // The core flags a COR further outside [0, 1] `cor-out-of-range` and leaves it out.
         if !(-COR_TOLERANCE..=1.0 + COR_TOLERANCE).contains(&k.cor) {
-            return out_of_range(
-                "cor",
-                k.cor,
-                &format!("within [-{COR_TOLERANCE}, {}]", 1.0 + COR_TOLERANCE),
-            );
+            return out_of_range("cor", k.cor.into(), Range::Cor);
         }
         let x = k.max_deformation_m;
         if !(-x..=x).contains(&k.permanent_deformation_m) {
-            return out_of_range(
-                "permanent_deformation_m",
-                k.permanent_deformation_m,
-                "within ± max_deformation_m",
-            );
+            let v = k.permanent_deformation_m.into();
+            return out_of_range("permanent_deformation_m", v, Range::WithinMaxDeformation);
         }
     }
     let residuals = [
@@ -65,7 +157,7 @@ pub(crate) fn check_report(r: &ImpactReport) -> Result<(), String> {
     ];
     for (field, v) in residuals {
         if let Some(v) = v {
-            non_negative(field, v.into(), &v)?;
+            non_negative(field, v.into())?;
         }
     }
     Ok(())
@@ -97,83 +189,50 @@ pub(crate) fn check_plausible(
     r: &ImpactReport,
     rate_hz: f64,
     gain: Option<f64>,
-) -> Result<(), String> {
+) -> Result<(), Implausible> {
     let sample = 1.0 / rate_hz;
     let capture = CAPTURE_LEN as f64 / rate_hz;
     let stream = r.end_sample as f64 / rate_hz + capture;
-    let at_most = |field: &str, v: f64, shown: &dyn Fn() -> String, limit: f64, why: &str| {
-        if v <= limit * (1.0 + 1e-6) + sample {
+    let at_most = |field, value: Value, limit: f64, why| {
+        if value.f64() <= limit * (1.0 + 1e-6) + sample {
             return Ok(());
         }
-        let unit = if field.ends_with("_m") { "m" } else { "s" };
-        Err(format!(
-            "{field}={}: implausible (at most {}: {why})",
-            shown(),
-            crate::report::fmt::human(limit, unit)
-        ))
+        Err(Implausible::Beyond {
+            field,
+            value,
+            limit,
+            why,
+        })
     };
     let in_stream = "the stream up to the impact's end and one capture after it";
     let contact = "from first touch, start_s, to one capture after the impact's end";
-    at_most(
-        "start_s",
-        r.start_s,
-        &|| value(r.start_s),
-        stream,
-        in_stream,
-    )?;
-    let t = r.peak_time_s;
-    at_most("peak_time_s", t, &|| value(t), stream, in_stream)?;
-    let d = r.duration_s;
-    at_most(
-        "duration_s",
-        d.into(),
-        &|| value(d),
-        stream - r.start_s,
-        contact,
-    )?;
+    at_most("start_s", r.start_s.into(), stream, in_stream)?;
+    at_most("peak_time_s", r.peak_time_s.into(), stream, in_stream)?;
+    let d = r.duration_s.into();
+    at_most("duration_s", d, stream - r.start_s, contact)?;
     for (field, w) in [("fwhm_s", r.fwhm_s), ("filtered_fwhm_s", r.filtered_fwhm_s)] {
         if let Some(w) = w {
-            at_most(field, w.into(), &|| value(w), capture, "one capture")?;
+            at_most(field, w.into(), capture, "one capture")?;
         }
     }
     if let Some(b) = &r.bounce {
-        let f = b.flight_s;
-        at_most("flight_s", f.into(), &|| value(f), stream, in_stream)?;
+        at_most("flight_s", b.flight_s.into(), stream, in_stream)?;
     }
     if let Some(k) = &r.kinematics {
         let c = k.crush_time_s;
-        at_most(
-            "crush_time_s",
-            c.into(),
-            &|| value(c),
-            stream - r.start_s,
-            contact,
-        )?;
+        at_most("crush_time_s", c.into(), stream - r.start_s, contact)?;
         if let Some(gain) = gain {
             // A sample more of travel: first touch may fall a fraction of one before the onset.
             let t = f64::from(c) + sample;
             let a = MAX_DEVIATION_COUNTS * gain.abs();
             let reach = f64::from(k.impact_velocity_m_s) * t + 0.5 * a * t * t;
-            let x = k.max_deformation_m;
             at_most(
                 "max_deformation_m",
-                x.into(),
-                &|| value(x),
+                k.max_deformation_m.into(),
                 reach,
                 "impact_velocity_m_s over crush_time_s under the largest acceleration the counts hold",
             )?;
         }
     }
     Ok(())
-}
-
-/// A field's value as a message shows it: as read (`0.1`, `86400`), or in exponent form when
-/// huge or tiny (`1e30`).
-fn value<T: Into<f64> + Copy + std::fmt::Display + std::fmt::LowerExp>(v: T) -> String {
-    let x: f64 = v.into();
-    if x != 0.0 && !(1e-4..1e6).contains(&x.abs()) {
-        format!("{v:e}")
-    } else {
-        v.to_string()
-    }
 }

@@ -1,12 +1,12 @@
 //! The board's captured windows put back together from its `wave` and `wave_frame` lines
 //! (docs/board.md), and written out as recordings `impact analyze` reads again.
 
-use std::collections::{BTreeMap, HashMap};
+use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 
 use impact_core::waveform::{self, FRAME_LEN};
 
-use crate::firmware_link::fields::num;
+use crate::firmware_link::line::WaveLine;
 use crate::report::waveform::WaveformJson;
 
 /// One impact's window as the board sent it.
@@ -29,33 +29,35 @@ pub struct Waveform {
     received: BTreeMap<u32, Vec<i16>>,
 }
 
+/// A frame the window cannot take.
+#[derive(Clone, Debug, PartialEq, Eq, thiserror::Error)]
+pub enum WaveError {
+    #[error("frame={frame}: impact {index} has {frames} frames")]
+    NoSuchFrame { frame: u32, index: u32, frames: u32 },
+    #[error("frame={frame} of impact {index} holds {got} values, not {want}")]
+    Length {
+        frame: u32,
+        index: u32,
+        got: usize,
+        want: usize,
+    },
+    #[error("frame={frame} of impact {index} twice")]
+    Twice { frame: u32, index: u32 },
+}
+
 impl Waveform {
-    /// A `wave` line's fields.
-    pub fn from_header(m: &HashMap<String, String>) -> Result<Self, String> {
-        let every: u16 = num(m, "every")?;
-        if every == 0 {
-            return Err("every=0: a window is sent with every >= 1".into());
-        }
-        let samples: u32 = num(m, "samples")?;
-        let frames: u32 = num(m, "frames")?;
-        let expected = waveform::frames(samples as usize, every);
-        if frames as usize != expected {
-            return Err(format!(
-                "frames={frames}: {samples} samples at every={every} make {expected} frames"
-            ));
-        }
-        let base_n: i64 = num(m, "base_n")?;
-        let base_sum: i64 = num(m, "base_sum")?;
-        Ok(Self {
-            index: num(m, "index")?,
-            first_sample: num(m, "first_sample")?,
-            samples,
-            every,
-            base_sum,
-            base_n,
-            frames,
+    /// The window a `wave` line announces, no frame received yet.
+    pub fn new(w: WaveLine) -> Self {
+        Self {
+            index: w.index,
+            first_sample: w.first_sample,
+            samples: w.samples,
+            every: w.every,
+            base_sum: w.base_sum,
+            base_n: w.base_n,
+            frames: w.frames,
             received: BTreeMap::new(),
-        })
+        }
     }
 
     /// Values the window holds (one per `every` samples).
@@ -64,23 +66,26 @@ impl Waveform {
     }
 
     /// Takes frame `frame`'s values, checking its number and length.
-    pub fn add_frame(&mut self, frame: u32, counts: Vec<i16>) -> Result<(), String> {
+    pub fn add_frame(&mut self, frame: u32, counts: Vec<i16>) -> Result<(), WaveError> {
+        let index = self.index;
         if frame >= self.frames {
-            return Err(format!(
-                "frame={frame}: impact {} has {} frames",
-                self.index, self.frames
-            ));
+            return Err(WaveError::NoSuchFrame {
+                frame,
+                index,
+                frames: self.frames,
+            });
         }
         let want = (self.values() - frame as usize * FRAME_LEN).min(FRAME_LEN);
         if counts.len() != want {
-            return Err(format!(
-                "frame={frame} of impact {} holds {} values, not {want}",
-                self.index,
-                counts.len()
-            ));
+            return Err(WaveError::Length {
+                frame,
+                index,
+                got: counts.len(),
+                want,
+            });
         }
         if self.received.insert(frame, counts).is_some() {
-            return Err(format!("frame={frame} of impact {} twice", self.index));
+            return Err(WaveError::Twice { frame, index });
         }
         Ok(())
     }
@@ -122,33 +127,6 @@ impl Waveform {
             run: None,
         }
     }
-}
-
-/// A `wave_frame` line: its impact, frame number and values. The values are the last field,
-/// `counts=[v, v, ...]` as defmt prints a slice.
-pub fn parse_frame(
-    line: &str,
-    m: &HashMap<String, String>,
-) -> Result<(u32, u32, Vec<i16>), String> {
-    let index: u32 = num(m, "index")?;
-    let frame: u32 = num(m, "frame")?;
-    let list = line
-        .split_once("counts=[")
-        .and_then(|(_, rest)| rest.split_once(']'))
-        .map(|(list, _)| list)
-        .ok_or("missing field counts=[...]")?;
-    let counts = if list.trim().is_empty() {
-        Vec::new()
-    } else {
-        list.split(',')
-            .map(|v| {
-                v.trim()
-                    .parse::<i16>()
-                    .map_err(|_| format!("counts: {} is not an i16", v.trim()))
-            })
-            .collect::<Result<Vec<_>, _>>()?
-    };
-    Ok((index, frame, counts))
 }
 
 /// Where window `index` of an export to `path` goes: `<stem>-<index>.<ext>`.
@@ -253,35 +231,26 @@ pub fn export(
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::firmware_link::line::{Fields, WaveFrameLine};
 
-    fn header(samples: u32, every: u16) -> HashMap<String, String> {
-        let frames = waveform::frames(samples as usize, every);
-        [
-            ("index", "3".to_string()),
-            ("first_sample", "1000".into()),
-            ("samples", samples.to_string()),
-            ("every", every.to_string()),
-            ("frames", frames.to_string()),
-            ("base_sum", "-12".into()),
-            ("base_n", "4".into()),
-        ]
-        .into_iter()
-        .map(|(k, v)| (k.to_string(), v))
-        .collect()
+    /// A `wave` line's fields, `frames` as given or as the samples make.
+    fn header(samples: u32, every: u16, frames: Option<usize>) -> Fields {
+        let frames = frames.unwrap_or_else(|| waveform::frames(samples as usize, every));
+        Fields::parse(&format!(
+            "index=3 first_sample=1000 samples={samples} every={every} frames={frames} \
+             base_sum=-12 base_n=4"
+        ))
+        .unwrap()
     }
 
     #[test]
     fn frames_rebuild_the_window_and_missing_ones_are_counted() {
-        let mut w = Waveform::from_header(&header(130, 1)).unwrap();
+        let mut w = Waveform::new(WaveLine::parse(&header(130, 1, None)).unwrap());
         assert_eq!(w.frames, 3);
         let line = "INFO wave_frame index=3 frame=2 counts=[-5, 7]";
-        let (i, f, c) = parse_frame(
-            line,
-            &HashMap::from([("index".into(), "3".into()), ("frame".into(), "2".into())]),
-        )
-        .unwrap();
-        assert_eq!((i, f, c.clone()), (3, 2, vec![-5, 7]));
-        w.add_frame(2, c).unwrap();
+        let f = WaveFrameLine::parse(line, &Fields::parse("index=3 frame=2").unwrap()).unwrap();
+        assert_eq!((f.index, f.frame, f.counts.clone()), (3, 2, vec![-5, 7]));
+        w.add_frame(2, f.counts).unwrap();
         w.add_frame(0, vec![1; 64]).unwrap();
         assert_eq!(w.missing_frames(), 1);
         assert_eq!(w.at_sample(1000), Some(1));
@@ -290,25 +259,16 @@ mod tests {
         assert_eq!(w.at_sample(1000 + 130), None);
         assert!(w.complete().is_none());
         // Wrong lengths, numbers and repeats are errors.
-        assert!(w
-            .add_frame(1, vec![0; 63])
-            .unwrap_err()
-            .contains("63 values"));
-        assert!(w
-            .add_frame(3, vec![0; 2])
-            .unwrap_err()
-            .contains("has 3 frames"));
-        assert!(w.add_frame(2, vec![0; 2]).unwrap_err().contains("twice"));
+        let e = |r: Result<(), WaveError>| r.unwrap_err().to_string();
+        assert!(e(w.add_frame(1, vec![0; 63])).contains("63 values"));
+        assert!(e(w.add_frame(3, vec![0; 2])).contains("has 3 frames"));
+        assert!(e(w.add_frame(2, vec![0; 2])).contains("twice"));
     }
 
     #[test]
     fn a_header_whose_counts_disagree_is_refused() {
-        let mut m = header(130, 2);
-        m.insert("frames".into(), "3".into());
-        assert!(Waveform::from_header(&m)
-            .unwrap_err()
-            .contains("make 2 frames"));
-        m.insert("every".into(), "0".into());
-        assert!(Waveform::from_header(&m).unwrap_err().contains("every=0"));
+        let e = |f: Fields| WaveLine::parse(&f).unwrap_err().to_string();
+        assert!(e(header(130, 2, Some(3))).contains("make 2 frames"));
+        assert!(e(header(130, 0, Some(3))).contains("every=0"));
     }
 }

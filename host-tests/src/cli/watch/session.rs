@@ -2,17 +2,17 @@
 //! protocol the page reads), keeping only what the view shows: the last impacts, the trend,
 //! running statistics, the board's health. Memory does not grow with the session.
 
-use std::collections::{HashMap, VecDeque};
+use std::collections::VecDeque;
 
 use impact_core::consts::STANDARD_GRAVITY;
 use impact_core::spec::Spec;
 use impact_core::ImpactReport;
 use serde_json::{json, Map, Value};
 
-use crate::firmware_link::fields::{fields, get, num};
-use crate::firmware_link::log::{parse_impact, parse_spectrum, parse_verdict, rate};
-use crate::firmware_link::plausible::check_report;
-use crate::firmware_link::waves::{parse_frame, Waveform};
+use crate::firmware_link::line::{
+    self, Counter, Fields, ImpactLine, LineKind, SpecLine, SrsLine, State, WaveFrameLine, WaveLine,
+};
+use crate::firmware_link::waves::Waveform;
 use crate::report::statistics::Running;
 
 /// Impacts kept with their pulses (the newest; the page's "last impact" and its table start).
@@ -161,119 +161,161 @@ impl Session {
     }
 
     fn read(&mut self, line: &str, now_ms: u64, events: &mut Vec<Value>) -> Result<(), String> {
-        // An impact's `srs` and `spec` lines (and a window's frames) follow it; any other
-        // data line shows the waiting impact first.
-        if let Some(m) = fields(line, "srs ") {
-            let (index, spectrum) = parse_spectrum(&m?)?;
-            match self.pending.as_mut().filter(|p| p.report.index == index) {
-                Some(p) => p.report.spectrum = Some(spectrum),
-                None => return Err(late("srs", index)),
-            }
-            return Ok(());
-        }
-        if let Some(m) = fields(line, "spec ") {
-            let (index, verdict) = parse_verdict(&m?)?;
-            match self.pending.as_mut().filter(|p| p.report.index == index) {
-                Some(p) => {
-                    p.report.verdict = Some(verdict);
-                    // The last line of its impact.
-                    self.show(events);
-                }
-                None => return Err(late("spec", index)),
-            }
-            return Ok(());
-        }
-        if let Some(m) = fields(line, "wave_frame ") {
-            let (index, frame, counts) = parse_frame(line, &m?)?;
-            if let Some(w) = self.wave.as_mut().filter(|w| w.index == index) {
-                w.add_frame(frame, counts)?;
-            }
-            return Ok(());
-        }
-        let data = ["impact ", "wave ", "heartbeat ", "summary ", "scene "]
-            .iter()
-            .find_map(|marker| fields(line, marker).map(|m| (*marker, m)));
-        let Some((marker, m)) = data else {
+        let Some((kind, fields)) = line::find(line, &KINDS) else {
             return Ok(());
         };
-        self.show(events);
-        let m = m?;
-        match marker {
-            "impact " => {
-                let report = parse_impact(&m)?;
-                check_report(&report)?;
-                let latency_s = crate::firmware_link::fields::opt(&m, "report_latency_s")?;
-                let wave = self.wave.take().filter(|w| w.index == report.index);
-                self.started = true;
-                self.pending = Some(Pending {
-                    received_ms: now_ms,
-                    report,
-                    latency_s,
-                    wave,
-                });
-            }
-            "wave " => {
-                self.started = true;
-                let w = Waveform::from_header(&m)?;
-                if w.samples > MAX_WAVE_SAMPLES {
-                    return Err(format!(
-                        "samples={}: a window of the board holds at most {MAX_WAVE_SAMPLES}",
-                        w.samples
-                    ));
-                }
-                self.wave = Some(w);
-            }
-            "heartbeat " => {
-                self.started = true;
-                self.last_heartbeat_ms = Some(now_ms);
-                let h = self.health(&m, now_ms)?;
-                self.health = Some(h.clone());
-                events.push(tagged("health", h));
-            }
-            "summary " => {
-                let h = self.health(&m, now_ms)?;
-                self.health = Some(h.clone());
-                events.push(tagged("health", h));
-                let end = json!({"result": get(&m, "result")?, "received_unix_ms": now_ms});
-                self.ended = Some(end.clone());
-                events.push(tagged("end", end));
-            }
-            _ => {
-                // A scene: the board (re)started (as `impact log` counts runs: any scene line
-                // after the first line of the board's is a restart).
-                let rate_hz = f64::from(rate(&m)?);
-                if self.started {
-                    self.run += 1;
-                    self.wave = None;
-                    self.ended = None;
-                }
-                self.started = true;
-                self.rate_hz = Some(rate_hz);
-                self.gain = m
-                    .get("gain_m_s2_per_count")
-                    .and_then(|g| g.parse::<f64>().ok())
-                    .filter(|g| g.is_finite());
-                let scene: Map<String, Value> = m
-                    .iter()
-                    .take(64)
-                    .map(|(k, v)| (cut(k), cut(v)))
-                    .map(|(k, v)| {
-                        let value = v
-                            .parse::<f64>()
-                            .ok()
-                            .filter(|x| x.is_finite())
-                            .map_or_else(|| json!(v), |x| json!(x));
-                        (k, value)
-                    })
-                    .collect();
-                let run = json!({"run": self.run, "received_unix_ms": now_ms, "scene": scene});
-                if self.runs.back().is_some_and(|r| r["run"] == self.run) {
-                    self.runs.pop_back();
-                }
-                push_bounded(&mut self.runs, run.clone(), RUNS);
-                events.push(tagged("run", run));
-            }
+        // An impact's `srs` and `spec` lines (and a window's frames) follow it; any other
+        // data line shows the waiting impact first.
+        if !matches!(kind, LineKind::Srs | LineKind::Spec | LineKind::WaveFrame) {
+            self.show(events);
         }
+        let fields = fields.map_err(text)?;
+        match kind {
+            LineKind::Srs => self.read_srs(&fields),
+            LineKind::Spec => self.read_spec(&fields, events),
+            LineKind::WaveFrame => self.read_wave_frame(line, &fields),
+            LineKind::Impact => self.read_impact(&fields, now_ms),
+            LineKind::Wave => self.read_wave(&fields),
+            LineKind::Heartbeat => self.read_heartbeat(fields, now_ms, events),
+            LineKind::Summary => self.read_summary(fields, now_ms, events),
+            LineKind::Scene => self.read_scene(fields, now_ms, events),
+        }
+    }
+
+    /// An `srs` line: the waiting impact's spectra.
+    fn read_srs(&mut self, f: &Fields) -> Result<(), String> {
+        let SrsLine { index, spectrum } = SrsLine::parse(f).map_err(text)?;
+        match self.pending.as_mut().filter(|p| p.report.index == index) {
+            Some(p) => p.report.spectrum = Some(spectrum),
+            None => return Err(late("srs", index)),
+        }
+        Ok(())
+    }
+
+    /// A `spec` line: the waiting impact's verdict, its last line (shown then).
+    fn read_spec(&mut self, f: &Fields, events: &mut Vec<Value>) -> Result<(), String> {
+        let SpecLine { index, verdict } = SpecLine::parse(f).map_err(text)?;
+        match self.pending.as_mut().filter(|p| p.report.index == index) {
+            Some(p) => {
+                p.report.verdict = Some(verdict);
+                self.show(events);
+            }
+            None => return Err(late("spec", index)),
+        }
+        Ok(())
+    }
+
+    /// A `wave_frame` line: a frame of the window being received (another's is passed over).
+    fn read_wave_frame(&mut self, line: &str, f: &Fields) -> Result<(), String> {
+        let WaveFrameLine {
+            index,
+            frame,
+            counts,
+        } = WaveFrameLine::parse(line, f).map_err(text)?;
+        if let Some(w) = self.wave.as_mut().filter(|w| w.index == index) {
+            w.add_frame(frame, counts).map_err(text)?;
+        }
+        Ok(())
+    }
+
+    /// An `impact` line: it waits for its `srs` and `spec` lines.
+    fn read_impact(&mut self, f: &Fields, now_ms: u64) -> Result<(), String> {
+        let ImpactLine {
+            report,
+            report_latency_s: latency_s,
+        } = ImpactLine::parse(f).map_err(text)?;
+        let wave = self.wave.take().filter(|w| w.index == report.index);
+        self.started = true;
+        self.pending = Some(Pending {
+            received_ms: now_ms,
+            report,
+            latency_s,
+            wave,
+        });
+        Ok(())
+    }
+
+    /// A `wave` line: the window received next (only the newest is kept).
+    fn read_wave(&mut self, f: &Fields) -> Result<(), String> {
+        self.started = true;
+        let w = Waveform::new(WaveLine::parse(f).map_err(text)?);
+        if w.samples > MAX_WAVE_SAMPLES {
+            return Err(format!(
+                "samples={}: a window of the board holds at most {MAX_WAVE_SAMPLES}",
+                w.samples
+            ));
+        }
+        self.wave = Some(w);
+        Ok(())
+    }
+
+    fn read_heartbeat(
+        &mut self,
+        f: Fields,
+        now_ms: u64,
+        events: &mut Vec<Value>,
+    ) -> Result<(), String> {
+        self.started = true;
+        self.last_heartbeat_ms = Some(now_ms);
+        let h = self.health(&State::new(f), now_ms)?;
+        self.health = Some(h.clone());
+        events.push(tagged("health", h));
+        Ok(())
+    }
+
+    fn read_summary(
+        &mut self,
+        f: Fields,
+        now_ms: u64,
+        events: &mut Vec<Value>,
+    ) -> Result<(), String> {
+        let state = State::new(f);
+        let h = self.health(&state, now_ms)?;
+        self.health = Some(h.clone());
+        events.push(tagged("health", h));
+        let result = state.result().map_err(text)?;
+        let end = json!({"result": result, "received_unix_ms": now_ms});
+        self.ended = Some(end.clone());
+        events.push(tagged("end", end));
+        Ok(())
+    }
+
+    /// A scene: the board (re)started (as `impact log` counts runs: any scene line after the
+    /// first line of the board's is a restart). Shown as the line gives it.
+    fn read_scene(
+        &mut self,
+        f: Fields,
+        now_ms: u64,
+        events: &mut Vec<Value>,
+    ) -> Result<(), String> {
+        let rate_hz = f64::from(line::rate(&f).map_err(text)?);
+        if self.started {
+            self.run += 1;
+            self.wave = None;
+            self.ended = None;
+        }
+        self.started = true;
+        self.rate_hz = Some(rate_hz);
+        self.gain = (f.readable::<f64>("gain_m_s2_per_count")).filter(|g| g.is_finite());
+        let scene: Map<String, Value> = f
+            .iter()
+            .take(64)
+            .map(|(k, v)| (cut(k), cut(v)))
+            .map(|(k, v)| {
+                let value = v
+                    .parse::<f64>()
+                    .ok()
+                    .filter(|x| x.is_finite())
+                    .map_or_else(|| json!(v), |x| json!(x));
+                (k, value)
+            })
+            .collect();
+        let run = json!({"run": self.run, "received_unix_ms": now_ms, "scene": scene});
+        if self.runs.back().is_some_and(|r| r["run"] == self.run) {
+            self.runs.pop_back();
+        }
+        push_bounded(&mut self.runs, run.clone(), RUNS);
+        events.push(tagged("run", run));
         Ok(())
     }
 
@@ -424,25 +466,21 @@ impl Session {
     }
 
     /// The board's health from a heartbeat's (or the summary's) counters.
-    fn health(&self, m: &HashMap<String, String>, now_ms: u64) -> Result<Value, String> {
-        let n = |k: &str| num::<u64>(m, k);
-        let samples = n("samples")?;
-        let rate_hz = f64::from(rate(m)?);
-        let busy = m
-            .get("busy_permille")
-            .and_then(|b| b.parse::<f64>().ok())
-            .map(|b| b / 1000.0);
-        let optional = |k: &str| m.get(k).and_then(|v| v.parse::<u64>().ok());
+    fn health(&self, s: &State, now_ms: u64) -> Result<Value, String> {
+        let n = |c: Counter| s.counter(c).map_err(text);
+        let samples = n(Counter::Samples)?;
+        let rate_hz = f64::from(s.rate_hz().map_err(text)?);
+        let shown = |c: Counter| s.readable(c);
         Ok(json!({
             "run": self.run, "received_unix_ms": now_ms,
             "board_time_s": samples as f64 / rate_hz, "samples": samples,
-            "samples_lost": n("samples_lost")?, "gaps": optional("gaps"),
-            "lines_dropped": optional("lines_dropped"),
-            "analyses_skipped": optional("analyses_skipped"),
-            "reports_dropped": optional("reports_dropped"),
-            "stack_peak_bytes": optional("stack_peak_bytes"),
-            "stack_size_bytes": optional("stack_size_bytes"),
-            "busy_share": busy, "impacts": n("impacts")?,
+            "samples_lost": n(Counter::SamplesLost)?, "gaps": shown(Counter::Gaps),
+            "lines_dropped": shown(Counter::LinesDropped),
+            "analyses_skipped": shown(Counter::AnalysesSkipped),
+            "reports_dropped": shown(Counter::ReportsDropped),
+            "stack_peak_bytes": shown(Counter::StackPeakBytes),
+            "stack_size_bytes": shown(Counter::StackSizeBytes),
+            "busy_share": s.busy_share(), "impacts": n(Counter::Impacts)?,
         }))
     }
 
@@ -513,6 +551,23 @@ impl Session {
         }
         events
     }
+}
+
+/// The order the session tries a line's kinds in: the lines that follow an impact first.
+const KINDS: [LineKind; 8] = [
+    LineKind::Srs,
+    LineKind::Spec,
+    LineKind::WaveFrame,
+    LineKind::Impact,
+    LineKind::Wave,
+    LineKind::Heartbeat,
+    LineKind::Summary,
+    LineKind::Scene,
+];
+
+/// A line's error as the warning says it.
+fn text(e: impl std::fmt::Display) -> String {
+    e.to_string()
 }
 
 /// The error of a `what` line (`srs`, `spec`) whose impact was shown already (or never came).
