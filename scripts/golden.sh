@@ -174,6 +174,44 @@ run sim-kv simulate --model kelvin-voigt --mass 0.06 --v0 1.3357 --stiffness 2e5
 run sim-two-phase simulate --model two-phase --mass 0.06 --v0 1.3357 --max-deformation 0.0186 --kr 12376 --permanent 0.0182 --damping 2 --json
 run sim-nonlinear simulate --model nonlinear --mass 0.06 --v0 1.3357 --stiffness 1e4 --damping 0.5 --json
 
+# Refusals: each message is an output too (the readers', the core's, the options').
+run err-mass simulate --model linear --mass -1 --v0 1 --stiffness 1e6
+run err-kr simulate --model two-phase --mass 0.06 --v0 1 --kc 1e5 --kr 1e4
+run err-v0 synth --model linear --mass 0.06 --v0 -1 --stiffness 1e6
+run err-target simulate --model linear --mass 1 --v0 1 --stiffness 1e6 --target-mass -1 --target-stiffness 1e4
+printf 'time_s,accel_g\n' >empty.csv
+run err-empty analyze empty.csv
+printf 'time_s,accel_g\n0,1\n' >one.csv
+run err-one analyze one.csv
+IMPACT_READ_WHOLE=1 run err-one-whole analyze one.csv
+run err-one-rate analyze one.csv --rate 1000
+printf 'time_s,accel_g\n0,1\n1e-6,2\n0.5e-6,3\n3e-6,1\n4e-6,1\n' >back.csv
+run err-back analyze back.csv
+IMPACT_READ_WHOLE=1 run err-back-whole analyze back.csv
+awk 'BEGIN{print "time_s,accel_g"; for(i=0;i<3000;i++){t=i*1e-6; if(i>=1500) t+=1e-6; printf "%.9f,%d\n", t, (i%7)-3}}' >gap.csv
+run err-gap analyze gap.csv
+IMPACT_READ_WHOLE=1 run err-gap-whole analyze gap.csv
+awk 'BEGIN{print "time_s,accel_g"; t=0; for(i=0;i<5000;i++){t+=1e-6*(1+i/20000); printf "%.9f,%d\n", t, (i%7)-3}}' >drift.csv
+run err-drift analyze drift.csv
+IMPACT_READ_WHOLE=1 run err-drift-whole analyze drift.csv
+printf 'time,accel\n0,1\n0.01,2\n0.02,1\n' >slow.csv
+run err-slow analyze slow.csv
+printf 'a,b\nx,y\n' >words.csv
+run err-words analyze words.csv
+run err-ide-rate analyze data/endaq-high-drop/High-Drop.IDE --rate 1000
+run err-column analyze data/afrl-drop-tower/accel_5.csv --column nope
+run err-units analyze data/endaq-high-drop/High-Drop_16g-DC_full.csv --units m/s2
+run err-raw analyze fixtures/afrl-test1-2ch.i16
+run err-raw-channels analyze fixtures/afrl-test1-2ch.i16 --rate 1e6 --raw-channels 65
+run err-wav-rate analyze fixtures/afrl-test1-int16.wav --rate 1000
+run err-npy-rate analyze fixtures/afrl-test1-int16.npy
+run err-tdms-column analyze fixtures/afrl-test1.tdms --column nope
+run err-missing analyze nothing-here.csv
+printf 'frequency_hz,acceleration_g\n10,1\n5,2\n' >bad-srs.csv
+run err-srs report "$afrl" --srs-required bad-srs.csv --html bad.html
+printf 'time_s,lower_g\n0,1\n' >bad-band.csv
+run err-band analyze "$afrl" --spec half-sine,50g,11ms,band-file=bad-band.csv
+
 # The emulated board (when QEMU is here), its log read back, and the live view's session.
 if command -v qemu-system-arm >/dev/null; then
   run emulate emulate seed.csv --mass 0.06 --v0 1.3357 --waveforms --log board.log

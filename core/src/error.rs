@@ -7,8 +7,8 @@ use crate::real::Real;
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub enum Error {
-    /// A parameter is outside its domain. `name` is the parameter as the `impact` tool spells
-    /// it (`"mass"`, `"v0"`, `"kc"`, ...).
+    /// A parameter is outside its domain. `name` is the parameter's name (`"mass"`, `"v0"`,
+    /// `"kc"`, ...), which the `impact` tool spells as its option (`--mass`).
     InvalidParameter {
         name: &'static str,
         reason: &'static str,
@@ -22,7 +22,7 @@ pub enum Error {
 impl core::fmt::Display for Error {
     fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
         match self {
-            Error::InvalidParameter { name, reason } => write!(f, "--{name}: {reason}"),
+            Error::InvalidParameter { name, reason } => write!(f, "{name}: {reason}"),
             Error::Unresolved(why) => write!(f, "contact not resolved: {why}"),
         }
     }

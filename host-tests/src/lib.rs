@@ -4,6 +4,7 @@
 pub mod bench;
 pub mod cli;
 pub mod firmware_link;
+pub mod flags;
 pub mod html;
 pub mod interrupt;
 pub mod output;

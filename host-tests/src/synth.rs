@@ -274,7 +274,7 @@ pub const SEED_BENCH_ARGS: [&str; 14] = [
 /// tool's CSV).
 pub fn synth(args: &SynthArgs) -> Result<Recording, String> {
     let impact = Impact::new(args.mass, args.v0);
-    impact.validate().map_err(|e| e.to_string())?;
+    impact.validate().map_err(crate::flags::core)?;
     let model = args.params.model(args.model, &impact)?;
     if !(args.rate.is_finite() && args.rate > 0.0) {
         return Err("--rate: must be finite and > 0".into());
@@ -341,7 +341,7 @@ pub fn synth(args: &SynthArgs) -> Result<Recording, String> {
             })
             .collect()
     };
-    record(&sensor, args.duration, &contacts).map_err(|e| e.to_string())
+    record(&sensor, args.duration, &contacts).map_err(crate::flags::core)
 }
 
 /// The contacts of `--bounces`: touch times from the first touch (0), approach speeds and
@@ -364,14 +364,14 @@ pub fn bounce_train(
         1e-3,
         args.bounces,
     )
-    .map_err(|e| e.to_string())?;
+    .map_err(crate::flags::core)?;
     train
         .map(|b| {
             b.map(|mut b| {
                 b.touch_time_s -= release;
                 b
             })
-            .map_err(|e| e.to_string())
+            .map_err(crate::flags::core)
         })
         .collect()
 }

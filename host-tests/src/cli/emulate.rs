@@ -145,7 +145,7 @@ pub fn adxl375_axes(setup: &mut pipeline::Setup) -> Result<Vec<[i16; 3]>, String
     setup
         .scene
         .validate()
-        .map_err(|e| format!("--adxl375: {e}"))?;
+        .map_err(|e| format!("--adxl375: {}", crate::flags::core(e)))?;
     Ok(axes)
 }
 

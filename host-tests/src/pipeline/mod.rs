@@ -563,7 +563,7 @@ pub struct MonitorRun {
 impl MonitorRun {
     pub fn new(scene: Scene) -> Result<Self, String> {
         Ok(Self {
-            monitor: HostMonitor::new(scene).map_err(|e| e.to_string())?,
+            monitor: HostMonitor::new(scene).map_err(crate::flags::core)?,
             reports: Vec::new(),
             samples: 0,
         })

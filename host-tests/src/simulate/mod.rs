@@ -167,7 +167,7 @@ impl ModelArgs {
             self.poisson2,
             if self.youngs2.is_some() { 0.3 } else { 0.0 },
         );
-        Hertz::from_bodies(&b1, &b2).map_err(|e| e.to_string())
+        Hertz::from_bodies(&b1, &b2).map_err(crate::flags::core)
     }
 
     /// Builds the model for `name` and the impact it will be used in.
@@ -180,7 +180,7 @@ impl ModelArgs {
                     let hertz = self.hertz("linear")?;
                     Model::Linear(
                         Linear::matching_max_deformation(&hertz, impact)
-                            .map_err(|e| e.to_string())?,
+                            .map_err(crate::flags::core)?,
                     )
                 }
                 None => {
@@ -312,7 +312,7 @@ pub fn run_any(args: &SimulateArgs) -> Result<Outcome, String> {
                     return Err("--with-linear: compares a Hertz contact with its linear spring; give --model hertz".into());
                 };
                 let l = impact_core::model::Linear::matching_max_deformation(&h, &impact)
-                    .map_err(|e| e.to_string())?;
+                    .map_err(crate::flags::core)?;
                 models.push((ModelName::Linear, Model::Linear(l)));
             }
             figure::wall_contact(&models, &impact, path)?;
@@ -327,7 +327,7 @@ pub fn run_any(args: &SimulateArgs) -> Result<Outcome, String> {
         return Err("--repeat: times the wall solvers; not with a target".into());
     }
     let impact = Impact::new(args.mass, args.v0);
-    impact.validate().map_err(|e| e.to_string())?;
+    impact.validate().map_err(crate::flags::core)?;
     let model = args.params.model(args.model, &impact)?;
     two_body::run(args, &model).map(|r| Outcome::Target(Box::new(r)))
 }
@@ -335,7 +335,7 @@ pub fn run_any(args: &SimulateArgs) -> Result<Outcome, String> {
 /// Runs `impact simulate` against a wall.
 pub fn run(args: &SimulateArgs) -> Result<SimulateReport, String> {
     let impact = Impact::new(args.mass, args.v0);
-    impact.validate().map_err(|e| e.to_string())?;
+    impact.validate().map_err(crate::flags::core)?;
     let model = args.params.model(args.model, &impact)?;
     let method = args.solver.unwrap_or(SolverName::Exact).method();
     let settings = match method {
@@ -363,7 +363,7 @@ pub fn run(args: &SimulateArgs) -> Result<SimulateReport, String> {
             )
         }
     }
-    .map_err(|e| e.to_string())?;
+    .map_err(crate::flags::core)?;
     Ok(SimulateReport {
         max_deformation_m: outcome.max_deformation_m,
         crush_time_s: outcome.crush_time_s,

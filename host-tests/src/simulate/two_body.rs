@@ -122,7 +122,7 @@ pub fn build(args: &TargetArgs) -> Result<Target<f64>, String> {
             args.target_stiffness.unwrap_or(0.0),
             args.target_damping.unwrap_or(0.0),
         )
-        .map_err(|e| e.to_string()),
+        .map_err(crate::flags::core),
         (None, None) => Err("no target given (--target-mass or --target)".into()),
     }
 }
@@ -244,8 +244,8 @@ pub fn run(args: &SimulateArgs, model: &Model<f64>) -> Result<TargetReport, Stri
             two_body::solve(&model_f32(model), &impact32, &narrow(&t), &s32).map(|o| widen(&o))
         }
     }
-    .map_err(|e| e.to_string())?;
-    let free = after(&t, &outcome).map_err(|e| e.to_string())?;
+    .map_err(crate::flags::core)?;
+    let free = after(&t, &outcome).map_err(crate::flags::core)?;
     if let Some(path) = &args.target.plot {
         plot(model, &impact, &t, &outcome, &free, path)?;
     }
@@ -381,7 +381,7 @@ fn plot(
 ) -> Result<(), String> {
     let mut samples: Vec<Sample<f64>> = Vec::new();
     two_body::trajectory(model, impact, t, 1e-10, &mut |s| samples.push(s))
-        .map_err(|e| e.to_string())?;
+        .map_err(crate::flags::core)?;
     let tc = o.contact_time_s;
     let period = free.ring_frequency_hz.map_or(tc, |f| 1.0 / f);
     let end = free
