@@ -5,6 +5,7 @@
 //! limit (`ulimit -f`) makes a write fail with an error instead of killing the tool (SIGXFSZ
 //! is ignored).
 
+use std::io::Write as _;
 use std::path::{Path, PathBuf};
 use std::sync::Mutex;
 
@@ -92,7 +93,11 @@ pub fn install() {
                     SIGTERM => "terminated",
                     _ => "hung up",
                 };
-                eprintln!("{name}: temporary files removed, child processes ended");
+                // (Not errln!: a closed stderr must not turn this signal into SIGPIPE.)
+                let _ = writeln!(
+                    std::io::stderr(),
+                    "{name}: temporary files removed, child processes ended"
+                );
             }
             die_of(sig);
         }
@@ -116,7 +121,7 @@ pub fn closed_pipe(error: std::io::Error) -> std::io::Error {
 pub fn stdout_failed(error: std::io::Error) -> ! {
     let error = closed_pipe(error);
     clean_up();
-    eprintln!("error: stdout: {error}");
+    crate::errln!("error: stdout: {error}");
     std::process::exit(1)
 }
 

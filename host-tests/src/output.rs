@@ -214,6 +214,19 @@ macro_rules! out {
     }};
 }
 
+/// `eprintln!` that a closed standard error never panics on: a closed pipe (`impact … 2>&1 |
+/// head`) ends the run as SIGPIPE would ([`crate::interrupt::closed_pipe`]); another error is
+/// dropped (standard error is where it would be said).
+#[macro_export]
+macro_rules! errln {
+    ($($arg:tt)*) => {{
+        use std::io::Write as _;
+        if let Err(e) = writeln!(std::io::stderr(), $($arg)*) {
+            let _ = $crate::interrupt::closed_pipe(e);
+        }
+    }};
+}
+
 /// `println!` through [`stdout`], as [`out!`](crate::out!).
 #[macro_export]
 macro_rules! outln {
