@@ -10,6 +10,7 @@ pub mod output;
 pub mod parse;
 pub mod pipeline;
 pub mod plot;
+pub mod read_errors;
 pub mod report;
 pub mod simulate;
 pub mod small_csv;

@@ -5,9 +5,55 @@
 //! CSV keeps the first of each kind for the end, an `.ide` stops at it); the faults and their
 //! order are the axis's.
 
-use std::fmt;
+pub use crate::error::{DriftFault, NotIncreasing, UnevenInterval};
+use crate::limits::{DRIFT_BLOCK, DRIFT_LIMIT};
 
-use crate::channel::{Drift, DriftFault, INTERVAL_RANGE};
+/// Every sample interval must lie within this range of the median interval, or the time axis
+/// counts as uneven (a gap or a rate change). Jittered time stamps, as enDAQ's, stay within
+/// 0.6..1.25.
+pub const INTERVAL_RANGE: std::ops::RangeInclusive<f64> = 0.5..=1.5;
+
+/// Checks that a time axis keeps its rate: the mean interval of every [`DRIFT_BLOCK`]
+/// intervals against the first block's. Fed the time stamps in order (any split), so the
+/// whole-file path and a stream refuse the same files at the same sample.
+#[derive(Clone, Copy, Debug, Default)]
+pub struct Drift {
+    /// Time stamps taken, and the time at the current block's start.
+    n: u64,
+    block_start_s: f64,
+    /// The first block's mean interval, s.
+    first_dt: Option<f64>,
+}
+
+impl Drift {
+    /// Takes the next time stamp `t` (s; the `n`-th from 0); a fault once a block's mean
+    /// interval is more than [`DRIFT_LIMIT`] off the first block's.
+    pub fn push(&mut self, t: f64) -> Result<(), DriftFault> {
+        let k = self.n;
+        self.n += 1;
+        if k == 0 {
+            self.block_start_s = t;
+            return Ok(());
+        }
+        if k % DRIFT_BLOCK != 0 {
+            return Ok(());
+        }
+        let mean = (t - self.block_start_s) / DRIFT_BLOCK as f64;
+        self.block_start_s = t;
+        let Some(first) = self.first_dt else {
+            self.first_dt = Some(mean);
+            return Ok(());
+        };
+        if (mean / first - 1.0).abs() > DRIFT_LIMIT {
+            return Err(DriftFault {
+                block_end: k,
+                mean_dt: mean,
+                first_dt: first,
+            });
+        }
+        Ok(())
+    }
+}
 
 /// The median as `select_nth_unstable(len / 2)` picks it (the upper one of an even count);
 /// `None` of nothing. Reorders `values`.
@@ -19,52 +65,12 @@ pub fn median(values: &mut [f64]) -> Option<f64> {
     Some(*values.select_nth_unstable_by(mid, f64::total_cmp).1)
 }
 
-/// An interval far from the head's median: a gap or a rate change.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct UnevenInterval {
-    /// The interval, s.
-    pub dt: f64,
-    /// The head's median interval, s.
-    pub median: f64,
-}
-
-impl fmt::Display for UnevenInterval {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        let (dt, median) = (self.dt, self.median);
-        let ratio = dt / median;
-        write!(
-            f,
-            "uneven time axis: {dt:.6e} s since the previous sample, {ratio:.3} times the first \
-             intervals' median {median:.6e} s (a gap or a rate change); give --resample to \
-             interpolate onto an even grid, or cut the file"
-        )
-    }
-}
-
 /// An interval `dt` within [`INTERVAL_RANGE`] times the median `median`.
 pub fn check_interval(dt: f64, median: f64) -> Result<(), UnevenInterval> {
     if INTERVAL_RANGE.contains(&(dt / median)) {
         Ok(())
     } else {
         Err(UnevenInterval { dt, median })
-    }
-}
-
-/// A time that does not increase.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct NotIncreasing {
-    /// The time, s, and the one before it.
-    pub t: f64,
-    pub previous: f64,
-}
-
-impl fmt::Display for NotIncreasing {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        write!(
-            f,
-            "time {} s does not increase (previous {} s)",
-            self.t, self.previous
-        )
     }
 }
 

@@ -19,9 +19,9 @@ mod ebml;
 mod header;
 mod read;
 
+pub use crate::error::IdeError;
 pub use header::{Channel, Recording, SubChannel};
 pub use read::{is_ide, pick, read_ide, Blocks, Pick};
-use std::fmt;
 use std::fs::File;
 use std::io::{BufReader, Read, Seek, SeekFrom};
 use std::path::Path;
@@ -43,76 +43,6 @@ const MAX_BLOCK: u64 = 64 << 20;
 /// idelib's default timecode moduli: 2^24 for ChannelDataBlock, 2^16 for SimpleChannelDataBlock.
 const MODULUS: u64 = 1 << 24;
 const SIMPLE_MODULUS: u64 = 1 << 16;
-
-#[derive(Debug)]
-pub enum IdeError {
-    Io(std::io::Error),
-    /// Not an IDE file (no EBML header, or another DocType).
-    NotIde(String),
-    /// An element that cannot be decoded, at a byte offset.
-    Malformed {
-        offset: u64,
-        what: String,
-    },
-    /// An element running past the end of its parent or of the file.
-    Truncated {
-        offset: u64,
-    },
-    /// An element bigger than this reader will hold in memory.
-    TooLarge {
-        offset: u64,
-        size: u64,
-    },
-    NoSuchChannel {
-        channel: u64,
-        subchannel: Option<u64>,
-    },
-    Unsupported(String),
-}
-
-impl fmt::Display for IdeError {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        match self {
-            IdeError::Io(e) => write!(f, "I/O error: {e}"),
-            IdeError::NotIde(why) => write!(f, "not an enDAQ IDE file: {why}"),
-            IdeError::Malformed { offset, what } => {
-                write!(f, "malformed IDE file at byte {offset}: {what}")
-            }
-            IdeError::Truncated { offset } => write!(
-                f,
-                "IDE file truncated: element at byte {offset} runs past its end"
-            ),
-            IdeError::TooLarge { offset, size } => write!(
-                f,
-                "IDE element at byte {offset} declares {size} bytes, more than this reader accepts"
-            ),
-            IdeError::NoSuchChannel {
-                channel,
-                subchannel: None,
-            } => write!(f, "no channel {channel} in the IDE file"),
-            IdeError::NoSuchChannel {
-                channel,
-                subchannel: Some(s),
-            } => write!(f, "no subchannel {channel}.{s} in the IDE file"),
-            IdeError::Unsupported(what) => write!(f, "unsupported IDE content: {what}"),
-        }
-    }
-}
-
-impl std::error::Error for IdeError {
-    fn source(&self) -> Option<&(dyn std::error::Error + 'static)> {
-        match self {
-            IdeError::Io(e) => Some(e),
-            _ => None,
-        }
-    }
-}
-
-impl From<std::io::Error> for IdeError {
-    fn from(e: std::io::Error) -> Self {
-        IdeError::Io(e)
-    }
-}
 
 /// A subchannel's calibration folded to `value = raw * c0 + c1`, or the bivariate form
 /// `raw * (d0*y + d1) + (d2*y + d3)` with `y` the referenced subchannel's mean.
