@@ -261,74 +261,153 @@ impl fmt::Display for DriftFault {
 }
 
 /// An `.ide` file's error ([`crate::ide`]).
-#[derive(Debug)]
+#[derive(Debug, thiserror::Error)]
 pub enum IdeError {
-    Io(std::io::Error),
+    #[error("I/O error: {0}")]
+    Io(#[from] std::io::Error),
     /// Not an IDE file (no EBML header, or another DocType).
-    NotIde(String),
+    #[error("not an enDAQ IDE file: {0}")]
+    NotIde(NotIde),
     /// An element that cannot be decoded, at a byte offset.
-    Malformed {
-        offset: u64,
-        what: String,
-    },
+    #[error("malformed IDE file at byte {offset}: {what}")]
+    Malformed { offset: u64, what: Malformation },
     /// An element running past the end of its parent or of the file.
-    Truncated {
-        offset: u64,
-    },
+    #[error("IDE file truncated: element at byte {offset} runs past its end")]
+    Truncated { offset: u64 },
     /// An element bigger than this reader will hold in memory.
-    TooLarge {
-        offset: u64,
-        size: u64,
-    },
-    NoSuchChannel {
+    #[error("IDE element at byte {offset} declares {size} bytes, more than this reader accepts")]
+    TooLarge { offset: u64, size: u64 },
+    #[error("no channel {channel} in the IDE file")]
+    NoSuchChannel { channel: u64 },
+    #[error("no subchannel {channel}.{subchannel} in the IDE file")]
+    NoSuchSubchannel { channel: u64, subchannel: u64 },
+    #[error("unsupported IDE content: {0}")]
+    Unsupported(IdeUnsupported),
+}
+
+/// Why a file is no `.ide` recording.
+#[derive(Clone, Debug, PartialEq, Eq, thiserror::Error)]
+pub enum NotIde {
+    #[error("empty file")]
+    Empty,
+    #[error("no EBML header")]
+    NoEbmlHeader,
+    /// An EBML file of another DocType.
+    #[error("DocType {0:?}")]
+    DocType(String),
+}
+
+/// An `.ide` element that cannot be decoded.
+#[derive(Clone, Debug, PartialEq, Eq, thiserror::Error)]
+pub enum Malformation {
+    #[error("timecode overflow")]
+    TimecodeOverflow,
+    /// A variable-size integer's first byte (`what`: `element ID`, `element size`).
+    #[error("invalid {what} byte 0x{byte:02X}")]
+    Vint { what: &'static str, byte: u8 },
+    #[error("{0}-byte unsigned integer")]
+    UintLength(usize),
+    #[error("{0}-byte float")]
+    FloatLength(usize),
+    #[error("calibration polynomial without CalID")]
+    CalibrationWithoutId,
+    #[error("bivariate calibration {id} without its channel reference")]
+    BivariateWithoutReference { id: u64 },
+    #[error("Channel without ChannelID")]
+    ChannelWithoutId,
+    #[error("channel {channel} payload of {payload} bytes is not a whole number of {record}-byte samples")]
+    PartialSample {
         channel: u64,
-        subchannel: Option<u64>,
+        payload: usize,
+        record: usize,
     },
-    Unsupported(String),
+    #[error("SimpleChannelDataBlock shorter than its header")]
+    ShortSimpleBlock,
+    /// A ChannelDataBlock without a child (`what`: `ChannelIDRef`, `a start timecode`).
+    #[error("ChannelDataBlock without {0}")]
+    BlockWithout(&'static str),
 }
 
-impl fmt::Display for IdeError {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        match self {
-            IdeError::Io(e) => write!(f, "I/O error: {e}"),
-            IdeError::NotIde(why) => write!(f, "not an enDAQ IDE file: {why}"),
-            IdeError::Malformed { offset, what } => {
-                write!(f, "malformed IDE file at byte {offset}: {what}")
-            }
-            IdeError::Truncated { offset } => write!(
-                f,
-                "IDE file truncated: element at byte {offset} runs past its end"
-            ),
-            IdeError::TooLarge { offset, size } => write!(
-                f,
-                "IDE element at byte {offset} declares {size} bytes, more than this reader accepts"
-            ),
-            IdeError::NoSuchChannel {
-                channel,
-                subchannel: None,
-            } => write!(f, "no channel {channel} in the IDE file"),
-            IdeError::NoSuchChannel {
-                channel,
-                subchannel: Some(s),
-            } => write!(f, "no subchannel {channel}.{s} in the IDE file"),
-            IdeError::Unsupported(what) => write!(f, "unsupported IDE content: {what}"),
-        }
-    }
+/// `.ide` content this reader does not read (never a silently different number).
+#[derive(Clone, Debug, PartialEq, Eq, thiserror::Error)]
+pub enum IdeUnsupported {
+    #[error("no ChannelList (old recorder using a default channel table)")]
+    NoChannelList,
+    #[error("element 0x{id:X} at byte {offset} has an unknown (streamed) size")]
+    UnknownSize { id: u32, offset: u64 },
+    /// A subchannel beyond its channel's sample format (`format`).
+    #[error("subchannel {channel}.{subchannel} has no field in the sample format {format:?}")]
+    NoField {
+        channel: u64,
+        subchannel: u64,
+        format: String,
+    },
+    #[error("sample field outside its record")]
+    FieldOutsideRecord,
+    #[error("calibration {id} on channel {channel}: only a linear univariate polynomial is supported at channel level")]
+    ChannelCalibration { id: u64, channel: u64 },
+    #[error("bivariate calibration {id} on channel {channel}.{subchannel} with {coefficients} coefficients")]
+    BivariateCoefficients {
+        id: u64,
+        channel: u64,
+        subchannel: u64,
+        coefficients: usize,
+    },
+    #[error("univariate calibration {id} with {coefficients} coefficients")]
+    UnivariateCoefficients { id: u64, coefficients: usize },
+    #[error("bivariate calibration {id} used where only a univariate one is supported")]
+    BivariateAsUnivariate { id: u64 },
+    /// A bivariate calibration (on `user`, channel.subchannel) whose reference
+    /// (`channel`.`subchannel`) cannot be used.
+    #[error("bivariate calibration on channel {}.{} references {channel}.{subchannel}, {problem}", .user.0, .user.1)]
+    Reference {
+        user: (u64, u64),
+        channel: u64,
+        subchannel: u64,
+        problem: ReferenceProblem,
+    },
+    #[error("multi-sample block without an end timecode (channel {channel}, byte {offset})")]
+    MultiSampleWithoutEnd { channel: u64, offset: u64 },
+    /// A channel this reader cannot read (`name`), and why.
+    #[error("channel {channel} ({name}): {problem}")]
+    Channel {
+        channel: u64,
+        name: String,
+        problem: ChannelProblem,
+    },
 }
 
-impl std::error::Error for IdeError {
-    fn source(&self) -> Option<&(dyn std::error::Error + 'static)> {
-        match self {
-            IdeError::Io(e) => Some(e),
-            _ => None,
-        }
-    }
+/// Why a bivariate calibration's reference cannot be used.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, thiserror::Error)]
+pub enum ReferenceProblem {
+    #[error("which is not defined")]
+    NotDefined,
+    #[error("which has no sample field")]
+    NoSampleField,
+    #[error("itself bivariate")]
+    Bivariate,
+    #[error("which has no samples")]
+    NoSamples,
 }
 
-impl From<std::io::Error> for IdeError {
-    fn from(e: std::io::Error) -> Self {
-        IdeError::Io(e)
-    }
+/// Why this reader cannot read an `.ide` channel ([`crate::ide::Channel::unsupported`]).
+#[derive(Clone, Debug, PartialEq, Eq, thiserror::Error)]
+pub enum ChannelProblem {
+    /// A legacy named sample parser (`MPL3115`, `LEGACYACCELEROMETER`).
+    #[error("legacy named sample parser {0}")]
+    LegacyParser(String),
+    #[error("no ChannelFormat")]
+    NoFormat,
+    /// A sample format (`format`) with a type code this reader does not know.
+    #[error("sample format {format:?}: type code {code:?}")]
+    TypeCode { format: String, code: char },
+    #[error("empty sample format {0:?}")]
+    EmptyFormat(String),
+    /// A TimeCodeScale that is no positive ratio.
+    #[error("TimeCodeScale {0:?}")]
+    TimeCodeScale(String),
+    #[error("TimeCodeModulus 0")]
+    ZeroModulus,
 }
 
 /// A file no reader takes: what it is, and what to do instead.
@@ -1309,6 +1388,20 @@ mod tests {
             named: crate::units::Units::MS2,
         };
         assert!(!spells_a_flag(&conflict.to_string()), "{conflict}");
+        for note in [
+            crate::ReadNote::ChannelChosen {
+                channel: "a".into(),
+                names: vec!["a".into(), "b".into()],
+            },
+            crate::ReadNote::SubchannelChosen {
+                subchannel: "8.0 X (2000g) [g]".into(),
+                count: 2,
+                subchannels: vec!["8.0 X (2000g) [g]".into(), "80.0 X (40g) [g]".into()],
+            },
+        ] {
+            let text = crate::Note::Read(note).text(Opt::field);
+            assert!(!spells_a_flag(&text), "{text}");
+        }
     }
 
     #[test]

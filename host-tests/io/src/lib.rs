@@ -143,50 +143,109 @@ pub fn read_limited(path: &Path, limit: u64, what: &'static str) -> Result<Vec<u
     Ok(bytes)
 }
 
+/// A note for the user: a reader's own (its settings named as the caller names them), or a
+/// caller's text.
+#[derive(Clone, Debug, PartialEq)]
+pub enum Note {
+    Text(String),
+    Read(ReadNote),
+}
+
+/// What a reader chose that the user may want to choose otherwise.
+#[derive(Clone, Debug, PartialEq)]
+pub enum ReadNote {
+    /// A CSV's first data column (`channel`'s header, or `column N`) taken among `names`.
+    ChannelChosen { channel: String, names: Vec<String> },
+    /// An `.ide` file's first acceleration subchannel taken among `count` (the file has
+    /// `subchannels`).
+    SubchannelChosen {
+        subchannel: String,
+        count: usize,
+        subchannels: Vec<String>,
+    },
+}
+
+impl Note {
+    /// The note's text, the settings it names written by `names`.
+    pub fn text(&self, names: OptionNames) -> String {
+        match self {
+            Note::Text(t) => t.clone(),
+            Note::Read(ReadNote::ChannelChosen { channel, names: all }) => format!(
+                "analysing {channel} of {} channels ({}): choose one with {}, or {} for their resultant",
+                all.len(),
+                all.join(", "),
+                names(Opt::Column),
+                names(Opt::Axes)
+            ),
+            Note::Read(ReadNote::SubchannelChosen {
+                subchannel,
+                count,
+                subchannels,
+            }) => format!(
+                "analysing {subchannel} of {count} acceleration subchannels: choose one with {} CH.SUB (the file has: {})",
+                names(Opt::Column),
+                subchannels.join(", ")
+            ),
+        }
+    }
+}
+
 /// Notes for the user, each once (a file read in passes is opened again for each pass).
-static NOTES: std::sync::Mutex<Vec<String>> = std::sync::Mutex::new(Vec::new());
+static NOTES: std::sync::Mutex<Vec<Note>> = std::sync::Mutex::new(Vec::new());
 
 /// Keeps `note: MESSAGE` for stderr: the tool prints its notes after a run that succeeded
 /// ([`take_notes`]), so that an error stays one line.
 pub fn note(message: &str) {
-    let own = OWN_NOTES.with(|own| match own.borrow_mut().as_mut() {
+    keep(Note::Text(message.to_string()));
+}
+
+/// Keeps a reader's note ([`note`]).
+pub(crate) fn note_read(note: ReadNote) {
+    keep(Note::Read(note));
+}
+
+fn keep(note: Note) {
+    let note = OWN_NOTES.with(|own| match own.borrow_mut().as_mut() {
         Some(notes) => {
-            if !notes.iter().any(|m| m == message) {
-                notes.push(message.to_string());
+            if !notes.contains(&note) {
+                notes.push(note);
             }
-            true
+            None
         }
-        None => false,
+        None => Some(note),
     });
-    if own {
-        return;
-    }
+    let Some(note) = note else { return };
     if let Ok(mut notes) = NOTES.lock() {
-        if !notes.iter().any(|m| m == message) {
-            notes.push(message.to_string());
+        if !notes.contains(&note) {
+            notes.push(note);
         }
     }
 }
 
 std::thread_local! {
     /// The notes of an analysis that keeps its own ([`with_own_notes`]).
-    static OWN_NOTES: std::cell::RefCell<Option<Vec<String>>> =
+    static OWN_NOTES: std::cell::RefCell<Option<Vec<Note>>> =
         const { std::cell::RefCell::new(None) };
 }
 
 /// Runs `f` with the notes it gives on this thread kept apart (a series' recordings,
-/// analysed side by side, each with its own notes), and returns them with its result.
-pub fn with_own_notes<R>(f: impl FnOnce() -> R) -> (R, Vec<String>) {
+/// analysed side by side, each with its own notes), and returns them with its result, the
+/// settings they name written by `names`.
+pub fn with_own_notes<R>(names: OptionNames, f: impl FnOnce() -> R) -> (R, Vec<String>) {
     OWN_NOTES.with(|own| *own.borrow_mut() = Some(Vec::new()));
     let r = f();
     let notes = OWN_NOTES.with(|own| own.borrow_mut().take());
-    (r, notes.unwrap_or_default())
+    let notes = notes.unwrap_or_default();
+    (r, notes.iter().map(|n| n.text(names)).collect())
 }
 
-/// The notes kept so far (and forgets them).
-pub fn take_notes() -> Vec<String> {
+/// The notes kept so far (and forgets them), the settings they name written by `names`.
+pub fn take_notes(names: OptionNames) -> Vec<String> {
     NOTES
         .lock()
         .map(|mut n| std::mem::take(&mut *n))
         .unwrap_or_default()
+        .iter()
+        .map(|n| n.text(names))
+        .collect()
 }

@@ -671,13 +671,10 @@ impl Table {
                             .cloned()
                             .unwrap_or_else(|| format!("column {c}"))
                     };
-                    let names: Vec<String> = data.iter().map(|&c| name(c)).collect();
-                    crate::note(&format!(
-                        "analysing {} of {} channels ({}): choose one with --column, or --axes for their resultant",
-                        name(first),
-                        data.len(),
-                        names.join(", ")
-                    ));
+                    crate::note_read(crate::ReadNote::ChannelChosen {
+                        channel: name(first),
+                        names: data.iter().map(|&c| name(c)).collect(),
+                    });
                 }
                 Ok(first)
             }
@@ -745,7 +742,7 @@ mod tests {
         assert!(most < 2 * SEQUENTIAL_TRAIL, "{most} bytes held");
     }
 
-    fn read(text: &str, format: CsvFormat) -> Result<Table, String> {
+    fn read(text: &str, format: CsvFormat) -> Result<Table, ReadError> {
         let dir = std::env::temp_dir().join(format!("impact-table-{}", std::process::id()));
         std::fs::create_dir_all(&dir).unwrap();
         let path = dir.join(format!(
@@ -753,7 +750,7 @@ mod tests {
             text.len() * 31 + text.bytes().map(usize::from).sum::<usize>()
         ));
         std::fs::write(&path, text).unwrap();
-        let t = read_table(&path, &format, None).map_err(|e| e.to_string());
+        let t = read_table(&path, &format, None);
         std::fs::remove_file(&path).unwrap();
         t
     }
@@ -772,7 +769,7 @@ mod tests {
     #[test]
     fn decimal_commas_need_the_option_and_another_delimiter() {
         let text = "time_s;a\n0,0;6,771553e-1\n0,5;1,25\n";
-        let e = read(text, CsvFormat::default()).unwrap_err();
+        let e = read(text, CsvFormat::default()).unwrap_err().to_string();
         assert!(
             e.contains(":2: not a number: \"0,0\" (decimal commas? give `format.decimal_comma`)"),
             "{e}"
@@ -793,7 +790,8 @@ mod tests {
                 decimal_comma: true,
             },
         )
-        .unwrap_err();
+        .unwrap_err()
+        .to_string();
         assert!(
             e.contains("`format.decimal_comma`: the delimiter is ','"),
             "{e}"
@@ -802,9 +800,13 @@ mod tests {
 
     #[test]
     fn a_row_wider_than_its_header_is_an_error_at_its_line() {
-        let e = read("accel_g\n6,771553e-1\n", CsvFormat::default()).unwrap_err();
+        let e = read("accel_g\n6,771553e-1\n", CsvFormat::default())
+            .unwrap_err()
+            .to_string();
         assert!(e.ends_with(":2: 2 fields, but the header (line 1) has 1 (decimal commas? give `format.decimal_comma` and `format.delimiter`)"), "{e}");
-        let e = read("t,a\n0,1\n1,2,3\n", CsvFormat::default()).unwrap_err();
+        let e = read("t,a\n0,1\n1,2,3\n", CsvFormat::default())
+            .unwrap_err()
+            .to_string();
         assert!(e.ends_with(":3: 3 fields, expected 2"), "{e}");
     }
 
@@ -822,19 +824,21 @@ mod tests {
         // that the long line began on.
         let mut text = String::from("t,a\n0,1\n\"");
         text.push_str(&"1,2\n".repeat(MAX_LINE_BYTES / 4 + 10));
-        let e = read(&text, CsvFormat::default()).unwrap_err();
+        let e = read(&text, CsvFormat::default()).unwrap_err().to_string();
         assert!(
             e.ends_with(":3: a quote opened on this line is not closed within 1048576 bytes"),
             "{e}"
         );
-        let e = read("t,a\n0,1\n\"1,2\n3,4\n", CsvFormat::default()).unwrap_err();
+        let e = read("t,a\n0,1\n\"1,2\n3,4\n", CsvFormat::default())
+            .unwrap_err()
+            .to_string();
         assert!(
             e.ends_with(":3: a quote opened on this line is never closed"),
             "{e}"
         );
         let mut text = String::from("t,a\n0,1\n\n1,");
         text.push_str(&"2".repeat(MAX_LINE_BYTES + 10));
-        let e = read(&text, CsvFormat::default()).unwrap_err();
+        let e = read(&text, CsvFormat::default()).unwrap_err().to_string();
         assert!(
             e.ends_with(":4: a line longer than 1048576 bytes: not a CSV recording"),
             "{e}"

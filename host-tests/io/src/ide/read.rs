@@ -113,12 +113,11 @@ pub fn pick<R: std::io::Read + std::io::Seek>(
                 subchannels: listing(),
             })?;
         if accel.len() > 1 {
-            crate::note(&format!(
-                "analysing {} of {} acceleration subchannels: choose one with --column CH.SUB (the file has: {})",
-                all[first].2,
-                accel.len(),
-                listing().join(", ")
-            ));
+            crate::note_read(crate::ReadNote::SubchannelChosen {
+                subchannel: all[first].2.clone(),
+                count: accel.len(),
+                subchannels: listing(),
+            });
         }
         vec![first]
     };
