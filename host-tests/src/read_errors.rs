@@ -36,6 +36,17 @@ pub fn into_message(e: ReadError) -> String {
     read_error_message(&e)
 }
 
+/// A secondary input's error ([`impact_io::read_limited`]: a scene file, a target, an
+/// ELF), the file named by its path as given: `-` is a file there, not standard input.
+pub fn input_file_message(e: &ReadError) -> String {
+    let at = match e.at {
+        Some(impact_io::At::Line(l)) => format!(":{l}"),
+        Some(impact_io::At::Sample(n)) => format!(": sample {n}"),
+        None => String::new(),
+    };
+    format!("{}{at}: {}", e.path.display(), kind_message(&e.kind))
+}
+
 /// What went wrong, without the file (for a message that names the input its own way).
 pub fn kind_message(kind: &ReadErrorKind) -> String {
     kind.display_with(flag).to_string()
@@ -71,6 +82,10 @@ mod tests {
             kind_message(&ReadErrorKind::NpyOptions),
             "an .npy array takes --rate and --column only (no --time-column, --resample, --axes)"
         );
+        // A secondary input's `-` is a file of that name.
+        let e = impact_io::read_limited(Path::new("-"), 1024, "scene file").unwrap_err();
+        let message = input_file_message(&e);
+        assert!(message.starts_with("-: "), "{message}");
         let conflict =
             impact_io::units::Units::resolve(Some(impact_io::units::Units::G), "table_m_s2")
                 .unwrap_err();

@@ -128,7 +128,8 @@ pub fn open_source(path: &Path, opts: &ReadOptions) -> Result<Box<dyn Source>, R
 
 /// Reads a secondary input (a scene, a target, an ELF) of at most `limit` bytes: a larger
 /// one (or an endless one, `/dev/zero`) is an error naming the limit (`what`: what the input
-/// is, `scene file`), read no further.
+/// is, `scene file`), read no further. (`-` is a file of that name here, not standard input,
+/// though the error's Display, as every reader's, calls it `stdin`.)
 pub fn read_limited(path: &Path, limit: u64, what: &'static str) -> Result<Vec<u8>, ReadError> {
     use std::io::Read;
     let err = |kind: ReadErrorKind| ReadError::new(path, kind);

@@ -253,7 +253,7 @@ pub fn scene_file(args: &AnalyzeArgs) -> Result<SceneFile, String> {
         None => SceneFile::default(),
         Some(path) => {
             let bytes = impact_io::read_limited(path, 1 << 20, "scene file")
-                .map_err(crate::read_errors::into_message)?;
+                .map_err(|e| crate::read_errors::input_file_message(&e))?;
             let file: SceneFile =
                 serde_json::from_slice(&bytes).map_err(|e| format!("{}: {e}", path.display()))?;
             file.check(path)?;
