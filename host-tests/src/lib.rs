@@ -11,6 +11,7 @@ pub mod output;
 pub mod parse;
 pub mod pipeline;
 pub mod plot;
+pub mod read_errors;
 pub mod report;
 pub mod simulate;
 pub mod small_csv;
@@ -18,7 +19,13 @@ pub mod standards;
 pub mod synth;
 pub mod testkit;
 
-pub use impact_io::{note, take_notes};
+pub use impact_io::note;
+
+/// The notes kept so far (and forgets them), worded as the tool words them
+/// ([`read_errors::flag`]).
+pub fn take_notes() -> Vec<String> {
+    impact_io::take_notes(read_errors::flag)
+}
 
 /// Runs `f` on a thread with a 64 MiB stack: the core's monitors hold their capture buffers
 /// inline (no allocation in `core`), which is more than a default thread's stack.

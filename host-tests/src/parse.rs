@@ -40,7 +40,7 @@ pub const EXPONENT: Limits = Limits {
 /// A command-line number within `limits`.
 fn within(s: &str, limits: &Limits) -> Result<f64, String> {
     match s.trim().parse::<f64>() {
-        Ok(v) => limits.check(v),
+        Ok(v) => limits.check(v).map_err(|e| e.to_string()),
         Err(_) => Err("not a number".into()),
     }
 }

@@ -1,83 +1,13 @@
 //! What every reader shares: the channel a recording gives (values, rate, first time), the
-//! options a reader takes, which column is meant, the time axis's units and checks, and
-//! errors that name the file and line. The leaf of `io`: the formats depend on it.
+//! options a reader takes, which column is meant, the time axis's units and checks. The leaf
+//! of `io`: the formats depend on it.
 
-use std::fmt;
-use std::path::{Path, PathBuf};
+use std::path::Path;
 
-/// A column chosen by header name or 0-based index.
-#[derive(Clone, Debug, PartialEq, Eq)]
-pub enum ColumnRef {
-    Name(String),
-    Index(usize),
-}
-
-impl std::str::FromStr for ColumnRef {
-    type Err = String;
-    fn from_str(s: &str) -> Result<Self, String> {
-        Ok(match s.parse::<usize>() {
-            Ok(i) => ColumnRef::Index(i),
-            Err(_) => ColumnRef::Name(s.to_string()),
-        })
-    }
-}
-
-/// What went wrong, and where.
-#[derive(Debug)]
-pub struct RecordingError {
-    pub file: PathBuf,
-    pub line: Option<u64>,
-    pub message: String,
-}
-
-impl fmt::Display for RecordingError {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        let file = input_name(&self.file);
-        match self.line {
-            Some(l) => write!(f, "{file}:{l}: {}", self.message),
-            None => write!(f, "{file}: {}", self.message),
-        }
-    }
-}
-
-impl std::error::Error for RecordingError {}
-
-impl RecordingError {
-    /// An error of the file as a whole (no line).
-    pub fn of(path: &Path, message: String) -> Self {
-        Self {
-            file: path.to_path_buf(),
-            line: None,
-            message,
-        }
-    }
-}
-
-/// An external library's message on one line (some span several, with pointers under a
-/// quoted source).
-pub fn one_line(message: impl std::fmt::Display) -> String {
-    message
-        .to_string()
-        .lines()
-        .map(str::trim)
-        .filter(|l| !l.is_empty())
-        .collect::<Vec<_>>()
-        .join(" ")
-}
-
-/// Whether a path names standard input (`-`).
-pub fn is_stdin(path: &Path) -> bool {
-    path.as_os_str() == "-"
-}
-
-/// How messages name an input: `stdin`, or the path.
-pub fn input_name(path: &Path) -> String {
-    if is_stdin(path) {
-        "stdin".to_string()
-    } else {
-        path.display().to_string()
-    }
-}
+pub use crate::error::{input_name, is_stdin, one_line, ColumnRef, DriftFault};
+use crate::error::{At, Numbered, ReadError, ReadErrorKind, TooFewSamples};
+pub use crate::limits::{sig, DRIFT_BLOCK, DRIFT_LIMIT};
+pub use crate::time_axis::{Drift, INTERVAL_RANGE};
 
 /// How the text is laid out.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
@@ -90,14 +20,19 @@ pub struct CsvFormat {
     pub decimal_comma: bool,
 }
 
-/// Parses a `--delimiter` value: one ASCII character, or `tab`.
-pub fn parse_delimiter(s: &str) -> Result<u8, String> {
+/// A delimiter that is not one ASCII character (other than a quote or line break) or `tab`.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, thiserror::Error)]
+#[error("must be one ASCII character other than a quote or line break, or `tab`")]
+pub struct BadDelimiter;
+
+/// Parses a delimiter's name: one ASCII character, or `tab`.
+pub fn parse_delimiter(s: &str) -> Result<u8, BadDelimiter> {
     match s {
         "tab" | "\\t" | "\t" => Ok(b'\t'),
         _ if s.len() == 1 && s.is_ascii() && s != "\"" && s != "\n" && s != "\r" => {
             Ok(s.as_bytes()[0])
         }
-        _ => Err("must be one ASCII character other than a quote or line break, or `tab`".into()),
+        _ => Err(BadDelimiter),
     }
 }
 
@@ -153,33 +88,34 @@ pub struct ReadOptions {
 }
 
 /// The 0-based channel `column` asks for among `count` numbered ones (default 0), or the
-/// message naming what the file has (`what`, e.g. "a WAV file's channels").
+/// error naming what the file has (`of`).
 pub fn numbered_column(
     column: Option<&ColumnRef>,
     count: usize,
-    what: &str,
-) -> Result<usize, String> {
+    of: Numbered,
+) -> Result<usize, ReadErrorKind> {
     match column {
         None => Ok(0),
         Some(ColumnRef::Index(i)) if *i < count => Ok(*i),
-        Some(c) => {
-            let c = match c {
-                ColumnRef::Index(i) => i.to_string(),
-                ColumnRef::Name(n) => n.clone(),
-            };
-            Err(format!(
-                "--column {c}: {what} are numbered 0..{}",
-                count.saturating_sub(1)
-            ))
-        }
+        Some(c) => Err(ReadErrorKind::ColumnNumbered {
+            column: c.clone(),
+            count,
+            of,
+        }),
     }
 }
 
 /// A channel of `values` sampled evenly at `rate_hz` from t = 0 (binary formats), or the
-/// message if it has fewer than two samples.
-pub fn evenly_sampled(name: String, values: Vec<f64>, rate_hz: f64) -> Result<Channel, String> {
+/// error if it has fewer than two samples.
+pub fn evenly_sampled(
+    name: String,
+    values: Vec<f64>,
+    rate_hz: f64,
+) -> Result<Channel, TooFewSamples> {
     if values.len() < 2 {
-        return Err(format!("{} samples; at least 2", values.len()));
+        return Err(TooFewSamples {
+            samples: values.len(),
+        });
     }
     let time_s = (0..values.len()).map(|k| k as f64 / rate_hz).collect();
     Ok(Channel {
@@ -238,6 +174,15 @@ pub fn time_unit_s(header: &str, given: Option<TimeUnit>) -> f64 {
         .unwrap_or(1.0)
 }
 
+/// A rate given (not read from the file) if it lies within [`crate::limits::RATE_HZ`].
+pub fn check_rate(rate_hz: f64) -> Result<f64, ReadErrorKind> {
+    if crate::limits::RATE_HZ.contains(rate_hz) {
+        Ok(rate_hz)
+    } else {
+        Err(ReadErrorKind::RateOutOfRange { rate_hz })
+    }
+}
+
 /// The slowest rate an impact recording can have, S/s: a pulse of milliseconds needs many
 /// samples. A time column that names no unit and, read in seconds, gives less was written in
 /// another unit.
@@ -246,37 +191,41 @@ pub const SLOWEST_RATE_HZ: f64 = 100.0;
 /// An error with the fix if a time column whose unit is neither named nor given gives a rate
 /// below [`SLOWEST_RATE_HZ`] read in seconds, or if any gives a rate beyond
 /// [`crate::limits::RATE_HZ`].
-pub fn check_time_unit(header: &str, given: Option<TimeUnit>, rate_hz: f64) -> Result<(), String> {
+pub fn check_time_unit(
+    header: &str,
+    given: Option<TimeUnit>,
+    rate_hz: f64,
+) -> Result<(), ReadErrorKind> {
     if !crate::limits::RATE_HZ.contains(rate_hz) {
-        return Err(format!(
-            "the time column {header:?} gives {} S/s: out of range ({}); is its unit right (--time-unit)?",
-            crate::limits::number(rate_hz),
-            crate::limits::RATE_HZ
-        ));
+        return Err(ReadErrorKind::TimeUnitOutOfRange {
+            header: header.to_string(),
+            rate_hz,
+        });
     }
     if given.is_some() || named_time_unit_s(header).is_some() || rate_hz >= SLOWEST_RATE_HZ {
         return Ok(());
     }
-    Err(format!(
-        "the time column {header:?} names no unit: read in seconds it gives {} S/s, too slow for an impact recording; if it is in ms or µs, give --time-unit ms (or us), or name the column time_ms (time_us)",
-        sig(rate_hz, 4)
-    ))
+    Err(ReadErrorKind::TimeUnitTooSlow {
+        header: header.to_string(),
+        rate_hz,
+    })
 }
 
-pub use crate::time_axis::{
-    Drift, DriftFault, DRIFT_BLOCK, DRIFT_LIMIT, HEAD_INTERVALS, INTERVAL_RANGE,
-};
+/// The intervals whose median every interval is checked against: the first 65 535 (those
+/// among the first 65 536 rows, as a file read in passes or a stream has them at hand).
+pub const HEAD_INTERVALS: usize = (1 << 16) - 1;
 
 /// Checks a time column: finite, strictly increasing and evenly sampled (every interval within
 /// [`INTERVAL_RANGE`] times the median of the first [`HEAD_INTERVALS`]). Returns `(rate,
 /// jitter)`; with `resample`, uneven intervals are allowed and the rate is the median
-/// interval's (of all of them).
+/// interval's (of all of them). `at` says where sample `k` is (a line, the sample).
 pub fn check_time(
     path: &Path,
     t: &[f64],
     resample: bool,
-    at: impl Fn(usize, String) -> RecordingError,
-) -> Result<(f64, f64), RecordingError> {
+    at: impl Fn(usize) -> At,
+) -> Result<(f64, f64), ReadError> {
+    let err = |k: usize, kind: ReadErrorKind| ReadError::at(path, at(k), kind);
     // One pass: time going back is the first error, then one sample, then the first uneven
     // interval (against the head's median), then drift.
     let mut axis = crate::time_axis::TimeAxis::new(true);
@@ -284,7 +233,7 @@ pub fn check_time(
     for (k, &tk) in t.iter().enumerate() {
         let f = axis.push(tk, k as u64);
         if let Some(e) = f.not_increasing {
-            return Err(at(k, e.to_string()));
+            return Err(err(k, ReadErrorKind::NotIncreasing(e)));
         }
         uneven = uneven.or(f.uneven.map(|e| (k as u64, e)));
         drift = drift.or(f.drift.map(|e| (k, e)));
@@ -293,11 +242,7 @@ pub fn check_time(
         }
     }
     if t.len() < 2 {
-        return Err(RecordingError {
-            file: path.to_path_buf(),
-            line: None,
-            message: "one sample: the rate cannot be told; give --rate".into(),
-        });
+        return Err(ReadError::new(path, ReadErrorKind::OneSample));
     }
     if resample {
         let mut dts: Vec<f64> = t.windows(2).map(|w| w[1] - w[0]).collect();
@@ -305,10 +250,10 @@ pub fn check_time(
         return Ok((1.0 / median, 0.0));
     }
     if let Some((k, e)) = uneven.or_else(|| axis.close_head()) {
-        return Err(at(k as usize, e.to_string()));
+        return Err(err(k as usize, ReadErrorKind::Uneven(e)));
     }
     if let Some((k, e)) = drift {
-        return Err(at(k, e.to_string()));
+        return Err(err(k, ReadErrorKind::Drift(e)));
     }
     let dt = (t[t.len() - 1] - t[0]) / (t.len() - 1) as f64;
     let jitter = t
@@ -335,19 +280,5 @@ impl RawType {
             "f32" => Some(RawType::F32),
             _ => None,
         }
-    }
-}
-
-/// `x` with `digits` significant digits, without trailing zeros (`1000000`, `19986.9`, `20`).
-pub fn sig(x: f64, digits: usize) -> String {
-    if x == 0.0 || !x.is_finite() {
-        return format!("{x}");
-    }
-    let decimals = (digits as i32 - 1 - x.abs().log10().floor() as i32).max(0) as usize;
-    let s = format!("{x:.decimals$}");
-    if s.contains('.') {
-        s.trim_end_matches('0').trim_end_matches('.').to_string()
-    } else {
-        s
     }
 }

@@ -5,8 +5,9 @@
 
 use std::path::Path;
 
-use super::channel::{CsvFormat, RecordingError};
+use super::channel::CsvFormat;
 use super::csv_fast::{self, FastRows, Layout, Parsed};
+use super::error::{ReadError, ReadErrorKind};
 use super::table::{Row, Rows, Table};
 
 /// What the next read gives.
@@ -36,7 +37,7 @@ pub struct Handover {
 /// sequential reader failed.
 pub enum HandoverError {
     Input { line: u64, error: std::io::Error },
-    Rows(RecordingError),
+    Rows(ReadError),
 }
 
 impl Handover {
@@ -107,7 +108,7 @@ pub fn read_table(
     path: &Path,
     format: &CsvFormat,
     progress: Option<fn(f64)>,
-) -> Result<Table, RecordingError> {
+) -> Result<Table, ReadError> {
     let rows = Rows::open(path, format, progress)?;
     let mut reader = Handover::new(rows, 0, progress);
     let mut table = Table::default();
@@ -129,7 +130,7 @@ pub fn read_table(
         let step = match reader.next(Some(&layout)) {
             Ok(step) => step,
             Err(HandoverError::Input { line, error }) => {
-                return Err(reader.rows.err(Some(line), error.to_string()))
+                return Err(reader.rows.err(Some(line), error.into()))
             }
             Err(HandoverError::Rows(e)) => return Err(e),
         };
@@ -166,11 +167,7 @@ pub fn read_table(
     }
     table.headers = reader.rows.headers;
     if table.columns.first().is_none_or(|c| c.is_empty()) {
-        return Err(RecordingError {
-            file: path.to_path_buf(),
-            line: None,
-            message: "no data rows".into(),
-        });
+        return Err(ReadError::new(path, ReadErrorKind::NoDataRows));
     }
     Ok(table)
 }

@@ -7,6 +7,7 @@
 pub mod channel;
 pub mod csv_fast;
 pub mod csv_read;
+pub mod error;
 pub mod ide;
 pub mod limits;
 pub mod npy;
@@ -24,7 +25,9 @@ pub mod wav;
 
 use std::path::Path;
 
-pub use channel::{Channel, ColumnRef, CsvFormat, ReadOptions, RecordingError, TimeUnit};
+pub use channel::{Channel, ColumnRef, CsvFormat, ReadOptions, TimeUnit};
+use error::UnsupportedFormat;
+pub use error::{At, Opt, OptionNames, ReadError, ReadErrorKind};
 use sources::Source;
 
 /// A recording's format: by the file's extension ([`crate::wav`], [`crate::npy`],
@@ -38,7 +41,7 @@ pub enum Format {
     Ide,
     Csv,
     /// A file no reader takes: what it is and what to do instead.
-    Unsupported(&'static str),
+    Unsupported(UnsupportedFormat),
 }
 
 impl Format {
@@ -55,16 +58,11 @@ impl Format {
             },
         }
     }
-
-    /// The error for a file no reader takes.
-    pub fn refuse(what: &str, name: &str) -> String {
-        format!("{name}: unsupported format: {what}")
-    }
 }
 
 /// What a file that is no CSV is, from its first bytes or its extension (a spreadsheet, a
 /// MATLAB or HDF5 file, an archive, other binary data); `None` for text.
-fn unsupported(path: &Path) -> Option<&'static str> {
+fn unsupported(path: &Path) -> Option<UnsupportedFormat> {
     let mut head = [0u8; 1024];
     // Only a regular file is sniffed (a pipe's bytes would be gone).
     let n = match std::fs::metadata(path) {
@@ -80,19 +78,19 @@ fn unsupported(path: &Path) -> Option<&'static str> {
         .map(str::to_ascii_lowercase)
         .unwrap_or_default();
     if head.starts_with(b"PK\x03\x04") || matches!(ext.as_str(), "xlsx" | "ods") {
-        Some("a spreadsheet or zip archive (.xlsx, .ods, .zip): save the sheet as CSV")
+        Some(UnsupportedFormat::Spreadsheet)
     } else if head.starts_with(&[0xD0, 0xCF, 0x11, 0xE0]) || ext == "xls" {
-        Some("an Excel 97 workbook (.xls): save the sheet as CSV")
+        Some(UnsupportedFormat::Excel97)
     } else if head.starts_with(b"MATLAB") {
-        Some("a MATLAB .mat file: save the channel as CSV or .npy (scipy.io.loadmat, numpy.save)")
+        Some(UnsupportedFormat::Matlab)
     } else if head.starts_with(b"\x89HDF") || matches!(ext.as_str(), "h5" | "hdf5" | "mat") {
-        Some("an HDF5 file (.h5, MATLAB 7.3 .mat): save the channel as CSV or .npy (h5py, numpy.save)")
+        Some(UnsupportedFormat::Hdf5)
     } else if head.starts_with(&[0x1F, 0x8B]) {
-        Some("a gzip archive: unpack it first")
+        Some(UnsupportedFormat::Gzip)
     } else if head.starts_with(b"MDF ") || ext == "mf4" {
-        Some("an ASAM MDF file: export the channel as CSV")
+        Some(UnsupportedFormat::Mdf)
     } else if head.contains(&0) {
-        Some("binary data: for raw samples name the file .i16 or .f32, or give --raw-type")
+        Some(UnsupportedFormat::Binary)
     } else {
         None
     }
@@ -100,99 +98,155 @@ fn unsupported(path: &Path) -> Option<&'static str> {
 
 /// Reads one channel and its time base from a CSV file (see [`csv_read::read_table`]), a WAV file, an
 /// `.npy` array, a TDMS file or a raw `.i16`/`.f32` file ([`Format`]).
-pub fn read_recording(path: &Path, opts: &ReadOptions) -> Result<Channel, RecordingError> {
+pub fn read_recording(path: &Path, opts: &ReadOptions) -> Result<Channel, ReadError> {
     match Format::of(path, opts.raw_type) {
         Format::Wav => wav::read_wav(path, opts),
         Format::Npy => npy::read_npy(path, opts),
         Format::Tdms => tdms::read_tdms(path, opts),
         Format::Ide => ide::read_ide(path, opts),
-        Format::Unsupported(what) => Err(RecordingError {
-            file: path.to_path_buf(),
-            line: None,
-            message: format!("unsupported format: {what}"),
-        }),
+        Format::Unsupported(what) => Err(ReadError::new(path, ReadErrorKind::Unsupported(what))),
         Format::Raw(kind) => raw::read_raw(path, kind, opts.raw_channels.unwrap_or(1), opts),
         Format::Csv => recording::read_csv(path, opts),
     }
 }
 
 /// Opens the reader for the file's format.
-pub fn open_source(path: &Path, opts: &ReadOptions, name: &str) -> Result<Box<dyn Source>, String> {
+pub fn open_source(path: &Path, opts: &ReadOptions) -> Result<Box<dyn Source>, ReadError> {
     use sources::{CsvSource, IdeSource, NpySource, RawSource, TdmsSource, WavSource};
     Ok(match Format::of(path, opts.raw_type) {
-        Format::Raw(kind) => Box::new(RawSource::open(path, opts, kind, name)?),
-        Format::Wav => Box::new(WavSource::open(path, opts, name)?),
-        Format::Npy => Box::new(NpySource::open(path, opts, name)?),
-        Format::Tdms => Box::new(TdmsSource::open(path, opts, name)?),
-        Format::Ide => Box::new(IdeSource::open(path, opts, name)?),
-        Format::Unsupported(what) => return Err(Format::refuse(what, name)),
+        Format::Raw(kind) => Box::new(RawSource::open(path, opts, kind)?),
+        Format::Wav => Box::new(WavSource::open(path, opts)?),
+        Format::Npy => Box::new(NpySource::open(path, opts)?),
+        Format::Tdms => Box::new(TdmsSource::open(path, opts)?),
+        Format::Ide => Box::new(IdeSource::open(path, opts)?),
+        Format::Unsupported(what) => {
+            return Err(ReadError::new(path, ReadErrorKind::Unsupported(what)))
+        }
         Format::Csv => Box::new(CsvSource::open(path, opts)?),
     })
 }
 
 /// Reads a secondary input (a scene, a target, an ELF) of at most `limit` bytes: a larger
-/// one (or an endless one, `/dev/zero`) is an error naming the limit, read no further.
-pub fn read_limited(path: &Path, limit: u64, what: &str) -> Result<Vec<u8>, String> {
+/// one (or an endless one, `/dev/zero`) is an error naming the limit (`what`: what the input
+/// is, `scene file`), read no further. (`-` is a file of that name here, not standard input,
+/// though the error's Display, as every reader's, calls it `stdin`.)
+pub fn read_limited(path: &Path, limit: u64, what: &'static str) -> Result<Vec<u8>, ReadError> {
     use std::io::Read;
-    let name = path.display();
-    let file = std::fs::File::open(path).map_err(|e| format!("{name}: {e}"))?;
+    let err = |kind: ReadErrorKind| ReadError::new(path, kind);
+    let file = std::fs::File::open(path).map_err(|e| err(ReadErrorKind::Io(e)))?;
     let mut bytes = Vec::new();
     file.take(limit + 1)
         .read_to_end(&mut bytes)
-        .map_err(|e| format!("{name}: {e}"))?;
+        .map_err(|e| err(ReadErrorKind::Io(e)))?;
     if bytes.len() as u64 > limit {
-        return Err(format!(
-            "{name}: more than {} KiB, larger than any {what}",
-            limit / 1024
-        ));
+        return Err(err(ReadErrorKind::TooLarge { limit, what }));
     }
     Ok(bytes)
 }
 
+/// A note for the user: a reader's own (its settings named as the caller names them), or a
+/// caller's text.
+#[derive(Clone, Debug, PartialEq)]
+pub enum Note {
+    Text(String),
+    Read(ReadNote),
+}
+
+/// What a reader chose that the user may want to choose otherwise.
+#[derive(Clone, Debug, PartialEq)]
+pub enum ReadNote {
+    /// A CSV's first data column (`channel`'s header, or `column N`) taken among `names`.
+    ChannelChosen { channel: String, names: Vec<String> },
+    /// An `.ide` file's first acceleration subchannel taken among `count` (the file has
+    /// `subchannels`).
+    SubchannelChosen {
+        subchannel: String,
+        count: usize,
+        subchannels: Vec<String>,
+    },
+}
+
+impl Note {
+    /// The note's text, the settings it names written by `names`.
+    pub fn text(&self, names: OptionNames) -> String {
+        match self {
+            Note::Text(t) => t.clone(),
+            Note::Read(ReadNote::ChannelChosen { channel, names: all }) => format!(
+                "analysing {channel} of {} channels ({}): choose one with {}, or {} for their resultant",
+                all.len(),
+                all.join(", "),
+                names(Opt::Column),
+                names(Opt::Axes)
+            ),
+            Note::Read(ReadNote::SubchannelChosen {
+                subchannel,
+                count,
+                subchannels,
+            }) => format!(
+                "analysing {subchannel} of {count} acceleration subchannels: choose one with {} CH.SUB (the file has: {})",
+                names(Opt::Column),
+                subchannels.join(", ")
+            ),
+        }
+    }
+}
+
 /// Notes for the user, each once (a file read in passes is opened again for each pass).
-static NOTES: std::sync::Mutex<Vec<String>> = std::sync::Mutex::new(Vec::new());
+static NOTES: std::sync::Mutex<Vec<Note>> = std::sync::Mutex::new(Vec::new());
 
 /// Keeps `note: MESSAGE` for stderr: the tool prints its notes after a run that succeeded
 /// ([`take_notes`]), so that an error stays one line.
 pub fn note(message: &str) {
-    let own = OWN_NOTES.with(|own| match own.borrow_mut().as_mut() {
+    keep(Note::Text(message.to_string()));
+}
+
+/// Keeps a reader's note ([`note`]).
+pub(crate) fn note_read(note: ReadNote) {
+    keep(Note::Read(note));
+}
+
+fn keep(note: Note) {
+    let note = OWN_NOTES.with(|own| match own.borrow_mut().as_mut() {
         Some(notes) => {
-            if !notes.iter().any(|m| m == message) {
-                notes.push(message.to_string());
+            if !notes.contains(&note) {
+                notes.push(note);
             }
-            true
+            None
         }
-        None => false,
+        None => Some(note),
     });
-    if own {
-        return;
-    }
+    let Some(note) = note else { return };
     if let Ok(mut notes) = NOTES.lock() {
-        if !notes.iter().any(|m| m == message) {
-            notes.push(message.to_string());
+        if !notes.contains(&note) {
+            notes.push(note);
         }
     }
 }
 
 std::thread_local! {
     /// The notes of an analysis that keeps its own ([`with_own_notes`]).
-    static OWN_NOTES: std::cell::RefCell<Option<Vec<String>>> =
+    static OWN_NOTES: std::cell::RefCell<Option<Vec<Note>>> =
         const { std::cell::RefCell::new(None) };
 }
 
 /// Runs `f` with the notes it gives on this thread kept apart (a series' recordings,
-/// analysed side by side, each with its own notes), and returns them with its result.
-pub fn with_own_notes<R>(f: impl FnOnce() -> R) -> (R, Vec<String>) {
+/// analysed side by side, each with its own notes), and returns them with its result, the
+/// settings they name written by `names`.
+pub fn with_own_notes<R>(names: OptionNames, f: impl FnOnce() -> R) -> (R, Vec<String>) {
     OWN_NOTES.with(|own| *own.borrow_mut() = Some(Vec::new()));
     let r = f();
     let notes = OWN_NOTES.with(|own| own.borrow_mut().take());
-    (r, notes.unwrap_or_default())
+    let notes = notes.unwrap_or_default();
+    (r, notes.iter().map(|n| n.text(names)).collect())
 }
 
-/// The notes kept so far (and forgets them).
-pub fn take_notes() -> Vec<String> {
+/// The notes kept so far (and forgets them), the settings they name written by `names`.
+pub fn take_notes(names: OptionNames) -> Vec<String> {
     NOTES
         .lock()
         .map(|mut n| std::mem::take(&mut *n))
         .unwrap_or_default()
+        .iter()
+        .map(|n| n.text(names))
+        .collect()
 }

@@ -41,20 +41,26 @@ impl Limits {
         value >= self.low && value <= self.high
     }
 
-    /// `value` if it lies within; else `out of range (between LOW and HIGH UNIT)`.
-    pub fn check(&self, value: f64) -> Result<f64, String> {
+    /// `value` if it lies within; else the error, `out of range (between LOW and HIGH
+    /// UNIT)`.
+    pub fn check(&self, value: f64) -> Result<f64, OutOfRange> {
         if self.contains(value) {
             Ok(value)
         } else {
-            Err(format!("out of range ({self})"))
+            Err(OutOfRange {
+                value,
+                limits: *self,
+            })
         }
     }
 
     /// [`Limits::check`] naming the value and where it came from (`what`: an option, a
     /// file's key): `--mass 1e300: out of range (between 1e-30 and 1e6 kg)`.
-    pub fn check_named(&self, what: &str, value: f64) -> Result<f64, String> {
-        self.check(value)
-            .map_err(|e| format!("{what} {}: {e}", number(value)))
+    pub fn check_named(&self, what: &str, value: f64) -> Result<f64, NamedOutOfRange> {
+        self.check(value).map_err(|range| NamedOutOfRange {
+            what: what.to_string(),
+            range,
+        })
     }
 
     /// The limits of the reciprocal (an interval's from a rate's), in `unit`.
@@ -67,6 +73,22 @@ impl Limits {
     }
 }
 
+/// A value outside its limits.
+#[derive(Clone, Copy, Debug, PartialEq, thiserror::Error)]
+#[error("out of range ({limits})")]
+pub struct OutOfRange {
+    pub value: f64,
+    pub limits: Limits,
+}
+
+/// A value outside its limits, with the name it was given by (an option, a file's key).
+#[derive(Clone, Debug, PartialEq, thiserror::Error)]
+#[error("{what} {}: {range}", number(.range.value))]
+pub struct NamedOutOfRange {
+    pub what: String,
+    pub range: OutOfRange,
+}
+
 impl fmt::Display for Limits {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         write!(f, "between {} and {}", number(self.low), number(self.high))?;
@@ -74,6 +96,36 @@ impl fmt::Display for Limits {
             write!(f, " {}", self.unit)?;
         }
         Ok(())
+    }
+}
+
+/// Longest record (line) read, bytes: a file without line breaks (`/dev/zero`) or with an
+/// unclosed quote is an error, not a memory blow-up.
+pub const MAX_LINE_BYTES: usize = 1 << 20;
+
+/// Largest magnitude a value may have: beyond it no sensor reading or time is meant (and the
+/// f32 sample path would overflow).
+pub const MAX_VALUE: f64 = 1e30;
+
+/// Intervals per block of the drift check ([`crate::channel::Drift`]).
+pub const DRIFT_BLOCK: u64 = 1024;
+/// Largest difference of a block's mean interval from the first block's (1 %): a sample
+/// clock is steady to parts per million; a time axis whose interval drifts further (each
+/// step may stay well inside [`crate::channel::INTERVAL_RANGE`]) is no even grid, and
+/// taking it for one puts the impacts at the wrong times with the wrong Δv.
+pub const DRIFT_LIMIT: f64 = 0.01;
+
+/// `x` with `digits` significant digits, without trailing zeros (`1000000`, `19986.9`, `20`).
+pub fn sig(x: f64, digits: usize) -> String {
+    if x == 0.0 || !x.is_finite() {
+        return format!("{x}");
+    }
+    let decimals = (digits as i32 - 1 - x.abs().log10().floor() as i32).max(0) as usize;
+    let s = format!("{x:.decimals$}");
+    if s.contains('.') {
+        s.trim_end_matches('0').trim_end_matches('.').to_string()
+    } else {
+        s
     }
 }
 
@@ -101,7 +153,7 @@ mod tests {
             ..positive("kg")
         };
         assert_eq!(
-            mass.check_named("--mass", 1e300).unwrap_err(),
+            mass.check_named("--mass", 1e300).unwrap_err().to_string(),
             "--mass 1e300: out of range (between 1e-30 and 1e6 kg)"
         );
         assert_eq!(mass.check(0.06), Ok(0.06));

@@ -5,9 +5,9 @@
 use std::io::BufReader;
 use std::path::Path;
 
-use crate::channel::{evenly_sampled, numbered_column, Channel, ColumnRef, ReadOptions};
-use crate::channel::{one_line, RecordingError};
-use crate::limits::RATE_HZ;
+use crate::channel::{check_rate, evenly_sampled, numbered_column};
+use crate::channel::{Channel, ColumnRef, ReadOptions};
+use crate::error::{NpyFault, Numbered, ReadError, ReadErrorKind};
 
 /// True for a `.npy` file name (any case).
 pub fn is_npy(path: &Path) -> bool {
@@ -16,29 +16,30 @@ pub fn is_npy(path: &Path) -> bool {
         .is_some_and(|e| e.eq_ignore_ascii_case("npy"))
 }
 
-/// An array's elements as f64, in storage order, read as they are asked for.
-pub type Elements = Box<dyn Iterator<Item = Result<f64, String>> + Send>;
+/// An array's elements as f64, in storage order, read as they are asked for (an error names
+/// the element).
+pub type Elements = Box<dyn Iterator<Item = Result<f64, NpyFault>> + Send>;
 
 /// An .npy file opened: its elements (in storage order, whatever the numeric dtype), shape
 /// and order.
-pub fn open_elements(path: &Path) -> Result<(Elements, Vec<u64>, npyz::Order), String> {
+pub fn open_elements(path: &Path) -> Result<(Elements, Vec<u64>, npyz::Order), ReadError> {
     fn boxed<T: npyz::Deserialize + Into<f64> + 'static>(
         r: npyz::NpyReader<T, BufReader<std::fs::File>>,
     ) -> Elements
     where
         npyz::NpyReader<T, BufReader<std::fs::File>>: Send,
     {
-        Box::new(r.enumerate().map(|(k, v)| {
+        Box::new(r.enumerate().map(|(element, v)| {
             v.map(Into::into)
-                .map_err(|e| format!("element {k}: {}", one_line(e)))
+                .map_err(|error| NpyFault::Element { element, error })
         }))
     }
-    let f = std::fs::File::open(path).map_err(|e| e.to_string())?;
-    let file =
-        npyz::NpyFile::new(BufReader::new(f)).map_err(|e| format!("npy: {}", one_line(e)))?;
+    let f = std::fs::File::open(path).map_err(|e| ReadError::new(path, e))?;
+    let file = npyz::NpyFile::new(BufReader::new(f))
+        .map_err(|e| ReadError::new(path, NpyFault::Header(e)))?;
     let shape = file.shape().to_vec();
     let order = file.order();
-    let dtype = file.dtype().descr();
+    let dtype = file.dtype();
     let file = match file.try_data::<f64>() {
         Ok(r) => return Ok((boxed(r), shape, order)),
         Err(f) => f,
@@ -65,56 +66,47 @@ pub fn open_elements(path: &Path) -> Result<(Elements, Vec<u64>, npyz::Order), S
     };
     match file.try_data::<u8>() {
         Ok(r) => Ok((boxed(r), shape, order)),
-        Err(_) => Err(format!(
-            "npy: dtype {dtype}: not one of float64, float32, int32, int16, uint16, int8, uint8"
-        )),
+        Err(_) => Err(ReadError::new(path, NpyFault::Dtype(dtype))),
     }
 }
 
 /// Samples, channels and the chosen channel of an array of `shape`: 1-D, or 2-D samples ×
 /// channels.
-pub fn layout(shape: &[u64], column: Option<&ColumnRef>) -> Result<(u64, u64, usize), String> {
+pub fn layout(
+    shape: &[u64],
+    column: Option<&ColumnRef>,
+) -> Result<(u64, u64, usize), ReadErrorKind> {
     let (rows, cols) = match *shape {
         [n] => (n, 1),
         [n, c] => (n, c),
-        _ => {
-            return Err(format!(
-                "npy: shape {shape:?}; a 1-D array or 2-D (samples × channels)"
-            ))
-        }
+        _ => return Err(NpyFault::Shape(shape.to_vec()).into()),
     };
-    let column = numbered_column(column, cols as usize, "the array's columns")?;
+    let column = numbered_column(column, cols as usize, Numbered::ArrayColumns)?;
     Ok((rows, cols, column))
 }
 
 /// Reads the channel `opts.column` of a 1-D or 2-D array at `opts.rate_hz`.
-pub fn read_npy(path: &Path, opts: &ReadOptions) -> Result<Channel, RecordingError> {
-    let err = |message: String| RecordingError {
-        file: path.to_path_buf(),
-        line: None,
-        message,
-    };
+pub fn read_npy(path: &Path, opts: &ReadOptions) -> Result<Channel, ReadError> {
+    let err = |kind: ReadErrorKind| ReadError::new(path, kind);
     let Some(rate_hz) = opts.rate_hz else {
-        return Err(err("an .npy array holds no time: give --rate".into()));
+        return Err(err(ReadErrorKind::NpyNoTime));
     };
-    RATE_HZ.check_named("--rate", rate_hz).map_err(err)?;
+    check_rate(rate_hz).map_err(err)?;
     if opts.time_column.is_some() || opts.resample || !opts.axes.is_empty() {
-        return Err(err(
-            "an .npy array takes --rate and --column only (no --time-column, --resample, --axes)"
-                .into(),
-        ));
+        return Err(err(ReadErrorKind::NpyOptions));
     }
-    let (elements, shape, order) = open_elements(path).map_err(err)?;
+    let (elements, shape, order) = open_elements(path)?;
     let (rows, cols, column) = layout(&shape, opts.column.as_ref()).map_err(err)?;
     let (rows, cols) = (rows as usize, cols as usize);
     let all: Vec<f64> = elements
-        .map(|e| e.map_err(|e| err(format!("npy: {}", one_line(e)))))
+        .map(|e| e.map_err(|e| err(e.into())))
         .collect::<Result<_, _>>()?;
     if all.len() != rows * cols {
-        return Err(err(format!(
-            "npy: {} elements for shape {shape:?}",
-            all.len()
-        )));
+        return Err(err(NpyFault::ElementCount {
+            elements: all.len(),
+            shape,
+        }
+        .into()));
     }
     let at = |i: usize| match order {
         npyz::Order::C => all.get(i * cols + column),
@@ -124,10 +116,16 @@ pub fn read_npy(path: &Path, opts: &ReadOptions) -> Result<Channel, RecordingErr
     for i in 0..rows {
         match at(i).copied() {
             Some(v) if v.is_finite() => values.push(v),
-            Some(v) => return Err(err(format!("npy: row {i}: {v} is not finite"))),
-            None => return Err(err(format!("npy: row {i} missing"))),
+            Some(value) => {
+                return Err(err(NpyFault::NotFinite {
+                    row: i as u64,
+                    value,
+                }
+                .into()))
+            }
+            None => return Err(err(NpyFault::RowMissing { row: i }.into())),
         }
     }
     evenly_sampled(format!("column {column}"), values, rate_hz)
-        .map_err(|e| err(format!("npy: {e}")))
+        .map_err(|e| err(NpyFault::Samples(e).into()))
 }

@@ -6,9 +6,8 @@ use std::path::Path;
 
 use super::channel::RawType;
 
-use crate::channel::RecordingError;
-use crate::channel::{evenly_sampled, numbered_column, Channel, ReadOptions};
-use crate::limits::RATE_HZ;
+use crate::channel::{check_rate, evenly_sampled, numbered_column, Channel, ReadOptions};
+use crate::error::{Numbered, ReadError, ReadErrorKind};
 
 impl RawType {
     /// The values at byte `at` of each `frame`-byte frame of `bytes` (whole frames), handed
@@ -54,50 +53,40 @@ pub fn read_raw(
     kind: RawType,
     channels: usize,
     opts: &ReadOptions,
-) -> Result<Channel, RecordingError> {
-    let err = |message: String| RecordingError {
-        file: path.to_path_buf(),
-        line: None,
-        message,
-    };
+) -> Result<Channel, ReadError> {
+    let err = |kind: ReadErrorKind| ReadError::new(path, kind);
     let Some(rate_hz) = opts.rate_hz else {
-        return Err(err("a raw file holds no time: give --rate".into()));
+        return Err(err(ReadErrorKind::RawNoTime));
     };
-    RATE_HZ.check_named("--rate", rate_hz).map_err(err)?;
+    check_rate(rate_hz).map_err(err)?;
     if opts.time_column.is_some() || opts.resample || !opts.axes.is_empty() {
-        return Err(err(
-            "a raw file takes --rate, --raw-channels and --column only".into(),
-        ));
+        return Err(err(ReadErrorKind::RawOptions));
     }
     if !(1..=64).contains(&channels) {
-        return Err(err(format!(
-            "--raw-channels {channels}: must lie in 1..=64"
-        )));
+        return Err(err(ReadErrorKind::RawChannels { channels }));
     }
-    let column = numbered_column(
-        opts.column.as_ref(),
-        channels,
-        &format!("the file's {channels} interleaved channels"),
-    )
-    .map_err(err)?;
-    let bytes = std::fs::read(path).map_err(|e| err(e.to_string()))?;
+    let column =
+        numbered_column(opts.column.as_ref(), channels, Numbered::FileChannels).map_err(err)?;
+    let bytes = std::fs::read(path).map_err(|e| err(e.into()))?;
     let frame = kind.bytes() * channels;
     if bytes.len() % frame != 0 {
-        return Err(err(format!(
-            "{} bytes: not a whole number of {frame}-byte frames ({channels} channel(s) of {} bytes); the last frame starts at byte {}",
-            bytes.len(),
-            kind.bytes(),
-            bytes.len() / frame * frame
-        )));
+        return Err(err(ReadErrorKind::RawPartialFrame {
+            bytes: bytes.len() as u64,
+            frame,
+            channels,
+            sample_bytes: kind.bytes(),
+        }));
     }
     let mut values = Vec::with_capacity(bytes.len() / frame);
     let at = column * kind.bytes();
     kind.decode(&bytes, frame, at, |v| values.push(v))
-        .map_err(|(k, v)| {
-            err(format!(
-                "frame {k} (byte {}): {v} is not finite",
-                k * frame + at
-            ))
+        .map_err(|(k, value)| {
+            err(ReadErrorKind::RawNotFinite {
+                frame: k as u64,
+                byte: (k * frame + at) as u64,
+                value,
+            })
         })?;
-    evenly_sampled(format!("channel {column}"), values, rate_hz).map_err(err)
+    evenly_sampled(format!("channel {column}"), values, rate_hz)
+        .map_err(|e| err(ReadErrorKind::TooFewSamples(e)))
 }

@@ -3,11 +3,10 @@
 
 use std::path::Path;
 
-use crate::channel::{
-    check_time, check_time_unit, time_unit_s, Channel, ReadOptions, RecordingError,
-};
+use crate::channel::{check_rate, check_time, check_time_unit, time_unit_s};
+use crate::channel::{Channel, ReadOptions};
 use crate::csv_read::read_table;
-use crate::limits::RATE_HZ;
+use crate::error::{At, ReadError, ReadErrorKind};
 
 /// A resampled recording may hold at most this many times the file's samples (a long gap in
 /// a fast recording would otherwise fill the memory with interpolated nothing).
@@ -19,19 +18,19 @@ pub fn resample(
     t: &[f64],
     v: &[f64],
     rate: f64,
-) -> Result<(Vec<f64>, Vec<f64>), RecordingError> {
+) -> Result<(Vec<f64>, Vec<f64>), ReadError> {
     let span = t[t.len() - 1] - t[0];
     let n = (span * rate).floor() as usize + 1;
     if n > MAX_RESAMPLE_GROWTH * t.len() + 1024 {
-        return Err(RecordingError {
-            file: path.to_path_buf(),
-            line: None,
-            message: format!(
-                "--resample: {span:.6e} s at {rate:.6e} Hz would be {n} samples from {} in the \
-                 file (a long gap?): cut the file",
-                t.len()
-            ),
-        });
+        return Err(ReadError::new(
+            path,
+            ReadErrorKind::ResampleTooLong {
+                span_s: span,
+                rate_hz: rate,
+                samples: n,
+                file_samples: t.len(),
+            },
+        ));
     }
     let mut times = Vec::with_capacity(n);
     let mut values = Vec::with_capacity(n);
@@ -49,12 +48,8 @@ pub fn resample(
 }
 
 /// Reads one channel and its time base (see [`read_table`] for the format).
-pub fn read_csv(path: &Path, opts: &ReadOptions) -> Result<Channel, RecordingError> {
-    let err = |message: String| RecordingError {
-        file: path.to_path_buf(),
-        line: None,
-        message,
-    };
+pub fn read_csv(path: &Path, opts: &ReadOptions) -> Result<Channel, ReadError> {
+    let err = |kind: ReadErrorKind| ReadError::new(path, kind);
     let table = read_table(path, &opts.format, opts.progress)?;
     let tcol = table
         .time_column_unless_rate(opts.rate_hz.is_some(), opts.time_column.as_ref())
@@ -74,10 +69,10 @@ pub fn read_csv(path: &Path, opts: &ReadOptions) -> Result<Channel, RecordingErr
             .map_err(err)?]
     } else {
         if !(2..=3).contains(&opts.axes.len()) {
-            return Err(err(format!(
-                "--axes: {} columns given; two or three (x,y or x,y,z)",
-                opts.axes.len()
-            )));
+            return Err(err(ReadErrorKind::AxesCount {
+                given: opts.axes.len(),
+                what: "columns",
+            }));
         }
         opts.axes
             .iter()
@@ -86,12 +81,16 @@ pub fn read_csv(path: &Path, opts: &ReadOptions) -> Result<Channel, RecordingErr
     };
     for (i, &col) in cols.iter().enumerate() {
         if Some(col) == tcol {
-            return Err(err(format!(
-                "column {col} is the time column: choose another with --column or --axes"
-            )));
+            return Err(err(ReadErrorKind::ChannelIsTimeColumn {
+                column: col,
+                axes: true,
+            }));
         }
         if cols[..i].contains(&col) {
-            return Err(err(format!("--axes: column {} given twice", name_of(col))));
+            return Err(err(ReadErrorKind::AxisTwice {
+                what: "column",
+                name: name_of(col),
+            }));
         }
     }
     let mut channels: Vec<Vec<f64>> = cols.iter().map(|&c| table.columns[c].clone()).collect();
@@ -100,7 +99,7 @@ pub fn read_csv(path: &Path, opts: &ReadOptions) -> Result<Channel, RecordingErr
     let unit = |t: usize| time_unit_s(&header(t), opts.time_unit);
     let (rate_hz, time_s, jitter, resampled) = match (opts.rate_hz, tcol) {
         (Some(r), _) => {
-            RATE_HZ.check_named("--rate", r).map_err(err)?;
+            check_rate(r).map_err(err)?;
             let t0 = tcol.map_or(0.0, |t| table.columns[t][0] * unit(t));
             let times = (0..len).map(|i| t0 + i as f64 / r).collect();
             (r, times, 0.0, false)
@@ -108,11 +107,7 @@ pub fn read_csv(path: &Path, opts: &ReadOptions) -> Result<Channel, RecordingErr
         (None, Some(t)) => {
             let scale = unit(t);
             let times: Vec<f64> = table.columns[t].iter().map(|v| v * scale).collect();
-            let at = |i: usize, message: String| RecordingError {
-                file: path.to_path_buf(),
-                line: Some(table.line_of(i)),
-                message,
-            };
+            let at = |i: usize| At::Line(table.line_of(i));
             let (rate, jitter) = check_time(path, &times, opts.resample, at)?;
             check_time_unit(&header(t), opts.time_unit, rate).map_err(err)?;
             if opts.resample {
@@ -127,11 +122,7 @@ pub fn read_csv(path: &Path, opts: &ReadOptions) -> Result<Channel, RecordingErr
                 (rate, times, jitter, false)
             }
         }
-        (None, None) => {
-            return Err(err(
-                "no time column found: give --time-column or --rate".into()
-            ))
-        }
+        (None, None) => return Err(err(ReadErrorKind::NoTimeColumn)),
     };
     let (name, values, axes) = if opts.axes.is_empty() {
         (name_of(cols[0]), channels.remove(0), Vec::new())

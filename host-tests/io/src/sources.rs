@@ -4,16 +4,17 @@
 
 use std::io::Read;
 
-use std::path::Path;
+use std::path::{Path, PathBuf};
 
 use super::channel::RawType;
-use super::channel::{is_stdin, ReadOptions};
+use super::channel::{check_rate, is_stdin, ReadOptions};
 use super::csv_fast::{Layout, Parsed};
 use super::csv_read::{Handover, HandoverError, Step};
 use super::quantise::Quantiser;
 use super::table::Rows;
-use super::time_axis::TimeAxis;
-use crate::limits::RATE_HZ;
+use super::time_axis::{NotIncreasing, TimeAxis, UnevenInterval};
+use crate::channel::DriftFault;
+use crate::error::{At, NpyFault, Numbered, ReadError, ReadErrorKind};
 
 /// Samples whose noise sets the default edge level (the whole-file path uses the whole
 /// recording's): the first 65 536.
@@ -24,7 +25,7 @@ pub const CHUNK: usize = 1 << 16;
 
 /// The first [`HEAD`] values × `scale` (fewer if the input is shorter); then what the head
 /// tells is fixed ([`Source::head_read`]).
-pub fn read_head(source: &mut dyn Source, scale: f64) -> Result<Vec<f64>, String> {
+pub fn read_head(source: &mut dyn Source, scale: f64) -> Result<Vec<f64>, ReadError> {
     let mut head = Vec::with_capacity(HEAD);
     while head.len() < HEAD {
         let before = head.len();
@@ -43,7 +44,7 @@ pub fn read_head(source: &mut dyn Source, scale: f64) -> Result<Vec<f64>, String
 /// Where the stream's values come from.
 pub trait Source: Send {
     /// Appends up to about `want` values to `out` (none at the end of the input).
-    fn next_values(&mut self, want: usize, out: &mut Vec<f64>) -> Result<(), String>;
+    fn next_values(&mut self, want: usize, out: &mut Vec<f64>) -> Result<(), ReadError>;
     /// Appends up to about `want` values to `out` as counts (`to_count(v × scale, gain)`),
     /// through `scratch`.
     fn next_counts(
@@ -52,15 +53,15 @@ pub trait Source: Send {
         q: Quantiser,
         scratch: &mut Vec<f64>,
         out: &mut Vec<i16>,
-    ) -> Result<(), String> {
+    ) -> Result<(), ReadError> {
         values_as_counts(self, want, q, scratch, out)
     }
     /// The head has been read: what it tells (a CSV's rate) is fixed, and checked.
-    fn head_read(&mut self) -> Result<(), String> {
+    fn head_read(&mut self) -> Result<(), ReadError> {
         Ok(())
     }
     /// The rate the scene runs at (after the head).
-    fn rate_hz(&self) -> Result<f64, String>;
+    fn rate_hz(&self) -> Result<f64, ReadError>;
     /// The rate the report gives (at the end: a CSV's mean interval over the whole file, as
     /// the whole-file path computes it); the scene's by default.
     fn final_rate_hz(&self) -> f64 {
@@ -84,7 +85,7 @@ fn values_as_counts<S: Source + ?Sized>(
     q: Quantiser,
     scratch: &mut Vec<f64>,
     out: &mut Vec<i16>,
-) -> Result<(), String> {
+) -> Result<(), ReadError> {
     scratch.clear();
     source.next_values(want, scratch)?;
     out.extend(scratch.iter().map(|&v| q.count(v)));
@@ -103,41 +104,34 @@ pub struct RawSource {
     held: usize,
     /// Bytes read so far.
     read: u64,
-    name: String,
+    path: PathBuf,
     rate_hz: f64,
     /// For 16-bit codes: each code's count under the quantiser.
     table: Option<(Quantiser, Vec<i16>)>,
 }
 
 impl RawSource {
-    pub fn open(
-        path: &Path,
-        opts: &ReadOptions,
-        kind: RawType,
-        name: &str,
-    ) -> Result<Self, String> {
+    pub fn open(path: &Path, opts: &ReadOptions, kind: RawType) -> Result<Self, ReadError> {
+        let err = |kind: ReadErrorKind| ReadError::new(path, kind);
         if opts.time_column.is_some() {
-            return Err(format!(
-                "{name}: a raw file takes --rate, --raw-channels and --column only"
-            ));
+            return Err(err(ReadErrorKind::RawOptions));
         }
-        let rate_hz = opts
-            .rate_hz
-            .ok_or_else(|| format!("{name}: a raw file holds no time: give --rate"))?;
-        RATE_HZ.check_named("--rate", rate_hz)?;
+        let rate_hz = opts.rate_hz.ok_or_else(|| err(ReadErrorKind::RawNoTime))?;
+        check_rate(rate_hz).map_err(err)?;
         let channels = opts.raw_channels.unwrap_or(1);
         if !(1..=64).contains(&channels) {
-            return Err(format!("--raw-channels {channels}: must lie in 1..=64"));
+            return Err(err(ReadErrorKind::RawChannels { channels }));
         }
         let column = crate::channel::numbered_column(
             opts.column.as_ref(),
             channels,
-            &format!("the stream's {channels} interleaved channels"),
-        )?;
+            Numbered::StreamChannels,
+        )
+        .map_err(err)?;
         let input: Box<dyn Read + Send> = if is_stdin(path) {
             Box::new(std::io::stdin())
         } else {
-            Box::new(std::fs::File::open(path).map_err(|e| format!("{name}: {e}"))?)
+            Box::new(std::fs::File::open(path).map_err(|e| err(e.into()))?)
         };
         Ok(Self {
             input,
@@ -147,7 +141,7 @@ impl RawSource {
             buf: vec![0u8; CHUNK],
             held: 0,
             read: 0,
-            name: name.to_string(),
+            path: path.to_path_buf(),
             rate_hz,
             table: None,
         })
@@ -155,11 +149,11 @@ impl RawSource {
 }
 
 impl Source for RawSource {
-    fn rate_hz(&self) -> Result<f64, String> {
+    fn rate_hz(&self) -> Result<f64, ReadError> {
         Ok(self.rate_hz)
     }
 
-    fn next_values(&mut self, want: usize, out: &mut Vec<f64>) -> Result<(), String> {
+    fn next_values(&mut self, want: usize, out: &mut Vec<f64>) -> Result<(), ReadError> {
         let (kind, frame, at) = (self.kind, self.frame, self.at);
         self.next_with(want, |bytes| kind.decode(bytes, frame, at, |v| out.push(v)))
     }
@@ -172,7 +166,7 @@ impl Source for RawSource {
         q: Quantiser,
         scratch: &mut Vec<f64>,
         out: &mut Vec<i16>,
-    ) -> Result<(), String> {
+    ) -> Result<(), ReadError> {
         if self.kind != RawType::I16 {
             return values_as_counts(self, want, q, scratch, out);
         }
@@ -206,23 +200,24 @@ impl RawSource {
         &mut self,
         want: usize,
         decode: impl FnOnce(&[u8]) -> Result<(), (usize, f32)>,
-    ) -> Result<(), String> {
+    ) -> Result<(), ReadError> {
         let end = (self.held + want.max(1) * self.frame).min(self.buf.len());
         let n = loop {
             match self.input.read(&mut self.buf[self.held..end]) {
                 Ok(n) => break n,
                 Err(e) if e.kind() == std::io::ErrorKind::Interrupted => continue,
-                Err(e) => return Err(format!("{}: {e}", self.name)),
+                Err(e) => return Err(ReadError::new(&self.path, e)),
             }
         };
         if n == 0 {
             if self.held > 0 {
-                return Err(format!(
-                    "{}: {} bytes: not a whole number of {}-byte frames; the last frame starts at byte {}",
-                    self.name,
-                    self.read,
-                    self.frame,
-                    self.read - self.held as u64
+                return Err(ReadError::new(
+                    &self.path,
+                    ReadErrorKind::RawStreamPartialFrame {
+                        bytes: self.read,
+                        frame: self.frame,
+                        last_frame: self.read - self.held as u64,
+                    },
                 ));
             }
             return Ok(());
@@ -232,10 +227,13 @@ impl RawSource {
         let whole = have / self.frame * self.frame;
         if let Err((k, v)) = decode(&self.buf[..whole]) {
             let frame_no = (self.read - have as u64) / self.frame as u64 + k as u64;
-            return Err(format!(
-                "{}: frame {frame_no} (byte {}): {v} is not finite",
-                self.name,
-                frame_no * self.frame as u64 + self.at as u64
+            return Err(ReadError::new(
+                &self.path,
+                ReadErrorKind::RawNotFinite {
+                    frame: frame_no,
+                    byte: frame_no * self.frame as u64 + self.at as u64,
+                    value: v,
+                },
             ));
         }
         self.buf.copy_within(whole..have, 0);
@@ -251,7 +249,7 @@ pub struct CsvSource {
     reader: Handover,
     /// One row's values (reused).
     row: Vec<f64>,
-    name: String,
+    path: PathBuf,
     channel: usize,
     /// The channel's header; the time column's, and its unit if given.
     column: String,
@@ -270,27 +268,25 @@ pub struct CsvSource {
     head_done: bool,
     ended: bool,
     /// The first time that does not increase, and the first uneven interval (reported at
-    /// the end, in this order, as the whole-file path does).
-    not_increasing: Option<String>,
-    uneven: Option<String>,
+    /// the end, in this order, as the whole-file path does), with their lines.
+    not_increasing: Option<(u64, NotIncreasing)>,
+    uneven: Option<(u64, UnevenInterval)>,
     /// The time stamps' drift check's first error (reported after those two).
-    drifting: Option<String>,
+    drifting: Option<(u64, DriftFault)>,
 }
 
 impl CsvSource {
-    pub fn open(path: &Path, opts: &ReadOptions) -> Result<Self, String> {
+    pub fn open(path: &Path, opts: &ReadOptions) -> Result<Self, ReadError> {
         let format = crate::channel::CsvFormat {
             delimiter: opts.format.delimiter,
             decimal_comma: opts.format.decimal_comma,
         };
-        let mut rows =
-            crate::table::Rows::open(path, &format, opts.progress).map_err(|e| e.to_string())?;
-        let name = crate::channel::input_name(path);
-        let err = |m: String| format!("{name}: {m}");
+        let mut rows = crate::table::Rows::open(path, &format, opts.progress)?;
+        let err = |kind: ReadErrorKind| ReadError::new(path, kind);
         // The first data row gives the columns their number (the header their names).
-        let (line, first) = match rows.next_row().map_err(|e| e.to_string())? {
+        let (line, first) = match rows.next_row()? {
             Some((line, _, row)) => (line, row.to_vec()),
-            None => return Err(err("no data rows".into())),
+            None => return Err(err(ReadErrorKind::NoDataRows)),
         };
         let shape = rows.shape();
         let tcol = shape
@@ -302,17 +298,16 @@ impl CsvSource {
             .channel(opts.column.as_ref(), time_like)
             .map_err(err)?;
         if Some(channel) == tcol {
-            return Err(err(format!(
-                "column {channel} is the time column: choose another with --column"
-            )));
+            return Err(err(ReadErrorKind::ChannelIsTimeColumn {
+                column: channel,
+                axes: false,
+            }));
         }
         if tcol.is_none() && opts.rate_hz.is_none() {
-            return Err(err(
-                "no time column found: give --time-column or --rate".into()
-            ));
+            return Err(err(ReadErrorKind::NoTimeColumn));
         }
         if let Some(r) = opts.rate_hz {
-            RATE_HZ.check_named("--rate", r).map_err(err)?;
+            check_rate(r).map_err(err)?;
         }
         let time_header = tcol
             .and_then(|t| shape.headers.get(t).cloned())
@@ -323,7 +318,7 @@ impl CsvSource {
             // The head is read row by row; the parallel reader may take over right after it.
             reader: Handover::new(rows, crate::csv_fast::SEQUENTIAL_ROWS, opts.progress),
             row: Vec::new(),
-            name,
+            path: path.to_path_buf(),
             channel,
             column,
             time_header,
@@ -339,40 +334,52 @@ impl CsvSource {
             uneven: None,
             drifting: None,
         };
-        source.pending = Some(source.take(line, &first)?);
+        source.pending = Some(source.take(line, &first));
         Ok(source)
     }
 
     /// Checks the time of row `line` and returns its channel's value.
-    fn take(&mut self, line: u64, row: &[f64]) -> Result<f64, String> {
+    fn take(&mut self, line: u64, row: &[f64]) -> f64 {
         let value = row.get(self.channel).copied().unwrap_or(0.0);
         let time = self.time.map(|(c, _)| row.get(c).copied().unwrap_or(0.0));
         self.take_values(line, value, time.unwrap_or(0.0))
     }
 
     /// [`CsvSource::take`] of a row's channel value and time column's value.
-    fn take_values(&mut self, line: u64, value: f64, time: f64) -> Result<f64, String> {
+    fn take_values(&mut self, line: u64, value: f64, time: f64) -> f64 {
         let Some((_, unit)) = self.time else {
             self.axis.count(1);
-            return Ok(value);
+            return value;
         };
         // Errors wait for the end, as in the whole-file path: a value that is not a number
         // anywhere comes first, then time going back, then an uneven interval, then drift
         // (the first of each). With --rate the column gives only the first time, as in the
         // whole-file path (the axis does not check it).
         let faults = self.axis.push(time * unit, line);
-        let name = &self.name;
-        let at = |m: &dyn std::fmt::Display| format!("{name}:{line}: {m}");
         if let Some(e) = faults.drift {
-            self.drifting.get_or_insert_with(|| at(&e));
+            self.drifting.get_or_insert((line, e));
         }
         if let Some(e) = faults.not_increasing {
-            self.not_increasing.get_or_insert_with(|| at(&e));
+            self.not_increasing.get_or_insert((line, e));
         }
         if let Some(e) = faults.uneven {
-            self.uneven.get_or_insert_with(|| at(&e));
+            self.uneven.get_or_insert((line, e));
         }
-        Ok(value)
+        value
+    }
+
+    /// The first fault of the time axis, in the order the whole-file path reports them
+    /// (taken: reported once).
+    fn take_fault(&mut self) -> Option<ReadError> {
+        let at = |line: u64, kind: ReadErrorKind| ReadError::at(&self.path, At::Line(line), kind);
+        if let Some((line, e)) = self.not_increasing.take() {
+            return Some(at(line, ReadErrorKind::NotIncreasing(e)));
+        }
+        if let Some((line, e)) = self.uneven.take() {
+            return Some(at(line, ReadErrorKind::Uneven(e)));
+        }
+        let (line, e) = self.drifting.take()?;
+        Some(at(line, ReadErrorKind::Drift(e)))
     }
 }
 
@@ -380,7 +387,7 @@ impl CsvSource {
     /// Appends the next rows' values: about `want` (the sequential reader) or a chunk (the
     /// parallel one); none at a hand-over from one to the other, or at the end (then
     /// `ended` is set).
-    fn next_some(&mut self, want: usize, out: &mut Vec<f64>) -> Result<(), String> {
+    fn next_some(&mut self, want: usize, out: &mut Vec<f64>) -> Result<(), ReadError> {
         // Past the head, plain rows go through the parallel reader (a file read again from
         // the row, or a stream's tape played from it), laid out for the channel and time
         // columns; its workers check what may still be the first error of its kind: time
@@ -418,9 +425,9 @@ impl CsvSource {
             let step = match self.reader.next(fast) {
                 Ok(step) => step,
                 Err(HandoverError::Input { error, .. }) => {
-                    return Err(format!("{}: {error}", self.name))
+                    return Err(ReadError::new(&self.path, error))
                 }
-                Err(HandoverError::Rows(e)) => return Err(e.to_string()),
+                Err(HandoverError::Rows(e)) => return Err(e),
             };
             match step {
                 Step::End => {
@@ -429,12 +436,13 @@ impl CsvSource {
                 }
                 Step::Chunk(chunk) => {
                     self.row = row;
-                    return self.take_chunk(chunk, out);
+                    self.take_chunk(chunk, out);
+                    return Ok(());
                 }
                 Step::Row((line, _, r)) => {
                     row.clear();
                     row.extend_from_slice(r);
-                    let v = self.take(line, &row)?;
+                    let v = self.take(line, &row);
                     out.push(v);
                     read += 1;
                 }
@@ -446,19 +454,17 @@ impl CsvSource {
 
     /// A chunk of the parallel reader: the first row follows the previous chunk's last and
     /// is checked here; the others the worker checked against the row before them.
-    fn take_chunk(&mut self, chunk: Parsed, out: &mut Vec<f64>) -> Result<(), String> {
+    fn take_chunk(&mut self, chunk: Parsed, out: &mut Vec<f64>) {
         out.reserve(chunk.rows.len());
         if let Some(&(value, time)) = chunk.rows.first() {
-            out.push(self.take_values(chunk.line, value, time)?);
+            out.push(self.take_values(chunk.line, value, time));
         }
         let rest = chunk.rows.iter().enumerate().skip(1);
         match self.time.map(|(_, unit)| unit) {
             Some(unit) => {
                 for (k, &(value, time)) in rest {
                     if let Some(e) = self.axis.push_checked(time * unit) {
-                        let line = chunk.line + k as u64;
-                        self.drifting
-                            .get_or_insert_with(|| format!("{}:{line}: {e}", self.name));
+                        self.drifting.get_or_insert((chunk.line + k as u64, e));
                     }
                     out.push(value);
                 }
@@ -468,60 +474,51 @@ impl CsvSource {
                 self.axis.count(chunk.rows.len().saturating_sub(1) as u64);
             }
         }
-        Ok(())
     }
 }
 
 impl Source for CsvSource {
-    fn next_values(&mut self, want: usize, out: &mut Vec<f64>) -> Result<(), String> {
+    fn next_values(&mut self, want: usize, out: &mut Vec<f64>) -> Result<(), ReadError> {
         // A hand-over between the readers can give no rows: only the end gives none.
         let before = out.len();
         while out.len() == before && !self.ended {
             self.next_some(want, out)?;
         }
         if self.ended {
-            if let Some(e) = self
-                .not_increasing
-                .take()
-                .or_else(|| self.uneven.take())
-                .or_else(|| self.drifting.take())
-            {
+            if let Some(e) = self.take_fault() {
                 return Err(e);
             }
         }
         Ok(())
     }
 
-    fn head_read(&mut self) -> Result<(), String> {
+    fn head_read(&mut self) -> Result<(), ReadError> {
         self.head_done = true;
         // The head's intervals against their median, as every later one.
         if let Some((line, e)) = self.axis.close_head() {
-            self.uneven
-                .get_or_insert_with(|| format!("{}:{line}: {e}", self.name));
+            self.uneven.get_or_insert((line, e));
         }
         if self.time.is_some() {
             // (None if time went back: `rate_hz` then gives that error.)
             self.head_rate = self.axis.rate_hz();
             if let (Some(rate), None) = (self.head_rate, self.rate_given) {
                 crate::channel::check_time_unit(&self.time_header, self.time_unit, rate)
-                    .map_err(|m| format!("{}: {m}", self.name))?;
+                    .map_err(|kind| ReadError::new(&self.path, kind))?;
             }
         }
         Ok(())
     }
 
-    fn rate_hz(&self) -> Result<f64, String> {
+    fn rate_hz(&self) -> Result<f64, ReadError> {
         if let Some(r) = self.rate_given {
             return Ok(r);
         }
         // A head without a rate: time went back (that error), or one sample.
-        self.head_rate.ok_or_else(|| {
-            self.not_increasing.clone().unwrap_or_else(|| {
-                format!(
-                    "{}: one sample: the rate cannot be told; give --rate",
-                    self.name
-                )
-            })
+        self.head_rate.ok_or_else(|| match self.not_increasing {
+            Some((line, e)) => {
+                ReadError::at(&self.path, At::Line(line), ReadErrorKind::NotIncreasing(e))
+            }
+            None => ReadError::new(&self.path, ReadErrorKind::OneSample),
         })
     }
 
@@ -547,7 +544,7 @@ impl Source for CsvSource {
 /// interval checked against the head's median as a CSV's are.
 pub struct IdeSource {
     blocks: crate::ide::Blocks,
-    name: String,
+    path: PathBuf,
     column: String,
     /// Values of the current block not yet handed on.
     pending: std::collections::VecDeque<f64>,
@@ -556,19 +553,17 @@ pub struct IdeSource {
 }
 
 impl IdeSource {
-    pub fn open(path: &Path, opts: &ReadOptions, name: &str) -> Result<Self, String> {
+    pub fn open(path: &Path, opts: &ReadOptions) -> Result<Self, ReadError> {
+        let err = |kind: ReadErrorKind| ReadError::new(path, kind);
         if opts.rate_hz.is_some() || opts.time_column.is_some() {
-            return Err(format!(
-                "{name}: an .ide file's samples carry their own time stamps: no --rate or --time-column"
-            ));
+            return Err(err(ReadErrorKind::IdeOwnTime));
         }
-        let file = crate::ide::IdeFile::open(path).map_err(|e| format!("{name}: {e}"))?;
-        let pick = crate::ide::pick(&file, opts.column.as_ref(), &[])
-            .map_err(|e| format!("{name}: {e}"))?;
+        let file = crate::ide::IdeFile::open(path).map_err(|e| err(e.into()))?;
+        let pick = crate::ide::pick(&file, opts.column.as_ref(), &[]).map_err(err)?;
         drop(file);
         Ok(Self {
             blocks: crate::ide::Blocks::start(path, pick.channel, pick.subs[0]),
-            name: name.to_string(),
+            path: path.to_path_buf(),
             column: pick.names[0].clone(),
             pending: std::collections::VecDeque::new(),
             axis: TimeAxis::new(true),
@@ -577,25 +572,24 @@ impl IdeSource {
     }
 
     /// Takes the next block's times (checked) and values.
-    fn refill(&mut self) -> Result<bool, String> {
+    fn refill(&mut self) -> Result<bool, ReadError> {
         let Some(block) = self.blocks.next_block() else {
             return Ok(false);
         };
-        let (times, values) = block.map_err(|e| format!("{}: {e}", self.name))?;
+        let (times, values) = block.map_err(|e| ReadError::new(&self.path, e))?;
         for &t in &times {
             // The first fault stops the read: drift, then time going back, then an uneven
             // interval.
             let n = self.axis.samples();
             let f = self.axis.push(t, n);
-            let fault: Option<&dyn std::fmt::Display> =
-                match (&f.drift, &f.not_increasing, &f.uneven) {
-                    (Some(e), _, _) => Some(e),
-                    (None, Some(e), _) => Some(e),
-                    (None, None, Some(e)) => Some(e),
-                    (None, None, None) => None,
-                };
-            if let Some(e) = fault {
-                return Err(format!("{}: sample {n}: {e}", self.name));
+            let fault = match (f.drift, f.not_increasing, f.uneven) {
+                (Some(e), _, _) => Some(ReadErrorKind::Drift(e)),
+                (None, Some(e), _) => Some(ReadErrorKind::NotIncreasing(e)),
+                (None, None, Some(e)) => Some(ReadErrorKind::Uneven(e)),
+                (None, None, None) => None,
+            };
+            if let Some(kind) = fault {
+                return Err(ReadError::at(&self.path, At::Sample(n), kind));
             }
         }
         self.pending.extend(values);
@@ -604,7 +598,7 @@ impl IdeSource {
 }
 
 impl Source for IdeSource {
-    fn next_values(&mut self, want: usize, out: &mut Vec<f64>) -> Result<(), String> {
+    fn next_values(&mut self, want: usize, out: &mut Vec<f64>) -> Result<(), ReadError> {
         if self.pending.is_empty() && !self.refill()? {
             return Ok(());
         }
@@ -613,24 +607,29 @@ impl Source for IdeSource {
         Ok(())
     }
 
-    fn head_read(&mut self) -> Result<(), String> {
+    fn head_read(&mut self) -> Result<(), ReadError> {
         if let Some((n, e)) = self.axis.close_head() {
-            return Err(format!("{}: sample {n}: {e}", self.name));
+            return Err(ReadError::at(
+                &self.path,
+                At::Sample(n),
+                ReadErrorKind::Uneven(e),
+            ));
         }
         if self.axis.median_dt().is_none() {
-            return Err(format!(
-                "{}: {} samples: the rate cannot be told",
-                self.name,
-                self.axis.samples()
+            return Err(ReadError::new(
+                &self.path,
+                ReadErrorKind::RateUnknown {
+                    samples: self.axis.samples(),
+                },
             ));
         }
         self.head_rate = self.axis.rate_hz();
         Ok(())
     }
 
-    fn rate_hz(&self) -> Result<f64, String> {
+    fn rate_hz(&self) -> Result<f64, ReadError> {
         self.head_rate
-            .ok_or_else(|| format!("{}: the rate cannot be told", self.name))
+            .ok_or_else(|| ReadError::new(&self.path, ReadErrorKind::NoRate))
     }
 
     fn final_rate_hz(&self) -> f64 {
@@ -649,34 +648,30 @@ impl Source for IdeSource {
 /// A WAV file's channel ([`crate::wav::WavChannel`], read as it goes).
 pub struct WavSource {
     channel: crate::wav::WavChannel,
-    name: String,
 }
 
 impl WavSource {
-    pub fn open(path: &Path, opts: &ReadOptions, name: &str) -> Result<Self, String> {
+    pub fn open(path: &Path, opts: &ReadOptions) -> Result<Self, ReadError> {
         if opts.rate_hz.is_some() || opts.time_column.is_some() {
-            return Err(format!(
-                "{name}: a WAV file gives its own rate: no --rate or --time-column"
+            return Err(ReadError::new(
+                path,
+                ReadErrorKind::WavGivesRate { resample: false },
             ));
         }
-        let channel = crate::wav::WavChannel::open(path, opts.column.as_ref())
-            .map_err(|e| format!("{name}: {e}"))?;
-        Ok(Self {
-            channel,
-            name: name.to_string(),
-        })
+        let channel = crate::wav::WavChannel::open(path, opts.column.as_ref())?;
+        Ok(Self { channel })
     }
 }
 
 impl Source for WavSource {
-    fn next_values(&mut self, want: usize, out: &mut Vec<f64>) -> Result<(), String> {
+    fn next_values(&mut self, want: usize, out: &mut Vec<f64>) -> Result<(), ReadError> {
         for v in self.channel.by_ref().take(want.max(1)) {
-            out.push(v.map_err(|e| format!("{}: {e}", self.name))?);
+            out.push(v?);
         }
         Ok(())
     }
 
-    fn rate_hz(&self) -> Result<f64, String> {
+    fn rate_hz(&self) -> Result<f64, ReadError> {
         Ok(self.channel.rate_hz)
     }
 }
@@ -693,24 +688,19 @@ pub struct NpySource {
     k: u64,
     given: u64,
     rate_hz: f64,
-    name: String,
+    path: PathBuf,
 }
 
 impl NpySource {
-    pub fn open(path: &Path, opts: &ReadOptions, name: &str) -> Result<Self, String> {
-        let rate_hz = opts
-            .rate_hz
-            .ok_or_else(|| format!("{name}: an .npy array holds no time: give --rate"))?;
-        RATE_HZ.check_named("--rate", rate_hz)?;
+    pub fn open(path: &Path, opts: &ReadOptions) -> Result<Self, ReadError> {
+        let err = |kind: ReadErrorKind| ReadError::new(path, kind);
+        let rate_hz = opts.rate_hz.ok_or_else(|| err(ReadErrorKind::NpyNoTime))?;
+        check_rate(rate_hz).map_err(err)?;
         if opts.time_column.is_some() {
-            return Err(format!(
-                "{name}: an .npy array has no time column (give --rate)"
-            ));
+            return Err(err(ReadErrorKind::NpyTimeColumn));
         }
-        let (elements, shape, order) =
-            crate::npy::open_elements(path).map_err(|e| format!("{name}: {e}"))?;
-        let (rows, cols, column) =
-            crate::npy::layout(&shape, opts.column.as_ref()).map_err(|e| format!("{name}: {e}"))?;
+        let (elements, shape, order) = crate::npy::open_elements(path)?;
+        let (rows, cols, column) = crate::npy::layout(&shape, opts.column.as_ref()).map_err(err)?;
         let column = column as u64;
         Ok(Self {
             elements,
@@ -721,24 +711,23 @@ impl NpySource {
             k: 0,
             given: 0,
             rate_hz,
-            name: name.to_string(),
+            path: path.to_path_buf(),
         })
     }
 }
 
 impl Source for NpySource {
-    fn next_values(&mut self, want: usize, out: &mut Vec<f64>) -> Result<(), String> {
+    fn next_values(&mut self, want: usize, out: &mut Vec<f64>) -> Result<(), ReadError> {
+        let err = |fault: NpyFault| ReadError::new(&self.path, fault);
         let mut pushed = 0;
         while pushed < want.max(1) && self.given < self.rows {
             let Some(element) = self.elements.next() else {
-                return Err(format!(
-                    "{}: npy: the data ends at element {} of the {} its shape holds",
-                    self.name,
-                    self.k,
-                    self.rows * self.cols
-                ));
+                return Err(err(NpyFault::DataEnds {
+                    element: self.k,
+                    total: self.rows * self.cols,
+                }));
             };
-            let v = element.map_err(|e| format!("{}: npy: {e}", self.name))?;
+            let v = element.map_err(err)?;
             let mine = if self.fortran {
                 self.k / self.rows == self.column
             } else {
@@ -747,10 +736,10 @@ impl Source for NpySource {
             self.k += 1;
             if mine {
                 if !v.is_finite() {
-                    return Err(format!(
-                        "{}: npy: row {}: {v} is not finite",
-                        self.name, self.given
-                    ));
+                    return Err(err(NpyFault::NotFinite {
+                        row: self.given,
+                        value: v,
+                    }));
                 }
                 out.push(v);
                 pushed += 1;
@@ -760,7 +749,7 @@ impl Source for NpySource {
         Ok(())
     }
 
-    fn rate_hz(&self) -> Result<f64, String> {
+    fn rate_hz(&self) -> Result<f64, ReadError> {
         Ok(self.rate_hz)
     }
 }
@@ -768,33 +757,24 @@ impl Source for NpySource {
 /// A TDMS file's channel ([`crate::tdms::TdmsStream`], a range at a time).
 pub struct TdmsSource {
     stream: crate::tdms::TdmsStream,
-    name: String,
 }
 
 impl TdmsSource {
-    pub fn open(path: &Path, opts: &ReadOptions, name: &str) -> Result<Self, String> {
+    pub fn open(path: &Path, opts: &ReadOptions) -> Result<Self, ReadError> {
         if opts.time_column.is_some() {
-            return Err(format!(
-                "{name}: a TDMS file takes --column (group/channel) and --rate only"
-            ));
+            return Err(ReadError::new(path, ReadErrorKind::TdmsOptions));
         }
-        let stream = crate::tdms::TdmsStream::open(path, opts.column.as_ref(), opts.rate_hz)
-            .map_err(|e| e.to_string())?;
-        Ok(Self {
-            stream,
-            name: name.to_string(),
-        })
+        let stream = crate::tdms::TdmsStream::open(path, opts.column.as_ref(), opts.rate_hz)?;
+        Ok(Self { stream })
     }
 }
 
 impl Source for TdmsSource {
-    fn next_values(&mut self, want: usize, out: &mut Vec<f64>) -> Result<(), String> {
-        self.stream
-            .next_values(want, out)
-            .map_err(|e| format!("{}: {e}", self.name))
+    fn next_values(&mut self, want: usize, out: &mut Vec<f64>) -> Result<(), ReadError> {
+        self.stream.next_values(want, out)
     }
 
-    fn rate_hz(&self) -> Result<f64, String> {
+    fn rate_hz(&self) -> Result<f64, ReadError> {
         Ok(self.stream.rate_hz)
     }
 

@@ -10,7 +10,9 @@
 use std::fs::File;
 use std::io::Write;
 use std::os::unix::fs::FileExt;
+use std::path::{Path, PathBuf};
 
+use crate::error::{ReadError, SpoolError};
 use crate::sources::{Source, CHUNK};
 
 /// Values being written to the spool.
@@ -22,9 +24,11 @@ pub struct SpoolWriter {
 }
 
 impl SpoolWriter {
-    pub fn new() -> Result<Self, String> {
-        let file =
-            tempfile::tempfile().map_err(|e| format!("a temporary file in {}: {e}", temp_dir()))?;
+    pub fn new() -> Result<Self, SpoolError> {
+        let file = tempfile::tempfile().map_err(|error| SpoolError::Create {
+            dir: std::env::temp_dir(),
+            error,
+        })?;
         Ok(Self {
             out: file,
             bytes: Vec::new(),
@@ -34,7 +38,7 @@ impl SpoolWriter {
 
     /// Appends the values. An error (a full disk) ends the spool: drop it, and its space is
     /// freed at once.
-    pub fn write(&mut self, values: &[f64]) -> Result<(), String> {
+    pub fn write(&mut self, values: &[f64]) -> Result<(), SpoolError> {
         self.bytes.clear();
         self.bytes
             .extend(values.iter().flat_map(|v| v.to_le_bytes()));
@@ -43,9 +47,11 @@ impl SpoolWriter {
         Ok(())
     }
 
-    /// The spool, with what the first pass's source told of the time axis.
-    pub fn finish(self, axis: Axis) -> Spool {
+    /// The spool of the recording `path`'s values, with what the first pass's source told
+    /// of the time axis.
+    pub fn finish(self, path: &Path, axis: Axis) -> Spool {
         Spool {
+            path: path.to_path_buf(),
             file: self.out,
             samples: self.samples,
             axis,
@@ -63,6 +69,8 @@ pub struct Axis {
 
 /// The values of a pass, read back as often as needed.
 pub struct Spool {
+    /// The recording (its errors' file).
+    path: PathBuf,
     file: File,
     samples: u64,
     axis: Axis,
@@ -70,9 +78,13 @@ pub struct Spool {
 
 impl Spool {
     /// A source of the values from the first, `progress` the fraction read.
-    pub fn source(&self, progress: Option<fn(f64)>) -> Result<Box<dyn Source>, String> {
-        let file = self.file.try_clone().map_err(failed)?;
+    pub fn source(&self, progress: Option<fn(f64)>) -> Result<Box<dyn Source>, ReadError> {
+        let file = self
+            .file
+            .try_clone()
+            .map_err(|e| ReadError::new(&self.path, failed(e)))?;
         Ok(Box::new(SpoolSource {
+            path: self.path.clone(),
             file,
             at: 0,
             samples: self.samples,
@@ -85,6 +97,7 @@ impl Spool {
 
 /// A spool read from its start (at its own offset, so two never interfere).
 struct SpoolSource {
+    path: PathBuf,
     file: File,
     /// Samples read.
     at: u64,
@@ -96,12 +109,12 @@ struct SpoolSource {
 
 impl SpoolSource {
     /// The next values' bytes (up to `want` values, none at the end).
-    fn next_bytes(&mut self, want: usize) -> Result<&[u8], String> {
+    fn next_bytes(&mut self, want: usize) -> Result<&[u8], ReadError> {
         let n = (want.clamp(1, CHUNK) as u64).min(self.samples - self.at) as usize;
         let bytes = &mut self.bytes[..n * 8];
         self.file
             .read_exact_at(bytes, self.at * 8)
-            .map_err(failed)?;
+            .map_err(|e| ReadError::new(&self.path, failed(e)))?;
         self.at += n as u64;
         if let Some(p) = self.progress {
             p(self.at as f64 / self.samples.max(1) as f64);
@@ -115,7 +128,7 @@ fn value(b: &[u8]) -> f64 {
 }
 
 impl Source for SpoolSource {
-    fn next_values(&mut self, want: usize, out: &mut Vec<f64>) -> Result<(), String> {
+    fn next_values(&mut self, want: usize, out: &mut Vec<f64>) -> Result<(), ReadError> {
         out.extend(self.next_bytes(want)?.chunks_exact(8).map(value));
         Ok(())
     }
@@ -126,14 +139,14 @@ impl Source for SpoolSource {
         q: crate::quantise::Quantiser,
         _scratch: &mut Vec<f64>,
         out: &mut Vec<i16>,
-    ) -> Result<(), String> {
+    ) -> Result<(), ReadError> {
         // (As `values_as_counts`, without the values' round trip through memory.)
         let bytes = self.next_bytes(want)?;
         out.extend(bytes.chunks_exact(8).map(|b| q.count(value(b))));
         Ok(())
     }
 
-    fn rate_hz(&self) -> Result<f64, String> {
+    fn rate_hz(&self) -> Result<f64, ReadError> {
         Ok(self.axis.rate_hz)
     }
 
@@ -146,12 +159,11 @@ impl Source for SpoolSource {
     }
 }
 
-fn temp_dir() -> String {
-    std::env::temp_dir().display().to_string()
-}
-
-fn failed(e: std::io::Error) -> String {
-    format!("the spool in {}: {e}", temp_dir())
+fn failed(error: std::io::Error) -> SpoolError {
+    SpoolError::Use {
+        dir: std::env::temp_dir(),
+        error,
+    }
 }
 
 #[cfg(test)]
@@ -173,7 +185,7 @@ mod tests {
             final_rate_hz: 4.9e5,
             t0_s: 1.5,
         };
-        let spool = w.finish(axis);
+        let spool = w.finish(Path::new("-"), axis);
         for want in [1, 1000, CHUNK, 10 * CHUNK] {
             let mut s = spool.source(None).unwrap();
             let mut back = Vec::new();

@@ -10,16 +10,9 @@ use crate::channel::is_stdin;
 use crate::channel::words;
 use crate::channel::ColumnRef;
 use crate::channel::CsvFormat;
-use crate::channel::RecordingError;
+use crate::error::{NumberHint, ReadError, ReadErrorKind, RecordFault};
+pub use crate::limits::{MAX_LINE_BYTES, MAX_VALUE};
 use crate::tape::Tape;
-
-/// Longest record (line) read, bytes: a file without line breaks (`/dev/zero`) or with an
-/// unclosed quote is an error, not a memory blow-up.
-pub const MAX_LINE_BYTES: usize = 1 << 20;
-
-/// Largest magnitude a value may have: beyond it no sensor reading or time is meant (and the
-/// f32 sample path would overflow).
-pub const MAX_VALUE: f64 = 1e30;
 
 /// All numeric columns of a CSV file, with the header names.
 #[derive(Clone, Debug, Default)]
@@ -98,10 +91,7 @@ impl<R: Read> Read for RecordLimit<R> {
         if n == 0 && !self.ended && !buf.is_empty() {
             if self.quote == Quote::Inside {
                 // (csv would take the rest of the input for one field.)
-                return Err(self.fail(
-                    self.quote_breaks,
-                    "a quote opened on this line is never closed".into(),
-                ));
+                return Err(self.fail(self.quote_breaks, RecordFault::QuoteNeverClosed));
             }
             // Every record ends with a line break, so that its line is `csv`'s line count
             // less one (see `read_table`).
@@ -194,35 +184,30 @@ impl<R> RecordLimit<R> {
             return Ok(());
         }
         Err(if self.quote == Quote::Outside {
-            self.fail(
-                self.record_breaks,
-                format!("a line longer than {MAX_LINE_BYTES} bytes: not a CSV recording"),
-            )
+            self.fail(self.record_breaks, RecordFault::LineTooLong)
         } else {
-            self.fail(
-                self.quote_breaks,
-                format!("a quote opened on this line is not closed within {MAX_LINE_BYTES} bytes"),
-            )
+            self.fail(self.quote_breaks, RecordFault::QuoteTooLong)
         })
     }
 
-    /// The error of a record that began after `breaks` line breaks.
-    fn fail(&mut self, breaks: u64, message: String) -> io::Error {
+    /// The error of a record that began after `breaks` line breaks (the fault inside an
+    /// `io::Error`, as `csv` passes its input's errors on).
+    fn fail(&mut self, breaks: u64, fault: RecordFault) -> io::Error {
         self.failed_at = Some(breaks);
-        io::Error::new(io::ErrorKind::InvalidData, message)
+        io::Error::new(io::ErrorKind::InvalidData, fault)
     }
 }
 
 /// Opens a file (or stdin for `-`) once, for reading (a FIFO is not opened twice); the size,
 /// if known, for progress.
-fn open(path: &Path) -> io::Result<(Box<dyn Read + Send>, Option<u64>)> {
+fn open(path: &Path) -> Result<(Box<dyn Read + Send>, Option<u64>), ReadErrorKind> {
     if is_stdin(path) {
         return Ok((Box::new(io::stdin()), None));
     }
     let file = File::open(path)?;
     let meta = file.metadata()?;
     if meta.is_dir() {
-        return Err(io::Error::other("is a directory"));
+        return Err(ReadErrorKind::IsDirectory);
     }
     let size = meta.is_file().then_some(meta.len());
     Ok((Box::new(file), size))
@@ -266,19 +251,18 @@ pub fn is_reading(v: f64) -> bool {
     v.is_finite() && v.abs() <= MAX_VALUE
 }
 
-/// Why a field is not a number (its first 64 characters), with a hint where the layout
-/// suggests one.
-fn not_a_number(field: &str, format: &CsvFormat, delimiter: u8) -> String {
+/// Why a field is not a number, with a hint where the layout suggests one.
+fn not_a_number(field: &str, format: &CsvFormat, delimiter: u8) -> ReadErrorKind {
     let hint = if field.contains('\u{feff}') {
-        " (a byte-order mark is read only at the start of the file: files joined?)"
+        Some(NumberHint::ByteOrderMark)
     } else if !format.decimal_comma && delimiter != b',' && field.contains(',') {
-        " (decimal commas? give --decimal-comma)"
+        Some(NumberHint::DecimalComma)
     } else {
-        ""
+        None
     };
-    match field.char_indices().nth(64) {
-        Some((cut, _)) => format!("not a number: {:?}...{hint}", &field[..cut]),
-        None => format!("not a number: {field:?}{hint}"),
+    ReadErrorKind::NotANumber {
+        field: field.to_string(),
+        hint,
     }
 }
 
@@ -327,8 +311,8 @@ impl Rows {
         path: &Path,
         format: &CsvFormat,
         progress: Option<fn(f64)>,
-    ) -> Result<Self, RecordingError> {
-        let (input, size) = open(path).map_err(|e| RecordingError::of(path, e.to_string()))?;
+    ) -> Result<Self, ReadError> {
+        let (input, size) = open(path).map_err(|e| ReadError::new(path, e))?;
         Self::from_input(path, input, size, format, progress)
     }
 
@@ -340,28 +324,26 @@ impl Rows {
         size: Option<u64>,
         format: &CsvFormat,
         progress: Option<fn(f64)>,
-    ) -> Result<Self, RecordingError> {
-        let err = |message: String| RecordingError::of(path, message);
+    ) -> Result<Self, ReadError> {
+        let err = |kind: ReadErrorKind| ReadError::new(path, kind);
         let (input, tape): (Box<dyn Read + Send>, _) = match size {
             Some(_) => (input, None),
             None => {
                 let tape = Tape::new(input);
-                let reader = sequential_reader(&tape, 0).map_err(|e| err(e.to_string()))?;
+                let reader = sequential_reader(&tape, 0).map_err(|e| err(e.into()))?;
                 (reader, Some(tape))
             }
         };
         let mut buffered = BufReader::with_capacity(1 << 16, input);
         // Peek at the first bytes for a byte-order mark and the delimiter.
-        let head = buffered.fill_buf().map_err(|e| err(e.to_string()))?;
+        let head = buffered.fill_buf().map_err(|e| err(e.into()))?;
         let bom = head.starts_with(b"\xEF\xBB\xBF");
         let delimiter = format.delimiter.unwrap_or_else(|| sniff_delimiter(head));
         if bom {
             buffered.consume(3);
         }
         if format.decimal_comma && delimiter == b',' {
-            return Err(err(
-                "--decimal-comma: the delimiter is ',' too; give --delimiter (e.g. ';')".into(),
-            ));
+            return Err(err(ReadErrorKind::DecimalCommaDelimiter));
         }
         let mut rows = Self::build(path, format, delimiter, buffered, size, progress);
         rows.skip = if bom { 3 } else { 0 };
@@ -415,12 +397,12 @@ impl Rows {
     /// The same table read again from byte `byte` of the file, the start of line `line`,
     /// past its header and first data row (so what it reads there reads as it would have
     /// in one pass).
-    pub fn resume(&self, byte: u64, line: u64) -> Result<Self, RecordingError> {
+    pub fn resume(&self, byte: u64, line: u64) -> Result<Self, ReadError> {
         let input = match &self.tape {
             Some(tape) => sequential_reader(tape, byte),
             None => self.input_from(byte),
         }
-        .map_err(|e| self.err(Some(line), e.to_string()))?;
+        .map_err(|e| self.err(Some(line), e.into()))?;
         // `csv` drops a byte-order mark at the start of its input: a line break (a blank
         // line, skipped) ahead of the line keeps one there in the row, which is refused as
         // on any line but the first.
@@ -491,16 +473,17 @@ impl Rows {
         &self.path
     }
 
-    pub fn err(&self, line: Option<u64>, message: String) -> RecordingError {
-        RecordingError {
-            file: self.path.clone(),
-            line,
-            message,
+    /// An error of the file read, at `line` if given.
+    pub fn err(&self, line: Option<u64>, kind: ReadErrorKind) -> ReadError {
+        ReadError {
+            path: self.path.clone(),
+            at: line.map(crate::error::At::Line),
+            kind,
         }
     }
 
     /// The next data row ([`Row`]); `None` at the end.
-    pub fn next_row(&mut self) -> Result<Option<Row<'_>>, RecordingError> {
+    pub fn next_row(&mut self) -> Result<Option<Row<'_>>, ReadError> {
         loop {
             let more = match self.reader.read_byte_record(&mut self.record) {
                 Ok(more) => more,
@@ -514,11 +497,7 @@ impl Rows {
                             .position()
                             .map_or(self.reader.position().line(), |p| p.line()),
                     } + self.line_offset;
-                    let message = match e.into_kind() {
-                        csv::ErrorKind::Io(io) => io.to_string(),
-                        other => format!("{other:?}"),
-                    };
-                    return Err(self.err(Some(line), message));
+                    return Err(self.err(Some(line), e.into()));
                 }
             };
             if !more {
@@ -554,9 +533,7 @@ impl Rows {
                 match read_number(f, self.format.decimal_comma, &mut self.scratch) {
                     Some(v) if is_reading(v) => self.row.push(v),
                     Some(v) => {
-                        bad.get_or_insert_with(|| {
-                            format!("value is {v:e}: not a finite reading within ±{MAX_VALUE:e}")
-                        });
+                        bad.get_or_insert(ReadErrorKind::NotReading { value: v });
                     }
                     None => {
                         let text = String::from_utf8_lossy(f);
@@ -593,30 +570,28 @@ impl Rows {
                     if self.header_fields != 0 && self.row.len() > self.header_fields {
                         return Err(self.err(
                             Some(lineno),
-                            format!(
-                                "{} fields, but the header (line {}) has {}{}",
-                                self.row.len(),
-                                self.header_line,
-                                self.header_fields,
-                                if self.delimiter == b',' {
-                                    " (decimal commas? give --decimal-comma and --delimiter)"
-                                } else {
-                                    ""
-                                }
-                            ),
+                            ReadErrorKind::WiderThanHeader {
+                                fields: self.row.len(),
+                                header_line: self.header_line,
+                                header_fields: self.header_fields,
+                                comma_delimited: self.delimiter == b',',
+                            },
                         ));
                     }
                     self.columns = self.row.len();
                     self.first_data_line = lineno;
                 }
             }
-            if let Some(message) = bad {
-                return Err(self.err(Some(lineno), message));
+            if let Some(kind) = bad {
+                return Err(self.err(Some(lineno), kind));
             }
             if self.row.len() != self.columns {
                 return Err(self.err(
                     Some(lineno),
-                    format!("{} fields, expected {}", self.row.len(), self.columns),
+                    ReadErrorKind::FieldCount {
+                        fields: self.row.len(),
+                        expected: self.columns,
+                    },
                 ));
             }
             return Ok(Some((lineno, breaks, &self.row)));
@@ -636,22 +611,26 @@ impl Rows {
 }
 
 impl Table {
-    /// Resolves a column reference.
-    pub fn find(&self, c: &ColumnRef, what: &str) -> Result<usize, String> {
+    /// Resolves a column reference (`what`: `column`, `time column`, `axis`, as the error
+    /// names it).
+    pub fn find(&self, c: &ColumnRef, what: &'static str) -> Result<usize, ReadErrorKind> {
         let n = self.columns.len();
         match c {
             ColumnRef::Index(i) if *i < n => Ok(*i),
-            ColumnRef::Index(i) => Err(format!("{what} {i} does not exist (rows have {n} fields)")),
+            ColumnRef::Index(i) => Err(ReadErrorKind::ColumnIndex {
+                what,
+                index: *i,
+                fields: n,
+            }),
             ColumnRef::Name(name) => self
                 .headers
                 .iter()
                 .position(|h| h.eq_ignore_ascii_case(name))
                 .filter(|&p| p < n)
-                .ok_or_else(|| {
-                    format!(
-                        "no {what} named {name:?} (columns: {})",
-                        self.headers.join(", ")
-                    )
+                .ok_or_else(|| ReadErrorKind::ColumnName {
+                    what,
+                    name: name.clone(),
+                    headers: self.headers.clone(),
                 }),
         }
     }
@@ -662,7 +641,7 @@ impl Table {
         &self,
         rate_given: bool,
         asked: Option<&ColumnRef>,
-    ) -> Result<Option<usize>, String> {
+    ) -> Result<Option<usize>, ReadErrorKind> {
         if rate_given && asked.is_none() {
             Ok(None)
         } else {
@@ -672,16 +651,18 @@ impl Table {
 
     /// The channel: the column asked for, or the first one that is not the time column (a
     /// note on stderr names it when there are others to choose from).
-    pub fn channel(&self, asked: Option<&ColumnRef>, time: Option<usize>) -> Result<usize, String> {
+    pub fn channel(
+        &self,
+        asked: Option<&ColumnRef>,
+        time: Option<usize>,
+    ) -> Result<usize, ReadErrorKind> {
         match asked {
             Some(c) => self.find(c, "column"),
             None => {
                 let data: Vec<usize> = (0..self.columns.len())
                     .filter(|&c| Some(c) != time)
                     .collect();
-                let first = *data
-                    .first()
-                    .ok_or_else(|| "no data column besides the time column".to_string())?;
+                let first = *data.first().ok_or(ReadErrorKind::NoDataColumn)?;
                 if data.len() > 1 {
                     let name = |c: usize| {
                         self.headers
@@ -690,13 +671,10 @@ impl Table {
                             .cloned()
                             .unwrap_or_else(|| format!("column {c}"))
                     };
-                    let names: Vec<String> = data.iter().map(|&c| name(c)).collect();
-                    crate::note(&format!(
-                        "analysing {} of {} channels ({}): choose one with --column, or --axes for their resultant",
-                        name(first),
-                        data.len(),
-                        names.join(", ")
-                    ));
+                    crate::note_read(crate::ReadNote::ChannelChosen {
+                        channel: name(first),
+                        names: data.iter().map(|&c| name(c)).collect(),
+                    });
                 }
                 Ok(first)
             }
@@ -706,7 +684,7 @@ impl Table {
     /// The time column: the one asked for, or the one column whose header looks like a time
     /// (`time…`, `t`, `t_…`); several such columns without `--time-column` are an error naming
     /// them.
-    pub fn time_column(&self, asked: Option<&ColumnRef>) -> Result<Option<usize>, String> {
+    pub fn time_column(&self, asked: Option<&ColumnRef>) -> Result<Option<usize>, ReadErrorKind> {
         if let Some(c) = asked {
             return self.find(c, "time column").map(Some);
         }
@@ -716,13 +694,9 @@ impl Table {
         match candidates.as_slice() {
             [] => Ok(None),
             [one] => Ok(Some(*one)),
-            many => Err(format!(
-                "several columns could be the time: {}; choose one with --time-column",
-                many.iter()
-                    .map(|&c| format!("{:?}", self.headers[c]))
-                    .collect::<Vec<_>>()
-                    .join(", ")
-            )),
+            many => Err(ReadErrorKind::SeveralTimeColumns {
+                headers: many.iter().map(|&c| self.headers[c].clone()).collect(),
+            }),
         }
     }
 }
@@ -768,7 +742,7 @@ mod tests {
         assert!(most < 2 * SEQUENTIAL_TRAIL, "{most} bytes held");
     }
 
-    fn read(text: &str, format: CsvFormat) -> Result<Table, String> {
+    fn read(text: &str, format: CsvFormat) -> Result<Table, ReadError> {
         let dir = std::env::temp_dir().join(format!("impact-table-{}", std::process::id()));
         std::fs::create_dir_all(&dir).unwrap();
         let path = dir.join(format!(
@@ -776,7 +750,7 @@ mod tests {
             text.len() * 31 + text.bytes().map(usize::from).sum::<usize>()
         ));
         std::fs::write(&path, text).unwrap();
-        let t = read_table(&path, &format, None).map_err(|e| e.to_string());
+        let t = read_table(&path, &format, None);
         std::fs::remove_file(&path).unwrap();
         t
     }
@@ -795,9 +769,9 @@ mod tests {
     #[test]
     fn decimal_commas_need_the_option_and_another_delimiter() {
         let text = "time_s;a\n0,0;6,771553e-1\n0,5;1,25\n";
-        let e = read(text, CsvFormat::default()).unwrap_err();
+        let e = read(text, CsvFormat::default()).unwrap_err().to_string();
         assert!(
-            e.contains(":2: not a number: \"0,0\" (decimal commas? give --decimal-comma)"),
+            e.contains(":2: not a number: \"0,0\" (decimal commas? give `format.decimal_comma`)"),
             "{e}"
         );
         let t = read(
@@ -816,15 +790,23 @@ mod tests {
                 decimal_comma: true,
             },
         )
-        .unwrap_err();
-        assert!(e.contains("--decimal-comma: the delimiter is ','"), "{e}");
+        .unwrap_err()
+        .to_string();
+        assert!(
+            e.contains("`format.decimal_comma`: the delimiter is ','"),
+            "{e}"
+        );
     }
 
     #[test]
     fn a_row_wider_than_its_header_is_an_error_at_its_line() {
-        let e = read("accel_g\n6,771553e-1\n", CsvFormat::default()).unwrap_err();
-        assert!(e.ends_with(":2: 2 fields, but the header (line 1) has 1 (decimal commas? give --decimal-comma and --delimiter)"), "{e}");
-        let e = read("t,a\n0,1\n1,2,3\n", CsvFormat::default()).unwrap_err();
+        let e = read("accel_g\n6,771553e-1\n", CsvFormat::default())
+            .unwrap_err()
+            .to_string();
+        assert!(e.ends_with(":2: 2 fields, but the header (line 1) has 1 (decimal commas? give `format.decimal_comma` and `format.delimiter`)"), "{e}");
+        let e = read("t,a\n0,1\n1,2,3\n", CsvFormat::default())
+            .unwrap_err()
+            .to_string();
         assert!(e.ends_with(":3: 3 fields, expected 2"), "{e}");
     }
 
@@ -842,19 +824,21 @@ mod tests {
         // that the long line began on.
         let mut text = String::from("t,a\n0,1\n\"");
         text.push_str(&"1,2\n".repeat(MAX_LINE_BYTES / 4 + 10));
-        let e = read(&text, CsvFormat::default()).unwrap_err();
+        let e = read(&text, CsvFormat::default()).unwrap_err().to_string();
         assert!(
             e.ends_with(":3: a quote opened on this line is not closed within 1048576 bytes"),
             "{e}"
         );
-        let e = read("t,a\n0,1\n\"1,2\n3,4\n", CsvFormat::default()).unwrap_err();
+        let e = read("t,a\n0,1\n\"1,2\n3,4\n", CsvFormat::default())
+            .unwrap_err()
+            .to_string();
         assert!(
             e.ends_with(":3: a quote opened on this line is never closed"),
             "{e}"
         );
         let mut text = String::from("t,a\n0,1\n\n1,");
         text.push_str(&"2".repeat(MAX_LINE_BYTES + 10));
-        let e = read(&text, CsvFormat::default()).unwrap_err();
+        let e = read(&text, CsvFormat::default()).unwrap_err().to_string();
         assert!(
             e.ends_with(":4: a line longer than 1048576 bytes: not a CSV recording"),
             "{e}"

@@ -140,18 +140,27 @@ impl Tape {
     }
 }
 
+/// Why a reader of the tape cannot read (inside the `io::Error` it gets).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, thiserror::Error)]
+pub enum TapeFault {
+    #[error("a reader of the stream panicked")]
+    Poisoned,
+    /// The byte asked for was released (the tape holds it from `held_from` on).
+    #[error("byte {byte} of the stream is no longer held (from {held_from} on)")]
+    Released { byte: u64, held_from: u64 },
+}
+
 fn lock<T>(m: &Mutex<T>) -> io::Result<std::sync::MutexGuard<'_, T>> {
-    m.lock()
-        .map_err(|_| io::Error::other("a reader of the stream panicked"))
+    m.lock().map_err(|_| io::Error::other(TapeFault::Poisoned))
 }
 
 impl State {
     fn check(&self, byte: u64) -> io::Result<()> {
         if byte < self.released {
-            return Err(io::Error::other(format!(
-                "byte {byte} of the stream is no longer held (from {} on)",
-                self.released
-            )));
+            return Err(io::Error::other(TapeFault::Released {
+                byte,
+                held_from: self.released,
+            }));
         }
         Ok(())
     }

@@ -4,12 +4,13 @@
 //! integer or float type; DAQmx raw (scaled) data is what the crate reads, and it is not
 //! checked against NI's own files here. Segments written interleaved are refused.
 
-use std::path::Path;
+use std::path::{Path, PathBuf};
 
 use tdms_rs::{DataType, PropertyValue, TdmsChannel, TdmsFile};
 
-use crate::channel::{evenly_sampled, Channel, ReadOptions};
-use crate::channel::{one_line, ColumnRef, RecordingError};
+use crate::channel::{check_rate, evenly_sampled, Channel, ColumnRef, ReadOptions};
+use crate::error::TdmsStructureFault as Fault;
+use crate::error::{ReadError, ReadErrorKind, TdmsChannelFault, TdmsFault};
 use crate::limits::RATE_HZ;
 
 /// True for a `.tdms` file name (any case).
@@ -25,16 +26,20 @@ const MAX_METADATA: u64 = 64 << 20;
 /// Walks the file's segments and their metadata (NI's "TDMS File Format Internal Structure")
 /// and checks every length against the bytes there, so that the reader never allocates for a
 /// length a damaged file claims: the byte where the first inconsistency is, if any.
-fn check_structure(path: &Path) -> Result<(), String> {
+fn check_structure(path: &Path) -> Result<(), TdmsFault> {
     use std::io::{Read, Seek, SeekFrom};
-    let mut file = std::fs::File::open(path).map_err(|e| e.to_string())?;
-    let len = file.metadata().map_err(|e| e.to_string())?.len() as usize;
+    let mut file = std::fs::File::open(path).map_err(TdmsFault::Io)?;
+    let len = file.metadata().map_err(TdmsFault::Io)?.len() as usize;
+    let at = |byte: usize, fault: Fault| TdmsFault::Structure {
+        byte: byte as u64,
+        fault,
+    };
     // Each segment's lead-in and metadata are read, never its data.
-    let mut read_at = |at: usize, n: usize| -> Result<Vec<u8>, String> {
+    let mut read_at = |byte: usize, n: usize| -> Result<Vec<u8>, TdmsFault> {
         let mut buf = vec![0u8; n];
-        file.seek(SeekFrom::Start(at as u64))
+        file.seek(SeekFrom::Start(byte as u64))
             .and_then(|_| file.read_exact(&mut buf))
-            .map_err(|e| format!("byte {at}: {e}"))?;
+            .map_err(|e| at(byte, Fault::Read(e)))?;
         Ok(buf)
     };
     struct Cursor<'a> {
@@ -45,27 +50,34 @@ fn check_structure(path: &Path) -> Result<(), String> {
         end: usize,
     }
     impl Cursor<'_> {
-        fn take(&mut self, n: usize) -> Result<&[u8], String> {
-            let to = self
-                .at
-                .checked_add(n)
-                .filter(|&t| t <= self.end)
-                .ok_or(format!(
-                    "byte {}: {n} bytes announced, {} left in the segment's metadata",
-                    self.base + self.at,
-                    self.end.saturating_sub(self.at)
-                ))?;
+        fn take(&mut self, n: usize) -> Result<&[u8], TdmsFault> {
+            let Some(to) = self.at.checked_add(n).filter(|&t| t <= self.end) else {
+                return Err(self.fault(Fault::Announced {
+                    announced: n,
+                    left: self.end.saturating_sub(self.at),
+                }));
+            };
             let s = &self.b[self.at..to];
             self.at = to;
             Ok(s)
         }
-        fn u32(&mut self) -> Result<u32, String> {
+        fn u32(&mut self) -> Result<u32, TdmsFault> {
             let s = self.take(4)?;
             Ok(u32::from_le_bytes([s[0], s[1], s[2], s[3]]))
         }
-        fn string(&mut self) -> Result<(), String> {
+        fn string(&mut self) -> Result<(), TdmsFault> {
             let n = self.u32()? as usize;
             self.take(n).map(|_| ())
+        }
+        /// A fault at the cursor's byte less `back`.
+        fn fault_back(&self, back: usize, fault: Fault) -> TdmsFault {
+            TdmsFault::Structure {
+                byte: (self.base + self.at - back) as u64,
+                fault,
+            }
+        }
+        fn fault(&self, fault: Fault) -> TdmsFault {
+            self.fault_back(0, fault)
         }
     }
     // Bytes of a property value of type `t` (strings are handled apart).
@@ -87,11 +99,11 @@ fn check_structure(path: &Path) -> Result<(), String> {
     let mut seg = 0usize;
     while seg < len {
         if seg + 28 > len {
-            return Err(format!("byte {seg}: a segment's lead-in is cut short"));
+            return Err(at(seg, Fault::LeadInCut));
         }
         let lead = read_at(seg, 28)?;
         if &lead[..4] != b"TDSm" {
-            return Err(format!("byte {seg}: no TDSm segment tag"));
+            return Err(at(seg, Fault::NoTag));
         }
         let u64_at = |i: usize| u64::from_le_bytes(lead[i..i + 8].try_into().unwrap_or([0; 8]));
         let toc = u32::from_le_bytes([lead[4], lead[5], lead[6], lead[7]]);
@@ -101,27 +113,19 @@ fn check_structure(path: &Path) -> Result<(), String> {
         let meta_end = body
             .checked_add(raw as usize)
             .filter(|&e| e <= len)
-            .ok_or(format!(
-                "byte {seg}: metadata of {raw} bytes runs past the file"
-            ))?;
+            .ok_or_else(|| at(seg, Fault::MetadataPastEnd { bytes: raw }))?;
         if toc & (1 << 6) != 0 {
-            return Err(format!(
-                "byte {seg}: a big-endian segment, which this reader does not read"
-            ));
+            return Err(at(seg, Fault::BigEndian));
         }
         // Interleaved raw data (1 << 5, with raw data 1 << 3): the crate reads it as if
         // contiguous, which gives another channel's values or none; refused.
         if toc & (1 << 5) != 0 && toc & (1 << 3) != 0 {
-            return Err(format!(
-                "byte {seg}: interleaved channels (ToC bit 5), which this reader does not read: write the channels one after the other (npTDMS's default) or export a CSV"
-            ));
+            return Err(at(seg, Fault::Interleaved));
         }
         // Metadata (1 << 1) or a new object list (1 << 2): the reader parses either.
         if toc & 0b110 != 0 {
             if raw > MAX_METADATA {
-                return Err(format!(
-                    "byte {seg}: metadata of {raw} bytes, more than a recording's"
-                ));
+                return Err(at(seg, Fault::MetadataTooLarge { bytes: raw }));
             }
             let meta = read_at(body, meta_end - body)?;
             let mut c = Cursor {
@@ -135,20 +139,12 @@ fn check_structure(path: &Path) -> Result<(), String> {
                 c.string()?;
                 match c.u32()? {
                     0xFFFF_FFFF | 0 => {}
-                    0x6912_0000 | 0x6913_0000 => {
-                        return Err(format!(
-                            "byte {}: DAQmx raw data, which this reader does not read",
-                            c.base + c.at - 4
-                        ))
-                    }
+                    0x6912_0000 | 0x6913_0000 => return Err(c.fault_back(4, Fault::DaqmxRaw)),
                     n => {
                         // Data type, dimension, value count, and for strings their size.
                         let n = n as usize;
                         if !(20..=28).contains(&n) {
-                            return Err(format!(
-                                "byte {}: raw data index of {n} bytes",
-                                c.base + c.at - 4
-                            ));
+                            return Err(c.fault_back(4, Fault::RawIndex { bytes: n }));
                         }
                         c.take(n - 4)?;
                     }
@@ -159,10 +155,8 @@ fn check_structure(path: &Path) -> Result<(), String> {
                     match c.u32()? {
                         0x20 => c.string()?,
                         t => {
-                            let n = fixed(t).ok_or(format!(
-                                "byte {}: property type {t:#x}",
-                                c.base + c.at - 4
-                            ))?;
+                            let n =
+                                fixed(t).ok_or_else(|| c.fault_back(4, Fault::PropertyType(t)))?;
                             c.take(n)?;
                         }
                     }
@@ -171,13 +165,13 @@ fn check_structure(path: &Path) -> Result<(), String> {
         }
         let next_seg = body
             .checked_add(next as usize)
-            .ok_or(format!("byte {seg}: next segment offset {next}"))?;
+            .ok_or_else(|| at(seg, Fault::NextOffset(next)))?;
         if next == u64::MAX || next_seg > len {
             // The last segment (still being written, or cut): nothing follows it.
             break;
         }
         if next_seg <= seg {
-            return Err(format!("byte {seg}: next segment offset {next} goes back"));
+            return Err(at(seg, Fault::NextGoesBack(next)));
         }
         seg = next_seg;
     }
@@ -185,26 +179,20 @@ fn check_structure(path: &Path) -> Result<(), String> {
 }
 
 /// Reads the channel `opts.column` [default: the first one].
-pub fn read_tdms(path: &Path, opts: &ReadOptions) -> Result<Channel, RecordingError> {
-    let err = |message: String| RecordingError {
-        file: path.to_path_buf(),
-        line: None,
-        message,
-    };
+pub fn read_tdms(path: &Path, opts: &ReadOptions) -> Result<Channel, ReadError> {
     if opts.time_column.is_some() || opts.resample || !opts.axes.is_empty() {
-        return Err(err(
-            "a TDMS file takes --column (group/channel) and --rate only".into(),
-        ));
+        return Err(ReadError::new(path, ReadErrorKind::TdmsOptions));
     }
     let mut open = TdmsStream::open(path, opts.column.as_ref(), opts.rate_hz)?;
     let mut values = Vec::with_capacity(open.len);
-    open.next_values(open.len, &mut values).map_err(err)?;
+    open.next_values(open.len, &mut values)?;
     let name = open.name.clone();
-    evenly_sampled(name.clone(), values, open.rate_hz).map_err(|e| err(format!("TDMS {name}: {e}")))
+    evenly_sampled(name, values, open.rate_hz).map_err(|e| open.fault(TdmsChannelFault::Samples(e)))
 }
 
 /// One channel of a TDMS file, read a range at a time (`impact analyze --stream`).
 pub struct TdmsStream {
+    path: PathBuf,
     file: TdmsFile,
     group: String,
     channel: String,
@@ -224,14 +212,10 @@ impl TdmsStream {
         path: &Path,
         column: Option<&ColumnRef>,
         rate_hz: Option<f64>,
-    ) -> Result<Self, RecordingError> {
-        let err = |message: String| RecordingError {
-            file: path.to_path_buf(),
-            line: None,
-            message,
-        };
-        check_structure(path).map_err(|e| err(format!("TDMS: {}", one_line(e))))?;
-        let file = TdmsFile::open(path).map_err(|e| err(format!("TDMS: {}", one_line(e))))?;
+    ) -> Result<Self, ReadError> {
+        let err = |kind: ReadErrorKind| ReadError::new(path, kind);
+        check_structure(path).map_err(|e| err(e.into()))?;
+        let file = TdmsFile::open(path).map_err(|e| err(TdmsFault::Library(e).into()))?;
         let all: Vec<(String, String)> = file
             .groups()
             .flat_map(|g| {
@@ -241,14 +225,9 @@ impl TdmsStream {
                     .collect::<Vec<_>>()
             })
             .collect();
-        let names = || {
-            all.iter()
-                .map(|(g, c)| format!("{g}/{c}"))
-                .collect::<Vec<_>>()
-                .join(", ")
-        };
+        let names = || all.iter().map(|(g, c)| format!("{g}/{c}")).collect();
         if all.is_empty() {
-            return Err(err("TDMS: the file holds no channels".into()));
+            return Err(err(TdmsFault::NoChannels.into()));
         }
         let found = match column {
             None => all.first(),
@@ -258,16 +237,13 @@ impl TdmsStream {
             }
         };
         let Some((group, channel)) = found.cloned() else {
-            return Err(err(format!(
-                "no such channel{}; the file has: {}",
-                column.map_or(String::new(), |c| match c {
-                    ColumnRef::Index(i) => format!(" {i}"),
-                    ColumnRef::Name(n) => format!(" {n}"),
-                }),
-                names()
-            )));
+            return Err(err(ReadErrorKind::TdmsNoSuchChannel {
+                column: column.cloned(),
+                channels: names(),
+            }));
         };
         let mut open = Self {
+            path: path.to_path_buf(),
             file,
             name: format!("{group}/{channel}"),
             group,
@@ -276,27 +252,25 @@ impl TdmsStream {
             len: 0,
             at: 0,
         };
-        let ch = open.channel().map_err(err)?;
+        let ch = open.channel()?;
         let name = open.name.clone();
         let increment = match ch.property("wf_increment") {
             Some(PropertyValue::Double(d)) if d.is_finite() && *d > 0.0 => Some(*d),
             _ => None,
         };
         let rate_hz = match (rate_hz, increment) {
-            (Some(r), _) => RATE_HZ.check_named("--rate", r).map_err(err)?,
+            (Some(r), _) => check_rate(r).map_err(err)?,
             (None, Some(dt)) => {
                 // The interval between samples, s: its limits are the rate's.
-                RATE_HZ
-                    .reciprocal("s")
-                    .check_named(&format!("{name}: wf_increment"), dt)
-                    .map_err(err)?;
+                if !RATE_HZ.reciprocal("s").contains(dt) {
+                    return Err(err(ReadErrorKind::TdmsIncrementOutOfRange {
+                        channel: name,
+                        increment_s: dt,
+                    }));
+                }
                 1.0 / dt
             }
-            (None, None) => {
-                return Err(err(format!(
-                    "{name} has no wf_increment property: give --rate"
-                )))
-            }
+            (None, None) => return Err(err(ReadErrorKind::TdmsNoIncrement { channel: name })),
         };
         // A header may claim more values than the file holds: check before allocating.
         let file_bytes = std::fs::metadata(path).map(|m| m.len()).unwrap_or(0);
@@ -307,10 +281,10 @@ impl TdmsStream {
             _ => 8,
         };
         if (ch.len() as u128) * item > u128::from(file_bytes) {
-            return Err(err(format!(
-                "TDMS {name}: {} values announced, more than the file's {file_bytes} bytes hold",
-                ch.len()
-            )));
+            return Err(open.fault(TdmsChannelFault::TooManyValues {
+                values: ch.len(),
+                file_bytes,
+            }));
         }
         let len = ch.len();
         (open.rate_hz, open.len) = (rate_hz, len);
@@ -318,31 +292,44 @@ impl TdmsStream {
     }
 
     /// The channel in the file.
-    fn channel(&self) -> Result<TdmsChannel<'_>, String> {
+    fn channel(&self) -> Result<TdmsChannel<'_>, ReadError> {
         self.file
             .groups()
             .find(|g| g.name() == self.group)
             .and_then(|g| g.channels().find(|c| c.name() == self.channel))
-            .ok_or_else(|| format!("TDMS: channel {} not found again", self.name))
+            .ok_or_else(|| {
+                ReadError::new(
+                    &self.path,
+                    TdmsFault::ChannelLost {
+                        channel: self.name.clone(),
+                    },
+                )
+            })
+    }
+
+    /// The error of the channel's `fault`.
+    fn fault(&self, fault: TdmsChannelFault) -> ReadError {
+        ReadError::new(
+            &self.path,
+            ReadErrorKind::TdmsChannel {
+                channel: self.name.clone(),
+                fault,
+            },
+        )
     }
 
     /// Appends the next values (at most `want`, none at the end) to `out`; an error names the
     /// value that is not finite.
-    pub fn next_values(&mut self, want: usize, out: &mut Vec<f64>) -> Result<(), String> {
+    pub fn next_values(&mut self, want: usize, out: &mut Vec<f64>) -> Result<(), ReadError> {
         let range = self.at..(self.at + want.max(1)).min(self.len);
         if range.is_empty() {
             return Ok(());
         }
         let ch = self.channel()?;
         let from = out.len();
-        read_range(&ch, range.clone(), out)
-            .map_err(|e| format!("TDMS {}: {}", self.name, one_line(e)))?;
+        read_range(&ch, range.clone(), out).map_err(|e| self.fault(e))?;
         if let Some(k) = out[from..].iter().position(|v| !v.is_finite()) {
-            return Err(format!(
-                "TDMS {}: value {} is not finite",
-                self.name,
-                range.start + k
-            ));
+            return Err(self.fault(TdmsChannelFault::NotFinite(range.start + k)));
         }
         self.at = range.end;
         Ok(())
@@ -354,14 +341,14 @@ fn read_range(
     ch: &TdmsChannel,
     range: std::ops::Range<usize>,
     out: &mut Vec<f64>,
-) -> Result<(), String> {
+) -> Result<(), TdmsChannelFault> {
     fn read<T: tdms_rs::api::reader::Pod + Default + Into<f64>>(
         ch: &TdmsChannel,
         range: std::ops::Range<usize>,
         out: &mut Vec<f64>,
-    ) -> Result<(), String> {
+    ) -> Result<(), TdmsChannelFault> {
         let mut buf = vec![T::default(); range.len()];
-        ch.read(range, &mut buf).map_err(|e| e.to_string())?;
+        ch.read(range, &mut buf).map_err(TdmsChannelFault::Read)?;
         out.extend(buf.into_iter().map(Into::into));
         Ok(())
     }
@@ -374,6 +361,6 @@ fn read_range(
         DataType::U8 => read::<u8>(ch, range, out),
         DataType::U16 => read::<u16>(ch, range, out),
         DataType::U32 => read::<u32>(ch, range, out),
-        other => Err(format!("channel type {other:?} is not a number this reads")),
+        other => Err(TdmsChannelFault::DataType(other)),
     }
 }

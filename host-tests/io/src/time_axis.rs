@@ -5,24 +5,13 @@
 //! CSV keeps the first of each kind for the end, an `.ide` stops at it); the faults and their
 //! order are the axis's.
 
-use std::fmt;
+pub use crate::error::{DriftFault, NotIncreasing, UnevenInterval};
+use crate::limits::{DRIFT_BLOCK, DRIFT_LIMIT};
 
 /// Every sample interval must lie within this range of the median interval, or the time axis
 /// counts as uneven (a gap or a rate change). Jittered time stamps, as enDAQ's, stay within
 /// 0.6..1.25.
 pub const INTERVAL_RANGE: std::ops::RangeInclusive<f64> = 0.5..=1.5;
-
-/// The intervals whose median every interval is checked against: the first 65 535 (those
-/// among the first 65 536 rows, as a file read in passes or a stream has them at hand).
-pub const HEAD_INTERVALS: usize = (1 << 16) - 1;
-
-/// Intervals per block of the drift check ([`Drift`]).
-pub const DRIFT_BLOCK: u64 = 1024;
-/// Largest difference of a block's mean interval from the first block's (1 %): a sample
-/// clock is steady to parts per million; a time axis whose interval drifts further (each
-/// step may stay well inside [`INTERVAL_RANGE`]) is no even grid, and taking it for one
-/// puts the impacts at the wrong times with the wrong Δv.
-pub const DRIFT_LIMIT: f64 = 0.01;
 
 /// Checks that a time axis keeps its rate: the mean interval of every [`DRIFT_BLOCK`]
 /// intervals against the first block's. Fed the time stamps in order (any split), so the
@@ -66,32 +55,6 @@ impl Drift {
     }
 }
 
-/// A block of intervals whose mean is more than [`DRIFT_LIMIT`] off the first block's.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct DriftFault {
-    /// The block's last sample (its first is [`DRIFT_BLOCK`] before).
-    pub block_end: u64,
-    /// The block's mean interval and the first block's, s.
-    pub mean_dt: f64,
-    pub first_dt: f64,
-}
-
-impl fmt::Display for DriftFault {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        let (k, mean, first) = (self.block_end, self.mean_dt, self.first_dt);
-        write!(
-            f,
-            "the time axis drifts: the mean interval of samples {}..{k} is {mean:.6e} s, \
-             {:+.2} % off the first {DRIFT_BLOCK} intervals' {first:.6e} s (more than \
-             {} %: no steady sample clock); give --resample to interpolate onto an even \
-             grid, or --rate if the column is wrong",
-            k - DRIFT_BLOCK,
-            100.0 * (mean / first - 1.0),
-            100.0 * DRIFT_LIMIT
-        )
-    }
-}
-
 /// The median as `select_nth_unstable(len / 2)` picks it (the upper one of an even count);
 /// `None` of nothing. Reorders `values`.
 pub fn median(values: &mut [f64]) -> Option<f64> {
@@ -102,52 +65,12 @@ pub fn median(values: &mut [f64]) -> Option<f64> {
     Some(*values.select_nth_unstable_by(mid, f64::total_cmp).1)
 }
 
-/// An interval far from the head's median: a gap or a rate change.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct UnevenInterval {
-    /// The interval, s.
-    pub dt: f64,
-    /// The head's median interval, s.
-    pub median: f64,
-}
-
-impl fmt::Display for UnevenInterval {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        let (dt, median) = (self.dt, self.median);
-        let ratio = dt / median;
-        write!(
-            f,
-            "uneven time axis: {dt:.6e} s since the previous sample, {ratio:.3} times the first \
-             intervals' median {median:.6e} s (a gap or a rate change); give --resample to \
-             interpolate onto an even grid, or cut the file"
-        )
-    }
-}
-
 /// An interval `dt` within [`INTERVAL_RANGE`] times the median `median`.
 pub fn check_interval(dt: f64, median: f64) -> Result<(), UnevenInterval> {
     if INTERVAL_RANGE.contains(&(dt / median)) {
         Ok(())
     } else {
         Err(UnevenInterval { dt, median })
-    }
-}
-
-/// A time that does not increase.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct NotIncreasing {
-    /// The time, s, and the one before it.
-    pub t: f64,
-    pub previous: f64,
-}
-
-impl fmt::Display for NotIncreasing {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        write!(
-            f,
-            "time {} s does not increase (previous {} s)",
-            self.t, self.previous
-        )
     }
 }
 

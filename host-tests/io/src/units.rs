@@ -4,6 +4,7 @@
 use impact_core::consts::STANDARD_GRAVITY;
 
 use crate::channel::words;
+use crate::error::{Opt, OptionNames};
 
 /// Units of a recorded channel.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -72,17 +73,52 @@ impl Units {
 
     /// The channel's units: the ones stated (`--units` or the scene file), else the ones its
     /// header names, else g; an error naming both if they disagree.
-    pub fn resolve(stated: Option<Units>, column: &str) -> Result<Units, String> {
+    pub fn resolve(stated: Option<Units>, column: &str) -> Result<Units, UnitsConflict> {
         match (stated, Units::of_header(column)) {
-            (Some(s), Some(h)) if s != h => Err(format!(
-                "--units {} contradicts the column's header {column:?}, which names {}: drop --units or choose another column",
-                s.name(),
-                h.name()
-            )),
+            (Some(s), Some(h)) if s != h => Err(UnitsConflict {
+                stated: s,
+                header: column.to_string(),
+                named: h,
+            }),
             (Some(s), _) => Ok(s),
             (None, Some(h)) => Ok(h),
             (None, None) => Ok(Units::G),
         }
+    }
+}
+
+/// Units stated that the channel's header contradicts.
+#[derive(Clone, Debug, PartialEq, Eq, thiserror::Error)]
+pub struct UnitsConflict {
+    pub stated: Units,
+    /// The header, and the units it names.
+    pub header: String,
+    pub named: Units,
+}
+
+impl UnitsConflict {
+    /// The message, naming the stated units' setting as `n` does.
+    pub fn display_with(&self, n: OptionNames) -> impl std::fmt::Display + '_ {
+        struct D<'a>(&'a UnitsConflict, OptionNames);
+        impl std::fmt::Display for D<'_> {
+            fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+                let (e, units) = (self.0, (self.1)(Opt::Units));
+                write!(
+                    f,
+                    "{units} {} contradicts the column's header {:?}, which names {}: drop {units} or choose another column",
+                    e.stated.name(),
+                    e.header,
+                    e.named.name()
+                )
+            }
+        }
+        D(self, n)
+    }
+}
+
+impl std::fmt::Display for UnitsConflict {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        self.display_with(Opt::field).fmt(f)
     }
 }
 
@@ -119,7 +155,9 @@ mod tests {
         );
         assert_eq!(Units::resolve(None, "test1"), Ok(Units::G));
         assert_eq!(Units::resolve(Some(Units::MS2), "test1"), Ok(Units::MS2));
-        let e = Units::resolve(Some(Units::G), "table_m_s2").unwrap_err();
-        assert!(e.contains("--units g") && e.contains("m/s2"), "{e}");
+        let e = Units::resolve(Some(Units::G), "table_m_s2")
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("`units` g") && e.contains("m/s2"), "{e}");
     }
 }

@@ -2,10 +2,10 @@
 //! rate the header gives, in the file's own units (integer codes or floats; `--gain` and
 //! `--units` turn them into an acceleration).
 
-use std::path::Path;
+use std::path::{Path, PathBuf};
 
 use crate::channel::{evenly_sampled, numbered_column, Channel, ReadOptions};
-use crate::channel::{one_line, RecordingError};
+use crate::error::{Numbered, ReadError, ReadErrorKind, WavFault};
 
 /// True for a `.wav` file name (any case).
 pub fn is_wav(path: &Path) -> bool {
@@ -17,6 +17,7 @@ pub fn is_wav(path: &Path) -> bool {
 /// One channel of a WAV file, read as it is asked for (hound's sample iterator): each value,
 /// or an error naming the frame.
 pub struct WavChannel {
+    path: PathBuf,
     samples: Samples,
     /// Samples read (all channels), the channels, the one wanted, and the frames the header
     /// announces.
@@ -37,19 +38,26 @@ enum Samples {
 
 impl WavChannel {
     /// Opens `path` and chooses the channel `column` (0-based, default 0).
-    pub fn open(path: &Path, column: Option<&crate::channel::ColumnRef>) -> Result<Self, String> {
-        let reader = hound::WavReader::open(path).map_err(|e| format!("WAV: {}", one_line(e)))?;
+    pub fn open(
+        path: &Path,
+        column: Option<&crate::channel::ColumnRef>,
+    ) -> Result<Self, ReadError> {
+        let err = |kind: ReadErrorKind| ReadError::new(path, kind);
+        let reader = hound::WavReader::open(path).map_err(|e| err(WavFault::Header(e).into()))?;
         let spec = reader.spec();
         let channels = usize::from(spec.channels);
-        let column = numbered_column(column, channels, "a WAV file's channels")?;
-        crate::limits::RATE_HZ
-            .check_named("WAV: the header's sample rate", f64::from(spec.sample_rate))?;
+        let column = numbered_column(column, channels, Numbered::WavChannels).map_err(err)?;
+        let rate_hz = f64::from(spec.sample_rate);
+        if !crate::limits::RATE_HZ.contains(rate_hz) {
+            return Err(err(WavFault::RateOutOfRange { rate_hz }.into()));
+        }
         let frames = reader.duration() as usize;
         let samples = match spec.sample_format {
             hound::SampleFormat::Int => Samples::Int(reader.into_samples()),
             hound::SampleFormat::Float => Samples::Float(reader.into_samples()),
         };
         Ok(Self {
+            path: path.to_path_buf(),
             samples,
             k: 0,
             channels: channels.max(1),
@@ -67,7 +75,7 @@ impl WavChannel {
 }
 
 impl Iterator for WavChannel {
-    type Item = Result<f64, String>;
+    type Item = Result<f64, ReadError>;
 
     fn next(&mut self) -> Option<Self::Item> {
         loop {
@@ -78,42 +86,35 @@ impl Iterator for WavChannel {
             let frame = self.k / self.channels;
             let mine = self.k % self.channels == self.column;
             self.k += 1;
-            let v = match sample {
-                Ok(v) => v,
-                Err(e) => {
-                    return Some(Err(format!(
-                        "WAV: frame {frame} (of {} the header announces): {}",
-                        self.frames,
-                        one_line(e)
-                    )))
+            let fault = match sample {
+                Ok(v) if v.is_finite() => {
+                    if mine {
+                        return Some(Ok(v));
+                    }
+                    continue;
                 }
+                Ok(value) => WavFault::NotFinite { frame, value },
+                Err(error) => WavFault::Frame {
+                    frame,
+                    frames: self.frames,
+                    error,
+                },
             };
-            if !v.is_finite() {
-                return Some(Err(format!("WAV: frame {frame}: {v} is not finite")));
-            }
-            if mine {
-                return Some(Ok(v));
-            }
+            return Some(Err(ReadError::new(&self.path, fault)));
         }
     }
 }
 
 /// Reads the channel `opts.column` (a 0-based index, default 0).
-pub fn read_wav(path: &Path, opts: &ReadOptions) -> Result<Channel, RecordingError> {
-    let err = |message: String| RecordingError {
-        file: path.to_path_buf(),
-        line: None,
-        message,
-    };
+pub fn read_wav(path: &Path, opts: &ReadOptions) -> Result<Channel, ReadError> {
+    let err = |kind: ReadErrorKind| ReadError::new(path, kind);
     if opts.rate_hz.is_some() || opts.time_column.is_some() || opts.resample {
-        return Err(err(
-            "a WAV file gives its own rate: no --rate, --time-column or --resample".into(),
-        ));
+        return Err(err(ReadErrorKind::WavGivesRate { resample: true }));
     }
     if !opts.axes.is_empty() {
-        return Err(err("--axes: not for WAV files yet; give --column".into()));
+        return Err(err(ReadErrorKind::WavAxes));
     }
-    let channel = WavChannel::open(path, opts.column.as_ref()).map_err(err)?;
+    let channel = WavChannel::open(path, opts.column.as_ref())?;
     let rate_hz = channel.rate_hz;
     let column = channel.column;
     // The header's frame count, but never more than the file's bytes could hold.
@@ -121,8 +122,8 @@ pub fn read_wav(path: &Path, opts: &ReadOptions) -> Result<Channel, RecordingErr
     let frame_bytes = channel.channels * channel.sample_bytes;
     let mut values = Vec::with_capacity(channel.frames().min(file_bytes / frame_bytes));
     for v in channel {
-        values.push(v.map_err(err)?);
+        values.push(v?);
     }
     evenly_sampled(format!("channel {column}"), values, rate_hz)
-        .map_err(|e| err(format!("WAV: {e}")))
+        .map_err(|e| err(WavFault::Samples(e).into()))
 }

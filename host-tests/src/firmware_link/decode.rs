@@ -22,7 +22,8 @@ pub fn decode(
     name: &str,
     mut on_line: impl FnMut(u64, &str) -> Result<(), String>,
 ) -> Result<u64, String> {
-    let bytes = impact_io::read_limited(elf, 256 << 20, "firmware ELF")?;
+    let bytes = impact_io::read_limited(elf, 256 << 20, "firmware ELF")
+        .map_err(|e| crate::read_errors::input_file_message(&e))?;
     let table = Table::parse(&bytes)
         .map_err(|e| format!("{}: not the firmware's ELF ({e})", elf.display()))?
         .ok_or_else(|| format!("{}: no defmt data (not the firmware's ELF)", elf.display()))?;

@@ -5,6 +5,9 @@ use impact_io::channel::time_unit_s;
 use impact_io::channel::ColumnRef;
 use impact_io::channel::CsvFormat;
 use impact_io::csv_read::read_table;
+use impact_io::ReadErrorKind;
+
+use crate::read_errors::{into_message, kind_message};
 use std::path::Path;
 
 /// The file of a `--free-fall FILE[:COLUMN]` (an input: no output may write over it).
@@ -26,17 +29,17 @@ fn split(spec: &str) -> (&Path, Option<&str>) {
 pub fn free_fall_before(spec: &str, impact_s: f64) -> Result<f64, String> {
     let (path, column) = split(spec);
     let column = column.map(|c| c.parse::<ColumnRef>().unwrap_or(ColumnRef::Name(c.into())));
-    let table = read_table(path, &CsvFormat::default(), None).map_err(|e| e.to_string())?;
+    let table = read_table(path, &CsvFormat::default(), None).map_err(into_message)?;
+    let in_file =
+        |e: ReadErrorKind| format!("--free-fall {}: {}", path.display(), kind_message(&e));
     let tcol = table
         .time_column(None)
-        .map_err(|e| format!("--free-fall {}: {e}", path.display()))?
+        .map_err(in_file)?
         .ok_or_else(|| format!("--free-fall {}: needs a time column", path.display()))?;
     let unit = time_unit_s(&table.headers.get(tcol).cloned().unwrap_or_default(), None);
     let time: Vec<f64> = table.columns[tcol].iter().map(|t| t * unit).collect();
     let cols: Vec<usize> = match &column {
-        Some(c) => vec![table
-            .find(c, "column")
-            .map_err(|e| format!("--free-fall {}: {e}", path.display()))?],
+        Some(c) => vec![table.find(c, "column").map_err(in_file)?],
         None => (0..table.columns.len()).filter(|&c| c != tcol).collect(),
     };
     let mag = |i: usize| {

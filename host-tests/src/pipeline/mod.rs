@@ -240,7 +240,8 @@ impl Setup {
 /// Reads the file and builds the scene (v0 from a free fall needs a first pass).
 pub fn setup(args: &AnalyzeArgs, progress: Option<fn(f64)>) -> Result<Setup, String> {
     let file = scene_file(args)?;
-    let ch = read_recording(&args.file, &args.read_options(progress)).map_err(|e| e.to_string())?;
+    let ch = read_recording(&args.file, &args.read_options(progress))
+        .map_err(crate::read_errors::into_message)?;
     let column = ch
         .axes
         .first()
@@ -340,7 +341,8 @@ pub(crate) fn mass_and_scale(
     column: &str,
 ) -> Result<(Option<f64>, f64, Units), String> {
     let mass = args.mass.or(file.mass);
-    let units = Units::resolve(args.units.or(file.units), column)?;
+    let units = Units::resolve(args.units.or(file.units), column)
+        .map_err(|e| crate::read_errors::units_message(&e))?;
     let invert = args.invert || file.invert.unwrap_or(false);
     let scale = units.to_m_s2(mass) * args.gain.unwrap_or(1.0) * if invert { -1.0 } else { 1.0 };
     Ok((mass, scale, units))

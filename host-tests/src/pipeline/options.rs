@@ -252,7 +252,8 @@ pub fn scene_file(args: &AnalyzeArgs) -> Result<SceneFile, String> {
     let file = match &args.scene {
         None => SceneFile::default(),
         Some(path) => {
-            let bytes = impact_io::read_limited(path, 1 << 20, "scene file")?;
+            let bytes = impact_io::read_limited(path, 1 << 20, "scene file")
+                .map_err(|e| crate::read_errors::input_file_message(&e))?;
             let file: SceneFile =
                 serde_json::from_slice(&bytes).map_err(|e| format!("{}: {e}", path.display()))?;
             file.check(path)?;
@@ -316,7 +317,9 @@ impl SceneFile {
             ("fits.exponent", exponent, &parse::EXPONENT),
         ] {
             if let Some(v) = value {
-                limits.check_named(&format!("{}: {key}", path.display()), v)?;
+                limits
+                    .check_named(&format!("{}: {key}", path.display()), v)
+                    .map_err(|e| e.to_string())?;
             }
         }
         Ok(())

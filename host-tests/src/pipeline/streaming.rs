@@ -19,6 +19,7 @@ use impact_core::{Calibration, ImpactReport};
 use crate::pipeline::screen::Removal;
 use crate::pipeline::survey::{self, Survey, Surveyed};
 use crate::pipeline::{self, AnalyzeArgs, MonitorRun, Reading, Setup};
+use crate::read_errors::into_message;
 use impact_io::channel::{input_name, is_stdin};
 use impact_io::open_source;
 use impact_io::quantise::Quantiser;
@@ -31,7 +32,6 @@ pub fn analyze(
     args: &AnalyzeArgs,
     progress: Option<fn(f64)>,
 ) -> Result<(Setup, Vec<ImpactReport>), String> {
-    let name = input_name(&args.file);
     let refuse = |what: &str| Err(format!("--stream: {what} needs the whole recording"));
     if args.plot.is_some() {
         return refuse("--plot");
@@ -46,7 +46,7 @@ pub fn analyze(
         return refuse("--resample");
     }
     let file = pipeline::scene_file(args)?;
-    let mut source = open_source(&args.file, &args.read_options(progress), &name)?;
+    let mut source = open_source(&args.file, &args.read_options(progress)).map_err(into_message)?;
     let column = source.column().to_string();
     let (mass, scale, units) = pipeline::mass_and_scale(args, &file, &column)?;
     let full_scale = pipeline::full_scale_m_s2(args, &file, mass).ok_or(
@@ -61,9 +61,9 @@ pub fn analyze(
     let clipping = crate::pipeline::screen::from_range(full_scale);
     // The head: its noise sets the default edge level, a CSV's first intervals the rate; its
     // readings are checked against the range.
-    let head = read_head(&mut *source, scale)?;
+    let head = read_head(&mut *source, scale).map_err(into_message)?;
     survey::check_range(head.iter().fold(0.0f64, |m, v| m.max(v.abs())), full_scale)?;
-    let rate_hz = source.rate_hz()?;
+    let rate_hz = source.rate_hz().map_err(into_message)?;
     let calibration = Calibration {
         gain_m_s2_per_count: gain as f32,
         sample_rate_hz: rate_hz as f32,
@@ -140,7 +140,7 @@ fn in_passes_then(
     };
     // (The spool first: standard input without one is refused before it is read.)
     let spool = Spooling::for_input(args, &name)?;
-    let input = open_source(&args.file, &args.read_options(bar(0.0, 0.5)), &name)?;
+    let input = open_source(&args.file, &args.read_options(bar(0.0, 0.5))).map_err(into_message)?;
     let column = input.column().to_string();
     let (mass, scale, units) = pipeline::mass_and_scale(args, &file, &column)?;
     let full_scale = pipeline::full_scale_m_s2(args, &file, mass);
@@ -150,7 +150,7 @@ fn in_passes_then(
         spool,
     } = survey_pass(input, scale, &[], !args.keep_spikes, spool)?;
     let axis = Axis {
-        rate_hz: source.rate_hz()?,
+        rate_hz: source.rate_hz().map_err(into_message)?,
         final_rate_hz: source.final_rate_hz(),
         t0_s: source.t0(),
     };
@@ -170,7 +170,7 @@ fn in_passes_then(
     // The later passes read the spool if there is one; a file whose spool failed (a full
     // disk) is read again (standard input's failure ended its pass).
     let spool = match spool {
-        Some(Ok(writer)) => Some(writer.finish(axis)),
+        Some(Ok(writer)) => Some(writer.finish(&args.file, axis)),
         Some(Err(e)) => {
             eprintln!("note: {e}: {name} is read again");
             None
@@ -178,9 +178,9 @@ fn in_passes_then(
         None => None,
     };
     let reopen = |progress: Option<fn(f64)>| match &spool {
-        Some(s) => Ok((s.source(progress)?, 1.0)),
+        Some(s) => Ok((s.source(progress).map_err(into_message)?, 1.0)),
         None => Ok::<_, String>((
-            open_source(&args.file, &args.read_options(progress), &name)?,
+            open_source(&args.file, &args.read_options(progress)).map_err(into_message)?,
             scale,
         )),
     };
@@ -266,7 +266,7 @@ fn head_counts(
     mut source: Box<dyn Source>,
     q: Quantiser,
 ) -> Result<(Box<dyn Source>, Vec<i16>), String> {
-    let head = read_head(&mut *source, q.scale)?;
+    let head = read_head(&mut *source, q.scale).map_err(into_message)?;
     Ok((source, q.counts_m_s2(&head)))
 }
 
@@ -324,7 +324,7 @@ fn survey_pass(
         let failure = std::sync::Arc::clone(&failure);
         move |(flat, spikes, spool), block| {
             if let Some(Ok(w)) = spool {
-                if let Err(e) = w.write(block) {
+                if let Err(e) = w.write(block).map_err(|e| e.to_string()) {
                     let _ = failure.set(e.clone());
                     *spool = Some(Err(e));
                 }
@@ -350,18 +350,20 @@ fn survey_pass(
         }
         Ok(())
     };
-    let read = read_head(&mut *source, scale).and_then(|mut head| {
-        take(&mut head)?;
-        read_ahead(
-            source,
-            move |s, _, out: &mut Vec<f64>| {
-                s.next_values(CHUNK, out)?;
-                out.iter_mut().for_each(|v| *v *= scale);
-                Ok(())
-            },
-            take,
-        )
-    });
+    let read = read_head(&mut *source, scale)
+        .map_err(into_message)
+        .and_then(|mut head| {
+            take(&mut head)?;
+            read_ahead(
+                source,
+                move |s, _, out: &mut Vec<f64>| {
+                    s.next_values(CHUNK, out).map_err(into_message)?;
+                    out.iter_mut().for_each(|v| *v *= scale);
+                    Ok(())
+                },
+                take,
+            )
+        });
     let (flat, with_flat, spool) = flat.finish()?;
     let spikes = spikes.map(Scan::finish).transpose()?.or(with_flat);
     let source = read?;
@@ -602,7 +604,10 @@ fn for_each_count(
     patched(&mut head)?;
     read_ahead(
         source,
-        move |s, scratch, counts| s.next_counts(CHUNK, q, scratch, counts),
+        move |s, scratch, counts| {
+            s.next_counts(CHUNK, q, scratch, counts)
+                .map_err(into_message)
+        },
         patched,
     )
 }

@@ -56,7 +56,7 @@ struct StateSpaceFile {
 fn read_state_space(path: &Path) -> Result<Target<f64>, String> {
     let name = path.display();
     let bytes = impact_io::read_limited(path, 1 << 20, "target file")
-        .map_err(|e| format!("--target {e}"))?;
+        .map_err(|e| format!("--target {}", crate::read_errors::input_file_message(&e)))?;
     let f: StateSpaceFile =
         serde_json::from_slice(&bytes).map_err(|e| format!("--target {name}: {e}"))?;
     let n = f.a.len();

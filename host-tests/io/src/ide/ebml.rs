@@ -3,6 +3,7 @@
 //! declared length before that length has been checked against what is really there.
 
 use super::IdeError;
+use crate::error::{IdeUnsupported, Malformation};
 use std::io::{ErrorKind, Read, Seek, SeekFrom};
 
 /// An element's header: its ID (marker bits kept, as schemas write them), the declared body
@@ -34,7 +35,7 @@ fn vint(buf: &[u8], offset: u64, is_id: bool) -> Result<(Option<u64>, usize), Id
         let what = if is_id { "element ID" } else { "element size" };
         return Err(IdeError::Malformed {
             offset,
-            what: format!("invalid {what} byte 0x{first:02X}"),
+            what: Malformation::Vint { what, byte: first },
         });
     }
     let bytes = buf.get(..len).ok_or(IdeError::Truncated { offset })?;
@@ -55,9 +56,10 @@ fn header_in(buf: &[u8], offset: u64) -> Result<(u32, u64, usize), IdeError> {
     let (id, il) = vint(buf, offset, true)?;
     let (size, sl) = vint(buf.get(il..).unwrap_or(&[]), offset + il as u64, false)?;
     let id = id.unwrap_or(0) as u32; // IDs never decode to None (is_id)
-    let size = size.ok_or(IdeError::Unsupported(format!(
-        "element 0x{id:X} at byte {offset} has an unknown (streamed) size"
-    )))?;
+    let size = size.ok_or(IdeError::Unsupported(IdeUnsupported::UnknownSize {
+        id,
+        offset,
+    }))?;
     Ok((id, size, il + sl))
 }
 
@@ -128,7 +130,7 @@ pub fn uint(b: &[u8], offset: u64) -> Result<u64, IdeError> {
     if b.len() > 8 {
         return Err(IdeError::Malformed {
             offset,
-            what: format!("{}-byte unsigned integer", b.len()),
+            what: Malformation::UintLength(b.len()),
         });
     }
     Ok(b.iter().fold(0u64, |v, &x| (v << 8) | x as u64))
@@ -144,7 +146,7 @@ pub fn float(b: &[u8], offset: u64) -> Result<f64, IdeError> {
         ])),
         n => Err(IdeError::Malformed {
             offset,
-            what: format!("{n}-byte float"),
+            what: Malformation::FloatLength(n),
         }),
     }
 }

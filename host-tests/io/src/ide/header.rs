@@ -3,6 +3,7 @@
 //! `RecordingProperties` elements (IDs from idelib's schemata/mide_ide.xml).
 
 use super::{ebml, IdeError};
+use crate::error::{ChannelProblem, IdeUnsupported, Malformation};
 use std::collections::HashMap;
 
 const UNIVARIATE: u32 = 0x4B01;
@@ -56,7 +57,7 @@ impl Recording {
             }
             let id = id.ok_or(IdeError::Malformed {
                 offset: at,
-                what: "calibration polynomial without CalID".into(),
+                what: Malformation::CalibrationWithoutId,
             })?;
             if kind == BIVARIATE {
                 match (ch2, sub2) {
@@ -64,9 +65,7 @@ impl Recording {
                     _ => {
                         return Err(IdeError::Malformed {
                             offset: at,
-                            what: format!(
-                                "bivariate calibration {id} without its channel reference"
-                            ),
+                            what: Malformation::BivariateWithoutReference { id },
                         })
                     }
                 }
@@ -133,7 +132,7 @@ impl Field {
 }
 
 /// Parses a `ChannelFormat`; sizes and packing are numpy's (how idelib reads payloads).
-fn parse_format(format: &str) -> Result<(Vec<Field>, usize), String> {
+fn parse_format(format: &str) -> Result<(Vec<Field>, usize), ChannelProblem> {
     let mut chars = format
         .trim()
         .bytes()
@@ -151,10 +150,10 @@ fn parse_format(format: &str) -> Result<(Vec<Field>, usize), String> {
             b'i' | b'I' | b'l' | b'L' | b'f' => 4,
             b'q' | b'Q' | b'd' => 8,
             _ => {
-                return Err(format!(
-                    "sample format {format:?}: type code {:?}",
-                    code as char
-                ))
+                return Err(ChannelProblem::TypeCode {
+                    format: format.to_string(),
+                    code: code as char,
+                })
             }
         };
         fields.push(Field {
@@ -166,7 +165,7 @@ fn parse_format(format: &str) -> Result<(Vec<Field>, usize), String> {
         offset += size;
     }
     if fields.is_empty() {
-        return Err(format!("empty sample format {format:?}"));
+        return Err(ChannelProblem::EmptyFormat(format.to_string()));
     }
     Ok((fields, offset))
 }
@@ -207,7 +206,7 @@ pub struct Channel {
     pub format: String,
     pub subchannels: Vec<SubChannel>,
     /// Why this reader cannot read the channel, if it cannot.
-    pub unsupported: Option<String>,
+    pub unsupported: Option<ChannelProblem>,
     pub(super) cal: Option<u64>,
     /// Microseconds per timecode tick (idelib's `timeScalars`).
     pub(super) tick_us: f64,
@@ -231,13 +230,15 @@ impl Poly {
     pub(super) fn linear(&self, id: u64) -> Result<(f64, f64), IdeError> {
         match (self.second, self.coeffs.as_slice()) {
             (None, &[a0, a1]) => Ok((a0, a1 - a0 * self.reference)),
-            (None, c) => Err(IdeError::Unsupported(format!(
-                "univariate calibration {id} with {} coefficients",
-                c.len()
-            ))),
-            (Some(_), _) => Err(IdeError::Unsupported(format!(
-                "bivariate calibration {id} used where only a univariate one is supported"
-            ))),
+            (None, c) => Err(IdeError::Unsupported(
+                IdeUnsupported::UnivariateCoefficients {
+                    id,
+                    coefficients: c.len(),
+                },
+            )),
+            (Some(_), _) => Err(IdeError::Unsupported(
+                IdeUnsupported::BivariateAsUnivariate { id },
+            )),
         }
     }
 }
@@ -292,7 +293,7 @@ fn parse_channel(body: &[u8], base: u64) -> Result<Channel, IdeError> {
     }
     ch.id = id.ok_or(IdeError::Malformed {
         offset: base,
-        what: "Channel without ChannelID".into(),
+        what: Malformation::ChannelWithoutId,
     })?;
     for sc in ch.subchannels.iter_mut().filter(|s| s.name.is_empty()) {
         sc.name = format!("{}:{:02}", ch.name, sc.id); // idelib's default name
@@ -304,9 +305,9 @@ fn parse_channel(body: &[u8], base: u64) -> Result<Channel, IdeError> {
             None
         }
         Some(p @ ("MPL3115" | "LEGACYACCELEROMETER")) => {
-            Some(format!("legacy named sample parser {p}"))
+            Some(ChannelProblem::LegacyParser(p.to_string()))
         }
-        _ if ch.format.is_empty() => Some("no ChannelFormat".to_string()),
+        _ if ch.format.is_empty() => Some(ChannelProblem::NoFormat),
         _ => None,
     };
     let problem = problem.or_else(|| match parse_format(&ch.format) {
@@ -322,9 +323,8 @@ fn parse_channel(body: &[u8], base: u64) -> Result<Channel, IdeError> {
             ch.tick_us = s * 1_000_000.0;
             None
         }
-        Some(None) => Some(format!("TimeCodeScale {:?}", scale.unwrap_or_default())),
+        Some(None) => Some(ChannelProblem::TimeCodeScale(scale.unwrap_or_default())),
     });
-    ch.unsupported =
-        problem.or_else(|| (ch.modulus == Some(0)).then(|| "TimeCodeModulus 0".to_string()));
+    ch.unsupported = problem.or((ch.modulus == Some(0)).then_some(ChannelProblem::ZeroModulus));
     Ok(ch)
 }

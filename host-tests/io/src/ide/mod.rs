@@ -19,9 +19,10 @@ mod ebml;
 mod header;
 mod read;
 
+pub use crate::error::IdeError;
+use crate::error::{IdeUnsupported, Malformation, NotIde, ReferenceProblem};
 pub use header::{Channel, Recording, SubChannel};
 pub use read::{is_ide, pick, read_ide, Blocks, Pick};
-use std::fmt;
 use std::fs::File;
 use std::io::{BufReader, Read, Seek, SeekFrom};
 use std::path::Path;
@@ -43,76 +44,6 @@ const MAX_BLOCK: u64 = 64 << 20;
 /// idelib's default timecode moduli: 2^24 for ChannelDataBlock, 2^16 for SimpleChannelDataBlock.
 const MODULUS: u64 = 1 << 24;
 const SIMPLE_MODULUS: u64 = 1 << 16;
-
-#[derive(Debug)]
-pub enum IdeError {
-    Io(std::io::Error),
-    /// Not an IDE file (no EBML header, or another DocType).
-    NotIde(String),
-    /// An element that cannot be decoded, at a byte offset.
-    Malformed {
-        offset: u64,
-        what: String,
-    },
-    /// An element running past the end of its parent or of the file.
-    Truncated {
-        offset: u64,
-    },
-    /// An element bigger than this reader will hold in memory.
-    TooLarge {
-        offset: u64,
-        size: u64,
-    },
-    NoSuchChannel {
-        channel: u64,
-        subchannel: Option<u64>,
-    },
-    Unsupported(String),
-}
-
-impl fmt::Display for IdeError {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        match self {
-            IdeError::Io(e) => write!(f, "I/O error: {e}"),
-            IdeError::NotIde(why) => write!(f, "not an enDAQ IDE file: {why}"),
-            IdeError::Malformed { offset, what } => {
-                write!(f, "malformed IDE file at byte {offset}: {what}")
-            }
-            IdeError::Truncated { offset } => write!(
-                f,
-                "IDE file truncated: element at byte {offset} runs past its end"
-            ),
-            IdeError::TooLarge { offset, size } => write!(
-                f,
-                "IDE element at byte {offset} declares {size} bytes, more than this reader accepts"
-            ),
-            IdeError::NoSuchChannel {
-                channel,
-                subchannel: None,
-            } => write!(f, "no channel {channel} in the IDE file"),
-            IdeError::NoSuchChannel {
-                channel,
-                subchannel: Some(s),
-            } => write!(f, "no subchannel {channel}.{s} in the IDE file"),
-            IdeError::Unsupported(what) => write!(f, "unsupported IDE content: {what}"),
-        }
-    }
-}
-
-impl std::error::Error for IdeError {
-    fn source(&self) -> Option<&(dyn std::error::Error + 'static)> {
-        match self {
-            IdeError::Io(e) => Some(e),
-            _ => None,
-        }
-    }
-}
-
-impl From<std::io::Error> for IdeError {
-    fn from(e: std::io::Error) -> Self {
-        IdeError::Io(e)
-    }
-}
 
 /// A subchannel's calibration folded to `value = raw * c0 + c1`, or the bivariate form
 /// `raw * (d0*y + d1) + (d2*y + d3)` with `y` the referenced subchannel's mean.
@@ -147,13 +78,13 @@ impl Clock {
                 .checked_add(self.modulus)
                 .ok_or(IdeError::Malformed {
                     offset: at,
-                    what: "timecode overflow".into(),
+                    what: Malformation::TimecodeOverflow,
                 })?;
         }
         self.last = ts;
         let total = ts.checked_add(self.offset).ok_or(IdeError::Malformed {
             offset: at,
-            what: "timecode overflow".into(),
+            what: Malformation::TimecodeOverflow,
         })?;
         Ok((total as f64 * self.tick_us).trunc()) // idelib: int(ticks * µs/tick)
     }
@@ -187,9 +118,9 @@ impl<R: Read + Seek> IdeFile<R> {
         };
         let first = match ebml::read_header(&mut f.src, 0) {
             Ok(Some(h)) if h.id == EBML_HEADER => h,
-            Ok(None) => return Err(IdeError::NotIde("empty file".into())),
+            Ok(None) => return Err(IdeError::NotIde(NotIde::Empty)),
             Ok(Some(_)) | Err(IdeError::Malformed { .. }) | Err(IdeError::Truncated { .. }) => {
-                return Err(IdeError::NotIde("no EBML header".into()))
+                return Err(IdeError::NotIde(NotIde::NoEbmlHeader))
             }
             Err(e) => return Err(e),
         };
@@ -197,7 +128,7 @@ impl<R: Read + Seek> IdeFile<R> {
         for child in ebml::children(&body, first.body) {
             let (id, b, _) = child?;
             if id == DOC_TYPE && ebml::string(b) != "mide" {
-                return Err(IdeError::NotIde(format!("DocType {:?}", ebml::string(b))));
+                return Err(IdeError::NotIde(NotIde::DocType(ebml::string(b))));
             }
         }
         let mut pos = f.end_of(&first)?;
@@ -226,9 +157,7 @@ impl<R: Read + Seek> IdeFile<R> {
             pos = f.end_of(&h)?;
         }
         if f.info.channels.is_empty() {
-            return Err(IdeError::Unsupported(
-                "no ChannelList (old recorder using a default channel table)".into(),
-            ));
+            return Err(IdeError::Unsupported(IdeUnsupported::NoChannelList));
         }
         Ok(f)
     }
@@ -248,10 +177,9 @@ impl<R: Read + Seek> IdeFile<R> {
 
     /// All subchannels of a channel, calibrated, with their times.
     pub fn read_channel(&mut self, channel: u64) -> Result<Series, IdeError> {
-        let ch = self.channel(channel).ok_or(IdeError::NoSuchChannel {
-            channel,
-            subchannel: None,
-        })?;
+        let ch = self
+            .channel(channel)
+            .ok_or(IdeError::NoSuchChannel { channel })?;
         let subs: Vec<u64> = ch.subchannels.iter().map(|s| s.id).collect();
         let mut out = Series {
             times: Vec::new(),
@@ -313,27 +241,25 @@ impl<R: Read + Seek> IdeFile<R> {
     {
         let ch = self
             .channel(channel)
-            .ok_or(IdeError::NoSuchChannel {
-                channel,
-                subchannel: None,
-            })?
+            .ok_or(IdeError::NoSuchChannel { channel })?
             .clone();
         usable(&ch)?;
         let mut maps = Vec::with_capacity(subchannels.len());
         for &s in subchannels {
-            let sc = ch
-                .subchannels
-                .iter()
-                .find(|x| x.id == s)
-                .ok_or(IdeError::NoSuchChannel {
-                    channel,
-                    subchannel: Some(s),
-                })?;
+            let sc =
+                ch.subchannels
+                    .iter()
+                    .find(|x| x.id == s)
+                    .ok_or(IdeError::NoSuchSubchannel {
+                        channel,
+                        subchannel: s,
+                    })?;
             let field = *ch.fields.get(s as usize).ok_or_else(|| {
-                IdeError::Unsupported(format!(
-                    "subchannel {channel}.{s} has no field in the sample format {:?}",
-                    ch.format
-                ))
+                IdeError::Unsupported(IdeUnsupported::NoField {
+                    channel,
+                    subchannel: s,
+                    format: ch.format.clone(),
+                })
             })?;
             let (c0, c1) = match self.resolve(&ch, sc)? {
                 Resolved::Linear(c0, c1) => (c0, c1),
@@ -356,9 +282,9 @@ impl<R: Read + Seek> IdeFile<R> {
             for ((field, c0, c1), col) in maps.iter().zip(cols.iter_mut()) {
                 col.clear();
                 for rec in payload.chunks_exact(ch.record) {
-                    let raw = field.decode(rec).ok_or_else(|| {
-                        IdeError::Unsupported("sample field outside its record".into())
-                    })?;
+                    let raw = field
+                        .decode(rec)
+                        .ok_or(IdeError::Unsupported(IdeUnsupported::FieldOutsideRecord))?;
                     col.push(raw * c0 + c1);
                 }
             }
@@ -369,10 +295,14 @@ impl<R: Read + Seek> IdeFile<R> {
     /// Folds channel and subchannel polynomials as idelib's `CombinedPoly` does.
     fn resolve(&self, ch: &Channel, sc: &SubChannel) -> Result<Resolved, IdeError> {
         // A calibration ID missing from the CalibrationList means no calibration (idelib).
-        let b = match ch.cal.and_then(|id| self.info.cals.get(&id).map(|p| (id, p))) {
+        let b = match ch
+            .cal
+            .and_then(|id| self.info.cals.get(&id).map(|p| (id, p)))
+        {
             None => (1.0, 0.0),
-            Some((id, p)) => p.linear(id).map_err(|_| IdeError::Unsupported(format!(
-                "calibration {id} on channel {}: only a linear univariate polynomial is supported at channel level", ch.id)))?,
+            Some((id, p)) => p.linear(id).map_err(|_| {
+                IdeError::Unsupported(IdeUnsupported::ChannelCalibration { id, channel: ch.id })
+            })?,
         };
         let Some((id, p)) = sc
             .cal
@@ -385,12 +315,14 @@ impl<R: Read + Seek> IdeFile<R> {
             return Ok(Resolved::Linear(a.0 * b.0, a.1 + a.0 * b.1));
         };
         let &[c0, c1, c2, c3] = p.coeffs.as_slice() else {
-            return Err(IdeError::Unsupported(format!(
-                "bivariate calibration {id} on channel {}.{} with {} coefficients",
-                ch.id,
-                sc.id,
-                p.coeffs.len()
-            )));
+            return Err(IdeError::Unsupported(
+                IdeUnsupported::BivariateCoefficients {
+                    id,
+                    channel: ch.id,
+                    subchannel: sc.id,
+                    coefficients: p.coeffs.len(),
+                },
+            ));
         };
         let r = p.reference;
         let a = [
@@ -412,25 +344,29 @@ impl<R: Read + Seek> IdeFile<R> {
     /// block means (the block's stored ChannelDataMinMeanMax when present), calibrated,
     /// averaged with the blocks' sample counts as weights.
     fn mean_of(&mut self, channel: u64, sub: u64, user: (u64, u64)) -> Result<f64, IdeError> {
-        let what = format!(
-            "bivariate calibration on channel {}.{} references {channel}.{sub}",
-            user.0, user.1
-        );
+        let fault = |problem| {
+            IdeError::Unsupported(IdeUnsupported::Reference {
+                user,
+                channel,
+                subchannel: sub,
+                problem,
+            })
+        };
         let ch = self
             .channel(channel)
             .cloned()
-            .ok_or_else(|| IdeError::Unsupported(format!("{what}, which is not defined")))?;
+            .ok_or(fault(ReferenceProblem::NotDefined))?;
         let sc = ch
             .subchannels
             .iter()
             .find(|s| s.id == sub)
-            .ok_or_else(|| IdeError::Unsupported(format!("{what}, which is not defined")))?;
+            .ok_or(fault(ReferenceProblem::NotDefined))?;
         let field = *ch
             .fields
             .get(sub as usize)
-            .ok_or_else(|| IdeError::Unsupported(format!("{what}, which has no sample field")))?;
+            .ok_or(fault(ReferenceProblem::NoSampleField))?;
         let Resolved::Linear(c0, c1) = self.resolve(&ch, sc)? else {
-            return Err(IdeError::Unsupported(format!("{what}, itself bivariate")));
+            return Err(fault(ReferenceProblem::Bivariate));
         };
         let (mut sum, mut count) = (0.0, 0.0);
         self.scan(&ch, &mut |_, _, n, payload, mmm| {
@@ -452,9 +388,7 @@ impl<R: Read + Seek> IdeFile<R> {
             Ok(true)
         })?;
         if count == 0.0 {
-            return Err(IdeError::Unsupported(format!(
-                "{what}, which has no samples"
-            )));
+            return Err(fault(ReferenceProblem::NoSamples));
         }
         Ok(sum / count)
     }
@@ -495,15 +429,23 @@ impl<R: Read + Seek> IdeFile<R> {
                         (t, t)
                     };
                     if payload.len() % ch.record != 0 {
-                        return Err(IdeError::Malformed { offset: h.offset, what: format!(
-                            "channel {} payload of {} bytes is not a whole number of {}-byte samples", ch.id, payload.len(), ch.record) });
+                        return Err(IdeError::Malformed {
+                            offset: h.offset,
+                            what: Malformation::PartialSample {
+                                channel: ch.id,
+                                payload: payload.len(),
+                                record: ch.record,
+                            },
+                        });
                     }
                     let n = payload.len() / ch.record;
                     if n > 1 && !has_end {
-                        return Err(IdeError::Unsupported(format!(
-                            "multi-sample block without an end timecode (channel {}, byte {})",
-                            ch.id, h.offset
-                        )));
+                        return Err(IdeError::Unsupported(
+                            IdeUnsupported::MultiSampleWithoutEnd {
+                                channel: ch.id,
+                                offset: h.offset,
+                            },
+                        ));
                     }
                     if n > 0 && !visit(start, end, n, payload, mmm)? {
                         return Ok(());
@@ -555,10 +497,11 @@ impl<R: Read + Seek> IdeFile<R> {
 fn usable(ch: &Channel) -> Result<(), IdeError> {
     match &ch.unsupported {
         None => Ok(()),
-        Some(why) => Err(IdeError::Unsupported(format!(
-            "channel {} ({}): {why}",
-            ch.id, ch.name
-        ))),
+        Some(problem) => Err(IdeError::Unsupported(IdeUnsupported::Channel {
+            channel: ch.id,
+            name: ch.name.clone(),
+            problem: problem.clone(),
+        })),
     }
 }
 
@@ -580,7 +523,7 @@ fn parse_block<'a>(
             )),
             _ => Err(IdeError::Malformed {
                 offset: h.offset,
-                what: "SimpleChannelDataBlock shorter than its header".into(),
+                what: Malformation::ShortSimpleBlock,
             }),
         };
     }
@@ -596,9 +539,9 @@ fn parse_block<'a>(
             _ => {}
         }
     }
-    let missing = |what: &str| IdeError::Malformed {
+    let missing = |what: &'static str| IdeError::Malformed {
         offset: h.offset,
-        what: format!("ChannelDataBlock without {what}"),
+        what: Malformation::BlockWithout(what),
     };
     Ok((
         ch.ok_or_else(|| missing("ChannelIDRef"))?,

@@ -6,9 +6,9 @@ use std::io::Read;
 use std::path::Path;
 use std::sync::mpsc;
 
-use super::IdeFile;
-use crate::channel::RecordingError;
+use super::{IdeError, IdeFile};
 use crate::channel::{check_time, Channel, ColumnRef, ReadOptions};
+use crate::error::{At, ReadError, ReadErrorKind};
 use crate::recording::resample;
 use crate::units::Units;
 
@@ -42,14 +42,15 @@ pub struct Pick {
 }
 
 /// The units of a subchannel's calibrated values, or why it is no acceleration or force.
-fn units_of(units: &str, name: &str) -> Result<Units, String> {
+fn units_of(units: &str, name: &str) -> Result<Units, ReadErrorKind> {
     match units.trim() {
         "g" | "G" => Ok(Units::G),
         "m/s²" | "m/s^2" | "m/s2" | "m/s/s" => Ok(Units::MS2),
         "N" | "n" => Ok(Units::N),
-        other => Err(format!(
-            "subchannel {name} is in {other:?}, not an acceleration (g, m/s²) or a force (N): choose another with --column"
-        )),
+        other => Err(ReadErrorKind::IdeNotAcceleration {
+            subchannel: name.to_string(),
+            units: other.to_string(),
+        }),
     }
 }
 
@@ -60,7 +61,7 @@ pub fn pick<R: std::io::Read + std::io::Seek>(
     file: &IdeFile<R>,
     column: Option<&ColumnRef>,
     axes: &[ColumnRef],
-) -> Result<Pick, String> {
+) -> Result<Pick, ReadErrorKind> {
     let all: Vec<(u64, u64, String, String)> = file
         .channels()
         .iter()
@@ -76,13 +77,8 @@ pub fn pick<R: std::io::Read + std::io::Seek>(
             })
         })
         .collect();
-    let listing = || {
-        all.iter()
-            .map(|(_, _, n, _)| n.as_str())
-            .collect::<Vec<_>>()
-            .join(", ")
-    };
-    let find = |c: &ColumnRef| -> Result<usize, String> {
+    let listing = || -> Vec<String> { all.iter().map(|(_, _, n, _)| n.clone()).collect() };
+    let find = |c: &ColumnRef| -> Result<usize, ReadErrorKind> {
         let found = match c {
             ColumnRef::Index(i) => (*i < all.len()).then_some(*i),
             ColumnRef::Name(n) => all.iter().position(|(ch, sub, name, _)| {
@@ -92,20 +88,17 @@ pub fn pick<R: std::io::Read + std::io::Seek>(
                         .is_some_and(|(_, rest)| rest.to_lowercase().starts_with(&n.to_lowercase()))
             }),
         };
-        found.ok_or_else(|| {
-            let c = match c {
-                ColumnRef::Index(i) => i.to_string(),
-                ColumnRef::Name(n) => n.clone(),
-            };
-            format!("no subchannel {c} (the file has: {})", listing())
+        found.ok_or_else(|| ReadErrorKind::IdeNoSubchannel {
+            column: c.clone(),
+            subchannels: listing(),
         })
     };
     let chosen: Vec<usize> = if !axes.is_empty() {
         if !(2..=3).contains(&axes.len()) {
-            return Err(format!(
-                "--axes: {} subchannels given; two or three (x,y or x,y,z)",
-                axes.len()
-            ));
+            return Err(ReadErrorKind::AxesCount {
+                given: axes.len(),
+                what: "subchannels",
+            });
         }
         axes.iter().map(find).collect::<Result<_, _>>()?
     } else if let Some(c) = column {
@@ -116,28 +109,29 @@ pub fn pick<R: std::io::Read + std::io::Seek>(
             .collect();
         let first = *accel
             .first()
-            .ok_or_else(|| format!("no acceleration subchannel (the file has: {})", listing()))?;
+            .ok_or_else(|| ReadErrorKind::IdeNoAcceleration {
+                subchannels: listing(),
+            })?;
         if accel.len() > 1 {
-            crate::note(&format!(
-                "analysing {} of {} acceleration subchannels: choose one with --column CH.SUB (the file has: {})",
-                all[first].2,
-                accel.len(),
-                listing()
-            ));
+            crate::note_read(crate::ReadNote::SubchannelChosen {
+                subchannel: all[first].2.clone(),
+                count: accel.len(),
+                subchannels: listing(),
+            });
         }
         vec![first]
     };
     let channel = all[chosen[0]].0;
     if chosen.iter().any(|&i| all[i].0 != channel) {
-        return Err(
-            "--axes: the subchannels must be of one channel (one time base), e.g. 32.0,32.1,32.2"
-                .into(),
-        );
+        return Err(ReadErrorKind::IdeAxesChannels);
     }
     for (k, &i) in chosen.iter().enumerate() {
         units_of(&all[i].3, &all[i].2)?;
         if chosen[..k].contains(&i) {
-            return Err(format!("--axes: subchannel {} given twice", all[i].2));
+            return Err(ReadErrorKind::AxisTwice {
+                what: "subchannel",
+                name: all[i].2.clone(),
+            });
         }
     }
     Ok(Pick {
@@ -149,32 +143,23 @@ pub fn pick<R: std::io::Read + std::io::Seek>(
 
 /// The channel (or the axes' resultant) of an `.ide` file with its time base, checked as a
 /// CSV's time column is (every interval within 0.5–1.5× the median; `--resample` otherwise).
-pub fn read_ide(path: &Path, opts: &ReadOptions) -> Result<Channel, RecordingError> {
-    let err = |message: String| RecordingError {
-        file: path.to_path_buf(),
-        line: None,
-        message,
-    };
-    let mut file = IdeFile::open(path).map_err(|e| err(e.to_string()))?;
+pub fn read_ide(path: &Path, opts: &ReadOptions) -> Result<Channel, ReadError> {
+    let err = |kind: ReadErrorKind| ReadError::new(path, kind);
+    let mut file = IdeFile::open(path).map_err(|e| err(e.into()))?;
     let pick = pick(&file, opts.column.as_ref(), &opts.axes).map_err(err)?;
     let series = file
         .read_channel_subs(pick.channel, &pick.subs)
-        .map_err(|e| err(e.to_string()))?;
+        .map_err(|e| err(e.into()))?;
     let (times, mut columns) = (series.times, series.columns);
     if times.len() < 2 {
-        return Err(err(format!(
-            "subchannel {}: {} samples; at least 2",
-            pick.names[0],
-            times.len()
-        )));
+        return Err(err(ReadErrorKind::IdeTooFewSamples {
+            subchannel: pick.names[0].clone(),
+            samples: times.len(),
+        }));
     }
-    let at = |i: usize, message: String| err(format!("sample {i}: {message}"));
+    let at = |i: usize| At::Sample(i as u64);
     let (rate_hz, jitter) = match opts.rate_hz {
-        Some(_) => {
-            return Err(err(
-                "--rate: an .ide file's samples carry their own time stamps".into(),
-            ))
-        }
+        Some(_) => return Err(err(ReadErrorKind::IdeRate)),
         None => check_time(path, &times, opts.resample, at)?,
     };
     let time_s = if opts.resample {
@@ -223,7 +208,7 @@ pub type Block = (Vec<f64>, Vec<f64>);
 /// Blocks of one subchannel, read on a thread of their own and handed over a few at a time
 /// (bounded memory): `(times_s, values)`, or the error that ended the reading.
 pub struct Blocks {
-    rx: mpsc::Receiver<Result<Block, String>>,
+    rx: mpsc::Receiver<Result<Block, IdeError>>,
 }
 
 impl Blocks {
@@ -238,14 +223,14 @@ impl Blocks {
                 })
             });
             if let Err(e) = result {
-                let _ = tx.send(Err(e.to_string()));
+                let _ = tx.send(Err(e));
             }
         });
         Self { rx }
     }
 
     /// The next block; `None` at the end.
-    pub fn next_block(&mut self) -> Option<Result<Block, String>> {
+    pub fn next_block(&mut self) -> Option<Result<Block, IdeError>> {
         self.rx.recv().ok()
     }
 }

@@ -1,0 +1,97 @@
+//! The readers' errors as the tool words them. `impact_io` names a setting a message asks
+//! for or refuses by its [`Opt`] (its own Display writes the `ReadOptions` field); here each
+//! is spelled as the `impact` option that gives it, so the messages read as they always have
+//! (`one sample: the rate cannot be told; give --rate`). Where a function's errors are still
+//! messages (`Result<_, String>`), a reader's error becomes one here, at the boundary.
+
+use impact_io::units::UnitsConflict;
+use impact_io::{Opt, ReadError, ReadErrorKind};
+
+/// The option that gives a reading's setting.
+pub fn flag(setting: Opt) -> &'static str {
+    match setting {
+        Opt::Rate => "--rate",
+        Opt::TimeColumn => "--time-column",
+        Opt::TimeUnit => "--time-unit",
+        Opt::Column => "--column",
+        Opt::Axes => "--axes",
+        Opt::Resample => "--resample",
+        Opt::RawChannels => "--raw-channels",
+        Opt::RawType => "--raw-type",
+        Opt::DecimalComma => "--decimal-comma",
+        Opt::Delimiter => "--delimiter",
+        Opt::Units => "--units",
+    }
+}
+
+/// A reader's error as the tool prints it: `FILE[:LINE]: what`, the settings named by their
+/// options.
+pub fn read_error_message(e: &ReadError) -> String {
+    e.display_with(flag).to_string()
+}
+
+/// [`read_error_message`] taking the error, for `map_err` where a function's errors are
+/// messages.
+pub fn into_message(e: ReadError) -> String {
+    read_error_message(&e)
+}
+
+/// A secondary input's error ([`impact_io::read_limited`]: a scene file, a target, an
+/// ELF), the file named by its path as given: `-` is a file there, not standard input.
+pub fn input_file_message(e: &ReadError) -> String {
+    let at = match e.at {
+        Some(impact_io::At::Line(l)) => format!(":{l}"),
+        Some(impact_io::At::Sample(n)) => format!(": sample {n}"),
+        None => String::new(),
+    };
+    format!("{}{at}: {}", e.path.display(), kind_message(&e.kind))
+}
+
+/// What went wrong, without the file (for a message that names the input its own way).
+pub fn kind_message(kind: &ReadErrorKind) -> String {
+    kind.display_with(flag).to_string()
+}
+
+/// Units given (`--units`, or the scene file's) that the channel's header contradicts.
+pub fn units_message(e: &UnitsConflict) -> String {
+    e.display_with(flag).to_string()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use std::path::Path;
+
+    #[test]
+    fn the_options_are_named_as_the_command_line_spells_them() {
+        let e = ReadError::new(Path::new("a.csv"), ReadErrorKind::OneSample);
+        assert_eq!(
+            read_error_message(&e),
+            "a.csv: one sample: the rate cannot be told; give --rate"
+        );
+        assert_eq!(
+            e.to_string(),
+            "a.csv: one sample: the rate cannot be told; give `rate_hz`"
+        );
+        let e = ReadError::new(Path::new("-"), ReadErrorKind::NoTimeColumn);
+        assert_eq!(
+            read_error_message(&e),
+            "stdin: no time column found: give --time-column or --rate"
+        );
+        assert_eq!(
+            kind_message(&ReadErrorKind::NpyOptions),
+            "an .npy array takes --rate and --column only (no --time-column, --resample, --axes)"
+        );
+        // A secondary input's `-` is a file of that name.
+        let e = impact_io::read_limited(Path::new("-"), 1024, "scene file").unwrap_err();
+        let message = input_file_message(&e);
+        assert!(message.starts_with("-: "), "{message}");
+        let conflict =
+            impact_io::units::Units::resolve(Some(impact_io::units::Units::G), "table_m_s2")
+                .unwrap_err();
+        assert_eq!(
+            units_message(&conflict),
+            "--units g contradicts the column's header \"table_m_s2\", which names m/s2: drop --units or choose another column"
+        );
+    }
+}
