@@ -18,7 +18,8 @@ root=$PWD
 
 check=0
 scratch=()
-trap 'rm -rf "${scratch[@]}"' EXIT
+watch_pid=
+trap '[[ -n "$watch_pid" ]] && kill "$watch_pid" 2>/dev/null; rm -rf "${scratch[@]}"' EXIT
 if [[ "${1:-}" == "--check" ]]; then
   check=1
   out=$(mktemp -d)
@@ -28,10 +29,11 @@ else
   mkdir -p "$out"
   out=$(cd "$out" && pwd)
 fi
-if [[ -z "${IMPACT:-}" ]]; then
-  cargo build --quiet --profile host-test -p impact-host --bin impact
-  IMPACT="$root/${CARGO_TARGET_DIR:-target}/host-test/impact"
-  [[ "${CARGO_TARGET_DIR:-}" == /* ]] && IMPACT="$CARGO_TARGET_DIR/host-test/impact"
+# --check always checks the tool as the tree builds it now (cargo says where it is).
+if [[ $check == 1 || -z "${IMPACT:-}" ]]; then
+  IMPACT=$(cargo build --quiet --profile host-test -p impact-host --bin impact --message-format=json |
+    sed -n 's/.*"executable":"\([^"]*\)".*/\1/p' | tail -n 1)
+  [[ -x "$IMPACT" ]] || { echo "golden: the impact tool was not built" >&2; exit 1; }
 fi
 
 # The commands run in a scratch folder holding links to the bundled data, so that every path
@@ -44,12 +46,18 @@ ln -s "$root/host-tests/examples" "$work/examples"
 ln -s "$root/docs" "$work/docs"
 cd "$work"
 
+# A path as a literal sed pattern.
+literal() { printf '%s' "$1" | sed 's/[][\.*^$+?(){}|#/]/\\&/g'; }
+work_re=$(literal "$work")
+impact_re=$(literal "$IMPACT")
+tmp_re=$(literal "${TMPDIR:-/tmp}")
+
 # Times that vary from run to run, and the scratch folder's name.
 normalise() {
   sed -E \
-    -e "s#$work#WORK#g" \
-    -e "s#$IMPACT#impact#g" \
-    -e 's#/tmp/impact-emulate-[A-Za-z0-9]+#TMP#g' \
+    -e "s#$work_re#WORK#g" \
+    -e "s#$impact_re#impact#g" \
+    -e "s#$tmp_re/impact-emulate-[^ :]+#TMP#g" \
     -e 's#127\.0\.0\.1:[0-9]+#127.0.0.1:PORT#g' \
     -e 's/(emulated in )[0-9.]+ s/\1T s/' \
     -e 's/(report_latency_s=)[0-9.e-]+/\1T/g' \
@@ -136,7 +144,7 @@ run npy-f analyze fixtures/afrl-test1-float32-fortran.npy --rate 1e6 --column 1 
 run wav analyze fixtures/afrl-test1-int16.wav --json
 run wav-f analyze fixtures/afrl-test1-float32.wav --csv
 run raw analyze fixtures/afrl-test1-2ch.i16 --rate 1e6 --raw-channels 2 --column 1 --gain 0.001 --json
-run stream analyze "$afrl" --stream --range 200g --trigger 2000g --json
+run stream analyze "$afrl" --stream --range 20000g --trigger 2000g --json
 run f32 analyze fixtures/afrl-test1.f32 --rate 1e6 --json
 run tdms analyze fixtures/afrl-test1.tdms --column afrl/bottom_kgn --json
 
@@ -229,16 +237,21 @@ if command -v qemu-system-arm >/dev/null; then
   run watch watch board.log --terminal --once --session session.log
   keep session.log watch-session.log
   # The live view's exports, as its page serves them.
-  port=$((20000 + RANDOM % 20000))
-  "$IMPACT" watch board.log --once --listen "127.0.0.1:$port" --session served.log >/dev/null 2>&1 &
+  "$IMPACT" watch board.log --once --listen 127.0.0.1:0 --session served.log >/dev/null 2>watch.err &
   watch_pid=$!
-  for _ in $(seq 100); do curl -sf "http://127.0.0.1:$port/state.json" >/dev/null && break; sleep 0.1; done
+  port=
+  for _ in $(seq 100); do
+    port=$(sed -n 's#^impact watch: http://127\.0\.0\.1:\([0-9]*\)/.*#\1#p' watch.err)
+    [[ -n "$port" ]] && curl -sf "http://127.0.0.1:$port/state.json" >/dev/null && break
+    sleep 0.1
+  done
   for path in session.json session.csv report.html; do
     curl -s "http://127.0.0.1:$port/$path" >"watch-$path" || true
     keep "watch-$path" "watch-export-$path"
   done
   kill "$watch_pid" 2>/dev/null || true
   wait "$watch_pid" 2>/dev/null || true
+  watch_pid=
   run watch-train watch train.log --terminal --once --spec half-sine,10g,3ms --session train-session.log
   keep train-session.log watch-train-session.log
 fi

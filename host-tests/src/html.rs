@@ -5,12 +5,12 @@
 //!   code wrote), with its arguments written by [`ToHtml`]: numbers as they are (their
 //!   format specs kept: `{:.1}`), text escaped (`&`, `<`, `>`, `"`), an [`Html`] fragment as
 //!   the markup it already is. Arguments are named after the literal, never captured inside
-//!   it (`{x}` would skip the escaping): `tests/html.rs` holds every `html!` in the crate to
-//!   that.
+//!   it (`{x}` would skip the escaping): `tests/escaping.rs` holds every `html!` in the crate
+//!   to that.
 //! - [`Html::raw`] takes only a `&'static str`: markup in the code (a style sheet), never
 //!   text read at run time.
-//! - [`Html::from_plotters`] takes an SVG drawn by plotters' SVG backend, which escapes its
-//!   text and attributes itself.
+//! - `Html::from_plotters` (crate-private) takes an SVG drawn by plotters' SVG backend, which
+//!   escapes its text and attributes itself; only `plot::svg_html` calls it.
 //!
 //! There is no other way to put a `String` into an [`Html`].
 
@@ -32,15 +32,10 @@ impl Html {
         self
     }
 
-    /// Another fragment, appended.
-    pub fn push(&mut self, other: &Html) -> &mut Self {
-        self.0.push_str(&other.0);
-        self
-    }
-
     /// An SVG drawn by plotters' SVG backend (`plotters_svg::SVGBackend`), which escapes
-    /// every text and attribute value it writes.
-    pub fn from_plotters(svg: String) -> Self {
+    /// every text and attribute value it writes: for `plot::svg_html` alone
+    /// (`tests/escaping.rs` holds that).
+    pub(crate) fn from_plotters(svg: String) -> Self {
         Self(svg)
     }
 
@@ -49,27 +44,18 @@ impl Html {
         &self.0
     }
 
-    /// The markup, owned.
-    pub fn into_string(self) -> String {
-        self.0
-    }
-
     /// Whether nothing was written.
     pub fn is_empty(&self) -> bool {
         self.0.is_empty()
     }
 
-    /// Drops the last `suffix` (markup this code wrote) if the fragment ends with it.
-    pub fn strip_suffix(&mut self, suffix: &'static str) -> bool {
-        let ends = self.0.ends_with(suffix);
-        if ends {
-            self.0.truncate(self.0.len() - suffix.len());
-        }
-        ends
+    /// The markup, owned.
+    pub fn into_string(self) -> String {
+        self.0
     }
 
     /// Writes `args`, built by [`html!`](crate::html!) from a literal and [`Arg`]s; not for
-    /// use outside that macro (`tests/html.rs` checks that it is not).
+    /// use outside that macro (`tests/escaping.rs` checks that it is not).
     #[doc(hidden)]
     pub fn __write_markup(&mut self, args: fmt::Arguments<'_>) {
         // Writing to a String cannot fail.
@@ -77,8 +63,14 @@ impl Html {
     }
 }
 
-/// How a value is written into HTML.
-pub trait ToHtml {
+mod sealed {
+    /// Only this module's types are written into HTML.
+    pub trait Sealed {}
+}
+
+/// How a value is written into HTML (implemented here only: a type outside cannot choose to
+/// write itself unescaped).
+pub trait ToHtml: sealed::Sealed {
     /// Writes the value, escaped as its type needs, with `f`'s format spec where it has one.
     fn fmt_html(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result;
 }
@@ -96,6 +88,7 @@ impl<T: ToHtml + ?Sized> fmt::Display for Arg<'_, T> {
 /// Numbers: their digits need no escaping, and their format spec is kept.
 macro_rules! numbers {
     ($($t:ty),*) => {$(
+        impl sealed::Sealed for $t {}
         impl ToHtml for $t {
             fn fmt_html(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
                 fmt::Display::fmt(self, f)
@@ -104,6 +97,13 @@ macro_rules! numbers {
     )*};
 }
 numbers!(f64, f32, u8, u16, u32, u64, usize, i8, i16, i32, i64, isize);
+
+// The text types and fragments below.
+impl sealed::Sealed for str {}
+impl sealed::Sealed for String {}
+impl sealed::Sealed for std::borrow::Cow<'_, str> {}
+impl sealed::Sealed for Html {}
+impl<T: sealed::Sealed + ?Sized> sealed::Sealed for &T {}
 
 impl ToHtml for str {
     fn fmt_html(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
@@ -155,14 +155,6 @@ macro_rules! html {
     };
 }
 
-/// Text escaped for HTML, as a `String` (for a test's expectation or an attribute built
-/// piecewise).
-pub fn escape(text: &str) -> String {
-    let mut h = Html::new();
-    html!(h, "{}", text);
-    h.into_string()
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -185,7 +177,5 @@ mod tests {
             h.as_str(),
             "<td>+2.2</td><td>7</td><td><b>a&lt;b&amp;&quot;c&quot;'</b></td><br>"
         );
-        assert_eq!(escape("<script>"), "&lt;script&gt;");
-        assert!(h.strip_suffix("<br>") && !h.strip_suffix("<br>"));
     }
 }

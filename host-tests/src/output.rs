@@ -227,6 +227,17 @@ macro_rules! errln {
     }};
 }
 
+/// `eprint!` as [`errln!`](crate::errln!) writes it.
+#[macro_export]
+macro_rules! err {
+    ($($arg:tt)*) => {{
+        use std::io::Write as _;
+        if let Err(e) = write!(std::io::stderr(), $($arg)*) {
+            let _ = $crate::interrupt::closed_pipe(e);
+        }
+    }};
+}
+
 /// `println!` through [`stdout`], as [`out!`](crate::out!).
 #[macro_export]
 macro_rules! outln {

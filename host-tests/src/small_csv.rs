@@ -19,10 +19,10 @@ pub struct SmallCsv {
 /// option and the file.
 #[derive(Debug, thiserror::Error)]
 pub enum SmallCsvError {
-    #[error("{0}")]
-    Io(#[from] std::io::Error),
-    #[error("more than {} KiB, larger than any {what}", MAX_BYTES / 1024)]
-    TooLarge { what: &'static str },
+    /// Not read ([`impact_io::read_limited`]: a missing file, one over 1 MiB); the file's
+    /// kind of failure without its name.
+    #[error("{}", crate::read_errors::kind_message(&.0.kind))]
+    Read(impact_io::ReadError),
     #[error("not UTF-8 text")]
     NotUtf8,
     #[error("empty: no header")]
@@ -34,14 +34,7 @@ pub enum SmallCsvError {
 impl SmallCsv {
     /// Reads `path` (`what` names the kind of file in the size error).
     pub fn read(path: &Path, what: &'static str) -> Result<Self, SmallCsvError> {
-        use std::io::Read;
-        let mut bytes = Vec::new();
-        std::fs::File::open(path)?
-            .take(MAX_BYTES + 1)
-            .read_to_end(&mut bytes)?;
-        if bytes.len() as u64 > MAX_BYTES {
-            return Err(SmallCsvError::TooLarge { what });
-        }
+        let bytes = impact_io::read_limited(path, MAX_BYTES, what).map_err(SmallCsvError::Read)?;
         let text = String::from_utf8(bytes).map_err(|_| SmallCsvError::NotUtf8)?;
         let text = text.strip_prefix('\u{feff}').unwrap_or(&text);
         let mut lines = Vec::new();
@@ -74,14 +67,35 @@ impl SmallCsv {
     }
 }
 
+/// `line` without the spaces after each comma outside quotes, so that a field quoted after
+/// a space (`3, "4,5"`) is read as quoted (the `csv` crate takes a quote only as a field's
+/// first character).
+fn tight(line: &str) -> String {
+    let mut out = String::with_capacity(line.len());
+    let (mut quoted, mut after_comma) = (false, false);
+    for c in line.chars() {
+        if after_comma && (c == ' ' || c == '\t') {
+            continue;
+        }
+        after_comma = !quoted && c == ',';
+        if c == '"' {
+            quoted = !quoted;
+        }
+        out.push(c);
+    }
+    out
+}
+
 /// One line's fields, as the `csv` crate reads them (quotes around a field, `""` inside
-/// one), each trimmed; a field quoted after a space (`3, "4"`, which the crate keeps as
-/// written) unquoted too.
+/// one), each trimmed; a field quoted after a space (`3, "4"`) unquoted too.
 fn fields(line: &str) -> Result<Vec<String>, csv::Error> {
+    let line = tight(line);
     let mut reader = csv::ReaderBuilder::new()
         .has_headers(false)
         .flexible(true)
         .trim(csv::Trim::All)
+        // (A line ends at its `\n`: a lone `\r` inside it is text, as an editor shows it.)
+        .terminator(csv::Terminator::Any(b'\n'))
         .from_reader(line.as_bytes());
     let mut record = csv::StringRecord::new();
     reader.read_record(&mut record)?;
@@ -106,7 +120,7 @@ mod tests {
         let path = dir.path().join("t.csv");
         std::fs::write(
             &path,
-            "\u{feff}# a\r\n\"Time_S\", x \r\n\r\n1,2\r\n# b\r\n3 , \"4\"\r\n\"5,6\",7\n",
+            "\u{feff}# a\r\n\"Time_S\", x \r\n\r\n1,2\r\n# b\r\n3 , \"4\"\r\n\"5,6\",7\n8, \"9,10\"\n11\r12,13\n",
         )
         .unwrap();
         let t = SmallCsv::read(&path, "table").unwrap();
@@ -117,7 +131,9 @@ mod tests {
             [
                 (4, vec!["1".to_string(), "2".into()]),
                 (6, vec!["3".into(), "4".into()]),
-                (7, vec!["5,6".into(), "7".into()])
+                (7, vec!["5,6".into(), "7".into()]),
+                (8, vec!["8".into(), "9,10".into()]),
+                (9, vec!["11\r12".into(), "13".into()])
             ]
         );
         std::fs::write(&path, "# only\n\n").unwrap();

@@ -241,6 +241,26 @@ fn a_closed_output_pipe_ends_the_tool_quietly() {
 }
 
 #[test]
+fn a_closed_error_pipe_ends_the_tool_quietly_too() {
+    // `impact … 2>&1 | head -0`: the error message meets a closed pipe. The run ends by
+    // SIGPIPE (or, if the write came first, by its status 1), never by a panic (101).
+    for _ in 0..20 {
+        let mut child = Command::new(env!("CARGO_BIN_EXE_impact"))
+            .args(["analyze", "/nonexistent/impact.csv"])
+            .stdout(Stdio::null())
+            .stderr(Stdio::piped())
+            .spawn()
+            .expect("impact runs");
+        drop(child.stderr.take());
+        let status = child.wait().unwrap();
+        assert!(
+            status.signal() == Some(libc::SIGPIPE) || status.code() == Some(1),
+            "{status:?}"
+        );
+    }
+}
+
+#[test]
 fn endless_or_blocking_inputs_end_in_bounded_memory() {
     let scratch = Scratch::new();
     // No line break at all: an error after a bounded read.

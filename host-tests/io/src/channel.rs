@@ -255,12 +255,13 @@ pub fn check_time(
     if let Some((k, e)) = drift {
         return Err(err(k, ReadErrorKind::Drift(e)));
     }
-    let dt = (t[t.len() - 1] - t[0]) / (t.len() - 1) as f64;
+    // (Two samples at least, checked above.)
+    let dt = axis.mean_interval_s().unwrap_or(f64::NAN);
     let jitter = t
         .windows(2)
         .map(|w| ((w[1] - w[0]) / dt - 1.0).abs())
         .fold(0.0, f64::max);
-    Ok((axis.rate_hz().unwrap_or(1.0 / dt), jitter))
+    Ok((1.0 / dt, jitter))
 }
 
 /// The sample type a raw file's extension names.

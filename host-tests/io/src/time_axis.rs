@@ -189,12 +189,15 @@ impl TimeAxis {
     /// The rate over what was taken, S/s: `(n − 1)` intervals over the span; `None` before
     /// two samples or where the span is not positive.
     pub fn rate_hz(&self) -> Option<f64> {
-        let t0 = self.t0?;
-        if self.n < 2 {
-            return None;
-        }
-        let rate = 1.0 / ((self.last - t0) / (self.n - 1) as f64);
+        let rate = 1.0 / self.mean_interval_s()?;
         (rate.is_finite() && rate > 0.0).then_some(rate)
+    }
+
+    /// The mean interval over what was taken, s: the span over `(n − 1)`; `None` before two
+    /// samples.
+    pub fn mean_interval_s(&self) -> Option<f64> {
+        let t0 = self.t0?;
+        (self.n >= 2).then(|| (self.last - t0) / (self.n - 1) as f64)
     }
 
     /// The first time, s (0 before any).
@@ -264,5 +267,33 @@ mod tests {
         assert_eq!(axis.push(0.5, 1), Faults::default());
         assert_eq!(median(&mut []), None);
         assert_eq!(median(&mut [3.0, 1.0, 2.0, 4.0]), Some(3.0));
+    }
+
+    #[test]
+    fn one_rate_for_every_reader() {
+        // 20 001 stamps over 0.999998703 s, where (n − 1)/span (the .ide reader's old rate) and
+        // 1/(span/(n − 1)) differ in the last bit: every reader now gives the whole-file
+        // CSV check's value.
+        let n = 20_001u64;
+        let t: Vec<f64> = (0..n)
+            .map(|k| k as f64 * (0.999998703 / 20_000.0))
+            .collect();
+        let mut axis = TimeAxis::new(true);
+        for (k, &tk) in t.iter().enumerate() {
+            axis.push(tk, k as u64);
+        }
+        let span = t[t.len() - 1] - t[0];
+        let whole = 1.0 / (span / (n - 1) as f64);
+        assert_eq!(axis.rate_hz(), Some(whole));
+        assert_ne!(
+            whole,
+            (n - 1) as f64 / span,
+            "the example no longer tells them apart"
+        );
+        let (rate, _) = crate::channel::check_time(std::path::Path::new("t.csv"), &t, false, |k| {
+            crate::At::Line(k as u64 + 2)
+        })
+        .unwrap();
+        assert_eq!(rate, whole);
     }
 }

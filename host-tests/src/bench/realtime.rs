@@ -193,7 +193,7 @@ pub fn run(args: &RealtimeArgs) -> Result<Vec<CaseResult>, String> {
             for &spacing in case.spacings {
                 let r = train(&elf, &case, &scene, args.impacts, spacing, args.clock_shift)?;
                 if !args.json {
-                    eprintln!(
+                    crate::errln!(
                         "{} {} fits, {:.1} ms apart: {} of {} reported, lost {}, skipped {}, latency median {} max {}",
                         case.name,
                         if fits { "with" } else { "without" },

@@ -111,18 +111,18 @@ fn main() -> ExitCode {
     if std::env::var_os("IMPACT_PEAK_MEMORY").is_some() {
         let status = std::fs::read_to_string("/proc/self/status").unwrap_or_default();
         if let Some(line) = status.lines().find(|l| l.starts_with("VmHWM:")) {
-            eprintln!("peak memory: {}", line.trim_start_matches("VmHWM:").trim());
+            impact_host::errln!("peak memory: {}", line.trim_start_matches("VmHWM:").trim());
         }
     }
     match result {
         Ok(()) => {
             for note in impact_host::take_notes() {
-                eprintln!("note: {note}");
+                impact_host::errln!("note: {note}");
             }
             ExitCode::SUCCESS
         }
         Err(e) => {
-            eprintln!("error: {e}");
+            impact_host::errln!("error: {e}");
             ExitCode::from(1)
         }
     }

@@ -102,7 +102,7 @@ fn run_series(cmd: &AnalyzeCommand, files: &[PathBuf]) -> Result<(), String> {
     let results = series::analyze(args, &entries);
     for e in &results {
         for n in &e.notes {
-            eprintln!("note: {}", series::failure(e, n));
+            crate::errln!("note: {}", series::failure(e, n));
         }
     }
     if args.json {

@@ -117,15 +117,15 @@ pub fn run(which: Bench) -> Result<(), String> {
                 crate::out!("{}", m4::table(&report));
             }
             if !profile.is_empty() {
-                eprint!("{profile}");
+                crate::err!("{profile}");
             }
             if let Some(path) = &args.check {
                 let text = std::fs::read_to_string(path)
                     .map_err(|e| format!("{}: {e}", path.display()))?;
                 let baseline: m4::M4Report =
                     serde_json::from_str(&text).map_err(|e| format!("{}: {e}", path.display()))?;
-                eprint!("{}", m4::check(&report, &baseline)?);
-                eprintln!("M4 instruction counts within 10 % of {}", path.display());
+                crate::err!("{}", m4::check(&report, &baseline)?);
+                crate::errln!("M4 instruction counts within 10 % of {}", path.display());
             }
         }
         Bench::Throughput {

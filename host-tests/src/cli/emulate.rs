@@ -265,7 +265,7 @@ pub fn emulate(args: &EmulateArgs) -> Result<(), String> {
                 return;
             }
             if to_stderr {
-                eprintln!("{line}");
+                crate::errln!("{line}");
             } else {
                 crate::outln!("{line}");
             }
@@ -280,11 +280,11 @@ pub fn emulate(args: &EmulateArgs) -> Result<(), String> {
     let text = run.lines.join("\n") + "\n";
     if let Some(path) = &args.log {
         crate::output::write(path, text.as_bytes())?;
-        eprintln!("wrote {}", path.display());
+        crate::errln!("wrote {}", path.display());
     }
     if let Some(path) = &args.defmt {
         crate::output::write(path, &run.raw)?;
-        eprintln!(
+        crate::errln!(
             "wrote {} (decode: impact log --elf {} {})",
             path.display(),
             elf.display(),
@@ -307,7 +307,7 @@ pub fn emulate(args: &EmulateArgs) -> Result<(), String> {
             "the emulator processed {samples} and lost {lost} of {total} samples (result={result})"
         ));
     }
-    eprintln!("emulated in {:.2} s", run.seconds);
+    crate::errln!("emulated in {:.2} s", run.seconds);
     let mut json = pipeline::to_json(&setup, &log.impacts);
     json.samples_lost = lost;
     json.analyses_skipped = state
@@ -316,7 +316,7 @@ pub fn emulate(args: &EmulateArgs) -> Result<(), String> {
     json.lines_dropped = log.lines_dropped;
     json.lines_missing = log.lines_missing;
     for w in &log.warnings {
-        eprintln!("warning: {w}");
+        crate::errln!("warning: {w}");
     }
     for (j, latency) in json.impacts.iter_mut().zip(&log.latencies) {
         j.report_latency_s = latency.map(f64::from);
@@ -420,7 +420,7 @@ pub fn check_waveforms(
         }
         frames += w.frames;
     }
-    eprintln!(
+    crate::errln!(
         "waveforms: {} windows, {frames} frames, equal to the replayed samples",
         log.waveforms.len()
     );

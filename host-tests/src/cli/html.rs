@@ -69,10 +69,10 @@ pub fn run(args: &ReportArgs) -> Result<(), String> {
     crate::output::write(&args.html, page.as_str().as_bytes())?;
     for e in &results {
         for n in &e.notes {
-            eprintln!("note: {}", series::failure(e, n));
+            crate::errln!("note: {}", series::failure(e, n));
         }
     }
-    eprintln!("wrote {}", args.html.display());
+    crate::errln!("wrote {}", args.html.display());
     let failed = results.iter().filter(|e| e.error.is_some()).count();
     if failed > 0 {
         return Err(format!(

@@ -74,7 +74,9 @@ pub fn log(args: &LogArgs) -> Result<(), String> {
                 .map_err(|e| format!("{name}: {}", e.to_string().replacen("line ", "frame ", 1)))
         })?;
         if skipped > 0 {
-            eprintln!("warning: {name}: {skipped} malformed defmt frames skipped (a cut stream)");
+            crate::errln!(
+                "warning: {name}: {skipped} malformed defmt frames skipped (a cut stream)"
+            );
         }
         return report(args, reader, &name);
     }
@@ -166,7 +168,7 @@ fn report(args: &LogArgs, reader: LogReader, name: &str) -> Result<(), String> {
         ));
     }
     for w in &log.warnings {
-        eprintln!("warning: {name}: {w}");
+        crate::errln!("warning: {name}: {w}");
     }
     let json = LogJson::new(&log, args.t0).map_err(|e| e.to_string())?;
     if args.plot.is_some() || args.export.is_some() {
@@ -211,7 +213,7 @@ fn report(args: &LogArgs, reader: LogReader, name: &str) -> Result<(), String> {
                 .with_some(args.elf.as_deref());
             for p in crate::firmware_link::waves::export(&log.waveforms, path, &inputs, rate, gain)?
             {
-                eprintln!("wrote {}", p.display());
+                crate::errln!("wrote {}", p.display());
             }
         }
     }

@@ -197,7 +197,7 @@ pub fn build_firmware_bin(feature: &str, bin: Option<&str>) -> Result<PathBuf, S
     }
     let cargo = std::env::var_os("CARGO").unwrap_or_else(|| "cargo".into());
     let bin_args = bin.map(|b| vec!["--bin", b]).unwrap_or_default();
-    eprintln!(
+    crate::errln!(
         "building the QEMU firmware (cargo build --release -p impact-firmware --no-default-features --features {feature}{}{})",
         if bin.is_some() { " " } else { "" },
         bin_args.join(" ")

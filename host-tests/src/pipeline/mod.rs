@@ -79,7 +79,7 @@ pub fn memory_for_whole(file: &std::path::Path) -> Result<(), String> {
     }
     drop(probe);
     if size > 1 << 30 {
-        eprintln!(
+        crate::errln!(
             "note: {} is {:.1} GB: read whole (for --axes, --free-fall, --resample or --adxl375) it takes some {:.0} GB of memory",
             file.display(),
             gb(size),

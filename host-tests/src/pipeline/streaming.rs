@@ -172,7 +172,7 @@ fn in_passes_then(
     let spool = match spool {
         Some(Ok(writer)) => Some(writer.finish(&args.file, axis)),
         Some(Err(e)) => {
-            eprintln!("note: {e}: {name} is read again");
+            crate::errln!("note: {e}: {name} is read again");
             None
         }
         None => None,
@@ -436,7 +436,7 @@ impl Spooling {
         match spooled(args).then(SpoolWriter::new).transpose() {
             Err(e) if stdin => Err(format!("stdin: {e}")),
             Err(e) => {
-                eprintln!("note: {e}: {name} is read again for each pass");
+                crate::errln!("note: {e}: {name} is read again for each pass");
                 Ok(None)
             }
             Ok(writer) => Ok(writer.map(|writer| Spooling {

@@ -68,7 +68,7 @@ pub fn impacts(
             draw_impacts(&body, signal, &shown, cols, spectra)
         },
     )?;
-    eprintln!("wrote {}", path.display());
+    crate::errln!("wrote {}", path.display());
     Ok(())
 }
 
@@ -94,6 +94,20 @@ fn draw_impacts(
     Ok(())
 }
 
+/// The samples of impact `r`'s window, and a sample's time in ms from the touch.
+fn window_ms(
+    signal: &Signal,
+    r: &impact_core::ImpactReport,
+) -> (std::ops::Range<usize>, impl Fn(usize) -> f64) {
+    let fs = signal.rate_hz;
+    let (start, len) = window(r, fs);
+    let (start, len) = (start as usize, len as usize);
+    let start_s = r.start_s;
+    (start..start + len, move |i: usize| {
+        (i as f64 / fs - start_s) * 1e3
+    })
+}
+
 /// What an impact's window shows, measured: the deceleration above the baseline, and from
 /// the touch on the velocity, deformation and the force (or deceleration) against the
 /// deformation, integrated from v0 (from rest without it). Times in ms from the touch.
@@ -107,11 +121,9 @@ struct Measured {
 impl Measured {
     fn of(signal: &Signal, r: &impact_core::ImpactReport) -> Self {
         let fs = signal.rate_hz;
-        let (start, len) = window(r, fs);
-        let (start, len) = (start as usize, len as usize);
+        let (samples, t_ms) = window_ms(signal, r);
         let base = r.baseline_m_s2 as f64;
-        let t_ms = |i: usize| (i as f64 / fs - r.start_s) * 1e3;
-        let accel: Vec<(f64, f64)> = (start..start + len)
+        let accel: Vec<(f64, f64)> = samples
             .map_while(|i| Some((t_ms(i), (signal.accel_m_s2)(i as u64)? - base)))
             .collect();
         let v0 = r.kinematics.map(|k| k.impact_velocity_m_s as f64);
@@ -221,13 +233,10 @@ fn cfc_trace(signal: &Signal, r: &impact_core::ImpactReport, curves: &mut Vec<Cu
     let Some((class, _)) = signal.cfc else {
         return title;
     };
-    let fs = signal.rate_hz;
-    let (start, len) = window(r, fs);
-    let (start, len) = (start as usize, len as usize);
-    let t_ms = |i: usize| (i as f64 / fs - r.start_s) * 1e3;
+    let (samples, t_ms) = window_ms(signal, r);
     match super::filtered(signal, r) {
         Some((first, values)) => {
-            let trace = (start..start + len)
+            let trace = samples
                 .filter_map(|i| {
                     let v = values.get(usize::try_from((i as u64).checked_sub(first)?).ok()?)?;
                     Some((t_ms(i), *v))

@@ -17,10 +17,12 @@ pub fn to_csv(a: &AnalysisJson) -> String {
 }
 
 /// A CSV writer of the tool's outputs: comma-separated, `\n` after each row, a cell quoted
-/// only where it holds a comma, a quote or a line break.
+/// only where it holds a comma, a quote or a line break; a row of another length than the
+/// header written as it is (never dropped).
 pub fn writer<W: Write>(out: W) -> csv::Writer<W> {
     csv::WriterBuilder::new()
         .terminator(csv::Terminator::Any(b'\n'))
+        .flexible(true)
         .from_writer(out)
 }
 

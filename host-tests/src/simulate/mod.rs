@@ -316,7 +316,7 @@ pub fn run_any(args: &SimulateArgs) -> Result<Outcome, String> {
                 models.push((ModelName::Linear, Model::Linear(l)));
             }
             figure::wall_contact(&models, &impact, path)?;
-            eprintln!("wrote {}", path.display());
+            crate::errln!("wrote {}", path.display());
         }
         return Ok(Outcome::Wall(report));
     }

@@ -7,10 +7,19 @@ pub mod browser;
 
 /// Runs `impact ARGS`: (exit code, stdout, stderr).
 pub fn impact(args: &[&str]) -> (i32, String, String) {
-    let out = Command::new(env!("CARGO_BIN_EXE_impact"))
-        .args(args)
-        .output()
-        .expect("runs");
+    run(Command::new(env!("CARGO_BIN_EXE_impact")).args(args))
+}
+
+/// Runs `impact ARGS` in `dir`: (exit code, stdout, stderr).
+#[allow(dead_code)] // not every test file needs it
+pub fn impact_in(dir: &std::path::Path, args: &[&str]) -> (i32, String, String) {
+    run(Command::new(env!("CARGO_BIN_EXE_impact"))
+        .current_dir(dir)
+        .args(args))
+}
+
+fn run(cmd: &mut Command) -> (i32, String, String) {
+    let out = cmd.output().expect("runs");
     (
         out.status.code().unwrap_or(-1),
         String::from_utf8_lossy(&out.stdout).into_owned(),

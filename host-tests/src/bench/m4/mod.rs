@@ -323,7 +323,7 @@ pub fn run(args: &M4Args) -> Result<(M4Report, String), String> {
         None => build()?,
     };
     let code = disassemble(&elf)?;
-    let files = BenchFiles::new()?;
+    let files = BenchFiles::new();
     let samples = seed_recording()?;
     let bytes: Vec<u8> = samples.iter().flat_map(|c| c.to_le_bytes()).collect();
     std::fs::write(&files.raw, bytes).map_err(|e| format!("{}: {e}", files.raw.display()))?;
@@ -378,7 +378,7 @@ struct BenchFiles {
 }
 
 impl BenchFiles {
-    fn new() -> Result<Self, String> {
+    fn new() -> Self {
         let dir = std::env::temp_dir();
         let nanos = std::time::SystemTime::now()
             .duration_since(std::time::UNIX_EPOCH)
@@ -388,12 +388,12 @@ impl BenchFiles {
         let trace_jobs = dir.join(format!("{stem}-trace.txt"));
         let count_jobs = dir.join(format!("{stem}-count.txt"));
         let _guards = [&raw, &trace_jobs, &count_jobs].map(|p| crate::interrupt::temporary(p));
-        Ok(Self {
+        Self {
             raw,
             trace_jobs,
             count_jobs,
             _guards,
-        })
+        }
     }
 }
 

@@ -167,12 +167,12 @@ pub fn run(args: &WatchArgs) -> Result<(), String> {
     let terminal = args.terminal;
     if let Some(l) = listener {
         let addr = l.local_addr().map_err(|e| e.to_string())?;
-        eprintln!(
+        crate::errln!(
             "impact watch: http://{addr}/ (session file {})",
             session_path.display()
         );
         if !loopback {
-            eprintln!(
+            crate::errln!(
                 "impact watch: --listen {addr} is not a loopback address: anyone who can reach \
                  it sees the session"
             );
@@ -180,10 +180,10 @@ pub fn run(args: &WatchArgs) -> Result<(), String> {
         let h = hub.clone();
         std::thread::spawn(move || server::serve(l, h));
     } else {
-        eprintln!("impact watch: session file {}", session_path.display());
+        crate::errln!("impact watch: session file {}", session_path.display());
     }
     if stdin && std::io::IsTerminal::is_terminal(&std::io::stdin()) {
-        eprintln!(
+        crate::errln!(
             "impact watch: reading the board's log from standard input: pipe it in \
              (cargo fw-run | impact watch), or name a log file"
         );
@@ -227,12 +227,14 @@ pub fn run(args: &WatchArgs) -> Result<(), String> {
         Some(elf) => {
             let skipped = crate::firmware_link::decode::decode(elf, source, &name, &mut on_line)?;
             if skipped > 0 {
-                eprintln!("warning: {name}: {skipped} malformed defmt frames skipped");
+                crate::errln!("warning: {name}: {skipped} malformed defmt frames skipped");
             }
         }
         None => crate::cli::log::for_each_line(source, &name, |n, line, cut| {
             if cut {
-                eprintln!("warning: {name}:{n}: a line longer than {MAX_LINE_BYTES} bytes, cut");
+                crate::errln!(
+                    "warning: {name}:{n}: a line longer than {MAX_LINE_BYTES} bytes, cut"
+                );
             }
             on_line(n, line)
         })?,
@@ -242,7 +244,7 @@ pub fn run(args: &WatchArgs) -> Result<(), String> {
         terminal::print(&events);
         return Ok(());
     }
-    eprintln!("impact watch: {name} ended; the page stays up (Ctrl-C to stop)");
+    crate::errln!("impact watch: {name} ended; the page stays up (Ctrl-C to stop)");
     loop {
         std::thread::park();
     }

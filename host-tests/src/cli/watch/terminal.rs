@@ -30,17 +30,21 @@ pub fn print(events: &[Value]) {
                 e["result"].as_str().unwrap_or("?")
             )),
             Some("warning") => {
-                eprintln!("warning: {}", e["text"].as_str().unwrap_or(""));
+                crate::errln!("warning: {}", e["text"].as_str().unwrap_or(""));
                 None
             }
             _ => None,
         };
         if let Some(l) = line {
             // A closed pipe ends the tool through its signal handling.
-            let _ = writeln!(out, "{l}");
+            if let Err(e) = writeln!(out, "{l}") {
+                crate::interrupt::stdout_failed(e);
+            }
         }
     }
-    let _ = out.flush();
+    if let Err(e) = out.flush() {
+        crate::interrupt::stdout_failed(e);
+    }
 }
 
 /// One impact's line: run and index, board time, peak, Δv, duration, COR, verdict, latency,
