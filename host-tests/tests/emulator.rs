@@ -638,7 +638,7 @@ fn a_forced_dma_overrun_is_a_counted_gap_and_later_positions_stay_right() {
             v0: Some(1.3357),
             ..Default::default()
         },
-        None,
+        impact_io::progress::Progress::none(),
     )
     .unwrap();
     let host = impact_host::pipeline::run(&setup.prepared.counts, &setup.scene).unwrap();
@@ -940,7 +940,7 @@ fn adxl375_host(
             mass: Some(0.06),
             ..Default::default()
         },
-        None,
+        impact_io::progress::Progress::none(),
     )
     .unwrap();
     let axes = impact_host::cli::emulate::adxl375_axes(&mut setup).unwrap();

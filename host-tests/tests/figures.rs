@@ -38,12 +38,14 @@ fn the_cfc_trace_drawn_is_the_analysis_s_filter() {
                     ..Default::default()
                 };
                 let analysed = if whole {
-                    pipeline::setup(&args, None).and_then(|setup| {
-                        let reports = pipeline::run(&setup.prepared.counts, &setup.scene)?;
-                        Ok((setup, reports))
-                    })
+                    pipeline::setup(&args, impact_io::progress::Progress::none()).and_then(
+                        |setup| {
+                            let reports = pipeline::run(&setup.prepared.counts, &setup.scene)?;
+                            Ok((setup, reports))
+                        },
+                    )
                 } else {
-                    pipeline::analyze(&args, None)
+                    pipeline::analyze(&args, impact_io::progress::Progress::none())
                 };
                 // (A rate too low for the class is refused as a whole.)
                 let Ok((setup, reports)) = analysed else {

@@ -16,7 +16,7 @@ fn data(rel: &str) -> PathBuf {
 }
 
 fn analyze(args: &AnalyzeArgs) -> Result<AnalysisJson, String> {
-    let setup = pipeline::setup(args, None)?;
+    let setup = pipeline::setup(args, impact_io::progress::Progress::none())?;
     let reports = pipeline::run(&setup.prepared.counts, &setup.scene)?;
     Ok(pipeline::to_json(&setup, &reports))
 }

@@ -23,7 +23,8 @@ fn analyze(name: &str, a: &[f64]) -> AnalysisJson {
         file: scratch.file(&format!("{name}.csv"), text),
         ..Default::default()
     };
-    let setup = pipeline::setup(&args, None).unwrap_or_else(|e| panic!("{e}"));
+    let setup = pipeline::setup(&args, impact_io::progress::Progress::none())
+        .unwrap_or_else(|e| panic!("{e}"));
     let reports = pipeline::run(&setup.prepared.counts, &setup.scene).unwrap();
     pipeline::to_json(&setup, &reports)
 }

@@ -15,7 +15,8 @@ fn signals() -> PathBuf {
 }
 
 fn analyze(args: AnalyzeArgs) -> AnalysisJson {
-    let setup = pipeline::setup(&args, None).unwrap_or_else(|e| panic!("{e}"));
+    let setup = pipeline::setup(&args, impact_io::progress::Progress::none())
+        .unwrap_or_else(|e| panic!("{e}"));
     let reports = pipeline::run(&setup.prepared.counts, &setup.scene).unwrap();
     pipeline::to_json(&setup, &reports)
 }

@@ -84,7 +84,7 @@ pub struct ReadOptions {
     /// The sample type of a raw file without the `.i16`/`.f32` extension.
     pub raw_type: Option<RawType>,
     /// Called with the fraction of the file read, for progress display.
-    pub progress: Option<fn(f64)>,
+    pub progress: crate::progress::Progress,
 }
 
 /// The 0-based channel `column` asks for among `count` numbered ones (default 0), or the

@@ -98,7 +98,7 @@ impl FastRows {
         mut input: Box<dyn Read + Send>,
         (byte, line): (u64, u64),
         layout: Layout,
-        progress: Option<(fn(f64), u64)>,
+        progress: Option<(crate::progress::Progress, u64)>,
         tape: Option<Arc<Tape>>,
     ) -> Self {
         let workers = std::thread::available_parallelism().map_or(2, |n| n.get().clamp(1, 4));
@@ -162,9 +162,9 @@ impl FastRows {
                     return;
                 }
                 (byte, seq) = (byte + cut as u64, seq + 1);
-                if let Some((p, size)) = progress {
+                if let Some((p, size)) = &progress {
                     if byte >= next_progress {
-                        p(byte as f64 / size.max(1) as f64);
+                        p.report(byte as f64 / (*size).max(1) as f64);
                         next_progress = byte + (size / 20).max(1);
                     }
                 }

@@ -30,7 +30,7 @@ pub struct Handover {
     sequential: usize,
     /// Where the parallel reader stopped: the sequential one resumes there next.
     resume_at: Option<(u64, u64)>,
-    progress: Option<fn(f64)>,
+    progress: crate::progress::Progress,
 }
 
 /// Why the hand-over failed: the input could not be opened again at a line, or resuming the
@@ -44,7 +44,7 @@ impl Handover {
     /// Starts with the sequential reader; the parallel one may take over once `sequential`
     /// rows have been read (0: not before [`csv_fast::SEQUENTIAL_ROWS`] rows, which is what
     /// a head read row by row leaves `sequential` at).
-    pub fn new(rows: Rows, sequential: usize, progress: Option<fn(f64)>) -> Self {
+    pub fn new(rows: Rows, sequential: usize, progress: crate::progress::Progress) -> Self {
         Self {
             rows,
             fast: None,
@@ -76,7 +76,10 @@ impl Handover {
                 input,
                 (byte, line),
                 layout(&self.rows),
-                self.progress.zip(self.rows.size()),
+                self.rows
+                    .size()
+                    .filter(|_| self.progress.is_shown())
+                    .map(|size| (self.progress.clone(), size)),
                 self.rows.tape(),
             ));
         }
@@ -107,9 +110,9 @@ impl Handover {
 pub fn read_table(
     path: &Path,
     format: &CsvFormat,
-    progress: Option<fn(f64)>,
+    progress: crate::progress::Progress,
 ) -> Result<Table, ReadError> {
-    let rows = Rows::open(path, format, progress)?;
+    let rows = Rows::open(path, format, progress.clone())?;
     let mut reader = Handover::new(rows, 0, progress);
     let mut table = Table::default();
     let mut next_line = 0;

@@ -11,6 +11,7 @@ pub mod error;
 pub mod ide;
 pub mod limits;
 pub mod npy;
+pub mod progress;
 pub mod quantise;
 pub mod raw;
 pub mod recording;

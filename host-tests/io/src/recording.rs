@@ -50,7 +50,7 @@ pub fn resample(
 /// Reads one channel and its time base (see [`read_table`] for the format).
 pub fn read_csv(path: &Path, opts: &ReadOptions) -> Result<Channel, ReadError> {
     let err = |kind: ReadErrorKind| ReadError::new(path, kind);
-    let table = read_table(path, &opts.format, opts.progress)?;
+    let table = read_table(path, &opts.format, opts.progress.clone())?;
     let tcol = table
         .time_column_unless_rate(opts.rate_hz.is_some(), opts.time_column.as_ref())
         .map_err(err)?;

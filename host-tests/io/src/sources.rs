@@ -281,7 +281,7 @@ impl CsvSource {
             delimiter: opts.format.delimiter,
             decimal_comma: opts.format.decimal_comma,
         };
-        let mut rows = crate::table::Rows::open(path, &format, opts.progress)?;
+        let mut rows = crate::table::Rows::open(path, &format, opts.progress.clone())?;
         let err = |kind: ReadErrorKind| ReadError::new(path, kind);
         // The first data row gives the columns their number (the header their names).
         let (line, first) = match rows.next_row()? {
@@ -316,7 +316,11 @@ impl CsvSource {
         let column = shape.headers.get(channel).cloned().unwrap_or_default();
         let mut source = Self {
             // The head is read row by row; the parallel reader may take over right after it.
-            reader: Handover::new(rows, crate::csv_fast::SEQUENTIAL_ROWS, opts.progress),
+            reader: Handover::new(
+                rows,
+                crate::csv_fast::SEQUENTIAL_ROWS,
+                opts.progress.clone(),
+            ),
             row: Vec::new(),
             path: path.to_path_buf(),
             channel,

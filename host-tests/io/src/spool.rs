@@ -78,7 +78,10 @@ pub struct Spool {
 
 impl Spool {
     /// A source of the values from the first, `progress` the fraction read.
-    pub fn source(&self, progress: Option<fn(f64)>) -> Result<Box<dyn Source>, ReadError> {
+    pub fn source(
+        &self,
+        progress: crate::progress::Progress,
+    ) -> Result<Box<dyn Source>, ReadError> {
         let file = self
             .file
             .try_clone()
@@ -104,7 +107,7 @@ struct SpoolSource {
     samples: u64,
     axis: Axis,
     bytes: Vec<u8>,
-    progress: Option<fn(f64)>,
+    progress: crate::progress::Progress,
 }
 
 impl SpoolSource {
@@ -116,9 +119,8 @@ impl SpoolSource {
             .read_exact_at(bytes, self.at * 8)
             .map_err(|e| ReadError::new(&self.path, failed(e)))?;
         self.at += n as u64;
-        if let Some(p) = self.progress {
-            p(self.at as f64 / self.samples.max(1) as f64);
-        }
+        self.progress
+            .report(self.at as f64 / self.samples.max(1) as f64);
         Ok(bytes)
     }
 }
@@ -187,7 +189,7 @@ mod tests {
         };
         let spool = w.finish(Path::new("-"), axis);
         for want in [1, 1000, CHUNK, 10 * CHUNK] {
-            let mut s = spool.source(None).unwrap();
+            let mut s = spool.source(crate::progress::Progress::none()).unwrap();
             let mut back = Vec::new();
             loop {
                 let before = back.len();
@@ -197,7 +199,7 @@ mod tests {
                 }
             }
             assert_eq!(back.len(), values.len());
-            let mut s = spool.source(None).unwrap();
+            let mut s = spool.source(crate::progress::Progress::none()).unwrap();
             let (mut counts, mut scratch) = (Vec::new(), Vec::new());
             loop {
                 let before = counts.len();

@@ -294,7 +294,7 @@ pub struct Rows {
     /// before the first one read (a byte-order mark, or a resumed reader's start).
     line_offset: u64,
     skip: u64,
-    progress: Option<fn(f64)>,
+    progress: crate::progress::Progress,
     size: Option<u64>,
     step: Option<u64>,
     next_progress: u64,
@@ -310,7 +310,7 @@ impl Rows {
     pub fn open(
         path: &Path,
         format: &CsvFormat,
-        progress: Option<fn(f64)>,
+        progress: crate::progress::Progress,
     ) -> Result<Self, ReadError> {
         let (input, size) = open(path).map_err(|e| ReadError::new(path, e))?;
         Self::from_input(path, input, size, format, progress)
@@ -323,7 +323,7 @@ impl Rows {
         input: Box<dyn Read + Send>,
         size: Option<u64>,
         format: &CsvFormat,
-        progress: Option<fn(f64)>,
+        progress: crate::progress::Progress,
     ) -> Result<Self, ReadError> {
         let err = |kind: ReadErrorKind| ReadError::new(path, kind);
         let (input, tape): (Box<dyn Read + Send>, _) = match size {
@@ -358,7 +358,7 @@ impl Rows {
         delimiter: u8,
         input: BufReader<Box<dyn Read + Send>>,
         size: Option<u64>,
-        progress: Option<fn(f64)>,
+        progress: crate::progress::Progress,
     ) -> Self {
         let limited = RecordLimit::new(input, delimiter);
         let reader = csv::ReaderBuilder::new()
@@ -415,7 +415,7 @@ impl Rows {
             self.delimiter,
             BufReader::with_capacity(1 << 16, input),
             None,
-            None,
+            crate::progress::Progress::none(),
         );
         rows.headers = self.headers.clone();
         rows.header_fields = self.header_fields;
@@ -513,10 +513,10 @@ impl Rows {
                 .filter(|&&b| b == b'\n')
                 .count() as u64;
             let lineno = self.reader.position().line() - breaks - 1 + self.line_offset;
-            if let (Some(p), Some(size)) = (self.progress, self.size) {
+            if let (true, Some(size)) = (self.progress.is_shown(), self.size) {
                 let read = self.reader.get_ref().read;
                 if read >= self.next_progress {
-                    p(read as f64 / size.max(1) as f64);
+                    self.progress.report(read as f64 / size.max(1) as f64);
                     self.next_progress = read + self.step.unwrap_or(u64::MAX);
                 }
             }
@@ -726,8 +726,14 @@ mod tests {
         }
         text.push_str("2,3\n");
         let input = Box::new(std::io::Cursor::new(text.into_bytes()));
-        let mut rows =
-            Rows::from_input(Path::new("-"), input, None, &CsvFormat::default(), None).unwrap();
+        let mut rows = Rows::from_input(
+            Path::new("-"),
+            input,
+            None,
+            &CsvFormat::default(),
+            crate::progress::Progress::none(),
+        )
+        .unwrap();
         let tape = rows.tape().unwrap();
         let mut most = 0;
         let mut n = 0;
@@ -750,7 +756,7 @@ mod tests {
             text.len() * 31 + text.bytes().map(usize::from).sum::<usize>()
         ));
         std::fs::write(&path, text).unwrap();
-        let t = read_table(&path, &format, None);
+        let t = read_table(&path, &format, crate::progress::Progress::none());
         std::fs::remove_file(&path).unwrap();
         t
     }

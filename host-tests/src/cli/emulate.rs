@@ -204,7 +204,7 @@ pub fn emulate(args: &EmulateArgs) -> Result<(), String> {
         }
         None => {
             pipeline::memory_for_whole(&a.file)?;
-            pipeline::setup(a, None)?
+            pipeline::setup(a, impact_io::progress::Progress::none())?
         }
     };
     setup.scene.waveform_every = args.waveforms.unwrap_or(0);

@@ -3,15 +3,19 @@
 use std::path::Path;
 
 /// A progress bar on stderr (indicatif) for a file over 8 MiB when stderr is a terminal.
-pub fn progress_for(file: &Path) -> Option<fn(f64)> {
+pub fn progress_for(file: &Path) -> impact_io::progress::Progress {
     use std::io::IsTerminal;
     let big = std::fs::metadata(file)
         .map(|m| m.len() > 8 << 20)
         .unwrap_or(false);
-    (big && std::io::stderr().is_terminal()).then_some(show_progress as fn(f64))
+    if big && std::io::stderr().is_terminal() {
+        impact_io::progress::Progress::new(show_progress)
+    } else {
+        impact_io::progress::Progress::none()
+    }
 }
 
-/// The bar, per mille of the file read (a plain function for the readers' callbacks).
+/// The terminal's one bar, per mille of the file read (cleared by [`finish`]).
 static PROGRESS: std::sync::OnceLock<indicatif::ProgressBar> = std::sync::OnceLock::new();
 
 fn show_progress(fraction: f64) {

@@ -226,7 +226,7 @@ fn analyze_one(args: &AnalyzeArgs, entry: &Entry, draw: bool) -> EntryJson {
         )
     };
     let (result, notes) = impact_io::with_own_notes(crate::read_errors::flag, || {
-        pipeline::analyze(&a, None).map(|(setup, reports)| {
+        pipeline::analyze(&a, impact_io::progress::Progress::none()).map(|(setup, reports)| {
             let json = pipeline::to_json(&setup, &reports);
             let channel = entry.shown_channel(json.column.as_deref());
             let figures = if draw {

@@ -29,7 +29,12 @@ fn split(spec: &str) -> (&Path, Option<&str>) {
 pub fn free_fall_before(spec: &str, impact_s: f64) -> Result<f64, String> {
     let (path, column) = split(spec);
     let column = column.map(|c| c.parse::<ColumnRef>().unwrap_or(ColumnRef::Name(c.into())));
-    let table = read_table(path, &CsvFormat::default(), None).map_err(into_message)?;
+    let table = read_table(
+        path,
+        &CsvFormat::default(),
+        impact_io::progress::Progress::none(),
+    )
+    .map_err(into_message)?;
     let in_file =
         |e: ReadErrorKind| format!("--free-fall {}: {}", path.display(), kind_message(&e));
     let tcol = table

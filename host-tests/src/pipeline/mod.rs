@@ -37,7 +37,7 @@ use survey::Survey;
 /// stream) and the reports.
 pub fn analyze(
     args: &AnalyzeArgs,
-    progress: Option<fn(f64)>,
+    progress: impact_io::progress::Progress,
 ) -> Result<(Setup, Vec<ImpactReport>), String> {
     let in_passes = streaming::in_passes(args);
     if !args.stream && !in_passes {
@@ -238,7 +238,7 @@ impl Setup {
 }
 
 /// Reads the file and builds the scene (v0 from a free fall needs a first pass).
-pub fn setup(args: &AnalyzeArgs, progress: Option<fn(f64)>) -> Result<Setup, String> {
+pub fn setup(args: &AnalyzeArgs, progress: impact_io::progress::Progress) -> Result<Setup, String> {
     let file = scene_file(args)?;
     let ch = read_recording(&args.file, &args.read_options(progress))
         .map_err(crate::read_errors::into_message)?;

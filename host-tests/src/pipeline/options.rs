@@ -227,7 +227,7 @@ pub struct AnalyzeArgs {
 
 impl AnalyzeArgs {
     /// What the readers take of the options (they never see the command line).
-    pub fn read_options(&self, progress: Option<fn(f64)>) -> ReadOptions {
+    pub fn read_options(&self, progress: impact_io::progress::Progress) -> ReadOptions {
         ReadOptions {
             column: self.column.clone(),
             axes: self.axes.clone(),

@@ -22,6 +22,7 @@ use crate::pipeline::{self, AnalyzeArgs, MonitorRun, Reading, Setup};
 use crate::read_errors::into_message;
 use impact_io::channel::{input_name, is_stdin};
 use impact_io::open_source;
+use impact_io::progress::Progress;
 use impact_io::quantise::Quantiser;
 use impact_io::sources::{read_head, Source, CHUNK};
 use impact_io::spool::{Axis, SpoolWriter};
@@ -30,7 +31,7 @@ use impact_io::spool::{Axis, SpoolWriter};
 /// `progress` (a CSV's fraction read) for a bar on a terminal.
 pub fn analyze(
     args: &AnalyzeArgs,
-    progress: Option<fn(f64)>,
+    progress: Progress,
 ) -> Result<(Setup, Vec<ImpactReport>), String> {
     let refuse = |what: &str| Err(format!("--stream: {what} needs the whole recording"));
     if args.plot.is_some() {
@@ -102,7 +103,7 @@ pub fn analyze(
 /// takes the median of all of them).
 pub fn analyze_in_passes(
     args: &AnalyzeArgs,
-    progress: Option<fn(f64)>,
+    progress: Progress,
 ) -> Result<(Setup, Vec<ImpactReport>), String> {
     in_passes_then(args, progress, Last::Analyse)
 }
@@ -111,7 +112,7 @@ pub fn analyze_in_passes(
 /// written to `out` in a last pass after the survey, in bounded memory: what `impact emulate`
 /// replays. The setup says how many (`samples`).
 pub fn counts_file(args: &AnalyzeArgs, out: &mut dyn std::io::Write) -> Result<Setup, String> {
-    in_passes_then(args, None, Last::Counts(out)).map(|(setup, _)| setup)
+    in_passes_then(args, Progress::none(), Last::Counts(out)).map(|(setup, _)| setup)
 }
 
 /// What the last pass does: analyse, or write the counts.
@@ -122,7 +123,7 @@ enum Last<'a> {
 
 fn in_passes_then(
     args: &AnalyzeArgs,
-    progress: Option<fn(f64)>,
+    progress: Progress,
     last: Last,
 ) -> Result<(Setup, Vec<ImpactReport>), String> {
     let name = input_name(&args.file);
@@ -130,14 +131,7 @@ fn in_passes_then(
     // The survey; again with the glitches replaced if there are any (they set the extremes).
     // One bar over the passes: the survey fills its first half, a second survey (if any)
     // the next sixth, the analysis the rest.
-    let bar = |from: f64, to: f64| {
-        progress.map(|p| {
-            if let Ok(mut span) = PASS_SPAN.lock() {
-                *span = (Some(p), from, to);
-            }
-            in_pass as fn(f64)
-        })
-    };
+    let bar = |from: f64, to: f64| progress.span(from, to);
     // (The spool first: standard input without one is refused before it is read.)
     let spool = Spooling::for_input(args, &name)?;
     let input = open_source(&args.file, &args.read_options(bar(0.0, 0.5))).map_err(into_message)?;
@@ -177,7 +171,7 @@ fn in_passes_then(
         }
         None => None,
     };
-    let reopen = |progress: Option<fn(f64)>| match &spool {
+    let reopen = |progress: Progress| match &spool {
         Some(s) => Ok((s.source(progress).map_err(into_message)?, 1.0)),
         None => Ok::<_, String>((
             open_source(&args.file, &args.read_options(progress)).map_err(into_message)?,
@@ -225,7 +219,7 @@ fn in_passes_then(
     // drawn, not the recording).
     let windows = match &args.plot {
         Some(_) => {
-            let (source, scale) = reopen(None)?;
+            let (source, scale) = reopen(Progress::none())?;
             let spans = figure_spans(&reports, &resolved.scene);
             let q = Quantiser { scale, gain };
             let (source, head) = head_counts(source, q)?;
@@ -268,20 +262,6 @@ fn head_counts(
 ) -> Result<(Box<dyn Source>, Vec<i16>), String> {
     let head = read_head(&mut *source, q.scale).map_err(into_message)?;
     Ok((source, q.counts_m_s2(&head)))
-}
-
-/// The caller's progress bar, and the span of it (from, to) the current pass fills.
-type Span = (Option<fn(f64)>, f64, f64);
-
-static PASS_SPAN: std::sync::Mutex<Span> = std::sync::Mutex::new((None, 0.0, 1.0));
-
-/// A pass's fraction read, shown on the caller's bar within the pass's span.
-fn in_pass(fraction: f64) {
-    if let Ok(span) = PASS_SPAN.lock() {
-        if let (Some(p), from, to) = *span {
-            p(from + (to - from) * fraction.clamp(0.0, 1.0));
-        }
-    }
 }
 
 /// Whether `impact analyze` reads `args.file` in passes ([`analyze_in_passes`]): a regular
