@@ -68,6 +68,64 @@ fn stdin_identity() -> Option<(u64, u64)> {
     None
 }
 
+/// Why an output cannot be written: refused before any work ([`check`]), or its write
+/// failed ([`write_with`]). `option` is the option that named it (`--plot`).
+#[derive(Debug, thiserror::Error)]
+pub enum OutputError {
+    #[error("{option} {}: directory {} does not exist", .path.display(), .dir.display())]
+    NoDirectory {
+        option: String,
+        path: PathBuf,
+        dir: PathBuf,
+    },
+    #[error("{option} {}: is a directory", .path.display())]
+    IsDirectory { option: String, path: PathBuf },
+    /// One of the command's inputs (`-`: the file read on standard input).
+    #[error(
+        "{option} {}: is {}; it would be overwritten (write to another file)",
+        .path.display(),
+        input_named(.input)
+    )]
+    IsAnInput {
+        option: String,
+        path: PathBuf,
+        input: PathBuf,
+    },
+    #[error("{option} {}: links to an input; it would be overwritten", .path.display())]
+    LinksToAnInput { option: String, path: PathBuf },
+    #[error(
+        "{option} {}: the output is {}: name the file .{ext}",
+        .path.display(),
+        .ext.to_uppercase()
+    )]
+    Extension {
+        option: String,
+        path: PathBuf,
+        ext: String,
+    },
+    /// The write itself (a full disk, a file-size limit); nothing was left behind.
+    #[error("{}: {source}", .path.display())]
+    Write {
+        path: PathBuf,
+        source: std::io::Error,
+    },
+}
+
+/// An input as a refusal names it.
+fn input_named(input: &Path) -> String {
+    if input.as_os_str() == "-" {
+        "the input file read on standard input".to_string()
+    } else {
+        format!("the input file {}", input.display())
+    }
+}
+
+impl From<OutputError> for String {
+    fn from(e: OutputError) -> String {
+        e.to_string()
+    }
+}
+
 /// Checks, before any work, that `path` (the value of `option`) can take an output: its
 /// directory exists, it is no directory itself, and it is none of the `inputs` (the same file,
 /// a link to one, standard input's file). `extension`, if given, is the one the output must
@@ -77,17 +135,21 @@ pub fn check(
     path: &Path,
     inputs: &Inputs,
     extension: Option<&str>,
-) -> Result<(), String> {
-    let shown = path.display();
+) -> Result<(), OutputError> {
+    let (option, owned) = (option.to_string(), path.to_path_buf());
     let dir = directory(path);
     if !dir.is_dir() {
-        return Err(format!(
-            "{option} {shown}: directory {} does not exist",
-            dir.display()
-        ));
+        return Err(OutputError::NoDirectory {
+            option,
+            path: owned,
+            dir: dir.to_path_buf(),
+        });
     }
     if path.is_dir() {
-        return Err(format!("{option} {shown}: is a directory"));
+        return Err(OutputError::IsDirectory {
+            option,
+            path: owned,
+        });
     }
     if let Some(out) = identity(path) {
         for input in &inputs.paths {
@@ -97,14 +159,11 @@ pub fn check(
                 identity(input) == Some(out)
             };
             if same {
-                let what = if input.as_os_str() == "-" {
-                    "the input file read on standard input".to_string()
-                } else {
-                    format!("the input file {}", input.display())
-                };
-                return Err(format!(
-                    "{option} {shown}: is {what}; it would be overwritten (write to another file)"
-                ));
+                return Err(OutputError::IsAnInput {
+                    option,
+                    path: owned,
+                    input: input.clone(),
+                });
             }
         }
     }
@@ -114,9 +173,10 @@ pub fn check(
         if let Ok(target) = std::fs::read_link(path) {
             let target = dir.join(target);
             if inputs.paths.contains(&target) {
-                return Err(format!(
-                    "{option} {shown}: links to an input; it would be overwritten"
-                ));
+                return Err(OutputError::LinksToAnInput {
+                    option,
+                    path: owned,
+                });
             }
         }
     }
@@ -125,10 +185,11 @@ pub fn check(
             .extension()
             .is_some_and(|e| e.eq_ignore_ascii_case(ext));
         if !ok {
-            return Err(format!(
-                "{option} {shown}: the output is {}: name the file .{ext}",
-                ext.to_uppercase()
-            ));
+            return Err(OutputError::Extension {
+                option,
+                path: owned,
+                ext: ext.to_string(),
+            });
         }
     }
     Ok(())
@@ -143,7 +204,7 @@ fn directory(path: &Path) -> &Path {
 }
 
 /// Writes `bytes` to `path`, whole or not at all (see the module).
-pub fn write(path: &Path, bytes: &[u8]) -> Result<(), String> {
+pub fn write(path: &Path, bytes: &[u8]) -> Result<(), OutputError> {
     write_with(path, |w| w.write_all(bytes))
 }
 
@@ -153,8 +214,11 @@ pub fn write(path: &Path, bytes: &[u8]) -> Result<(), String> {
 pub fn write_with(
     path: &Path,
     fill: impl FnOnce(&mut dyn Write) -> std::io::Result<()>,
-) -> Result<(), String> {
-    let shown = path.display();
+) -> Result<(), OutputError> {
+    let failed = |source: std::io::Error| OutputError::Write {
+        path: path.to_path_buf(),
+        source,
+    };
     let name = path
         .file_name()
         .map_or_else(|| "output".into(), |n| n.to_string_lossy().into_owned());
@@ -162,22 +226,21 @@ pub fn write_with(
         .prefix(&format!(".{name}."))
         .suffix(".part")
         .tempfile_in(directory(path))
-        .map_err(|e| format!("{shown}: {e}"))?;
+        .map_err(failed)?;
     let guard = crate::interrupt::temporary(tmp.path());
     {
         let mut w = std::io::BufWriter::new(tmp.as_file());
-        fill(&mut w).map_err(|e| format!("{shown}: {e}"))?;
-        w.flush().map_err(|e| format!("{shown}: {e}"))?;
+        fill(&mut w).map_err(failed)?;
+        w.flush().map_err(failed)?;
     }
     // A new file's usual permissions (the temporary one is private).
     #[cfg(unix)]
     {
         use std::os::unix::fs::PermissionsExt;
         let mode = std::fs::Permissions::from_mode(0o644);
-        std::fs::set_permissions(tmp.path(), mode).map_err(|e| format!("{shown}: {e}"))?;
+        std::fs::set_permissions(tmp.path(), mode).map_err(failed)?;
     }
-    tmp.persist(path)
-        .map_err(|e| format!("{shown}: {}", e.error))?;
+    tmp.persist(path).map_err(|e| failed(e.error))?;
     drop(guard);
     Ok(())
 }
@@ -259,6 +322,10 @@ mod tests {
         d
     }
 
+    fn input_path(inputs: &Inputs) -> PathBuf {
+        inputs.paths[0].clone()
+    }
+
     #[test]
     fn an_input_a_link_to_it_or_its_hard_link_is_refused() {
         let d = dir();
@@ -270,7 +337,11 @@ mod tests {
         let _ = std::fs::remove_file(&hard);
         std::fs::hard_link(&input, &hard).unwrap();
         let e = check("--plot", &hard, &inputs, Some("svg")).unwrap_err();
-        assert!(e.contains("would be overwritten"), "{e}");
+        assert!(
+            matches!(&e, OutputError::IsAnInput { input, .. } if *input == input_path(&inputs)),
+            "{e:?}"
+        );
+        assert!(e.to_string().contains("would be overwritten"), "{e}");
         #[cfg(unix)]
         {
             let soft = d.join("soft.svg");
@@ -279,8 +350,14 @@ mod tests {
             assert!(check("--plot", &soft, &inputs, Some("svg")).is_err());
         }
         assert!(check("--plot", &d.join("new.svg"), &inputs, Some("svg")).is_ok());
-        assert!(check("--plot", &d.join("new.png"), &inputs, Some("svg")).is_err());
-        assert!(check("--plot", &d.join("nowhere/x.svg"), &inputs, None).is_err());
+        assert!(matches!(
+            check("--plot", &d.join("new.png"), &inputs, Some("svg")),
+            Err(OutputError::Extension { .. })
+        ));
+        assert!(matches!(
+            check("--plot", &d.join("nowhere/x.svg"), &inputs, None),
+            Err(OutputError::NoDirectory { .. })
+        ));
     }
 
     #[test]
@@ -295,7 +372,11 @@ mod tests {
             Err(std::io::Error::other("disk full"))
         })
         .unwrap_err();
-        assert!(e.contains("whole.txt") && e.contains("disk full"), "{e}");
+        assert!(
+            matches!(&e, OutputError::Write { path, .. } if *path == out),
+            "{e:?}"
+        );
+        assert!(e.to_string().contains("whole.txt") && e.to_string().contains("disk full"));
         assert_eq!(std::fs::read(&out).unwrap(), b"complete\n");
         let left: Vec<_> = std::fs::read_dir(&d)
             .unwrap()

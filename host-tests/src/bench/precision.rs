@@ -288,5 +288,5 @@ pub fn work_precision(points: &[Point], path: &std::path::Path) -> Result<(), St
         }
         root.present().map_err(|e| e.to_string())?;
     }
-    crate::output::write(path, text.as_bytes())
+    Ok(crate::output::write(path, text.as_bytes())?)
 }

@@ -53,8 +53,8 @@ pub(crate) fn write_svg(
 /// to a `.svg`, rasterised ([`png::from_svg`]) to a `.png`.
 pub(crate) fn write_figure(path: &std::path::Path, svg: &str) -> Result<(), String> {
     match format(path) {
-        Some("png") => crate::output::write(path, &png::from_svg(svg)?),
-        Some(_) => crate::output::write(path, svg.as_bytes()),
+        Some("png") => Ok(crate::output::write(path, &png::from_svg(svg)?)?),
+        Some(_) => Ok(crate::output::write(path, svg.as_bytes())?),
         None => Err(format!(
             "--plot {}: name the figure .svg or .png",
             path.display()
