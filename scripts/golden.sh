@@ -215,6 +215,12 @@ run err-wav-rate analyze fixtures/afrl-test1-int16.wav --rate 1000
 run err-npy-rate analyze fixtures/afrl-test1-int16.npy
 run err-tdms-column analyze fixtures/afrl-test1.tdms --column nope
 run err-missing analyze nothing-here.csv
+run err-opt-mass analyze "$afrl" --mass abc
+run err-opt-mass-range analyze "$afrl" --mass -1
+run err-opt-rate analyze fixtures/afrl-test1.f32 --rate 0
+run err-opt-cfc analyze "$afrl" --cfc 7
+run err-opt-spec analyze "$afrl" --spec half-sine,11000,0.1
+run err-opt-gain analyze "$afrl" --gain 0
 printf 'frequency_hz,acceleration_g\n10,1\n5,2\n' >bad-srs.csv
 run err-srs report "$afrl" --srs-required bad-srs.csv --html bad.html
 printf 'time_s,lower_g\n0,1\n' >bad-band.csv

@@ -37,60 +37,71 @@ pub const EXPONENT: Limits = Limits {
     unit: "",
 };
 
+/// Why an option's number was refused (clap names the option and the value given).
+#[derive(Clone, Copy, Debug, PartialEq, thiserror::Error)]
+pub enum NumberError {
+    #[error("not a number")]
+    NotANumber,
+    #[error(transparent)]
+    OutOfRange(#[from] impact_io::limits::OutOfRange),
+    #[error("must be finite and > 0")]
+    NotPositive,
+}
+
 /// A command-line number within `limits`.
-fn within(s: &str, limits: &Limits) -> Result<f64, String> {
+fn within(s: &str, limits: &Limits) -> Result<f64, NumberError> {
     match s.trim().parse::<f64>() {
-        Ok(v) => limits.check(v).map_err(|e| e.to_string()),
-        Err(_) => Err("not a number".into()),
+        Ok(v) => Ok(limits.check(v)?),
+        Err(_) => Err(NumberError::NotANumber),
     }
 }
 
 /// `--rate`, Hz ([`RATE_HZ`]).
-pub fn rate_hz(s: &str) -> Result<f64, String> {
+pub fn rate_hz(s: &str) -> Result<f64, NumberError> {
     within(s, &RATE_HZ)
 }
 
 /// `--mass`, kg ([`MASS_KG`]).
-pub fn mass_kg(s: &str) -> Result<f64, String> {
+pub fn mass_kg(s: &str) -> Result<f64, NumberError> {
     within(s, &MASS_KG)
 }
 
 /// `--hold`, `--settle`, `--max-impact`, `--max-flight`, s ([`SECONDS`]).
-pub fn seconds(s: &str) -> Result<f64, String> {
+pub fn seconds(s: &str) -> Result<f64, NumberError> {
     within(s, &SECONDS)
 }
 
 /// `--v0`, m/s ([`SPEED_M_S`]).
-pub fn speed_m_s(s: &str) -> Result<f64, String> {
+pub fn speed_m_s(s: &str) -> Result<f64, NumberError> {
     within(s, &SPEED_M_S)
 }
 
 /// `--drop-height`, m ([`HEIGHT_M`]).
-pub fn height_m(s: &str) -> Result<f64, String> {
+pub fn height_m(s: &str) -> Result<f64, NumberError> {
     within(s, &HEIGHT_M)
 }
 
 /// `--gravity`, m/s² ([`GRAVITY_M_S2`]).
-pub fn gravity_m_s2(s: &str) -> Result<f64, String> {
+pub fn gravity_m_s2(s: &str) -> Result<f64, NumberError> {
     within(s, &GRAVITY_M_S2)
 }
 
 /// `--srs-low`, Hz ([`FREQUENCY_HZ`]).
-pub fn frequency_hz(s: &str) -> Result<f64, String> {
+pub fn frequency_hz(s: &str) -> Result<f64, NumberError> {
     within(s, &FREQUENCY_HZ)
 }
 
 /// `--gain` ([`GAIN`]).
-pub fn gain(s: &str) -> Result<f64, String> {
+pub fn gain(s: &str) -> Result<f64, NumberError> {
     within(s, &GAIN)
 }
 
 /// A command-line number that must be finite and > 0 (a count or a factor the core does not
 /// take as f32; quantities have their limits above).
-pub fn positive_f64(s: &str) -> Result<f64, String> {
+pub fn positive_f64(s: &str) -> Result<f64, NumberError> {
     match s.parse::<f64>() {
         Ok(v) if v.is_finite() && v > 0.0 => Ok(v),
-        Ok(_) => Err("must be finite and > 0".into()),
-        Err(_) => Err("not a number".into()),
+        Ok(_) => Err(NumberError::NotPositive),
+        Err(_) => Err(NumberError::NotANumber),
     }
 }
