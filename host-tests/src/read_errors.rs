@@ -1,28 +1,12 @@
 //! The readers' errors as the tool words them. `impact_io` names a setting a message asks
-//! for or refuses by its [`Opt`] (its own Display writes the `ReadOptions` field); here each
-//! is spelled as the `impact` option that gives it, so the messages read as they always have
+//! for or refuses by its [`impact_io::Opt`] (its own Display writes the `ReadOptions` field);
+//! here each is spelled as the `impact` option that gives it ([`crate::flags::flag`]), so the messages read as they always have
 //! (`one sample: the rate cannot be told; give --rate`). Where a function's errors are still
 //! messages (`Result<_, String>`), a reader's error becomes one here, at the boundary.
 
+pub use crate::flags::flag;
 use impact_io::units::UnitsConflict;
-use impact_io::{Opt, ReadError, ReadErrorKind};
-
-/// The option that gives a reading's setting.
-pub fn flag(setting: Opt) -> &'static str {
-    match setting {
-        Opt::Rate => "--rate",
-        Opt::TimeColumn => "--time-column",
-        Opt::TimeUnit => "--time-unit",
-        Opt::Column => "--column",
-        Opt::Axes => "--axes",
-        Opt::Resample => "--resample",
-        Opt::RawChannels => "--raw-channels",
-        Opt::RawType => "--raw-type",
-        Opt::DecimalComma => "--decimal-comma",
-        Opt::Delimiter => "--delimiter",
-        Opt::Units => "--units",
-    }
-}
+use impact_io::{ReadError, ReadErrorKind};
 
 /// A reader's error as the tool prints it: `FILE[:LINE]: what`, the settings named by their
 /// options.

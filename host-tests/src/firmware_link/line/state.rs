@@ -101,38 +101,24 @@ impl State {
     }
 }
 
-/// A `heartbeat` line: its counts of samples and impacts and its rate checked as it is read,
-/// the other counters when asked.
+/// A `heartbeat` or `summary` line (the two carry the same counters; a summary adds how the
+/// run ended, [`State::result`]): its counts of samples and impacts and its rate checked as
+/// it is read, the other counters when asked.
 #[derive(Clone, Debug, PartialEq)]
-pub struct HeartbeatLine {
+pub struct CountsLine {
     pub samples: u64,
     pub impacts: u64,
     pub rate_hz: f32,
     pub state: State,
 }
 
-impl HeartbeatLine {
-    pub fn parse(fields: Fields) -> Result<Self, LineError> {
-        let (samples, impacts, rate_hz) = counts(&fields)?;
-        Ok(Self {
-            samples,
-            impacts,
-            rate_hz,
-            state: State(fields),
-        })
-    }
-}
+/// A `heartbeat` line ([`CountsLine`]).
+pub type HeartbeatLine = CountsLine;
 
-/// A `summary` line: as a heartbeat, and how the run ended.
-#[derive(Clone, Debug, PartialEq)]
-pub struct SummaryLine {
-    pub samples: u64,
-    pub impacts: u64,
-    pub rate_hz: f32,
-    pub state: State,
-}
+/// A `summary` line ([`CountsLine`]; how the run ended: [`State::result`]).
+pub type SummaryLine = CountsLine;
 
-impl SummaryLine {
+impl CountsLine {
     pub fn parse(fields: Fields) -> Result<Self, LineError> {
         let (samples, impacts, rate_hz) = counts(&fields)?;
         Ok(Self {
