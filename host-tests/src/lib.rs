@@ -3,6 +3,7 @@
 
 pub mod bench;
 pub mod cli;
+pub mod drop;
 pub mod firmware_link;
 pub mod flags;
 pub mod html;
