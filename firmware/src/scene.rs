@@ -82,6 +82,10 @@ pub const BENCH: Scene = Scene {
         nonlinear_exponent: 1.0,
         hertz: true,
     },
+    // A horizontal strike: no gravity in the contact (a drop height, a train or
+    // `vertical: true` puts it there, see `Scene::contact_gravity_m_s2`).
+    gravity_m_s2: impact_core::consts::STANDARD_GRAVITY as f32,
+    vertical: false,
     train: None,
     spectrum: None,
     spec: None,
@@ -158,7 +162,9 @@ impl defmt::Format for SceneError {
 /// | `two_phase`, `nonlinear`, `fit_exponent`, `hertz` | `0` or `1` |
 /// | `exponent` | nonlinear exponent when not fitted (f32) |
 /// | `train` | bounce trains: `flight`, `rebound` (which speed the kinematics use) or `none` |
-/// | `gravity`, `max_flight` | the train's gravity, m/s², and longest flight, s |
+/// | `gravity` | gravity along the sensor's axis, m/s² (a vertical contact's, a drop's, a train's flights) |
+/// | `vertical` | `0` or `1`: gravity in the contact although neither a drop height nor a train says so |
+/// | `max_flight` | a train's longest flight, s |
 /// | `srs` | `0` or `1`: shock spectra per impact |
 /// | `srs_damping`, `srs_bands`, `srs_low` | damping ratio, bands per octave (6, 12), lowest band, Hz |
 /// | `spec` | judge each impact against a specified pulse: `half-sine`, `sawtooth`, `trapezoid` or `none` |
@@ -260,12 +266,11 @@ pub fn apply(scene: &mut Scene, key: &str, value: &str) -> Result<(), SceneError
             }
             scene.spectrum = Some(sp);
         }
-        "gravity" | "max_flight" => {
+        "gravity" => scene.gravity_m_s2 = float(value)?,
+        "vertical" => scene.vertical = flag(value)?,
+        "max_flight" => {
             let mut t = scene.train.ok_or(SceneError::BadValue)?;
-            match key {
-                "gravity" => t.gravity_m_s2 = float(value)?,
-                _ => t.max_flight_s = float(value)?,
-            }
+            t.max_flight_s = float(value)?;
             scene.train = Some(t);
         }
         "spec" => {

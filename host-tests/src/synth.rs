@@ -134,7 +134,6 @@ pub fn record(
     let period = 1.0 / sensor.rate_hz;
     let mut accel = vec![0.0f64; n];
     let mut truth = Vec::new();
-    let mut noise = Noise(sensor.seed.max(1));
     for c in contacts {
         // Sample times k*period measured from a touch at touch_s.
         let first = (c.touch_s * sensor.rate_hz).ceil() as usize;
@@ -150,10 +149,24 @@ pub fn record(
         }
         truth.push(exact);
     }
+    let (samples, clipped) = quantise(sensor, &accel);
+    Ok(Recording {
+        samples,
+        calibration: sensor.calibration(),
+        truth,
+        clipped,
+    })
+}
+
+/// The sensor's codes for the accelerations `accel` (m/s², one per sample period): offset,
+/// drift, noise, rounding, rails, dropped samples; and how many hit a rail.
+pub fn quantise(sensor: &Sensor, accel: &[f64]) -> (Vec<i16>, usize) {
+    let period = 1.0 / sensor.rate_hz;
+    let mut noise = Noise(sensor.seed.max(1));
     let gain = sensor.gain();
     let top = ((1u64 << sensor.bits) - 1) as f64;
     let mid = (1u64 << (sensor.bits - 1)) as f64;
-    let mut samples = Vec::with_capacity(n);
+    let mut samples = Vec::with_capacity(accel.len());
     let mut clipped = 0;
     for (k, a) in accel.iter().enumerate() {
         if sensor.drop_every > 0 && k % sensor.drop_every == sensor.drop_every - 1 {
@@ -171,12 +184,7 @@ pub fn record(
         }
         samples.push(q.clamp(0.0, top) as i16);
     }
-    Ok(Recording {
-        samples,
-        calibration: sensor.calibration(),
-        truth,
-        clipped,
-    })
+    (samples, clipped)
 }
 
 /// Most samples `impact synth` renders (80 s at 500 kS/s; the recording is held in memory).
@@ -238,9 +246,11 @@ pub struct SynthArgs {
     /// Time between the first touches of an `--impacts` train, s.
     #[arg(long, help_heading = "Trains", default_value_t = 0.08)]
     pub every: f64,
-    /// A bounce train: the body touches at --v0 (dropped from v0²/2g) and bounces under
-    /// standard gravity (flights in closed form, each contact at its own speed), this many
-    /// contacts in all, fewer if a rebound falls below 1 mm/s or the recording ends.
+    /// A bounce train: the body touches at --v0 and bounces under standard gravity, this
+    /// many contacts in all (the physical drop of `impact_host::drop`: gravity in each
+    /// contact, ballistic flights from where the body left to the pad's recovered surface, a
+    /// two-phase pad keeping its dent); the recording ends at the landing after the last
+    /// contact, after a rebound below 1 mm/s, or where the pad could not recover in a flight.
     #[arg(
         long,
         help_heading = "Trains",
@@ -322,17 +332,20 @@ pub fn synth(args: &SynthArgs) -> Result<Recording, String> {
     if args.bounces == 0 || args.bounces > 10_000 {
         return Err("--bounces: must lie in 1..=10000".into());
     }
-    let contacts: Vec<Placed> = if args.bounces > 1 {
-        bounce_train(args, &model)?
-            .into_iter()
-            .take_while(|b| args.touch + b.touch_time_s < args.duration)
-            .map(|b| Placed {
-                touch_s: args.touch + b.touch_time_s,
-                law: &model,
-                impact: Impact::new(args.mass, b.impact_velocity_m_s),
-            })
-            .collect()
-    } else {
+    if args.bounces > 1 {
+        let n = (args.duration * args.rate).ceil() as usize;
+        let rendered = bounce_drop(args, &model)
+            .render(args.rate, n)
+            .map_err(crate::flags::core)?;
+        let (samples, clipped) = quantise(&sensor, &rendered.accel_m_s2);
+        return Ok(Recording {
+            samples,
+            calibration: sensor.calibration(),
+            truth: rendered.contacts.iter().map(outcome).collect(),
+            clipped,
+        });
+    }
+    let contacts: Vec<Placed> = {
         (0..args.impacts)
             .map(|k| Placed {
                 touch_s: args.touch + k as f64 * args.every,
@@ -344,36 +357,49 @@ pub fn synth(args: &SynthArgs) -> Result<Recording, String> {
     record(&sensor, args.duration, &contacts).map_err(crate::flags::core)
 }
 
-/// The contacts of `--bounces`: touch times from the first touch (0), approach speeds and
-/// the exact outcomes (the oracle of the bounce-train tests).
+/// The physical drop `--bounces` renders: the body in free flight from the record's start,
+/// touching at `--touch` at `--v0`, bouncing under standard gravity.
+pub fn bounce_drop(args: &SynthArgs, model: &impact_core::Model<f64>) -> crate::drop::Drop {
+    crate::drop::Drop {
+        law: *model,
+        mass_kg: args.mass,
+        gravity_m_s2: impact_core::consts::STANDARD_GRAVITY,
+        start: crate::drop::Start::Moving {
+            touch_s: args.touch,
+            v0_m_s: args.v0,
+        },
+        max_contacts: args.bounces,
+        min_rebound_m_s: 1e-3,
+    }
+}
+
+/// The contacts of `--bounces` as the generator rendered them (the oracle of the
+/// bounce-train tests): times from the record's start.
 pub fn bounce_train(
     args: &SynthArgs,
     model: &impact_core::Model<f64>,
-) -> Result<Vec<impact_core::solve::bounce::Bounce<f64>>, String> {
-    use impact_core::consts::STANDARD_GRAVITY;
-    use impact_core::solve::bounce::Bounces;
-    let g = STANDARD_GRAVITY;
-    let height = args.v0 * args.v0 / (2.0 * g);
-    let release = (2.0 * height / g).sqrt();
-    let train = Bounces::new(
-        model,
-        impact_core::Settings::exact(),
-        args.mass,
-        height,
-        g,
-        1e-3,
-        args.bounces,
-    )
-    .map_err(crate::flags::core)?;
-    train
-        .map(|b| {
-            b.map(|mut b| {
-                b.touch_time_s -= release;
-                b
-            })
-            .map_err(crate::flags::core)
-        })
-        .collect()
+) -> Result<Vec<crate::drop::ContactTruth>, String> {
+    let n = (args.duration * args.rate).ceil() as usize;
+    Ok(bounce_drop(args, model)
+        .render(args.rate, n)
+        .map_err(crate::flags::core)?
+        .contacts)
+}
+
+/// A contact's truth as a model outcome (`permanent_deformation_m`: the deformation at
+/// separation, as the analysis reports it; zeros where the record ended first).
+fn outcome(t: &crate::drop::ContactTruth) -> ImpactOutcome<f64> {
+    let s = t.separation;
+    ImpactOutcome {
+        max_deformation_m: t.max_deformation_m.unwrap_or(0.0),
+        crush_time_s: t.crush_time_s.unwrap_or(0.0),
+        contact_time_s: s.map_or(0.0, |s| s.contact_time_s),
+        rebound_velocity_m_s: s.map_or(0.0, |s| s.rebound_m_s),
+        cor: s.map_or(0.0, |s| s.cor),
+        peak_force_n: t.peak_force_n,
+        permanent_deformation_m: s.map_or(0.0, |s| s.deformation_m),
+        rhs_evaluations: 0,
+    }
 }
 
 /// The virtual sensor `args` describe.

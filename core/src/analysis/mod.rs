@@ -315,6 +315,12 @@ fn analyse_kinematics<const CAP: usize>(
         separation
     };
     let v0d = v0 as f64;
+    // A vertical contact: the body decelerates at the reading less gravity.
+    let gravity = scene.contact_gravity_m_s2();
+    let motion = match gravity {
+        Some(g) => deviation.above(g as f64 / scene.calibration.gain_m_s2_per_count as f64),
+        None => deviation,
+    };
     let motion_scale = Scale {
         v0: v0d,
         kv: scene.calibration.gain_m_s2_per_count as f64 / s.base_n.max(1) as f64 / fs,
@@ -365,15 +371,13 @@ fn analyse_kinematics<const CAP: usize>(
         v: &mut *velocity,
         every,
     });
-    let Some(found) = motion::integrate(from_onset, deviation, &motion_scale, separation, out)
-    else {
+    let Some(found) = motion::integrate(from_onset, motion, &motion_scale, separation, out) else {
         r.flags.insert(Flags::NO_STOP);
         return r;
     };
-    let Some(delta_v) = r.delta_v_m_s else {
+    let Some(rebound) = report::rebound_m_s(&r, v0, gravity) else {
         return r;
     };
-    let rebound = delta_v - v0;
     let cor = rebound / v0;
     if !(-COR_TOLERANCE..=1.0 + COR_TOLERANCE).contains(&cor) {
         r.flags.insert(Flags::COR_OUT_OF_RANGE);
@@ -386,9 +390,11 @@ fn analyse_kinematics<const CAP: usize>(
         rebound_velocity_m_s: rebound,
         cor,
         permanent_deformation_m: found.x_sep as f32,
-        absorbed_energy_j: scene
-            .mass_kg
-            .map(|m| 0.5 * m * (v0 * v0 - rebound * rebound)),
+        // Gravity's work over the contact counts in a vertical one.
+        absorbed_energy_j: scene.mass_kg.map(|m| {
+            0.5 * m * (v0 * v0 - rebound * rebound)
+                + gravity.map_or(0.0, |g| m * g * found.x_sep as f32)
+        }),
     };
     r.kinematics = Some(k);
 

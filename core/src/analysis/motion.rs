@@ -5,8 +5,8 @@
 //!
 //! With the baseline frozen as the rational `S / W`, sample `j` contributes the integer
 //! `d_j = W x_j - S`. After `k` samples from the onset, `C_k = Σ_{j<k} d_j` and
-//! `Q_k = Σ_{j=1..k} C_j` are exact (i64: `|d| < 2^28` and at most 2^17 samples keep `Q` below
-//! 2^62), and
+//! `Q_k = Σ_{j=1..k} C_j` are exact (i64: `|d| < 2^29`, gravity's shift included, and at
+//! most 2^17 samples keep `|Q| <= |d| k (k + 1) / 2` below 2^62), and
 //!
 //! ```text
 //! v_k = v0 - kv C_k                          (kv = gain / (W fs), m/s per unit of C)

@@ -254,6 +254,15 @@ pub(crate) fn per_count(scene: &Scene, base_n: i64) -> f32 {
     scene.calibration.gain_m_s2_per_count / base_n.max(1) as f32
 }
 
+/// The rebound speed the report's Δv gives for an approach at `v0`, m/s: the pulse's area
+/// less the approach, less gravity's `g t_c` over the contact in a vertical one (the reading
+/// is specific force: in a contact the body's deceleration is the reading less `g`).
+/// `None` without a Δv.
+pub fn rebound_m_s(r: &ImpactReport, v0: f32, gravity_m_s2: Option<f32>) -> Option<f32> {
+    let delta_v = r.delta_v_m_s?;
+    Some(delta_v - v0 - gravity_m_s2.map_or(0.0, |g| g * r.duration_s))
+}
+
 /// The report of the streaming fields alone (`analysis` skipped); the analysis fills in the
 /// rest.
 pub fn streaming(s: &Summary, scene: &Scene) -> ImpactReport {

@@ -17,13 +17,6 @@ pub struct Bounce {
     pub v0_rebound_m_s: Option<f32>,
 }
 
-impl Bounce {
-    /// The COR with approach speed `v0` given this impact's Δv: `(Δv - v0) / v0`.
-    pub fn cor(v0: f32, delta_v: f32) -> f32 {
-        (delta_v - v0) / v0
-    }
-}
-
 /// What the streaming stage knows of one impact when it ends: positions, and exact integer
 /// sums of the baseline-removed raw counts `d = W x - S` (`S / W` is the frozen baseline).
 #[derive(Clone, Copy, Debug, PartialEq)]

@@ -29,14 +29,12 @@ pub enum Approach {
 }
 
 impl Approach {
-    /// The approach speed, m/s, if known.
-    pub fn v0_m_s(&self) -> Option<f32> {
+    /// The approach speed, m/s, if known, under gravity `gravity_m_s2` (a drop's).
+    pub fn v0_m_s(&self, gravity_m_s2: f32) -> Option<f32> {
         match *self {
             Approach::Unknown => None,
             Approach::Speed { v0_m_s } => Some(v0_m_s),
-            Approach::DropHeight { height_m } => {
-                Some(libm::sqrtf(2.0 * STANDARD_GRAVITY as f32 * height_m))
-            }
+            Approach::DropHeight { height_m } => Some(libm::sqrtf(2.0 * gravity_m_s2 * height_m)),
         }
     }
 }
@@ -111,6 +109,13 @@ pub struct Scene {
     /// class; costs an f64 biquad per idle sample, so it is off unless asked for).
     pub trigger_cfc: Option<Cfc>,
     pub fits: FitSet,
+    /// Gravity along the sensor's axis, m/s² (standard gravity unless the bench says): in the
+    /// contact of a vertical impact ([`Scene::contact_gravity_m_s2`]), a drop's approach
+    /// speed and a train's flights.
+    pub gravity_m_s2: f32,
+    /// The impact is vertical although neither a drop height nor a train says so (a body
+    /// dropped at a measured speed, a light gate above the pad).
+    pub vertical: bool,
     /// Bounce trains: each impact after the first takes its approach speed from the flight
     /// since the previous separation or from the previous rebound ([`crate::stream::train`]).
     pub train: Option<Train>,
@@ -142,11 +147,32 @@ impl Scene {
             cfc: None,
             trigger_cfc: None,
             fits: FitSet::none(),
+            gravity_m_s2: STANDARD_GRAVITY as f32,
+            vertical: false,
             train: None,
             spectrum: None,
             spec: None,
             waveform_every: 0,
         }
+    }
+
+    /// Gravity in the contact, m/s², by the one rule that decides whether an impact is
+    /// vertical: a drop from a height, a bounce train (every impact but the first follows a
+    /// flight, and the first a fall), or a scene that says `vertical`. `None`: horizontal.
+    ///
+    /// An accelerometer reads specific force: in a vertical contact the body's deceleration
+    /// is the reading less `g`, so the kinematics integrate `a - g` (the pulse's area, the
+    /// `delta_v_m_s` the shock standards define, stays the reading's).
+    pub fn contact_gravity_m_s2(&self) -> Option<f32> {
+        let vertical = self.vertical
+            || self.train.is_some()
+            || matches!(self.approach, Approach::DropHeight { .. });
+        vertical.then_some(self.gravity_m_s2)
+    }
+
+    /// The approach speed, m/s, if known (a drop's under the scene's gravity).
+    pub fn v0_m_s(&self) -> Option<f32> {
+        self.approach.v0_m_s(self.gravity_m_s2)
     }
 
     /// Checks every field, naming the offending one.
@@ -183,8 +209,17 @@ impl Scene {
             Approach::Speed { v0_m_s } => positive(v0_m_s, "v0")?,
             Approach::DropHeight { height_m } => positive(height_m, "drop-height")?,
         }
+        positive(self.gravity_m_s2, "gravity")?;
+        // Gravity in counts, as the kinematics subtract it: within the sensor's range.
+        if self.contact_gravity_m_s2().is_some()
+            && !(self.gravity_m_s2 / libm::fabsf(c.gain_m_s2_per_count) <= 32768.0)
+        {
+            return Err(Error::InvalidParameter {
+                name: "gravity",
+                reason: "must be within the sensor's range (at most 32768 counts)",
+            });
+        }
         if let Some(t) = self.train {
-            positive(t.gravity_m_s2, "gravity")?;
             positive(t.max_flight_s, "max-flight")?;
         }
         if let Some(sp) = self.spectrum {

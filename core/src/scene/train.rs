@@ -1,7 +1,5 @@
 //! A scene's bounce-train settings: which measure of a bounce's approach speed the
-//! kinematics use, gravity, the longest flight ([`crate::stream::train`] follows a train).
-
-use crate::consts::STANDARD_GRAVITY;
+//! kinematics use, the longest flight (gravity is the scene's) ([`crate::stream::train`] follows a train).
 
 /// Which measure of a bounce's approach speed the kinematics use.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -30,18 +28,15 @@ impl TrainSpeed {
 pub struct Train {
     /// The approach speed the kinematics use for bounces after the first.
     pub speed: TrainSpeed,
-    /// Gravity along the sensor's axis, m/s² (standard gravity unless the bench says).
-    pub gravity_m_s2: f32,
     /// A flight longer than this starts a new train, s (default 2 s: a 4.9 m bounce).
     pub max_flight_s: f32,
 }
 
 impl Train {
-    /// Standard gravity, flights up to 2 s, the kinematics on the flight time.
+    /// Flights up to 2 s, the kinematics on the flight time.
     pub const fn new() -> Self {
         Self {
             speed: TrainSpeed::Flight,
-            gravity_m_s2: STANDARD_GRAVITY as f32,
             max_flight_s: 2.0,
         }
     }

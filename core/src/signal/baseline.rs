@@ -334,6 +334,19 @@ impl Deviation {
         }
     }
 
+    /// The deviation from a level `counts` above the baseline (`S + W counts`, its product
+    /// rounded to an integer: within `1 / (2 W)` of a count, `1/8192` of a count or less for
+    /// the stream's baseline). The scene keeps `|counts| <= 2^15` (gravity within the
+    /// sensor's range), so `|d|` stays below 2^29.
+    pub fn above(self, counts: f64) -> Self {
+        let shift = libm::round(self.w as f64 * counts);
+        Self {
+            w: self.w,
+            // Saturating conversion: never wraps, whatever the input.
+            s: (self.s as f64 + shift) as i32,
+        }
+    }
+
     #[inline]
     pub fn of(self, x: i16) -> i32 {
         (x as i32).wrapping_mul(self.w).wrapping_sub(self.s)

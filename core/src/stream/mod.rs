@@ -24,6 +24,7 @@ mod tail;
 pub mod train;
 
 use crate::capture::Sink;
+use crate::consts::STANDARD_GRAVITY;
 use crate::error::Error;
 use crate::report::Status;
 use crate::scene::{Approach, FitSet, Scene};
@@ -161,6 +162,8 @@ impl<const PRE: usize> Stream<PRE> {
                 clip_counts: (i16::MIN, i16::MAX),
                 cfc: None,
                 trigger_cfc: None,
+                gravity_m_s2: STANDARD_GRAVITY as f32,
+                vertical: false,
                 train: None,
                 spectrum: None,
                 spec: None,
@@ -238,7 +241,7 @@ impl<const PRE: usize> Stream<PRE> {
         self.baseline.clear();
         self.active = None;
         self.index = 0;
-        self.v0 = scene.approach.v0_m_s();
+        self.v0 = scene.v0_m_s();
         self.train = train::Tracker::new();
         self.counters = Counters::default();
         self.trigger_counts = scene.trigger_m_s2 / gain;

@@ -62,7 +62,7 @@ impl Tracker {
         let bounce = Bounce {
             number: self.number.saturating_add(1),
             flight_s,
-            v0_flight_m_s: train.gravity_m_s2 * flight_s / 2.0,
+            v0_flight_m_s: scene.gravity_m_s2 * flight_s / 2.0,
             v0_rebound_m_s: self.rebound_m_s,
         };
         let v0 = match train.speed {
@@ -83,13 +83,15 @@ impl Tracker {
         };
         // A clipped impact's Δv is a lower bound: no rebound from it.
         let rebound = match (s.v0_m_s, separation) {
-            (Some(v0), Some(_)) if !s.clipped => report::streaming(s, scene)
-                .delta_v_m_s
-                .map(|dv| dv - v0)
-                .filter(|r| {
-                    let cor = r / v0;
-                    cor.is_finite() && (0.0..=1.0 + COR_TOLERANCE).contains(&cor) && *r > 0.0
-                }),
+            (Some(v0), Some(_)) if !s.clipped => report::rebound_m_s(
+                &report::streaming(s, scene),
+                v0,
+                scene.contact_gravity_m_s2(),
+            )
+            .filter(|r| {
+                let cor = r / v0;
+                cor.is_finite() && (0.0..=1.0 + COR_TOLERANCE).contains(&cor) && *r > 0.0
+            }),
             _ => None,
         };
         *self = Tracker {

@@ -401,7 +401,7 @@ pub fn log_scene(scene: &Scene) {
     let (v0, drop_height) = match scene.approach {
         Approach::Unknown => (None, None),
         Approach::Speed { v0_m_s } => (Some(v0_m_s), None),
-        Approach::DropHeight { height_m } => (scene.approach.v0_m_s(), Some(height_m)),
+        Approach::DropHeight { height_m } => (scene.v0_m_s(), Some(height_m)),
     };
     let fits = &scene.fits;
     info!(
@@ -426,7 +426,8 @@ pub fn log_scene(scene: &Scene) {
         fits.nonlinear_exponent,
         fits.hertz,
         scene.train.map_or("none", |t| t.speed.name()),
-        Opt(scene.train.map(|t| t.gravity_m_s2)),
+        // Gravity in the contact: `none` for a horizontal strike.
+        Opt(scene.contact_gravity_m_s2()),
         Opt(scene.train.map(|t| t.max_flight_s)),
         scene.spectrum.is_some(),
         scene.waveform_every,

@@ -25,6 +25,8 @@ pub struct LogJson<'a> {
     log: &'a Log,
     t0: f64,
     fits: impact_core::FitSet,
+    /// Gravity in the contacts, m/s² (the scene line's `gravity_m_s2`; none: horizontal).
+    gravity: Option<f32>,
 }
 
 impl<'a> LogJson<'a> {
@@ -67,6 +69,12 @@ impl<'a> LogJson<'a> {
                 .collect(),
             sample_rate_hz: rate as f64,
             v0_source,
+            contact_gravity_m_s2: scene
+                .map(|s| s.fields().opt::<f32>("gravity_m_s2"))
+                .transpose()
+                .map_err(LogError::whole)?
+                .flatten()
+                .map(crate::report::fmt::shortest),
             free_fall_s: None,
             samples_lost: total(|r| r.samples_lost),
             analyses_skipped: total(|r| r.analyses_skipped),
@@ -80,6 +88,11 @@ impl<'a> LogJson<'a> {
             log,
             t0,
             fits,
+            gravity: scene
+                .map(|s| s.fields().opt::<f32>("gravity_m_s2"))
+                .transpose()
+                .map_err(LogError::whole)?
+                .flatten(),
         };
         json.head.trains = crate::report::train::trains(json.impacts());
         Ok(json)
@@ -90,7 +103,7 @@ impl<'a> LogJson<'a> {
         let log = self.log;
         let runs = log.runs.len() > 1;
         (log.impacts.iter().zip(&log.latencies).enumerate()).map(move |(k, (r, latency))| {
-            let mut j = crate::report::impact_json(r, self.t0, &self.fits);
+            let mut j = crate::report::impact_json(r, self.t0, &self.fits, self.gravity);
             j.report_latency_s = latency.map(f64::from);
             j.run = runs.then(|| log.runs.partition_point(|run| run.impacts.end <= k) as u32 + 1);
             j

@@ -73,11 +73,14 @@ pub fn scene_args(scene: &Scene) -> Vec<String> {
             format!("srs_low={}", f(sp.low_hz)),
         ]),
     }
+    args.extend([
+        format!("gravity={}", f(scene.gravity_m_s2)),
+        format!("vertical={}", b(scene.vertical)),
+    ]);
     match scene.train {
         None => args.push("train=none".into()),
         Some(t) => args.extend([
             format!("train={}", t.speed.name()),
-            format!("gravity={}", f(t.gravity_m_s2)),
             format!("max_flight={}", f(t.max_flight_s)),
         ]),
     }

@@ -419,6 +419,12 @@ pub(crate) fn build_scene(
         _ => (Approach::Unknown, None),
     };
     scene.approach = approach;
+    if let Some(g) = args.train.gravity.or(file.gravity) {
+        scene.gravity_m_s2 = g as f32;
+    }
+    // A free fall is a drop: vertical (`Scene::contact_gravity_m_s2` has the rule).
+    scene.vertical =
+        args.train.vertical || file.vertical.unwrap_or(false) || args.free_fall.is_some();
     scene.train = args.train.train();
     scene.spectrum = args.spectrum.settings();
     scene.spec = args.spec.map(|s| s.spec);
@@ -618,11 +624,12 @@ pub fn to_json(setup: &Setup, reports: &[ImpactReport]) -> AnalysisJson {
         v0_m_s: match setup.scene.approach {
             Approach::Speed { v0_m_s } => Some(shortest(v0_m_s)),
             Approach::DropHeight { height_m } => {
-                Some((2.0 * STANDARD_GRAVITY * f64::from(height_m)).sqrt())
+                Some((2.0 * f64::from(setup.scene.gravity_m_s2) * f64::from(height_m)).sqrt())
             }
             _ => None,
         },
         v0_source: setup.v0_source.clone(),
+        contact_gravity_m_s2: setup.scene.contact_gravity_m_s2().map(shortest),
         free_fall_s: setup.free_fall_s,
         samples_lost: 0,
         analyses_skipped: reports
@@ -644,7 +651,12 @@ pub fn to_json(setup: &Setup, reports: &[ImpactReport]) -> AnalysisJson {
             .iter()
             .enumerate()
             .map(|(k, r)| {
-                let mut j = impact_json(r, setup.prepared.t0, &setup.scene.fits);
+                let mut j = impact_json(
+                    r,
+                    setup.prepared.t0,
+                    &setup.scene.fits,
+                    setup.scene.contact_gravity_m_s2(),
+                );
                 if !setup.axes.is_empty() {
                     let previous_end = k
                         .checked_sub(1)

@@ -43,6 +43,11 @@ pub struct SceneFile {
     pub range: Option<Level>,
     pub invert: Option<bool>,
     pub fits: Option<FitsFile>,
+    /// Gravity along the sensor's axis, m/s² (as `--gravity`).
+    #[serde(alias = "gravity_m_s2")]
+    pub gravity: Option<f64>,
+    /// The impact is vertical (as `--vertical`).
+    pub vertical: Option<bool>,
 }
 
 /// Which fits to run (scene file).
@@ -363,8 +368,19 @@ pub struct TrainArgs {
     #[arg(long, help_heading = "Analysis", value_enum)]
     pub train: Option<SpeedArg>,
     /// Gravity along the sensor's axis, m/s² [default: 9.80665].
-    #[arg(long, help_heading = "Analysis", requires = "train", value_parser = parse::gravity_m_s2)]
+    ///
+    /// Gravity along the sensor's axis, m/s² [default: 9.80665]: taken out of each vertical
+    /// contact (a drop, a train, --vertical), and a drop's and a flight's speed.
+    #[arg(long, help_heading = "Analysis", value_parser = parse::gravity_m_s2)]
     pub gravity: Option<f64>,
+    /// The impact is vertical: take gravity out of each contact.
+    ///
+    /// The impact is vertical: the accelerometer reads specific force, so in each contact the
+    /// body's deceleration is the reading less gravity, and the kinematics integrate that.
+    /// Implied by --drop-height, --free-fall and --train; give it for a vertical impact
+    /// whose speed comes from --v0 (a light gate above the pad).
+    #[arg(long, help_heading = "Analysis")]
+    pub vertical: bool,
     /// A flight longer than this starts a new train (a new drop), s [default: 2].
     #[arg(long, help_heading = "Analysis", requires = "train", value_parser = parse::seconds)]
     pub max_flight: Option<f64>,
@@ -380,7 +396,6 @@ impl TrainArgs {
         let d = Train::new();
         Some(Train {
             speed,
-            gravity_m_s2: self.gravity.map_or(d.gravity_m_s2, |g| g as f32),
             max_flight_s: self.max_flight.map_or(d.max_flight_s, |t| t as f32),
         })
     }

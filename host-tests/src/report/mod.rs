@@ -129,6 +129,10 @@ pub struct AnalysisJson {
     pub v0_source: Option<String>,
     /// Free fall measured on the DC channel, s.
     pub free_fall_s: Option<f64>,
+    /// Gravity taken out of each contact, m/s²: the impact is vertical (a drop height, a
+    /// free fall, a train, `--vertical`), so the kinematics integrate the reading less `g`
+    /// (Δv stays the pulse's area). Null: horizontal, the reading is the deceleration.
+    pub contact_gravity_m_s2: Option<f64>,
     /// Samples the source lost (only a real-time run on the firmware loses any).
     pub samples_lost: u64,
     /// Impacts reported without analysis because no capture buffer was free (likewise).
@@ -323,8 +327,14 @@ pub fn null_reasons(r: &ImpactReport, fits: &FitSet) -> BTreeMap<String, String>
 }
 
 /// A core report as JSON; times shifted by `t0` (the recording's first time stamp); `fits`
-/// is what the scene asked for (for the reasons of absent fits).
-pub fn impact_json(r: &ImpactReport, t0: f64, fits: &FitSet) -> ImpactJson {
+/// is what the scene asked for (for the reasons of absent fits); `gravity_m_s2` the gravity
+/// in its contacts (a bounce's COR by either source takes it out).
+pub fn impact_json(
+    r: &ImpactReport,
+    t0: f64,
+    fits: &FitSet,
+    gravity_m_s2: Option<f32>,
+) -> ImpactJson {
     let k = r.kinematics;
     let f = |v: f32| v as f64;
     ImpactJson {
@@ -359,7 +369,7 @@ pub fn impact_json(r: &ImpactReport, t0: f64, fits: &FitSet) -> ImpactJson {
             .spectrum
             .as_ref()
             .map(crate::report::spectrum::spectrum_json),
-        bounce: crate::report::train::bounce_json(r),
+        bounce: crate::report::train::bounce_json(r, gravity_m_s2),
         axes: None,
         run: None,
         spec: r

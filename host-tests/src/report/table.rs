@@ -47,6 +47,18 @@ pub fn to_table(a: &AnalysisJson) -> String {
             (d, m) => format!("; {d} LINES DROPPED by the board, {m} missing"),
         },
     );
+    // The frame the kinematics assumed, whenever there are kinematics to assume it for.
+    if a.v0_m_s.is_some() {
+        s.push_str(&match a.contact_gravity_m_s2 {
+            Some(g) => format!(
+                "vertical: gravity ({}) taken out of each contact; Δv is the pulse's area\n",
+                human(g, "m/s²")
+            ),
+            None => "horizontal: the reading is the deceleration (--vertical for a vertical \
+                     impact given its v0)\n"
+                .to_string(),
+        });
+    }
     if a.resampled {
         s.push_str("time axis resampled onto an even grid (--resample)\n");
     }

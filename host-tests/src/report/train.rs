@@ -32,8 +32,8 @@ pub struct BounceJson {
     pub v0_disagreement: Option<f64>,
 }
 
-/// The bounce of `r`, if it continues a train.
-pub fn bounce_json(r: &ImpactReport) -> Option<BounceJson> {
+/// The bounce of `r`, if it continues a train; `gravity_m_s2` in its contact.
+pub fn bounce_json(r: &ImpactReport, gravity_m_s2: Option<f32>) -> Option<BounceJson> {
     let b = r.bounce?;
     let f = |v: f32| v as f64;
     let tol = impact_core::report::COR_TOLERANCE as f64;
@@ -42,8 +42,8 @@ pub fn bounce_json(r: &ImpactReport) -> Option<BounceJson> {
             return Err("clipped");
         }
         let v0 = v0.ok_or("no-rebound")?;
-        let dv = r.delta_v_m_s.ok_or("ac-coupled")?;
-        let c = f(impact_core::Bounce::cor(v0, dv));
+        let rebound = impact_core::report::rebound_m_s(r, v0, gravity_m_s2).ok_or("ac-coupled")?;
+        let c = f(rebound / v0);
         if c.is_finite() && (-tol..=1.0 + tol).contains(&c) {
             Ok(c)
         } else {

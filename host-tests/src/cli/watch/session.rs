@@ -74,6 +74,8 @@ pub struct Session {
     started: bool,
     rate_hz: Option<f64>,
     gain: Option<f64>,
+    /// Gravity in the contacts, m/s² (the scene line's; none: horizontal).
+    contact_gravity_m_s2: Option<f32>,
     /// The window being received (only the newest is kept).
     wave: Option<Waveform>,
     pending: Option<Pending>,
@@ -125,6 +127,7 @@ impl Session {
             started: false,
             rate_hz: None,
             gain: None,
+            contact_gravity_m_s2: None,
             wave: None,
             pending: None,
             impacts: VecDeque::new(),
@@ -297,6 +300,9 @@ impl Session {
         self.started = true;
         self.rate_hz = Some(rate_hz);
         self.gain = (f.readable::<f64>("gain_m_s2_per_count")).filter(|g| g.is_finite());
+        // Gravity in the contacts (`none`: horizontal), for a bounce's COR.
+        self.contact_gravity_m_s2 =
+            (f.readable::<f32>("gravity_m_s2")).filter(|g| g.is_finite() && *g > 0.0);
         let scene: Map<String, Value> = f
             .iter()
             .take(64)
@@ -372,7 +378,12 @@ impl Session {
     /// An impact's event: its numbers, verdict and pulse.
     fn impact(&self, p: &Pending) -> Value {
         let r = &p.report;
-        let j = crate::report::impact_json(r, 0.0, &impact_core::FitSet::default());
+        let j = crate::report::impact_json(
+            r,
+            0.0,
+            &impact_core::FitSet::default(),
+            self.contact_gravity_m_s2,
+        );
         let g = STANDARD_GRAVITY;
         let verdict = r.verdict.as_ref().map(|v| match v {
             Ok(v) => json!({
