@@ -909,3 +909,46 @@ pub fn to_json(setup: &Setup, reports: &[ImpactReport]) -> AnalysisJson {
     a.trains = crate::report::train::trains(&a.impacts);
     a
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use std::path::Path;
+
+    #[test]
+    fn an_error_said_of_its_recording_drops_the_file_it_begins_with() {
+        let file = Path::new("runs/a.csv");
+        let few = PipelineError::TooFewSamples {
+            path: file.to_path_buf(),
+            column: "x_g".into(),
+            samples: 1,
+        };
+        assert_eq!(few.to_string(), "runs/a.csv: x_g: 1 samples; at least 2");
+        assert_eq!(
+            few.of_recording(file).to_string(),
+            "x_g: 1 samples; at least 2"
+        );
+        // Another file's error, and an error at a line, keep their file.
+        assert_eq!(
+            few.of_recording(Path::new("b.csv")).to_string(),
+            few.to_string()
+        );
+        let read = |at| {
+            PipelineError::Read(
+                impact_io::ReadError {
+                    path: file.to_path_buf(),
+                    at,
+                    kind: impact_io::ReadErrorKind::OneSample,
+                }
+                .into(),
+            )
+        };
+        assert_eq!(
+            read(None).of_recording(file).to_string(),
+            "one sample: the rate cannot be told; give --rate"
+        );
+        let at_line = read(Some(impact_io::At::Line(3)));
+        assert_eq!(at_line.of_recording(file).to_string(), at_line.to_string());
+        assert!(at_line.to_string().starts_with("runs/a.csv:3: "));
+    }
+}

@@ -263,5 +263,29 @@ mod tests {
             let e = parse(bad).unwrap_err().to_string();
             assert!(e.contains(want), "{bad}: {e}");
         }
+        // The kinds, with what was given.
+        let refused = |s: &str| parse(s).unwrap_err();
+        assert!(matches!(refused("half-sine"), SpecError::Form));
+        assert!(
+            matches!(refused("square,50g,11ms"), SpecError::Shape { name } if name == "square")
+        );
+        assert!(
+            matches!(refused("half-sine,50q,11ms"), SpecError::PeakNotANumber { text } if text == "50q")
+        );
+        assert!(matches!(
+            refused("half-sine,50g,-1ms"),
+            SpecError::DurationRange { .. }
+        ));
+        assert!(matches!(
+            refused("half-sine,50g,11ms,band=2"),
+            SpecError::Invalid(impact_core::Error::InvalidParameter { .. })
+        ));
+        assert!(matches!(
+            refused("half-sine,50g,11ms,rise=0.1"),
+            SpecError::Key {
+                trapezoid: false,
+                ..
+            }
+        ));
     }
 }
