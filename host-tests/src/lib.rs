@@ -28,15 +28,33 @@ pub fn take_notes() -> Vec<String> {
     impact_io::take_notes(read_errors::flag)
 }
 
+/// Why [`on_big_stack`]'s thread gave no result.
+#[derive(Debug, thiserror::Error)]
+pub enum WorkerError {
+    /// The thread could not be started (the system's limit on threads or memory).
+    #[error(transparent)]
+    Spawn(std::io::Error),
+    #[error("the worker thread panicked")]
+    Panicked,
+}
+
+/// Temporary, while callers still hold messages (`bench/`): the error as its message.
+impl From<WorkerError> for String {
+    fn from(e: WorkerError) -> Self {
+        e.to_string()
+    }
+}
+
 /// Runs `f` on a thread with a 64 MiB stack: the core's monitors hold their capture buffers
-/// inline (no allocation in `core`), which is more than a default thread's stack.
-pub fn on_big_stack<T: Send + 'static>(
-    f: impl FnOnce() -> Result<T, String> + Send + 'static,
-) -> Result<T, String> {
+/// inline (no allocation in `core`), which is more than a default thread's stack. `f`'s
+/// error, or the thread's own ([`WorkerError`]) as `f`'s error type.
+pub fn on_big_stack<T: Send + 'static, E: From<WorkerError> + Send + 'static>(
+    f: impl FnOnce() -> Result<T, E> + Send + 'static,
+) -> Result<T, E> {
     std::thread::Builder::new()
         .stack_size(64 << 20)
         .spawn(f)
-        .map_err(|e| e.to_string())?
+        .map_err(WorkerError::Spawn)?
         .join()
-        .map_err(|_| "the worker thread panicked".to_string())?
+        .map_err(|_| WorkerError::Panicked)?
 }

@@ -1,8 +1,9 @@
 //! The readers' errors as the tool words them. `impact_io` names a setting a message asks
 //! for or refuses by its [`impact_io::Opt`] (its own Display writes the `ReadOptions` field);
 //! here each is spelled as the `impact` option that gives it ([`crate::flags::flag`]), so the messages read as they always have
-//! (`one sample: the rate cannot be told; give --rate`). Where a function's errors are still
-//! messages (`Result<_, String>`), a reader's error becomes one here, at the boundary.
+//! (`one sample: the rate cannot be told; give --rate`). The host's error types hold a
+//! reader's error in one of the wrappers here ([`ReadFailure`], [`InputFileFailure`],
+//! [`UnitsFailure`]), whose Display is the message the tool prints.
 
 pub use crate::flags::flag;
 use impact_io::units::UnitsConflict;
@@ -12,12 +13,6 @@ use impact_io::{ReadError, ReadErrorKind};
 /// options.
 pub fn read_error_message(e: &ReadError) -> String {
     e.display_with(flag).to_string()
-}
-
-/// [`read_error_message`] taking the error, for `map_err` where a function's errors are
-/// messages.
-pub fn into_message(e: ReadError) -> String {
-    read_error_message(&e)
 }
 
 /// A secondary input's error ([`impact_io::read_limited`]: a scene file, a target, an
@@ -40,6 +35,37 @@ pub fn kind_message(kind: &ReadErrorKind) -> String {
 pub fn units_message(e: &UnitsConflict) -> String {
     e.display_with(flag).to_string()
 }
+
+/// A reader's error (the recording's, a free-fall recording's) as the tool prints it
+/// ([`read_error_message`]: `FILE[:LINE]: what`, the settings named by their options).
+/// (Boxed, as in [`InputFileFailure`]: a `ReadError` is large, the errors holding it many.)
+#[derive(Debug, thiserror::Error)]
+#[error("{}", read_error_message(.0))]
+pub struct ReadFailure(#[source] pub Box<ReadError>);
+
+impl From<ReadError> for ReadFailure {
+    fn from(e: ReadError) -> Self {
+        Self(Box::new(e))
+    }
+}
+
+/// A secondary input's error (a scene file) as the tool prints it
+/// ([`input_file_message`]: the file named by its path as given).
+#[derive(Debug, thiserror::Error)]
+#[error("{}", input_file_message(.0))]
+pub struct InputFileFailure(#[source] pub Box<ReadError>);
+
+impl From<ReadError> for InputFileFailure {
+    fn from(e: ReadError) -> Self {
+        Self(Box::new(e))
+    }
+}
+
+/// Units given that the channel's header contradicts, as the tool prints them
+/// ([`units_message`]).
+#[derive(Debug, thiserror::Error)]
+#[error("{}", units_message(.0))]
+pub struct UnitsFailure(#[source] pub UnitsConflict);
 
 #[cfg(test)]
 mod tests {

@@ -131,10 +131,10 @@ fn main() -> ExitCode {
 fn run(cli: Cli) -> Result<(), String> {
     match cli.command {
         Command::Simulate(args) => cli::simulate::run(&args),
-        Command::Analyze(args) => cli::analyze::run(&args),
+        Command::Analyze(args) => Ok(cli::analyze::run(&args)?),
         Command::Emulate(args) => cli::emulate::emulate(&args),
         Command::Log(args) => cli::log::log(&args),
-        Command::Report(args) => cli::html::run(&args),
+        Command::Report(args) => Ok(cli::html::run(&args)?),
         Command::Watch(args) => cli::watch::run(&args),
         Command::Synth(command) => cli::synth::run(command),
         Command::Bench { which } => cli::bench::run(which),

@@ -48,8 +48,50 @@ pub fn inputs(args: &AnalyzeArgs) -> Vec<&std::path::Path> {
     inputs
 }
 
+/// Why `impact analyze` failed.
+#[derive(Debug, thiserror::Error)]
+pub enum AnalyzeError {
+    /// (Boxed: the analysis's error is large.)
+    #[error(transparent)]
+    Pipeline(Box<pipeline::PipelineError>),
+    #[error(transparent)]
+    Plot(#[from] plot::PlotError),
+    #[error(transparent)]
+    Series(#[from] series::SeriesError),
+    /// The JSON not made.
+    #[error(transparent)]
+    Json(#[from] serde_json::Error),
+    #[error(
+        "--plot draws one recording: give one file and one channel (draw a series' \
+         recordings one call each)"
+    )]
+    PlotSeries,
+    /// One recording of the series failed (of `recordings`).
+    #[error("1 of {recordings} recordings failed: {failed}")]
+    OneFailed {
+        recordings: usize,
+        failed: Box<series::Failed>,
+    },
+    /// Several recordings of the series failed (the output names each).
+    #[error("{failed} of {recordings} recordings failed (each named in the output)")]
+    Failed { failed: usize, recordings: usize },
+}
+
+impl From<pipeline::PipelineError> for AnalyzeError {
+    fn from(e: pipeline::PipelineError) -> Self {
+        AnalyzeError::Pipeline(Box::new(e))
+    }
+}
+
+/// Temporary, while `bin/impact.rs` holds messages: the error as its message.
+impl From<AnalyzeError> for String {
+    fn from(e: AnalyzeError) -> Self {
+        e.to_string()
+    }
+}
+
 /// Runs `impact analyze`.
-pub fn run(cmd: &AnalyzeCommand) -> Result<(), String> {
+pub fn run(cmd: &AnalyzeCommand) -> Result<(), AnalyzeError> {
     let mut files = vec![cmd.args.file.clone()];
     files.extend(cmd.more.iter().cloned());
     if series::is_series(&files, &cmd.channels) {
@@ -65,10 +107,7 @@ pub fn run(cmd: &AnalyzeCommand) -> Result<(), String> {
     super::progress::finish();
     let a = pipeline::to_json(&setup, &reports);
     if args.json {
-        crate::outln!(
-            "{}",
-            serde_json::to_string_pretty(&a).map_err(|e| e.to_string())?
-        );
+        crate::outln!("{}", serde_json::to_string_pretty(&a)?);
     } else if args.csv {
         crate::out!("{}", report::to_csv(&a));
     } else {
@@ -89,14 +128,10 @@ pub fn run(cmd: &AnalyzeCommand) -> Result<(), String> {
 
 /// A test series: every recording analysed, the rows and statistics printed, each
 /// recording's notes named by it; exit status 1 if one failed (its error in the output).
-fn run_series(cmd: &AnalyzeCommand, files: &[PathBuf]) -> Result<(), String> {
+fn run_series(cmd: &AnalyzeCommand, files: &[PathBuf]) -> Result<(), AnalyzeError> {
     let args = &cmd.args;
     if args.plot.is_some() {
-        return Err(
-            "--plot draws one recording: give one file and one channel (draw a series' \
-             recordings one call each)"
-                .into(),
-        );
+        return Err(AnalyzeError::PlotSeries);
     }
     let entries = series::entries(files, &cmd.channels, args.column.as_ref())?;
     let results = series::analyze(args, &entries);
@@ -108,25 +143,27 @@ fn run_series(cmd: &AnalyzeCommand, files: &[PathBuf]) -> Result<(), String> {
     if args.json {
         crate::outln!(
             "{}",
-            serde_json::to_string_pretty(&series::to_json(&results)).map_err(|e| e.to_string())?
+            serde_json::to_string_pretty(&series::to_json(&results))?
         );
     } else if args.csv {
         crate::out!("{}", series::to_csv(&results));
     } else {
         crate::out!("{}", series::to_table(&results));
     }
-    let failed: Vec<&series::EntryJson> = results.iter().filter(|e| e.error.is_some()).collect();
-    match failed.as_slice() {
-        [] => Ok(()),
-        [one] => Err(format!(
-            "1 of {} recordings failed: {}",
-            results.len(),
-            series::failure(one, one.error.as_deref().unwrap_or_default())
-        )),
-        many => Err(format!(
-            "{} of {} recordings failed (each named in the output)",
-            many.len(),
-            results.len()
-        )),
+    let recordings = results.len();
+    let mut failed: Vec<series::Failed> = results
+        .into_iter()
+        .filter_map(series::EntryJson::into_failure)
+        .collect();
+    match failed.len() {
+        0 => Ok(()),
+        1 => Err(AnalyzeError::OneFailed {
+            recordings,
+            failed: Box::new(failed.remove(0)),
+        }),
+        n => Err(AnalyzeError::Failed {
+            failed: n,
+            recordings,
+        }),
     }
 }

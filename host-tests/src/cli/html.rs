@@ -34,14 +34,49 @@ pub struct ReportArgs {
     pub srs_required: Option<PathBuf>,
 }
 
+/// Why `impact report` failed.
+#[derive(Debug, thiserror::Error)]
+pub enum ReportError {
+    #[error("--plot, --json, --csv: `impact analyze` writes those; the report is --html")]
+    NotAReport,
+    #[error(transparent)]
+    Series(#[from] series::SeriesError),
+    #[error(transparent)]
+    Output(#[from] crate::output::OutputError),
+    #[error(transparent)]
+    RequiredSrs(#[from] srs_required::RequiredSrsError),
+    /// Some of the recordings failed (the page names each).
+    #[error("{failed} of {recordings} recordings failed (each named in the report)")]
+    Failed { failed: usize, recordings: usize },
+}
+
+/// Temporary, while `bin/impact.rs` holds messages: the error as its message.
+impl From<ReportError> for String {
+    fn from(e: ReportError) -> Self {
+        e.to_string()
+    }
+}
+
+/// Why a board's log could not be reported ([`log_report`]).
+#[derive(Debug, thiserror::Error)]
+pub enum LogReportError {
+    /// The log not read: `impact log`'s reader ([`crate::cli::log::read_log`]) still gives
+    /// its message, held here until that reader has a typed error of its own.
+    #[error("{message}")]
+    ReadLog { message: String },
+    #[error(transparent)]
+    Log(#[from] crate::firmware_link::log::LogError),
+    /// The log's scene line without a field the figures need.
+    #[error(transparent)]
+    Field(#[from] crate::firmware_link::line::FieldError),
+}
+
 /// Runs `impact report`.
-pub fn run(args: &ReportArgs) -> Result<(), String> {
+pub fn run(args: &ReportArgs) -> Result<(), ReportError> {
     let cmd = &args.analyze;
     let a = &cmd.args;
     if a.plot.is_some() || a.json || a.csv {
-        return Err(
-            "--plot, --json, --csv: `impact analyze` writes those; the report is --html".into(),
-        );
+        return Err(ReportError::NotAReport);
     }
     let mut files = vec![a.file.clone()];
     files.extend(cmd.more.iter().cloned());
@@ -75,10 +110,10 @@ pub fn run(args: &ReportArgs) -> Result<(), String> {
     crate::errln!("wrote {}", args.html.display());
     let failed = results.iter().filter(|e| e.error.is_some()).count();
     if failed > 0 {
-        return Err(format!(
-            "{failed} of {} recordings failed (each named in the report)",
-            results.len()
-        ));
+        return Err(ReportError::Failed {
+            failed,
+            recordings: results.len(),
+        });
     }
     Ok(())
 }
@@ -113,7 +148,7 @@ fn page(cfc: Option<u32>, results: &[EntryJson], required: Option<&RequiredSrs>)
             html!(
                 h,
                 "<p class=\"fail\">FAILED {}</p>\n",
-                series::failure(e, err)
+                series::failure(e, err.of_recording())
             );
         }
     }
@@ -370,7 +405,12 @@ fn spectra(h: &mut Html, results: &[EntryJson], required: &RequiredSrs) {
                 drawn += 1;
             }
             Err(err) => {
-                html!(h, "<p class=\"fail\">{}: not drawn: {}</p>\n", title, err);
+                html!(
+                    h,
+                    "<p class=\"fail\">{}: not drawn: {}</p>\n",
+                    title,
+                    err.to_string()
+                );
             }
         }
     }
@@ -382,17 +422,17 @@ fn spectra(h: &mut Html, results: &[EntryJson], required: &RequiredSrs) {
 pub fn log_report(
     path: &std::path::Path,
     spec: Option<&impact_core::spec::Spec>,
-) -> Result<String, String> {
+) -> Result<String, LogReportError> {
     let name = path.display().to_string();
-    let log = crate::cli::log::read_log(path)?;
-    let mut analysis =
-        crate::firmware_link::log_json::log_json(&log, 0.0).map_err(|e| e.to_string())?;
+    let log =
+        crate::cli::log::read_log(path).map_err(|message| LogReportError::ReadLog { message })?;
+    let mut analysis = crate::firmware_link::log_json::log_json(&log, 0.0)?;
     analysis.spec = spec.map(crate::report::spec::spec_json);
     let mut figures = Vec::new();
     if let Some(scene) = &log.scene {
         let rate = f64::from(scene.rate_hz);
-        let gain = f64::from(scene.gain().map_err(|e| e.to_string())?);
-        let mass = scene.mass_kg().map_err(|e| e.to_string())?;
+        let gain = f64::from(scene.gain()?);
+        let mass = scene.mass_kg()?;
         for (k, run) in log.runs.iter().enumerate() {
             let waves = &log.waveforms[run.waveforms.clone()];
             for r in &log.impacts[run.impacts.clone()] {

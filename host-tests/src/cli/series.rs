@@ -9,13 +9,104 @@ use impact_core::consts::STANDARD_GRAVITY;
 use impact_io::channel::ColumnRef;
 use serde::Serialize;
 
-use crate::pipeline::{self, AnalyzeArgs};
+use crate::pipeline::{self, AnalyzeArgs, PipelineError};
 use crate::report::fmt::human;
 use crate::report::statistics::{pass_rate, statistics, PassRate, Statistic, METRICS};
 use crate::report::{AnalysisJson, ImpactJson};
 
 /// The extensions of the recordings a folder contributes (as `impact analyze` reads them).
 pub const RECORDING_EXTENSIONS: [&str; 7] = ["csv", "ide", "wav", "npy", "tdms", "i16", "f32"];
+
+/// Why a series' recordings could not be listed.
+#[derive(Debug, thiserror::Error)]
+pub enum SeriesError {
+    #[error("a series reads files: standard input (-) can be one recording only")]
+    Stdin,
+    /// A folder given not listed.
+    #[error("{}: {source}", .path.display())]
+    Folder {
+        path: PathBuf,
+        source: std::io::Error,
+    },
+    #[error(
+        "{}: a folder with no recordings (files ending .{})",
+        .path.display(),
+        RECORDING_EXTENSIONS.join(", .")
+    )]
+    NoRecordings { path: PathBuf },
+    /// A pattern (as given) that is none.
+    #[error("{pattern}: not a pattern ({source})")]
+    Pattern {
+        pattern: String,
+        source: glob::PatternError,
+    },
+    /// A pattern (as given) that matches no file.
+    #[error("{pattern}: no file matches")]
+    NoMatch { pattern: String },
+}
+
+/// Why one recording of a series has no analysis.
+#[derive(Debug, thiserror::Error)]
+pub enum EntryError {
+    /// Its analysis failed (`file`: the recording, as its entry names it).
+    #[error("{error}")]
+    Analysis {
+        file: PathBuf,
+        #[source]
+        error: PipelineError,
+    },
+    /// Its thread panicked.
+    #[error("the analysis stopped on an internal error (please report it)")]
+    Internal,
+}
+
+impl EntryError {
+    /// What the error says of its recording: the message without the recording's name
+    /// where it would begin with it ([`PipelineError::of_recording`]), for a line that names
+    /// the recording first ([`failure`]).
+    pub fn of_recording(&self) -> OfEntry<'_> {
+        OfEntry(self)
+    }
+}
+
+/// An [`EntryError`] said of its recording ([`EntryError::of_recording`]).
+pub struct OfEntry<'a>(&'a EntryError);
+
+impl std::fmt::Display for OfEntry<'_> {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self.0 {
+            EntryError::Analysis { file, error } => error.of_recording(file).fmt(f),
+            e => e.fmt(f),
+        }
+    }
+}
+
+/// The JSON's `error`: the message as the tool prints it.
+fn error_message<S: serde::Serializer>(e: &Option<EntryError>, s: S) -> Result<S::Ok, S::Error> {
+    match e {
+        Some(e) => s.collect_str(e),
+        None => s.serialize_none(),
+    }
+}
+
+/// A failed recording of a series: its file and channel as its entry names them, and why.
+#[derive(Debug)]
+pub struct Failed {
+    pub file: String,
+    pub channel: String,
+    pub error: EntryError,
+}
+
+impl std::fmt::Display for Failed {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        Named {
+            file: &self.file,
+            channel: &self.channel,
+            what: self.error.of_recording(),
+        }
+        .fmt(f)
+    }
+}
 
 /// One recording of a series: a file and its channel (`None`: the file's default).
 #[derive(Clone, Debug)]
@@ -63,39 +154,41 @@ pub fn entries(
     files: &[PathBuf],
     channels: &[ColumnRef],
     column: Option<&ColumnRef>,
-) -> Result<Vec<Entry>, String> {
+) -> Result<Vec<Entry>, SeriesError> {
     let mut paths = Vec::new();
     for f in files {
         if f.as_os_str() == "-" {
-            return Err(
-                "a series reads files: standard input (-) can be one recording only".into(),
-            );
+            return Err(SeriesError::Stdin);
         }
         if f.is_dir() {
             let mut found: Vec<PathBuf> = std::fs::read_dir(f)
-                .map_err(|e| format!("{}: {e}", f.display()))?
+                .map_err(|source| SeriesError::Folder {
+                    path: f.clone(),
+                    source,
+                })?
                 .filter_map(|e| e.ok().map(|e| e.path()))
                 .filter(|p| p.is_file() && is_recording(p))
                 .collect();
             found.sort();
             if found.is_empty() {
-                return Err(format!(
-                    "{}: a folder with no recordings (files ending .{})",
-                    f.display(),
-                    RECORDING_EXTENSIONS.join(", .")
-                ));
+                return Err(SeriesError::NoRecordings { path: f.clone() });
             }
             paths.extend(found);
         } else if is_pattern(f) && !f.exists() {
             let pattern = f.to_string_lossy();
             let mut found: Vec<PathBuf> = glob::glob(&pattern)
-                .map_err(|e| format!("{pattern}: not a pattern ({e})"))?
+                .map_err(|source| SeriesError::Pattern {
+                    pattern: pattern.to_string(),
+                    source,
+                })?
                 .filter_map(Result::ok)
                 .filter(|p| p.is_file())
                 .collect();
             found.sort();
             if found.is_empty() {
-                return Err(format!("{pattern}: no file matches"));
+                return Err(SeriesError::NoMatch {
+                    pattern: pattern.to_string(),
+                });
             }
             paths.extend(found);
         } else {
@@ -134,8 +227,11 @@ fn is_recording(path: &Path) -> bool {
 pub struct EntryJson {
     pub file: String,
     pub channel: String,
-    #[serde(skip_serializing_if = "Option::is_none")]
-    pub error: Option<String>,
+    #[serde(
+        skip_serializing_if = "Option::is_none",
+        serialize_with = "error_message"
+    )]
+    pub error: Option<EntryError>,
     #[serde(skip_serializing_if = "Vec::is_empty")]
     pub notes: Vec<String>,
     #[serde(flatten, skip_serializing_if = "Option::is_none")]
@@ -197,7 +293,7 @@ fn analyze_all(args: &AnalyzeArgs, entries: &[Entry], draw: bool) -> Vec<EntryJs
             None => out.push(EntryJson {
                 file: entry.file.display().to_string(),
                 channel: entry.channel(),
-                error: Some("the analysis stopped on an internal error (please report it)".into()),
+                error: Some(EntryError::Internal),
                 notes: Vec::new(),
                 analysis: None,
                 figures: Vec::new(),
@@ -252,7 +348,14 @@ fn analyze_one(args: &AnalyzeArgs, entry: &Entry, draw: bool) -> EntryJson {
     });
     let (analysis, figures, error) = match result {
         Ok((j, f)) => (Some(j), f, None),
-        Err(e) => (None, Vec::new(), Some(e)),
+        Err(error) => (
+            None,
+            Vec::new(),
+            Some(EntryError::Analysis {
+                file: entry.file.clone(),
+                error,
+            }),
+        ),
     };
     EntryJson {
         file: entry.file.display().to_string(),
@@ -419,20 +522,48 @@ pub fn to_table(entries: &[EntryJson]) -> String {
     }
     for e in entries {
         if let Some(err) = &e.error {
-            s.push_str(&format!("FAILED {}\n", failure(e, err)));
+            s.push_str(&format!("FAILED {}\n", failure(e, err.of_recording())));
         }
     }
     s
 }
 
-/// A recording's failure as one line: its file, its channel if given, the error (which may
-/// name the file already).
-pub fn failure(e: &EntryJson, err: &str) -> String {
-    let err = err.strip_prefix(&format!("{}: ", e.file)).unwrap_or(err);
-    if e.channel.is_empty() {
-        format!("{}: {err}", e.file)
-    } else {
-        format!("{} channel {}: {err}", e.file, e.channel)
+/// A recording's line (a failure, a note): its file, its channel if given, and `what` it
+/// says of it (an error without the file: [`EntryError::of_recording`]).
+pub fn failure(e: &EntryJson, what: impl std::fmt::Display) -> String {
+    Named {
+        file: &e.file,
+        channel: &e.channel,
+        what,
+    }
+    .to_string()
+}
+
+/// `FILE: what`, or `FILE channel CHANNEL: what` if a channel is named.
+struct Named<'a, D> {
+    file: &'a str,
+    channel: &'a str,
+    what: D,
+}
+
+impl<D: std::fmt::Display> std::fmt::Display for Named<'_, D> {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        if self.channel.is_empty() {
+            write!(f, "{}: {}", self.file, self.what)
+        } else {
+            write!(f, "{} channel {}: {}", self.file, self.channel, self.what)
+        }
+    }
+}
+
+impl EntryJson {
+    /// The recording's failure, if it failed.
+    pub fn into_failure(self) -> Option<Failed> {
+        Some(Failed {
+            error: self.error?,
+            file: self.file,
+            channel: self.channel,
+        })
     }
 }
 

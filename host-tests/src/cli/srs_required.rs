@@ -1,18 +1,62 @@
 //! The required SRS of `impact report --srs-required FILE`: read from a CSV, each impact's
 //! measured SRS judged against it within MIL-STD-810H's −1.5/+3 dB, and drawn over it.
 
-use std::path::Path;
+use std::path::{Path, PathBuf};
 
 use impact_core::consts::STANDARD_GRAVITY;
 use plotters::prelude::*;
 
-use crate::plot::{draw_panel, svg_html, Panel};
+use crate::plot::{draw_panel, svg_html, Panel, PlotError};
 use crate::report::fmt::human;
-use crate::small_csv::SmallCsv;
+use crate::small_csv::{SmallCsv, SmallCsvError};
 use crate::standards::SRS_TOLERANCE_DB;
 
 /// Breakpoints a required SRS may have at most (a specification has a handful).
 const MAX_POINTS: usize = 10_000;
+
+/// A required SRS refused: the file as given and what is wrong with it
+/// (`--srs-required FILE: what`).
+#[derive(Debug, thiserror::Error)]
+#[error("--srs-required {}: {fault}", .path.display())]
+pub struct RequiredSrsError {
+    pub path: PathBuf,
+    #[source]
+    pub fault: Box<RequiredSrsFault>,
+}
+
+/// What is wrong with a required SRS's file; lines numbered as an editor numbers them.
+#[derive(Debug, thiserror::Error)]
+pub enum RequiredSrsFault {
+    #[error(transparent)]
+    Csv(#[from] SmallCsvError),
+    /// No `frequency_hz` column (the header's names as read).
+    #[error(
+        "needs the columns frequency_hz and acceleration_m_s2 (or acceleration_g); its header is {:?}",
+        .header.join(",")
+    )]
+    Columns { header: Vec<String> },
+    #[error("needs a column acceleration_m_s2 (or acceleration_g)")]
+    NoAcceleration,
+    /// A field (`text`, as read) of the column `column` (its header) that is no positive
+    /// number.
+    #[error("line {line}: {column} {text:?} is not a positive number")]
+    NotPositive {
+        line: usize,
+        column: String,
+        text: String,
+    },
+    /// A natural frequency, Hz, not above the previous row's.
+    #[error("line {line}: frequency_hz {frequency_hz} does not increase (after {last_hz})")]
+    NotIncreasing {
+        line: usize,
+        frequency_hz: f64,
+        last_hz: f64,
+    },
+    #[error("more than {MAX_POINTS} breakpoints")]
+    TooMany,
+    #[error("needs at least two breakpoints")]
+    TooFew,
+}
 
 /// A required SRS: its breakpoints (natural frequency, Hz; acceleration, m/s²), the
 /// frequencies increasing, straight between them on log–log axes (a constant dB/octave slope).
@@ -27,10 +71,13 @@ impl RequiredSrs {
     /// header naming `frequency_hz` and `acceleration_m_s2` or `acceleration_g` (in any case;
     /// other columns ignored): at least two rows, frequencies increasing, every value a
     /// positive number.
-    pub fn read(path: &Path) -> Result<Self, String> {
+    pub fn read(path: &Path) -> Result<Self, RequiredSrsError> {
         let file = path.display().to_string();
-        let err = |what: String| format!("--srs-required {file}: {what}");
-        let csv = SmallCsv::read(path, "required SRS").map_err(|e| err(e.to_string()))?;
+        let err = |fault: RequiredSrsFault| RequiredSrsError {
+            path: path.to_path_buf(),
+            fault: Box::new(fault),
+        };
+        let csv = SmallCsv::read(path, "required SRS").map_err(|e| err(e.into()))?;
         let header = &csv.header;
         let column = |name: &str| csv.column(name);
         let (Some(f_col), acceleration) = (
@@ -39,43 +86,45 @@ impl RequiredSrs {
                 .map(|c| (c, 1.0))
                 .or_else(|| column("acceleration_g").map(|c| (c, STANDARD_GRAVITY))),
         ) else {
-            return Err(err(format!(
-                "needs the columns frequency_hz and acceleration_m_s2 (or acceleration_g); its header is {:?}",
-                header.join(",")
-            )));
+            return Err(err(RequiredSrsFault::Columns {
+                header: header.clone(),
+            }));
         };
         let Some((a_col, scale)) = acceleration else {
-            return Err(err(
-                "needs a column acceleration_m_s2 (or acceleration_g)".into()
-            ));
+            return Err(err(RequiredSrsFault::NoAcceleration));
         };
         let mut points: Vec<(f64, f64)> = Vec::new();
         for (line, row) in &csv.rows {
-            let value = |col: usize, name: &str| -> Result<f64, String> {
+            let line = *line;
+            let value = |col: usize, name: &str| -> Result<f64, RequiredSrsError> {
                 let text = row.get(col).map_or("", String::as_str);
                 match text.parse::<f64>() {
                     Ok(v) if v.is_finite() && v > 0.0 => Ok(v),
-                    _ => Err(err(format!(
-                        "line {line}: {name} {text:?} is not a positive number"
-                    ))),
+                    _ => Err(err(RequiredSrsFault::NotPositive {
+                        line,
+                        column: name.to_string(),
+                        text: text.to_string(),
+                    })),
                 }
             };
             let f = value(f_col, "frequency_hz")?;
             let a = value(a_col, &header[a_col])? * scale;
             if let Some(&(last, _)) = points.last() {
                 if f <= last {
-                    return Err(err(format!(
-                        "line {line}: frequency_hz {f} does not increase (after {last})"
-                    )));
+                    return Err(err(RequiredSrsFault::NotIncreasing {
+                        line,
+                        frequency_hz: f,
+                        last_hz: last,
+                    }));
                 }
             }
             if points.len() == MAX_POINTS {
-                return Err(err(format!("more than {MAX_POINTS} breakpoints")));
+                return Err(err(RequiredSrsFault::TooMany));
             }
             points.push((f, a));
         }
         if points.len() < 2 {
-            return Err(err("needs at least two breakpoints".into()));
+            return Err(err(RequiredSrsFault::TooFew));
         }
         Ok(Self { file, points })
     }
@@ -182,7 +231,7 @@ pub fn svg(
     frequency_hz: &[f64],
     srs_m_s2: &[f64],
     required: &RequiredSrs,
-) -> Result<crate::html::Html, String> {
+) -> Result<crate::html::Html, PlotError> {
     let (low, high) = SRS_TOLERANCE_DB;
     let scaled = |db: f64| -> Vec<(f64, f64)> {
         let k = 10f64.powf(db / 20.0);
@@ -209,7 +258,7 @@ pub fn svg(
         legend: true,
     };
     svg_html((530, 340), |root| {
-        root.fill(&WHITE).map_err(|e| e.to_string())?;
+        root.fill(&WHITE)?;
         draw_panel(root, None, &panel)
     })
 }

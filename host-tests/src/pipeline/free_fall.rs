@@ -7,8 +7,35 @@ use impact_io::channel::CsvFormat;
 use impact_io::csv_read::read_table;
 use impact_io::ReadErrorKind;
 
-use crate::read_errors::{into_message, kind_message};
-use std::path::Path;
+use crate::read_errors::{kind_message, ReadFailure};
+use std::path::{Path, PathBuf};
+
+/// Why the free fall before an impact could not be measured (`--free-fall FILE[:COLUMN]`).
+#[derive(Debug, thiserror::Error)]
+pub enum FreeFallError {
+    /// The file not read.
+    #[error(transparent)]
+    Read(#[from] ReadFailure),
+    /// The file read, its columns not found (a column named that is not there).
+    #[error("--free-fall {}: {}", .path.display(), kind_message(.kind))]
+    Columns { path: PathBuf, kind: ReadErrorKind },
+    #[error("--free-fall {}: needs a time column", .path.display())]
+    NoTimeColumn { path: PathBuf },
+    #[error("--free-fall: the DC channel starts after the impact")]
+    StartsAfterImpact,
+    /// The DC channel's last time, s, before the impact's, s.
+    #[error(
+        "--free-fall {}: the DC channel ends at {ends_s:.6} s, before the impact at {impact_s:.6} s",
+        .path.display()
+    )]
+    EndsBeforeImpact {
+        path: PathBuf,
+        ends_s: f64,
+        impact_s: f64,
+    },
+    #[error("--free-fall: no free fall (|a| < 0.5 g) within 50 ms before the impact")]
+    NoFreeFall,
+}
 
 /// The file of a `--free-fall FILE[:COLUMN]` (an input: no output may write over it).
 pub fn file(spec: &str) -> &Path {
@@ -26,7 +53,7 @@ fn split(spec: &str) -> (&Path, Option<&str>) {
 /// Free-fall time ending at or before `impact_s`, from a DC accelerometer file in g: the
 /// stretch where |a| < 0.5 g (half way between rest and free fall) that ends within 50 ms
 /// before the impact.
-pub fn free_fall_before(spec: &str, impact_s: f64) -> Result<f64, String> {
+pub fn free_fall_before(spec: &str, impact_s: f64) -> Result<f64, FreeFallError> {
     let (path, column) = split(spec);
     let column = column.map(|c| c.parse::<ColumnRef>().unwrap_or(ColumnRef::Name(c.into())));
     let table = read_table(
@@ -34,13 +61,18 @@ pub fn free_fall_before(spec: &str, impact_s: f64) -> Result<f64, String> {
         &CsvFormat::default(),
         impact_io::progress::Progress::none(),
     )
-    .map_err(into_message)?;
-    let in_file =
-        |e: ReadErrorKind| format!("--free-fall {}: {}", path.display(), kind_message(&e));
-    let tcol = table
-        .time_column(None)
-        .map_err(in_file)?
-        .ok_or_else(|| format!("--free-fall {}: needs a time column", path.display()))?;
+    .map_err(ReadFailure::from)?;
+    let in_file = |kind: ReadErrorKind| FreeFallError::Columns {
+        path: path.to_path_buf(),
+        kind,
+    };
+    let tcol =
+        table
+            .time_column(None)
+            .map_err(in_file)?
+            .ok_or_else(|| FreeFallError::NoTimeColumn {
+                path: path.to_path_buf(),
+            })?;
     let unit = time_unit_s(&table.headers.get(tcol).cloned().unwrap_or_default(), None);
     let time: Vec<f64> = table.columns[tcol].iter().map(|t| t * unit).collect();
     let cols: Vec<usize> = match &column {
@@ -56,17 +88,16 @@ pub fn free_fall_before(spec: &str, impact_s: f64) -> Result<f64, String> {
     let end = time
         .iter()
         .rposition(|&t| t <= impact_s)
-        .ok_or("--free-fall: the DC channel starts after the impact")?;
+        .ok_or(FreeFallError::StartsAfterImpact)?;
     // The DC channel must run up to the impact: a file that ends before it cannot tell when
     // the fall ended.
     let interval = (time[time.len() - 1] - time[0]) / (time.len().max(2) - 1) as f64;
     if end + 1 == time.len() && impact_s - time[end] > 2.0 * interval {
-        return Err(format!(
-            "--free-fall {}: the DC channel ends at {:.6} s, before the impact at {:.6} s",
-            path.display(),
-            time[end],
-            impact_s
-        ));
+        return Err(FreeFallError::EndsBeforeImpact {
+            path: path.to_path_buf(),
+            ends_s: time[end],
+            impact_s,
+        });
     }
     // Walk back from the impact to the last free-falling sample, then to the release.
     let mut i = end;
@@ -74,9 +105,7 @@ pub fn free_fall_before(spec: &str, impact_s: f64) -> Result<f64, String> {
         i -= 1;
     }
     if mag(i) >= FREE_FALL_G {
-        return Err(
-            "--free-fall: no free fall (|a| < 0.5 g) within 50 ms before the impact".into(),
-        );
+        return Err(FreeFallError::NoFreeFall);
     }
     let last = i;
     while i > 0 && mag(i - 1) < FREE_FALL_G {

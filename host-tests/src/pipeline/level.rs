@@ -29,18 +29,17 @@ impl Level {
     }
 
     /// Parses `VALUE[UNIT]`: finite and > 0.
-    pub fn parse(s: &str) -> Result<Level, String> {
+    pub fn parse(s: &str) -> Result<Level, LevelError> {
         let s = s.trim();
         let split = s
             .find(|c: char| c.is_alphabetic() && c != 'e' && c != 'E')
             .unwrap_or(s.len());
         let (number, unit) = s.split_at(split);
-        let value: f64 = number
-            .trim()
-            .parse()
-            .map_err(|_| format!("{s:?} is not a number with an optional unit (5, 5g, 49m/s2)"))?;
+        let value: f64 = number.trim().parse().map_err(|_| LevelError::NotANumber {
+            text: s.to_string(),
+        })?;
         if !(value.is_finite() && value > 0.0) {
-            return Err("must be finite and > 0".into());
+            return Err(LevelError::NotPositive);
         }
         let units = match unit.trim().to_lowercase().as_str() {
             "" | "m/s2" | "m/s²" | "m/s^2" | "ms2" | "m_s2" => Units::MS2,
@@ -48,9 +47,9 @@ impl Level {
             "kgn" | "kg_n" => Units::Kgn,
             "n" => Units::N,
             other => {
-                return Err(format!(
-                    "unit {other:?}: one of m/s2 (the default), g, kgn, n"
-                ))
+                return Err(LevelError::Unit {
+                    unit: other.to_string(),
+                })
             }
         };
         Ok(Level { value, units })
@@ -67,9 +66,23 @@ impl fmt::Display for Level {
     }
 }
 
+/// Why a level was refused (clap names the option and the value given; a scene file's
+/// reader, the key).
+#[derive(Clone, Debug, PartialEq, thiserror::Error)]
+pub enum LevelError {
+    /// The number part (`text`: the level as given, trimmed) is not a number.
+    #[error("{text:?} is not a number with an optional unit (5, 5g, 49m/s2)")]
+    NotANumber { text: String },
+    #[error("must be finite and > 0")]
+    NotPositive,
+    /// A unit (lower-cased, as given) none of those a level takes.
+    #[error("unit {unit:?}: one of m/s2 (the default), g, kgn, n")]
+    Unit { unit: String },
+}
+
 impl std::str::FromStr for Level {
-    type Err = String;
-    fn from_str(s: &str) -> Result<Self, String> {
+    type Err = LevelError;
+    fn from_str(s: &str) -> Result<Self, LevelError> {
         Level::parse(s)
     }
 }

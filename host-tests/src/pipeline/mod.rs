@@ -26,8 +26,231 @@ use crate::report::fmt::shortest;
 use crate::report::{impact_json, AnalysisJson, Clipping, Spike, SPIKE_REMOVED};
 use impact_io::quantise::to_count;
 use impact_io::read_recording;
-pub use options::{scene_file, AnalyzeArgs, FitsFile, Level, SceneFile, Units};
+pub use options::{scene_file, AnalyzeArgs, FitsFile, Level, SceneFile, Setting, Units};
 use survey::Survey;
+
+use crate::read_errors::{ReadFailure, UnitsFailure};
+use std::path::PathBuf;
+
+/// Why a recording could not be analysed: its read, the settings, its survey, the stream's
+/// needs, the threads. Each message as the tool prints it.
+#[derive(Debug, thiserror::Error)]
+pub enum PipelineError {
+    /// The recording not read (its file named, the settings by their options).
+    #[error(transparent)]
+    Read(#[from] ReadFailure),
+    #[error(transparent)]
+    Units(#[from] UnitsFailure),
+    #[error(transparent)]
+    Scene(#[from] options::SceneError),
+    #[error(transparent)]
+    Survey(#[from] survey::SurveyError),
+    #[error(transparent)]
+    FreeFall(#[from] free_fall::FreeFallError),
+    #[error(transparent)]
+    Worker(#[from] crate::WorkerError),
+    /// A recording read whole would take `need_bytes` of memory, which cannot be had.
+    #[error("{}: {}", .path.display(), NeedsMemory(*.need_bytes))]
+    Memory { path: PathBuf, need_bytes: u64 },
+    #[error("--free-fall: no impact in the recording")]
+    NoImpactForFreeFall,
+    /// A CFC class (`--cfc`, the scene file's `cfc`, `--trigger-cfc`) none of SAE J211's.
+    #[error("{setting}: {class} is not one of 60, 180, 600, 1000")]
+    Cfc { setting: Setting, class: u32 },
+    /// The scene refused by the core: its parameter named as it was given (an option or
+    /// the scene file's key).
+    #[error("{setting}: {reason}")]
+    Invalid {
+        setting: Setting,
+        reason: &'static str,
+    },
+    /// The core refused the scene otherwise.
+    #[error(transparent)]
+    Core(impact_core::Error),
+    /// The core's monitor refused the scene: a parameter named as its option
+    /// ([`crate::flags::core`]).
+    #[error("{}", crate::flags::core(*.0))]
+    Monitor(impact_core::Error),
+    /// The longest impact (given or its default) shorter than the hold.
+    #[error("{longest}: shorter than the hold (at least {hold})")]
+    LongestUnderHold { longest: TimeGiven, hold: TimeGiven },
+    /// The hold given longer than the longest impact (its default).
+    #[error("{hold}: longer than the longest impact (at most {longest})")]
+    HoldOverLongest { hold: TimeGiven, longest: TimeGiven },
+    /// The settling time given, s, shorter than the hold.
+    #[error("{setting} {}: shorter than the hold (at least {hold})", impact_io::limits::number(*.settle_s))]
+    SettleUnderHold {
+        setting: Setting,
+        settle_s: f64,
+        hold: TimeGiven,
+    },
+    /// The edge level given not below the trigger level (`trigger_m_s2`).
+    #[error(
+        "{setting} {level}: not below the trigger level (below {trigger}, {})",
+        crate::report::fmt::human(*.trigger_m_s2, "m/s²")
+    )]
+    EdgeNotBelowTrigger {
+        setting: Setting,
+        level: options::LevelAsGiven,
+        trigger: TriggerGiven,
+        trigger_m_s2: f64,
+    },
+    /// `--stream` with an option (`--plot`) that needs the whole recording.
+    #[error("--stream: {option} needs the whole recording")]
+    StreamNeedsWhole { option: &'static str },
+    #[error(
+        "--stream: give --range (the sensor's full scale sets the quantisation before the \
+         recording's extremes are known)"
+    )]
+    StreamNeedsRange,
+    #[error(
+        "--stream: give --trigger (the level cannot be learned from a recording not yet read)"
+    )]
+    StreamNeedsTrigger,
+    /// A recording of fewer than 2 samples (`column`: its channel's header, empty if none).
+    #[error(
+        "{}: {}",
+        impact_io::channel::input_name(.path),
+        FewSamples(.column, *.samples)
+    )]
+    TooFewSamples {
+        path: PathBuf,
+        column: String,
+        samples: u64,
+    },
+    /// Standard input's spool (its values kept for the later passes) not made or written.
+    #[error("stdin: {0}")]
+    Spool(#[source] std::sync::Arc<impact_io::error::SpoolError>),
+    #[error("the survey's thread panicked")]
+    SurveyPanicked,
+    #[error("the reader thread panicked")]
+    ReaderPanicked,
+    /// The counts for `impact emulate` not written.
+    #[error("the recording's counts for the emulator: {0}")]
+    Counts(#[source] std::io::Error),
+}
+
+impl PipelineError {
+    /// The message without the recording's name where it begins with it (`file`, as a
+    /// series names its entry): what the error says of the recording.
+    pub fn of_recording<'a>(&'a self, file: &'a std::path::Path) -> OfRecording<'a> {
+        OfRecording { error: self, file }
+    }
+}
+
+/// A [`PipelineError`] as said of the recording `file` ([`PipelineError::of_recording`]):
+/// an error that names the file first (its read, its memory, its length) without it.
+pub struct OfRecording<'a> {
+    error: &'a PipelineError,
+    file: &'a std::path::Path,
+}
+
+impl std::fmt::Display for OfRecording<'_> {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self.error {
+            PipelineError::Read(ReadFailure(e))
+                if e.at.is_none() && e.kind.names_the_file() && e.path == self.file =>
+            {
+                f.write_str(&crate::read_errors::kind_message(&e.kind))
+            }
+            PipelineError::Memory { path, need_bytes } if path == self.file => {
+                NeedsMemory(*need_bytes).fmt(f)
+            }
+            PipelineError::TooFewSamples {
+                path,
+                column,
+                samples,
+            } if path == self.file => FewSamples(column, *samples).fmt(f),
+            e => e.fmt(f),
+        }
+    }
+}
+
+/// What a recording read whole needs, bytes, that cannot be had (without its file).
+struct NeedsMemory(u64);
+
+impl std::fmt::Display for NeedsMemory {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(
+            f,
+            "read whole (for --axes, --free-fall, --resample, --adxl375) it takes some {:.1} GB of memory, which is not available: analyse it without those options (read in passes, in bounded memory)",
+            self.0 as f64 / 1e9
+        )
+    }
+}
+
+/// A recording's channel (its header, empty if none) with too few samples (without its
+/// file).
+struct FewSamples<'a>(&'a str, u64);
+
+impl std::fmt::Display for FewSamples<'_> {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        if !self.0.is_empty() {
+            write!(f, "{}: ", self.0)?;
+        }
+        write!(f, "{} samples; at least 2", self.1)
+    }
+}
+
+/// Temporary, while `impact emulate` holds messages: the error as its message.
+impl From<PipelineError> for String {
+    fn from(e: PipelineError) -> Self {
+        e.to_string()
+    }
+}
+
+/// One of the times given (or its default), s, as messages name it: `--hold 0.5`,
+/// `scene.json: max_impact 1e-9`, `the default --hold, 0.002 s`.
+#[derive(Clone, Debug, PartialEq)]
+pub enum TimeGiven {
+    Given {
+        setting: Setting,
+        value_s: f64,
+    },
+    /// The option's default (`name`: `hold`).
+    Default {
+        name: &'static str,
+        value_s: f64,
+    },
+}
+
+impl std::fmt::Display for TimeGiven {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            TimeGiven::Given { setting, value_s } => {
+                write!(f, "{setting} {}", impact_io::limits::number(*value_s))
+            }
+            TimeGiven::Default { name, value_s } => write!(
+                f,
+                "the default --{name}, {} s",
+                impact_io::limits::number(*value_s)
+            ),
+        }
+    }
+}
+
+/// Where the trigger level an edge level is checked against came from.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum TriggerGiven {
+    /// `--trigger`, as given.
+    Option(Level),
+    /// The scene file's `trigger`, as given.
+    SceneFile(Level),
+    /// Learned from the signal's noise.
+    Learned,
+}
+
+impl std::fmt::Display for TriggerGiven {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            TriggerGiven::Option(t) => write!(f, "--trigger {t}"),
+            TriggerGiven::SceneFile(t) => write!(f, "the scene file's trigger {t}"),
+            TriggerGiven::Learned => {
+                f.write_str("the trigger level learned from the signal's noise")
+            }
+        }
+    }
+}
 
 /// Analyses a recording: the one entry of the three ways of reading it. A regular file or
 /// standard input is read in passes in bounded memory ([`streaming::analyze_in_passes`]),
@@ -38,7 +261,7 @@ use survey::Survey;
 pub fn analyze(
     args: &AnalyzeArgs,
     progress: impact_io::progress::Progress,
-) -> Result<(Setup, Vec<ImpactReport>), String> {
+) -> Result<(Setup, Vec<ImpactReport>), PipelineError> {
     let in_passes = streaming::in_passes(args);
     if !args.stream && !in_passes {
         memory_for_whole(&args.file)?;
@@ -58,7 +281,7 @@ pub fn analyze(
 /// ADXL375's axes) finds the memory it takes (its values, the signal and the counts: about
 /// three times a CSV's size, ten times a binary file's): a message naming the need when it
 /// does not (a memory limit), never an abort half way; a note for one over 1 GB.
-pub fn memory_for_whole(file: &std::path::Path) -> Result<(), String> {
+pub fn memory_for_whole(file: &std::path::Path) -> Result<(), PipelineError> {
     let size = std::fs::metadata(file).map_or(0, |m| m.len());
     let binary = matches!(
         impact_io::Format::of(file, None),
@@ -71,11 +294,10 @@ pub fn memory_for_whole(file: &std::path::Path) -> Result<(), String> {
         .try_reserve_exact(usize::try_from(need).unwrap_or(usize::MAX))
         .is_err()
     {
-        return Err(format!(
-            "{}: read whole (for --axes, --free-fall, --resample, --adxl375) it takes some {:.1} GB of memory, which is not available: analyse it without those options (read in passes, in bounded memory)",
-            file.display(),
-            gb(need)
-        ));
+        return Err(PipelineError::Memory {
+            path: file.to_path_buf(),
+            need_bytes: need,
+        });
     }
     drop(probe);
     if size > 1 << 30 {
@@ -238,10 +460,12 @@ impl Setup {
 }
 
 /// Reads the file and builds the scene (v0 from a free fall needs a first pass).
-pub fn setup(args: &AnalyzeArgs, progress: impact_io::progress::Progress) -> Result<Setup, String> {
+pub fn setup(
+    args: &AnalyzeArgs,
+    progress: impact_io::progress::Progress,
+) -> Result<Setup, PipelineError> {
     let file = scene_file(args)?;
-    let ch = read_recording(&args.file, &args.read_options(progress))
-        .map_err(crate::read_errors::into_message)?;
+    let ch = read_recording(&args.file, &args.read_options(progress)).map_err(ReadFailure::from)?;
     let column = ch
         .axes
         .first()
@@ -320,7 +544,7 @@ pub fn setup(args: &AnalyzeArgs, progress: impact_io::progress::Progress) -> Res
         let start = first
             .first()
             .map(|r| setup.prepared.t0 + r.start_s)
-            .ok_or("--free-fall: no impact in the recording")?;
+            .ok_or(PipelineError::NoImpactForFreeFall)?;
         let t_ff = free_fall_before(spec, start)?;
         setup.free_fall_s = Some(t_ff);
         setup.scene.approach = Approach::Speed {
@@ -339,10 +563,9 @@ pub(crate) fn mass_and_scale(
     args: &AnalyzeArgs,
     file: &SceneFile,
     column: &str,
-) -> Result<(Option<f64>, f64, Units), String> {
+) -> Result<(Option<f64>, f64, Units), PipelineError> {
     let mass = args.mass.or(file.mass);
-    let units = Units::resolve(args.units.or(file.units), column)
-        .map_err(|e| crate::read_errors::units_message(&e))?;
+    let units = Units::resolve(args.units.or(file.units), column).map_err(UnitsFailure)?;
     let invert = args.invert || file.invert.unwrap_or(false);
     let scale = units.to_m_s2(mass) * args.gain.unwrap_or(1.0) * if invert { -1.0 } else { 1.0 };
     Ok((mass, scale, units))
@@ -358,7 +581,7 @@ pub(crate) fn build_scene(
     edge: f64,
     clipping: Option<&Clipping>,
     mass: Option<f64>,
-) -> Result<Resolved, String> {
+) -> Result<Resolved, PipelineError> {
     let mut scene = Scene::new(calibration, trigger as f32);
     scene.edge_m_s2 = edge as f32;
     if let Some(c) = clipping {
@@ -380,17 +603,17 @@ pub(crate) fn build_scene(
     };
     scene.mass_kg = mass.map(|m| m as f32);
     scene.cfc = match args.cfc.or(file.cfc) {
-        Some(c) => Some(Cfc::from_class(c).ok_or_else(|| {
-            let name = name_of(args, file, "cfc");
-            format!("{name}: {c} is not one of 60, 180, 600, 1000")
+        Some(c) => Some(Cfc::from_class(c).ok_or_else(|| PipelineError::Cfc {
+            setting: name_of(args, file, "cfc"),
+            class: c,
         })?),
         None => None,
     };
     scene.trigger_cfc = match args.trigger_cfc {
-        Some(c) => Some(
-            Cfc::from_class(c)
-                .ok_or_else(|| format!("--trigger-cfc: {c} is not one of 60, 180, 600, 1000"))?,
-        ),
+        Some(c) => Some(Cfc::from_class(c).ok_or(PipelineError::Cfc {
+            setting: Setting::Option("trigger-cfc"),
+            class: c,
+        })?),
         None => None,
     };
     let f = file.fits.clone().unwrap_or_default();
@@ -430,10 +653,11 @@ pub(crate) fn build_scene(
     scene.spec = args.spec.map(|s| s.spec);
     scene.validate().map_err(|e| match e {
         // Named as it was given: an option, or the scene file's key.
-        impact_core::Error::InvalidParameter { name, reason } => {
-            format!("{}: {reason}", name_of(args, file, name))
-        }
-        e => e.to_string(),
+        impact_core::Error::InvalidParameter { name, reason } => PipelineError::Invalid {
+            setting: name_of(args, file, name),
+            reason,
+        },
+        e => PipelineError::Core(e),
     })?;
     Ok(Resolved {
         scene,
@@ -446,7 +670,7 @@ const DEFAULT_HOLD_S: f64 = 2e-3;
 
 /// How messages name the core's parameter `name` (`hold`, `max-impact`): the scene file's
 /// key if the file gives it and the command line does not, else the option.
-fn name_of(args: &AnalyzeArgs, file: &SceneFile, name: &str) -> String {
+fn name_of(args: &AnalyzeArgs, file: &SceneFile, name: &'static str) -> Setting {
     // (On the command line, and in the file.)
     let (cli, in_file) = match name {
         "mass" => (args.mass.is_some(), file.mass.is_some()),
@@ -462,12 +686,7 @@ fn name_of(args: &AnalyzeArgs, file: &SceneFile, name: &str) -> String {
         "exponent" => (false, true),
         _ => (true, false),
     };
-    let key = match name {
-        "exponent" => "fits.exponent".to_string(),
-        _ => name.replace('-', "_"),
-    };
-    let option = format!("--{name}");
-    options::setting_name(args, cli, in_file, &option, &key).unwrap_or(option)
+    options::setting_name(args, cli, in_file, name).unwrap_or(Setting::Option(name))
 }
 
 /// One of the times given (or its default), s, and how messages name it: `--hold 0.5`,
@@ -475,26 +694,25 @@ fn name_of(args: &AnalyzeArgs, file: &SceneFile, name: &str) -> String {
 fn time_given(
     args: &AnalyzeArgs,
     file: &SceneFile,
-    name: &str,
+    name: &'static str,
     (cli, in_file): (Option<f64>, Option<f64>),
     default: f64,
-) -> (f64, String, bool) {
+) -> (f64, TimeGiven, bool) {
     match cli.or(in_file) {
         Some(v) => (
             v,
-            format!(
-                "{} {}",
-                name_of(args, file, name),
-                impact_io::limits::number(v)
-            ),
+            TimeGiven::Given {
+                setting: name_of(args, file, name),
+                value_s: v,
+            },
             true,
         ),
         None => (
             default,
-            format!(
-                "the default --{name}, {} s",
-                impact_io::limits::number(default)
-            ),
+            TimeGiven::Default {
+                name,
+                value_s: default,
+            },
             false,
         ),
     }
@@ -503,7 +721,11 @@ fn time_given(
 /// The hold at most the longest impact (`default_longest_s` if none is given), the settling
 /// time at least the hold: an error names the time given that breaks it (and the other,
 /// given or its default).
-fn check_times(args: &AnalyzeArgs, file: &SceneFile, default_longest_s: f64) -> Result<(), String> {
+fn check_times(
+    args: &AnalyzeArgs,
+    file: &SceneFile,
+    default_longest_s: f64,
+) -> Result<(), PipelineError> {
     let (hold, hold_name, hold_given) =
         time_given(args, file, "hold", (args.hold, file.hold), DEFAULT_HOLD_S);
     let (longest, longest_name, longest_given) = time_given(
@@ -515,18 +737,24 @@ fn check_times(args: &AnalyzeArgs, file: &SceneFile, default_longest_s: f64) -> 
     );
     if hold > longest {
         return Err(if longest_given || !hold_given {
-            format!("{longest_name}: shorter than the hold (at least {hold_name})")
+            PipelineError::LongestUnderHold {
+                longest: longest_name,
+                hold: hold_name,
+            }
         } else {
-            format!("{hold_name}: longer than the longest impact (at most {longest_name})")
+            PipelineError::HoldOverLongest {
+                hold: hold_name,
+                longest: longest_name,
+            }
         });
     }
     if let Some(settle) = args.settle.or(file.settle) {
         if settle < hold {
-            let name = name_of(args, file, "settle");
-            let settle = impact_io::limits::number(settle);
-            return Err(format!(
-                "{name} {settle}: shorter than the hold (at least {hold_name})"
-            ));
+            return Err(PipelineError::SettleUnderHold {
+                setting: name_of(args, file, "settle"),
+                settle_s: settle,
+                hold: hold_name,
+            });
         }
     }
     Ok(())
@@ -539,24 +767,24 @@ fn check_edge(
     trigger: f64,
     edge: f64,
     mass: Option<f64>,
-) -> Result<(), String> {
+) -> Result<(), PipelineError> {
     let Some(level) = args.edge.or(file.edge) else {
         return Ok(());
     };
     if (edge as f32) < (trigger as f32) {
         return Ok(());
     }
-    let trigger_name = match (args.trigger, file.trigger) {
-        (Some(t), _) => format!("--trigger {t}"),
-        (None, Some(t)) => format!("the scene file's trigger {t}"),
-        (None, None) => "the trigger level learned from the signal's noise".into(),
+    let trigger_given = match (args.trigger, file.trigger) {
+        (Some(t), _) => TriggerGiven::Option(t),
+        (None, Some(t)) => TriggerGiven::SceneFile(t),
+        (None, None) => TriggerGiven::Learned,
     };
-    Err(format!(
-        "{} {}: not below the trigger level (below {trigger_name}, {})",
-        name_of(args, file, "edge"),
-        options::level_as_given(level, mass),
-        crate::report::fmt::human(trigger, "m/s²"),
-    ))
+    Err(PipelineError::EdgeNotBelowTrigger {
+        setting: name_of(args, file, "edge"),
+        level: options::LevelAsGiven { level, mass },
+        trigger: trigger_given,
+        trigger_m_s2: trigger,
+    })
 }
 
 /// The core's monitor fed blocks of counts: the one analysis loop of every way of reading a
@@ -569,9 +797,9 @@ pub struct MonitorRun {
 }
 
 impl MonitorRun {
-    pub fn new(scene: Scene) -> Result<Self, String> {
+    pub fn new(scene: Scene) -> Result<Self, PipelineError> {
         Ok(Self {
-            monitor: HostMonitor::new(scene).map_err(crate::flags::core)?,
+            monitor: HostMonitor::new(scene).map_err(PipelineError::Monitor)?,
             reports: Vec::new(),
             samples: 0,
         })
@@ -590,7 +818,7 @@ impl MonitorRun {
     /// The stream has ended: the reports and the samples seen. A signal that never gave a
     /// baseline has no impacts, as on the board (`impact emulate` on the same file): a note
     /// says why.
-    pub fn finish(mut self) -> Result<(Vec<ImpactReport>, u64), String> {
+    pub fn finish(mut self) -> Result<(Vec<ImpactReport>, u64), PipelineError> {
         let reports = &mut self.reports;
         self.monitor
             .finish(&mut |r: &ImpactReport| reports.push(*r));
@@ -602,7 +830,7 @@ impl MonitorRun {
 }
 
 /// Analyses the counts of a whole recording.
-pub fn run(counts: &[i16], scene: &Scene) -> Result<Vec<ImpactReport>, String> {
+pub fn run(counts: &[i16], scene: &Scene) -> Result<Vec<ImpactReport>, PipelineError> {
     let scene = *scene;
     let counts = counts.to_vec();
     crate::on_big_stack(move || {
@@ -692,4 +920,47 @@ pub fn to_json(setup: &Setup, reports: &[ImpactReport]) -> AnalysisJson {
     };
     a.trains = crate::report::train::trains(&a.impacts);
     a
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use std::path::Path;
+
+    #[test]
+    fn an_error_said_of_its_recording_drops_the_file_it_begins_with() {
+        let file = Path::new("runs/a.csv");
+        let few = PipelineError::TooFewSamples {
+            path: file.to_path_buf(),
+            column: "x_g".into(),
+            samples: 1,
+        };
+        assert_eq!(few.to_string(), "runs/a.csv: x_g: 1 samples; at least 2");
+        assert_eq!(
+            few.of_recording(file).to_string(),
+            "x_g: 1 samples; at least 2"
+        );
+        // Another file's error, and an error at a line, keep their file.
+        assert_eq!(
+            few.of_recording(Path::new("b.csv")).to_string(),
+            few.to_string()
+        );
+        let read = |at| {
+            PipelineError::Read(
+                impact_io::ReadError {
+                    path: file.to_path_buf(),
+                    at,
+                    kind: impact_io::ReadErrorKind::OneSample,
+                }
+                .into(),
+            )
+        };
+        assert_eq!(
+            read(None).of_recording(file).to_string(),
+            "one sample: the rate cannot be told; give --rate"
+        );
+        let at_line = read(Some(impact_io::At::Line(3)));
+        assert_eq!(at_line.of_recording(file).to_string(), at_line.to_string());
+        assert!(at_line.to_string().starts_with("runs/a.csv:3: "));
+    }
 }

@@ -253,14 +253,17 @@ impl AnalyzeArgs {
 
 /// The `--scene` file's settings (all defaults without one), each number within its limits
 /// ([`SceneFile::check`]); and the levels given, there or as options ([`check_levels`]).
-pub fn scene_file(args: &AnalyzeArgs) -> Result<SceneFile, String> {
+pub fn scene_file(args: &AnalyzeArgs) -> Result<SceneFile, SceneError> {
     let file = match &args.scene {
         None => SceneFile::default(),
         Some(path) => {
             let bytes = impact_io::read_limited(path, 1 << 20, "scene file")
-                .map_err(|e| crate::read_errors::input_file_message(&e))?;
+                .map_err(|e| SceneError::Read(e.into()))?;
             let file: SceneFile =
-                serde_json::from_slice(&bytes).map_err(|e| format!("{}: {e}", path.display()))?;
+                serde_json::from_slice(&bytes).map_err(|source| SceneError::Json {
+                    path: path.clone(),
+                    source,
+                })?;
             file.check(path)?;
             file
         }
@@ -271,46 +274,112 @@ pub fn scene_file(args: &AnalyzeArgs) -> Result<SceneFile, String> {
 
 /// Each level given (`--trigger`, `--edge`, `--range`, or the scene file's) within
 /// [`parse::LEVEL_M_S2`] once in m/s² (a force over the mass given), named as it was given.
-pub fn check_levels(args: &AnalyzeArgs, file: &SceneFile) -> Result<(), String> {
+pub fn check_levels(args: &AnalyzeArgs, file: &SceneFile) -> Result<(), SceneError> {
     let mass = args.mass.or(file.mass);
-    for (option, key, cli, in_file) in [
-        ("--trigger", "trigger", args.trigger, file.trigger),
-        ("--edge", "edge", args.edge, file.edge),
-        ("--range", "range", args.range, file.range),
+    for (name, cli, in_file) in [
+        ("trigger", args.trigger, file.trigger),
+        ("edge", args.edge, file.edge),
+        ("range", args.range, file.range),
     ] {
-        let (Some(level), Some(name)) = (
+        let (Some(level), Some(setting)) = (
             cli.or(in_file),
-            setting_name(args, cli.is_some(), in_file.is_some(), option, key),
+            setting_name(args, cli.is_some(), in_file.is_some(), name),
         ) else {
             continue;
         };
         if !parse::LEVEL_M_S2.contains(level.to_m_s2(mass)) {
-            return Err(format!(
-                "{name} {}: out of range ({})",
-                level_as_given(level, mass),
-                parse::LEVEL_M_S2
-            ));
+            return Err(SceneError::LevelOutOfRange {
+                setting,
+                level: LevelAsGiven { level, mass },
+            });
         }
     }
     Ok(())
 }
 
-/// A level as given, and in m/s² if it was given in another unit: `5g (49.03 m/s²)`.
-pub fn level_as_given(level: Level, mass: Option<f64>) -> String {
-    match level.units {
-        Units::MS2 => level.to_string(),
-        _ => format!(
-            "{level} ({})",
-            crate::report::fmt::human(level.to_m_s2(mass), "m/s²")
-        ),
+/// A level as given, and in m/s² if it was given in another unit (a force over `mass`, kg):
+/// `5g (49.03 m/s²)`.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct LevelAsGiven {
+    pub level: Level,
+    pub mass: Option<f64>,
+}
+
+impl std::fmt::Display for LevelAsGiven {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        let level = self.level;
+        match level.units {
+            Units::MS2 => write!(f, "{level}"),
+            _ => write!(
+                f,
+                "{level} ({})",
+                crate::report::fmt::human(level.to_m_s2(self.mass), "m/s²")
+            ),
+        }
     }
 }
+
+/// Why the scene's settings (the scene file's, the levels given) were refused.
+#[derive(Debug, thiserror::Error)]
+pub enum SceneError {
+    /// The scene file not read (missing, over 1 MiB).
+    #[error(transparent)]
+    Read(InputFileFailure),
+    #[error("{}: {source}", .path.display())]
+    Json {
+        path: PathBuf,
+        source: serde_json::Error,
+    },
+    /// A number of the scene file (`key`: `hold`, `fits.exponent`) outside its limits.
+    #[error("{}: {key} {}: {range}", .path.display(), impact_io::limits::number(.range.value))]
+    OutOfRange {
+        path: PathBuf,
+        key: &'static str,
+        range: impact_io::limits::OutOfRange,
+    },
+    /// A level (`--trigger`, `--edge`, `--range`, or the scene file's) outside
+    /// [`parse::LEVEL_M_S2`] once in m/s².
+    #[error("{setting} {level}: out of range ({})", parse::LEVEL_M_S2)]
+    LevelOutOfRange {
+        setting: Setting,
+        level: LevelAsGiven,
+    },
+}
+
+/// How a message names a setting: by its option (`--max-impact`), or by the scene file's key
+/// (`scene.json: max_impact`) when only the file gives it.
+#[derive(Clone, Debug, PartialEq)]
+pub enum Setting {
+    /// The option, by its name without the dashes (`max-impact`; the core's parameters are
+    /// named as their options are).
+    Option(&'static str),
+    /// The scene file's key for the option `name`: `max-impact` is `max_impact`, the fits'
+    /// `exponent` is `fits.exponent`.
+    SceneKey { scene: PathBuf, name: &'static str },
+}
+
+impl std::fmt::Display for Setting {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            Setting::Option(name) => write!(f, "--{name}"),
+            Setting::SceneKey {
+                scene,
+                name: "exponent",
+            } => write!(f, "{}: fits.exponent", scene.display()),
+            Setting::SceneKey { scene, name } => {
+                write!(f, "{}: {}", scene.display(), name.replace('-', "_"))
+            }
+        }
+    }
+}
+
+use crate::read_errors::InputFileFailure;
 
 impl SceneFile {
     /// Checks each number against its limits (as the options' are), naming the file and
     /// the key: `scene.json: hold 1e-300: out of range (between 1e-30 and 1e30 s)`. (The
     /// levels are checked in m/s², with the mass: [`check_levels`].)
-    pub fn check(&self, path: &Path) -> Result<(), String> {
+    pub fn check(&self, path: &Path) -> Result<(), SceneError> {
         let exponent = self.fits.as_ref().and_then(|f| f.exponent);
         for (key, value, limits) in [
             ("mass", self.mass, &parse::MASS_KG),
@@ -322,27 +391,31 @@ impl SceneFile {
             ("fits.exponent", exponent, &parse::EXPONENT),
         ] {
             if let Some(v) = value {
-                limits
-                    .check_named(&format!("{}: {key}", path.display()), v)
-                    .map_err(|e| e.to_string())?;
+                limits.check(v).map_err(|range| SceneError::OutOfRange {
+                    path: path.to_path_buf(),
+                    key,
+                    range,
+                })?;
             }
         }
         Ok(())
     }
 }
 
-/// How messages name a setting given on the command line (`option`, `--hold`) or else in the
-/// scene file (`key`: `scene.json: hold`); `None` if neither gives it.
+/// How messages name the setting `name` (`hold`, `max-impact`) given on the command line
+/// (`--hold`) or else in the scene file (`scene.json: hold`); `None` if neither gives it.
 pub fn setting_name(
     args: &AnalyzeArgs,
     on_command_line: bool,
     in_file: bool,
-    option: &str,
-    key: &str,
-) -> Option<String> {
+    name: &'static str,
+) -> Option<Setting> {
     match (&args.scene, on_command_line, in_file) {
-        (_, true, _) => Some(option.to_string()),
-        (Some(path), false, true) => Some(format!("{}: {key}", path.display())),
+        (_, true, _) => Some(Setting::Option(name)),
+        (Some(path), false, true) => Some(Setting::SceneKey {
+            scene: path.clone(),
+            name,
+        }),
         _ => None,
     }
 }
@@ -429,18 +502,29 @@ impl SpectrumArgs {
     }
 }
 
-fn per_octave(s: &str) -> Result<u32, String> {
+/// Why a shock spectrum's option was refused (clap names the option and the value given).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, thiserror::Error)]
+pub enum SpectrumOptionError {
+    #[error("must be 6 or 12")]
+    BandsPerOctave,
+    #[error("must lie in [0, 0.5]")]
+    Damping,
+    #[error("not a number")]
+    NotANumber,
+}
+
+fn per_octave(s: &str) -> Result<u32, SpectrumOptionError> {
     match s {
         "6" => Ok(6),
         "12" => Ok(12),
-        _ => Err("must be 6 or 12".into()),
+        _ => Err(SpectrumOptionError::BandsPerOctave),
     }
 }
 
-fn damping(s: &str) -> Result<f64, String> {
+fn damping(s: &str) -> Result<f64, SpectrumOptionError> {
     match s.parse::<f64>() {
         Ok(v) if (0.0..=0.5).contains(&v) => Ok(v),
-        Ok(_) => Err("must lie in [0, 0.5]".into()),
-        Err(_) => Err("not a number".into()),
+        Ok(_) => Err(SpectrumOptionError::Damping),
+        Err(_) => Err(SpectrumOptionError::NotANumber),
     }
 }

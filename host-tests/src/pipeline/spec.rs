@@ -7,7 +7,7 @@ use std::path::{Path, PathBuf};
 use impact_core::consts::STANDARD_GRAVITY;
 use impact_core::spec::{Shape, Spec};
 
-use super::band_file;
+use super::band_file::{self, BandFileError};
 
 use crate::standards::STANDARDS;
 
@@ -21,8 +21,58 @@ pub struct SpecArg {
     pub band_file: Option<&'static Path>,
 }
 
+/// Why a `--spec` was refused (clap names the option and the value given). The texts held
+/// are the parts as given.
+#[derive(Debug, thiserror::Error)]
+pub enum SpecError {
+    #[error("SHAPE,PEAK,DURATION (half-sine,50g,11ms), then KEY=VALUE tolerances")]
+    Form,
+    #[error("peak {text:?}: not a number with an optional unit (50g, 490m/s2)")]
+    PeakNotANumber { text: String },
+    #[error("peak {text:?}: must be between 1e-30 and 1e30 m/s²")]
+    PeakRange { text: String },
+    #[error("duration {text:?}: not a number with an optional unit (11ms, 0.011)")]
+    DurationNotANumber { text: String },
+    #[error("duration {text:?}: must be between 1e-30 and 1e30 s")]
+    DurationRange { text: String },
+    /// A part after the duration without its `=`.
+    #[error("{part:?}: KEY=VALUE (standard=, band=, dv=, …)")]
+    NotKeyValue { part: String },
+    #[error("standard={name}: one of {}", STANDARDS.map(|s| s.name).join(", "))]
+    Standard { name: String },
+    #[error("{key}={value}: not a number")]
+    NotANumber { key: String, value: String },
+    /// A key none of the tolerances (`trapezoid`: whether the shape takes `rise` and `fall`).
+    #[error(
+        "{key}: one of standard, band-file, band, outside, slack, dv, before, after, watch{}",
+        if *.trapezoid { ", rise, fall" } else { " (rise, fall: a trapezoid's)" }
+    )]
+    Key { key: String, trapezoid: bool },
+    #[error("shape {name:?}: one of half-sine, sawtooth (terminal-peak), trapezoid")]
+    Shape { name: String },
+    /// The pulse or its tolerances refused by the core (a parameter named by the core's
+    /// name: `spec-tolerance`).
+    #[error(transparent)]
+    Invalid(#[from] impact_core::Error),
+    #[error(transparent)]
+    BandFile(#[from] BandFileError),
+    /// The pulse with the user's band refused by the core.
+    #[error("band-file={}: {source}", .path.display())]
+    BandInvalid {
+        path: PathBuf,
+        source: impact_core::Error,
+    },
+}
+
+/// Temporary, while `impact watch` holds messages: the error as its message.
+impl From<SpecError> for String {
+    fn from(e: SpecError) -> Self {
+        e.to_string()
+    }
+}
+
 /// An acceleration with an optional unit: `50g`, `490.3m/s2` (m/s² without one).
-fn acceleration(s: &str) -> Result<f32, String> {
+fn acceleration(s: &str) -> Result<f32, SpecError> {
     let t = s.trim();
     let (num, scale) = if let Some(n) = t.strip_suffix('g') {
         (n, STANDARD_GRAVITY)
@@ -33,19 +83,20 @@ fn acceleration(s: &str) -> Result<f32, String> {
             .unwrap_or(t);
         (n, 1.0)
     };
-    let v: f64 = num
-        .trim()
-        .parse()
-        .map_err(|_| format!("peak {s:?}: not a number with an optional unit (50g, 490m/s2)"))?;
+    let v: f64 = num.trim().parse().map_err(|_| SpecError::PeakNotANumber {
+        text: s.to_string(),
+    })?;
     let v = v * scale;
     if !(v.is_finite() && (1e-30..=1e30).contains(&v)) {
-        return Err(format!("peak {s:?}: must be between 1e-30 and 1e30 m/s²"));
+        return Err(SpecError::PeakRange {
+            text: s.to_string(),
+        });
     }
     Ok(v as f32)
 }
 
 /// A duration with an optional unit: `11ms`, `500us`, `0.011` (s without one).
-fn duration(s: &str) -> Result<f32, String> {
+fn duration(s: &str) -> Result<f32, SpecError> {
     let t = s.trim();
     let (num, scale) = [("ms", 1e-3), ("us", 1e-6), ("µs", 1e-6), ("s", 1.0)]
         .iter()
@@ -54,10 +105,14 @@ fn duration(s: &str) -> Result<f32, String> {
     let v: f64 = num
         .trim()
         .parse()
-        .map_err(|_| format!("duration {s:?}: not a number with an optional unit (11ms, 0.011)"))?;
+        .map_err(|_| SpecError::DurationNotANumber {
+            text: s.to_string(),
+        })?;
     let v = v * scale;
     if !(v.is_finite() && (1e-30..=1e30).contains(&v)) {
-        return Err(format!("duration {s:?}: must be between 1e-30 and 1e30 s"));
+        return Err(SpecError::DurationRange {
+            text: s.to_string(),
+        });
     }
     Ok(v as f32)
 }
@@ -67,28 +122,30 @@ fn duration(s: &str) -> Result<f32, String> {
 /// tolerance by hand: `band`, `outside`, `slack`, `dv`, `before`, `after`, `watch` (fractions of
 /// the peak or of the duration), a trapezoid's `rise` and `fall`; `band-file=` a user's band
 /// (a CSV, [`band_file::read`]) instead of `band` and `slack`.
-pub fn parse(s: &str) -> Result<SpecArg, String> {
+pub fn parse(s: &str) -> Result<SpecArg, SpecError> {
     let mut parts = s.split(',').map(str::trim);
     let shape_name = parts.next().unwrap_or_default();
     let (Some(peak), Some(dur)) = (parts.next(), parts.next()) else {
-        return Err("SHAPE,PEAK,DURATION (half-sine,50g,11ms), then KEY=VALUE tolerances".into());
+        return Err(SpecError::Form);
     };
     let peak_m_s2 = acceleration(peak)?;
     let duration_s = duration(dur)?;
     let mut pairs = Vec::new();
     for p in parts {
-        let (k, v) = p
-            .split_once('=')
-            .ok_or_else(|| format!("{p:?}: KEY=VALUE (standard=, band=, dv=, …)"))?;
+        let (k, v) = p.split_once('=').ok_or_else(|| SpecError::NotKeyValue {
+            part: p.to_string(),
+        })?;
         pairs.push((k.trim(), v.trim()));
     }
     let standard = match pairs.iter().find(|(k, _)| *k == "standard") {
-        Some((_, name)) => STANDARDS.iter().find(|s| s.name == *name).ok_or_else(|| {
-            format!(
-                "standard={name}: one of {}",
-                STANDARDS.map(|s| s.name).join(", ")
-            )
-        })?,
+        Some((_, name)) => {
+            STANDARDS
+                .iter()
+                .find(|s| s.name == *name)
+                .ok_or_else(|| SpecError::Standard {
+                    name: name.to_string(),
+                })?
+        }
         None => &STANDARDS[0],
     };
     let mut t = standard.tolerance;
@@ -107,7 +164,10 @@ pub fn parse(s: &str) -> Result<SpecArg, String> {
             .parse()
             .ok()
             .filter(|x: &f32| x.is_finite())
-            .ok_or_else(|| format!("{k}={v}: not a number"))?;
+            .ok_or_else(|| SpecError::NotANumber {
+                key: k.to_string(),
+                value: v.to_string(),
+            })?;
         let slot = match k {
             "band" => &mut t.band,
             "outside" => &mut t.outside,
@@ -119,15 +179,10 @@ pub fn parse(s: &str) -> Result<SpecArg, String> {
             "rise" if shape_name == "trapezoid" => &mut rise,
             "fall" if shape_name == "trapezoid" => &mut fall,
             _ => {
-                let keys = "standard, band-file, band, outside, slack, dv, before, after, watch";
-                return Err(format!(
-                    "{k}: one of {keys}{}",
-                    if shape_name == "trapezoid" {
-                        ", rise, fall"
-                    } else {
-                        " (rise, fall: a trapezoid's)"
-                    }
-                ));
+                return Err(SpecError::Key {
+                    key: k.to_string(),
+                    trapezoid: shape_name == "trapezoid",
+                });
             }
         };
         *slot = x;
@@ -138,9 +193,9 @@ pub fn parse(s: &str) -> Result<SpecArg, String> {
         "sawtooth" => Shape::Sawtooth,
         "trapezoid" => Shape::Trapezoid { rise, fall },
         other => {
-            return Err(format!(
-                "shape {other:?}: one of half-sine, sawtooth (terminal-peak), trapezoid"
-            ))
+            return Err(SpecError::Shape {
+                name: other.to_string(),
+            })
         }
     };
     let mut spec = Spec {
@@ -150,17 +205,15 @@ pub fn parse(s: &str) -> Result<SpecArg, String> {
         tolerance: t,
         band: None,
     };
-    let invalid = |e| match e {
-        impact_core::Error::InvalidParameter { name, reason } => format!("{name}: {reason}"),
-        e => e.to_string(),
-    };
-    spec.validate().map_err(invalid)?;
+    spec.validate()?;
     let mut band_source = None;
     if let Some(path) = band_path {
         // The band is watched over its rows (`Spec::watched`); Δv keeps its window.
         spec.band = Some(band_file::read(Path::new(path), &spec)?);
-        spec.validate()
-            .map_err(|e| format!("band-file={path}: {}", invalid(e)))?;
+        spec.validate().map_err(|source| SpecError::BandInvalid {
+            path: PathBuf::from(path),
+            source,
+        })?;
         custom = true;
         band_source = Some(&*Box::leak(PathBuf::from(path).into_boxed_path()));
     }
@@ -207,8 +260,32 @@ mod tests {
             ("half-sine,50g,11ms,rise=0.1", "rise: one of"),
             ("half-sine,50g,11ms,dv", "KEY=VALUE"),
         ] {
-            let e = parse(bad).unwrap_err();
+            let e = parse(bad).unwrap_err().to_string();
             assert!(e.contains(want), "{bad}: {e}");
         }
+        // The kinds, with what was given.
+        let refused = |s: &str| parse(s).unwrap_err();
+        assert!(matches!(refused("half-sine"), SpecError::Form));
+        assert!(
+            matches!(refused("square,50g,11ms"), SpecError::Shape { name } if name == "square")
+        );
+        assert!(
+            matches!(refused("half-sine,50q,11ms"), SpecError::PeakNotANumber { text } if text == "50q")
+        );
+        assert!(matches!(
+            refused("half-sine,50g,-1ms"),
+            SpecError::DurationRange { .. }
+        ));
+        assert!(matches!(
+            refused("half-sine,50g,11ms,band=2"),
+            SpecError::Invalid(impact_core::Error::InvalidParameter { .. })
+        ));
+        assert!(matches!(
+            refused("half-sine,50g,11ms,rise=0.1"),
+            SpecError::Key {
+                trapezoid: false,
+                ..
+            }
+        ));
     }
 }

@@ -18,9 +18,12 @@ use impact_core::{Calibration, ImpactReport};
 
 use crate::pipeline::screen::Removal;
 use crate::pipeline::survey::{self, Survey, Surveyed};
-use crate::pipeline::{self, AnalyzeArgs, MonitorRun, Reading, Setup};
-use crate::read_errors::into_message;
+use std::sync::Arc;
+
+use crate::pipeline::{self, AnalyzeArgs, MonitorRun, PipelineError, Reading, Setup};
+use crate::read_errors::ReadFailure;
 use impact_io::channel::{input_name, is_stdin};
+use impact_io::error::SpoolError;
 use impact_io::open_source;
 use impact_io::progress::Progress;
 use impact_io::quantise::Quantiser;
@@ -32,8 +35,8 @@ use impact_io::spool::{Axis, SpoolWriter};
 pub fn analyze(
     args: &AnalyzeArgs,
     progress: Progress,
-) -> Result<(Setup, Vec<ImpactReport>), String> {
-    let refuse = |what: &str| Err(format!("--stream: {what} needs the whole recording"));
+) -> Result<(Setup, Vec<ImpactReport>), PipelineError> {
+    let refuse = |option| Err(PipelineError::StreamNeedsWhole { option });
     if args.plot.is_some() {
         return refuse("--plot");
     }
@@ -47,24 +50,21 @@ pub fn analyze(
         return refuse("--resample");
     }
     let file = pipeline::scene_file(args)?;
-    let mut source = open_source(&args.file, &args.read_options(progress)).map_err(into_message)?;
+    let mut source =
+        open_source(&args.file, &args.read_options(progress)).map_err(ReadFailure::from)?;
     let column = source.column().to_string();
     let (mass, scale, units) = pipeline::mass_and_scale(args, &file, &column)?;
-    let full_scale = pipeline::full_scale_m_s2(args, &file, mass).ok_or(
-        "--stream: give --range (the sensor's full scale sets the quantisation before the \
-         recording's extremes are known)",
-    )?;
+    let full_scale =
+        pipeline::full_scale_m_s2(args, &file, mass).ok_or(PipelineError::StreamNeedsRange)?;
     let (trigger, edge) = pipeline::given_levels(args, &file, mass);
-    let trigger = trigger.ok_or(
-        "--stream: give --trigger (the level cannot be learned from a recording not yet read)",
-    )?;
+    let trigger = trigger.ok_or(PipelineError::StreamNeedsTrigger)?;
     let gain = impact_io::quantise::gain_for(full_scale);
     let clipping = crate::pipeline::screen::from_range(full_scale);
     // The head: its noise sets the default edge level, a CSV's first intervals the rate; its
     // readings are checked against the range.
-    let head = read_head(&mut *source, scale).map_err(into_message)?;
+    let head = read_head(&mut *source, scale).map_err(ReadFailure::from)?;
     survey::check_range(head.iter().fold(0.0f64, |m, v| m.max(v.abs())), full_scale)?;
-    let rate_hz = source.rate_hz().map_err(into_message)?;
+    let rate_hz = source.rate_hz().map_err(ReadFailure::from)?;
     let calibration = Calibration {
         gain_m_s2_per_count: gain as f32,
         sample_rate_hz: rate_hz as f32,
@@ -104,14 +104,17 @@ pub fn analyze(
 pub fn analyze_in_passes(
     args: &AnalyzeArgs,
     progress: Progress,
-) -> Result<(Setup, Vec<ImpactReport>), String> {
+) -> Result<(Setup, Vec<ImpactReport>), PipelineError> {
     in_passes_then(args, progress, Last::Analyse)
 }
 
 /// The recording's counts (little-endian i16, as the board's ADC gives them to the stream),
 /// written to `out` in a last pass after the survey, in bounded memory: what `impact emulate`
 /// replays. The setup says how many (`samples`).
-pub fn counts_file(args: &AnalyzeArgs, out: &mut dyn std::io::Write) -> Result<Setup, String> {
+pub fn counts_file(
+    args: &AnalyzeArgs,
+    out: &mut dyn std::io::Write,
+) -> Result<Setup, PipelineError> {
     in_passes_then(args, Progress::none(), Last::Counts(out)).map(|(setup, _)| setup)
 }
 
@@ -125,7 +128,7 @@ fn in_passes_then(
     args: &AnalyzeArgs,
     progress: Progress,
     last: Last,
-) -> Result<(Setup, Vec<ImpactReport>), String> {
+) -> Result<(Setup, Vec<ImpactReport>), PipelineError> {
     let name = input_name(&args.file);
     let file = pipeline::scene_file(args)?;
     // The survey; again with the glitches replaced if there are any (they set the extremes).
@@ -134,7 +137,8 @@ fn in_passes_then(
     let bar = |from: f64, to: f64| progress.span(from, to);
     // (The spool first: standard input without one is refused before it is read.)
     let spool = Spooling::for_input(args, &name)?;
-    let input = open_source(&args.file, &args.read_options(bar(0.0, 0.5))).map_err(into_message)?;
+    let input =
+        open_source(&args.file, &args.read_options(bar(0.0, 0.5))).map_err(ReadFailure::from)?;
     let column = input.column().to_string();
     let (mass, scale, units) = pipeline::mass_and_scale(args, &file, &column)?;
     let full_scale = pipeline::full_scale_m_s2(args, &file, mass);
@@ -144,21 +148,17 @@ fn in_passes_then(
         spool,
     } = survey_pass(input, scale, &[], !args.keep_spikes, spool)?;
     let axis = Axis {
-        rate_hz: source.rate_hz().map_err(into_message)?,
+        rate_hz: source.rate_hz().map_err(ReadFailure::from)?,
         final_rate_hz: source.final_rate_hz(),
         t0_s: source.t0(),
     };
     let (t0, rate_hz) = (axis.t0_s, axis.final_rate_hz);
     if first.samples < 2 {
-        let channel = if column.is_empty() {
-            String::new()
-        } else {
-            format!("{column}: ")
-        };
-        return Err(format!(
-            "{name}: {channel}{} samples; at least 2",
-            first.samples
-        ));
+        return Err(PipelineError::TooFewSamples {
+            path: args.file.clone(),
+            column,
+            samples: first.samples,
+        });
     }
     drop(source);
     // The later passes read the spool if there is one; a file whose spool failed (a full
@@ -172,9 +172,9 @@ fn in_passes_then(
         None => None,
     };
     let reopen = |progress: Progress| match &spool {
-        Some(s) => Ok((s.source(progress).map_err(into_message)?, 1.0)),
-        None => Ok::<_, String>((
-            open_source(&args.file, &args.read_options(progress)).map_err(into_message)?,
+        Some(s) => Ok((s.source(progress).map_err(ReadFailure::from)?, 1.0)),
+        None => Ok::<_, PipelineError>((
+            open_source(&args.file, &args.read_options(progress)).map_err(ReadFailure::from)?,
             scale,
         )),
     };
@@ -259,8 +259,8 @@ fn figure_spans(reports: &[ImpactReport], scene: &impact_core::Scene) -> Vec<(u6
 fn head_counts(
     mut source: Box<dyn Source>,
     q: Quantiser,
-) -> Result<(Box<dyn Source>, Vec<i16>), String> {
-    let head = read_head(&mut *source, q.scale).map_err(into_message)?;
+) -> Result<(Box<dyn Source>, Vec<i16>), PipelineError> {
+    let head = read_head(&mut *source, q.scale).map_err(ReadFailure::from)?;
     Ok((source, q.counts_m_s2(&head)))
 }
 
@@ -285,16 +285,16 @@ fn survey_pass(
     removals: &[Removal],
     screen: bool,
     spool: Option<Spooling>,
-) -> Result<SurveyPass, String> {
+) -> Result<SurveyPass, PipelineError> {
     let mut survey = Survey::new(screen);
     // The shape's two scans on threads of their own (a copy of each block to each, as
     // read); with a spool, which a CSV's parse or standard input comes with, both on one
     // thread with the spool (the parse keeps both cores busy: a third thread only costs).
     // A spool that fails is dropped at once (its space freed); one that must not fail ends
     // the pass.
-    let stops = spool.as_ref().and_then(|s| s.stops.clone());
+    let stops = spool.as_ref().is_some_and(|s| s.stops);
     let spool = spool.map(|s| Ok(s.writer));
-    let failure = std::sync::Arc::new(std::sync::OnceLock::<String>::new());
+    let failure = Arc::new(std::sync::OnceLock::<Arc<SpoolError>>::new());
     let (flat, spikes) = survey.take_shape().split();
     let (with_flat, spikes) = match spool {
         Some(_) => (spikes, None),
@@ -304,8 +304,8 @@ fn survey_pass(
         let failure = std::sync::Arc::clone(&failure);
         move |(flat, spikes, spool), block| {
             if let Some(Ok(w)) = spool {
-                if let Err(e) = w.write(block).map_err(|e| e.to_string()) {
-                    let _ = failure.set(e.clone());
+                if let Err(e) = w.write(block).map_err(Arc::new) {
+                    let _ = failure.set(Arc::clone(&e));
                     *spool = Some(Err(e));
                 }
             }
@@ -319,8 +319,8 @@ fn survey_pass(
     let mut patch = Patches::new(removals);
     // Each block, the head first: the removals put in, surveyed here and sent to the scans.
     let mut take = |block: &mut [f64]| {
-        if let (Some(name), Some(e)) = (&stops, failure.get()) {
-            return Err(format!("{name}: {e}"));
+        if let (true, Some(e)) = (stops, failure.get()) {
+            return Err(PipelineError::Spool(Arc::clone(e)));
         }
         patch.values(block);
         survey.push_levels(block);
@@ -331,13 +331,13 @@ fn survey_pass(
         Ok(())
     };
     let read = read_head(&mut *source, scale)
-        .map_err(into_message)
+        .map_err(|e| PipelineError::Read(e.into()))
         .and_then(|mut head| {
             take(&mut head)?;
             read_ahead(
                 source,
                 move |s, _, out: &mut Vec<f64>| {
-                    s.next_values(CHUNK, out).map_err(into_message)?;
+                    s.next_values(CHUNK, out).map_err(ReadFailure::from)?;
                     out.iter_mut().for_each(|v| *v *= scale);
                     Ok(())
                 },
@@ -347,8 +347,8 @@ fn survey_pass(
     let (flat, with_flat, spool) = flat.finish()?;
     let spikes = spikes.map(Scan::finish).transpose()?.or(with_flat);
     let source = read?;
-    if let (Some(name), Some(Err(e))) = (&stops, &spool) {
-        return Err(format!("{name}: {e}"));
+    if let (true, Some(Err(e))) = (stops, &spool) {
+        return Err(PipelineError::Spool(Arc::clone(e)));
     }
     survey.put_shape(crate::pipeline::survey::Shape::join(flat, spikes));
     Ok(SurveyPass {
@@ -392,36 +392,36 @@ impl<S: Send + 'static> Scan<S> {
     }
 
     /// The scan's state once it has every block sent.
-    fn finish(self) -> Result<S, String> {
+    fn finish(self) -> Result<S, PipelineError> {
         drop(self.blocks);
         self.thread
             .join()
-            .map_err(|_| "the survey's thread panicked".to_string())
+            .map_err(|_| PipelineError::SurveyPanicked)
     }
 }
 
-/// A spool for a first pass to write, and the input's name if its failure ends the pass
-/// (standard input, which cannot be read again).
+/// A spool for a first pass to write, and whether its failure ends the pass (standard
+/// input, which cannot be read again).
 struct Spooling {
     writer: SpoolWriter,
-    stops: Option<String>,
+    stops: bool,
 }
 
 impl Spooling {
     /// The spool `args.file` (named `name`) is read into, if it gets one ([`spooled`]): a
     /// spool that cannot be made is an error for standard input (read once), a note for a
     /// file (read again for each pass).
-    fn for_input(args: &AnalyzeArgs, name: &str) -> Result<Option<Self>, String> {
+    fn for_input(args: &AnalyzeArgs, name: &str) -> Result<Option<Self>, PipelineError> {
         let stdin = is_stdin(&args.file);
         match spooled(args).then(SpoolWriter::new).transpose() {
-            Err(e) if stdin => Err(format!("stdin: {e}")),
+            Err(e) if stdin => Err(PipelineError::Spool(Arc::new(e))),
             Err(e) => {
                 crate::errln!("note: {e}: {name} is read again for each pass");
                 Ok(None)
             }
             Ok(writer) => Ok(writer.map(|writer| Spooling {
                 writer,
-                stops: stdin.then(|| name.to_string()),
+                stops: stdin,
             })),
         }
     }
@@ -432,7 +432,7 @@ impl Spooling {
 struct SurveyPass {
     survey: Surveyed,
     source: Box<dyn Source>,
-    spool: Option<Result<SpoolWriter, String>>,
+    spool: Option<Result<SpoolWriter, Arc<SpoolError>>>,
 }
 
 /// Whether the first pass keeps the values for the later ones ([`impact_io::spool`]): standard
@@ -446,10 +446,12 @@ fn spooled(args: &AnalyzeArgs) -> bool {
 /// until `fill` gives nothing; the source back, or the first error (of either).
 fn read_ahead<T: Send + 'static>(
     mut source: Box<dyn Source>,
-    fill: impl Fn(&mut dyn Source, &mut Vec<f64>, &mut Vec<T>) -> Result<(), String> + Send + 'static,
-    mut take: impl FnMut(&mut [T]) -> Result<(), String>,
-) -> Result<Box<dyn Source>, String> {
-    let (tx, rx) = std::sync::mpsc::sync_channel::<Result<Vec<T>, String>>(4);
+    fill: impl Fn(&mut dyn Source, &mut Vec<f64>, &mut Vec<T>) -> Result<(), PipelineError>
+        + Send
+        + 'static,
+    mut take: impl FnMut(&mut [T]) -> Result<(), PipelineError>,
+) -> Result<Box<dyn Source>, PipelineError> {
+    let (tx, rx) = std::sync::mpsc::sync_channel::<Result<Vec<T>, PipelineError>>(4);
     let (back, spare) = std::sync::mpsc::channel::<Vec<T>>();
     let reader = std::thread::spawn(move || {
         let mut scratch = Vec::with_capacity(CHUNK);
@@ -483,9 +485,7 @@ fn read_ahead<T: Send + 'static>(
         }
     }
     drop(rx);
-    let source = reader
-        .join()
-        .map_err(|_| "the reader thread panicked".to_string())?;
+    let source = reader.join().map_err(|_| PipelineError::ReaderPanicked)?;
     match failed {
         Some(e) => Err(e),
         None => Ok(source),
@@ -500,7 +500,7 @@ fn run_monitor(
     q: Quantiser,
     scene: impact_core::Scene,
     removals: Vec<Removal>,
-) -> Result<Analysed, String> {
+) -> Result<Analysed, PipelineError> {
     crate::on_big_stack(move || {
         let mut run = MonitorRun::new(scene)?;
         let source = for_each_count(source, head, q, &removals, |counts| {
@@ -524,19 +524,17 @@ fn write_counts(
     q: Quantiser,
     removals: Vec<Removal>,
     out: &mut dyn std::io::Write,
-) -> Result<u64, String> {
+) -> Result<u64, PipelineError> {
     let mut count = 0u64;
     let mut bytes = Vec::new();
     for_each_count(source, head, q, &removals, |counts| {
         bytes.clear();
         bytes.extend(counts.iter().flat_map(|c| c.to_le_bytes()));
-        out.write_all(&bytes)
-            .map_err(|e| format!("the recording's counts for the emulator: {e}"))?;
+        out.write_all(&bytes).map_err(PipelineError::Counts)?;
         count += counts.len() as u64;
         Ok(())
     })?;
-    out.flush()
-        .map_err(|e| format!("the recording's counts for the emulator: {e}"))?;
+    out.flush().map_err(PipelineError::Counts)?;
     Ok(count)
 }
 
@@ -549,7 +547,7 @@ fn collect_windows(
     q: Quantiser,
     removals: Vec<Removal>,
     spans: Vec<(u64, u64)>,
-) -> Result<Vec<(u64, Vec<i16>)>, String> {
+) -> Result<Vec<(u64, Vec<i16>)>, PipelineError> {
     let mut windows: Vec<(u64, Vec<i16>)> =
         spans.iter().map(|&(from, _)| (from, Vec::new())).collect();
     let mut at = 0u64;
@@ -574,8 +572,8 @@ fn for_each_count(
     mut head: Vec<i16>,
     q: Quantiser,
     removals: &[Removal],
-    mut take: impl FnMut(&[i16]) -> Result<(), String>,
-) -> Result<Box<dyn Source>, String> {
+    mut take: impl FnMut(&[i16]) -> Result<(), PipelineError>,
+) -> Result<Box<dyn Source>, PipelineError> {
     let mut patch = Patches::new(removals);
     let mut patched = |counts: &mut [i16]| {
         patch.counts(counts, q);
@@ -585,8 +583,8 @@ fn for_each_count(
     read_ahead(
         source,
         move |s, scratch, counts| {
-            s.next_counts(CHUNK, q, scratch, counts)
-                .map_err(into_message)
+            Ok(s.next_counts(CHUNK, q, scratch, counts)
+                .map_err(ReadFailure::from)?)
         },
         patched,
     )

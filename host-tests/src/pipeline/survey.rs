@@ -6,7 +6,8 @@
 //! as it is read: the same code on the same values, so both give the same reports.
 
 use crate::pipeline::histogram::OrderHistogram;
-use crate::pipeline::screen::{self, FlatTops, Removal, SpikeScan};
+use crate::pipeline::screen::{self, FlatTops, Removal, SpikeScan, TooManyGlitches};
+use crate::report::fmt::human;
 use crate::report::Clipping;
 
 /// One pass over a recording (values in m/s²).
@@ -150,13 +151,10 @@ impl Survey {
         }
     }
 
-    pub fn finish(self) -> Result<Surveyed, String> {
+    pub fn finish(self) -> Result<Surveyed, SurveyError> {
         let finite = self.min.is_finite() && self.max.is_finite();
         if !self.values.is_empty() && !finite {
-            return Err(
-                "a reading times the units and --gain is beyond the range of f64 (give a smaller --gain)"
-                    .into(),
-            );
+            return Err(SurveyError::NotFinite);
         }
         let median = self.values.median().unwrap_or(0.0);
         let noise = noise_of(&self.steps);
@@ -180,7 +178,7 @@ impl Survey {
     }
 
     /// One pass over a slice.
-    pub fn of(x: &[f64], screen: bool) -> Result<Surveyed, String> {
+    pub fn of(x: &[f64], screen: bool) -> Result<Surveyed, SurveyError> {
         let mut s = Self::new(screen);
         s.push(x);
         s.finish()
@@ -208,7 +206,7 @@ pub fn levels(
     range_m_s2: Option<f64>,
     trigger: Option<f64>,
     edge: Option<f64>,
-) -> Result<Levels, String> {
+) -> Result<Levels, SurveyError> {
     match range_m_s2 {
         Some(fs) => check_range(s.peak_m_s2(), fs)?,
         None => check_peak(s.peak_m_s2())?,
@@ -234,14 +232,12 @@ pub const RANGE_EXCEEDED: f64 = 2.0;
 
 /// An error if `peak_m_s2` (a reading's distance from zero) exceeds [`RANGE_EXCEEDED`] ×
 /// the full scale `range_m_s2`.
-pub fn check_range(peak_m_s2: f64, range_m_s2: f64) -> Result<(), String> {
+pub fn check_range(peak_m_s2: f64, range_m_s2: f64) -> Result<(), SurveyError> {
     if peak_m_s2 > RANGE_EXCEEDED * range_m_s2 {
-        return Err(format!(
-            "--range: the recording reaches {}, {:.1}× the full scale given ({}): a bare --range is in m/s²; give its unit, e.g. --range 16g for a ±16 g sensor",
-            crate::report::fmt::human(peak_m_s2, "m/s²"),
-            peak_m_s2 / range_m_s2,
-            crate::report::fmt::human(range_m_s2, "m/s²"),
-        ));
+        return Err(SurveyError::BeyondRange {
+            peak_m_s2,
+            range_m_s2,
+        });
     }
     Ok(())
 }
@@ -249,15 +245,40 @@ pub fn check_range(peak_m_s2: f64, range_m_s2: f64) -> Result<(), String> {
 /// An error if `peak_m_s2`, the largest reading's distance from zero and the full scale
 /// when no range is given, is not 0 and not within [`impact_io::limits::LEVEL_M_S2`]: counts
 /// at a smaller full scale would all be 0 (the impacts lost), at a larger one not finite.
-pub fn check_peak(peak_m_s2: f64) -> Result<(), String> {
+pub fn check_peak(peak_m_s2: f64) -> Result<(), SurveyError> {
     let limits = impact_io::limits::LEVEL_M_S2;
     if peak_m_s2 == 0.0 || limits.contains(peak_m_s2) {
         return Ok(());
     }
-    Err(format!(
-        "the recording reaches {} (its values in their units times --gain): out of range ({limits}); give a --gain that brings it within",
-        crate::report::fmt::human(peak_m_s2, "m/s²"),
-    ))
+    Err(SurveyError::PeakOutOfRange { peak_m_s2 })
+}
+
+/// Why a recording's survey refuses it.
+#[derive(Clone, Copy, Debug, PartialEq, thiserror::Error)]
+pub enum SurveyError {
+    #[error(
+        "a reading times the units and --gain is beyond the range of f64 (give a smaller --gain)"
+    )]
+    NotFinite,
+    #[error(transparent)]
+    Glitches(#[from] TooManyGlitches),
+    /// The largest reading's distance from zero beyond [`RANGE_EXCEEDED`] × the full scale
+    /// given, both m/s².
+    #[error(
+        "--range: the recording reaches {}, {:.1}× the full scale given ({}): a bare --range is in m/s²; give its unit, e.g. --range 16g for a ±16 g sensor",
+        human(*.peak_m_s2, "m/s²"),
+        .peak_m_s2 / .range_m_s2,
+        human(*.range_m_s2, "m/s²")
+    )]
+    BeyondRange { peak_m_s2: f64, range_m_s2: f64 },
+    /// The largest reading's distance from zero, m/s², outside
+    /// [`impact_io::limits::LEVEL_M_S2`].
+    #[error(
+        "the recording reaches {} (its values in their units times --gain): out of range ({}); give a --gain that brings it within",
+        human(*.peak_m_s2, "m/s²"),
+        impact_io::limits::LEVEL_M_S2
+    )]
+    PeakOutOfRange { peak_m_s2: f64 },
 }
 
 /// A flat top is taken for a rail only more than this many steps of the recording's

@@ -6,7 +6,7 @@ use impact_core::signal::cfc::Cfc;
 use plotters::prelude::*;
 
 use super::signal::{window, Signal};
-use super::{draw_panel, write_svg, Curve, Panel};
+use super::{draw_panel, write_svg, Curve, Panel, PlotError};
 
 /// The CFC-filtered trace's colour: dark, over the light raw one.
 const CFC_TRACE: RGBColor = RGBColor(25, 45, 120);
@@ -35,7 +35,7 @@ pub fn impacts(
     signal: &Signal,
     reports: &[impact_core::ImpactReport],
     path: &std::path::Path,
-) -> Result<(), String> {
+) -> Result<(), PlotError> {
     let shown: Vec<_> = reports.iter().take(SHOWN).collect();
     if shown.is_empty() {
         crate::note(&format!(
@@ -57,14 +57,13 @@ pub fn impacts(
         path,
         (400 * cols as u32, 330 * shown.len() as u32 + TITLE_HEIGHT),
         |root| {
-            root.fill(&WHITE).map_err(|e| e.to_string())?;
+            root.fill(&WHITE)?;
             let (head, body) = root.split_vertically(TITLE_HEIGHT);
             head.draw(&Text::new(
                 signal.title.clone(),
                 (12, 10),
                 ("sans-serif", 18).into_font().style(FontStyle::Bold),
-            ))
-            .map_err(|e| e.to_string())?;
+            ))?;
             draw_impacts(&body, signal, &shown, cols, spectra)
         },
     )?;
@@ -79,8 +78,8 @@ fn draw_impacts(
     shown: &[&impact_core::ImpactReport],
     cols: usize,
     spectra: bool,
-) -> Result<(), String> {
-    root.fill(&WHITE).map_err(|e| e.to_string())?;
+) -> Result<(), PlotError> {
+    root.fill(&WHITE)?;
     let rows = root.split_evenly((shown.len(), cols));
     for (k, r) in shown.iter().enumerate() {
         let mut panels = kinematics_panels(signal, r);

@@ -14,22 +14,55 @@ use ticks::{log_tick, log_ticks, tick};
 use impact_core::consts::STANDARD_GRAVITY;
 use plotters::prelude::*;
 
+/// Why a figure was not drawn or written.
+#[derive(Debug, thiserror::Error)]
+pub enum PlotError {
+    /// The output refused ([`crate::output::check`]) or its write failed.
+    #[error(transparent)]
+    Output(#[from] crate::output::OutputError),
+    /// `--plot` named neither `.svg` nor `.png`, found before any work.
+    #[error("--plot {}: the figure is SVG or PNG: name the file .svg or .png", .path.display())]
+    Format { path: std::path::PathBuf },
+    /// A figure to write to a file named neither `.svg` nor `.png`.
+    #[error("--plot {}: name the figure .svg or .png", .path.display())]
+    Name { path: std::path::PathBuf },
+    /// plotters' drawing on the SVG backend (whose errors are `std::io::Error`s).
+    #[error(transparent)]
+    Draw(#[from] DrawingAreaErrorKind<std::io::Error>),
+    /// The SVG not parsed for the PNG.
+    #[error("the figure: {0}")]
+    Svg(#[from] resvg::usvg::Error),
+    #[error("the figure: {width} × {height} px is too large for a PNG")]
+    TooLarge { width: u32, height: u32 },
+    /// The PNG not encoded: tiny-skia's `png::EncodingError` (the `png` crate, which this
+    /// crate does not depend on to name it), boxed.
+    #[error("the figure: {0}")]
+    Png(#[source] Box<dyn std::error::Error + Send + Sync>),
+}
+
+/// Temporary, while callers hold messages (`impact emulate`, `impact log`, `impact
+/// simulate`): the error as its message.
+impl From<PlotError> for String {
+    fn from(e: PlotError) -> Self {
+        e.to_string()
+    }
+}
+
 /// The figures' formats, by the file's extension.
 const FORMATS: [&str; 2] = ["svg", "png"];
 
 /// Checks that `path` can take a figure before any work is done: its directory exists and it
 /// is none of the `inputs` (the same file, a link to one, standard input's file: the output
 /// rule of [`crate::output`]), and it is named `.svg` or `.png` (the format).
-pub fn check_output(path: &std::path::Path, inputs: &[&std::path::Path]) -> Result<(), String> {
+pub fn check_output(path: &std::path::Path, inputs: &[&std::path::Path]) -> Result<(), PlotError> {
     let all = inputs
         .iter()
         .fold(crate::output::Inputs::new(), |all, i| all.with(i));
     crate::output::check("--plot", path, &all, None)?;
     if format(path).is_none() {
-        return Err(format!(
-            "--plot {}: the figure is SVG or PNG: name the file .svg or .png",
-            path.display()
-        ));
+        return Err(PlotError::Format {
+            path: path.to_path_buf(),
+        });
     }
     Ok(())
 }
@@ -44,34 +77,33 @@ fn format(path: &std::path::Path) -> Option<&'static str> {
 pub(crate) fn write_svg(
     path: &std::path::Path,
     size: (u32, u32),
-    draw: impl FnOnce(&DrawingArea<SVGBackend, plotters::coord::Shift>) -> Result<(), String>,
-) -> Result<(), String> {
+    draw: impl FnOnce(&DrawingArea<SVGBackend, plotters::coord::Shift>) -> Result<(), PlotError>,
+) -> Result<(), PlotError> {
     write_figure(path, &svg_text(size, draw)?)
 }
 
 /// Writes the figure `svg` to `path` whole or not at all ([`crate::output::write`]): as it is
 /// to a `.svg`, rasterised ([`png::from_svg`]) to a `.png`.
-pub(crate) fn write_figure(path: &std::path::Path, svg: &str) -> Result<(), String> {
+pub(crate) fn write_figure(path: &std::path::Path, svg: &str) -> Result<(), PlotError> {
     match format(path) {
         Some("png") => Ok(crate::output::write(path, &png::from_svg(svg)?)?),
         Some(_) => Ok(crate::output::write(path, svg.as_bytes())?),
-        None => Err(format!(
-            "--plot {}: name the figure .svg or .png",
-            path.display()
-        )),
+        None => Err(PlotError::Name {
+            path: path.to_path_buf(),
+        }),
     }
 }
 
 /// A `size` SVG drawn with `draw`, as text.
 pub(crate) fn svg_text(
     size: (u32, u32),
-    draw: impl FnOnce(&DrawingArea<SVGBackend, plotters::coord::Shift>) -> Result<(), String>,
-) -> Result<String, String> {
+    draw: impl FnOnce(&DrawingArea<SVGBackend, plotters::coord::Shift>) -> Result<(), PlotError>,
+) -> Result<String, PlotError> {
     let mut text = String::new();
     {
         let root = SVGBackend::with_string(&mut text, size).into_drawing_area();
         draw(&root)?;
-        root.present().map_err(|e| e.to_string())?;
+        root.present()?;
     }
     Ok(text)
 }
@@ -79,8 +111,8 @@ pub(crate) fn svg_text(
 /// A `size` SVG drawn with `draw`, as markup for a page (plotters escapes its text).
 pub(crate) fn svg_html(
     size: (u32, u32),
-    draw: impl FnOnce(&DrawingArea<SVGBackend, plotters::coord::Shift>) -> Result<(), String>,
-) -> Result<crate::html::Html, String> {
+    draw: impl FnOnce(&DrawingArea<SVGBackend, plotters::coord::Shift>) -> Result<(), PlotError>,
+) -> Result<crate::html::Html, PlotError> {
     svg_text(size, draw).map(crate::html::Html::from_plotters)
 }
 
@@ -165,7 +197,7 @@ pub(crate) fn draw_panel(
     area: &DrawingArea<SVGBackend, plotters::coord::Shift>,
     index: Option<u32>,
     p: &Panel,
-) -> Result<(), String> {
+) -> Result<(), PlotError> {
     let label = if p.log { log_tick } else { tick };
     let finite =
         |q: &(f64, f64)| q.0.is_finite() && q.1.is_finite() && (!p.log || (q.0 > 0.0 && q.1 > 0.0));
@@ -216,7 +248,7 @@ pub(crate) fn draw_panel(
             if p.g_axis {
                 mesh.y_desc("m/s²");
             }
-            mesh.draw().map_err(|e| e.to_string())?;
+            mesh.draw()?;
             if !p.measured.is_empty() {
                 $chart
                     .draw_series(LineSeries::new(
@@ -224,8 +256,7 @@ pub(crate) fn draw_panel(
                             .into_iter()
                             .filter(|q| finite(q)),
                         MEASURED.stroke_width(4),
-                    ))
-                    .map_err(|e| e.to_string())?
+                    ))?
                     .label(p.measured_label)
                     .legend(|(x, y)| {
                         PathElement::new(vec![(x, y), (x + 18, y)], MEASURED.stroke_width(4))
@@ -237,8 +268,7 @@ pub(crate) fn draw_panel(
                     .draw_series(LineSeries::new(
                         decimate(s, COLUMNS).into_iter().filter(|q| finite(q)),
                         c.stroke_width(2),
-                    ))
-                    .map_err(|e| e.to_string())?
+                    ))?
                     .label(*name)
                     .legend(move |(x, y)| {
                         PathElement::new(vec![(x, y), (x + 18, y)], c.stroke_width(2))
@@ -252,8 +282,7 @@ pub(crate) fn draw_panel(
                         6,
                         4,
                         c.stroke_width(1),
-                    ))
-                    .map_err(|e| e.to_string())?
+                    ))?
                     .label(*name)
                     .legend(move |(x, y)| {
                         plotters::element::DashedPathElement::new(
@@ -270,25 +299,21 @@ pub(crate) fn draw_panel(
                     .position(corner)
                     .background_style(WHITE.mix(0.85))
                     .border_style(BLACK)
-                    .draw()
-                    .map_err(|e| e.to_string())?;
+                    .draw()?;
             }
         }};
     }
     // The chart on ranges `x` and `y` (in m/s² with the g axis: `y_g` is the same range in g).
     macro_rules! chart {
         ($x:expr, $y:expr, $y_g:expr) => {{
-            let mut chart = builder
-                .build_cartesian_2d($x, $y)
-                .map_err(|e| e.to_string())?;
+            let mut chart = builder.build_cartesian_2d($x, $y)?;
             if p.g_axis {
                 let mut chart = chart.set_secondary_coord($x, $y_g);
                 chart
                     .configure_secondary_axes()
                     .y_desc("g")
                     .y_label_formatter(&|v| label(*v))
-                    .draw()
-                    .map_err(|e| e.to_string())?;
+                    .draw()?;
                 curves!(chart);
             } else {
                 curves!(chart);
@@ -419,7 +444,7 @@ mod tests {
     /// A 400 × 300 panel of `measured` drawn alone, as SVG text.
     pub(super) fn panel_svg(measured: Vec<(f64, f64)>, log: bool, g_axis: bool) -> String {
         svg_text((400, 300), |root| {
-            root.fill(&WHITE).map_err(|e| e.to_string())?;
+            root.fill(&WHITE)?;
             draw_panel(
                 root,
                 None,

@@ -71,5 +71,5 @@ pub fn wall_contact(
         }
         root.present().map_err(|e| e.to_string())?;
     }
-    crate::plot::write_figure(path, &text)
+    Ok(crate::plot::write_figure(path, &text)?)
 }

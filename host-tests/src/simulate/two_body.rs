@@ -510,5 +510,5 @@ fn plot(
         }
         root.present().map_err(|e| e.to_string())?;
     }
-    crate::plot::write_figure(path, &text)
+    Ok(crate::plot::write_figure(path, &text)?)
 }

@@ -10,7 +10,7 @@ pub mod rails;
 pub mod spikes;
 
 pub use rails::{flat_tops, from_range, FlatTops, RAIL_FRACTION};
-pub use spikes::{apply, Removal, SpikeScan, MAX_GLITCHES};
+pub use spikes::{apply, Removal, SpikeScan, TooManyGlitches, MAX_GLITCHES};
 
 #[cfg(test)]
 mod tests {
@@ -35,7 +35,7 @@ mod tests {
 
     /// Finds isolated spikes in `x` and replaces each by the straight line between its
     /// neighbours ([`SpikeScan`] over the whole slice, `median` the recording's).
-    fn remove_spikes(x: &mut [f64], median: f64) -> Result<Vec<Spike>, String> {
+    fn remove_spikes(x: &mut [f64], median: f64) -> Result<Vec<Spike>, TooManyGlitches> {
         let mut scan = SpikeScan::default();
         scan.push(x);
         Ok(apply(&scan.finish(median)?, x, 0.0, 1.0))
@@ -255,7 +255,8 @@ mod tests {
             x[10 * k + 5] = 1e6 + k as f64;
         }
         let e = remove_spikes(&mut x.clone(), 0.0).unwrap_err();
-        assert!(e.contains("--keep-spikes"), "{e}");
+        assert_eq!(e, TooManyGlitches);
+        assert!(e.to_string().contains("--keep-spikes"), "{e}");
     }
 
     #[test]

@@ -193,7 +193,7 @@ impl SpikeScan {
     /// The spikes, given the recording's median (the samples never tried, at the end, lie
     /// outside the candidates). An error if more than [`MAX_GLITCHES`] glitches dwarfed the
     /// rest of the recording while it was read.
-    pub fn finish(mut self, median: f64) -> Result<Vec<Removal>, String> {
+    pub fn finish(mut self, median: f64) -> Result<Vec<Removal>, TooManyGlitches> {
         // The samples never tried are outside the candidates (0 and 1 are counted in push).
         let end = self.seen;
         let mut k = self.next.max(2).min(end);
@@ -206,10 +206,7 @@ impl SpikeScan {
         let held = std::mem::take(&mut self.held);
         self.held = held.into_iter().filter(|c| self.may_dwarf(c)).collect();
         if self.overflow || self.held.len() > MAX_GLITCHES {
-            return Err(format!(
-                "more than {MAX_GLITCHES} isolated glitches each far beyond the rest of the \
-                 recording: not screened (give --keep-spikes to analyse it as it is)"
-            ));
+            return Err(TooManyGlitches);
         }
         let rest = self.outside.map_or(0.0, |(lo, hi)| {
             (hi - median).abs().max((lo - median).abs()).max(0.0)
@@ -327,3 +324,11 @@ pub(super) fn isolated(w: &[f64], len: usize) -> bool {
     }
     least >= SPIKE_RATIO * local && least > 0.0
 }
+/// More than [`MAX_GLITCHES`] isolated glitches dwarfed the rest of a recording: too many to
+/// be glitches, so none is removed.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, thiserror::Error)]
+#[error(
+    "more than {MAX_GLITCHES} isolated glitches each far beyond the rest of the \
+     recording: not screened (give --keep-spikes to analyse it as it is)"
+)]
+pub struct TooManyGlitches;
