@@ -103,6 +103,9 @@ fn scene() -> Scene {
         cfc: Some(Cfc::Cfc1000),
         trigger_cfc: Some(Cfc::Cfc1000),
         fits: FitSet::all(),
+        // Vertical, so that the gravity shift of the kinematics is linked in too.
+        gravity_m_s2: black_box(impact_core::consts::STANDARD_GRAVITY as f32),
+        vertical: true,
         train: Some(impact_core::Train::new()),
         spectrum: Some(impact_core::signal::spectrum::SpectrumSettings::new()),
         spec: Some(impact_core::spec::Spec {

@@ -106,6 +106,9 @@ fn scene(b: &mut Bytes) -> (Scene, bool) {
             nonlinear_exponent: 1.0 + (fit_byte & 8) as f32 / 16.0,
             hertz: fit_byte & 16 != 0,
         },
+        // Gravity in the contact (a drop, a train or this flag), at standard gravity.
+        gravity_m_s2: impact_core::consts::STANDARD_GRAVITY as f32,
+        vertical: stage_byte & 8 != 0,
         // Bounce trains on either speed source, with short flights so that they chain.
         train: (stage_byte & 3 != 0).then(|| Train {
             speed: if stage_byte & 1 != 0 {
@@ -114,7 +117,6 @@ fn scene(b: &mut Bytes) -> (Scene, bool) {
                 TrainSpeed::Rebound
             },
             max_flight_s: max_samples as f32 * 4.0 / rate,
-            ..Train::new()
         }),
         // Spectra at 1/6 or 1/12 octave.
         spectrum: (stage_byte & 4 != 0).then(|| SpectrumSettings {
