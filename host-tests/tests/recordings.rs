@@ -582,7 +582,8 @@ fn noise_free_flat_tops_are_clipped_and_a_clipped_bounce_has_no_cor() {
     assert_eq!(a.impacts.len(), 1, "{:#?}", a.impacts);
     assert!(a.impacts[0].clipped, "{:#?}", a.impacts[0]);
     assert!(a.impacts[0].flags.iter().any(|f| f == "clipped"));
-    // A train (COR 0.6, 12 ms contacts, flights 2 v' / g) from 2.2 m/s: the first three
+    // A train (COR 0.6, 12 ms contacts with gravity in them, flights 2 v' / g) from 2.2 m/s:
+    // the first three
     // bounces are clipped at 16 g, the rest are not.
     let (e, width) = (0.6, 0.012);
     let mut touches = Vec::new();
@@ -601,7 +602,9 @@ fn noise_free_flat_tops_are_clipped_and_a_clipped_bounce_has_no_cor() {
                     hs(
                         t,
                         t0,
-                        v * (1.0 + e) * std::f64::consts::PI / (2.0 * width),
+                        // The area: the velocity change and gravity's over the contact
+                        // (the reading is specific force).
+                        (v * (1.0 + e) + G * width) * std::f64::consts::PI / (2.0 * width),
                         width,
                     )
                 })

@@ -70,7 +70,7 @@ impl<'a> LogJson<'a> {
             sample_rate_hz: rate as f64,
             v0_source,
             contact_gravity_m_s2: scene
-                .map(|s| s.fields().opt::<f32>("gravity_m_s2"))
+                .map(SceneLine::contact_gravity_m_s2)
                 .transpose()
                 .map_err(LogError::whole)?
                 .flatten()
@@ -89,7 +89,7 @@ impl<'a> LogJson<'a> {
             t0,
             fits,
             gravity: scene
-                .map(|s| s.fields().opt::<f32>("gravity_m_s2"))
+                .map(SceneLine::contact_gravity_m_s2)
                 .transpose()
                 .map_err(LogError::whole)?
                 .flatten(),

@@ -70,6 +70,15 @@ impl SceneLine {
         self.fields.flag("hertz")
     }
 
+    /// Gravity the board takes out of each contact, m/s² (`none`: a horizontal strike; a
+    /// line without the field, as a log of an older board, is horizontal too).
+    pub fn contact_gravity_m_s2(&self) -> Result<Option<f32>, FieldError> {
+        match self.fields.get("gravity_m_s2") {
+            None => Ok(None),
+            Some(_) => self.fields.opt("gravity_m_s2"),
+        }
+    }
+
     /// The bounce train's speed (`flight`, `rebound`), as the line names it, if any.
     pub fn train(&self) -> Option<&str> {
         self.fields.get("train").filter(|t| *t != "none")
