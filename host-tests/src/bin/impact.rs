@@ -128,15 +128,46 @@ fn main() -> ExitCode {
     }
 }
 
-fn run(cli: Cli) -> Result<(), String> {
+/// What ended a command: its own error, printed `error: …` with exit status 1 (each
+/// command's error says what it refused or what failed in the words the user sees).
+#[derive(Debug, thiserror::Error)]
+enum Error {
+    #[error(transparent)]
+    Simulate(#[from] simulate::SimulateError),
+    /// `impact analyze`.
+    // errs-a: `cli::analyze::run` still returns its message; `#[from]` its typed error at the
+    // merge.
+    #[error("{0}")]
+    Analyze(String),
+    #[error(transparent)]
+    Emulate(#[from] cli::emulate::EmulateError),
+    #[error(transparent)]
+    Log(#[from] cli::log::LogCommandError),
+    /// `impact report`.
+    // errs-a: `cli::html::run` still returns its message; `#[from]` its typed error at the
+    // merge.
+    #[error("{0}")]
+    Report(String),
+    #[error(transparent)]
+    Watch(#[from] cli::watch::WatchError),
+    #[error(transparent)]
+    Synth(#[from] impact_host::synth::SynthError),
+    /// (Boxed: the benchmarks' errors are the largest, and the rarest.)
+    #[error(transparent)]
+    Bench(Box<impact_host::bench::BenchError>),
+}
+
+fn run(cli: Cli) -> Result<(), Error> {
     match cli.command {
-        Command::Simulate(args) => cli::simulate::run(&args),
-        Command::Analyze(args) => cli::analyze::run(&args),
-        Command::Emulate(args) => cli::emulate::emulate(&args),
-        Command::Log(args) => cli::log::log(&args),
-        Command::Report(args) => cli::html::run(&args),
-        Command::Watch(args) => cli::watch::run(&args),
-        Command::Synth(command) => cli::synth::run(command),
-        Command::Bench { which } => cli::bench::run(which),
+        Command::Simulate(args) => Ok(cli::simulate::run(&args)?),
+        // errs-a: analyze's message.
+        Command::Analyze(args) => cli::analyze::run(&args).map_err(Error::Analyze),
+        Command::Emulate(args) => Ok(cli::emulate::emulate(&args)?),
+        Command::Log(args) => Ok(cli::log::log(&args)?),
+        // errs-a: report's message.
+        Command::Report(args) => cli::html::run(&args).map_err(Error::Report),
+        Command::Watch(args) => Ok(cli::watch::run(&args)?),
+        Command::Synth(command) => Ok(cli::synth::run(command)?),
+        Command::Bench { which } => cli::bench::run(which).map_err(|e| Error::Bench(Box::new(e))),
     }
 }
