@@ -38,13 +38,6 @@ pub enum WorkerError {
     Panicked,
 }
 
-/// Temporary, while callers still hold messages (`bench/`): the error as its message.
-impl From<WorkerError> for String {
-    fn from(e: WorkerError) -> Self {
-        e.to_string()
-    }
-}
-
 /// Runs `f` on a thread with a 64 MiB stack: the core's monitors hold their capture buffers
 /// inline (no allocation in `core`), which is more than a default thread's stack. `f`'s
 /// error, or the thread's own ([`WorkerError`]) as `f`'s error type.

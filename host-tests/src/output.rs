@@ -120,12 +120,6 @@ fn input_named(input: &Path) -> String {
     }
 }
 
-impl From<OutputError> for String {
-    fn from(e: OutputError) -> String {
-        e.to_string()
-    }
-}
-
 /// Checks, before any work, that `path` (the value of `option`) can take an output: its
 /// directory exists, it is no directory itself, and it is none of the `inputs` (the same file,
 /// a link to one, standard input's file). `extension`, if given, is the one the output must

@@ -280,63 +280,92 @@ pub const SEED_BENCH_ARGS: [&str; 14] = [
     "2",
 ];
 
+/// Why `impact synth` refused, or could not render or write the recording.
+#[derive(Debug, thiserror::Error)]
+pub enum SynthError {
+    #[error(transparent)]
+    Model(#[from] crate::simulate::ModelError),
+    /// A parameter out of its domain (or a contact not resolved), named as its option.
+    #[error("{}", crate::flags::core(*.0))]
+    Core(#[from] Error),
+    /// An option's value outside what it takes: `{option}: must {rule}`.
+    #[error("{option}: must {rule}")]
+    Invalid {
+        option: &'static str,
+        rule: &'static str,
+    },
+    #[error(
+        "--duration x --rate: {samples:.3e} samples; at most {MAX_SAMPLES:.0e} in one synthetic recording"
+    )]
+    TooManySamples { samples: f64 },
+    #[error("--output and --raw are both {}", .path.display())]
+    SameFile { path: std::path::PathBuf },
+    #[error(transparent)]
+    Output(#[from] crate::output::OutputError),
+    #[error("stdout: {0}")]
+    Stdout(std::io::Error),
+}
+
+/// `--drop-every` refused (clap shows it after the option and the value).
+#[derive(Debug, thiserror::Error)]
+pub enum DropEveryError {
+    #[error("1 would drop every sample: give 0 (none) or at least 2")]
+    All,
+    #[error(transparent)]
+    NotANumber(#[from] std::num::ParseIntError),
+}
+
 /// Renders the recording described by `args` (raw codes; [`write_csv`] writes it as the
 /// tool's CSV).
-pub fn synth(args: &SynthArgs) -> Result<Recording, String> {
+pub fn synth(args: &SynthArgs) -> Result<Recording, SynthError> {
+    let invalid = |option, rule| Err(SynthError::Invalid { option, rule });
     let impact = Impact::new(args.mass, args.v0);
-    impact.validate().map_err(crate::flags::core)?;
+    impact.validate()?;
     let model = args.params.model(args.model, &impact)?;
     if !(args.rate.is_finite() && args.rate > 0.0) {
-        return Err("--rate: must be finite and > 0".into());
+        return invalid("--rate", "be finite and > 0");
     }
     if !(2..=15).contains(&args.bits) {
         // Codes are offset binary (mid-scale is zero) in the i16 sample path.
-        return Err(
-            "--bits: must lie in 2..=15 (offset-binary codes in the i16 sample path)".into(),
+        return invalid(
+            "--bits",
+            "lie in 2..=15 (offset-binary codes in the i16 sample path)",
         );
     }
-    let finite = |name: &str, x: f64| {
-        if x.is_finite() {
-            Ok(())
-        } else {
-            Err(format!("--{name}: must be finite"))
+    for (option, x) in [("--offset", args.offset), ("--drift", args.drift)] {
+        if !x.is_finite() {
+            return invalid(option, "be finite");
         }
-    };
-    finite("offset", args.offset)?;
-    finite("drift", args.drift)?;
+    }
     if !(args.noise.is_finite() && args.noise >= 0.0) {
-        return Err("--noise: must be finite and >= 0".into());
+        return invalid("--noise", "be finite and >= 0");
     }
     if !(args.full_scale.is_finite() && args.full_scale > 0.0) {
-        return Err("--full-scale: must be finite and > 0".into());
+        return invalid("--full-scale", "be finite and > 0");
     }
     if !(args.duration.is_finite() && args.duration > 0.0) {
-        return Err("--duration: must be finite and > 0".into());
+        return invalid("--duration", "be finite and > 0");
     }
     let samples = args.duration * args.rate;
     if samples > MAX_SAMPLES as f64 {
-        return Err(format!(
-            "--duration x --rate: {samples:.3e} samples; at most {MAX_SAMPLES:.0e} in one synthetic recording"
-        ));
+        return Err(SynthError::TooManySamples { samples });
     }
     if !(args.touch.is_finite() && args.touch >= 0.0 && args.touch < args.duration) {
-        return Err("--touch: must lie in [0, --duration)".into());
+        return invalid("--touch", "lie in [0, --duration)");
     }
     let sensor = sensor(args);
     if args.impacts == 0 || args.impacts > 100_000 {
-        return Err("--impacts: must lie in 1..=100000".into());
+        return invalid("--impacts", "lie in 1..=100000");
     }
     if args.impacts > 1 && !(args.every.is_finite() && args.every > 0.0) {
-        return Err("--every: must be finite and > 0".into());
+        return invalid("--every", "be finite and > 0");
     }
     if args.bounces == 0 || args.bounces > 10_000 {
-        return Err("--bounces: must lie in 1..=10000".into());
+        return invalid("--bounces", "lie in 1..=10000");
     }
     if args.bounces > 1 {
         let n = (args.duration * args.rate).ceil() as usize;
-        let rendered = bounce_drop(args, &model)
-            .render(args.rate, n)
-            .map_err(crate::flags::core)?;
+        let rendered = bounce_drop(args, &model).render(args.rate, n)?;
         let (samples, clipped) = quantise(&sensor, &rendered.accel_m_s2);
         return Ok(Recording {
             samples,
@@ -354,7 +383,7 @@ pub fn synth(args: &SynthArgs) -> Result<Recording, String> {
             })
             .collect()
     };
-    record(&sensor, args.duration, &contacts).map_err(crate::flags::core)
+    Ok(record(&sensor, args.duration, &contacts)?)
 }
 
 /// The physical drop `--bounces` renders: the body in free flight from the record's start,
@@ -378,12 +407,9 @@ pub fn bounce_drop(args: &SynthArgs, model: &impact_core::Model<f64>) -> crate::
 pub fn bounce_train(
     args: &SynthArgs,
     model: &impact_core::Model<f64>,
-) -> Result<Vec<crate::drop::ContactTruth>, String> {
+) -> Result<Vec<crate::drop::ContactTruth>, Error> {
     let n = (args.duration * args.rate).ceil() as usize;
-    Ok(bounce_drop(args, model)
-        .render(args.rate, n)
-        .map_err(crate::flags::core)?
-        .contacts)
+    Ok(bounce_drop(args, model).render(args.rate, n)?.contacts)
 }
 
 /// A contact's truth as a model outcome (`permanent_deformation_m`: the deformation at
@@ -436,10 +462,9 @@ pub fn write_csv(rec: &Recording, args: &SynthArgs, out: &mut impl Write) -> std
 }
 
 /// `--drop-every`: 0 (none) or at least 2 (1 would drop every sample and write no recording).
-fn drop_every(s: &str) -> Result<usize, String> {
-    match s.parse::<usize>() {
-        Ok(1) => Err("1 would drop every sample: give 0 (none) or at least 2".into()),
-        Ok(n) => Ok(n),
-        Err(e) => Err(e.to_string()),
+fn drop_every(s: &str) -> Result<usize, DropEveryError> {
+    match s.parse::<usize>()? {
+        1 => Err(DropEveryError::All),
+        n => Ok(n),
     }
 }

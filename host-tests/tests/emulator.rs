@@ -15,12 +15,12 @@ use std::time::Instant;
 mod common;
 use common::{impact_ok as impact, Scratch};
 use impact_host::firmware_link::line::Counter;
-use impact_host::firmware_link::qemu::{Pacing, Samples, BOARD_CLOCK_SHIFT};
+use impact_host::firmware_link::qemu::{Pacing, QemuError, Samples, BOARD_CLOCK_SHIFT};
 
 /// The emulator firmware, built once for all tests; `None` (and a note on stderr) if the
 /// tools are missing.
 fn firmware() -> Option<PathBuf> {
-    static ELF: OnceLock<Result<PathBuf, String>> = OnceLock::new();
+    static ELF: OnceLock<Result<PathBuf, QemuError>> = OnceLock::new();
     let elf = ELF.get_or_init(|| {
         impact_host::firmware_link::qemu::tools_available()?;
         let t = Instant::now();
@@ -33,7 +33,7 @@ fn firmware() -> Option<PathBuf> {
     });
     match elf {
         Ok(elf) => Some(elf.clone()),
-        Err(e) if e.contains("not found") => {
+        Err(e) if e.is_tool_missing() => {
             if std::env::var_os("IMPACT_REQUIRE_EMULATOR").is_some() {
                 panic!("{e} (IMPACT_REQUIRE_EMULATOR is set)");
             }

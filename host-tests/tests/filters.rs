@@ -15,7 +15,7 @@ fn data(rel: &str) -> PathBuf {
         .join(rel)
 }
 
-fn analyze(args: &AnalyzeArgs) -> Result<AnalysisJson, String> {
+fn analyze(args: &AnalyzeArgs) -> Result<AnalysisJson, pipeline::PipelineError> {
     let setup = pipeline::setup(args, impact_io::progress::Progress::none())?;
     let reports = pipeline::run(&setup.prepared.counts, &setup.scene)?;
     Ok(pipeline::to_json(&setup, &reports))

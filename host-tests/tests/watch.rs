@@ -379,6 +379,55 @@ fn shown(x: f64) -> String {
     format!("{:.*}", digits2.max(0) as usize, r2)
 }
 
+/// Text from the board's lines and the session file's name reaches the live page as text:
+/// a summary whose `result` is hostile, a line whose error quotes a hostile value, a session
+/// file named with markup. The page (headless Chromium) shows them literally and holds no
+/// element they would make if parsed as HTML (`<script>`, `<b data-injected>`).
+#[cfg(target_os = "linux")]
+#[test]
+fn hostile_text_shows_as_text_on_the_live_page() {
+    // No spaces (a field's value ends at one), no `/` in the file's name.
+    const VALUE: &str = "=cmd|<script>\"'&<b/data-injected>";
+    const NAME: &str = "=cmd|<script>\"'&<b data-injected>";
+    let scratch = Scratch::new();
+    let Some(browser) = common::browser::chromium() else {
+        return;
+    };
+    let session = scratch.join(&format!("{NAME}.log"));
+    let mut w = Watch::start(&session, &[]);
+    let _browser = open_browser(browser, &w.addr, &scratch, "hostile");
+    wait_for_page(&w);
+    w.send(SCENE);
+    w.send(&heartbeat(1, 1000, 0));
+    // Not a number: the warning quotes it.
+    w.send(&heartbeat(2, 2000, 0).replace("samples=2000", &format!("samples={VALUE}")));
+    w.send(&summary(3, 3000, 0).replace("result=ok", &format!("result={VALUE}")));
+    let ended = format!("stream ended: {VALUE}");
+    let quoted = format!("samples={VALUE}: not a number");
+    let t = Instant::now();
+    let shown = loop {
+        let r = receipts(&w);
+        if let Some(n) = r.iter().rev().find(|r| {
+            r.get("kind").is_some_and(|k| k == "notices")
+                && r.get("text").is_some_and(|t| t.contains(&ended))
+        }) {
+            break n.clone();
+        }
+        assert!(
+            t.elapsed() < Duration::from_secs(20),
+            "the page never showed the stream's end: {r:?}"
+        );
+        std::thread::sleep(Duration::from_millis(100));
+    };
+    let text = &shown["text"];
+    assert!(text.contains(&quoted), "{text}");
+    // One element per notice (its div), the page's own script only, nothing injected.
+    assert_eq!(shown["elements"], shown["notices"], "{shown:?}");
+    assert_eq!(shown["scripts"], "1", "{shown:?}");
+    assert_eq!(shown["injected"], "0", "{shown:?}");
+    assert_eq!(shown["session_file"], session.display().to_string());
+}
+
 /// A real-time emulated train piped into the view, watched by headless Chromium: every
 /// impact's row (its numbers) and its pulse (the board's window) are on the page within a
 /// second of its line reaching the tool, and when the board falls silent (the lines stop, no

@@ -208,7 +208,7 @@ pub fn summary(points: &[Point], target: f64) -> String {
 
 /// Draws time per impact (µs) against max relative error, one series per solver, one panel
 /// per model case, into an SVG file.
-pub fn work_precision(points: &[Point], path: &std::path::Path) -> Result<(), String> {
+pub fn work_precision(points: &[Point], path: &std::path::Path) -> Result<(), super::BenchError> {
     let mut cases: Vec<&str> = points.iter().map(|p| p.case.as_str()).collect();
     cases.dedup();
     let cols = 2usize;
@@ -217,7 +217,7 @@ pub fn work_precision(points: &[Point], path: &std::path::Path) -> Result<(), St
     {
         let root =
             SVGBackend::with_string(&mut text, (1100, 380 * rows as u32)).into_drawing_area();
-        root.fill(&WHITE).map_err(|e| e.to_string())?;
+        root.fill(&WHITE)?;
         let panels = root.split_evenly((rows, cols));
         let solvers = [
             ("euler", RGBColor(200, 80, 40)),
@@ -245,16 +245,14 @@ pub fn work_precision(points: &[Point], path: &std::path::Path) -> Result<(), St
                 .build_cartesian_2d(
                     (1e-17f64..1.0f64).log_scale(),
                     ((tmin * 0.5)..(tmax * 2.0)).log_scale(),
-                )
-                .map_err(|e| e.to_string())?;
+                )?;
             chart
                 .configure_mesh()
                 .x_desc("max relative error")
                 .y_desc("time per impact, µs")
                 .x_label_formatter(&|v| format!("{v:.0e}"))
                 .y_label_formatter(&|v| format!("{v:.2}"))
-                .draw()
-                .map_err(|e| e.to_string())?;
+                .draw()?;
             for (solver, color) in solvers {
                 let series: Vec<(f64, f64)> = pts
                     .iter()
@@ -265,28 +263,24 @@ pub fn work_precision(points: &[Point], path: &std::path::Path) -> Result<(), St
                     continue;
                 }
                 chart
-                    .draw_series(LineSeries::new(series.clone(), color.stroke_width(2)))
-                    .map_err(|e| e.to_string())?
+                    .draw_series(LineSeries::new(series.clone(), color.stroke_width(2)))?
                     .label(solver)
                     .legend(move |(x, y)| {
                         PathElement::new(vec![(x, y), (x + 20, y)], color.stroke_width(2))
                     });
-                chart
-                    .draw_series(
-                        series
-                            .into_iter()
-                            .map(|xy| Circle::new(xy, 3, color.filled())),
-                    )
-                    .map_err(|e| e.to_string())?;
+                chart.draw_series(
+                    series
+                        .into_iter()
+                        .map(|xy| Circle::new(xy, 3, color.filled())),
+                )?;
             }
             chart
                 .configure_series_labels()
                 .background_style(WHITE.mix(0.8))
                 .border_style(BLACK)
-                .draw()
-                .map_err(|e| e.to_string())?;
+                .draw()?;
         }
-        root.present().map_err(|e| e.to_string())?;
+        root.present()?;
     }
     Ok(crate::output::write(path, text.as_bytes())?)
 }

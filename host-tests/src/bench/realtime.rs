@@ -16,6 +16,8 @@ use crate::firmware_link::qemu::{self, Pacing};
 use crate::synth::{record, DynLaw, Placed, Sensor};
 use crate::testkit::cases;
 
+use super::BenchError;
+
 /// `impact bench realtime` options.
 #[derive(Args, Clone, Debug)]
 pub struct RealtimeArgs {
@@ -117,7 +119,7 @@ pub struct CaseResult {
     pub runs: Vec<TrainRun>,
 }
 
-fn counts(case: &Case, n: usize, spacing: f64) -> Result<(Vec<i16>, Calibration), String> {
+fn counts(case: &Case, n: usize, spacing: f64) -> Result<(Vec<i16>, Calibration), BenchError> {
     let placed: Vec<Placed<'_>> = (0..n)
         .map(|k| Placed {
             touch_s: 0.01 + spacing * k as f64,
@@ -126,7 +128,7 @@ fn counts(case: &Case, n: usize, spacing: f64) -> Result<(Vec<i16>, Calibration)
         })
         .collect();
     let duration = 0.01 + spacing * n as f64;
-    let rec = record(&case.sensor, duration, &placed).map_err(|e| e.to_string())?;
+    let rec = record(&case.sensor, duration, &placed)?;
     Ok((rec.samples, rec.calibration))
 }
 
@@ -137,7 +139,7 @@ fn train(
     n: usize,
     spacing: f64,
     clock_shift: u8,
-) -> Result<TrainRun, String> {
+) -> Result<TrainRun, BenchError> {
     let (samples, _) = counts(case, n, spacing)?;
     let run = qemu::run_emulator(
         elf,
@@ -151,14 +153,10 @@ fn train(
         Duration::from_secs(1200),
         |_| {},
     )?;
-    let log =
-        crate::firmware_link::log::parse_log(&run.lines.join("\n")).map_err(|e| e.to_string())?;
-    let summary = log
-        .summary
-        .as_ref()
-        .ok_or("the emulator's log has no summary line")?;
-    let get = |c: Counter| -> Result<u64, String> {
-        (summary.state.readable(c)).ok_or(format!("summary: no {}", c.name()))
+    let log = crate::firmware_link::log::parse_log(&run.lines.join("\n"))?;
+    let summary = log.summary.as_ref().ok_or(BenchError::NoSummary)?;
+    let get = |counter: Counter| {
+        (summary.state.readable(counter)).ok_or(BenchError::NoCounter { counter })
     };
     let mut latencies: Vec<f64> = log.latencies.iter().flatten().map(|&l| l as f64).collect();
     let max = latencies.iter().copied().reduce(f64::max);
@@ -178,7 +176,7 @@ fn train(
 }
 
 /// Runs every case with and without fits.
-pub fn run(args: &RealtimeArgs) -> Result<Vec<CaseResult>, String> {
+pub fn run(args: &RealtimeArgs) -> Result<Vec<CaseResult>, BenchError> {
     qemu::tools_available()?;
     let elf = match &args.elf {
         Some(p) => p.clone(),

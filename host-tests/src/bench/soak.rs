@@ -5,6 +5,8 @@ use std::time::Instant;
 use impact_core::{Calibration, ImpactReport, Monitor, Scene, Status};
 use serde::Serialize;
 
+use super::BenchError;
+
 /// What a soak run found.
 #[derive(Clone, Debug, Serialize)]
 pub struct SoakResult {
@@ -19,14 +21,14 @@ pub struct SoakResult {
 
 /// Streams `samples` samples of ±1-count noise with a half-sine pulse (`pulse_len` samples,
 /// 200 counts) every `spacing` samples through a monitor at 1 MS/s, in blocks of 256.
-pub fn run(samples: u64, spacing: u64, pulse_len: u64) -> Result<SoakResult, String> {
+pub fn run(samples: u64, spacing: u64, pulse_len: u64) -> Result<SoakResult, BenchError> {
     if spacing <= pulse_len + 8192 {
-        return Err("--spacing must exceed the pulse by the hold and the baseline window".into());
+        return Err(BenchError::Spacing);
     }
-    crate::on_big_stack(move || run_inner(samples, spacing, pulse_len))
+    super::on_big_stack(move || run_inner(samples, spacing, pulse_len))
 }
 
-fn run_inner(samples: u64, spacing: u64, pulse_len: u64) -> Result<SoakResult, String> {
+fn run_inner(samples: u64, spacing: u64, pulse_len: u64) -> Result<SoakResult, BenchError> {
     let mut scene = Scene::new(
         Calibration {
             gain_m_s2_per_count: 1.0,
@@ -36,7 +38,7 @@ fn run_inner(samples: u64, spacing: u64, pulse_len: u64) -> Result<SoakResult, S
     );
     scene.edge_m_s2 = 8.0;
     scene.hold_s = 1e-3;
-    let mut m = Monitor::<4096, 16384>::new(scene).map_err(|e| e.to_string())?;
+    let mut m = Monitor::<4096, 16384>::new(scene)?;
     let pulse: Vec<i16> = (0..pulse_len)
         .map(|k| (200.0 * (std::f64::consts::PI * k as f64 / pulse_len as f64).sin()) as i16)
         .collect();

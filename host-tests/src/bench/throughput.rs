@@ -5,6 +5,8 @@ use std::time::Instant;
 use impact_core::{Calibration, FitSet, ImpactReport, Monitor, Scene};
 use serde::Serialize;
 
+use super::BenchError;
+
 /// Measured costs.
 #[derive(Clone, Debug, Serialize)]
 pub struct PipelineCost {
@@ -41,17 +43,17 @@ fn scene(fits: bool) -> Scene {
 }
 
 /// Runs the measurements (a few seconds).
-pub fn measure(block: usize) -> Result<PipelineCost, String> {
-    crate::on_big_stack(move || measure_inner(block))
+pub fn measure(block: usize) -> Result<PipelineCost, BenchError> {
+    super::on_big_stack(move || measure_inner(block))
 }
 
-fn measure_inner(block: usize) -> Result<PipelineCost, String> {
+fn measure_inner(block: usize) -> Result<PipelineCost, BenchError> {
     let block = block.max(1);
     // Idle: 2^24 samples of ±1-count noise around 2065.
     let idle: Vec<i16> = (0..1u32 << 24)
         .map(|k| 2065 + ((k.wrapping_mul(2_654_435_761) >> 30) as i16 - 1))
         .collect();
-    let mut m = M::new(scene(false)).map_err(|e| e.to_string())?;
+    let mut m = M::new(scene(false))?;
     let mut count = 0u32;
     let t = Instant::now();
     for b in idle.chunks(block) {
@@ -59,7 +61,7 @@ fn measure_inner(block: usize) -> Result<PipelineCost, String> {
     }
     let idle_s = t.elapsed().as_secs_f64();
     if count != 0 {
-        return Err(format!("noise triggered {count} impacts"));
+        return Err(BenchError::NoiseTriggered { count });
     }
     let idle_ns = idle_s * 1e9 / idle.len() as f64;
 
@@ -72,8 +74,8 @@ fn measure_inner(block: usize) -> Result<PipelineCost, String> {
         stream.extend(&pulse);
         stream.extend(std::iter::repeat_n(2065i16, 2000));
     }
-    let run = |fits: bool| -> Result<(f64, u32), String> {
-        let mut m = M::new(scene(fits)).map_err(|e| e.to_string())?;
+    let run = |fits: bool| -> Result<(f64, u32), BenchError> {
+        let mut m = M::new(scene(fits))?;
         let mut n = 0u32;
         let t = Instant::now();
         for b in stream.chunks(block) {
@@ -84,7 +86,7 @@ fn measure_inner(block: usize) -> Result<PipelineCost, String> {
     let (plain_s, n) = run(false)?;
     let (fits_s, n2) = run(true)?;
     if n != 200 || n2 != 200 {
-        return Err(format!("expected 200 impacts, got {n} and {n2}"));
+        return Err(BenchError::Impacts200 { plain: n, fits: n2 });
     }
     // In-impact samples: the pulses plus the hold; the rest is idle at idle cost.
     let in_impact = 200.0 * (8000.0 + 500.0);
@@ -182,17 +184,17 @@ pub fn throughput(
     block: usize,
     csv_rows: usize,
     analyze_exe: &std::path::Path,
-) -> Result<Throughput, String> {
+) -> Result<Throughput, BenchError> {
     let block = block.max(1);
     let stream = impact_stream(samples, impacts);
     // Best of three runs (a fresh monitor each), the usual way to quote a throughput on a
     // machine shared with other work; the median is kept beside it.
     let mut runs = Vec::new();
     for _ in 0..3 {
-        runs.push(crate::on_big_stack({
+        runs.push(super::on_big_stack({
             let stream = stream.clone();
-            move || -> Result<(f64, u64), String> {
-                let mut m = M::new(stream_scene()).map_err(|e| e.to_string())?;
+            move || -> Result<(f64, u64), BenchError> {
+                let mut m = M::new(stream_scene())?;
                 let mut n = 0u64;
                 let t = Instant::now();
                 for b in stream.chunks(block) {
@@ -207,10 +209,16 @@ pub fn throughput(
     let (seconds, reported) = runs[0];
     let median_seconds = runs[1].0;
     if let Some(r) = runs.iter().find(|r| r.1 != reported) {
-        return Err(format!("runs disagree: {} and {} impacts", reported, r.1));
+        return Err(BenchError::RunsDisagree {
+            first: reported,
+            other: r.1,
+        });
     }
     if reported != impacts as u64 {
-        return Err(format!("{impacts} impacts inserted, {reported} reported"));
+        return Err(BenchError::Lost {
+            inserted: impacts,
+            reported,
+        });
     }
     let (analyze, formats, peers) = analyze_files(
         &stream[..csv_rows.min(stream.len())],
@@ -267,11 +275,9 @@ fn run_child(
     exe: &std::path::Path,
     args: &[&str],
     stdin: Option<&std::path::Path>,
-) -> Result<(String, f64, f64), String> {
+) -> Result<(String, f64, f64), BenchError> {
     let input = match stdin {
-        Some(p) => std::fs::File::open(p)
-            .map_err(|e| format!("{}: {e}", p.display()))?
-            .into(),
+        Some(p) => std::fs::File::open(p).map_err(super::file(p))?.into(),
         None => std::process::Stdio::null(),
     };
     let t = Instant::now();
@@ -282,24 +288,23 @@ fn run_child(
         .stdout(std::process::Stdio::piped())
         .stderr(std::process::Stdio::piped())
         .spawn()
-        .map_err(|e| format!("{}: {e}", exe.display()))?;
+        .map_err(super::file(exe))?;
     let _child = crate::interrupt::child(child.id());
-    let out = child.wait_with_output().map_err(|e| e.to_string())?;
+    let out = child.wait_with_output().map_err(BenchError::Io)?;
     let seconds = t.elapsed().as_secs_f64();
     let stderr = String::from_utf8_lossy(&out.stderr);
     if !out.status.success() {
-        return Err(format!(
-            "{} {} failed: {}",
-            exe.display(),
-            args.join(" "),
-            stderr.trim()
-        ));
+        return Err(BenchError::ChildFailed {
+            exe: exe.to_path_buf(),
+            args: args.join(" "),
+            stderr: stderr.trim().to_string(),
+        });
     }
     let kib: f64 = stderr
         .lines()
         .find_map(|l| l.strip_prefix("peak memory: "))
         .and_then(|v| v.trim_end_matches("kB").trim().parse().ok())
-        .ok_or("the child printed no peak memory")?;
+        .ok_or(BenchError::NoPeakMemory)?;
     Ok((
         String::from_utf8_lossy(&out.stdout).into_owned(),
         seconds,
@@ -337,7 +342,7 @@ fn analyze_files(
         Vec<FormatThroughput>,
         Vec<PeerThroughput>,
     ),
-    String,
+    BenchError,
 > {
     use std::io::Write;
     let dir = std::env::temp_dir();
@@ -345,10 +350,10 @@ fn analyze_files(
     let raw = dir.join(format!("impact-throughput-{}.i16", std::process::id()));
     let _temporaries = [&csv, &raw].map(|p| crate::interrupt::temporary(p));
     let result = (|| {
-        let file = std::fs::File::create(&csv).map_err(|e| format!("{}: {e}", csv.display()))?;
+        let file = std::fs::File::create(&csv).map_err(super::file(&csv))?;
         let mut w = std::io::BufWriter::with_capacity(1 << 20, file);
         let gain_g = 1600.0 / 4096.0 / impact_core::consts::STANDARD_GRAVITY;
-        writeln!(w, "time_s,accel_g").map_err(|e| e.to_string())?;
+        writeln!(w, "time_s,accel_g").map_err(BenchError::Io)?;
         for (k, &c) in counts.iter().enumerate() {
             writeln!(
                 w,
@@ -356,22 +361,20 @@ fn analyze_files(
                 k as f64 * 2e-6,
                 (c as f64 - 2048.0) * gain_g
             )
-            .map_err(|e| e.to_string())?;
+            .map_err(BenchError::Io)?;
         }
-        w.flush().map_err(|e| e.to_string())?;
+        w.flush().map_err(BenchError::Io)?;
         drop(w);
         let bytes: Vec<u8> = long.iter().flat_map(|c| c.to_le_bytes()).collect();
-        std::fs::write(&raw, bytes).map_err(|e| format!("{}: {e}", raw.display()))?;
+        std::fs::write(&raw, bytes).map_err(super::file(&raw))?;
         let size = |p: &std::path::Path| std::fs::metadata(p).map(|m| m.len()).unwrap_or(0);
-        let check = |out: &str, rows: usize| -> Result<u64, String> {
+        let check = |out: &str, rows: usize| -> Result<u64, BenchError> {
             let expected = (impacts as u64 * rows as u64) / samples.max(1) as u64;
             let v: serde_json::Value =
-                serde_json::from_str(out).map_err(|e| format!("analyze JSON: {e}"))?;
+                serde_json::from_str(out).map_err(BenchError::AnalyzeJson)?;
             let reported = v["impacts"].as_array().map_or(0, |a| a.len()) as u64;
             if reported.abs_diff(expected) > 1 {
-                return Err(format!(
-                    "analyze reported {reported} impacts, about {expected} expected"
-                ));
+                return Err(BenchError::Reported { reported, expected });
             }
             Ok(reported)
         };
@@ -444,7 +447,7 @@ fn analyze_files(
                 });
             }
         }
-        let default = default.ok_or("no run of the default path")?;
+        let default = default.ok_or(BenchError::NoDefaultRun)?;
         Ok((default, formats, peers))
     })();
     let _ = std::fs::remove_file(&csv);

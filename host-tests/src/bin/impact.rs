@@ -128,15 +128,38 @@ fn main() -> ExitCode {
     }
 }
 
-fn run(cli: Cli) -> Result<(), String> {
+/// What ended a command: its own error, printed `error: …` with exit status 1 (each
+/// command's error says what it refused or what failed in the words the user sees).
+#[derive(Debug, thiserror::Error)]
+enum Error {
+    #[error(transparent)]
+    Simulate(#[from] simulate::SimulateError),
+    #[error(transparent)]
+    Analyze(#[from] cli::analyze::AnalyzeError),
+    #[error(transparent)]
+    Emulate(#[from] cli::emulate::EmulateError),
+    #[error(transparent)]
+    Log(#[from] cli::log::LogCommandError),
+    #[error(transparent)]
+    Report(#[from] cli::html::ReportError),
+    #[error(transparent)]
+    Watch(#[from] cli::watch::WatchError),
+    #[error(transparent)]
+    Synth(#[from] impact_host::synth::SynthError),
+    /// (Boxed: the benchmarks' errors are the largest, and the rarest.)
+    #[error(transparent)]
+    Bench(Box<impact_host::bench::BenchError>),
+}
+
+fn run(cli: Cli) -> Result<(), Error> {
     match cli.command {
-        Command::Simulate(args) => cli::simulate::run(&args),
+        Command::Simulate(args) => Ok(cli::simulate::run(&args)?),
         Command::Analyze(args) => Ok(cli::analyze::run(&args)?),
-        Command::Emulate(args) => cli::emulate::emulate(&args),
-        Command::Log(args) => cli::log::log(&args),
+        Command::Emulate(args) => Ok(cli::emulate::emulate(&args)?),
+        Command::Log(args) => Ok(cli::log::log(&args)?),
         Command::Report(args) => Ok(cli::html::run(&args)?),
-        Command::Watch(args) => cli::watch::run(&args),
-        Command::Synth(command) => cli::synth::run(command),
-        Command::Bench { which } => cli::bench::run(which),
+        Command::Watch(args) => Ok(cli::watch::run(&args)?),
+        Command::Synth(command) => Ok(cli::synth::run(command)?),
+        Command::Bench { which } => cli::bench::run(which).map_err(|e| Error::Bench(Box::new(e))),
     }
 }

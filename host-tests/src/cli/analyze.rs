@@ -83,13 +83,6 @@ impl From<pipeline::PipelineError> for AnalyzeError {
     }
 }
 
-/// Temporary, while `bin/impact.rs` holds messages: the error as its message.
-impl From<AnalyzeError> for String {
-    fn from(e: AnalyzeError) -> Self {
-        e.to_string()
-    }
-}
-
 /// Runs `impact analyze`.
 pub fn run(cmd: &AnalyzeCommand) -> Result<(), AnalyzeError> {
     let mut files = vec![cmd.args.file.clone()];

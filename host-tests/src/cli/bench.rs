@@ -6,7 +6,7 @@ use std::time::Duration;
 
 use clap::Subcommand;
 
-use crate::bench::{m4, precision, realtime, soak, stability, throughput, two_body};
+use crate::bench::{m4, precision, realtime, soak, stability, throughput, two_body, BenchError};
 use crate::firmware_link::memory;
 
 #[derive(Subcommand)]
@@ -93,15 +93,12 @@ pub enum Bench {
 }
 
 /// Runs one benchmark and prints its results.
-pub fn run(which: Bench) -> Result<(), String> {
+pub fn run(which: Bench) -> Result<(), BenchError> {
     match which {
         Bench::Realtime(args) => {
             let results = realtime::run(&args)?;
             if args.json {
-                crate::outln!(
-                    "{}",
-                    serde_json::to_string_pretty(&results).map_err(|e| e.to_string())?
-                );
+                crate::outln!("{}", serde_json::to_string_pretty(&results)?);
             } else {
                 crate::out!("{}", realtime::table(&results));
             }
@@ -109,10 +106,7 @@ pub fn run(which: Bench) -> Result<(), String> {
         Bench::M4(args) => {
             let (report, profile) = m4::run(&args)?;
             if args.json {
-                crate::outln!(
-                    "{}",
-                    serde_json::to_string_pretty(&report).map_err(|e| e.to_string())?
-                );
+                crate::outln!("{}", serde_json::to_string_pretty(&report)?);
             } else {
                 crate::out!("{}", m4::table(&report));
             }
@@ -120,10 +114,15 @@ pub fn run(which: Bench) -> Result<(), String> {
                 crate::err!("{profile}");
             }
             if let Some(path) = &args.check {
-                let text = std::fs::read_to_string(path)
-                    .map_err(|e| format!("{}: {e}", path.display()))?;
+                let text = std::fs::read_to_string(path).map_err(|source| BenchError::File {
+                    path: path.clone(),
+                    source,
+                })?;
                 let baseline: m4::M4Report =
-                    serde_json::from_str(&text).map_err(|e| format!("{}: {e}", path.display()))?;
+                    serde_json::from_str(&text).map_err(|source| BenchError::Baseline {
+                        path: path.clone(),
+                        source,
+                    })?;
                 crate::err!("{}", m4::check(&report, &baseline)?);
                 crate::errln!("M4 instruction counts within 10 % of {}", path.display());
             }
@@ -135,13 +134,10 @@ pub fn run(which: Bench) -> Result<(), String> {
             csv_rows,
             json,
         } => {
-            let exe = std::env::current_exe().map_err(|e| e.to_string())?;
+            let exe = std::env::current_exe().map_err(BenchError::Io)?;
             let r = throughput::throughput(samples, impacts, block, csv_rows, &exe)?;
             if json {
-                crate::outln!(
-                    "{}",
-                    serde_json::to_string_pretty(&r).map_err(|e| e.to_string())?
-                );
+                crate::outln!("{}", serde_json::to_string_pretty(&r)?);
             } else {
                 crate::outln!(
                     "pipeline: {} samples, {} impacts (all reported) in {:.3} s on one core: {:.3e} samples/s best of 3, {:.3e} median (target 1e9)",
@@ -182,18 +178,13 @@ pub fn run(which: Bench) -> Result<(), String> {
             let mut rows = stability::run(full);
             rows.extend(two_body::stability(full));
             if json {
-                crate::outln!(
-                    "{}",
-                    serde_json::to_string_pretty(&rows).map_err(|e| e.to_string())?
-                );
+                crate::outln!("{}", serde_json::to_string_pretty(&rows)?);
             } else {
                 crate::out!("{}", stability::table(&rows));
             }
             let failures = stability::failures(&rows);
             if failures > 0 {
-                return Err(format!(
-                    "bench stability: {failures} results outside their stated bounds or not finite"
-                ));
+                return Err(BenchError::Stability { failures });
             }
         }
         Bench::Soak {
@@ -202,16 +193,14 @@ pub fn run(which: Bench) -> Result<(), String> {
             pulse,
         } => {
             let r = soak::run(samples, spacing, pulse)?;
-            crate::outln!(
-                "{}",
-                serde_json::to_string_pretty(&r).map_err(|e| e.to_string())?
-            );
+            crate::outln!("{}", serde_json::to_string_pretty(&r)?);
             if r.impacts_reported != r.impacts_inserted || r.mismatched != 0 || r.samples != samples
             {
-                return Err(format!(
-                    "soak: {} impacts inserted, {} reported, {} mismatched",
-                    r.impacts_inserted, r.impacts_reported, r.mismatched
-                ));
+                return Err(BenchError::Soak {
+                    inserted: r.impacts_inserted,
+                    reported: r.impacts_reported,
+                    mismatched: r.mismatched,
+                });
             }
         }
         Bench::Memory { elf, map, json } => {
@@ -224,10 +213,7 @@ pub fn run(which: Bench) -> Result<(), String> {
                 map.as_deref().unwrap_or(&default_map),
             )?;
             if json {
-                crate::outln!(
-                    "{}",
-                    serde_json::to_string_pretty(&b).map_err(|e| e.to_string())?
-                );
+                crate::outln!("{}", serde_json::to_string_pretty(&b)?);
             } else {
                 crate::out!("{}", memory::table(&b));
             }
@@ -235,10 +221,7 @@ pub fn run(which: Bench) -> Result<(), String> {
         Bench::Pipeline { block, json } => {
             let c = throughput::measure(block)?;
             if json {
-                crate::outln!(
-                    "{}",
-                    serde_json::to_string_pretty(&c).map_err(|e| e.to_string())?
-                );
+                crate::outln!("{}", serde_json::to_string_pretty(&c)?);
             } else {
                 crate::outln!(
                     "streaming pipeline on this host, blocks of {} samples:",
@@ -266,17 +249,21 @@ pub fn run(which: Bench) -> Result<(), String> {
                 Duration::from_millis(budget_ms),
             );
             points.extend(two_body::precision(Duration::from_millis(budget_ms)));
-            std::fs::create_dir_all(&out).map_err(|e| format!("{}: {e}", out.display()))?;
+            std::fs::create_dir_all(&out).map_err(|source| BenchError::File {
+                path: out.clone(),
+                source,
+            })?;
             let csv_path = out.join("work-precision.csv");
-            std::fs::write(&csv_path, precision::csv(&points))
-                .map_err(|e| format!("{}: {e}", csv_path.display()))?;
+            std::fs::write(&csv_path, precision::csv(&points)).map_err(|source| {
+                BenchError::File {
+                    path: csv_path.clone(),
+                    source,
+                }
+            })?;
             let svg_path = out.join("work-precision.svg");
             precision::work_precision(&points, &svg_path)?;
             if json {
-                crate::outln!(
-                    "{}",
-                    serde_json::to_string_pretty(&points).map_err(|e| e.to_string())?
-                );
+                crate::outln!("{}", serde_json::to_string_pretty(&points)?);
             } else {
                 crate::out!("{}", precision::table(&points));
                 crate::out!("{}", precision::summary(&points, 1e-9));

@@ -9,12 +9,105 @@ use std::time::Duration;
 
 use clap::Args;
 
-use crate::firmware_link::line::Counter;
-use crate::firmware_link::log::parse_log;
+use crate::firmware_link::line::{Counter, FieldError};
+use crate::firmware_link::log::{parse_log, LogError};
 use crate::firmware_link::qemu::{
-    build_firmware, run_emulator, tools_available, Pacing, Samples, BOARD_CLOCK_SHIFT,
+    build_firmware, run_emulator, tools_available, Pacing, QemuError, Samples, BOARD_CLOCK_SHIFT,
 };
 use crate::pipeline::{self, AnalyzeArgs};
+
+/// Why `impact emulate` refused, or its run failed or disagreed with the recording.
+#[derive(Debug, thiserror::Error)]
+pub enum EmulateError {
+    #[error(transparent)]
+    Qemu(#[from] QemuError),
+    #[error(
+        "--stream: the emulator replays a recording it has read whole (impact analyze --stream reads one as it comes)"
+    )]
+    Stream,
+    /// `--plot`: refused before any work, or its figure not written.
+    #[error(transparent)]
+    Plot(#[from] crate::plot::PlotError),
+    /// The recording could not be read or prepared as `impact analyze` prepares it.
+    #[error(transparent)]
+    Pipeline(#[from] pipeline::PipelineError),
+    #[error(transparent)]
+    Output(#[from] crate::output::OutputError),
+    #[error("--log and --defmt: the same file; give each its own")]
+    SameFile,
+    #[error("a temporary file in {}: {source}", .dir.display())]
+    TempFile {
+        dir: PathBuf,
+        source: std::io::Error,
+    },
+    #[error(
+        "--adxl375: the ADXL375 samples at 3200, 1600, 800, 400, 200 or 100 S/s; this recording is at {rate} S/s (render one at the part's rate with `impact synth --rate 3200`)"
+    )]
+    Adxl375Rate { rate: f64 },
+    /// The board's ADXL375 scene is invalid (a core parameter, named as its option).
+    #[error("--adxl375: {}", crate::flags::core(*.0))]
+    Adxl375Scene(impact_core::Error),
+    #[error("the emulated firmware failed ({status}); see its log above")]
+    Firmware { status: std::process::ExitStatus },
+    #[error(transparent)]
+    Log(#[from] LogError),
+    #[error("the emulator's log has no summary line")]
+    NoSummary,
+    #[error(transparent)]
+    Field(#[from] FieldError),
+    #[error(
+        "the emulator processed {samples} and lost {lost} of {total} samples (result={result})"
+    )]
+    Processed {
+        samples: u64,
+        lost: u64,
+        total: u64,
+        result: String,
+    },
+    #[error(transparent)]
+    Waveform(#[from] WaveformMismatch),
+    #[error(transparent)]
+    Replay(#[from] ReplayError),
+    #[error(transparent)]
+    Json(#[from] serde_json::Error),
+    #[error(transparent)]
+    Stdout(std::io::Error),
+}
+
+/// The replayed stream's counts could not be read back.
+#[derive(Debug, thiserror::Error)]
+pub enum ReplayError {
+    /// The counts file (written for QEMU) could not be opened or sought.
+    #[error("{}: {source}", .path.display())]
+    File {
+        path: PathBuf,
+        source: std::io::Error,
+    },
+    /// Past the end of the counts file.
+    #[error("a window beyond the recording")]
+    WindowBeyond,
+    /// Past the end of the counts held.
+    #[error("beyond the recording")]
+    Beyond,
+}
+
+/// How the firmware's windows differ from the replayed samples.
+#[derive(Debug, thiserror::Error)]
+pub enum WaveformMismatch {
+    #[error("the firmware sent {sent} waveforms for {analysed} analysed impacts")]
+    Count { sent: usize, analysed: usize },
+    #[error("impact {index}: waveform every={every}, asked {asked}")]
+    Every { index: u32, every: u16, asked: u16 },
+    #[error("impact {index}: its window lies beyond the recording")]
+    Beyond { index: u32 },
+    #[error("impact {index}: waveform value {at} is {got:?}, the replayed samples give {want}")]
+    Value {
+        index: u32,
+        at: usize,
+        got: Option<i16>,
+        want: i16,
+    },
+}
 
 /// `impact emulate` options: `impact analyze`'s, and where the firmware comes from.
 #[derive(Args, Clone, Debug)]
@@ -67,10 +160,19 @@ pub struct EmulateArgs {
     pub defmt: Option<PathBuf>,
 }
 
-fn positive_f32(s: &str) -> Result<f32, String> {
+/// `--rate-scale` refused (clap shows it after the option and the value).
+#[derive(Debug, thiserror::Error)]
+#[error("{value}: not a positive number")]
+pub struct NotPositive {
+    pub value: String,
+}
+
+fn positive_f32(s: &str) -> Result<f32, NotPositive> {
     match s.parse::<f32>() {
         Ok(v) if v.is_finite() && v > 0.0 => Ok(v),
-        _ => Err(format!("{s}: not a positive number")),
+        _ => Err(NotPositive {
+            value: s.to_string(),
+        }),
     }
 }
 
@@ -92,15 +194,13 @@ const ADXL375_CLIP_COUNTS: (i16, i16) = (i16::MIN, 4095);
 /// the channel as x) in the part's counts, and the setup changed to the board's ADXL375 scene
 /// (scale, rails) with what the board streams as its counts: the resultant of the axes, or
 /// the one channel's axis.
-pub fn adxl375_axes(setup: &mut pipeline::Setup) -> Result<Vec<[i16; 3]>, String> {
+pub fn adxl375_axes(setup: &mut pipeline::Setup) -> Result<Vec<[i16; 3]>, EmulateError> {
     let rate = setup.rate_hz;
     if !ADXL375_RATES_HZ
         .iter()
         .any(|r| ((rate - r) / r).abs() < 1e-3)
     {
-        return Err(format!(
-            "--adxl375: the ADXL375 samples at 3200, 1600, 800, 400, 200 or 100 S/s; this recording is at {rate} S/s (render one at the part's rate with `impact synth --rate 3200`)"
-        ));
+        return Err(EmulateError::Adxl375Rate { rate });
     }
     let gain = f64::from(ADXL375_GAIN_M_S2);
     let count = |a: f64| {
@@ -142,23 +242,17 @@ pub fn adxl375_axes(setup: &mut pipeline::Setup) -> Result<Vec<[i16; 3]>, String
     } else {
         ADXL375_CLIP_COUNTS
     };
-    setup
-        .scene
-        .validate()
-        .map_err(|e| format!("--adxl375: {}", crate::flags::core(e)))?;
+    setup.scene.validate().map_err(EmulateError::Adxl375Scene)?;
     Ok(axes)
 }
 
 /// `impact emulate`: prints what `impact analyze` would, computed by the emulated firmware.
-pub fn emulate(args: &EmulateArgs) -> Result<(), String> {
+pub fn emulate(args: &EmulateArgs) -> Result<(), EmulateError> {
     let a = &args.analyze;
     // Check the tools before a possibly long build.
     tools_available()?;
     if a.stream {
-        return Err(
-            "--stream: the emulator replays a recording it has read whole (impact analyze --stream reads one as it comes)"
-                .into(),
-        );
+        return Err(EmulateError::Stream);
     }
     // No output over an input (the recording, the scene, the free fall, the firmware).
     let mut inputs = super::analyze::inputs(a);
@@ -175,7 +269,7 @@ pub fn emulate(args: &EmulateArgs) -> Result<(), String> {
         }
     }
     if args.log.is_some() && args.log == args.defmt {
-        return Err("--log and --defmt: the same file; give each its own".into());
+        return Err(EmulateError::SameFile);
     }
     // One channel from a file or standard input is surveyed in passes and its counts written
     // a block at a time to the file QEMU replays (memory bounded whatever its length); the
@@ -186,11 +280,9 @@ pub fn emulate(args: &EmulateArgs) -> Result<(), String> {
             .prefix("impact-emulate-")
             .suffix(".i16")
             .tempfile()
-            .map_err(|e| {
-                format!(
-                    "a temporary file in {}: {e}",
-                    std::env::temp_dir().display()
-                )
+            .map_err(|source| EmulateError::TempFile {
+                dir: std::env::temp_dir(),
+                source,
             })?;
         let guard = crate::interrupt::temporary(tmp.path());
         Some((tmp, guard))
@@ -224,7 +316,7 @@ pub fn emulate(args: &EmulateArgs) -> Result<(), String> {
     let total = samples.len() as u64;
     // Counts of the replayed stream, `n` from stream index `from`: read back from the file
     // when the recording was not held.
-    let replayed = |from: u64, n: usize| -> Result<Vec<i16>, String> {
+    let replayed = |from: u64, n: usize| -> Result<Vec<i16>, ReplayError> {
         match &counts_file {
             Some((tmp, _)) => read_counts(tmp.path(), from, n),
             None => setup
@@ -233,7 +325,7 @@ pub fn emulate(args: &EmulateArgs) -> Result<(), String> {
                 .get(usize::try_from(from).unwrap_or(usize::MAX)..)
                 .and_then(|c| c.get(..n))
                 .map(<[i16]>::to_vec)
-                .ok_or_else(|| "beyond the recording".to_string()),
+                .ok_or(ReplayError::Beyond),
         }
     };
     let elf = match &args.elf {
@@ -272,10 +364,7 @@ pub fn emulate(args: &EmulateArgs) -> Result<(), String> {
         },
     )?;
     if !run.status.success() {
-        return Err(format!(
-            "the emulated firmware failed ({}); see its log above",
-            run.status
-        ));
+        return Err(EmulateError::Firmware { status: run.status });
     }
     let text = run.lines.join("\n") + "\n";
     if let Some(path) = &args.log {
@@ -291,28 +380,24 @@ pub fn emulate(args: &EmulateArgs) -> Result<(), String> {
             path.display()
         );
     }
-    let log = parse_log(&text).map_err(|e| e.to_string())?;
-    let summary = log
-        .summary
-        .as_ref()
-        .ok_or("the emulator's log has no summary line")?;
+    let log = parse_log(&text)?;
+    let summary = log.summary.as_ref().ok_or(EmulateError::NoSummary)?;
     let state = &summary.state;
     let samples = summary.samples;
-    let lost = state
-        .counter(Counter::SamplesLost)
-        .map_err(|e| e.to_string())?;
-    let result = state.result().map_err(|e| e.to_string())?;
+    let lost = state.counter(Counter::SamplesLost)?;
+    let result = state.result()?;
     if samples + lost != total || result != "ok" {
-        return Err(format!(
-            "the emulator processed {samples} and lost {lost} of {total} samples (result={result})"
-        ));
+        return Err(EmulateError::Processed {
+            samples,
+            lost,
+            total,
+            result: result.to_string(),
+        });
     }
     crate::errln!("emulated in {:.2} s", run.seconds);
     let mut json = pipeline::to_json(&setup, &log.impacts);
     json.samples_lost = lost;
-    json.analyses_skipped = state
-        .counter(Counter::AnalysesSkipped)
-        .map_err(|e| e.to_string())?;
+    json.analyses_skipped = state.counter(Counter::AnalysesSkipped)?;
     json.lines_dropped = log.lines_dropped;
     json.lines_missing = log.lines_missing;
     for w in &log.warnings {
@@ -327,13 +412,14 @@ pub fn emulate(args: &EmulateArgs) -> Result<(), String> {
     }
     let mut out = crate::output::stdout();
     let text = if a.json {
-        serde_json::to_string_pretty(&json).map_err(|e| e.to_string())? + "\n"
+        serde_json::to_string_pretty(&json)? + "\n"
     } else if a.csv {
         crate::report::to_csv(&json)
     } else {
         crate::report::to_table(&json)
     };
-    out.write_all(text.as_bytes()).map_err(|e| e.to_string())?;
+    out.write_all(text.as_bytes())
+        .map_err(EmulateError::Stdout)?;
     if let Some(path) = &a.plot {
         if counts_file.is_some() {
             // The windows the figure draws, from the replayed counts.
@@ -360,14 +446,17 @@ pub fn emulate(args: &EmulateArgs) -> Result<(), String> {
 }
 
 /// `n` little-endian i16 counts from index `from` of the file at `path`.
-fn read_counts(path: &std::path::Path, from: u64, n: usize) -> Result<Vec<i16>, String> {
+fn read_counts(path: &std::path::Path, from: u64, n: usize) -> Result<Vec<i16>, ReplayError> {
     use std::io::{Read, Seek, SeekFrom};
-    let mut file = std::fs::File::open(path).map_err(|e| format!("{}: {e}", path.display()))?;
-    file.seek(SeekFrom::Start(from * 2))
-        .map_err(|e| format!("{}: {e}", path.display()))?;
+    let failed = |source| ReplayError::File {
+        path: path.to_path_buf(),
+        source,
+    };
+    let mut file = std::fs::File::open(path).map_err(failed)?;
+    file.seek(SeekFrom::Start(from * 2)).map_err(failed)?;
     let mut bytes = vec![0u8; n * 2];
     file.read_exact(&mut bytes)
-        .map_err(|_| "a window beyond the recording".to_string())?;
+        .map_err(|_| ReplayError::WindowBeyond)?;
     Ok(bytes
         .chunks_exact(2)
         .map(|b| i16::from_le_bytes([b[0], b[1]]))
@@ -379,30 +468,31 @@ fn read_counts(path: &std::path::Path, from: u64, n: usize) -> Result<Vec<i16>, 
 /// difference. Prints what it checked.
 pub fn check_waveforms(
     log: &crate::firmware_link::log::Log,
-    replayed: &dyn Fn(u64, usize) -> Result<Vec<i16>, String>,
+    replayed: &dyn Fn(u64, usize) -> Result<Vec<i16>, ReplayError>,
     every: u16,
-) -> Result<(), String> {
+) -> Result<(), WaveformMismatch> {
     let analysed = log
         .impacts
         .iter()
         .filter(|r| r.analysis != impact_core::Analysis::Skipped)
         .count();
     if log.waveforms.len() != analysed {
-        return Err(format!(
-            "the firmware sent {} waveforms for {analysed} analysed impacts",
-            log.waveforms.len()
-        ));
+        return Err(WaveformMismatch::Count {
+            sent: log.waveforms.len(),
+            analysed,
+        });
     }
     let mut frames = 0;
     for w in &log.waveforms {
         if w.every != every {
-            return Err(format!(
-                "impact {}: waveform every={}, asked {every}",
-                w.index, w.every
-            ));
+            return Err(WaveformMismatch::Every {
+                index: w.index,
+                every: w.every,
+                asked: every,
+            });
         }
         let window = replayed(w.first_sample, w.samples as usize)
-            .map_err(|_| format!("impact {}: its window lies beyond the recording", w.index))?;
+            .map_err(|_| WaveformMismatch::Beyond { index: w.index })?;
         let window = window.as_slice();
         let mut expected = [0i16; impact_core::waveform::FRAME_LEN];
         for k in 0..w.frames as usize {
@@ -411,10 +501,12 @@ pub fn check_waveforms(
                 let at = k * impact_core::waveform::FRAME_LEN + j;
                 let got = w.value(at);
                 if got != Some(*want) {
-                    return Err(format!(
-                        "impact {}: waveform value {at} is {got:?}, the replayed samples give {want}",
-                        w.index
-                    ));
+                    return Err(WaveformMismatch::Value {
+                        index: w.index,
+                        at,
+                        got,
+                        want: *want,
+                    });
                 }
             }
         }

@@ -50,20 +50,12 @@ pub enum ReportError {
     Failed { failed: usize, recordings: usize },
 }
 
-/// Temporary, while `bin/impact.rs` holds messages: the error as its message.
-impl From<ReportError> for String {
-    fn from(e: ReportError) -> Self {
-        e.to_string()
-    }
-}
-
 /// Why a board's log could not be reported ([`log_report`]).
 #[derive(Debug, thiserror::Error)]
 pub enum LogReportError {
-    /// The log not read: `impact log`'s reader ([`crate::cli::log::read_log`]) still gives
-    /// its message, held here until that reader has a typed error of its own.
-    #[error("{message}")]
-    ReadLog { message: String },
+    /// The log not read ([`crate::cli::log::read_log`]'s error; boxed, it is large).
+    #[error(transparent)]
+    ReadLog(Box<crate::cli::log::LogCommandError>),
     #[error(transparent)]
     Log(#[from] crate::firmware_link::log::LogError),
     /// The log's scene line without a field the figures need.
@@ -424,8 +416,7 @@ pub fn log_report(
     spec: Option<&impact_core::spec::Spec>,
 ) -> Result<String, LogReportError> {
     let name = path.display().to_string();
-    let log =
-        crate::cli::log::read_log(path).map_err(|message| LogReportError::ReadLog { message })?;
+    let log = crate::cli::log::read_log(path).map_err(|e| LogReportError::ReadLog(Box::new(e)))?;
     let mut analysis = crate::firmware_link::log_json::log_json(&log, 0.0)?;
     analysis.spec = spec.map(crate::report::spec::spec_json);
     let mut figures = Vec::new();

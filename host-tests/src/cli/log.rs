@@ -7,8 +7,11 @@ use std::path::PathBuf;
 
 use clap::Args;
 
-use crate::firmware_link::log::LogReader;
+use crate::firmware_link::decode::DefmtError;
+use crate::firmware_link::line::FieldError;
+use crate::firmware_link::log::{LogError, LogReader};
 use crate::firmware_link::log_json::LogJson;
+use crate::firmware_link::waves::ExportError;
 use impact_io::channel::is_stdin;
 use impact_io::table::MAX_LINE_BYTES;
 
@@ -44,17 +47,97 @@ pub struct LogArgs {
     pub export: Option<PathBuf>,
 }
 
-fn finite_f64(s: &str) -> Result<f64, String> {
+/// Why `impact log` (or `impact watch`'s export of its session file) could not read a log or
+/// write what it gives. `name` is the input as the tool names it (`stdin`, or its path).
+#[derive(Debug, thiserror::Error)]
+pub enum LogCommandError {
+    /// `--plot`: refused before any work, or its figure not written.
+    #[error(transparent)]
+    Plot(#[from] crate::plot::PlotError),
+    #[error("{name}: {source}")]
+    Open {
+        name: String,
+        source: std::io::Error,
+    },
+    #[error(transparent)]
+    ReadLine(#[from] ReadLineError),
+    #[error("{name}:{line}: a line longer than {MAX_LINE_BYTES} bytes: not a decoded defmt log")]
+    LineTooLong { name: String, line: u64 },
+    #[error(transparent)]
+    Defmt(#[from] DefmtError),
+    /// A raw defmt stream's log error: its lines are the stream's frames.
+    #[error("{name}: {}", in_frames(.error))]
+    InFrames { name: String, error: Box<LogError> },
+    #[error("{name}: {error}")]
+    Log { name: String, error: Box<LogError> },
+    /// What the whole log lacks for its report (no rate).
+    #[error(transparent)]
+    Report(LogError),
+    /// A value of the scene line the figure or the export needs.
+    #[error(transparent)]
+    Scene(#[from] FieldError),
+    #[error(
+        "--plot/--export: {name} holds {runs} runs (the board restarted on line {restart}): their \
+         sample positions overlap; split the log into runs"
+    )]
+    Runs {
+        name: String,
+        runs: usize,
+        restart: u64,
+    },
+    #[error("--plot/--export: the log has no scene line (the rate and the gain)")]
+    NoScene,
+    #[error("--plot: the log has no waveforms (the scene's wave=0)")]
+    NoWaveforms,
+    #[error(transparent)]
+    Export(#[from] ExportError),
+    /// The report written to `name` (an export of the session file).
+    #[error("{name}: {source}")]
+    Write {
+        name: String,
+        source: std::io::Error,
+    },
+    #[error("stdout: {0}")]
+    Stdout(std::io::Error),
+}
+
+/// A log error of a raw defmt stream, its line numbers the frames': `frame N: what`.
+fn in_frames(e: &LogError) -> String {
+    match e.line {
+        Some(n) => format!("frame {n}: {}", e.kind),
+        None => e.kind.to_string(),
+    }
+}
+
+/// A line of `name` that could not be read.
+#[derive(Debug, thiserror::Error)]
+#[error("{name}:{line}: {source}")]
+pub struct ReadLineError {
+    pub name: String,
+    pub line: u64,
+    pub source: std::io::Error,
+}
+
+/// `--t0` refused (clap shows it after the option and the value).
+#[derive(Debug, thiserror::Error)]
+pub enum FiniteError {
+    #[error("must be finite")]
+    NotFinite,
+    #[error("not a number")]
+    NotANumber,
+}
+
+fn finite_f64(s: &str) -> Result<f64, FiniteError> {
     match s.parse::<f64>() {
         Ok(v) if v.is_finite() => Ok(v),
-        Ok(_) => Err("must be finite".into()),
-        Err(_) => Err("not a number".into()),
+        Ok(_) => Err(FiniteError::NotFinite),
+        Err(_) => Err(FiniteError::NotANumber),
     }
 }
 
 /// `impact log`: a decoded firmware log as JSON (default) or CSV. The file (or stdin, `-`)
 /// is read line by line, each line at most [`MAX_LINE_BYTES`].
-pub fn log(args: &LogArgs) -> Result<(), String> {
+pub fn log(args: &LogArgs) -> Result<(), LogCommandError> {
     let name = impact_io::channel::input_name(&args.file);
     if let Some(path) = &args.plot {
         let mut inputs = vec![args.file.as_path()];
@@ -64,14 +147,22 @@ pub fn log(args: &LogArgs) -> Result<(), String> {
     let input: Box<dyn Read> = if is_stdin(&args.file) {
         Box::new(std::io::stdin())
     } else {
-        Box::new(std::fs::File::open(&args.file).map_err(|e| format!("{name}: {e}"))?)
+        Box::new(
+            std::fs::File::open(&args.file).map_err(|source| LogCommandError::Open {
+                name: name.clone(),
+                source,
+            })?,
+        )
     };
     let mut reader = LogReader::default();
     if let Some(elf) = &args.elf {
         let skipped = crate::firmware_link::decode::decode(elf, input, &name, |n, line| {
             reader
                 .line(n, line)
-                .map_err(|e| format!("{name}: {}", e.to_string().replacen("line ", "frame ", 1)))
+                .map_err(|error| LogCommandError::InFrames {
+                    name: name.clone(),
+                    error: Box::new(error),
+                })
         })?;
         if skipped > 0 {
             crate::errln!(
@@ -88,11 +179,18 @@ pub fn log(args: &LogArgs) -> Result<(), String> {
 /// (from 1), its text, and whether it was cut: a line is at most [`MAX_LINE_BYTES`] with its
 /// newline; of a longer one `on_line` gets the first [`MAX_LINE_BYTES`] bytes (it may end the
 /// reading there) and the rest is passed over, never held.
-pub fn for_each_line(
+pub fn for_each_line<E: From<ReadLineError>>(
     input: impl Read,
     name: &str,
-    mut on_line: impl FnMut(u64, &str, bool) -> Result<(), String>,
-) -> Result<(), String> {
+    mut on_line: impl FnMut(u64, &str, bool) -> Result<(), E>,
+) -> Result<(), E> {
+    let failed = |line: u64| {
+        move |source| ReadLineError {
+            name: name.to_string(),
+            line,
+            source,
+        }
+    };
     let mut input = BufReader::with_capacity(1 << 16, input);
     let mut buf = Vec::new();
     for n in 1.. {
@@ -100,7 +198,7 @@ pub fn for_each_line(
         let read = (&mut input)
             .take(MAX_LINE_BYTES as u64 + 1)
             .read_until(b'\n', &mut buf)
-            .map_err(|e| format!("{name}:{n}: {e}"))?;
+            .map_err(failed(n))?;
         if read == 0 {
             break;
         }
@@ -109,9 +207,7 @@ pub fn for_each_line(
         buf.truncate(MAX_LINE_BYTES);
         on_line(n, String::from_utf8_lossy(&buf).trim_end(), cut)?;
         if rest {
-            input
-                .skip_until(b'\n')
-                .map_err(|e| format!("{name}:{n}: {e}"))?;
+            input.skip_until(b'\n').map_err(failed(n))?;
         }
     }
     Ok(())
@@ -119,70 +215,82 @@ pub fn for_each_line(
 
 /// Reads the decoded log `input` (called `name` in errors) line by line into `reader`; a line
 /// longer than [`MAX_LINE_BYTES`] is an error.
-fn read_text(input: impl Read, name: &str, reader: &mut LogReader) -> Result<(), String> {
+fn read_text(input: impl Read, name: &str, reader: &mut LogReader) -> Result<(), LogCommandError> {
     for_each_line(input, name, |n, line, cut| {
         if cut {
-            return Err(format!(
-                "{name}:{n}: a line longer than {MAX_LINE_BYTES} bytes: not a decoded defmt log"
-            ));
+            return Err(LogCommandError::LineTooLong {
+                name: name.to_string(),
+                line: n,
+            });
         }
-        reader.line(n, line).map_err(|e| format!("{name}: {e}"))
+        reader.line(n, line).map_err(in_log(name))
     })
 }
 
+/// A log error of the input `name`.
+fn in_log(name: &str) -> impl Fn(LogError) -> LogCommandError + '_ {
+    move |error| LogCommandError::Log {
+        name: name.to_string(),
+        error: Box::new(error),
+    }
+}
+
 /// The decoded log at `path` (`impact watch`'s session file), read and checked.
-pub fn read_log(path: &std::path::Path) -> Result<crate::firmware_link::log::Log, String> {
+pub fn read_log(path: &std::path::Path) -> Result<crate::firmware_link::log::Log, LogCommandError> {
     let name = path.display().to_string();
-    let file = std::fs::File::open(path).map_err(|e| format!("{name}: {e}"))?;
+    let file = std::fs::File::open(path).map_err(|source| LogCommandError::Open {
+        name: name.clone(),
+        source,
+    })?;
     let mut reader = LogReader::default();
     read_text(file, &name, &mut reader)?;
-    reader.finish().map_err(|e| format!("{name}: {e}"))
+    reader.finish().map_err(in_log(&name))
 }
 
 /// The decoded log at `path` (`impact watch`'s session file) as `impact log`'s JSON, or CSV,
 /// written to `out`.
-pub fn export(path: &std::path::Path, csv: bool, out: &mut impl Write) -> Result<(), String> {
+pub fn export(
+    path: &std::path::Path,
+    csv: bool,
+    out: &mut impl Write,
+) -> Result<(), LogCommandError> {
     let name = path.display().to_string();
     let log = read_log(path)?;
-    let json = LogJson::new(&log, 0.0).map_err(|e| e.to_string())?;
+    let json = LogJson::new(&log, 0.0).map_err(LogCommandError::Report)?;
     if csv {
         crate::report::csv::write_csv(&json.head, json.impacts(), out)
     } else {
         crate::report::write_json(&json.head, json.impacts(), out)
     }
-    .map_err(|e| format!("{name}: {e}"))
+    .map_err(|source| LogCommandError::Write { name, source })
 }
 
 /// The log read: its warnings on stderr, the figure and exports asked for, the JSON or CSV.
-fn report(args: &LogArgs, reader: LogReader, name: &str) -> Result<(), String> {
-    let log = reader.finish().map_err(|e| format!("{name}: {e}"))?;
+fn report(args: &LogArgs, reader: LogReader, name: &str) -> Result<(), LogCommandError> {
+    let log = reader.finish().map_err(in_log(name))?;
     if let (true, [_, second, ..]) = (
         args.plot.is_some() || args.export.is_some(),
         log.runs.as_slice(),
     ) {
-        return Err(format!(
-            "--plot/--export: {name} holds {} runs (the board restarted on line {}): their \
-             sample positions overlap; split the log into runs",
-            log.runs.len(),
-            second.line
-        ));
+        return Err(LogCommandError::Runs {
+            name: name.to_string(),
+            runs: log.runs.len(),
+            restart: second.line,
+        });
     }
     for w in &log.warnings {
         crate::errln!("warning: {name}: {w}");
     }
-    let json = LogJson::new(&log, args.t0).map_err(|e| e.to_string())?;
+    let json = LogJson::new(&log, args.t0).map_err(LogCommandError::Report)?;
     if args.plot.is_some() || args.export.is_some() {
-        let scene = log
-            .scene
-            .as_ref()
-            .ok_or("--plot/--export: the log has no scene line (the rate and the gain)")?;
+        let scene = log.scene.as_ref().ok_or(LogCommandError::NoScene)?;
         let rate = f64::from(scene.rate_hz);
-        let gain = f64::from(scene.gain().map_err(|e| e.to_string())?);
+        let gain = f64::from(scene.gain()?);
         if let Some(path) = &args.plot {
             if log.waveforms.is_empty() {
-                return Err("--plot: the log has no waveforms (the scene's wave=0)".into());
+                return Err(LogCommandError::NoWaveforms);
             }
-            let mass = scene.mass_kg().map_err(|e| e.to_string())?;
+            let mass = scene.mass_kg()?;
             let waves = &log.waveforms;
             // The board sends the impact's window only: not the samples around it that its
             // CFC filtered.
@@ -225,5 +333,5 @@ fn report(args: &LogArgs, reader: LogReader, name: &str) -> Result<(), String> {
         crate::report::write_json(&json.head, json.impacts(), &mut out)
     }
     .and_then(|()| out.flush())
-    .map_err(|e| format!("stdout: {e}"))
+    .map_err(LogCommandError::Stdout)
 }

@@ -1,12 +1,12 @@
 //! `impact simulate`: one impact of a contact model, on a wall or a target, as a table or
 //! JSON.
 
-use crate::simulate::{self, SimulateArgs};
+use crate::simulate::{self, SimulateArgs, SimulateError};
 
 /// Runs `impact simulate`.
-pub fn run(args: &SimulateArgs) -> Result<(), String> {
-    fn json<T: serde::Serialize>(v: &T) -> Result<String, String> {
-        serde_json::to_string(v).map_err(|e| e.to_string())
+pub fn run(args: &SimulateArgs) -> Result<(), SimulateError> {
+    fn json<T: serde::Serialize>(v: &T) -> Result<String, SimulateError> {
+        Ok(serde_json::to_string(v)?)
     }
     match simulate::run_any(args)? {
         simulate::Outcome::Wall(report) if args.json => crate::outln!("{}", json(&report)?),

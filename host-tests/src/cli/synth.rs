@@ -5,7 +5,7 @@ use std::path::PathBuf;
 
 use clap::Args;
 
-use crate::synth;
+use crate::synth::{self, SynthError};
 
 /// `impact synth` options: the impact and the recording ([`synth::SynthArgs`]), and where
 /// they go.
@@ -23,11 +23,11 @@ pub struct SynthCommand {
 }
 
 /// Runs `impact synth`.
-pub fn run(command: SynthCommand) -> Result<(), String> {
+pub fn run(command: SynthCommand) -> Result<(), SynthError> {
     let SynthCommand { args, output, raw } = command;
     if let (Some(o), Some(r)) = (&output, &raw) {
         if o == r {
-            return Err(format!("--output and --raw are both {}", o.display()));
+            return Err(SynthError::SameFile { path: o.clone() });
         }
     }
     let inputs = crate::output::Inputs::new();
@@ -52,7 +52,7 @@ pub fn run(command: SynthCommand) -> Result<(), String> {
                 &args,
                 &mut std::io::BufWriter::with_capacity(1 << 16, stdout),
             )
-            .map_err(|e| format!("stdout: {e}"))?;
+            .map_err(SynthError::Stdout)?;
         }
     }
     Ok(())

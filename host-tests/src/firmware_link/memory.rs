@@ -16,15 +16,47 @@ pub struct Region {
     pub length: u64,
 }
 
+/// Why a linker script's `MEMORY` regions could not be read.
+#[derive(Debug, thiserror::Error)]
+pub enum RegionsError {
+    #[error("no MEMORY block")]
+    NoMemoryBlock,
+    /// An `ORIGIN` or `LENGTH` that is no number (`0x...`, `64K`, `1M`).
+    #[error("{value}: not a size")]
+    NotASize { value: String },
+}
+
+/// Why the firmware's memory budget could not be read.
+#[derive(Debug, thiserror::Error)]
+pub enum MemoryError {
+    /// The ELF or the memory map could not be read.
+    #[error("{}: {source}", .path.display())]
+    Read {
+        path: PathBuf,
+        source: std::io::Error,
+    },
+    #[error("{}: {source}", .elf.display())]
+    Elf { elf: PathBuf, source: object::Error },
+    #[error("{}: {source}", .map.display())]
+    Map { map: PathBuf, source: RegionsError },
+    #[error("{}: no region {name}", .map.display())]
+    NoRegion { map: PathBuf, name: &'static str },
+    /// Cargo could not be started.
+    #[error("cargo: {0}")]
+    Cargo(std::io::Error),
+    #[error("cargo fw failed ({status})")]
+    BuildFailed { status: std::process::ExitStatus },
+}
+
 /// The `MEMORY` regions of a linker script (`NAME : ORIGIN = 0x..., LENGTH = 64K`).
-pub fn regions(script: &str) -> Result<Vec<Region>, String> {
+pub fn regions(script: &str) -> Result<Vec<Region>, RegionsError> {
     let body = script
         .split_once("MEMORY")
         .and_then(|(_, rest)| rest.split_once('{'))
         .and_then(|(_, rest)| rest.split_once('}'))
         .map(|(body, _)| body)
-        .ok_or("no MEMORY block")?;
-    let number = |s: &str| -> Result<u64, String> {
+        .ok_or(RegionsError::NoMemoryBlock)?;
+    let number = |s: &str| -> Result<u64, RegionsError> {
         let s = s.trim();
         let (digits, scale) = match s.strip_suffix('K') {
             Some(d) => (d, 1024),
@@ -37,7 +69,9 @@ pub fn regions(script: &str) -> Result<Vec<Region>, String> {
             Some(hex) => u64::from_str_radix(hex, 16),
             None => digits.parse(),
         };
-        v.map(|v| v * scale).map_err(|_| format!("{s}: not a size"))
+        v.map(|v| v * scale).map_err(|_| RegionsError::NotASize {
+            value: s.to_string(),
+        })
     };
     let mut out = Vec::new();
     for line in body.lines() {
@@ -110,17 +144,32 @@ impl Budget {
 }
 
 /// Reads the budget of `elf`, built with the memory map `map` (a board-memory.x).
-pub fn budget(elf: &Path, map: &Path) -> Result<Budget, String> {
-    let bytes = std::fs::read(elf).map_err(|e| format!("{}: {e}", elf.display()))?;
-    let file = object::File::parse(&*bytes).map_err(|e| format!("{}: {e}", elf.display()))?;
-    let script = std::fs::read_to_string(map).map_err(|e| format!("{}: {e}", map.display()))?;
-    let regions = regions(&script).map_err(|e| format!("{}: {e}", map.display()))?;
-    let region = |name: &str| {
+pub fn budget(elf: &Path, map: &Path) -> Result<Budget, MemoryError> {
+    fn read(path: &Path) -> impl FnOnce(std::io::Error) -> MemoryError + '_ {
+        move |source| MemoryError::Read {
+            path: path.to_path_buf(),
+            source,
+        }
+    }
+    let bytes = std::fs::read(elf).map_err(read(elf))?;
+    let file = object::File::parse(&*bytes).map_err(|source| MemoryError::Elf {
+        elf: elf.to_path_buf(),
+        source,
+    })?;
+    let script = std::fs::read_to_string(map).map_err(read(map))?;
+    let regions = regions(&script).map_err(|source| MemoryError::Map {
+        map: map.to_path_buf(),
+        source,
+    })?;
+    let region = |name: &'static str| {
         regions
             .iter()
             .find(|r| r.name == name)
             .map(|r| r.length)
-            .ok_or_else(|| format!("{}: no region {name}", map.display()))
+            .ok_or_else(|| MemoryError::NoRegion {
+                map: map.to_path_buf(),
+                name,
+            })
     };
     let size = |name: &str| file.section_by_name(name).map_or(0, |s| s.size());
     let code = size(".vector_table") + size(".text");
@@ -247,7 +296,7 @@ pub fn table(b: &Budget) -> String {
 }
 
 /// The board's ELF, built (`cargo fw`) if it is missing; the workspace's memory map.
-pub fn board_elf() -> Result<(PathBuf, PathBuf), String> {
+pub fn board_elf() -> Result<(PathBuf, PathBuf), MemoryError> {
     let root = Path::new(env!("CARGO_MANIFEST_DIR"))
         .parent()
         .map(Path::to_path_buf)
@@ -262,9 +311,9 @@ pub fn board_elf() -> Result<(PathBuf, PathBuf), String> {
         .current_dir(&root)
         .args(["fw", "--quiet"])
         .status()
-        .map_err(|e| format!("cargo: {e}"))?;
+        .map_err(MemoryError::Cargo)?;
     if !status.success() {
-        return Err(format!("cargo fw failed ({status})"));
+        return Err(MemoryError::BuildFailed { status });
     }
     Ok((elf, root.join("firmware/stm32/board-memory.x")))
 }

@@ -11,6 +11,64 @@ use std::time::{Duration, Instant};
 use impact_core::Approach;
 use impact_core::Scene;
 
+/// Why the emulator could not be built or run.
+#[derive(Debug, thiserror::Error)]
+pub enum QemuError {
+    #[error("the workspace ({}) is not here to build the firmware: give --elf", .root.display())]
+    NoWorkspace { root: PathBuf },
+    /// Cargo could not be started.
+    #[error("cargo: {0}")]
+    Cargo(std::io::Error),
+    #[error(
+        "building the QEMU firmware ({feature}) failed ({status}); is the thumbv7em-none-eabihf target installed (scripts/setup.sh)?"
+    )]
+    BuildFailed {
+        feature: &'static str,
+        status: ExitStatus,
+    },
+    /// A tool the emulator needs is not installed; `how` installs it.
+    #[error("{tool} not found: run scripts/setup.sh (or {how})")]
+    ToolNotFound {
+        tool: &'static str,
+        how: &'static str,
+    },
+    /// A tool could not be run (or waited for), other than missing.
+    #[error("{tool}: {source}")]
+    Tool {
+        tool: &'static str,
+        source: std::io::Error,
+    },
+    /// A semihosting argument (`what`) holding what semihosting cannot pass.
+    #[error("{what} contains a space or comma, which semihosting cannot pass: {arg}")]
+    Unpassable { what: &'static str, arg: String },
+    #[error("{}: no such firmware ELF", .elf.display())]
+    NoElf { elf: PathBuf },
+    /// A file the emulator reads or is given (the ELF, a temporary file).
+    #[error("{}: {source}", .path.display())]
+    File {
+        path: PathBuf,
+        source: std::io::Error,
+    },
+    #[error("qemu-system-arm: no stdout")]
+    NoStdout,
+    #[error("the emulator did not finish within {seconds} s (--timeout)")]
+    Timeout { seconds: u64 },
+    /// The thread decoding QEMU's output panicked.
+    #[error("decoding the emulator's log failed")]
+    DecoderPanicked,
+    #[error(transparent)]
+    Defmt(#[from] crate::firmware_link::decode::DefmtError),
+    #[error("the emulator's defmt stream had {skipped} malformed frames")]
+    Malformed { skipped: u64 },
+}
+
+impl QemuError {
+    /// Whether a tool the emulator needs is missing (the tests skip then).
+    pub fn is_tool_missing(&self) -> bool {
+        matches!(self, QemuError::ToolNotFound { .. })
+    }
+}
+
 /// The `-icount shift` that stands for the STM32F407 at 168 MHz: 8 ns an instruction.
 pub const BOARD_CLOCK_SHIFT: u8 = 3;
 
@@ -118,7 +176,7 @@ fn workspace_root() -> PathBuf {
 }
 
 /// Builds the emulator firmware with cargo (nothing to do when it is current); returns the ELF.
-pub fn build_firmware() -> Result<PathBuf, String> {
+pub fn build_firmware() -> Result<PathBuf, QemuError> {
     build_firmware_bin("emulator", None)
 }
 
@@ -177,13 +235,10 @@ fn newest_input(root: &Path) -> Option<std::time::SystemTime> {
 /// with `bin` = `m4-bench`) into the emulator's target directory; returns the ELF. Cargo is
 /// not run (it takes about a second to find there is nothing to do) when the ELF is newer
 /// than every file the build reads; `IMPACT_REBUILD=1` runs it anyway.
-pub fn build_firmware_bin(feature: &str, bin: Option<&str>) -> Result<PathBuf, String> {
+pub fn build_firmware_bin(feature: &'static str, bin: Option<&str>) -> Result<PathBuf, QemuError> {
     let root = workspace_root();
     if !root.join("firmware").join("Cargo.toml").is_file() {
-        return Err(format!(
-            "the workspace ({}) is not here to build the firmware: give --elf",
-            root.display()
-        ));
+        return Err(QemuError::NoWorkspace { root });
     }
     let target_dir = emulator_target_dir(&root);
     let elf = target_dir
@@ -223,11 +278,9 @@ pub fn build_firmware_bin(feature: &str, bin: Option<&str>) -> Result<PathBuf, S
         .args(&bin_args)
         .stdout(Stdio::null())
         .status()
-        .map_err(|e| format!("cargo: {e}"))?;
+        .map_err(QemuError::Cargo)?;
     if !status.success() {
-        return Err(format!(
-            "building the QEMU firmware ({feature}) failed ({status}); is the thumbv7em-none-eabihf target installed (scripts/setup.sh)?"
-        ));
+        return Err(QemuError::BuildFailed { feature, status });
     }
     // Cargo leaves an ELF it found current untouched: dated now, it is current for the check
     // above until an input changes again.
@@ -239,7 +292,7 @@ pub fn build_firmware_bin(feature: &str, bin: Option<&str>) -> Result<PathBuf, S
 }
 
 /// Checks that a tool runs; else says how to install it.
-fn require(tool: &str, how: &str) -> Result<(), String> {
+fn require(tool: &'static str, how: &'static str) -> Result<(), QemuError> {
     match Command::new(tool)
         .arg("--version")
         .stdout(Stdio::null())
@@ -248,24 +301,25 @@ fn require(tool: &str, how: &str) -> Result<(), String> {
     {
         Ok(_) => Ok(()),
         Err(e) if e.kind() == std::io::ErrorKind::NotFound => {
-            Err(format!("{tool} not found: run scripts/setup.sh (or {how})"))
+            Err(QemuError::ToolNotFound { tool, how })
         }
-        Err(e) => Err(format!("{tool}: {e}")),
+        Err(source) => Err(QemuError::Tool { tool, source }),
     }
 }
 
 /// True if `qemu-system-arm` can be run (the defmt log is decoded in this process).
-pub fn tools_available() -> Result<(), String> {
+pub fn tools_available() -> Result<(), QemuError> {
     require("qemu-system-arm", "apt-get install qemu-system-arm")
 }
 
 /// A semihosting argument cannot hold spaces (arguments are joined by them) nor commas
 /// (QEMU's option separator).
-fn check_arg(what: &str, s: &str) -> Result<(), String> {
+fn check_arg(what: &'static str, s: &str) -> Result<(), QemuError> {
     if s.contains([' ', ',', '\t', '\n']) {
-        Err(format!(
-            "{what} contains a space or comma, which semihosting cannot pass: {s}"
-        ))
+        Err(QemuError::Unpassable {
+            what,
+            arg: s.to_string(),
+        })
     } else {
         Ok(())
     }
@@ -294,7 +348,7 @@ struct TempFile {
 
 impl TempFile {
     /// Writes `bytes` to `impact-emulate-PID-NANOS.EXT` in the temporary directory.
-    fn write(ext: &str, nanos: u32, bytes: &[u8]) -> Result<Self, String> {
+    fn write(ext: &str, nanos: u32, bytes: &[u8]) -> Result<Self, QemuError> {
         let path = std::env::temp_dir().join(format!(
             "impact-emulate-{}-{nanos}.{ext}",
             std::process::id()
@@ -303,7 +357,10 @@ impl TempFile {
             _guard: crate::interrupt::temporary(&path),
             path,
         };
-        std::fs::write(&file.path, bytes).map_err(|e| format!("{}: {e}", file.path.display()))?;
+        std::fs::write(&file.path, bytes).map_err(|source| QemuError::File {
+            path: file.path.clone(),
+            source,
+        })?;
         Ok(file)
     }
 }
@@ -375,14 +432,17 @@ pub fn run_emulator(
     pacing: Pacing,
     timeout: Duration,
     echo: impl FnMut(&str) + Send + 'static,
-) -> Result<EmulatorRun, String> {
+) -> Result<EmulatorRun, QemuError> {
     tools_available()?;
     if !elf.is_file() {
-        return Err(format!("{}: no such firmware ELF", elf.display()));
+        return Err(QemuError::NoElf {
+            elf: elf.to_path_buf(),
+        });
     }
-    let elf = elf
-        .canonicalize()
-        .map_err(|e| format!("{}: {e}", elf.display()))?;
+    let elf = elf.canonicalize().map_err(|source| QemuError::File {
+        path: elf.to_path_buf(),
+        source,
+    })?;
     let elf_s = elf.to_string_lossy().into_owned();
     check_arg("the ELF path", &elf_s)?;
     let nanos = std::time::SystemTime::now()
@@ -465,12 +525,15 @@ pub fn run_emulator(
         .stdin(Stdio::null())
         .stdout(Stdio::piped())
         .spawn()
-        .map_err(|e| format!("qemu-system-arm: {e}"))?;
+        .map_err(|source| QemuError::Tool {
+            tool: "qemu-system-arm",
+            source,
+        })?;
     // Ended with the tool on an interrupt.
     let _child = crate::interrupt::child(qemu.id());
     let Some(frames) = qemu.stdout.take() else {
         let _ = qemu.kill();
-        return Err("qemu-system-arm: no stdout".into());
+        return Err(QemuError::NoStdout);
     };
     // The raw frames are kept and decoded here against the ELF (defmt-decoder, as
     // defmt-print and probe-rs do), each line echoed as it comes.
@@ -483,7 +546,7 @@ pub fn run_emulator(
                 inner: frames,
                 raw: Vec::new(),
             };
-            let decoded = crate::firmware_link::decode::decode(
+            let decoded = crate::firmware_link::decode::decode::<QemuError>(
                 &elf,
                 &mut tee,
                 "the emulator's defmt stream",
@@ -503,24 +566,24 @@ pub fn run_emulator(
                 let _ = qemu.kill();
                 let _ = qemu.wait();
                 let _ = reader.join();
-                return Err(format!(
-                    "the emulator did not finish within {} s (--timeout)",
-                    timeout.as_secs()
-                ));
+                return Err(QemuError::Timeout {
+                    seconds: timeout.as_secs(),
+                });
             }
             Ok(None) => std::thread::sleep(Duration::from_millis(20)),
-            Err(e) => return Err(format!("qemu-system-arm: {e}")),
+            Err(source) => {
+                return Err(QemuError::Tool {
+                    tool: "qemu-system-arm",
+                    source,
+                })
+            }
         }
     };
     let seconds = started.elapsed().as_secs_f64();
-    let (decoded, lines, raw) = reader
-        .join()
-        .map_err(|_| "decoding the emulator's log failed".to_string())?;
+    let (decoded, lines, raw) = reader.join().map_err(|_| QemuError::DecoderPanicked)?;
     let skipped = decoded?;
     if skipped > 0 {
-        return Err(format!(
-            "the emulator's defmt stream had {skipped} malformed frames"
-        ));
+        return Err(QemuError::Malformed { skipped });
     }
     Ok(EmulatorRun {
         lines,

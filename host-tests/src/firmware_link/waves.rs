@@ -141,6 +141,31 @@ fn numbered(path: &Path, index: u32) -> PathBuf {
     path.with_file_name(format!("{stem}-{index}{ext}"))
 }
 
+/// Why the board's windows could not be written as recordings (`impact log --export`).
+#[derive(Debug, thiserror::Error)]
+pub enum ExportError {
+    #[error("--export {}: the name must end in .csv or .wav", .path.display())]
+    Extension { path: PathBuf },
+    #[error("--export: the log has no waveforms (the scene's wave=0)")]
+    NoWaveforms,
+    #[error(transparent)]
+    Output(#[from] crate::output::OutputError),
+    #[error("--export {}: a WAV file's rate is a whole number of Hz, not {rate}", .path.display())]
+    WavRate { path: PathBuf, rate: f64 },
+    #[error(
+        "--export {}: impact {index} misses {missing} frames, and a WAV file has no gaps (export .csv)",
+        .path.display()
+    )]
+    WavGaps {
+        path: PathBuf,
+        index: u32,
+        missing: u32,
+    },
+    /// The WAV encoder's own error, for the file `out`.
+    #[error("{}: {source}", .out.display())]
+    Wav { out: PathBuf, source: hound::Error },
+}
+
 /// Writes each window as a recording: `.csv` (`time_s,accel_m_s2`, the stream's time and the
 /// counts times the gain, baseline included; a missing frame leaves a gap in the time
 /// column) or `.wav` (16-bit PCM of the counts at rate / every, the gain for `--gain`). One
@@ -151,19 +176,18 @@ pub fn export(
     inputs: &crate::output::Inputs,
     rate_hz: f64,
     gain_m_s2_per_count: f64,
-) -> Result<Vec<PathBuf>, String> {
+) -> Result<Vec<PathBuf>, ExportError> {
     let ext = path
         .extension()
         .map(|e| e.to_string_lossy().to_ascii_lowercase())
         .unwrap_or_default();
     if ext != "csv" && ext != "wav" {
-        return Err(format!(
-            "--export {}: the name must end in .csv or .wav",
-            path.display()
-        ));
+        return Err(ExportError::Extension {
+            path: path.to_path_buf(),
+        });
     }
     if waves.is_empty() {
-        return Err("--export: the log has no waveforms (the scene's wave=0)".into());
+        return Err(ExportError::NoWaveforms);
     }
     // Every numbered name checked before any is written: none may be an input (`x-0.csv`
     // read, `--export x.csv` asked).
@@ -190,18 +214,15 @@ pub fn export(
         } else {
             let rate = rate_hz / every as f64;
             if !(rate.fract() == 0.0 && rate >= 1.0 && rate <= f64::from(u32::MAX)) {
-                return Err(format!(
-                    "--export {}: a WAV file's rate is a whole number of Hz, not {rate}",
-                    path.display()
-                ));
+                return Err(ExportError::WavRate {
+                    path: path.to_path_buf(),
+                    rate,
+                });
             }
-            let values = w.complete().ok_or_else(|| {
-                format!(
-                    "--export {}: impact {} misses {} frames, and a WAV file has no gaps (export .csv)",
-                    path.display(),
-                    w.index,
-                    w.missing_frames()
-                )
+            let values = w.complete().ok_or_else(|| ExportError::WavGaps {
+                path: path.to_path_buf(),
+                index: w.index,
+                missing: w.missing_frames(),
             })?;
             let spec = hound::WavSpec {
                 channels: 1,
@@ -211,16 +232,15 @@ pub fn export(
             };
             // A window is at most a capture: made in memory, written whole.
             let mut bytes = std::io::Cursor::new(Vec::new());
-            let mut writer = hound::WavWriter::new(&mut bytes, spec)
-                .map_err(|e| format!("{}: {e}", out.display()))?;
+            let wav = |source| ExportError::Wav {
+                out: out.clone(),
+                source,
+            };
+            let mut writer = hound::WavWriter::new(&mut bytes, spec).map_err(wav)?;
             for v in values {
-                writer
-                    .write_sample(v)
-                    .map_err(|e| format!("{}: {e}", out.display()))?;
+                writer.write_sample(v).map_err(wav)?;
             }
-            writer
-                .finalize()
-                .map_err(|e| format!("{}: {e}", out.display()))?;
+            writer.finalize().map_err(wav)?;
             crate::output::write(&out, bytes.get_ref())?;
         }
         written.push(out);

@@ -192,13 +192,6 @@ impl std::fmt::Display for FewSamples<'_> {
     }
 }
 
-/// Temporary, while `impact emulate` holds messages: the error as its message.
-impl From<PipelineError> for String {
-    fn from(e: PipelineError) -> Self {
-        e.to_string()
-    }
-}
-
 /// One of the times given (or its default), s, as messages name it: `--hold 0.5`,
 /// `scene.json: max_impact 1e-9`, `the default --hold, 0.002 s`.
 #[derive(Clone, Debug, PartialEq)]

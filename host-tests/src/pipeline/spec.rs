@@ -64,13 +64,6 @@ pub enum SpecError {
     },
 }
 
-/// Temporary, while `impact watch` holds messages: the error as its message.
-impl From<SpecError> for String {
-    fn from(e: SpecError) -> Self {
-        e.to_string()
-    }
-}
-
 /// An acceleration with an optional unit: `50g`, `490.3m/s2` (m/s² without one).
 fn acceleration(s: &str) -> Result<f32, SpecError> {
     let t = s.trim();

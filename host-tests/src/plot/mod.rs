@@ -40,14 +40,6 @@ pub enum PlotError {
     Png(#[source] Box<dyn std::error::Error + Send + Sync>),
 }
 
-/// Temporary, while callers hold messages (`impact emulate`, `impact log`, `impact
-/// simulate`): the error as its message.
-impl From<PlotError> for String {
-    fn from(e: PlotError) -> Self {
-        e.to_string()
-    }
-}
-
 /// The figures' formats, by the file's extension.
 const FORMATS: [&str; 2] = ["svg", "png"];
 

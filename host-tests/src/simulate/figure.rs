@@ -12,8 +12,9 @@ pub fn wall_contact(
     models: &[(crate::simulate::ModelName, impact_core::Model<f64>)],
     impact: &impact_core::Impact<f64>,
     path: &std::path::Path,
-) -> Result<(), String> {
+) -> Result<(), crate::simulate::SimulateError> {
     use crate::simulate::ModelName;
+    use crate::simulate::SimulateError;
     use impact_core::solve::trajectory;
     use impact_core::ContactLaw;
     const COLOURS: [RGBColor; 3] = [
@@ -35,7 +36,7 @@ pub fn wall_contact(
         let scale = model.time_scale(impact);
         let dt = (scale / 400.0).max(f64::MIN_POSITIVE);
         trajectory::sample(model, impact, 1e-10, 0.0, dt, 20_000, |p| s.push(p))
-            .map_err(|e| e.to_string())?;
+            .map_err(SimulateError::Trajectory)?;
         let map = |f: &dyn Fn(&trajectory::Sample<f64>) -> (f64, f64)| {
             s.iter().map(f).collect::<Vec<_>>()
         };
@@ -47,7 +48,7 @@ pub fn wall_contact(
     let mut text = String::new();
     {
         let root = SVGBackend::with_string(&mut text, (1600, 360)).into_drawing_area();
-        root.fill(&WHITE).map_err(|e| e.to_string())?;
+        root.fill(&WHITE)?;
         let areas = root.split_evenly((1, 4));
         let titles = [
             ("deformation x(t), mm", "time from touch, ms"),
@@ -69,7 +70,7 @@ pub fn wall_contact(
             };
             draw_panel(&areas[j], None, &p)?;
         }
-        root.present().map_err(|e| e.to_string())?;
+        root.present()?;
     }
     Ok(crate::plot::write_figure(path, &text)?)
 }

@@ -137,8 +137,53 @@ pub struct SimulateArgs {
 }
 
 /// A parameter problem, worded for the command line.
-fn missing(name: &str, model: &str) -> String {
-    format!("--{name} is required for --model {model}")
+/// Why a model could not be built from the options.
+#[derive(Debug, thiserror::Error)]
+pub enum ModelError {
+    /// An option the model needs (`option`: its name without `--`, and what else gives it).
+    #[error("--{option} is required for --model {model}")]
+    Missing {
+        option: &'static str,
+        model: &'static str,
+    },
+    /// A parameter out of its domain, named as its option.
+    #[error("{}", crate::flags::core(*.0))]
+    Core(#[from] Error),
+}
+
+/// Why `impact simulate` refused, or could not solve or draw.
+#[derive(Debug, thiserror::Error)]
+pub enum SimulateError {
+    #[error(transparent)]
+    Model(#[from] ModelError),
+    /// A parameter out of its domain (or a contact not resolved), named as its option.
+    #[error("{}", crate::flags::core(*.0))]
+    Core(#[from] Error),
+    /// The figure's trajectory could not be sampled (the core's words, its parameter by name).
+    #[error(transparent)]
+    Trajectory(Error),
+    #[error(transparent)]
+    Target(#[from] two_body::TargetError),
+    #[error("--with-linear: compares a Hertz contact with its linear spring; give --model hertz")]
+    WithLinearNotHertz,
+    #[error("--with-linear: against a wall only")]
+    WithLinearTarget,
+    #[error("--repeat: times the wall solvers; not with a target")]
+    RepeatTarget,
+    #[error("--repeat: must be at least 1")]
+    RepeatZero,
+    /// The figure could not be drawn (plotters' SVG backend).
+    #[error(transparent)]
+    Draw(#[from] plotters::drawing::DrawingAreaErrorKind<std::io::Error>),
+    /// `--plot`: refused before any work, or its figure not written.
+    #[error(transparent)]
+    Plot(#[from] crate::plot::PlotError),
+    #[error(transparent)]
+    Json(#[from] serde_json::Error),
+}
+
+fn missing(option: &'static str, model: &'static str) -> ModelError {
+    ModelError::Missing { option, model }
 }
 
 fn body(r: Option<f64>, e: Option<f64>, nu: Option<f64>, default_nu: f64) -> Body<f64> {
@@ -151,7 +196,7 @@ fn body(r: Option<f64>, e: Option<f64>, nu: Option<f64>, default_nu: f64) -> Bod
 
 impl ModelArgs {
     /// Hertz stiffness from --stiffness, or from the two bodies' geometry and elasticity.
-    fn hertz(&self, model: &str) -> Result<Hertz<f64>, String> {
+    fn hertz(&self, model: &'static str) -> Result<Hertz<f64>, ModelError> {
         if let Some(k) = self.stiffness {
             return Ok(Hertz { k });
         }
@@ -167,21 +212,18 @@ impl ModelArgs {
             self.poisson2,
             if self.youngs2.is_some() { 0.3 } else { 0.0 },
         );
-        Hertz::from_bodies(&b1, &b2).map_err(crate::flags::core)
+        Ok(Hertz::from_bodies(&b1, &b2)?)
     }
 
     /// Builds the model for `name` and the impact it will be used in.
-    pub fn model(&self, name: ModelName, impact: &Impact<f64>) -> Result<Model<f64>, String> {
+    pub fn model(&self, name: ModelName, impact: &Impact<f64>) -> Result<Model<f64>, ModelError> {
         let model = match name {
             ModelName::Hertz => Model::Hertz(self.hertz("hertz")?),
             ModelName::Linear => match self.stiffness {
                 Some(k) => Model::Linear(Linear { k }),
                 None if self.radius.is_some() => {
                     let hertz = self.hertz("linear")?;
-                    Model::Linear(
-                        Linear::matching_max_deformation(&hertz, impact)
-                            .map_err(crate::flags::core)?,
-                    )
+                    Model::Linear(Linear::matching_max_deformation(&hertz, impact)?)
                 }
                 None => {
                     return Err(missing(
@@ -299,7 +341,7 @@ pub enum Outcome {
 }
 
 /// Runs `impact simulate`, on the target if one is given.
-pub fn run_any(args: &SimulateArgs) -> Result<Outcome, String> {
+pub fn run_any(args: &SimulateArgs) -> Result<Outcome, SimulateError> {
     if !args.target.given() {
         let report = run(args)?;
         if let Some(path) = &args.target.plot {
@@ -309,10 +351,9 @@ pub fn run_any(args: &SimulateArgs) -> Result<Outcome, String> {
             let mut models = vec![(args.model, model)];
             if args.with_linear {
                 let Model::Hertz(h) = model else {
-                    return Err("--with-linear: compares a Hertz contact with its linear spring; give --model hertz".into());
+                    return Err(SimulateError::WithLinearNotHertz);
                 };
-                let l = impact_core::model::Linear::matching_max_deformation(&h, &impact)
-                    .map_err(crate::flags::core)?;
+                let l = impact_core::model::Linear::matching_max_deformation(&h, &impact)?;
                 models.push((ModelName::Linear, Model::Linear(l)));
             }
             figure::wall_contact(&models, &impact, path)?;
@@ -321,21 +362,21 @@ pub fn run_any(args: &SimulateArgs) -> Result<Outcome, String> {
         return Ok(Outcome::Wall(report));
     }
     if args.with_linear {
-        return Err("--with-linear: against a wall only".into());
+        return Err(SimulateError::WithLinearTarget);
     }
     if args.repeat.is_some() {
-        return Err("--repeat: times the wall solvers; not with a target".into());
+        return Err(SimulateError::RepeatTarget);
     }
     let impact = Impact::new(args.mass, args.v0);
-    impact.validate().map_err(crate::flags::core)?;
+    impact.validate()?;
     let model = args.params.model(args.model, &impact)?;
     two_body::run(args, &model).map(|r| Outcome::Target(Box::new(r)))
 }
 
 /// Runs `impact simulate` against a wall.
-pub fn run(args: &SimulateArgs) -> Result<SimulateReport, String> {
+pub fn run(args: &SimulateArgs) -> Result<SimulateReport, SimulateError> {
     let impact = Impact::new(args.mass, args.v0);
-    impact.validate().map_err(crate::flags::core)?;
+    impact.validate()?;
     let model = args.params.model(args.model, &impact)?;
     let method = args.solver.unwrap_or(SolverName::Exact).method();
     let settings = match method {
@@ -344,7 +385,7 @@ pub fn run(args: &SimulateArgs) -> Result<SimulateReport, String> {
         m => Settings::fixed(m, args.steps),
     };
     if args.repeat == Some(0) {
-        return Err("--repeat: must be at least 1".into());
+        return Err(SimulateError::RepeatZero);
     }
     let repeat = args.repeat.unwrap_or(1);
     let (outcome, seconds) = match args.precision {
@@ -362,8 +403,7 @@ pub fn run(args: &SimulateArgs) -> Result<SimulateReport, String> {
                 repeat,
             )
         }
-    }
-    .map_err(crate::flags::core)?;
+    }?;
     Ok(SimulateReport {
         max_deformation_m: outcome.max_deformation_m,
         crush_time_s: outcome.crush_time_s,

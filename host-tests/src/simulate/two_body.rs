@@ -10,7 +10,7 @@ use impact_core::{ContactLaw, Impact, Method, Settings};
 use plotters::prelude::*;
 use serde::{Deserialize, Serialize};
 
-use super::{model_f32, Precision, SimulateArgs};
+use super::{model_f32, Precision, SimulateArgs, SimulateError};
 
 /// The target the impactor hits instead of a wall (seed 000, section 3.2).
 #[derive(Args, Clone, Debug, Default)]
@@ -53,40 +53,80 @@ struct StateSpaceFile {
     d: Option<Vec<f64>>,
 }
 
-fn read_state_space(path: &Path) -> Result<Target<f64>, String> {
-    let name = path.display();
-    let bytes = impact_io::read_limited(path, 1 << 20, "target file")
-        .map_err(|e| format!("--target {}", crate::read_errors::input_file_message(&e)))?;
+/// Why the target could not be built (`--target FILE`, `--target-mass`).
+#[derive(Debug, thiserror::Error)]
+pub enum TargetError {
+    /// The file could not be read (a secondary input: `-` is a file there).
+    #[error("--target {}", crate::read_errors::input_file_message(.0))]
+    Read(impact_io::ReadError),
+    #[error("--target {}: {source}", .path.display())]
+    Json {
+        path: PathBuf,
+        source: serde_json::Error,
+    },
+    #[error("--target {}: A must have 1 to {MAX_STATES} rows, not {n}", .path.display())]
+    Rows { path: PathBuf, n: usize },
+    #[error("--target {}: A row {row} has {len} entries, not {n}", .path.display())]
+    Row {
+        path: PathBuf,
+        row: usize,
+        len: usize,
+        n: usize,
+    },
+    #[error("--target {}: B has {len} entries, not {n}", .path.display())]
+    B { path: PathBuf, len: usize, n: usize },
+    #[error(
+        "--target {}: C must be two rows (displacement, velocity) of {n} entries",
+        .path.display()
+    )]
+    C { path: PathBuf, n: usize },
+    #[error("--target {}: D must have 2 entries, not {len}", .path.display())]
+    D { path: PathBuf, len: usize },
+    /// The file's system refused by the core (its reason, without the parameter's name).
+    #[error("--target {}: {}", .path.display(), reason(.error))]
+    Invalid {
+        path: PathBuf,
+        error: impact_core::Error,
+    },
+    /// `--target-mass` and its spring refused by the core, named as its option.
+    #[error("{}", crate::flags::core(*.0))]
+    SpringMass(impact_core::Error),
+    #[error("no target given (--target-mass or --target)")]
+    NotGiven,
+}
+
+fn read_state_space(path: &Path) -> Result<Target<f64>, TargetError> {
+    let p = || path.to_path_buf();
+    let bytes = impact_io::read_limited(path, 1 << 20, "target file").map_err(TargetError::Read)?;
     let f: StateSpaceFile =
-        serde_json::from_slice(&bytes).map_err(|e| format!("--target {name}: {e}"))?;
+        serde_json::from_slice(&bytes).map_err(|source| TargetError::Json { path: p(), source })?;
     let n = f.a.len();
     if n == 0 || n > MAX_STATES {
-        return Err(format!(
-            "--target {name}: A must have 1 to {MAX_STATES} rows, not {n}"
-        ));
+        return Err(TargetError::Rows { path: p(), n });
     }
     let mut a = [[0.0; MAX_STATES]; MAX_STATES];
     for (i, row) in f.a.iter().enumerate() {
         if row.len() != n {
-            return Err(format!(
-                "--target {name}: A row {i} has {} entries, not {n}",
-                row.len()
-            ));
+            return Err(TargetError::Row {
+                path: p(),
+                row: i,
+                len: row.len(),
+                n,
+            });
         }
         a[i][..n].copy_from_slice(row);
     }
     if f.b.len() != n {
-        return Err(format!(
-            "--target {name}: B has {} entries, not {n}",
-            f.b.len()
-        ));
+        return Err(TargetError::B {
+            path: p(),
+            len: f.b.len(),
+            n,
+        });
     }
     let mut b = [0.0; MAX_STATES];
     b[..n].copy_from_slice(&f.b);
     if f.c.len() != 2 || f.c.iter().any(|r| r.len() != n) {
-        return Err(format!(
-            "--target {name}: C must be two rows (displacement, velocity) of {n} entries"
-        ));
+        return Err(TargetError::C { path: p(), n });
     }
     let mut c = [[0.0; MAX_STATES]; 2];
     for (i, row) in f.c.iter().enumerate() {
@@ -96,13 +136,13 @@ fn read_state_space(path: &Path) -> Result<Target<f64>, String> {
         None => [0.0, 0.0],
         Some([x, y]) => [*x, *y],
         Some(other) => {
-            return Err(format!(
-                "--target {name}: D must have 2 entries, not {}",
-                other.len()
-            ))
+            return Err(TargetError::D {
+                path: p(),
+                len: other.len(),
+            })
         }
     };
-    Target::state_space(n, a, b, c, d).map_err(|e| format!("--target {name}: {}", reason(&e)))
+    Target::state_space(n, a, b, c, d).map_err(|error| TargetError::Invalid { path: p(), error })
 }
 
 /// The error's reason without its `--name:` prefix.
@@ -114,7 +154,7 @@ fn reason(e: &impact_core::Error) -> String {
 }
 
 /// Builds the target from the options.
-pub fn build(args: &TargetArgs) -> Result<Target<f64>, String> {
+pub fn build(args: &TargetArgs) -> Result<Target<f64>, TargetError> {
     match (&args.target, args.target_mass) {
         (Some(path), _) => read_state_space(path),
         (None, Some(m2)) => Target::spring_mass(
@@ -122,8 +162,8 @@ pub fn build(args: &TargetArgs) -> Result<Target<f64>, String> {
             args.target_stiffness.unwrap_or(0.0),
             args.target_damping.unwrap_or(0.0),
         )
-        .map_err(crate::flags::core),
-        (None, None) => Err("no target given (--target-mass or --target)".into()),
+        .map_err(TargetError::SpringMass),
+        (None, None) => Err(TargetError::NotGiven),
     }
 }
 
@@ -210,7 +250,7 @@ pub fn widen(o: &TargetOutcome<f32>) -> TargetOutcome<f64> {
 }
 
 /// Runs `impact simulate` with a target.
-pub fn run(args: &SimulateArgs, model: &Model<f64>) -> Result<TargetReport, String> {
+pub fn run(args: &SimulateArgs, model: &Model<f64>) -> Result<TargetReport, SimulateError> {
     if let Some(path) = &args.target.plot {
         // Before the target file is read: a figure never writes over it.
         let inputs: Vec<_> = args.target.target.iter().map(|p| p.as_path()).collect();
@@ -243,9 +283,8 @@ pub fn run(args: &SimulateArgs, model: &Model<f64>) -> Result<TargetReport, Stri
             let impact32 = Impact::new(args.mass as f32, args.v0 as f32);
             two_body::solve(&model_f32(model), &impact32, &narrow(&t), &s32).map(|o| widen(&o))
         }
-    }
-    .map_err(crate::flags::core)?;
-    let free = after(&t, &outcome).map_err(crate::flags::core)?;
+    }?;
+    let free = after(&t, &outcome)?;
     if let Some(path) = &args.target.plot {
         plot(model, &impact, &t, &outcome, &free, path)?;
     }
@@ -378,10 +417,9 @@ fn plot(
     o: &TargetOutcome<f64>,
     free: &FreeResponse<f64>,
     path: &Path,
-) -> Result<(), String> {
+) -> Result<(), SimulateError> {
     let mut samples: Vec<Sample<f64>> = Vec::new();
-    two_body::trajectory(model, impact, t, 1e-10, &mut |s| samples.push(s))
-        .map_err(crate::flags::core)?;
+    two_body::trajectory(model, impact, t, 1e-10, &mut |s| samples.push(s))?;
     let tc = o.contact_time_s;
     let period = free.ring_frequency_hz.map_or(tc, |f| 1.0 / f);
     let end = free
@@ -405,7 +443,7 @@ fn plot(
     let mut text = String::new();
     {
         let root = SVGBackend::with_string(&mut text, (1300, 900)).into_drawing_area();
-        root.fill(&WHITE).map_err(|e| e.to_string())?;
+        root.fill(&WHITE)?;
         let panels = root.split_evenly((3, 2));
         let ms = |s: &Sample<f64>| s.t_s * 1e3;
         let impactor = RGBColor(200, 60, 30);
@@ -459,14 +497,12 @@ fn plot(
                 .margin(10)
                 .x_label_area_size(40)
                 .y_label_area_size(70)
-                .build_cartesian_2d(t0 * 1e3..t1 * 1e3, (lo - pad)..(hi + pad))
-                .map_err(|e| e.to_string())?;
+                .build_cartesian_2d(t0 * 1e3..t1 * 1e3, (lo - pad)..(hi + pad))?;
             chart
                 .configure_mesh()
                 .x_desc("time from first touch, ms")
                 .y_desc(ylabel)
-                .draw()
-                .map_err(|e| e.to_string())?;
+                .draw()?;
             let name1 = if second.is_some() {
                 "impactor"
             } else {
@@ -476,8 +512,7 @@ fn plot(
                 .draw_series(LineSeries::new(
                     shown.iter().map(|s| (ms(s), first(s))),
                     impactor.stroke_width(2),
-                ))
-                .map_err(|e| e.to_string())?
+                ))?
                 .label(name1)
                 .legend(move |(x, y)| {
                     PathElement::new(vec![(x, y), (x + 20, y)], impactor.stroke_width(2))
@@ -487,8 +522,7 @@ fn plot(
                     .draw_series(LineSeries::new(
                         shown.iter().map(|s| (ms(s), g(s))),
                         target_c.stroke_width(2),
-                    ))
-                    .map_err(|e| e.to_string())?
+                    ))?
                     .label("target (contact point)")
                     .legend(move |(x, y)| {
                         PathElement::new(vec![(x, y), (x + 20, y)], target_c.stroke_width(2))
@@ -496,8 +530,7 @@ fn plot(
             }
             let sep = vec![(tc * 1e3, lo - pad), (tc * 1e3, hi + pad)];
             chart
-                .draw_series(std::iter::once(PathElement::new(sep, BLACK.mix(0.4))))
-                .map_err(|e| e.to_string())?
+                .draw_series(std::iter::once(PathElement::new(sep, BLACK.mix(0.4))))?
                 .label("separation")
                 .legend(|(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], BLACK.mix(0.4)));
             chart
@@ -505,10 +538,9 @@ fn plot(
                 .background_style(WHITE.mix(0.8))
                 .border_style(BLACK)
                 .position(SeriesLabelPosition::UpperRight)
-                .draw()
-                .map_err(|e| e.to_string())?;
+                .draw()?;
         }
-        root.present().map_err(|e| e.to_string())?;
+        root.present()?;
     }
     Ok(crate::plot::write_figure(path, &text)?)
 }

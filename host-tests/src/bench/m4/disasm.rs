@@ -20,14 +20,17 @@ pub(super) struct Code {
     pub(super) end: (u32, u32),
 }
 
-pub(super) fn disassemble(elf: &Path) -> Result<Code, String> {
+pub(super) fn disassemble(elf: &Path) -> Result<Code, super::M4Error> {
+    use super::M4Error;
     let out = Command::new("arm-none-eabi-objdump")
         .arg("-d")
         .arg(elf)
         .output()
-        .map_err(|e| format!("arm-none-eabi-objdump: {e} (run scripts/setup.sh)"))?;
+        .map_err(M4Error::Objdump)?;
     if !out.status.success() {
-        return Err(format!("arm-none-eabi-objdump -d {} failed", elf.display()));
+        return Err(M4Error::ObjdumpFailed {
+            elf: elf.to_path_buf(),
+        });
     }
     let text = String::from_utf8_lossy(&out.stdout);
     let mut insns = HashMap::new();
@@ -74,11 +77,11 @@ pub(super) fn disassemble(elf: &Path) -> Result<Code, String> {
             }
         }
     }
-    let range = |name: &str| {
-        ranges
-            .get(name)
-            .copied()
-            .ok_or_else(|| format!("{}: no `{name}` symbol", elf.display()))
+    let range = |name: &'static str| {
+        ranges.get(name).copied().ok_or_else(|| M4Error::NoSymbol {
+            elf: elf.to_path_buf(),
+            name,
+        })
     };
     Ok(Code {
         begin: range("bench_begin")?,

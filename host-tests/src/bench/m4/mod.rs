@@ -31,6 +31,77 @@ use maths::{host_math, math_error, maths};
 pub use report::{check, table};
 use trace::{profile_text, run_qemu, Region, TraceState};
 
+/// Why the M4 benchmark could not run, or its firmware's output is not what it reads.
+#[derive(Debug, thiserror::Error)]
+pub enum M4Error {
+    #[error(transparent)]
+    Qemu(#[from] crate::firmware_link::qemu::QemuError),
+    /// The seed recording's options (clap's own error).
+    #[error(transparent)]
+    Args(#[from] clap::Error),
+    #[error(transparent)]
+    Synth(#[from] crate::synth::SynthError),
+    /// A file the runs read or write.
+    #[error("{}: {source}", .path.display())]
+    File {
+        path: PathBuf,
+        source: std::io::Error,
+    },
+    /// A jobs file could not be written.
+    #[error(transparent)]
+    Jobs(std::io::Error),
+    #[error("{}: semihosting cannot pass a path with spaces or commas", .path.display())]
+    Unpassable { path: PathBuf },
+    /// A tool (`qemu-system-arm`, `mkfifo`) could not be run.
+    #[error("{tool}: {source}")]
+    Tool {
+        tool: &'static str,
+        source: std::io::Error,
+    },
+    #[error("mkfifo {} failed", .fifo.display())]
+    Mkfifo { fifo: PathBuf },
+    #[error("reading the trace: {0}")]
+    Trace(std::io::Error),
+    /// The bench firmware failed: its status and what it printed (stdout, then QEMU's
+    /// stderr), the only account of why.
+    #[error("the M4 bench failed ({status}):\n{output}")]
+    Failed {
+        status: std::process::ExitStatus,
+        output: String,
+    },
+    /// The firmware's self-test failed: its output, the only account of what.
+    #[error("the M4 self-test did not pass:\n{output}")]
+    SelfTest { output: String },
+    #[error("arm-none-eabi-objdump: {0} (run scripts/setup.sh)")]
+    Objdump(std::io::Error),
+    #[error("arm-none-eabi-objdump -d {} failed", .elf.display())]
+    ObjdumpFailed { elf: PathBuf },
+    #[error("{}: no `{name}` symbol", .elf.display())]
+    NoSymbol { elf: PathBuf, name: &'static str },
+    #[error("trace: {regions} regions for {blocks} blocks")]
+    Regions { regions: usize, blocks: usize },
+    #[error("trace run: no stream line")]
+    NoStreamLine,
+    #[error("count run: no `{prefix}` line")]
+    NoCountLine { prefix: String },
+    #[error("M4 bench output: no `{key}`")]
+    NoField { key: &'static str },
+    #[error("the seed recording gave {reports} reports, not 1")]
+    Reports { reports: u32 },
+    #[error("trace: unexpected block kinds {kinds}")]
+    Kinds { kinds: String },
+    /// A case's exact solve on the host (the core's words).
+    #[error("{case}: {source}")]
+    Case {
+        case: &'static str,
+        source: impact_core::Error,
+    },
+    #[error("no host maths function")]
+    NoHostMath,
+    #[error("the {fit} fit gave no result on the seed impact")]
+    NoFit { fit: &'static str },
+}
+
 /// CPU clock of the STM32F407 board, Hz.
 pub const BOARD_CLOCK_HZ: f64 = 168e6;
 /// The seed experiment's sample rate, S/s.
@@ -171,15 +242,15 @@ fn fields(line: &str) -> HashMap<&str, &str> {
         .collect()
 }
 
-fn number<T: std::str::FromStr>(m: &HashMap<&str, &str>, key: &str) -> Result<T, String> {
+fn number<T: std::str::FromStr>(m: &HashMap<&str, &str>, key: &'static str) -> Result<T, M4Error> {
     m.get(key)
         .and_then(|v| v.parse().ok())
-        .ok_or_else(|| format!("M4 bench output: no `{key}`"))
+        .ok_or(M4Error::NoField { key })
 }
 
 /// The seed bench impact (seed 001: 60 g at 1.3357 m/s, two-phase), 40 ms after the start of
 /// a 120 ms recording at 500 kS/s, 12-bit ADC codes.
-pub fn seed_recording() -> Result<Vec<i16>, String> {
+pub fn seed_recording() -> Result<Vec<i16>, M4Error> {
     use clap::Parser;
     #[derive(Parser)]
     struct Wrap {
@@ -190,7 +261,7 @@ pub fn seed_recording() -> Result<Vec<i16>, String> {
         .into_iter()
         .chain(crate::synth::SEED_BENCH_ARGS)
         .chain(["--touch", "0.04", "--duration", "0.12"]);
-    let args = Wrap::try_parse_from(args).map_err(|e| e.to_string())?;
+    let args = Wrap::try_parse_from(args)?;
     Ok(crate::synth::synth(&args.synth)?.samples)
 }
 
@@ -311,12 +382,15 @@ fn bits(o: &ImpactOutcome<f32>) -> String {
 }
 
 /// Builds the bench ELF with cargo (a no-op when up to date).
-fn build() -> Result<PathBuf, String> {
-    crate::firmware_link::qemu::build_firmware_bin("m4-bench", Some("m4-bench"))
+fn build() -> Result<PathBuf, M4Error> {
+    Ok(crate::firmware_link::qemu::build_firmware_bin(
+        "m4-bench",
+        Some("m4-bench"),
+    )?)
 }
 
 /// Runs the whole benchmark (about a minute: the trace run dominates).
-pub fn run(args: &M4Args) -> Result<(M4Report, String), String> {
+pub fn run(args: &M4Args) -> Result<(M4Report, String), M4Error> {
     crate::firmware_link::qemu::tools_available()?;
     let elf = match &args.elf {
         Some(e) => e.clone(),
@@ -326,7 +400,7 @@ pub fn run(args: &M4Args) -> Result<(M4Report, String), String> {
     let files = BenchFiles::new();
     let samples = seed_recording()?;
     let bytes: Vec<u8> = samples.iter().flat_map(|c| c.to_le_bytes()).collect();
-    std::fs::write(&files.raw, bytes).map_err(|e| format!("{}: {e}", files.raw.display()))?;
+    std::fs::write(&files.raw, bytes).map_err(file(&files.raw))?;
     let streaming = trace_run(&elf, &code, &files, args.profile)?;
     let counted = count_run(&elf, &files)?;
     let firmware = crate::firmware_link::qemu::build_firmware()?;
@@ -429,12 +503,12 @@ fn trace_run(
     code: &disasm::Code,
     files: &BenchFiles,
     profiling: bool,
-) -> Result<Streaming, String> {
+) -> Result<Streaming, M4Error> {
     std::fs::write(
         &files.trace_jobs,
         format!("selftest\n{}\nstream pipeline\n", scene_line(NO_FITS)),
     )
-    .map_err(|e| e.to_string())?;
+    .map_err(M4Error::Jobs)?;
     // Per-block regions.
     let mut regions: Vec<Region> = Vec::new();
     let mut profile: Vec<HashMap<String, u64>> = Vec::new();
@@ -451,29 +525,28 @@ fn trace_run(
         false,
     )?;
     if !out.lines().any(|l| l == "selftest ok") {
-        return Err(format!("the M4 self-test did not pass:\n{out}"));
+        return Err(M4Error::SelfTest { output: out });
     }
     let kinds: String = out
         .lines()
         .filter_map(|l| l.strip_prefix("kinds "))
         .collect();
     if kinds.len() != regions.len() {
-        return Err(format!(
-            "trace: {} regions for {} blocks",
-            regions.len(),
-            kinds.len()
-        ));
+        return Err(M4Error::Regions {
+            regions: regions.len(),
+            blocks: kinds.len(),
+        });
     }
     let stream = out
         .lines()
         .find(|l| l.starts_with("stream "))
         .map(fields)
-        .ok_or("trace run: no stream line")?;
+        .ok_or(M4Error::NoStreamLine)?;
     let n_samples: usize = number(&stream, "samples")?;
     let block: usize = number(&stream, "block")?;
     let reports: u32 = number(&stream, "reports")?;
     if reports != 1 {
-        return Err(format!("the seed recording gave {reports} reports, not 1"));
+        return Err(M4Error::Reports { reports });
     }
     let mut per_kind: HashMap<char, (Region, usize, u64)> = HashMap::new();
     for (k, (kind, r)) in kinds.chars().zip(&regions).enumerate() {
@@ -490,7 +563,7 @@ fn trace_run(
     let (trigger, _, trigger_n) = get('t');
     let (end, _, end_n) = get('e');
     if idle_n == 0 || active_n == 0 || trigger_n == 0 || end_n == 0 {
-        return Err(format!("trace: unexpected block kinds {kinds}"));
+        return Err(M4Error::Kinds { kinds });
     }
     let per = |r: Region, n: u64| r.instructions as f64 / n as f64;
     let per_c = |r: Region, n: u64| r.cycles as f64 / n as f64;
@@ -532,7 +605,7 @@ type MathJob = (&'static str, &'static str, f64);
 
 /// The count run's jobs: the stream with each fit variant, the spectra and the verdicts; the
 /// f32 solves of every case and method the board would use; each maths back-end.
-fn count_jobs() -> Result<(String, Vec<SolveJob>, Vec<MathJob>), String> {
+fn count_jobs() -> Result<(String, Vec<SolveJob>, Vec<MathJob>), M4Error> {
     let mut jobs = String::new();
     jobs.push_str(&format!("{}\nstream no-fit\n", scene_line(NO_FITS)));
     for (i, (_, keys)) in FIT_VARIANTS.iter().enumerate() {
@@ -546,8 +619,12 @@ fn count_jobs() -> Result<(String, Vec<SolveJob>, Vec<MathJob>), String> {
     ));
     let mut solve_rows = Vec::new();
     for case in solve_cases() {
-        let exact = solve(&case.model, &case.impact, &Settings::exact())
-            .map_err(|e| format!("{}: {e}", case.name))?;
+        let exact = solve(&case.model, &case.impact, &Settings::exact()).map_err(|source| {
+            M4Error::Case {
+                case: case.name,
+                source,
+            }
+        })?;
         let (model, params) = f32_model(&case.model);
         let impact = Impact::new(case.impact.mass_kg as f32, case.impact.v0_m_s as f32);
         for method in [
@@ -588,7 +665,7 @@ fn count_jobs() -> Result<(String, Vec<SolveJob>, Vec<MathJob>), String> {
     for (op, reference, range, backends) in maths() {
         for b in backends {
             jobs.push_str(&format!("math {op} {b} {:e} {:e}\n", range.0, range.1));
-            let f = host_math(op, b).ok_or("no host maths function")?;
+            let f = host_math(op, b).ok_or(M4Error::NoHostMath)?;
             math_rows.push((op, *b, math_error(f, reference, range)));
         }
     }
@@ -596,9 +673,9 @@ fn count_jobs() -> Result<(String, Vec<SolveJob>, Vec<MathJob>), String> {
 }
 
 /// The count run ([`count_jobs`] under `-icount`, timed by SysTick, calibrated each run).
-fn count_run(elf: &Path, files: &BenchFiles) -> Result<Counted, String> {
+fn count_run(elf: &Path, files: &BenchFiles) -> Result<Counted, M4Error> {
     let (jobs, solve_rows, math_rows) = count_jobs()?;
-    std::fs::write(&files.count_jobs, jobs).map_err(|e| e.to_string())?;
+    std::fs::write(&files.count_jobs, jobs).map_err(M4Error::Jobs)?;
     let out = run_qemu(
         elf,
         &[
@@ -615,15 +692,17 @@ fn count_run(elf: &Path, files: &BenchFiles) -> Result<Counted, String> {
             .iter()
             .find(|l| l.starts_with(prefix))
             .map(|l| fields(l))
-            .ok_or_else(|| format!("count run: no `{prefix}` line"))
+            .ok_or_else(|| M4Error::NoCountLine {
+                prefix: prefix.to_string(),
+            })
     };
     let cal = find("calibrate ")?;
     let ipt = number::<f64>(&cal, "instructions")? / number::<f64>(&cal, "ticks")?;
-    let ticks_total = |label: &str| -> Result<f64, String> {
+    let ticks_total = |label: &str| -> Result<f64, M4Error> {
         number::<f64>(&find(&format!("ticks {label} "))?, "total")
     };
     let base = ticks_total("no-fit")?;
-    let over_base = |label: &str| -> Result<u64, String> {
+    let over_base = |label: &str| -> Result<u64, M4Error> {
         Ok(((ticks_total(label)? - base) * ipt).max(0.0) as u64)
     };
     let mut fits = Vec::new();
@@ -631,7 +710,7 @@ fn count_run(elf: &Path, files: &BenchFiles) -> Result<Counted, String> {
         let s = find(&format!("stream fit{i} "))?;
         let got: String = number(&s, "fits")?;
         if !got.contains('1') {
-            return Err(format!("the {name} fit gave no result on the seed impact"));
+            return Err(M4Error::NoFit { fit: name });
         }
         fits.push(FitCost {
             fit: name.to_string(),
@@ -679,7 +758,7 @@ fn count_run(elf: &Path, files: &BenchFiles) -> Result<Counted, String> {
 
 /// Instructions the whole emulator firmware executes per idle sample (see
 /// [`M4Report::firmware_idle_instructions_per_sample`]).
-fn firmware_idle_marginal(firmware: &Path) -> Result<f64, String> {
+fn firmware_idle_marginal(firmware: &Path) -> Result<f64, M4Error> {
     let dir = std::env::temp_dir();
     let mut totals = Vec::new();
     for n in [1usize << 17, 1 << 18] {
@@ -687,7 +766,7 @@ fn firmware_idle_marginal(firmware: &Path) -> Result<f64, String> {
         let raw = dir.join(format!("impact-m4-idle-{}-{n}.i16", std::process::id()));
         let _raw = crate::interrupt::temporary(&raw);
         let bytes: Vec<u8> = counts.iter().flat_map(|c| c.to_le_bytes()).collect();
-        std::fs::write(&raw, bytes).map_err(|e| format!("{}: {e}", raw.display()))?;
+        std::fs::write(&raw, bytes).map_err(file(&raw))?;
         let mut lines = 0u64;
         let mut count = |_: &str| lines += 1;
         // icount: SysTick (the time driver) then ticks with the instructions, not the wall
@@ -724,12 +803,20 @@ fn solve_cases() -> Vec<Case> {
         .collect()
 }
 
-fn path_arg(p: &Path) -> Result<String, String> {
+fn path_arg(p: &Path) -> Result<String, M4Error> {
     let s = p.to_string_lossy().into_owned();
     if s.contains([' ', ',']) {
-        return Err(format!(
-            "{s}: semihosting cannot pass a path with spaces or commas"
-        ));
+        return Err(M4Error::Unpassable {
+            path: p.to_path_buf(),
+        });
     }
     Ok(s)
+}
+
+/// An I/O error of the file at `path`.
+fn file(path: &Path) -> impl FnOnce(std::io::Error) -> M4Error + '_ {
+    move |source| M4Error::File {
+        path: path.to_path_buf(),
+        source,
+    }
 }

@@ -94,8 +94,54 @@ pub fn table(r: &M4Report) -> String {
     s
 }
 
+/// One way a run's counts fail against the baseline or the targets.
+#[derive(Clone, Debug, PartialEq)]
+pub enum Regression {
+    /// A count grew by more than 10 %.
+    Grew { name: String, now: f64, then: f64 },
+    /// A solve the M4 and the host give different bits for.
+    Disagree { case: String, method: String },
+    /// A per-impact count over its absolute target.
+    OverTarget {
+        name: &'static str,
+        now: u64,
+        target: u64,
+    },
+}
+
+impl std::fmt::Display for Regression {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            Regression::Grew { name, now, then } => write!(f, "{name}: {now:.2} against {then:.2}"),
+            Regression::Disagree { case, method } => {
+                write!(f, "solve {case} {method}: the M4 and the host disagree")
+            }
+            Regression::OverTarget { name, now, target } => {
+                write!(f, "{name}: {now} instructions, over its target of {target}")
+            }
+        }
+    }
+}
+
+/// The counts regressed: the comparison's table and what failed, a line each.
+#[derive(Clone, Debug, PartialEq, thiserror::Error)]
+#[error("M4 instruction counts regressed by more than 10 %:\n{table}{}", lines(.failed))]
+pub struct Regressed {
+    pub table: String,
+    pub failed: Vec<Regression>,
+}
+
+fn lines(failed: &[Regression]) -> String {
+    failed
+        .iter()
+        .map(Regression::to_string)
+        .collect::<Vec<_>>()
+        .join("\n")
+}
+
 /// Compares `r` with a stored baseline: every instruction count may grow by 10 % at most.
-pub fn check(r: &M4Report, baseline: &M4Report) -> Result<String, String> {
+/// The comparison's table, or what regressed.
+pub fn check(r: &M4Report, baseline: &M4Report) -> Result<String, Regressed> {
     let mut rows: Vec<(String, f64, f64)> = vec![
         (
             "idle instructions/sample".into(),
@@ -174,29 +220,27 @@ pub fn check(r: &M4Report, baseline: &M4Report) -> Result<String, String> {
             100.0 * (ratio - 1.0)
         ));
         if ratio > 1.10 {
-            failed.push(format!("{name}: {now:.2} against {then:.2}"));
+            failed.push(Regression::Grew { name, now, then });
         }
     }
     for v in r.solves.iter().filter(|v| !v.same_bits_as_host) {
-        failed.push(format!(
-            "solve {} {}: the M4 and the host disagree",
-            v.case, v.method
-        ));
+        failed.push(Regression::Disagree {
+            case: v.case.clone(),
+            method: v.method.clone(),
+        });
     }
     for (name, now, target) in targets(r) {
         if now > target {
-            failed.push(format!(
-                "{name}: {now} instructions, over its target of {target}"
-            ));
+            failed.push(Regression::OverTarget { name, now, target });
         }
     }
     if failed.is_empty() {
         Ok(text)
     } else {
-        Err(format!(
-            "M4 instruction counts regressed by more than 10 %:\n{text}{}",
-            failed.join("\n")
-        ))
+        Err(Regressed {
+            table: text,
+            failed,
+        })
     }
 }
 
@@ -299,7 +343,10 @@ mod tests {
             instructions: EXPONENT_FIT_TARGET + 1,
         });
         let e = check(&r, &base).unwrap_err();
-        assert!(e.contains("over its target"), "{e}");
+        assert!(
+            matches!(e.failed[..], [Regression::OverTarget { .. }]),
+            "{e}"
+        );
         r.fits[0].instructions = EXPONENT_FIT_TARGET;
         assert!(check(&r, &base).is_ok());
         r.analysis_instructions = ANALYSIS_TARGET + 1;

@@ -9,6 +9,7 @@ use std::process::{Command, Stdio};
 
 use super::cycles::cycles;
 use super::disasm::Code;
+use super::M4Error;
 
 /// Counts of one measured region.
 #[derive(Clone, Copy, Debug, Default)]
@@ -24,9 +25,13 @@ pub(super) fn run_qemu(
     args: &[String],
     trace: Option<&mut dyn FnMut(&str)>,
     icount: bool,
-) -> Result<String, String> {
+) -> Result<String, M4Error> {
+    let qemu = |source| M4Error::Tool {
+        tool: "qemu-system-arm",
+        source,
+    };
     let dir = std::env::temp_dir().join(format!("impact-m4-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).map_err(|e| format!("{}: {e}", dir.display()))?;
+    std::fs::create_dir_all(&dir).map_err(super::file(&dir))?;
     let _dir = crate::interrupt::temporary(&dir);
     let mut cmd = Command::new("qemu-system-arm");
     cmd.args([
@@ -61,23 +66,25 @@ pub(super) fn run_qemu(
                 let _child = crate::interrupt::child(child.id());
                 child.wait_with_output()
             })
-            .map_err(|e| format!("qemu-system-arm: {e}")),
+            .map_err(qemu),
         Some(on_line) => {
             let _ = std::fs::remove_file(&fifo);
             let status = Command::new("mkfifo")
                 .arg(&fifo)
                 .status()
-                .map_err(|e| format!("mkfifo: {e}"))?;
+                .map_err(|source| M4Error::Tool {
+                    tool: "mkfifo",
+                    source,
+                })?;
             if !status.success() {
-                return Err(format!("mkfifo {} failed", fifo.display()));
+                return Err(M4Error::Mkfifo { fifo });
             }
             cmd.args(["-singlestep", "-d", "exec,nochain", "-D"])
                 .arg(&fifo);
-            let child = cmd.spawn().map_err(|e| format!("qemu-system-arm: {e}"))?;
+            let child = cmd.spawn().map_err(qemu)?;
             let _child = crate::interrupt::child(child.id());
             // QEMU opens the log when it starts; the FIFO blocks until then.
-            let file =
-                std::fs::File::open(&fifo).map_err(|e| format!("{}: {e}", fifo.display()))?;
+            let file = std::fs::File::open(&fifo).map_err(super::file(&fifo))?;
             let mut reader = BufReader::with_capacity(1 << 20, file);
             let mut line = String::new();
             loop {
@@ -85,12 +92,10 @@ pub(super) fn run_qemu(
                 match reader.read_line(&mut line) {
                     Ok(0) => break,
                     Ok(_) => on_line(&line),
-                    Err(e) => return Err(format!("reading the trace: {e}")),
+                    Err(e) => return Err(M4Error::Trace(e)),
                 }
             }
-            child
-                .wait_with_output()
-                .map_err(|e| format!("qemu-system-arm: {e}"))
+            child.wait_with_output().map_err(qemu)
         }
     };
     let _ = std::fs::remove_file(&fifo);
@@ -98,12 +103,10 @@ pub(super) fn run_qemu(
     let out = result?;
     let stdout = String::from_utf8_lossy(&out.stdout).into_owned();
     if !out.status.success() || stdout.lines().any(|l| l.starts_with("error")) {
-        return Err(format!(
-            "the M4 bench failed ({}):\n{}{}",
-            out.status,
-            stdout,
-            String::from_utf8_lossy(&out.stderr)
-        ));
+        return Err(M4Error::Failed {
+            status: out.status,
+            output: stdout + &String::from_utf8_lossy(&out.stderr),
+        });
     }
     Ok(stdout)
 }

@@ -93,8 +93,49 @@ impl Read for Follow {
     }
 }
 
+/// Why `impact watch` could not start, or stopped.
+#[derive(Debug, thiserror::Error)]
+pub enum WatchError {
+    /// `--spec` refused.
+    #[error(transparent)]
+    Spec(#[from] crate::pipeline::spec::SpecError),
+    #[error(transparent)]
+    Output(#[from] crate::output::OutputError),
+    /// The board's log (`name`: as the tool names it) could not be opened.
+    #[error("{name}: {source}")]
+    Open {
+        name: String,
+        source: std::io::Error,
+    },
+    #[error(
+        "--listen {address}: {source} (another `impact watch`? give another port, or :0 for any)"
+    )]
+    Listen {
+        address: String,
+        source: std::io::Error,
+    },
+    #[error("--session {}: {source} (a session file is never overwritten)", .path.display())]
+    Session {
+        path: PathBuf,
+        source: std::io::Error,
+    },
+    /// The bound listener's own address could not be read.
+    #[error(transparent)]
+    Address(std::io::Error),
+    /// A line could not be kept in the session file.
+    #[error("{}: {source}", .path.display())]
+    Write {
+        path: PathBuf,
+        source: std::io::Error,
+    },
+    #[error(transparent)]
+    Defmt(#[from] crate::firmware_link::decode::DefmtError),
+    #[error(transparent)]
+    ReadLine(#[from] crate::cli::log::ReadLineError),
+}
+
 /// Runs `impact watch`.
-pub fn run(args: &WatchArgs) -> Result<(), String> {
+pub fn run(args: &WatchArgs) -> Result<(), WatchError> {
     let input = args.input.clone().unwrap_or_else(|| PathBuf::from("-"));
     let stdin = impact_io::channel::is_stdin(&input);
     let name = impact_io::channel::input_name(&input);
@@ -127,7 +168,10 @@ pub fn run(args: &WatchArgs) -> Result<(), String> {
     let source: Box<dyn Read + Send> = if stdin {
         Box::new(std::io::stdin())
     } else {
-        let file = std::fs::File::open(&input).map_err(|e| format!("{name}: {e}"))?;
+        let file = std::fs::File::open(&input).map_err(|source| WatchError::Open {
+            name: name.clone(),
+            source,
+        })?;
         Box::new(Follow {
             file,
             at: 0,
@@ -138,11 +182,9 @@ pub fn run(args: &WatchArgs) -> Result<(), String> {
     let listener = if args.terminal {
         None
     } else {
-        let l = TcpListener::bind(&args.listen).map_err(|e| {
-            format!(
-                "--listen {}: {e} (another `impact watch`? give another port, or :0 for any)",
-                args.listen
-            )
+        let l = TcpListener::bind(&args.listen).map_err(|source| WatchError::Listen {
+            address: args.listen.clone(),
+            source,
         })?;
         Some(l)
     };
@@ -150,11 +192,9 @@ pub fn run(args: &WatchArgs) -> Result<(), String> {
         .write(true)
         .create_new(true)
         .open(&session_path)
-        .map_err(|e| {
-            format!(
-                "--session {}: {e} (a session file is never overwritten)",
-                session_path.display()
-            )
+        .map_err(|source| WatchError::Session {
+            path: session_path.clone(),
+            source,
         })?;
     let mut log = std::io::BufWriter::new(file);
     let spec_only = spec.as_ref().map(|(s, _)| *s);
@@ -166,7 +206,7 @@ pub fn run(args: &WatchArgs) -> Result<(), String> {
     let hub = Arc::new(Hub::new(session, session_path.clone(), spec_only, loopback));
     let terminal = args.terminal;
     if let Some(l) = listener {
-        let addr = l.local_addr().map_err(|e| e.to_string())?;
+        let addr = l.local_addr().map_err(WatchError::Address)?;
         crate::errln!(
             "impact watch: http://{addr}/ (session file {})",
             session_path.display()
@@ -213,10 +253,13 @@ pub fn run(args: &WatchArgs) -> Result<(), String> {
             }
         });
     }
-    let mut on_line = |n: u64, line: &str| -> Result<(), String> {
+    let mut on_line = |n: u64, line: &str| -> Result<(), WatchError> {
         writeln!(log, "{line}")
             .and_then(|()| log.flush())
-            .map_err(|e| format!("{}: {e}", session_path.display()))?;
+            .map_err(|source| WatchError::Write {
+                path: session_path.clone(),
+                source,
+            })?;
         let events = hub.with(|s| s.line(n, line, now_ms()));
         if terminal {
             terminal::print(&events);

@@ -10,9 +10,10 @@ use impact_core::ImpactReport;
 use serde_json::{json, Map, Value};
 
 use crate::firmware_link::line::{
-    self, Counter, Fields, ImpactLine, LineKind, SpecLine, SrsLine, State, WaveFrameLine, WaveLine,
+    self, Counter, FieldError, Fields, ImpactLine, LineError, LineKind, SpecLine, SrsLine, State,
+    WaveFrameLine, WaveLine,
 };
-use crate::firmware_link::waves::Waveform;
+use crate::firmware_link::waves::{WaveError, Waveform};
 use crate::report::statistics::Running;
 
 /// Impacts kept with their pulses (the newest; the page's "last impact" and its table start).
@@ -156,14 +157,19 @@ impl Session {
         let mut events = Vec::new();
         if let Err(e) = self.read(line, now_ms, &mut events) {
             self.bad_lines += 1;
-            let text = format!("line {n}: {}", cut(&e));
+            let text = format!("line {n}: {}", cut(&e.to_string()));
             self.last_error = Some(text.clone());
             events.push(json!({"type": "warning", "text": text}));
         }
         events
     }
 
-    fn read(&mut self, line: &str, now_ms: u64, events: &mut Vec<Value>) -> Result<(), String> {
+    fn read(
+        &mut self,
+        line: &str,
+        now_ms: u64,
+        events: &mut Vec<Value>,
+    ) -> Result<(), SessionError> {
         let Some((kind, fields)) = line::find(line, &KINDS) else {
             return Ok(());
         };
@@ -172,7 +178,7 @@ impl Session {
         if !matches!(kind, LineKind::Srs | LineKind::Spec | LineKind::WaveFrame) {
             self.show(events);
         }
-        let fields = fields.map_err(text)?;
+        let fields = fields?;
         match kind {
             LineKind::Srs => self.read_srs(&fields),
             LineKind::Spec => self.read_spec(&fields, events),
@@ -186,47 +192,57 @@ impl Session {
     }
 
     /// An `srs` line: the waiting impact's spectra.
-    fn read_srs(&mut self, f: &Fields) -> Result<(), String> {
-        let SrsLine { index, spectrum } = SrsLine::parse(f).map_err(text)?;
+    fn read_srs(&mut self, f: &Fields) -> Result<(), SessionError> {
+        let SrsLine { index, spectrum } = SrsLine::parse(f)?;
         match self.pending.as_mut().filter(|p| p.report.index == index) {
             Some(p) => p.report.spectrum = Some(spectrum),
-            None => return Err(late("srs", index)),
+            None => {
+                return Err(SessionError::Late {
+                    kind: LineKind::Srs,
+                    index,
+                })
+            }
         }
         Ok(())
     }
 
     /// A `spec` line: the waiting impact's verdict, its last line (shown then).
-    fn read_spec(&mut self, f: &Fields, events: &mut Vec<Value>) -> Result<(), String> {
-        let SpecLine { index, verdict } = SpecLine::parse(f).map_err(text)?;
+    fn read_spec(&mut self, f: &Fields, events: &mut Vec<Value>) -> Result<(), SessionError> {
+        let SpecLine { index, verdict } = SpecLine::parse(f)?;
         match self.pending.as_mut().filter(|p| p.report.index == index) {
             Some(p) => {
                 p.report.verdict = Some(verdict);
                 self.show(events);
             }
-            None => return Err(late("spec", index)),
+            None => {
+                return Err(SessionError::Late {
+                    kind: LineKind::Spec,
+                    index,
+                })
+            }
         }
         Ok(())
     }
 
     /// A `wave_frame` line: a frame of the window being received (another's is passed over).
-    fn read_wave_frame(&mut self, line: &str, f: &Fields) -> Result<(), String> {
+    fn read_wave_frame(&mut self, line: &str, f: &Fields) -> Result<(), SessionError> {
         let WaveFrameLine {
             index,
             frame,
             counts,
-        } = WaveFrameLine::parse(line, f).map_err(text)?;
+        } = WaveFrameLine::parse(line, f)?;
         if let Some(w) = self.wave.as_mut().filter(|w| w.index == index) {
-            w.add_frame(frame, counts).map_err(text)?;
+            w.add_frame(frame, counts)?;
         }
         Ok(())
     }
 
     /// An `impact` line: it waits for its `srs` and `spec` lines.
-    fn read_impact(&mut self, f: &Fields, now_ms: u64) -> Result<(), String> {
+    fn read_impact(&mut self, f: &Fields, now_ms: u64) -> Result<(), SessionError> {
         let ImpactLine {
             report,
             report_latency_s: latency_s,
-        } = ImpactLine::parse(f).map_err(text)?;
+        } = ImpactLine::parse(f)?;
         let wave = self.wave.take().filter(|w| w.index == report.index);
         self.started = true;
         self.pending = Some(Pending {
@@ -239,14 +255,11 @@ impl Session {
     }
 
     /// A `wave` line: the window received next (only the newest is kept).
-    fn read_wave(&mut self, f: &Fields) -> Result<(), String> {
+    fn read_wave(&mut self, f: &Fields) -> Result<(), SessionError> {
         self.started = true;
-        let w = Waveform::new(WaveLine::parse(f).map_err(text)?);
+        let w = Waveform::new(WaveLine::parse(f)?);
         if w.samples > MAX_WAVE_SAMPLES {
-            return Err(format!(
-                "samples={}: a window of the board holds at most {MAX_WAVE_SAMPLES}",
-                w.samples
-            ));
+            return Err(SessionError::WaveTooLong { samples: w.samples });
         }
         self.wave = Some(w);
         Ok(())
@@ -257,7 +270,7 @@ impl Session {
         f: Fields,
         now_ms: u64,
         events: &mut Vec<Value>,
-    ) -> Result<(), String> {
+    ) -> Result<(), SessionError> {
         self.started = true;
         self.last_heartbeat_ms = Some(now_ms);
         let h = self.health(&State::new(f), now_ms)?;
@@ -271,12 +284,12 @@ impl Session {
         f: Fields,
         now_ms: u64,
         events: &mut Vec<Value>,
-    ) -> Result<(), String> {
+    ) -> Result<(), SessionError> {
         let state = State::new(f);
         let h = self.health(&state, now_ms)?;
         self.health = Some(h.clone());
         events.push(tagged("health", h));
-        let result = state.result().map_err(text)?;
+        let result = state.result()?;
         let end = json!({"result": result, "received_unix_ms": now_ms});
         self.ended = Some(end.clone());
         events.push(tagged("end", end));
@@ -290,8 +303,8 @@ impl Session {
         f: Fields,
         now_ms: u64,
         events: &mut Vec<Value>,
-    ) -> Result<(), String> {
-        let rate_hz = f64::from(line::rate(&f).map_err(text)?);
+    ) -> Result<(), SessionError> {
+        let rate_hz = f64::from(line::rate(&f)?);
         if self.started {
             self.run += 1;
             self.wave = None;
@@ -477,10 +490,10 @@ impl Session {
     }
 
     /// The board's health from a heartbeat's (or the summary's) counters.
-    fn health(&self, s: &State, now_ms: u64) -> Result<Value, String> {
-        let n = |c: Counter| s.counter(c).map_err(text);
+    fn health(&self, s: &State, now_ms: u64) -> Result<Value, SessionError> {
+        let n = |c: Counter| s.counter(c);
         let samples = n(Counter::Samples)?;
-        let rate_hz = f64::from(s.rate_hz().map_err(text)?);
+        let rate_hz = f64::from(s.rate_hz()?);
         let shown = |c: Counter| s.readable(c);
         Ok(json!({
             "run": self.run, "received_unix_ms": now_ms,
@@ -576,17 +589,24 @@ const KINDS: [LineKind; 8] = [
     LineKind::Scene,
 ];
 
-/// A line's error as the warning says it.
-fn text(e: impl std::fmt::Display) -> String {
-    e.to_string()
-}
-
-/// The error of a `what` line (`srs`, `spec`) whose impact was shown already (or never came).
-fn late(what: &str, index: u32) -> String {
-    format!(
-        "{what} index={index}: after its impact was shown (or without its impact line): not \
+/// Why a line of the board's could not be read into the session (shown as a `warning`
+/// event, `line N: what`; the session goes on).
+#[derive(Debug, thiserror::Error)]
+pub enum SessionError {
+    #[error(transparent)]
+    Field(#[from] FieldError),
+    #[error(transparent)]
+    Line(#[from] LineError),
+    #[error(transparent)]
+    Wave(#[from] WaveError),
+    /// An `srs` or `spec` line whose impact was shown already (or never came).
+    #[error(
+        "{kind} index={index}: after its impact was shown (or without its impact line): not \
          on the page; the session file has it (impact log reads it)"
-    )
+    )]
+    Late { kind: LineKind, index: u32 },
+    #[error("samples={samples}: a window of the board holds at most {MAX_WAVE_SAMPLES}")]
+    WaveTooLong { samples: u32 },
 }
 
 /// `text`, at most [`MAX_TEXT`] bytes of it (cut at a character's boundary, marked).
