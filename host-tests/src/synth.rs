@@ -105,6 +105,8 @@ pub struct Recording {
     pub truth: Vec<ImpactOutcome<f64>>,
     /// Samples that hit a rail.
     pub clipped: usize,
+    /// A physical drop's end, where it came before `--duration` (the recording is shorter).
+    pub ended: Option<(f64, crate::drop::End)>,
 }
 
 /// xorshift64* and Box–Muller: reproducible noise without a dependency.
@@ -155,6 +157,7 @@ pub fn record(
         calibration: sensor.calibration(),
         truth,
         clipped,
+        ended: None,
     })
 }
 
@@ -199,9 +202,30 @@ pub struct SynthArgs {
     /// Mass of the body, kg.
     #[arg(short = 'm', long, help_heading = "Model")]
     pub mass: f64,
-    /// Approach speed, m/s.
-    #[arg(long, help_heading = "Model")]
-    pub v0: f64,
+    /// Approach speed, m/s (or --drop-height).
+    #[arg(
+        long,
+        help_heading = "Model",
+        required_unless_present = "drop_height",
+        conflicts_with = "drop_height"
+    )]
+    pub v0: Option<f64>,
+    /// A drop from rest: held on a support for --rest (the sensor reads +1 g), released, and
+    /// falling this far to the pad, m (v0 = sqrt(2 g h)); gravity in every contact.
+    #[arg(long, help_heading = "Model", conflicts_with_all = ["touch", "impacts"])]
+    pub drop_height: Option<f64>,
+    /// Time at rest on the support before the release, s (with --drop-height).
+    #[arg(
+        long,
+        help_heading = "Model",
+        requires = "drop_height",
+        default_value_t = 0.05
+    )]
+    pub rest: f64,
+    /// A vertical impact at --v0: gravity in the contact, the body in free fall before it
+    /// (implied by --bounces and --drop-height; without it, a horizontal strike).
+    #[arg(long, help_heading = "Model", conflicts_with = "impacts")]
+    pub vertical: bool,
     #[command(flatten)]
     pub params: crate::simulate::ModelArgs,
     /// Sample rate, Hz.
@@ -319,7 +343,15 @@ pub enum DropEveryError {
 /// tool's CSV).
 pub fn synth(args: &SynthArgs) -> Result<Recording, SynthError> {
     let invalid = |option, rule| Err(SynthError::Invalid { option, rule });
-    let impact = Impact::new(args.mass, args.v0);
+    if let Some(h) = args.drop_height {
+        if !(h.is_finite() && h > 0.0) {
+            return invalid("--drop-height", "be finite and > 0");
+        }
+        if !(args.rest.is_finite() && args.rest >= 0.0) {
+            return invalid("--rest", "be finite and >= 0");
+        }
+    }
+    let impact = Impact::new(args.mass, args.v0_m_s());
     impact.validate()?;
     let model = args.params.model(args.model, &impact)?;
     if !(args.rate.is_finite() && args.rate > 0.0) {
@@ -363,15 +395,17 @@ pub fn synth(args: &SynthArgs) -> Result<Recording, SynthError> {
     if args.bounces == 0 || args.bounces > 10_000 {
         return invalid("--bounces", "lie in 1..=10000");
     }
-    if args.bounces > 1 {
+    if args.physical() {
         let n = (args.duration * args.rate).ceil() as usize;
         let rendered = bounce_drop(args, &model).render(args.rate, n)?;
         let (samples, clipped) = quantise(&sensor, &rendered.accel_m_s2);
+        let ended = (samples.len() < n).then(|| (samples.len() as f64 / args.rate, rendered.end));
         return Ok(Recording {
             samples,
             calibration: sensor.calibration(),
             truth: rendered.contacts.iter().map(outcome).collect(),
             clipped,
+            ended,
         });
     }
     let contacts: Vec<Placed> = {
@@ -386,17 +420,42 @@ pub fn synth(args: &SynthArgs) -> Result<Recording, SynthError> {
     Ok(record(&sensor, args.duration, &contacts)?)
 }
 
-/// The physical drop `--bounces` renders: the body in free flight from the record's start,
-/// touching at `--touch` at `--v0`, bouncing under standard gravity.
+impl SynthArgs {
+    /// The approach speed: `--v0`, or a drop's from `--drop-height` under standard gravity.
+    pub fn v0_m_s(&self) -> f64 {
+        match (self.v0, self.drop_height) {
+            (Some(v0), _) => v0,
+            (None, Some(h)) => (2.0 * impact_core::consts::STANDARD_GRAVITY * h).sqrt(),
+            (None, None) => f64::NAN,
+        }
+    }
+
+    /// True if the recording is a physical drop ([`crate::drop`]): a train, a drop from
+    /// rest, or a vertical impact.
+    pub fn physical(&self) -> bool {
+        self.bounces > 1 || self.drop_height.is_some() || self.vertical
+    }
+}
+
+/// The physical drop `--bounces`, `--drop-height` or `--vertical` renders under standard
+/// gravity: from rest on a support (`--drop-height`, `--rest`), or in free flight from the
+/// record's start, touching at `--touch` at `--v0`.
 pub fn bounce_drop(args: &SynthArgs, model: &impact_core::Model<f64>) -> crate::drop::Drop {
+    let start = match args.drop_height {
+        Some(height_m) => crate::drop::Start::Rest {
+            rest_s: args.rest,
+            height_m,
+        },
+        None => crate::drop::Start::Moving {
+            touch_s: args.touch,
+            v0_m_s: args.v0_m_s(),
+        },
+    };
     crate::drop::Drop {
         law: *model,
         mass_kg: args.mass,
         gravity_m_s2: impact_core::consts::STANDARD_GRAVITY,
-        start: crate::drop::Start::Moving {
-            touch_s: args.touch,
-            v0_m_s: args.v0,
-        },
+        start,
         max_contacts: args.bounces,
         min_rebound_m_s: 1e-3,
     }

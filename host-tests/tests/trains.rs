@@ -19,7 +19,7 @@ struct Synth {
 /// The exact (v0, COR) of each contact the synth arguments render.
 fn exact(args: &[&str]) -> Vec<(f64, f64)> {
     let s = Synth::parse_from(std::iter::once("synth").chain(args.iter().copied()));
-    let impact = impact_core::Impact::new(s.args.mass, s.args.v0);
+    let impact = impact_core::Impact::new(s.args.mass, s.args.v0_m_s());
     let model = s.args.params.model(s.args.model, &impact).unwrap();
     bounce_train(&s.args, &model)
         .unwrap()

@@ -325,8 +325,10 @@ fn analyse_kinematics<const CAP: usize>(
         v0: v0d,
         kv: scene.calibration.gain_m_s2_per_count as f64 / s.base_n.max(1) as f64 / fs,
         dt,
-        // Between first touch and the onset sample the body still moves at ~v0.
-        x_lead: v0d * (-touch).max(0.0) * dt,
+        // The sums start half a sample before the onset sample's instant (the midpoint rule,
+        // [`motion`]); from first touch to there the body moves at ~v0 (a touch within that
+        // half sample leaves the body short of it: the deformation is negative).
+        x_lead: v0d * (-touch - 0.5) * dt,
     };
     let from_onset = samples.get(onset..).unwrap_or(&[]);
     let contact = from_onset.len();

@@ -13,7 +13,13 @@
 //! x_k = x_lead + dt (k v0 - kv T_k / 2)      (trapezoid; T_k = 2 Q_k - C_k)
 //! ```
 //!
-//! so nothing drifts however long the capture; the only rounding is the conversion of the
+//! Samples are instants (sample `j` at time `j`, in samples from the onset, as every
+//! position the stream reports), each standing for the interval `[j - ½, j + ½)` (the
+//! midpoint rule): `v_k` is the velocity at time `k - ½`, and `x_k` the deformation then
+//! (`x_lead` is the deformation at `-½`). Counting a sample's interval from its instant
+//! instead put every crush half a sample late.
+//!
+//! So nothing drifts however long the capture; the only rounding is the conversion of the
 //! sums at the few points where a value is needed. Per sample the pass costs two i64
 //! additions (no floating point), which is what makes it cheap on the Cortex-M4.
 
@@ -31,8 +37,8 @@ pub struct Scale {
     pub kv: f64,
     /// Sample period, s.
     pub dt: f64,
-    /// Deformation already reached at the onset sample, m (first touch came a fraction of a
-    /// sample earlier, at `v0`).
+    /// Deformation at half a sample before the onset sample, m (first touch came a fraction
+    /// of a sample earlier or later, at `v0`: negative if later, the body still approaching).
     pub x_lead: f64,
 }
 
@@ -58,7 +64,7 @@ pub struct PointsOut<'a> {
 /// The kinematics the pass found, in samples from the onset and metres.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Found {
-    /// When the velocity reached zero (fractional samples after the onset sample's start).
+    /// When the velocity reached zero (fractional samples from the onset sample's instant).
     pub crush: f64,
     /// The deformation then, m.
     pub x_max: f64,
@@ -168,7 +174,9 @@ pub fn integrate(
     } else {
         i64::MAX
     };
-    let sep_floor = libm::floor(separation) as usize;
+    // The deformation at time `s` is the sums' after `s + ½` samples (midpoint rule).
+    let sep_at = separation + 0.5;
+    let sep_floor = libm::floor(sep_at) as usize;
     let n_points = points.as_ref().map_or(0, |p| p.x.len().min(p.v.len()));
     let every = points.as_ref().map_or(1, |p| p.every.max(1));
     // The points in f32 (one conversion of each sum, a multiply-add): the velocity in units
@@ -236,13 +244,13 @@ pub fn integrate(
     let [Some(s0), Some(s1)] = at_sep else {
         return None;
     };
-    let frac = separation - sep_floor as f64;
+    let frac = sep_at - sep_floor as f64;
     let (x0, x1) = (
         scale.deformation(s0.k, s0.t()),
         scale.deformation(s1.k, s1.t()),
     );
     Some(Found {
-        crush: at.k as f64 + f,
+        crush: at.k as f64 + f - 0.5,
         x_max,
         x_sep: x0 + frac * (x1 - x0),
     })
@@ -283,7 +291,8 @@ mod tests {
             dt: 1e-3,
             x_lead: 0.0,
         };
-        // v reaches 0 after 1 / (1e-3 * 10) = 100 samples; x then is v0^2 / (2 a) with
+        // The sums start half a sample before the onset's instant (x_lead there): v reaches 0
+        // after 1 / (1e-3 * 10) = 100 samples, at 99.5; x then is v0^2 / (2 a) with
         // a = 10 * kv / dt = 10 m/s²: 0.05 m.
         let mut x = [0f32; 4];
         let mut v = [0f32; 4];
@@ -299,10 +308,10 @@ mod tests {
             }),
         )
         .unwrap();
-        assert!((f.crush - 100.0).abs() < 1e-9, "{}", f.crush);
+        assert!((f.crush - 99.5).abs() < 1e-9, "{}", f.crush);
         assert!((f.x_max - 0.05).abs() < 1e-9, "{}", f.x_max);
-        // At 150.5 samples: 0.05 - 10 (0.0505)^2 / 2 (moving back out).
-        let want = 0.05 - 10.0 * 0.0505f64.powi(2) / 2.0;
+        // At 150.5 samples, 151 after the start: 0.05 - 10 (0.051)^2 / 2 (moving back out).
+        let want = 0.05 - 10.0 * 0.051f64.powi(2) / 2.0;
         assert!((f.x_sep - want).abs() < 2e-6, "{} {want}", f.x_sep);
         // Point i: after sample 40 i, k = 40 i + 1: v = 1 - 0.01 k.
         for (i, (&x, &v)) in x.iter().zip(&v).enumerate() {

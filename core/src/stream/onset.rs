@@ -15,13 +15,33 @@ pub(super) enum Onset {
 }
 
 impl<const PRE: usize> Stream<PRE> {
+    /// The sensor's zero force, counts, in a vertical scene whose baseline is the rest on a
+    /// support: free fall reads `g` less than rest (an accelerometer reads specific force).
+    /// With the tolerance a level is taken as it within: a quarter of `g` (a gain 25 % off
+    /// still tells free fall from rest, `g` apart, whatever the edge level). `None` in a
+    /// horizontal scene.
+    fn free_fall(&self) -> Option<(f32, f32)> {
+        let g = self.scene.contact_gravity_m_s2()?;
+        let g_counts = g / self.scene.calibration.gain_m_s2_per_count;
+        let level = self.baseline.mean() - g_counts;
+        Some((level, 0.25 * libm::fabsf(g_counts)))
+    }
+
+    /// True if `level` (counts) is the free-fall level of a vertical scene
+    /// ([`Self::free_fall`]).
+    pub(super) fn is_free_fall(&self, level: f32) -> bool {
+        self.free_fall()
+            .is_some_and(|(at, tol)| libm::fabsf(level - at) <= tol)
+    }
+
     /// The steady level just before the pulse, if the signal moved away from the baseline
     /// since it was learned (a step below the trigger, an orientation change, drift): walking
     /// back from the trigger past the pulse's rise (the strides that are not flat), a run of
     /// flat strides (each spanning at most twice the edge level) within the edge level of one
     /// another, beyond the edge level from the baseline, lasting at least the settle time (and
-    /// one stride). `(Σx, n)` over the run, as the baseline's rational; `None` for no such
-    /// run within the flanks' reach.
+    /// one stride; two strides at the free-fall level of a vertical scene, which physics
+    /// names: the body falls before every touch, whatever the ring's length). `(Σx, n)` over
+    /// the run, as the baseline's rational; `None` for no such run within the flanks' reach.
     pub(super) fn level_before(&self) -> Option<(i64, i64)> {
         let edge = self.edge_counts;
         let mean = self.baseline.mean();
@@ -38,28 +58,51 @@ impl<const PRE: usize> Stream<PRE> {
         };
         let flat = |(_, min, max): (i32, i16, i16)| (max as f32 - min as f32) <= 2.0 * edge;
         let level = |(sum, _, _): (i32, i16, i16)| sum as f32 / STRIDE as f32;
-        let mut k = 0;
-        let first = loop {
-            let st = stride(k)?;
-            if flat(st) {
-                break st;
+        // The first flat stride walking back; in a vertical scene the first at the free-fall
+        // level if there is one (a smooth foot rising from free fall through the rest level
+        // has flat strides at neither), else the first flat one.
+        let first_from = |wanted: &dyn Fn((i32, i16, i16)) -> bool| {
+            let mut k = 0;
+            loop {
+                let st = stride(k)?;
+                if flat(st) && wanted(st) {
+                    return Some((k, st));
+                }
+                k += 1;
             }
-            k += 1;
         };
+        let at_free_fall = |st| self.is_free_fall(level(st));
+        let (mut k, first) = (self.free_fall().is_some())
+            .then(|| first_from(&at_free_fall))
+            .flatten()
+            .or_else(|| first_from(&|_| true))?;
         let at = level(first);
-        if libm::fabsf(at - mean) <= 2.0 * edge {
+        // (Free fall is a level however close the edge level puts it to rest.)
+        if libm::fabsf(at - mean) <= 2.0 * edge && !self.is_free_fall(at) {
             return None;
         }
         let (mut sum, mut n) = (0i64, 0i64);
         let mut varies = false;
-        while let Some(st) = stride(k).filter(|&st| flat(st) && libm::fabsf(level(st) - at) <= edge)
-        {
+        // A free fall's run holds free fall only (an edge level wider than `g` would take the
+        // rest before the release into it).
+        let free_fall = self.is_free_fall(at);
+        let same = |st| {
+            flat(st)
+                && libm::fabsf(level(st) - at) <= edge
+                && (!free_fall || self.is_free_fall(level(st)))
+        };
+        while let Some(st) = stride(k).filter(|&st| same(st)) {
             sum += i64::from(st.0);
             n += STRIDE as i64;
             varies |= st.2 > st.1;
             k += 1;
         }
-        (varies && n >= i64::from(self.settle).max(STRIDE as i64)).then_some((sum, n))
+        let needed = if free_fall {
+            2 * STRIDE as i64
+        } else {
+            i64::from(self.settle).max(STRIDE as i64)
+        };
+        (varies && n >= needed).then_some((sum, n))
     }
 
     /// What fired the trigger at sample `x` (the next one): a pulse, measured from the baseline
@@ -71,6 +114,12 @@ impl<const PRE: usize> Stream<PRE> {
     /// faster), or when `x` is no further than the trigger level from the level the signal
     /// settled at.
     pub(super) fn onset(&self, x: i16) -> Onset {
+        // A vertical scene's release: the step from rest to free fall is no pulse; the
+        // baseline moves to the free-fall level at once (its strides then refine it).
+        if let Some((at, _)) = self.free_fall().filter(|_| self.is_free_fall(x as f32)) {
+            let n = STRIDE as i64;
+            return Onset::Moved((libm::round(at as f64 * n as f64) as i64, n));
+        }
         let level = self.level_before();
         let last_stride = || {
             let sum: i64 = (0..STRIDE)
@@ -124,13 +173,16 @@ impl<const PRE: usize> Stream<PRE> {
         self.start(sink, x, moved);
     }
 
-    /// The baseline moves to the level `sum / n` (a level change without a pulse).
+    /// The baseline moves to the level `sum / n` (a level change without a pulse). The
+    /// free-fall level of a vertical scene is the sensor's zero: no impact is flagged as
+    /// measured from a level other than it.
     #[cold]
     pub(super) fn move_baseline(&mut self, sum: i64, n: i64) {
+        let free_fall = n > 0 && self.is_free_fall(sum as f32 / n as f32);
         self.baseline.restart_at(sum, n);
         self.thresholds = None;
         self.counters.level_changes += 1;
-        self.moved = true;
+        self.moved |= !free_fall;
         let level = self.baseline.mean() as f64;
         if let Some(f) = self.trigger_filter.as_mut() {
             f.reset(level);

@@ -37,6 +37,19 @@ pub fn run(command: SynthCommand) -> Result<(), SynthError> {
         }
     }
     let rec = synth::synth(&args)?;
+    if let Some((at_s, end)) = rec.ended {
+        let why = match end {
+            crate::drop::End::Contacts => {
+                "where the body lands after the last contact modelled (--bounces)"
+            }
+            crate::drop::End::PadNotRecovered => {
+                "after a contact the pad could not recover from before the next landing"
+            }
+            crate::drop::End::Rests => "where the body comes to rest on the pad",
+            crate::drop::End::Duration => "at --duration",
+        };
+        crate::errln!("note: the recording ends at {at_s} s, {why}");
+    }
     if let Some(path) = raw {
         let bytes: Vec<u8> = rec.samples.iter().flat_map(|c| c.to_le_bytes()).collect();
         crate::output::write(&path, &bytes)?;
