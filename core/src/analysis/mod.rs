@@ -391,7 +391,8 @@ fn analyse_kinematics<const CAP: usize>(
         max_deformation_m: found.x_max as f32,
         rebound_velocity_m_s: rebound,
         cor,
-        permanent_deformation_m: found.x_sep as f32,
+        separation_deformation_m: found.x_sep as f32,
+        permanent_deformation_m: None,
         // Gravity's work over the contact counts in a vertical one.
         absorbed_energy_j: scene.mass_kg.map(|m| {
             0.5 * m * (v0 * v0 - rebound * rebound)
@@ -418,11 +419,15 @@ fn analyse_kinematics<const CAP: usize>(
         };
         let set = &scene.fits;
         let n = (!set.fit_exponent).then_some(set.nonlinear_exponent);
+        let pad_set = fit::set(&p);
         r.fits = crate::report::Fits {
             two_phase: set.two_phase.then(|| fit::two_phase(&p)).flatten(),
             nonlinear: set.nonlinear.then(|| fit::nonlinear(&p, n, ln_x)).flatten(),
             hertz: set.hertz.then(|| fit::hertz(&p)).flatten(),
         };
+        if let Some(k) = r.kinematics.as_mut() {
+            k.permanent_deformation_m = pad_set;
+        }
     }
     r
 }

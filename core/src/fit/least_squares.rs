@@ -102,21 +102,16 @@ pub fn two_phase(p: &Points<'_>) -> Option<TwoPhaseFit> {
         return None;
     }
     let mut compression = Sums::<2>::new();
-    let mut restitution = Sums::<9>::new();
     let mut restoring = false;
     for (x, v, f) in p.iter() {
         restoring |= v <= 0.0;
-        if restoring {
-            let u = x - 1.0;
-            restitution.add([u * u, u, u * v, 1.0, v, v * v, u * f, f, v * f]);
-        } else {
+        if !restoring {
             compression.add([f * x, x * x]);
         }
     }
     let [sfx, sxx] = compression.get();
-    let [uu, u, uv, n, sv, vv, uf, sf, vf] = restitution.get();
     let kc = sfx / sxx;
-    let [kr, b, c] = solve3([[uu, u, uv], [u, n, sv], [uv, sv, vv]], [uf, sf, vf])?;
+    let [kr, b, c] = restitution_line(p)?;
     if !(kc.is_finite() && kr > 0.0) {
         return None;
     }
@@ -140,6 +135,56 @@ pub fn two_phase(p: &Points<'_>) -> Option<TwoPhaseFit> {
         permanent_m: (krxp / kr * xs) as f32,
         residual: rms,
     })
+}
+
+/// The restitution line `F = kr (X - 1) + b + c V` fitted to the points from the first one
+/// moving back out (scaled units; `kr x_p = kr - b`).
+fn restitution_line(p: &Points<'_>) -> Option<[f64; 3]> {
+    let mut restitution = Sums::<9>::new();
+    let mut restoring = false;
+    for (x, v, f) in p.iter() {
+        restoring |= v <= 0.0;
+        if restoring {
+            let u = x - 1.0;
+            restitution.add([u * u, u, u * v, 1.0, v, v * v, u * f, f, v * f]);
+        }
+    }
+    let [uu, u, uv, n, sv, vv, uf, sf, vf] = restitution.get();
+    solve3([[uu, u, uv], [u, n, sv], [uv, sv, vv]], [uf, sf, vf])
+}
+
+/// Largest RMS residual of the restitution line, relative to the peak force, for its set to
+/// be reported ([`set`]): an elastic and a viscous part that fit the unloading to 2 %.
+pub const SET_RESIDUAL: f32 = 0.02;
+
+/// The set the pad keeps once it has recovered, m: where the unloading's elastic part
+/// `kr (x - x_s)` is zero, from the restitution line `F = kr (x - x_s) + c v` fitted to the
+/// unloading (0 for a Kelvin–Voigt pad, whose viscous part holds the separation at
+/// `x_sep = -c v_r / k > 0`; `x_p` for the two-phase law). `None` where the line does not
+/// hold the unloading to [`SET_RESIDUAL`] (a Hertz or `x^n` unloading: the record cannot
+/// tell the set) or no line fits.
+pub fn set(p: &Points<'_>) -> Option<f32> {
+    if !p.usable() {
+        return None;
+    }
+    let [kr, b, c] = restitution_line(p)?;
+    if !(kr > 0.0) {
+        return None;
+    }
+    let (kr32, b32, c32) = (kr as f32, b as f32, c as f32);
+    let mut restoring = false;
+    let mut s = Sums::<2>::new();
+    for (x, v, f) in p.iter() {
+        restoring |= v <= 0.0;
+        if restoring {
+            let r = f - (kr32 * (x - 1.0) + b32 + c32 * v);
+            s.add([r * r, 1.0]);
+        }
+    }
+    let [rss, n] = s.get();
+    let rms = libm::sqrt(rss / n.max(1.0)) as f32;
+    let x_s = ((kr - b) / kr * p.x_m as f64) as f32;
+    (rms <= SET_RESIDUAL && x_s.is_finite()).then_some(x_s)
 }
 
 /// `F = k X^n + q X^n V` at one exponent: `(k, q, rss)` in scaled units, from the normal

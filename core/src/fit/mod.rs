@@ -15,7 +15,7 @@ mod least_squares;
 #[cfg(feature = "fit")]
 mod sums;
 #[cfg(feature = "fit")]
-pub use least_squares::{hertz, nonlinear, two_phase, Points};
+pub use least_squares::{hertz, nonlinear, set, two_phase, Points, SET_RESIDUAL};
 
 /// Two-phase Kelvin–Voigt parameters identified from one impact.
 #[derive(Clone, Copy, Debug, PartialEq)]

@@ -4,7 +4,7 @@
 
 /// Every field of [`super::ImpactReport`] but the bounce, in order, as the `impact` line and
 /// the CSV name them (kinematics and fits flattened).
-pub const FIELDS: [&str; 35] = [
+pub const FIELDS: [&str; 36] = [
     "index",
     "status",
     "analysis",
@@ -27,6 +27,7 @@ pub const FIELDS: [&str; 35] = [
     "max_deformation_m",
     "rebound_velocity_m_s",
     "cor",
+    "separation_deformation_m",
     "permanent_deformation_m",
     "absorbed_energy_j",
     "two_phase_kc_n_m",

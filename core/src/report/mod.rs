@@ -182,9 +182,16 @@ pub struct Kinematics {
     pub rebound_velocity_m_s: f32,
     /// `v' / v0`.
     pub cor: f32,
-    /// Deformation left at separation, m.
-    pub permanent_deformation_m: f32,
-    /// `m (v0² - v'²) / 2`, J (when the mass is known).
+    /// Deformation at separation (where the contact force returned to zero), m: the set
+    /// plus what the pad's viscous part still held (a Kelvin–Voigt pad's `c v_r / k`).
+    pub separation_deformation_m: f32,
+    /// The set the pad keeps once it has recovered, m ([`crate::fit::set`]): 0 for a
+    /// Kelvin–Voigt pad, `x_p` for the two-phase law; `None` where the record cannot tell
+    /// (the unloading no line of an elastic and a viscous part, or no fit points: no mass or
+    /// no fit asked).
+    pub permanent_deformation_m: Option<f32>,
+    /// `m (v0² - v'²) / 2` (plus gravity's work `m g x_sep` in a vertical contact), J (when
+    /// the mass is known).
     pub absorbed_energy_j: Option<f32>,
 }
 

@@ -117,7 +117,11 @@ fn approach(scene: Option<&SceneLine>) -> Result<(Option<f64>, Option<String>), 
         return Ok((None, None));
     };
     if let Some(h) = scene.drop_height_m()? {
-        let v0 = (2.0 * STANDARD_GRAVITY * f64::from(h)).sqrt();
+        // A drop is vertical: the scene line gives its gravity (an older board's, none).
+        let g = scene
+            .contact_gravity_m_s2()?
+            .map_or(STANDARD_GRAVITY, crate::report::fmt::shortest);
+        let v0 = (2.0 * g * f64::from(h)).sqrt();
         return Ok((Some(v0), Some("drop-height".to_string())));
     }
     Ok(match scene.v0_m_s()? {

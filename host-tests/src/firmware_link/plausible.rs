@@ -145,9 +145,13 @@ pub(crate) fn check_report(r: &ImpactReport) -> Result<(), Implausible> {
             return out_of_range("cor", k.cor.into(), Range::Cor);
         }
         let x = k.max_deformation_m;
-        if !(-x..=x).contains(&k.permanent_deformation_m) {
-            let v = k.permanent_deformation_m.into();
-            return out_of_range("permanent_deformation_m", v, Range::WithinMaxDeformation);
+        for (field, value) in [
+            ("separation_deformation_m", Some(k.separation_deformation_m)),
+            ("permanent_deformation_m", k.permanent_deformation_m),
+        ] {
+            if let Some(v) = value.filter(|v| !(-x..=x).contains(v)) {
+                return out_of_range(field, v.into(), Range::WithinMaxDeformation);
+            }
         }
     }
     let residuals = [

@@ -845,7 +845,9 @@ pub fn to_json(setup: &Setup, reports: &[ImpactReport]) -> AnalysisJson {
         v0_m_s: match setup.scene.approach {
             Approach::Speed { v0_m_s } => Some(shortest(v0_m_s)),
             Approach::DropHeight { height_m } => {
-                Some((2.0 * f64::from(setup.scene.gravity_m_s2) * f64::from(height_m)).sqrt())
+                // Gravity as its decimal digits name it, as `impact log` reads it off the
+                // board's scene line.
+                Some((2.0 * shortest(setup.scene.gravity_m_s2) * f64::from(height_m)).sqrt())
             }
             _ => None,
         },

@@ -159,6 +159,7 @@ impl Columns {
             o(i.max_deformation_m),
             o(i.rebound_velocity_m_s),
             o(i.cor),
+            o(i.separation_deformation_m),
             o(i.permanent_deformation_m),
             o(i.absorbed_energy_j),
             o(tp.map(|t| t.kc_n_m)),

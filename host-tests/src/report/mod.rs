@@ -82,6 +82,10 @@ pub struct ImpactJson {
     pub max_deformation_m: Option<f64>,
     pub rebound_velocity_m_s: Option<f64>,
     pub cor: Option<f64>,
+    /// Deformation at separation, m (the set plus what the pad's viscous part still held).
+    pub separation_deformation_m: Option<f64>,
+    /// The set the pad keeps once recovered, m (null where the record cannot tell:
+    /// `set-not-resolved`).
     pub permanent_deformation_m: Option<f64>,
     pub absorbed_energy_j: Option<f64>,
     pub fits: FitsJson,
@@ -300,13 +304,21 @@ pub fn null_reasons(r: &ImpactReport, fits: &FitSet) -> BTreeMap<String, String>
             "max_deformation_m",
             "rebound_velocity_m_s",
             "cor",
+            "separation_deformation_m",
             "permanent_deformation_m",
             "absorbed_energy_j",
         ] {
             put(field, why);
         }
-    } else if r.kinematics.is_some_and(|k| k.absorbed_energy_j.is_none()) {
-        put("absorbed_energy_j", "no-mass");
+    } else {
+        if r.kinematics.is_some_and(|k| k.absorbed_energy_j.is_none()) {
+            put("absorbed_energy_j", "no-mass");
+        }
+        if r.kinematics.is_some_and(|k| k.permanent_deformation_m.is_none()) {
+            // No line of an elastic and a viscous part holds the unloading, or no fit
+            // points were taken (no mass, no fit asked).
+            put("permanent_deformation_m", "set-not-resolved");
+        }
     }
     for (name, asked, got) in [
         ("fits.two_phase", fits.two_phase, r.fits.two_phase.is_some()),
@@ -360,7 +372,8 @@ pub fn impact_json(
         max_deformation_m: k.map(|k| f(k.max_deformation_m)),
         rebound_velocity_m_s: k.map(|k| f(k.rebound_velocity_m_s)),
         cor: k.map(|k| f(k.cor)),
-        permanent_deformation_m: k.map(|k| f(k.permanent_deformation_m)),
+        separation_deformation_m: k.map(|k| f(k.separation_deformation_m)),
+        permanent_deformation_m: k.and_then(|k| k.permanent_deformation_m).map(f),
         absorbed_energy_j: k.and_then(|k| k.absorbed_energy_j).map(f),
         fits: fits_json(&r.fits),
         null_reasons: null_reasons(r, fits),

@@ -25,7 +25,7 @@ pub struct Statistic {
 /// The metrics the statistics cover, with their units (for the table), and how each is read
 /// off an impact.
 type Metric = (&'static str, &'static str, fn(&ImpactJson) -> Option<f64>);
-pub const METRICS: [Metric; 13] = [
+pub const METRICS: [Metric; 14] = [
     ("peak_acceleration_m_s2", "m/s²", |i| {
         Some(i.peak_acceleration_m_s2)
     }),
@@ -41,6 +41,9 @@ pub const METRICS: [Metric; 13] = [
     ("fwhm_s", "s", |i| i.fwhm_s),
     ("crush_time_s", "s", |i| i.crush_time_s),
     ("max_deformation_m", "m", |i| i.max_deformation_m),
+    ("separation_deformation_m", "m", |i| {
+        i.separation_deformation_m
+    }),
     ("permanent_deformation_m", "m", |i| {
         i.permanent_deformation_m
     }),

@@ -163,21 +163,23 @@ pub fn to_table(a: &AnalysisJson) -> String {
                 i.null_reasons.get("spec"),
             ));
         }
-        if let (Some(v0), Some(tm), Some(xm), Some(v1), Some(cor), Some(xp)) = (
+        if let (Some(v0), Some(tm), Some(xm), Some(v1), Some(cor), Some(xs)) = (
             i.impact_velocity_m_s,
             i.crush_time_s,
             i.max_deformation_m,
             i.rebound_velocity_m_s,
             i.cor,
-            i.permanent_deformation_m,
+            i.separation_deformation_m,
         ) {
             s.push_str(&format!(
-                "    v0 {}, crush time {}, x_m {}, rebound {}, COR {cor:.4}, x_p {}{}\n",
+                "    v0 {}, crush time {}, x_m {}, rebound {}, COR {cor:.4}, x at separation {}, set {}{}\n",
                 human(v0, "m/s"),
                 human(tm, "s"),
                 human(xm, "m"),
                 human(v1, "m/s"),
-                human(xp, "m"),
+                human(xs, "m"),
+                i.permanent_deformation_m
+                    .map_or("not resolved".to_string(), |x| human(x, "m")),
                 i.absorbed_energy_j
                     .map_or(String::new(), |e| format!(", absorbed {}", human(e, "J")))
             ));

@@ -89,7 +89,8 @@ fn kinematics(f: &Fields) -> Result<Option<Kinematics>, LineError> {
         max_deformation_m: f.num("max_deformation_m")?,
         rebound_velocity_m_s: f.num("rebound_velocity_m_s")?,
         cor: f.num("cor")?,
-        permanent_deformation_m: f.num("permanent_deformation_m")?,
+        separation_deformation_m: f.num("separation_deformation_m")?,
+        permanent_deformation_m: f.opt("permanent_deformation_m")?,
         absorbed_energy_j: f.opt("absorbed_energy_j")?,
     }))
 }
