@@ -32,6 +32,7 @@ fn json_csv_and_table_agree() {
         "max_deformation_m",
         "rebound_velocity_m_s",
         "cor",
+        "separation_deformation_m",
         "permanent_deformation_m",
         "fits",
     ] {

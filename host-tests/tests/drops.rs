@@ -60,7 +60,7 @@ fn within(got: &Value, want: f64, rel: f64, what: &str) {
 
 /// Each contact's kinematics against the truth, within 1 % (`touch`: the crush time's and
 /// `x_m`'s, which hang on where first touch is found).
-fn check(r: &Value, t: &ContactTruth, what: &str, touch: f64) {
+fn check(r: &Value, t: &ContactTruth, law: &str, what: &str, touch: f64) {
     let s = t.separation.unwrap();
     let w = |f: &str| format!("{what}: {f}");
     within(&r["cor"], s.cor, 0.01, &w("cor"));
@@ -83,6 +83,33 @@ fn check(r: &Value, t: &ContactTruth, what: &str, touch: f64) {
         &w("x_m"),
     );
     within(&r["peak_force_n"], t.peak_force_n, 0.01, &w("peak force"));
+    // The set after recovery within 1 % of x_m (and the touch's share: every deformation
+    // carries first touch's error): reported for the laws whose unloading is an
+    // elastic and a viscous part (linear, Kelvin–Voigt, two-phase), null (the record cannot
+    // tell) or right for the others.
+    let x_m = t.max_deformation_m.unwrap();
+    match r["permanent_deformation_m"].as_f64() {
+        Some(set) => assert!(
+            (set - s.set_m).abs() <= touch * x_m,
+            "{}: {set} vs true {}",
+            w("set"),
+            s.set_m
+        ),
+        None => assert!(
+            !matches!(law, "linear" | "kelvin-voigt" | "two-phase"),
+            "{}: null ({})",
+            w("set"),
+            r["null_reasons"]["permanent_deformation_m"]
+        ),
+    }
+    let x_sep = r["separation_deformation_m"].as_f64().unwrap();
+    assert!(
+        // (First touch's error, and separation's: both ends of the contact's feet.)
+        (x_sep - s.deformation_m).abs() <= 2.0 * touch * x_m,
+        "{}: {x_sep} vs true {}",
+        w("x at separation"),
+        s.deformation_m
+    );
     // Energy within 1 % of the impact's (½ m v0²): an elastic contact absorbs none.
     let e0 = 0.5 * 0.06 * t.approach_m_s * t.approach_m_s;
     let e = r["absorbed_energy_j"].as_f64().unwrap();
@@ -163,6 +190,7 @@ fn a_vertical_contact_takes_gravity_out() {
             check(
                 &impacts[0],
                 &truth[0],
+                name,
                 &format!("{name} at {rate} S/s"),
                 touch,
             );
@@ -203,7 +231,7 @@ fn a_nonlinear_bounce_train_within_one_percent() {
                     &format!("{what}: v0"),
                 );
                 if t.separation.is_some() {
-                    check(r, t, &what, 0.01);
+                    check(r, t, name, &what, 0.01);
                 }
             }
         }
@@ -296,7 +324,7 @@ fn drops_from_rest_are_measured_from_free_fall() {
                     &what,
                 );
                 let touch = touch_tolerance(name, rate, &truth[0]);
-                check(r, &truth[0], &what, touch);
+                check(r, &truth[0], name, &what, touch);
             }
         }
     }

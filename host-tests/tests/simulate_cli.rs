@@ -16,7 +16,7 @@ const FIELDS: [&str; 9] = [
     "rebound_velocity_m_s",
     "cor",
     "peak_force_n",
-    "permanent_deformation_m",
+    "separation_deformation_m",
     "solver",
     "rhs_evaluations",
 ];

@@ -137,25 +137,29 @@ pub fn two_phase(p: &Points<'_>) -> Option<TwoPhaseFit> {
     })
 }
 
-/// The restitution line `F = kr (X - 1) + b + c V` fitted to the points from the first one
-/// moving back out (scaled units; `kr x_p = kr - b`).
+/// The points of the restitution: after the first one moving back out (that one may still
+/// read the compression's force: the two-phase law jumps at the maximum, between points).
+fn restoring<'a>(p: &'a Points<'a>) -> impl Iterator<Item = (f32, f32, f32)> + 'a {
+    p.iter().skip_while(|&(_, v, _)| v > 0.0).skip(1)
+}
+
+/// The restitution line `F = kr (X - 1) + b + c V` fitted to the restitution's points
+/// ([`restoring`]; scaled units; `kr x_p = kr - b`).
 fn restitution_line(p: &Points<'_>) -> Option<[f64; 3]> {
     let mut restitution = Sums::<9>::new();
-    let mut restoring = false;
-    for (x, v, f) in p.iter() {
-        restoring |= v <= 0.0;
-        if restoring {
-            let u = x - 1.0;
-            restitution.add([u * u, u, u * v, 1.0, v, v * v, u * f, f, v * f]);
-        }
+    for (x, v, f) in restoring(p) {
+        let u = x - 1.0;
+        restitution.add([u * u, u, u * v, 1.0, v, v * v, u * f, f, v * f]);
     }
     let [uu, u, uv, n, sv, vv, uf, sf, vf] = restitution.get();
     solve3([[uu, u, uv], [u, n, sv], [uv, sv, vv]], [uf, sf, vf])
 }
 
 /// Largest RMS residual of the restitution line, relative to the peak force, for its set to
-/// be reported ([`set`]): an elastic and a viscous part that fit the unloading to 2 %.
-pub const SET_RESIDUAL: f32 = 0.02;
+/// be reported ([`set`]): an elastic and a viscous part that fit the unloading to 1 % (a
+/// Kelvin–Voigt or two-phase unloading fits to the noise; `k x (1 + c v)` and Hertz's
+/// `x^1.5` do not, and their line's zero is no set).
+pub const SET_RESIDUAL: f32 = 0.01;
 
 /// The set the pad keeps once it has recovered, m: where the unloading's elastic part
 /// `kr (x - x_s)` is zero, from the restitution line `F = kr (x - x_s) + c v` fitted to the
@@ -172,19 +176,17 @@ pub fn set(p: &Points<'_>) -> Option<f32> {
         return None;
     }
     let (kr32, b32, c32) = (kr as f32, b as f32, c as f32);
-    let mut restoring = false;
     let mut s = Sums::<2>::new();
-    for (x, v, f) in p.iter() {
-        restoring |= v <= 0.0;
-        if restoring {
-            let r = f - (kr32 * (x - 1.0) + b32 + c32 * v);
-            s.add([r * r, 1.0]);
-        }
+    for (x, v, f) in restoring(p) {
+        let r = f - (kr32 * (x - 1.0) + b32 + c32 * v);
+        s.add([r * r, 1.0]);
     }
     let [rss, n] = s.get();
     let rms = libm::sqrt(rss / n.max(1.0)) as f32;
     let x_s = ((kr - b) / kr * p.x_m as f64) as f32;
-    (rms <= SET_RESIDUAL && x_s.is_finite()).then_some(x_s)
+    // A set lies between the surface and the deepest point (a hair below 0 for noise).
+    let inside = (-0.01 * p.x_m..=p.x_m).contains(&x_s);
+    (rms <= SET_RESIDUAL && inside).then_some(x_s)
 }
 
 /// `F = k X^n + q X^n V` at one exponent: `(k, q, rss)` in scaled units, from the normal

@@ -314,7 +314,9 @@ pub fn null_reasons(r: &ImpactReport, fits: &FitSet) -> BTreeMap<String, String>
         if r.kinematics.is_some_and(|k| k.absorbed_energy_j.is_none()) {
             put("absorbed_energy_j", "no-mass");
         }
-        if r.kinematics.is_some_and(|k| k.permanent_deformation_m.is_none()) {
+        if r.kinematics
+            .is_some_and(|k| k.permanent_deformation_m.is_none())
+        {
             // No line of an elastic and a viscous part holds the unloading, or no fit
             // points were taken (no mass, no fit asked).
             put("permanent_deformation_m", "set-not-resolved");

@@ -282,7 +282,9 @@ pub struct SimulateReport {
     pub rebound_velocity_m_s: f64,
     pub cor: f64,
     pub peak_force_n: f64,
-    pub permanent_deformation_m: f64,
+    /// Deformation at separation, where the contact force returned to zero, m (not the set a
+    /// pad keeps once recovered: a Kelvin–Voigt pad's viscous part still holds it).
+    pub separation_deformation_m: f64,
     pub solver: String,
     pub rhs_evaluations: u32,
     #[serde(skip_serializing_if = "Option::is_none")]
@@ -411,7 +413,7 @@ pub fn run(args: &SimulateArgs) -> Result<SimulateReport, SimulateError> {
         rebound_velocity_m_s: outcome.rebound_velocity_m_s,
         cor: outcome.cor,
         peak_force_n: outcome.peak_force_n,
-        permanent_deformation_m: outcome.permanent_deformation_m,
+        separation_deformation_m: outcome.permanent_deformation_m,
         solver: method.name().to_string(),
         rhs_evaluations: outcome.rhs_evaluations,
         seconds_per_impact: args.repeat.map(|_| seconds),
@@ -428,7 +430,7 @@ pub fn table(r: &SimulateReport) -> String {
         ("rebound velocity", r.rebound_velocity_m_s, "m/s"),
         ("COR", r.cor, ""),
         ("peak force", r.peak_force_n, "N"),
-        ("permanent deformation", r.permanent_deformation_m, "m"),
+        ("x at separation", r.separation_deformation_m, "m"),
     ];
     for (name, value, unit) in rows {
         s.push_str(&format!("{name:<24}{value:>22.12e} {unit}\n"));

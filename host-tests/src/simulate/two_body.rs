@@ -174,7 +174,8 @@ pub struct TargetReport {
     pub contact_time_s: f64,
     pub crush_time_s: f64,
     pub max_deformation_m: f64,
-    pub permanent_deformation_m: f64,
+    /// Deformation at separation, m (not the set a pad keeps once recovered).
+    pub separation_deformation_m: f64,
     pub peak_force_n: f64,
     /// The impactor's, positive away from the target.
     pub rebound_velocity_m_s: f64,
@@ -337,7 +338,7 @@ fn report(
         contact_time_s: o.contact_time_s,
         crush_time_s: o.crush_time_s,
         max_deformation_m: o.max_deformation_m,
-        permanent_deformation_m: o.permanent_deformation_m,
+        separation_deformation_m: o.permanent_deformation_m,
         peak_force_n: o.peak_force_n,
         rebound_velocity_m_s: o.rebound_velocity_m_s,
         target_velocity_m_s: o.target_velocity_m_s,
@@ -368,11 +369,7 @@ pub fn table(r: &TargetReport) -> String {
     row("contact time", Some(r.contact_time_s), "s");
     row("crush time", Some(r.crush_time_s), "s");
     row("max deformation", Some(r.max_deformation_m), "m");
-    row(
-        "permanent deformation",
-        Some(r.permanent_deformation_m),
-        "m",
-    );
+    row("x at separation", Some(r.separation_deformation_m), "m");
     row("peak force", Some(r.peak_force_n), "N");
     row(
         "rebound velocity",

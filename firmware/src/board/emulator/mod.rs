@@ -28,8 +28,11 @@ use impact_firmware::semihosting as host;
 
 pub use irq::{start_high, start_low, start_medium};
 
-/// Longest semihosting command line accepted, bytes.
-const COMMAND_LINE_LEN: usize = 2048;
+/// Longest semihosting command line accepted, bytes: the recording's path and every scene
+/// key `impact emulate` passes (about 700 bytes with a spec) with room to spare; the
+/// emulator's data RAM is the board's 104 KiB, which the reports' queues fill to within
+/// this line's slack.
+const COMMAND_LINE_LEN: usize = 1920;
 
 /// What the semihosting command line asks for:
 /// `<program> <samples-file> [realtime|lossless] [rate_scale=X] [stall=BLOCK:US]
