@@ -419,9 +419,11 @@ fn analyse_kinematics<const CAP: usize>(
         };
         let set = &scene.fits;
         let n = (!set.fit_exponent).then_some(set.nonlinear_exponent);
-        let pad_set = fit::set(&p);
+        // The restitution line once, for the set and the two-phase fit.
+        let line = fit::restitution(&p);
+        let pad_set = fit::set(&p, line);
         r.fits = crate::report::Fits {
-            two_phase: set.two_phase.then(|| fit::two_phase(&p)).flatten(),
+            two_phase: set.two_phase.then(|| fit::two_phase(&p, line)).flatten(),
             nonlinear: set.nonlinear.then(|| fit::nonlinear(&p, n, ln_x)).flatten(),
             hertz: set.hertz.then(|| fit::hertz(&p)).flatten(),
         };

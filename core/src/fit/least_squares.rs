@@ -96,8 +96,9 @@ fn residual(p: &Points<'_>, mut model: impl FnMut(f32, f32) -> f32) -> f32 {
 
 /// Two-phase Kelvin–Voigt: compression (up to the first point moving back out) `F = kc x`;
 /// restitution `F = kr (x - x_p) + c v`, fitted as `kr (X - 1) + b + c V` (columns centred
-/// at the maximum deformation, where `X` and 1 would be nearly collinear).
-pub fn two_phase(p: &Points<'_>) -> Option<TwoPhaseFit> {
+/// at the maximum deformation, where `X` and 1 would be nearly collinear); `line` is
+/// [`restitution`]'s, fitted once for this fit and the [`set`].
+pub fn two_phase(p: &Points<'_>, line: Option<Restitution>) -> Option<TwoPhaseFit> {
     if !p.usable() {
         return None;
     }
@@ -111,7 +112,7 @@ pub fn two_phase(p: &Points<'_>) -> Option<TwoPhaseFit> {
     }
     let [sfx, sxx] = compression.get();
     let kc = sfx / sxx;
-    let [kr, b, c] = restitution_line(p)?;
+    let Restitution { kr, b, c } = line?;
     if !(kc.is_finite() && kr > 0.0) {
         return None;
     }
@@ -143,16 +144,29 @@ fn restoring<'a>(p: &'a Points<'a>) -> impl Iterator<Item = (f32, f32, f32)> + '
     p.iter().skip_while(|&(_, v, _)| v > 0.0).skip(1)
 }
 
-/// The restitution line `F = kr (X - 1) + b + c V` fitted to the restitution's points
-/// ([`restoring`]; scaled units; `kr x_p = kr - b`).
-fn restitution_line(p: &Points<'_>) -> Option<[f64; 3]> {
+/// The restitution line `F = kr (X - 1) + b + c V` (scaled units; `kr x_p = kr - b`), the
+/// two-phase fit's second branch and the [`set`]'s line.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Restitution {
+    kr: f64,
+    b: f64,
+    c: f64,
+}
+
+/// The restitution line fitted to the restitution's points ([`restoring`]), once for the
+/// two-phase fit and the set.
+pub fn restitution(p: &Points<'_>) -> Option<Restitution> {
+    if !p.usable() {
+        return None;
+    }
     let mut restitution = Sums::<9>::new();
     for (x, v, f) in restoring(p) {
         let u = x - 1.0;
         restitution.add([u * u, u, u * v, 1.0, v, v * v, u * f, f, v * f]);
     }
     let [uu, u, uv, n, sv, vv, uf, sf, vf] = restitution.get();
-    solve3([[uu, u, uv], [u, n, sv], [uv, sv, vv]], [uf, sf, vf])
+    let [kr, b, c] = solve3([[uu, u, uv], [u, n, sv], [uv, sv, vv]], [uf, sf, vf])?;
+    Some(Restitution { kr, b, c })
 }
 
 /// Largest RMS residual of the restitution line, relative to the peak force, for its set to
@@ -166,12 +180,9 @@ pub const SET_RESIDUAL: f32 = 0.01;
 /// unloading (0 for a Kelvin–Voigt pad, whose viscous part holds the separation at
 /// `x_sep = -c v_r / k > 0`; `x_p` for the two-phase law). `None` where the line does not
 /// hold the unloading to [`SET_RESIDUAL`] (a Hertz or `x^n` unloading: the record cannot
-/// tell the set) or no line fits.
-pub fn set(p: &Points<'_>) -> Option<f32> {
-    if !p.usable() {
-        return None;
-    }
-    let [kr, b, c] = restitution_line(p)?;
+/// tell the set) or no line fits (`line`: [`restitution`]'s).
+pub fn set(p: &Points<'_>, line: Option<Restitution>) -> Option<f32> {
+    let Restitution { kr, b, c } = line?;
     if !(kr > 0.0) {
         return None;
     }

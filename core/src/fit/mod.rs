@@ -15,7 +15,9 @@ mod least_squares;
 #[cfg(feature = "fit")]
 mod sums;
 #[cfg(feature = "fit")]
-pub use least_squares::{hertz, nonlinear, set, two_phase, Points, SET_RESIDUAL};
+pub use least_squares::{
+    hertz, nonlinear, restitution, set, two_phase, Points, Restitution, SET_RESIDUAL,
+};
 
 /// Two-phase Kelvin–Voigt parameters identified from one impact.
 #[derive(Clone, Copy, Debug, PartialEq)]

@@ -58,38 +58,38 @@ impl<const PRE: usize> Stream<PRE> {
         };
         let flat = |(_, min, max): (i32, i16, i16)| (max as f32 - min as f32) <= 2.0 * edge;
         let level = |(sum, _, _): (i32, i16, i16)| sum as f32 / STRIDE as f32;
+        let free_fall = self.free_fall();
+        let at_free_fall = |l: f32| free_fall.is_some_and(|(ff, tol)| libm::fabsf(l - ff) <= tol);
         // The first flat stride walking back; in a vertical scene the first at the free-fall
         // level if there is one (a smooth foot rising from free fall through the rest level
         // has flat strides at neither), else the first flat one.
-        let first_from = |wanted: &dyn Fn((i32, i16, i16)) -> bool| {
+        let first_flat = |only_free_fall: bool| {
             let mut k = 0;
             loop {
                 let st = stride(k)?;
-                if flat(st) && wanted(st) {
+                if flat(st) && (!only_free_fall || at_free_fall(level(st))) {
                     return Some((k, st));
                 }
                 k += 1;
             }
         };
-        let at_free_fall = |st| self.is_free_fall(level(st));
-        let (mut k, first) = (self.free_fall().is_some())
-            .then(|| first_from(&at_free_fall))
-            .flatten()
-            .or_else(|| first_from(&|_| true))?;
+        let (mut k, first) = free_fall
+            .and_then(|_| first_flat(true))
+            .or_else(|| first_flat(false))?;
         let at = level(first);
-        // (Free fall is a level however close the edge level puts it to rest.)
-        if libm::fabsf(at - mean) <= 2.0 * edge && !self.is_free_fall(at) {
+        // A free fall's run holds free fall only (an edge level wider than `g` would take the
+        // rest before the release into it); free fall is a level however close the edge level
+        // puts it to rest.
+        let in_free_fall = at_free_fall(at);
+        if libm::fabsf(at - mean) <= 2.0 * edge && !in_free_fall {
             return None;
         }
         let (mut sum, mut n) = (0i64, 0i64);
         let mut varies = false;
-        // A free fall's run holds free fall only (an edge level wider than `g` would take the
-        // rest before the release into it).
-        let free_fall = self.is_free_fall(at);
         let same = |st| {
             flat(st)
                 && libm::fabsf(level(st) - at) <= edge
-                && (!free_fall || self.is_free_fall(level(st)))
+                && (!in_free_fall || at_free_fall(level(st)))
         };
         while let Some(st) = stride(k).filter(|&st| same(st)) {
             sum += i64::from(st.0);
@@ -97,7 +97,7 @@ impl<const PRE: usize> Stream<PRE> {
             varies |= st.2 > st.1;
             k += 1;
         }
-        let needed = if free_fall {
+        let needed = if in_free_fall {
             2 * STRIDE as i64
         } else {
             i64::from(self.settle).max(STRIDE as i64)
@@ -116,7 +116,10 @@ impl<const PRE: usize> Stream<PRE> {
     pub(super) fn onset(&self, x: i16) -> Onset {
         // A vertical scene's release: the step from rest to free fall is no pulse; the
         // baseline moves to the free-fall level at once (its strides then refine it).
-        if let Some((at, _)) = self.free_fall().filter(|_| self.is_free_fall(x as f32)) {
+        let release = self
+            .free_fall()
+            .filter(|&(at, tol)| libm::fabsf(x as f32 - at) <= tol);
+        if let Some((at, _)) = release {
             let n = STRIDE as i64;
             return Onset::Moved((libm::round(at as f64 * n as f64) as i64, n));
         }
