@@ -39,7 +39,13 @@ impl<'a> LogJson<'a> {
             (None, None) => return Err(LogError::whole(LogErrorKind::NoRate)),
         };
         let scene = log.scene.as_ref();
-        let (v0_m_s, v0_source) = approach(scene).map_err(LogError::whole)?;
+        // Gravity in the contacts, read once (none: horizontal).
+        let gravity = scene
+            .map(SceneLine::contact_gravity_m_s2)
+            .transpose()
+            .map_err(LogError::whole)?
+            .flatten();
+        let (v0_m_s, v0_source) = approach(scene, gravity).map_err(LogError::whole)?;
         let fits = asked(scene).map_err(LogError::whole)?;
         let train_speed = scene.and_then(SceneLine::train).map(str::to_string);
         let total = |f: fn(&Run) -> u64| log.runs.iter().map(f).sum::<u64>();
@@ -69,12 +75,7 @@ impl<'a> LogJson<'a> {
                 .collect(),
             sample_rate_hz: rate as f64,
             v0_source,
-            contact_gravity_m_s2: scene
-                .map(SceneLine::contact_gravity_m_s2)
-                .transpose()
-                .map_err(LogError::whole)?
-                .flatten()
-                .map(crate::report::fmt::shortest),
+            contact_gravity_m_s2: gravity.map(crate::report::fmt::shortest),
             free_fall_s: None,
             samples_lost: total(|r| r.samples_lost),
             analyses_skipped: total(|r| r.analyses_skipped),
@@ -88,11 +89,7 @@ impl<'a> LogJson<'a> {
             log,
             t0,
             fits,
-            gravity: scene
-                .map(SceneLine::contact_gravity_m_s2)
-                .transpose()
-                .map_err(LogError::whole)?
-                .flatten(),
+            gravity,
         };
         json.head.trains = crate::report::train::trains(json.impacts());
         Ok(json)
@@ -111,16 +108,18 @@ impl<'a> LogJson<'a> {
     }
 }
 
-/// The approach speed the scene gives, m/s, and where it comes from (`drop-height`, `v0`).
-fn approach(scene: Option<&SceneLine>) -> Result<(Option<f64>, Option<String>), FieldError> {
+/// The approach speed the scene gives, m/s, and where it comes from (`drop-height`, `v0`);
+/// `gravity` is the scene line's gravity in the contacts.
+fn approach(
+    scene: Option<&SceneLine>,
+    gravity: Option<f32>,
+) -> Result<(Option<f64>, Option<String>), FieldError> {
     let Some(scene) = scene else {
         return Ok((None, None));
     };
     if let Some(h) = scene.drop_height_m()? {
         // A drop is vertical: the scene line gives its gravity (an older board's, none).
-        let g = scene
-            .contact_gravity_m_s2()?
-            .map_or(STANDARD_GRAVITY, crate::report::fmt::shortest);
+        let g = gravity.map_or(STANDARD_GRAVITY, crate::report::fmt::shortest);
         let v0 = (2.0 * g * f64::from(h)).sqrt();
         return Ok((Some(v0), Some("drop-height".to_string())));
     }
