@@ -90,7 +90,6 @@ impl Event {
 /// What one contact did, in absolute depth and record time.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Contact {
-    pub touch: State,
     /// The state at the maximum depth.
     pub max: Option<State>,
     /// Largest contact force, N.
@@ -119,7 +118,6 @@ pub fn integrate(
     let mut branch = body.pad.first_branch();
     let mut s = touch;
     let mut out = Contact {
-        touch,
         max: None,
         peak_force_n: body.force(s, branch),
         separation: None,

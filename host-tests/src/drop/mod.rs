@@ -285,8 +285,3 @@ fn fill(
         out.push(value);
     }
 }
-
-/// The law's time scale at `v0`, s (for callers sizing a record).
-pub fn time_scale(law: &Model<f64>, mass_kg: f64, v0_m_s: f64) -> f64 {
-    law.time_scale(&impact_core::Impact::new(mass_kg, v0_m_s))
-}

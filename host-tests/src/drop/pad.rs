@@ -74,11 +74,6 @@ impl Pad {
         self.law.raw_force(z, v, phase)
     }
 
-    /// True if the law changes at the maximum depth (two-phase).
-    pub fn switches_at_max(&self) -> bool {
-        self.law.switches_at_max()
-    }
-
     /// The branch after the maximum depth `z_max` of a contact on `branch`.
     pub fn after_max(&self, branch: Branch, z_max: f64) -> Branch {
         match branch {
