@@ -230,7 +230,7 @@ run err-band analyze "$afrl" --spec half-sine,50g,11ms,band-file=bad-band.csv
 if command -v qemu-system-arm >/dev/null; then
   run emulate emulate seed.csv --mass 0.06 --v0 1.3357 --waveforms --log board.log
   keep board.log board.log
-  run emulate-train emulate seed-train.csv --mass 0.06 --v0 1.3357 --srs --spec half-sine,10g,3ms --log train.log
+  run emulate-train emulate seed-train.csv --mass 0.06 --v0 1.3357 --v0-every --srs --spec half-sine,10g,3ms --log train.log
   keep train.log train.log
   run log-csv log board.log --csv
   run log-plain log board.log

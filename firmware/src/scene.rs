@@ -86,6 +86,7 @@ pub const BENCH: Scene = Scene {
     // `vertical: true` puts it there, see `Scene::contact_gravity_m_s2`).
     gravity_m_s2: impact_core::consts::STANDARD_GRAVITY as f32,
     vertical: false,
+    v0_every: false,
     train: None,
     spectrum: None,
     spec: None,
@@ -164,6 +165,7 @@ impl defmt::Format for SceneError {
 /// | `train` | bounce trains: `flight`, `rebound` (which speed the kinematics use) or `none` |
 /// | `gravity` | gravity along the sensor's axis, m/s² (a vertical contact's, a drop's, a train's flights) |
 /// | `vertical` | `0` or `1`: gravity in the contact although neither a drop height nor a train says so |
+/// | `v0_every` | `0` or `1`: every impact comes at `v0` (else an impact that follows a flight has no approach speed unless a train measures it) |
 /// | `max_flight` | a train's longest flight, s |
 /// | `srs` | `0` or `1`: shock spectra per impact |
 /// | `srs_damping`, `srs_bands`, `srs_low` | damping ratio, bands per octave (6, 12), lowest band, Hz |
@@ -268,6 +270,7 @@ pub fn apply(scene: &mut Scene, key: &str, value: &str) -> Result<(), SceneError
         }
         "gravity" => scene.gravity_m_s2 = float(value)?,
         "vertical" => scene.vertical = flag(value)?,
+        "v0_every" => scene.v0_every = flag(value)?,
         "max_flight" => {
             let mut t = scene.train.ok_or(SceneError::BadValue)?;
             t.max_flight_s = float(value)?;

@@ -1137,7 +1137,7 @@ fn spec_verdicts_on_the_board_are_the_hosts() {
 #[test]
 fn vertical_drops_and_trains_match_the_host() {
     let scratch = Scratch::new();
-    let cases: [(&str, &[&str], &[&str]); 2] = [
+    let cases: [(&str, &[&str], &[&str]); 3] = [
         (
             "kv-drop.csv",
             &[
@@ -1175,6 +1175,25 @@ fn vertical_drops_and_trains_match_the_host() {
                 "1",
             ],
             &["--mass", "0.06", "--v0", "1.3357", "--train", "flight"],
+        ),
+        (
+            // Without a train the bounces' approach is unknown on the board too (#41).
+            "nonlinear-bounces.csv",
+            &[
+                "--model",
+                "nonlinear",
+                "--stiffness",
+                "1e4",
+                "--damping",
+                "0.5",
+                "--v0",
+                "1.3357",
+                "--bounces",
+                "3",
+                "--duration",
+                "1",
+            ],
+            &["--mass", "0.06", "--v0", "1.3357", "--vertical"],
         ),
     ];
     for (name, synth, analyze) in cases {

@@ -158,7 +158,7 @@ fn the_nonlinear_laws_cor_falls_with_speed() {
 }
 
 #[test]
-fn without_train_a_bounce_has_no_speed_and_a_long_flight_starts_a_new_train() {
+fn without_train_a_bounce_has_no_speed_unless_every_impact_comes_at_v0_and_a_long_flight_starts_a_new_train() {
     let args = [
         "synth",
         "--model",
@@ -179,16 +179,48 @@ fn without_train_a_bounce_has_no_speed_and_a_long_flight_starts_a_new_train() {
     let scratch = Scratch::new();
     let csv = scratch.file("train.csv", impact_ok(&args).0);
     let path = csv.to_str().unwrap();
-    // Without --train every impact takes --v0 (a horizontal bench's repeated impacts).
+    // Without --train, --v0 is the drop's first impact's: the bounces came back at a speed
+    // nothing measured, so they have no kinematics, and say why (#41).
     let (out, _) = impact_ok(&["analyze", path, "--v0", "1.3357", "--json"]);
     let a: Value = serde_json::from_str(&out).unwrap();
     let impacts = a["impacts"].as_array().unwrap();
     assert_eq!(impacts.len(), 3);
     assert!(impacts.iter().all(|i| i["bounce"].is_null()));
     assert!(a["trains"].as_array().unwrap().is_empty());
+    assert_eq!(
+        impacts[0]["impact_velocity_m_s"].as_f64(),
+        Some(1.3357f32 as f64)
+    );
+    assert!(impacts[0]["cor"].as_f64().is_some());
+    for i in &impacts[1..] {
+        assert!(i["cor"].is_null() && i["impact_velocity_m_s"].is_null());
+        assert_eq!(i["null_reasons"]["cor"], "approach-unknown");
+        assert_eq!(i["flags"], serde_json::json!(["approach-unknown"]));
+    }
+    let (table, _) = impact_ok(&["analyze", path, "--v0", "1.3357"]);
+    assert_eq!(
+        table.matches("no kinematics: approach-unknown (a bounce: --v0 is the drop's first impact's; --train or --v0-every)").count(),
+        2,
+        "{table}"
+    );
+    // A rig that strikes again and again at one speed says so: every impact takes --v0.
+    let (out, _) = impact_ok(&["analyze", path, "--v0", "1.3357", "--v0-every", "--json"]);
+    let a: Value = serde_json::from_str(&out).unwrap();
+    let impacts = a["impacts"].as_array().unwrap();
     assert!(impacts
         .iter()
         .all(|i| i["impact_velocity_m_s"].as_f64() == Some(1.3357f32 as f64)));
+    // So does a scene file.
+    let scene = scratch.file("every.json", r#"{"v0": 1.3357, "v0_every": true}"#);
+    let (out, _) = impact_ok(&[
+        "analyze",
+        path,
+        "--scene",
+        scene.to_str().unwrap(),
+        "--json",
+    ]);
+    let b: Value = serde_json::from_str(&out).unwrap();
+    assert_eq!(a["impacts"], b["impacts"]);
     // Flights of about 0.24 s: with --max-flight 0.1 each impact starts its own train.
     let (out, _) = impact_ok(&[
         "analyze",

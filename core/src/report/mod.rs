@@ -131,9 +131,15 @@ impl Flags {
     /// start, duration and Δv cover only the part after it; the kinematics and the fits are
     /// absent.
     pub const IN_PREVIOUS: Flags = Flags(1 << 10);
+    /// The impact follows a flight (it came within a train's longest flight of the previous
+    /// contact's separation), and the scene's approach speed is the first impact's (a drop's
+    /// `v0` or height, without a train): this one's approach speed is unknown, so the
+    /// kinematics and the fits are absent. A train measures a bounce's approach speed; a
+    /// rig that strikes every time at one speed says `v0_every`.
+    pub const APPROACH_UNKNOWN: Flags = Flags(1 << 11);
 
     /// Every flag with its name in the reports.
-    pub const NAMES: [(Flags, &'static str); 11] = [
+    pub const NAMES: [(Flags, &'static str); 12] = [
         (Flags::AC_COUPLED, "ac-coupled"),
         (Flags::COR_OUT_OF_RANGE, "cor-out-of-range"),
         (Flags::NO_STOP, "no-stop"),
@@ -145,6 +151,7 @@ impl Flags {
         (Flags::LEVEL_CHANGE, "level-change"),
         (Flags::DRIFT, "drift"),
         (Flags::IN_PREVIOUS, "in-previous"),
+        (Flags::APPROACH_UNKNOWN, "approach-unknown"),
     ];
 
     pub const fn empty() -> Self {
@@ -283,7 +290,9 @@ pub fn streaming(s: &Summary, scene: &Scene) -> ImpactReport {
     // Δv over the contact; the whole window's (the contact and the hold after it) undoing
     // most of it is the mark of a channel that does not hold DC.
     let mut flags = Flags::empty();
-    if s.v0_m_s.is_none() {
+    if s.approach_unknown {
+        flags.insert(Flags::APPROACH_UNKNOWN);
+    } else if s.v0_m_s.is_none() {
         flags.insert(Flags::NO_APPROACH_SPEED);
     }
     if s.clipped {

@@ -38,6 +38,9 @@ pub struct Summary {
     /// The pulse was already beyond the edge level where the previous impact's contact ended
     /// (the signal never came back between them): its start is that contact's end.
     pub in_previous: bool,
+    /// The impact follows a flight and the scene's approach speed is only the first
+    /// impact's: `v0_m_s` is `None` for that reason ([`crate::stream::train`]).
+    pub approach_unknown: bool,
     /// Stream index of the impact's window's first sample (the pre-trigger margin before the
     /// onset); every streaming field is measured over the window.
     pub first_index: u64,
@@ -137,6 +140,7 @@ impl Summary {
         level_change: false,
         drift: false,
         in_previous: false,
+        approach_unknown: false,
         first_index: 0,
         filter_lead: 0,
         onset_index: 0,

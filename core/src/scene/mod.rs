@@ -116,6 +116,11 @@ pub struct Scene {
     /// The impact is vertical although neither a drop height nor a train says so (a body
     /// dropped at a measured speed, a light gate above the pad).
     pub vertical: bool,
+    /// Every impact comes at the scene's approach speed (a rig that strikes again and again
+    /// at one speed). Otherwise the speed is the first impact's, and an impact that follows
+    /// a flight (a bounce) has no approach speed unless a train measures it
+    /// ([`crate::stream::train`]).
+    pub v0_every: bool,
     /// Bounce trains: each impact after the first takes its approach speed from the flight
     /// since the previous separation or from the previous rebound ([`crate::stream::train`]).
     pub train: Option<Train>,
@@ -149,6 +154,7 @@ impl Scene {
             fits: FitSet::none(),
             gravity_m_s2: STANDARD_GRAVITY as f32,
             vertical: false,
+            v0_every: false,
             train: None,
             spectrum: None,
             spec: None,

@@ -559,7 +559,9 @@ impl<const PRE: usize> Stream<PRE> {
         let touch = self.touch(&a);
         let (touch_offset, lead_c, in_previous) = self.lobe(&a, touch);
         let touch = a.onset_index as f64 + touch_offset as f64;
-        let (v0, bounce) = self.train.approach(&self.scene, touch, self.v0);
+        let approach = self
+            .train
+            .approach(&self.scene, touch, self.v0, self.v0_measured);
         let summary = Summary {
             index: self.counters.impacts.min(u32::MAX as u64) as u32,
             status,
@@ -568,6 +570,7 @@ impl<const PRE: usize> Stream<PRE> {
             level_change: a.level_change,
             drift: a.drift,
             in_previous,
+            approach_unknown: approach.unknown,
             first_index: a.first_index,
             filter_lead: a.filter_lead,
             onset_index: a.onset_index,
@@ -583,8 +586,8 @@ impl<const PRE: usize> Stream<PRE> {
             contact_c: a
                 .separation
                 .map(|_| a.separation_c - a.pre_onset_c + lead_c + tail_c),
-            v0_m_s: v0,
-            bounce: bounce.into(),
+            v0_m_s: approach.v0_m_s,
+            bounce: approach.bounce.into(),
         };
         self.train.ended(&summary, &self.scene);
         self.counters.impacts += 1;

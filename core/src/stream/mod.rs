@@ -83,6 +83,9 @@ pub struct Stream<const PRE: usize> {
     /// Stream index of the next sample.
     index: u64,
     v0: Option<f32>,
+    /// `v0` is a light gate's reading ([`Self::set_approach_speed`]): it holds for every
+    /// impact, a bounce's too.
+    v0_measured: bool,
     /// The previous impact, for bounce trains.
     train: train::Tracker,
     counters: Counters,
@@ -164,6 +167,7 @@ impl<const PRE: usize> Stream<PRE> {
                 trigger_cfc: None,
                 gravity_m_s2: STANDARD_GRAVITY as f32,
                 vertical: false,
+                v0_every: false,
                 train: None,
                 spectrum: None,
                 spec: None,
@@ -181,6 +185,7 @@ impl<const PRE: usize> Stream<PRE> {
             active: None,
             index: 0,
             v0: None,
+            v0_measured: false,
             train: train::Tracker::new(),
             counters: Counters {
                 samples: 0,
@@ -242,6 +247,7 @@ impl<const PRE: usize> Stream<PRE> {
         self.active = None;
         self.index = 0;
         self.v0 = scene.v0_m_s();
+        self.v0_measured = false;
         self.train = train::Tracker::new();
         self.counters = Counters::default();
         self.trigger_counts = scene.trigger_m_s2 / gain;
@@ -302,6 +308,7 @@ impl<const PRE: usize> Stream<PRE> {
     /// Sets the approach speed for the next impacts (a light gate's reading), m/s.
     pub fn set_approach_speed(&mut self, v0_m_s: Option<f32>) {
         self.v0 = v0_m_s.filter(|v| v.is_finite() && *v > 0.0);
+        self.v0_measured = self.v0.is_some();
     }
 
     /// A block of samples (whatever the DMA hands over). Impacts go to `sink`.

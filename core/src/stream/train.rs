@@ -17,16 +17,37 @@
 //! impact without a separation (settled, too long, a gap, the stream ended) or without an
 //! approach speed ends the train: the next impact is a first one, with the scene's
 //! [`crate::scene::Approach`].
+//!
+//! Without a train the scene's approach speed (a drop's `v0` or height) is the first
+//! impact's: an impact that follows a flight (its first touch within a train's longest
+//! flight of the previous separation) came back at a speed nothing measured, so it has none
+//! ([`crate::report::Flags::APPROACH_UNKNOWN`]), unless the scene says every impact comes at
+//! it (`v0_every`, a rig that strikes again and again) or a light gate measured it.
 
 use crate::report::summary::Summary;
 use crate::report::{self, Bounce, Status, COR_TOLERANCE};
-use crate::scene::{Scene, TrainSpeed};
+use crate::scene::{Scene, Train, TrainSpeed};
+
+/// An impact's approach, as the tracker decides it.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(crate) struct Approached {
+    /// The approach speed the kinematics use, m/s.
+    pub v0_m_s: Option<f32>,
+    /// The bounce, if the impact continues a train.
+    pub bounce: Option<Bounce>,
+    /// The impact follows a flight and the scene's speed was the first impact's: no speed.
+    pub unknown: bool,
+}
 
 /// What the stream remembers of the previous impact between two impacts.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub(crate) struct Tracker {
-    /// Stream position of the previous separation (fractional samples), if it had one.
+    /// Stream position of the previous separation (fractional samples), if it had one (and
+    /// the train goes on from it).
     separation: Option<f64>,
+    /// Where the previous impact's contact ended, whatever its status (its separation, or
+    /// the end of its window), stream position: a drop's later impacts follow a flight.
+    last_end: Option<f64>,
     /// The previous impact's rebound speed, m/s, if known and in range.
     rebound_m_s: Option<f32>,
     /// The previous impact's bounce number (0 for a train's first impact).
@@ -38,26 +59,50 @@ impl Tracker {
     pub(crate) const fn new() -> Self {
         Self {
             separation: None,
+            last_end: None,
             rebound_m_s: None,
             number: 0,
         }
     }
 
-    /// The approach speed of an impact whose first touch is at stream position `touch`
-    /// (fractional samples), and its bounce, if it continues a train; `first` is the speed a
-    /// train's first impact gets (the scene's approach, or a light gate's).
+    /// The approach of an impact whose first touch is at stream position `touch`
+    /// (fractional samples); `first` is the speed a first impact gets (the scene's approach,
+    /// or a light gate's), `measured` whether a light gate measured it (then it holds for
+    /// every impact).
     pub(crate) fn approach(
         &self,
         scene: &Scene,
         touch: f64,
         first: Option<f32>,
-    ) -> (Option<f32>, Option<Bounce>) {
-        let (Some(train), Some(separation)) = (scene.train, self.separation) else {
-            return (first, None);
+        measured: bool,
+    ) -> Approached {
+        let plain = Approached {
+            v0_m_s: first,
+            bounce: None,
+            unknown: false,
         };
-        let flight_s = ((touch - separation) / scene.calibration.sample_rate_hz as f64) as f32;
+        let fs = scene.calibration.sample_rate_hz as f64;
+        let flight = |from: f64| ((touch - from) / fs) as f32;
+        let Some(train) = scene.train else {
+            // No train: an impact within a train's longest flight of the previous one is a
+            // bounce, and the scene's speed was the drop's.
+            let max = Train::new().max_flight_s;
+            let bounced = self.last_end.is_some_and(|e| flight(e) <= max);
+            return match first {
+                Some(_) if bounced && !(scene.v0_every || measured) => Approached {
+                    v0_m_s: None,
+                    bounce: None,
+                    unknown: true,
+                },
+                _ => plain,
+            };
+        };
+        let Some(separation) = self.separation else {
+            return plain;
+        };
+        let flight_s = flight(separation);
         if !(flight_s > 0.0 && flight_s <= train.max_flight_s) {
-            return (first, None);
+            return plain;
         }
         let bounce = Bounce {
             number: self.number.saturating_add(1),
@@ -69,21 +114,22 @@ impl Tracker {
             TrainSpeed::Flight => Some(bounce.v0_flight_m_s),
             TrainSpeed::Rebound => bounce.v0_rebound_m_s,
         };
-        (v0.filter(|v| v.is_finite() && *v > 0.0), Some(bounce))
+        Approached {
+            v0_m_s: v0.filter(|v| v.is_finite() && *v > 0.0),
+            bounce: Some(bounce),
+            unknown: false,
+        }
     }
 
     /// Remembers the impact that just ended (its summary complete, `v0_m_s` included).
     pub(crate) fn ended(&mut self, s: &Summary, scene: &Scene) {
-        if scene.train.is_none() {
-            return;
-        }
         let separation = match (s.status, s.separation_index) {
             (Status::Complete, Some(i)) => Some(i as f64 + s.separation_offset as f64),
             _ => None,
         };
         // A clipped impact's Δv is a lower bound: no rebound from it.
         let rebound = match (s.v0_m_s, separation) {
-            (Some(v0), Some(_)) if !s.clipped => report::rebound_m_s(
+            (Some(v0), Some(_)) if !s.clipped && scene.train.is_some() => report::rebound_m_s(
                 &report::streaming(s, scene),
                 v0,
                 scene.contact_gravity_m_s2(),
@@ -94,8 +140,15 @@ impl Tracker {
             }),
             _ => None,
         };
+        let last_end = s.separation_index.unwrap_or(s.end_index) as f64
+            + if s.separation_index.is_some() {
+                s.separation_offset as f64
+            } else {
+                0.0
+            };
         *self = Tracker {
-            separation,
+            separation: separation.filter(|_| scene.train.is_some()),
+            last_end: Some(last_end),
             rebound_m_s: rebound,
             number: s.bounce.get().map_or(0, |b| b.number),
         };
@@ -105,8 +158,15 @@ impl Tracker {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::scene::Train;
     use crate::signal::Calibration;
+
+    fn plain(v0: Option<f32>) -> Approached {
+        Approached {
+            v0_m_s: v0,
+            bounce: None,
+            unknown: false,
+        }
+    }
 
     fn scene() -> Scene {
         let mut s = Scene::new(
@@ -124,18 +184,43 @@ mod tests {
     fn the_first_impact_and_a_long_flight_take_the_scenes_speed() {
         let s = scene();
         let t = Tracker::new();
-        assert_eq!(t.approach(&s, 1e4, Some(1.5)), (Some(1.5), None));
+        assert_eq!(t.approach(&s, 1e4, Some(1.5), false), plain(Some(1.5)));
         let t = Tracker {
             separation: Some(0.0),
+            last_end: Some(0.0),
             rebound_m_s: Some(1.0),
             number: 0,
         };
         // 2.5 s of flight: a new drop.
-        assert_eq!(t.approach(&s, 250_000.0, Some(1.5)), (Some(1.5), None));
-        // Without a train in the scene every impact is a first one.
-        let mut plain = s;
-        plain.train = None;
-        assert_eq!(t.approach(&plain, 10_000.0, Some(1.5)), (Some(1.5), None));
+        assert_eq!(t.approach(&s, 250_000.0, Some(1.5), false), plain(Some(1.5)));
+    }
+
+    #[test]
+    fn without_a_train_the_scenes_speed_is_the_first_impacts() {
+        let mut s = scene();
+        s.train = None;
+        let t = Tracker {
+            separation: None,
+            last_end: Some(0.0),
+            rebound_m_s: None,
+            number: 0,
+        };
+        // 0.1 s after the previous contact: a bounce, at a speed nothing measured.
+        let bounce = t.approach(&s, 10_000.0, Some(1.5), false);
+        assert_eq!((bounce.v0_m_s, bounce.unknown), (None, true));
+        // A light gate's reading, or a rig that says every impact comes at v0, holds.
+        assert_eq!(t.approach(&s, 10_000.0, Some(1.5), true), plain(Some(1.5)));
+        s.v0_every = true;
+        assert_eq!(t.approach(&s, 10_000.0, Some(1.5), false), plain(Some(1.5)));
+        s.v0_every = false;
+        // Beyond a train's longest flight: a new drop. No speed given: nothing is unknown.
+        assert_eq!(t.approach(&s, 250_000.0, Some(1.5), false), plain(Some(1.5)));
+        assert_eq!(t.approach(&s, 10_000.0, None, false), plain(None));
+        // The first impact of the stream takes it.
+        assert_eq!(
+            Tracker::new().approach(&s, 10_000.0, Some(1.5), false),
+            plain(Some(1.5))
+        );
     }
 
     #[test]
@@ -143,12 +228,13 @@ mod tests {
         let mut s = scene();
         let t = Tracker {
             separation: Some(1000.0),
+            last_end: Some(1000.0),
             rebound_m_s: Some(0.4),
             number: 2,
         };
         // 0.1 s of flight: g t / 2 = 0.4903 m/s.
-        let (v0, b) = t.approach(&s, 11_000.0, Some(1.5));
-        let b = b.unwrap();
+        let a = t.approach(&s, 11_000.0, Some(1.5), false);
+        let (v0, b) = (a.v0_m_s, a.bounce.unwrap());
         assert_eq!(b.number, 3);
         assert!((b.flight_s - 0.1).abs() < 1e-6);
         assert!((b.v0_flight_m_s - 0.490_332_5).abs() < 1e-5);
@@ -158,14 +244,14 @@ mod tests {
             ..Train::new()
         });
         assert_eq!(s.train.unwrap().speed.name(), "rebound");
-        assert_eq!(t.approach(&s, 11_000.0, Some(1.5)).0, Some(0.4));
+        assert_eq!(t.approach(&s, 11_000.0, Some(1.5), false).v0_m_s, Some(0.4));
         // No rebound to chain from: no speed, but the bounce is still reported.
         let t = Tracker {
             rebound_m_s: None,
             ..t
         };
-        let (v0, b) = t.approach(&s, 11_000.0, Some(1.5));
-        assert_eq!(v0, None);
-        assert!(b.is_some());
+        let a = t.approach(&s, 11_000.0, Some(1.5), false);
+        assert_eq!(a.v0_m_s, None);
+        assert!(a.bounce.is_some() && !a.unknown);
     }
 }

@@ -106,6 +106,7 @@ fn scene() -> Scene {
         // Vertical, so that the gravity shift of the kinematics is linked in too.
         gravity_m_s2: black_box(impact_core::consts::STANDARD_GRAVITY as f32),
         vertical: true,
+        v0_every: black_box(false),
         train: Some(impact_core::Train::new()),
         spectrum: Some(impact_core::signal::spectrum::SpectrumSettings::new()),
         spec: Some(impact_core::spec::Spec {

@@ -406,7 +406,7 @@ pub fn log_scene(scene: &Scene) {
     };
     let fits = &scene.fits;
     info!(
-        "scene rate_hz={=f32} gain_m_s2_per_count={=f32} mass_kg={} v0_m_s={} drop_height_m={} trigger_m_s2={=f32} edge_m_s2={=f32} hold_s={=f32} max_impact_s={=f32} settle_s={=f32} clip_low={=i16} clip_high={=i16} cfc={} trigger_cfc={} two_phase={=bool} nonlinear={=bool} fit_exponent={=bool} exponent={=f32} hertz={=bool} train={=str} gravity_m_s2={} max_flight_s={} srs={=bool} wave_every={=u16}",
+        "scene rate_hz={=f32} gain_m_s2_per_count={=f32} mass_kg={} v0_m_s={} drop_height_m={} trigger_m_s2={=f32} edge_m_s2={=f32} hold_s={=f32} max_impact_s={=f32} settle_s={=f32} clip_low={=i16} clip_high={=i16} cfc={} trigger_cfc={} two_phase={=bool} nonlinear={=bool} fit_exponent={=bool} exponent={=f32} hertz={=bool} train={=str} gravity_m_s2={} max_flight_s={} srs={=bool} wave_every={=u16} v0_every={=bool}",
         scene.calibration.sample_rate_hz,
         scene.calibration.gain_m_s2_per_count,
         Opt(scene.mass_kg),
@@ -432,5 +432,6 @@ pub fn log_scene(scene: &Scene) {
         Opt(scene.train.map(|t| t.max_flight_s)),
         scene.spectrum.is_some(),
         scene.waveform_every,
+        scene.v0_every,
     );
 }

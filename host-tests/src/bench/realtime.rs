@@ -88,6 +88,8 @@ fn scene(sensor: &Sensor, trigger: f32, edge: f32, hold: f32, v0: f64) -> Scene 
     s.hold_s = hold;
     s.mass_kg = Some(0.06);
     s.approach = Approach::Speed { v0_m_s: v0 as f32 };
+    // A train of strikes, every one at v0.
+    s.v0_every = true;
     s.clip_counts = (0, 4095);
     s
 }

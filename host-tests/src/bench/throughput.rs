@@ -38,6 +38,8 @@ fn scene(fits: bool) -> Scene {
     s.mass_kg = Some(0.06);
     // Δv of the test pulse is ~0.4 m/s: v0 = 0.2 m/s gives a crush and a rebound.
     s.approach = impact_core::Approach::Speed { v0_m_s: 0.2 };
+    // Every pulse of the stream is a strike at that speed.
+    s.v0_every = true;
     s.fits = if fits { FitSet::all() } else { FitSet::none() };
     s
 }
@@ -172,6 +174,7 @@ fn stream_scene() -> Scene {
     s.hold_s = 2e-3;
     s.mass_kg = Some(0.06);
     s.approach = impact_core::Approach::Speed { v0_m_s: 0.1 };
+    s.v0_every = true;
     s.fits = FitSet::none();
     s
 }

@@ -134,6 +134,7 @@ pub fn scene_args(scene: &Scene) -> Vec<String> {
     args.extend([
         format!("gravity={}", f(scene.gravity_m_s2)),
         format!("vertical={}", b(scene.vertical)),
+        format!("v0_every={}", b(scene.v0_every)),
     ]);
     match scene.train {
         None => args.push("train=none".into()),

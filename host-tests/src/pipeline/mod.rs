@@ -642,6 +642,7 @@ pub(crate) fn build_scene(
     scene.vertical =
         args.train.vertical || file.vertical.unwrap_or(false) || args.free_fall.is_some();
     scene.train = args.train.train();
+    scene.v0_every = args.v0_every || file.v0_every.unwrap_or(false);
     scene.spectrum = args.spectrum.settings();
     scene.spec = args.spec.map(|s| s.spec);
     scene.validate().map_err(|e| match e {

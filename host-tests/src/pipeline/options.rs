@@ -48,6 +48,8 @@ pub struct SceneFile {
     pub gravity: Option<f64>,
     /// The impact is vertical (as `--vertical`).
     pub vertical: Option<bool>,
+    /// Every impact comes at `v0` (as `--v0-every`).
+    pub v0_every: Option<bool>,
 }
 
 /// Which fits to run (scene file).
@@ -162,6 +164,14 @@ pub struct AnalyzeArgs {
     /// Approach speed, m/s.
     #[arg(long, help_heading = "Bench", conflicts_with_all = ["drop_height", "free_fall"], value_parser = parse::speed_m_s)]
     pub v0: Option<f64>,
+    /// Every impact comes at --v0 (a rig that strikes again and again at one speed).
+    ///
+    /// Every impact comes at --v0 (a rig that strikes again and again at one speed). Without
+    /// it --v0 and --drop-height are a drop's first impact's: an impact that follows a flight
+    /// (within 2 s of the previous contact) came back at a speed nothing measured, so it has
+    /// no kinematics (`approach-unknown`); --train measures a bounce's from its flight.
+    #[arg(long, help_heading = "Bench", conflicts_with = "train")]
+    pub v0_every: bool,
     /// Drop height, m: v0 = sqrt(2 g h).
     #[arg(long, help_heading = "Bench", conflicts_with = "free_fall", value_parser = parse::height_m)]
     pub drop_height: Option<f64>,

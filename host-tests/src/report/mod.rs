@@ -278,6 +278,8 @@ pub fn null_reasons(r: &ImpactReport, fits: &FitSet) -> BTreeMap<String, String>
     // The kinematics: the first reason that applies.
     let kinematics = if r.kinematics.is_some() {
         None
+    } else if flag(Flags::APPROACH_UNKNOWN) {
+        Some("approach-unknown".to_string())
     } else if flag(Flags::NO_APPROACH_SPEED) {
         Some("no-approach-speed".to_string())
     } else if skipped {

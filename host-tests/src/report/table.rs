@@ -140,7 +140,13 @@ pub fn to_table(a: &AnalysisJson) -> String {
             .get("cor")
             .filter(|r| *r != "no-approach-speed")
         {
-            s.push_str(&format!("    no kinematics: {why}\n"));
+            // A bounce's missing speed names the options that give it.
+            let fix = if why == "approach-unknown" {
+                " (a bounce: --v0 is the drop's first impact's; --train or --v0-every)"
+            } else {
+                ""
+            };
+            s.push_str(&format!("    no kinematics: {why}{fix}\n"));
         }
         if let Some(latency) = i.report_latency_s {
             s.push_str(&format!(
