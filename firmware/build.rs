@@ -7,8 +7,10 @@
 //!   regions and sizes at the MPS2's addresses);
 //! * `m4-bench` (implies `emulator`): `firmware/m4-bench/board-memory.x`, the emulator's map
 //!   with all 4 MiB of data RAM for statics (the bench holds a whole recording in RAM);
-//! * `panic-check` alone (neither of the above): the STM32F407VG map, for the
-//!   `panic-check` binary (`src/bin/panic_check.rs`).
+//! * `panic-check` alone (neither of the above): the M4 bench's map, for the `panic-check`
+//!   binary (`src/bin/panic_check.rs`), which never runs: it only has to link, and its one
+//!   `Monitor` holds the analysis workspace the board keeps in CCM RAM beside the stream and
+//!   the capture, more than the board's SRAM.
 //!
 //! The `-Tlink.x` / `-Tdefmt.x` / `--nmagic` link arguments come from the workspace's
 //! `.cargo/config.toml` (`[target.thumbv7em-none-eabihf] rustflags`) and only from there;
@@ -40,7 +42,7 @@ fn main() {
     }
 
     let m4_bench = env::var_os("CARGO_FEATURE_M4_BENCH").is_some();
-    let memory_dir = manifest_dir.join(if m4_bench {
+    let memory_dir = manifest_dir.join(if m4_bench || (panic_check && !emulator) {
         "m4-bench"
     } else if emulator {
         "emulator"

@@ -158,7 +158,8 @@ fn the_nonlinear_laws_cor_falls_with_speed() {
 }
 
 #[test]
-fn without_train_a_bounce_has_no_speed_unless_every_impact_comes_at_v0_and_a_long_flight_starts_a_new_train() {
+fn without_train_a_bounce_has_no_speed_unless_every_impact_comes_at_v0_and_a_long_flight_starts_a_new_train(
+) {
     let args = [
         "synth",
         "--model",

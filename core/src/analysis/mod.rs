@@ -8,10 +8,11 @@
 use crate::capture::Capture;
 pub mod motion;
 
-use crate::report::{self, Analysis, Flags, ImpactReport, Kinematics, Status, COR_TOLERANCE};
+use crate::report::motion::{motion_deviation, Frame};
+use crate::report::{self, Analysis, Flags, ImpactReport, Status};
 use crate::scene::Scene;
 use crate::signal::baseline::Deviation;
-use motion::{PointsOut, Scale};
+use motion::PointsOut;
 
 /// Points the fits see at most: a contact of 12 600 samples (the seed bench at 500 kS/s) is
 /// thinned to every 6th sample, which moves no fitted value beyond its noise.
@@ -283,54 +284,20 @@ fn analyse_kinematics<const CAP: usize>(
     // The fits scale by the peak of the signal they fit.
     let (_, peak_a) = filtered.unwrap_or((raw_i, raw_a));
 
-    // Kinematics (and the fit points) need the approach speed and the whole, unclipped
-    // impact.
-    let (Some(v0), Status::Complete, Some(sep_index), false) = (
-        s.v0_m_s,
-        s.status,
-        s.separation_index,
-        s.clipped || s.cut_at_start || s.in_previous,
-    ) else {
+    // The kinematics come from the stream's online sums ([`report::streaming`]); the fit
+    // points, and the kinematics where those sums lost the crush or the separation, from a
+    // pass over the capture when it holds the whole, unclipped impact (the same sums: the
+    // two agree to the bit where both run).
+    let whole = s.status == Status::Complete && !(s.clipped || s.cut_at_start || s.in_previous);
+    let Some(frame) = Frame::of(s, scene, Some(n)).filter(|_| whole) else {
         return r;
     };
+    let from_stream = s.motion.get().ok();
     let Some(onset) = s.onset_index.checked_sub(s.first_index).map(|o| o as usize) else {
         return r;
     };
-    // The whole samples between first touch and the onset are the contact's foot (its Δv
-    // counts them, [`Summary::contact_c`]): the integration starts at the first of them.
-    let lead = (libm::floor(-(s.touch_offset as f64)).max(0.0) as usize).min(onset);
-    let onset = onset - lead;
-    let fs = scene.calibration.sample_rate_hz as f64;
-    let dt = 1.0 / fs;
-    // Fractional positions from the onset sample: first touch (<= 0) and separation.
-    let touch = s.touch_offset as f64 + lead as f64;
-    // (A falling foot's zero may lie a little past the hold's end, where the capture stops:
-    // the integration stops at its last sample; a separation sample beyond it is no stop.)
-    let captured = samples.len().saturating_sub(onset + 1) as f64;
-    let first_quiet = (sep_index - s.onset_index) as f64 + lead as f64;
-    let separation = first_quiet + s.separation_offset as f64;
-    let separation = if first_quiet <= captured {
-        separation.min(captured)
-    } else {
-        separation
-    };
-    let v0d = v0 as f64;
-    // A vertical contact: the body decelerates at the reading less gravity.
-    let gravity = scene.contact_gravity_m_s2();
-    let motion = match gravity {
-        Some(g) => deviation.above(g as f64 / scene.calibration.gain_m_s2_per_count as f64),
-        None => deviation,
-    };
-    let motion_scale = Scale {
-        v0: v0d,
-        kv: scene.calibration.gain_m_s2_per_count as f64 / s.base_n.max(1) as f64 / fs,
-        dt,
-        // The sums start half a sample before the onset sample's instant (the midpoint rule,
-        // [`motion`]); from first touch to there the body moves at ~v0 (a touch within that
-        // half sample leaves the body short of it: the deformation is negative).
-        x_lead: v0d * (-touch - 0.5) * dt,
-    };
-    let from_onset = samples.get(onset..).unwrap_or(&[]);
+    let motion = motion_deviation(s.base_sum, s.base_n, scene);
+    let from_onset = samples.get(onset - frame.lead as usize..).unwrap_or(&[]);
     let contact = from_onset.len();
 
     // The fit points, if the scene asks for fits: `points` of each of force, velocity,
@@ -338,23 +305,29 @@ fn analyse_kinematics<const CAP: usize>(
     let fit_mass = scene
         .mass_kg
         .filter(|_| cfg!(feature = "fit") && scene.fits.any());
-    let fit_len = contact.min(libm::ceil(separation) as usize);
+    let fit_len = contact.min(libm::ceil(frame.separation) as usize);
     let every = fit_len.div_ceil(MAX_FIT_POINTS).max(1);
     let points = match fit_mass {
-        Some(_) => fit_len.div_ceil(every).min(work.buf.len() / 4),
-        None => 0,
+        Some(_) if r.kinematics.is_some() || from_stream.is_none() => {
+            fit_len.div_ceil(every).min(work.buf.len() / 4)
+        }
+        _ => 0,
     };
+    if points == 0 && from_stream.is_some() {
+        return r;
+    }
     let f_peak = libm::fabsf(peak_a) * fit_mass.unwrap_or(0.0);
     if points > 0 {
         let f_scale = fit_mass.unwrap_or(0.0) / f_peak;
         // With a CFC the filtered acceleration fills the workspace: point i reads sample
         // filter_lead + onset + i every >= i, so compacting it forwards in place overwrites
         // nothing unread.
+        let start = onset - frame.lead as usize;
         for i in 0..points {
             let j = i * every;
             let a = if filtered.is_some() {
                 work.buf
-                    .get(filter_lead + onset + j)
+                    .get(filter_lead + start + j)
                     .copied()
                     .unwrap_or(0.0)
             } else {
@@ -373,33 +346,29 @@ fn analyse_kinematics<const CAP: usize>(
         v: &mut *velocity,
         every,
     });
-    let Some(found) = motion::integrate(from_onset, motion, &motion_scale, separation, out) else {
-        r.flags.insert(Flags::NO_STOP);
-        return r;
-    };
-    let Some(rebound) = report::rebound_m_s(&r, v0, gravity) else {
-        return r;
-    };
-    let cor = rebound / v0;
-    if !(-COR_TOLERANCE..=1.0 + COR_TOLERANCE).contains(&cor) {
-        r.flags.insert(Flags::COR_OUT_OF_RANGE);
-        return r;
+    let passed = motion::integrate(from_onset, motion, &frame, out);
+    if from_stream.is_none() {
+        // The pass holds what the online sums lost.
+        let Some((crush, separation)) = passed else {
+            r.flags.insert(Flags::NO_STOP);
+            r.flags.remove(Flags::KINEMATICS_NOT_HELD);
+            return r;
+        };
+        r.flags.remove(Flags::NO_STOP);
+        r.flags.remove(Flags::KINEMATICS_NOT_HELD);
+        report::motion::kinematics(&mut r, scene, &frame, &frame.found(crush, separation));
     }
-    let k = Kinematics {
-        impact_velocity_m_s: v0,
-        crush_time_s: ((found.crush - touch) * dt) as f32,
-        max_deformation_m: found.x_max as f32,
-        rebound_velocity_m_s: rebound,
-        cor,
-        separation_deformation_m: found.x_sep as f32,
-        permanent_deformation_m: None,
-        // Gravity's work over the contact counts in a vertical one.
-        absorbed_energy_j: scene.mass_kg.map(|m| {
-            0.5 * m * (v0 * v0 - rebound * rebound)
-                + gravity.map_or(0.0, |g| m * g * found.x_sep as f32)
-        }),
+    let Some(k) = r.kinematics else {
+        return r;
     };
-    r.kinematics = Some(k);
+    // The maximum deformation in f64, from whichever sums gave the kinematics.
+    let found = match from_stream {
+        Some(found) => Some(found),
+        None => passed.map(|(crush, separation)| frame.found(crush, separation)),
+    };
+    let (Some(found), Some(_)) = (found, passed) else {
+        return r;
+    };
 
     #[cfg(feature = "fit")]
     if points > 0 {
@@ -414,7 +383,7 @@ fn analyse_kinematics<const CAP: usize>(
             v: velocity,
             f: force,
             x_m: k.max_deformation_m,
-            v0,
+            v0: k.impact_velocity_m_s,
             f_peak,
         };
         let set = &scene.fits;

@@ -2,6 +2,7 @@
 //! when the analysis ran, the widths, the kinematics (with the approach speed) and the fits.
 
 pub mod fields;
+pub mod motion;
 pub mod summary;
 
 pub use crate::fit::{Fits, HertzFit, NonlinearFit, TwoPhaseFit};
@@ -137,9 +138,13 @@ impl Flags {
     /// kinematics and the fits are absent. A train measures a bounce's approach speed; a
     /// rig that strikes every time at one speed says `v0_every`.
     pub const APPROACH_UNKNOWN: Flags = Flags(1 << 11);
+    /// The contact outlasted the capture and the stream's online sums lost its crush or its
+    /// separation (first touch or the approach speed found at the end moved them beyond the
+    /// samples kept around them): the kinematics and the fits are absent.
+    pub const KINEMATICS_NOT_HELD: Flags = Flags(1 << 12);
 
     /// Every flag with its name in the reports.
-    pub const NAMES: [(Flags, &'static str); 12] = [
+    pub const NAMES: [(Flags, &'static str); 13] = [
         (Flags::AC_COUPLED, "ac-coupled"),
         (Flags::COR_OUT_OF_RANGE, "cor-out-of-range"),
         (Flags::NO_STOP, "no-stop"),
@@ -152,6 +157,7 @@ impl Flags {
         (Flags::DRIFT, "drift"),
         (Flags::IN_PREVIOUS, "in-previous"),
         (Flags::APPROACH_UNKNOWN, "approach-unknown"),
+        (Flags::KINEMATICS_NOT_HELD, "kinematics-not-held"),
     ];
 
     pub const fn empty() -> Self {
@@ -164,6 +170,10 @@ impl Flags {
 
     pub fn insert(&mut self, other: Flags) {
         self.0 |= other.0;
+    }
+
+    pub fn remove(&mut self, other: Flags) {
+        self.0 &= !other.0;
     }
 
     /// The names of the flags set, in [`Self::NAMES`] order.
@@ -322,7 +332,7 @@ pub fn streaming(s: &Summary, scene: &Scene) -> ImpactReport {
         Some(i) => i as f64 + s.separation_offset as f64,
         None => s.end_index as f64,
     };
-    ImpactReport {
+    let mut r = ImpactReport {
         index: s.index,
         status: s.status,
         analysis: Analysis::Skipped,
@@ -345,5 +355,19 @@ pub fn streaming(s: &Summary, scene: &Scene) -> ImpactReport {
         bounce: s.bounce.get(),
         spectrum: None,
         verdict: None,
+    };
+    // The kinematics from the stream's online sums, however long the contact.
+    match s.motion.get() {
+        Ok(found) => {
+            if let Some(frame) = motion::Frame::of(s, scene, None) {
+                motion::kinematics(&mut r, scene, &frame, &found);
+            }
+        }
+        Err(Some(motion::Missing::NoStop)) => r.flags.insert(Flags::NO_STOP),
+        Err(Some(motion::Missing::CrushNotHeld | motion::Missing::EdgeNotHeld)) => {
+            r.flags.insert(Flags::KINEMATICS_NOT_HELD)
+        }
+        Err(_) => {}
     }
+    r
 }

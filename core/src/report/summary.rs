@@ -78,6 +78,9 @@ pub struct Summary {
     pub v0_m_s: Option<f32>,
     /// The impact continues a bounce train: both measures of its approach speed.
     pub bounce: BounceSlot,
+    /// The kinematics' states the stream's online sums found (`stream/online.rs`), or why
+    /// not: the crush and the separation however long the contact, captured or not.
+    pub motion: Record,
 }
 
 /// A summary's bounce, all zeros when the impact continues no train: `Option<Bounce>` keeps
@@ -156,7 +159,92 @@ impl Summary {
         contact_c: None,
         v0_m_s: None,
         bounce: BounceSlot::NONE,
+        motion: Record::NONE,
     };
+}
+
+/// What the stream's online sums found ([`Summary::motion`], `stream/online.rs`): the kinematics from the crush
+/// and the two states around the separation, or why not. All zeros: nothing (so a capture's
+/// summary stays in `.bss`).
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct Record {
+    /// 0: found; else why not ([`Missing`] as a number; 0 with `held` false: no reason).
+    why: u8,
+    held: bool,
+    found: Found,
+}
+
+/// Why the online sums hold no kinematics.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub enum Missing {
+    /// No approach speed, or the impact is not one the kinematics are for (not complete,
+    /// clipped, cut at the start, inside the previous one).
+    NotKinematic = 1,
+    /// The velocity never reached zero within the impact.
+    NoStop = 2,
+    /// The crush lay outside the samples the stream kept around it (the approach speed or
+    /// first touch found at the end moved it beyond them).
+    CrushNotHeld = 3,
+    /// The separation's samples were no longer in the ring when it was located, or first
+    /// touch lay further back than the samples kept before the onset.
+    EdgeNotHeld = 4,
+}
+
+impl Record {
+    /// Nothing, no reason (a placeholder).
+    pub const NONE: Self = Self {
+        why: 0,
+        held: false,
+        found: Found {
+            crush: 0.0,
+            x_max: 0.0,
+            x_sep: 0.0,
+        },
+    };
+
+    /// Found.
+    pub fn found(found: Found) -> Self {
+        Self {
+            why: 0,
+            held: true,
+            found,
+        }
+    }
+
+    /// Nothing, for `why`.
+    pub fn missing(why: Missing) -> Self {
+        Self {
+            why: why as u8,
+            ..Self::NONE
+        }
+    }
+
+    /// The kinematics found, or why not.
+    pub fn get(&self) -> Result<Found, Option<Missing>> {
+        if self.held {
+            return Ok(self.found);
+        }
+        Err(match self.why {
+            1 => Some(Missing::NotKinematic),
+            2 => Some(Missing::NoStop),
+            3 => Some(Missing::CrushNotHeld),
+            4 => Some(Missing::EdgeNotHeld),
+            _ => None,
+        })
+    }
+}
+
+/// The kinematics the sums found, in samples from the onset and metres.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct Found {
+    /// When the velocity reached zero (fractional samples from the integration's first
+    /// sample's instant).
+    pub crush: f64,
+    /// The deformation then, m.
+    pub x_max: f64,
+    /// The deformation at the separation, m.
+    pub x_sep: f64,
 }
 
 #[cfg(test)]

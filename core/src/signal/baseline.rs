@@ -327,7 +327,7 @@ pub struct Deviation {
 
 impl Deviation {
     /// For the baseline `base_sum / base_n` (`base_n <= 4096`, as the stream's baseline).
-    pub fn new(base_sum: i64, base_n: i64) -> Self {
+    pub const fn new(base_sum: i64, base_n: i64) -> Self {
         Self {
             w: base_n as i32,
             s: base_sum as i32,

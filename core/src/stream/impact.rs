@@ -99,8 +99,8 @@ impl<const PRE: usize> Stream<PRE> {
         let line_in_previous = touch_offset < touch_floor;
         let touch_offset = touch_offset.max(touch_floor);
         // The whole samples from first touch to the onset (its foot below the edge level).
-        let lead = libm::floorf(-touch_offset).max(0.0) as usize;
-        let lead_c: i64 = (pulse..pulse + lead)
+        let line_lead = libm::floorf(-touch_offset).max(0.0) as usize;
+        let lead_c: i64 = (pulse..pulse + line_lead)
             .map_while(|i| back(i).map(|x| deviation.of(x) as i64))
             .sum();
         let since_last =
@@ -238,6 +238,33 @@ impl<const PRE: usize> Stream<PRE> {
             self.index - (older.len() + newer.len()) as u64,
         );
         record_fall(&mut a, newer, self.index - newer.len() as u64);
+        // The kinematics' sums from the onset, towards the crush a provisional approach
+        // speed gives (the one known now: the scene's, or a bounce's from the line's touch).
+        let scene = &self.scene;
+        let touch = onset_index as f64 + touch_offset as f64;
+        let v0 = self
+            .train
+            .approach(scene, touch, self.v0, self.v0_measured)
+            .v0_m_s;
+        let c_stop = v0.and_then(|v0| {
+            let fs = scene.calibration.sample_rate_hz as f64;
+            crate::report::motion::Scale {
+                v0: v0 as f64,
+                kv: scene.calibration.gain_m_s2_per_count as f64 / base_n.max(1) as f64 / fs,
+                dt: 1.0 / fs,
+                x_lead: 0.0,
+            }
+            .c_stop()
+        });
+        let lobe_lead = libm::floorf(-a.lobe_touch).max(0.0) as usize;
+        self.online.start(
+            crate::report::motion::motion_deviation(base_sum, base_n, scene),
+            &self.ring,
+            pulse,
+            before_onset,
+            [line_lead, lobe_lead],
+            c_stop,
+        );
         self.active = Some(a);
     }
 
@@ -310,6 +337,11 @@ impl<const PRE: usize> Stream<PRE> {
         let mut used = samples.len();
         let mut ended = None;
         let (d_hi, d_lo) = (a.d_hi, a.d_lo);
+        // The kinematics' online sums ([`super::online`]).
+        let online = &mut self.online;
+        let motion = online.motion;
+        let m0 = online.m;
+        let (mut cm, mut qm, mut mark) = (online.c, online.q, online.mark);
         let n = samples.len();
         let mut k = 0;
         // Alternating stretches of samples beyond the edge level (loud) and within it
@@ -379,6 +411,17 @@ impl<const PRE: usize> Stream<PRE> {
                     quiet = 0;
                 }
                 sum += d as i64;
+                let dm = motion.of(x) as i64;
+                cm = cm.wrapping_add(dm);
+                qm = qm.wrapping_add(cm);
+                if cm >= mark {
+                    mark = online.band_step(
+                        x,
+                        m0 + k as u64,
+                        cm.wrapping_sub(dm),
+                        qm.wrapping_sub(cm),
+                    );
+                }
                 k += 1;
             }
             // Quiet: the first quiet sample after the peak is the separation.
@@ -393,6 +436,17 @@ impl<const PRE: usize> Stream<PRE> {
                 }
                 quiet += 1;
                 sum += d as i64;
+                let dm = motion.of(x) as i64;
+                cm = cm.wrapping_add(dm);
+                qm = qm.wrapping_add(cm);
+                if cm >= mark {
+                    mark = online.band_step(
+                        x,
+                        m0 + k as u64,
+                        cm.wrapping_sub(dm),
+                        qm.wrapping_sub(cm),
+                    );
+                }
                 if quiet >= first_mark {
                     returned |= quiet >= min_gap;
                     if quiet >= hold && start + k as u64 > a.trigger_index {
@@ -404,6 +458,8 @@ impl<const PRE: usize> Stream<PRE> {
                 k += 1;
             }
         }
+        online.m = m0 + used as u64;
+        (online.c, online.q, online.mark) = (cm, qm, mark);
         let kept = samples.get(..used).unwrap_or(&[]);
         // Only when the samples reach a rail does it matter which of them did.
         if scan.min <= lo || scan.max >= hi {
@@ -476,6 +532,14 @@ impl<const PRE: usize> Stream<PRE> {
         // pre-trigger history come from it.
         self.keep(kept);
         self.locate_separation();
+        if let Some((onset, Some((at, offset, _)))) = self
+            .active
+            .as_ref()
+            .map(|a| (a.onset_index, a.separation_at))
+        {
+            self.online
+                .follow_separation(&self.ring, self.index, onset, at, offset);
+        }
         if too_long {
             self.end_unreturned(Status::TooLong, sink);
             return (used, None);
@@ -562,7 +626,7 @@ impl<const PRE: usize> Stream<PRE> {
         let approach = self
             .train
             .approach(&self.scene, touch, self.v0, self.v0_measured);
-        let summary = Summary {
+        let mut summary = Summary {
             index: self.counters.impacts.min(u32::MAX as u64) as u32,
             status,
             clipped: a.clipped,
@@ -588,7 +652,19 @@ impl<const PRE: usize> Stream<PRE> {
                 .map(|_| a.separation_c - a.pre_onset_c + lead_c + tail_c),
             v0_m_s: approach.v0_m_s,
             bounce: approach.bounce.into(),
+            motion: crate::report::motion::Record::NONE,
         };
+        // The online sums' crush and separation, now that touch and speed are final.
+        if let Some(s) = a.separation {
+            self.online.follow_separation(
+                &self.ring,
+                self.index,
+                a.onset_index,
+                s,
+                separation_offset,
+            );
+        }
+        summary.motion = self.online.finish(&summary, &self.scene);
         self.train.ended(&summary, &self.scene);
         self.counters.impacts += 1;
         if status != Status::Complete {

@@ -18,6 +18,7 @@ mod active;
 mod feet;
 mod impact;
 mod level;
+mod online;
 mod onset;
 mod rise;
 mod tail;
@@ -127,6 +128,8 @@ pub struct Stream<const PRE: usize> {
     /// The baseline moved to another level (or is being learned again) since the last impact
     /// started: the next one says so.
     moved: bool,
+    /// The kinematics' sums of the impact being followed ([`online`]).
+    online: online::Online,
 }
 
 impl<const PRE: usize> Stream<PRE> {
@@ -213,6 +216,7 @@ impl<const PRE: usize> Stream<PRE> {
             trigger_pending: false,
             handed_over: false,
             moved: false,
+            online: online::Online::new(),
         }
     }
 

@@ -124,7 +124,11 @@ impl Tracker {
     /// Remembers the impact that just ended (its summary complete, `v0_m_s` included).
     pub(crate) fn ended(&mut self, s: &Summary, scene: &Scene) {
         let separation = match (s.status, s.separation_index) {
-            (Status::Complete, Some(i)) => Some(i as f64 + s.separation_offset as f64),
+            // A full capture cut nothing the stream measured: the separation and Δv are
+            // whole.
+            (Status::Complete | Status::BufferFull, Some(i)) => {
+                Some(i as f64 + s.separation_offset as f64)
+            }
             _ => None,
         };
         // A clipped impact's Δv is a lower bound: no rebound from it.
@@ -192,7 +196,10 @@ mod tests {
             number: 0,
         };
         // 2.5 s of flight: a new drop.
-        assert_eq!(t.approach(&s, 250_000.0, Some(1.5), false), plain(Some(1.5)));
+        assert_eq!(
+            t.approach(&s, 250_000.0, Some(1.5), false),
+            plain(Some(1.5))
+        );
     }
 
     #[test]
@@ -214,7 +221,10 @@ mod tests {
         assert_eq!(t.approach(&s, 10_000.0, Some(1.5), false), plain(Some(1.5)));
         s.v0_every = false;
         // Beyond a train's longest flight: a new drop. No speed given: nothing is unknown.
-        assert_eq!(t.approach(&s, 250_000.0, Some(1.5), false), plain(Some(1.5)));
+        assert_eq!(
+            t.approach(&s, 250_000.0, Some(1.5), false),
+            plain(Some(1.5))
+        );
         assert_eq!(t.approach(&s, 10_000.0, None, false), plain(None));
         // The first impact of the stream takes it.
         assert_eq!(

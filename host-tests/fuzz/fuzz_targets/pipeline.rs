@@ -109,6 +109,8 @@ fn scene(b: &mut Bytes) -> (Scene, bool) {
         // Gravity in the contact (a drop, a train or this flag), at standard gravity.
         gravity_m_s2: impact_core::consts::STANDARD_GRAVITY as f32,
         vertical: stage_byte & 8 != 0,
+        // Every impact at v0, or only one that follows no flight.
+        v0_every: stage_byte & 0x10 != 0,
         // Bounce trains on either speed source, with short flights so that they chain.
         train: (stage_byte & 3 != 0).then(|| Train {
             speed: if stage_byte & 1 != 0 {

@@ -282,20 +282,23 @@ pub fn null_reasons(r: &ImpactReport, fits: &FitSet) -> BTreeMap<String, String>
         Some("approach-unknown".to_string())
     } else if flag(Flags::NO_APPROACH_SPEED) {
         Some("no-approach-speed".to_string())
-    } else if skipped {
-        Some("analysis-skipped".to_string())
     } else if flag(Flags::AC_COUPLED) {
         Some("ac-coupled".to_string())
     } else if flag(Flags::CLIPPED) {
         Some("clipped".to_string())
     } else if flag(Flags::CUT_AT_START) {
         Some("cut-at-start".to_string())
-    } else if r.status != Status::Complete {
+    } else if !matches!(r.status, Status::Complete | Status::BufferFull) {
+        // (A full capture cut nothing the stream's online sums measured.)
         Some(format!("status-{}", r.status.name()))
     } else if flag(Flags::COR_OUT_OF_RANGE) {
         Some("cor-out-of-range".to_string())
     } else if flag(Flags::NO_STOP) {
         Some("no-stop".to_string())
+    } else if flag(Flags::KINEMATICS_NOT_HELD) {
+        Some("kinematics-not-held".to_string())
+    } else if skipped {
+        Some("analysis-skipped".to_string())
     } else {
         Some("not-found".to_string())
     };
@@ -319,9 +322,17 @@ pub fn null_reasons(r: &ImpactReport, fits: &FitSet) -> BTreeMap<String, String>
         if r.kinematics
             .is_some_and(|k| k.permanent_deformation_m.is_none())
         {
-            // No line of an elastic and a viscous part holds the unloading, or no fit
-            // points were taken (no mass, no fit asked).
-            put("permanent_deformation_m", "set-not-resolved");
+            // The stream's online sums gave the kinematics of a contact no capture held
+            // whole; else no line of an elastic and a viscous part holds the unloading, or no
+            // fit points were taken (no mass, no fit asked).
+            let why = if skipped {
+                "analysis-skipped"
+            } else if r.status == Status::BufferFull {
+                "capture-full"
+            } else {
+                "set-not-resolved"
+            };
+            put("permanent_deformation_m", why);
         }
     }
     for (name, asked, got) in [
@@ -334,6 +345,9 @@ pub fn null_reasons(r: &ImpactReport, fits: &FitSet) -> BTreeMap<String, String>
                 _ if !asked => "not-asked",
                 _ if r.peak_force_n.is_none() => "no-mass",
                 Some(k) => k.as_str(),
+                // Kinematics from the online sums, but the loop the fits need was not held.
+                None if skipped => "analysis-skipped",
+                None if r.status == Status::BufferFull => "capture-full",
                 None => "not-identifiable",
             };
             put(name, why);

@@ -29,9 +29,10 @@ use impact_firmware::semihosting as host;
 pub use irq::{start_high, start_low, start_medium};
 
 /// Longest semihosting command line accepted, bytes: the recording's path and every scene
-/// key `impact emulate` passes (about 700 bytes with a spec) with room to spare; the
-/// emulator's data RAM is the board's 104 KiB, which the reports' queues fill to within
-/// this line's slack.
+/// key `impact emulate` passes (about 700 bytes with a spec) with room to spare. Read into
+/// `init`'s frame, not a static: the emulator's data RAM is the board's 104 KiB, which the
+/// board's own statics fill; only the samples file's path is kept (a static of
+/// [`host::MAX_PATH_LEN`] bytes).
 const COMMAND_LINE_LEN: usize = 1920;
 
 /// What the semihosting command line asks for:
@@ -71,7 +72,7 @@ pub enum Pacing {
 }
 
 #[derive(defmt::Format)]
-enum ConfigError {
+enum ConfigError<'a> {
     Host(host::HostError),
     NoSamplesFile,
     /// A positional argument after the samples file that is not a pacing.
@@ -85,7 +86,7 @@ enum ConfigError {
     /// `axis` is not `x`, `y`, `z` or `resultant`.
     BadAxis,
     Scene {
-        key: &'static str,
+        key: &'a str,
         error: SceneError,
     },
     /// `spec_table` is given without a `spec`, or its file is not whole rows of three
@@ -99,7 +100,7 @@ enum ConfigError {
 /// of three little-endian f32s (time over the duration, lower and upper limit over the peak),
 /// as `impact` writes them, so that the board judges with the host's very bits
 /// ([`impact_firmware::scene::band_table`]).
-fn read_band(path: &str) -> Result<&'static [BandPoint], ConfigError> {
+fn read_band(path: &str) -> Result<&'static [BandPoint], ConfigError<'static>> {
     let mut file = host::HostFile::open(path).map_err(ConfigError::Host)?;
     let rows = core::iter::from_fn(|| {
         let mut row = [0u8; 12];
@@ -125,12 +126,12 @@ fn read_band(path: &str) -> Result<&'static [BandPoint], ConfigError> {
     })
 }
 
-fn parse(line: &'static str) -> Result<Config, ConfigError> {
+fn parse(line: &str) -> Result<Config, ConfigError<'_>> {
     let mut positional = line
         .split(' ')
         .filter(|a| !a.is_empty() && !a.contains('='));
     let _program = positional.next();
-    let samples_path = positional.next().ok_or(ConfigError::NoSamplesFile)?;
+    let samples_path = keep_path(positional.next().ok_or(ConfigError::NoSamplesFile)?)?;
     let pacing = match positional.next() {
         None | Some("realtime") => Pacing::RealTime,
         Some("lossless") => Pacing::Lossless,
@@ -197,6 +198,22 @@ fn parse(line: &'static str) -> Result<Config, ConfigError> {
     })
 }
 
+/// The samples file's path, kept for the run in a static of its longest length (the command
+/// line it came from lives in `init`'s frame).
+fn keep_path(path: &str) -> Result<&'static str, ConfigError<'static>> {
+    static PATH: ConstStaticCell<[u8; host::MAX_PATH_LEN]> =
+        ConstStaticCell::new([0; host::MAX_PATH_LEN]);
+    let bytes = path.as_bytes();
+    let kept = PATH
+        .try_take()
+        .ok_or(ConfigError::Host(host::HostError::CommandLine))?;
+    let slot = kept
+        .get_mut(..bytes.len())
+        .ok_or(ConfigError::Host(host::HostError::PathTooLong))?;
+    slot.copy_from_slice(bytes);
+    core::str::from_utf8(slot).map_err(|_| ConfigError::Host(host::HostError::CommandLineNotUtf8))
+}
+
 /// What the board hands the tasks.
 pub struct Setup {
     /// The scene the stream and the analysis run.
@@ -207,15 +224,12 @@ pub struct Setup {
 }
 
 /// Reads the command line and brings the board up (the time driver). A bad command line ends
-/// the run (exit status 1).
+/// the run (exit status 1). Not inlined: the line's buffer lives in this frame, which is gone
+/// before the executors start (inlined into `main`, it sat under every task's stack).
+#[inline(never)]
 pub fn init() -> Setup {
-    static LINE: ConstStaticCell<[u8; COMMAND_LINE_LEN]> =
-        ConstStaticCell::new([0; COMMAND_LINE_LEN]);
-    let Some(buf) = LINE.try_take() else {
-        error!("emulator: started twice");
-        fault_exit()
-    };
-    let config = match host::command_line(buf)
+    let mut buf = [0u8; COMMAND_LINE_LEN];
+    let config = match host::command_line(&mut buf)
         .map_err(ConfigError::Host)
         .and_then(parse)
     {

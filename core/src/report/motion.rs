@@ -1,0 +1,218 @@
+//! The frame of an impact's kinematics, shared by the two ways its motion is integrated: the
+//! pass over a capture ([`crate::analysis::motion`]) and the sums the stream keeps online
+//! (`stream/online.rs`). Both integrate `d' = W x - S - G` (the deviation from the frozen
+//! baseline, less gravity's shift `G` in a vertical contact) from the first whole sample of
+//! the contact's foot, and both hand their states here, so the two give the same bits.
+//!
+//! After `k` samples of the integration, `C_k = Σ_{j<k} d'_j` and `Q_k = Σ_{j=1..k} C_j`:
+//!
+//! ```text
+//! v_k = v0 - kv C_k                          (kv = gain / (W fs), m/s per unit of C)
+//! x_k = x_lead + dt (k v0 - kv T_k / 2)      (trapezoid; T_k = 2 Q_k - C_k)
+//! ```
+//!
+//! Samples are instants (sample `j` at time `j`, in samples from the integration's start),
+//! each standing for the interval `[j - ½, j + ½)` (the midpoint rule): `v_k` is the velocity
+//! at time `k - ½`, and `x_k` the deformation then (`x_lead` the deformation at `-½`).
+
+use super::summary::Summary;
+pub use super::summary::{Found, Missing, Record};
+use super::{rebound_m_s, Flags, ImpactReport, Kinematics, COR_TOLERANCE};
+use crate::scene::Scene;
+use crate::signal::baseline::Deviation;
+
+/// The sums after `k` samples: `(k, C_k, Q_k)`.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct Sums {
+    pub k: u32,
+    pub c: i64,
+    pub q: i64,
+}
+
+impl Sums {
+    /// `T_k = 2 Q_k - C_k`.
+    pub fn t(&self) -> i64 {
+        self.q.wrapping_mul(2).wrapping_sub(self.c)
+    }
+}
+
+/// Where the velocity first reached zero: the state before the sample whose `C` first reached
+/// [`Scale::c_stop`], and `C` after it.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct Crush {
+    pub at: Sums,
+    pub c_next: i64,
+}
+
+/// What turns sums into metres and metres per second.
+#[derive(Clone, Copy, Debug)]
+pub struct Scale {
+    /// Approach speed, m/s.
+    pub v0: f64,
+    /// Velocity per unit of `C`, m/s (`gain / (W fs)`).
+    pub kv: f64,
+    /// Sample period, s.
+    pub dt: f64,
+    /// Deformation at half a sample before the integration's first sample, m (first touch
+    /// came a fraction of a sample earlier or later, at `v0`: negative if later).
+    pub x_lead: f64,
+}
+
+impl Scale {
+    pub fn velocity(&self, c: i64) -> f64 {
+        self.v0 - self.kv * c as f64
+    }
+
+    /// Deformation after `k` samples, with `t = T_k`.
+    pub fn deformation(&self, k: u32, t: i64) -> f64 {
+        self.x_lead + self.dt * (k as f64 * self.v0 - self.kv * t as f64 / 2.0)
+    }
+
+    /// Stopped (`v <= 0`) once `C >= c_stop`; `None` if the scale cannot stop anything.
+    pub fn c_stop(&self) -> Option<i64> {
+        if !(self.kv > 0.0 && self.kv.is_finite() && self.v0 > 0.0) {
+            return None;
+        }
+        let c = libm::ceil(self.v0 / self.kv);
+        Some(if c < i64::MAX as f64 {
+            c as i64
+        } else {
+            i64::MAX
+        })
+    }
+}
+
+/// An impact's kinematic frame, from its summary: where the integration starts, where first
+/// touch and the separation lie, and the scale.
+#[derive(Clone, Copy, Debug)]
+pub struct Frame {
+    /// Whole samples of the foot before the onset the integration starts with.
+    pub lead: u32,
+    /// First touch, fractional samples from the integration's first sample (`<= 0` … `< 1`).
+    pub touch: f64,
+    /// The separation, fractional samples from the integration's first sample.
+    pub separation: f64,
+    /// The separation's two states are after `sep_floor` and `sep_floor + 1` samples, and
+    /// the separation lies `frac` of the way between them.
+    pub sep_floor: u32,
+    pub frac: f64,
+    pub scale: Scale,
+}
+
+/// The deviation the kinematics integrate for the baseline `base_sum / base_n`: the reading's
+/// less gravity in a vertical contact (the body decelerates at the reading less `g`).
+pub fn motion_deviation(base_sum: i64, base_n: i64, scene: &Scene) -> Deviation {
+    let deviation = Deviation::new(base_sum, base_n);
+    match scene.contact_gravity_m_s2() {
+        Some(g) => deviation.above(g as f64 / scene.calibration.gain_m_s2_per_count as f64),
+        None => deviation,
+    }
+}
+
+impl Frame {
+    /// The frame of summary `s` if its kinematics can be known (an approach speed, a
+    /// separation); `held`: the samples a capture holds from the window's first sample on
+    /// (the pass over it stops at its end), `None` for the online sums.
+    pub fn of(s: &Summary, scene: &Scene, held: Option<usize>) -> Option<Self> {
+        let v0 = s.v0_m_s? as f64;
+        let sep_index = s.separation_index?;
+        let onset = s.onset_index.checked_sub(s.first_index)?;
+        let onset = usize::try_from(onset).ok()?;
+        // The whole samples between first touch and the onset are the contact's foot (its Δv
+        // counts them, [`Summary::contact_c`]): the integration starts at the first of them.
+        let lead = (libm::floor(-(s.touch_offset as f64)).max(0.0) as usize).min(onset);
+        let fs = scene.calibration.sample_rate_hz as f64;
+        let dt = 1.0 / fs;
+        // Fractional positions from the first sample of the integration.
+        let touch = s.touch_offset as f64 + lead as f64;
+        let first_quiet = sep_index.checked_sub(s.onset_index)? as f64 + lead as f64;
+        let separation = first_quiet + s.separation_offset as f64;
+        // (A falling foot's zero may lie a little past the hold's end, where a capture stops:
+        // the pass stops at its last sample; a separation sample beyond it is no stop.)
+        let separation = match held {
+            Some(n) => {
+                let captured = n.saturating_sub(onset - lead + 1) as f64;
+                if first_quiet <= captured {
+                    separation.min(captured)
+                } else {
+                    separation
+                }
+            }
+            None => separation,
+        };
+        if !(separation >= 0.0) {
+            return None;
+        }
+        // The deformation at time `s` is the sums' after `s + ½` samples (midpoint rule).
+        let sep_at = separation + 0.5;
+        let sep_floor = libm::floor(sep_at);
+        if !(sep_floor < u32::MAX as f64 - 1.0) {
+            return None;
+        }
+        let gain = scene.calibration.gain_m_s2_per_count;
+        Some(Self {
+            lead: lead as u32,
+            touch,
+            separation,
+            sep_floor: sep_floor as u32,
+            frac: sep_at - sep_floor,
+            scale: Scale {
+                v0,
+                kv: gain as f64 / s.base_n.max(1) as f64 / fs,
+                dt,
+                // The sums start half a sample before their first sample's instant (the
+                // midpoint rule); from first touch to there the body moves at ~v0 (a touch
+                // within that half sample leaves the body short of it: negative).
+                x_lead: v0 * (-touch - 0.5) * dt,
+            },
+        })
+    }
+
+    /// The kinematics from the crush and the separation's two states.
+    pub fn found(&self, crush: Crush, separation: [Sums; 2]) -> Found {
+        let scale = &self.scale;
+        let (v, v_next) = (scale.velocity(crush.at.c), scale.velocity(crush.c_next));
+        let f = v / (v - v_next);
+        let x_max = scale.deformation(crush.at.k, crush.at.t()) + scale.dt * f * v / 2.0;
+        let [s0, s1] = separation;
+        let (x0, x1) = (
+            scale.deformation(s0.k, s0.t()),
+            scale.deformation(s1.k, s1.t()),
+        );
+        Found {
+            crush: crush.at.k as f64 + f - 0.5,
+            x_max,
+            x_sep: x0 + self.frac * (x1 - x0),
+        }
+    }
+}
+
+/// Fills in `r`'s kinematics from what the sums found in `frame`: the rebound from the
+/// report's Δv, the COR (flagged and left out beyond its tolerance), the energy absorbed.
+/// The set a pad keeps comes from the fits ([`crate::fit::set`]).
+pub fn kinematics(r: &mut ImpactReport, scene: &Scene, frame: &Frame, found: &Found) {
+    let v0 = frame.scale.v0 as f32;
+    let gravity = scene.contact_gravity_m_s2();
+    let Some(rebound) = rebound_m_s(r, v0, gravity) else {
+        return;
+    };
+    let cor = rebound / v0;
+    if !(-COR_TOLERANCE..=1.0 + COR_TOLERANCE).contains(&cor) {
+        r.flags.insert(Flags::COR_OUT_OF_RANGE);
+        return;
+    }
+    r.kinematics = Some(Kinematics {
+        impact_velocity_m_s: v0,
+        crush_time_s: ((found.crush - frame.touch) * frame.scale.dt) as f32,
+        max_deformation_m: found.x_max as f32,
+        rebound_velocity_m_s: rebound,
+        cor,
+        separation_deformation_m: found.x_sep as f32,
+        permanent_deformation_m: None,
+        // Gravity's work over the contact counts in a vertical one.
+        absorbed_energy_j: scene.mass_kg.map(|m| {
+            0.5 * m * (v0 * v0 - rebound * rebound)
+                + gravity.map_or(0.0, |g| m * g * found.x_sep as f32)
+        }),
+    });
+}

@@ -1,0 +1,404 @@
+//! The impact's motion integrated online: the kinematics' exact sums kept while the impact
+//! streams, so that every impact whose approach speed is known has its crush and its
+//! separation's states however long its contact, whether or not a capture holds it.
+//!
+//! ```text
+//!            foot          onset                crush band           separation
+//!   ... p_32 … p_2 p_1 | d'_0 d'_1 … ──────── [ 128 samples ] ─────── [4 states] ───
+//!   `before` (raw)      C'_m, Q'_m from the onset, per sample (wrapping i64)
+//! ```
+//!
+//! The sums run from the onset sample (`m` samples after it: `C'_m = Σ_{j<m} d'_j`,
+//! `Q'_m = Σ_{i=1..m} C'_i`, `d'` the deviation less gravity's shift in a vertical contact).
+//! What is found only at the end — first touch (the foot's fit, the whole lobe), and with it
+//! the approach speed of a bounce — moves where the host's pass starts (`lead` samples before
+//! the onset) and where it stops (`c_stop`). Both are exact integer shifts of the sums: with
+//! `L = Σ_{r=1..lead} p_r` and `Q_L = Σ r p_r` over the foot (`p_r` the sample `r` before the
+//! onset), the pass's state after `lead + m` samples is `(L + C'_m, Q_L + m L + Q'_m)`. So the
+//! stream keeps:
+//!
+//! - the raw samples of the foot ([`BEFORE`]), and the sums over a longer lobe found at the
+//!   start;
+//! - the raw samples from where `C'` first reached within reach of the crush ([`BAND`],
+//!   from a provisional `c_stop` less a margin): the crush for the final `c_stop` is found in
+//!   them, the same sample as the pass's, since every `C'` before them lies below the margin;
+//! - the sums at the four samples around the separation, walked back from the running sums
+//!   over the ring while it holds them.
+//!
+//! Per in-impact sample this costs the deviation less gravity, two i64 additions and a
+//! compare (`impact bench m4`). The sums wrap instead of overflowing: exact modulo 2^64, so
+//! every state is exact while its true value fits an i64 (`|Q| <= |d'| m² / 2`: at full scale
+//! 2^17 samples; for a real contact, whose `C` stays near `v0 / kv`, far longer).
+
+use super::REACH;
+use crate::report::motion::{Crush, Frame, Missing, Record, Sums};
+use crate::report::{Status, Summary};
+use crate::scene::Scene;
+use crate::signal::baseline::Deviation;
+use crate::signal::ring::Ring;
+
+/// Raw samples kept from where the sums first came within reach of the crush.
+pub(super) const BAND: usize = 128;
+/// Raw samples kept before the onset: the foot a first touch found at the end reaches back
+/// to (a longer lobe's sums are taken at the start).
+pub(super) const BEFORE: usize = 32;
+/// States kept around the separation: from one sample before the one it falls in to two
+/// after.
+const AROUND: usize = 4;
+
+/// The sums over a lead of the foot: `L`, `Q_L`, and the largest `C` within it.
+#[derive(Clone, Copy, Debug, Default)]
+struct Lead {
+    len: u32,
+    l: i64,
+    q: i64,
+    max_c: i64,
+}
+
+/// The four states around a separation.
+#[derive(Clone, Copy, Debug, Default)]
+struct Around {
+    /// The separation's stream index and offset they are for.
+    index: u64,
+    offset: f32,
+    /// `m` of the first state.
+    first_m: i64,
+    /// `(C'_m, Q'_m)` for `m = first_m ..`; `held` of them walked so far.
+    states: [(i64, i64); AROUND],
+    held: bool,
+}
+
+/// The online sums of the impact being followed.
+pub(super) struct Online {
+    /// The deviation the kinematics integrate (the baseline's, less gravity in a vertical
+    /// contact).
+    pub(super) motion: Deviation,
+    /// Samples integrated since the onset, and `C'`, `Q'` after them.
+    pub(super) m: u64,
+    pub(super) c: i64,
+    pub(super) q: i64,
+    /// The per-sample loop calls [`Self::band_step`] once `C' >= mark` (`i64::MAX`: never).
+    pub(super) mark: i64,
+    /// Where the band starts: the first `C'` at or above it.
+    lo: i64,
+    band_from: Option<Sums>,
+    band_len: usize,
+    band: [i16; BAND],
+    /// `p_1 ..`: the raw samples before the onset, newest first.
+    before: [i16; BEFORE],
+    before_len: usize,
+    /// The whole lobe's sums if it reaches further back than `before`.
+    lobe: Option<Lead>,
+    around: Option<Around>,
+}
+
+impl Online {
+    pub(super) const fn new() -> Self {
+        Self {
+            motion: Deviation::new(0, 1),
+            m: 0,
+            c: 0,
+            q: 0,
+            mark: i64::MAX,
+            lo: 0,
+            band_from: None,
+            band_len: 0,
+            band: [0; BAND],
+            before: [0; BEFORE],
+            before_len: 0,
+            lobe: None,
+            around: None,
+        }
+    }
+
+    /// A new impact: `motion` its deviation, the ring's newest `pulse` samples from the onset
+    /// on, `room` samples before the onset a pass may start at (the window's margin);
+    /// `leads` the first touches known now (whole samples of foot: the straight line's, the
+    /// lobe's) and `c_stop` the provisional stop (`None`: no approach speed known now).
+    pub(super) fn start<const PRE: usize>(
+        &mut self,
+        motion: Deviation,
+        ring: &Ring<PRE>,
+        pulse: usize,
+        room: usize,
+        leads: [usize; 2],
+        c_stop: Option<i64>,
+    ) {
+        self.motion = motion;
+        self.m = 0;
+        self.c = 0;
+        self.q = 0;
+        self.band_from = None;
+        self.band_len = 0;
+        self.around = None;
+        self.lobe = None;
+        // Sample `r` before the onset is the ring's `pulse + r - 1` from the newest.
+        let p = |r: usize| ring.back(pulse + r - 1).filter(|_| pulse + r <= REACH);
+        self.before_len = 0;
+        for r in 1..=BEFORE.min(room) {
+            let Some(x) = p(r) else { break };
+            if let Some(slot) = self.before.get_mut(r - 1) {
+                *slot = x;
+                self.before_len = r;
+            }
+        }
+        let leads = leads.map(|l| l.min(room));
+        if let Some(&far) = leads.iter().filter(|&&l| l > self.before_len).max() {
+            self.lobe = lead_sums(motion, far, p);
+        }
+        // The band from the lowest stop the known touches give, less a margin: 1/4096 of the
+        // stop (a bounce's speed moves with the final touch, by g/2 a sample) and eight foot
+        // samples (the foot's fit moves first touch by a few).
+        self.mark = match c_stop {
+            Some(c_stop) => {
+                let lowest = leads
+                    .iter()
+                    .filter_map(|&l| self.lead(l).map(|s| c_stop.saturating_sub(s.l)))
+                    .min()
+                    .unwrap_or(c_stop);
+                let foot = self
+                    .before
+                    .iter()
+                    .take(8)
+                    .map(|&x| motion.of(x).unsigned_abs() as i64);
+                let margin = c_stop / 4096 + foot.max().unwrap_or(0).saturating_mul(8);
+                lowest.saturating_sub(margin.max(1))
+            }
+            None => i64::MAX,
+        };
+        self.lo = self.mark;
+        // The pulse so far, oldest first.
+        for i in (0..pulse).rev() {
+            if let Some(x) = ring.back(i) {
+                self.take(x);
+            }
+        }
+    }
+
+    /// One sample, outside the per-sample loop (the pulse's first samples).
+    fn take(&mut self, x: i16) {
+        let dm = self.motion.of(x) as i64;
+        let (c0, q0) = (self.c, self.q);
+        self.c = c0.wrapping_add(dm);
+        self.q = q0.wrapping_add(self.c);
+        if self.c >= self.mark {
+            self.mark = self.band_step(x, self.m, c0, q0);
+        }
+        self.m += 1;
+    }
+
+    /// The sums over the `len` samples of foot before the onset, from the kept samples or
+    /// the lobe's.
+    fn lead(&self, len: usize) -> Option<Lead> {
+        if len <= self.before_len {
+            let kept = |r: usize| self.before.get(r - 1).copied();
+            return lead_sums(self.motion, len, kept);
+        }
+        self.lobe.filter(|l| l.len as usize == len)
+    }
+
+    /// Sample `x`, the `m`-th from the onset, took the sums to `C' >= mark`; `(c, q)` are
+    /// the sums before it. Returns the next mark.
+    #[inline(never)]
+    pub(super) fn band_step(&mut self, x: i16, m: u64, c: i64, q: i64) -> i64 {
+        if self.band_from.is_none() {
+            self.band_from = Some(Sums {
+                k: u32::try_from(m).unwrap_or(u32::MAX),
+                c,
+                q,
+            });
+        }
+        if let Some(slot) = self.band.get_mut(self.band_len) {
+            *slot = x;
+            self.band_len += 1;
+        }
+        if self.band_len < BAND {
+            i64::MIN
+        } else {
+            i64::MAX
+        }
+    }
+
+    /// The separation at stream index `index` (offset `offset`) of an impact whose onset is
+    /// `onset`: the states around it, walked back from the running sums over the ring (the
+    /// stream's next sample is `next`) once the sums have passed them.
+    pub(super) fn follow_separation<const PRE: usize>(
+        &mut self,
+        ring: &Ring<PRE>,
+        next: u64,
+        onset: u64,
+        index: u64,
+        offset: f32,
+    ) {
+        let fresh = match self.around {
+            Some(a) => a.index != index || a.offset.to_bits() != offset.to_bits(),
+            None => true,
+        };
+        if fresh {
+            let m = index.saturating_sub(onset) as f64 + offset as f64 + 0.5;
+            self.around = Some(Around {
+                index,
+                offset,
+                first_m: libm::floor(m) as i64 - 1,
+                states: [(0, 0); AROUND],
+                held: false,
+            });
+        }
+        let Some(a) = self.around.as_mut() else {
+            return;
+        };
+        let last = a.first_m + AROUND as i64 - 1;
+        if a.held || a.first_m < 0 || (self.m as i64) < last {
+            return;
+        }
+        // Back from `m` to `first_m`: C'_{k-1} = C'_k - d'_{k-1}, Q'_{k-1} = Q'_k - C'_k.
+        let (mut c, mut q) = (self.c, self.q);
+        let mut k = self.m as i64;
+        while k > a.first_m {
+            if k <= last {
+                if let Some(s) = a.states.get_mut((k - a.first_m) as usize) {
+                    *s = (c, q);
+                }
+            }
+            // Sample `k - 1` from the onset is stream index `onset + k - 1`.
+            let Some(back) = next.checked_sub(onset + k as u64) else {
+                return;
+            };
+            let Some(x) = usize::try_from(back).ok().and_then(|b| ring.back(b)) else {
+                return;
+            };
+            q = q.wrapping_sub(c);
+            c = c.wrapping_sub(self.motion.of(x) as i64);
+            k -= 1;
+        }
+        if let Some(s) = a.states.get_mut(0) {
+            *s = (c, q);
+        }
+        a.held = true;
+    }
+
+    /// The record of the impact that ended with summary `s` (its touch, speed and
+    /// separation final).
+    pub(super) fn finish(&self, s: &Summary, scene: &Scene) -> Record {
+        let kinematic = matches!(s.status, Status::Complete | Status::BufferFull)
+            && !(s.clipped || s.cut_at_start || s.in_previous);
+        let frame = Frame::of(s, scene, None).filter(|_| kinematic);
+        let (Some(frame), Some(c_stop)) = (frame, frame.and_then(|f| f.scale.c_stop())) else {
+            return Record::missing(Missing::NotKinematic);
+        };
+        let Some(lead) = self.lead(frame.lead as usize) else {
+            return Record::missing(Missing::EdgeNotHeld);
+        };
+        let crush = match self.crush(lead, c_stop) {
+            Ok(c) => c,
+            Err(why) => return Record::missing(why),
+        };
+        let Some(separation) = self.separation(&frame, lead, s) else {
+            return Record::missing(Missing::EdgeNotHeld);
+        };
+        Record::found(frame.found(crush, separation))
+    }
+
+    /// The crush in the pass's coordinates (`lead` samples of foot first).
+    fn crush(&self, lead: Lead, c_stop: i64) -> Result<Crush, Missing> {
+        if lead.max_c >= c_stop {
+            // Stopped within the foot (an approach far slower than the pulse's Δv): from
+            // the kept samples.
+            return self.crush_in_foot(lead.len as usize, c_stop);
+        }
+        let theta = c_stop.wrapping_sub(lead.l);
+        let Some(from) = self.band_from else {
+            // The sums never reached the band: nor the stop, if it lies above it.
+            return Err(if theta >= self.lo {
+                Missing::NoStop
+            } else {
+                Missing::CrushNotHeld
+            });
+        };
+        if theta < self.lo {
+            return Err(Missing::CrushNotHeld);
+        }
+        let (mut k, mut c, mut q) = (from.k, from.c, from.q);
+        for &x in self.band.get(..self.band_len).unwrap_or(&[]) {
+            let c_next = c.wrapping_add(self.motion.of(x) as i64);
+            if c_next >= theta {
+                return Ok(Crush {
+                    at: shifted(lead, k, c, q),
+                    c_next: lead.l.wrapping_add(c_next),
+                });
+            }
+            c = c_next;
+            q = q.wrapping_add(c);
+            k += 1;
+        }
+        Err(if self.band_len < BAND {
+            Missing::NoStop
+        } else {
+            Missing::CrushNotHeld
+        })
+    }
+
+    /// The crush within the foot's `len` kept samples.
+    fn crush_in_foot(&self, len: usize, c_stop: i64) -> Result<Crush, Missing> {
+        let oldest_first = self.before.get(..len).ok_or(Missing::EdgeNotHeld)?;
+        let (mut c, mut q) = (0i64, 0i64);
+        for (k, &x) in oldest_first.iter().rev().enumerate() {
+            let c_next = c + self.motion.of(x) as i64;
+            if c_next >= c_stop {
+                return Ok(Crush {
+                    at: Sums { k: k as u32, c, q },
+                    c_next,
+                });
+            }
+            c = c_next;
+            q += c;
+        }
+        Err(Missing::EdgeNotHeld)
+    }
+
+    /// The states after `sep_floor` and `sep_floor + 1` samples of the pass.
+    fn separation(&self, frame: &Frame, lead: Lead, s: &Summary) -> Option<[Sums; 2]> {
+        let a = self.around?;
+        if !(a.held && Some(a.index) == s.separation_index)
+            || a.offset.to_bits() != s.separation_offset.to_bits()
+        {
+            return None;
+        }
+        let m = frame.sep_floor as i64 - lead.len as i64;
+        let i = usize::try_from(m - a.first_m).ok()?;
+        let (c0, q0) = *a.states.get(i)?;
+        let (c1, q1) = *a.states.get(i + 1)?;
+        let m = u32::try_from(m).ok()?;
+        Some([shifted(lead, m, c0, q0), shifted(lead, m + 1, c1, q1)])
+    }
+}
+
+/// The pass's state after `lead` samples of foot and `m` from the onset, from the onset's
+/// sums `(c, q)`.
+fn shifted(lead: Lead, m: u32, c: i64, q: i64) -> Sums {
+    Sums {
+        k: lead.len + m,
+        c: lead.l.wrapping_add(c),
+        q: lead
+            .q
+            .wrapping_add((m as i64).wrapping_mul(lead.l))
+            .wrapping_add(q),
+    }
+}
+
+/// The sums over `len` samples of foot (`p(r)` the raw sample `r` before the onset).
+fn lead_sums(motion: Deviation, len: usize, p: impl Fn(usize) -> Option<i16>) -> Option<Lead> {
+    // `C` over the foot runs from its oldest sample: `p(len)` first.
+    let (mut l, mut q, mut max_c) = (0i64, 0i64, i64::MIN);
+    for r in (1..=len).rev() {
+        l += motion.of(p(r)?) as i64;
+        q += l;
+        max_c = max_c.max(l);
+    }
+    Some(Lead {
+        len: u32::try_from(len).ok()?,
+        l,
+        q,
+        max_c,
+    })
+}
