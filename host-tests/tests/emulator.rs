@@ -462,6 +462,18 @@ const STREAMING_FIELDS: [&str; 12] = [
     "baseline_m_s2",
 ];
 
+/// The kinematics: from the stream's online sums, on the board as on the host, whether or
+/// not the analysis ran or the capture held the contact.
+const KINEMATICS_FIELDS: [&str; 7] = [
+    "impact_velocity_m_s",
+    "crush_time_s",
+    "max_deformation_m",
+    "rebound_velocity_m_s",
+    "cor",
+    "separation_deformation_m",
+    "absorbed_energy_j",
+];
+
 /// A train of `n` seed-bench impacts `every` seconds apart, as a CSV file in `scratch`.
 fn seed_train(scratch: &Scratch, n: usize, every: f64) -> String {
     let (n_s, every_s) = (n.to_string(), every.to_string());
@@ -490,7 +502,8 @@ fn realtime_matches_host(file: &str, extra: &[&str]) -> serde_json::Value {
         return serde_json::Value::Null;
     };
     let elf = elf.to_string_lossy().into_owned();
-    let scene = ["--mass", "0.06", "--v0", "1.3357"];
+    // Strikes at one speed, again and again.
+    let scene = ["--mass", "0.06", "--v0", "1.3357", "--v0-every"];
     let mut args = vec!["analyze", file, "--json"];
     args.extend(scene);
     let (host, _) = impact(&args);
@@ -525,9 +538,17 @@ fn realtime_matches_host(file: &str, extra: &[&str]) -> serde_json::Value {
             }
             "skipped" => {
                 skipped += 1;
-                for field in ["fwhm_s", "crush_time_s", "cor"] {
-                    assert!(e[field].is_null(), "skipped but {field} = {}", e[field]);
+                assert!(
+                    e["fwhm_s"].is_null(),
+                    "skipped but fwhm_s = {}",
+                    e["fwhm_s"]
+                );
+                // The kinematics come from the stream's online sums: a skipped analysis
+                // keeps them, the host's to the bit (#41).
+                for field in KINEMATICS_FIELDS {
+                    assert_eq!(e[field], h[field], "skipped impact {}: {field}", h["index"]);
                 }
+                assert!(h["cor"].is_number(), "{h}");
             }
             other => panic!("analysis = {other}"),
         }
@@ -636,6 +657,7 @@ fn a_forced_dma_overrun_is_a_counted_gap_and_later_positions_stay_right() {
             file: file.clone().into(),
             mass: Some(0.06),
             v0: Some(1.3357),
+            v0_every: true,
             ..Default::default()
         },
         impact_io::progress::Progress::none(),
@@ -778,6 +800,7 @@ fn realtime_runs_of_seconds_lose_nothing_at_500_ks_and_1_ms() {
         "0.06",
         "--v0",
         "7",
+        "--v0-every",
         "--realtime",
         "--json",
         "--elf",
@@ -803,6 +826,7 @@ fn realtime_spectra_and_a_bounce_train_to_10_ms_flights_lose_nothing() {
         "0.06",
         "--v0",
         "1.3357",
+        "--v0-every",
         "--srs",
         "--realtime",
         "--json",
@@ -812,6 +836,11 @@ fn realtime_spectra_and_a_bounce_train_to_10_ms_flights_lose_nothing() {
     let json: serde_json::Value = serde_json::from_str(&out).unwrap();
     assert_eq!(json["impacts"].as_array().unwrap().len(), 5);
     assert_eq!(json["analyses_skipped"], 0);
+    assert!(json["impacts"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .all(|i| i["cor"].is_number()));
     within_board_limits(&log);
     // A bounce train whose flights shrink below 10 ms, the
     // recording ending 20 ms after its last contact (COR 0.85, 20 contacts): every bounce reported, the last one too,
@@ -1204,5 +1233,77 @@ fn vertical_drops_and_trains_match_the_host() {
         impact(&args);
         // (The train's CSV time stamps give a rate beyond f32: `impact log` cannot know it.)
         emulator_and_log_match_host(&path, analyze, name == "kv-drop.csv");
+    }
+}
+
+/// The bench (#41): a vertical train of seed 001's nonlinear law on a soft barrier
+/// (60 g at 1.3357 m/s, `F = k x (1 + c v)`, k 240 N/m: contacts of 55–64 ms, twice the
+/// board's 30.2 ms capture), 500 kS/s, in real time with the board's limits: every contact
+/// has its COR, crush time and deformations on the board, the host's to the bit, from the
+/// stream's online sums; nothing lost; the same with the shock spectra.
+#[test]
+fn realtime_contacts_twice_the_capture_have_their_kinematics_on_the_board() {
+    let scratch = Scratch::new();
+    let Some(elf) = firmware() else { return };
+    let elf = elf.to_string_lossy().into_owned();
+    let file = synth(
+        &scratch,
+        "soft-train.csv",
+        &[
+            "--model",
+            "nonlinear",
+            "--mass",
+            "0.06",
+            "--v0",
+            "1.3357",
+            "--stiffness",
+            "240",
+            "--damping",
+            "0.5",
+            "--bounces",
+            "4",
+            "--full-scale",
+            "156.9",
+            "--duration",
+            "0.8",
+        ],
+    );
+    let scene = ["--mass", "0.06", "--v0", "1.3357", "--train", "flight"];
+    let mut args = vec!["analyze", &file, "--json"];
+    args.extend(scene);
+    let (host, _) = impact(&args);
+    let host: serde_json::Value = serde_json::from_str(&host).unwrap();
+    let host = host["impacts"].as_array().unwrap().clone();
+    assert_eq!(host.len(), 4);
+    for extra in [&[][..], &["--srs"][..]] {
+        let mut args = vec!["emulate", &file, "--json", "--realtime", "--elf", &elf];
+        args.extend(scene);
+        args.extend(extra);
+        let (out, log) = impact(&args);
+        let json: serde_json::Value = serde_json::from_str(&out).unwrap();
+        assert_eq!(json["samples_lost"], 0, "{log}");
+        let board = json["impacts"].as_array().unwrap();
+        assert_eq!(board.len(), host.len(), "{log}");
+        for (e, h) in board.iter().zip(&host) {
+            assert!(h["duration_s"].as_f64().unwrap() > 0.0302, "{h}");
+            assert_eq!(e["status"], "buffer-full", "{e}");
+            assert!(e["cor"].is_number(), "{extra:?}: no COR on the board: {e}");
+            for field in KINEMATICS_FIELDS {
+                assert_eq!(
+                    e[field], h[field],
+                    "{extra:?} impact {}: {field}",
+                    h["index"]
+                );
+            }
+            // What needs the whole loop says so.
+            assert_eq!(e["null_reasons"]["permanent_deformation_m"], "capture-full");
+            eprintln!(
+                "{extra:?} impact {}: COR {}, reported {:.1} ms after its hold",
+                e["index"],
+                e["cor"],
+                e["report_latency_s"].as_f64().unwrap() * 1e3
+            );
+        }
+        within_board_limits(&log);
     }
 }

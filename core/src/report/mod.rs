@@ -23,8 +23,9 @@ pub enum Status {
     Complete,
     /// The stream ended inside the impact.
     StreamEnded,
-    /// The capture buffer filled up: Δv and the peak cover the whole impact, the rest only
-    /// the captured part (no kinematics, no fits).
+    /// The capture buffer filled up: Δv, the peak and the kinematics (the stream's online
+    /// sums, `stream/online.rs`) cover the whole impact; the width, the filtered fields, the
+    /// spectra and the verdict only the captured part; no fits (they need the whole loop).
     BufferFull,
     /// The signal stayed away from the baseline longer than the scene's maximum impact time
     /// (stuck, drifting or disconnected sensor); the baseline is learned again.

@@ -258,12 +258,15 @@ impl<const PRE: usize> Stream<PRE> {
         });
         let lobe_lead = libm::floorf(-a.lobe_touch).max(0.0) as usize;
         self.online.start(
+            deviation,
             crate::report::motion::motion_deviation(base_sum, base_n, scene),
             &self.ring,
             pulse,
             before_onset,
             [line_lead, lobe_lead],
             c_stop,
+            // The largest |d| of the window so far (the pulse's included).
+            a.peak_d.saturating_abs(),
         );
         self.active = Some(a);
     }
@@ -337,11 +340,9 @@ impl<const PRE: usize> Stream<PRE> {
         let mut used = samples.len();
         let mut ended = None;
         let (d_hi, d_lo) = (a.d_hi, a.d_lo);
-        // The kinematics' online sums ([`super::online`]).
-        let online = &mut self.online;
-        let motion = online.motion;
-        let m0 = online.m;
-        let (mut cm, mut qm, mut mark) = (online.c, online.q, online.mark);
+        // The kinematics' online sums ([`super::online`]): `Σ` of the running `Σ d` per
+        // sample here, the rest once per call.
+        let mut sum2: i64 = 0;
         let n = samples.len();
         let mut k = 0;
         // Alternating stretches of samples beyond the edge level (loud) and within it
@@ -411,17 +412,7 @@ impl<const PRE: usize> Stream<PRE> {
                     quiet = 0;
                 }
                 sum += d as i64;
-                let dm = motion.of(x) as i64;
-                cm = cm.wrapping_add(dm);
-                qm = qm.wrapping_add(cm);
-                if cm >= mark {
-                    mark = online.band_step(
-                        x,
-                        m0 + k as u64,
-                        cm.wrapping_sub(dm),
-                        qm.wrapping_sub(cm),
-                    );
-                }
+                sum2 = sum2.wrapping_add(sum);
                 k += 1;
             }
             // Quiet: the first quiet sample after the peak is the separation.
@@ -436,17 +427,7 @@ impl<const PRE: usize> Stream<PRE> {
                 }
                 quiet += 1;
                 sum += d as i64;
-                let dm = motion.of(x) as i64;
-                cm = cm.wrapping_add(dm);
-                qm = qm.wrapping_add(cm);
-                if cm >= mark {
-                    mark = online.band_step(
-                        x,
-                        m0 + k as u64,
-                        cm.wrapping_sub(dm),
-                        qm.wrapping_sub(cm),
-                    );
-                }
+                sum2 = sum2.wrapping_add(sum);
                 if quiet >= first_mark {
                     returned |= quiet >= min_gap;
                     if quiet >= hold && start + k as u64 > a.trigger_index {
@@ -458,9 +439,9 @@ impl<const PRE: usize> Stream<PRE> {
                 k += 1;
             }
         }
-        online.m = m0 + used as u64;
-        (online.c, online.q, online.mark) = (cm, qm, mark);
         let kept = samples.get(..used).unwrap_or(&[]);
+        // Σ d' = Σ d - n G; Σ C' from Σ of the running Σ d: exact, once per call.
+        self.online.advance(kept, sum, sum2, scan.max);
         // Only when the samples reach a rail does it matter which of them did.
         if scan.min <= lo || scan.max >= hi {
             a.clipped |= kept.iter().any(|&x| x <= lo || x >= hi);
