@@ -2,8 +2,10 @@
 //! over a capture that holds the whole contact: the board's capture (15 104 samples) and a
 //! host-sized one give the same bits for every impact, however long its contact (#41).
 
+use impact_core::analysis::{analyse, analyse_by_pass};
 use impact_core::signal::Calibration;
-use impact_core::{Approach, ImpactReport, Monitor, Scene};
+use impact_core::stream::Stream;
+use impact_core::{Approach, Capture, ImpactReport, Scene, Sink, Workspace};
 
 /// A pulse of `len` samples: a half-sine of `peak` counts, its rise softened (a foot) by
 /// `foot` (0: none), on a baseline of 2000 counts; 0.2 s of quiet before and after it.
@@ -42,24 +44,68 @@ fn scene(rate: f64, v0: f32, vertical: bool) -> Scene {
     s
 }
 
-/// The reports of `samples` through a monitor whose capture holds `CAP` samples.
-fn run<const CAP: usize>(samples: &[i16], scene: Scene) -> Vec<ImpactReport> {
+/// Each impact's report as the stream and analysis give it (kinematics from the online
+/// sums where they hold them) and the analysis with the kinematics from the capture pass
+/// alone.
+struct Both<const CAP: usize> {
+    capture: Box<Capture<CAP>>,
+    work: Box<Workspace<CAP>>,
+    out: Vec<(ImpactReport, Option<ImpactReport>)>,
+}
+
+impl<const CAP: usize> Sink<CAP> for Both<CAP> {
+    fn buffer(&mut self) -> Option<&mut Capture<CAP>> {
+        Some(&mut self.capture)
+    }
+    fn captured(&mut self, scene: &Scene) {
+        let online = analyse(&self.capture, scene, &mut self.work);
+        let pass = analyse_by_pass(&self.capture, scene, &mut self.work);
+        self.out.push((online, Some(pass)));
+    }
+    fn skipped(&mut self, report: &ImpactReport) {
+        self.out.push((*report, None));
+    }
+}
+
+/// The reports of `samples` through a stream whose capture holds `CAP` samples.
+fn run<const CAP: usize>(
+    samples: &[i16],
+    scene: Scene,
+) -> Vec<(ImpactReport, Option<ImpactReport>)> {
     let samples = samples.to_vec();
     std::thread::Builder::new()
         .stack_size(256 << 20)
         .spawn(move || {
-            let mut m: Box<Monitor<4096, CAP>> = Box::new(Monitor::unconfigured());
-            m.configure(scene).unwrap();
-            let mut out = Vec::new();
+            let mut stream: Box<Stream<4096>> = Box::new(Stream::new(scene).unwrap());
+            let mut sink = Both::<CAP> {
+                capture: Box::new(Capture::new()),
+                work: Box::new(Workspace::new()),
+                out: Vec::new(),
+            };
             for block in samples.chunks(256) {
-                m.push_block(block, &mut |r| out.push(*r));
+                stream.push_block(block, &mut sink);
             }
-            m.finish(&mut |r| out.push(*r));
-            out
+            stream.finish(&mut sink);
+            sink.out
         })
         .unwrap()
         .join()
         .unwrap()
+}
+
+/// The kinematics' bits.
+fn bits(r: &ImpactReport) -> Option<[u32; 6]> {
+    r.kinematics.map(|k| {
+        [
+            k.impact_velocity_m_s,
+            k.crush_time_s,
+            k.max_deformation_m,
+            k.rebound_velocity_m_s,
+            k.cor,
+            k.separation_deformation_m,
+        ]
+        .map(f32::to_bits)
+    })
 }
 
 #[test]
@@ -83,29 +129,98 @@ fn every_contact_has_the_same_kinematics_with_the_boards_capture_and_a_whole_one
         let whole = run::<65_536>(&x, sc);
         assert_eq!(board.len(), 1, "{len}");
         assert_eq!(whole.len(), 1, "{len}");
-        let (b, w) = (&board[0], &whole[0]);
-        let k = w
-            .kinematics
-            .unwrap_or_else(|| panic!("{len}: host: {:?}", w.flags));
+        let (b, w) = (&board[0].0, &whole[0]);
+        // The whole capture's pass: what the online sums are held to.
+        let pass = w.1.expect("a whole capture");
+        assert!(pass.kinematics.is_some(), "{len}: pass: {:?}", pass.flags);
         assert_eq!(
-            b.kinematics.map(|k| (
-                k.crush_time_s.to_bits(),
-                k.max_deformation_m.to_bits(),
-                k.cor.to_bits(),
-                k.separation_deformation_m.to_bits()
-            )),
-            Some((
-                k.crush_time_s.to_bits(),
-                k.max_deformation_m.to_bits(),
-                k.cor.to_bits(),
-                k.separation_deformation_m.to_bits()
-            )),
-            "{len} {foot}: board {:?} {:?}, whole {:?}",
-            b.status,
-            b.flags,
-            k
+            bits(&w.0),
+            bits(&pass),
+            "{len} {foot}: online and pass, whole capture"
         );
+        assert_eq!(
+            bits(b),
+            bits(&pass),
+            "{len} {foot}: board {:?} {:?} against the whole capture's pass",
+            b.status,
+            b.flags
+        );
+        if len > 15_104 {
+            assert_eq!(b.status, impact_core::Status::BufferFull);
+        }
         checked += 1;
     }
     assert_eq!(checked, 5);
+}
+
+/// A small deterministic generator (an LCG) for the random cases.
+struct Lcg(u64);
+
+impl Lcg {
+    fn f(&mut self) -> f64 {
+        self.0 = self
+            .0
+            .wrapping_mul(6364136223846793005)
+            .wrapping_add(1442695040888963407);
+        (self.0 >> 11) as f64 / (1u64 << 53) as f64
+    }
+
+    /// `n` samples of a half-sine of `peak` counts (0: quiet) with its foot softened by
+    /// `foot`, and noise of a few counts, onto `x`.
+    fn push(&mut self, x: &mut Vec<i16>, n: usize, peak: f64, foot: f64) {
+        for j in 0..n {
+            let t = j as f64 / n as f64;
+            let s = (std::f64::consts::PI * t).sin();
+            let shape = if foot > 0.0 {
+                s.powf(1.0 + foot * (1.0 - t))
+            } else {
+                s
+            };
+            let noise = (self.f() * 5.0).floor() - 2.0;
+            x.push((2000.0 + peak * shape + noise * 0.6).round() as i16);
+        }
+    }
+}
+
+/// A next hit that begins before the hold is up ends the impact where the signal last left
+/// the baseline: the online sums took the next hit's rising flank too, and must not find a
+/// crush (or a separation) there that the capture's pass, which stops at the window's end,
+/// does not (an approach about as fast as the pulse's Δv stops, if at all, at its very end;
+/// the review of #41 found 6 such crushes in 3 500 impacts like these).
+#[test]
+fn a_next_hit_lends_its_flank_to_no_crush() {
+    let rate = 100_000.0;
+    let mut rng = Lcg(12345);
+    let mut compared = 0;
+    for _ in 0..1500 {
+        let mut x = Vec::new();
+        rng.push(&mut x, 20_000, 0.0, 0.0);
+        let (start, len) = (x.len(), 200 + (rng.f() * 6000.0) as usize);
+        let foot = [0.0, 0.5, 1.5][(rng.f() * 3.0) as usize % 3];
+        let peak = 200.0 + rng.f() * 2500.0;
+        rng.push(&mut x, len, peak, foot);
+        let area = x[start..].iter().map(|&c| (c - 2000) as f64).sum::<f64>() * 0.05 / rate;
+        // A next hit within the hold (200 samples), after more than an eighth of it.
+        let gap = 30 + (rng.f() * 150.0) as usize;
+        rng.push(&mut x, gap, 0.0, 0.0);
+        let (len2, peak2) = (200 + (rng.f() * 3000.0) as usize, 200.0 + rng.f() * 2500.0);
+        rng.push(&mut x, len2, peak2, 0.0);
+        rng.push(&mut x, 20_000, 0.0, 0.0);
+        let mut sc = scene(rate, ((0.96 + rng.f() * 0.06) * area) as f32, false);
+        sc.v0_every = true;
+        for (online, pass) in run::<65_536>(&x, sc) {
+            let pass = pass.expect("captured");
+            assert_eq!(
+                bits(&online),
+                bits(&pass),
+                "impact {}: online {:?} {:?}, pass {:?}",
+                online.index,
+                online.kinematics,
+                online.flags,
+                pass.kinematics
+            );
+            compared += 1;
+        }
+    }
+    assert!(compared >= 3000, "{compared}");
 }

@@ -114,7 +114,7 @@ pub fn analyse<const CAP: usize>(
     scene: &Scene,
     work: &mut Workspace<CAP>,
 ) -> ImpactReport {
-    let mut r = analyse_kinematics(capture, scene, work);
+    let mut r = analyse_kinematics(capture, capture.summary(), scene, work);
     if let Some(settings) = scene.spectrum {
         r.spectrum = spectrum(capture, scene, &settings, work);
     }
@@ -229,13 +229,27 @@ fn filter<const CAP: usize>(
     Some((lead + i, v))
 }
 
-/// Everything but the spectra.
-fn analyse_kinematics<const CAP: usize>(
+/// The analysis with the kinematics from the pass over the capture alone, the stream's
+/// online sums left out: what the two are held to (they give the same bits wherever the
+/// capture holds the contact; `host-tests/tests/online.rs`). No spectra, no verdict.
+#[doc(hidden)]
+pub fn analyse_by_pass<const CAP: usize>(
     capture: &Capture<CAP>,
     scene: &Scene,
     work: &mut Workspace<CAP>,
 ) -> ImpactReport {
-    let s = capture.summary();
+    let mut s = *capture.summary();
+    s.motion = report::motion::Record::NONE;
+    analyse_kinematics(capture, &s, scene, work)
+}
+
+/// Everything but the spectra, for the capture's summary `s`.
+fn analyse_kinematics<const CAP: usize>(
+    capture: &Capture<CAP>,
+    s: &crate::capture::Summary,
+    scene: &Scene,
+    work: &mut Workspace<CAP>,
+) -> ImpactReport {
     let mut r = report::streaming(s, scene);
     r.analysis = Analysis::Full;
     let samples = capture.samples();

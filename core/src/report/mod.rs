@@ -133,15 +133,16 @@ impl Flags {
     /// start, duration and Δv cover only the part after it; the kinematics and the fits are
     /// absent.
     pub const IN_PREVIOUS: Flags = Flags(1 << 10);
-    /// The impact follows a flight (it came within a train's longest flight of the previous
-    /// contact's separation), and the scene's approach speed is the first impact's (a drop's
-    /// `v0` or height, without a train): this one's approach speed is unknown, so the
-    /// kinematics and the fits are absent. A train measures a bounce's approach speed; a
-    /// rig that strikes every time at one speed says `v0_every`.
+    /// The impact follows a flight (its first touch came within a train's longest flight of
+    /// the previous contact's end, or before it), and the scene's approach speed is the
+    /// first impact's (a drop's `v0` or height) and no train timed this flight: its approach
+    /// speed is unknown, so the kinematics and the fits are absent. A train measures a
+    /// bounce's approach speed; a rig that strikes every time at one speed says `v0_every`.
     pub const APPROACH_UNKNOWN: Flags = Flags(1 << 11);
-    /// The contact outlasted the capture and the stream's online sums lost its crush or its
-    /// separation (first touch or the approach speed found at the end moved them beyond the
-    /// samples kept around them): the kinematics and the fits are absent.
+    /// No capture holds the whole contact (it outlasted the capture, or the analysis was
+    /// skipped) and the stream's online sums lost its crush or its separation (first touch or
+    /// the approach speed found at the end moved them beyond the samples kept around them):
+    /// the kinematics and the fits are absent.
     pub const KINEMATICS_NOT_HELD: Flags = Flags(1 << 12);
 
     /// Every flag with its name in the reports.

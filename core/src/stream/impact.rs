@@ -607,6 +607,11 @@ impl<const PRE: usize> Stream<PRE> {
         let approach = self
             .train
             .approach(&self.scene, touch, self.v0, self.v0_measured);
+        // A light gate's reading is the next impact's approach speed, not its bounces'.
+        if self.v0_measured {
+            self.v0 = self.scene.v0_m_s();
+            self.v0_measured = false;
+        }
         let mut summary = Summary {
             index: self.counters.impacts.min(u32::MAX as u64) as u32,
             status,

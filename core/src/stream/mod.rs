@@ -309,7 +309,8 @@ impl<const PRE: usize> Stream<PRE> {
         self.index
     }
 
-    /// Sets the approach speed for the next impacts (a light gate's reading), m/s.
+    /// Sets the approach speed of the next impact (a light gate's reading), m/s: it holds for
+    /// that impact only (after it the scene's is back), so no bounce takes it.
     pub fn set_approach_speed(&mut self, v0_m_s: Option<f32>) {
         self.v0 = v0_m_s.filter(|v| v.is_finite() && *v > 0.0);
         self.v0_measured = self.v0.is_some();

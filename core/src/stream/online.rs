@@ -1,6 +1,9 @@
 //! The impact's motion integrated online: the kinematics' exact sums kept while the impact
-//! streams, so that every impact whose approach speed is known has its crush and its
-//! separation's states however long its contact, whether or not a capture holds it.
+//! streams, so that an impact whose approach speed is known has its crush and its
+//! separation's states however long its contact, whether or not a capture holds it (or,
+//! rarely, says why not: `crush-not-held`/`edge-not-held` when what is found only at the end
+//! moved them beyond the samples kept around them). Only the impact's window counts: a next
+//! hit's flank the sums took before the impact ended is beyond its end.
 //!
 //! ```text
 //!            foot          onset                crush band           separation
@@ -389,17 +392,30 @@ impl Online {
     pub(super) fn finish(&self, s: &Summary, scene: &Scene) -> Record {
         let kinematic = matches!(s.status, Status::Complete | Status::BufferFull)
             && !(s.clipped || s.cut_at_start || s.in_previous);
-        let frame = Frame::of(s, scene, None).filter(|_| kinematic);
+        // The impact's window (to its end: the hold's, or where a next hit began), as a
+        // capture that holds it gives it to the pass: the sums took more (a next hit's
+        // rising flank), which no state may use.
+        let window = usize::try_from(s.end_index.saturating_sub(s.first_index)).ok();
+        let frame = Frame::of(s, scene, window).filter(|_| kinematic);
         let (Some(frame), Some(c_stop)) = (frame, frame.and_then(|f| f.scale.c_stop())) else {
             return Record::missing(Missing::NotKinematic);
         };
+        // Samples of the window from the first the pass integrates.
+        let start = (s.onset_index.saturating_sub(s.first_index) as usize)
+            .saturating_sub(frame.lead as usize);
+        let reach = window.unwrap_or(0).saturating_sub(start) as u64;
         let Some(lead) = self.lead(frame.lead as usize) else {
             return Record::missing(Missing::EdgeNotHeld);
         };
         let crush = match self.crush(lead, c_stop) {
-            Ok(c) => c,
+            // The sample that stopped it must lie in the window.
+            Ok(c) if u64::from(c.at.k) < reach => c,
+            Ok(_) => return Record::missing(Missing::NoStop),
             Err(why) => return Record::missing(why),
         };
+        if u64::from(frame.sep_floor) + 1 > reach {
+            return Record::missing(Missing::NoStop);
+        }
         let Some(separation) = self.separation(&frame, lead, s) else {
             return Record::missing(Missing::EdgeNotHeld);
         };
@@ -436,7 +452,7 @@ impl Online {
             }
             c = c_next;
             q = q.wrapping_add(c);
-            k += 1;
+            k = k.saturating_add(1);
         }
         Err(if self.band_len < BAND {
             Missing::NoStop
@@ -484,7 +500,7 @@ impl Online {
 /// sums `(c, q)`.
 fn shifted(lead: Lead, m: u32, c: i64, q: i64) -> Sums {
     Sums {
-        k: lead.len + m,
+        k: lead.len.saturating_add(m),
         c: lead.l.wrapping_add(c),
         q: lead
             .q

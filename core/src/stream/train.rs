@@ -67,8 +67,8 @@ impl Tracker {
 
     /// The approach of an impact whose first touch is at stream position `touch`
     /// (fractional samples); `first` is the speed a first impact gets (the scene's approach,
-    /// or a light gate's), `measured` whether a light gate measured it (then it holds for
-    /// every impact).
+    /// or a light gate's), `measured` whether a light gate measured it for this impact (then
+    /// it holds after a flight too).
     pub(crate) fn approach(
         &self,
         scene: &Scene,
@@ -83,27 +83,33 @@ impl Tracker {
         };
         let fs = scene.calibration.sample_rate_hz as f64;
         let flight = |from: f64| ((touch - from) / fs) as f32;
+        // Within the longest flight of the previous contact's end (or overlapping it): a
+        // bounce, whose approach nothing measured unless a train does.
+        let max = scene
+            .train
+            .map_or(Train::new().max_flight_s, |t| t.max_flight_s);
+        let bounced = self.last_end.is_some_and(|e| flight(e) <= max);
+        let unmeasured = |holds: bool| match first {
+            Some(_) if bounced && !holds => Approached {
+                v0_m_s: None,
+                bounce: None,
+                unknown: true,
+            },
+            _ => plain,
+        };
         let Some(train) = scene.train else {
-            // No train: an impact within a train's longest flight of the previous one is a
-            // bounce, and the scene's speed was the drop's.
-            let max = Train::new().max_flight_s;
-            let bounced = self.last_end.is_some_and(|e| flight(e) <= max);
-            return match first {
-                Some(_) if bounced && !(scene.v0_every || measured) => Approached {
-                    v0_m_s: None,
-                    bounce: None,
-                    unknown: true,
-                },
-                _ => plain,
-            };
+            // No train: the scene's speed was the drop's, unless every impact comes at it.
+            return unmeasured(scene.v0_every || measured);
         };
-        let Some(separation) = self.separation else {
-            return plain;
+        // A train goes on from a separation it could time; a bounce after one it could not
+        // (a gap, a contact that settled) has no speed but a light gate's.
+        let Some(flight_s) = self
+            .separation
+            .map(flight)
+            .filter(|&f| f > 0.0 && f <= train.max_flight_s)
+        else {
+            return unmeasured(measured);
         };
-        let flight_s = flight(separation);
-        if !(flight_s > 0.0 && flight_s <= train.max_flight_s) {
-            return plain;
-        }
         let bounce = Bounce {
             number: self.number.saturating_add(1),
             flight_s,
@@ -144,6 +150,13 @@ impl Tracker {
             }),
             _ => None,
         };
+        // A contact that came back (not a level the signal settled at, as a release's jolt,
+        // nor a stuck sensor or the stream's end): the next impact within a flight of it is
+        // a bounce.
+        let contact = matches!(
+            s.status,
+            Status::Complete | Status::BufferFull | Status::Gap
+        );
         let last_end = s.separation_index.unwrap_or(s.end_index) as f64
             + if s.separation_index.is_some() {
                 s.separation_offset as f64
@@ -152,7 +165,7 @@ impl Tracker {
             };
         *self = Tracker {
             separation: separation.filter(|_| scene.train.is_some()),
-            last_end: Some(last_end),
+            last_end: contact.then_some(last_end),
             rebound_m_s: rebound,
             number: s.bounce.get().map_or(0, |b| b.number),
         };
@@ -231,6 +244,29 @@ mod tests {
             Tracker::new().approach(&s, 10_000.0, Some(1.5), false),
             plain(Some(1.5))
         );
+    }
+
+    #[test]
+    fn a_train_that_could_not_time_a_flight_gives_a_bounce_no_speed() {
+        let s = scene();
+        // The previous contact ended (a gap in it: no separation to time from) 0.1 s ago.
+        let t = Tracker {
+            separation: None,
+            last_end: Some(0.0),
+            rebound_m_s: None,
+            number: 0,
+        };
+        let a = t.approach(&s, 10_000.0, Some(1.5), false);
+        assert_eq!((a.v0_m_s, a.unknown), (None, true));
+        assert_eq!(t.approach(&s, 10_000.0, Some(1.5), true), plain(Some(1.5)));
+        // A level the signal settled at (a release's jolt) is no contact: the drop's first
+        // impact keeps the scene's speed.
+        let mut t = Tracker::new();
+        let mut settled = Summary::EMPTY;
+        settled.status = Status::Settled;
+        settled.end_index = 1000;
+        t.ended(&settled, &s);
+        assert_eq!(t.approach(&s, 10_000.0, Some(1.5), false), plain(Some(1.5)));
     }
 
     #[test]
