@@ -7,23 +7,33 @@ use impact_core::signal::Calibration;
 use impact_core::stream::Stream;
 use impact_core::{Approach, Capture, ImpactReport, Scene, Sink, Workspace};
 
-/// A pulse of `len` samples: a half-sine of `peak` counts, its rise softened (a foot) by
-/// `foot` (0: none), on a baseline of 2000 counts; 0.2 s of quiet before and after it.
-fn pulse(len: usize, peak: f64, foot: f64, rate: f64) -> Vec<i16> {
-    let quiet = (0.2 * rate) as usize;
-    let mut x = vec![2000i16; quiet];
-    for j in 0..len {
-        let t = j as f64 / len as f64;
+/// `n` samples of a half-sine of `peak` counts (0: quiet) on a baseline of 2000 counts, its
+/// rise softened (a foot) by `foot` (0: none), with `noise(j)` codes (a few) added, onto `x`.
+fn half_sine(
+    x: &mut Vec<i16>,
+    n: usize,
+    peak: f64,
+    foot: f64,
+    mut noise: impl FnMut(usize) -> f64,
+) {
+    for j in 0..n {
+        let t = j as f64 / n as f64;
         let s = (std::f64::consts::PI * t).sin();
         let shape = if foot > 0.0 {
             s.powf(1.0 + foot * (1.0 - t))
         } else {
             s
         };
-        // A little deterministic noise (a few counts), as a real channel has.
-        let noise = ((j * 7919) % 5) as f64 - 2.0;
-        x.push((2000.0 + peak * shape + noise * 0.6).round() as i16);
+        x.push((2000.0 + peak * shape + noise(j) * 0.6).round() as i16);
     }
+}
+
+/// A pulse of `len` samples ([`half_sine`], a little deterministic noise, as a real channel
+/// has), 0.2 s of quiet before and after it.
+fn pulse(len: usize, peak: f64, foot: f64, rate: f64) -> Vec<i16> {
+    let quiet = (0.2 * rate) as usize;
+    let mut x = vec![2000i16; quiet];
+    half_sine(&mut x, len, peak, foot, |j| ((j * 7919) % 5) as f64 - 2.0);
     x.extend(std::iter::repeat_n(2000i16, quiet));
     x
 }
@@ -165,20 +175,9 @@ impl Lcg {
         (self.0 >> 11) as f64 / (1u64 << 53) as f64
     }
 
-    /// `n` samples of a half-sine of `peak` counts (0: quiet) with its foot softened by
-    /// `foot`, and noise of a few counts, onto `x`.
+    /// `n` samples of [`half_sine`] with random noise onto `x`.
     fn push(&mut self, x: &mut Vec<i16>, n: usize, peak: f64, foot: f64) {
-        for j in 0..n {
-            let t = j as f64 / n as f64;
-            let s = (std::f64::consts::PI * t).sin();
-            let shape = if foot > 0.0 {
-                s.powf(1.0 + foot * (1.0 - t))
-            } else {
-                s
-            };
-            let noise = (self.f() * 5.0).floor() - 2.0;
-            x.push((2000.0 + peak * shape + noise * 0.6).round() as i16);
-        }
+        half_sine(x, n, peak, foot, |_| (self.f() * 5.0).floor() - 2.0);
     }
 }
 

@@ -289,9 +289,29 @@ pub fn rebound_m_s(r: &ImpactReport, v0: f32, gravity_m_s2: Option<f32>) -> Opti
     Some(delta_v - v0 - gravity_m_s2.map_or(0.0, |g| g * r.duration_s))
 }
 
-/// The report of the streaming fields alone (`analysis` skipped); the analysis fills in the
-/// rest.
+/// The report of what the stream measured (`analysis` skipped): its fields and the
+/// kinematics its online sums found; the analysis fills in the rest.
 pub fn streaming(s: &Summary, scene: &Scene) -> ImpactReport {
+    let mut r = measured(s, scene);
+    // The kinematics from the stream's online sums, however long the contact.
+    match s.motion.get() {
+        Ok(found) => {
+            if let Some(frame) = motion::Frame::of(s, scene, None) {
+                motion::kinematics(&mut r, scene, &frame, &found);
+            }
+        }
+        Err(Some(motion::Missing::NoStop)) => r.flags.insert(Flags::NO_STOP),
+        Err(Some(motion::Missing::CrushNotHeld | motion::Missing::EdgeNotHeld)) => {
+            r.flags.insert(Flags::KINEMATICS_NOT_HELD)
+        }
+        Err(_) => {}
+    }
+    r
+}
+
+/// The streaming fields alone (peak, Δv, times, flags), no kinematics: what a bounce
+/// train needs of the previous impact.
+pub(crate) fn measured(s: &Summary, scene: &Scene) -> ImpactReport {
     let fs = scene.calibration.sample_rate_hz as f64;
     let n = s.base_n.max(1) as f64;
     let per_d = scene.calibration.gain_m_s2_per_count as f64 / n;
@@ -334,7 +354,7 @@ pub fn streaming(s: &Summary, scene: &Scene) -> ImpactReport {
         Some(i) => i as f64 + s.separation_offset as f64,
         None => s.end_index as f64,
     };
-    let mut r = ImpactReport {
+    ImpactReport {
         index: s.index,
         status: s.status,
         analysis: Analysis::Skipped,
@@ -357,19 +377,5 @@ pub fn streaming(s: &Summary, scene: &Scene) -> ImpactReport {
         bounce: s.bounce.get(),
         spectrum: None,
         verdict: None,
-    };
-    // The kinematics from the stream's online sums, however long the contact.
-    match s.motion.get() {
-        Ok(found) => {
-            if let Some(frame) = motion::Frame::of(s, scene, None) {
-                motion::kinematics(&mut r, scene, &frame, &found);
-            }
-        }
-        Err(Some(motion::Missing::NoStop)) => r.flags.insert(Flags::NO_STOP),
-        Err(Some(motion::Missing::CrushNotHeld | motion::Missing::EdgeNotHeld)) => {
-            r.flags.insert(Flags::KINEMATICS_NOT_HELD)
-        }
-        Err(_) => {}
     }
-    r
 }

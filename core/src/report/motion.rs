@@ -59,6 +59,18 @@ pub struct Scale {
 }
 
 impl Scale {
+    /// The scale of an impact at `v0` measured from a baseline of `base_n` samples in
+    /// `scene` (`kv = gain / (W fs)`), the deformation `x_lead` at its first half sample.
+    pub fn new(v0: f64, scene: &Scene, base_n: i64, x_lead: f64) -> Self {
+        let fs = scene.calibration.sample_rate_hz as f64;
+        Self {
+            v0,
+            kv: scene.calibration.gain_m_s2_per_count as f64 / base_n.max(1) as f64 / fs,
+            dt: 1.0 / fs,
+            x_lead,
+        }
+    }
+
     pub fn velocity(&self, c: i64) -> f64 {
         self.v0 - self.kv * c as f64
     }
@@ -149,22 +161,16 @@ impl Frame {
         if !(sep_floor < u32::MAX as f64 - 1.0) {
             return None;
         }
-        let gain = scene.calibration.gain_m_s2_per_count;
         Some(Self {
             lead: lead as u32,
             touch,
             separation,
             sep_floor: sep_floor as u32,
             frac: sep_at - sep_floor,
-            scale: Scale {
-                v0,
-                kv: gain as f64 / s.base_n.max(1) as f64 / fs,
-                dt,
-                // The sums start half a sample before their first sample's instant (the
-                // midpoint rule); from first touch to there the body moves at ~v0 (a touch
-                // within that half sample leaves the body short of it: negative).
-                x_lead: v0 * (-touch - 0.5) * dt,
-            },
+            // The sums start half a sample before their first sample's instant (the midpoint
+            // rule); from first touch to there the body moves at ~v0 (a touch within that
+            // half sample leaves the body short of it: negative).
+            scale: Scale::new(v0, scene, s.base_n, v0 * (-touch - 0.5) * dt),
         })
     }
 

@@ -247,14 +247,7 @@ impl<const PRE: usize> Stream<PRE> {
             .approach(scene, touch, self.v0, self.v0_measured)
             .v0_m_s;
         let c_stop = v0.and_then(|v0| {
-            let fs = scene.calibration.sample_rate_hz as f64;
-            crate::report::motion::Scale {
-                v0: v0 as f64,
-                kv: scene.calibration.gain_m_s2_per_count as f64 / base_n.max(1) as f64 / fs,
-                dt: 1.0 / fs,
-                x_lead: 0.0,
-            }
-            .c_stop()
+            crate::report::motion::Scale::new(v0 as f64, scene, base_n, 0.0).c_stop()
         });
         let lobe_lead = libm::floorf(-a.lobe_touch).max(0.0) as usize;
         self.online.start(

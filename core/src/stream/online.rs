@@ -79,13 +79,13 @@ struct Around {
 pub(super) struct Online {
     /// The deviation the kinematics integrate (the baseline's, less gravity in a vertical
     /// contact).
-    pub(super) motion: Deviation,
+    motion: Deviation,
     /// Gravity's shift: `d' = d - g` (0 in a horizontal contact).
     g: i64,
     /// Samples integrated since the onset, and `C'`, `Q'` after them.
-    pub(super) m: u64,
-    pub(super) c: i64,
-    pub(super) q: i64,
+    m: u64,
+    c: i64,
+    q: i64,
     /// The band takes the samples from the first whose `C'` reaches this on (`i64::MIN`:
     /// while it fills; `i64::MAX`: never, or full).
     mark: i64,

@@ -140,7 +140,7 @@ impl Tracker {
         // A clipped impact's Δv is a lower bound: no rebound from it.
         let rebound = match (s.v0_m_s, separation) {
             (Some(v0), Some(_)) if !s.clipped && scene.train.is_some() => report::rebound_m_s(
-                &report::streaming(s, scene),
+                &report::measured(s, scene),
                 v0,
                 scene.contact_gravity_m_s2(),
             )
