@@ -3,6 +3,7 @@
 //! `#[path]` or `include!`. Nothing here touches a peripheral; it builds for the host too,
 //! where the defmt formatting is left out.
 //!
+//! * [`analog`]: the ADC's scale from the supply VREFINT measures;
 //! * [`scene`]: the compiled-in bench and the emulator's `key=value` scene parser;
 //! * [`rate`]: the build's sample rate;
 //! * [`adxl375`]: the ADXL375 driver over `embedded-hal-async` (SPI traffic, FIFO, scale);
@@ -14,6 +15,7 @@
 #![no_std]
 
 pub mod adxl375;
+pub mod analog;
 pub mod fifo;
 pub mod light_gate;
 pub mod rate;

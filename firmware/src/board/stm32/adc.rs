@@ -27,7 +27,7 @@
 
 use defmt::{info, warn};
 use embassy_futures::select::{select, Either};
-use embassy_stm32::adc::{Adc, AdcChannel, Exten, RingBufferedAdc, SampleTime};
+use embassy_stm32::adc::{Adc, AdcChannel, Exten, RingBufferedAdc, SampleTime, VrefInt};
 use embassy_stm32::interrupt;
 use embassy_stm32::peripherals::{ADC1, DMA2_CH0, PA1, TIM2, TIM3};
 use embassy_stm32::time::Hertz;
@@ -41,6 +41,7 @@ use static_cell::ConstStaticCell;
 use super::Irqs;
 use crate::queues::BLOCK_LEN;
 use crate::source::sender::{BlockSender, SAMPLE_CLOCK, SOURCE_STATS};
+use impact_firmware::analog::{self, VddaError};
 use impact_firmware::SAMPLE_RATE_HZ;
 
 /// DMA ring length in samples: two blocks, so the DMA fills one half while the task reads
@@ -57,6 +58,28 @@ const STALL_TIMEOUT: Duration = Duration::from_millis(10);
 pub fn dma_buffer() -> &'static mut [u16; DMA_BUF_LEN] {
     static BUF: ConstStaticCell<[u16; DMA_BUF_LEN]> = ConstStaticCell::new([0; DMA_BUF_LEN]);
     BUF.take()
+}
+
+/// Conversions of VREFINT averaged for the supply (each 480 ADCCLK cycles, 22.9 us: VREFINT
+/// needs 10 us of sampling, DS8626 Table 71).
+const VREFINT_READS: u32 = 16;
+
+/// The supply the ADC converts against, volts, from VREFINT and its factory calibration
+/// (`impact_firmware::analog`). Runs once, before the sampler takes the ADC.
+pub fn vdda_v(adc: Peri<'_, ADC1>) -> Result<f32, VddaError> {
+    let mut adc = Adc::new(adc);
+    let mut vrefint = adc.enable_vrefint();
+    // VREFINT's start-up time (DS8626 Table 71: 10 us).
+    embassy_time::block_for(Duration::from_micros(VrefInt::start_time_us().into()));
+    let mut sum = 0u32;
+    for _ in 0..VREFINT_READS {
+        sum += u32::from(adc.blocking_read(&mut vrefint, SampleTime::CYCLES480));
+    }
+    // SAFETY: a read of the factory calibration word in the system memory's OTP area, which
+    // the F407 always maps (RM0090 2.3, DS8626 6.3.22).
+    let cal = unsafe { core::ptr::read_volatile(analog::VREFINT_CAL_ADDR as *const u16) };
+    // Dropping the driver stops the ADC and gates its clock; the sampler brings it up again.
+    analog::vdda_v(cal, sum as f32 / VREFINT_READS as f32)
 }
 
 /// TIM2 in external clock mode 1 on ITR2 = TIM3's TRGO: a 32-bit count of the conversions

@@ -67,18 +67,61 @@ pub struct Setup {
     p: Peripherals,
 }
 
-/// Brings the chip up at 168 MHz with the flash accelerator on, logs why it last reset, and
-/// starts the independent watchdog.
+/// Brings the chip up at 168 MHz with the flash accelerator on, logs why it last reset,
+/// starts the independent watchdog, and sets the ADC's scale from the supply it measures.
 pub fn init() -> Setup {
-    let p = embassy_stm32::init(clock_config());
+    #[allow(unused_mut)]
+    let mut p = embassy_stm32::init(clock_config());
     enable_flash_accelerator();
     info!("reset reason: {}", reset_reason());
     start_watchdog();
+    #[allow(unused_mut)]
+    let mut scene = impact_firmware::scene::BENCH;
+    #[cfg(not(feature = "adxl375"))]
+    {
+        scene.calibration.gain_m_s2_per_count = analog_scale(adc::vdda_v(p.ADC1.reborrow()));
+    }
     Setup {
-        scene: impact_firmware::scene::BENCH,
+        scene,
         backpressure: Backpressure::Never,
         p,
     }
+}
+
+/// The ADC's gain, m/s² per count, for the supply VREFINT measured (logged with the range the
+/// ADC then covers), or for the Discovery's nominal 3.0 V when it could not be measured.
+#[cfg(not(feature = "adxl375"))]
+fn analog_scale(vdda: Result<f32, impact_firmware::analog::VddaError>) -> f32 {
+    use impact_firmware::analog::{Scale, VddaError, NOMINAL_VDDA_V, SENSOR};
+    let v = match vdda {
+        Ok(v) => v,
+        Err(e) => {
+            match e {
+                VddaError::NoCalibration(cal) => {
+                    defmt::warn!("VDDA not measured: VREFINT_CAL reads {=u16:#x}", cal)
+                }
+                VddaError::NoReading => defmt::warn!("VDDA not measured: VREFINT read 0"),
+                VddaError::OutOfRange(v) => {
+                    defmt::warn!("VDDA not measured: VREFINT gives {=f32} V", v)
+                }
+            }
+            defmt::warn!(
+                "the ADC's scale assumes VDDA = {=f32} V (the Discovery's regulator)",
+                NOMINAL_VDDA_V
+            );
+            NOMINAL_VDDA_V
+        }
+    };
+    let s = Scale::new(v, SENSOR);
+    info!(
+        "ADC scale: VDDA {=f32} V, {=f32} m/s2 per count, 0 m/s2 at code {=f32}, range {=f32} to {=f32} m/s2",
+        v,
+        s.gain_m_s2_per_count,
+        s.zero_counts,
+        s.range_m_s2.0,
+        s.range_m_s2.1
+    );
+    s.gain_m_s2_per_count
 }
 
 /// Why the chip last reset (RCC_CSR's flags, then cleared): a watchdog reset means the
