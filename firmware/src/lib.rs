@@ -9,6 +9,7 @@
 //! * [`adxl375`]: the ADXL375 driver over `embedded-hal-async` (SPI traffic, FIFO, scale);
 //! * [`fifo`]: samples a polled FIFO lost, counted against the sensor's own stream;
 //! * [`light_gate`]: two beams' cuts paired into passages and speeds;
+//! * [`reset_record`]: why the firmware reset itself, kept across the reset;
 //! * [`ticks`]: deadlines beyond a 32-bit one-shot timer's reach, in several shots;
 //! * `semihosting` (QEMU builds only): the host's command line, files and exit status.
 
@@ -19,6 +20,7 @@ pub mod analog;
 pub mod fifo;
 pub mod light_gate;
 pub mod rate;
+pub mod reset_record;
 pub mod scene;
 #[cfg(all(target_os = "none", feature = "emulator"))]
 pub mod semihosting;

@@ -134,6 +134,13 @@ pub fn frames_dropped() -> u32 {
     DROPPED.load(Ordering::Relaxed)
 }
 
+/// Whether the reader (the probe, or the emulator's drain) has taken every byte written.
+#[cfg_attr(not(feature = "stm32"), allow(dead_code))]
+pub fn drained() -> bool {
+    let ch = &_SEGGER_RTT.up;
+    ch.read.load(Ordering::Acquire) == ch.write.load(Ordering::Relaxed)
+}
+
 /// The next data line's sequence number (from 0, one per `impact`, `srs`, `heartbeat`,
 /// `summary`, `scene`, `wave` and `wave_frame` line).
 pub fn next_seq() -> u32 {

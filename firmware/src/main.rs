@@ -40,6 +40,8 @@ use defmt::{info, unwrap};
 fn main() -> ! {
     stack::zero_ccmram();
     stack::paint();
+    // Before anything can fault again: what the previous run kept before it reset the chip.
+    let previous = fault::take_previous();
     info!(
         "impact-firmware {} up; blocks of {}, pre-trigger {}, {} captures of {} samples",
         env!("CARGO_PKG_VERSION"),
@@ -48,7 +50,7 @@ fn main() -> ! {
         queues::CAPTURE_SLOTS,
         queues::CAPTURE_LEN
     );
-    let setup = board::init();
+    let setup = board::init(previous);
     let (samples_in, samples_out) = unwrap!(queues::sample_queue());
     let (captures_in, captures_out) = unwrap!(queues::capture_queue());
 

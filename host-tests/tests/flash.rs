@@ -86,12 +86,19 @@ fn fw_run_flashes_the_monitor_through_probe_rs() {
         );
         let called = std::fs::read_to_string(&calls).unwrap();
         let words: Vec<&str> = called.split_whitespace().collect();
+        // The firmware's own fault handler and restart run under the probe as without it.
         assert_eq!(
-            words[..3],
-            ["run", "--chip", "STM32F407VGTx"],
+            words[..5],
+            [
+                "run",
+                "--chip",
+                "STM32F407VGTx",
+                "--no-catch-reset",
+                "--no-catch-hardfault"
+            ],
             "{args:?}: probe-rs called as {called}"
         );
-        let elf = Path::new(words[3]);
+        let elf = Path::new(words[5]);
         assert!(
             elf.ends_with("thumbv7em-none-eabihf/release/impact-firmware"),
             "{args:?}: flashed {}",

@@ -150,7 +150,7 @@ fn train(
         Pacing::RealTime {
             rate_scale: 1.0,
             clock_shift,
-            stall: None,
+            inject: None,
         },
         Duration::from_secs(1200),
         |_| {},

@@ -339,7 +339,7 @@ pub fn emulate(args: &EmulateArgs) -> Result<(), EmulateError> {
         Pacing::RealTime {
             rate_scale: args.rate_scale,
             clock_shift: args.clock_shift,
-            stall: None,
+            inject: None,
         }
     } else {
         Pacing::Lossless

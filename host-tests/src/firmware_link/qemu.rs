@@ -79,13 +79,23 @@ pub enum Pacing {
     Lossless,
     /// An emulated DMA at `rate_scale` times the recording's rate, in instruction-paced
     /// virtual time: each instruction takes 2^`clock_shift` ns ([`BOARD_CLOCK_SHIFT`]: the
-    /// STM32F407's speed). `stall` (tests only): before block `.0` the firmware's sampler
-    /// busy-waits `.1` µs, so the DMA ring overruns as on a board whose sampler is held up.
+    /// STM32F407's speed). `inject` (tests only): a fault to inject.
     RealTime {
         rate_scale: f32,
         clock_shift: u8,
-        stall: Option<(u32, u32)>,
+        inject: Option<Inject>,
     },
+}
+
+/// A fault the tests inject into a real-time run.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Inject {
+    /// Before block `block` the firmware's sampler busy-waits `us` µs, so the DMA ring
+    /// overruns as on a board whose sampler is held up.
+    Stall { block: u32, us: u32 },
+    /// A HardFault at start-up: the emulated board resets as the STM32 does (the run goes on
+    /// after the reset; the next start-up logs the reset record).
+    FaultAtStart,
 }
 
 /// The scene as the firmware's `key=value` semihosting arguments. Floats are written as
@@ -478,11 +488,15 @@ pub fn run_emulator(
         Pacing::RealTime {
             rate_scale,
             clock_shift,
-            stall,
+            inject,
         } => {
             config.push_str(&format!(",arg=realtime,arg=rate_scale={rate_scale:e}"));
-            if let Some((block, us)) = stall {
-                config.push_str(&format!(",arg=stall={block}:{us}"));
+            match inject {
+                Some(Inject::Stall { block, us }) => {
+                    config.push_str(&format!(",arg=stall={block}:{us}"))
+                }
+                Some(Inject::FaultAtStart) => config.push_str(",arg=fault=start"),
+                None => {}
             }
             // 2^shift ns of virtual time per instruction; idle time (wfi) skipped, so runs
             // are deterministic and fast.

@@ -23,6 +23,7 @@ use static_cell::ConstStaticCell;
 
 use crate::tasks::stream::Backpressure;
 use impact_firmware::adxl375::Axis;
+use impact_firmware::reset_record::Cause;
 use impact_firmware::scene::{BandTableError, SceneError};
 use impact_firmware::semihosting as host;
 
@@ -37,7 +38,8 @@ const COMMAND_LINE_LEN: usize = 1920;
 
 /// What the semihosting command line asks for:
 /// `<program> <samples-file> [realtime|lossless] [rate_scale=X] [stall=BLOCK:US]
-/// [sensor=adc|adxl375] [axis=x|y|z|resultant] [spec_table=PATH] [key=value ...]` (scene keys:
+/// [fault=start] [sensor=adc|adxl375] [axis=x|y|z|resultant] [spec_table=PATH] [key=value ...]`
+/// (scene keys:
 /// see [`impact_firmware::scene::apply`]; unset keys keep the seed bench's values,
 /// [`impact_firmware::scene::BENCH`]).
 pub struct Config {
@@ -51,6 +53,10 @@ pub struct Config {
     /// taking this block (or poll, with the ADXL375), so the emulated DMA (or FIFO) laps it as
     /// it would on a stalled board.
     pub stall: Option<(u32, u32)>,
+    /// `fault=start`, fault injection for tests: a HardFault at start-up, after which the
+    /// machine resets as the board would (not exits), unless the previous run kept a fault:
+    /// the reset record's path through a real system reset.
+    pub fault_at_start: bool,
     /// `sensor=adxl375`: the file holds three axes, read through the ADXL375 path.
     pub adxl375: bool,
     /// `axis=x|y|z|resultant` (ADXL375 path): what the stream gets of each sample.
@@ -83,6 +89,8 @@ enum ConfigError<'a> {
     BadStall,
     /// `sensor` is not `adc` or `adxl375`.
     BadSensor,
+    /// `fault` is not `start`.
+    BadFault,
     /// `axis` is not `x`, `y`, `z` or `resultant`.
     BadAxis,
     Scene {
@@ -143,6 +151,7 @@ fn parse(line: &str) -> Result<Config, ConfigError<'_>> {
     let mut scene = impact_firmware::scene::BENCH;
     let mut rate_scale = 1.0f32;
     let mut stall = None;
+    let mut fault_at_start = false;
     let mut adxl375 = false;
     let mut axis = Axis::Resultant;
     let mut band_path = None;
@@ -169,6 +178,12 @@ fn parse(line: &str) -> Result<Config, ConfigError<'_>> {
                 let parse = |v: &str| v.parse::<u32>().map_err(|_| ConfigError::BadStall);
                 stall = Some((parse(block)?, parse(us)?));
             }
+            Some(("fault", value)) => {
+                fault_at_start = value == "start";
+                if !fault_at_start {
+                    return Err(ConfigError::BadFault);
+                }
+            }
             Some(("rate_scale", value)) => {
                 rate_scale = value
                     .parse::<f32>()
@@ -192,6 +207,7 @@ fn parse(line: &str) -> Result<Config, ConfigError<'_>> {
         pacing,
         rate_scale,
         stall,
+        fault_at_start,
         adxl375,
         axis,
         scene,
@@ -227,7 +243,7 @@ pub struct Setup {
 /// the run (exit status 1). Not inlined: the line's buffer lives in this frame, which is gone
 /// before the executors start (inlined into `main`, it sat under every task's stack).
 #[inline(never)]
-pub fn init() -> Setup {
+pub fn init(previous: Option<Cause>) -> Setup {
     let mut buf = [0u8; COMMAND_LINE_LEN];
     let config = match host::command_line(&mut buf)
         .map_err(ConfigError::Host)
@@ -239,6 +255,13 @@ pub fn init() -> Setup {
             fault_exit()
         }
     };
+    crate::fault::log_previous(previous);
+    if config.fault_at_start && !matches!(previous, Some(Cause::Fault(_))) {
+        INJECTED_FAULT.store(true, Ordering::Relaxed);
+        defmt::warn!("faulting at start-up (fault injection)");
+        drain::flush();
+        cortex_m::asm::udf()
+    }
     irq::init();
     time::init();
     let lossless = config.pacing == Pacing::Lossless;
@@ -314,9 +337,17 @@ pub fn stall_sampler(us: u32) {
 /// The watchdog is the board's: QEMU stops a locked-up core itself (the run fails).
 pub fn feed_watchdog() {}
 
-/// After a fault has been logged: the run fails.
+/// The fault was the test's (`fault=start`): reset as the board does.
+static INJECTED_FAULT: AtomicBool = AtomicBool::new(false);
+
+/// After a fault has been kept and logged: the run fails; an injected fault resets the
+/// machine instead, as the board does (QEMU keeps RAM across a system reset and reloads only
+/// the ELF's initialised sections), and the next start-up logs the record.
 pub fn fault_exit() -> ! {
     drain::flush();
+    if INJECTED_FAULT.load(Ordering::Relaxed) {
+        cortex_m::peripheral::SCB::sys_reset()
+    }
     host::exit(false)
 }
 

@@ -8,6 +8,7 @@ use embassy_executor::SendSpawner;
 use embassy_stm32::interrupt::{InterruptExt, Priority};
 use embassy_stm32::{bind_interrupts, dma, interrupt, peripherals, Config, Peripherals};
 use impact_core::Scene;
+use impact_firmware::reset_record::Cause;
 use panic_probe as _;
 
 use crate::executors::{HIGH, LOW, MEDIUM};
@@ -69,11 +70,12 @@ pub struct Setup {
 
 /// Brings the chip up at 168 MHz with the flash accelerator on, logs why it last reset,
 /// starts the independent watchdog, and sets the ADC's scale from the supply it measures.
-pub fn init() -> Setup {
+pub fn init(previous: Option<Cause>) -> Setup {
     #[allow(unused_mut)]
     let mut p = embassy_stm32::init(clock_config());
     enable_flash_accelerator();
-    info!("reset reason: {}", reset_reason());
+    info!("reset reason: {}", reset_reason(previous.is_some()));
+    crate::fault::log_previous(previous);
     start_watchdog();
     #[allow(unused_mut)]
     let mut scene = impact_firmware::scene::BENCH;
@@ -126,8 +128,10 @@ fn analog_scale(vdda: Result<f32, impact_firmware::analog::VddaError>) -> f32 {
 
 /// Why the chip last reset (RCC_CSR's flags, then cleared): a watchdog reset means the
 /// firmware stopped: a hang, or a core locked up by a fault it could not stack (an
-/// overflowing stack runs into reserved memory below SRAM).
-fn reset_reason() -> &'static str {
+/// overflowing stack runs into reserved memory below SRAM). A software reset is the
+/// firmware's own when it kept a record (`recorded`: a fault, or a stream that ended),
+/// otherwise a debugger's (flashing, `probe-rs reset`).
+fn reset_reason(recorded: bool) -> &'static str {
     use embassy_stm32::pac::RCC;
     let csr = RCC.csr().read();
     RCC.csr().modify(|w| w.set_rmvf(true));
@@ -135,8 +139,10 @@ fn reset_reason() -> &'static str {
         "independent watchdog (the firmware had stopped: a hang, or a stack overflow that locked up the core)"
     } else if csr.wwdgrstf() {
         "window watchdog"
+    } else if csr.sftrstf() && recorded {
+        "software, by the firmware (the next line says why)"
     } else if csr.sftrstf() {
-        "software (a fault, or a sample stream that ended: see the lines before the reset)"
+        "software, by a debugger (flashing, or probe-rs reset)"
     } else if csr.lpwrrstf() {
         "low-power management"
     } else if csr.borrstf() || csr.porrstf() {
@@ -177,9 +183,62 @@ pub fn feed_watchdog() {
         .write(|w| w.set_key(Key::RESET));
 }
 
-/// After a fault has been logged: resets the chip (the next start-up logs the reason).
+/// After a fault has been kept and logged: resets the chip (the next start-up logs the
+/// record). A debugger attached gets up to [`PROBE_WAIT_MS`] to read the fault's line first.
 pub fn fault_exit() -> ! {
+    wait_for_probe();
     cortex_m::peripheral::SCB::sys_reset()
+}
+
+/// The longest wait for a probe to read the log before a reset, ms (probe-rs polls RTT every
+/// few ms; the watchdog is fed meanwhile).
+const PROBE_WAIT_MS: u32 = 250;
+
+/// With a debugger attached (DHCSR.C_DEBUGEN), waits until it has read the whole RTT buffer,
+/// or [`PROBE_WAIT_MS`]; without one, returns at once (nobody would read it: the reset
+/// record carries the fault to the next start-up).
+fn wait_for_probe() {
+    // SAFETY: a read of the Debug Halting Control and Status Register.
+    let dhcsr = unsafe { (*cortex_m::peripheral::DCB::PTR).dhcsr.read() };
+    if dhcsr & 1 == 0 {
+        return;
+    }
+    let mut clock = CycleClock::start();
+    while !crate::logger::drained() && clock.elapsed_ms() < PROBE_WAIT_MS {
+        feed_watchdog();
+    }
+}
+
+/// Milliseconds counted by the core's cycle counter (DWT CYCCNT at 168 MHz): a timer that
+/// needs no interrupt, so it also runs in the fault handler, unlike a spin loop's guess of
+/// cycles per iteration.
+struct CycleClock {
+    last: u32,
+    cycles: u64,
+}
+
+impl CycleClock {
+    const HZ: u64 = 168_000_000;
+
+    fn start() -> Self {
+        // SAFETY: the core peripherals, stolen: DEMCR's trace enable and DWT's cycle counter
+        // are set here only, and a running counter is left running.
+        let mut cp = unsafe { cortex_m::Peripherals::steal() };
+        cp.DCB.enable_trace();
+        cp.DWT.enable_cycle_counter();
+        Self {
+            last: cortex_m::peripheral::DWT::cycle_count(),
+            cycles: 0,
+        }
+    }
+
+    /// Milliseconds since [`CycleClock::start`]; call at least every 25 s (the counter wraps).
+    fn elapsed_ms(&mut self) -> u32 {
+        let now = cortex_m::peripheral::DWT::cycle_count();
+        self.cycles += u64::from(now.wrapping_sub(self.last));
+        self.last = now;
+        u32::try_from(self.cycles * 1000 / Self::HZ).unwrap_or(u32::MAX)
+    }
 }
 
 /// ART accelerator on: prefetch and the instruction and data caches (RM0090 3.5.2).
@@ -272,10 +331,12 @@ pub fn end_of_stream(success: bool) -> ! {
         success,
         RESTART_AFTER_S
     );
-    for _ in 0..RESTART_AFTER_S * 10 {
+    crate::fault::keep(Cause::StreamEnded);
+    // Timed by the cycle counter, the watchdog fed all along (a spin loop's `asm::delay` ran
+    // about three times the cycles it was given).
+    let mut clock = CycleClock::start();
+    while clock.elapsed_ms() < RESTART_AFTER_S * 1000 {
         feed_watchdog();
-        // 100 ms at 168 MHz.
-        cortex_m::asm::delay(16_800_000);
     }
     cortex_m::peripheral::SCB::sys_reset()
 }
