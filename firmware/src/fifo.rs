@@ -7,11 +7,15 @@
 //! poll reads all that its entry count showed, and reads that count first), so while the
 //! FIFO does not overrun the samples read over the time between polls *is* the sensor's
 //! output rate, measured on its own clock against the MCU's: good to one sample over the
-//! whole clean stretch, whatever the part's rate tolerance. Only a poll whose overrun flag is
-//! set loses samples, and it lost what the measured rate produced since the previous poll
-//! less what it read (at least one: the flag says so). So a rate error never adds up into a
-//! false gap, a real loss is never missed, and the estimate's error is bounded by one poll
-//! interval's worth of the rate's uncertainty (a sample or two).
+//! whole clean stretch, whatever the part's rate tolerance. The ADXL375's overrun flag means
+//! the FIFO *filled* (in stream and FIFO modes the data sheet sets it when the FIFO is
+//! full, not only when an entry is overwritten), so a poll with the flag set lost what the
+//! measured rate produced since the previous poll less what it read, which may be none (a
+//! late poll that finds 32 or 33 entries): the flag alone is no loss, and a poll that finds
+//! fewer entries than the FIFO holds lost none at all (entries leave only when read, so an
+//! overwrite leaves it full). So a rate error never
+//! adds up into a false gap, a full FIFO is not a gap, and the estimate's error is bounded by
+//! one poll interval's worth of the rate's uncertainty (a sample or two).
 
 /// Clean time, µs, before the measured rate replaces the nominal one (a tenth of a second:
 /// several hundred samples at the ADXL375's rates, so the measurement's ±1 sample is < 1 %).
@@ -25,6 +29,9 @@ const MAX_RATE_DEVIATION: f64 = 0.2;
 #[derive(Clone, Debug)]
 pub struct LossCounter {
     nominal_hz: f64,
+    /// Entries a poll finds at most (the FIFO and the output registers): only a poll that
+    /// finds it this full can follow an overwrite, since entries go only when read.
+    capacity: usize,
     /// When the previous poll read the sensor's entry count, µs (MCU clock).
     last_us: u64,
     /// Samples read, and µs elapsed, over the intervals that ended without an overrun.
@@ -34,10 +41,11 @@ pub struct LossCounter {
 
 impl LossCounter {
     /// The sensor started producing at `start_us` (MCU clock, µs) at a nominal
-    /// `nominal_hz` samples per second.
-    pub fn new(nominal_hz: f32, start_us: u64) -> Self {
+    /// `nominal_hz` samples per second into a FIFO a poll finds at most `capacity` entries in.
+    pub fn new(nominal_hz: f32, capacity: usize, start_us: u64) -> Self {
         Self {
             nominal_hz: f64::from(nominal_hz),
+            capacity,
             last_us: start_us,
             clean_samples: 0,
             clean_us: 0,
@@ -59,14 +67,17 @@ impl LossCounter {
     }
 
     /// One poll: at `now_us` (taken just before the sensor's entry count was read) it read
-    /// `read` samples, and `overrun` is the sensor's flag. Returns how many samples the
-    /// sensor produced and overwrote before the ones read (0 without the flag). A poll that
+    /// `read` samples, and `overrun` is the sensor's flag (the FIFO filled). Returns how many
+    /// samples the sensor produced and overwrote before the ones read (0 without the flag,
+    /// and 0 when the clock says every sample produced was read). A poll that
     /// failed (nothing read, the FIFO left as it was) is not a poll: skip the call.
     pub fn poll(&mut self, now_us: u64, read: usize, overrun: bool) -> u64 {
         let interval_us = now_us.saturating_sub(self.last_us);
         self.last_us = now_us;
+        // Below capacity the FIFO never overflowed since the last poll, flag or not.
+        let full = read >= self.capacity;
         let read = read as u64;
-        if !overrun {
+        if !overrun || !full {
             self.clean_samples = self.clean_samples.saturating_add(read);
             self.clean_us = self.clean_us.saturating_add(interval_us);
             return 0;
@@ -74,6 +85,13 @@ impl LossCounter {
         let produced = self.rate_hz() * interval_us as f64 * 1e-6;
         // `produced` is finite and non-negative; the cast saturates.
         let produced = (produced + 0.5) as u64;
-        produced.saturating_sub(read).max(1)
+        let lost = produced.saturating_sub(read);
+        if lost == 0 {
+            // Full, nothing overwritten: a clean interval too (leaving the full ones out
+            // would measure the rate over the shorter intervals only, biased low).
+            self.clean_samples = self.clean_samples.saturating_add(read);
+            self.clean_us = self.clean_us.saturating_add(interval_us);
+        }
+        lost
     }
 }

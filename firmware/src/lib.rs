@@ -4,6 +4,7 @@
 //! where the defmt formatting is left out.
 //!
 //! * [`analog`]: the ADC's scale from the supply VREFINT measures;
+//! * [`conversions`]: the ADC's conversions counted against the samples delivered;
 //! * [`scene`]: the compiled-in bench and the emulator's `key=value` scene parser;
 //! * [`rate`]: the build's sample rate;
 //! * [`adxl375`]: the ADXL375 driver over `embedded-hal-async` (SPI traffic, FIFO, scale);
@@ -17,6 +18,7 @@
 
 pub mod adxl375;
 pub mod analog;
+pub mod conversions;
 pub mod fifo;
 pub mod light_gate;
 pub mod rate;

@@ -58,6 +58,19 @@ pub enum Passage {
     Away(f32),
 }
 
+/// Edges of one beam closer than this, µs, are one cut (a receiver's output bouncing as the
+/// body's edge crosses the beam): the first edge of such a burst is the cut's time. At the
+/// fastest speed believed (100 m/s) the two beams, 10 mm apart, are cut 100 µs apart, so no
+/// real passage is merged; a rebound re-cuts a beam milliseconds later.
+pub const DEBOUNCE_US: u32 = 50;
+
+/// Whether an edge at `now_us` is a new cut, given the beam's previous edge (accepted or
+/// not) at `last_us`; times in µs of a wrapping 32-bit clock. Edges that keep coming closer
+/// than [`DEBOUNCE_US`] apart stay one cut.
+pub fn new_cut(last_us: Option<u32>, now_us: u32) -> bool {
+    last_us.is_none_or(|last| now_us.wrapping_sub(last) >= DEBOUNCE_US)
+}
+
 /// Longest time between the two cuts of one passage, µs: a later cut starts a new passage.
 pub const PAIRING_WINDOW_US: u64 = 1_000_000;
 

@@ -29,6 +29,7 @@ mod executors;
 mod fault;
 mod logger;
 mod queues;
+mod reset;
 mod source;
 mod stack;
 mod tasks;
@@ -40,8 +41,9 @@ use defmt::{info, unwrap};
 fn main() -> ! {
     stack::zero_ccmram();
     stack::paint();
+    stack::guard();
     // Before anything can fault again: what the previous run kept before it reset the chip.
-    let previous = fault::take_previous();
+    let previous = reset::take_previous();
     info!(
         "impact-firmware {} up; blocks of {}, pre-trigger {}, {} captures of {} samples",
         env!("CARGO_PKG_VERSION"),

@@ -1,8 +1,10 @@
 //! The RAM start-up leaves to the firmware, on both builds: the CCM section zeroed
-//! ([`zero_ccmram`]), and the stack's high-water mark: the stack region below the current
-//! frame is painted at start-up, and [`peak_bytes`] finds how deep the stack has gone since
-//! (interrupts included: they share the main stack). The heartbeat and the summary report it,
-//! so every run shows its margin (see docs/board.md for the RAM budget).
+//! ([`zero_ccmram`]), the stack's bottom guarded ([`guard`]: an MPU region no access may
+//! touch, so an overflow faults on any part, whatever lies below SRAM), and the stack's
+//! high-water mark: the stack region below the current frame and above the guard is painted
+//! at start-up, and [`peak_bytes`] finds how deep the stack has gone since (interrupts
+//! included: they share the main stack). The heartbeat and the summary report it, so every
+//! run shows its margin (see docs/board.md for the RAM budget).
 
 use core::sync::atomic::{AtomicUsize, Ordering};
 
@@ -10,6 +12,8 @@ use core::sync::atomic::{AtomicUsize, Ordering};
 const PAINT: u32 = 0x5354_4b21;
 /// Left alone below the current stack pointer when painting: the live frames.
 const MARGIN: usize = 256;
+/// The guard at the stack's bottom, bytes: the MPU's smallest region.
+pub const GUARD_BYTES: usize = 32;
 
 static BOTTOM: AtomicUsize = AtomicUsize::new(0);
 static TOP: AtomicUsize = AtomicUsize::new(0);
@@ -42,11 +46,45 @@ fn stack_start() -> usize {
     core::ptr::addr_of!(_stack_start) as usize
 }
 
-/// Paints the free stack below the caller's frame. Call once, first thing.
+/// The stack's lowest address (the guard's start).
+fn stack_end() -> usize {
+    // Only the symbol's address is taken, never its contents.
+    core::ptr::addr_of!(_stack_end) as usize
+}
+
+/// Guards the stack's bottom [`GUARD_BYTES`] with MPU region 0: no access, privileged or
+/// not, and no execution (the rest of the map stays the default one, PRIVDEFENA). A stack
+/// that grows into it faults while stacking, which locks the core up: the board's watchdog
+/// resets it, QEMU stops. Without it an overflow ran below 0x2000_0000, into space the F407
+/// calls reserved, which need not fault. Call after [`paint`] (which leaves the guard alone).
+pub fn guard() {
+    let bottom = stack_end();
+    if bottom % GUARD_BYTES != 0 {
+        return;
+    }
+    // RASR: XN (bit 28), AP = 0b000 (bits 26:24: no access), SIZE = 4 (2^(4+1) = 32 bytes),
+    // ENABLE. CTRL: PRIVDEFENA (bit 2), ENABLE.
+    const RASR: u32 = (1 << 28) | (4 << 1) | 1;
+    const CTRL: u32 = (1 << 2) | 1;
+    // SAFETY: MPU region 0 is only this guard's; the region covers no static, no code and no
+    // live frame (the stack's bottom, 24 KiB below the first frame).
+    unsafe {
+        let mpu = &*cortex_m::peripheral::MPU::PTR;
+        mpu.rnr.write(0);
+        mpu.rbar.write(bottom as u32);
+        mpu.rasr.write(RASR);
+        mpu.ctrl.write(CTRL);
+    }
+    cortex_m::asm::dsb();
+    cortex_m::asm::isb();
+}
+
+/// Paints the free stack below the caller's frame and above the guard. Call once, first
+/// thing.
 pub fn paint() {
     let sp = cortex_m::register::msp::read() as usize;
     let top = sp.saturating_sub(MARGIN) & !3;
-    let bottom = (core::ptr::addr_of!(_stack_end) as usize + 3) & !3;
+    let bottom = (stack_end() + GUARD_BYTES + 3) & !3;
     if bottom >= top {
         return;
     }
@@ -76,7 +114,13 @@ pub fn peak_bytes() -> Option<(usize, bool)> {
     Some((stack_start().saturating_sub(addr), addr == bottom))
 }
 
-/// Stack size available beside the statics, bytes.
+/// Stack size available beside the statics, bytes (the guard's left out).
 pub fn size_bytes() -> usize {
-    stack_start().saturating_sub(core::ptr::addr_of!(_stack_end) as usize)
+    stack_start().saturating_sub(stack_end() + GUARD_BYTES)
+}
+
+/// The guard's address: a test's injected fault writes there (the emulator's `fault=guard`).
+#[cfg_attr(not(feature = "emulator"), allow(dead_code))]
+pub fn guard_address() -> usize {
+    stack_end()
 }

@@ -15,7 +15,9 @@ use std::time::Instant;
 mod common;
 use common::{impact_ok as impact, Scratch};
 use impact_host::firmware_link::line::Counter;
-use impact_host::firmware_link::qemu::{Inject, Pacing, QemuError, Samples, BOARD_CLOCK_SHIFT};
+use impact_host::firmware_link::qemu::{
+    Inject, Pacing, QemuError, Samples, StartFault, BOARD_CLOCK_SHIFT,
+};
 
 /// The emulator firmware, built once for all tests; `None` (and a note on stderr) if the
 /// tools are missing.
@@ -572,7 +574,8 @@ fn within_board_limits(log: &str) {
     assert_eq!(get(Counter::LinesDropped), 0, "{log}");
     assert_eq!(parsed.lines_missing, 0, "{log}");
     let (peak, size) = (get(Counter::StackPeakBytes), get(Counter::StackSizeBytes));
-    assert_eq!(size, 24 * 1024, "the emulator's stack is the board's");
+    // The board's 24 KiB less the MPU guard's 32 bytes at its bottom.
+    assert_eq!(size, 24 * 1024 - 32, "the emulator's stack is the board's");
     assert!(
         peak * 4 <= size * 3,
         "stack peak {peak} of {size} bytes: over 75 %"
@@ -710,11 +713,12 @@ fn a_forced_dma_overrun_is_a_counted_gap_and_later_positions_stay_right() {
 }
 
 /// A fault reaches the next start-up however soon the reset follows it: the emulated board
-/// faults at start-up (an undefined instruction), keeps the fault in its reset record
-/// (`.uninit`), resets as the STM32 does (a system reset: QEMU keeps RAM and reloads only the
-/// ELF's initialised sections, as the chip's start-up copies only `.data`), and the next
-/// start-up logs the record's registers (the very ones the fault's own line gave), then replays
-/// the recording to the end as if nothing had happened.
+/// faults at start-up, keeps the fault in its reset record (`.uninit`), resets as the STM32
+/// does (a system reset: QEMU keeps RAM and reloads only the ELF's initialised sections, as
+/// the chip's start-up copies only `.data`), and the next start-up logs the record's
+/// registers (the very ones the fault's own line gave), then replays the recording to the end
+/// as if nothing had happened. Two faults: an undefined instruction, and a write into the
+/// stack's MPU guard, which proves the guard faults (an overflowing stack meets it first).
 #[test]
 fn a_fault_is_kept_across_the_reset_and_logged_at_the_next_start_up() {
     let scratch = Scratch::new();
@@ -730,70 +734,81 @@ fn a_fault_is_kept_across_the_reset_and_logged_at_the_next_start_up() {
         impact_io::progress::Progress::none(),
     )
     .unwrap();
-    let run = impact_host::firmware_link::qemu::run_emulator(
-        &elf,
-        Samples::Adc(&setup.prepared.counts),
-        &setup.scene,
-        Pacing::RealTime {
-            rate_scale: 1.0,
-            clock_shift: BOARD_CLOCK_SHIFT,
-            inject: Some(Inject::FaultAtStart),
-        },
-        std::time::Duration::from_secs(300),
-        |_| {},
-    )
-    .unwrap();
-    let text = run.lines.join("\n");
-    assert!(
-        run.status.success(),
-        "the run after the reset ends well\n{text}"
-    );
-    let registers = |prefix: &str| -> Vec<String> {
-        let line = run
+    let host = impact_host::pipeline::run(&setup.prepared.counts, &setup.scene).unwrap();
+    for fault in [StartFault::Undefined, StartFault::StackGuard] {
+        let run = impact_host::firmware_link::qemu::run_emulator(
+            &elf,
+            Samples::Adc(&setup.prepared.counts),
+            &setup.scene,
+            Pacing::RealTime {
+                rate_scale: 1.0,
+                clock_shift: BOARD_CLOCK_SHIFT,
+                inject: Some(Inject::FaultAtStart(fault)),
+            },
+            std::time::Duration::from_secs(300),
+            |_| {},
+        )
+        .unwrap();
+        let text = run.lines.join("\n");
+        assert!(
+            run.status.success(),
+            "{fault:?}: the run after the reset ends well\n{text}"
+        );
+        let registers = |prefix: &str| -> Vec<String> {
+            let line = run
+                .lines
+                .iter()
+                .find(|l| l.contains(prefix))
+                .unwrap_or_else(|| panic!("no `{prefix}` line\n{text}"));
+            let rest = &line[line.find(prefix).unwrap() + prefix.len()..];
+            rest.split_whitespace().map(str::to_string).collect()
+        };
+        let at_fault = registers("fault pc=");
+        let recorded = registers("previous run faulted: pc=");
+        assert_eq!(
+            recorded, at_fault,
+            "the record holds the fault's registers\n{text}"
+        );
+        let field = |name: &str| {
+            let v = recorded
+                .iter()
+                .find_map(|w| w.strip_prefix(name))
+                .unwrap_or_else(|| panic!("{name}\n{text}"));
+            u32::from_str_radix(v.trim_start_matches("0x"), 16).unwrap()
+        };
+        // Escalated to a HardFault (HFSR.FORCED).
+        assert_ne!(field("hfsr=") & (1 << 30), 0, "{text}");
+        match fault {
+            // UFSR.UNDEFINSTR.
+            StartFault::Undefined => assert_ne!(field("cfsr=") & (1 << 16), 0, "{text}"),
+            // MMFSR.DACCVIOL with MMARVALID, at the stack's bottom (0x2000_0000).
+            StartFault::StackGuard => {
+                assert_eq!(field("cfsr=") & 0x82, 0x82, "{text}");
+                assert_eq!(field("mmfar="), 0x2000_0000, "{text}");
+            }
+        }
+        // Two start-ups, one fault: the second found the record and did not fault again.
+        let ups = run
             .lines
             .iter()
-            .find(|l| l.contains(prefix))
-            .unwrap_or_else(|| panic!("no `{prefix}` line\n{text}"));
-        let rest = &line[line.find(prefix).unwrap() + prefix.len()..];
-        rest.split_whitespace().map(str::to_string).collect()
-    };
-    let at_fault = registers("fault pc=");
-    let recorded = registers("previous run faulted: pc=");
-    assert_eq!(
-        recorded, at_fault,
-        "the record holds the fault's registers\n{text}"
-    );
-    let field = |name: &str| {
-        let v = recorded
-            .iter()
-            .find_map(|w| w.strip_prefix(name))
-            .unwrap_or_else(|| panic!("{name}\n{text}"));
-        u32::from_str_radix(v.trim_start_matches("0x"), 16).unwrap()
-    };
-    // An undefined instruction (UFSR.UNDEFINSTR), escalated to a HardFault (HFSR.FORCED).
-    assert_ne!(field("cfsr=") & (1 << 16), 0, "{text}");
-    assert_ne!(field("hfsr=") & (1 << 30), 0, "{text}");
-    // Two start-ups, one fault: the second found the record and did not fault again.
-    let ups = run
-        .lines
-        .iter()
-        .filter(|l| l.contains("impact-firmware"))
-        .count();
-    assert!(ups >= 2, "{text}");
-    assert_eq!(
-        run.lines
-            .iter()
-            .filter(|l| l.contains("faulting at start-up"))
-            .count(),
-        1,
-        "{text}"
-    );
-    // After the reset the replay runs whole: the recording's impact, where the host finds it.
-    let after = &text[text.find("previous run faulted").unwrap()..];
-    let log = impact_host::firmware_link::log::parse_log(after).unwrap();
-    let host = impact_host::pipeline::run(&setup.prepared.counts, &setup.scene).unwrap();
-    assert_eq!(log.impacts.len(), host.len(), "{text}");
-    assert_eq!(log.impacts[0].start_sample, host[0].start_sample);
+            .filter(|l| l.contains("impact-firmware"))
+            .count();
+        assert!(ups >= 2, "{text}");
+        assert_eq!(
+            run.lines
+                .iter()
+                .filter(|l| l.contains("faulting at start-up"))
+                .count(),
+            1,
+            "{text}"
+        );
+        // After the reset the replay runs whole: the recording's impact, where the host
+        // finds it.
+        let after = &text[text.find("previous run faulted").unwrap()..];
+        let log = impact_host::firmware_link::log::parse_log(after).unwrap();
+        assert_eq!(log.impacts.len(), host.len(), "{text}");
+        assert_eq!(log.impacts[0].start_sample, host[0].start_sample);
+    }
 }
 
 /// A synthetic recording from `impact synth ARGS`, as a CSV file in `scratch`.

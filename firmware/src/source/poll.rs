@@ -59,7 +59,7 @@ pub async fn run<F: Fifo>(
     rate_hz: f32,
     started: Instant,
 ) {
-    let mut losses = LossCounter::new(rate_hz, started.as_micros());
+    let mut losses = LossCounter::new(rate_hz, MAX_ENTRIES, started.as_micros());
     let mut entries = [[0i16; 3]; MAX_ENTRIES];
     let mut ticker = Ticker::every(POLL_PERIOD);
     loop {
@@ -74,7 +74,8 @@ pub async fn run<F: Fifo>(
             }
         };
         let lost = losses.poll(read.at.as_micros(), read.samples, read.overrun);
-        if read.overrun {
+        // The flag says the FIFO filled; only what the clock says was overwritten is a gap.
+        if lost > 0 {
             let n = SOURCE_STATS.overrun();
             warn!(
                 "FIFO overrun (#{}): {} samples lost (at {} S/s measured)",

@@ -93,9 +93,18 @@ pub enum Inject {
     /// Before block `block` the firmware's sampler busy-waits `us` µs, so the DMA ring
     /// overruns as on a board whose sampler is held up.
     Stall { block: u32, us: u32 },
-    /// A HardFault at start-up: the emulated board resets as the STM32 does (the run goes on
+    /// A fault at start-up: the emulated board resets as the STM32 does (the run goes on
     /// after the reset; the next start-up logs the reset record).
-    FaultAtStart,
+    FaultAtStart(StartFault),
+}
+
+/// The fault [`Inject::FaultAtStart`] makes.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum StartFault {
+    /// An undefined instruction.
+    Undefined,
+    /// A write into the stack's MPU guard (its bottom 32 bytes).
+    StackGuard,
 }
 
 /// The scene as the firmware's `key=value` semihosting arguments. Floats are written as
@@ -495,7 +504,12 @@ pub fn run_emulator(
                 Some(Inject::Stall { block, us }) => {
                     config.push_str(&format!(",arg=stall={block}:{us}"))
                 }
-                Some(Inject::FaultAtStart) => config.push_str(",arg=fault=start"),
+                Some(Inject::FaultAtStart(StartFault::Undefined)) => {
+                    config.push_str(",arg=fault=udf")
+                }
+                Some(Inject::FaultAtStart(StartFault::StackGuard)) => {
+                    config.push_str(",arg=fault=guard")
+                }
                 None => {}
             }
             // 2^shift ns of virtual time per instruction; idle time (wfi) skipped, so runs

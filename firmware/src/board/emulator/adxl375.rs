@@ -1,7 +1,8 @@
 //! The ADXL375, emulated for the real-time replay: CMSDK timer 0 interrupts once per sample
 //! period of virtual time and pushes the file's next three-axis sample into a FIFO of the
-//! part's depth in stream mode (32 entries and the output registers: 33), overwriting the
-//! oldest entry and setting the overrun flag when it is full, whatever the tasks are doing.
+//! part's depth in stream mode (32 entries and the output registers: 33), setting the overrun
+//! flag when its 32 levels fill and overwriting the oldest entry when all 33 are taken,
+//! whatever the tasks are doing.
 //! The board's ADXL375 source ([`crate::source::poll`]) polls it as it polls the part, so a
 //! sample is lost exactly when the part's FIFO would overwrite it; the emulation also counts
 //! what it overwrote, which the firmware's own estimate can be held to.
@@ -86,6 +87,9 @@ pub fn failed() -> bool {
     FAILED.load(Ordering::Relaxed)
 }
 
+/// The FIFO's levels (the output registers hold one entry more: [`MAX_ENTRIES`]).
+const FIFO_LEVELS: usize = 32;
+
 /// Samples the emulated part produced and overwrote unread so far.
 pub fn counts() -> (u64, u64) {
     critical_section::with(|cs| {
@@ -169,7 +173,6 @@ pub fn on_timer() {
             // Stream mode: the oldest entry goes.
             s.head = (s.head + 1) % MAX_ENTRIES;
             s.len -= 1;
-            s.overrun = true;
             s.overwritten += 1;
         }
         let tail = (s.head + s.len) % MAX_ENTRIES;
@@ -178,6 +181,11 @@ pub fn on_timer() {
         }
         s.len += 1;
         s.produced += 1;
+        // The data sheet's stream mode: the flag is set when the FIFO fills (its 32 levels;
+        // the output registers hold one more), whether or not an entry was overwritten.
+        if s.len >= FIFO_LEVELS {
+            s.overrun = true;
+        }
         arm(&mut s);
     });
 }

@@ -38,7 +38,7 @@ const COMMAND_LINE_LEN: usize = 1920;
 
 /// What the semihosting command line asks for:
 /// `<program> <samples-file> [realtime|lossless] [rate_scale=X] [stall=BLOCK:US]
-/// [fault=start] [sensor=adc|adxl375] [axis=x|y|z|resultant] [spec_table=PATH] [key=value ...]`
+/// [fault=udf|guard] [sensor=adc|adxl375] [axis=x|y|z|resultant] [spec_table=PATH] [key=value ...]`
 /// (scene keys:
 /// see [`impact_firmware::scene::apply`]; unset keys keep the seed bench's values,
 /// [`impact_firmware::scene::BENCH`]).
@@ -53,16 +53,27 @@ pub struct Config {
     /// taking this block (or poll, with the ADXL375), so the emulated DMA (or FIFO) laps it as
     /// it would on a stalled board.
     pub stall: Option<(u32, u32)>,
-    /// `fault=start`, fault injection for tests: a HardFault at start-up, after which the
-    /// machine resets as the board would (not exits), unless the previous run kept a fault:
-    /// the reset record's path through a real system reset.
-    pub fault_at_start: bool,
+    /// `fault=udf|guard`, fault injection for tests: a fault at start-up (an undefined
+    /// instruction, or a write into the stack's guard), after which the machine resets as the
+    /// board would (not exits), unless the previous run kept a fault: the reset record's path
+    /// through a real system reset, and the guard's proof.
+    pub fault_at_start: Option<StartFault>,
     /// `sensor=adxl375`: the file holds three axes, read through the ADXL375 path.
     pub adxl375: bool,
     /// `axis=x|y|z|resultant` (ADXL375 path): what the stream gets of each sample.
     pub axis: Axis,
     /// The scene the stream runs.
     pub scene: Scene,
+}
+
+/// A fault the tests inject at start-up.
+#[derive(Clone, Copy, PartialEq, Eq)]
+pub enum StartFault {
+    /// An undefined instruction (`udf`): a UsageFault escalated to a HardFault.
+    Undefined,
+    /// A write into the stack's MPU guard: a MemManage fault escalated to a HardFault, at
+    /// the guard's address.
+    Guard,
 }
 
 /// How the replay hands blocks to the stream.
@@ -89,7 +100,7 @@ enum ConfigError<'a> {
     BadStall,
     /// `sensor` is not `adc` or `adxl375`.
     BadSensor,
-    /// `fault` is not `start`.
+    /// `fault` is not `udf` or `guard`.
     BadFault,
     /// `axis` is not `x`, `y`, `z` or `resultant`.
     BadAxis,
@@ -151,7 +162,7 @@ fn parse(line: &str) -> Result<Config, ConfigError<'_>> {
     let mut scene = impact_firmware::scene::BENCH;
     let mut rate_scale = 1.0f32;
     let mut stall = None;
-    let mut fault_at_start = false;
+    let mut fault_at_start = None;
     let mut adxl375 = false;
     let mut axis = Axis::Resultant;
     let mut band_path = None;
@@ -179,10 +190,11 @@ fn parse(line: &str) -> Result<Config, ConfigError<'_>> {
                 stall = Some((parse(block)?, parse(us)?));
             }
             Some(("fault", value)) => {
-                fault_at_start = value == "start";
-                if !fault_at_start {
-                    return Err(ConfigError::BadFault);
-                }
+                fault_at_start = Some(match value {
+                    "udf" => StartFault::Undefined,
+                    "guard" => StartFault::Guard,
+                    _ => return Err(ConfigError::BadFault),
+                });
             }
             Some(("rate_scale", value)) => {
                 rate_scale = value
@@ -255,12 +267,11 @@ pub fn init(previous: Option<Cause>) -> Setup {
             fault_exit()
         }
     };
-    crate::fault::log_previous(previous);
-    if config.fault_at_start && !matches!(previous, Some(Cause::Fault(_))) {
-        INJECTED_FAULT.store(true, Ordering::Relaxed);
-        defmt::warn!("faulting at start-up (fault injection)");
-        drain::flush();
-        cortex_m::asm::udf()
+    crate::reset::log_previous(previous);
+    if let Some(fault) = config.fault_at_start {
+        if !matches!(previous, Some(Cause::Fault(_))) {
+            inject(fault)
+        }
     }
     irq::init();
     time::init();
@@ -337,7 +348,26 @@ pub fn stall_sampler(us: u32) {
 /// The watchdog is the board's: QEMU stops a locked-up core itself (the run fails).
 pub fn feed_watchdog() {}
 
-/// The fault was the test's (`fault=start`): reset as the board does.
+/// Faults as the test asked (`fault=udf|guard`).
+fn inject(fault: StartFault) -> ! {
+    INJECTED_FAULT.store(true, Ordering::Relaxed);
+    defmt::warn!("faulting at start-up (fault injection)");
+    drain::flush();
+    match fault {
+        StartFault::Undefined => cortex_m::asm::udf(),
+        StartFault::Guard => {
+            // SAFETY: none: this write must fault (the MPU forbids the guard), and the fault
+            // handler does not return.
+            unsafe { core::ptr::write_volatile(crate::stack::guard_address() as *mut u32, 0) };
+            // Reached only if the guard let the write through.
+            defmt::error!("the stack's guard did not fault");
+            drain::flush();
+            host::exit(false)
+        }
+    }
+}
+
+/// The fault was the test's (`fault=udf|guard`): reset as the board does.
 static INJECTED_FAULT: AtomicBool = AtomicBool::new(false);
 
 /// After a fault has been kept and logged: the run fails; an injected fault resets the

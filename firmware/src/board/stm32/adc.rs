@@ -12,18 +12,26 @@
 //! | 15 cycles     | 27 cycles  | 778 kS/s     |
 //! | 28 cycles     | 40 cycles  | 525 kS/s     |
 //!
-//! so 500 kS/s with 28-cycle sampling (1.33 us, easier on the source impedance) is close to
-//! the limit of this clock tree. The F407's single-ADC maximum, 2.4 MS/s, needs ADCCLK =
-//! 36 MHz, i.e. APB2 = 72 MHz (SYSCLK 144 MHz); the triple-interleaved mode (7.2 MS/s) is not
-//! used here. TIM3 runs from 84 MHz: 500 kS/s is exactly 168 timer clocks per sample.
+//! so 500 kS/s (2 us, 42 ADCCLK cycles between triggers) takes 15-cycle sampling: 27 cycles of
+//! conversion plus the trigger's 2-cycle latency (RM0090 13.3.8) leave 13 cycles (0.62 us) of
+//! margin. 28-cycle sampling left none (28 + 12 + 2 = 42), so a trigger could come while the
+//! previous conversion ran: TIM2 would count it, no sample would come, and the time base
+//! would drift. 15 cycles (0.71 us) settle the ADC's 4 pF sample capacitor to 12 bits through
+//! a source up to 11.8 kOhm (DS8626 Eq. 1: R_AIN <= (k - 0.5) / (f_ADC C_ADC ln(2^14)) - R_ADC,
+//! with R_ADC = 6 kOhm): drive PA1 from an amplifier or a divider below that. The F407's
+//! single-ADC maximum, 2.4 MS/s, needs ADCCLK = 36 MHz, i.e. APB2 = 72 MHz (SYSCLK 144 MHz);
+//! the triple-interleaved mode (7.2 MS/s) is not used here. TIM3 runs from 84 MHz: 500 kS/s
+//! is exactly 168 timer clocks per sample.
 //!
 //! Losses are counted, never silent: TIM2 (32 bits) counts every TIM3 trigger, i.e. every
 //! conversion, so after a DMA ring overrun (the sampler task fell a full ring behind) or an
 //! ADC overrun (no DMA service in time: the ADC stops its DMA requests) the number of samples
 //! lost is the count minus the samples delivered, announced to the stream with the next
-//! block. An ADC overrun is taken from its OVR flag by the ADC's interrupt ([`ADC`]), counted
-//! there one by one, and the sampler re-arms the DMA at once (not after the stall timeout).
-//! Not verified on a board here: the conversion in flight at the resync (±1 sample).
+//! block; and after every block the count is checked against the samples delivered
+//! (`impact_firmware::conversions`), so triggers that made no sample are found too. An ADC
+//! overrun is taken from its OVR flag by the ADC's interrupt ([`ADC`]), counted there once,
+//! and the sampler recovers in RM0090 13.8.1's order (DMA requests re-armed, then OVR
+//! cleared). Not verified on a board here: the conversion in flight at the resync (±1 sample).
 
 use defmt::{info, warn};
 use embassy_futures::select::{select, Either};
@@ -42,14 +50,16 @@ use super::Irqs;
 use crate::queues::BLOCK_LEN;
 use crate::source::sender::{BlockSender, SAMPLE_CLOCK, SOURCE_STATS};
 use impact_firmware::analog::{self, VddaError};
+use impact_firmware::conversions::{self, Check, Resync};
 use impact_firmware::SAMPLE_RATE_HZ;
 
 /// DMA ring length in samples: two blocks, so the DMA fills one half while the task reads
 /// the other (half-transfer and transfer-complete interrupts).
 pub const DMA_BUF_LEN: usize = 2 * BLOCK_LEN;
 
-/// ADC sampling time: 28 + 12 = 40 ADCCLK cycles at 21 MHz = 1.90 us <= 2 us per sample.
-const SAMPLE_TIME: SampleTime = SampleTime::CYCLES28;
+/// ADC sampling time: 15 + 12 = 27 ADCCLK cycles at 21 MHz = 1.29 us, and the trigger's 2
+/// cycles, in the 42 of a sample's 2 us (module documentation).
+const SAMPLE_TIME: SampleTime = SampleTime::CYCLES15;
 
 /// No half-buffer for this long means the ADC stopped (ADC overrun): 10 ms = ~20 blocks.
 const STALL_TIMEOUT: Duration = Duration::from_millis(10);
@@ -158,12 +168,14 @@ static ADC_OVERRUN: Signal<CriticalSectionRawMutex, ()> = Signal::new();
 
 /// The ADC's interrupt, for its overrun flag only (embassy-stm32's DMA mode also enables the
 /// end-of-conversion interrupt, which [`sampler`] turns off: it would come 500 000 times a
-/// second). Counts the overrun, clears the flag, and wakes the sampler.
+/// second). Counts the overrun (the one place that counts ADC overruns), masks its own
+/// interrupt until the sampler has recovered (OVR stays set: RM0090 13.8.1 clears it after
+/// the DMA is re-armed), and wakes the sampler.
 #[interrupt]
 fn ADC() {
     let regs = embassy_stm32::pac::ADC1;
     if regs.sr().read().ovr() {
-        regs.sr().modify(|w| w.set_ovr(false));
+        regs.cr1().modify(|w| w.set_ovrie(false));
         SOURCE_STATS.overrun();
         ADC_OVERRUN.signal(());
     }
@@ -181,14 +193,17 @@ fn enable_overrun_interrupt() {
     unsafe { interrupt::ADC.enable() };
 }
 
-/// Clears an ADC overrun (OVR) and re-arms the ADC's DMA requests; returns whether OVR was
-/// set. RM0090 13.8.1: after OVR the ADC issues no more DMA requests until it is cleared.
-fn clear_adc_overrun() -> bool {
+/// Recovers from an ADC overrun (OVR) in RM0090 13.8.1's order: the ADC's DMA requests
+/// re-armed (the circular stream keeps its address and count), then OVR cleared, then the
+/// overrun interrupt unmasked; the next TIM3 trigger starts the next conversion. Returns
+/// whether OVR was set. After OVR the ADC issues no DMA request until this runs.
+fn recover_adc_overrun() -> bool {
     let regs = embassy_stm32::pac::ADC1;
     let overrun = regs.sr().read().ovr();
-    regs.sr().modify(|w| w.set_ovr(false));
     regs.cr2().modify(|w| w.set_dma(false));
     regs.cr2().modify(|w| w.set_dma(true));
+    regs.sr().modify(|w| w.set_ovr(false));
+    regs.cr1().modify(|w| w.set_ovrie(true));
     overrun
 }
 
@@ -201,15 +216,27 @@ pub async fn sampler(mut s: AdcSampler, samples: crate::queues::SampleSender) {
     let mut delivered = 0u32;
 
     s.counter.zero();
+    // embassy's `start` also sets SWSTART: one conversion no TIM3 trigger made, which TIM2
+    // never counts. Let it land, then drop it, so every sample in the ring is a counted one.
     s.adc.start();
+    embassy_time::block_for(Duration::from_micros(5));
+    s.adc.clear();
     enable_overrun_interrupt();
     s.trigger.start();
     SAMPLE_CLOCK.start(SAMPLE_RATE_HZ as f32);
-    info!(
-        "ADC1/PA1 sampling at {} Hz (TIM3 TRGO), blocks of {}",
-        s.trigger.get_frequency().0,
-        BLOCK_LEN
-    );
+    let rate = trigger_rate_hz(&s.trigger);
+    if rate == SAMPLE_RATE_HZ {
+        info!(
+            "ADC1/PA1 sampling at {} Hz (TIM3 TRGO), blocks of {}",
+            rate, BLOCK_LEN
+        );
+    } else {
+        defmt::error!(
+            "ADC1/PA1 sampling at {} Hz, not the scene's {} Hz: every time is off",
+            rate,
+            SAMPLE_RATE_HZ
+        );
+    }
 
     loop {
         let read = select(
@@ -221,7 +248,7 @@ pub async fn sampler(mut s: AdcSampler, samples: crate::queues::SampleSender) {
             Either::First(r) => r,
             // An ADC overrun (counted by the interrupt): re-arm the DMA, resync, go on.
             Either::Second(()) => {
-                clear_adc_overrun();
+                recover_adc_overrun();
                 let lost = resync(&mut s, &mut delivered);
                 sender.lost(lost);
                 warn!(
@@ -241,6 +268,18 @@ pub async fn sampler(mut s: AdcSampler, samples: crate::queues::SampleSender) {
                     }
                 });
                 delivered = delivered.wrapping_add(BLOCK_LEN as u32);
+                // The count against what was delivered: triggers that made no sample.
+                if let Check::Missed { missed } =
+                    conversions::check(s.counter.conversions(), delivered, DMA_BUF_LEN as u32)
+                {
+                    let n = SOURCE_STATS.error();
+                    let lost = resync(&mut s, &mut delivered);
+                    sender.lost(lost);
+                    warn!(
+                        "ADC: {} triggers made no sample (error #{}): {} samples lost",
+                        missed, n, lost
+                    );
+                }
             }
             // embassy-stm32's `OverrunError` (not exported by name): the DMA lapped the reader
             // and the ring has dropped what it held. The DMA keeps running.
@@ -251,13 +290,16 @@ pub async fn sampler(mut s: AdcSampler, samples: crate::queues::SampleSender) {
                 warn!("ADC DMA ring overrun (#{}): {} samples lost", n, lost);
             }
             Err(_timeout) => {
-                if clear_adc_overrun() {
-                    let n = SOURCE_STATS.overrun();
-                    warn!("ADC overrun (#{}): conversions stalled, DMA re-armed", n);
+                if recover_adc_overrun() {
+                    // The interrupt counted it (and may have signalled: that is this one).
+                    ADC_OVERRUN.reset();
+                    warn!("ADC overrun: conversions stalled, DMA re-armed");
                 } else {
                     let n = SOURCE_STATS.error();
                     warn!("ADC stalled without overrun (error #{}): restarting", n);
                     s.adc.start();
+                    // Its software-started conversion lands before the resync drops the ring.
+                    embassy_time::block_for(Duration::from_micros(5));
                 }
                 let lost = resync(&mut s, &mut delivered);
                 sender.lost(lost);
@@ -266,14 +308,30 @@ pub async fn sampler(mut s: AdcSampler, samples: crate::queues::SampleSender) {
     }
 }
 
+/// TIM3's trigger rate as its registers make it: the timer clock over (PSC + 1)(ARR + 1).
+/// (embassy-stm32 0.6's `get_frequency` divides by ARR, not ARR + 1: 502 994 Hz for these
+/// 500 000.)
+fn trigger_rate_hz(t: &Timer<'static, TIM3>) -> u32 {
+    let r = t.regs_gp16();
+    let clocks = (u32::from(r.psc().read()) + 1) * (u32::from(r.arr().read().arr()) + 1);
+    t.get_clock_frequency().0 / clocks.max(1)
+}
+
 /// Drops what the ring holds and returns how many conversions were not delivered since the
-/// last block (the ring's contents included).
+/// last block (the ring's contents included). A count behind the samples delivered (a
+/// conversion no trigger made) loses nothing.
 fn resync(s: &mut AdcSampler, delivered: &mut u32) -> u32 {
     let now = critical_section::with(|_| {
         s.adc.clear();
         s.counter.conversions()
     });
-    let lost = now.wrapping_sub(*delivered);
+    let lost = match conversions::resync(now, *delivered) {
+        Resync::Lost(n) => n,
+        Resync::Uncounted(extra) => {
+            warn!("ADC: {} conversions no trigger counted", extra);
+            0
+        }
+    };
     *delivered = now;
     lost
 }

@@ -14,7 +14,9 @@ use embassy_sync::channel::Channel;
 use embassy_time::Instant;
 
 use crate::tasks::stream::APPROACH_SPEED;
-use impact_firmware::light_gate::{Beam, Pairing, Passage};
+use core::sync::atomic::{AtomicBool, AtomicU32, Ordering};
+
+use impact_firmware::light_gate::{new_cut, Beam, Pairing, Passage};
 use impact_firmware::scene::LIGHT_GATE_SPACING_M;
 
 /// Cuts waiting for the task: (beam, µs since start-up).
@@ -30,14 +32,30 @@ fn EXTI1() {
     cut(1, Beam::Second);
 }
 
-/// Time-stamps first, then clears the line's pending bit (write 1) and queues the cut (a
-/// full queue drops it: four cuts faster than the task can take them are not a passage).
+/// Each line's previous edge, µs (low 32 bits), and whether there was one.
+static LAST_EDGE_US: [AtomicU32; 2] = [AtomicU32::new(0), AtomicU32::new(0)];
+static SEEN: [AtomicBool; 2] = [AtomicBool::new(false), AtomicBool::new(false)];
+
+/// Time-stamps first, then clears the line's pending bit (write 1), debounces (edges of one
+/// beam closer than `light_gate::DEBOUNCE_US` are one cut, at the first edge) and queues the
+/// cut (a full queue drops it: four cuts faster than the task can take them are not a
+/// passage).
 fn cut(line: usize, beam: Beam) {
     let t = Instant::now().as_micros();
     pac::EXTI
         .pr(0)
         .write_value(pac::exti::regs::Lines(1 << line));
-    let _ = CUTS.try_send((beam, t));
+    let (Some(last), Some(seen)) = (LAST_EDGE_US.get(line), SEEN.get(line)) else {
+        return;
+    };
+    let now = t as u32;
+    let previous = seen
+        .swap(true, Ordering::Relaxed)
+        .then(|| last.load(Ordering::Relaxed));
+    last.store(now, Ordering::Relaxed);
+    if new_cut(previous, now) {
+        let _ = CUTS.try_send((beam, t));
+    }
 }
 
 /// The two beams' inputs, kept alive (and armed on the rising edge) for the program's life.

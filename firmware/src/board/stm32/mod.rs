@@ -75,7 +75,7 @@ pub fn init(previous: Option<Cause>) -> Setup {
     let mut p = embassy_stm32::init(clock_config());
     enable_flash_accelerator();
     info!("reset reason: {}", reset_reason(previous.is_some()));
-    crate::fault::log_previous(previous);
+    crate::reset::log_previous(previous);
     start_watchdog();
     #[allow(unused_mut)]
     let mut scene = impact_firmware::scene::BENCH;
@@ -331,7 +331,7 @@ pub fn end_of_stream(success: bool) -> ! {
         success,
         RESTART_AFTER_S
     );
-    crate::fault::keep(Cause::StreamEnded);
+    crate::reset::keep(Cause::StreamEnded);
     // Timed by the cycle counter, the watchdog fed all along (a spin loop's `asm::delay` ran
     // about three times the cycles it was given).
     let mut clock = CycleClock::start();

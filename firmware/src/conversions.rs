@@ -1,0 +1,68 @@
+//! The ADC's conversions counted against the samples delivered: the board's time base.
+//!
+//! TIM2 counts every TIM3 trigger (32 bits, wrapping); the sampler counts the samples it took
+//! out of the DMA ring or declared lost. A sample's place in the stream is its count, so the
+//! two must agree: the counter may run ahead by what the ring holds and has not been read yet
+//! (at most the ring's length, and the conversion in flight), never further. Further means
+//! triggers that made no sample (a conversion still running when the next trigger came, or a
+//! ring the DMA lapped unseen): those samples are lost and the stream must be told, or every
+//! later time is early by them.
+//!
+//! Both counts wrap at 2^32 (2.4 hours at 500 kS/s); their difference is taken signed, so a
+//! sample delivered before the counter saw its trigger (a software-started conversion) is a
+//! count of −1, not 4 294 967 295 lost.
+
+/// After a block was read: whether the counter is further ahead than the ring can hold.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Check {
+    /// Within the ring's reach (`pending` samples counted and not yet read).
+    Ok { pending: u32 },
+    /// `missed` triggers made no sample: resynchronise and count them lost.
+    Missed { missed: u32 },
+    /// More samples delivered than triggers counted (a conversion nobody triggered).
+    Uncounted { extra: u32 },
+}
+
+/// What a resynchronisation finds (the ring's unread contents dropped first).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Resync {
+    /// Conversions counted since the last sample delivered: lost.
+    Lost(u32),
+    /// More delivered than counted: nothing lost, the stream ran `extra` samples ahead.
+    Uncounted(u32),
+}
+
+/// The counter's lead over the samples delivered (negative: more delivered than counted).
+pub fn lead(counted: u32, delivered: u32) -> i64 {
+    i64::from(counted.wrapping_sub(delivered) as i32)
+}
+
+/// The check after each block: `ring` samples is what the DMA ring holds; one more may be
+/// in flight (counted at its trigger, in the ring 27 ADC cycles later).
+pub fn check(counted: u32, delivered: u32, ring: u32) -> Check {
+    let lead = lead(counted, delivered);
+    if lead < 0 {
+        Check::Uncounted {
+            extra: lead.unsigned_abs() as u32,
+        }
+    } else if lead > i64::from(ring) + 1 {
+        Check::Missed {
+            missed: (lead - i64::from(ring) - 1) as u32,
+        }
+    } else {
+        Check::Ok {
+            pending: lead as u32,
+        }
+    }
+}
+
+/// At a resynchronisation (the ring dropped, the counter read): what was lost since the last
+/// sample delivered.
+pub fn resync(counted: u32, delivered: u32) -> Resync {
+    let lead = lead(counted, delivered);
+    if lead < 0 {
+        Resync::Uncounted(lead.unsigned_abs() as u32)
+    } else {
+        Resync::Lost(lead as u32)
+    }
+}
