@@ -13,7 +13,7 @@ use std::sync::OnceLock;
 use std::time::Instant;
 
 mod common;
-use common::{impact_ok as impact, Scratch};
+use common::{impact_judged, impact_ok as impact, Scratch};
 use impact_host::firmware_link::line::Counter;
 use impact_host::firmware_link::qemu::{
     Inject, Pacing, QemuError, Samples, StartFault, BOARD_CLOCK_SHIFT,
@@ -1237,8 +1237,19 @@ fn spec_verdicts_on_the_board_are_the_hosts() {
         let file = scratch.join(&format!("spec-{name}.csv"));
         std::fs::write(&file, csv).unwrap();
         let file = file.to_string_lossy().into_owned();
-        let (host, _) = impact(&["analyze", &file, "--spec", spec, "--json"]);
-        let (emulated, log) = impact(&["emulate", &file, "--spec", spec, "--json", "--elf", &elf]);
+        let (code, host, _) = common::impact(&["analyze", &file, "--spec", spec, "--json"]);
+        let (emulated_code, emulated, log) =
+            common::impact(&["emulate", &file, "--spec", spec, "--json", "--elf", &elf]);
+        // Exit status 3 for the failing verdicts, on the host and the board alike.
+        assert_eq!(
+            (code, emulated_code),
+            if matches!(name, "fail" | "band" | "step") {
+                (3, 3)
+            } else {
+                (0, 0)
+            },
+            "{name}\n{log}"
+        );
         assert_eq!(emulated, host, "{name}\n--- emulator log ---\n{log}");
         let host: serde_json::Value = serde_json::from_str(&host).unwrap();
         let verdict = &host["impacts"][0]["spec"];
@@ -1257,7 +1268,7 @@ fn spec_verdicts_on_the_board_are_the_hosts() {
         }
         let log_file = scratch.join(&format!("spec-{name}.log"));
         std::fs::write(&log_file, &log).unwrap();
-        let (from_log, _) = impact(&["log", &log_file.to_string_lossy()]);
+        let (from_log, _) = impact_judged(&["log", &log_file.to_string_lossy()]);
         let from_log: serde_json::Value = serde_json::from_str(&from_log).unwrap();
         assert_eq!(from_log["impacts"], host["impacts"], "{name}: impact log");
     }

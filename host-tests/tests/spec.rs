@@ -4,7 +4,7 @@
 //! table rings after the pulse). The emulated board's verdicts: `tests/emulator.rs`.
 
 mod common;
-use common::{impact, impact_ok, Scratch};
+use common::{impact, impact_judged, Scratch};
 
 /// A recording at 50 kS/s, in g: `pulse(t)` (t from the pulse's start at 50 ms, s) over 200 ms,
 /// with ±0.02 g of deterministic noise, written to `name`.csv in `scratch`: its path.
@@ -35,13 +35,16 @@ fn judged(file: &str, spec: &str) -> (serde_json::Value, serde_json::Value) {
     judged_with(file, spec, &[])
 }
 
+/// (The exit status is checked too: 3 exactly when the verdict is a failure.)
 fn judged_with(file: &str, spec: &str, more: &[&str]) -> (serde_json::Value, serde_json::Value) {
     let mut args = vec!["analyze", file, "--spec", spec, "--json"];
     args.extend(more);
-    let (out, _) = impact_ok(&args);
-    let j: serde_json::Value = serde_json::from_str(&out).unwrap();
+    let (code, out, err) = impact(&args);
+    let j: serde_json::Value = serde_json::from_str(&out).unwrap_or_else(|e| panic!("{e}: {err}"));
     let impacts = j["impacts"].as_array().unwrap();
     assert_eq!(impacts.len(), 1, "{out}");
+    let failed = impacts[0]["spec"]["pass"].as_bool() == Some(false);
+    assert_eq!(code, if failed { 3 } else { 0 }, "{err}");
     (impacts[0].clone(), j)
 }
 
@@ -163,7 +166,7 @@ fn pulses_off_the_specification_fail_by_their_margin() {
                 0.0
             }
     });
-    let (out, _) = impact_ok(&["analyze", &file, "--spec", "half-sine,50g,11ms", "--json"]);
+    let (out, _) = impact_judged(&["analyze", &file, "--spec", "half-sine,50g,11ms", "--json"]);
     let j: serde_json::Value = serde_json::from_str(&out).unwrap();
     assert_eq!(
         j["impacts"][0]["null_reasons"]["spec"], "spec-window",
@@ -186,9 +189,9 @@ fn pulses_off_the_specification_fail_by_their_margin() {
         "--trigger",
         "20g",
     ];
-    let (table, _) = impact_ok(&spec);
+    let (table, _) = impact_judged(&spec);
     assert!(table.contains("spec: FAIL: band EXCEEDED"), "{table}");
-    let (csv, _) = impact_ok(&[&spec[..], &["--csv"]].concat());
+    let (csv, _) = impact_judged(&[&spec[..], &["--csv"]].concat());
     let mut lines = csv.lines();
     let header: Vec<&str> = lines.next().unwrap().split(',').collect();
     let row: Vec<&str> = lines.next().unwrap().split(',').collect();
@@ -206,7 +209,7 @@ fn a_window_the_capture_cannot_hold_is_null_with_its_reason() {
     let (i, _) = judged(&file, "half-sine,50g,1s");
     assert!(i["spec"].is_null(), "{}", i["spec"]);
     assert_eq!(i["null_reasons"]["spec"], "spec-window");
-    let (table, _) = impact_ok(&["analyze", &file, "--spec", "half-sine,50g,1s"]);
+    let (table, _) = impact_judged(&["analyze", &file, "--spec", "half-sine,50g,1s"]);
     assert!(table.contains("spec: not judged (spec-window)"), "{table}");
     // A bad specification is refused naming the part.
     let (code, _, err) = impact(&["analyze", &file, "--spec", "half-sine,50g"]);
@@ -223,7 +226,7 @@ fn the_afrl_drop_tower_pulse_fails_in_its_ringing() {
         env!("CARGO_MANIFEST_DIR"),
         "/data/afrl-drop-tower/series1_test1_full_100ms.csv"
     );
-    let (out, _) = impact_ok(&[
+    let (out, _) = impact_judged(&[
         "analyze",
         file,
         "--column",
@@ -285,11 +288,11 @@ fn a_users_band_from_a_file_judges_as_written() {
     assert!((f(&v["limit_m_s2"]) - 55.0 * 9.80665).abs() < 0.1, "{v}");
     assert!((f(&v["worst_time_s"]) - 0.0555).abs() < 0.0003, "{v}");
     // The table names the band; the report lists its rows.
-    let (table, _) = impact_ok(&["analyze", &file, "--spec", &spec]);
+    let (table, _) = impact_judged(&["analyze", &file, "--spec", &spec]);
     assert!(table.contains("the user's band of 9 rows"), "{table}");
     let html = scratch.join("band.html");
     let html_s = html.to_string_lossy().into_owned();
-    impact_ok(&["report", &file, "--spec", &spec, "--html", &html_s]);
+    impact_judged(&["report", &file, "--spec", &spec, "--html", &html_s]);
     let page = std::fs::read_to_string(&html).unwrap();
     assert!(
         page.contains("9 rows (time from the nominal start")
@@ -383,4 +386,63 @@ fn a_users_band_from_a_file_judges_as_written() {
     common::assert_refused(Some(code), &err, "--log", "over the band");
     let kept = std::fs::read_to_string(&normalised).unwrap();
     assert!(kept.starts_with("time_over_duration"), "{kept}");
+}
+
+/// The exit status gates on the verdicts: 0 when every judged impact passed or none was
+/// judged, 3 when one failed (distinct from 1, an error), with a last line on stderr that
+/// counts them; a series and `impact report` the same.
+#[test]
+fn a_failed_verdict_is_exit_status_3() {
+    let scratch = Scratch::new();
+    let good = recording(&scratch, "good", half_sine(50.0, 0.011));
+    let high = recording(&scratch, "high", half_sine(65.0, 0.011));
+    let status = |args: &[&str]| {
+        let (code, _, err) = impact(args);
+        (code, err)
+    };
+    let (code, err) = status(&["analyze", &good, "--spec", "half-sine,50g,11ms"]);
+    assert_eq!(code, 0, "{err}");
+    assert!(!err.contains("FAIL"), "{err}");
+    let (code, err) = status(&["analyze", &high, "--spec", "half-sine,50g,11ms"]);
+    assert_eq!(code, 3, "{err}");
+    assert!(
+        err.trim_end()
+            .ends_with("FAIL: 1 of 1 judged impact failed the specification (exit status 3)"),
+        "{err}"
+    );
+    // Not judged (a 1 s pulse: the capture cannot hold its window) is no failure.
+    let (code, err) = status(&["analyze", &good, "--spec", "half-sine,50g,1s"]);
+    assert_eq!(code, 0, "{err}");
+    // A series of a passing and a failing recording, as a table, JSON and an HTML report.
+    for more in [&[][..], &["--json"], &["--csv"]] {
+        let mut args = vec!["analyze", &good, &high, "--spec", "half-sine,50g,11ms"];
+        args.extend_from_slice(more);
+        let (code, err) = status(&args);
+        assert_eq!(code, 3, "{more:?}: {err}");
+        assert!(err.contains("FAIL: 1 of 2 judged impacts"), "{err}");
+    }
+    let html = scratch.join("r.html");
+    let html = html.to_str().unwrap();
+    let (code, err) = status(&[
+        "report",
+        &good,
+        &high,
+        "--spec",
+        "half-sine,50g,11ms",
+        "--html",
+        html,
+    ]);
+    assert_eq!(code, 3, "{err}");
+    let (code, err) = status(&[
+        "report",
+        &good,
+        "--spec",
+        "half-sine,50g,11ms",
+        "--html",
+        html,
+    ]);
+    assert_eq!(code, 0, "{err}");
+    // Without a spec nothing is judged.
+    let (code, err) = status(&["analyze", &high]);
+    assert_eq!(code, 0, "{err}");
 }

@@ -4,6 +4,8 @@
 
 use std::process::ExitCode;
 
+use impact_host::report::spec::{Judged, EXIT_FAILED_VERDICT};
+
 use clap::{Parser, Subcommand};
 use impact_host::cli::{self, progress};
 use impact_host::simulate;
@@ -115,11 +117,21 @@ fn main() -> ExitCode {
         }
     }
     match result {
-        Ok(()) => {
+        Ok(judged) => {
             for note in impact_host::take_notes() {
                 impact_host::errln!("note: {note}");
             }
-            ExitCode::SUCCESS
+            if judged.failed > 0 {
+                impact_host::errln!(
+                    "FAIL: {} of {} judged impact{} failed the specification (exit status {EXIT_FAILED_VERDICT})",
+                    judged.failed,
+                    judged.judged,
+                    if judged.judged == 1 { "" } else { "s" }
+                );
+                ExitCode::from(EXIT_FAILED_VERDICT)
+            } else {
+                ExitCode::SUCCESS
+            }
         }
         Err(e) => {
             impact_host::errln!("error: {e}");
@@ -151,15 +163,20 @@ enum Error {
     Bench(Box<impact_host::bench::BenchError>),
 }
 
-fn run(cli: Cli) -> Result<(), Error> {
+/// Runs the command; the verdicts of the commands that judge impacts against a spec
+/// (`analyze`, `report`, `emulate`, `log`), none for the others.
+fn run(cli: Cli) -> Result<Judged, Error> {
+    let none = Judged::default();
     match cli.command {
-        Command::Simulate(args) => Ok(cli::simulate::run(&args)?),
+        Command::Simulate(args) => Ok(cli::simulate::run(&args).map(|()| none)?),
         Command::Analyze(args) => Ok(cli::analyze::run(&args)?),
         Command::Emulate(args) => Ok(cli::emulate::emulate(&args)?),
         Command::Log(args) => Ok(cli::log::log(&args)?),
         Command::Report(args) => Ok(cli::html::run(&args)?),
-        Command::Watch(args) => Ok(cli::watch::run(&args)?),
-        Command::Synth(command) => Ok(cli::synth::run(command)?),
-        Command::Bench { which } => cli::bench::run(which).map_err(|e| Error::Bench(Box::new(e))),
+        Command::Watch(args) => Ok(cli::watch::run(&args).map(|()| none)?),
+        Command::Synth(command) => Ok(cli::synth::run(command).map(|()| none)?),
+        Command::Bench { which } => cli::bench::run(which)
+            .map(|()| none)
+            .map_err(|e| Error::Bench(Box::new(e))),
     }
 }

@@ -8,6 +8,7 @@ use impact_io::channel::ColumnRef;
 
 use super::series;
 use crate::pipeline::{self, AnalyzeArgs};
+use crate::report::spec::Judged;
 use crate::{plot, report};
 
 /// `impact analyze`'s command line: one recording's options, and the series' recordings.
@@ -83,8 +84,8 @@ impl From<pipeline::PipelineError> for AnalyzeError {
     }
 }
 
-/// Runs `impact analyze`.
-pub fn run(cmd: &AnalyzeCommand) -> Result<(), AnalyzeError> {
+/// Runs `impact analyze`; returns the verdicts (the exit status says whether one failed).
+pub fn run(cmd: &AnalyzeCommand) -> Result<Judged, AnalyzeError> {
     let mut files = vec![cmd.args.file.clone()];
     files.extend(cmd.more.iter().cloned());
     if series::is_series(&files, &cmd.channels) {
@@ -116,12 +117,12 @@ pub fn run(cmd: &AnalyzeCommand) -> Result<(), AnalyzeError> {
         signal.title = format!("{name}, {}", signal.title);
         plot::impacts(&signal, &reports, path)?;
     }
-    Ok(())
+    Ok(Judged::reports(&reports))
 }
 
 /// A test series: every recording analysed, the rows and statistics printed, each
 /// recording's notes named by it; exit status 1 if one failed (its error in the output).
-fn run_series(cmd: &AnalyzeCommand, files: &[PathBuf]) -> Result<(), AnalyzeError> {
+fn run_series(cmd: &AnalyzeCommand, files: &[PathBuf]) -> Result<Judged, AnalyzeError> {
     let args = &cmd.args;
     if args.plot.is_some() {
         return Err(AnalyzeError::PlotSeries);
@@ -144,12 +145,18 @@ fn run_series(cmd: &AnalyzeCommand, files: &[PathBuf]) -> Result<(), AnalyzeErro
         crate::out!("{}", series::to_table(&results));
     }
     let recordings = results.len();
+    let judged = Judged::impacts(
+        results
+            .iter()
+            .filter_map(|e| e.analysis.as_ref())
+            .flat_map(|a| &a.impacts),
+    );
     let mut failed: Vec<series::Failed> = results
         .into_iter()
         .filter_map(series::EntryJson::into_failure)
         .collect();
     match failed.len() {
-        0 => Ok(()),
+        0 => Ok(judged),
         1 => Err(AnalyzeError::OneFailed {
             recordings,
             failed: Box::new(failed.remove(0)),

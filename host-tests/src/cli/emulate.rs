@@ -247,7 +247,9 @@ pub fn adxl375_axes(setup: &mut pipeline::Setup) -> Result<Vec<[i16; 3]>, Emulat
 }
 
 /// `impact emulate`: prints what `impact analyze` would, computed by the emulated firmware.
-pub fn emulate(args: &EmulateArgs) -> Result<(), EmulateError> {
+/// Runs `impact emulate`; returns the board's verdicts (the exit status says whether one
+/// failed).
+pub fn emulate(args: &EmulateArgs) -> Result<crate::report::spec::Judged, EmulateError> {
     let a = &args.analyze;
     // Check the tools before a possibly long build.
     tools_available()?;
@@ -442,7 +444,7 @@ pub fn emulate(args: &EmulateArgs) -> Result<(), EmulateError> {
         signal.title = format!("{name} on the emulated board, {}", signal.title);
         crate::plot::impacts(&signal, &log.impacts, path)?;
     }
-    Ok(())
+    Ok(crate::report::spec::Judged::reports(&log.impacts))
 }
 
 /// `n` little-endian i16 counts from index `from` of the file at `path`.

@@ -63,8 +63,8 @@ pub enum LogReportError {
     Field(#[from] crate::firmware_link::line::FieldError),
 }
 
-/// Runs `impact report`.
-pub fn run(args: &ReportArgs) -> Result<(), ReportError> {
+/// Runs `impact report`; returns the verdicts (the exit status says whether one failed).
+pub fn run(args: &ReportArgs) -> Result<crate::report::spec::Judged, ReportError> {
     let cmd = &args.analyze;
     let a = &cmd.args;
     if a.plot.is_some() || a.json || a.csv {
@@ -107,7 +107,12 @@ pub fn run(args: &ReportArgs) -> Result<(), ReportError> {
             recordings: results.len(),
         });
     }
-    Ok(())
+    Ok(crate::report::spec::Judged::impacts(
+        results
+            .iter()
+            .filter_map(|e| e.analysis.as_ref())
+            .flat_map(|a| &a.impacts),
+    ))
 }
 
 const STYLE: &str = "body{font-family:system-ui,sans-serif;margin:2em;color:#222;max-width:1100px}\

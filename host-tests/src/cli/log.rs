@@ -2,6 +2,7 @@
 //! checked line by line, and turned into `impact analyze`'s JSON and CSV, its figure and its
 //! windows as recordings.
 
+use crate::report::spec::Judged;
 use std::io::{BufRead, BufReader, BufWriter, Read, Write};
 use std::path::PathBuf;
 
@@ -137,7 +138,8 @@ fn finite_f64(s: &str) -> Result<f64, FiniteError> {
 
 /// `impact log`: a decoded firmware log as JSON (default) or CSV. The file (or stdin, `-`)
 /// is read line by line, each line at most [`MAX_LINE_BYTES`].
-pub fn log(args: &LogArgs) -> Result<(), LogCommandError> {
+/// Runs `impact log`; returns the board's verdicts (the exit status says whether one failed).
+pub fn log(args: &LogArgs) -> Result<Judged, LogCommandError> {
     let name = impact_io::channel::input_name(&args.file);
     if let Some(path) = &args.plot {
         let mut inputs = vec![args.file.as_path()];
@@ -266,7 +268,7 @@ pub fn export(
 }
 
 /// The log read: its warnings on stderr, the figure and exports asked for, the JSON or CSV.
-fn report(args: &LogArgs, reader: LogReader, name: &str) -> Result<(), LogCommandError> {
+fn report(args: &LogArgs, reader: LogReader, name: &str) -> Result<Judged, LogCommandError> {
     let log = reader.finish().map_err(in_log(name))?;
     if let (true, [_, second, ..]) = (
         args.plot.is_some() || args.export.is_some(),
@@ -333,5 +335,6 @@ fn report(args: &LogArgs, reader: LogReader, name: &str) -> Result<(), LogComman
         crate::report::write_json(&json.head, json.impacts(), &mut out)
     }
     .and_then(|()| out.flush())
-    .map_err(LogCommandError::Stdout)
+    .map_err(LogCommandError::Stdout)?;
+    Ok(Judged::reports(&log.impacts))
 }

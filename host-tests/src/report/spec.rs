@@ -7,6 +7,44 @@ use serde::Serialize;
 
 use super::fmt::shortest;
 
+/// The verdicts of a run: how many impacts were judged and how many of them failed. Any
+/// failure makes the tool's exit status [`EXIT_FAILED_VERDICT`], so a script or CI can gate on
+/// it (an impact not judged is neither).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct Judged {
+    pub judged: usize,
+    pub failed: usize,
+}
+
+/// The exit status when the run finished and at least one judged impact failed its
+/// specification: distinct from 1 (an error: the run did not finish) and 2 (a usage error).
+pub const EXIT_FAILED_VERDICT: u8 = 3;
+
+impl Judged {
+    /// The verdicts among the analysis's (or the board's) reports.
+    pub fn reports<'a>(reports: impl IntoIterator<Item = &'a impact_core::ImpactReport>) -> Self {
+        reports
+            .into_iter()
+            .filter_map(|r| r.verdict.as_ref()?.as_ref().ok())
+            .fold(Self::default(), |j, v| j.with(v.pass))
+    }
+
+    /// The verdicts among the impacts of JSON outputs (a series).
+    pub fn impacts<'a>(impacts: impl IntoIterator<Item = &'a super::ImpactJson>) -> Self {
+        impacts
+            .into_iter()
+            .filter_map(|i| i.spec.as_ref()?.as_ref())
+            .fold(Self::default(), |j, v| j.with(v.pass))
+    }
+
+    fn with(self, pass: bool) -> Self {
+        Self {
+            judged: self.judged + 1,
+            failed: self.failed + usize::from(!pass),
+        }
+    }
+}
+
 /// The specified pulse and the tolerances it is judged with (fractions of the peak, or of
 /// the duration for the windows and the slack).
 #[derive(Clone, Debug, Serialize, PartialEq)]

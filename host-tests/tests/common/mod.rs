@@ -35,6 +35,22 @@ pub fn impact_ok(args: &[&str]) -> (String, String) {
     (out, err)
 }
 
+/// Runs `impact ARGS`, which must finish: exit status 0, or 3 when a judged impact failed
+/// its specification (then stderr ends saying so): (stdout, stderr).
+#[allow(dead_code)] // not every test file needs it
+pub fn impact_judged(args: &[&str]) -> (String, String) {
+    let (code, out, err) = impact(args);
+    match code {
+        0 => assert!(!err.contains("failed the specification"), "{err}"),
+        3 => assert!(
+            err.contains("failed the specification (exit status 3)"),
+            "{err}"
+        ),
+        _ => panic!("impact {}: exit {code}\n{err}", args.join(" ")),
+    }
+    (out, err)
+}
+
 /// `impact synth` of a two-phase impact (seed-001 bench body; kc 1e4, kr 5e4, damping 5): one
 /// 55.6 g impact at 10 ms, the hostile-input issue's `T2`.
 #[allow(dead_code)] // not every test file needs it
