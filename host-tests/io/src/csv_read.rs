@@ -7,7 +7,7 @@ use std::path::Path;
 
 use super::channel::CsvFormat;
 use super::csv_fast::{self, FastRows, Layout, Parsed};
-use super::error::{ReadError, ReadErrorKind};
+use super::error::ReadError;
 use super::table::{Row, Rows, Table};
 
 /// What the next read gives.
@@ -168,9 +168,9 @@ pub fn read_table(
             }
         }
     }
-    table.headers = reader.rows.headers;
     if table.columns.first().is_none_or(|c| c.is_empty()) {
-        return Err(ReadError::new(path, ReadErrorKind::NoDataRows));
+        return Err(ReadError::new(path, reader.rows.no_data_rows()));
     }
+    table.headers = reader.rows.headers;
     Ok(table)
 }

@@ -675,7 +675,21 @@ pub enum ReadErrorKind {
         fields: usize,
         expected: usize,
     },
+    /// Rows split on white space under a one-field header whose names, split too, do not
+    /// name the columns one to one.
+    HeaderNamesColumns {
+        header_line: u64,
+        names: Vec<String>,
+        fields: usize,
+    },
     NoDataRows,
+    /// Every line held text: `lines` of them, the first after the header at `line` with
+    /// `field`, not a number.
+    NoNumericRows {
+        lines: u64,
+        line: u64,
+        field: String,
+    },
 
     // Columns and channels.
     /// A column index past the rows' fields (`what`: `column`, `time column`, `axis`).
@@ -952,6 +966,20 @@ impl ReadErrorKind {
                     None => Ok(()),
                 }
             }
+            K::HeaderNamesColumns {
+                header_line,
+                names,
+                fields,
+            } => write!(
+                f,
+                "{fields} columns split on white space, but the header (line {header_line}) splits into {} names ({}), which cannot be matched to them: separate the header's names with a tab or two spaces",
+                names.len(),
+                names
+                    .iter()
+                    .map(|n| format!("{n:?}"))
+                    .collect::<Vec<_>>()
+                    .join(", ")
+            ),
             K::WiderThanHeader {
                 fields,
                 header_line,
@@ -976,6 +1004,10 @@ impl ReadErrorKind {
                 write!(f, "{fields} fields, expected {expected}")
             }
             K::NoDataRows => f.write_str("no data rows"),
+            K::NoNumericRows { lines, line, field } => write!(
+                f,
+                "no data rows: all {lines} lines hold text; line {line}, the first after the header, has {field:?}, not a number"
+            ),
             K::ColumnIndex {
                 what,
                 index,
@@ -1267,7 +1299,17 @@ mod tests {
                 fields: 3,
                 expected: 2,
             },
+            K::HeaderNamesColumns {
+                header_line: 1,
+                names: vec!["Time".into(), "(ms)".into(), "Accel".into()],
+                fields: 2,
+            },
             K::NoDataRows,
+            K::NoNumericRows {
+                lines: 5500,
+                line: 2,
+                field: "12:00:01.5".into(),
+            },
             K::ColumnIndex {
                 what: "column",
                 index: 9,

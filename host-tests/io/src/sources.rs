@@ -286,7 +286,7 @@ impl CsvSource {
         // The first data row gives the columns their number (the header their names).
         let (line, first) = match rows.next_row()? {
             Some((line, _, row)) => (line, row.to_vec()),
-            None => return Err(err(ReadErrorKind::NoDataRows)),
+            None => return Err(err(rows.no_data_rows())),
         };
         let shape = rows.shape();
         let tcol = shape

@@ -225,6 +225,19 @@ fn sniff_delimiter(head: &[u8]) -> u8 {
     }
 }
 
+/// A field's parts: the field trimmed, or, where white space lies inside it and `split`, each
+/// run of other bytes (a row aligned with spaces read under another delimiter). An empty field stays
+/// one empty field.
+fn white_space_fields(field: &[u8], split: bool) -> impl Iterator<Item = &[u8]> {
+    let field = field.trim_ascii();
+    let inside = split && field.iter().any(|&b| b == b' ' || b == b'\t');
+    let whole = (!inside).then_some(field);
+    let parts = field
+        .split(|&b| b == b' ' || b == b'\t')
+        .filter(move |p| inside && !p.is_empty());
+    whole.into_iter().chain(parts)
+}
+
 /// A decimal number (`1.5e-3`, `-2`, `.5`; also `NaN` and `inf`, refused by the caller).
 fn parse_number(field: &[u8]) -> Option<f64> {
     match field.first() {
@@ -288,6 +301,10 @@ pub struct Rows {
     header_line: u64,
     /// Fields per data row (0 before the first).
     pub columns: usize,
+    /// Lines taken for headers, and the first text field of the second of them (a line
+    /// after the header that still holds text: what kept the rows from being data).
+    text_lines: u64,
+    text_after_header: Option<(u64, String)>,
     /// Line of the first data row.
     pub first_data_line: u64,
     /// Lines before the first one read (a reader resumed mid-file), and the file's bytes
@@ -383,6 +400,8 @@ impl Rows {
             header_fields: 0,
             header_line: 0,
             columns: 0,
+            text_lines: 0,
+            text_after_header: None,
             first_data_line: 0,
             line_offset: 0,
             skip: 0,
@@ -528,8 +547,24 @@ impl Rows {
             self.row.clear();
             let mut bad = None;
             let mut text_field = false;
-            for f in self.record.iter() {
-                let f = f.trim_ascii();
+            // A field with white space inside is several (a table whose columns are aligned
+            // with spaces, as LabVIEW and many loggers write them, even under a header whose
+            // names a tab separates): each run of spaces and tabs separates two fields. Only
+            // where tabs delimit, or no delimiter split the line (a `;` or `,` table's field
+            // with a space inside is an error: a thousands separator, say).
+            // A tab at the line's start or end (LabVIEW ends every row with one) opens no
+            // field; an empty field between two is still an error.
+            let split = self.delimiter == b'\t' || self.record.len() == 1;
+            let last = self.record.len().saturating_sub(1);
+            let edge =
+                |k: usize, f: &[u8]| split && (k == 0 || k == last) && f.trim_ascii().is_empty();
+            for f in self
+                .record
+                .iter()
+                .enumerate()
+                .filter(|&(k, f)| !edge(k, f))
+                .flat_map(|(_, f)| white_space_fields(f, split))
+            {
                 match read_number(f, self.format.decimal_comma, &mut self.scratch) {
                     Some(v) if is_reading(v) => self.row.push(v),
                     Some(v) => {
@@ -551,6 +586,19 @@ impl Rows {
             }
             if self.columns == 0 {
                 if text_field {
+                    self.text_lines += 1;
+                    if self.text_lines == 2 {
+                        let text = self
+                            .record
+                            .iter()
+                            .flat_map(|f| white_space_fields(f, split))
+                            .find(|f| {
+                                read_number(f, self.format.decimal_comma, &mut Vec::new()).is_none()
+                            })
+                            .map(|f| String::from_utf8_lossy(f).into_owned())
+                            .unwrap_or_default();
+                        self.text_after_header = Some((lineno, text));
+                    }
                     // Text makes a header line; a number that is not finite or beyond any
                     // sensor is an error wherever it is (a NaN row before the data is not a
                     // header).
@@ -564,6 +612,12 @@ impl Rows {
                     continue;
                 }
                 if bad.is_none() {
+                    // Rows split on white space under a header of one field: the header's
+                    // names are split too (on tabs, else on runs of two or more spaces, else
+                    // on each space), and must name every column.
+                    if self.header_fields == 1 && self.row.len() > 1 && self.record.len() == 1 {
+                        self.split_header(lineno)?;
+                    }
                     // A row wider than its header has fields no name covers (decimal commas
                     // split in two, most often); a narrower one leaves names over, as the
                     // AFRL drop tower's files do (seven names, six columns), and is read.
@@ -595,6 +649,58 @@ impl Rows {
                 ));
             }
             return Ok(Some((lineno, breaks, &self.row)));
+        }
+    }
+
+    /// The one-field header split into names for rows of `self.row.len()` white-space
+    /// separated fields (the first data row, at `lineno`): on tabs if it has any, else on runs
+    /// of two or more spaces, else on each space. Names that do not match the columns one to
+    /// one are an error naming both (a guess would put a unit's name on a column).
+    fn split_header(&mut self, lineno: u64) -> Result<(), ReadError> {
+        let Some(header) = self.headers.first().cloned() else {
+            return Ok(());
+        };
+        let names: Vec<String> = if header.contains('\t') {
+            header
+                .split('\t')
+                .map(str::trim)
+                .map(String::from)
+                .collect()
+        } else if header.contains("  ") {
+            header
+                .split("  ")
+                .map(str::trim)
+                .filter(|n| !n.is_empty())
+                .map(String::from)
+                .collect()
+        } else {
+            header.split_ascii_whitespace().map(String::from).collect()
+        };
+        if names.len() != self.row.len() {
+            return Err(self.err(
+                Some(lineno),
+                ReadErrorKind::HeaderNamesColumns {
+                    header_line: self.header_line,
+                    names,
+                    fields: self.row.len(),
+                },
+            ));
+        }
+        self.header_fields = names.len();
+        self.headers = names;
+        Ok(())
+    }
+
+    /// Why the file gave no data row: none at all, or lines that all held text (then the
+    /// first one after the header and its text, which kept it from being data).
+    pub fn no_data_rows(&self) -> ReadErrorKind {
+        match &self.text_after_header {
+            Some((line, field)) => ReadErrorKind::NoNumericRows {
+                lines: self.text_lines,
+                line: *line,
+                field: field.clone(),
+            },
+            None => ReadErrorKind::NoDataRows,
         }
     }
 

@@ -5,6 +5,8 @@ use impact_io::channel::time_unit_s;
 use impact_io::channel::ColumnRef;
 use impact_io::channel::CsvFormat;
 use impact_io::csv_read::read_table;
+use impact_core::consts::STANDARD_GRAVITY;
+use impact_io::units::Units;
 use impact_io::ReadErrorKind;
 
 use crate::read_errors::{kind_message, ReadFailure};
@@ -42,8 +44,21 @@ pub fn file(spec: &str) -> &Path {
     split(spec).0
 }
 
-/// `FILE[:COLUMN]` split (a colon in a directory name is the file's).
+/// `FILE[:COLUMN]` split: the whole of it if that is a file; else at the first colon whose
+/// left part is a file (a column's name may hold colons and slashes: `Acceleration z
+/// (m/s^2)`); else, where no such file exists, at the last colon not followed by a path
+/// (the error then names that file).
 fn split(spec: &str) -> (&Path, Option<&str>) {
+    if Path::new(spec).is_file() {
+        return (Path::new(spec), None);
+    }
+    let at_file = spec
+        .match_indices(':')
+        .map(|(i, _)| (&spec[..i], &spec[i + 1..]))
+        .find(|(p, _)| !p.is_empty() && Path::new(p).is_file());
+    if let Some((p, c)) = at_file {
+        return (Path::new(p), Some(c));
+    }
     match spec.rsplit_once(':') {
         Some((p, c)) if !p.is_empty() && !c.contains('/') => (Path::new(p), Some(c)),
         _ => (Path::new(spec), None),
@@ -79,9 +94,31 @@ pub fn free_fall_before(spec: &str, impact_s: f64) -> Result<f64, FreeFallError>
         Some(c) => vec![table.find(c, "column").map_err(in_file)?],
         None => (0..table.columns.len()).filter(|&c| c != tcol).collect(),
     };
+    // Each column in g, by the unit its header names (as the main input's); a column that
+    // names none is read as g, and a note says so.
+    let header = |c: usize| table.headers.get(c).cloned().unwrap_or_default();
+    let to_g: Vec<f64> = cols
+        .iter()
+        .map(|&c| match Units::of_header(&header(c)) {
+            Some(u) => u.to_m_s2(None) / STANDARD_GRAVITY,
+            None => {
+                let name = if header(c).is_empty() {
+                    format!("column {c}")
+                } else {
+                    header(c)
+                };
+                impact_io::note(&format!(
+                    "--free-fall {}: {name} names no unit: read as g",
+                    path.display()
+                ));
+                1.0
+            }
+        })
+        .collect();
     let mag = |i: usize| {
         cols.iter()
-            .map(|&c| table.columns[c][i].powi(2))
+            .zip(&to_g)
+            .map(|(&c, k)| (table.columns[c][i] * k).powi(2))
             .sum::<f64>()
             .sqrt()
     };

@@ -1,0 +1,243 @@
+//! Tables as loggers write them, not only as CSV: columns aligned with spaces (LabVIEW's
+//! "Write To Measurement File" text, many DAQ exports), a header whose names a tab separates
+//! over rows padded with spaces, lines ending CR CR LF, time in ms. Each is made here from rows
+//! of the bundled AFRL record and gives its CSV twin's report; a table whose rows never hold
+//! numbers says which line and field kept them from being data, not "no data rows".
+
+mod common;
+
+use std::path::{Path, PathBuf};
+
+use common::{impact, impact_ok, Scratch};
+
+/// `count` rows of AFRL test 1 (its bottom channel, kg_n) from row `first`.
+fn afrl(first: usize, count: usize) -> Vec<f64> {
+    let path = PathBuf::from(env!("CARGO_MANIFEST_DIR"))
+        .join("data/afrl-drop-tower/series1_test1_full_100ms.csv");
+    std::fs::read_to_string(path)
+        .unwrap()
+        .lines()
+        .skip(1 + first)
+        .take(count)
+        .map(|l| l.split(',').nth(1).unwrap().parse().unwrap())
+        .collect()
+}
+
+/// The report's impact lines (the table, rounded as the user sees it) of `file` in kg_n.
+fn impacts(file: &Path) -> Vec<String> {
+    let (out, err) = impact_ok(&["analyze", file.to_str().unwrap(), "--units", "kgn"]);
+    let lines: Vec<String> = out
+        .lines()
+        .filter(|l| l.starts_with("impact "))
+        .map(String::from)
+        .collect();
+    assert!(!lines.is_empty(), "{out}{err}");
+    lines
+}
+
+#[test]
+fn space_aligned_tables_read_as_their_csv_twin() {
+    let scratch = Scratch::new();
+    let values = afrl(5000, 20_000);
+    // The twin: plain CSV, time in s at 1 MS/s.
+    let mut csv = String::from("time_s,bottom\n");
+    for (k, v) in values.iter().enumerate() {
+        csv.push_str(&format!("{:.6},{v}\n", k as f64 * 1e-6));
+    }
+    let twin = scratch.file("twin.csv", csv);
+    let want = impacts(&twin);
+    let stream = [
+        "--units",
+        "kgn",
+        "--stream",
+        "--range",
+        "20000g",
+        "--trigger",
+        "1000g",
+    ];
+    let streamed = |file: &Path| -> Vec<String> {
+        let mut args = vec!["analyze", file.to_str().unwrap()];
+        args.extend(stream);
+        let (out, err) = impact_ok(&args);
+        let lines: Vec<String> = out
+            .lines()
+            .filter(|l| l.starts_with("impact "))
+            .map(String::from)
+            .collect();
+        assert!(!lines.is_empty(), "{out}{err}");
+        lines
+    };
+    let want_streamed = streamed(&twin);
+    // (name, header, a row's format from (time in ms, value), line end)
+    type Row = fn(f64, f64) -> String;
+    let layouts: [(&str, &str, Row, &str); 5] = [
+        // LabVIEW: tab-separated names, rows padded with spaces around a tab, CR CR LF.
+        (
+            "tab-padded",
+            "Time (ms)\tbottom",
+            |t, v| format!("{t:>10.3}\t{v:>12}"),
+            "\r\r\n",
+        ),
+        // Names a tab separates, rows aligned with spaces only.
+        (
+            "tab-header-space-rows",
+            "Time (ms)\tbottom",
+            |t, v| format!("{t:>10.3}  {v:>12}"),
+            "\r\r\n",
+        ),
+        // Everything aligned with spaces: names two spaces apart, leading spaces.
+        (
+            "spaces",
+            "  Time (ms)    bottom",
+            |t, v| format!("  {t:>10.3}    {v:>12}"),
+            "\n",
+        ),
+        // One space between names without spaces, a single space between fields.
+        (
+            "single-space",
+            "time_ms bottom",
+            |t, v| format!("{t:.3} {v}"),
+            "\r\n",
+        ),
+        // Tabs and spaces mixed in the rows.
+        (
+            "mixed",
+            "time_ms\tbottom",
+            |t, v| format!(" {t:.3} \t  {v}\t"),
+            "\n",
+        ),
+    ];
+    for (name, header, row, end) in layouts {
+        let mut text = format!("{header}{end}");
+        for (k, v) in values.iter().enumerate() {
+            text.push_str(&row(k as f64 * 1e-3, *v));
+            text.push_str(end);
+        }
+        let file = scratch.file(&format!("{name}.txt"), text);
+        assert_eq!(impacts(&file), want, "{name}");
+        // Streamed a block at a time alike.
+        assert_eq!(streamed(&file), want_streamed, "{name} --stream");
+    }
+}
+
+/// Names that cannot be matched to the columns (single spaces between names with spaces
+/// inside) are refused with the fix; a unit is never put on a column as its name.
+#[test]
+fn a_header_whose_names_cannot_be_told_apart_is_refused_with_the_fix() {
+    let scratch = Scratch::new();
+    let mut text = String::from("Time (ms) Accel (g)\n");
+    for k in 0..100 {
+        text.push_str(&format!("{:.3} {}\n", k as f64 * 0.01, k % 7));
+    }
+    let file = scratch.file("ambiguous.txt", text);
+    let (code, _, err) = impact(&["analyze", file.to_str().unwrap()]);
+    assert_eq!(code, 1, "{err}");
+    assert!(
+        err.contains("line 1) splits into 4 names (\"Time\", \"(ms)\", \"Accel\", \"(g)\")")
+            && err.contains("separate the header's names with a tab or two spaces"),
+        "{err}"
+    );
+}
+
+/// A file with rows is never "no data rows" without a reason: rows that all hold text (a
+/// clock time, a unit after each number) name the first line after the header and its field.
+#[test]
+fn rows_that_hold_text_say_which_line_and_field() {
+    let scratch = Scratch::new();
+    for (name, rows, field) in [
+        (
+            "clock",
+            "12:00:01.000,0.5\n12:00:01.001,0.7\n",
+            "12:00:01.000",
+        ),
+        ("units", "0.000 s,0.5 g\n0.001 s,0.7 g\n", "0.000 s"),
+    ] {
+        let file = scratch.file(&format!("{name}.csv"), format!("time,accel\n{rows}"));
+        let (code, _, err) = impact(&["analyze", file.to_str().unwrap()]);
+        assert_eq!(code, 1, "{err}");
+        assert!(
+            err.contains(&format!(
+                "no data rows: all 3 lines hold text; line 2, the first after the header, has {field:?}, not a number"
+            )),
+            "{name}: {err}"
+        );
+    }
+    // No row at all: the plain message.
+    let file = scratch.file("empty.csv", "time,accel\n");
+    let (_, _, err) = impact(&["analyze", file.to_str().unwrap()]);
+    assert!(err.trim_end().ends_with("no data rows"), "{err}");
+}
+
+/// A `;` or `,` table's field with a space inside is not split (a thousands separator would
+/// make two numbers of one): it stays an error at its line.
+#[test]
+fn a_space_inside_a_delimited_field_is_not_a_new_column() {
+    let scratch = Scratch::new();
+    let file = scratch.file(
+        "thousands.csv",
+        "time;accel\n0,000;1 234,5\n0,001;1 240,0\n",
+    );
+    let (code, _, err) = impact(&["analyze", file.to_str().unwrap(), "--decimal-comma"]);
+    assert_eq!(code, 1, "{err}");
+    assert!(
+        err.contains("line 2, the first after the header, has \"1 234,5\""),
+        "{err}"
+    );
+}
+
+/// `--free-fall FILE:COLUMN` takes any column name the main input takes (a phone's
+/// `Acceleration z (m/s^2)`, a slash and spaces in it) and reads each column in the unit its
+/// header names, as the main input does: the same fall in m/s² and in g gives the same v0,
+/// by name or by index; a column that names no unit is read as g, and a note says so.
+#[test]
+fn free_fall_columns_take_any_name_and_their_units() {
+    let scratch = Scratch::new();
+    // An impact at 10 ms (a 2 ms half-sine of 50 g at 100 kS/s).
+    let mut main = String::from("time_s,accel_g\n");
+    for k in 0..5500 {
+        let t = f64::from(k) / 1e5;
+        let tt = t - 0.01;
+        let a = if (0.0..0.002).contains(&tt) {
+            50.0 * (std::f64::consts::PI * tt / 0.002).sin()
+        } else {
+            0.0
+        };
+        main.push_str(&format!("{t:.5},{a:.6}\n"));
+    }
+    let main = scratch.file("drop.csv", main);
+    // The holder's DC channel: at rest (1 g) until 2 ms, then free fall until the impact,
+    // reading 0.1 g there (a phone's sensor in free fall is no exact zero: 0.98 m/s², which
+    // read as g is no free fall).
+    let fall = |header: &str, g: f64| {
+        let mut text = format!("{header}\n");
+        for k in 0..200 {
+            let t = f64::from(k) / 1e4;
+            let z = if (0.002..0.0101).contains(&t) { 0.1 * g } else { g };
+            text.push_str(&format!("{t:.4},0.01,{z}\n"));
+        }
+        text
+    };
+    let ms2 = scratch.file(
+        "phone.csv",
+        fall("Time (s),Acceleration x (m/s^2),Acceleration z (m/s^2)", 9.80665),
+    );
+    let in_g = scratch.file("g.csv", fall("time_s,x_g,z_g", 1.0));
+    let bare = scratch.file("bare.csv", fall("time,x,z", 1.0));
+    let v0 = |spec: String| -> (String, String) {
+        let (out, err) = impact_ok(&["analyze", main.to_str().unwrap(), "--free-fall", &spec]);
+        let head = out.lines().next().unwrap_or_default();
+        let v0 = head
+            .split("; v0 ")
+            .nth(1)
+            .unwrap_or_else(|| panic!("{spec}: {out}{err}"))
+            .to_string();
+        (v0, err)
+    };
+    let (want, _) = v0(format!("{}:Acceleration z (m/s^2)", ms2.display()));
+    assert!(want.starts_with("0.0789"), "{want}");
+    assert_eq!(v0(format!("{}:2", ms2.display())).0, want, "by index");
+    assert_eq!(v0(format!("{}:z_g", in_g.display())).0, want, "in g");
+    let (bare_v0, err) = v0(format!("{}:z", bare.display()));
+    assert_eq!(bare_v0, want, "no unit: g");
+    assert!(err.contains("z names no unit: read as g"), "{err}");
+}
