@@ -67,8 +67,9 @@ pub const FIFO_CTL_STREAM: u8 = 0x80;
 pub const FIFO_CTL_BYPASS: u8 = 0x00;
 /// FIFO_STATUS entries field.
 pub const FIFO_STATUS_ENTRIES: u8 = 0x3F;
-/// INT_SOURCE overrun flag: new data replaced unread data (in stream mode: the FIFO was
-/// full and its oldest sample was lost).
+/// INT_SOURCE overrun flag: in bypass mode, new data replaced unread data; in stream mode the
+/// data sheet sets it when the FIFO fills, whether or not a sample was overwritten
+/// (`crate::fifo` counts the loss from the clock).
 pub const INT_SOURCE_OVERRUN: u8 = 0x01;
 
 /// FIFO depth in samples; one more sample can wait in the output registers (33 entries).

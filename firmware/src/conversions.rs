@@ -11,6 +11,31 @@
 //! Both counts wrap at 2^32 (2.4 hours at 500 kS/s); their difference is taken signed, so a
 //! sample delivered before the counter saw its trigger (a software-started conversion) is a
 //! count of −1, not 4 294 967 295 lost.
+//!
+//! The exact check after each block compares the counter with the DMA's position in its
+//! ring, read together: every trigger moves both by one (the DMA a conversion later), so
+//! `(count − position) mod ring` keeps its value from one resynchronisation to the next, or
+//! one more while a conversion is in flight. Any other change is triggers that made no
+//! sample ([`drift`]).
+
+/// `(counted − position) mod ring`: what [`drift`] compares (`ring` a power of two, so that
+/// the counter's wrap at 2^32 keeps it).
+pub fn phase(counted: u32, position: u32, ring: u32) -> u32 {
+    counted.wrapping_sub(position) % ring.max(1)
+}
+
+/// Triggers that made no sample since the phase was `phase0`, from the counter and the
+/// DMA's ring position read together: 0 on a healthy board (a conversion in flight when
+/// either was read shows as ±1), else how many at least.
+pub fn drift(phase0: u32, counted: u32, position: u32, ring: u32) -> u32 {
+    let ring = ring.max(1);
+    let d = (phase(counted, position, ring) + ring - phase0 % ring) % ring;
+    if d <= 1 || d + 1 == ring {
+        0
+    } else {
+        d - 1
+    }
+}
 
 /// After a block was read: whether the counter is further ahead than the ring can hold.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]

@@ -10,13 +10,28 @@
 //! contents SRAM powers up with. The next start-up logs it with the reset reason, so a fault
 //! on a bench without a probe is seen at the next attach.
 //!
-//! A software reset without a record is not the firmware's: a debugger's (flashing, `probe-rs
-//! reset`), which the board names so.
+//! The record is kept as soon as the cause is known ([`PENDING`]: a fault's registers are
+//! safe even if its log line hangs) and committed ([`MAGIC`]) just before the firmware
+//! resets the chip. A software reset with a committed record is the firmware's; without one
+//! it is a debugger's (flashing, `probe-rs reset`, perhaps during the probe wait or the
+//! restart countdown), which the board names so.
 //!
 //! The encoding is plain words, so the host tests check it (`tests/reset_record.rs`).
 
-/// Marks a record (not SRAM's random power-up contents).
+/// Marks a record the firmware committed just before it reset the chip (not SRAM's random
+/// power-up contents).
 pub const MAGIC: u32 = 0x1A7F_C0DE;
+
+/// Marks a record kept but not yet committed: the reset that followed was not the
+/// firmware's.
+pub const PENDING: u32 = 0x1A7F_0BAD;
+
+/// A record read back: what the firmware kept, and whether it then reset the chip itself.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Record {
+    pub cause: Cause,
+    pub reset_by_firmware: bool,
+}
 
 /// Words in a stored record.
 pub const WORDS: usize = 10;
@@ -54,19 +69,26 @@ pub struct Fault {
 const FAULT: u32 = 1;
 const STREAM_ENDED: u32 = 2;
 
-/// The check word of a record's other words: a rotate-xor fold seeded with the magic, so an
+/// The check word of a record's words before it (the magic first): a rotate-xor fold, so an
 /// all-zero or all-ones RAM, or a record with one word changed, does not pass.
-fn check(words: &[u32]) -> u32 {
+pub fn check(words: &[u32]) -> u32 {
     words
         .iter()
-        .fold(MAGIC ^ 0x5A5A_5A5A, |acc, &w| acc.rotate_left(5) ^ w)
+        .fold(0x5A5A_5A5A, |acc, &w| acc.rotate_left(5) ^ w)
+}
+
+/// A kept record's words committed: the magic [`MAGIC`] and the check word again.
+pub fn commit(words: &mut [u32; WORDS]) {
+    words[0] = MAGIC;
+    words[9] = check(&words[..9]);
 }
 
 impl Cause {
-    /// The record's words: magic, kind, seven registers (zero for a stream's end), check.
+    /// The record's words as kept (not yet committed): [`PENDING`], kind, seven registers
+    /// (zero for a stream's end), check.
     pub fn encode(&self) -> [u32; WORDS] {
         let mut w = [0u32; WORDS];
-        w[0] = MAGIC;
+        w[0] = PENDING;
         match self {
             Cause::Fault(f) => {
                 w[1] = FAULT;
@@ -78,12 +100,12 @@ impl Cause {
         w
     }
 
-    /// The cause a record holds, or `None` for anything that is not a whole record.
-    pub fn decode(w: &[u32; WORDS]) -> Option<Self> {
-        if w[0] != MAGIC || w[9] != check(&w[..9]) {
+    /// The record the words hold, or `None` for anything that is not a whole record.
+    pub fn decode(w: &[u32; WORDS]) -> Option<Record> {
+        if !matches!(w[0], MAGIC | PENDING) || w[9] != check(&w[..9]) {
             return None;
         }
-        match w[1] {
+        let cause = match w[1] {
             FAULT => Some(Cause::Fault(Fault {
                 pc: w[2],
                 lr: w[3],
@@ -95,6 +117,10 @@ impl Cause {
             })),
             STREAM_ENDED if w[2..9].iter().all(|&x| x == 0) => Some(Cause::StreamEnded),
             _ => None,
-        }
+        }?;
+        Some(Record {
+            cause,
+            reset_by_firmware: w[0] == MAGIC,
+        })
     }
 }

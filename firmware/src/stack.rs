@@ -52,27 +52,44 @@ fn stack_end() -> usize {
     core::ptr::addr_of!(_stack_end) as usize
 }
 
-/// Guards the stack's bottom [`GUARD_BYTES`] with MPU region 0: no access, privileged or
-/// not, and no execution (the rest of the map stays the default one, PRIVDEFENA). A stack
-/// that grows into it faults while stacking, which locks the core up: the board's watchdog
-/// resets it, QEMU stops. Without it an overflow ran below 0x2000_0000, into space the F407
-/// calls reserved, which need not fault. Call after [`paint`] (which leaves the guard alone).
+/// The 32 KiB below the stack's bottom, guarded too (MPU region 1): a function whose frame
+/// is larger than [`GUARD_BYTES`] (the stream's end takes 5.4 KiB) moves the stack pointer
+/// past the small guard in one step, and its stores land below it. (On the F407 this is
+/// reserved space and the option bytes, which the firmware never reads; the factory's
+/// VREFINT calibration at 0x1FFF_7A2A lies below it.)
+const BELOW_BYTES: usize = 32 * 1024;
+
+/// Guards the stack's bottom with two MPU regions no access may touch (privileged or not,
+/// no execution; the rest of the map stays the default one, PRIVDEFENA): region 0, the
+/// stack's lowest [`GUARD_BYTES`] (an overflow by a small frame), and region 1, the
+/// [`BELOW_BYTES`] below it (one by a large frame). A stack that grows into either faults
+/// while stacking, which locks the core up: the board's watchdog resets it, QEMU stops.
+/// Without them an overflow ran below 0x2000_0000, into space the F407 calls reserved, which
+/// need not fault. Call after [`paint`] (which leaves the guard alone).
 pub fn guard() {
     let bottom = stack_end();
-    if bottom % GUARD_BYTES != 0 {
+    if bottom % BELOW_BYTES != 0 || bottom < BELOW_BYTES {
         return;
     }
-    // RASR: XN (bit 28), AP = 0b000 (bits 26:24: no access), SIZE = 4 (2^(4+1) = 32 bytes),
-    // ENABLE. CTRL: PRIVDEFENA (bit 2), ENABLE.
-    const RASR: u32 = (1 << 28) | (4 << 1) | 1;
+    // RASR: XN (bit 28), AP = 0b000 (bits 26:24: no access), SIZE (bits 5:1: 2^(SIZE+1)
+    // bytes), ENABLE. CTRL: PRIVDEFENA (bit 2), ENABLE.
+    const fn rasr(size_log2: u32) -> u32 {
+        (1 << 28) | ((size_log2 - 1) << 1) | 1
+    }
     const CTRL: u32 = (1 << 2) | 1;
-    // SAFETY: MPU region 0 is only this guard's; the region covers no static, no code and no
-    // live frame (the stack's bottom, 24 KiB below the first frame).
+    let regions = [
+        (bottom, rasr(GUARD_BYTES.trailing_zeros())),
+        (bottom - BELOW_BYTES, rasr(BELOW_BYTES.trailing_zeros())),
+    ];
+    // SAFETY: MPU regions 0 and 1 are only the guard's; they cover no static, no code and no
+    // live frame (the stack's bottom, 24 KiB below the first frame, and what lies below).
     unsafe {
         let mpu = &*cortex_m::peripheral::MPU::PTR;
-        mpu.rnr.write(0);
-        mpu.rbar.write(bottom as u32);
-        mpu.rasr.write(RASR);
+        for (n, (base, rasr)) in regions.into_iter().enumerate() {
+            mpu.rnr.write(n as u32);
+            mpu.rbar.write(base as u32);
+            mpu.rasr.write(rasr);
+        }
         mpu.ctrl.write(CTRL);
     }
     cortex_m::asm::dsb();

@@ -717,8 +717,10 @@ fn a_forced_dma_overrun_is_a_counted_gap_and_later_positions_stay_right() {
 /// does (a system reset: QEMU keeps RAM and reloads only the ELF's initialised sections, as
 /// the chip's start-up copies only `.data`), and the next start-up logs the record's
 /// registers (the very ones the fault's own line gave), then replays the recording to the end
-/// as if nothing had happened. Two faults: an undefined instruction, and a write into the
-/// stack's MPU guard, which proves the guard faults (an overflowing stack meets it first).
+/// as if nothing had happened. Three faults: an undefined instruction, a write into the
+/// stack's MPU guard, and one 2 KiB below the stack (where a large frame's stores land past
+/// the guard), which prove an overflow faults there whatever the part has below its SRAM
+/// (QEMU's MPS2 has nothing there either, but that would be a BusFault, not a MemManage).
 #[test]
 fn a_fault_is_kept_across_the_reset_and_logged_at_the_next_start_up() {
     let scratch = Scratch::new();
@@ -735,7 +737,11 @@ fn a_fault_is_kept_across_the_reset_and_logged_at_the_next_start_up() {
     )
     .unwrap();
     let host = impact_host::pipeline::run(&setup.prepared.counts, &setup.scene).unwrap();
-    for fault in [StartFault::Undefined, StartFault::StackGuard] {
+    for fault in [
+        StartFault::Undefined,
+        StartFault::StackGuard,
+        StartFault::BelowStack,
+    ] {
         let run = impact_host::firmware_link::qemu::run_emulator(
             &elf,
             Samples::Adc(&setup.prepared.counts),
@@ -785,6 +791,10 @@ fn a_fault_is_kept_across_the_reset_and_logged_at_the_next_start_up() {
             StartFault::StackGuard => {
                 assert_eq!(field("cfsr=") & 0x82, 0x82, "{text}");
                 assert_eq!(field("mmfar="), 0x2000_0000, "{text}");
+            }
+            StartFault::BelowStack => {
+                assert_eq!(field("cfsr=") & 0x82, 0x82, "{text}");
+                assert_eq!(field("mmfar="), 0x2000_0000 - 2048, "{text}");
             }
         }
         // Two start-ups, one fault: the second found the record and did not fault again.

@@ -2,7 +2,7 @@
 //! `.uninit` before it resets the chip. The path through a real system reset runs in the
 //! emulator (`tests/emulator.rs`, `a_fault_is_kept_across_the_reset_and_logged_at_the_next_start_up`).
 
-use impact_firmware::reset_record::{Cause, Fault, MAGIC, WORDS};
+use impact_firmware::reset_record::{commit, Cause, Fault, Record, MAGIC, PENDING, WORDS};
 
 fn fault() -> Cause {
     Cause::Fault(Fault {
@@ -16,12 +16,29 @@ fn fault() -> Cause {
     })
 }
 
+/// Kept, a record reads back as not the firmware's reset (a debugger may reset the chip
+/// during the probe wait or the restart countdown); committed, as the firmware's.
 #[test]
-fn a_record_reads_back_as_what_was_kept() {
+fn a_record_reads_back_as_what_was_kept_and_whether_it_was_committed() {
     for cause in [fault(), Cause::StreamEnded] {
-        let words = cause.encode();
+        let mut words = cause.encode();
+        assert_eq!(words[0], PENDING);
+        assert_eq!(
+            Cause::decode(&words),
+            Some(Record {
+                cause,
+                reset_by_firmware: false
+            })
+        );
+        commit(&mut words);
         assert_eq!(words[0], MAGIC);
-        assert_eq!(Cause::decode(&words), Some(cause));
+        assert_eq!(
+            Cause::decode(&words),
+            Some(Record {
+                cause,
+                reset_by_firmware: true
+            })
+        );
     }
 }
 
@@ -32,7 +49,8 @@ fn anything_but_a_whole_record_is_none() {
     assert_eq!(Cause::decode(&[0; WORDS]), None);
     assert_eq!(Cause::decode(&[u32::MAX; WORDS]), None);
     for cause in [fault(), Cause::StreamEnded] {
-        let words = cause.encode();
+        let mut words = cause.encode();
+        commit(&mut words);
         for i in 0..WORDS {
             for bit in [0, 7, 31] {
                 let mut bad = words;
@@ -55,8 +73,8 @@ fn anything_but_a_whole_record_is_none() {
     for _ in 0..1_000_000 {
         let mut w = [0u32; WORDS];
         w.iter_mut().for_each(|v| *v = next());
-        // Even with the magic in place by chance.
-        w[0] = MAGIC;
+        // Even with a magic in place by chance.
+        w[0] = if w[1] & 1 == 0 { MAGIC } else { PENDING };
         assert_eq!(Cause::decode(&w), None, "{w:x?}");
     }
 }

@@ -105,6 +105,8 @@ pub enum StartFault {
     Undefined,
     /// A write into the stack's MPU guard (its bottom 32 bytes).
     StackGuard,
+    /// A write 2 KiB below the stack's bottom (a large frame's store past the guard).
+    BelowStack,
 }
 
 /// The scene as the firmware's `key=value` semihosting arguments. Floats are written as
@@ -509,6 +511,9 @@ pub fn run_emulator(
                 }
                 Some(Inject::FaultAtStart(StartFault::StackGuard)) => {
                     config.push_str(",arg=fault=guard")
+                }
+                Some(Inject::FaultAtStart(StartFault::BelowStack)) => {
+                    config.push_str(",arg=fault=below-stack")
                 }
                 None => {}
             }

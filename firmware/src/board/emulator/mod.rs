@@ -23,7 +23,7 @@ use static_cell::ConstStaticCell;
 
 use crate::tasks::stream::Backpressure;
 use impact_firmware::adxl375::Axis;
-use impact_firmware::reset_record::Cause;
+use impact_firmware::reset_record::{Cause, Record};
 use impact_firmware::scene::{BandTableError, SceneError};
 use impact_firmware::semihosting as host;
 
@@ -38,7 +38,7 @@ const COMMAND_LINE_LEN: usize = 1920;
 
 /// What the semihosting command line asks for:
 /// `<program> <samples-file> [realtime|lossless] [rate_scale=X] [stall=BLOCK:US]
-/// [fault=udf|guard] [sensor=adc|adxl375] [axis=x|y|z|resultant] [spec_table=PATH] [key=value ...]`
+/// [fault=udf|guard|below-stack] [sensor=adc|adxl375] [axis=x|y|z|resultant] [spec_table=PATH] [key=value ...]`
 /// (scene keys:
 /// see [`impact_firmware::scene::apply`]; unset keys keep the seed bench's values,
 /// [`impact_firmware::scene::BENCH`]).
@@ -74,6 +74,9 @@ pub enum StartFault {
     /// A write into the stack's MPU guard: a MemManage fault escalated to a HardFault, at
     /// the guard's address.
     Guard,
+    /// A write 2 KiB below the stack's bottom, where a large frame's stores land past the
+    /// guard: a MemManage fault there too.
+    BelowStack,
 }
 
 /// How the replay hands blocks to the stream.
@@ -100,7 +103,7 @@ enum ConfigError<'a> {
     BadStall,
     /// `sensor` is not `adc` or `adxl375`.
     BadSensor,
-    /// `fault` is not `udf` or `guard`.
+    /// `fault` is not `udf`, `guard` or `below-stack`.
     BadFault,
     /// `axis` is not `x`, `y`, `z` or `resultant`.
     BadAxis,
@@ -193,6 +196,7 @@ fn parse(line: &str) -> Result<Config, ConfigError<'_>> {
                 fault_at_start = Some(match value {
                     "udf" => StartFault::Undefined,
                     "guard" => StartFault::Guard,
+                    "below-stack" => StartFault::BelowStack,
                     _ => return Err(ConfigError::BadFault),
                 });
             }
@@ -255,7 +259,7 @@ pub struct Setup {
 /// the run (exit status 1). Not inlined: the line's buffer lives in this frame, which is gone
 /// before the executors start (inlined into `main`, it sat under every task's stack).
 #[inline(never)]
-pub fn init(previous: Option<Cause>) -> Setup {
+pub fn init(previous: Option<Record>) -> Setup {
     let mut buf = [0u8; COMMAND_LINE_LEN];
     let config = match host::command_line(&mut buf)
         .map_err(ConfigError::Host)
@@ -269,7 +273,7 @@ pub fn init(previous: Option<Cause>) -> Setup {
     };
     crate::reset::log_previous(previous);
     if let Some(fault) = config.fault_at_start {
-        if !matches!(previous, Some(Cause::Fault(_))) {
+        if !matches!(previous.map(|r| r.cause), Some(Cause::Fault(_))) {
             inject(fault)
         }
     }
@@ -355,10 +359,14 @@ fn inject(fault: StartFault) -> ! {
     drain::flush();
     match fault {
         StartFault::Undefined => cortex_m::asm::udf(),
-        StartFault::Guard => {
-            // SAFETY: none: this write must fault (the MPU forbids the guard), and the fault
+        StartFault::Guard | StartFault::BelowStack => {
+            let at = match fault {
+                StartFault::Guard => crate::stack::guard_address(),
+                _ => crate::stack::guard_address() - 2048,
+            };
+            // SAFETY: none: this write must fault (the MPU forbids it), and the fault
             // handler does not return.
-            unsafe { core::ptr::write_volatile(crate::stack::guard_address() as *mut u32, 0) };
+            unsafe { core::ptr::write_volatile(at as *mut u32, 0) };
             // Reached only if the guard let the write through.
             defmt::error!("the stack's guard did not fault");
             drain::flush();
@@ -376,6 +384,7 @@ static INJECTED_FAULT: AtomicBool = AtomicBool::new(false);
 pub fn fault_exit() -> ! {
     drain::flush();
     if INJECTED_FAULT.load(Ordering::Relaxed) {
+        crate::reset::commit();
         cortex_m::peripheral::SCB::sys_reset()
     }
     host::exit(false)

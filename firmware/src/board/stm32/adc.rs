@@ -50,7 +50,7 @@ use super::Irqs;
 use crate::queues::BLOCK_LEN;
 use crate::source::sender::{BlockSender, SAMPLE_CLOCK, SOURCE_STATS};
 use impact_firmware::analog::{self, VddaError};
-use impact_firmware::conversions::{self, Check, Resync};
+use impact_firmware::conversions::{self, Resync};
 use impact_firmware::SAMPLE_RATE_HZ;
 
 /// DMA ring length in samples: two blocks, so the DMA fills one half while the task reads
@@ -181,14 +181,16 @@ fn ADC() {
     }
 }
 
-/// Only the overrun interrupt of ADC1, at the sample source's priority.
+/// Only the overrun interrupt of ADC1, just above the sample source's priority.
 fn enable_overrun_interrupt() {
     use embassy_stm32::interrupt::{InterruptExt, Priority};
     embassy_stm32::pac::ADC1.cr1().modify(|w| {
         w.set_eocie(false);
         w.set_ovrie(true);
     });
-    interrupt::ADC.set_priority(Priority::P2);
+    // Above the sampler's executor (P2), so the interrupt has always counted and masked an
+    // overrun before the sampler's stall path recovers from it.
+    interrupt::ADC.set_priority(Priority::P1);
     // SAFETY: the handler above is ready; it touches ADC1's status register and two statics.
     unsafe { interrupt::ADC.enable() };
 }
@@ -212,15 +214,15 @@ fn recover_adc_overrun() -> bool {
 pub async fn sampler(mut s: AdcSampler, samples: crate::queues::SampleSender) {
     let mut sender = BlockSender::new(samples);
     let mut half = [0u16; BLOCK_LEN];
-    // Conversions taken out of the ring or counted lost (wrapping, like the counter).
-    let mut delivered = 0u32;
+    // Conversions taken out of the ring or counted lost (wrapping, like the counter): set
+    // below.
 
     s.counter.zero();
     // embassy's `start` also sets SWSTART: one conversion no TIM3 trigger made, which TIM2
-    // never counts. Let it land, then drop it, so every sample in the ring is a counted one.
+    // never counts. It is sample 0 of the stream (dropping it would put every block off the
+    // ring's halves): `delivered` starts one behind, the signed lead takes it.
+    let mut delivered = u32::MAX;
     s.adc.start();
-    embassy_time::block_for(Duration::from_micros(5));
-    s.adc.clear();
     enable_overrun_interrupt();
     s.trigger.start();
     SAMPLE_CLOCK.start(SAMPLE_RATE_HZ as f32);
@@ -237,6 +239,9 @@ pub async fn sampler(mut s: AdcSampler, samples: crate::queues::SampleSender) {
             SAMPLE_RATE_HZ
         );
     }
+    // The counter against the DMA's position (module documentation), from here and from
+    // every resynchronisation.
+    let mut phase0 = ring_phase(&s);
 
     loop {
         let read = select(
@@ -250,6 +255,7 @@ pub async fn sampler(mut s: AdcSampler, samples: crate::queues::SampleSender) {
             Either::Second(()) => {
                 recover_adc_overrun();
                 let lost = resync(&mut s, &mut delivered);
+                phase0 = ring_phase(&s);
                 sender.lost(lost);
                 warn!(
                     "ADC overrun (#{}): {} samples lost, DMA re-armed",
@@ -268,15 +274,16 @@ pub async fn sampler(mut s: AdcSampler, samples: crate::queues::SampleSender) {
                     }
                 });
                 delivered = delivered.wrapping_add(BLOCK_LEN as u32);
-                // The count against what was delivered: triggers that made no sample.
-                if let Check::Missed { missed } =
-                    conversions::check(s.counter.conversions(), delivered, DMA_BUF_LEN as u32)
-                {
+                // The count against the DMA's position: triggers that made no sample.
+                let (counted, position) = positions(&s);
+                let missed = conversions::drift(phase0, counted, position, DMA_BUF_LEN as u32);
+                if missed > 0 {
                     let n = SOURCE_STATS.error();
                     let lost = resync(&mut s, &mut delivered);
+                    phase0 = ring_phase(&s);
                     sender.lost(lost);
                     warn!(
-                        "ADC: {} triggers made no sample (error #{}): {} samples lost",
+                        "ADC: at least {} triggers made no sample (error #{}): {} samples lost",
                         missed, n, lost
                     );
                 }
@@ -286,6 +293,7 @@ pub async fn sampler(mut s: AdcSampler, samples: crate::queues::SampleSender) {
             Ok(Err(_overrun)) => {
                 let n = SOURCE_STATS.overrun();
                 let lost = resync(&mut s, &mut delivered);
+                phase0 = ring_phase(&s);
                 sender.lost(lost);
                 warn!("ADC DMA ring overrun (#{}): {} samples lost", n, lost);
             }
@@ -302,6 +310,7 @@ pub async fn sampler(mut s: AdcSampler, samples: crate::queues::SampleSender) {
                     embassy_time::block_for(Duration::from_micros(5));
                 }
                 let lost = resync(&mut s, &mut delivered);
+                phase0 = ring_phase(&s);
                 sender.lost(lost);
             }
         }
@@ -315,6 +324,23 @@ fn trigger_rate_hz(t: &Timer<'static, TIM3>) -> u32 {
     let r = t.regs_gp16();
     let clocks = (u32::from(r.psc().read()) + 1) * (u32::from(r.arr().read().arr()) + 1);
     t.get_clock_frequency().0 / clocks.max(1)
+}
+
+/// TIM2's count and the DMA's write position in the ring (DMA2 stream 0's NDTR counts down
+/// from the ring's length), read together.
+fn positions(_s: &AdcSampler) -> (u32, u32) {
+    critical_section::with(|_| {
+        let counted = embassy_stm32::pac::TIM2.cnt().read();
+        let left = u32::from(embassy_stm32::pac::DMA2.st(0).ndtr().read().ndt());
+        let ring = DMA_BUF_LEN as u32;
+        (counted, (ring - left.min(ring)) % ring)
+    })
+}
+
+/// The phase [`conversions::drift`] is measured from.
+fn ring_phase(s: &AdcSampler) -> u32 {
+    let (counted, position) = positions(s);
+    conversions::phase(counted, position, DMA_BUF_LEN as u32)
 }
 
 /// Drops what the ring holds and returns how many conversions were not delivered since the

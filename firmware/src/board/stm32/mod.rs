@@ -8,7 +8,7 @@ use embassy_executor::SendSpawner;
 use embassy_stm32::interrupt::{InterruptExt, Priority};
 use embassy_stm32::{bind_interrupts, dma, interrupt, peripherals, Config, Peripherals};
 use impact_core::Scene;
-use impact_firmware::reset_record::Cause;
+use impact_firmware::reset_record::{Cause, Record};
 use panic_probe as _;
 
 use crate::executors::{HIGH, LOW, MEDIUM};
@@ -70,11 +70,14 @@ pub struct Setup {
 
 /// Brings the chip up at 168 MHz with the flash accelerator on, logs why it last reset,
 /// starts the independent watchdog, and sets the ADC's scale from the supply it measures.
-pub fn init(previous: Option<Cause>) -> Setup {
+pub fn init(previous: Option<Record>) -> Setup {
     #[allow(unused_mut)]
     let mut p = embassy_stm32::init(clock_config());
     enable_flash_accelerator();
-    info!("reset reason: {}", reset_reason(previous.is_some()));
+    info!(
+        "reset reason: {}",
+        reset_reason(previous.is_some_and(|r| r.reset_by_firmware))
+    );
     crate::reset::log_previous(previous);
     start_watchdog();
     #[allow(unused_mut)]
@@ -187,6 +190,7 @@ pub fn feed_watchdog() {
 /// record). A debugger attached gets up to [`PROBE_WAIT_MS`] to read the fault's line first.
 pub fn fault_exit() -> ! {
     wait_for_probe();
+    crate::reset::commit();
     cortex_m::peripheral::SCB::sys_reset()
 }
 
@@ -338,6 +342,7 @@ pub fn end_of_stream(success: bool) -> ! {
     while clock.elapsed_ms() < RESTART_AFTER_S * 1000 {
         feed_watchdog();
     }
+    crate::reset::commit();
     cortex_m::peripheral::SCB::sys_reset()
 }
 
