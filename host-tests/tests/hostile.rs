@@ -731,12 +731,12 @@ fn quiet_or_unsettled_recordings_have_no_impacts_and_empty_ones_name_their_file(
     let f = scratch.file("empty.wav", &wav);
     fails(
         &["analyze", f.to_str().unwrap()],
-        "empty.wav: 0 samples; at least 2",
+        "empty.wav: channel 0: 0 samples; at least 2",
     );
     let f = scratch.file("empty.f32", b"");
     fails(
         &["analyze", f.to_str().unwrap(), "--rate", "1000"],
-        "empty.f32: 0 samples; at least 2",
+        "empty.f32: channel 0: 0 samples; at least 2",
     );
 }
 

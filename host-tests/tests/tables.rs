@@ -212,14 +212,21 @@ fn free_fall_columns_take_any_name_and_their_units() {
         let mut text = format!("{header}\n");
         for k in 0..200 {
             let t = f64::from(k) / 1e4;
-            let z = if (0.002..0.0101).contains(&t) { 0.1 * g } else { g };
+            let z = if (0.002..0.0101).contains(&t) {
+                0.1 * g
+            } else {
+                g
+            };
             text.push_str(&format!("{t:.4},0.01,{z}\n"));
         }
         text
     };
     let ms2 = scratch.file(
         "phone.csv",
-        fall("Time (s),Acceleration x (m/s^2),Acceleration z (m/s^2)", 9.80665),
+        fall(
+            "Time (s),Acceleration x (m/s^2),Acceleration z (m/s^2)",
+            9.80665,
+        ),
     );
     let in_g = scratch.file("g.csv", fall("time_s,x_g,z_g", 1.0));
     let bare = scratch.file("bare.csv", fall("time,x,z", 1.0));
@@ -240,4 +247,56 @@ fn free_fall_columns_take_any_name_and_their_units() {
     let (bare_v0, err) = v0(format!("{}:z", bare.display()));
     assert_eq!(bare_v0, want, "no unit: g");
     assert!(err.contains("z names no unit: read as g"), "{err}");
+}
+
+/// A unit neither the header nor the options name is assumed aloud: the channel read as g
+/// and the time column in seconds, each said in a note naming the column and the option that
+/// changes it, marked in the table's head and listed in the JSON; named or given, nothing is
+/// assumed (and the numbers are the same as with the assumption stated).
+#[test]
+fn an_assumed_unit_is_said_where_the_user_looks() {
+    let scratch = Scratch::new();
+    let mut rows = String::new();
+    for k in 0..5000 {
+        let t = f64::from(k) / 1e5;
+        let tt = t - 0.01;
+        let a = if (0.0..0.002).contains(&tt) {
+            490.0 * (std::f64::consts::PI * tt / 0.002).sin()
+        } else {
+            0.0
+        };
+        rows.push_str(&format!("{t:.5},{a:.4}\n"));
+    }
+    let bare = scratch.file("bare.csv", format!("time,accel\n{rows}"));
+    let named = scratch.file("named.csv", format!("time_s,accel_g\n{rows}"));
+    let bare = bare.to_str().unwrap();
+    let (table, err) = impact_ok(&["analyze", bare]);
+    assert!(
+        table.starts_with("accel in g (assumed): 5000 samples at 100000 S/s (time assumed in s)"),
+        "{table}"
+    );
+    assert!(
+        err.contains("note: \"accel\" names no unit: its values read as g (give --units")
+            && err.contains(
+                "note: the time column \"time\" names no unit: read in seconds (give --time-unit"
+            ),
+        "{err}"
+    );
+    let (json, _) = impact_ok(&["analyze", bare, "--json"]);
+    let j: serde_json::Value = serde_json::from_str(&json).unwrap();
+    let assumed = j["assumptions"].as_array().unwrap();
+    assert_eq!(assumed.len(), 2, "{json}");
+    // Stated, or named in the header: nothing assumed, the same numbers.
+    for (file, more) in [
+        (bare, &["--units", "g", "--time-unit", "s"][..]),
+        (named.to_str().unwrap(), &[][..]),
+    ] {
+        let mut args = vec!["analyze", file, "--json"];
+        args.extend_from_slice(more);
+        let (out, err) = impact_ok(&args);
+        let k: serde_json::Value = serde_json::from_str(&out).unwrap();
+        assert!(k.get("assumptions").is_none(), "{out}");
+        assert!(!err.contains("names no unit"), "{err}");
+        assert_eq!(k["impacts"], j["impacts"]);
+    }
 }

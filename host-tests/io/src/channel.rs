@@ -59,6 +59,9 @@ pub struct Channel {
     /// With [`ReadOptions::axes`]: each axis (header name, values on the same time base);
     /// `values` is then their resultant `sqrt(x² + y² + z²)`.
     pub axes: Vec<(String, Vec<f64>)>,
+    /// The time column's header when its unit was neither named there nor given (read in
+    /// seconds: an assumption the report states).
+    pub time_unit_assumed: Option<String>,
 }
 
 /// How to read the file.
@@ -126,6 +129,7 @@ pub fn evenly_sampled(
         jitter: 0.0,
         resampled: false,
         axes: Vec::new(),
+        time_unit_assumed: None,
     })
 }
 
@@ -163,6 +167,12 @@ pub fn named_time_unit_s(header: &str) -> Option<f64> {
         _ => None,
     });
     unit
+}
+
+/// The time column's header if its unit is neither `given` nor named there (then seconds
+/// are assumed).
+pub fn time_unit_assumed(header: &str, given: Option<TimeUnit>) -> Option<String> {
+    (given.is_none() && named_time_unit_s(header).is_none()).then(|| header.to_string())
 }
 
 /// Seconds per unit of a time column: `given` (`--time-unit`), else the one its header names,

@@ -143,6 +143,11 @@ pub fn read_csv(path: &Path, opts: &ReadOptions) -> Result<Channel, ReadError> {
             names.into_iter().zip(channels).collect(),
         )
     };
+    // Read in seconds where the column names no unit and none was given (with a rate given,
+    // the time column sets only the start).
+    let time_unit_assumed = tcol
+        .filter(|_| opts.rate_hz.is_none())
+        .and_then(|t| crate::channel::time_unit_assumed(&header(t), opts.time_unit));
     Ok(Channel {
         name,
         values,
@@ -151,5 +156,6 @@ pub fn read_csv(path: &Path, opts: &ReadOptions) -> Result<Channel, ReadError> {
         jitter,
         resampled,
         axes,
+        time_unit_assumed,
     })
 }

@@ -76,6 +76,12 @@ pub trait Source: Send {
     fn column(&self) -> &str {
         ""
     }
+
+    /// The time column's header when its unit was assumed (seconds), as
+    /// [`crate::channel::Channel::time_unit_assumed`].
+    fn time_unit_assumed(&self) -> Option<String> {
+        None
+    }
 }
 
 /// [`Source::next_counts`] through [`Source::next_values`] and `scratch`.
@@ -108,6 +114,8 @@ pub struct RawSource {
     rate_hz: f64,
     /// For 16-bit codes: each code's count under the quantiser.
     table: Option<(Quantiser, Vec<i16>)>,
+    /// The channel's name, as the whole-file reader gives it (`channel N`).
+    name: String,
 }
 
 impl RawSource {
@@ -144,6 +152,7 @@ impl RawSource {
             path: path.to_path_buf(),
             rate_hz,
             table: None,
+            name: format!("channel {column}"),
         })
     }
 }
@@ -151,6 +160,10 @@ impl RawSource {
 impl Source for RawSource {
     fn rate_hz(&self) -> Result<f64, ReadError> {
         Ok(self.rate_hz)
+    }
+
+    fn column(&self) -> &str {
+        &self.name
     }
 
     fn next_values(&mut self, want: usize, out: &mut Vec<f64>) -> Result<(), ReadError> {
@@ -541,6 +554,12 @@ impl Source for CsvSource {
     fn column(&self) -> &str {
         &self.column
     }
+
+    fn time_unit_assumed(&self) -> Option<String> {
+        self.time
+            .filter(|_| self.rate_given.is_none())
+            .and_then(|_| crate::channel::time_unit_assumed(&self.time_header, self.time_unit))
+    }
 }
 
 /// An `.ide` file's subchannel, read block by block on a thread of its own
@@ -652,6 +671,8 @@ impl Source for IdeSource {
 /// A WAV file's channel ([`crate::wav::WavChannel`], read as it goes).
 pub struct WavSource {
     channel: crate::wav::WavChannel,
+    /// The channel's name, as the whole-file reader gives it (`channel N`).
+    name: String,
 }
 
 impl WavSource {
@@ -663,7 +684,8 @@ impl WavSource {
             ));
         }
         let channel = crate::wav::WavChannel::open(path, opts.column.as_ref())?;
-        Ok(Self { channel })
+        let name = format!("channel {}", channel.column());
+        Ok(Self { channel, name })
     }
 }
 
@@ -677,6 +699,10 @@ impl Source for WavSource {
 
     fn rate_hz(&self) -> Result<f64, ReadError> {
         Ok(self.channel.rate_hz)
+    }
+
+    fn column(&self) -> &str {
+        &self.name
     }
 }
 
@@ -693,6 +719,8 @@ pub struct NpySource {
     given: u64,
     rate_hz: f64,
     path: PathBuf,
+    /// The column's name, as the whole-file reader gives it (`column N`).
+    name: String,
 }
 
 impl NpySource {
@@ -716,6 +744,7 @@ impl NpySource {
             given: 0,
             rate_hz,
             path: path.to_path_buf(),
+            name: format!("column {column}"),
         })
     }
 }
@@ -755,6 +784,10 @@ impl Source for NpySource {
 
     fn rate_hz(&self) -> Result<f64, ReadError> {
         Ok(self.rate_hz)
+    }
+
+    fn column(&self) -> &str {
+        &self.name
     }
 }
 

@@ -74,6 +74,13 @@ impl WavChannel {
     }
 }
 
+impl WavChannel {
+    /// The channel read (0-based).
+    pub fn column(&self) -> usize {
+        self.column
+    }
+}
+
 impl Iterator for WavChannel {
     type Item = Result<f64, ReadError>;
 

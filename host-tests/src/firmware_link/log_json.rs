@@ -61,6 +61,9 @@ impl<'a> LogJson<'a> {
             lines_dropped: log.lines_dropped,
             lines_missing: log.lines_missing,
             v0_m_s,
+            assumptions: Vec::new(),
+            units_assumed: false,
+            time_unit_assumed: false,
             samples: total(|r| r.samples),
             train_speed,
             // The board's spec lines give each impact's verdict; the pulse is the scene's.

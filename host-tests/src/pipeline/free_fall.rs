@@ -1,11 +1,11 @@
 //! The approach speed from a free fall measured on a DC channel before the impact
 //! (`--free-fall`).
 
+use impact_core::consts::STANDARD_GRAVITY;
 use impact_io::channel::time_unit_s;
 use impact_io::channel::ColumnRef;
 use impact_io::channel::CsvFormat;
 use impact_io::csv_read::read_table;
-use impact_core::consts::STANDARD_GRAVITY;
 use impact_io::units::Units;
 use impact_io::ReadErrorKind;
 

@@ -364,6 +364,8 @@ pub struct Setup {
     /// A recording read in passes keeps no counts: the windows `--plot` draws, read in a
     /// last pass (first sample's stream index, counts).
     pub windows: Vec<(u64, Vec<i16>)>,
+    /// What the tool assumed that neither the file nor the options said (a unit).
+    pub assumptions: Vec<Assumption>,
 }
 
 /// What was read of a recording, however it was read: its channel, units, time base and
@@ -416,6 +418,7 @@ impl Setup {
             resampled: false,
             axes: Vec::new(),
             windows: Vec::new(),
+            assumptions: Vec::new(),
         }
     }
 
@@ -525,6 +528,10 @@ pub fn setup(
         rate_hz: ch.rate_hz,
     };
     let mut setup = Setup::new(reading, resolved);
+    setup.assumptions.extend(assumed_units(args, &file, column));
+    setup
+        .assumptions
+        .extend(ch.time_unit_assumed.as_deref().map(assumed_time_unit));
     setup.prepared.counts = counts;
     setup.prepared.accel_m_s2 = accel;
     setup.spikes = spikes;
@@ -559,9 +566,68 @@ pub(crate) fn mass_and_scale(
 ) -> Result<(Option<f64>, f64, Units), PipelineError> {
     let mass = args.mass.or(file.mass);
     let units = Units::resolve(args.units.or(file.units), column).map_err(UnitsFailure)?;
+    if let Some(assumed) = assumed_units(args, file, column) {
+        assumed.noted();
+    }
     let invert = args.invert || file.invert.unwrap_or(false);
     let scale = units.to_m_s2(mass) * args.gain.unwrap_or(1.0) * if invert { -1.0 } else { 1.0 };
     Ok((mass, scale, units))
+}
+
+/// What the tool assumed that neither the file nor the options said.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub enum Assumption {
+    /// The channel (`column`'s header names no unit) read as g.
+    Units { column: String },
+    /// The time column (`column`) read in seconds.
+    TimeUnit { column: String },
+}
+
+impl Assumption {
+    /// The sentence: the assumption and the option that changes it.
+    pub fn text(&self) -> String {
+        match self {
+            Assumption::Units { column } if column.is_empty() => "the channel names no unit: its values read as g (give --units g, m/s2, kgn or n)".to_string(),
+            Assumption::Units { column } => format!(
+                "{column:?} names no unit: its values read as g (give --units g, m/s2, kgn or n, or name the unit in the header: accel_m_s2, accel (g))"
+            ),
+            Assumption::TimeUnit { column } => format!(
+                "the time column {column:?} names no unit: read in seconds (give --time-unit ms, us or ns, or name the unit in the header: time_ms, time (ms))"
+            ),
+        }
+    }
+
+    /// Kept as a note for stderr too (each once), and returned.
+    fn noted(self) -> Self {
+        impact_io::note(&self.text());
+        self
+    }
+}
+
+/// The channel read as g when neither the options, the scene file nor its header (`column`)
+/// named a unit; none for an enDAQ `.ide`, whose channels are in g by the recorder's
+/// calibration.
+pub(crate) fn assumed_units(
+    args: &AnalyzeArgs,
+    file: &SceneFile,
+    column: &str,
+) -> Option<Assumption> {
+    let stated = args.units.or(file.units).is_some() || Units::of_header(column).is_some();
+    let ide = matches!(
+        impact_io::Format::of(&args.file, args.raw_type),
+        impact_io::Format::Ide
+    );
+    (!stated && !ide).then(|| Assumption::Units {
+        column: column.to_string(),
+    })
+}
+
+/// A time column (`column`) read in seconds, its header naming no unit and none given.
+pub(crate) fn assumed_time_unit(column: &str) -> Assumption {
+    Assumption::TimeUnit {
+        column: column.to_string(),
+    }
+    .noted()
 }
 
 /// The scene from the options and the scene file, with the levels and rails found; and
@@ -841,6 +907,15 @@ pub fn to_json(setup: &Setup, reports: &[ImpactReport]) -> AnalysisJson {
         lines_missing: 0,
         column: setup.column.clone(),
         units: Some(setup.units.name().to_string()),
+        assumptions: setup.assumptions.iter().map(Assumption::text).collect(),
+        units_assumed: setup
+            .assumptions
+            .iter()
+            .any(|x| matches!(x, Assumption::Units { .. })),
+        time_unit_assumed: setup
+            .assumptions
+            .iter()
+            .any(|x| matches!(x, Assumption::TimeUnit { .. })),
         samples: setup.samples,
         sample_rate_hz: setup.rate_hz,
         v0_m_s: match setup.scene.approach {

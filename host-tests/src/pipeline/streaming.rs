@@ -53,6 +53,7 @@ pub fn analyze(
     let mut source =
         open_source(&args.file, &args.read_options(progress)).map_err(ReadFailure::from)?;
     let column = source.column().to_string();
+    let setup_column = column.clone();
     let (mass, scale, units) = pipeline::mass_and_scale(args, &file, &column)?;
     let full_scale =
         pipeline::full_scale_m_s2(args, &file, mass).ok_or(PipelineError::StreamNeedsRange)?;
@@ -88,7 +89,15 @@ pub fn analyze(
         samples: run.samples,
         rate_hz: run.source.final_rate_hz(),
     };
+    let assumed = pipeline::assumed_units(args, &file, &setup_column);
+    let time_assumed = run
+        .source
+        .time_unit_assumed()
+        .as_deref()
+        .map(pipeline::assumed_time_unit);
     let mut setup = Setup::new(reading, resolved);
+    setup.assumptions.extend(assumed);
+    setup.assumptions.extend(time_assumed);
     setup.clipping = Some(clipping);
     Ok((setup, run.reports))
 }
@@ -140,6 +149,7 @@ fn in_passes_then(
     let input =
         open_source(&args.file, &args.read_options(bar(0.0, 0.5))).map_err(ReadFailure::from)?;
     let column = input.column().to_string();
+    let setup_column = column.clone();
     let (mass, scale, units) = pipeline::mass_and_scale(args, &file, &column)?;
     let full_scale = pipeline::full_scale_m_s2(args, &file, mass);
     let SurveyPass {
@@ -147,6 +157,7 @@ fn in_passes_then(
         source,
         spool,
     } = survey_pass(input, scale, &[], !args.keep_spikes, spool)?;
+    let time_unit_assumed = source.time_unit_assumed();
     let axis = Axis {
         rate_hz: source.rate_hz().map_err(ReadFailure::from)?,
         final_rate_hz: source.final_rate_hz(),
@@ -235,7 +246,13 @@ fn in_passes_then(
         samples,
         rate_hz,
     };
+    let assumed = pipeline::assumed_units(args, &file, &setup_column);
+    let time_assumed = time_unit_assumed
+        .as_deref()
+        .map(pipeline::assumed_time_unit);
     let mut setup = Setup::new(reading, resolved);
+    setup.assumptions.extend(assumed);
+    setup.assumptions.extend(time_assumed);
     setup.spikes = spikes;
     setup.clipping = levels.clipping;
     setup.windows = windows;

@@ -124,6 +124,16 @@ pub struct AnalysisJson {
     pub column: Option<String>,
     #[serde(skip_serializing)]
     pub units: Option<String>,
+    /// What the tool assumed that neither the file nor the options said (a unit), each a
+    /// sentence naming the option that changes it; absent when nothing was assumed.
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub assumptions: Vec<String>,
+    /// Whether the channel's units, and the time column's unit, were assumed (the table
+    /// marks them).
+    #[serde(skip_serializing)]
+    pub units_assumed: bool,
+    #[serde(skip_serializing)]
+    pub time_unit_assumed: bool,
     pub samples: u64,
     pub sample_rate_hz: f64,
     /// The approach speed of the first impact (from `--v0`, `--drop-height` or a free

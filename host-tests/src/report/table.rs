@@ -8,14 +8,23 @@ use super::AnalysisJson;
 /// A readable table.
 pub fn to_table(a: &AnalysisJson) -> String {
     let mut s = format!(
-        "{}{} samples at {} S/s{}{}{}{}\n",
+        "{}{} samples at {} S/s{}{}{}{}{}\n",
         match (&a.column, &a.units) {
+            // An assumed unit is marked where it is shown (the note on stderr says why).
+            (Some(c), Some(u)) if a.units_assumed => {
+                format!("{c} in {u} (assumed): ")
+            }
             (Some(c), Some(u)) => format!("{c} in {u}: "),
             (Some(c), None) => format!("{c}: "),
             _ => String::new(),
         },
         a.samples,
         sig(a.sample_rate_hz, 6),
+        if a.time_unit_assumed {
+            " (time assumed in s)"
+        } else {
+            ""
+        },
         match (&a.v0_source, a.v0_m_s, a.free_fall_s) {
             (Some(_), Some(v), Some(t)) => format!(
                 "; v0 {} from {} of free fall",

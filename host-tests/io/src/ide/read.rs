@@ -199,6 +199,8 @@ pub fn read_ide(path: &Path, opts: &ReadOptions) -> Result<Channel, ReadError> {
         jitter: if opts.resample { 0.0 } else { jitter },
         resampled: opts.resample,
         axes,
+        // The recorder's own time stamps.
+        time_unit_assumed: None,
     })
 }
 
