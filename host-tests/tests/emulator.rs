@@ -1231,6 +1231,8 @@ fn spec_verdicts_on_the_board_are_the_hosts() {
         ("window", 50.0, "half-sine,50g,1s"),
         ("band", 57.0, band.as_str()),
         ("step", 57.0, step.as_str()),
+        // A pulse of another shape: judged (it failed), not "not judged".
+        ("shape", 50.0, "sawtooth,50g,11ms"),
     ] {
         // A half-sine of `peak_g` over 11 ms at 50 kS/s, from 50 ms.
         let mut csv = String::from("time_s,accel_g\n");
@@ -1253,7 +1255,7 @@ fn spec_verdicts_on_the_board_are_the_hosts() {
         // Exit status 3 for the failing verdicts, on the host and the board alike.
         assert_eq!(
             (code, emulated_code),
-            if matches!(name, "fail" | "band" | "step") {
+            if matches!(name, "fail" | "band" | "step" | "shape") {
                 (3, 3)
             } else {
                 (0, 0)
@@ -1266,6 +1268,7 @@ fn spec_verdicts_on_the_board_are_the_hosts() {
         match name {
             "pass" => assert_eq!(verdict["pass"], true, "{verdict}"),
             "fail" => assert_eq!(verdict["pass"], false, "{verdict}"),
+            "shape" => assert_eq!(verdict["band_pass"], false, "{verdict}"),
             "band" | "step" => assert_eq!(
                 (
                     verdict["band_pass"].as_bool(),

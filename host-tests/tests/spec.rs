@@ -446,3 +446,57 @@ fn a_failed_verdict_is_exit_status_3() {
     let (code, err) = status(&["analyze", &high]);
     assert_eq!(code, 0, "{err}");
 }
+
+/// A pulse of another shape than the spec's is judged, not "not judged": a terminal-peak
+/// sawtooth, an initial-peak one and a trapezoid of the spec's own peak and duration against
+/// a half-sine spec (and a half-sine against a sawtooth spec) fail the band, with the worst
+/// point inside the pulse's window. The capture held too little after a peak at the pulse's
+/// end (the verdict places the nominal pulse by the peak, which the padding did not allow for).
+#[test]
+fn a_pulse_of_another_shape_fails_instead_of_going_unjudged() {
+    let scratch = Scratch::new();
+    let d = 0.011;
+    let terminal = move |t: f64| {
+        if (0.0..d).contains(&t) {
+            50.0 * t / d
+        } else {
+            0.0
+        }
+    };
+    let initial = move |t: f64| {
+        if (0.0..d).contains(&t) {
+            50.0 * (1.0 - t / d)
+        } else {
+            0.0
+        }
+    };
+    let trapezoid = move |t: f64| {
+        if (0.0..d).contains(&t) {
+            50.0 * (t / (0.1 * d)).min((d - t) / (0.1 * d)).min(1.0)
+        } else {
+            0.0
+        }
+    };
+    let cases: [(&str, Box<dyn Fn(f64) -> f64>, &str); 4] = [
+        ("terminal", Box::new(terminal), "half-sine,50g,11ms"),
+        ("initial", Box::new(initial), "half-sine,50g,11ms"),
+        ("trapezoid", Box::new(trapezoid), "half-sine,50g,11ms"),
+        (
+            "half-sine",
+            Box::new(half_sine(50.0, d)),
+            "sawtooth,50g,11ms",
+        ),
+    ];
+    for (name, pulse, spec) in cases {
+        let file = recording(&scratch, name, pulse);
+        let (i, _) = judged(&file, spec);
+        let v = &i["spec"];
+        assert!(v.is_object(), "{name}: not judged: {i}");
+        assert_eq!(v["band_pass"], false, "{name}: {v}");
+        let worst = f(&v["worst_time_s"]);
+        assert!(
+            (0.045..0.075).contains(&worst),
+            "{name}: worst at {worst} s"
+        );
+    }
+}

@@ -333,12 +333,20 @@ impl Spec {
         }
     }
 
-    /// Samples the verdict needs held on either side of the contact at `rate_hz`: the watched
-    /// window's reach beyond the nominal pulse, and half a duration for the placement.
+    /// Samples the verdict needs held on either side of the contact at `rate_hz`. The nominal
+    /// pulse is placed by the measured peak, which may lie anywhere in the contact (at its
+    /// end for a terminal-peak pulse, at its start for an initial-peak one, whatever the
+    /// spec's shape): so on either side, the watched window's reach from the nominal peak
+    /// (before it: the shape's rise and the window before the pulse; after it: the shape's
+    /// fall and the window after), and half a duration for the placement.
     pub fn padding_samples(&self, rate_hz: f32) -> u32 {
         let (before, watch) = self.watched();
-        let reach = (before + 1.0).max(watch.max(self.tolerance.after)) + 0.5;
-        let n = libm::ceilf(reach * self.duration_s * rate_hz);
+        let peak_at = self.shape.peak_at();
+        let ahead = before.max(self.tolerance.before) + peak_at;
+        let behind = watch.max(self.tolerance.after) + 1.0 - peak_at;
+        let reach = ahead.max(behind) + 0.5;
+        // Two samples over: the verdict rounds its window's ends outward.
+        let n = libm::ceilf(reach * self.duration_s * rate_hz) + 2.0;
         if n.is_finite() && n < u32::MAX as f32 {
             n as u32
         } else {
