@@ -477,7 +477,8 @@ fn a_pulse_of_another_shape_fails_instead_of_going_unjudged() {
             0.0
         }
     };
-    let cases: [(&str, Box<dyn Fn(f64) -> f64>, &str); 4] = [
+    type Pulse = Box<dyn Fn(f64) -> f64>;
+    let cases: [(&str, Pulse, &str); 4] = [
         ("terminal", Box::new(terminal), "half-sine,50g,11ms"),
         ("initial", Box::new(initial), "half-sine,50g,11ms"),
         ("trapezoid", Box::new(trapezoid), "half-sine,50g,11ms"),
@@ -499,4 +500,37 @@ fn a_pulse_of_another_shape_fails_instead_of_going_unjudged() {
             "{name}: worst at {worst} s"
         );
     }
+}
+
+/// A spec far from every measured pulse, none judged, is said with the likely unit slip:
+/// AFRL's 11 000 g, 100 µs pulse judged as `half-sine,11000,0.1` (bare numbers: 11 000 m/s²
+/// and 100 ms) names both; written with units it is judged and says nothing of the kind.
+#[test]
+fn bare_spec_numbers_far_from_the_pulse_name_the_slip() {
+    let afrl = std::path::PathBuf::from(env!("CARGO_MANIFEST_DIR"))
+        .join("data/afrl-drop-tower/series1_test1_full_100ms.csv");
+    let afrl = afrl.to_str().unwrap();
+    let (_, err) = impact_judged(&[
+        "analyze",
+        afrl,
+        "--column",
+        "bottom_kgn",
+        "--spec",
+        "half-sine,11000,0.1",
+    ]);
+    assert!(
+        err.contains("the specified pulse (11000 m/s², 100.0 ms) is far from every measured one")
+            && err.contains("a bare peak is m/s²: 11000g?")
+            && err.contains("a bare duration is s: 0.1ms?"),
+        "{err}"
+    );
+    let (_, err) = impact_judged(&[
+        "analyze",
+        afrl,
+        "--column",
+        "bottom_kgn",
+        "--spec",
+        "half-sine,11000g,0.1ms",
+    ]);
+    assert!(!err.contains("far from every"), "{err}");
 }

@@ -259,7 +259,7 @@ pub fn analyze(
     if !args.stream && !in_passes {
         memory_for_whole(&args.file)?;
     }
-    if args.stream {
+    let (setup, reports) = if args.stream {
         streaming::analyze(args, progress)
     } else if in_passes {
         streaming::analyze_in_passes(args, progress)
@@ -267,7 +267,14 @@ pub fn analyze(
         let setup = setup(args, progress)?;
         let reports = run(&setup.prepared.counts, &setup.scene)?;
         Ok((setup, reports))
+    }?;
+    if let Some(note) = args
+        .spec
+        .and_then(|s| spec::far_from_every_pulse(&s, &reports))
+    {
+        impact_io::note(&note);
     }
+    Ok((setup, reports))
 }
 
 /// Checks that a recording read whole (for `--axes`, `--free-fall`, `--resample` or an

@@ -19,6 +19,8 @@ pub struct SpecArg {
     pub standard: &'static str,
     /// The user's band's file (`band-file=`): an input, which no output may overwrite.
     pub band_file: Option<&'static Path>,
+    /// The peak and the duration as written with no unit (m/s² and s taken).
+    pub bare: (bool, bool),
 }
 
 /// Why a `--spec` was refused (clap names the option and the value given). The texts held
@@ -210,11 +212,80 @@ pub fn parse(s: &str) -> Result<SpecArg, SpecError> {
         custom = true;
         band_source = Some(&*Box::leak(PathBuf::from(path).into_boxed_path()));
     }
+    let no_unit = |t: &str| t.trim().parse::<f64>().is_ok();
     Ok(SpecArg {
         spec,
         standard: if custom { "custom" } else { standard.name },
         band_file: band_source,
+        bare: (no_unit(peak), no_unit(dur)),
     })
+}
+
+/// How far apart two positive quantities are, as a factor (≥ 1).
+fn factor(a: f64, b: f64) -> f64 {
+    if a > 0.0 && b > 0.0 {
+        (a / b).max(b / a)
+    } else {
+        f64::INFINITY
+    }
+}
+
+/// A note when no impact was judged and the specified pulse is far from every measured one
+/// (peak or duration more than 3× off, the nearest impact named): the likely slip named where
+/// it fits a unit's factor (a bare peak is m/s², so 11000 meant as g is 9.8× low; a bare
+/// duration is s, so 0.1 meant as ms is 1000× long).
+pub fn far_from_every_pulse(
+    arg: &SpecArg,
+    reports: &[impact_core::ImpactReport],
+) -> Option<String> {
+    if reports.is_empty() || reports.iter().any(|r| matches!(r.verdict, Some(Ok(_)))) {
+        return None;
+    }
+    let spec = &arg.spec;
+    let (peak, dur) = (f64::from(spec.peak_m_s2), f64::from(spec.duration_s));
+    let nearest = reports
+        .iter()
+        .map(|r| {
+            let p = f64::from(r.peak_acceleration_m_s2.abs());
+            let d = f64::from(r.duration_s);
+            (factor(p, peak).max(factor(d, dur)), p, d)
+        })
+        .min_by(|a, b| a.0.total_cmp(&b.0))?;
+    let (off, p, d) = nearest;
+    if off <= 3.0 {
+        return None;
+    }
+    let mut fixes = Vec::new();
+    let g = STANDARD_GRAVITY;
+    // Within a factor the unit's own (9.8, 1000) tells apart from no slip at all.
+    if arg.bare.0 && (0.33..=3.0).contains(&(p / (peak * g))) {
+        fixes.push(format!("a bare peak is m/s²: {}g?", shortest(peak)));
+    }
+    if arg.bare.1 {
+        for (unit, k) in [("ms", 1e-3), ("us", 1e-6)] {
+            if (0.2..=5.0).contains(&(d / (dur * k))) {
+                fixes.push(format!("a bare duration is s: {}{unit}?", shortest(dur)));
+            }
+        }
+    }
+    let human = crate::report::fmt::human;
+    Some(format!(
+        "--spec: no impact judged, and the specified pulse ({}, {}) is far from every measured one (the nearest: peak {}, duration {}){}",
+        human(peak, "m/s²"),
+        human(dur, "s"),
+        human(p, "m/s²"),
+        human(d, "s"),
+        if fixes.is_empty() {
+            String::new()
+        } else {
+            format!("; {}", fixes.join("; "))
+        }
+    ))
+}
+
+/// The shortest decimal of `v` (as the user might write it).
+fn shortest(v: f64) -> String {
+    format!("{}", v as f32)
 }
 
 #[cfg(test)]
