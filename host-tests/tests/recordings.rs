@@ -315,7 +315,8 @@ fn endaq_dc_channel_gives_one_report_per_bounce_and_marks_the_clipped_ones() {
             }
             Some(_) => {
                 assert_eq!(c.from, "range");
-                assert!((15.9..16.0).contains(&rail), "{rail}");
+                // 99 % of the range: where a noisy rail is.
+                assert!((15.8..16.0).contains(&rail), "{rail}");
             }
         }
         // Δv of the bounces comes from the DC channel itself (no AC flag); the last one ends

@@ -164,6 +164,9 @@ fn page(cfc: Option<u32>, results: &[EntryJson], required: Option<&RequiredSrs>)
             }
         );
     }
+    if let Some(text) = json.statistics_left_out.text(json.impacts) {
+        html!(h, "<p>{}.</p>\n", text);
+    }
     if !json.statistics.is_empty() {
         h.raw("<h2>Statistics across the series</h2><p>sd: sample standard deviation; CV: sd / |mean|.</p><table><tr><th class=\"l\">metric</th><th>n</th><th>mean</th><th>sd</th><th>CV</th><th>min</th><th>max</th></tr>\n");
         for st in &json.statistics {

@@ -11,7 +11,9 @@ use serde::Serialize;
 
 use crate::pipeline::{self, AnalyzeArgs, PipelineError};
 use crate::report::fmt::human;
-use crate::report::statistics::{pass_rate, statistics, PassRate, Statistic, METRICS};
+use crate::report::statistics::{
+    comparable, pass_rate, statistics, LeftOut, PassRate, Statistic, METRICS,
+};
 use crate::report::{AnalysisJson, ImpactJson};
 
 /// The extensions of the recordings a folder contributes (as `impact analyze` reads them).
@@ -375,7 +377,10 @@ pub struct SeriesJson<'a> {
     pub impacts: usize,
     #[serde(skip_serializing_if = "Option::is_none")]
     pub spec: Option<PassRate>,
+    /// Over the comparable impacts only: complete, unclipped, each drop's first.
     pub statistics: Vec<Statistic>,
+    /// The impacts the statistics left out, by why.
+    pub statistics_left_out: LeftOut,
     pub entries: &'a [EntryJson],
 }
 
@@ -389,12 +394,14 @@ pub fn impacts(entries: &[EntryJson]) -> impl Iterator<Item = (&EntryJson, &Impa
 }
 
 pub fn to_json(entries: &[EntryJson]) -> SeriesJson<'_> {
+    let (kept, left_out) = comparable(impacts(entries).map(|(_, i)| i));
     SeriesJson {
         recordings: entries.len(),
         failed: entries.iter().filter(|e| e.error.is_some()).count(),
         impacts: impacts(entries).count(),
         spec: pass_rate(impacts(entries).map(|(_, i)| i)),
-        statistics: statistics(impacts(entries).map(|(_, i)| i)),
+        statistics: statistics(kept.iter().copied()),
+        statistics_left_out: left_out,
         entries,
     }
 }
@@ -489,6 +496,9 @@ pub fn to_table(entries: &[EntryJson]) -> String {
                 String::new()
             }
         ));
+    }
+    if let Some(text) = json.statistics_left_out.text(json.impacts) {
+        s.push_str(&format!("\n{text}\n"));
     }
     if !json.statistics.is_empty() {
         s.push_str("\nstatistics (sd: sample standard deviation; CV: sd / |mean|)\n");

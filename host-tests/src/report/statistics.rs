@@ -52,6 +52,69 @@ pub const METRICS: [Metric; 14] = [
     ("absorbed_energy_j", "J", |i| i.absorbed_energy_j),
 ];
 
+/// Impacts the statistics leave out, by why: they do not measure the same pulse as the rest
+/// (an impact cut short by the recording or a gap, or still under way; a clipped one, whose
+/// peak and Δv are lower bounds; a later bounce of a drop, a different, slower impact).
+#[derive(Clone, Copy, Debug, Default, Serialize, PartialEq, Eq)]
+pub struct LeftOut {
+    pub incomplete: usize,
+    pub clipped: usize,
+    pub later_bounces: usize,
+}
+
+impl LeftOut {
+    /// Impacts left out in all.
+    pub fn total(&self) -> usize {
+        self.incomplete + self.clipped + self.later_bounces
+    }
+
+    /// The sentence the table and the report print when any impact of the `impacts` was left
+    /// out.
+    pub fn text(&self, impacts: usize) -> Option<String> {
+        let why: Vec<String> = [
+            (self.incomplete, "incomplete"),
+            (self.clipped, "clipped"),
+            (self.later_bounces, "later bounces of a drop"),
+        ]
+        .iter()
+        .filter(|(n, _)| *n > 0)
+        .map(|(n, what)| format!("{n} {what}"))
+        .collect();
+        (!why.is_empty()).then(|| {
+            format!(
+                "statistics over the {} comparable impacts (complete, unclipped, each drop's first); left out: {}",
+                impacts.saturating_sub(self.total()),
+                why.join(", ")
+            )
+        })
+    }
+}
+
+/// The impacts the statistics compare, and those left out (counted by why): complete,
+/// unclipped, and each drop's first impact (a train's later bounces are other pulses).
+pub fn comparable<'a>(
+    impacts: impl Iterator<Item = &'a ImpactJson> + Clone,
+) -> (Vec<&'a ImpactJson>, LeftOut) {
+    let mut left = LeftOut::default();
+    let kept = impacts
+        .filter(|i| {
+            if i.status != "complete" {
+                left.incomplete += 1;
+                false
+            } else if i.clipped {
+                left.clipped += 1;
+                false
+            } else if i.bounce.as_ref().is_some_and(|b| b.number > 0) {
+                left.later_bounces += 1;
+                false
+            } else {
+                true
+            }
+        })
+        .collect();
+    (kept, left)
+}
+
 /// Each metric's statistics over `impacts` (a metric no impact has is left out). Sums in f64
 /// with the mean taken out first (two passes), so a series of nearly equal values keeps its
 /// spread.

@@ -318,7 +318,7 @@ mod tests {
     fn range_levels_are_just_inside_full_scale() {
         let c = from_range(16.0 * 9.80665);
         assert!(c.high_m_s2.unwrap() < 16.0 * 9.80665);
-        assert!(c.high_m_s2.unwrap() > 15.9 * 9.80665);
+        assert!(c.high_m_s2.unwrap() > 15.8 * 9.80665);
         assert_eq!(c.low_m_s2, c.high_m_s2.map(|v| -v));
     }
 }
