@@ -300,3 +300,68 @@ fn an_assumed_unit_is_said_where_the_user_looks() {
         assert_eq!(k["impacts"], j["impacts"]);
     }
 }
+
+/// A tab at the start of every line (header too) names no column; an empty first field under
+/// a header that names that column would shift every value under its neighbour's name, and
+/// is refused with the fix.
+#[test]
+fn an_empty_edge_field_never_shifts_a_column_under_another_name() {
+    let scratch = Scratch::new();
+    let mut lead = String::from("\tTime (s)\tAccel (g)\n");
+    let mut named = String::from("X_Value\tVoltage\tComment\n");
+    for k in 0..200 {
+        lead.push_str(&format!("\t{:.4}\t{}\n", f64::from(k) * 1e-3, k % 3));
+        named.push_str(&format!("\t{}\t\n", k % 3));
+    }
+    let lead = scratch.file("lead.txt", lead);
+    let (out, _) = impact_ok(&["analyze", lead.to_str().unwrap(), "--json"]);
+    let j: serde_json::Value = serde_json::from_str(&out).unwrap();
+    assert_eq!(j["sample_rate_hz"], 1000.0, "{out}");
+    let named = scratch.file("named.txt", named);
+    let (code, _, err) = impact(&["analyze", named.to_str().unwrap(), "--rate", "1000"]);
+    assert_eq!(code, 1, "{err}");
+    assert!(
+        err.contains("named.txt:2: the first field is empty under \"X_Value\"")
+            && err.contains("remove \"X_Value\" from the header"),
+        "{err}"
+    );
+}
+
+/// Axes whose headers name different units are refused (one scale took them all: an m/s²
+/// axis read in the first axis's g was 9.8× high); axes that name none are each said assumed.
+#[test]
+fn axes_in_different_units_are_refused_and_unnamed_ones_said() {
+    let scratch = Scratch::new();
+    let mut mixed = String::from("time_s,ax_g,ay_m_s2,az_m_s2\n");
+    let mut bare = String::from("time_s,ax,ay,az\n");
+    for k in 0..2000 {
+        let t = f64::from(k) / 1e4;
+        mixed.push_str(&format!("{t:.4},0.1,0.98,9.8\n"));
+        bare.push_str(&format!("{t:.4},0.1,0.1,1.0\n"));
+    }
+    let mixed = scratch.file("mixed.csv", mixed);
+    let (code, _, err) = impact(&[
+        "analyze",
+        mixed.to_str().unwrap(),
+        "--axes",
+        "ax_g,ay_m_s2,az_m_s2",
+    ]);
+    assert_eq!(code, 1, "{err}");
+    assert!(
+        err.contains("--axes: \"ax_g\" is in g, \"ay_m_s2\" in m/s2: give axes in one unit"),
+        "{err}"
+    );
+    let bare = scratch.file("bare.csv", bare);
+    let (out, err) = impact_ok(&[
+        "analyze",
+        bare.to_str().unwrap(),
+        "--axes",
+        "ax,ay,az",
+        "--json",
+    ]);
+    let j: serde_json::Value = serde_json::from_str(&out).unwrap();
+    assert_eq!(j["assumptions"].as_array().map(Vec::len), Some(3), "{out}");
+    for axis in ["ax", "ay", "az"] {
+        assert!(err.contains(&format!("\"{axis}\" names no unit")), "{err}");
+    }
+}

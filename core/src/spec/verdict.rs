@@ -97,7 +97,9 @@ pub fn judge(
     let base = peak_index
         .checked_sub(libm::ceilf(reach) as u64)
         .ok_or(Missing::Window)?;
-    let guess = peak_index as f32 - spec.shape.peak_at() * d - base as f32; // from base
+    // From base: the difference of the two indices is exact in u64, where each index alone in
+    // f32 is not (past 2^24 samples, 33 s of a board's stream at 500 kS/s).
+    let guess = (peak_index - base) as f32 - spec.shape.peak_at() * d;
     let from = guess - d / 2.0 - lead; // >= 0
     let to = guess + d / 2.0 + (1.0 + watch.max(t.after)) * d;
     let span = libm::ceilf(to) as u32 + 1;
@@ -286,6 +288,30 @@ mod tests {
             peak_index.min(2000 + (dur * rate) as u64 - 1),
         )
         .unwrap()
+    }
+
+    /// The same pulse late in a long stream (its indices past 2^31, where an index alone in
+    /// f32 is off by hundreds of samples) gets the same verdict as at its start: the
+    /// placement works from the indices' difference.
+    #[test]
+    fn a_pulse_late_in_the_stream_is_judged_as_an_early_one() {
+        let s = spec(Shape::HalfSine);
+        let (rate, dur, start) = (50_000.0f32, 0.011f32, 2000u64);
+        let at = |offset: u64| {
+            let a = move |i: u64| {
+                let k = i.checked_sub(offset)?;
+                (k < 10_000).then(|| {
+                    let u = (k as f32 - start as f32) / (dur * rate);
+                    500.0 * s.shape.at(u)
+                })
+            };
+            let peak = offset + start + (0.5 * dur * rate) as u64;
+            judge(a, rate, &s, peak).unwrap()
+        };
+        let (early, late) = (at(0), at((1 << 31) + 12_345));
+        assert!(early.pass && late.pass, "{early:?} {late:?}");
+        assert_eq!(early.margin, late.margin);
+        assert_eq!(early.delta_v_m_s, late.delta_v_m_s);
     }
 
     #[test]

@@ -683,6 +683,12 @@ pub enum ReadErrorKind {
         fields: usize,
     },
     NoDataRows,
+    /// The first data row's first field is empty under a header that names that column:
+    /// the values would shift under their neighbours' names.
+    EmptyUnderName {
+        name: String,
+        header_line: u64,
+    },
     /// Every line held text: `lines` of them, the first after the header at `line` with
     /// `field`, not a number.
     NoNumericRows {
@@ -1004,6 +1010,10 @@ impl ReadErrorKind {
                 write!(f, "{fields} fields, expected {expected}")
             }
             K::NoDataRows => f.write_str("no data rows"),
+            K::EmptyUnderName { name, header_line } => write!(
+                f,
+                "the first field is empty under {name:?} (the header, line {header_line}): a column with no values, which would put every value under its neighbour's name; remove {name:?} from the header"
+            ),
             K::NoNumericRows { lines, line, field } => write!(
                 f,
                 "no data rows: all {lines} lines hold text; line {line}, the first after the header, has {field:?}, not a number"
@@ -1305,6 +1315,10 @@ mod tests {
                 fields: 2,
             },
             K::NoDataRows,
+            K::EmptyUnderName {
+                name: "X_Value".into(),
+                header_line: 1,
+            },
             K::NoNumericRows {
                 lines: 5500,
                 line: 2,

@@ -305,6 +305,8 @@ pub struct Rows {
     /// after the header that still holds text: what kept the rows from being data).
     text_lines: u64,
     text_after_header: Option<(u64, String)>,
+    /// The header line's first field names a column (is not empty).
+    header_leads: bool,
     /// Line of the first data row.
     pub first_data_line: u64,
     /// Lines before the first one read (a reader resumed mid-file), and the file's bytes
@@ -402,6 +404,7 @@ impl Rows {
             columns: 0,
             text_lines: 0,
             text_after_header: None,
+            header_leads: false,
             first_data_line: 0,
             line_offset: 0,
             skip: 0,
@@ -602,14 +605,39 @@ impl Rows {
                     // Text makes a header line; a number that is not finite or beyond any
                     // sensor is an error wherever it is (a NaN row before the data is not a
                     // header).
+                    // The same edges as the data's: a tab at the header's start or end names
+                    // no column.
                     self.headers = self
                         .record
                         .iter()
-                        .map(|f| String::from_utf8_lossy(f.trim_ascii()).into_owned())
+                        .enumerate()
+                        .filter(|&(k, f)| !edge(k, f))
+                        .map(|(_, f)| String::from_utf8_lossy(f.trim_ascii()).into_owned())
                         .collect();
-                    self.header_fields = self.record.len();
+                    self.header_fields = self.headers.len();
                     self.header_line = lineno;
+                    self.header_leads = self
+                        .record
+                        .get(0)
+                        .is_some_and(|f| !f.trim_ascii().is_empty());
                     continue;
+                }
+                // A row whose first field is empty under a header whose first field names a
+                // column: dropping it would put every value under its neighbour's name.
+                let leading_empty = split
+                    && self.record.len() > 1
+                    && self
+                        .record
+                        .get(0)
+                        .is_some_and(|f| f.trim_ascii().is_empty());
+                if bad.is_none() && leading_empty && self.header_leads {
+                    return Err(self.err(
+                        Some(lineno),
+                        ReadErrorKind::EmptyUnderName {
+                            name: self.headers.first().cloned().unwrap_or_default(),
+                            header_line: self.header_line,
+                        },
+                    ));
                 }
                 if bad.is_none() {
                     // Rows split on white space under a header of one field: the header's

@@ -275,7 +275,7 @@ pub fn table(b: &Budget) -> String {
         kib(b.data_image_bytes)
     ));
     s.push_str(&format!(
-        "| SRAM stack | {} at 0x2000_0000 | below the statics, its bottom 32 B an MPU guard: an overflow faults instead of overwriting them |\n",
+        "| SRAM stack | {} at 0x2000_0000 | below the statics, MPU-guarded (its lowest 32 B and the 32 KiB below SRAM): an overflow faults instead of overwriting them |\n",
         kib(b.stack_bytes)
     ));
     s.push_str(&format!(

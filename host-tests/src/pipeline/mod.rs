@@ -107,6 +107,16 @@ pub enum PipelineError {
         "--stream: give --trigger (the level cannot be learned from a recording not yet read)"
     )]
     StreamNeedsTrigger,
+    /// `--axes` whose headers name different units (one scale takes every axis to m/s²).
+    #[error(
+        "--axes: {first:?} is in {first_units}, {other:?} in {other_units}: give axes in one unit"
+    )]
+    AxesUnits {
+        first: String,
+        first_units: &'static str,
+        other: String,
+        other_units: &'static str,
+    },
     /// A recording of fewer than 2 samples (`column`: its channel's header, empty if none).
     #[error(
         "{}: {}",
@@ -474,8 +484,20 @@ pub fn setup(
         .first()
         .map_or(ch.name.as_str(), |(name, _)| name.as_str());
     let (mass, scale, units) = mass_and_scale(args, &file, column)?;
+    // Every axis in the first one's units (one scale takes them all to m/s²): axes whose
+    // headers name other units are refused, not read 9.8× off.
+    let mut assumed: Vec<Assumption> = assumed_units(args, &file, column).into_iter().collect();
     for (name, _) in ch.axes.iter().skip(1) {
-        mass_and_scale(args, &file, name)?;
+        let (_, _, u) = mass_and_scale(args, &file, name)?;
+        if u != units {
+            return Err(PipelineError::AxesUnits {
+                first: column.to_string(),
+                first_units: units.name(),
+                other: name.clone(),
+                other_units: u.name(),
+            });
+        }
+        assumed.extend(assumed_units(args, &file, name));
     }
     let mut accel: Vec<f64> = ch.values.iter().map(|v| v * scale).collect();
     let full_scale = full_scale_m_s2(args, &file, mass);
@@ -535,7 +557,7 @@ pub fn setup(
         rate_hz: ch.rate_hz,
     };
     let mut setup = Setup::new(reading, resolved);
-    setup.assumptions.extend(assumed_units(args, &file, column));
+    setup.assumptions.extend(assumed);
     setup
         .assumptions
         .extend(ch.time_unit_assumed.as_deref().map(assumed_time_unit));

@@ -171,7 +171,8 @@ impl Survey {
             flat_tops: {
                 let q = self.shape.flat.resolution();
                 let found = self.shape.flat.finish();
-                found.and_then(|c| beyond_floor(c, median, q))
+                let span = if finite { self.max - self.min } else { 0.0 };
+                found.and_then(|c| beyond_floor(c, median, q, span))
             },
             removals,
         })
@@ -289,10 +290,18 @@ pub enum SurveyError {
 /// has its median there: its flat top is not taken.
 const RAIL_STEPS: f64 = 10.0;
 
+/// The histogram median's accuracy, as a fraction of the recording's span (its bins'; taken
+/// with room).
+const MEDIAN_ACCURACY: f64 = 0.005;
+
 /// The flat tops' levels more than [`RAIL_STEPS`] × `q` (the resolution) from the median;
 /// `None` if none is.
-fn beyond_floor(c: Clipping, median: f64, q: f64) -> Option<Clipping> {
-    let far = |level: &f64| (level - median).abs() > RAIL_STEPS * q;
+fn beyond_floor(c: Clipping, median: f64, q: f64, span: f64) -> Option<Clipping> {
+    // Also beyond the histogram median's own accuracy (a fraction of the recording's span):
+    // a noise-free recording resting at one level (its minimum, at 1 g) has q = 0 and its
+    // median within that of the rest level, which is no rail.
+    let floor = (RAIL_STEPS * q).max(MEDIAN_ACCURACY * span);
+    let far = |level: &f64| (level - median).abs() > floor;
     let (low, high) = (c.low_m_s2.filter(far), c.high_m_s2.filter(far));
     (low.is_some() || high.is_some()).then_some(Clipping {
         low_m_s2: low,

@@ -9,10 +9,6 @@ use crate::report::Clipping;
 /// 156.86 m/s², its neighbours up to 1 % lower).
 pub const RAIL_FRACTION: f64 = 0.99;
 
-/// A level held for more than this fraction of the recording's samples is the level it rests
-/// at (a noise-free recording resting at 1 g, its minimum), not a rail.
-const REST_FRACTION: f64 = 0.25;
-
 /// Clipping levels from the sensor's full scale, m/s² (readings at ±[`RAIL_FRACTION`] of it
 /// and beyond are at the rail).
 pub fn from_range(full_scale_m_s2: f64) -> Clipping {
@@ -39,8 +35,6 @@ pub(super) struct RunsAt {
     level: f64,
     long: f64,
     short: [f64; 5],
-    /// Readings in runs of three or more at this level.
-    held: u64,
 }
 
 impl RunsAt {
@@ -49,7 +43,6 @@ impl RunsAt {
             level,
             long: f64::NEG_INFINITY,
             short: [f64::NEG_INFINITY; 5],
-            held: 0,
         }
     }
 
@@ -95,8 +88,6 @@ pub struct FlatTops {
     /// The first [`STEP_SAMPLE`] non-zero steps, to tell whether the smallest is the
     /// recording's quantum ([`FlatTops::quantum`]).
     steps: Vec<f64>,
-    /// Readings pushed.
-    total: u64,
 }
 
 /// Non-zero steps kept to check the resolution against.
@@ -112,14 +103,12 @@ impl Default for FlatTops {
             run: None,
             ended: None,
             steps: Vec::new(),
-            total: 0,
         }
     }
 }
 
 impl FlatTops {
     pub fn push(&mut self, block: &[f64]) {
-        self.total += block.len() as u64;
         // The resolution: the smallest non-zero step (four running minima, so no step
         // waits for the one before).
         let nonzero = |d: f64| if d > 0.0 { d } else { f64::INFINITY };
@@ -269,7 +258,6 @@ impl FlatTops {
         let slope = run.entry.max(exit);
         for at in [&mut self.high, &mut self.low].into_iter().flatten() {
             if at.level == run.level {
-                at.held += run.len;
                 match run.len {
                     3..=7 => {
                         let k = (run.len - 3) as usize;
@@ -324,15 +312,8 @@ impl FlatTops {
         if !q.is_finite() {
             return None;
         }
-        let rests = |at: &RunsAt| at.held as f64 > REST_FRACTION * self.total as f64;
-        let high = self
-            .high
-            .filter(|h| h.clipped(q) && !rests(h))
-            .map(|h| h.level);
-        let low = self
-            .low
-            .filter(|l| l.clipped(q) && !rests(l))
-            .map(|l| l.level);
+        let high = self.high.filter(|h| h.clipped(q)).map(|h| h.level);
+        let low = self.low.filter(|l| l.clipped(q)).map(|l| l.level);
         (high.is_some() || low.is_some()).then(|| Clipping {
             low_m_s2: low,
             high_m_s2: high,
