@@ -368,21 +368,39 @@ fn scan_row(
 }
 
 /// The channel's value and the time (0 without a time column) of a plain row: every field a
-/// number the sequential reader accepts, as many as the table's rows have, no quote.
+/// number the sequential reader accepts, as many as the table's rows have, no quote. Fields
+/// split as the sequential reader splits them ([`crate::table::Rows::next_row`]): where tabs
+/// delimit or no delimiter splits the line, white space inside a field separates fields and
+/// an empty last field is none (an empty first one is left to the sequential reader, which
+/// refuses it under a header that names that column).
 fn plain_row(text: &[u8], layout: &Layout, fields: &mut Vec<f64>) -> Option<(f64, f64)> {
-    let (mut row, mut count) = ((0.0, 0.0), 0);
+    let (mut row, mut count) = ((0.0, 0.0), 0usize);
     let mut scratch = Vec::new();
-    for (k, field) in text.split(|&b| b == layout.delimiter).enumerate() {
+    let n = text.split(|&b| b == layout.delimiter).count();
+    let split = layout.delimiter == b'\t' || n == 1;
+    for (i, field) in text.split(|&b| b == layout.delimiter).enumerate() {
         let field = field.trim_ascii();
         if field.first() == Some(&b'"') {
             return None;
         }
-        let x = read_number(field, layout.decimal_comma, &mut scratch)?;
-        if !is_reading(x) {
+        if split && n > 1 && field.is_empty() {
+            if i + 1 == n {
+                continue;
+            }
             return None;
         }
-        layout.keep(k, x, &mut row, fields);
-        count += 1;
+        let inside = split && field.iter().any(|&b| b == b' ' || b == b'\t');
+        let parts = field
+            .split(|&b| inside && (b == b' ' || b == b'\t'))
+            .filter(|p| !inside || !p.is_empty());
+        for part in parts {
+            let x = read_number(part, layout.decimal_comma, &mut scratch)?;
+            if !is_reading(x) {
+                return None;
+            }
+            layout.keep(count, x, &mut row, fields);
+            count += 1;
+        }
     }
     (count == layout.columns).then_some(row)
 }
