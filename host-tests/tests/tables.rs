@@ -247,6 +247,10 @@ fn free_fall_columns_take_any_name_and_their_units() {
     let (bare_v0, err) = v0(format!("{}:z", bare.display()));
     assert_eq!(bare_v0, want, "no unit: g");
     assert!(err.contains("z names no unit: read as g"), "{err}");
+    assert!(
+        err.contains("the time column \"time\" names no unit: read in seconds"),
+        "{err}"
+    );
 }
 
 /// A unit neither the header nor the options name is assumed aloud: the channel read as g
@@ -286,6 +290,12 @@ fn an_assumed_unit_is_said_where_the_user_looks() {
     let j: serde_json::Value = serde_json::from_str(&json).unwrap();
     let assumed = j["assumptions"].as_array().unwrap();
     assert_eq!(assumed.len(), 2, "{json}");
+    // The report a lab hands in lists them with the recording's provenance.
+    let html = scratch.join("bare.html");
+    impact_ok(&["report", bare, "--html", html.to_str().unwrap()]);
+    let page = std::fs::read_to_string(&html).unwrap();
+    assert_eq!(page.matches("<dt>assumed</dt>").count(), 2, "{page}");
+    assert!(page.contains("names no unit: its values read as g"), "{page}");
     // Stated, or named in the header: nothing assumed, the same numbers.
     for (file, more) in [
         (bare, &["--units", "g", "--time-unit", "s"][..]),

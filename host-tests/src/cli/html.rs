@@ -240,6 +240,10 @@ fn provenance(
             "recording",
             &format!("{} [{}]{size}{rate}", e.file, e.channel),
         );
+        // What the tool assumed of this recording, where the customer reads its provenance.
+        for assumed in e.analysis.iter().flat_map(|a| &a.assumptions) {
+            dd("assumed", assumed);
+        }
     }
     dd(
         "filter",

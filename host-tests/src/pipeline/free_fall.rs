@@ -88,7 +88,14 @@ pub fn free_fall_before(spec: &str, impact_s: f64) -> Result<f64, FreeFallError>
             .ok_or_else(|| FreeFallError::NoTimeColumn {
                 path: path.to_path_buf(),
             })?;
-    let unit = time_unit_s(&table.headers.get(tcol).cloned().unwrap_or_default(), None);
+    let time_header = table.headers.get(tcol).cloned().unwrap_or_default();
+    if impact_io::channel::named_time_unit_s(&time_header).is_none() {
+        impact_io::note(&format!(
+            "--free-fall {}: the time column {time_header:?} names no unit: read in seconds (name it in the header: time_ms, time (ms))",
+            path.display()
+        ));
+    }
+    let unit = time_unit_s(&time_header, None);
     let time: Vec<f64> = table.columns[tcol].iter().map(|t| t * unit).collect();
     let cols: Vec<usize> = match &column {
         Some(c) => vec![table.find(c, "column").map_err(in_file)?],
