@@ -295,7 +295,10 @@ fn an_assumed_unit_is_said_where_the_user_looks() {
     impact_ok(&["report", bare, "--html", html.to_str().unwrap()]);
     let page = std::fs::read_to_string(&html).unwrap();
     assert_eq!(page.matches("<dt>assumed</dt>").count(), 2, "{page}");
-    assert!(page.contains("names no unit: its values read as g"), "{page}");
+    assert!(
+        page.contains("names no unit: its values read as g"),
+        "{page}"
+    );
     // Stated, or named in the header: nothing assumed, the same numbers.
     for (file, more) in [
         (bare, &["--units", "g", "--time-unit", "s"][..]),
