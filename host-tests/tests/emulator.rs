@@ -624,6 +624,28 @@ fn realtime_twenty_impacts_40_ms_apart_are_all_analysed() {
     all_analysed_within(&json, 20, 0.05);
 }
 
+/// A real-time run of `samples` with `scene` at the board's speed, with the fault `inject`.
+fn injected(
+    elf: &std::path::Path,
+    samples: Samples<'_>,
+    scene: &impact_core::Scene,
+    inject: Inject,
+) -> impact_host::firmware_link::qemu::EmulatorRun {
+    impact_host::firmware_link::qemu::run_emulator(
+        elf,
+        samples,
+        scene,
+        Pacing::RealTime {
+            rate_scale: 1.0,
+            clock_shift: BOARD_CLOCK_SHIFT,
+            inject: Some(inject),
+        },
+        std::time::Duration::from_secs(300),
+        |_| {},
+    )
+    .unwrap()
+}
+
 /// A real-time run of `samples` with `scene` whose sampler stalls `stall.1` µs before block (or
 /// poll) `stall.0`: the decoded log as text and parsed.
 fn stalled(
@@ -632,23 +654,11 @@ fn stalled(
     scene: &impact_core::Scene,
     stall: (u32, u32),
 ) -> (String, impact_host::firmware_link::log::Log) {
-    let run = impact_host::firmware_link::qemu::run_emulator(
-        elf,
-        samples,
-        scene,
-        Pacing::RealTime {
-            rate_scale: 1.0,
-            clock_shift: BOARD_CLOCK_SHIFT,
-            inject: Some(Inject::Stall {
-                block: stall.0,
-                us: stall.1,
-            }),
-        },
-        std::time::Duration::from_secs(300),
-        |_| {},
-    )
-    .unwrap();
-    let text = run.lines.join("\n");
+    let inject = Inject::Stall {
+        block: stall.0,
+        us: stall.1,
+    };
+    let text = injected(elf, samples, scene, inject).lines.join("\n");
     let log = impact_host::firmware_link::log::parse_log(&text).unwrap();
     (text, log)
 }
@@ -742,19 +752,12 @@ fn a_fault_is_kept_across_the_reset_and_logged_at_the_next_start_up() {
         StartFault::StackGuard,
         StartFault::BelowStack,
     ] {
-        let run = impact_host::firmware_link::qemu::run_emulator(
+        let run = injected(
             &elf,
             Samples::Adc(&setup.prepared.counts),
             &setup.scene,
-            Pacing::RealTime {
-                rate_scale: 1.0,
-                clock_shift: BOARD_CLOCK_SHIFT,
-                inject: Some(Inject::FaultAtStart(fault)),
-            },
-            std::time::Duration::from_secs(300),
-            |_| {},
-        )
-        .unwrap();
+            Inject::FaultAtStart(fault),
+        );
         let text = run.lines.join("\n");
         assert!(
             run.status.success(),

@@ -25,7 +25,14 @@ fn afrl(first: usize, count: usize) -> Vec<f64> {
 
 /// The report's impact lines (the table, rounded as the user sees it) of `file` in kg_n.
 fn impacts(file: &Path) -> Vec<String> {
-    let (out, err) = impact_ok(&["analyze", file.to_str().unwrap(), "--units", "kgn"]);
+    impacts_with(file, &["--units", "kgn"])
+}
+
+/// The impact lines of `file` analysed with `options`.
+fn impacts_with(file: &Path, options: &[&str]) -> Vec<String> {
+    let mut args = vec!["analyze", file.to_str().unwrap()];
+    args.extend_from_slice(options);
+    let (out, err) = impact_ok(&args);
     let lines: Vec<String> = out
         .lines()
         .filter(|l| l.starts_with("impact "))
@@ -55,18 +62,7 @@ fn space_aligned_tables_read_as_their_csv_twin() {
         "--trigger",
         "1000g",
     ];
-    let streamed = |file: &Path| -> Vec<String> {
-        let mut args = vec!["analyze", file.to_str().unwrap()];
-        args.extend(stream);
-        let (out, err) = impact_ok(&args);
-        let lines: Vec<String> = out
-            .lines()
-            .filter(|l| l.starts_with("impact "))
-            .map(String::from)
-            .collect();
-        assert!(!lines.is_empty(), "{out}{err}");
-        lines
-    };
+    let streamed = |file: &Path| impacts_with(file, &stream);
     let want_streamed = streamed(&twin);
     // (name, header, a row's format from (time in ms, value), line end)
     type Row = fn(f64, f64) -> String;
