@@ -483,12 +483,12 @@ pub fn setup(
         .axes
         .first()
         .map_or(ch.name.as_str(), |(name, _)| name.as_str());
-    let (mass, scale, units) = mass_and_scale(args, &file, column)?;
+    let (mass, scale, units, first_assumed) = mass_and_scale(args, &file, column)?;
     // Every axis in the first one's units (one scale takes them all to m/s²): axes whose
     // headers name other units are refused, not read 9.8× off.
-    let mut assumed: Vec<Assumption> = assumed_units(args, &file, column).into_iter().collect();
+    let mut assumed: Vec<Assumption> = first_assumed.into_iter().collect();
     for (name, _) in ch.axes.iter().skip(1) {
-        let (_, _, u) = mass_and_scale(args, &file, name)?;
+        let (_, _, u, axis_assumed) = mass_and_scale(args, &file, name)?;
         if u != units {
             return Err(PipelineError::AxesUnits {
                 first: column.to_string(),
@@ -497,7 +497,7 @@ pub fn setup(
                 other_units: u.name(),
             });
         }
-        assumed.extend(assumed_units(args, &file, name));
+        assumed.extend(axis_assumed);
     }
     let mut accel: Vec<f64> = ch.values.iter().map(|v| v * scale).collect();
     let full_scale = full_scale_m_s2(args, &file, mass);
@@ -587,20 +587,19 @@ pub fn setup(
 /// The body's mass and the factor from the file's values to m/s² (units, `--gain`,
 /// `--invert`), from the options or the scene file (checked as they were read: the options'
 /// parsers, [`scene_file`]); the units are those stated, else those the channel's header
-/// (`column`) names, else g (an error if the two disagree).
+/// (`column`) names, else g (an error if the two disagree), and that assumption if g was
+/// assumed (kept as a note too).
 pub(crate) fn mass_and_scale(
     args: &AnalyzeArgs,
     file: &SceneFile,
     column: &str,
-) -> Result<(Option<f64>, f64, Units), PipelineError> {
+) -> Result<(Option<f64>, f64, Units, Option<Assumption>), PipelineError> {
     let mass = args.mass.or(file.mass);
     let units = Units::resolve(args.units.or(file.units), column).map_err(UnitsFailure)?;
-    if let Some(assumed) = assumed_units(args, file, column) {
-        assumed.noted();
-    }
+    let assumed = assumed_units(args, file, column).map(Assumption::noted);
     let invert = args.invert || file.invert.unwrap_or(false);
     let scale = units.to_m_s2(mass) * args.gain.unwrap_or(1.0) * if invert { -1.0 } else { 1.0 };
-    Ok((mass, scale, units))
+    Ok((mass, scale, units, assumed))
 }
 
 /// What the tool assumed that neither the file nor the options said.
@@ -636,17 +635,16 @@ impl Assumption {
 /// The channel read as g when neither the options, the scene file nor its header (`column`)
 /// named a unit; none for an enDAQ `.ide`, whose channels are in g by the recorder's
 /// calibration.
-pub(crate) fn assumed_units(
-    args: &AnalyzeArgs,
-    file: &SceneFile,
-    column: &str,
-) -> Option<Assumption> {
+fn assumed_units(args: &AnalyzeArgs, file: &SceneFile, column: &str) -> Option<Assumption> {
     let stated = args.units.or(file.units).is_some() || Units::of_header(column).is_some();
-    let ide = matches!(
-        impact_io::Format::of(&args.file, args.raw_type),
-        impact_io::Format::Ide
-    );
-    (!stated && !ide).then(|| Assumption::Units {
+    // (The format sniffed only when no unit was stated: it reads the file's first bytes.)
+    let ide = || {
+        matches!(
+            impact_io::Format::of(&args.file, args.raw_type),
+            impact_io::Format::Ide
+        )
+    };
+    (!stated && !ide()).then(|| Assumption::Units {
         column: column.to_string(),
     })
 }

@@ -53,8 +53,7 @@ pub fn analyze(
     let mut source =
         open_source(&args.file, &args.read_options(progress)).map_err(ReadFailure::from)?;
     let column = source.column().to_string();
-    let setup_column = column.clone();
-    let (mass, scale, units) = pipeline::mass_and_scale(args, &file, &column)?;
+    let (mass, scale, units, assumed) = pipeline::mass_and_scale(args, &file, &column)?;
     let full_scale =
         pipeline::full_scale_m_s2(args, &file, mass).ok_or(PipelineError::StreamNeedsRange)?;
     let (trigger, edge) = pipeline::given_levels(args, &file, mass);
@@ -89,7 +88,6 @@ pub fn analyze(
         samples: run.samples,
         rate_hz: run.source.final_rate_hz(),
     };
-    let assumed = pipeline::assumed_units(args, &file, &setup_column);
     let time_assumed = run
         .source
         .time_unit_assumed()
@@ -149,8 +147,7 @@ fn in_passes_then(
     let input =
         open_source(&args.file, &args.read_options(bar(0.0, 0.5))).map_err(ReadFailure::from)?;
     let column = input.column().to_string();
-    let setup_column = column.clone();
-    let (mass, scale, units) = pipeline::mass_and_scale(args, &file, &column)?;
+    let (mass, scale, units, assumed) = pipeline::mass_and_scale(args, &file, &column)?;
     let full_scale = pipeline::full_scale_m_s2(args, &file, mass);
     let SurveyPass {
         survey: first,
@@ -246,7 +243,6 @@ fn in_passes_then(
         samples,
         rate_hz,
     };
-    let assumed = pipeline::assumed_units(args, &file, &setup_column);
     let time_assumed = time_unit_assumed
         .as_deref()
         .map(pipeline::assumed_time_unit);
