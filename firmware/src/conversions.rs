@@ -37,17 +37,6 @@ pub fn drift(phase0: u32, counted: u32, position: u32, ring: u32) -> u32 {
     }
 }
 
-/// After a block was read: whether the counter is further ahead than the ring can hold.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum Check {
-    /// Within the ring's reach (`pending` samples counted and not yet read).
-    Ok { pending: u32 },
-    /// `missed` triggers made no sample: resynchronise and count them lost.
-    Missed { missed: u32 },
-    /// More samples delivered than triggers counted (a conversion nobody triggered).
-    Uncounted { extra: u32 },
-}
-
 /// What a resynchronisation finds (the ring's unread contents dropped first).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Resync {
@@ -60,25 +49,6 @@ pub enum Resync {
 /// The counter's lead over the samples delivered (negative: more delivered than counted).
 pub fn lead(counted: u32, delivered: u32) -> i64 {
     i64::from(counted.wrapping_sub(delivered) as i32)
-}
-
-/// The check after each block: `ring` samples is what the DMA ring holds; one more may be
-/// in flight (counted at its trigger, in the ring 27 ADC cycles later).
-pub fn check(counted: u32, delivered: u32, ring: u32) -> Check {
-    let lead = lead(counted, delivered);
-    if lead < 0 {
-        Check::Uncounted {
-            extra: lead.unsigned_abs() as u32,
-        }
-    } else if lead > i64::from(ring) + 1 {
-        Check::Missed {
-            missed: (lead - i64::from(ring) - 1) as u32,
-        }
-    } else {
-        Check::Ok {
-            pending: lead as u32,
-        }
-    }
 }
 
 /// At a resynchronisation (the ring dropped, the counter read): what was lost since the last
