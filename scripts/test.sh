@@ -33,10 +33,11 @@ cargo fmt --all --check
 step "clippy (host crates and fuzz targets, all targets)"
 cargo clippy --workspace --exclude impact-firmware --all-targets -- -D warnings
 
-step "clippy (firmware: board, board + ADXL375, board + light gate, emulator, panic check, M4 bench)"
+step "clippy (firmware: board, board + ADXL375, board + light gate, board + self-test, emulator, panic check, M4 bench)"
 cargo clippy --release -p impact-firmware --target thumbv7em-none-eabihf -- -D warnings
 cargo clippy --release -p impact-firmware --target thumbv7em-none-eabihf --features adxl375 -- -D warnings
 cargo clippy --release -p impact-firmware --target thumbv7em-none-eabihf --features light-gate -- -D warnings
+cargo clippy --release -p impact-firmware --target thumbv7em-none-eabihf --features selftest -- -D warnings
 cargo clippy --release -p impact-firmware --target thumbv7em-none-eabihf --no-default-features --features emulator -- -D warnings
 cargo clippy --release -p impact-firmware --target thumbv7em-none-eabihf --no-default-features --features panic-check --bin panic-check -- -D warnings
 cargo clippy --release -p impact-firmware --target thumbv7em-none-eabihf --no-default-features --features m4-bench --bin m4-bench -- -D warnings

@@ -6,6 +6,7 @@
 //! * [`analog`]: the ADC's scale from the supply VREFINT measures;
 //! * [`conversions`]: the ADC's conversions counted against the samples delivered;
 //! * [`scene`]: the compiled-in bench and the emulator's `key=value` scene parser;
+//! * [`selftest`]: the bring-up self-test's played pulse (DAC → ADC) and its judge;
 //! * [`rate`]: the build's sample rate;
 //! * [`adxl375`]: the ADXL375 driver over `embedded-hal-async` (SPI traffic, FIFO, scale);
 //! * [`fifo`]: samples a polled FIFO lost, counted against the sensor's own stream;
@@ -24,6 +25,7 @@ pub mod light_gate;
 pub mod rate;
 pub mod reset_record;
 pub mod scene;
+pub mod selftest;
 #[cfg(all(target_os = "none", feature = "emulator"))]
 pub mod semihosting;
 pub mod ticks;

@@ -23,6 +23,8 @@ compile_error!(
 );
 #[cfg(not(any(feature = "stm32", feature = "emulator")))]
 compile_error!("enable one of the features `stm32` (default) or `emulator`");
+#[cfg(all(feature = "selftest", feature = "adxl375"))]
+compile_error!("the self-test plays into the ADC: build `selftest` without `adxl375`");
 
 mod board;
 mod executors;
@@ -67,7 +69,10 @@ fn main() -> ! {
     // Middle: the streaming stage (baseline, trigger, capture, exact sums; it feeds the
     // watchdog) and the reporter (defmt lines in index order); preempt the analysis.
     let medium = board::start_medium();
-    medium.spawn(unwrap!(tasks::reporter::reporter(board::end_of_stream)));
+    medium.spawn(unwrap!(tasks::reporter::reporter(
+        board::end_of_stream,
+        setup.selftest
+    )));
     medium.spawn(unwrap!(tasks::stream::stream(
         setup.scene,
         setup.backpressure,

@@ -635,6 +635,7 @@ fn injected(
         elf,
         samples,
         scene,
+        false,
         Pacing::RealTime {
             rate_scale: 1.0,
             clock_shift: BOARD_CLOCK_SHIFT,
@@ -1428,4 +1429,47 @@ fn realtime_contacts_twice_the_capture_have_their_kinematics_on_the_board() {
         }
         within_board_limits(&log);
     }
+}
+
+/// The bring-up self-test's path through the whole emulated monitor (`impact selftest`): what
+/// the DAC plays, replayed as the ADC's codes, passes; a 10 % divider on the wire fails on
+/// the peak and an ADC sampling 0.2 % slow on the rate, with exit status 3.
+#[test]
+fn the_self_test_passes_what_the_dac_plays_and_fails_a_faulty_loop() {
+    let Some(elf) = firmware() else { return };
+    let elf = elf.to_string_lossy().into_owned();
+    let selftest = |extra: &[&str]| {
+        let mut args = vec!["selftest", "--elf", &elf];
+        args.extend(extra);
+        common::impact(&args)
+    };
+    let lines = |out: &str, key: &str| -> Vec<bool> {
+        out.lines()
+            .filter(|l| l.contains("selftest pulse="))
+            .map(|l| l.contains(&format!("{key}=true")))
+            .collect()
+    };
+
+    let (code, out, err) = selftest(&[]);
+    assert_eq!(code, 0, "{out}\n{err}");
+    assert_eq!(lines(&out, "pass"), vec![true; 10], "{out}");
+    assert!(
+        out.contains("selftest_result pass=true passed=10 judged=10"),
+        "{out}"
+    );
+    assert!(out.contains("self-test PASS: 10 of 10"), "{out}");
+
+    let (code, out, err) = selftest(&["--wire-gain", "0.9"]);
+    assert_eq!(code, 3, "{out}\n{err}");
+    assert_eq!(lines(&out, "peak_pass"), vec![false; 10], "{out}");
+    assert_eq!(lines(&out, "fwhm_pass"), vec![true; 10], "{out}");
+    assert!(out.contains("self-test FAIL: 0 of 10"), "{out}");
+    assert!(err.contains("(exit status 3)"), "{err}");
+
+    let (code, out, err) = selftest(&["--adc-rate", "499000"]);
+    assert_eq!(code, 3, "{out}\n{err}");
+    let mut rate = vec![false; 10];
+    rate[0] = true; // the first pulse has no previous one to time
+    assert_eq!(lines(&out, "rate_pass"), rate, "{out}");
+    assert_eq!(lines(&out, "peak_pass"), vec![true; 10], "{out}");
 }

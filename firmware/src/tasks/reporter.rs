@@ -22,6 +22,8 @@ use embassy_time::{Duration, Instant, Timer};
 use heapless::Vec;
 use impact_core::{Approach, ImpactReport, Scene};
 
+use impact_firmware::selftest::{Judge, Measured, Outcome, Played, Verdict};
+
 use crate::queues::{FromStream, Heartbeat, StreamEnd, ANALYSED, FROM_STREAM};
 use crate::source::sender::{SAMPLE_CLOCK, SOURCE_STATS};
 
@@ -47,15 +49,18 @@ struct Order {
     held: Vec<ImpactReport, REORDER_LEN>,
     printed: u64,
     out_of_order: u32,
+    /// The bring-up self-test's judge, when it runs.
+    selftest: Option<Judge>,
 }
 
 impl Order {
-    const fn new() -> Self {
+    const fn new(selftest: Option<Judge>) -> Self {
         Self {
             next: 0,
             held: Vec::new(),
             printed: 0,
             out_of_order: 0,
+            selftest,
         }
     }
 
@@ -83,6 +88,9 @@ impl Order {
         }
         if let Some(v) = &r.verdict {
             log_verdict(r.index, v);
+        }
+        if let Some(judge) = &mut self.selftest {
+            selftest(judge, r);
         }
         self.printed += 1;
         if r.index >= self.next {
@@ -122,17 +130,21 @@ impl Order {
     }
 }
 
-/// Logs reports until the end of the stream, then tells the board how it went.
+/// Logs reports until the end of the stream, then tells the board how it went; judges each
+/// against the pulse the self-test played when `selftest` is given.
 #[embassy_executor::task]
-pub async fn reporter(end_of_stream: fn(bool) -> !) {
+pub async fn reporter(end_of_stream: fn(bool) -> !, selftest: Option<Played>) {
     let started = Instant::now();
-    let mut order = Order::new();
+    let mut order = Order::new(selftest.map(Judge::new));
     let mut end: Option<(Heartbeat, StreamEnd)> = None;
     let success = loop {
         if let Some((last, stream_end)) = end {
             // Every impact the stream saw has been printed (or its report was dropped).
             if order.printed + u64::from(last.reports_dropped) >= last.counters.impacts {
                 order.drain();
+                if let Some(v) = order.selftest.as_ref().and_then(Judge::at_end) {
+                    log_selftest_verdict(&v);
+                }
                 let elapsed = started.elapsed().as_millis();
                 break summarize(&last, stream_end, order.out_of_order, elapsed);
             }
@@ -264,6 +276,65 @@ fn log_verdict(
             index,
             m.name(),
         ),
+    }
+}
+
+/// The self-test's judgement of one report: a `selftest` line for a judged pulse (measured
+/// beside played), and the verdict after the last (docs/board.md, "Bring-up self-test").
+fn selftest(judge: &mut Judge, r: &ImpactReport) {
+    let measured = Measured {
+        whole: r.status == impact_core::Status::Complete && !r.clipped,
+        start_s: r.start_s,
+        peak_time_s: r.peak_time_s,
+        peak_m_s2: r.peak_acceleration_m_s2,
+        fwhm_s: r.fwhm_s,
+    };
+    let Outcome::Judged(c, verdict) = judge.judge(measured) else {
+        return;
+    };
+    let played = judge.played();
+    info!(
+        "selftest pulse={=u32} index={=u32} pass={=bool} status={=str} clipped={=bool} peak_m_s2={=f32} played_peak_m_s2={=f32} peak_pass={=bool} fwhm_s={} played_fwhm_s={=f32} fwhm_pass={=bool} rate_hz={} played_rate_hz={=f32} rate_pass={=bool} vdda_v={}",
+        c.number,
+        r.index,
+        c.pass,
+        r.status.name(),
+        r.clipped,
+        c.measured.peak_m_s2,
+        played.peak_m_s2,
+        c.peak_pass,
+        Opt(c.measured.fwhm_s),
+        played.fwhm_s,
+        c.fwhm_pass,
+        Opt(c.rate_hz),
+        played.rate_hz,
+        c.rate_pass,
+        Opt(played.vdda_v),
+    );
+    if let Some(v) = verdict {
+        log_selftest_verdict(&v);
+    }
+}
+
+fn log_selftest_verdict(v: &Verdict) {
+    info!(
+        "selftest_result pass={=bool} passed={=u32} judged={=u32} pulses={=u32}",
+        v.pass,
+        v.passed,
+        v.judged,
+        impact_firmware::selftest::PULSES
+    );
+    if v.pass {
+        info!(
+            "self-test PASS: {=u32} of {=u32} pulses as played",
+            v.passed, v.judged
+        );
+    } else {
+        error!(
+            "self-test FAIL: {=u32} of {=u32} pulses as played (see the selftest lines)",
+            v.passed,
+            impact_firmware::selftest::PULSES
+        );
     }
 }
 

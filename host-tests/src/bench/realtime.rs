@@ -147,6 +147,7 @@ fn train(
         elf,
         qemu::Samples::Adc(&samples),
         scene,
+        false,
         Pacing::RealTime {
             rate_scale: 1.0,
             clock_shift,

@@ -33,6 +33,9 @@ const WATCH_EXAMPLES: &str = "Examples:
   impact emulate seed.csv --mass 0.06 --v0 1.3357 --realtime --waveforms 8 | impact watch
   impact watch board.log --spec half-sine,100g,3ms
   impact watch board.log --terminal --once";
+const SELFTEST_EXAMPLES: &str = "Examples:
+  impact selftest
+  impact selftest --wire-gain 0.9";
 const LOG_EXAMPLES: &str = "Examples:
   impact log board.log --csv
   impact log board.log --plot board.svg";
@@ -84,6 +87,11 @@ enum Command {
     /// web page (or in the terminal), every line kept in a session file.
     #[command(after_help = WATCH_EXAMPLES)]
     Watch(Box<cli::watch::WatchArgs>),
+    /// The board's bring-up self-test (`--features selftest`) on the emulated board: the
+    /// DAC's half-sine replayed through the monitor and judged as the board judges it
+    /// (peak, FWHM, sample rate; PASS, or FAIL with exit status 3).
+    #[command(after_help = SELFTEST_EXAMPLES)]
+    Selftest(cli::selftest::SelftestArgs),
     /// Render a model impact as an accelerometer recording (CSV on stdout or --output, raw
     /// ADC codes with --raw).
     #[command(allow_negative_numbers = true, after_help = SYNTH_EXAMPLES)]
@@ -158,13 +166,16 @@ enum Error {
     Watch(#[from] cli::watch::WatchError),
     #[error(transparent)]
     Synth(#[from] impact_host::synth::SynthError),
+    #[error(transparent)]
+    Selftest(#[from] cli::selftest::SelftestError),
     /// (Boxed: the benchmarks' errors are the largest, and the rarest.)
     #[error(transparent)]
     Bench(Box<impact_host::bench::BenchError>),
 }
 
 /// Runs the command; the verdicts of the commands that judge impacts against a spec
-/// (`analyze`, `report`, `emulate`, `log`), none for the others.
+/// (`analyze`, `report`, `emulate`, `log`) or pulses against the played one (`selftest`),
+/// none for the others.
 fn run(cli: Cli) -> Result<Judged, Error> {
     let none = Judged::default();
     match cli.command {
@@ -174,6 +185,7 @@ fn run(cli: Cli) -> Result<Judged, Error> {
         Command::Log(args) => Ok(cli::log::log(&args)?),
         Command::Report(args) => Ok(cli::html::run(&args)?),
         Command::Watch(args) => Ok(cli::watch::run(&args).map(|()| none)?),
+        Command::Selftest(args) => Ok(cli::selftest::run(&args)?),
         Command::Synth(command) => Ok(cli::synth::run(command).map(|()| none)?),
         Command::Bench { which } => cli::bench::run(which)
             .map(|()| none)

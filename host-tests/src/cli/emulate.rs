@@ -350,6 +350,7 @@ pub fn emulate(args: &EmulateArgs) -> Result<crate::report::spec::Judged, Emulat
         &elf,
         samples,
         &setup.scene,
+        false,
         pacing,
         Duration::from_secs(args.timeout),
         move |line| {

@@ -8,6 +8,7 @@ pub mod html;
 pub mod log;
 pub mod progress;
 pub mod pulse;
+pub mod selftest;
 pub mod series;
 pub mod simulate;
 pub mod srs_required;

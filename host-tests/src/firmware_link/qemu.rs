@@ -445,12 +445,14 @@ impl Samples<'_> {
     }
 }
 
-/// Replays `samples` on the emulator firmware `elf` with `scene` and `pacing`; each decoded
-/// line is passed to `echo` as it arrives.
+/// Replays `samples` on the emulator firmware `elf` with `scene` and `pacing` (`selftest`:
+/// the firmware judges each report against the self-test's played pulse); each decoded line
+/// is passed to `echo` as it arrives.
 pub fn run_emulator(
     elf: &Path,
     samples: Samples<'_>,
     scene: &Scene,
+    selftest: bool,
     pacing: Pacing,
     timeout: Duration,
     echo: impl FnMut(&str) + Send + 'static,
@@ -492,6 +494,9 @@ pub fn run_emulator(
             Some(2) => "z",
             _ => "resultant",
         });
+    }
+    if selftest {
+        config.push_str(",arg=selftest=1");
     }
     let mut icount = Vec::new();
     match pacing {

@@ -38,7 +38,7 @@ const COMMAND_LINE_LEN: usize = 1920;
 
 /// What the semihosting command line asks for:
 /// `<program> <samples-file> [realtime|lossless] [rate_scale=X] [stall=BLOCK:US]
-/// [fault=udf|guard|below-stack] [sensor=adc|adxl375] [axis=x|y|z|resultant] [spec_table=PATH] [key=value ...]`
+/// [fault=udf|guard|below-stack] [sensor=adc|adxl375] [axis=x|y|z|resultant] [selftest=0|1] [spec_table=PATH] [key=value ...]`
 /// (scene keys:
 /// see [`impact_firmware::scene::apply`]; unset keys keep the seed bench's values,
 /// [`impact_firmware::scene::BENCH`]).
@@ -62,6 +62,9 @@ pub struct Config {
     pub adxl375: bool,
     /// `axis=x|y|z|resultant` (ADXL375 path): what the stream gets of each sample.
     pub axis: Axis,
+    /// `selftest=1`: the samples are the self-test's DAC output replayed; each report is
+    /// judged against the played pulse, as on a board at its nominal 3.0 V.
+    pub selftest: bool,
     /// The scene the stream runs.
     pub scene: Scene,
 }
@@ -107,6 +110,8 @@ enum ConfigError<'a> {
     BadFault,
     /// `axis` is not `x`, `y`, `z` or `resultant`.
     BadAxis,
+    /// `selftest` is not `0` or `1`.
+    BadSelftest,
     Scene {
         key: &'a str,
         error: SceneError,
@@ -168,6 +173,7 @@ fn parse(line: &str) -> Result<Config, ConfigError<'_>> {
     let mut fault_at_start = None;
     let mut adxl375 = false;
     let mut axis = Axis::Resultant;
+    let mut selftest = false;
     let mut band_path = None;
     for arg in line.split(' ') {
         match arg.split_once('=') {
@@ -178,6 +184,13 @@ fn parse(line: &str) -> Result<Config, ConfigError<'_>> {
                     "z" => Axis::Z,
                     "resultant" => Axis::Resultant,
                     _ => return Err(ConfigError::BadAxis),
+                };
+            }
+            Some(("selftest", value)) => {
+                selftest = match value {
+                    "0" => false,
+                    "1" => true,
+                    _ => return Err(ConfigError::BadSelftest),
                 };
             }
             Some(("sensor", value)) => {
@@ -226,6 +239,7 @@ fn parse(line: &str) -> Result<Config, ConfigError<'_>> {
         fault_at_start,
         adxl375,
         axis,
+        selftest,
         scene,
     })
 }
@@ -252,6 +266,8 @@ pub struct Setup {
     pub scene: Scene,
     /// Whether the stream may wait for the analysis (lossless replay only).
     pub backpressure: Backpressure,
+    /// `selftest=1`: the pulse the self-test's DAC plays, on a board at its nominal 3.0 V.
+    pub selftest: Option<impact_firmware::selftest::Played>,
     config: Config,
 }
 
@@ -282,12 +298,21 @@ pub fn init(previous: Option<Record>) -> Setup {
     let lossless = config.pacing == Pacing::Lossless;
     crate::logger::set_waiting(lossless);
     drain::init(lossless);
+    let selftest = config.selftest.then(|| {
+        use impact_firmware::analog::{Scale, NOMINAL_VDDA_V, SENSOR};
+        impact_firmware::selftest::Played::new(
+            Scale::new(NOMINAL_VDDA_V, SENSOR).gain_m_s2_per_count,
+            config.scene.calibration.sample_rate_hz,
+            None,
+        )
+    });
     Setup {
         scene: config.scene,
         backpressure: match config.pacing {
             Pacing::RealTime => Backpressure::Never,
             Pacing::Lossless => Backpressure::WaitForCapture,
         },
+        selftest,
         config,
     }
 }

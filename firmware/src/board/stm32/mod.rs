@@ -19,6 +19,8 @@ use crate::tasks::stream::Backpressure;
 pub mod accel;
 #[cfg(not(feature = "adxl375"))]
 pub mod adc;
+#[cfg(feature = "selftest")]
+pub mod dac;
 #[cfg(feature = "light-gate")]
 pub mod gate;
 
@@ -65,6 +67,8 @@ pub struct Setup {
     pub scene: Scene,
     /// A live source: the stream never waits for the analysis.
     pub backpressure: Backpressure,
+    /// With `--features selftest`: the pulse the DAC plays, which the reporter judges.
+    pub selftest: Option<impact_firmware::selftest::Played>,
     p: Peripherals,
 }
 
@@ -83,21 +87,36 @@ pub fn init(previous: Option<Record>) -> Setup {
     #[allow(unused_mut)]
     let mut scene = impact_firmware::scene::BENCH;
     #[cfg(not(feature = "adxl375"))]
-    {
-        scene.calibration.gain_m_s2_per_count = analog_scale(adc::vdda_v(p.ADC1.reborrow()));
-    }
+    let vdda = {
+        let (gain, vdda) = analog_scale(adc::vdda_v(p.ADC1.reborrow()));
+        scene.calibration.gain_m_s2_per_count = gain;
+        vdda
+    };
+    #[cfg(feature = "selftest")]
+    let selftest = Some(impact_firmware::selftest::Played::new(
+        scene.calibration.gain_m_s2_per_count,
+        scene.calibration.sample_rate_hz,
+        vdda,
+    ));
+    #[cfg(not(feature = "selftest"))]
+    let selftest = None;
+    #[cfg(all(not(feature = "adxl375"), not(feature = "selftest")))]
+    let _ = vdda;
     Setup {
         scene,
         backpressure: Backpressure::Never,
+        selftest,
         p,
     }
 }
 
 /// The ADC's gain, m/s² per count, for the supply VREFINT measured (logged with the range the
-/// ADC then covers), or for the Discovery's nominal 3.0 V when it could not be measured.
+/// ADC then covers), or for the Discovery's nominal 3.0 V when it could not be measured; and
+/// the supply measured.
 #[cfg(not(feature = "adxl375"))]
-fn analog_scale(vdda: Result<f32, impact_firmware::analog::VddaError>) -> f32 {
+fn analog_scale(vdda: Result<f32, impact_firmware::analog::VddaError>) -> (f32, Option<f32>) {
     use impact_firmware::analog::{Scale, VddaError, NOMINAL_VDDA_V, SENSOR};
+    let measured = vdda.as_ref().ok().copied();
     let v = match vdda {
         Ok(v) => v,
         Err(e) => {
@@ -126,7 +145,7 @@ fn analog_scale(vdda: Result<f32, impact_firmware::analog::VddaError>) -> f32 {
         s.range_m_s2.0,
         s.range_m_s2.1
     );
-    s.gain_m_s2_per_count
+    (s.gain_m_s2_per_count, measured)
 }
 
 /// Why the chip last reset (RCC_CSR's flags, then cleared): a watchdog reset means the
@@ -316,6 +335,12 @@ pub fn spawn_sources(setup: Setup, high: SendSpawner, samples: crate::queues::Sa
         };
         let sensor = accel::sensor(p.SPI1, pins, p.DMA2_CH3, p.DMA2_CH2, Irqs);
         high.spawn(unwrap!(accel::sampler(sensor, samples)));
+    }
+
+    #[cfg(feature = "selftest")]
+    {
+        let player = super::dac::player(p.DAC1, p.DMA1_CH5, p.PA4, p.TIM6);
+        high.spawn(unwrap!(super::dac::play(player)));
     }
 
     #[cfg(feature = "light-gate")]
