@@ -1,9 +1,10 @@
 //! Light-gate speed: two beams a known distance apart, cut in turn by the body just before it
 //! hits, give the approach speed `v0 = spacing / (t2 - t1)` that an accelerometer cannot.
 //!
-//! Hardware-free (the host tests include this file): the speed, and the pairing of beam cuts
-//! into passages with their direction. The EXTI handlers that time-stamp the cuts and the
-//! task that pairs them are in `gate.rs`.
+//! Hardware-free (the host tests include this file): the speed, the pairing of beam cuts
+//! into passages with their direction, and the capture timer's 32-bit counts made into one
+//! time line ([`CaptureClock`]). The timer's input capture that time-stamps the cuts and the
+//! task that pairs them are in `board/stm32/gate.rs`.
 
 /// Slowest and fastest approach speeds believed, m/s: outside them the gate was cut by
 /// something else (a hand, a bounce) and the reading is refused.
@@ -110,5 +111,50 @@ impl Pairing {
                 None
             }
         }
+    }
+}
+
+/// A 32-bit capture counter at 1 MHz (it wraps every 71.6 minutes) made into one 64-bit time
+/// line, µs: each capture is placed after the previous one by the counts between them, which
+/// is exact while captures come less than half a wrap apart. After a longer silence (told by
+/// a coarse clock that does not wrap, e.g. the system's uptime) the line starts again from the
+/// coarse clock: the pairing only compares cuts a second apart at most, so nothing it uses
+/// spans the restart.
+#[derive(Clone, Copy, Debug, Default)]
+pub struct CaptureClock {
+    /// The last capture: its raw count, its time on the line and on the coarse clock, µs.
+    last: Option<(u32, u64, u64)>,
+}
+
+/// Half the capture counter's wrap, µs: captures closer than this are ordered by their counts.
+pub const HALF_WRAP_US: u64 = 1 << 31;
+
+impl CaptureClock {
+    pub const fn new() -> Self {
+        Self { last: None }
+    }
+
+    /// The time, µs, of a capture of `raw` counts, read at `coarse_us` on the coarse clock
+    /// (soon after the capture). Captures must come in the order they were taken.
+    pub fn extend(&mut self, raw: u32, coarse_us: u64) -> u64 {
+        let t = match self.last {
+            Some((raw0, t0, coarse0)) if coarse_us.saturating_sub(coarse0) < HALF_WRAP_US => {
+                t0 + u64::from(raw.wrapping_sub(raw0))
+            }
+            _ => coarse_us,
+        };
+        self.last = Some((raw, t, coarse_us));
+        t
+    }
+}
+
+/// Two captures taken together (both beams' flags found in one interrupt, microseconds
+/// apart), in the order they were taken: `b` is after `a` when it is less than half a wrap of
+/// counts after it.
+pub fn in_capture_order<T>(a: (u32, T), b: (u32, T)) -> [(u32, T); 2] {
+    if u64::from(b.0.wrapping_sub(a.0)) < HALF_WRAP_US {
+        [a, b]
+    } else {
+        [b, a]
     }
 }

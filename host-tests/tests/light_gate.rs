@@ -83,3 +83,39 @@ fn a_bouncing_beam_is_one_cut_at_its_first_edge() {
         vec![wrap, wrap.wrapping_add(500)]
     );
 }
+
+#[test]
+fn the_capture_counter_becomes_one_time_line_across_its_wraps() {
+    use impact_firmware::light_gate::{in_capture_order, CaptureClock, HALF_WRAP_US};
+    let mut c = CaptureClock::new();
+    // The first capture starts the line at the coarse clock.
+    assert_eq!(c.extend(4_294_960_000, 5_000_000), 5_000_000);
+    // 7486 µs later, across the counter's wrap: exact, whatever the coarse clock's jitter.
+    assert_eq!(
+        c.extend(4_294_960_000u32.wrapping_add(7_486), 5_007_700),
+        5_007_486
+    );
+    // A minute later, and many wraps' worth of captures a minute apart: still on the counts.
+    let mut raw = 4_294_960_000u32.wrapping_add(7_486);
+    let mut t = 5_007_486u64;
+    for k in 1..200u64 {
+        raw = raw.wrapping_add(60_000_000);
+        t += 60_000_000;
+        assert_eq!(c.extend(raw, t + 3_000 + k), t, "capture {k}");
+    }
+    // After more than half a wrap of silence the counts cannot tell: the coarse clock again,
+    // and the counts from there.
+    let late = t + HALF_WRAP_US + 10_000;
+    assert_eq!(c.extend(raw.wrapping_add(12_345), late), late);
+    assert_eq!(
+        c.extend(raw.wrapping_add(22_345), late + 10_050),
+        late + 10_000
+    );
+    // Two captures read in one interrupt are ordered by their counts, across the wrap too.
+    assert_eq!(in_capture_order((10, 'a'), (5, 'b')), [(5, 'b'), (10, 'a')]);
+    assert_eq!(
+        in_capture_order((3, 'a'), (u32::MAX - 2, 'b')),
+        [(u32::MAX - 2, 'b'), (3, 'a')]
+    );
+    assert_eq!(in_capture_order((7, 'a'), (7, 'b')), [(7, 'a'), (7, 'b')]);
+}

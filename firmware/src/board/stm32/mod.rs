@@ -345,7 +345,7 @@ pub fn spawn_sources(setup: Setup, high: SendSpawner, samples: crate::queues::Sa
 
     #[cfg(feature = "light-gate")]
     {
-        let beams = super::gate::Beams::new(p.PB0, p.EXTI0, p.PB1, p.EXTI1);
+        let beams = super::gate::Beams::new(p.TIM5, p.PA2, p.PA3);
         high.spawn(unwrap!(super::gate::light_gate(beams)));
     }
 }
