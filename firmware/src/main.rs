@@ -8,7 +8,7 @@
 //! builds differ only in the board ([`board`]: its sample sources, clocks, interrupt lines and
 //! embassy-time driver); the hardware-free half is the `impact_firmware` library:
 //!
-//! * `stm32` (default): the board, brought up at 168 MHz; ADC1 (or, with `adxl375`, an
+//! * `stm32` (default): the board, brought up at 168 MHz; ADC2 (or, with `adxl375`, an
 //!   ADXL375 on SPI1) samples the sensor; defmt over RTT. `cargo fw` at the workspace root
 //!   builds it, `cargo run --release` inside `firmware/` flashes it and shows the log.
 //! * `emulator`: QEMU `-machine mps2-an386`; samples are replayed from a host file; defmt

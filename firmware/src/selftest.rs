@@ -5,7 +5,7 @@
 //! loop. The DAC plays [`TABLE`] over and over, one code every [`DAC_RATE_HZ`]-th of a
 //! second (TIM6's update, DMA1 stream 5 in circular mode from flash): a half-sine of
 //! [`AMPLITUDE_CODES`] above [`ZERO_CODE`] lasting [`PULSE_S`], then rest, every [`PERIOD_S`].
-//! The samples go the way every sample goes (TIM3, ADC1, DMA2, the stream, the analysis), and
+//! The samples go the way every sample goes (TIM3, ADC2, DMA2, the stream, the analysis), and
 //! each report is judged here against what was played:
 //!
 //! * the peak: the DAC and the ADC both convert against VREF+ (VDDA on the Discovery), so the

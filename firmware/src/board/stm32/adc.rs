@@ -1,6 +1,8 @@
-//! STM32 sample source: ADC1 on PA1 (ADC123_IN1), converted on each TIM3 update (TRGO) at
-//! [`SAMPLE_RATE_HZ`] and moved by DMA2 stream 0 into a ring of two blocks; each half of the
-//! ring becomes one block for the monitor.
+//! STM32 sample source: ADC2 on PA1 (ADC123_IN1), converted on each TIM3 update (TRGO) at
+//! [`SAMPLE_RATE_HZ`] and moved by DMA2 stream 2 (channel 1) into a ring of two blocks; each
+//! half of the ring becomes one block for the monitor. ADC2, not ADC1: only ADC1 reaches
+//! VREFINT, and it measures the supply once a second meanwhile ([`super::supply`]), taking
+//! none of these conversions.
 //!
 //! Rates. The 168 MHz clock tree gives APB2 = 84 MHz; the ADC prescaler (/2, /4, /6, /8) must
 //! keep ADCCLK at or below 36 MHz, so ADCCLK = 84 / 4 = 21 MHz. A 12-bit conversion takes
@@ -35,9 +37,9 @@
 
 use defmt::{info, warn};
 use embassy_futures::select::{select, Either};
-use embassy_stm32::adc::{Adc, AdcChannel, Exten, RingBufferedAdc, SampleTime, VrefInt};
+use embassy_stm32::adc::{Adc, AdcChannel, Exten, RingBufferedAdc, SampleTime};
 use embassy_stm32::interrupt;
-use embassy_stm32::peripherals::{ADC1, DMA2_CH0, PA1, TIM2, TIM3};
+use embassy_stm32::peripherals::{ADC2, DMA2_CH2, PA1, TIM2, TIM3};
 use embassy_stm32::time::Hertz;
 use embassy_stm32::timer::low_level::{MasterMode, RoundTo, SlaveMode, Timer, TriggerSource};
 use embassy_stm32::{triggers, Peri};
@@ -49,9 +51,11 @@ use static_cell::ConstStaticCell;
 use super::Irqs;
 use crate::queues::BLOCK_LEN;
 use crate::source::sender::{BlockSender, SAMPLE_CLOCK, SOURCE_STATS};
-use impact_firmware::analog::{self, VddaError};
 use impact_firmware::conversions::{self, Resync};
 use impact_firmware::SAMPLE_RATE_HZ;
+
+/// The DMA2 stream that moves ADC2's conversions (channel 1; `Irqs` binds its interrupt).
+const DMA_STREAM: usize = 2;
 
 /// DMA ring length in samples: two blocks, so the DMA fills one half while the task reads
 /// the other (half-transfer and transfer-complete interrupts).
@@ -68,28 +72,6 @@ const STALL_TIMEOUT: Duration = Duration::from_millis(10);
 pub fn dma_buffer() -> &'static mut [u16; DMA_BUF_LEN] {
     static BUF: ConstStaticCell<[u16; DMA_BUF_LEN]> = ConstStaticCell::new([0; DMA_BUF_LEN]);
     BUF.take()
-}
-
-/// Conversions of VREFINT averaged for the supply (each 480 ADCCLK cycles, 22.9 us: VREFINT
-/// needs 10 us of sampling, DS8626 Table 71).
-const VREFINT_READS: u32 = 16;
-
-/// The supply the ADC converts against, volts, from VREFINT and its factory calibration
-/// (`impact_firmware::analog`). Runs once, before the sampler takes the ADC.
-pub fn vdda_v(adc: Peri<'_, ADC1>) -> Result<f32, VddaError> {
-    let mut adc = Adc::new(adc);
-    let mut vrefint = adc.enable_vrefint();
-    // VREFINT's start-up time (DS8626 Table 71: 10 us).
-    embassy_time::block_for(Duration::from_micros(VrefInt::start_time_us().into()));
-    let mut sum = 0u32;
-    for _ in 0..VREFINT_READS {
-        sum += u32::from(adc.blocking_read(&mut vrefint, SampleTime::CYCLES480));
-    }
-    // SAFETY: a read of the factory calibration word in the system memory's OTP area, which
-    // the F407 always maps (RM0090 2.3, DS8626 6.3.22).
-    let cal = unsafe { core::ptr::read_volatile(analog::VREFINT_CAL_ADDR as *const u16) };
-    // Dropping the driver stops the ADC and gates its clock; the sampler brings it up again.
-    analog::vdda_v(cal, sum as f32 / VREFINT_READS as f32)
 }
 
 /// TIM2 in external clock mode 1 on ITR2 = TIM3's TRGO: a 32-bit count of the conversions
@@ -119,20 +101,20 @@ impl ConversionCounter {
     }
 }
 
-/// ADC1 in DMA ring-buffer mode with the TIM3 trigger that paces it (dropping the timer
+/// ADC2 in DMA ring-buffer mode with the TIM3 trigger that paces it (dropping the timer
 /// would stop its clock, so it is kept here) and the counter of its triggers.
 pub struct AdcSampler {
-    adc: RingBufferedAdc<'static, ADC1>,
+    adc: RingBufferedAdc<'static, ADC2>,
     trigger: Timer<'static, TIM3>,
     counter: ConversionCounter,
 }
 
 impl AdcSampler {
-    /// Configures TIM3 and ADC1; nothing is converted until [`sampler`] starts them.
+    /// Configures TIM3 and ADC2; nothing is converted until [`sampler`] starts them.
     pub fn new(
-        adc: Peri<'static, ADC1>,
+        adc: Peri<'static, ADC2>,
         pin: Peri<'static, PA1>,
-        dma: Peri<'static, DMA2_CH0>,
+        dma: Peri<'static, DMA2_CH2>,
         tim: Peri<'static, TIM3>,
         count: Peri<'static, TIM2>,
         irqs: Irqs,
@@ -173,7 +155,7 @@ static ADC_OVERRUN: Signal<CriticalSectionRawMutex, ()> = Signal::new();
 /// the DMA is re-armed), and wakes the sampler.
 #[interrupt]
 fn ADC() {
-    let regs = embassy_stm32::pac::ADC1;
+    let regs = embassy_stm32::pac::ADC2;
     if regs.sr().read().ovr() {
         regs.cr1().modify(|w| w.set_ovrie(false));
         SOURCE_STATS.overrun();
@@ -181,17 +163,17 @@ fn ADC() {
     }
 }
 
-/// Only the overrun interrupt of ADC1, just above the sample source's priority.
+/// Only the overrun interrupt of ADC2, just above the sample source's priority.
 fn enable_overrun_interrupt() {
     use embassy_stm32::interrupt::{InterruptExt, Priority};
-    embassy_stm32::pac::ADC1.cr1().modify(|w| {
+    embassy_stm32::pac::ADC2.cr1().modify(|w| {
         w.set_eocie(false);
         w.set_ovrie(true);
     });
     // Above the sampler's executor (P2), so the interrupt has always counted and masked an
     // overrun before the sampler's stall path recovers from it.
     interrupt::ADC.set_priority(Priority::P1);
-    // SAFETY: the handler above is ready; it touches ADC1's status register and two statics.
+    // SAFETY: the handler above is ready; it touches ADC2's status register and two statics.
     unsafe { interrupt::ADC.enable() };
 }
 
@@ -200,7 +182,7 @@ fn enable_overrun_interrupt() {
 /// overrun interrupt unmasked; the next TIM3 trigger starts the next conversion. Returns
 /// whether OVR was set. After OVR the ADC issues no DMA request until this runs.
 fn recover_adc_overrun() -> bool {
-    let regs = embassy_stm32::pac::ADC1;
+    let regs = embassy_stm32::pac::ADC2;
     let overrun = regs.sr().read().ovr();
     regs.cr2().modify(|w| w.set_dma(false));
     regs.cr2().modify(|w| w.set_dma(true));
@@ -229,12 +211,12 @@ pub async fn sampler(mut s: AdcSampler, samples: crate::queues::SampleSender) {
     let rate = trigger_rate_hz(&s.trigger);
     if rate == SAMPLE_RATE_HZ {
         info!(
-            "ADC1/PA1 sampling at {} Hz (TIM3 TRGO), blocks of {}",
+            "ADC2/PA1 sampling at {} Hz (TIM3 TRGO), blocks of {}",
             rate, BLOCK_LEN
         );
     } else {
         defmt::error!(
-            "ADC1/PA1 sampling at {} Hz, not the scene's {} Hz: every time is off",
+            "ADC2/PA1 sampling at {} Hz, not the scene's {} Hz: every time is off",
             rate,
             SAMPLE_RATE_HZ
         );
@@ -326,12 +308,12 @@ fn trigger_rate_hz(t: &Timer<'static, TIM3>) -> u32 {
     t.get_clock_frequency().0 / clocks.max(1)
 }
 
-/// TIM2's count and the DMA's write position in the ring (DMA2 stream 0's NDTR counts down
+/// TIM2's count and the DMA's write position in the ring (DMA2 stream 2's NDTR counts down
 /// from the ring's length), read together.
 fn positions(_s: &AdcSampler) -> (u32, u32) {
     critical_section::with(|_| {
         let counted = embassy_stm32::pac::TIM2.cnt().read();
-        let left = u32::from(embassy_stm32::pac::DMA2.st(0).ndtr().read().ndt());
+        let left = u32::from(embassy_stm32::pac::DMA2.st(DMA_STREAM).ndtr().read().ndt());
         let ring = DMA_BUF_LEN as u32;
         (counted, (ring - left.min(ring)) % ring)
     })

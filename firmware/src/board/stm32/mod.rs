@@ -1,7 +1,8 @@
 //! The `stm32` board: STM32F4-Discovery (STM32F407VG). Clock tree and flash accelerator, the
 //! executors' interrupt lines and priorities, the watchdog and the reset reason; its sample
-//! sources (ADC1 and DMA in [`adc`], or the ADXL375 on SPI1 in `accel`) and the light gate
-//! (`gate`); defmt over RTT, panics through panic-probe.
+//! sources (ADC2 and DMA in [`adc`], with the supply measured on ADC1 in [`supply`]; or the
+//! ADXL375 on SPI1 in `accel`) and the light gate (`gate`); defmt over RTT, panics through
+//! panic-probe.
 
 use defmt::{info, unwrap};
 use embassy_executor::SendSpawner;
@@ -23,12 +24,14 @@ pub mod adc;
 pub mod dac;
 #[cfg(feature = "light-gate")]
 pub mod gate;
+#[cfg(not(feature = "adxl375"))]
+pub mod supply;
 
 #[cfg(not(feature = "adxl375"))]
 bind_interrupts!(
     /// DMA interrupts of the sample source.
     pub struct Irqs {
-        DMA2_STREAM0 => dma::InterruptHandler<peripherals::DMA2_CH0>;
+        DMA2_STREAM2 => dma::InterruptHandler<peripherals::DMA2_CH2>;
     }
 );
 
@@ -69,6 +72,10 @@ pub struct Setup {
     pub backpressure: Backpressure,
     /// With `--features selftest`: the pulse the DAC plays, which the reporter judges.
     pub selftest: Option<impact_firmware::selftest::Played>,
+    /// ADC1, which measured the supply at start-up and goes on measuring it, and what it
+    /// measured then.
+    #[cfg(not(feature = "adxl375"))]
+    supply: (supply::Supply, Option<f32>),
     p: Peripherals,
 }
 
@@ -87,10 +94,12 @@ pub fn init(previous: Option<Record>) -> Setup {
     #[allow(unused_mut)]
     let mut scene = impact_firmware::scene::BENCH;
     #[cfg(not(feature = "adxl375"))]
-    let vdda = {
-        let (gain, vdda) = analog_scale(adc::vdda_v(p.ADC1.reborrow()));
+    let (supply, vdda) = {
+        // SAFETY: ADC1 is taken here and never again: the supply's measurements own it.
+        let mut supply = supply::Supply::new(unsafe { p.ADC1.clone_unchecked() });
+        let (gain, vdda) = analog_scale(supply.vdda_v());
         scene.calibration.gain_m_s2_per_count = gain;
-        vdda
+        (supply, vdda)
     };
     #[cfg(feature = "selftest")]
     let selftest = Some(impact_firmware::selftest::Played::new(
@@ -100,12 +109,12 @@ pub fn init(previous: Option<Record>) -> Setup {
     ));
     #[cfg(not(feature = "selftest"))]
     let selftest = None;
-    #[cfg(all(not(feature = "adxl375"), not(feature = "selftest")))]
-    let _ = vdda;
     Setup {
         scene,
         backpressure: Backpressure::Never,
         selftest,
+        #[cfg(not(feature = "adxl375"))]
+        supply: (supply, vdda),
         p,
     }
 }
@@ -319,8 +328,10 @@ pub fn spawn_sources(setup: Setup, high: SendSpawner, samples: crate::queues::Sa
         use super::adc;
         let dma_buf = adc::dma_buffer();
         let sampler =
-            adc::AdcSampler::new(p.ADC1, p.PA1, p.DMA2_CH0, p.TIM3, p.TIM2, Irqs, dma_buf);
+            adc::AdcSampler::new(p.ADC2, p.PA1, p.DMA2_CH2, p.TIM3, p.TIM2, Irqs, dma_buf);
         high.spawn(unwrap!(adc::sampler(sampler, samples)));
+        let (supply, start) = setup.supply;
+        high.spawn(unwrap!(super::supply::watch(supply, start)));
     }
 
     #[cfg(feature = "adxl375")]
