@@ -115,3 +115,31 @@ impl Scale {
         }
     }
 }
+
+/// A change of the supply since start-up beyond which the board warns, relative: 0.2 %, ten
+/// times the measurement's own scatter (16 conversions of VREFINT, about ±1 count in 1500).
+pub const WARN_CHANGE: f32 = 0.002;
+
+/// The supply's change since start-up, relative, and the error it makes in every reading
+/// (the gain set at start-up is kept: an absolute sensor then reads `-change` off).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct SupplyChange {
+    /// `now / start − 1`.
+    pub change: f32,
+    /// The readings' relative error: `start / now − 1`.
+    pub reading_error: f32,
+    /// Whether `change` exceeds [`WARN_CHANGE`].
+    pub warn: bool,
+}
+
+impl SupplyChange {
+    /// The change from `start_v` (the start-up measurement) to `now_v`, volts.
+    pub fn new(start_v: f32, now_v: f32) -> Self {
+        let change = now_v / start_v - 1.0;
+        Self {
+            change,
+            reading_error: start_v / now_v - 1.0,
+            warn: change.abs() > WARN_CHANGE,
+        }
+    }
+}

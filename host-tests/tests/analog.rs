@@ -108,3 +108,25 @@ fn a_reading_that_cannot_be_a_supply_is_refused_by_name() {
         Err(VddaError::OutOfRange(_))
     ));
 }
+
+#[test]
+fn a_supply_that_moved_since_start_up_is_warned_with_the_error_it_makes() {
+    use impact_firmware::analog::{Scale, SupplyChange, SENSOR, WARN_CHANGE};
+    // 3.00 V at start-up, 3.03 V now: 1 % up, and the start-up gain reads 1/1.01 − 1 low.
+    let c = SupplyChange::new(3.0, 3.03);
+    assert!((c.change - 0.01).abs() < 1e-6, "{c:?}");
+    assert!(c.warn);
+    // The error is the one the start-up scale makes against today's true scale.
+    let (then, now) = (Scale::new(3.0, SENSOR), Scale::new(3.03, SENSOR));
+    let truth = then.gain_m_s2_per_count / now.gain_m_s2_per_count - 1.0;
+    assert!((c.reading_error - truth).abs() < 1e-6, "{c:?} vs {truth}");
+    // Within the measurement's scatter: no warning, either way.
+    for now in [
+        3.0 * (1.0 + WARN_CHANGE * 0.9),
+        3.0 * (1.0 - WARN_CHANGE * 0.9),
+        3.0,
+    ] {
+        assert!(!SupplyChange::new(3.0, now).warn, "{now}");
+    }
+    assert!(SupplyChange::new(3.0, 3.0 * (1.0 - WARN_CHANGE * 1.1)).warn);
+}

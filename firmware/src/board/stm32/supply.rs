@@ -5,8 +5,9 @@
 //!
 //! The start-up value sets the ADC's gain for the run (`impact_firmware::analog`); the
 //! measurement each second logs `supply vdda_v=… start_vdda_v=… change=…` (the relative
-//! change since start-up) and warns when the supply has moved more than [`WARN_CHANGE`]: every
-//! reading is then off by that much, since the gain was set at start-up.
+//! change since start-up) and warns when the supply has moved more than
+//! [`analog::WARN_CHANGE`]: every reading is then off by about that much, since the gain was
+//! set at start-up ([`analog::SupplyChange`]).
 //!
 //! ADC1 is driven through its registers, not embassy's `Adc`: creating one resets every ADC
 //! (the F407 has one reset bit for the three), which would stop ADC2's sampling. So each
@@ -28,9 +29,6 @@ const READS: u32 = 16;
 
 /// VREFINT's channel on ADC1.
 const VREFINT_CHANNEL: u8 = 17;
-
-/// A change of the supply since start-up beyond which the log warns, relative.
-pub const WARN_CHANGE: f32 = 0.002;
 
 /// One conversion's wait: 480 + 12 ADCCLK cycles at 21 MHz is 23.4 us.
 const CONVERSION: Duration = Duration::from_micros(25);
@@ -129,16 +127,16 @@ pub async fn watch(mut supply: Supply, start: Option<f32>) {
         let v = supply.vdda_v_async().await;
         match (v, start) {
             (Ok(v), Some(v0)) => {
-                let change = v / v0 - 1.0;
+                let c = analog::SupplyChange::new(v0, v);
                 info!(
                     "supply vdda_v={=f32} start_vdda_v={=f32} change={=f32}",
-                    v, v0, change
+                    v, v0, c.change
                 );
-                if change.abs() > WARN_CHANGE {
+                if c.warn {
                     warn!(
                         "VDDA has moved {=f32} % since start-up: readings are {=f32} % off (the ADC's gain was set at start-up; restart to set it again)",
-                        change * 100.0,
-                        -change * 100.0
+                        c.change * 100.0,
+                        c.reading_error * 100.0
                     );
                 }
             }
