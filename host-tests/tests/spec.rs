@@ -169,7 +169,7 @@ fn pulses_off_the_specification_fail_by_their_margin() {
     let (out, _) = impact_judged(&["analyze", &file, "--spec", "half-sine,50g,11ms", "--json"]);
     let j: serde_json::Value = serde_json::from_str(&out).unwrap();
     assert_eq!(
-        j["impacts"][0]["null_reasons"]["spec"], "spec-window",
+        j["impacts"][0]["null_reasons"]["spec"], "spec-window-after",
         "{out}"
     );
     let (i, _) = judged_with(&file, "half-sine,50g,11ms", &["--trigger", "20g"]);
@@ -210,7 +210,10 @@ fn a_window_the_capture_cannot_hold_is_null_with_its_reason() {
     assert!(i["spec"].is_null(), "{}", i["spec"]);
     assert_eq!(i["null_reasons"]["spec"], "spec-window");
     let (table, _) = impact_judged(&["analyze", &file, "--spec", "half-sine,50g,1s"]);
-    assert!(table.contains("spec: not judged (spec-window)"), "{table}");
+    assert!(
+        table.contains("spec: not judged (spec-window: the record holds neither side"),
+        "{table}"
+    );
     // A bad specification is refused naming the part.
     let (code, _, err) = impact(&["analyze", &file, "--spec", "half-sine,50g"]);
     common::assert_refused(Some(code), &err, "SHAPE,PEAK,DURATION", "--spec");
@@ -533,4 +536,43 @@ fn bare_spec_numbers_far_from_the_pulse_name_the_slip() {
         "half-sine,11000g,0.1ms",
     ]);
     assert!(!err.contains("far from every"), "{err}");
+}
+
+/// A pulse the record cuts on one side is not judged, and the reason says which side: the
+/// record starting 2 ms before an 11 ms pulse lacks the window before it (0.4 D and half a
+/// duration of search); one ending 5 ms after it lacks the window after it.
+#[test]
+fn a_window_cut_on_one_side_says_which() {
+    let scratch = Scratch::new();
+    let rate = 50_000.0;
+    let write = |name: &str, lead_s: f64, total_s: f64| {
+        let mut csv = String::from("time_s,accel_g\n");
+        let n = (total_s * rate) as u32;
+        for k in 0..n {
+            let t = f64::from(k) / rate;
+            let noise =
+                0.02 * (((k.wrapping_mul(2_654_435_761) >> 16) % 1000) as f64 / 500.0 - 1.0);
+            csv.push_str(&format!(
+                "{t:.6},{:.5}\n",
+                half_sine(50.0, 0.011)(t - lead_s) + noise
+            ));
+        }
+        scratch.text(&format!("{name}.csv"), &csv)
+    };
+    for (file, side) in [
+        (write("early", 0.002, 0.2), "before"),
+        (write("late", 0.1, 0.116), "after"),
+    ] {
+        let (i, _) = judged(&file, "half-sine,50g,11ms");
+        assert_eq!(
+            i["null_reasons"]["spec"],
+            format!("spec-window-{side}"),
+            "{file}"
+        );
+        let (table, _) = impact_judged(&["analyze", &file, "--spec", "half-sine,50g,11ms"]);
+        assert!(
+            table.contains(&format!("not judged (spec-window-{side}: ")),
+            "{table}"
+        );
+    }
 }

@@ -37,9 +37,17 @@ pub struct Verdict {
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub enum Missing {
-    /// The capture does not hold the window the verdict watches (the nominal duration is
-    /// too long for the capture at this rate, or the impact lies at its edge).
+    /// The record holds neither side of the window the verdict watches around the pulse (a
+    /// nominal duration too long for the capture at this rate, or for the recording).
     Window,
+    /// The capture (or the recording) does not reach back over the window the verdict
+    /// watches before the pulse (`before` × D before it, and the search's half duration): the
+    /// record starts too soon before the pulse.
+    WindowBefore,
+    /// The capture (or the recording) ends before the window the verdict watches after the
+    /// pulse (`watch` × D after it): the pulse is cut by the capture's length, or the record
+    /// ends too soon after it.
+    WindowAfter,
     /// The nominal duration is shorter than 4 samples at this rate.
     Resolution,
     /// A number of the verdict is beyond f32 (the scene's gain or peak out of any real range).
@@ -47,10 +55,21 @@ pub enum Missing {
 }
 
 impl Missing {
+    /// Every reason.
+    pub const ALL: [Missing; 5] = [
+        Missing::Window,
+        Missing::WindowBefore,
+        Missing::WindowAfter,
+        Missing::Resolution,
+        Missing::Overflow,
+    ];
+
     /// The reason's name in the reports.
     pub fn name(self) -> &'static str {
         match self {
             Missing::Window => "spec-window",
+            Missing::WindowBefore => "spec-window-before",
+            Missing::WindowAfter => "spec-window-after",
             Missing::Resolution => "spec-resolution",
             Missing::Overflow => "spec-overflow",
         }
@@ -94,20 +113,34 @@ pub fn judge(
     let (before, watch) = spec.watched();
     let lead = before * d;
     let reach = spec.shape.peak_at() * d + d / 2.0 + lead;
-    let base = peak_index
-        .checked_sub(libm::ceilf(reach) as u64)
-        .ok_or(Missing::Window)?;
+    let before_reach = libm::ceilf(reach) as u64;
     // From base: the difference of the two indices is exact in u64, where each index alone in
     // f32 is not (past 2^24 samples, 33 s of a board's stream at 500 kS/s).
-    let guess = (peak_index - base) as f32 - spec.shape.peak_at() * d;
+    let guess = before_reach as f32 - spec.shape.peak_at() * d;
     let from = guess - d / 2.0 - lead; // >= 0
     let to = guess + d / 2.0 + (1.0 + watch.max(t.after)) * d;
     let span = libm::ceilf(to) as u32 + 1;
+    // Which side of the window the record lacks, if any: both, or the one it lacks.
+    let after_held = a((peak_index + u64::from(span)).saturating_sub(before_reach + 1)).is_some();
+    let base = match peak_index.checked_sub(before_reach) {
+        Some(base) if a(base).is_some() => base,
+        _ if after_held => return Err(Missing::WindowBefore),
+        _ => return Err(Missing::Window),
+    };
+    // A sample the record does not hold is missing before the pulse when it lies before the
+    // measured peak, after it otherwise.
+    let a = |i: u64| {
+        a(i).ok_or(if i < peak_index {
+            Missing::WindowBefore
+        } else {
+            Missing::WindowAfter
+        })
+    };
     // The signal's extremes in BUCKETS spans of `w` samples from `base`.
     let w = span as f32 / BUCKETS as f32;
     let mut ext = [(f32::INFINITY, f32::NEG_INFINITY); BUCKETS];
     for k in 0..span {
-        let v = a(base + u64::from(k)).ok_or(Missing::Window)?;
+        let v = a(base + u64::from(k))?;
         let j = (k as usize * BUCKETS / span as usize).min(BUCKETS - 1);
         if let Some(e) = ext.get_mut(j) {
             e.0 = e.0.min(v);
@@ -162,7 +195,7 @@ pub fn judge(
         let k0 = libm::ceilf((start - lead).max(0.0)) as u32;
         let k1 = (libm::floorf(start + (1.0 + watch) * d) as u32).min(span - 1);
         let excursion = |k: u32| -> Result<(f32, f32, f32), Missing> {
-            let v = a(base + u64::from(k)).ok_or(Missing::Window)?;
+            let v = a(base + u64::from(k))?;
             let (lo, hi) = band((k as f32 - start) / d);
             let (lo, hi) = (lo * peak, hi * peak);
             Ok(if v - hi >= lo - v {
@@ -210,7 +243,7 @@ pub fn judge(
     // Compensated f32 sums (Kahan): an f64's accuracy at the FPU's speed.
     let (mut sum, mut carry) = (0.0f32, 0.0f32);
     for k in k0..=k1 {
-        let y = a(base + u64::from(k)).ok_or(Missing::Window)? - carry;
+        let y = a(base + u64::from(k))? - carry;
         let next = sum + y;
         carry = (next - sum) - y;
         sum = next;

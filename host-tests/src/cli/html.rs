@@ -323,7 +323,9 @@ fn impacts_table(h: &mut Html, results: &[EntryJson], required: Option<&Required
             Some(None) => html!(
                 verdict,
                 "not judged ({})",
-                i.null_reasons.get("spec").map_or("", String::as_str)
+                crate::report::spec::not_judged(
+                    i.null_reasons.get("spec").map_or("", String::as_str)
+                )
             ),
             None => {
                 verdict.raw("—");

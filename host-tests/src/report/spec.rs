@@ -188,7 +188,7 @@ pub fn table_line(v: Option<&VerdictJson>, why: Option<&String>) -> String {
     let Some(v) = v else {
         return format!(
             "    spec: not judged ({})\n",
-            why.map_or("unknown", String::as_str)
+            not_judged(why.map_or("unknown", String::as_str))
         );
     };
     format!(
@@ -211,4 +211,21 @@ pub fn table_line(v: Option<&VerdictJson>, why: Option<&String>) -> String {
             "OUTSIDE its tolerance"
         },
     )
+}
+
+/// Why an impact was not judged, in words after the reason's name (`spec-window-after: …`).
+pub fn not_judged(reason: &str) -> String {
+    let words = match reason {
+        "spec-window" => "the record holds neither side of the window the verdict watches",
+        "spec-window-before" => {
+            "the record starts too soon before the pulse for the window the verdict watches"
+        }
+        "spec-window-after" => {
+            "the record (or the capture) ends before the window the verdict watches after the pulse"
+        }
+        "spec-resolution" => "the nominal duration is shorter than 4 samples at this rate",
+        "spec-overflow" => "a number of the verdict is beyond f32",
+        _ => return reason.to_string(),
+    };
+    format!("{reason}: {words}")
 }

@@ -67,7 +67,7 @@ fn list(f: &Fields, field: &'static str) -> Result<Vec<f32>, LineError> {
 }
 
 /// Every reason a verdict can be missing: their names are the core's ([`Missing::name`]).
-const MISSING: [Missing; 3] = [Missing::Window, Missing::Resolution, Missing::Overflow];
+const MISSING: [Missing; 5] = Missing::ALL;
 
 /// A `spec` line: the verdict of the impact with its `index`, or why there is none
 /// (`pass=none reason=...`).
@@ -120,7 +120,11 @@ mod tests {
         // A reason the core adds breaks this match: list it in MISSING too.
         for m in MISSING {
             match m {
-                Missing::Window | Missing::Resolution | Missing::Overflow => {}
+                Missing::Window
+                | Missing::WindowBefore
+                | Missing::WindowAfter
+                | Missing::Resolution
+                | Missing::Overflow => {}
             }
         }
         for m in MISSING {
