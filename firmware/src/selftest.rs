@@ -14,14 +14,17 @@
 //!   the ADC's gain errors, ±0.5 % and a few counts; the baseline removes both offsets);
 //! * the full width at half maximum: two thirds of the half-sine's duration, within
 //!   [`FWHM_TOLERANCE`] (the DAC holds each code for 10 ADC samples: up to one hold, 1.5 %);
-//! * the sample rate: the stream's time between successive peaks against the DAC's period.
-//!   Both timers run from the one crystal, so they agree exactly unless the ADC's trigger
-//!   or its count is wrong; within [`RATE_TOLERANCE`] (a peak found anywhere on its 10-sample
-//!   plateau moves it 1e-4 at most).
+//! * the sample rate: the stream's time between the starts of whole pulses of the played
+//!   width (a spurious one times nothing) against the DAC's period. Each start is the rising
+//!   flank extrapolated to zero, which a few counts of noise move by microseconds (the crest's
+//!   plateau of codes within noise of the top spans ±60 µs, too wide to time by). Both timers run from the one crystal, so they agree exactly
+//!   unless the ADC's trigger or its count is wrong; within [`RATE_TOLERANCE`].
 //!
 //! Pulses that start in the first [`SETTLE_S`] of the stream are not judged (the DAC starts
 //! before the ADC, so the first may be cut; the baseline is still being learned). After
-//! [`PULSES`] judged pulses the test gives its verdict: PASS when every one passed. Nothing
+//! [`PULSES`] judged pulses the test gives its verdict: PASS when every one passed. If they
+//! have not all come by [`DEADLINE_S`] of stream time (no jumper, a dead DAC), the verdict is
+//! FAIL then ([`Judge::deadline`]), so a board whose stream never ends still gives one. Nothing
 //! here touches the chip, so the host tests judge replayed samples with it, and the emulator
 //! runs the same judge on the DAC's samples replayed through the whole monitor.
 
@@ -53,6 +56,10 @@ pub const SETTLE_S: f64 = 0.5;
 
 /// Pulses judged before the verdict.
 pub const PULSES: u32 = 10;
+
+/// Stream time by which the [`PULSES`] pulses must have been judged, s: the settling time and
+/// two periods to spare.
+pub const DEADLINE_S: f64 = SETTLE_S + (PULSES as f64 + 2.0) * PERIOD_S as f64;
 
 /// The largest relative difference of the measured peak from the played one.
 pub const PEAK_TOLERANCE: f32 = 0.03;
@@ -98,8 +105,13 @@ const fn table() -> [u16; TABLE_LEN] {
 /// started `offset` DAC updates before the first sample: what the replayed self-test feeds
 /// the emulator (each code held until the next update, as the DAC's output register holds it).
 pub fn code_at(n: u64, adc_rate_hz: f64, offset: u64) -> u16 {
-    let update = (n as f64 * f64::from(DAC_RATE_HZ) / adc_rate_hz) as u64 + offset;
-    TABLE[(update % TABLE_LEN as u64) as usize]
+    let len = TABLE_LEN as u64;
+    // Saturating casts: any rate gives an update count, and the table wraps it.
+    let update = (n as f64 * f64::from(DAC_RATE_HZ) / adc_rate_hz) as u64 % len;
+    TABLE
+        .get(((update + offset % len) % len) as usize)
+        .copied()
+        .unwrap_or(ZERO_CODE)
 }
 
 /// What the DAC played, in the units of the reports.
@@ -133,10 +145,8 @@ impl Played {
 pub struct Measured {
     /// Whether the pulse was whole and unclipped (`complete`, not clipped).
     pub whole: bool,
-    /// Stream time of the impact's start, s.
+    /// Stream time of the impact's start (its rising flank extrapolated to zero), s.
     pub start_s: f64,
-    /// Stream time of the peak, s.
-    pub peak_time_s: f64,
     /// Peak above the baseline, m/s².
     pub peak_m_s2: f32,
     /// Full width at half maximum, s, if measured.
@@ -149,8 +159,8 @@ pub struct PulseCheck {
     /// 1 for the first judged pulse.
     pub number: u32,
     pub measured: Measured,
-    /// The sample rate the time since the previous judged pulse gives, Hz (none for the
-    /// first, or when the pulses were not a whole number of periods apart).
+    /// The sample rate the time since the previous whole pulse of the played width gives, Hz
+    /// (none for the first, or when there was none before).
     pub rate_hz: Option<f32>,
     pub peak_pass: bool,
     pub fwhm_pass: bool,
@@ -182,7 +192,10 @@ pub struct Judge {
     played: Played,
     judged: u32,
     passed: u32,
-    last_peak_s: Option<f64>,
+    /// The start of the last whole pulse of the played width, s.
+    last_start_s: Option<f64>,
+    /// Whether the verdict has been given.
+    given: bool,
 }
 
 fn within(measured: f32, played: f32, tolerance: f32) -> bool {
@@ -196,7 +209,8 @@ impl Judge {
             played,
             judged: 0,
             passed: 0,
-            last_peak_s: None,
+            last_start_s: None,
+            given: false,
         }
     }
 
@@ -206,23 +220,28 @@ impl Judge {
 
     /// Judges one report.
     pub fn judge(&mut self, m: Measured) -> Outcome {
-        if m.start_s < SETTLE_S || self.judged >= PULSES {
+        if m.start_s < SETTLE_S || self.given {
             return Outcome::Skipped;
         }
-        let rate_hz = self.last_peak_s.and_then(|last| {
-            let apart = m.peak_time_s - last;
-            // Rounded to whole periods (saturating: a negative time apart gives none).
+        let peak_pass = m.whole && within(m.peak_m_s2, self.played.peak_m_s2, PEAK_TOLERANCE);
+        let fwhm_pass = m
+            .fwhm_s
+            .is_some_and(|w| within(w, self.played.fwhm_s, FWHM_TOLERANCE));
+        // Timed from the last whole pulse of the played width, over whole periods
+        // (saturating: a negative time apart gives none).
+        let rate_hz = self.last_start_s.and_then(|last| {
+            let apart = m.start_s - last;
             let periods = (apart / f64::from(PERIOD_S) + 0.5) as u64;
             (periods >= 1).then(|| {
                 let expected_s = periods as f64 * f64::from(PERIOD_S);
                 (f64::from(self.played.rate_hz) * apart / expected_s) as f32
             })
         });
-        self.last_peak_s = Some(m.peak_time_s);
-        let peak_pass = m.whole && within(m.peak_m_s2, self.played.peak_m_s2, PEAK_TOLERANCE);
-        let fwhm_pass = m
-            .fwhm_s
-            .is_some_and(|w| within(w, self.played.fwhm_s, FWHM_TOLERANCE));
+        // A whole pulse of the played width times the next (whatever its height: a divider on
+        // the wire fails the peak, and the rate can still be told).
+        if m.whole && fwhm_pass {
+            self.last_start_s = Some(m.start_s);
+        }
         let rate_pass = rate_hz.is_none_or(|r| within(r, self.played.rate_hz, RATE_TOLERANCE));
         let pass = peak_pass && fwhm_pass && rate_pass;
         self.judged += 1;
@@ -236,21 +255,30 @@ impl Judge {
             rate_pass,
             pass,
         };
-        let verdict = (self.judged == PULSES).then_some(Verdict {
+        let verdict = (self.judged == PULSES).then(|| self.give());
+        Outcome::Judged(check, verdict)
+    }
+
+    /// The verdict, given once: PASS when all [`PULSES`] were judged and passed.
+    fn give(&mut self) -> Verdict {
+        self.given = true;
+        Verdict {
             passed: self.passed,
             judged: self.judged,
-            pass: self.passed == self.judged,
-        });
-        Outcome::Judged(check, verdict)
+            pass: self.judged == PULSES && self.passed == PULSES,
+        }
+    }
+
+    /// After `samples` of the stream (at the played rate): a failing verdict if it is past
+    /// [`DEADLINE_S`] and the pulses have not all come (none once the verdict was given).
+    pub fn deadline(&mut self, samples: u64) -> Option<Verdict> {
+        let stream_s = samples as f64 / f64::from(self.played.rate_hz);
+        (!self.given && stream_s > DEADLINE_S).then(|| self.give())
     }
 
     /// At the end of a finite stream: a failing verdict if fewer than [`PULSES`] pulses were
     /// judged (none if the verdict was given).
-    pub fn at_end(&self) -> Option<Verdict> {
-        (self.judged < PULSES).then_some(Verdict {
-            passed: self.passed,
-            judged: self.judged,
-            pass: false,
-        })
+    pub fn at_end(&mut self) -> Option<Verdict> {
+        (!self.given).then(|| self.give())
     }
 }

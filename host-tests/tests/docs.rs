@@ -194,7 +194,7 @@ fn the_help_examples_are_documented_commands() {
             }
         }
     }
-    for sub in ["analyze", "emulate", "simulate", "synth", "log"] {
+    for sub in ["analyze", "emulate", "simulate", "synth", "log", "selftest"] {
         let out = std::process::Command::new(env!("CARGO_BIN_EXE_impact"))
             .args([sub, "--help"])
             .output()

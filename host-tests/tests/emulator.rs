@@ -1433,7 +1433,8 @@ fn realtime_contacts_twice_the_capture_have_their_kinematics_on_the_board() {
 
 /// The bring-up self-test's path through the whole emulated monitor (`impact selftest`): what
 /// the DAC plays, replayed as the ADC's codes, passes; a 10 % divider on the wire fails on
-/// the peak and an ADC sampling 0.2 % slow on the rate, with exit status 3.
+/// the peak, an ADC sampling 0.2 % slow on the rate, and no pulse at all by their absence,
+/// each with exit status 3.
 #[test]
 fn the_self_test_passes_what_the_dac_plays_and_fails_a_faulty_loop() {
     let Some(elf) = firmware() else { return };
@@ -1443,10 +1444,15 @@ fn the_self_test_passes_what_the_dac_plays_and_fails_a_faulty_loop() {
         args.extend(extra);
         common::impact(&args)
     };
-    let lines = |out: &str, key: &str| -> Vec<bool> {
+    // Each `selftest` line's flag `key`, read as a field (`pass` is not `peak_pass`).
+    let lines = |out: &str, key: &'static str| -> Vec<bool> {
         out.lines()
-            .filter(|l| l.contains("selftest pulse="))
-            .map(|l| l.contains(&format!("{key}=true")))
+            .filter_map(|l| l.split_once("selftest pulse="))
+            .map(|(_, rest)| {
+                let f = impact_host::firmware_link::line::Fields::parse(&format!("pulse={rest}"))
+                    .unwrap();
+                f.flag(key).unwrap()
+            })
             .collect()
     };
 
@@ -1472,4 +1478,10 @@ fn the_self_test_passes_what_the_dac_plays_and_fails_a_faulty_loop() {
     rate[0] = true; // the first pulse has no previous one to time
     assert_eq!(lines(&out, "rate_pass"), rate, "{out}");
     assert_eq!(lines(&out, "peak_pass"), vec![true; 10], "{out}");
+
+    // No pulse reaches the ADC (a wire that is not there): the verdict still comes, FAIL.
+    let (code, out, err) = selftest(&["--wire-gain", "0.005"]);
+    assert_eq!(code, 3, "{out}\n{err}");
+    assert!(lines(&out, "pass").is_empty(), "{out}");
+    assert!(out.contains("self-test FAIL: 0 of 10 pulses came"), "{out}");
 }

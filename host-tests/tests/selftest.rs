@@ -4,8 +4,8 @@
 //! monitor is in tests/emulator.rs (`impact selftest`).
 
 use impact_firmware::selftest::{
-    code_at, Judge, Measured, Outcome, Played, AMPLITUDE_CODES, DAC_RATE_HZ, PERIOD_S, PULSES,
-    PULSE_S, PULSE_STEPS, SETTLE_S, TABLE, TABLE_LEN, ZERO_CODE,
+    code_at, Judge, Measured, Outcome, Played, AMPLITUDE_CODES, DAC_RATE_HZ, DEADLINE_S, PERIOD_S,
+    PULSES, PULSE_S, PULSE_STEPS, SETTLE_S, TABLE, TABLE_LEN, ZERO_CODE,
 };
 
 const GAIN: f32 = 1600.0 / 4096.0;
@@ -55,7 +55,6 @@ fn measured(k: u32, peak_scale: f32, fwhm_scale: f32, period_scale: f64) -> Meas
     Measured {
         whole: true,
         start_s: start,
-        peak_time_s: start + 1e-3,
         peak_m_s2: played.peak_m_s2 * peak_scale,
         fwhm_s: Some(played.fwhm_s * fwhm_scale),
     }
@@ -87,10 +86,10 @@ fn what_was_played_passes_after_ten_pulses() {
     );
     assert!(passes.iter().all(|&p| p));
     assert_eq!(verdict, Some((PULSES, true)));
-    // Within the tolerances: 2 % low, FWHM 2 % wide, a peak 20 µs off its place.
+    // Within the tolerances: 2 % low, FWHM 2 % wide, a start 20 µs off its place.
     let near = (0..10).map(|k| {
         let mut m = measured(k, 0.98, 1.02, 1.0);
-        m.peak_time_s += if k % 2 == 0 { 20e-6 } else { 0.0 };
+        m.start_s += if k % 2 == 0 { 20e-6 } else { 0.0 };
         m
     });
     assert_eq!(run(near).1, Some((PULSES, true)));
@@ -142,6 +141,32 @@ fn pulses_in_the_settling_time_are_not_judged_and_too_few_fail_at_the_end() {
         .at_end()
         .expect("a verdict for a stream that ended early");
     assert_eq!((v.passed, v.judged, v.pass), (3, 3, false));
+    assert_eq!(judge.at_end(), None, "one verdict");
+    // A board's stream never ends: pulses that stop coming fail it by the deadline, once.
+    let mut judge = Judge::new(Played::new(GAIN, RATE, None));
+    judge.judge(measured(0, 1.0, 1.0, 1.0));
+    let at = |s: f64| (s * f64::from(RATE)) as u64;
+    assert_eq!(judge.deadline(at(DEADLINE_S - 0.01)), None);
+    let v = judge
+        .deadline(at(DEADLINE_S + 0.01))
+        .expect("a verdict at the deadline");
+    assert_eq!((v.passed, v.judged, v.pass), (1, 1, false));
+    assert_eq!(judge.deadline(at(DEADLINE_S + 1.0)), None, "one verdict");
+    assert_eq!(judge.judge(measured(1, 1.0, 1.0, 1.0)), Outcome::Skipped);
+    // All ten in time: the deadline passes by without a second verdict.
+    let mut judge = Judge::new(Played::new(GAIN, RATE, None));
+    for k in 0..10 {
+        judge.judge(measured(k, 1.0, 1.0, 1.0));
+    }
+    assert_eq!(judge.deadline(at(DEADLINE_S + 1.0)), None);
+    // A spurious pulse (not of the played width) times nothing: the next is timed from the
+    // last one of the played width.
+    let mut judge = Judge::new(Played::new(GAIN, RATE, None));
+    judge.judge(measured(0, 1.0, 1.0, 1.0));
+    let mut spurious = measured(1, 0.5, 0.3, 1.0);
+    spurious.start_s += 0.05;
+    assert!(matches!(judge.judge(spurious), Outcome::Judged(c, _) if !c.pass));
+    assert!(matches!(judge.judge(measured(2, 1.0, 1.0, 1.0)), Outcome::Judged(c, _) if c.pass));
     // A missed pulse between two judged ones: the rate still comes from whole periods.
     let mut judge = Judge::new(Played::new(GAIN, RATE, None));
     judge.judge(measured(0, 1.0, 1.0, 1.0));
@@ -152,4 +177,33 @@ fn pulses_in_the_settling_time_are_not_judged_and_too_few_fail_at_the_end() {
         }
         o => panic!("{o:?}"),
     }
+}
+
+#[test]
+fn the_replay_starts_its_first_pulse_50_ms_in_and_scales_it_on_the_wire() {
+    use impact_host::cli::selftest::codes;
+    let c = codes(200_000, 500_000.0, 1.0);
+    let first = c.iter().position(|&x| x != ZERO_CODE as i16).unwrap();
+    // The first update after rest lands 50 ms in (sample 25 000): its code, held 10 samples.
+    assert_eq!(first, 25_010, "{first}");
+    assert_eq!(
+        c[25_000 + 10 * PULSE_STEPS / 2],
+        (ZERO_CODE + AMPLITUDE_CODES) as i16
+    );
+    assert_eq!(
+        c[125_000 + 10 * PULSE_STEPS / 2],
+        (ZERO_CODE + AMPLITUDE_CODES) as i16
+    );
+    // A 10 % divider scales the excursion from rest, not the rest.
+    let d = codes(30_000, 500_000.0, 0.9);
+    assert_eq!(d[0], ZERO_CODE as i16);
+    assert_eq!(
+        d[25_000 + 10 * PULSE_STEPS / 2],
+        (2048.0 + 1024.0 * 0.9f64).round() as i16
+    );
+    // Any rate the option allows gives codes, wrapping the table.
+    assert_eq!(
+        code_at(u64::MAX, 1e3, u64::MAX),
+        code_at(u64::MAX, 1e3, u64::MAX)
+    );
 }

@@ -142,7 +142,7 @@ pub async fn reporter(end_of_stream: fn(bool) -> !, selftest: Option<Played>) {
             // Every impact the stream saw has been printed (or its report was dropped).
             if order.printed + u64::from(last.reports_dropped) >= last.counters.impacts {
                 order.drain();
-                if let Some(v) = order.selftest.as_ref().and_then(Judge::at_end) {
+                if let Some(v) = order.selftest.as_mut().and_then(Judge::at_end) {
                     log_selftest_verdict(&v);
                 }
                 let elapsed = started.elapsed().as_millis();
@@ -157,7 +157,15 @@ pub async fn reporter(end_of_stream: fn(bool) -> !, selftest: Option<Played>) {
         .await
         {
             Either3::First(r) | Either3::Second(FromStream::Skipped(r)) => order.accept(r),
-            Either3::Second(FromStream::Heartbeat(h)) => log_heartbeat(&h),
+            Either3::Second(FromStream::Heartbeat(h)) => {
+                log_heartbeat(&h);
+                // The self-test's pulses that never came (no jumper, a dead DAC) fail it by
+                // its deadline: a board's stream never ends to say so.
+                let samples = h.counters.samples;
+                if let Some(v) = order.selftest.as_mut().and_then(|j| j.deadline(samples)) {
+                    log_selftest_verdict(&v);
+                }
+            }
             Either3::Second(FromStream::End { last, end: e }) => end = Some((last, e)),
             // Nothing for a while: what is held goes out (an analysis is taking long).
             Either3::Third(()) if !order.held.is_empty() => order.drain(),
@@ -285,7 +293,6 @@ fn selftest(judge: &mut Judge, r: &ImpactReport) {
     let measured = Measured {
         whole: r.status == impact_core::Status::Complete && !r.clipped,
         start_s: r.start_s,
-        peak_time_s: r.peak_time_s,
         peak_m_s2: r.peak_acceleration_m_s2,
         fwhm_s: r.fwhm_s,
     };
@@ -324,16 +331,23 @@ fn log_selftest_verdict(v: &Verdict) {
         v.judged,
         impact_firmware::selftest::PULSES
     );
+    let pulses = impact_firmware::selftest::PULSES;
     if v.pass {
         info!(
             "self-test PASS: {=u32} of {=u32} pulses as played",
             v.passed, v.judged
         );
+    } else if v.judged < pulses {
+        error!(
+            "self-test FAIL: {=u32} of {=u32} pulses came ({=u32} as played): check the jumper from PA4 to PA1",
+            v.judged,
+            pulses,
+            v.passed
+        );
     } else {
         error!(
             "self-test FAIL: {=u32} of {=u32} pulses as played (see the selftest lines)",
-            v.passed,
-            impact_firmware::selftest::PULSES
+            v.passed, pulses
         );
     }
 }

@@ -22,9 +22,10 @@ pub struct SelftestArgs {
     /// error) of 10 %.
     #[arg(long, default_value_t = 1.0, value_parser = positive)]
     pub wire_gain: f64,
-    /// The rate the emulated ADC really samples at, Hz, while the firmware takes it for the
-    /// board's nominal rate (a mis-set trigger timer) [default: the nominal rate].
-    #[arg(long, value_parser = positive)]
+    /// The rate the emulated ADC really samples at, Hz (1 kS/s to 10 MS/s), while the
+    /// firmware takes it for the board's nominal rate (a mis-set trigger timer) [default: the
+    /// nominal rate].
+    #[arg(long, value_parser = adc_rate)]
     pub adc_rate: Option<f64>,
     /// Emulator firmware ELF [default: build it with cargo into target/emulator when its
     /// sources changed].
@@ -49,6 +50,22 @@ fn positive(s: &str) -> Result<f64, NotPositive> {
     match s.parse::<f64>() {
         Ok(v) if v.is_finite() && v > 0.0 => Ok(v),
         _ => Err(NotPositive {
+            value: s.to_string(),
+        }),
+    }
+}
+
+/// An ADC rate in 1 kS/s – 10 MS/s.
+#[derive(Debug, thiserror::Error)]
+#[error("{value}: not a rate from 1000 to 10000000 Hz")]
+pub struct NotARate {
+    value: String,
+}
+
+fn adc_rate(s: &str) -> Result<f64, NotARate> {
+    match s.parse::<f64>() {
+        Ok(v) if (1e3..=1e7).contains(&v) => Ok(v),
+        _ => Err(NotARate {
             value: s.to_string(),
         }),
     }
@@ -121,14 +138,26 @@ pub fn run(args: &SelftestArgs) -> Result<Judged, SelftestError> {
             }
         },
     )?;
-    if !run.status.success() {
-        return Err(SelftestError::Firmware { status: run.status });
-    }
     if let Some(path) = &args.log {
         crate::output::write(path, (run.lines.join("\n") + "\n").as_bytes())?;
         crate::errln!("wrote {}", path.display());
     }
+    if !run.status.success() {
+        // Only the self-test's lines were shown: the rest says why the run failed.
+        for line in run.lines.iter().filter(|l| !l.contains("selftest")) {
+            crate::errln!("{line}");
+        }
+        return Err(SelftestError::Firmware { status: run.status });
+    }
     let verdict = verdict(&run.lines)?;
+    if verdict.judged < PULSES {
+        crate::errln!(
+            "self-test: {} of {PULSES} pulses came; the {} that did not count as failed",
+            verdict.judged,
+            PULSES - verdict.judged
+        );
+    }
+    // The pulses that did not come count as failed: the verdict is PASS only with all of them.
     Ok(Judged {
         judged: PULSES as usize,
         failed: (PULSES - verdict.passed.min(PULSES)) as usize,

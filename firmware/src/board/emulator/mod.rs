@@ -62,8 +62,8 @@ pub struct Config {
     pub adxl375: bool,
     /// `axis=x|y|z|resultant` (ADXL375 path): what the stream gets of each sample.
     pub axis: Axis,
-    /// `selftest=1`: the samples are the self-test's DAC output replayed; each report is
-    /// judged against the played pulse, as on a board at its nominal 3.0 V.
+    /// `selftest=1`: the samples are the self-test's DAC output replayed (its codes); each
+    /// report is judged against the played pulse at the scene's gain.
     pub selftest: bool,
     /// The scene the stream runs.
     pub scene: Scene,
@@ -266,7 +266,7 @@ pub struct Setup {
     pub scene: Scene,
     /// Whether the stream may wait for the analysis (lossless replay only).
     pub backpressure: Backpressure,
-    /// `selftest=1`: the pulse the self-test's DAC plays, on a board at its nominal 3.0 V.
+    /// `selftest=1`: the pulse the self-test's DAC plays, at the scene's gain.
     pub selftest: Option<impact_firmware::selftest::Played>,
     config: Config,
 }
@@ -298,10 +298,10 @@ pub fn init(previous: Option<Record>) -> Setup {
     let lossless = config.pacing == Pacing::Lossless;
     crate::logger::set_waiting(lossless);
     drain::init(lossless);
+    // The replayed counts are the DAC's codes: the played peak through the stream's own gain.
     let selftest = config.selftest.then(|| {
-        use impact_firmware::analog::{Scale, NOMINAL_VDDA_V, SENSOR};
         impact_firmware::selftest::Played::new(
-            Scale::new(NOMINAL_VDDA_V, SENSOR).gain_m_s2_per_count,
+            config.scene.calibration.gain_m_s2_per_count,
             config.scene.calibration.sample_rate_hz,
             None,
         )

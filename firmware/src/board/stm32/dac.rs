@@ -3,22 +3,27 @@
 //! over and over (DMA1 stream 5, channel 7, circular), with no CPU after the start. A jumper
 //! from PA4 to PA1 feeds it to the ADC (`docs/board.md`, "Bring-up self-test").
 //!
-//! embassy-stm32 0.6 offers no DAC trigger but the software one on the F407, so the channel
-//! is made with that and its trigger selection then set to TIM6's TRGO (RM0090 14.5.1:
-//! TSEL1 = 000) while the channel is off; the DAC asks the DMA for the next code on each
-//! trigger (DMAEN1), and moves it to its output one APB1 cycle later.
+//! The channel takes TIM6's TRGO as its trigger (TSEL1 = 000, written by the driver before it
+//! enables the channel); TEN1 is set by hand while the channel is off, the rest level loaded,
+//! and the DAC asks the DMA for the next code on each trigger (DMAEN1) and moves it to its
+//! output three APB1 cycles later (RM0090 14.3.6). TIM6 starts only once the DMA stream is
+//! armed: a trigger before it would set DMAUDR1 and stop the DAC's requests for good. The
+//! player checks DMAUDR1 once a second and says so if it is ever set.
 //!
-//! On the Discovery PA4 is also the CS43L22 audio codec's I2S word-select input (UM1472); the
-//! codec is held in reset (PD4 low) and its input only loads the DAC's buffered output.
+//! On the Discovery PA4 also goes to the CS43L22 audio codec's I2S word-select pin (UM1472),
+//! an input: it only loads the DAC's buffered output.
 
-use defmt::{info, warn};
-use embassy_stm32::dac::{DacChannel, ValueArray, SOFTWARE};
+use defmt::{error, info, warn};
+use embassy_futures::join::join;
+use embassy_futures::select::select;
+use embassy_stm32::dac::{DacChannel, ValueArray};
 use embassy_stm32::mode::Async;
 use embassy_stm32::pac::timer::vals::Mms;
 use embassy_stm32::peripherals::{DAC1, DMA1_CH5, PA4, TIM6};
 use embassy_stm32::time::Hertz;
 use embassy_stm32::timer::low_level::{RoundTo, Timer};
-use embassy_stm32::{bind_interrupts, dma, peripherals, Peri};
+use embassy_stm32::{bind_interrupts, dma, peripherals, triggers, Peri};
+use embassy_time::Duration;
 use impact_firmware::selftest;
 
 bind_interrupts!(
@@ -31,11 +36,11 @@ bind_interrupts!(
 /// The DAC channel and the timer that paces it (dropping the timer would stop its clock).
 pub struct Player {
     dac: DacChannel<'static, Async>,
-    _pace: Timer<'static, TIM6>,
+    pace: Timer<'static, TIM6>,
 }
 
-/// Sets TIM6 to update at the DAC's rate (TRGO on update) and the DAC to take it as its
-/// trigger; nothing plays until [`play`] runs.
+/// Sets TIM6 to update at the DAC's rate (TRGO on update, not started) and the DAC to take it
+/// as its trigger; nothing plays until [`play`] runs.
 pub fn player(
     dac: Peri<'static, DAC1>,
     dma: Peri<'static, DMA1_CH5>,
@@ -47,17 +52,14 @@ pub fn player(
     pace.generate_update_event();
     // TRGO on update (TIM6 is a basic timer: embassy's `set_master_mode` wants a general one).
     pace.regs_basic().cr2().modify(|w| w.set_mms(Mms::UPDATE));
-    let dac = DacChannel::new_triggered(dac, dma, SOFTWARE, DacIrqs, pin);
-    // The driver enabled the channel with TSEL1 = software and TEN1 clear. EN1 is cleared by
-    // hand (its `disable` would gate the DAC's clock), TSEL1 = 000 (TIM6 TRGO) and TEN1 set
-    // while it is off, and the rest level loaded; `write` sets EN1 and DMAEN1 again.
+    let dac = DacChannel::new_triggered(dac, dma, triggers::TIM6_TRGO, DacIrqs, pin);
+    // The driver enabled the channel with TSEL1 = TIM6 and TEN1 clear. EN1 is cleared by
+    // hand (its `disable` would gate the DAC's clock), the rest level loaded, and TEN1 set
+    // while it is off; `write` sets EN1 and DMAEN1 again.
     let regs = embassy_stm32::pac::DAC1;
     regs.cr().modify(|w| w.set_en(0, false));
-    regs.cr().modify(|w| {
-        w.set_tsel(0, 0);
-        w.set_ten(0, true);
-    });
     regs.dhr12r(0).write(|w| w.set_dhr(selftest::ZERO_CODE));
+    regs.cr().modify(|w| w.set_ten(0, true));
     let r = pace.regs_basic();
     let (psc, arr) = (u32::from(r.psc().read()), u32::from(r.arr().read().arr()));
     let rate = pace.get_clock_frequency().0 / ((psc + 1) * (arr + 1));
@@ -70,11 +72,11 @@ pub fn player(
             selftest::DAC_RATE_HZ
         );
     }
-    pace.start();
-    Player { dac, _pace: pace }
+    Player { dac, pace }
 }
 
-/// Plays the table for ever (the circular transfer never completes).
+/// Plays the table for ever (the circular transfer never completes): the DMA armed first,
+/// then TIM6 started; DMAUDR1 checked once a second.
 #[embassy_executor::task]
 pub async fn play(mut p: Player) {
     info!(
@@ -83,7 +85,21 @@ pub async fn play(mut p: Player) {
         selftest::AMPLITUDE_CODES,
         selftest::PERIOD_S
     );
-    p.dac
-        .write(ValueArray::Bit12Right(&selftest::TABLE), true)
-        .await;
+    let pace = &p.pace;
+    let playing = join(
+        p.dac.write(ValueArray::Bit12Right(&selftest::TABLE), true),
+        // Polled after the write's first poll has armed the DMA stream.
+        async { pace.start() },
+    );
+    let watch = async {
+        let mut said = false;
+        loop {
+            embassy_time::Timer::after(Duration::from_secs(1)).await;
+            if embassy_stm32::pac::DAC1.sr().read().dmaudr(0) && !said {
+                error!("self-test: the DAC's DMA underran (DMAUDR1): the DAC stopped playing");
+                said = true;
+            }
+        }
+    };
+    select(playing, watch).await;
 }
