@@ -247,6 +247,47 @@ fn free_fall_columns_take_any_name_and_their_units() {
         err.contains("the time column \"time\" names no unit: read in seconds"),
         "{err}"
     );
+    // The JSON lists them with the main input's assumptions; a file that names its units
+    // adds none.
+    let json = |spec: String| -> serde_json::Value {
+        let (out, _) = impact_ok(&[
+            "analyze",
+            main.to_str().unwrap(),
+            "--free-fall",
+            &spec,
+            "--json",
+        ]);
+        serde_json::from_str(&out).unwrap()
+    };
+    let listed = json(format!("{}:z", bare.display()))["assumptions"].clone();
+    let listed: Vec<&str> = listed
+        .as_array()
+        .unwrap()
+        .iter()
+        .filter_map(|a| a.as_str())
+        .filter(|a| a.starts_with("--free-fall"))
+        .collect();
+    assert_eq!(listed.len(), 2, "{listed:?}");
+    assert!(
+        listed
+            .iter()
+            .any(|a| a.ends_with("z names no unit: read as g")),
+        "{listed:?}"
+    );
+    assert!(
+        listed
+            .iter()
+            .any(|a| a.contains("the time column \"time\" names no unit")),
+        "{listed:?}"
+    );
+    let named = json(format!("{}:z_g", in_g.display()))["assumptions"].clone();
+    // (No assumption at all: the field is left out.)
+    assert!(
+        !named.as_array().is_some_and(|a| a
+            .iter()
+            .any(|a| a.as_str().unwrap_or("").starts_with("--free-fall"))),
+        "{named}"
+    );
 }
 
 /// A unit neither the header nor the options name is assumed aloud: the channel read as g
@@ -373,4 +414,39 @@ fn axes_in_different_units_are_refused_and_unnamed_ones_said() {
     for axis in ["ax", "ay", "az"] {
         assert!(err.contains(&format!("\"{axis}\" names no unit")), "{err}");
     }
+}
+
+/// A time column that names no unit is read in seconds; when the Δv that gives is beyond any
+/// drop or shock test (ms read as s: 1000× too long a pulse), a note names it and the fix,
+/// with the Δv under each unit. Stated in ms, or with a plausible Δv, there is no such note.
+#[test]
+fn a_time_base_that_makes_an_impossible_delta_v_is_named_with_the_fix() {
+    let scratch = Scratch::new();
+    // AFRL's pulse at 1 MS/s, its time column written in ms under a bare `time`.
+    let rows = afrl(0, 20_000);
+    let mut ms = String::from("time,accel_kgn\n");
+    for (k, g) in rows.iter().enumerate() {
+        ms.push_str(&format!("{:.3},{g}\n", k as f64 * 1e-3));
+    }
+    let bare = scratch.text("bare-ms.csv", &ms);
+    let (out, err) = impact_ok(&["analyze", &bare]);
+    assert!(out.contains("(time assumed in s)"), "{out}");
+    assert!(
+        err.contains("note: the time column \"time\" was read in seconds (it names no unit), and impact 0's Δv is then"),
+        "{err}"
+    );
+    assert!(err.contains("give --time-unit ms (Δv 7.6"), "{err}");
+    // Told the unit: the pulse's true Δv, no such note.
+    let (out, err) = impact_ok(&["analyze", &bare, "--time-unit", "ms"]);
+    assert!(out.contains("Δv 7.6"), "{out}");
+    assert!(!err.contains("beyond any drop"), "{err}");
+    // Read in seconds and plausible (the same pulse with its time in s): no note.
+    let mut s = String::from("time,accel_kgn\n");
+    for (k, g) in rows.iter().enumerate() {
+        s.push_str(&format!("{:.6},{g}\n", k as f64 * 1e-6));
+    }
+    let plain = scratch.text("bare-s.csv", &s);
+    let (_, err) = impact_ok(&["analyze", &plain]);
+    assert!(err.contains("names no unit: read in seconds"), "{err}");
+    assert!(!err.contains("beyond any drop"), "{err}");
 }

@@ -9,6 +9,7 @@ use impact_io::csv_read::read_table;
 use impact_io::units::Units;
 use impact_io::ReadErrorKind;
 
+use crate::pipeline::Assumption;
 use crate::read_errors::{kind_message, ReadFailure};
 use std::path::{Path, PathBuf};
 
@@ -67,8 +68,12 @@ fn split(spec: &str) -> (&Path, Option<&str>) {
 
 /// Free-fall time ending at or before `impact_s`, from a DC accelerometer file in g: the
 /// stretch where |a| < 0.5 g (half way between rest and free fall) that ends within 50 ms
-/// before the impact.
-pub fn free_fall_before(spec: &str, impact_s: f64) -> Result<f64, FreeFallError> {
+/// before the impact; and what was assumed of the file (units its headers do not name).
+pub fn free_fall_before(
+    spec: &str,
+    impact_s: f64,
+) -> Result<(f64, Vec<Assumption>), FreeFallError> {
+    let mut assumed = Vec::new();
     let (path, column) = split(spec);
     let column = column.map(|c| c.parse::<ColumnRef>().unwrap_or(ColumnRef::Name(c.into())));
     let table = read_table(
@@ -90,10 +95,13 @@ pub fn free_fall_before(spec: &str, impact_s: f64) -> Result<f64, FreeFallError>
             })?;
     let time_header = table.headers.get(tcol).cloned().unwrap_or_default();
     if impact_io::channel::named_time_unit_s(&time_header).is_none() {
-        impact_io::note(&format!(
-            "--free-fall {}: the time column {time_header:?} names no unit: read in seconds (name it in the header: time_ms, time (ms))",
-            path.display()
-        ));
+        assumed.push(
+            Assumption::FreeFallTimeUnit {
+                file: path.display().to_string(),
+                column: time_header.clone(),
+            }
+            .noted(),
+        );
     }
     let unit = time_unit_s(&time_header, None);
     let time: Vec<f64> = table.columns[tcol].iter().map(|t| t * unit).collect();
@@ -114,10 +122,13 @@ pub fn free_fall_before(spec: &str, impact_s: f64) -> Result<f64, FreeFallError>
                 } else {
                     header(c)
                 };
-                impact_io::note(&format!(
-                    "--free-fall {}: {name} names no unit: read as g",
-                    path.display()
-                ));
+                assumed.push(
+                    Assumption::FreeFallUnits {
+                        file: path.display().to_string(),
+                        column: name,
+                    }
+                    .noted(),
+                );
                 1.0
             }
         })
@@ -162,7 +173,7 @@ pub fn free_fall_before(spec: &str, impact_s: f64) -> Result<f64, FreeFallError>
     };
     // Free fall runs from half a sample before the first quiet sample to the impact.
     let release = time[i] - dt / 2.0;
-    Ok(impact_s - release)
+    Ok((impact_s - release, assumed))
 }
 
 /// Below this magnitude (g) the DC channel is taken as free-falling.

@@ -284,7 +284,40 @@ pub fn analyze(
     {
         impact_io::note(&note);
     }
+    if let Some(note) = time_base_implausible(&setup.assumptions, &reports) {
+        impact_io::note(&note);
+    }
     Ok((setup, reports))
+}
+
+/// The largest velocity change a drop, shock or impact test makes, m/s: a Δv beyond it comes
+/// from a time base read in the wrong unit (ms read as s makes every Δv 1000× too large).
+pub const PLAUSIBLE_DELTA_V_M_S: f64 = 1000.0;
+
+/// A note when the time column's unit was assumed (seconds) and an impact's Δv under it is
+/// beyond [`PLAUSIBLE_DELTA_V_M_S`]: the largest named, with what it would be in ms and µs.
+pub fn time_base_implausible(
+    assumptions: &[Assumption],
+    reports: &[ImpactReport],
+) -> Option<String> {
+    let column = assumptions.iter().find_map(|a| match a {
+        Assumption::TimeUnit { column } => Some(column),
+        _ => None,
+    })?;
+    let (index, dv) = reports
+        .iter()
+        .filter_map(|r| r.delta_v_m_s.map(|dv| (r.index, f64::from(dv).abs())))
+        .max_by(|a, b| a.1.total_cmp(&b.1))?;
+    (dv > PLAUSIBLE_DELTA_V_M_S).then(|| {
+        let human = crate::report::fmt::human;
+        format!(
+            "the time column {column:?} was read in seconds (it names no unit), and impact {index}'s Δv is then {}, beyond any drop or shock test ({}): if the column is in ms, give --time-unit ms (Δv {}); in µs, --time-unit us (Δv {})",
+            human(dv, "m/s"),
+            human(PLAUSIBLE_DELTA_V_M_S, "m/s"),
+            human(dv * 1e-3, "m/s"),
+            human(dv * 1e-6, "m/s"),
+        )
+    })
 }
 
 /// Checks that a recording read whole (for `--axes`, `--free-fall`, `--resample` or an
@@ -574,7 +607,8 @@ pub fn setup(
             .first()
             .map(|r| setup.prepared.t0 + r.start_s)
             .ok_or(PipelineError::NoImpactForFreeFall)?;
-        let t_ff = free_fall_before(spec, start)?;
+        let (t_ff, assumed) = free_fall_before(spec, start)?;
+        setup.assumptions.extend(assumed);
         setup.free_fall_s = Some(t_ff);
         setup.scene.approach = Approach::Speed {
             v0_m_s: (STANDARD_GRAVITY * t_ff) as f32,
@@ -609,6 +643,10 @@ pub enum Assumption {
     Units { column: String },
     /// The time column (`column`) read in seconds.
     TimeUnit { column: String },
+    /// `--free-fall`'s file (`file`): its time column (`column`) read in seconds.
+    FreeFallTimeUnit { file: String, column: String },
+    /// `--free-fall`'s file (`file`): a column (`column`) that names no unit read as g.
+    FreeFallUnits { file: String, column: String },
 }
 
 impl Assumption {
@@ -622,11 +660,17 @@ impl Assumption {
             Assumption::TimeUnit { column } => format!(
                 "the time column {column:?} names no unit: read in seconds (give --time-unit ms, us or ns, or name the unit in the header: time_ms, time (ms))"
             ),
+            Assumption::FreeFallTimeUnit { file, column } => format!(
+                "--free-fall {file}: the time column {column:?} names no unit: read in seconds (name it in the header: time_ms, time (ms))"
+            ),
+            Assumption::FreeFallUnits { file, column } => {
+                format!("--free-fall {file}: {column} names no unit: read as g")
+            }
         }
     }
 
     /// Kept as a note for stderr too (each once), and returned.
-    fn noted(self) -> Self {
+    pub(crate) fn noted(self) -> Self {
         impact_io::note(&self.text());
         self
     }
