@@ -15,7 +15,11 @@
 - host-tests/fixtures/afrl-test1.f32: the bottom channel's float32 kg_n, little-endian, by
   numpy's tofile;
 - host-tests/fixtures/afrl-test1.tdms: group `afrl`, channels `bottom_kgn` (float64 kg_n) and
-  `top_codes` (int16 codes), both with wf_increment 1e-6, written by npTDMS 1.13.0.
+  `top_codes` (int16 codes), both with wf_increment 1e-6, written by npTDMS 1.13.0;
+- host-tests/fixtures/afrl-test1-units.tdms: group `afrl`, the bottom channel whose names
+  carry no unit, its unit in NI's `unit_string` property: `bottom` (float64 g, "g"),
+  `bottom_si` (float64 m/s², "m/s^2", g = 9.80665 m/s²) and `bare` (float64 g, no
+  unit_string), wf_increment 1e-6, written by npTDMS 1.13.0.
 
 Made with CPython 3.11.7 (`wave`), numpy 2.4.6, scipy 1.17.1 and npTDMS 1.13.0:
     python3 -m venv /tmp/wavpy && /tmp/wavpy/bin/pip install numpy==2.4.6 scipy==1.17.1 npTDMS==1.13.0
@@ -66,5 +70,12 @@ with TdmsWriter(str(OUT / "afrl-test1.tdms")) as w:
     w.write_segment([
         ChannelObject("afrl", "bottom_kgn", b.astype(np.float64), properties={"wf_increment": 1e-6}),
         ChannelObject("afrl", "top_codes", codes[:, 1].copy(), properties={"wf_increment": 1e-6}),
+    ])
+g = b.astype(np.float64) * 1000.0
+with TdmsWriter(str(OUT / "afrl-test1-units.tdms")) as w:
+    w.write_segment([
+        ChannelObject("afrl", "bottom", g, properties={"wf_increment": 1e-6, "unit_string": "g"}),
+        ChannelObject("afrl", "bottom_si", g * 9.80665, properties={"wf_increment": 1e-6, "unit_string": "m/s^2"}),
+        ChannelObject("afrl", "bare", g, properties={"wf_increment": 1e-6}),
     ])
 print("wrote", sorted(p.name for p in OUT.glob("*.*")))

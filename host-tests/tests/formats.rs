@@ -265,6 +265,63 @@ fn tdms_channels_give_their_csv_twins_reports() {
     );
 }
 
+/// A TDMS channel whose name names no unit takes NI's `unit_string` property as its header's
+/// unit: `g` and `m/s^2` give the kg_n channel's impacts with nothing assumed (read whole and
+/// streamed); one without the property is read as g and the assumption said.
+#[test]
+fn a_tdms_channels_unit_string_is_its_unit() {
+    let units = root().join("fixtures/afrl-test1-units.tdms");
+    let file = units.to_str().unwrap();
+    let reference = impacts_of(&[
+        root().join("fixtures/afrl-test1.tdms").to_str().unwrap(),
+        "--column",
+        "afrl/bottom_kgn",
+        "--units",
+        "kgn",
+    ]);
+    let near = |a: &[(f64, f64, f64, bool)], b: &[(f64, f64, f64, bool)]| {
+        a.len() == b.len()
+            && a.iter().zip(b).all(|(x, y)| {
+                (x.0 - y.0).abs() < 1e-9
+                    && (x.1 / y.1 - 1.0).abs() < 1e-6
+                    && (x.2 - y.2).abs() <= 1e-6 * y.2.abs().max(1.0)
+                    && x.3 == y.3
+            })
+    };
+    for (column, head) in [
+        ("afrl/bottom", "afrl/bottom (g) in g: "),
+        ("afrl/bottom_si", "afrl/bottom_si (m/s^2) in m/s2: "),
+    ] {
+        let got = impacts_of(&[file, "--column", column]);
+        assert!(near(&got, &reference), "{column}: {got:?} vs {reference:?}");
+        let (out, err) = impact_ok(&["analyze", file, "--column", column]);
+        assert!(out.starts_with(head), "{out}");
+        assert!(!err.contains("names no unit"), "{err}");
+        let (out, _) = impact_ok(&["analyze", file, "--column", column, "--json"]);
+        let j: serde_json::Value = serde_json::from_str(&out).unwrap();
+        assert!(j.get("assumptions").is_none(), "{column}: {out}");
+        // Streamed, the same units.
+        let (out, err) = impact_ok(&[
+            "analyze",
+            file,
+            "--column",
+            column,
+            "--stream",
+            "--range",
+            "20000g",
+            "--trigger",
+            "500g",
+        ]);
+        assert!(out.starts_with(head), "{column} streamed: {out}");
+        assert!(!err.contains("names no unit"), "{err}");
+    }
+    let (_, err) = impact_ok(&["analyze", file, "--column", "afrl/bare"]);
+    assert!(
+        err.contains("\"afrl/bare\" names no unit: its values read as g"),
+        "{err}"
+    );
+}
+
 /// The impacts of `impact analyze ARGS --json`: (start, peak, Δv or 0, clipped) each.
 fn impacts_of(args: &[&str]) -> Vec<(f64, f64, f64, bool)> {
     let mut all = vec!["analyze"];

@@ -196,7 +196,8 @@ pub struct TdmsStream {
     file: TdmsFile,
     group: String,
     channel: String,
-    /// `group/channel`, its rate (Hz) and its values' count.
+    /// `group/channel` (and its `unit_string` in brackets when the name names no unit), its
+    /// rate (Hz) and its values' count.
     pub name: String,
     pub rate_hz: f64,
     pub len: usize,
@@ -253,7 +254,18 @@ impl TdmsStream {
             at: 0,
         };
         let ch = open.channel()?;
-        let name = open.name.clone();
+        // NI's writers keep the channel's unit in `unit_string`: it names the units as a
+        // CSV header's brackets do (`group/channel (m/s^2)`), unless the name already does.
+        let unit = match ch.property("unit_string") {
+            Some(PropertyValue::String(u)) if !u.trim().is_empty() => Some(u.trim().to_string()),
+            _ => None,
+        };
+        let name = match unit {
+            Some(u) if crate::units::Units::of_header(&open.name).is_none() => {
+                format!("{} ({u})", open.name)
+            }
+            _ => open.name.clone(),
+        };
         let increment = match ch.property("wf_increment") {
             Some(PropertyValue::Double(d)) if d.is_finite() && *d > 0.0 => Some(*d),
             _ => None,
@@ -287,7 +299,7 @@ impl TdmsStream {
             }));
         }
         let len = ch.len();
-        (open.rate_hz, open.len) = (rate_hz, len);
+        (open.rate_hz, open.len, open.name) = (rate_hz, len, name);
         Ok(open)
     }
 
