@@ -116,12 +116,13 @@ impl Scale {
     }
 }
 
-/// A change of the supply since start-up beyond which the board warns, relative: 0.2 %, ten
-/// times the measurement's own scatter (16 conversions of VREFINT, about ±1 count in 1500).
+/// A change of the supply beyond which the board warns, relative: 0.2 %, about ten times the
+/// measurement's own scatter (16 conversions of VREFINT, about ±1 count in 1650 at 3.0 V).
 pub const WARN_CHANGE: f32 = 0.002;
 
-/// The supply's change since start-up, relative, and the error it makes in every reading
-/// (the gain set at start-up is kept: an absolute sensor then reads `-change` off).
+/// The supply's change from a reference, relative, and the error it makes in every reading
+/// of a sensor not powered from VDDA (the gain set at start-up is kept); a ratiometric sensor
+/// on the 3.0 V rail follows the supply and makes none.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct SupplyChange {
     /// `now / start − 1`.
@@ -133,7 +134,7 @@ pub struct SupplyChange {
 }
 
 impl SupplyChange {
-    /// The change from `start_v` (the start-up measurement) to `now_v`, volts.
+    /// The change from `start_v` (the reference) to `now_v`, volts.
     pub fn new(start_v: f32, now_v: f32) -> Self {
         let change = now_v / start_v - 1.0;
         Self {

@@ -115,8 +115,9 @@ impl Pairing {
 }
 
 /// A 32-bit capture counter at 1 MHz (it wraps every 71.6 minutes) made into one 64-bit time
-/// line, µs: each capture is placed after the previous one by the counts between them, which
-/// is exact while captures come less than half a wrap apart. After a longer silence (told by
+/// line, µs: each capture is placed from the previous one by the counts between them, forward
+/// or back (a capture read late, after a later one of the other beam, is earlier), whichever
+/// the coarse clock's own advance is nearer. After a silence longer than half a wrap (told by
 /// a coarse clock that does not wrap, e.g. the system's uptime) the line starts again from the
 /// coarse clock: the pairing only compares cuts a second apart at most, so nothing it uses
 /// spans the restart.
@@ -135,11 +136,19 @@ impl CaptureClock {
     }
 
     /// The time, µs, of a capture of `raw` counts, read at `coarse_us` on the coarse clock
-    /// (soon after the capture). Captures must come in the order they were taken.
+    /// (soon after the capture).
     pub fn extend(&mut self, raw: u32, coarse_us: u64) -> u64 {
         let t = match self.last {
             Some((raw0, t0, coarse0)) if coarse_us.saturating_sub(coarse0) < HALF_WRAP_US => {
-                t0 + u64::from(raw.wrapping_sub(raw0))
+                let ahead = i64::from(raw.wrapping_sub(raw0));
+                let behind = ahead - (1i64 << 32);
+                let coarse = coarse_us as i64 - coarse0 as i64;
+                let step = if (ahead - coarse).abs() <= (behind - coarse).abs() {
+                    ahead
+                } else {
+                    behind
+                };
+                t0.saturating_add_signed(step)
             }
             _ => coarse_us,
         };

@@ -111,6 +111,13 @@ fn the_capture_counter_becomes_one_time_line_across_its_wraps() {
         c.extend(raw.wrapping_add(22_345), late + 10_050),
         late + 10_000
     );
+    // A capture read after a later one of the other beam (its interrupt came late) is placed
+    // before it, not a wrap ahead; the next is placed from it.
+    let mut c = CaptureClock::new();
+    assert_eq!(c.extend(1_000_000, 9_000_000), 9_000_000);
+    assert_eq!(c.extend(1_000_500, 9_000_600), 9_000_500);
+    assert_eq!(c.extend(1_000_450, 9_000_610), 9_000_450);
+    assert_eq!(c.extend(1_010_450, 9_010_500), 9_010_450);
     // Two captures read in one interrupt are ordered by their counts, across the wrap too.
     assert_eq!(in_capture_order((10, 'a'), (5, 'b')), [(5, 'b'), (10, 'a')]);
     assert_eq!(

@@ -95,7 +95,8 @@ pub fn init(previous: Option<Record>) -> Setup {
     let mut scene = impact_firmware::scene::BENCH;
     #[cfg(not(feature = "adxl375"))]
     let (supply, vdda) = {
-        // SAFETY: ADC1 is taken here and never again: the supply's measurements own it.
+        // SAFETY: ADC1 is taken here and `p.ADC1` never used again: the supply's measurements
+        // own it (the clone stays in `Setup.p` only because `p` moves whole).
         let mut supply = supply::Supply::new(unsafe { p.ADC1.clone_unchecked() });
         let (gain, vdda) = analog_scale(supply.vdda_v());
         scene.calibration.gain_m_s2_per_count = gain;
@@ -298,8 +299,8 @@ fn enable_flash_accelerator() {
     });
 }
 
-// The executors, below the device interrupts (DMA, EXTI and the time driver's timer stay at
-// priority 0), on three lines of peripherals the board does not use.
+// The executors, below the device interrupts (DMA, TIM5's light-gate captures and the time
+// driver's timer stay at priority 0), on three lines of peripherals the board does not use.
 
 /// Starts the high executor (the sample source) at NVIC priority 2, on UART4's line.
 pub fn start_high() -> SendSpawner {

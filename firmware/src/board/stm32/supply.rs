@@ -9,10 +9,14 @@
 //! [`analog::WARN_CHANGE`]: every reading is then off by about that much, since the gain was
 //! set at start-up ([`analog::SupplyChange`]).
 //!
-//! ADC1 is driven through its registers, not embassy's `Adc`: creating one resets every ADC
-//! (the F407 has one reset bit for the three), which would stop ADC2's sampling. So each
-//! measurement sets up what it needs (clock on, VREFINT on, channel 17 at 480 cycles), as
-//! embassy's reset of the ADCs when the sampler starts clears ADC1's set-up.
+//! ADC1 is driven through its registers, not embassy's `Adc`: dropped, that gates ADC1's
+//! clock, and its reads spin for each conversion, where these are awaited. Each measurement
+//! sets up what it needs (clock on, VREFINT on, channel 17 at 480 cycles), which costs a few
+//! register writes and leaves nothing to what ran before it.
+//!
+//! The start-up measurement runs with ADC2 idle, the later ones while it converts at
+//! 500 kS/s; the warning compares each with the first of the later ones (the same
+//! conditions), and the line gives the change since start-up too.
 
 use defmt::{info, warn};
 use embassy_stm32::pac::adc::vals::SampleTime;
@@ -30,8 +34,9 @@ const READS: u32 = 16;
 /// VREFINT's channel on ADC1.
 const VREFINT_CHANNEL: u8 = 17;
 
-/// One conversion's wait: 480 + 12 ADCCLK cycles at 21 MHz is 23.4 us.
-const CONVERSION: Duration = Duration::from_micros(25);
+/// One conversion's wait: 480 + 12 ADCCLK cycles at 21 MHz is 23.4 us; 30 us leaves the
+/// 1 MHz tick's rounding and the start's latency room.
+const CONVERSION: Duration = Duration::from_micros(30);
 
 /// How often the supply is measured.
 const EVERY: Duration = Duration::from_secs(1);
@@ -42,11 +47,18 @@ pub struct Supply {
 }
 
 impl Supply {
-    /// Takes ADC1; its clock on, and ADCCLK = PCLK2 / 4 = 21 MHz (the prescaler embassy
-    /// picks for the sampler's ADC2 too: the fastest within 36 MHz).
+    /// Takes ADC1; its clock on, and ADCCLK the fastest PCLK2 division within 36 MHz
+    /// (21 MHz from 84 MHz: the prescaler embassy picks for the sampler's ADC2 too).
     pub fn new(adc: Peri<'static, Adc1>) -> Self {
         RCC.apb2enr().modify(|w| w.set_adc1en(true));
-        ADC123_COMMON.ccr().modify(|w| w.set_adcpre(Adcpre::DIV4));
+        let pclk2 = embassy_stm32::rcc::frequency::<Adc1>().0;
+        let pre = match pclk2.div_ceil(36_000_000) {
+            0..=2 => Adcpre::DIV2,
+            3..=4 => Adcpre::DIV4,
+            5..=6 => Adcpre::DIV6,
+            _ => Adcpre::DIV8,
+        };
+        ADC123_COMMON.ccr().modify(|w| w.set_adcpre(pre));
         Self { _adc: adc }
     }
 
@@ -116,32 +128,40 @@ fn calibration() -> u16 {
 }
 
 /// Measures the supply once a second (each conversion awaited, so the high executor it
-/// shares with the sampler is held for microseconds at a time) and logs it against the start-up value (`start`, none
-/// when the start-up measurement failed and 3.0 V was assumed).
+/// shares with the sampler is held for microseconds at a time) and logs it against the
+/// start-up value (`start`, none when the start-up measurement failed and 3.0 V was assumed);
+/// warns once each time it moves past [`analog::WARN_CHANGE`] from the first in-run reading.
 #[embassy_executor::task]
 pub async fn watch(mut supply: Supply, start: Option<f32>) {
     let mut next = Instant::now() + EVERY;
+    let mut reference: Option<f32> = None;
+    let mut warned = false;
     loop {
         Timer::at(next).await;
         next += EVERY;
-        let v = supply.vdda_v_async().await;
-        match (v, start) {
-            (Ok(v), Some(v0)) => {
-                let c = analog::SupplyChange::new(v0, v);
-                info!(
-                    "supply vdda_v={=f32} start_vdda_v={=f32} change={=f32}",
-                    v, v0, c.change
-                );
-                if c.warn {
-                    warn!(
-                        "VDDA has moved {=f32} % since start-up: readings are {=f32} % off (the ADC's gain was set at start-up; restart to set it again)",
-                        c.change * 100.0,
-                        c.reading_error * 100.0
-                    );
-                }
+        let v = match supply.vdda_v_async().await {
+            Ok(v) => v,
+            Err(_) => {
+                warn!("supply: VREFINT gave no plausible VDDA");
+                continue;
             }
-            (Ok(v), None) => info!("supply vdda_v={=f32} start_vdda_v=none change=none", v),
-            (Err(_), _) => warn!("supply: VREFINT gave no plausible VDDA"),
+        };
+        let since_start = start.map(|v0| analog::SupplyChange::new(v0, v).change);
+        info!(
+            "supply vdda_v={=f32} start_vdda_v={} change={}",
+            v,
+            crate::tasks::reporter::Opt(start),
+            crate::tasks::reporter::Opt(since_start)
+        );
+        let r = *reference.get_or_insert(v);
+        let c = analog::SupplyChange::new(r, v);
+        if c.warn && !warned {
+            warn!(
+                "VDDA has moved {=f32} % since the first reading: a sensor not powered from VDDA now reads {=f32} % off (the ADC's gain was set at start-up; restart to set it again)",
+                c.change * 100.0,
+                c.reading_error * 100.0
+            );
         }
+        warned = c.warn;
     }
 }
