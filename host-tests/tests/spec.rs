@@ -146,9 +146,61 @@ fn pulses_off_the_specification_fail_by_their_margin() {
     let file = recording(&scratch, "dv", half_sine(57.0, 0.011));
     let (iec, _) = judged(&file, "half-sine,50g,11ms");
     assert_eq!(iec["spec"]["pass"], true, "{}", iec["spec"]);
-    let (mil, _) = judged(&file, "half-sine,50g,11ms,standard=mil-std-810h");
+    let (mil, j) = judged(&file, "half-sine,50g,11ms,standard=mil-std-810h");
     assert_eq!(mil["spec"]["band_pass"], true, "{}", mil["spec"]);
     assert_eq!(mil["spec"]["delta_v_pass"], false, "{}", mil["spec"]);
+    // 810H's Δv tolerance has two readings (its text's ±10 %, a transcription of its figure's
+    // ±20 %): the JSON gives the other and its source, the table says this Δv is within it.
+    assert_eq!(j["spec"]["delta_v_tolerance_other"], 0.2, "{}", j["spec"]);
+    assert!(
+        j["spec"]["delta_v_tolerance_other_source"]
+            .as_str()
+            .unwrap()
+            .contains("Figure 516.8-5"),
+        "{}",
+        j["spec"]
+    );
+    let (table, _) = impact_judged(&[
+        "analyze",
+        &file,
+        "--spec",
+        "half-sine,50g,11ms,standard=mil-std-810h",
+    ]);
+    assert!(
+        table.contains("Δv 3.434 m/s ±10 % (±20 % in another reading)"),
+        "{table}"
+    );
+    assert!(
+        table.contains("OUTSIDE its tolerance (within the other reading's)"),
+        "{table}"
+    );
+    // Each of the standard's numbers with its source and confidence; IEC has no other reading.
+    let sources = j["spec"]["sources"].as_array().unwrap();
+    let band = sources.iter().find(|x| x["tolerance"] == "band").unwrap();
+    assert_eq!(band["confidence"], "secondary", "{band}");
+    let before = sources.iter().find(|x| x["tolerance"] == "before").unwrap();
+    assert_eq!(before["confidence"], "quoted", "{before}");
+    let (_, j) = judged(&file, "half-sine,50g,11ms");
+    assert!(
+        j["spec"].get("delta_v_tolerance_other").is_none(),
+        "{}",
+        j["spec"]
+    );
+    // Set by hand: no standard's sources.
+    let (_, j) = judged(&file, "half-sine,50g,11ms,dv=0.3");
+    assert!(j["spec"].get("sources").is_none(), "{}", j["spec"]);
+    // MIL-STD-202H specifies a half-sine and a sawtooth only.
+    let (code, _, err) = impact(&[
+        "analyze",
+        &file,
+        "--spec",
+        "trapezoid,50g,11ms,standard=mil-std-202h",
+    ]);
+    assert_eq!(code, 2, "{err}");
+    assert!(
+        err.contains("trapezoid: MIL-STD-202H Method 213 specifies only half-sine and sawtooth"),
+        "{err}"
+    );
     // Half as long: Δv half the nominal one, and the band fails where the nominal is high.
     let file = recording(&scratch, "short", half_sine(50.0, 0.0055));
     let (i, _) = judged(&file, "half-sine,50g,11ms");

@@ -295,6 +295,22 @@ fn provenance(
                 ),
             );
         }
+        for x in &s.sources {
+            dd(
+                &format!("source of {}", x.tolerance),
+                &format!("{} ({})", x.source, x.confidence),
+            );
+        }
+        if let (Some(o), Some(from)) = (s.delta_v_tolerance_other, s.delta_v_tolerance_other_source)
+        {
+            dd(
+                "Δv, other reading",
+                &format!(
+                    "±{:.0} %: {from}; each verdict says whether Δv passes under it",
+                    100.0 * o
+                ),
+            );
+        }
     }
     h.raw("</dl>\n");
 }
@@ -315,11 +331,33 @@ fn impacts_table(h: &mut Html, results: &[EntryJson], required: Option<&Required
             Some(Some(v)) if v.pass => {
                 verdict.raw("<span class=\"pass\">PASS</span>");
             }
-            Some(Some(v)) => html!(
-                verdict,
-                "<span class=\"fail\">FAIL</span> ({:+.1} % of the peak)",
-                100.0 * v.margin
-            ),
+            Some(Some(v)) => {
+                // Which part failed: the band (by its worst excursion) or Δv (by its offset
+                // from the nominal, and the standard's other reading when it has one).
+                let spec = e.analysis.as_ref().and_then(|a| a.spec.as_ref());
+                let mut why = Vec::new();
+                if !v.band_pass {
+                    why.push(format!("band {:+.1} % of the peak", 100.0 * v.margin));
+                }
+                if !v.delta_v_pass {
+                    let off = spec.map_or(String::new(), |s| {
+                        format!(
+                            " {:+.1} % of nominal",
+                            100.0 * (v.delta_v_m_s / s.nominal_delta_v_m_s - 1.0)
+                        )
+                    });
+                    let other = match crate::report::spec::delta_v_pass_other(v, spec) {
+                        Some(true) => ", within the other reading's tolerance",
+                        _ => "",
+                    };
+                    why.push(format!("Δv{off}{other}"));
+                }
+                html!(
+                    verdict,
+                    "<span class=\"fail\">FAIL</span> ({})",
+                    why.join("; ")
+                )
+            }
             Some(None) => html!(
                 verdict,
                 "not judged ({})",

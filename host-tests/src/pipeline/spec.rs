@@ -52,6 +52,13 @@ pub enum SpecError {
     Key { key: String, trapezoid: bool },
     #[error("shape {name:?}: one of half-sine, sawtooth (terminal-peak), trapezoid")]
     Shape { name: String },
+    /// A shape the standard does not specify (MIL-STD-202H: half-sine and sawtooth only).
+    #[error("{shape}: {title} specifies only {}; give another standard= or the tolerances by hand", .shapes.join(" and "))]
+    NotInStandard {
+        shape: String,
+        title: &'static str,
+        shapes: &'static [&'static str],
+    },
     /// The pulse or its tolerances refused by the core (a parameter named by the core's
     /// name: `spec-tolerance`).
     #[error(transparent)]
@@ -182,6 +189,15 @@ pub fn parse(s: &str) -> Result<SpecArg, SpecError> {
         };
         *slot = x;
         custom |= !matches!(k, "rise" | "fall");
+    }
+    if !standard.shapes.contains(&shape_name)
+        && ["half-sine", "sawtooth", "trapezoid"].contains(&shape_name)
+    {
+        return Err(SpecError::NotInStandard {
+            shape: shape_name.to_string(),
+            title: standard.title,
+            shapes: standard.shapes,
+        });
     }
     let shape = match shape_name {
         "half-sine" => Shape::HalfSine,

@@ -176,6 +176,7 @@ pub fn to_table(a: &AnalysisJson) -> String {
             s.push_str(&crate::report::spec::table_line(
                 v.as_ref(),
                 i.null_reasons.get("spec"),
+                a.spec.as_ref(),
             ));
         }
         if let (Some(v0), Some(tm), Some(xm), Some(v1), Some(cor), Some(xs)) = (
