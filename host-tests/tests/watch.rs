@@ -542,6 +542,24 @@ fn an_emulated_train_shows_live_in_a_headless_browser() {
     };
     let state = w.state();
     let r = receipts(&w);
+    // The last verdict is greyed once the board is silent: it is not the board's state now.
+    let silent_receipt = r
+        .iter()
+        .find(|r| r.get("state").is_some_and(|s| s == "SILENT"))
+        .unwrap();
+    assert_eq!(
+        silent_receipt.get("verdict_stale").map(String::as_str),
+        Some("true"),
+        "{silent_receipt:?}"
+    );
+    assert!(
+        r.iter().any(|r| r.get("state").is_some_and(|s| s == "LIVE")
+            && r.get("verdict_stale").is_some_and(|v| v == "false")),
+        "{r:?}"
+    );
+    // The board's scene line states the pulse it judges: the session says so.
+    assert_eq!(state["spec"]["from"], "board", "{}", state["spec"]);
+    assert!(state["spec"]["differs"].is_null(), "{}", state["spec"]);
     eprintln!(
         "silent shown {:.2} s after the last heartbeat",
         silent.as_secs_f64()
@@ -727,4 +745,80 @@ impl Drop for Ended {
         }
         let _ = self.child.wait();
     }
+}
+
+/// The board's scene line states the pulse it judges: the view draws that one and says so;
+/// a `--spec` unlike it is named in a warning (the board's is drawn); a scene line whose spec
+/// is malformed is a warning, the session goes on.
+#[test]
+fn the_board_states_the_pulse_it_judges_and_a_different_spec_is_warned() {
+    let scratch = Scratch::new();
+    let board_spec = " spec=half-sine spec_peak_m_s2=588.399 spec_duration_s=0.00245 spec_band=0.2 spec_outside=0.2 spec_slack=0.1 spec_dv=0.15 spec_before=0.4 spec_after=0.1 spec_watch=1.1 spec_rise=none spec_fall=none spec_band_u=none spec_band_lower=none spec_band_upper=none";
+    let run = |name: &str, scene: String, spec: &[&str]| {
+        let mut lines = board_log(3, None);
+        lines[0] = scene;
+        let text = lines.join("\n") + "\n";
+        let mut child = Command::new(env!("CARGO_BIN_EXE_impact"))
+            .args(["watch", "--terminal", "--session"])
+            .arg(scratch.join(name))
+            .args(spec)
+            .stdin(Stdio::piped())
+            .stdout(Stdio::piped())
+            .stderr(Stdio::piped())
+            .spawn()
+            .unwrap();
+        child
+            .stdin
+            .take()
+            .unwrap()
+            .write_all(text.as_bytes())
+            .unwrap();
+        let out = child.wait_with_output().unwrap();
+        assert!(out.status.success());
+        (
+            String::from_utf8_lossy(&out.stdout).to_string(),
+            String::from_utf8_lossy(&out.stderr).to_string(),
+        )
+    };
+    let (out, err) = run(
+        "given.log",
+        format!("{SCENE}{board_spec}"),
+        &["--spec", "half-sine,60g,2.45ms,dv=0.3"],
+    );
+    assert!(
+        out.contains("the board judges half-sine 60 g 2.45 ms, IEC 60068-2-27:2008"),
+        "{out}"
+    );
+    assert!(
+        err.contains("warning: --spec half-sine 60 g 2.45 ms, custom differs from the pulse the board judges (half-sine 60 g 2.45 ms, IEC 60068-2-27:2008): the board's is drawn"),
+        "{err}"
+    );
+    // The same pulse: no warning.
+    let (_, err) = run(
+        "same.log",
+        format!("{SCENE}{board_spec}"),
+        &["--spec", "half-sine,60g,2.45ms"],
+    );
+    assert!(!err.contains("differs"), "{err}");
+    // An older board's line (no spec) leaves --spec's pulse; a malformed one is a warning.
+    let (out, _) = run(
+        "old.log",
+        SCENE.to_string(),
+        &["--spec", "half-sine,60g,2.45ms"],
+    );
+    assert!(!out.contains("the board judges"), "{out}");
+    let (out, err) = run(
+        "bad.log",
+        format!("{SCENE}{}", board_spec.replace("half-sine", "triangle")),
+        &[],
+    );
+    assert!(
+        err.contains("warning: scene: spec: triangle: not a shape"),
+        "{err}"
+    );
+    assert_eq!(
+        out.lines().filter(|l| l.contains(" impact ")).count(),
+        3,
+        "{out}"
+    );
 }

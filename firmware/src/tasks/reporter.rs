@@ -490,8 +490,17 @@ pub fn log_scene(scene: &Scene) {
         Approach::DropHeight { height_m } => (scene.v0_m_s(), Some(height_m)),
     };
     let fits = &scene.fits;
+    // The pulse the board judges, whole: the host draws its band from this, not from its own
+    // command line.
+    let spec = scene.spec.as_ref();
+    let t = spec.map(|s| s.tolerance);
+    let (rise, fall) = match spec.map(|s| s.shape) {
+        Some(impact_core::spec::Shape::Trapezoid { rise, fall }) => (Some(rise), Some(fall)),
+        _ => (None, None),
+    };
+    let band = spec.and_then(|s| s.band);
     info!(
-        "scene rate_hz={=f32} gain_m_s2_per_count={=f32} mass_kg={} v0_m_s={} drop_height_m={} trigger_m_s2={=f32} edge_m_s2={=f32} hold_s={=f32} max_impact_s={=f32} settle_s={=f32} clip_low={=i16} clip_high={=i16} cfc={} trigger_cfc={} two_phase={=bool} nonlinear={=bool} fit_exponent={=bool} exponent={=f32} hertz={=bool} train={=str} gravity_m_s2={} max_flight_s={} srs={=bool} wave_every={=u16} v0_every={=bool}",
+        "scene rate_hz={=f32} gain_m_s2_per_count={=f32} mass_kg={} v0_m_s={} drop_height_m={} trigger_m_s2={=f32} edge_m_s2={=f32} hold_s={=f32} max_impact_s={=f32} settle_s={=f32} clip_low={=i16} clip_high={=i16} cfc={} trigger_cfc={} two_phase={=bool} nonlinear={=bool} fit_exponent={=bool} exponent={=f32} hertz={=bool} train={=str} gravity_m_s2={} max_flight_s={} srs={=bool} wave_every={=u16} v0_every={=bool} spec={=str} spec_peak_m_s2={} spec_duration_s={} spec_band={} spec_outside={} spec_slack={} spec_dv={} spec_before={} spec_after={} spec_watch={} spec_rise={} spec_fall={} spec_band_u={} spec_band_lower={} spec_band_upper={}",
         scene.calibration.sample_rate_hz,
         scene.calibration.gain_m_s2_per_count,
         Opt(scene.mass_kg),
@@ -518,5 +527,42 @@ pub fn log_scene(scene: &Scene) {
         scene.spectrum.is_some(),
         scene.waveform_every,
         scene.v0_every,
+        spec.map_or("none", |s| s.shape.name()),
+        Opt(spec.map(|s| s.peak_m_s2)),
+        Opt(spec.map(|s| s.duration_s)),
+        Opt(t.map(|t| t.band)),
+        Opt(t.map(|t| t.outside)),
+        Opt(t.map(|t| t.slack)),
+        Opt(t.map(|t| t.delta_v)),
+        Opt(t.map(|t| t.before)),
+        Opt(t.map(|t| t.after)),
+        Opt(t.map(|t| t.watch)),
+        Opt(rise),
+        Opt(fall),
+        BandColumn(band, |p| p.u),
+        BandColumn(band, |p| p.lower),
+        BandColumn(band, |p| p.upper),
     );
+}
+
+/// One column of a user's band as a comma-separated list (`none` without a band).
+struct BandColumn(
+    Option<&'static [impact_core::spec::BandPoint]>,
+    fn(&impact_core::spec::BandPoint) -> f32,
+);
+
+impl defmt::Format for BandColumn {
+    fn format(&self, f: defmt::Formatter<'_>) {
+        match self.0 {
+            None => defmt::write!(f, "none"),
+            Some(rows) => {
+                for (k, row) in rows.iter().enumerate() {
+                    if k > 0 {
+                        defmt::write!(f, ",");
+                    }
+                    defmt::write!(f, "{=f32}", (self.1)(row));
+                }
+            }
+        }
+    }
 }

@@ -470,7 +470,13 @@ pub fn log_report(
     let name = path.display().to_string();
     let log = crate::cli::log::read_log(path).map_err(|e| LogReportError::ReadLog(Box::new(e)))?;
     let mut analysis = crate::firmware_link::log_json::log_json(&log, 0.0)?;
-    analysis.spec = spec.map(crate::report::spec::spec_json);
+    // The pulse given, else the one the board's scene line states (log_json's).
+    let board = log.scene.as_ref().and_then(|s| s.spec().ok()).flatten();
+    let spec = spec.copied().or(board);
+    if let Some(s) = &spec {
+        analysis.spec = Some(crate::report::spec::spec_json(s));
+    }
+    let spec = spec.as_ref();
     let mut figures = Vec::new();
     if let Some(scene) = &log.scene {
         let rate = f64::from(scene.rate_hz);

@@ -48,6 +48,12 @@ impl<'a> LogJson<'a> {
         let (v0_m_s, v0_source) = approach(scene, gravity).map_err(LogError::whole)?;
         let fits = asked(scene).map_err(LogError::whole)?;
         let train_speed = scene.and_then(SceneLine::train).map(str::to_string);
+        // The pulse the board judged, as its scene line states it.
+        let spec = scene
+            .map(SceneLine::spec)
+            .transpose()
+            .map_err(LogError::whole)?
+            .flatten();
         let total = |f: fn(&Run) -> u64| log.runs.iter().map(f).sum::<u64>();
         // The run of each impact and window (1-based), with more than one run.
         let runs = log.runs.len() > 1;
@@ -67,7 +73,7 @@ impl<'a> LogJson<'a> {
             samples: total(|r| r.samples),
             train_speed,
             // The board's spec lines give each impact's verdict; the pulse is the scene's.
-            spec: None,
+            spec: spec.as_ref().map(crate::report::spec::spec_json),
             trains: Vec::new(),
             waveforms: (log.waveforms.iter().enumerate())
                 .map(|(k, w)| {

@@ -30,8 +30,9 @@ pub struct WatchArgs {
     /// Read a file to its end, then stop following it.
     #[arg(long)]
     pub once: bool,
-    /// The pulse the board judges (its scene's `spec`, as `--spec` of `impact analyze`):
-    /// draws the nominal pulse and tolerance band where each verdict placed it.
+    /// The pulse the board judges, as `--spec` of `impact analyze`: drawn (the nominal pulse
+    /// and tolerance band where each verdict placed it) until the board's scene line states
+    /// its own, which is drawn then; one that differs from the board's is shown as a warning.
     #[arg(long, value_name = "SHAPE,PEAK,DURATION[,KEY=VALUE…]")]
     pub spec: Option<String>,
     /// Where the page is served (a loopback address by default: only this machine).
@@ -144,21 +145,7 @@ pub fn run(args: &WatchArgs) -> Result<(), WatchError> {
         .as_deref()
         .map(crate::pipeline::spec::parse)
         .transpose()?;
-    let spec = parsed.map(|a| {
-        let text = format!(
-            "{} {} g {} ms, {}",
-            a.spec.shape.name(),
-            crate::report::fmt::sig(
-                f64::from(a.spec.peak_m_s2) / impact_core::consts::STANDARD_GRAVITY,
-                4
-            ),
-            crate::report::fmt::sig(f64::from(a.spec.duration_s) * 1e3, 4),
-            crate::standards::title(a.standard),
-        ) + &a.spec.band.map_or(String::new(), |rows| {
-            format!(", the user's band ({} rows)", rows.len())
-        });
-        (a.spec, text)
-    });
+    let spec = parsed.map(|a| (a.spec, session::spec_text(&a.spec)));
     let session_path = args.session.clone().unwrap_or_else(default_session);
     let inputs = crate::output::Inputs::new()
         .with(&input)

@@ -291,7 +291,9 @@ fn connection(stream: TcpStream, hub: &Hub) -> std::io::Result<()> {
             }
         }
         "/report.html" => {
-            match crate::cli::html::log_report(&hub.session_file, hub.spec.as_ref()) {
+            // The pulse drawn: the board's, once its scene line stated it, else `--spec`'s.
+            let spec = lock(&hub.session).spec().or(hub.spec);
+            match crate::cli::html::log_report(&hub.session_file, spec.as_ref()) {
                 Ok(page) => respond(
                     &mut out,
                     "200 OK",

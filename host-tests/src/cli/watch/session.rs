@@ -68,7 +68,11 @@ struct Pending {
 
 /// What the session knows and shows.
 pub struct Session {
+    /// The pulse the impacts are drawn against: the board's (its scene line states it), else
+    /// the one `--spec` gave.
     spec: Option<Spec>,
+    /// The pulse `--spec` gave, if any.
+    given: Option<Spec>,
     head: Map<String, Value>,
     run: u32,
     /// Whether the current run has had a data line (a `scene` line then is a restart).
@@ -112,17 +116,12 @@ impl Session {
         head.insert("session_file".into(), json!(session_file));
         head.insert(
             "spec".into(),
-            spec.as_ref().map_or(Value::Null, |(s, text)| {
-                json!({
-                    "text": text,
-                    "shape": s.shape.name(),
-                    "peak_g": f64::from(s.peak_m_s2) / STANDARD_GRAVITY,
-                    "duration_s": f64::from(s.duration_s),
-                })
-            }),
+            spec.as_ref()
+                .map_or(Value::Null, |(s, text)| spec_head(s, text, "--spec", None)),
         );
         Self {
-            spec: spec.map(|(s, _)| s),
+            spec: spec.as_ref().map(|(s, _)| *s),
+            given: spec.map(|(s, _)| s),
             head,
             run: 1,
             started: false,
@@ -146,6 +145,11 @@ impl Session {
             bad_lines: 0,
             last_error: None,
         }
+    }
+
+    /// The pulse the impacts are drawn against (the board's, else `--spec`'s).
+    pub fn spec(&self) -> Option<Spec> {
+        self.spec
     }
 
     /// Reads line `n` of the input, received at `now_ms` (Unix ms); returns the events it
@@ -329,6 +333,7 @@ impl Session {
                 (k, value)
             })
             .collect();
+        self.board_spec(&f, events);
         let run = json!({"run": self.run, "received_unix_ms": now_ms, "scene": scene});
         if self.runs.back().is_some_and(|r| r["run"] == self.run) {
             self.runs.pop_back();
@@ -336,6 +341,35 @@ impl Session {
         push_bounded(&mut self.runs, run.clone(), RUNS);
         events.push(tagged("run", run));
         Ok(())
+    }
+
+    /// The pulse the board judges, from its scene line: drawn from now on, and said (a
+    /// `spec` event); a `--spec` unlike it is named in a warning the page keeps. A scene
+    /// line without one (`spec=none`, or an older board's) leaves the pulse as it was.
+    fn board_spec(&mut self, f: &Fields, events: &mut Vec<Value>) {
+        let scene = match line::SceneLine::parse(f.clone()) {
+            Ok(scene) => scene,
+            Err(_) => return,
+        };
+        let board = match scene.spec() {
+            Ok(Some(board)) => board,
+            Ok(None) => return,
+            Err(e) => {
+                events.push(json!({"type": "warning", "text": cut(&e.to_string())}));
+                return;
+            }
+        };
+        let differs = self.given.filter(|g| *g != board).map(|g| {
+            format!(
+                "--spec {} differs from the pulse the board judges ({}): the board's is drawn",
+                spec_text(&g),
+                spec_text(&board)
+            )
+        });
+        self.spec = Some(board);
+        let head = spec_head(&board, &spec_text(&board), "board", differs);
+        self.head.insert("spec".into(), head.clone());
+        events.push(tagged("spec", head));
     }
 
     /// Shows the waiting impact if it has waited [`HOLD_MS`] by `now_ms`.
@@ -622,6 +656,34 @@ fn cut(text: &str) -> String {
 }
 
 /// `value` (an object) with its event `type` first.
+/// The pulse as the page names it: shape, peak in g, duration in ms, the standard (or
+/// `custom`), a user's band's rows.
+pub fn spec_text(spec: &Spec) -> String {
+    let standard = crate::report::spec::spec_json(spec).standard;
+    format!(
+        "{} {} g {} ms, {}",
+        spec.shape.name(),
+        crate::report::fmt::sig(f64::from(spec.peak_m_s2) / STANDARD_GRAVITY, 4),
+        crate::report::fmt::sig(f64::from(spec.duration_s) * 1e3, 4),
+        crate::standards::title(&standard),
+    ) + &spec.band.map_or(String::new(), |rows| {
+        format!(", the user's band ({} rows)", rows.len())
+    })
+}
+
+/// The session head's `spec`: the pulse drawn, where it came from (`board`: its scene line;
+/// `--spec`) and, when `--spec` differs from the board's, the warning that says so.
+fn spec_head(spec: &Spec, text: &str, from: &str, differs: Option<String>) -> Value {
+    json!({
+        "text": text,
+        "shape": spec.shape.name(),
+        "peak_g": f64::from(spec.peak_m_s2) / STANDARD_GRAVITY,
+        "duration_s": f64::from(spec.duration_s),
+        "from": from,
+        "differs": differs,
+    })
+}
+
 fn tagged(kind: &str, value: Value) -> Value {
     let mut m = Map::new();
     m.insert("type".into(), json!(kind));

@@ -33,6 +33,16 @@ pub fn print(events: &[Value]) {
                 crate::errln!("warning: {}", e["text"].as_str().unwrap_or(""));
                 None
             }
+            // The board's scene line states the pulse it judges.
+            Some("spec") => {
+                if let Some(d) = e["differs"].as_str() {
+                    crate::errln!("warning: {d}");
+                }
+                Some(format!(
+                    "the board judges {}",
+                    e["text"].as_str().unwrap_or("?")
+                ))
+            }
             _ => None,
         };
         if let Some(l) = line {

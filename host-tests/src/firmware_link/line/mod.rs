@@ -136,6 +136,10 @@ pub enum LineError {
     /// A `spec` line's `reason` that is none of the core's.
     #[error("reason={text}: not a reason a verdict is missing")]
     Reason { text: String },
+    /// The scene line's pulse specification does not make one (its shape unknown, a number
+    /// missing, its band's columns of different lengths, or refused by the core).
+    #[error("scene: spec: {why}")]
+    SceneSpec { why: String },
     /// A value of an `srs` line's list that is not a finite number >= 0.
     #[error("{field}: {text} is not a finite value >= 0")]
     ListValue { field: &'static str, text: String },
