@@ -277,3 +277,88 @@ fn statistics_leave_out_clipped_and_cut_pulses_and_count_them() {
         "{peak}"
     );
 }
+
+/// A series of drops that bounce: the statistics compare each drop's first impact, and the
+/// later bounces bounce by bounce (bounce 1 of every drop, bounce 2, …), never averaged
+/// together (their peaks fall from bounce to bounce).
+#[test]
+fn bounces_are_compared_bounce_by_bounce() {
+    let scratch = Scratch::new();
+    let mut files = Vec::new();
+    for (name, v0) in [("a.csv", "1.3357"), ("b.csv", "1.30")] {
+        let path = scratch.join(name);
+        impact_ok(&[
+            "synth",
+            "--model",
+            "nonlinear",
+            "--mass",
+            "0.06",
+            "--v0",
+            v0,
+            "--stiffness",
+            "1e4",
+            "--damping",
+            "0.5",
+            "--bounces",
+            "4",
+            "--duration",
+            "1.5",
+            "-o",
+            path.to_str().unwrap(),
+        ]);
+        files.push(path.to_str().unwrap().to_string());
+    }
+    let mut args = vec!["analyze"];
+    args.extend(files.iter().map(String::as_str));
+    args.extend(["--mass", "0.06", "--v0", "1.3357", "--train", "flight"]);
+    let (table, _) = impact_ok(&args);
+    args.push("--json");
+    let (out, _) = impact_ok(&args);
+    let j: serde_json::Value = serde_json::from_str(&out).unwrap();
+    let n_of = |stats: &serde_json::Value, metric: &str| {
+        stats
+            .as_array()
+            .unwrap()
+            .iter()
+            .find(|s| s["metric"] == metric)
+            .unwrap()["n"]
+            .as_u64()
+            .unwrap()
+    };
+    // The drops' first impacts.
+    assert_eq!(
+        n_of(&j["statistics"], "peak_acceleration_m_s2"),
+        2,
+        "{}",
+        j["statistics"]
+    );
+    let groups = j["bounce_statistics"].as_array().unwrap();
+    assert!(groups.len() >= 3, "{groups:?}");
+    let mut last_peak = f64::INFINITY;
+    for (k, g) in groups.iter().enumerate() {
+        assert_eq!(g["bounce_number"], k as u64 + 1);
+        assert_eq!(n_of(&g["statistics"], "peak_acceleration_m_s2"), 2, "{g}");
+        let mean = g["statistics"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .find(|s| s["metric"] == "peak_acceleration_m_s2")
+            .unwrap()["mean"]
+            .as_f64()
+            .unwrap();
+        assert!(
+            mean < last_peak,
+            "bounce {}: {mean} after {last_peak}",
+            k + 1
+        );
+        last_peak = mean;
+    }
+    assert!(
+        table.contains("statistics of bounce 1 (each drop's, complete and unclipped)"),
+        "{table}"
+    );
+    assert!(
+        table.contains("later bounces of a drop (compared bounce by bounce below)"),
+        "{table}"
+    );
+}

@@ -168,26 +168,16 @@ fn page(cfc: Option<u32>, results: &[EntryJson], required: Option<&RequiredSrs>)
         html!(h, "<p>{}.</p>\n", text);
     }
     if !json.statistics.is_empty() {
-        h.raw("<h2>Statistics across the series</h2><p>sd: sample standard deviation; CV: sd / |mean|.</p><table><tr><th class=\"l\">metric</th><th>n</th><th>mean</th><th>sd</th><th>CV</th><th>min</th><th>max</th></tr>\n");
-        for st in &json.statistics {
-            let u = crate::report::statistics::METRICS
-                .iter()
-                .find(|(m, _, _)| *m == st.metric)
-                .map_or("", |(_, u, _)| u);
-            let q = |v: f64| human(v, u).trim_end().to_string();
-            html!(
-                h,
-                "<tr><td class=\"l\">{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td></tr>\n",
-                st.metric,
-                st.n,
-                q(st.mean),
-                st.sd.map_or("—".into(), q),
-                st.cv.map_or("—".into(), |c| format!("{:.2} %", 100.0 * c)),
-                q(st.min),
-                q(st.max)
-            );
-        }
-        h.raw("</table>\n");
+        h.raw("<h2>Statistics across the series</h2><p>sd: sample standard deviation; CV: sd / |mean|.</p>");
+        statistics_table(&mut h, &json.statistics);
+    }
+    for g in &json.bounce_statistics {
+        html!(
+            h,
+            "<h3>Bounce {} of each drop</h3><p>Complete and unclipped.</p>",
+            g.bounce_number
+        );
+        statistics_table(&mut h, &g.statistics);
     }
     // The pulses.
     h.raw("<h2>Pulses</h2>\n");
@@ -313,6 +303,30 @@ fn provenance(
         }
     }
     h.raw("</dl>\n");
+}
+
+/// A statistics table: a row per metric.
+fn statistics_table(h: &mut Html, statistics: &[crate::report::statistics::Statistic]) {
+    h.raw("<table><tr><th class=\"l\">metric</th><th>n</th><th>mean</th><th>sd</th><th>CV</th><th>min</th><th>max</th></tr>\n");
+    for st in statistics {
+        let u = crate::report::statistics::METRICS
+            .iter()
+            .find(|(m, _, _)| *m == st.metric)
+            .map_or("", |(_, u, _)| u);
+        let q = |v: f64| human(v, u).trim_end().to_string();
+        html!(
+            h,
+            "<tr><td class=\"l\">{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td></tr>\n",
+            st.metric,
+            st.n,
+            q(st.mean),
+            st.sd.map_or("—".into(), q),
+            st.cv.map_or("—".into(), |c| format!("{:.2} %", 100.0 * c)),
+            q(st.min),
+            q(st.max)
+        );
+    }
+    h.raw("</table>\n");
 }
 
 /// The series table: a row per impact, with the required SRS's column when there is one.

@@ -381,6 +381,10 @@ pub struct SeriesJson<'a> {
     pub statistics: Vec<Statistic>,
     /// The impacts the statistics left out, by why.
     pub statistics_left_out: LeftOut,
+    /// The drops' later bounces, compared bounce by bounce (bounce 1 of every drop, bounce
+    /// 2, …): complete and unclipped ones; empty without bounces.
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub bounce_statistics: Vec<crate::report::statistics::BounceGroup>,
     pub entries: &'a [EntryJson],
 }
 
@@ -402,6 +406,9 @@ pub fn to_json(entries: &[EntryJson]) -> SeriesJson<'_> {
         spec: pass_rate(impacts(entries).map(|(_, i)| i)),
         statistics: statistics(kept.iter().copied()),
         statistics_left_out: left_out,
+        bounce_statistics: crate::report::statistics::bounce_groups(
+            impacts(entries).map(|(_, i)| i),
+        ),
         entries,
     }
 }
@@ -502,33 +509,14 @@ pub fn to_table(entries: &[EntryJson]) -> String {
     }
     if !json.statistics.is_empty() {
         s.push_str("\nstatistics (sd: sample standard deviation; CV: sd / |mean|)\n");
-        let unit_of = |m: &str| {
-            METRICS
-                .iter()
-                .find(|(name, _, _)| *name == m)
-                .map_or("", |(_, u, _)| u)
-        };
-        let rows: Vec<[String; 7]> = json
-            .statistics
-            .iter()
-            .map(|st| {
-                let u = unit_of(st.metric);
-                let q = |v: f64| human(v, u).trim_end().to_string();
-                [
-                    st.metric.to_string(),
-                    st.n.to_string(),
-                    q(st.mean),
-                    st.sd.map_or("-".into(), q),
-                    st.cv.map_or("-".into(), |c| format!("{:.2} %", 100.0 * c)),
-                    q(st.min),
-                    q(st.max),
-                ]
-            })
-            .collect();
-        s.push_str(&columns(
-            &["metric", "n", "mean", "sd", "CV", "min", "max"],
-            &rows,
+        s.push_str(&statistics_table(&json.statistics));
+    }
+    for g in &json.bounce_statistics {
+        s.push_str(&format!(
+            "\nstatistics of bounce {} (each drop's, complete and unclipped)\n",
+            g.bounce_number
         ));
+        s.push_str(&statistics_table(&g.statistics));
     }
     for e in entries {
         if let Some(err) = &e.error {
@@ -575,6 +563,33 @@ impl EntryJson {
             channel: self.channel,
         })
     }
+}
+
+/// A statistics table: a row per metric (n, mean, sd, CV, min, max in its unit).
+fn statistics_table(statistics: &[Statistic]) -> String {
+    let unit_of = |m: &str| {
+        METRICS
+            .iter()
+            .find(|(name, _, _)| *name == m)
+            .map_or("", |(_, u, _)| u)
+    };
+    let rows: Vec<[String; 7]> = statistics
+        .iter()
+        .map(|st| {
+            let u = unit_of(st.metric);
+            let q = |v: f64| human(v, u).trim_end().to_string();
+            [
+                st.metric.to_string(),
+                st.n.to_string(),
+                q(st.mean),
+                st.sd.map_or("-".into(), q),
+                st.cv.map_or("-".into(), |c| format!("{:.2} %", 100.0 * c)),
+                q(st.min),
+                q(st.max),
+            ]
+        })
+        .collect();
+    columns(&["metric", "n", "mean", "sd", "CV", "min", "max"], &rows)
 }
 
 /// Left-aligned columns two spaces apart.

@@ -74,7 +74,10 @@ impl LeftOut {
         let why: Vec<String> = [
             (self.incomplete, "incomplete"),
             (self.clipped, "clipped"),
-            (self.later_bounces, "later bounces of a drop"),
+            (
+                self.later_bounces,
+                "later bounces of a drop (compared bounce by bounce below)",
+            ),
         ]
         .iter()
         .filter(|(n, _)| *n > 0)
@@ -113,6 +116,42 @@ pub fn comparable<'a>(
         })
         .collect();
     (kept, left)
+}
+
+/// The later bounces of the series' drops, compared bounce by bounce: bounce `number` (1
+/// for the first after the drop's first impact) of every drop, complete and unclipped.
+#[derive(Clone, Debug, Serialize, PartialEq)]
+pub struct BounceGroup {
+    pub bounce_number: u32,
+    pub statistics: Vec<Statistic>,
+}
+
+/// The later bounces (those [`comparable`] left out as `later_bounces`), complete and
+/// unclipped, grouped by their bounce number, each group's statistics; numbers in order.
+pub fn bounce_groups<'a>(
+    impacts: impl Iterator<Item = &'a ImpactJson> + Clone,
+) -> Vec<BounceGroup> {
+    let whole = |i: &&ImpactJson| i.status == "complete" && !i.clipped;
+    let mut numbers: Vec<u32> = impacts
+        .clone()
+        .filter(whole)
+        .filter_map(|i| i.bounce.as_ref().map(|b| b.number))
+        .filter(|&n| n > 0)
+        .collect();
+    numbers.sort_unstable();
+    numbers.dedup();
+    numbers
+        .into_iter()
+        .map(|number| BounceGroup {
+            bounce_number: number,
+            statistics: statistics(
+                impacts
+                    .clone()
+                    .filter(whole)
+                    .filter(move |i| i.bounce.as_ref().is_some_and(|b| b.number == number)),
+            ),
+        })
+        .collect()
 }
 
 /// Each metric's statistics over `impacts` (a metric no impact has is left out). Sums in f64
