@@ -182,3 +182,58 @@ fn a_pulse_that_never_comes_back_after_drift_has_no_delta_v() {
         r.impacts
     );
 }
+
+/// A record in which the signal only drifts (a DC channel at a 300 g offset wandering by
+/// 8 g over a second, 0.3 g of noise, 200 kS/s) holds no impact: none is listed, and the
+/// table says the signal drifted; the same drift with a real 3 ms, 150 g pulse on it lists
+/// that pulse.
+#[test]
+fn a_record_that_only_drifts_lists_no_impact_and_says_it_drifted() {
+    let scratch = common::Scratch::new();
+    let write = |name: &str, pulse: bool| {
+        let rate = 200_000.0;
+        let mut state = 0x9e37_79b9_7f4a_7c15u64;
+        let mut csv = String::from("time_s,table_g\n");
+        for k in 0..200_000u32 {
+            let t = f64::from(k) / rate;
+            // Gaussian noise, 0.3 g (Box–Muller on a xorshift).
+            let mut uniform = || {
+                state ^= state << 13;
+                state ^= state >> 7;
+                state ^= state << 17;
+                ((state >> 11) as f64 + 0.5) / (1u64 << 53) as f64
+            };
+            let (u1, u2) = (uniform(), uniform());
+            let noise = 0.3 * (-2.0 * u1.ln()).sqrt() * (2.0 * PI * u2).cos();
+            let drift = 8.0 * t + 3.0 * (2.0 * PI * 0.7 * t).sin();
+            let u = t - 0.6;
+            let p = if pulse && (0.0..0.003).contains(&u) {
+                150.0 * (PI * u / 0.003).sin()
+            } else {
+                0.0
+            };
+            csv.push_str(&format!("{t:.6},{:.4}\n", 300.0 + drift + p + noise));
+        }
+        scratch.text(name, &csv)
+    };
+    let only = write("drift.csv", false);
+    let (out, _) = common::impact_ok(&["analyze", &only, "--json"]);
+    let j: serde_json::Value = serde_json::from_str(&out).unwrap();
+    assert_eq!(j["impacts"].as_array().unwrap().len(), 0, "{out}");
+    assert_eq!(j["drifts"].as_array().unwrap().len(), 1, "{out}");
+    let (table, _) = common::impact_ok(&["analyze", &only]);
+    assert!(table.contains("the signal drifted"), "{table}");
+    assert!(!table.contains("impact 0 ["), "{table}");
+    // A pulse on the drift is an impact.
+    let with = write("drift-pulse.csv", true);
+    let (out, _) = common::impact_ok(&["analyze", &with, "--json"]);
+    let j: serde_json::Value = serde_json::from_str(&out).unwrap();
+    let impacts = j["impacts"].as_array().unwrap();
+    assert!(
+        impacts.iter().any(|i| {
+            let p = i["peak_acceleration_m_s2"].as_f64().unwrap() / 9.80665;
+            (140.0..160.0).contains(&p) && i["fwhm_s"].is_number()
+        }),
+        "{out}"
+    );
+}

@@ -92,6 +92,7 @@ impl<'a> LogJson<'a> {
             spikes_removed: Vec::new(),
             clipping: None,
             impacts: Vec::new(),
+            drifts: Vec::new(),
         };
         let mut json = Self {
             head: a,
@@ -101,11 +102,23 @@ impl<'a> LogJson<'a> {
             gravity,
         };
         json.head.trains = crate::report::train::trains(json.impacts());
+        // The events that are drift, not impacts (as `impact analyze` separates them).
+        json.head.drifts = json
+            .events()
+            .filter(crate::report::is_drift)
+            .map(|i| crate::report::DriftJson::of(&i))
+            .collect();
         Ok(json)
     }
 
-    /// The impacts' JSON, in the log's order, made as they are taken.
+    /// The impacts' JSON, in the log's order, made as they are taken (the events that are
+    /// drift left out: the head's `drifts`).
     pub fn impacts(&self) -> impl Iterator<Item = ImpactJson> + Clone + '_ {
+        self.events().filter(|i| !crate::report::is_drift(i))
+    }
+
+    /// Every event's JSON, in the log's order, made as they are taken.
+    fn events(&self) -> impl Iterator<Item = ImpactJson> + Clone + '_ {
         let log = self.log;
         let runs = log.runs.len() > 1;
         (log.impacts.iter().zip(&log.latencies).enumerate()).map(move |(k, (r, latency))| {

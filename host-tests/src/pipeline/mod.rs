@@ -1059,7 +1059,9 @@ pub fn to_json(setup: &Setup, reports: &[ImpactReport]) -> AnalysisJson {
                 j
             })
             .collect(),
+        drifts: Vec::new(),
     };
+    crate::report::separate_drifts(&mut a);
     a.trains = crate::report::train::trains(&a.impacts);
     a
 }

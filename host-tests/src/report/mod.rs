@@ -170,6 +170,11 @@ pub struct AnalysisJson {
     #[serde(skip_serializing_if = "Option::is_none")]
     pub spec: Option<crate::report::spec::SpecJson>,
     pub impacts: Vec<ImpactJson>,
+    /// Events the board's trigger took that are no impact: the signal drifted (it left the
+    /// baseline and never came back, with no pulse in it: half its peak not reached on both
+    /// sides). Not listed among the impacts, nor counted in a series.
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub drifts: Vec<DriftJson>,
     /// With `--train`: each train of bounces and its COR against impact speed.
     pub trains: Vec<crate::report::train::TrainJson>,
     /// `impact log` / `impact emulate --waveforms`: the captured windows the board sent.
@@ -417,6 +422,45 @@ pub fn impact_json(
             .verdict
             .as_ref()
             .map(|v| crate::report::spec::verdict_json(v, t0)),
+    }
+}
+
+/// A drift the trigger took for an impact: where it started, how long it ran (to the end of
+/// the impact's hold or the recording), how far it went from the baseline.
+#[derive(Clone, Debug, Serialize, PartialEq)]
+pub struct DriftJson {
+    pub index: u32,
+    pub start_s: f64,
+    pub duration_s: f64,
+    pub excursion_m_s2: f64,
+}
+
+/// Whether an event is drift rather than an impact: flagged `drift` (it never came back to
+/// the baseline and left it more than the settle time before its peak) and no pulse in it
+/// (half its peak not reached on both sides: no FWHM), its capture whole.
+pub fn is_drift(i: &ImpactJson) -> bool {
+    // (A capture that filled cannot tell: its pulse may lie beyond what it holds.)
+    i.flags.iter().any(|f| f == "drift") && i.fwhm_s.is_none() && i.status != "buffer-full"
+}
+
+/// Moves the events that are drift out of `a`'s impacts into its drifts.
+pub fn separate_drifts(a: &mut AnalysisJson) {
+    let (drifts, impacts): (Vec<ImpactJson>, Vec<ImpactJson>) = std::mem::take(&mut a.impacts)
+        .into_iter()
+        .partition(is_drift);
+    a.impacts = impacts;
+    a.drifts = drifts.iter().map(DriftJson::of).collect();
+}
+
+impl DriftJson {
+    /// The drift an event (`is_drift`) was.
+    pub fn of(i: &ImpactJson) -> Self {
+        Self {
+            index: i.index,
+            start_s: i.start_s,
+            duration_s: i.duration_s,
+            excursion_m_s2: i.peak_acceleration_m_s2,
+        }
     }
 }
 

@@ -228,5 +228,13 @@ pub fn to_table(a: &AnalysisJson) -> String {
         }
     }
     s.push_str(&crate::report::train::table_lines(&a.trains));
+    for d in &a.drifts {
+        s.push_str(&format!(
+            "no impact at {:.6} s: the signal drifted {} from its baseline over {} and did not come back, with no pulse in it (half its peak is not reached on both sides)\n",
+            d.start_s,
+            crate::report::fmt::human(d.excursion_m_s2.abs(), "m/s²"),
+            crate::report::fmt::human(d.duration_s, "s"),
+        ));
+    }
     s
 }
