@@ -1229,12 +1229,32 @@ fn spec_verdicts_on_the_board_are_the_hosts() {
     )
     .unwrap();
     let step = format!("half-sine,50g,11ms,band-file={}", step_file.display());
+    // A band of the most rows a board holds (64): the scene line that states it is the
+    // longest line the board logs.
+    let wide_file = scratch.join("spec-64-rows.csv");
+    let mut rows = String::from("time_over_duration,lower_over_peak,upper_over_peak\n");
+    for k in 0..64 {
+        let u = -0.4 + 2.0 * f64::from(k) / 63.0;
+        let nominal = if (0.0..=1.0).contains(&u) {
+            (std::f64::consts::PI * u).sin()
+        } else {
+            0.0
+        };
+        rows.push_str(&format!(
+            "{u:.6},{:.6},{:.6}\n",
+            nominal - 0.25,
+            nominal + 0.25
+        ));
+    }
+    std::fs::write(&wide_file, rows).unwrap();
+    let wide = format!("half-sine,50g,11ms,band-file={}", wide_file.display());
     for (name, peak_g, spec) in [
         ("pass", 50.0, "half-sine,50g,11ms"),
         ("fail", 65.0, "half-sine,50g,11ms,standard=mil-std-810h"),
         ("window", 50.0, "half-sine,50g,1s"),
         ("band", 57.0, band.as_str()),
         ("step", 57.0, step.as_str()),
+        ("wide", 50.0, wide.as_str()),
         // A pulse of another shape: judged (it failed), not "not judged".
         ("shape", 50.0, "sawtooth,50g,11ms"),
     ] {
@@ -1270,7 +1290,7 @@ fn spec_verdicts_on_the_board_are_the_hosts() {
         let host: serde_json::Value = serde_json::from_str(&host).unwrap();
         let verdict = &host["impacts"][0]["spec"];
         match name {
-            "pass" => assert_eq!(verdict["pass"], true, "{verdict}"),
+            "pass" | "wide" => assert_eq!(verdict["pass"], true, "{verdict}"),
             "fail" => assert_eq!(verdict["pass"], false, "{verdict}"),
             "shape" => assert_eq!(verdict["band_pass"], false, "{verdict}"),
             "band" | "step" => assert_eq!(
@@ -1288,6 +1308,8 @@ fn spec_verdicts_on_the_board_are_the_hosts() {
         let (from_log, _) = impact_judged(&["log", &log_file.to_string_lossy()]);
         let from_log: serde_json::Value = serde_json::from_str(&from_log).unwrap();
         assert_eq!(from_log["impacts"], host["impacts"], "{name}: impact log");
+        // The board's scene line stated the pulse it judged, a 64-row band too.
+        assert_eq!(from_log["spec"], host["spec"], "{name}: impact log's spec");
     }
 }
 

@@ -189,6 +189,26 @@ fn pulses_off_the_specification_fail_by_their_margin() {
     // Set by hand: no standard's sources.
     let (_, j) = judged(&file, "half-sine,50g,11ms,dv=0.3");
     assert!(j["spec"].get("sources").is_none(), "{}", j["spec"]);
+    // MIL-STD-202H has 810H's numbers but is named for itself: its own sources, no other
+    // reading of its Δv tolerance.
+    let (_, j) = judged(&file, "half-sine,50g,11ms,standard=mil-std-202h");
+    assert_eq!(j["spec"]["standard"], "mil-std-202h", "{}", j["spec"]);
+    assert!(
+        j["spec"].get("delta_v_tolerance_other").is_none(),
+        "{}",
+        j["spec"]
+    );
+    let watch = j["spec"]["sources"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .find(|x| x["tolerance"] == "watch")
+        .unwrap()
+        .clone();
+    assert!(
+        watch["source"].as_str().unwrap().contains("MIL-STD-202H"),
+        "{watch}"
+    );
     // MIL-STD-202H specifies a half-sine and a sawtooth only.
     let (code, _, err) = impact(&[
         "analyze",

@@ -790,7 +790,7 @@ fn the_board_states_the_pulse_it_judges_and_a_different_spec_is_warned() {
         "{out}"
     );
     assert!(
-        err.contains("warning: --spec half-sine 60 g 2.45 ms, custom differs from the pulse the board judges (half-sine 60 g 2.45 ms, IEC 60068-2-27:2008): the board's is drawn"),
+        err.contains("warning: --spec half-sine 60 g 2.45 ms, custom differs from the pulse the board judges (half-sine 60 g 2.45 ms, IEC 60068-2-27:2008; its dv 0.15, not 0.3): the board's is drawn"),
         "{err}"
     );
     // The same pulse: no warning.
@@ -819,6 +819,47 @@ fn the_board_states_the_pulse_it_judges_and_a_different_spec_is_warned() {
     assert_eq!(
         out.lines().filter(|l| l.contains(" impact ")).count(),
         3,
+        "{out}"
+    );
+    // A board that restarts judging nothing (`spec=none`) is drawn against nothing again.
+    let none = board_spec
+        .split(' ')
+        .map(|kv| match kv.split_once('=') {
+            Some((k, _)) => format!("{k}=none"),
+            None => kv.to_string(),
+        })
+        .collect::<Vec<_>>()
+        .join(" ");
+    let mut lines = board_log(3, None);
+    lines[0] = format!("{SCENE}{board_spec}");
+    lines.insert(2, format!("{SCENE}{none}"));
+    let text = lines.join("\n") + "\n";
+    let mut child = Command::new(env!("CARGO_BIN_EXE_impact"))
+        .args(["watch", "--terminal", "--session"])
+        .arg(scratch.join("restart.log"))
+        .stdin(Stdio::piped())
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    child
+        .stdin
+        .take()
+        .unwrap()
+        .write_all(text.as_bytes())
+        .unwrap();
+    let out = child.wait_with_output().unwrap();
+    let out = String::from_utf8_lossy(&out.stdout);
+    let judges: Vec<&str> = out
+        .lines()
+        .filter(|l| l.starts_with("the board judges"))
+        .collect();
+    assert_eq!(
+        judges,
+        [
+            "the board judges half-sine 60 g 2.45 ms, IEC 60068-2-27:2008",
+            "the board judges no pulse"
+        ],
         "{out}"
     );
 }

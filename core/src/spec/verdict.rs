@@ -119,9 +119,16 @@ pub fn judge(
     let guess = before_reach as f32 - spec.shape.peak_at() * d;
     let from = guess - d / 2.0 - lead; // >= 0
     let to = guess + d / 2.0 + (1.0 + watch.max(t.after)) * d;
+    // A window beyond any record's reach (2^32 samples) is held by none.
+    if !(to < u32::MAX as f32) {
+        return Err(Missing::Window);
+    }
     let span = libm::ceilf(to) as u32 + 1;
     // Which side of the window the record lacks, if any: both, or the one it lacks.
-    let after_held = a((peak_index + u64::from(span)).saturating_sub(before_reach + 1)).is_some();
+    let last = peak_index
+        .saturating_add(u64::from(span))
+        .saturating_sub(before_reach.saturating_add(1));
+    let after_held = a(last).is_some();
     let base = match peak_index.checked_sub(before_reach) {
         Some(base) if a(base).is_some() => base,
         _ if after_held => return Err(Missing::WindowBefore),

@@ -260,9 +260,20 @@ impl TdmsStream {
             Some(PropertyValue::String(u)) if !u.trim().is_empty() => Some(u.trim().to_string()),
             _ => None,
         };
+        // An acceleration or force unit the header parser knows is taken; another (a voltage,
+        // `EU`, a velocity's `m/s`) is said, and the channel read as an unnamed one.
+        let known =
+            |u: &str| u != "m/s" && crate::units::Units::of_header(&format!("x ({u})")).is_some();
         let name = match unit {
-            Some(u) if crate::units::Units::of_header(&open.name).is_none() => {
+            Some(u) if crate::units::Units::of_header(&open.name).is_none() && known(&u) => {
                 format!("{} ({u})", open.name)
+            }
+            Some(u) if !known(&u) => {
+                crate::note(&format!(
+                    "{}: its unit_string {u:?} is no acceleration or force unit this tool reads",
+                    open.name
+                ));
+                open.name.clone()
             }
             _ => open.name.clone(),
         };

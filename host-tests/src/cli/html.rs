@@ -479,16 +479,20 @@ fn spectra(h: &mut Html, results: &[EntryJson], required: &RequiredSrs) {
 /// (its run's), with `spec`'s band where its verdict placed it.
 pub fn log_report(
     path: &std::path::Path,
-    spec: Option<&impact_core::spec::Spec>,
+    spec: Option<(impact_core::spec::Spec, Option<&str>)>,
 ) -> Result<String, LogReportError> {
     let name = path.display().to_string();
     let log = crate::cli::log::read_log(path).map_err(|e| LogReportError::ReadLog(Box::new(e)))?;
     let mut analysis = crate::firmware_link::log_json::log_json(&log, 0.0)?;
-    // The pulse given, else the one the board's scene line states (log_json's).
+    // The pulse given (and the standard it named), else the one the board's scene line
+    // states (log_json's).
     let board = log.scene.as_ref().and_then(|s| s.spec().ok()).flatten();
-    let spec = spec.copied().or(board);
+    let (spec, named) = match spec {
+        Some((s, named)) => (Some(s), named),
+        None => (board, None),
+    };
     if let Some(s) = &spec {
-        analysis.spec = Some(crate::report::spec::spec_json(s));
+        analysis.spec = Some(crate::report::spec::spec_json(s, named));
     }
     let spec = spec.as_ref();
     let mut figures = Vec::new();

@@ -49,11 +49,14 @@ impl<'a> LogJson<'a> {
         let fits = asked(scene).map_err(LogError::whole)?;
         let train_speed = scene.and_then(SceneLine::train).map(str::to_string);
         // The pulse the board judged, as its scene line states it.
-        let spec = scene
-            .map(SceneLine::spec)
-            .transpose()
-            .map_err(LogError::whole)?
-            .flatten();
+        // (One this tool cannot read, a newer board's shape say, is said and left out.)
+        let spec = match scene.map(SceneLine::spec).transpose() {
+            Ok(spec) => spec.flatten(),
+            Err(e) => {
+                impact_io::note(&format!("the scene line's pulse is left out: {e}"));
+                None
+            }
+        };
         let total = |f: fn(&Run) -> u64| log.runs.iter().map(f).sum::<u64>();
         // The run of each impact and window (1-based), with more than one run.
         let runs = log.runs.len() > 1;
@@ -73,7 +76,9 @@ impl<'a> LogJson<'a> {
             samples: total(|r| r.samples),
             train_speed,
             // The board's spec lines give each impact's verdict; the pulse is the scene's.
-            spec: spec.as_ref().map(crate::report::spec::spec_json),
+            spec: spec
+                .as_ref()
+                .map(|s| crate::report::spec::spec_json(s, None)),
             trains: Vec::new(),
             waveforms: (log.waveforms.iter().enumerate())
                 .map(|(k, w)| {

@@ -416,6 +416,8 @@ pub struct Setup {
     pub windows: Vec<(u64, Vec<i16>)>,
     /// What the tool assumed that neither the file nor the options said (a unit).
     pub assumptions: Vec<Assumption>,
+    /// The standard `--spec` named, if a spec was given ([`Resolved::spec_standard`]).
+    pub spec_standard: Option<&'static str>,
 }
 
 /// What was read of a recording, however it was read: its channel, units, time base and
@@ -435,6 +437,8 @@ pub struct Reading {
 pub struct Resolved {
     pub scene: Scene,
     pub v0_source: Option<&'static str>,
+    /// The standard `--spec` named (its tolerances' source), if a spec was given.
+    pub spec_standard: Option<&'static str>,
 }
 
 impl Setup {
@@ -459,6 +463,7 @@ impl Setup {
                 accel_m_s2: Vec::new(),
             },
             scene: resolved.scene,
+            spec_standard: resolved.spec_standard,
             v0_source: resolved.v0_source.map(str::to_string),
             free_fall_s: None,
             samples,
@@ -793,6 +798,7 @@ pub(crate) fn build_scene(
     Ok(Resolved {
         scene,
         v0_source: source,
+        spec_standard: args.spec.map(|s| s.standard),
     })
 }
 
@@ -1014,7 +1020,7 @@ pub fn to_json(setup: &Setup, reports: &[ImpactReport]) -> AnalysisJson {
             .scene
             .spec
             .as_ref()
-            .map(crate::report::spec::spec_json),
+            .map(|s| crate::report::spec::spec_json(s, setup.spec_standard)),
         trains: Vec::new(),
         waveforms: Vec::new(),
         impacts: reports

@@ -53,7 +53,7 @@ pub enum SpecError {
     #[error("shape {name:?}: one of half-sine, sawtooth (terminal-peak), trapezoid")]
     Shape { name: String },
     /// A shape the standard does not specify (MIL-STD-202H: half-sine and sawtooth only).
-    #[error("{shape}: {title} specifies only {}; give another standard= or the tolerances by hand", .shapes.join(" and "))]
+    #[error("{shape}: {title} specifies only {}; give another standard=", .shapes.join(" and "))]
     NotInStandard {
         shape: String,
         title: &'static str,

@@ -101,13 +101,35 @@ pub struct BandRowJson {
     pub upper_over_peak: f64,
 }
 
-/// `spec` as JSON; its standard is the preset whose tolerances it has, else `custom`.
-pub fn spec_json(spec: &Spec) -> SpecJson {
+/// `spec` as JSON. Its standard: the one `named` (`--spec`'s `standard=`) when the spec has
+/// its tolerances, else the one preset whose tolerances it has; several presets with the same
+/// tolerances and none named (a board's scene line names none) are listed (`mil-std-810h or
+/// mil-std-202h`) with no sources; `custom` for tolerances of none.
+pub fn spec_json(spec: &Spec, named: Option<&str>) -> SpecJson {
     let t = spec.tolerance;
-    let preset = crate::standards::STANDARDS
+    let matching: Vec<&crate::standards::Standard> = crate::standards::STANDARDS
         .iter()
-        .find(|s| s.tolerance == t && spec.band.is_none());
-    let standard = preset.map_or("custom", |s| s.name);
+        .filter(|s| s.tolerance == t && spec.band.is_none())
+        .collect();
+    let preset = match named.and_then(|n| matching.iter().find(|s| s.name == n)) {
+        Some(s) => Some(*s),
+        None if matching.len() == 1 => matching.first().copied(),
+        None => None,
+    };
+    let standard = match (preset, matching.len()) {
+        (Some(p), _) => p.name.to_string(),
+        (None, 0) => "custom".to_string(),
+        (None, _) => matching
+            .iter()
+            .map(|s| s.name)
+            .collect::<Vec<_>>()
+            .join(" or "),
+    };
+    // A trapezoid's rise and fall are the standard's only at its own ramp.
+    let own_ramp = match spec.shape {
+        Shape::Trapezoid { rise, fall } => preset.is_some_and(|p| rise == p.ramp && fall == p.ramp),
+        _ => false,
+    };
     let (rise, fall) = match spec.shape {
         Shape::Trapezoid { rise, fall } => (Some(shortest(rise)), Some(shortest(fall))),
         _ => (None, None),
@@ -119,7 +141,7 @@ pub fn spec_json(spec: &Spec) -> SpecJson {
         peak_m_s2: shortest(spec.peak_m_s2),
         duration_s: shortest(spec.duration_s),
         nominal_delta_v_m_s: f64::from(spec.delta_v_m_s()),
-        standard: standard.to_string(),
+        standard,
         band: shortest(t.band),
         outside: shortest(t.outside),
         slack: shortest(t.slack),
@@ -132,7 +154,7 @@ pub fn spec_json(spec: &Spec) -> SpecJson {
         sources: preset.map_or_else(Vec::new, |p| {
             p.sources
                 .iter()
-                .filter(|x| x.key != "rise, fall" || matches!(spec.shape, Shape::Trapezoid { .. }))
+                .filter(|x| x.key != "rise, fall" || own_ramp)
                 .map(|x| SourceJson {
                     tolerance: x.key,
                     confidence: x.confidence.name(),

@@ -145,7 +145,7 @@ pub fn run(args: &WatchArgs) -> Result<(), WatchError> {
         .as_deref()
         .map(crate::pipeline::spec::parse)
         .transpose()?;
-    let spec = parsed.map(|a| (a.spec, session::spec_text(&a.spec)));
+    let spec = parsed.map(|a| (a.spec, a.standard));
     let session_path = args.session.clone().unwrap_or_else(default_session);
     let inputs = crate::output::Inputs::new()
         .with(&input)
@@ -184,13 +184,12 @@ pub fn run(args: &WatchArgs) -> Result<(), WatchError> {
             source,
         })?;
     let mut log = std::io::BufWriter::new(file);
-    let spec_only = spec.as_ref().map(|(s, _)| *s);
     let session = Session::new(&name, &session_path.display().to_string(), spec);
     let loopback = listener
         .as_ref()
         .and_then(|l| l.local_addr().ok())
         .is_some_and(|a| a.ip().is_loopback());
-    let hub = Arc::new(Hub::new(session, session_path.clone(), spec_only, loopback));
+    let hub = Arc::new(Hub::new(session, session_path.clone(), loopback));
     let terminal = args.terminal;
     if let Some(l) = listener {
         let addr = l.local_addr().map_err(WatchError::Address)?;

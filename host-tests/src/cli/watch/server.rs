@@ -52,8 +52,6 @@ pub struct Hub {
     receipts: Mutex<VecDeque<String>>,
     /// The session file (the whole log as it arrived), for the exports.
     session_file: PathBuf,
-    /// The pulse the board judges, for the report's bands.
-    spec: Option<impact_core::spec::Spec>,
     /// Whether the server is bound to a loopback address (then only `Host: localhost` or a
     /// loopback address is served, so a web page elsewhere cannot read the session).
     loopback: bool,
@@ -74,14 +72,8 @@ pub fn now_ms() -> u64 {
 }
 
 impl Hub {
-    pub fn new(
-        session: Session,
-        session_file: PathBuf,
-        spec: Option<impact_core::spec::Spec>,
-        loopback: bool,
-    ) -> Self {
+    pub fn new(session: Session, session_file: PathBuf, loopback: bool) -> Self {
         Self {
-            spec,
             session: Mutex::new(session),
             clients: Mutex::new(Vec::new()),
             receipts: Mutex::new(VecDeque::new()),
@@ -292,8 +284,8 @@ fn connection(stream: TcpStream, hub: &Hub) -> std::io::Result<()> {
         }
         "/report.html" => {
             // The pulse drawn: the board's, once its scene line stated it, else `--spec`'s.
-            let spec = lock(&hub.session).spec().or(hub.spec);
-            match crate::cli::html::log_report(&hub.session_file, spec.as_ref()) {
+            let drawn = lock(&hub.session).spec();
+            match crate::cli::html::log_report(&hub.session_file, drawn) {
                 Ok(page) => respond(
                     &mut out,
                     "200 OK",

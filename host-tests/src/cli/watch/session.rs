@@ -71,8 +71,8 @@ pub struct Session {
     /// The pulse the impacts are drawn against: the board's (its scene line states it), else
     /// the one `--spec` gave.
     spec: Option<Spec>,
-    /// The pulse `--spec` gave, if any.
-    given: Option<Spec>,
+    /// The pulse `--spec` gave, if any, and the standard it named.
+    given: Option<(Spec, &'static str)>,
     head: Map<String, Value>,
     run: u32,
     /// Whether the current run has had a data line (a `scene` line then is a restart).
@@ -104,9 +104,9 @@ pub struct Session {
 }
 
 impl Session {
-    /// A session reading `source` into `session_file`, its impacts judged against `spec`
-    /// (`spec_text` says which) when given.
-    pub fn new(source: &str, session_file: &str, spec: Option<(Spec, String)>) -> Self {
+    /// A session reading `source` into `session_file`, its impacts drawn against `spec` (and
+    /// the standard `--spec` named) when given, until the board states its own.
+    pub fn new(source: &str, session_file: &str, spec: Option<(Spec, &'static str)>) -> Self {
         let mut head = Map::new();
         head.insert(
             "tool".into(),
@@ -116,12 +116,13 @@ impl Session {
         head.insert("session_file".into(), json!(session_file));
         head.insert(
             "spec".into(),
-            spec.as_ref()
-                .map_or(Value::Null, |(s, text)| spec_head(s, text, "--spec", None)),
+            spec.as_ref().map_or(Value::Null, |(s, named)| {
+                spec_head(s, &spec_text(s, Some(named)), "--spec", None)
+            }),
         );
         Self {
             spec: spec.as_ref().map(|(s, _)| *s),
-            given: spec.map(|(s, _)| s),
+            given: spec,
             head,
             run: 1,
             started: false,
@@ -148,8 +149,14 @@ impl Session {
     }
 
     /// The pulse the impacts are drawn against (the board's, else `--spec`'s).
-    pub fn spec(&self) -> Option<Spec> {
-        self.spec
+    /// The pulse drawn and the standard named for it (`--spec`'s while it is drawn; a
+    /// board's names none).
+    pub fn spec(&self) -> Option<(Spec, Option<&'static str>)> {
+        let named = self
+            .given
+            .filter(|(g, _)| Some(*g) == self.spec)
+            .map(|(_, n)| n);
+        self.spec.map(|s| (s, named))
     }
 
     /// Reads line `n` of the input, received at `now_ms` (Unix ms); returns the events it
@@ -353,21 +360,46 @@ impl Session {
         };
         let board = match scene.spec() {
             Ok(Some(board)) => board,
+            // A board that judges nothing (`spec=none`): `--spec`'s pulse again, if any.
+            Ok(None) if f.get("spec") == Some("none") => {
+                let was = self.spec;
+                self.spec = self.given.map(|(g, _)| g);
+                // Said only when the pulse drawn changes (a board that never judged says
+                // nothing).
+                if was == self.spec {
+                    return;
+                }
+                let head = self.given.map_or(Value::Null, |(g, named)| {
+                    spec_head(&g, &spec_text(&g, Some(named)), "--spec", None)
+                });
+                self.head.insert("spec".into(), head.clone());
+                events.push(if head.is_null() {
+                    json!({"type": "spec"})
+                } else {
+                    tagged("spec", head)
+                });
+                return;
+            }
+            // An older board's line, without the field: `--spec`'s stays.
             Ok(None) => return,
             Err(e) => {
                 events.push(json!({"type": "warning", "text": cut(&e.to_string())}));
                 return;
             }
         };
-        let differs = self.given.filter(|g| *g != board).map(|g| {
-            format!(
-                "--spec {} differs from the pulse the board judges ({}): the board's is drawn",
-                spec_text(&g),
-                spec_text(&board)
+        let differs = self
+            .given
+            .filter(|(g, _)| !same_spec(g, &board))
+            .map(|(g, named)| {
+                format!(
+                "--spec {} differs from the pulse the board judges ({}{}): the board's is drawn",
+                spec_text(&g, Some(named)),
+                spec_text(&board, None),
+                first_difference(&g, &board)
             )
-        });
+            });
         self.spec = Some(board);
-        let head = spec_head(&board, &spec_text(&board), "board", differs);
+        let head = spec_head(&board, &spec_text(&board, None), "board", differs);
         self.head.insert("spec".into(), head.clone());
         events.push(tagged("spec", head));
     }
@@ -655,11 +687,10 @@ fn cut(text: &str) -> String {
     format!("{}…", &text[..end])
 }
 
-/// `value` (an object) with its event `type` first.
 /// The pulse as the page names it: shape, peak in g, duration in ms, the standard (or
 /// `custom`), a user's band's rows.
-pub fn spec_text(spec: &Spec) -> String {
-    let standard = crate::report::spec::spec_json(spec).standard;
+pub fn spec_text(spec: &Spec, named: Option<&str>) -> String {
+    let standard = crate::report::spec::spec_json(spec, named).standard;
     format!(
         "{} {} g {} ms, {}",
         spec.shape.name(),
@@ -669,6 +700,67 @@ pub fn spec_text(spec: &Spec) -> String {
     ) + &spec.band.map_or(String::new(), |rows| {
         format!(", the user's band ({} rows)", rows.len())
     })
+}
+
+/// Whether two specs are the same pulse and tolerances, each number within 1e-6 of the other
+/// (a board's static `50.0 * g` and the host's parse of `50g` may differ in the last bit).
+fn same_spec(a: &Spec, b: &Spec) -> bool {
+    use impact_core::spec::Shape;
+    let near = |x: f32, y: f32| (x - y).abs() <= 1e-6 * x.abs().max(y.abs()).max(f32::MIN_POSITIVE);
+    let shapes = match (a.shape, b.shape) {
+        (Shape::Trapezoid { rise: r1, fall: f1 }, Shape::Trapezoid { rise: r2, fall: f2 }) => {
+            near(r1, r2) && near(f1, f2)
+        }
+        (x, y) => x == y,
+    };
+    let (t, u) = (a.tolerance, b.tolerance);
+    let bands = match (a.band, b.band) {
+        (None, None) => true,
+        (Some(p), Some(q)) => {
+            p.len() == q.len()
+                && p.iter().zip(q).all(|(x, y)| {
+                    near(x.u, y.u) && near(x.lower, y.lower) && near(x.upper, y.upper)
+                })
+        }
+        _ => false,
+    };
+    shapes
+        && bands
+        && [
+            (a.peak_m_s2, b.peak_m_s2),
+            (a.duration_s, b.duration_s),
+            (t.band, u.band),
+            (t.outside, u.outside),
+            (t.slack, u.slack),
+            (t.delta_v, u.delta_v),
+            (t.before, u.before),
+            (t.after, u.after),
+            (t.watch, u.watch),
+        ]
+        .iter()
+        .all(|&(x, y)| near(x, y))
+}
+
+/// Where two specs differ, as `; its dv 0.1, not 0.3` (the first field that does), for a
+/// warning whose two texts may read alike.
+fn first_difference(given: &Spec, board: &Spec) -> String {
+    let (g, b) = (given.tolerance, board.tolerance);
+    let fields = [
+        ("peak_m_s2", given.peak_m_s2, board.peak_m_s2),
+        ("duration_s", given.duration_s, board.duration_s),
+        ("band", g.band, b.band),
+        ("outside", g.outside, b.outside),
+        ("slack", g.slack, b.slack),
+        ("dv", g.delta_v, b.delta_v),
+        ("before", g.before, b.before),
+        ("after", g.after, b.after),
+        ("watch", g.watch, b.watch),
+    ];
+    match fields.iter().find(|(_, x, y)| x != y) {
+        Some((name, x, y)) => format!("; its {name} {y}, not {x}"),
+        None if given.shape != board.shape => "; its shape".to_string(),
+        None => "; its band's rows".to_string(),
+    }
 }
 
 /// The session head's `spec`: the pulse drawn, where it came from (`board`: its scene line;
@@ -684,6 +776,7 @@ fn spec_head(spec: &Spec, text: &str, from: &str, differs: Option<String>) -> Va
     })
 }
 
+/// `value` (an object) with its event `type` first.
 fn tagged(kind: &str, value: Value) -> Value {
     let mut m = Map::new();
     m.insert("type".into(), json!(kind));

@@ -38,10 +38,11 @@ pub fn print(events: &[Value]) {
                 if let Some(d) = e["differs"].as_str() {
                     crate::errln!("warning: {d}");
                 }
-                Some(format!(
-                    "the board judges {}",
-                    e["text"].as_str().unwrap_or("?")
-                ))
+                Some(match (e["text"].as_str(), e["from"].as_str()) {
+                    (Some(t), Some("board")) => format!("the board judges {t}"),
+                    (Some(t), _) => format!("the board judges no pulse; drawn: --spec {t}"),
+                    (None, _) => "the board judges no pulse".to_string(),
+                })
             }
             _ => None,
         };

@@ -189,7 +189,8 @@ impl std::fmt::Display for SceneDifference {
 }
 
 /// A user's band read from a scene line, for the program's life: each distinct band once
-/// (a log of many restarts repeats one band, and keeps one copy).
+/// (a log of many restarts repeats one band, and keeps one copy; a band the spec then refuses
+/// is kept too). At most 768 B a band (64 rows), one per distinct band the log states.
 fn leak_band(u: &[f32], lower: &[f32], upper: &[f32]) -> &'static [impact_core::spec::BandPoint] {
     use impact_core::spec::BandPoint;
     use std::sync::Mutex;
