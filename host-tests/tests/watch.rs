@@ -7,7 +7,7 @@
 
 use std::io::{BufRead, BufReader, Read, Write};
 use std::net::TcpStream;
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 use std::process::{Child, ChildStdin, Command, Stdio};
 use std::time::{Duration, Instant};
 
@@ -113,6 +113,27 @@ impl Watch {
     }
 }
 
+/// `impact watch --terminal --session SESSION EXTRA…` fed `text` on its standard input, to
+/// its end.
+fn watch_terminal(session: &Path, text: &str, extra: &[&str]) -> std::process::Output {
+    let mut child = Command::new(env!("CARGO_BIN_EXE_impact"))
+        .args(["watch", "--terminal", "--session"])
+        .arg(session)
+        .args(extra)
+        .stdin(Stdio::piped())
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    child
+        .stdin
+        .take()
+        .unwrap()
+        .write_all(text.as_bytes())
+        .unwrap();
+    child.wait_with_output().unwrap()
+}
+
 /// A log of `impacts` impacts (a heartbeat every 12), the board restarting after `restart`
 /// of them when given, and its summary.
 fn board_log(impacts: u64, restart: Option<u64>) -> Vec<String> {
@@ -141,21 +162,7 @@ fn the_terminal_view_prints_every_impact_and_the_health() {
     let session = scratch.join("terminal.log");
     let log = board_log(30, Some(20));
     let text = log.join("\n") + "\n";
-    let mut child = Command::new(env!("CARGO_BIN_EXE_impact"))
-        .args(["watch", "--terminal", "--session"])
-        .arg(&session)
-        .stdin(Stdio::piped())
-        .stdout(Stdio::piped())
-        .stderr(Stdio::piped())
-        .spawn()
-        .unwrap();
-    child
-        .stdin
-        .take()
-        .unwrap()
-        .write_all(text.as_bytes())
-        .unwrap();
-    let out = child.wait_with_output().unwrap();
+    let out = watch_terminal(&session, &text, &[]);
     let stdout = String::from_utf8_lossy(&out.stdout);
     assert!(
         out.status.success(),
@@ -754,26 +761,15 @@ impl Drop for Ended {
 fn the_board_states_the_pulse_it_judges_and_a_different_spec_is_warned() {
     let scratch = Scratch::new();
     let board_spec = " spec=half-sine spec_peak_m_s2=588.399 spec_duration_s=0.00245 spec_band=0.2 spec_outside=0.2 spec_slack=0.1 spec_dv=0.15 spec_before=0.4 spec_after=0.1 spec_watch=1.1 spec_rise=none spec_fall=none spec_band_u=none spec_band_lower=none spec_band_upper=none";
-    let run = |name: &str, scene: String, spec: &[&str]| {
+    // The session's lines (a log of 3 impacts whose scene lines are `scenes`, the first
+    // replaced, the others inserted after its first impact) through `watch --terminal`.
+    let run = |name: &str, scenes: &[String], spec: &[&str]| {
         let mut lines = board_log(3, None);
-        lines[0] = scene;
-        let text = lines.join("\n") + "\n";
-        let mut child = Command::new(env!("CARGO_BIN_EXE_impact"))
-            .args(["watch", "--terminal", "--session"])
-            .arg(scratch.join(name))
-            .args(spec)
-            .stdin(Stdio::piped())
-            .stdout(Stdio::piped())
-            .stderr(Stdio::piped())
-            .spawn()
-            .unwrap();
-        child
-            .stdin
-            .take()
-            .unwrap()
-            .write_all(text.as_bytes())
-            .unwrap();
-        let out = child.wait_with_output().unwrap();
+        lines[0] = scenes[0].clone();
+        for (k, scene) in scenes.iter().enumerate().skip(1) {
+            lines.insert(1 + k, scene.clone());
+        }
+        let out = watch_terminal(&scratch.join(name), &(lines.join("\n") + "\n"), spec);
         assert!(out.status.success());
         (
             String::from_utf8_lossy(&out.stdout).to_string(),
@@ -782,7 +778,7 @@ fn the_board_states_the_pulse_it_judges_and_a_different_spec_is_warned() {
     };
     let (out, err) = run(
         "given.log",
-        format!("{SCENE}{board_spec}"),
+        &[format!("{SCENE}{board_spec}")],
         &["--spec", "half-sine,60g,2.45ms,dv=0.3"],
     );
     assert!(
@@ -796,20 +792,23 @@ fn the_board_states_the_pulse_it_judges_and_a_different_spec_is_warned() {
     // The same pulse: no warning.
     let (_, err) = run(
         "same.log",
-        format!("{SCENE}{board_spec}"),
+        &[format!("{SCENE}{board_spec}")],
         &["--spec", "half-sine,60g,2.45ms"],
     );
     assert!(!err.contains("differs"), "{err}");
     // An older board's line (no spec) leaves --spec's pulse; a malformed one is a warning.
     let (out, _) = run(
         "old.log",
-        SCENE.to_string(),
+        &[SCENE.to_string()],
         &["--spec", "half-sine,60g,2.45ms"],
     );
     assert!(!out.contains("the board judges"), "{out}");
     let (out, err) = run(
         "bad.log",
-        format!("{SCENE}{}", board_spec.replace("half-sine", "triangle")),
+        &[format!(
+            "{SCENE}{}",
+            board_spec.replace("half-sine", "triangle")
+        )],
         &[],
     );
     assert!(
@@ -830,26 +829,11 @@ fn the_board_states_the_pulse_it_judges_and_a_different_spec_is_warned() {
         })
         .collect::<Vec<_>>()
         .join(" ");
-    let mut lines = board_log(3, None);
-    lines[0] = format!("{SCENE}{board_spec}");
-    lines.insert(2, format!("{SCENE}{none}"));
-    let text = lines.join("\n") + "\n";
-    let mut child = Command::new(env!("CARGO_BIN_EXE_impact"))
-        .args(["watch", "--terminal", "--session"])
-        .arg(scratch.join("restart.log"))
-        .stdin(Stdio::piped())
-        .stdout(Stdio::piped())
-        .stderr(Stdio::piped())
-        .spawn()
-        .unwrap();
-    child
-        .stdin
-        .take()
-        .unwrap()
-        .write_all(text.as_bytes())
-        .unwrap();
-    let out = child.wait_with_output().unwrap();
-    let out = String::from_utf8_lossy(&out.stdout);
+    let (out, _) = run(
+        "restart.log",
+        &[format!("{SCENE}{board_spec}"), format!("{SCENE}{none}")],
+        &[],
+    );
     let judges: Vec<&str> = out
         .lines()
         .filter(|l| l.starts_with("the board judges"))
