@@ -309,21 +309,17 @@ fn provenance(
 fn statistics_table(h: &mut Html, statistics: &[crate::report::statistics::Statistic]) {
     h.raw("<table><tr><th class=\"l\">metric</th><th>n</th><th>mean</th><th>sd</th><th>CV</th><th>min</th><th>max</th></tr>\n");
     for st in statistics {
-        let u = crate::report::statistics::METRICS
-            .iter()
-            .find(|(m, _, _)| *m == st.metric)
-            .map_or("", |(_, u, _)| u);
-        let q = |v: f64| human(v, u).trim_end().to_string();
+        let [metric, n, mean, sd, cv, min, max] = st.cells("—");
         html!(
             h,
             "<tr><td class=\"l\">{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td></tr>\n",
-            st.metric,
-            st.n,
-            q(st.mean),
-            st.sd.map_or("—".into(), q),
-            st.cv.map_or("—".into(), |c| format!("{:.2} %", 100.0 * c)),
-            q(st.min),
-            q(st.max)
+            metric,
+            n,
+            mean,
+            sd,
+            cv,
+            min,
+            max
         );
     }
     h.raw("</table>\n");

@@ -11,9 +11,7 @@ use serde::Serialize;
 
 use crate::pipeline::{self, AnalyzeArgs, PipelineError};
 use crate::report::fmt::human;
-use crate::report::statistics::{
-    comparable, pass_rate, statistics, LeftOut, PassRate, Statistic, METRICS,
-};
+use crate::report::statistics::{comparable, pass_rate, statistics, LeftOut, PassRate, Statistic};
 use crate::report::{AnalysisJson, ImpactJson};
 
 /// The extensions of the recordings a folder contributes (as `impact analyze` reads them).
@@ -567,28 +565,7 @@ impl EntryJson {
 
 /// A statistics table: a row per metric (n, mean, sd, CV, min, max in its unit).
 fn statistics_table(statistics: &[Statistic]) -> String {
-    let unit_of = |m: &str| {
-        METRICS
-            .iter()
-            .find(|(name, _, _)| *name == m)
-            .map_or("", |(_, u, _)| u)
-    };
-    let rows: Vec<[String; 7]> = statistics
-        .iter()
-        .map(|st| {
-            let u = unit_of(st.metric);
-            let q = |v: f64| human(v, u).trim_end().to_string();
-            [
-                st.metric.to_string(),
-                st.n.to_string(),
-                q(st.mean),
-                st.sd.map_or("-".into(), q),
-                st.cv.map_or("-".into(), |c| format!("{:.2} %", 100.0 * c)),
-                q(st.min),
-                q(st.max),
-            ]
-        })
-        .collect();
+    let rows: Vec<[String; 7]> = statistics.iter().map(|st| st.cells("-")).collect();
     columns(&["metric", "n", "mean", "sd", "CV", "min", "max"], &rows)
 }
 

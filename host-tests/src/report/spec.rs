@@ -101,22 +101,25 @@ pub struct BandRowJson {
     pub upper_over_peak: f64,
 }
 
-/// `spec` as JSON. Its standard: the one `named` (`--spec`'s `standard=`) when the spec has
-/// its tolerances, else the one preset whose tolerances it has; several presets with the same
-/// tolerances and none named (a board's scene line names none) are listed (`mil-std-810h or
-/// mil-std-202h`) with no sources; `custom` for tolerances of none.
-pub fn spec_json(spec: &Spec, named: Option<&str>) -> SpecJson {
-    let t = spec.tolerance;
-    let matching: Vec<&crate::standards::Standard> = crate::standards::STANDARDS
+/// The standard whose tolerances `spec` has, and its name in the reports: the one `named`
+/// (`--spec`'s `standard=`) when the spec has its tolerances, else the one preset whose
+/// tolerances it has; several presets with the same tolerances and none named (a board's
+/// scene line names none) are listed (`mil-std-810h or mil-std-202h`) with no preset;
+/// `custom` for tolerances of none.
+pub fn standard_of(
+    spec: &Spec,
+    named: Option<&str>,
+) -> (Option<&'static crate::standards::Standard>, String) {
+    let matching: Vec<&'static crate::standards::Standard> = crate::standards::STANDARDS
         .iter()
-        .filter(|s| s.tolerance == t && spec.band.is_none())
+        .filter(|s| s.tolerance == spec.tolerance && spec.band.is_none())
         .collect();
     let preset = match named.and_then(|n| matching.iter().find(|s| s.name == n)) {
         Some(s) => Some(*s),
         None if matching.len() == 1 => matching.first().copied(),
         None => None,
     };
-    let standard = match (preset, matching.len()) {
+    let name = match (preset, matching.len()) {
         (Some(p), _) => p.name.to_string(),
         (None, 0) => "custom".to_string(),
         (None, _) => matching
@@ -125,6 +128,14 @@ pub fn spec_json(spec: &Spec, named: Option<&str>) -> SpecJson {
             .collect::<Vec<_>>()
             .join(" or "),
     };
+    (preset, name)
+}
+
+/// `spec` as JSON, its standard [`standard_of`] it (sources and another Δv reading only for
+/// one preset).
+pub fn spec_json(spec: &Spec, named: Option<&str>) -> SpecJson {
+    let t = spec.tolerance;
+    let (preset, standard) = standard_of(spec, named);
     // A trapezoid's rise and fall are the standard's only at its own ramp.
     let own_ramp = match spec.shape {
         Shape::Trapezoid { rise, fall } => preset.is_some_and(|p| rise == p.ramp && fall == p.ramp),

@@ -22,6 +22,28 @@ pub struct Statistic {
     pub null_reason: Option<&'static str>,
 }
 
+impl Statistic {
+    /// The row a table shows: metric, n, mean, sd, CV, min, max, each value in the metric's
+    /// unit (`unknown` where sd or CV is null).
+    pub fn cells(&self, unknown: &str) -> [String; 7] {
+        let unit = METRICS
+            .iter()
+            .find(|(name, _, _)| *name == self.metric)
+            .map_or("", |(_, u, _)| u);
+        let q = |v: f64| super::fmt::human(v, unit).trim_end().to_string();
+        [
+            self.metric.to_string(),
+            self.n.to_string(),
+            q(self.mean),
+            self.sd.map_or(unknown.into(), q),
+            self.cv
+                .map_or(unknown.into(), |c| format!("{:.2} %", 100.0 * c)),
+            q(self.min),
+            q(self.max),
+        ]
+    }
+}
+
 /// The metrics the statistics cover, with their units (for the table), and how each is read
 /// off an impact.
 type Metric = (&'static str, &'static str, fn(&ImpactJson) -> Option<f64>);

@@ -63,7 +63,9 @@ impl Supply {
     }
 
     /// The supply now, volts, from [`READS`] conversions of VREFINT and the factory's
-    /// calibration word. Blocks for about 0.4 ms (start-up only).
+    /// calibration word. Blocks for about 0.5 ms (start-up only: no executor runs yet, and
+    /// embassy's timer queue takes only its executors' wakers, so the async twin below cannot
+    /// be blocked on).
     pub fn vdda_v(&mut self) -> Result<f32, VddaError> {
         self.set_up();
         let mut sum = 0;

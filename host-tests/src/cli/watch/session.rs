@@ -354,11 +354,7 @@ impl Session {
     /// `spec` event); a `--spec` unlike it is named in a warning the page keeps. A scene
     /// line without one (`spec=none`, or an older board's) leaves the pulse as it was.
     fn board_spec(&mut self, f: &Fields, events: &mut Vec<Value>) {
-        let scene = match line::SceneLine::parse(f.clone()) {
-            Ok(scene) => scene,
-            Err(_) => return,
-        };
-        let board = match scene.spec() {
+        let board = match line::spec_of(f) {
             Ok(Some(board)) => board,
             // A board that judges nothing (`spec=none`): `--spec`'s pulse again, if any.
             Ok(None) if f.get("spec") == Some("none") => {
@@ -690,7 +686,7 @@ fn cut(text: &str) -> String {
 /// The pulse as the page names it: shape, peak in g, duration in ms, the standard (or
 /// `custom`), a user's band's rows.
 pub fn spec_text(spec: &Spec, named: Option<&str>) -> String {
-    let standard = crate::report::spec::spec_json(spec, named).standard;
+    let (_, standard) = crate::report::spec::standard_of(spec, named);
     format!(
         "{} {} g {} ms, {}",
         spec.shape.name(),

@@ -18,7 +18,7 @@ mod wave;
 
 pub use fields::{FieldError, Fields, Number};
 pub use impact::ImpactLine;
-pub use scene::{SceneDifference, SceneLine};
+pub use scene::{spec_of, SceneDifference, SceneLine};
 pub use spectrum::{SpecLine, SrsLine};
 pub use state::{Counter, HeartbeatLine, State, SummaryLine};
 pub use wave::{WaveFrameLine, WaveLine};

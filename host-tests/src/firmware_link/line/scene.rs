@@ -89,68 +89,9 @@ impl SceneLine {
         self.fields.get("cfc").filter(|c| *c != "none")
     }
 
-    /// The pulse the board judges (`spec` and its `spec_*` fields), as the core's `Spec`:
-    /// `None` for `spec=none` or a line without the field (an older board's). A user's band
-    /// is kept for the program's life (each distinct one once: [`leak_band`]).
+    /// The pulse the board judges ([`spec_of`] its fields).
     pub fn spec(&self) -> Result<Option<impact_core::spec::Spec>, LineError> {
-        use impact_core::spec::{Shape, Spec, Tolerance};
-        let f = &self.fields;
-        let shape = match f.get("spec") {
-            None | Some("none") => return Ok(None),
-            Some(name) => name,
-        };
-        let bad = |why: String| LineError::SceneSpec { why };
-        let num = |k: &'static str| -> Result<f32, LineError> {
-            f.opt::<f32>(k)?.ok_or_else(|| bad(format!("{k}=none")))
-        };
-        let shape = match shape {
-            "half-sine" => Shape::HalfSine,
-            "sawtooth" => Shape::Sawtooth,
-            "trapezoid" => Shape::Trapezoid {
-                rise: num("spec_rise")?,
-                fall: num("spec_fall")?,
-            },
-            other => return Err(bad(format!("{other}: not a shape"))),
-        };
-        let column = |k: &'static str| -> Result<Option<Vec<f32>>, LineError> {
-            match f.get(k) {
-                None | Some("none") => Ok(None),
-                Some(list) => list
-                    .split(',')
-                    .map(|v| v.parse::<f32>().ok().filter(|x| x.is_finite()))
-                    .collect::<Option<Vec<f32>>>()
-                    .map(Some)
-                    .ok_or_else(|| bad(format!("{k}: {list} is not a list of numbers"))),
-            }
-        };
-        let band = match (
-            column("spec_band_u")?,
-            column("spec_band_lower")?,
-            column("spec_band_upper")?,
-        ) {
-            (None, None, None) => None,
-            (Some(u), Some(lo), Some(hi)) if u.len() == lo.len() && u.len() == hi.len() => {
-                Some(leak_band(&u, &lo, &hi))
-            }
-            _ => return Err(bad("the band's three columns differ in length".to_string())),
-        };
-        let spec = Spec {
-            shape,
-            peak_m_s2: num("spec_peak_m_s2")?,
-            duration_s: num("spec_duration_s")?,
-            tolerance: Tolerance {
-                band: num("spec_band")?,
-                outside: num("spec_outside")?,
-                slack: num("spec_slack")?,
-                delta_v: num("spec_dv")?,
-                before: num("spec_before")?,
-                after: num("spec_after")?,
-                watch: num("spec_watch")?,
-            },
-            band,
-        };
-        spec.validate().map_err(|e| bad(e.to_string()))?;
-        Ok(Some(spec))
+        spec_of(&self.fields)
     }
 
     /// The first field (in name order) in which the scene `new` differs from this one.
@@ -210,4 +151,67 @@ fn leak_band(u: &[f32], lower: &[f32], upper: &[f32]) -> &'static [impact_core::
     let leaked: &'static [BandPoint] = Box::leak(rows.into_boxed_slice());
     kept.push(leaked);
     leaked
+}
+
+/// The pulse a scene line's fields state (`spec` and its `spec_*` fields), as the core's
+/// `Spec`: `None` for `spec=none` or a line without the field (an older board's). A user's
+/// band is kept for the program's life (each distinct one once: [`leak_band`]).
+pub fn spec_of(f: &Fields) -> Result<Option<impact_core::spec::Spec>, LineError> {
+    use impact_core::spec::{Shape, Spec, Tolerance};
+    let shape = match f.get("spec") {
+        None | Some("none") => return Ok(None),
+        Some(name) => name,
+    };
+    let bad = |why: String| LineError::SceneSpec { why };
+    let num = |k: &'static str| -> Result<f32, LineError> {
+        f.opt::<f32>(k)?.ok_or_else(|| bad(format!("{k}=none")))
+    };
+    let shape = match shape {
+        "half-sine" => Shape::HalfSine,
+        "sawtooth" => Shape::Sawtooth,
+        "trapezoid" => Shape::Trapezoid {
+            rise: num("spec_rise")?,
+            fall: num("spec_fall")?,
+        },
+        other => return Err(bad(format!("{other}: not a shape"))),
+    };
+    let column = |k: &'static str| -> Result<Option<Vec<f32>>, LineError> {
+        match f.get(k) {
+            None | Some("none") => Ok(None),
+            Some(list) => list
+                .split(',')
+                .map(|v| v.parse::<f32>().ok().filter(|x| x.is_finite()))
+                .collect::<Option<Vec<f32>>>()
+                .map(Some)
+                .ok_or_else(|| bad(format!("{k}: {list} is not a list of numbers"))),
+        }
+    };
+    let band = match (
+        column("spec_band_u")?,
+        column("spec_band_lower")?,
+        column("spec_band_upper")?,
+    ) {
+        (None, None, None) => None,
+        (Some(u), Some(lo), Some(hi)) if u.len() == lo.len() && u.len() == hi.len() => {
+            Some(leak_band(&u, &lo, &hi))
+        }
+        _ => return Err(bad("the band's three columns differ in length".to_string())),
+    };
+    let spec = Spec {
+        shape,
+        peak_m_s2: num("spec_peak_m_s2")?,
+        duration_s: num("spec_duration_s")?,
+        tolerance: Tolerance {
+            band: num("spec_band")?,
+            outside: num("spec_outside")?,
+            slack: num("spec_slack")?,
+            delta_v: num("spec_dv")?,
+            before: num("spec_before")?,
+            after: num("spec_after")?,
+            watch: num("spec_watch")?,
+        },
+        band,
+    };
+    spec.validate().map_err(|e| bad(e.to_string()))?;
+    Ok(Some(spec))
 }
