@@ -69,7 +69,20 @@ impl<const PRE: usize, const CAP: usize> Monitor<PRE, CAP> {
     /// Starts over with `scene`, in place; fails on an invalid scene or sizes (the hold must
     /// be under half the capture), and then leaves the monitor as it was.
     pub fn configure(&mut self, scene: Scene) -> Result<(), Error> {
-        self.stream.configure_for(scene, CAP)
+        self.stream.configure_for(scene, self.capture.capacity())
+    }
+
+    /// As [`Self::configure`], with captures of `len` samples (at least 64, at most `CAP`): a
+    /// host analysing with the board's capture length. A contact longer than the capture is
+    /// kept at a coarser step ([`Capture::extend_decimating`]).
+    pub fn configure_with_capture(&mut self, scene: Scene, len: usize) -> Result<(), Error> {
+        let before = self.capture.capacity();
+        self.capture.set_capacity(len);
+        let done = self.stream.configure_for(scene, self.capture.capacity());
+        if done.is_err() {
+            self.capture.set_capacity(before);
+        }
+        done
     }
 
     /// The scene in use.

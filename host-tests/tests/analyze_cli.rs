@@ -75,9 +75,12 @@ fn with_mass_and_v0_the_kinematics_and_fits_appear_and_a_plot_is_drawn() {
     assert_eq!(code, 0, "{err}");
     let f = scratch.file("bench.csv", &csv);
     let svg = f.with_extension("svg");
+    // Its 50 ms contact outlasts the board's capture: held at every sample for the fits.
     let (code, out, err) = impact(&[
         "analyze",
         f.to_str().unwrap(),
+        "--capture-samples",
+        "131072",
         "--mass",
         "0.06",
         "--v0",

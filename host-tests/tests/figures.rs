@@ -40,7 +40,11 @@ fn the_cfc_trace_drawn_is_the_analysis_s_filter() {
                 let analysed = if whole {
                     pipeline::setup(&args, impact_io::progress::Progress::none()).and_then(
                         |setup| {
-                            let reports = pipeline::run(&setup.prepared.counts, &setup.scene)?;
+                            let reports = pipeline::run(
+                                &setup.prepared.counts,
+                                &setup.scene,
+                                setup.capture_len,
+                            )?;
                             Ok((setup, reports))
                         },
                     )

@@ -17,7 +17,7 @@ fn data(rel: &str) -> PathBuf {
 
 fn analyze(args: &AnalyzeArgs) -> Result<AnalysisJson, pipeline::PipelineError> {
     let setup = pipeline::setup(args, impact_io::progress::Progress::none())?;
-    let reports = pipeline::run(&setup.prepared.counts, &setup.scene)?;
+    let reports = pipeline::run(&setup.prepared.counts, &setup.scene, setup.capture_len)?;
     Ok(pipeline::to_json(&setup, &reports))
 }
 
@@ -127,6 +127,9 @@ fn cfc_60_on_the_1_ms_s_afrl_record_is_the_whole_records_filter() {
         file: data("afrl-drop-tower/series1_test1_full_100ms.csv"),
         units: Some(Units::Kgn),
         column: Some(ColumnRef::Index(1)),
+        // CFC 60's 10 ms of padding at 1 MS/s: more than the board's capture holds before
+        // the pulse.
+        capture_samples: Some(131_072),
         ..Default::default()
     };
     let plain = analyze(&args).unwrap();

@@ -156,7 +156,9 @@ fn every_contact_has_the_same_kinematics_with_the_boards_capture_and_a_whole_one
             b.flags
         );
         if len > 15_104 {
-            assert_eq!(b.status, impact_core::Status::BufferFull);
+            // Whole at a coarser step.
+            assert_eq!(b.status, impact_core::Status::Complete);
+            assert!(b.flags.contains(impact_core::report::Flags::DECIMATED));
         }
         checked += 1;
     }

@@ -17,7 +17,7 @@ fn signals() -> PathBuf {
 fn analyze(args: AnalyzeArgs) -> AnalysisJson {
     let setup = pipeline::setup(&args, impact_io::progress::Progress::none())
         .unwrap_or_else(|e| panic!("{e}"));
-    let reports = pipeline::run(&setup.prepared.counts, &setup.scene).unwrap();
+    let reports = pipeline::run(&setup.prepared.counts, &setup.scene, setup.capture_len).unwrap();
     pipeline::to_json(&setup, &reports)
 }
 

@@ -31,7 +31,7 @@ fn spectra(args: AnalyzeArgs) -> (ShockSpectrumJson, ShockSpectrumJson, f64) {
     };
     let setup = pipeline::setup(&args, impact_io::progress::Progress::none())
         .unwrap_or_else(|e| panic!("{e}"));
-    let reports = pipeline::run(&setup.prepared.counts, &setup.scene).unwrap();
+    let reports = pipeline::run(&setup.prepared.counts, &setup.scene, setup.capture_len).unwrap();
     let r = &reports[0];
     let board = spectrum::spectrum_json(r.spectrum.as_ref().expect("the report's spectra"));
     (

@@ -39,6 +39,10 @@ fn analyse(csv: &std::path::Path, speed: &str) -> Value {
         "--train",
         speed,
         "--json",
+        // Every sample of its long contacts held: the pass over the capture finds what the
+        // online sums lose where first touch moves late (`kinematics-not-held`).
+        "--capture-samples",
+        "131072",
     ]);
     serde_json::from_str(&out).unwrap()
 }

@@ -93,6 +93,16 @@ fn fwhm_raw(samples: &[i16], dev: Deviation, per_count: f32, peak: usize) -> Opt
     Some(right - left)
 }
 
+/// Values of a decimated capture a width at half maximum must span to be reported: its two
+/// crossings, each within half a value of the samples', move it by at most 1/32 of itself.
+pub const RESOLVED_WIDTH: f32 = 32.0;
+
+/// A width of `w` values at `step` samples each is resolved: any width on every sample, at
+/// least [`RESOLVED_WIDTH`] values on a decimated capture.
+fn resolved(w: f32, step: u32) -> bool {
+    step == 1 || w >= RESOLVED_WIDTH
+}
+
 /// The first sample of largest `|a|` (index and value); `(0, 0)` if every sample is 0.
 fn scan_peak(a: &[f32]) -> (usize, f32) {
     a.iter().enumerate().fold((0, 0.0f32), |best, (i, &v)| {
@@ -126,7 +136,8 @@ pub fn analyse<const CAP: usize>(
 
 /// The impact judged against the scene's specified pulse ([`crate::spec::verdict`]) on every
 /// sample the capture holds (its padding around the window included), in m/s² above the
-/// baseline in the direction of the impact's peak.
+/// baseline in the direction of the impact's peak. A decimated capture is judged at its step
+/// (each value at the middle of its group), where the nominal duration spans enough of them.
 #[inline(never)]
 fn verdict<const CAP: usize>(
     capture: &Capture<CAP>,
@@ -136,7 +147,7 @@ fn verdict<const CAP: usize>(
 ) -> Result<crate::spec::verdict::Verdict, crate::spec::verdict::Missing> {
     let s = capture.summary();
     let samples = capture.held();
-    let first = s.first_index.saturating_sub(u64::from(s.filter_lead));
+    let first = capture.held_from();
     let per_count = report::per_count(scene, s.base_n);
     let deviation = Deviation::new(s.base_sum, s.base_n);
     let sign = if r.peak_acceleration_m_s2 < 0.0 {
@@ -144,11 +155,22 @@ fn verdict<const CAP: usize>(
     } else {
         1.0
     };
-    let a = |i: u64| {
-        let k = usize::try_from(i.checked_sub(first)?).ok()?;
-        Some(sign * deviation.of(*samples.get(k)?) as f32 * per_count)
-    };
-    crate::spec::verdict::judge(a, scene.calibration.sample_rate_hz, spec, s.peak_index)
+    let value = move |k: usize| Some(sign * deviation.of(*samples.get(k)?) as f32 * per_count);
+    let rate = scene.calibration.sample_rate_hz;
+    let step = capture.step();
+    if step == 1 {
+        let a = |i: u64| value(usize::try_from(i.checked_sub(first)?).ok()?);
+        return crate::spec::verdict::judge(a, rate, spec, s.peak_index);
+    }
+    // In the capture's values: value k is the mean of the samples from stream index
+    // `first + k step`, centred half a group later.
+    let a = |k: u64| value(usize::try_from(k).ok()?);
+    let peak = s.peak_index.saturating_sub(first) / u64::from(step);
+    let mut v = crate::spec::verdict::judge(a, rate / step as f32, spec, peak)?;
+    let shift = (first as f64 + f64::from(step - 1) / 2.0) / f64::from(rate);
+    v.start_s += shift;
+    v.worst_s += shift;
+    Ok(v)
 }
 
 /// The window from [`SPECTRUM_LEAD`] samples before the onset to the end of the capture, in
@@ -165,11 +187,12 @@ fn spectrum<const CAP: usize>(
     let samples = capture.samples();
     let per_count = report::per_count(scene, s.base_n);
     let deviation = Deviation::new(s.base_sum, s.base_n);
-    let from = s
-        .onset_index
-        .saturating_sub(SPECTRUM_LEAD)
-        .max(s.first_index);
-    let skip = (from - s.first_index) as usize;
+    // (In the capture's values: a decimated capture's are `step` samples apart.)
+    let step = u64::from(capture.step());
+    let onset = capture.window_value_at(s.onset_index).unwrap_or(0);
+    let skip = onset.saturating_sub(SPECTRUM_LEAD as usize);
+    let window_from = capture.held_from() + (s.filter_lead as u64 / step) * step;
+    let from = window_from + skip as u64 * step;
     let window = samples.get(skip..)?;
     // The whole workspace: the room beyond the window holds the decimated levels' copies.
     let Workspace { buf, spectrum } = work;
@@ -180,12 +203,12 @@ fn spectrum<const CAP: usize>(
     let mut sp = crate::signal::spectrum::spectrum(
         buf,
         len,
-        scene.calibration.sample_rate_hz,
+        scene.calibration.sample_rate_hz / step as f32,
         settings,
         spectrum,
     )?;
     sp.from_sample = from;
-    sp.to_sample = from + window.len() as u64;
+    sp.to_sample = from + window.len() as u64 * step;
     Some(sp)
 }
 
@@ -206,16 +229,19 @@ fn filter<const CAP: usize>(
 ) -> Option<(usize, f32)> {
     let s = capture.summary();
     let held = capture.held();
-    let pad = class.padding_samples(scene.calibration.sample_rate_hz) as u64;
-    let held_from = s.first_index.saturating_sub(u64::from(s.filter_lead));
-    let before = s.onset_index.saturating_sub(held_from);
+    // (In the capture's values: a decimated capture's are `step` samples apart.)
+    let step = u64::from(capture.step());
+    let rate = scene.calibration.sample_rate_hz / step as f32;
+    let pad = class.padding_samples(rate) as u64;
+    let held_from = capture.held_from();
+    let before = s.onset_index.saturating_sub(held_from) / step;
     let contact_end = s.separation_index.unwrap_or(s.end_index);
-    let after = (held_from + held.len() as u64).saturating_sub(contact_end);
+    let after = (held.len() as u64).saturating_sub(contact_end.saturating_sub(held_from) / step);
     let from_start = held_from == 0 && !s.cut_at_start;
     if (before < pad && !from_start) || after < pad {
         return None;
     }
-    let b = crate::signal::cfc::Biquad::cfc(class, scene.calibration.sample_rate_hz as f64)?;
+    let b = crate::signal::cfc::Biquad::cfc(class, rate as f64)?;
     let a = work.buf.get_mut(..held.len())?;
     let per_count = report::per_count(scene, s.base_n);
     let deviation = Deviation::new(s.base_sum, s.base_n);
@@ -223,7 +249,7 @@ fn filter<const CAP: usize>(
         *slot = deviation.of(x) as f32 * per_count;
     }
     b.phaseless_f32(a);
-    let lead = s.filter_lead as usize;
+    let lead = s.filter_lead as usize >> capture.step().trailing_zeros();
     let window = a.get(lead..lead + capture.samples().len()).unwrap_or(&[]);
     let (i, v) = scan_peak(window);
     Some((lead + i, v))
@@ -254,6 +280,13 @@ fn analyse_kinematics<const CAP: usize>(
     r.analysis = Analysis::Full;
     let samples = capture.samples();
     let n = samples.len();
+    // A decimated capture's values are `step` samples apart (`rate` is theirs).
+    let step = capture.step();
+    let rate = scene.calibration.sample_rate_hz / step as f32;
+    if step > 1 {
+        r.flags.insert(Flags::DECIMATED);
+        r.decimation = step;
+    }
     let per_count = report::per_count(scene, s.base_n);
     let deviation = Deviation::new(s.base_sum, s.base_n);
     let raw = |i: usize| samples.get(i).map_or(0, |&x| deviation.of(x));
@@ -274,13 +307,14 @@ fn analyse_kinematics<const CAP: usize>(
         let held = capture.held().len();
         let a = work.buf.get(..held).unwrap_or(&[]);
         r.filtered_fwhm_s = fwhm(held, |j| a.get(j).map_or(0.0, |v| libm::fabsf(*v)), i)
-            .map(|w| w / scene.calibration.sample_rate_hz);
+            .filter(|&w| resolved(w, step))
+            .map(|w| w / rate);
         r.filtered_peak_acceleration_m_s2 = Some(v);
     }
     // The raw peak's width, always: a filter never changes an unfiltered field. (The
     // stream's peak, if the capture holds it; else the captured part's own.)
-    let (raw_i, raw_a) = match s.peak_index.checked_sub(s.first_index) {
-        Some(i) if (i as usize) < n => (i as usize, r.peak_acceleration_m_s2),
+    let (raw_i, raw_a) = match capture.window_value_at(s.peak_index) {
+        Some(i) if i < n => (i, r.peak_acceleration_m_s2),
         _ => (0..n).fold((0, 0.0f32), |best, i| {
             let v = raw(i) as f32 * per_count;
             if libm::fabsf(v) > libm::fabsf(best.1) {
@@ -290,10 +324,15 @@ fn analyse_kinematics<const CAP: usize>(
             }
         }),
     };
-    r.fwhm_s = fwhm_raw(samples, deviation, per_count, raw_i)
-        .map(|w| w / scene.calibration.sample_rate_hz);
-    if r.fwhm_s.is_none() {
+    let raw_width = fwhm_raw(samples, deviation, per_count, raw_i);
+    r.fwhm_s = raw_width.filter(|&w| resolved(w, step)).map(|w| w / rate);
+    if raw_width.is_none() {
         r.flags.insert(Flags::HALF_MAXIMUM_OUTSIDE);
+    }
+    // The pass and the fits need every sample: a decimated capture keeps the kinematics of
+    // the stream's online sums, and no fit.
+    if step > 1 {
+        return r;
     }
     // The fits scale by the peak of the signal they fit.
     let (_, peak_a) = filtered.unwrap_or((raw_i, raw_a));

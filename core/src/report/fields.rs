@@ -4,7 +4,7 @@
 
 /// Every field of [`super::ImpactReport`] but the bounce, in order, as the `impact` line and
 /// the CSV name them (kinematics and fits flattened).
-pub const FIELDS: [&str; 36] = [
+pub const FIELDS: [&str; 37] = [
     "index",
     "status",
     "analysis",
@@ -22,6 +22,7 @@ pub const FIELDS: [&str; 36] = [
     "fwhm_s",
     "filtered_peak_acceleration_m_s2",
     "filtered_fwhm_s",
+    "decimation",
     "impact_velocity_m_s",
     "crush_time_s",
     "max_deformation_m",

@@ -144,9 +144,15 @@ impl Flags {
     /// the approach speed found at the end moved them beyond the samples kept around them):
     /// the kinematics and the fits are absent.
     pub const KINEMATICS_NOT_HELD: Flags = Flags(1 << 12);
+    /// The contact outlasted the capture, which holds it whole at a coarser step: each value
+    /// the mean of `decimation` samples. The streaming fields and the kinematics are the
+    /// stream's (every sample); the widths, the filtered fields, the spectra and the verdict
+    /// are measured on the coarser values where they resolve them (else absent); the fits
+    /// and the permanent set, which need every sample, are absent.
+    pub const DECIMATED: Flags = Flags(1 << 13);
 
     /// Every flag with its name in the reports.
-    pub const NAMES: [(Flags, &'static str); 13] = [
+    pub const NAMES: [(Flags, &'static str); 14] = [
         (Flags::AC_COUPLED, "ac-coupled"),
         (Flags::COR_OUT_OF_RANGE, "cor-out-of-range"),
         (Flags::NO_STOP, "no-stop"),
@@ -160,6 +166,7 @@ impl Flags {
         (Flags::IN_PREVIOUS, "in-previous"),
         (Flags::APPROACH_UNKNOWN, "approach-unknown"),
         (Flags::KINEMATICS_NOT_HELD, "kinematics-not-held"),
+        (Flags::DECIMATED, "decimated"),
     ];
 
     pub const fn empty() -> Self {
@@ -257,6 +264,9 @@ pub struct ImpactReport {
     pub filtered_peak_acceleration_m_s2: Option<f32>,
     /// Width at half the filtered peak, s (only with a CFC).
     pub filtered_fwhm_s: Option<f32>,
+    /// Samples per value of the capture the analysis fields were measured on: 1, or the power
+    /// of two a contact longer than the capture was decimated to ([`Flags::DECIMATED`]).
+    pub decimation: u32,
     pub kinematics: Option<Kinematics>,
     pub fits: Fits,
     /// The impact continues a bounce train (a streaming field): its flight and both measures
@@ -372,6 +382,7 @@ pub(crate) fn measured(s: &Summary, scene: &Scene) -> ImpactReport {
         fwhm_s: None,
         filtered_peak_acceleration_m_s2: None,
         filtered_fwhm_s: None,
+        decimation: 1,
         kinematics: None,
         fits: Fits::default(),
         bounce: s.bounce.get(),

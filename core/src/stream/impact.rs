@@ -118,7 +118,8 @@ impl<const PRE: usize> Stream<PRE> {
         rise.take(0, pulse, |k| pd(pulse.saturating_sub(1 + k)).unwrap_or(0));
         // The window from `margin` samples before the onset (as far as the ring reaches, and
         // not into the previous impact's window).
-        let reach = self.ring.len().min(REACH).min(CAP / 2);
+        let half_capture = self.capture_len::<CAP>() / 2;
+        let reach = self.ring.len().min(REACH).min(half_capture);
         let margin = (pulse + self.hold as usize / 2)
             .min(reach)
             .min(since_last.max(pulse));
@@ -128,7 +129,7 @@ impl<const PRE: usize> Stream<PRE> {
         // them.
         let lead = (pulse + self.filter_pad as usize)
             .min(self.ring.len())
-            .min(CAP / 2)
+            .min(half_capture)
             .saturating_sub(margin);
         let mut capture = sink.buffer();
         if let Some(c) = capture.as_mut() {
@@ -439,17 +440,17 @@ impl<const PRE: usize> Stream<PRE> {
         if scan.min <= lo || scan.max >= hi {
             a.clipped |= kept.iter().any(|&x| x <= lo || x >= hi);
         }
-        // The capture keeps the first CAP samples of the impact (a filter's lead-in gives way
-        // to them).
+        // The capture keeps the whole impact: a filter's lead-in gives way to it first (the
+        // window at every sample keeps the fits), then it goes on at a coarser step
+        // (`Capture::extend_decimating`).
         if a.captured && !a.full {
             a.full = match sink.buffer() {
                 Some(c) => {
-                    let held = c.held().len();
-                    if a.filter_lead > 0 && held + kept.len() > CAP {
+                    if a.filter_lead > 0 && c.held().len() + kept.len() > c.capacity() {
                         c.drop_front(a.filter_lead as usize);
                         a.filter_lead = 0;
                     }
-                    c.extend(kept) < kept.len()
+                    c.extend_decimating(kept) < kept.len()
                 }
                 None => true,
             };
@@ -560,6 +561,25 @@ impl<const PRE: usize> Stream<PRE> {
         self.end(status, sink);
     }
 
+    /// Whether the tail of `a`'s capture decimates it once full (at stream index `fills_to`):
+    /// where that serves, for a verdict whose window after the peak reaches beyond, or for a
+    /// filter whose padding before the contact is held (else the filter cannot run, and the
+    /// window at every sample keeps the fits).
+    fn tail_decimates(&self, a: &Active, fills_to: u64) -> bool {
+        let rate = self.scene.calibration.sample_rate_hz;
+        let verdict_short = self.scene.spec.is_some_and(|s| {
+            a.peak_index
+                .saturating_add(u64::from(s.padding_samples(rate)))
+                > fills_to
+        });
+        let held_from = a.first_index - u64::from(a.filter_lead);
+        let before = a.onset_index.saturating_sub(held_from);
+        let filter_served = self.scene.cfc.is_some_and(|c| {
+            before >= u64::from(c.padding_samples(rate)) || (held_from == 0 && !a.cut_at_start)
+        });
+        verdict_short || filter_served
+    }
+
     /// The active impact ends without the signal coming back to its baseline (`status`: too
     /// long, settled elsewhere, or the stream ended). A pulse whose onset came more than the
     /// settle time before its peak rode on drift or an orientation change: flagged `drift`.
@@ -661,8 +681,13 @@ impl<const PRE: usize> Stream<PRE> {
                 let contact_end = a.separation.unwrap_or(summary.end_index);
                 let until = contact_end.saturating_add(u64::from(self.filter_pad));
                 let more = !matches!(status, Status::StreamEnded | Status::Gap);
-                if self.filter_pad > 0 && more && !a.full && !c.is_full() && until > self.index {
-                    self.tail = Some(until);
+                // The stream index a capture filled at its step would reach.
+                let fills_to =
+                    c.held_from() + (c.capacity() as u64).saturating_mul(u64::from(c.step()));
+                let decimate = self.tail_decimates(&a, fills_to);
+                let room = !c.is_full() || decimate;
+                if self.filter_pad > 0 && more && !a.full && room && until > self.index {
+                    self.tail = Some((until, decimate));
                 } else {
                     sink.captured(&self.scene);
                     self.handed_over = true;

@@ -96,6 +96,8 @@ pub struct Stream<const PRE: usize> {
     /// Samples a flat new level must last to be a level change.
     settle: u32,
     max_samples: u64,
+    /// The capture's length in use, samples ([`Self::configure_for`]; 0: all `CAP`).
+    capture_len: usize,
     /// Trigger thresholds (raw counts) in force until the next refresh.
     thresholds: Option<(i32, i32)>,
     /// The ring's history is being run again after the first baseline (see `replay_history`).
@@ -118,8 +120,9 @@ pub struct Stream<const PRE: usize> {
     /// it), so neither ever changes where an impact starts or ends.
     filter_pad: u32,
     /// The impact just ended still takes samples into its capture up to this stream index
-    /// (its filter's tail): handed over there, at the next trigger, a gap or the end.
-    tail: Option<u64>,
+    /// (its filter's tail), decimating it if full when the flag says so: handed over there,
+    /// at the next trigger, a gap or the end.
+    tail: Option<(u64, bool)>,
     /// A trigger fired while a capture was handed over: the next call starts its impact at
     /// its first sample (see [`Self::push_to_impact_end`]).
     trigger_pending: bool,
@@ -204,6 +207,7 @@ impl<const PRE: usize> Stream<PRE> {
             hold: 1,
             settle: 1,
             max_samples: 1,
+            capture_len: 0,
             thresholds: None,
             replaying: false,
             trigger_filter: None,
@@ -232,7 +236,17 @@ impl<const PRE: usize> Stream<PRE> {
                 reason: "hold time at this sample rate must be under half the capture length (shorten the hold or lower the rate)",
             });
         }
-        self.configure(scene)
+        self.configure(scene)?;
+        self.capture_len = cap;
+        Ok(())
+    }
+
+    /// The capture's length in use for captures of `CAP` samples.
+    fn capture_len<const CAP: usize>(&self) -> usize {
+        match self.capture_len {
+            0 => CAP,
+            n => n.min(CAP),
+        }
     }
 
     /// As [`Self::configure_for`], without a capture length to check.
@@ -264,6 +278,7 @@ impl<const PRE: usize> Stream<PRE> {
         self.hold = scene.samples(scene.hold_s);
         self.settle = scene.samples(scene.settle_s);
         self.max_samples = scene.samples(scene.max_impact_s) as u64;
+        self.capture_len = 0;
         self.thresholds = None;
         self.replaying = false;
         self.gap_end = None;

@@ -7,12 +7,13 @@ use crate::capture::Sink;
 
 impl<const PRE: usize> Stream<PRE> {
     /// The samples up to `until` into the capture whose tail is being taken (before they are
-    /// kept); hands it over once the tail is complete or the capture full.
+    /// kept; at a coarser step once it is full if `decimate`, see [`Stream::end`]); hands it
+    /// over once the tail is complete or the capture full.
     #[cold]
     #[inline(never)]
     pub(super) fn extend_tail<const CAP: usize>(
         &mut self,
-        until: u64,
+        (until, decimate): (u64, bool),
         samples: &[i16],
         sink: &mut impl Sink<CAP>,
     ) {
@@ -20,7 +21,14 @@ impl<const PRE: usize> Stream<PRE> {
             .unwrap_or(usize::MAX)
             .min(samples.len());
         let part = samples.get(..n).unwrap_or(&[]);
-        let full = sink.buffer().is_none_or(|c| c.extend(part) < part.len());
+        let full = sink.buffer().is_none_or(|c| {
+            let took = if decimate {
+                c.extend_decimating(part)
+            } else {
+                c.extend(part)
+            };
+            took < part.len()
+        });
         if full || n < samples.len() || self.index + n as u64 >= until {
             self.hand_over(sink);
         }

@@ -25,6 +25,10 @@ pub enum EmulateError {
         "--stream: the emulator replays a recording it has read whole (impact analyze --stream reads one as it comes)"
     )]
     Stream,
+    #[error(
+        "--capture-samples: the board's capture is {board} samples; the emulator runs the board as built (impact analyze --capture-samples analyses with another)"
+    )]
+    CaptureSamples { board: usize },
     /// `--plot`: refused before any work, or its figure not written.
     #[error(transparent)]
     Plot(#[from] crate::plot::PlotError),
@@ -255,6 +259,10 @@ pub fn emulate(args: &EmulateArgs) -> Result<crate::report::spec::Judged, Emulat
     tools_available()?;
     if a.stream {
         return Err(EmulateError::Stream);
+    }
+    let board = impact_core::board::CAPTURE_LEN;
+    if a.capture_samples.is_some_and(|n| n as usize != board) {
+        return Err(EmulateError::CaptureSamples { board });
     }
     // No output over an input (the recording, the scene, the free fall, the firmware).
     let mut inputs = super::analyze::inputs(a);

@@ -18,6 +18,9 @@ pub enum Implausible {
     },
     #[error("end_sample={end} before start_sample={start}")]
     EndBeforeStart { start: u64, end: u64 },
+    /// A capture's step is a power of two up to the coarsest the core decimates to.
+    #[error("decimation={value}: not a power of two from 1 to {max}")]
+    Decimation { value: u32, max: u32 },
     /// Beyond what the impact's stream allows (`limit`: s, or m for a `_m` field).
     #[error(
         "{field}={}: implausible (at most {}: {why})",
@@ -177,8 +180,8 @@ const MAX_DEVIATION_COUNTS: f64 = 65_535.0;
 ///
 /// * every time and duration (`start_s`, `peak_time_s`, `duration_s`, `crush_time_s`,
 ///   `fwhm_s`, `filtered_fwhm_s`, `flight_s`), s, lies in the stream up to the impact's end
-///   (`end_sample`) and at most one capture after it ([`CAPTURE_LEN`] samples: a foot or a
-///   filter's tail past the hold);
+///   (`end_sample`) and at most one capture after it ([`CAPTURE_LEN`] values of
+///   `decimation` samples each: a foot or a filter's tail past the hold);
 /// * the contact (`duration_s`, `crush_time_s`, from first touch at `start_s`) ends there
 ///   too, and a width measured in the capture (`fwhm_s`, `filtered_fwhm_s`) is at most one
 ///   capture;
@@ -195,7 +198,14 @@ pub(crate) fn check_plausible(
     gain: Option<f64>,
 ) -> Result<(), Implausible> {
     let sample = 1.0 / rate_hz;
-    let capture = CAPTURE_LEN as f64 / rate_hz;
+    let max = 1u32 << impact_core::capture::MAX_DECIMATION_LOG2;
+    if !r.decimation.is_power_of_two() || r.decimation > max {
+        return Err(Implausible::Decimation {
+            value: r.decimation,
+            max,
+        });
+    }
+    let capture = CAPTURE_LEN as f64 * f64::from(r.decimation) / rate_hz;
     let stream = r.end_sample as f64 / rate_hz + capture;
     let at_most = |field, value: Value, limit: f64, why| {
         if value.f64() <= limit * (1.0 + 1e-6) + sample {

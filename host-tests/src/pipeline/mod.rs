@@ -275,7 +275,7 @@ pub fn analyze(
         streaming::analyze_in_passes(args, progress)
     } else {
         let setup = setup(args, progress)?;
-        let reports = run(&setup.prepared.counts, &setup.scene)?;
+        let reports = run(&setup.prepared.counts, &setup.scene, setup.capture_len)?;
         Ok((setup, reports))
     }?;
     if let Some(note) = args
@@ -287,7 +287,41 @@ pub fn analyze(
     if let Some(note) = time_base_implausible(&setup.assumptions, &reports) {
         impact_io::note(&note);
     }
+    if let Some(note) = decimated(args, setup.rate_hz, &reports) {
+        impact_io::note(&note);
+    }
     Ok((setup, reports))
+}
+
+/// A note when impacts outlasted the capture and were analysed at a coarser step: how many,
+/// what they lack, and the option that holds every sample (if it can).
+pub fn decimated(args: &AnalyzeArgs, rate_hz: f64, reports: &[ImpactReport]) -> Option<String> {
+    let coarse: Vec<_> = reports
+        .iter()
+        .filter(|r| r.flags.contains(impact_core::report::Flags::DECIMATED))
+        .collect();
+    let step = coarse.iter().map(|r| r.decimation).max()?;
+    let len = capture_len(args);
+    let human = crate::report::fmt::human;
+    let whose = if args.capture_samples.is_some() {
+        "the capture"
+    } else {
+        "the board's capture"
+    };
+    let lift = if len < 131_072 {
+        format!(
+            "; --capture-samples 131072 holds {} at every sample",
+            human(131_072.0 / rate_hz, "s")
+        )
+    } else {
+        String::new()
+    };
+    Some(format!(
+        "{} of {} impacts outlasted {whose} ({len} samples, {}) and were measured on the means of up to {step} samples (flag decimated): their kinematics are every sample's, their fits and set are null{lift}",
+        coarse.len(),
+        reports.len(),
+        human(len as f64 / rate_hz, "s"),
+    ))
 }
 
 /// The largest velocity change a drop, shock or impact test makes, m/s: a Δv beyond it comes
@@ -356,8 +390,14 @@ pub fn memory_for_whole(file: &std::path::Path) -> Result<(), PipelineError> {
 
 /// The host's monitor: a 2^15-sample ring (the flanks reach back 4096 samples, as on the board;
 /// the rest is history for a CFC's lead-in: CFC 60's 10 ms up to 3.2 MS/s), a 2^17-sample
-/// capture.
+/// capture, of which `--capture-samples` are used (the board's by default).
 pub type HostMonitor = Monitor<32768, 131072>;
+
+/// The capture length `analyze` uses: `--capture-samples`, else the board's.
+pub fn capture_len(args: &AnalyzeArgs) -> usize {
+    args.capture_samples
+        .map_or(impact_core::board::CAPTURE_LEN, |n| n as usize)
+}
 
 /// A recording turned into raw counts for the core pipeline.
 #[derive(Clone, Debug)]
@@ -403,6 +443,8 @@ pub struct Setup {
     pub free_fall_s: Option<f64>,
     pub samples: u64,
     pub rate_hz: f64,
+    /// The capture's length, samples ([`capture_len`]).
+    pub capture_len: usize,
     /// Isolated spikes removed before quantising (see [`screen::SpikeScan`]).
     pub spikes: Vec<Spike>,
     /// The channel's rails, if known.
@@ -439,6 +481,8 @@ pub struct Resolved {
     pub v0_source: Option<&'static str>,
     /// The standard `--spec` named (its tolerances' source), if a spec was given.
     pub spec_standard: Option<&'static str>,
+    /// The capture's length, samples ([`capture_len`]).
+    pub capture_len: usize,
 }
 
 impl Setup {
@@ -463,6 +507,7 @@ impl Setup {
                 accel_m_s2: Vec::new(),
             },
             scene: resolved.scene,
+            capture_len: resolved.capture_len,
             spec_standard: resolved.spec_standard,
             v0_source: resolved.v0_source.map(str::to_string),
             free_fall_s: None,
@@ -607,7 +652,7 @@ pub fn setup(
     setup.axes = axes;
     if let Some(spec) = &args.free_fall {
         // First pass without v0 to find the first impact, then the free fall before it.
-        let first = run(&setup.prepared.counts, &setup.scene)?;
+        let first = run(&setup.prepared.counts, &setup.scene, setup.capture_len)?;
         let start = first
             .first()
             .map(|r| setup.prepared.t0 + r.start_s)
@@ -799,6 +844,7 @@ pub(crate) fn build_scene(
         scene,
         v0_source: source,
         spec_standard: args.spec.map(|s| s.standard),
+        capture_len: capture_len(args),
     })
 }
 
@@ -934,9 +980,14 @@ pub struct MonitorRun {
 }
 
 impl MonitorRun {
-    pub fn new(scene: Scene) -> Result<Self, PipelineError> {
+    /// With captures of `capture_len` samples (at most the host monitor's).
+    pub fn new(scene: Scene, capture_len: usize) -> Result<Self, PipelineError> {
+        let mut monitor = HostMonitor::unconfigured();
+        monitor
+            .configure_with_capture(scene, capture_len)
+            .map_err(PipelineError::Monitor)?;
         Ok(Self {
-            monitor: HostMonitor::new(scene).map_err(PipelineError::Monitor)?,
+            monitor,
             reports: Vec::new(),
             samples: 0,
         })
@@ -967,11 +1018,15 @@ impl MonitorRun {
 }
 
 /// Analyses the counts of a whole recording.
-pub fn run(counts: &[i16], scene: &Scene) -> Result<Vec<ImpactReport>, PipelineError> {
+pub fn run(
+    counts: &[i16],
+    scene: &Scene,
+    capture_len: usize,
+) -> Result<Vec<ImpactReport>, PipelineError> {
     let scene = *scene;
     let counts = counts.to_vec();
     crate::on_big_stack(move || {
-        let mut run = MonitorRun::new(scene)?;
+        let mut run = MonitorRun::new(scene, capture_len)?;
         run.push(&counts);
         run.finish().map(|(reports, _)| reports)
     })

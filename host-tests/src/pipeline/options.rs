@@ -213,6 +213,15 @@ pub struct AnalyzeArgs {
     /// SAE J211 channel frequency class for the captured windows: 60, 180, 600 or 1000.
     #[arg(long, help_heading = "Analysis")]
     pub cfc: Option<u32>,
+    /// Capture length, samples [default: the board's, 15104].
+    ///
+    /// Capture length, samples, up to 131072 [default: the board's, 15104, so `analyze` and
+    /// the board agree on every impact]: a contact longer is kept whole at a coarser step
+    /// (the mean of 2, 4, 8 … samples: flag `decimated`, field `decimation`), where the
+    /// widths, filter, spectra and verdict are measured and the fits are not. `emulate` runs
+    /// the board's.
+    #[arg(long, help_heading = "Analysis", value_name = "SAMPLES", value_parser = clap::value_parser!(u32).range(256..=131072))]
+    pub capture_samples: Option<u32>,
     #[command(flatten)]
     pub train: crate::pipeline::options::TrainArgs,
     #[command(flatten)]

@@ -273,13 +273,13 @@ pub fn far_from_every_pulse(
         .iter()
         .map(|r| {
             let p = f64::from(r.peak_acceleration_m_s2.abs());
-            let d = r
-                .fwhm_s
-                .map_or(f64::from(r.duration_s), |w| f64::from(w) / fraction);
-            (factor(p, peak).max(factor(d, dur)), p, d)
+            let (d, by) = r.fwhm_s.map_or((f64::from(r.duration_s), "contact"), |w| {
+                (f64::from(w) / fraction, "FWHM")
+            });
+            (factor(p, peak).max(factor(d, dur)), p, d, by)
         })
         .min_by(|a, b| a.0.total_cmp(&b.0))?;
-    let (off, p, d) = nearest;
+    let (off, p, d, by) = nearest;
     if off <= 3.0 {
         return None;
     }
@@ -298,7 +298,7 @@ pub fn far_from_every_pulse(
     }
     let human = crate::report::fmt::human;
     Some(format!(
-        "--spec: no impact judged, and the specified pulse ({}, {}) is far from every measured one (the nearest: peak {}, duration {} by its FWHM){}",
+        "--spec: no impact judged, and the specified pulse ({}, {}) is far from every measured one (the nearest: peak {}, duration {} by its {by}){}",
         human(peak, "m/s²"),
         human(dur, "s"),
         human(p, "m/s²"),

@@ -80,7 +80,7 @@ pub fn analyze(
         mass,
     )?;
     let q = Quantiser { scale, gain };
-    let run = run_monitor(source, q.counts_m_s2(&head), q, resolved.scene, Vec::new())?;
+    let run = run_monitor(source, q.counts_m_s2(&head), q, &resolved, Vec::new())?;
     let reading = Reading {
         column,
         units,
@@ -215,7 +215,7 @@ fn in_passes_then(
     let (source, head) = head_counts(source, q)?;
     let (reports, samples) = match last {
         Last::Analyse => {
-            let run = run_monitor(source, head, q, resolved.scene, removals.clone())?;
+            let run = run_monitor(source, head, q, &resolved, removals.clone())?;
             (run.reports, run.samples)
         }
         Last::Counts(out) => (
@@ -511,11 +511,12 @@ fn run_monitor(
     source: Box<dyn Source>,
     head: Vec<i16>,
     q: Quantiser,
-    scene: impact_core::Scene,
+    resolved: &pipeline::Resolved,
     removals: Vec<Removal>,
 ) -> Result<Analysed, PipelineError> {
+    let (scene, capture_len) = (resolved.scene, resolved.capture_len);
     crate::on_big_stack(move || {
-        let mut run = MonitorRun::new(scene)?;
+        let mut run = MonitorRun::new(scene, capture_len)?;
         let source = for_each_count(source, head, q, &removals, |counts| {
             run.push(counts);
             Ok(())

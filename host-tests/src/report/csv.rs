@@ -154,6 +154,7 @@ impl Columns {
             o(i.fwhm_s),
             o(i.filtered_peak_acceleration_m_s2),
             o(i.filtered_fwhm_s),
+            i.decimation.to_string(),
             o(i.impact_velocity_m_s),
             o(i.crush_time_s),
             o(i.max_deformation_m),

@@ -77,6 +77,9 @@ pub struct ImpactJson {
     pub fwhm_s: Option<f64>,
     pub filtered_peak_acceleration_m_s2: Option<f64>,
     pub filtered_fwhm_s: Option<f64>,
+    /// Samples per value of the capture the analysis fields were measured on: 1, or the
+    /// power of two a contact longer than the capture was decimated to (flag `decimated`).
+    pub decimation: u32,
     pub impact_velocity_m_s: Option<f64>,
     pub crush_time_s: Option<f64>,
     pub max_deformation_m: Option<f64>,
@@ -274,6 +277,9 @@ pub fn null_reasons(r: &ImpactReport, fits: &FitSet) -> BTreeMap<String, String>
         // The raw signal's width: a CFC's window does not touch it.
         let why = if skipped {
             "analysis-skipped"
+        } else if flag(Flags::DECIMATED) && !flag(Flags::HALF_MAXIMUM_OUTSIDE) {
+            // Fewer values across it than `analysis::RESOLVED_WIDTH`.
+            "decimated-too-coarse"
         } else {
             "half-maximum-outside"
         };
@@ -284,7 +290,13 @@ pub fn null_reasons(r: &ImpactReport, fits: &FitSet) -> BTreeMap<String, String>
     }
     if r.filtered_fwhm_s.is_none() {
         let own = if r.filtered_peak_acceleration_m_s2.is_some() {
-            "half-maximum-outside"
+            // (A decimated capture holds the whole contact and the filter's padding: its
+            // half maximum lies inside.)
+            if flag(Flags::DECIMATED) {
+                "decimated-too-coarse"
+            } else {
+                "half-maximum-outside"
+            }
         } else {
             "no-cfc"
         };
@@ -344,6 +356,8 @@ pub fn null_reasons(r: &ImpactReport, fits: &FitSet) -> BTreeMap<String, String>
                 "analysis-skipped"
             } else if r.status == Status::BufferFull {
                 "capture-full"
+            } else if flag(Flags::DECIMATED) {
+                "capture-decimated"
             } else {
                 "set-not-resolved"
             };
@@ -363,6 +377,7 @@ pub fn null_reasons(r: &ImpactReport, fits: &FitSet) -> BTreeMap<String, String>
                 // Kinematics from the online sums, but the loop the fits need was not held.
                 None if skipped => "analysis-skipped",
                 None if r.status == Status::BufferFull => "capture-full",
+                None if flag(Flags::DECIMATED) => "capture-decimated",
                 None => "not-identifiable",
             };
             put(name, why);
@@ -400,6 +415,7 @@ pub fn impact_json(
         fwhm_s: r.fwhm_s.map(f),
         filtered_peak_acceleration_m_s2: r.filtered_peak_acceleration_m_s2.map(f),
         filtered_fwhm_s: r.filtered_fwhm_s.map(f),
+        decimation: r.decimation,
         impact_velocity_m_s: k.map(|k| f(k.impact_velocity_m_s)),
         crush_time_s: k.map(|k| f(k.crush_time_s)),
         max_deformation_m: k.map(|k| f(k.max_deformation_m)),

@@ -29,11 +29,17 @@ impl ImpactLine {
     }
 }
 
+/// Fields older firmware did not write, each read as what that firmware meant: `decimation`
+/// (it held every sample, or cut the capture).
+const ADDED: [&str; 1] = ["decimation"];
+
 /// The report's fields. Every field of the contract is looked for first, in its order: the
-/// first missing one is the error.
+/// first missing one is the error (but for [`ADDED`]).
 fn report(f: &Fields) -> Result<ImpactReport, LineError> {
     for field in impact_core::report::FIELDS {
-        f.text(field)?;
+        if !ADDED.contains(&field) {
+            f.text(field)?;
+        }
     }
     let status = f.text("status")?;
     let status = Status::ALL
@@ -70,6 +76,8 @@ fn report(f: &Fields) -> Result<ImpactReport, LineError> {
         fwhm_s: f.opt("fwhm_s")?,
         filtered_peak_acceleration_m_s2: f.opt("filtered_peak_acceleration_m_s2")?,
         filtered_fwhm_s: f.opt("filtered_fwhm_s")?,
+        // (Firmware before the decimating capture wrote none: it held every sample.)
+        decimation: f.given("decimation")?.unwrap_or(1),
         kinematics,
         fits,
         bounce,
