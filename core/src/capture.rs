@@ -124,10 +124,10 @@ impl<const CAP: usize> Capture<CAP> {
         &self.summary
     }
 
-    /// True if the buffer takes no more samples: full at the step it holds, and not
-    /// decimating (or at [`MAX_DECIMATION_LOG2`]).
+    /// True if the buffer holds as many values as it can at its step (only
+    /// [`Self::extend_decimating`] takes more, at a coarser one).
     pub fn is_full(&self) -> bool {
-        self.len >= self.capacity() && (self.log2 == 0 || self.log2 >= MAX_DECIMATION_LOG2)
+        self.len >= self.capacity()
     }
 
     pub(crate) fn clear(&mut self) {
@@ -137,11 +137,11 @@ impl<const CAP: usize> Capture<CAP> {
         self.pending_n = 0;
     }
 
-    /// Appends what fits (at the step the capture holds: a decimated capture goes on
-    /// decimating); returns how many samples did.
+    /// Appends what fits at the step the capture holds (a decimated capture takes groups,
+    /// but never halves here); returns how many samples did.
     pub(crate) fn extend(&mut self, samples: &[i16]) -> usize {
         if self.log2 > 0 {
-            return self.extend_decimating(samples);
+            return self.extend_grouped(samples, false);
         }
         let cap = self.capacity();
         let free = self.samples.get_mut(self.len..cap).unwrap_or(&mut []);
@@ -154,15 +154,22 @@ impl<const CAP: usize> Capture<CAP> {
     /// Appends every sample, halving what the buffer holds whenever it is full (up to
     /// [`MAX_DECIMATION_LOG2`]); returns how many samples it took.
     pub(crate) fn extend_decimating(&mut self, samples: &[i16]) -> usize {
-        let mut rest = samples;
-        if self.log2 == 0 {
-            let took = self.extend(rest);
-            rest = rest.get(took..).unwrap_or(&[]);
+        if self.log2 > 0 {
+            return self.extend_grouped(samples, true);
         }
+        let took = self.extend(samples);
+        let rest = samples.get(took..).unwrap_or(&[]);
+        took + self.extend_grouped(rest, true)
+    }
+
+    /// Appends samples as groups of [`Self::step`] (halving what the buffer holds when full
+    /// if `halve`); returns how many it took.
+    fn extend_grouped(&mut self, samples: &[i16], halve: bool) -> usize {
+        let mut rest = samples;
         let cap = self.capacity();
         while !rest.is_empty() {
             if self.len >= cap {
-                if self.log2 >= MAX_DECIMATION_LOG2 || !self.halve() {
+                if !halve || self.log2 >= MAX_DECIMATION_LOG2 || !self.halve() {
                     break;
                 }
                 continue;
@@ -315,9 +322,11 @@ mod tests {
         assert_eq!(c.extend_decimating(&[3; 300]), 300);
         assert_eq!((c.step(), c.held().len()), (4, 75));
         assert!(c.held().iter().all(|&v| v == 3));
-        // Once decimated, a plain extend goes on at its step.
+        // Once decimated, a plain extend goes on at its step, but never halves.
         assert_eq!(c.extend(&[3; 100]), 100);
         assert_eq!((c.step(), c.held().len()), (4, 100));
+        assert_eq!(c.extend(&[3; 200]), 112);
+        assert!(c.is_full() && c.step() == 4);
     }
 
     #[test]

@@ -572,7 +572,7 @@ impl<const PRE: usize> Stream<PRE> {
                 .saturating_add(u64::from(s.padding_samples(rate)))
                 > fills_to
         });
-        let held_from = a.first_index - u64::from(a.filter_lead);
+        let held_from = a.first_index.saturating_sub(u64::from(a.filter_lead));
         let before = a.onset_index.saturating_sub(held_from);
         let filter_served = self.scene.cfc.is_some_and(|c| {
             before >= u64::from(c.padding_samples(rate)) || (held_from == 0 && !a.cut_at_start)
@@ -686,6 +686,7 @@ impl<const PRE: usize> Stream<PRE> {
                     c.held_from() + (c.capacity() as u64).saturating_mul(u64::from(c.step()));
                 let decimate = self.tail_decimates(&a, fills_to);
                 let room = !c.is_full() || decimate;
+                // (`is_full`: no room at the capture's step; only a decimating tail makes it.)
                 if self.filter_pad > 0 && more && !a.full && room && until > self.index {
                     self.tail = Some((until, decimate));
                 } else {

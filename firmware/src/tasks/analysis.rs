@@ -34,7 +34,9 @@ pub async fn analysis(scene: Scene, mut captures: CaptureReceiver) {
     loop {
         let capture = captures.receive().await;
         let report = analyse(capture, &scene, work);
-        if scene.waveform_every > 0 {
+        // (A decimated capture's values are `step` samples apart, which the `wave` line
+        // cannot say yet: it sends none, as for a skipped analysis.)
+        if scene.waveform_every > 0 && capture.step() == 1 {
             send_waveform(capture, scene.waveform_every).await;
         }
         captures.receive_done();
