@@ -111,12 +111,22 @@ fn a_contact_longer_than_the_capture_keeps_every_field_that_resolves() {
         assert_eq!(bv["pass"], wv["pass"], "impact {i}: {bv} / {wv}");
         within("margin", num(bv, "margin"), num(wv, "margin"), 1e-2);
         within("Δv", num(bv, "delta_v_m_s"), num(wv, "delta_v_m_s"), 1e-2);
-        // The fits and the set need every sample: null, saying so; present on the whole.
-        let reasons = &b["null_reasons"];
-        for field in ["fits.nonlinear", "permanent_deformation_m"] {
-            assert_eq!(reasons[field], "capture-decimated", "impact {i}: {field}");
+        // The fits on the coarser values' points: the law's parameters within 2 %.
+        let (bf, wf) = (&b["fits"]["nonlinear"], &w["fits"]["nonlinear"]);
+        for p in ["k", "c_s_m", "exponent"] {
+            eprintln!("impact {i} {p}: {} vs {}", bf[p], wf[p]);
+            within(p, num(bf, p), num(wf, p), 2e-2);
         }
-        assert!(w["fits"]["nonlinear"].is_object(), "{w}");
+        // The set, where the whole capture resolves it: within 1 % of the crush's deformation.
+        let x_m = num(w, "max_deformation_m");
+        match (
+            b["permanent_deformation_m"].as_f64(),
+            w["permanent_deformation_m"].as_f64(),
+        ) {
+            (Some(x), Some(y)) => assert!((x - y).abs() <= 0.01 * x_m, "set {x} vs {y}"),
+            (None, None) => {}
+            other => panic!("impact {i}: set {other:?}"),
+        }
     }
 }
 

@@ -1469,11 +1469,6 @@ fn realtime_contacts_twice_the_capture_have_their_kinematics_on_the_board() {
             let mut e_all = e.clone();
             e_all.as_object_mut().unwrap().remove("report_latency_s");
             assert_eq!(&e_all, h, "{extra:?}");
-            // What needs every sample says so.
-            assert_eq!(
-                e["null_reasons"]["permanent_deformation_m"],
-                "capture-decimated"
-            );
             eprintln!(
                 "{extra:?} impact {}: COR {}, reported {:.1} ms after its hold",
                 e["index"],

@@ -255,6 +255,42 @@ fn filter<const CAP: usize>(
     Some((lead + i, v))
 }
 
+/// A decimated capture's window as a recording at the coarser rate: value `k` of
+/// [`Capture::samples`] at instant `k`, the middle of its group of `step` samples (each
+/// standing for its group's interval, so the pass's sums are the samples' sums). Touch and
+/// separation are carried over to that time line; the stream's online record is kept (its
+/// kinematics are every sample's). `None` if the peak is not held.
+fn coarse<const CAP: usize>(
+    capture: &Capture<CAP>,
+    s: &crate::capture::Summary,
+    scene: &Scene,
+) -> Option<(crate::capture::Summary, Scene)> {
+    let step = capture.step();
+    let stepf = f64::from(step);
+    let lead = u64::from(s.filter_lead >> step.trailing_zeros());
+    // The stream index of the window's first value's first sample.
+    let origin = capture.held_from() + lead * u64::from(step);
+    let at = |t: f64| (t - origin as f64 - (stepf - 1.0) / 2.0) / stepf;
+    let touch = at(s.onset_index as f64 + f64::from(s.touch_offset));
+    let onset = libm::ceil(touch).max(0.0);
+    let mut c = *s;
+    c.first_index = 0;
+    c.filter_lead = lead as u32;
+    c.onset_index = onset as u64;
+    c.touch_offset = (touch - onset) as f32;
+    if let Some(i) = s.separation_index {
+        let separation = at(i as f64 + f64::from(s.separation_offset));
+        let first_quiet = libm::ceil(separation).max(onset);
+        c.separation_index = Some(first_quiet as u64);
+        c.separation_offset = (separation - first_quiet) as f32;
+    }
+    c.end_index = capture.samples().len() as u64;
+    c.peak_index = capture.window_value_at(s.peak_index)? as u64;
+    let mut coarse = *scene;
+    coarse.calibration.sample_rate_hz = scene.calibration.sample_rate_hz / step as f32;
+    Some((c, coarse))
+}
+
 /// The analysis with the kinematics from the pass over the capture alone, the stream's
 /// online sums left out: what the two are held to (they give the same bits wherever the
 /// capture holds the contact; `host-tests/tests/online.rs`). No spectra, no verdict.
@@ -329,11 +365,18 @@ fn analyse_kinematics<const CAP: usize>(
     if raw_width.is_none() {
         r.flags.insert(Flags::HALF_MAXIMUM_OUTSIDE);
     }
-    // The pass and the fits need every sample: a decimated capture keeps the kinematics of
-    // the stream's online sums, and no fit.
-    if step > 1 {
-        return r;
-    }
+    // A decimated capture: the pass below runs on its values as on a recording at the
+    // coarser rate ([`coarse`]); the stream's own kinematics stay where it has them.
+    let view;
+    let (s, scene, filter_lead) = if step > 1 {
+        let Some(v) = coarse(capture, s, scene) else {
+            return r;
+        };
+        view = v;
+        (&view.0, &view.1, view.0.filter_lead as usize)
+    } else {
+        (s, scene, filter_lead)
+    };
     // The fits scale by the peak of the signal they fit.
     let (_, peak_a) = filtered.unwrap_or((raw_i, raw_a));
 

@@ -146,9 +146,10 @@ impl Flags {
     pub const KINEMATICS_NOT_HELD: Flags = Flags(1 << 12);
     /// The contact outlasted the capture, which holds it whole at a coarser step: each value
     /// the mean of `decimation` samples. The streaming fields and the kinematics are the
-    /// stream's (every sample); the widths, the filtered fields, the spectra and the verdict
-    /// are measured on the coarser values where they resolve them (else absent); the fits
-    /// and the permanent set, which need every sample, are absent.
+    /// stream's (every sample); the widths, the filtered fields, the spectra, the verdict,
+    /// the fit points (and the kinematics where the stream's online sums lost them) are
+    /// measured on the coarser values, as on a recording at the coarser rate, where they
+    /// resolve them (else absent).
     pub const DECIMATED: Flags = Flags(1 << 13);
 
     /// Every flag with its name in the reports.

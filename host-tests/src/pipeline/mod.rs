@@ -317,7 +317,7 @@ pub fn decimated(args: &AnalyzeArgs, rate_hz: f64, reports: &[ImpactReport]) -> 
         String::new()
     };
     Some(format!(
-        "{} of {} impacts outlasted {whose} ({len} samples, {}) and were measured on the means of up to {step} samples (flag decimated): their kinematics are every sample's, their fits and set are null{lift}",
+        "{} of {} impacts outlasted {whose} ({len} samples, {}) and were held as the means of up to {step} samples (flag decimated): their kinematics come from every sample, their widths, filter, spectra, verdict and fits from those means{lift}",
         coarse.len(),
         reports.len(),
         human(len as f64 / rate_hz, "s"),

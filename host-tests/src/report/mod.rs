@@ -356,8 +356,6 @@ pub fn null_reasons(r: &ImpactReport, fits: &FitSet) -> BTreeMap<String, String>
                 "analysis-skipped"
             } else if r.status == Status::BufferFull {
                 "capture-full"
-            } else if flag(Flags::DECIMATED) {
-                "capture-decimated"
             } else {
                 "set-not-resolved"
             };
@@ -377,7 +375,6 @@ pub fn null_reasons(r: &ImpactReport, fits: &FitSet) -> BTreeMap<String, String>
                 // Kinematics from the online sums, but the loop the fits need was not held.
                 None if skipped => "analysis-skipped",
                 None if r.status == Status::BufferFull => "capture-full",
-                None if flag(Flags::DECIMATED) => "capture-decimated",
                 None => "not-identifiable",
             };
             put(name, why);
