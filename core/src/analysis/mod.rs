@@ -190,7 +190,8 @@ fn spectrum<const CAP: usize>(
     // (In the capture's values: a decimated capture's are `step` samples apart.)
     let step = u64::from(capture.step());
     let onset = capture.window_value_at(s.onset_index).unwrap_or(0);
-    let skip = onset.saturating_sub(SPECTRUM_LEAD as usize);
+    // (The lead-in in samples: as many values as cover them.)
+    let skip = onset.saturating_sub(SPECTRUM_LEAD.div_ceil(step) as usize);
     let window_from = capture.held_from() + (s.filter_lead as u64 / step) * step;
     let from = window_from + skip as u64 * step;
     let window = samples.get(skip..)?;
