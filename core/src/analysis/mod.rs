@@ -260,12 +260,12 @@ fn filter<const CAP: usize>(
 /// [`Capture::samples`] at instant `k`, the middle of its group of `step` samples (each
 /// standing for its group's interval, so the pass's sums are the samples' sums). Touch and
 /// separation are carried over to that time line; the stream's online record is kept (its
-/// kinematics are every sample's). `None` if the peak is not held.
+/// kinematics are every sample's).
 fn coarse<const CAP: usize>(
     capture: &Capture<CAP>,
     s: &crate::capture::Summary,
     scene: &Scene,
-) -> Option<(crate::capture::Summary, Scene)> {
+) -> (crate::capture::Summary, Scene) {
     let step = capture.step();
     let stepf = f64::from(step);
     let lead = u64::from(s.filter_lead >> step.trailing_zeros());
@@ -280,21 +280,25 @@ fn coarse<const CAP: usize>(
     c.onset_index = onset as u64;
     c.touch_offset = (touch - onset) as f32;
     if let Some(i) = s.separation_index {
+        // The first quiet sample's instant, and the zero relative to it (as on every sample:
+        // the frame keeps a separation past the capture's end within it).
         let separation = at(i as f64 + f64::from(s.separation_offset));
-        let first_quiet = libm::ceil(separation).max(onset);
+        let first_quiet = libm::ceil(at(i as f64)).max(onset);
         c.separation_index = Some(first_quiet as u64);
         c.separation_offset = (separation - first_quiet) as f32;
     }
     c.end_index = capture.samples().len() as u64;
-    c.peak_index = capture.window_value_at(s.peak_index)? as u64;
+    c.peak_index = capture.window_value_at(s.peak_index).unwrap_or(0) as u64;
     let mut coarse = *scene;
     coarse.calibration.sample_rate_hz = scene.calibration.sample_rate_hz / step as f32;
-    Some((c, coarse))
+    (c, coarse)
 }
 
 /// The analysis with the kinematics from the pass over the capture alone, the stream's
 /// online sums left out: what the two are held to (they give the same bits wherever the
-/// capture holds the contact; `host-tests/tests/online.rs`). No spectra, no verdict.
+/// capture holds the contact at every sample; `host-tests/tests/online.rs`; on a decimated
+/// capture the pass runs on the coarser values and agrees to their step). No spectra, no
+/// verdict.
 #[doc(hidden)]
 pub fn analyse_by_pass<const CAP: usize>(
     capture: &Capture<CAP>,
@@ -370,10 +374,7 @@ fn analyse_kinematics<const CAP: usize>(
     // coarser rate ([`coarse`]); the stream's own kinematics stay where it has them.
     let view;
     let (s, scene, filter_lead) = if step > 1 {
-        let Some(v) = coarse(capture, s, scene) else {
-            return r;
-        };
-        view = v;
+        view = coarse(capture, s, scene);
         (&view.0, &view.1, view.0.filter_lead as usize)
     } else {
         (s, scene, filter_lead)
@@ -384,9 +385,11 @@ fn analyse_kinematics<const CAP: usize>(
     // The kinematics come from the stream's online sums ([`report::streaming`]); the fit
     // points, and the kinematics where those sums lost the crush or the separation, from a
     // pass over the capture when it holds the whole, unclipped impact (the same sums: the
-    // two agree to the bit where both run).
+    // two agree to the bit where both run on every sample, to the step on a decimated
+    // capture, whose contact must then span `RESOLVED_WIDTH` values).
     let whole = s.status == Status::Complete && !(s.clipped || s.cut_at_start || s.in_previous);
-    let Some(frame) = Frame::of(s, scene, Some(n)).filter(|_| whole) else {
+    let resolves = |f: &Frame| step == 1 || f.separation - f.touch >= f64::from(RESOLVED_WIDTH);
+    let Some(frame) = Frame::of(s, scene, Some(n)).filter(|f| whole && resolves(f)) else {
         return r;
     };
     let from_stream = s.motion.get().ok();
