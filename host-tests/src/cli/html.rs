@@ -392,7 +392,7 @@ fn impacts_table(h: &mut Html, results: &[EntryJson], required: Option<&Required
             human(i.duration_s, "s"),
             o(i.fwhm_s, "s"),
             o(i.cor, ""),
-            std::iter::once(i.status.as_str()).chain(i.flags.iter().map(String::as_str)).collect::<Vec<_>>().join(" "),
+            status_cell(i),
             verdict,
         );
         if let Some(r) = required {
@@ -534,4 +534,16 @@ pub fn log_report(
         figures,
     };
     Ok(page(None, std::slice::from_ref(&entry), None).into_string())
+}
+
+/// An impact's status cell: its status and flags, a decimated capture's with its step.
+fn status_cell(i: &crate::report::ImpactJson) -> String {
+    let flags = i.flags.iter().map(|f| match f.as_str() {
+        "decimated" => format!("decimated ×{}", i.decimation),
+        f => f.to_string(),
+    });
+    std::iter::once(i.status.clone())
+        .chain(flags)
+        .collect::<Vec<_>>()
+        .join(" ")
 }

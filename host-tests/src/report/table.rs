@@ -95,7 +95,7 @@ pub fn to_table(a: &AnalysisJson) -> String {
     }
     for i in &a.impacts {
         s.push_str(&format!(
-            "impact {} [{}{}{}{}] at {:.6} s: peak {}{} ({}){}, Δv {}, duration {}, FWHM {}\n",
+            "impact {} [{}{}{}{}{}] at {:.6} s: peak {}{} ({}){}, Δv {}, duration {}, FWHM {}\n",
             i.index,
             i.status,
             if i.clipped { ", CLIPPED" } else { "" },
@@ -108,6 +108,11 @@ pub fn to_table(a: &AnalysisJson) -> String {
                 ", analysis skipped"
             } else {
                 ""
+            },
+            if i.decimation > 1 {
+                format!(", decimated ×{}", i.decimation)
+            } else {
+                String::new()
             },
             i.start_s,
             if i.clipped { "≥" } else { "" },
