@@ -85,12 +85,30 @@ impl<const CAP: usize> Capture<CAP> {
         let lead = s.filter_lead as usize;
         let window =
             usize::try_from(s.end_index.saturating_sub(s.first_index)).unwrap_or(usize::MAX);
-        let from = lead >> self.log2;
         let end = lead
             .saturating_add(window)
             .div_ceil(self.step() as usize)
             .min(self.len);
-        self.samples.get(from..end).unwrap_or(&[])
+        self.samples.get(self.window_lead()..end).unwrap_or(&[])
+    }
+
+    /// The values of [`Self::held`] before [`Self::samples`] (the filter's lead-in, in values;
+    /// valid once handed over).
+    pub fn window_lead(&self) -> usize {
+        self.summary.filter_lead as usize >> self.log2
+    }
+
+    /// Stream index of the first sample of [`Self::samples`]' first value (`first_index`, or
+    /// up to a step before it on a decimated capture; valid once handed over).
+    pub fn window_from(&self) -> u64 {
+        self.held_from() + ((self.window_lead() as u64) << self.log2)
+    }
+
+    /// The stream time (a fractional sample index) value `k` of [`Self::held`] stands at: the
+    /// middle of its group of [`Self::step`] samples (valid once handed over).
+    pub fn value_time(&self, k: f64) -> f64 {
+        let step = f64::from(self.step());
+        self.held_from() as f64 + k * step + (step - 1.0) / 2.0
     }
 
     /// Stream index of the first sample held (valid once handed over): the window's first
@@ -109,8 +127,7 @@ impl<const CAP: usize> Capture<CAP> {
 
     /// The value of [`Self::samples`] that holds stream index `i`, if held.
     pub fn window_value_at(&self, i: u64) -> Option<usize> {
-        let lead = self.summary.filter_lead as usize >> self.log2;
-        self.value_at(i)?.checked_sub(lead)
+        self.value_at(i)?.checked_sub(self.window_lead())
     }
 
     /// Every sample held: the filter's lead-in (`summary().filter_lead` samples), the window

@@ -7,29 +7,9 @@ mod common;
 use common::{impact, impact_judged, Scratch};
 use serde_json::Value;
 
-/// A soft bounce train of seed 001's nonlinear law (the seed bench's 60 g body, first
-/// approach 1.3357 m/s): 4 contacts of 55–64 ms at 500 kS/s, each outlasting the board's
-/// capture (30.2 ms).
+/// The common soft train ([`common::soft_train_args`]): 4 contacts of 55–64 ms at 500 kS/s.
 fn soft_train(scratch: &Scratch) -> String {
-    let (code, csv, err) = impact(&[
-        "synth",
-        "--model",
-        "nonlinear",
-        "--mass",
-        "0.06",
-        "--v0",
-        "1.3357",
-        "--stiffness",
-        "240",
-        "--damping",
-        "0.5",
-        "--bounces",
-        "4",
-        "--full-scale",
-        "156.9",
-        "--duration",
-        "0.8",
-    ]);
+    let (code, csv, err) = impact(&common::soft_train_args("4", "0.8"));
     assert_eq!(code, 0, "{err}");
     scratch.text("soft-train.csv", &csv)
 }

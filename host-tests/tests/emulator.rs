@@ -1415,24 +1415,7 @@ fn realtime_contacts_twice_the_capture_have_their_kinematics_on_the_board() {
     let file = synth(
         &scratch,
         "soft-train.csv",
-        &[
-            "--model",
-            "nonlinear",
-            "--mass",
-            "0.06",
-            "--v0",
-            "1.3357",
-            "--stiffness",
-            "240",
-            "--damping",
-            "0.5",
-            "--bounces",
-            "4",
-            "--full-scale",
-            "156.9",
-            "--duration",
-            "0.8",
-        ],
+        &common::soft_train_args("4", "0.8")[1..],
     );
     let scene = ["--mass", "0.06", "--v0", "1.3357", "--train", "flight"];
     for extra in [&[][..], &["--srs"][..]] {
@@ -1490,24 +1473,7 @@ fn waveforms_leave_out_decimated_captures_and_say_so() {
     let file = synth(
         &scratch,
         "soft.csv",
-        &[
-            "--model",
-            "nonlinear",
-            "--mass",
-            "0.06",
-            "--v0",
-            "1.3357",
-            "--stiffness",
-            "240",
-            "--damping",
-            "0.5",
-            "--bounces",
-            "2",
-            "--full-scale",
-            "156.9",
-            "--duration",
-            "0.4",
-        ],
+        &common::soft_train_args("2", "0.4")[1..],
     );
     let (_, err) = impact(&["emulate", &file, "--waveforms", "4", "--elf", &elf]);
     assert!(

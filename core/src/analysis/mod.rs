@@ -103,6 +103,11 @@ fn resolved(w: f32, step: u32) -> bool {
     step == 1 || w >= RESOLVED_WIDTH
 }
 
+/// The rate of a capture's values, Hz: the scene's, over a decimated capture's step.
+fn value_rate<const CAP: usize>(capture: &Capture<CAP>, scene: &Scene) -> f32 {
+    scene.calibration.sample_rate_hz / capture.step() as f32
+}
+
 /// The first sample of largest `|a|` (index and value); `(0, 0)` if every sample is 0.
 fn scan_peak(a: &[f32]) -> (usize, f32) {
     a.iter().enumerate().fold((0, 0.0f32), |best, (i, &v)| {
@@ -162,12 +167,11 @@ fn verdict<const CAP: usize>(
         let a = |i: u64| value(usize::try_from(i.checked_sub(first)?).ok()?);
         return crate::spec::verdict::judge(a, rate, spec, s.peak_index);
     }
-    // In the capture's values: value k is the mean of the samples from stream index
-    // `first + k step`, centred half a group later.
+    // In the capture's values, each at the middle of its group (`Capture::value_time`).
     let a = |k: u64| value(usize::try_from(k).ok()?);
     let peak = s.peak_index.saturating_sub(first) / u64::from(step);
-    let mut v = crate::spec::verdict::judge(a, rate / step as f32, spec, peak)?;
-    let shift = (first as f64 + f64::from(step - 1) / 2.0) / f64::from(rate);
+    let mut v = crate::spec::verdict::judge(a, value_rate(capture, scene), spec, peak)?;
+    let shift = capture.value_time(0.0) / f64::from(rate);
     v.start_s += shift;
     v.worst_s += shift;
     Ok(v)
@@ -192,8 +196,7 @@ fn spectrum<const CAP: usize>(
     let onset = capture.window_value_at(s.onset_index).unwrap_or(0);
     // (The lead-in in samples: as many values as cover them.)
     let skip = onset.saturating_sub(SPECTRUM_LEAD.div_ceil(step) as usize);
-    let window_from = capture.held_from() + (s.filter_lead as u64 / step) * step;
-    let from = window_from + skip as u64 * step;
+    let from = capture.window_from() + skip as u64 * step;
     let window = samples.get(skip..)?;
     // The whole workspace: the room beyond the window holds the decimated levels' copies.
     let Workspace { buf, spectrum } = work;
@@ -204,7 +207,7 @@ fn spectrum<const CAP: usize>(
     let mut sp = crate::signal::spectrum::spectrum(
         buf,
         len,
-        scene.calibration.sample_rate_hz / step as f32,
+        value_rate(capture, scene),
         settings,
         spectrum,
     )?;
@@ -232,7 +235,7 @@ fn filter<const CAP: usize>(
     let held = capture.held();
     // (In the capture's values: a decimated capture's are `step` samples apart.)
     let step = u64::from(capture.step());
-    let rate = scene.calibration.sample_rate_hz / step as f32;
+    let rate = value_rate(capture, scene);
     let pad = class.padding_samples(rate) as u64;
     let held_from = capture.held_from();
     let before = s.onset_index.saturating_sub(held_from) / step;
@@ -250,7 +253,7 @@ fn filter<const CAP: usize>(
         *slot = deviation.of(x) as f32 * per_count;
     }
     b.phaseless_f32(a);
-    let lead = s.filter_lead as usize >> capture.step().trailing_zeros();
+    let lead = capture.window_lead();
     let window = a.get(lead..lead + capture.samples().len()).unwrap_or(&[]);
     let (i, v) = scan_peak(window);
     Some((lead + i, v))
@@ -266,12 +269,10 @@ fn coarse<const CAP: usize>(
     s: &crate::capture::Summary,
     scene: &Scene,
 ) -> (crate::capture::Summary, Scene) {
-    let step = capture.step();
-    let stepf = f64::from(step);
-    let lead = u64::from(s.filter_lead >> step.trailing_zeros());
-    // The stream index of the window's first value's first sample.
-    let origin = capture.held_from() + lead * u64::from(step);
-    let at = |t: f64| (t - origin as f64 - (stepf - 1.0) / 2.0) / stepf;
+    // Stream time `t` on the window's values' time line (value 0 at instant 0).
+    let lead = capture.window_lead();
+    let origin = capture.value_time(lead as f64);
+    let at = |t: f64| (t - origin) / f64::from(capture.step());
     let touch = at(s.onset_index as f64 + f64::from(s.touch_offset));
     let onset = libm::ceil(touch).max(0.0);
     let mut c = *s;
@@ -290,7 +291,7 @@ fn coarse<const CAP: usize>(
     c.end_index = capture.samples().len() as u64;
     c.peak_index = capture.window_value_at(s.peak_index).unwrap_or(0) as u64;
     let mut coarse = *scene;
-    coarse.calibration.sample_rate_hz = scene.calibration.sample_rate_hz / step as f32;
+    coarse.calibration.sample_rate_hz = value_rate(capture, scene);
     (c, coarse)
 }
 
@@ -323,7 +324,7 @@ fn analyse_kinematics<const CAP: usize>(
     let n = samples.len();
     // A decimated capture's values are `step` samples apart (`rate` is theirs).
     let step = capture.step();
-    let rate = scene.calibration.sample_rate_hz / step as f32;
+    let rate = value_rate(capture, scene);
     if step > 1 {
         r.flags.insert(Flags::DECIMATED);
         r.decimation = step;

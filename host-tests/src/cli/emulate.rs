@@ -482,11 +482,16 @@ pub fn check_waveforms(
     replayed: &dyn Fn(u64, usize) -> Result<Vec<i16>, ReplayError>,
     every: u16,
 ) -> Result<(), WaveformMismatch> {
+    // (A decimated capture's window is not sent: the `wave` line cannot say its step.)
+    let decimated = log
+        .impacts
+        .iter()
+        .filter(|r| r.flags.contains(impact_core::report::Flags::DECIMATED))
+        .count();
     let analysed = log
         .impacts
         .iter()
         .filter(|r| r.analysis != impact_core::Analysis::Skipped)
-        // (A decimated capture's window is not sent: the `wave` line cannot say its step.)
         .filter(|r| !r.flags.contains(impact_core::report::Flags::DECIMATED))
         .count();
     if log.waveforms.len() != analysed {
@@ -525,11 +530,6 @@ pub fn check_waveforms(
         }
         frames += w.frames;
     }
-    let decimated = log
-        .impacts
-        .iter()
-        .filter(|r| r.flags.contains(impact_core::report::Flags::DECIMATED))
-        .count();
     let unsent = if decimated > 0 {
         format!("; {decimated} decimated captures not sent (the wave line cannot say their step)")
     } else {

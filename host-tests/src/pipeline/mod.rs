@@ -308,10 +308,10 @@ pub fn decimated(args: &AnalyzeArgs, rate_hz: f64, reports: &[ImpactReport]) -> 
     } else {
         "the board's capture"
     };
-    let lift = if len < 131_072 {
+    let lift = if len < HOST_CAPTURE_LEN {
         format!(
-            "; --capture-samples 131072 holds {} at every sample",
-            human(131_072.0 / rate_hz, "s")
+            "; --capture-samples {HOST_CAPTURE_LEN} holds {} at every sample",
+            human(HOST_CAPTURE_LEN as f64 / rate_hz, "s")
         )
     } else {
         String::new()
@@ -391,7 +391,10 @@ pub fn memory_for_whole(file: &std::path::Path) -> Result<(), PipelineError> {
 /// The host's monitor: a 2^15-sample ring (the flanks reach back 4096 samples, as on the board;
 /// the rest is history for a CFC's lead-in: CFC 60's 10 ms up to 3.2 MS/s), a 2^17-sample
 /// capture, of which `--capture-samples` are used (the board's by default).
-pub type HostMonitor = Monitor<32768, 131072>;
+pub type HostMonitor = Monitor<32768, HOST_CAPTURE_LEN>;
+
+/// The host's capture buffer, samples: the most `--capture-samples` may ask for.
+pub const HOST_CAPTURE_LEN: usize = 131_072;
 
 /// The capture length `analyze` uses: `--capture-samples`, else the board's.
 pub fn capture_len(args: &AnalyzeArgs) -> usize {

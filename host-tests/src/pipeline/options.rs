@@ -220,7 +220,7 @@ pub struct AnalyzeArgs {
     /// (the mean of 2, 4, 8 … samples: flag `decimated`, field `decimation`), where the
     /// widths, filter, spectra and verdict are measured and the fits are not. `emulate` runs
     /// the board's.
-    #[arg(long, help_heading = "Analysis", value_name = "SAMPLES", value_parser = clap::value_parser!(u32).range(256..=131072))]
+    #[arg(long, help_heading = "Analysis", value_name = "SAMPLES", value_parser = clap::value_parser!(u32).range(256..=crate::pipeline::HOST_CAPTURE_LEN as i64))]
     pub capture_samples: Option<u32>,
     #[command(flatten)]
     pub train: crate::pipeline::options::TrainArgs,

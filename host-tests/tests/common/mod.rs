@@ -148,6 +148,33 @@ pub fn untitled(svg: &str) -> (String, String) {
     (svg[i..j].to_string(), format!("{}{}", &svg[..i], &svg[j..]))
 }
 
+/// `impact synth` (its arguments, from `synth`) of a soft bounce train of seed 001's nonlinear
+/// law: the seed bench's 60 g body at a first approach of 1.3357 m/s on a soft barrier
+/// (k 240, c 0.5), ±16 g at 500 kS/s, `bounces` contacts of 55 ms and more (each outlasting
+/// the board's capture, 30.2 ms) over `duration` s.
+#[allow(dead_code)] // not every test file needs it
+pub fn soft_train_args<'a>(bounces: &'a str, duration: &'a str) -> [&'a str; 17] {
+    [
+        "synth",
+        "--model",
+        "nonlinear",
+        "--mass",
+        "0.06",
+        "--v0",
+        "1.3357",
+        "--stiffness",
+        "240",
+        "--damping",
+        "0.5",
+        "--bounces",
+        bounces,
+        "--full-scale",
+        "156.9",
+        "--duration",
+        duration,
+    ]
+}
+
 /// A scratch folder for a test's files, removed when it drops (also when the test fails).
 #[allow(dead_code)] // not every test file needs it
 pub struct Scratch(tempfile::TempDir);
