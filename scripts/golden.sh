@@ -66,6 +66,7 @@ normalise() {
     -e 's/^\[[0-9.:, ]+\]/[T]/' \
     -e 's/^[0-9]+\.[0-9]+ (TRACE|DEBUG|INFO|WARN|ERROR) /T \1 /' \
     -e 's/(busy )[0-9.]+ %/\1T %/g' \
+    -e 's/(stack )[0-9]+( of [0-9]+ B \()[0-9]+( %\))/\1T\2T\3/g' \
     -e '/^building the QEMU firmware/d' \
     "$1"
 }
