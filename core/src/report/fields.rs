@@ -46,9 +46,10 @@ pub const FIELDS: [&str; 37] = [
 
 /// The bounce of a train ([`super::Bounce`]), after [`FIELDS`] (all `none` for a train's
 /// first impact).
-pub const BOUNCE_FIELDS: [&str; 4] = [
+pub const BOUNCE_FIELDS: [&str; 5] = [
     "bounce_number",
     "flight_s",
     "v0_flight_m_s",
     "v0_rebound_m_s",
+    "landing_height_m",
 ];

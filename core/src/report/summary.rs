@@ -11,10 +11,18 @@ pub struct Bounce {
     pub number: u32,
     /// From the previous separation to this first touch, s.
     pub flight_s: f32,
-    /// `g t_flight / 2`, m/s.
+    /// The landing speed the flight time gives, `g t / 2 - h / t`, m/s.
     pub v0_flight_m_s: f32,
-    /// The previous impact's rebound, m/s; absent if it had none (no Δv, a COR out of range).
+    /// The landing speed the previous rebound gives, `sqrt(v_r² - 2 g h)`, m/s; absent if the
+    /// previous impact had no rebound (no Δv, a COR out of range).
     pub v0_rebound_m_s: Option<f32>,
+    /// `h`: how far above the previous separation the body landed, m. The body leaves a pad
+    /// at its separation deformation `x_sep`; a pad that recovers its shape (elastic,
+    /// viscoelastic) meets it again at the surface it touched (`h = x_sep`), one that keeps
+    /// the dent where the body left it (a crushed pad) at that depth (`h = 0`). Of the two,
+    /// the one whose take-off speed `g t / 2 + h / t` is nearer the previous rebound; 0 where
+    /// nothing measured the rebound or `x_sep` (see `stream/train.rs`).
+    pub landing_height_m: f32,
 }
 
 /// What the streaming stage knows of one impact when it ends: positions, and exact integer
@@ -95,6 +103,7 @@ pub struct BounceSlot {
     v0_flight_m_s: f32,
     v0_rebound_m_s: f32,
     has_rebound: bool,
+    landing_height_m: f32,
 }
 
 impl BounceSlot {
@@ -105,6 +114,7 @@ impl BounceSlot {
         v0_flight_m_s: 0.0,
         v0_rebound_m_s: 0.0,
         has_rebound: false,
+        landing_height_m: 0.0,
     };
 
     /// The bounce kept (a bounce's number is at least 1).
@@ -114,6 +124,7 @@ impl BounceSlot {
             flight_s: self.flight_s,
             v0_flight_m_s: self.v0_flight_m_s,
             v0_rebound_m_s: self.has_rebound.then_some(self.v0_rebound_m_s),
+            landing_height_m: self.landing_height_m,
         })
     }
 }
@@ -127,6 +138,7 @@ impl From<Option<Bounce>> for BounceSlot {
                 v0_flight_m_s: b.v0_flight_m_s,
                 v0_rebound_m_s: b.v0_rebound_m_s.unwrap_or(0.0),
                 has_rebound: b.v0_rebound_m_s.is_some(),
+                landing_height_m: b.landing_height_m,
             },
             None => Self::NONE,
         }
@@ -263,6 +275,7 @@ mod tests {
             flight_s: 0.1,
             v0_flight_m_s: 0.5,
             v0_rebound_m_s: None,
+            landing_height_m: 2e-4,
         };
         assert_eq!(BounceSlot::from(Some(b)).get(), Some(b));
         let b = Bounce {

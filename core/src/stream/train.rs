@@ -2,17 +2,31 @@
 //! since the previous separation and from the previous rebound.
 //!
 //! A body dropped on a barrier bounces: between two contacts it flies up and falls back under
-//! gravity, so it lands at the speed it left with (no drag; gravity along the sensor's axis,
-//! the flight vertical) and
+//! gravity (no drag; gravity along the sensor's axis, the flight vertical). It leaves the pad
+//! at the previous contact's separation deformation `x_sep` and lands `h` higher, where the
+//! pad's surface is by then, so after a flight `t` (from one separation to the next first
+//! touch)
 //!
 //! ```text
-//! v0_flight = g t_flight / 2        (t_flight from one separation to the next first touch)
-//! v0_rebound = Δv_prev - v0_prev     (the previous impact's measured rebound)
+//! v0_flight  = g t / 2 - h / t             (ballistic: up at g t / 2 + h / t, down at this)
+//! v0_rebound = sqrt(v_r² - 2 g h)           (v_r: the previous impact's measured rebound)
 //! ```
 //!
-//! are two independent measures of the same speed: the flight time needs only the stream's
-//! positions (exact) and `g`; the rebound carries the previous approach speed's error with
-//! the opposite sign. Both are reported; the scene picks the one the kinematics use.
+//! are two measures of the same speed: the flight time needs only the stream's positions
+//! (exact) and `g`; the rebound carries the previous approach speed's error with the opposite
+//! sign. Both are reported; the scene picks the one the kinematics use.
+//!
+//! The landing height `h` (Stronge, *Impact Mechanics*, ch. 1: the pad's surface after
+//! restitution) is one of two: `x_sep`, for a pad that recovers its shape between contacts
+//! (elastic and viscoelastic: a Kelvin–Voigt pad leaves the body `c v / k` deep and springs
+//! back behind it), or 0, for one that keeps the dent where the body left it (a crushed pad;
+//! the two-phase law, whose separation lies at its set). The previous rebound chooses: the
+//! one whose take-off speed `g t / 2 + h / t` is nearer to it. They differ by `x_sep / t`,
+//! which matters (a crushed pad's first bounce: 9 %) exactly where the rebound tells them
+//! apart; where the rebound cannot (a Kelvin–Voigt pad's last bounces) they differ by less
+//! than its error. Without a rebound or a separation deformation the body is taken to land
+//! where it left (`h = 0`), as before this rule, and the report's `landing_height_m` says so.
+//!
 //! A flight longer than the scene's longest (a new drop, the body picked up), a previous
 //! impact without a separation (settled, too long, a gap, the stream ended) or without an
 //! approach speed ends the train: the next impact is a first one, with the scene's
@@ -50,6 +64,9 @@ pub(crate) struct Tracker {
     last_end: Option<f64>,
     /// The previous impact's rebound speed, m/s, if known and in range.
     rebound_m_s: Option<f32>,
+    /// The previous impact's separation deformation, m (0 if the online sums found none, or
+    /// below its touch point).
+    separation_deformation_m: f32,
     /// The previous impact's bounce number (0 for a train's first impact).
     number: u32,
 }
@@ -61,6 +78,7 @@ impl Tracker {
             separation: None,
             last_end: None,
             rebound_m_s: None,
+            separation_deformation_m: 0.0,
             number: 0,
         }
     }
@@ -110,11 +128,17 @@ impl Tracker {
         else {
             return unmeasured(measured);
         };
+        let g = scene.gravity_m_s2;
+        let half = g * flight_s / 2.0;
+        let h = self.landing_height_m(half, flight_s);
         let bounce = Bounce {
             number: self.number.saturating_add(1),
             flight_s,
-            v0_flight_m_s: scene.gravity_m_s2 * flight_s / 2.0,
-            v0_rebound_m_s: self.rebound_m_s,
+            v0_flight_m_s: half - h / flight_s,
+            v0_rebound_m_s: self
+                .rebound_m_s
+                .map(|v| libm::sqrtf((v * v - 2.0 * g * h).max(0.0))),
+            landing_height_m: h,
         };
         let v0 = match train.speed {
             TrainSpeed::Flight => Some(bounce.v0_flight_m_s),
@@ -124,6 +148,25 @@ impl Tracker {
             v0_m_s: v0.filter(|v| v.is_finite() && *v > 0.0),
             bounce: Some(bounce),
             unknown: false,
+        }
+    }
+
+    /// The landing height `h` after a flight of `flight_s` (`half`: `g t / 2`): the previous
+    /// separation deformation if the pad recovered, 0 if it kept the dent, whichever take-off
+    /// speed `g t / 2 + h / t` is nearer the previous rebound (a tie: recovered); 0 without a
+    /// rebound.
+    fn landing_height_m(&self, half: f32, flight_s: f32) -> f32 {
+        let x_sep = self.separation_deformation_m;
+        match self.rebound_m_s {
+            Some(v_r) if x_sep > 0.0 => {
+                let recovered = half + x_sep / flight_s;
+                if (v_r - recovered).abs() <= (v_r - half).abs() {
+                    x_sep
+                } else {
+                    0.0
+                }
+            }
+            _ => 0.0,
         }
     }
 
@@ -163,10 +206,17 @@ impl Tracker {
             } else {
                 0.0
             };
+        // (The online sums' separation deformation: the analysis's comes later, and the next
+        // impact's approach cannot wait for it.)
+        let separation_deformation_m = match s.motion.get() {
+            Ok(found) if found.x_sep.is_finite() && found.x_sep > 0.0 => found.x_sep as f32,
+            _ => 0.0,
+        };
         *self = Tracker {
             separation: separation.filter(|_| scene.train.is_some()),
             last_end: contact.then_some(last_end),
             rebound_m_s: rebound,
+            separation_deformation_m,
             number: s.bounce.get().map_or(0, |b| b.number),
         };
     }
@@ -206,6 +256,7 @@ mod tests {
             separation: Some(0.0),
             last_end: Some(0.0),
             rebound_m_s: Some(1.0),
+            separation_deformation_m: 0.0,
             number: 0,
         };
         // 2.5 s of flight: a new drop.
@@ -223,6 +274,7 @@ mod tests {
             separation: None,
             last_end: Some(0.0),
             rebound_m_s: None,
+            separation_deformation_m: 0.0,
             number: 0,
         };
         // 0.1 s after the previous contact: a bounce, at a speed nothing measured.
@@ -254,6 +306,7 @@ mod tests {
             separation: None,
             last_end: Some(0.0),
             rebound_m_s: None,
+            separation_deformation_m: 0.0,
             number: 0,
         };
         let a = t.approach(&s, 10_000.0, Some(1.5), false);
@@ -276,6 +329,7 @@ mod tests {
             separation: Some(1000.0),
             last_end: Some(1000.0),
             rebound_m_s: Some(0.4),
+            separation_deformation_m: 0.0,
             number: 2,
         };
         // 0.1 s of flight: g t / 2 = 0.4903 m/s.
@@ -299,5 +353,49 @@ mod tests {
         let a = t.approach(&s, 11_000.0, Some(1.5), false);
         assert_eq!(a.v0_m_s, None);
         assert!(a.bounce.is_some() && !a.unknown);
+    }
+
+    #[test]
+    fn a_bounce_lands_where_the_pad_is_after_the_flight() {
+        let s = scene();
+        let g = s.gravity_m_s2;
+        // 0.1 s of flight after a contact that left the body 2 mm deep.
+        let t = Tracker {
+            separation: Some(1000.0),
+            last_end: Some(1000.0),
+            rebound_m_s: None,
+            separation_deformation_m: 2e-3,
+            number: 1,
+        };
+        let half = g * 0.1 / 2.0;
+        let speeds = |t: &Tracker| {
+            let b = t.approach(&s, 11_000.0, Some(1.5), false).bounce.unwrap();
+            (b.landing_height_m, b.v0_flight_m_s, b.v0_rebound_m_s)
+        };
+        // No rebound to tell the pads apart: it lands where it left, as if nothing rose.
+        assert_eq!(speeds(&t), (0.0, half, None));
+        // A rebound at the take-off speed of a recovered pad: it lands 2 mm higher, slower.
+        let up = half + 2e-3 / 0.1;
+        let (h, flight, rebound) = speeds(&Tracker {
+            rebound_m_s: Some(up),
+            ..t
+        });
+        assert_eq!(h, 2e-3);
+        assert!((flight - (half - 0.02)).abs() < 1e-6, "{flight}");
+        // Both measures agree: sqrt(up² - 2 g h) = g t - up.
+        assert!((rebound.unwrap() - flight).abs() < 1e-5, "{rebound:?}");
+        // A rebound at the take-off speed of a crushed pad: it lands where it left.
+        let (h, flight, rebound) = speeds(&Tracker {
+            rebound_m_s: Some(half * 1.001),
+            ..t
+        });
+        assert_eq!((h, flight, rebound), (0.0, half, Some(half * 1.001)));
+        // A separation the sums did not find (0): nothing rises.
+        let (h, flight, _) = speeds(&Tracker {
+            rebound_m_s: Some(up),
+            separation_deformation_m: 0.0,
+            ..t
+        });
+        assert_eq!((h, flight), (0.0, half));
     }
 }

@@ -190,7 +190,7 @@ fn log_impact(r: &ImpactReport) {
     let hz = r.fits.hertz;
     let b = r.bounce;
     info!(
-        "impact seq={=u32} index={=u32} status={=str} analysis={=str} clipped={=bool} flags={=u16} start_sample={=u64} end_sample={=u64} start_s={=f64} peak_time_s={=f64} peak_acceleration_m_s2={=f32} peak_force_n={} delta_v_m_s={} duration_s={=f32} baseline_m_s2={=f32} fwhm_s={} filtered_peak_acceleration_m_s2={} filtered_fwhm_s={} decimation={=u32} impact_velocity_m_s={} crush_time_s={} max_deformation_m={} rebound_velocity_m_s={} cor={} separation_deformation_m={} permanent_deformation_m={} absorbed_energy_j={} two_phase_kc_n_m={} two_phase_kr_n_m={} two_phase_c_n_s_m={} two_phase_permanent_deformation_m={} two_phase_residual={} nonlinear_k={} nonlinear_c_s_m={} nonlinear_exponent={} nonlinear_residual={} hertz_k={} hertz_residual={} bounce_number={} flight_s={} v0_flight_m_s={} v0_rebound_m_s={} report_latency_s={}",
+        "impact seq={=u32} index={=u32} status={=str} analysis={=str} clipped={=bool} flags={=u16} start_sample={=u64} end_sample={=u64} start_s={=f64} peak_time_s={=f64} peak_acceleration_m_s2={=f32} peak_force_n={} delta_v_m_s={} duration_s={=f32} baseline_m_s2={=f32} fwhm_s={} filtered_peak_acceleration_m_s2={} filtered_fwhm_s={} decimation={=u32} impact_velocity_m_s={} crush_time_s={} max_deformation_m={} rebound_velocity_m_s={} cor={} separation_deformation_m={} permanent_deformation_m={} absorbed_energy_j={} two_phase_kc_n_m={} two_phase_kr_n_m={} two_phase_c_n_s_m={} two_phase_permanent_deformation_m={} two_phase_residual={} nonlinear_k={} nonlinear_c_s_m={} nonlinear_exponent={} nonlinear_residual={} hertz_k={} hertz_residual={} bounce_number={} flight_s={} v0_flight_m_s={} v0_rebound_m_s={} landing_height_m={} report_latency_s={}",
         crate::logger::next_seq(),
         r.index,
         r.status.name(),
@@ -233,6 +233,7 @@ fn log_impact(r: &ImpactReport) {
         Opt(b.map(|b| b.flight_s)),
         Opt(b.map(|b| b.v0_flight_m_s)),
         Opt(b.and_then(|b| b.v0_rebound_m_s)),
+        Opt(b.map(|b| b.landing_height_m)),
         Opt(SAMPLE_CLOCK.since_sample_s(r.end_sample)),
     );
 }

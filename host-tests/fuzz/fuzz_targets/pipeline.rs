@@ -202,7 +202,9 @@ fn finite(r: &ImpactReport) -> bool {
     if let Some(b) = &r.bounce {
         ok &= b.flight_s.is_finite()
             && b.v0_flight_m_s.is_finite()
-            && b.v0_rebound_m_s.is_none_or(f32::is_finite);
+            && b.v0_rebound_m_s.is_none_or(f32::is_finite)
+            && b.landing_height_m.is_finite()
+            && b.landing_height_m >= 0.0;
     }
     if let Some(s) = &r.spectrum {
         ok &= s.srs_m_s2.iter().chain(&s.pvss_m_s).all(|v| v.is_finite());

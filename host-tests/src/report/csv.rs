@@ -183,6 +183,7 @@ impl Columns {
                 o(b.map(|b| b.flight_s)),
                 o(b.map(|b| b.v0_flight_m_s)),
                 o(b.and_then(|b| b.v0_rebound_m_s)),
+                o(b.map(|b| b.landing_height_m)),
                 o(b.and_then(|b| b.cor_flight)),
                 o(b.and_then(|b| b.cor_rebound)),
             ]);

@@ -14,10 +14,15 @@ pub struct BounceJson {
     pub number: u32,
     /// From the previous separation to this first touch, s.
     pub flight_s: f64,
-    /// `g t_flight / 2`, m/s.
+    /// The landing speed the flight gives, `g t / 2 - h / t`, m/s.
     pub v0_flight_m_s: f64,
-    /// The previous impact's rebound, m/s (null: it had none).
+    /// The landing speed the previous rebound gives, `sqrt(v_r² - 2 g h)`, m/s (null: it had
+    /// none).
     pub v0_rebound_m_s: Option<f64>,
+    /// `h`, how far above the previous separation the body landed, m: the previous separation
+    /// deformation (the pad recovered its shape) or 0 (it kept the dent), as the previous
+    /// rebound chose (core's `stream/train.rs`).
+    pub landing_height_m: f64,
     /// `(Δv - v0) / v0` with each speed; null when it cannot be known, the reason beside:
     /// `clipped` (Δv a lower bound), `ac-coupled` (no Δv), `no-rebound` (no previous rebound,
     /// or it was clipped), `cor-out-of-range` (outside
@@ -56,6 +61,7 @@ pub fn bounce_json(r: &ImpactReport, gravity_m_s2: Option<f32>) -> Option<Bounce
         flight_s: f(b.flight_s),
         v0_flight_m_s: f(b.v0_flight_m_s),
         v0_rebound_m_s: b.v0_rebound_m_s.map(f),
+        landing_height_m: f(b.landing_height_m),
         cor_flight: flight.ok(),
         cor_flight_null_reason: flight.err().map(str::to_string),
         cor_rebound: rebound.ok(),
@@ -206,9 +212,14 @@ pub fn table_line(b: &BounceJson) -> String {
         (None, None) => "-".to_string(),
     };
     format!(
-        "    bounce {}: flight {} → v0 {} (COR {}); previous rebound {} (COR {}){}\n",
+        "    bounce {}: flight {}{} → v0 {} (COR {}); previous rebound {} (COR {}){}\n",
         b.number,
         h(b.flight_s, "s"),
+        if b.landing_height_m > 0.0 {
+            format!(", landing {} up", h(b.landing_height_m, "m"))
+        } else {
+            String::new()
+        },
         h(b.v0_flight_m_s, "m/s"),
         cor(b.cor_flight, &b.cor_flight_null_reason),
         b.v0_rebound_m_s

@@ -154,5 +154,11 @@ fn bounce(f: &Fields) -> Result<Option<Bounce>, LineError> {
         flight_s: f.num("flight_s")?,
         v0_flight_m_s: f.num("v0_flight_m_s")?,
         v0_rebound_m_s: f.opt("v0_rebound_m_s")?,
+        // (Firmware before the landing height took every flight to land where it left.)
+        landing_height_m: if f.contains("landing_height_m") {
+            f.num("landing_height_m")?
+        } else {
+            0.0
+        },
     }))
 }
