@@ -1466,10 +1466,11 @@ fn realtime_contacts_twice_the_capture_have_their_kinematics_on_the_board() {
     }
 }
 
-/// A decimated capture's window is not sent (the `wave` line cannot say its step yet): the
-/// check of the windows sent passes and says how many were not.
+/// A decimated capture's window is sent at its step (`every` rounded down to whole values,
+/// at least the step): the check against the replayed samples' means passes and says how
+/// many were decimated; `impact log` puts each window back at its samples' times.
 #[test]
-fn waveforms_leave_out_decimated_captures_and_say_so() {
+fn a_decimated_captures_window_is_sent_at_its_step() {
     let scratch = Scratch::new();
     let Some(elf) = firmware() else { return };
     let elf = elf.to_string_lossy().into_owned();
@@ -1478,11 +1479,83 @@ fn waveforms_leave_out_decimated_captures_and_say_so() {
         "soft.csv",
         &common::soft_train_args("2", "0.4")[1..],
     );
-    let (_, err) = impact(&["emulate", &file, "--waveforms", "4", "--elf", &elf]);
+    let log = scratch.join_str("soft.log");
+    let log = log.as_str();
+    let (out, err) = impact(&[
+        "emulate",
+        &file,
+        "--waveforms",
+        "4",
+        "--elf",
+        &elf,
+        "--json",
+        "--log",
+        log,
+    ]);
     assert!(
-        err.contains("waveforms: 0 windows, 0 frames, equal to the replayed samples; 2 decimated captures not sent"),
+        err.contains("waveforms: 2 windows,")
+            && err.contains("(2 decimated captures within 2 counts of the samples' means)"),
         "{err}"
     );
+    let json: serde_json::Value = serde_json::from_str(&out).unwrap();
+    for (w, r) in json["waveforms"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .zip(json["impacts"].as_array().unwrap())
+    {
+        let step = r["decimation"].as_u64().unwrap();
+        assert!(step > 1, "{r}");
+        // Every 4 samples asked: whole values of `step` samples, at least one.
+        assert_eq!(
+            w["every"].as_u64().unwrap(),
+            (4 / step * step).max(step),
+            "{w}"
+        );
+        assert_eq!(w["samples"].as_u64().unwrap() % step, 0, "{w}");
+        let (first, samples) = (
+            w["first_sample"].as_u64().unwrap(),
+            w["samples"].as_u64().unwrap(),
+        );
+        assert!(
+            first <= r["start_sample"].as_u64().unwrap()
+                && first + samples >= r["end_sample"].as_u64().unwrap() - step,
+            "{w} {r}"
+        );
+    }
+    // Every sample asked: one value per step, each the capture's own.
+    let (_, err) = impact(&["emulate", &file, "--waveforms", "--elf", &elf]);
+    assert!(
+        err.contains("(2 decimated captures within 2 counts of the samples' means)"),
+        "{err}"
+    );
+    // The board's log read back: each window's values at their samples' times (a row per
+    // `every` samples, at its first sample's time, as for any `every`).
+    let csv = scratch.join_str("w.csv");
+    impact(&["log", log, "--export", &csv]);
+    let rate = json["sample_rate_hz"].as_f64().unwrap();
+    let w = &json["waveforms"][0];
+    let text = std::fs::read_to_string(scratch.join("w-0.csv")).unwrap();
+    let times: Vec<f64> = text
+        .lines()
+        .skip(1)
+        .map(|l| l.split(',').next().unwrap().parse().unwrap())
+        .collect();
+    let every = w["every"].as_f64().unwrap();
+    assert_eq!(
+        times.len() as u64,
+        w["samples"]
+            .as_u64()
+            .unwrap()
+            .div_ceil(w["every"].as_u64().unwrap())
+    );
+    assert!(
+        ((times[1] - times[0]) * rate - every).abs() < 1e-6,
+        "{:?}",
+        &times[..2]
+    );
+    let first = w["first_sample"].as_f64().unwrap();
+    assert!((times[0] * rate - first).abs() < 1e-3, "{}", times[0]);
 }
 
 /// The bring-up self-test's path through the whole emulated monitor (`impact selftest`): what

@@ -34,9 +34,7 @@ pub async fn analysis(scene: Scene, mut captures: CaptureReceiver) {
     loop {
         let capture = captures.receive().await;
         let report = analyse(capture, &scene, work);
-        // (A decimated capture's values are `step` samples apart, which the `wave` line
-        // cannot say yet: it sends none, as for a skipped analysis.)
-        if scene.waveform_every > 0 && capture.step() == 1 {
+        if scene.waveform_every > 0 {
             send_waveform(capture, scene.waveform_every).await;
         }
         captures.receive_done();
@@ -45,25 +43,33 @@ pub async fn analysis(scene: Scene, mut captures: CaptureReceiver) {
 }
 
 /// The captured window as a `wave` line and its `wave_frame` lines (docs/board.md),
-/// before the impact's own line.
+/// before the impact's own line. The line speaks in samples: a decimated capture's values
+/// each hold `step` of them, so a value sent is the mean of `every / step` values (at least
+/// one) and stands for `every` samples rounded down to a whole number of values (at least
+/// `step`; at most `max(every, step)`, within a `u16`); the window spans its values × `step`.
 async fn send_waveform(capture: &FwCapture, every: u16) {
     let s = capture.summary();
-    let samples = capture.samples();
-    let frames = waveform::frames(samples.len(), every);
+    let values = capture.samples();
+    let step = capture.step();
+    // (`step` is at most 4096 and `every / step * step` at most `every`: both fit a u16.)
+    let per_value = (u32::from(every) / step).max(1);
+    let every_samples = u16::try_from(per_value * step).unwrap_or(u16::MAX);
+    let per_value = per_value as u16;
+    let frames = waveform::frames(values.len(), per_value);
     info!(
         "wave seq={=u32} index={=u32} first_sample={=u64} samples={=u32} every={=u16} frames={=u32} base_sum={=i64} base_n={=i64}",
         crate::logger::next_seq(),
         s.index,
-        s.first_index,
-        samples.len() as u32,
-        every,
+        capture.window_from(),
+        (values.len() as u32).saturating_mul(step),
+        every_samples,
         frames as u32,
         s.base_sum,
         s.base_n,
     );
     let mut buf = [0i16; FRAME_LEN];
     for k in 0..frames {
-        let n = waveform::frame(samples, every, k, &mut buf);
+        let n = waveform::frame(values, per_value, k, &mut buf);
         info!(
             "wave_frame seq={=u32} index={=u32} frame={=u32} counts={=[?]}",
             crate::logger::next_seq(),

@@ -476,23 +476,19 @@ fn read_counts(path: &std::path::Path, from: u64, n: usize) -> Result<Vec<i16>, 
 
 /// Every analysed impact's window, as the firmware sent it, against the replayed samples
 /// (whole or averaged the same way): equal value for value, or an error naming the first
-/// difference. Prints what it checked.
+/// difference. A decimated capture's window (its values each the mean of `step` samples,
+/// halved in place as the buffer filled) comes at `every` rounded down to whole values (at
+/// least `step`), each value within [`DECIMATED_ROUNDING`] counts of the samples' mean.
+/// Prints what it checked.
 pub fn check_waveforms(
     log: &crate::firmware_link::log::Log,
     replayed: &dyn Fn(u64, usize) -> Result<Vec<i16>, ReplayError>,
     every: u16,
 ) -> Result<(), WaveformMismatch> {
-    // (A decimated capture's window is not sent: the `wave` line cannot say its step.)
-    let decimated = log
-        .impacts
-        .iter()
-        .filter(|r| r.flags.contains(impact_core::report::Flags::DECIMATED))
-        .count();
     let analysed = log
         .impacts
         .iter()
         .filter(|r| r.analysis != impact_core::Analysis::Skipped)
-        .filter(|r| !r.flags.contains(impact_core::report::Flags::DECIMATED))
         .count();
     if log.waveforms.len() != analysed {
         return Err(WaveformMismatch::Count {
@@ -500,25 +496,43 @@ pub fn check_waveforms(
             analysed,
         });
     }
-    let mut frames = 0;
+    let step_of = |index: u32| {
+        log.impacts
+            .iter()
+            .find(|r| r.index == index)
+            .map_or(1, |r| r.decimation.max(1))
+    };
+    let (mut frames, mut decimated) = (0, 0);
     for w in &log.waveforms {
-        if w.every != every {
+        let step = step_of(w.index);
+        // (As the firmware rounds it: whole values of `step` samples, at least one.)
+        let asked = u32::from(every) / step * step;
+        let asked = u16::try_from(asked.max(step)).unwrap_or(u16::MAX);
+        if w.every != asked {
             return Err(WaveformMismatch::Every {
                 index: w.index,
                 every: w.every,
-                asked: every,
+                asked,
             });
         }
+        let tolerance = if step > 1 {
+            decimated += 1;
+            DECIMATED_ROUNDING
+        } else {
+            0
+        };
         let window = replayed(w.first_sample, w.samples as usize)
             .map_err(|_| WaveformMismatch::Beyond { index: w.index })?;
         let window = window.as_slice();
         let mut expected = [0i16; impact_core::waveform::FRAME_LEN];
         for k in 0..w.frames as usize {
-            let n = impact_core::waveform::frame(window, every, k, &mut expected);
+            let n = impact_core::waveform::frame(window, w.every, k, &mut expected);
             for (j, want) in expected.iter().take(n).enumerate() {
                 let at = k * impact_core::waveform::FRAME_LEN + j;
                 let got = w.value(at);
-                if got != Some(*want) {
+                let close =
+                    got.is_some_and(|g| (i32::from(g) - i32::from(*want)).abs() <= tolerance);
+                if !close {
                     return Err(WaveformMismatch::Value {
                         index: w.index,
                         at,
@@ -530,14 +544,20 @@ pub fn check_waveforms(
         }
         frames += w.frames;
     }
-    let unsent = if decimated > 0 {
-        format!("; {decimated} decimated captures not sent (the wave line cannot say their step)")
+    let coarse = if decimated > 0 {
+        format!(" ({decimated} decimated captures within {DECIMATED_ROUNDING} counts of the samples' means)")
     } else {
         String::new()
     };
     crate::errln!(
-        "waveforms: {} windows, {frames} frames, equal to the replayed samples{unsent}",
+        "waveforms: {} windows, {frames} frames, equal to the replayed samples{coarse}",
         log.waveforms.len()
     );
     Ok(())
 }
+
+/// How far a decimated capture's sent value may lie from its samples' mean, counts: each
+/// halving rounds the mean of two values (half a count) and halves the error it inherits
+/// (so less than one count in all), and the frame's mean of whole values rounds once more,
+/// as does the mean it is checked against.
+pub const DECIMATED_ROUNDING: i32 = 2;

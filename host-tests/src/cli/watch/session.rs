@@ -26,8 +26,9 @@ pub const RUNS: usize = 100;
 /// follow it at once from the board's reporter; the wait covers a file followed in 50 ms
 /// polls and a link's hiccups).
 pub const HOLD_MS: u64 = 300;
-/// The longest window (`wave` line) read: a capture (15 104 samples) with room to spare.
-const MAX_WAVE_SAMPLES: u32 = 1 << 16;
+/// The most values a window (`wave` line) read holds: a capture (15 104 values, each one
+/// sample or, decimated, the mean of several) with room to spare.
+const MAX_WAVE_VALUES: usize = 1 << 16;
 /// The longest text kept of a line's error or a scene's value, bytes.
 const MAX_TEXT: usize = 200;
 /// A board is silent when its last heartbeat (one a second) is older than this, ms: within
@@ -269,8 +270,11 @@ impl Session {
     fn read_wave(&mut self, f: &Fields) -> Result<(), SessionError> {
         self.started = true;
         let w = Waveform::new(WaveLine::parse(f)?);
-        if w.samples > MAX_WAVE_SAMPLES {
-            return Err(SessionError::WaveTooLong { samples: w.samples });
+        if w.values() > MAX_WAVE_VALUES {
+            return Err(SessionError::WaveTooLong {
+                samples: w.samples,
+                every: w.every,
+            });
         }
         self.wave = Some(w);
         Ok(())
@@ -667,8 +671,10 @@ pub enum SessionError {
          on the page; the session file has it (impact log reads it)"
     )]
     Late { kind: LineKind, index: u32 },
-    #[error("samples={samples}: a window of the board holds at most {MAX_WAVE_SAMPLES}")]
-    WaveTooLong { samples: u32 },
+    #[error(
+        "samples={samples} every={every}: a window of the board holds at most {MAX_WAVE_VALUES} values"
+    )]
+    WaveTooLong { samples: u32, every: u16 },
 }
 
 /// `text`, at most [`MAX_TEXT`] bytes of it (cut at a character's boundary, marked).
