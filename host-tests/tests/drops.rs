@@ -331,29 +331,35 @@ fn seed_nonlinear_stiff() -> Model<f64> {
 
 /// Bounce trains on pads that recover (Kelvin–Voigt: the body leaves `x_sep = c v / k` deep
 /// and lands on the surface it touched, higher) and on one that keeps its dent (the two-phase
-/// pad: it lands where it left), each bounce's approach from the flight (`--train flight`):
-/// the landing height the previous rebound chose is the pad's, and v0, the rebound and the
-/// COR are within 1 % on every bounce (a flight taken to land where it left had a
-/// Kelvin–Voigt pad's v0 up to 1.9 % high and its COR 5.2 % low by bounce 7).
+/// pad's first contact: it lands where it left), each bounce's approach from the flight
+/// (`--train flight`): the landing height is the pad's, and v0, the rebound and the COR are
+/// within 1 % on every bounce (a flight taken to land where it left had a Kelvin–Voigt pad's
+/// v0 up to 1.9 % high and its COR 5.2 % low by bounce 7). A first approach speed given
+/// 0.3 % high moves no later bounce's landing (the rebound decides only where the two
+/// landings are far apart).
 #[test]
 fn a_bounce_lands_where_the_pad_is() {
     let scratch = Scratch::new();
-    for (name, law) in [
-        ("kelvin-voigt", kelvin_voigt_pad()),
-        ("two-phase", seed_two_phase_pad()),
+    for (name, law, v0) in [
+        ("kelvin-voigt", kelvin_voigt_pad(), "1.3357"),
+        ("two-phase", seed_two_phase_pad(), "1.3357"),
+        ("kelvin-voigt", kelvin_voigt_pad(), "1.34"),
     ] {
         for rate in [500_000.0, 100_000.0] {
             let (text, truth) = csv(&moving(law, 8), rate, 2.0, 1000.0);
             let a = analyse(
                 &scratch,
-                &format!("landing-{name}-{rate}.csv"),
+                &format!("landing-{name}-{rate}-{v0}.csv"),
                 text,
-                &["--v0", "1.3357", "--train", "flight"],
+                &["--v0", v0, "--train", "flight"],
             );
             let impacts = a["impacts"].as_array().unwrap();
             assert_eq!(impacts.len(), truth.len(), "{name} at {rate}");
             for (i, (r, t)) in impacts.iter().zip(&truth).enumerate() {
-                let what = format!("{name} at {rate} S/s, bounce {i}");
+                let what = format!("{name} at {rate} S/s from {v0} m/s, bounce {i}");
+                if i == 0 && v0 != "1.3357" {
+                    continue;
+                }
                 within(
                     &r["impact_velocity_m_s"],
                     t.approach_m_s,
@@ -391,6 +397,60 @@ fn a_bounce_lands_where_the_pad_is() {
                 if name == "kelvin-voigt" {
                     assert!(h > 0.0, "{what}: recovered");
                 }
+            }
+        }
+    }
+}
+
+/// A soft pad (seed 001's law at k 240 N/m, c 0.5 s/m: contacts of 55–76 ms) on which the
+/// body settles after six bounces: its seventh contact never ends (the force dips to 0.04 g
+/// and rises again, the body never leaves). A vertical scene's edge level lies at its noise
+/// (the free-fall level is the zero force), so every bounce is found whole (COR within 1 %;
+/// a fifth of the trigger cut the sixth's contact 0.65 ms short, COR +1.7 %) and the
+/// settling is one impact that never separates, without COR, not three contacts with
+/// flights between them.
+#[test]
+fn a_body_settling_on_a_soft_pad_is_one_contact_that_never_ends() {
+    let scratch = Scratch::new();
+    let law = Model::Nonlinear(Nonlinear {
+        k: 240.0,
+        c: 0.5,
+        n: 1.0,
+    });
+    let (text, truth) = csv(&moving(law, 9), 500_000.0, 2.0, 156.9);
+    assert!(truth.last().unwrap().separation.is_none());
+    let a = analyse(
+        &scratch,
+        "settling.csv",
+        text,
+        &[
+            "--v0",
+            "1.3357",
+            "--train",
+            "flight",
+            "--range",
+            "156.9",
+            "--capture-samples",
+            "131072",
+        ],
+    );
+    let impacts = a["impacts"].as_array().unwrap();
+    assert_eq!(impacts.len(), truth.len(), "{impacts:#?}");
+    for (i, (r, t)) in impacts.iter().zip(&truth).enumerate() {
+        let what = format!("soft pad, bounce {i}");
+        match t.separation {
+            Some(s) => {
+                within(
+                    &r["impact_velocity_m_s"],
+                    t.approach_m_s,
+                    0.01,
+                    &format!("{what}: v0"),
+                );
+                within(&r["cor"], s.cor, 0.01, &format!("{what}: cor"));
+            }
+            None => {
+                assert_ne!(r["status"], "complete", "{what}: {r}");
+                assert!(r["cor"].is_null(), "{what}: {r}");
             }
         }
     }

@@ -13,15 +13,14 @@ pub struct Bounce {
     pub flight_s: f32,
     /// The landing speed the flight time gives, `g t / 2 - h / t`, m/s.
     pub v0_flight_m_s: f32,
-    /// The landing speed the previous rebound gives, `sqrt(v_r² - 2 g h)`, m/s; absent if the
-    /// previous impact had no rebound (no Δv, a COR out of range).
+    /// The previous impact's rebound, m/s (the body taken to land where it left); absent if
+    /// it had none (no Δv, a COR out of range).
     pub v0_rebound_m_s: Option<f32>,
     /// `h`: how far above the previous separation the body landed, m. The body leaves a pad
     /// at its separation deformation `x_sep`; a pad that recovers its shape (elastic,
     /// viscoelastic) meets it again at the surface it touched (`h = x_sep`), one that keeps
-    /// the dent where the body left it (a crushed pad) at that depth (`h = 0`). Of the two,
-    /// the one whose take-off speed `g t / 2 + h / t` is nearer the previous rebound; 0 where
-    /// nothing measured the rebound or `x_sep` (see `stream/train.rs`).
+    /// the dent where the body left it (a crushed pad) at that depth (`h = 0`): recovered,
+    /// unless the previous rebound clearly says dented (see `stream/train.rs`).
     pub landing_height_m: f32,
 }
 

@@ -5,10 +5,12 @@
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub enum TrainSpeed {
-    /// `g t_flight / 2`: independent for every bounce (the default).
+    /// `g t / 2 - h / t` from the flight `t` since the previous separation and the landing
+    /// height `h` (`stream/train.rs`): each bounce measured afresh (the default).
     Flight,
-    /// The previous impact's rebound: no assumption on gravity or the flight's direction,
-    /// but each bounce inherits the previous one's error.
+    /// The previous impact's rebound (`Δv - v0 - g t_c`, the body taken to land where it
+    /// left): no assumption on the flight's direction, but each bounce inherits the previous
+    /// one's error.
     Rebound,
 }
 

@@ -60,6 +60,19 @@ impl<const PRE: usize> Stream<PRE> {
         let level = |(sum, _, _): (i32, i16, i16)| sum as f32 / STRIDE as f32;
         let free_fall = self.free_fall();
         let at_free_fall = |l: f32| free_fall.is_some_and(|(ff, tol)| libm::fabsf(l - ff) <= tol);
+        // Two strides of free fall hold one level to within their noise: their means differ
+        // by less than a quarter of their spread (a 64-sample mean's noise is a 36th of its
+        // spread), and a count. A slow foot rising out of free fall has strides flat within a
+        // low edge level and within the free-fall tolerance (a quarter of g), but each a step
+        // above the one before: no level.
+        let agree = |a: (i32, i16, i16), b: (i32, i16, i16)| {
+            let spread = (a.2 as f32 - a.1 as f32).max(b.2 as f32 - b.1 as f32);
+            libm::fabsf(level(a) - level(b)) <= (spread / 4.0).max(1.0)
+        };
+        let free_fall_at = |k: usize, st: (i32, i16, i16)| {
+            at_free_fall(level(st))
+                && stride(k + 1).is_some_and(|older| flat(older) && agree(st, older))
+        };
         // The first flat stride walking back; in a vertical scene the first at the free-fall
         // level if there is one (a smooth foot rising from free fall through the rest level
         // has flat strides at neither), else the first flat one.
@@ -67,7 +80,7 @@ impl<const PRE: usize> Stream<PRE> {
             let mut k = 0;
             loop {
                 let st = stride(k)?;
-                if flat(st) && (!only_free_fall || at_free_fall(level(st))) {
+                if flat(st) && (!only_free_fall || free_fall_at(k, st)) {
                     return Some((k, st));
                 }
                 k += 1;
@@ -89,7 +102,7 @@ impl<const PRE: usize> Stream<PRE> {
         let same = |st| {
             flat(st)
                 && libm::fabsf(level(st) - at) <= edge
-                && (!in_free_fall || at_free_fall(level(st)))
+                && (!in_free_fall || (at_free_fall(level(st)) && agree(st, first)))
         };
         while let Some(st) = stride(k).filter(|&st| same(st)) {
             sum += i64::from(st.0);

@@ -9,23 +9,30 @@
 //!
 //! ```text
 //! v0_flight  = g t / 2 - h / t             (ballistic: up at g t / 2 + h / t, down at this)
-//! v0_rebound = sqrt(v_r² - 2 g h)           (v_r: the previous impact's measured rebound)
+//! v0_rebound = v_r                          (the previous impact's measured rebound)
 //! ```
 //!
 //! are two measures of the same speed: the flight time needs only the stream's positions
-//! (exact) and `g`; the rebound carries the previous approach speed's error with the opposite
-//! sign. Both are reported; the scene picks the one the kinematics use.
+//! (exact), `g` and the landing; the rebound carries the previous approach speed's error with
+//! the opposite sign, and takes the body to land where it left (`sqrt(v_r² - 2 g h)` would
+//! feed the separation deformation's error, which grows with that speed's, back into the
+//! chain: on an elastic pad, whose `h` is 0, a chain's COR drifted 4 % by bounce 7). Both
+//! are reported; the scene picks the one the kinematics use.
 //!
 //! The landing height `h` (Stronge, *Impact Mechanics*, ch. 1: the pad's surface after
 //! restitution) is one of two: `x_sep`, for a pad that recovers its shape between contacts
 //! (elastic and viscoelastic: a Kelvin–Voigt pad leaves the body `c v / k` deep and springs
-//! back behind it), or 0, for one that keeps the dent where the body left it (a crushed pad;
-//! the two-phase law, whose separation lies at its set). The previous rebound chooses: the
-//! one whose take-off speed `g t / 2 + h / t` is nearer to it. They differ by `x_sep / t`,
-//! which matters (a crushed pad's first bounce: 9 %) exactly where the rebound tells them
-//! apart; where the rebound cannot (a Kelvin–Voigt pad's last bounces) they differ by less
-//! than its error. Without a rebound or a separation deformation the body is taken to land
-//! where it left (`h = 0`), as before this rule, and the report's `landing_height_m` says so.
+//! back behind it; a crushed pad reloading elastically), or 0, for one that keeps the dent
+//! where the body left it (the two-phase law's first contact, whose separation lies at its
+//! set). The pad recovering is taken, unless the previous rebound says otherwise clearly:
+//! the two take-off speeds `g t / 2 + h / t` differ by more than [`LANDING_MARGIN`] of the
+//! speed and the rebound is nearer the dent's (a crushed pad's first bounce: 9 % apart).
+//! Nearer than that, the rebound cannot tell them (a Kelvin–Voigt pad's are 0.1–0.2 % apart
+//! on every bounce, `x_sep / t ≈ c g / 2 k`, while the rebound carries the approach speed's
+//! error), and a choice made by it would confirm itself bounce after bounce (a wrong dent
+//! makes the next rebound low by the same `x_sep / t`). Without a rebound the pad recovers.
+//! `h = x_sep` is taken only where it leaves a landing speed (`x_sep / t < g t / 2`, and
+//! `v_r² > 2 g x_sep`); the report's `landing_height_m` gives the `h` used.
 //!
 //! A flight longer than the scene's longest (a new drop, the body picked up), a previous
 //! impact without a separation (settled, too long, a gap, the stream ended) or without an
@@ -41,6 +48,11 @@
 use crate::report::summary::Summary;
 use crate::report::{self, Bounce, Status, COR_TOLERANCE};
 use crate::scene::{Scene, Train, TrainSpeed};
+
+/// The previous rebound chooses a dented pad's landing only where the two take-off speeds
+/// differ by more than this share of the speed: beyond any approach speed's error a lab
+/// would give, so a choice does not hang on it (and, made, confirm itself).
+pub const LANDING_MARGIN: f32 = 0.02;
 
 /// An impact's approach, as the tracker decides it.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -130,14 +142,12 @@ impl Tracker {
         };
         let g = scene.gravity_m_s2;
         let half = g * flight_s / 2.0;
-        let h = self.landing_height_m(half, flight_s);
+        let h = self.landing_height_m(half, flight_s, g);
         let bounce = Bounce {
             number: self.number.saturating_add(1),
             flight_s,
             v0_flight_m_s: half - h / flight_s,
-            v0_rebound_m_s: self
-                .rebound_m_s
-                .map(|v| libm::sqrtf((v * v - 2.0 * g * h).max(0.0))),
+            v0_rebound_m_s: self.rebound_m_s,
             landing_height_m: h,
         };
         let v0 = match train.speed {
@@ -151,22 +161,26 @@ impl Tracker {
         }
     }
 
-    /// The landing height `h` after a flight of `flight_s` (`half`: `g t / 2`): the previous
-    /// separation deformation if the pad recovered, 0 if it kept the dent, whichever take-off
-    /// speed `g t / 2 + h / t` is nearer the previous rebound (a tie: recovered); 0 without a
-    /// rebound.
-    fn landing_height_m(&self, half: f32, flight_s: f32) -> f32 {
+    /// The landing height `h` after a flight of `flight_s` (`half`: `g t / 2`; `g`): the
+    /// previous separation deformation (the pad recovered) unless the previous rebound is
+    /// clearly the take-off speed of a pad that kept its dent (0), or the deformation leaves
+    /// no landing speed (0).
+    fn landing_height_m(&self, half: f32, flight_s: f32, g: f32) -> f32 {
         let x_sep = self.separation_deformation_m;
-        match self.rebound_m_s {
-            Some(v_r) if x_sep > 0.0 => {
-                let recovered = half + x_sep / flight_s;
-                if (v_r - recovered).abs() <= (v_r - half).abs() {
-                    x_sep
-                } else {
-                    0.0
-                }
-            }
-            _ => 0.0,
+        let recovered = half + x_sep / flight_s;
+        let lands = x_sep > 0.0
+            && x_sep / flight_s < half
+            && self.rebound_m_s.is_none_or(|v| v * v > 2.0 * g * x_sep);
+        if !lands {
+            return 0.0;
+        }
+        let dented = self.rebound_m_s.is_some_and(|v_r| {
+            recovered - half > LANDING_MARGIN * half && (v_r - half).abs() < (v_r - recovered).abs()
+        });
+        if dented {
+            0.0
+        } else {
+            x_sep
         }
     }
 
@@ -372,9 +386,11 @@ mod tests {
             let b = t.approach(&s, 11_000.0, Some(1.5), false).bounce.unwrap();
             (b.landing_height_m, b.v0_flight_m_s, b.v0_rebound_m_s)
         };
-        // No rebound to tell the pads apart: it lands where it left, as if nothing rose.
-        assert_eq!(speeds(&t), (0.0, half, None));
-        // A rebound at the take-off speed of a recovered pad: it lands 2 mm higher, slower.
+        // No rebound: the pad recovered, and the body lands 2 mm above where it left, slower.
+        let (h, flight, rebound) = speeds(&t);
+        assert_eq!((h, rebound), (2e-3, None));
+        assert!((flight - (half - 0.02)).abs() < 1e-6, "{flight}");
+        // A rebound at the take-off speed of a recovered pad: the same.
         let up = half + 2e-3 / 0.1;
         let (h, flight, rebound) = speeds(&Tracker {
             rebound_m_s: Some(up),
@@ -382,14 +398,34 @@ mod tests {
         });
         assert_eq!(h, 2e-3);
         assert!((flight - (half - 0.02)).abs() < 1e-6, "{flight}");
-        // Both measures agree: sqrt(up² - 2 g h) = g t - up.
-        assert!((rebound.unwrap() - flight).abs() < 1e-5, "{rebound:?}");
-        // A rebound at the take-off speed of a crushed pad: it lands where it left.
+        // The rebound's measure is the take-off speed itself.
+        assert_eq!(rebound, Some(up));
+        // A rebound at the take-off speed of a crushed pad, the two 4 % apart: it lands where
+        // it left, the rebound's speed unchanged.
         let (h, flight, rebound) = speeds(&Tracker {
             rebound_m_s: Some(half * 1.001),
             ..t
         });
         assert_eq!((h, flight, rebound), (0.0, half, Some(half * 1.001)));
+        // 0.5 mm: the two 1 % apart, within what the rebound can tell: the pad recovered.
+        let (h, _, _) = speeds(&Tracker {
+            rebound_m_s: Some(half * 1.001),
+            separation_deformation_m: 5e-4,
+            ..t
+        });
+        assert_eq!(h, 5e-4);
+        // A deformation no flight of 0.1 s rises from (it would land upwards), or one the
+        // rebound could not have climbed: it lands where it left.
+        let (h, flight, _) = speeds(&Tracker {
+            separation_deformation_m: 0.06,
+            ..t
+        });
+        assert_eq!((h, flight), (0.0, half));
+        let (h, _, _) = speeds(&Tracker {
+            rebound_m_s: Some(0.01),
+            ..t
+        });
+        assert_eq!(h, 0.0);
         // A separation the sums did not find (0): nothing rises.
         let (h, flight, _) = speeds(&Tracker {
             rebound_m_s: Some(up),

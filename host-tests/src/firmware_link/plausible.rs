@@ -136,6 +136,11 @@ pub(crate) fn check_report(r: &ImpactReport) -> Result<(), Implausible> {
             end: r.end_sample,
         });
     }
+    if let Some(b) = &r.bounce {
+        non_negative("flight_s", b.flight_s.into())?;
+        // (The core takes no landing below where the body left.)
+        non_negative("landing_height_m", b.landing_height_m.into())?;
+    }
     if let Some(k) = &r.kinematics {
         non_negative("crush_time_s", k.crush_time_s.into())?;
         non_negative("max_deformation_m", k.max_deformation_m.into())?;

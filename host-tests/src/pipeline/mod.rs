@@ -422,6 +422,25 @@ pub(crate) fn full_scale_m_s2(
     args.range.or(file.range).map(|r| r.to_m_s2(mass))
 }
 
+/// Whether the scene the options and the scene file make is vertical (core's rule,
+/// `Scene::contact_gravity_m_s2`: `--vertical`, a free fall, a drop height or a train),
+/// known before the scene is built: its default edge level depends on it.
+pub(crate) fn vertical(args: &AnalyzeArgs, file: &SceneFile) -> bool {
+    args.train.vertical
+        || file.vertical.unwrap_or(false)
+        || args.free_fall.is_some()
+        || args.train.train.is_some()
+        || {
+            // (As `build_scene` takes the approach: the command line's over the file's.)
+            let (v0, height) = if args.v0.is_some() || args.drop_height.is_some() {
+                (args.v0, args.drop_height)
+            } else {
+                (file.v0, file.drop_height)
+            };
+            v0.is_none() && height.is_some()
+        }
+}
+
 /// The trigger and edge levels given (`--trigger`, `--edge` or the scene's), m/s².
 pub(crate) fn given_levels(
     args: &AnalyzeArgs,
@@ -608,12 +627,12 @@ pub fn setup(
         .collect();
     let (trigger, edge) = given_levels(args, &file, mass);
     let levels = if axes.is_empty() {
-        survey::levels(&survey, full_scale, trigger, edge)?
+        survey::levels(&survey, full_scale, trigger, edge, vertical(args, &file))?
     } else {
         let fs = full_scale.map(|fs| fs * (axes.len() as f64).sqrt());
         survey::Levels {
             clipping: None,
-            ..survey::levels(&survey, fs, trigger, edge)?
+            ..survey::levels(&survey, fs, trigger, edge, vertical(args, &file))?
         }
     };
     let clipping = levels.clipping.clone();
@@ -1170,5 +1189,46 @@ mod tests {
         let at_line = read(Some(impact_io::At::Line(3)));
         assert_eq!(at_line.of_recording(file).to_string(), at_line.to_string());
         assert!(at_line.to_string().starts_with("runs/a.csv:3: "));
+    }
+
+    /// The edge level's rule for a vertical scene is the scene's own, for every way a scene
+    /// becomes vertical (or not), from the command line and from a scene file.
+    #[test]
+    fn the_edge_levels_vertical_is_the_scenes() {
+        use clap::Parser;
+        #[derive(Parser)]
+        struct Wrap {
+            #[command(flatten)]
+            analyze: AnalyzeArgs,
+        }
+        let calibration = Calibration {
+            gain_m_s2_per_count: 0.1,
+            sample_rate_hz: 1e5,
+        };
+        let cases: [(&[&str], &str); 10] = [
+            (&[], "{}"),
+            (&["--v0", "1"], "{}"),
+            (&["--vertical", "--v0", "1"], "{}"),
+            (&["--drop-height", "0.1"], "{}"),
+            (&["--train", "flight", "--v0", "1"], "{}"),
+            (&[], r#"{"drop_height": 0.1}"#),
+            (&[], r#"{"v0": 1.0, "drop_height": 0.1}"#),
+            (&["--v0", "1"], r#"{"drop_height": 0.1}"#),
+            (&[], r#"{"vertical": true}"#),
+            (&["--free-fall", "release.csv"], "{}"),
+        ];
+        for (options, json) in cases {
+            let argv = ["analyze", "x.csv"].iter().chain(options).copied();
+            let args = Wrap::try_parse_from(argv).unwrap().analyze;
+            let file: SceneFile = serde_json::from_str(json).unwrap();
+            let scene = build_scene(&args, &file, calibration, 10.0, 2.0, None, Some(0.06))
+                .unwrap()
+                .scene;
+            assert_eq!(
+                vertical(&args, &file),
+                scene.contact_gravity_m_s2().is_some(),
+                "{options:?} with {json}"
+            );
+        }
     }
 }

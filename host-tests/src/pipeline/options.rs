@@ -189,7 +189,9 @@ pub struct AnalyzeArgs {
     #[arg(long, help_heading = "Detection", value_name = "LEVEL")]
     pub trigger: Option<Level>,
     /// Edge level (onset, separation), in m/s² or with a unit [default: a fifth of the
-    /// trigger, at least 3 × the noise].
+    /// trigger, at least 3 × the noise; in a vertical scene, where a flight reads the
+    /// free-fall level, 5 × the noise, at least 3 of the recording's quanta and a twentieth of
+    /// the trigger].
     #[arg(long, help_heading = "Detection", value_name = "LEVEL")]
     pub edge: Option<Level>,
     /// Quiet time that ends an impact, s [default: 2 ms].
@@ -442,9 +444,10 @@ pub fn setting_name(
 /// Which measure of a bounce's approach speed the kinematics use.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
 pub enum SpeedArg {
-    /// `g t_flight / 2`, from the flight since the previous separation.
+    /// `g t / 2 - h / t`, from the flight `t` since the previous separation (`h`: how far
+    /// above where it left the body lands, the pad recovered or dented).
     Flight,
-    /// The previous impact's rebound (`Δv - v0`).
+    /// The previous impact's rebound (`Δv - v0 - g t_c`).
     Rebound,
 }
 

@@ -69,7 +69,11 @@ pub fn analyze(
         gain_m_s2_per_count: gain as f32,
         sample_rate_hz: rate_hz as f32,
     };
-    let edge = edge.unwrap_or_else(|| survey::default_edge(survey::noise_rms(&head), trigger));
+    // (A vertical scene's edge level takes the head's quantum: its noise may read as none.)
+    let quantum = pipeline::vertical(args, &file)
+        .then(|| survey::Survey::of(&head, false).map_or(0.0, |s| s.resolution_m_s2));
+    let edge =
+        edge.unwrap_or_else(|| survey::default_edge(survey::noise_rms(&head), trigger, quantum));
     let resolved = pipeline::build_scene(
         args,
         &file,
@@ -194,7 +198,13 @@ fn in_passes_then(
         survey_pass(input, scale, &removals, false, None)?.survey
     };
     let (trigger, edge) = pipeline::given_levels(args, &file, mass);
-    let levels = survey::levels(&survey, full_scale, trigger, edge)?;
+    let levels = survey::levels(
+        &survey,
+        full_scale,
+        trigger,
+        edge,
+        pipeline::vertical(args, &file),
+    )?;
     let gain = levels.gain_m_s2_per_count;
     let calibration = Calibration {
         gain_m_s2_per_count: gain as f32,

@@ -54,6 +54,9 @@ pub struct Surveyed {
     pub median_m_s2: f64,
     /// Robust noise: the median absolute step / sqrt(2) × 1.4826 (to 0.2 %).
     pub noise_rms_m_s2: f64,
+    /// The recording's quantum (an ADC's code, a CSV's last decimal): its smallest non-zero
+    /// step when the steps are whole multiples of it; 0 if none is.
+    pub resolution_m_s2: f64,
     pub min_m_s2: f64,
     pub max_m_s2: f64,
     /// Flat tops at the extremes ([`FlatTops`]) beyond the noise floor ([`RAIL_STEPS`]).
@@ -162,14 +165,15 @@ impl Survey {
             Some(s) => s.finish(median)?,
             None => Vec::new(),
         };
+        let q = self.shape.flat.resolution();
         Ok(Surveyed {
             samples: self.values.len(),
             median_m_s2: median,
             noise_rms_m_s2: noise,
+            resolution_m_s2: if q.is_finite() { q } else { 0.0 },
             min_m_s2: self.min,
             max_m_s2: self.max,
             flat_tops: {
-                let q = self.shape.flat.resolution();
                 let found = self.shape.flat.finish();
                 let span = if finite { self.max - self.min } else { 0.0 };
                 found.and_then(|c| beyond_floor(c, median, q, span))
@@ -207,6 +211,7 @@ pub fn levels(
     range_m_s2: Option<f64>,
     trigger: Option<f64>,
     edge: Option<f64>,
+    vertical: bool,
 ) -> Result<Levels, SurveyError> {
     match range_m_s2 {
         Some(fs) => check_range(s.peak_m_s2(), fs)?,
@@ -217,7 +222,7 @@ pub fn levels(
         None => s.flat_tops.clone(),
     };
     let gain = impact_io::quantise::gain_for(range_m_s2.unwrap_or_else(|| s.peak_m_s2()));
-    let (trigger, edge) = trigger_and_edge(s, gain, trigger, edge);
+    let (trigger, edge) = trigger_and_edge(s, gain, trigger, edge, vertical);
     Ok(Levels {
         clipping,
         full_scale_m_s2: range_m_s2,
@@ -326,11 +331,39 @@ pub fn noise_rms(x: &[f64]) -> f64 {
 }
 
 /// The default edge level: 3 × the noise, within a fifth and a half of the trigger.
-pub fn default_edge(noise_m_s2: f64, trigger_m_s2: f64) -> f64 {
-    (3.0 * noise_m_s2)
+///
+/// In a vertical scene (`vertical`: the recording's quantum `resolution_m_s2`, 0 if none)
+/// the contact force is zero at separation and in every flight, where the sensor reads its
+/// free-fall level to within its noise: the edge is [`VERTICAL_EDGE_NOISE`] × the noise, at
+/// least [`VERTICAL_EDGE_QUANTA`] quanta (a quantised channel's noise, whose steps are mostly
+/// 0, reads as none) and a [`VERTICAL_EDGE_TRIGGER`]th of the trigger (a noise-free
+/// recording's), no higher than the horizontal default. A fifth of the trigger took a soft pad's slow feet for
+/// flight up to 0.65 ms early (COR +1.7 %), and a body settling on the pad, whose force dips
+/// to 0.04 g without its leaving, for a flight and two more contacts.
+pub fn default_edge(noise_m_s2: f64, trigger_m_s2: f64, vertical: Option<f64>) -> f64 {
+    let horizontal = (3.0 * noise_m_s2)
         .max(trigger_m_s2 / 5.0)
-        .min(trigger_m_s2 / 2.0)
+        .min(trigger_m_s2 / 2.0);
+    match vertical {
+        Some(q) => (VERTICAL_EDGE_NOISE * noise_m_s2)
+            .max(VERTICAL_EDGE_QUANTA * q)
+            .max(trigger_m_s2 / VERTICAL_EDGE_TRIGGER)
+            .min(horizontal),
+        None => horizontal,
+    }
 }
+
+/// A vertical scene's edge level in the noise's RMS: a sample of Gaussian noise crosses it
+/// once in 1.7 million.
+pub const VERTICAL_EDGE_NOISE: f64 = 5.0;
+
+/// A vertical scene's edge level is at least this many of the recording's quanta: a code of
+/// noise each side of the level, and room.
+pub const VERTICAL_EDGE_QUANTA: f64 = 3.0;
+
+/// A vertical scene's edge level is at least the trigger over this: a twentieth of 5 % of
+/// the recording's span.
+pub const VERTICAL_EDGE_TRIGGER: f64 = 20.0;
 
 /// The trigger level (given, or 10 × the noise, 5 % of the range, 4 counts, the largest)
 /// and the edge level (given, or [`default_edge`]).
@@ -339,6 +372,7 @@ fn trigger_and_edge(
     gain: f64,
     trigger: Option<f64>,
     edge: Option<f64>,
+    vertical: bool,
 ) -> (f64, f64) {
     let sigma = s.noise_rms_m_s2;
     let trigger = trigger.unwrap_or_else(|| {
@@ -346,7 +380,8 @@ fn trigger_and_edge(
             .max(0.05 * s.range_m_s2())
             .max(f64::from(gain as f32) * 4.0)
     });
-    let edge = edge.unwrap_or_else(|| default_edge(sigma, trigger));
+    let quantum = vertical.then_some(s.resolution_m_s2);
+    let edge = edge.unwrap_or_else(|| default_edge(sigma, trigger, quantum));
     (trigger, edge)
 }
 

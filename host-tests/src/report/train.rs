@@ -16,8 +16,7 @@ pub struct BounceJson {
     pub flight_s: f64,
     /// The landing speed the flight gives, `g t / 2 - h / t`, m/s.
     pub v0_flight_m_s: f64,
-    /// The landing speed the previous rebound gives, `sqrt(v_r² - 2 g h)`, m/s (null: it had
-    /// none).
+    /// The previous impact's rebound, m/s (null: it had none).
     pub v0_rebound_m_s: Option<f64>,
     /// `h`, how far above the previous separation the body landed, m: the previous separation
     /// deformation (the pad recovered its shape) or 0 (it kept the dent), as the previous
