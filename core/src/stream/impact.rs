@@ -54,45 +54,12 @@ impl<const PRE: usize> Stream<PRE> {
         // samples of the other sign just before it are ringing (an anti-alias filter's
         // before a sharp edge), not the pulse.
         let sign: i64 = if deviation.of(trigger_x) >= 0 { 1 } else { -1 };
-        // The ring's samples within the flanks' reach, newest first.
         let ring = &self.ring;
         let back = |i: usize| ring.back(i).filter(|_| i < REACH);
         let pd = |i: usize| back(i).map(|x| sign * deviation.of(x) as i64);
-        // Walk back from the newest sample while it is beyond the edge level that way.
-        let mut pulse = 0usize;
-        while let Some(y) = pd(pulse) {
-            if y <= edge_d {
-                break;
-            }
-            pulse += 1;
-        }
-        // The rising flank from the onset forwards (the trigger sample, next, ends it).
-        let mut flank = Flank::default();
-        for k in 0..pulse {
-            match pd(pulse - 1 - k) {
-                Some(y) if y <= flank_d && flank.add(k as i64, y) => {}
-                _ => break,
-            }
-        }
+        let (pulse, touch_offset) = self.rising_flank(sign, deviation, edge_d, flank_d, trigger_x);
         let onset_index = self.index - pulse as u64;
         let cut_at_start = onset_index == 0 && pd(pulse).is_none();
-        let touch_offset = match flank.zero(true, -1.0, edge_d as f64) {
-            Some(z) => z as f32,
-            // The edge crossing between the last sample before the pulse and the onset (the
-            // trigger sample itself when the pulse starts there).
-            None => {
-                let onset = match pulse.checked_sub(1) {
-                    Some(i) => pd(i),
-                    None => Some(sign * deviation.of(trigger_x) as i64),
-                };
-                match (pd(pulse), onset) {
-                    (Some(y0), Some(y1)) => {
-                        (crossing(y0 as f64, y1 as f64, edge_d as f64) - 1.0) as f32
-                    }
-                    _ => 0.0,
-                }
-            }
-        };
         // First touch cannot come before the previous contact ended: reports never overlap.
         let earliest = self.last_end as f64 - onset_index as f64;
         let touch_floor = earliest.min(0.0) as f32;
@@ -185,6 +152,121 @@ impl<const PRE: usize> Stream<PRE> {
                 u64::from(self.settle),
             ),
         };
+        let before_onset = margin.saturating_sub(pulse);
+        self.replay_window(&mut a, capture, lead, margin, before_onset, deviation);
+        // The falling side so far: from the peak to the newest sample.
+        let after_peak = self.index.saturating_sub(a.peak_index) as usize;
+        let (older, newer) = self.ring.last(after_peak);
+        record_fall(
+            &mut a,
+            older,
+            self.index - (older.len() + newer.len()) as u64,
+        );
+        record_fall(&mut a, newer, self.index - newer.len() as u64);
+        self.start_online(&a, deviation, pulse, before_onset, line_lead);
+        self.active = Some(a);
+    }
+
+    /// The kinematics' sums from the onset (`pulse` samples back, `before_onset` into the
+    /// window, the line's touch `line_lead` whole samples before it), towards the crush a
+    /// provisional approach speed gives (the one known now: the scene's, or a bounce's from
+    /// the line's touch).
+    fn start_online(
+        &mut self,
+        a: &Active,
+        deviation: Deviation,
+        pulse: usize,
+        before_onset: usize,
+        line_lead: usize,
+    ) {
+        let scene = &self.scene;
+        let touch = a.onset_index as f64 + a.touch_offset as f64;
+        let v0 = self
+            .train
+            .approach(scene, touch, self.v0, self.v0_measured)
+            .v0_m_s;
+        let c_stop = v0.and_then(|v0| {
+            crate::report::motion::Scale::new(v0 as f64, scene, a.base_n, 0.0).c_stop()
+        });
+        let lobe_lead = libm::floorf(-a.lobe_touch).max(0.0) as usize;
+        self.online.start(
+            deviation,
+            crate::report::motion::motion_deviation(a.base_sum, a.base_n, scene),
+            &self.ring,
+            pulse,
+            before_onset,
+            [line_lead, lobe_lead],
+            c_stop,
+            // The largest |d| of the window so far (the pulse's included).
+            a.peak_d.saturating_abs(),
+        );
+    }
+
+    /// The pulse's rising flank, walking back from the newest sample (the trigger's) while
+    /// it is beyond the edge level the pulse's way (`sign`): how many samples the pulse has
+    /// risen for (the onset is that many back) and first touch, fractional samples from the
+    /// onset (the flank's line through zero, or the edge crossing before the onset).
+    fn rising_flank(
+        &self,
+        sign: i64,
+        deviation: Deviation,
+        edge_d: i64,
+        flank_d: i64,
+        trigger_x: i16,
+    ) -> (usize, f32) {
+        // The ring's samples within the flanks' reach, newest first.
+        let ring = &self.ring;
+        let back = |i: usize| ring.back(i).filter(|_| i < REACH);
+        let pd = |i: usize| back(i).map(|x| sign * deviation.of(x) as i64);
+        // Walk back from the newest sample while it is beyond the edge level that way.
+        let mut pulse = 0usize;
+        while let Some(y) = pd(pulse) {
+            if y <= edge_d {
+                break;
+            }
+            pulse += 1;
+        }
+        // The rising flank from the onset forwards (the trigger sample, next, ends it).
+        let mut flank = Flank::default();
+        for k in 0..pulse {
+            match pd(pulse - 1 - k) {
+                Some(y) if y <= flank_d && flank.add(k as i64, y) => {}
+                _ => break,
+            }
+        }
+        let touch_offset = match flank.zero(true, -1.0, edge_d as f64) {
+            Some(z) => z as f32,
+            // The edge crossing between the last sample before the pulse and the onset (the
+            // trigger sample itself when the pulse starts there).
+            None => {
+                let onset = match pulse.checked_sub(1) {
+                    Some(i) => pd(i),
+                    None => Some(sign * deviation.of(trigger_x) as i64),
+                };
+                match (pd(pulse), onset) {
+                    (Some(y0), Some(y1)) => {
+                        (crossing(y0 as f64, y1 as f64, edge_d as f64) - 1.0) as f32
+                    }
+                    _ => 0.0,
+                }
+            }
+        };
+        (pulse, touch_offset)
+    }
+
+    /// The window's samples the ring holds, replayed into the impact at its start: the
+    /// filter's `lead` samples into the capture only, then the `margin` samples from the
+    /// window's first (`before_onset` of them before the onset) into the capture and the
+    /// running sums (Σd, the part before the onset, the peak, the rails).
+    fn replay_window<const CAP: usize>(
+        &self,
+        a: &mut Active,
+        mut capture: Option<&mut crate::capture::Capture<CAP>>,
+        lead: usize,
+        margin: usize,
+        before_onset: usize,
+        deviation: Deviation,
+    ) {
         let (clip_lo, clip_hi) = self.scene.clip_counts;
         let (older, newer) = self.ring.last(lead + margin);
         // The lead-in into the capture only; the window into the sums too.
@@ -194,8 +276,7 @@ impl<const PRE: usize> Stream<PRE> {
                 a.full |= c.extend(run) < run.len();
             }
         }
-        let before_onset = margin.saturating_sub(pulse);
-        let (w, s) = (base_n, base_sum);
+        let (w, s) = (a.base_n, a.base_sum);
         for run in window_runs {
             if let Some(c) = capture.as_mut() {
                 a.full |= c.extend(run) < run.len();
@@ -230,39 +311,6 @@ impl<const PRE: usize> Stream<PRE> {
                 rest = after;
             }
         }
-        // The falling side so far: from the peak to the newest sample.
-        let after_peak = self.index.saturating_sub(a.peak_index) as usize;
-        let (older, newer) = self.ring.last(after_peak);
-        record_fall(
-            &mut a,
-            older,
-            self.index - (older.len() + newer.len()) as u64,
-        );
-        record_fall(&mut a, newer, self.index - newer.len() as u64);
-        // The kinematics' sums from the onset, towards the crush a provisional approach
-        // speed gives (the one known now: the scene's, or a bounce's from the line's touch).
-        let scene = &self.scene;
-        let touch = onset_index as f64 + touch_offset as f64;
-        let v0 = self
-            .train
-            .approach(scene, touch, self.v0, self.v0_measured)
-            .v0_m_s;
-        let c_stop = v0.and_then(|v0| {
-            crate::report::motion::Scale::new(v0 as f64, scene, base_n, 0.0).c_stop()
-        });
-        let lobe_lead = libm::floorf(-a.lobe_touch).max(0.0) as usize;
-        self.online.start(
-            deviation,
-            crate::report::motion::motion_deviation(base_sum, base_n, scene),
-            &self.ring,
-            pulse,
-            before_onset,
-            [line_lead, lobe_lead],
-            c_stop,
-            // The largest |d| of the window so far (the pulse's included).
-            a.peak_d.saturating_abs(),
-        );
-        self.active = Some(a);
     }
 
     /// Feeds samples to the active impact until it ends; returns how many it used.
