@@ -181,6 +181,30 @@ fn a_space_inside_a_delimited_field_is_not_a_new_column() {
     );
 }
 
+/// Whether a row splits on white space is the file's, decided by its first data row: a `,`
+/// table of two columns whose later row is one quoted field with a space inside (`"1 234"`)
+/// is refused at that line for the number it is not (read row by row, it was two numbers
+/// under the two names); a one-column table aligned with spaces keeps splitting every row.
+#[test]
+fn white_space_splits_the_rows_of_a_file_not_of_one_row() {
+    let scratch = Scratch::new();
+    let file = scratch.file(
+        "one-field.csv",
+        "time,accel\n0.000,1.0\n0.001,2.0\n\"0.002 3.0\"\n0.003,4.0\n",
+    );
+    let (code, _, err) = impact(&["analyze", file.to_str().unwrap()]);
+    assert_eq!(code, 1, "{err}");
+    assert!(err.contains("one-field.csv:4: not a number"), "{err}");
+    assert!(err.contains("\"0.002 3.0\""), "{err}");
+    // Aligned with spaces from its first row on: every row splits.
+    let file = scratch.file(
+        "aligned.txt",
+        "time accel\n0.000   1.0\n0.001   2.0\n0.002   3.0\n",
+    );
+    let (code, _, err) = impact(&["analyze", file.to_str().unwrap()]);
+    assert_ne!(code, 1, "{err}");
+}
+
 /// `--free-fall FILE:COLUMN` takes any column name the main input takes (a phone's
 /// `Acceleration z (m/s^2)`, a slash and spaces in it) and reads each column in the unit its
 /// header names, as the main input does: the same fall in m/s² and in g gives the same v0,

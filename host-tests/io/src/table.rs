@@ -309,6 +309,11 @@ pub struct Rows {
     header_leads: bool,
     /// Line of the first data row.
     pub first_data_line: u64,
+    /// Whether a data row's fields split further on white space (`None` before the first
+    /// data row, which decides it for the file: tabs delimit, or no delimiter split it).
+    /// Decided once, so a `,` table's later row of one field (`"1 234"`) is refused as the
+    /// number it is not, not read as two columns.
+    white_space: Option<bool>,
     /// Lines before the first one read (a reader resumed mid-file), and the file's bytes
     /// before the first one read (a byte-order mark, or a resumed reader's start).
     line_offset: u64,
@@ -406,6 +411,7 @@ impl Rows {
             text_after_header: None,
             header_leads: false,
             first_data_line: 0,
+            white_space: None,
             line_offset: 0,
             skip: 0,
             progress,
@@ -444,6 +450,7 @@ impl Rows {
         rows.header_line = self.header_line;
         rows.columns = self.columns;
         rows.first_data_line = self.first_data_line;
+        rows.white_space = self.white_space;
         // (Less the line break put ahead.)
         rows.line_offset = line.saturating_sub(1 + ahead);
         rows.skip = byte - ahead;
@@ -557,7 +564,9 @@ impl Rows {
             // with a space inside is an error: a thousands separator, say).
             // A tab at the line's start or end (LabVIEW ends every row with one) opens no
             // field; an empty field between two is still an error.
-            let split = self.delimiter == b'\t' || self.record.len() == 1;
+            let split = self
+                .white_space
+                .unwrap_or(self.delimiter == b'\t' || self.record.len() == 1);
             let last = self.record.len().saturating_sub(1);
             let edge =
                 |k: usize, f: &[u8]| split && (k == 0 || k == last) && f.trim_ascii().is_empty();
@@ -662,6 +671,7 @@ impl Rows {
                     }
                     self.columns = self.row.len();
                     self.first_data_line = lineno;
+                    self.white_space = Some(split);
                 }
             }
             if let Some(kind) = bad {
