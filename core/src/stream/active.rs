@@ -63,14 +63,13 @@ pub(super) struct Active {
     /// The baseline moved to another level since the previous impact.
     pub(super) level_change: bool,
     /// The signal did not come back, and the onset came more than the settle time before the
-    /// peak: the pulse rode on drift.
+    /// peak: the pulse rode on drift; or a ramp into it began beyond the flanks' reach.
     pub(super) drift: bool,
     /// The rising flank's straight line reaches zero inside the previous impact's contact.
     pub(super) line_in_previous: bool,
     /// The whole lobe before the onset: where it crosses the baseline (relative to the
-    /// onset, samples), its samples and `Σ d` over them.
+    /// onset, samples) and `Σ d` over its samples.
     pub(super) lobe_touch: f32,
-    pub(super) lobe_len: u32,
     pub(super) lobe_c: i64,
     /// The sink gave a buffer for this impact.
     pub(super) captured: bool,

@@ -72,7 +72,7 @@ impl<const PRE: usize> Stream<PRE> {
             .sum();
         let since_last =
             usize::try_from(self.index - self.window_end.min(self.index)).unwrap_or(usize::MAX);
-        let (lobe_touch, lobe_len, lobe_c) = self.lobe_before(OnsetWalk {
+        let lobe = self.lobe_before(OnsetWalk {
             pulse,
             sign,
             deviation,
@@ -133,11 +133,11 @@ impl<const PRE: usize> Stream<PRE> {
             clipped: false,
             cut_at_start,
             level_change,
-            drift: false,
+            // A ramp into the pulse from beyond the flanks' reach: it rode on it.
+            drift: lobe.cut,
             line_in_previous,
-            lobe_touch,
-            lobe_len,
-            lobe_c,
+            lobe_touch: lobe.touch,
+            lobe_c: lobe.c,
             captured: capture.is_some(),
             full: false,
             // The walk back reached the gap: the pulse began while samples were lost.
@@ -638,7 +638,7 @@ impl<const PRE: usize> Stream<PRE> {
     ) {
         let settle = u64::from(self.settle);
         if let Some(a) = self.active.as_mut() {
-            a.drift = a.peak_index.saturating_sub(a.onset_index) > settle;
+            a.drift |= a.peak_index.saturating_sub(a.onset_index) > settle;
         }
         self.end(status, sink);
     }

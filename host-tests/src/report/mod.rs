@@ -259,7 +259,13 @@ pub fn null_reasons(r: &ImpactReport, fits: &FitSet) -> BTreeMap<String, String>
         put("peak_force_n", "no-mass");
     }
     if r.delta_v_m_s.is_none() {
-        put("delta_v_m_s", "ac-coupled");
+        // (The core empties Δv for these two flags alone.)
+        let why = if flag(Flags::DRIFT) {
+            "drift"
+        } else {
+            "ac-coupled"
+        };
+        put("delta_v_m_s", why);
     }
     if let Some(Err(m)) = r.verdict {
         put("spec", m.name());
@@ -311,6 +317,8 @@ pub fn null_reasons(r: &ImpactReport, fits: &FitSet) -> BTreeMap<String, String>
         Some("no-approach-speed".to_string())
     } else if flag(Flags::AC_COUPLED) {
         Some("ac-coupled".to_string())
+    } else if flag(Flags::DRIFT) {
+        Some("drift".to_string())
     } else if flag(Flags::CLIPPED) {
         Some("clipped".to_string())
     } else if flag(Flags::CUT_AT_START) {
