@@ -123,10 +123,10 @@ impl<const PRE: usize> Stream<PRE> {
             if lobe_len >= LOBE_LOOK && 2 * newest >= edge_d && 4 * oldest > edge_d.max(newest) {
                 // A ramp that reaches the pulse, ended by its noise while still high: walk
                 // on through its dips (a lobe shorter than the window is no slow ramp, and
-                // the window could not judge it: a piezo's offset before its pulse). Ran out (stopped where fewer than `LOBE_LOOK` samples
-                // were left to judge a dip by, at the flanks' reach or the record's first
-                // sample; not at the previous impact's window, where a lobe stops): the ramp
-                // began further back.
+                // the window could not judge it: a piezo's offset before its pulse). Ran out
+                // (stopped where fewer than `LOBE_LOOK` samples were left to judge a dip by,
+                // at the flanks' reach; not at the previous impact's window, where a lobe
+                // stops): the ramp began further back.
                 let (len, c, judged) = walk(lobe_len, lobe_c, true);
                 (lobe_len, lobe_c) = (len, c);
                 cut = !judged && since_last > REACH.max(pulse + len);
