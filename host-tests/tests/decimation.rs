@@ -131,6 +131,24 @@ fn a_width_the_coarser_values_cannot_resolve_is_null_and_says_why() {
     assert!(r["decimation"].as_u64().unwrap() >= 4, "{r}");
     assert!(r["fwhm_s"].is_null(), "{r}");
     assert_eq!(r["null_reasons"]["fwhm_s"], "decimated-too-coarse");
+    // The filtered width likewise: its half maximum lies inside (no flag says otherwise).
+    let (code, out, err) = impact(&[
+        "analyze",
+        file,
+        "--spec",
+        "half-sine,11000g,100ms",
+        "--cfc",
+        "1000",
+        "--json",
+    ]);
+    assert!(code == 0 || code == 3, "{err}");
+    let v: Value = serde_json::from_str(&out).unwrap();
+    let r = &v["impacts"][0];
+    assert!(r["filtered_peak_acceleration_m_s2"].is_number(), "{r}");
+    assert!(r["filtered_fwhm_s"].is_null(), "{r}");
+    assert_eq!(r["null_reasons"]["filtered_fwhm_s"], "decimated-too-coarse");
+    let flags = r["flags"].to_string();
+    assert!(!flags.contains("half-maximum-outside"), "{flags}");
     // With every sample held, the width is there.
     let (_, out, _) = impact(&[
         "analyze",
@@ -143,6 +161,36 @@ fn a_width_the_coarser_values_cannot_resolve_is_null_and_says_why() {
     ]);
     let v: Value = serde_json::from_str(&out).unwrap();
     assert!(v["impacts"][0]["fwhm_s"].is_number());
+}
+
+#[test]
+fn a_filtered_half_maximum_outside_the_capture_says_so() {
+    // A 2 ms, 100 g half-sine that settles at 70 g (a sensor knocked to a new level): neither
+    // the raw nor the filtered signal comes back below half the peak.
+    let scratch = Scratch::new();
+    let mut csv = String::from("time_s,accel_g\n");
+    let rate = 50_000.0;
+    for i in 0..30_000 {
+        let t = i as f64 / rate;
+        let pulse = if (0.2..0.202).contains(&t) {
+            100.0 * (std::f64::consts::PI * (t - 0.2) / 0.002).sin()
+        } else {
+            0.0
+        };
+        let level = if t >= 0.201 { 70.0 } else { 0.0 };
+        let a = pulse.max(level) + 0.05 * (i as f64 * 1.3).sin();
+        csv.push_str(&format!("{t:.6},{a:.4}\n"));
+    }
+    let file = scratch.text("step.csv", &csv);
+    let r = &impacts(&file, &["--cfc", "1000"])[0];
+    assert!(r["filtered_peak_acceleration_m_s2"].is_number(), "{r}");
+    assert!(r["filtered_fwhm_s"].is_null(), "{r}");
+    assert_eq!(r["null_reasons"]["filtered_fwhm_s"], "half-maximum-outside");
+    let flags = r["flags"].to_string();
+    assert!(
+        flags.contains("\"filtered-half-maximum-outside\""),
+        "{flags}"
+    );
 }
 
 #[test]

@@ -348,9 +348,11 @@ fn analyse_kinematics<const CAP: usize>(
     if let Some((i, v)) = filtered {
         let held = capture.held().len();
         let a = work.buf.get(..held).unwrap_or(&[]);
-        r.filtered_fwhm_s = fwhm(held, |j| a.get(j).map_or(0.0, |v| libm::fabsf(*v)), i)
-            .filter(|&w| resolved(w, step))
-            .map(|w| w / rate);
+        let width = fwhm(held, |j| a.get(j).map_or(0.0, |v| libm::fabsf(*v)), i);
+        if width.is_none() {
+            r.flags.insert(Flags::FILTERED_HALF_MAXIMUM_OUTSIDE);
+        }
+        r.filtered_fwhm_s = width.filter(|&w| resolved(w, step)).map(|w| w / rate);
         r.filtered_peak_acceleration_m_s2 = Some(v);
     }
     // The raw peak's width, always: a filter never changes an unfiltered field. (The

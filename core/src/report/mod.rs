@@ -153,9 +153,13 @@ impl Flags {
     /// measured on the coarser values, as on a recording at the coarser rate, where they
     /// resolve them (else absent).
     pub const DECIMATED: Flags = Flags(1 << 13);
+    /// Half the CFC-filtered peak is not reached on both sides inside the capture: no
+    /// `filtered_fwhm_s` (a decimated capture whose filtered width is too coarse to resolve
+    /// does not set it: that is [`Self::DECIMATED`]'s).
+    pub const FILTERED_HALF_MAXIMUM_OUTSIDE: Flags = Flags(1 << 14);
 
     /// Every flag with its name in the reports.
-    pub const NAMES: [(Flags, &'static str); 14] = [
+    pub const NAMES: [(Flags, &'static str); 15] = [
         (Flags::AC_COUPLED, "ac-coupled"),
         (Flags::COR_OUT_OF_RANGE, "cor-out-of-range"),
         (Flags::NO_STOP, "no-stop"),
@@ -170,6 +174,10 @@ impl Flags {
         (Flags::APPROACH_UNKNOWN, "approach-unknown"),
         (Flags::KINEMATICS_NOT_HELD, "kinematics-not-held"),
         (Flags::DECIMATED, "decimated"),
+        (
+            Flags::FILTERED_HALF_MAXIMUM_OUTSIDE,
+            "filtered-half-maximum-outside",
+        ),
     ];
 
     pub const fn empty() -> Self {

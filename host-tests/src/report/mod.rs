@@ -296,12 +296,11 @@ pub fn null_reasons(r: &ImpactReport, fits: &FitSet) -> BTreeMap<String, String>
     }
     if r.filtered_fwhm_s.is_none() {
         let own = if r.filtered_peak_acceleration_m_s2.is_some() {
-            // (A decimated capture holds the whole contact and the filter's padding: its
-            // half maximum lies inside.)
-            if flag(Flags::DECIMATED) {
-                "decimated-too-coarse"
-            } else {
+            if flag(Flags::FILTERED_HALF_MAXIMUM_OUTSIDE) || !flag(Flags::DECIMATED) {
                 "half-maximum-outside"
+            } else {
+                // Fewer values across it than `analysis::RESOLVED_WIDTH`.
+                "decimated-too-coarse"
             }
         } else {
             "no-cfc"
