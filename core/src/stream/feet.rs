@@ -178,7 +178,7 @@ impl<const PRE: usize> Stream<PRE> {
     /// set it were kept).
     #[inline(never)]
     pub(super) fn locate_separation(&mut self) {
-        let Some(a) = self.active.as_ref() else {
+        let Some(a) = self.run.active.as_ref() else {
             return;
         };
         let Some(s) = a.separation else {
@@ -191,9 +191,9 @@ impl<const PRE: usize> Stream<PRE> {
             .fall(a, s)
             .unwrap_or_else(|| (self.separation_offset(a, s), 0, None));
         if clear.is_some() {
-            self.foot_power = clear;
+            self.run.foot_power = clear;
         }
-        if let Some(a) = self.active.as_mut() {
+        if let Some(a) = self.run.active.as_mut() {
             a.separation_at = Some((s, offset, tail));
         }
     }
@@ -208,7 +208,7 @@ impl<const PRE: usize> Stream<PRE> {
         match self.rise_foot(a) {
             Some(foot) => {
                 if foot.clear {
-                    self.foot_power = Some(foot.power);
+                    self.run.foot_power = Some(foot.power);
                 }
                 let touch = foot.zero.max(a.touch_floor);
                 let lead = libm::floorf(-touch).max(0.0) as i64;
@@ -255,7 +255,7 @@ impl<const PRE: usize> Stream<PRE> {
             .filter(|&(_, d)| d > 0)
             .map(|(p, d)| (p as f32, d as f32 / peak));
         let choice = power_flank::Choice::Free {
-            prior: self.foot_power,
+            prior: self.run.foot_power,
         };
         power_flank::zero(points, true, -1.0, a.edge_d as f32 / peak, choice)
     }
@@ -298,11 +298,11 @@ impl<const PRE: usize> Stream<PRE> {
     /// or the edge crossing between the last sample beyond the edge and the first within it.
     pub(super) fn separation_offset(&self, a: &Active, separation: u64) -> f32 {
         let deviation = a.deviation();
-        // The ring ends at `self.index - 1`: sample `i` is `back(index - 1 - i)`; no further
+        // The ring ends at `self.run.index - 1`: sample `i` is `back(index - 1 - i)`; no further
         // than the look-back before the separation.
         let oldest = separation.saturating_sub(1 + Self::LOOKBACK as u64);
         let d_at = |i: u64| {
-            let back = self.index.checked_sub(1)?.checked_sub(i)?;
+            let back = self.run.index.checked_sub(1)?.checked_sub(i)?;
             let x = self
                 .ring
                 .back(usize::try_from(back).ok().filter(|_| i >= oldest)?)?;

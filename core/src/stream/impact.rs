@@ -13,6 +13,7 @@ use super::active::Active;
 use super::feet::{record_fall, OnsetWalk};
 use super::level::LevelWatch;
 use super::rise::{Fall, Rise};
+use super::walk::{End, Levels, Walk};
 use super::{Stream, FLANK_EDGES, REACH};
 use crate::capture::{Sink, Summary};
 use crate::report::{self, Status};
@@ -20,18 +21,8 @@ use crate::signal::baseline::Deviation;
 use crate::signal::baseline::{Stats, STRIDE};
 use crate::signal::flank::{crossing, Flank};
 
-/// How a run of samples ended the impact.
-enum End {
-    /// Back within the edge level for the hold time.
-    Quiet,
-    /// A new hit after separation: the next impact starts at the sample not used.
-    NextHit,
-    /// Settled at a new level.
-    Settled(super::level::Settled),
-}
-
 impl<const PRE: usize> Stream<PRE> {
-    /// The trigger fired at `self.index`: find the onset in the ring, fix the baseline from
+    /// The trigger fired at `self.run.index`: find the onset in the ring, fix the baseline from
     /// the samples before it, fit the rising flank, and replay the pre-trigger samples into
     /// the capture (if the sink has a buffer) and the running sums.
     pub(super) fn start<const CAP: usize>(
@@ -44,7 +35,7 @@ impl<const PRE: usize> Stream<PRE> {
         // the level the signal settled at since it was learned, if it did: `level_change`).
         let (base_sum, base_n) = self.baseline.rational();
         let deviation = Deviation::new(base_sum, base_n);
-        let edge_d = (self.edge_counts * base_n as f32) as i64;
+        let edge_d = (self.limits.edge_counts * base_n as f32) as i64;
         let (lo, hi) = self.current_thresholds();
         let d_hi = hi as i64 * base_n - base_sum;
         let d_lo = lo as i64 * base_n - base_sum;
@@ -58,10 +49,10 @@ impl<const PRE: usize> Stream<PRE> {
         let back = |i: usize| ring.back(i).filter(|_| i < REACH);
         let pd = |i: usize| back(i).map(|x| sign * deviation.of(x) as i64);
         let (pulse, touch_offset) = self.rising_flank(sign, deviation, edge_d, flank_d, trigger_x);
-        let onset_index = self.index - pulse as u64;
+        let onset_index = self.run.index - pulse as u64;
         let cut_at_start = onset_index == 0 && pd(pulse).is_none();
         // First touch cannot come before the previous contact ended: reports never overlap.
-        let earliest = self.last_end as f64 - onset_index as f64;
+        let earliest = self.run.last_end as f64 - onset_index as f64;
         let touch_floor = earliest.min(0.0) as f32;
         let line_in_previous = touch_offset < touch_floor;
         let touch_offset = touch_offset.max(touch_floor);
@@ -70,8 +61,8 @@ impl<const PRE: usize> Stream<PRE> {
         let lead_c: i64 = (pulse..pulse + line_lead)
             .map_while(|i| back(i).map(|x| deviation.of(x) as i64))
             .sum();
-        let since_last =
-            usize::try_from(self.index - self.window_end.min(self.index)).unwrap_or(usize::MAX);
+        let since_last = usize::try_from(self.run.index - self.run.window_end.min(self.run.index))
+            .unwrap_or(usize::MAX);
         let lobe = self.lobe_before(OnsetWalk {
             pulse,
             sign,
@@ -87,14 +78,14 @@ impl<const PRE: usize> Stream<PRE> {
         // not into the previous impact's window).
         let half_capture = self.capture_len::<CAP>() / 2;
         let reach = self.ring.len().min(REACH).min(half_capture);
-        let margin = (pulse + self.hold as usize / 2)
+        let margin = (pulse + self.limits.hold as usize / 2)
             .min(reach)
             .min(since_last.max(pulse));
-        let first_index = self.index - margin as u64;
+        let first_index = self.run.index - margin as u64;
         // With a CFC, the capture also takes the samples the filter needs to settle before
         // the onset (the true history, the previous impact's too): no streaming field sees
         // them.
-        let lead = (pulse + self.filter_pad as usize)
+        let lead = (pulse + self.limits.filter_pad as usize)
             .min(self.ring.len())
             .min(half_capture)
             .saturating_sub(margin);
@@ -105,7 +96,7 @@ impl<const PRE: usize> Stream<PRE> {
         let mut a = Active {
             first_index,
             filter_lead: lead as u32,
-            trigger_index: self.index,
+            trigger_index: self.run.index,
             onset_index,
             touch_offset,
             touch_floor,
@@ -127,7 +118,7 @@ impl<const PRE: usize> Stream<PRE> {
             lead_c,
             pre_onset_c: 0,
             peak_d: 0,
-            peak_index: self.index,
+            peak_index: self.run.index,
             total_c: 0,
             samples: 0,
             clipped: false,
@@ -141,30 +132,30 @@ impl<const PRE: usize> Stream<PRE> {
             captured: capture.is_some(),
             full: false,
             // The walk back reached the gap: the pulse began while samples were lost.
-            began_in_gap: self.gap_end.is_some_and(|g| onset_index <= g),
+            began_in_gap: self.run.gap_end.is_some_and(|g| onset_index <= g),
             last_quiet: onset_index,
             end_at: None,
             level: LevelWatch::new(
                 base_n,
                 base_sum,
-                self.edge_counts,
+                self.limits.edge_counts,
                 self.scene.clip_counts,
-                u64::from(self.settle),
+                u64::from(self.limits.settle),
             ),
         };
         let before_onset = margin.saturating_sub(pulse);
         self.replay_window(&mut a, capture, lead, margin, before_onset, deviation);
         // The falling side so far: from the peak to the newest sample.
-        let after_peak = self.index.saturating_sub(a.peak_index) as usize;
+        let after_peak = self.run.index.saturating_sub(a.peak_index) as usize;
         let (older, newer) = self.ring.last(after_peak);
         record_fall(
             &mut a,
             older,
-            self.index - (older.len() + newer.len()) as u64,
+            self.run.index - (older.len() + newer.len()) as u64,
         );
-        record_fall(&mut a, newer, self.index - newer.len() as u64);
+        record_fall(&mut a, newer, self.run.index - newer.len() as u64);
         self.start_online(&a, deviation, pulse, before_onset, line_lead);
-        self.active = Some(a);
+        self.run.active = Some(a);
     }
 
     /// The kinematics' sums from the onset (`pulse` samples back, `before_onset` into the
@@ -182,14 +173,15 @@ impl<const PRE: usize> Stream<PRE> {
         let scene = &self.scene;
         let touch = a.onset_index as f64 + a.touch_offset as f64;
         let v0 = self
+            .run
             .train
-            .approach(scene, touch, self.v0, self.v0_measured)
+            .approach(scene, touch, self.run.v0, self.run.v0_measured)
             .v0_m_s;
         let c_stop = v0.and_then(|v0| {
             crate::report::motion::Scale::new(v0 as f64, scene, a.base_n, 0.0).c_stop()
         });
         let lobe_lead = libm::floorf(-a.lobe_touch).max(0.0) as usize;
-        self.online.start(
+        self.run.online.start(
             deviation,
             crate::report::motion::motion_deviation(a.base_sum, a.base_n, scene),
             &self.ring,
@@ -329,25 +321,20 @@ impl<const PRE: usize> Stream<PRE> {
         used
     }
 
-    /// The in-impact loop: returns how many samples it took and how the impact ended, if it
-    /// did.
+    /// The in-impact loop ([`super::walk`]) over a chunk: returns how many samples it took
+    /// and how the impact ended, if it did.
     ///
     /// The level watch runs first, over whole strides of raw samples: where the signal
-    /// settles (if it does) is known before the per-sample loop, which stops there. The
-    /// running state lives in locals (the compiler cannot keep fields of `self` in registers
-    /// across the capture's push) and is written back once per call.
+    /// settles (if it does) is known before the per-sample loop, which stops there.
     fn run_part<const CAP: usize>(
         &mut self,
         samples: &[i16],
         sink: &mut impl Sink<CAP>,
     ) -> (usize, Option<End>) {
-        let hold = self.hold;
-        // A return to the baseline that lets a new hit start a new impact.
-        let min_gap = (hold / 8).max(2);
-        let first_mark = min_gap.min(hold);
         let (lo, hi) = self.scene.clip_counts;
-        let max_samples = self.max_samples;
-        let Some(a) = self.active.as_mut() else {
+        let max_samples = self.limits.max_samples;
+        let hold = self.limits.hold;
+        let Some(a) = self.run.active.as_mut() else {
             return (0, None);
         };
         // At most the samples that keep the impact within its longest duration.
@@ -357,223 +344,46 @@ impl<const PRE: usize> Stream<PRE> {
         let samples = samples.get(..room).unwrap_or(&[]);
         let scan = a.level.scan(samples);
         let samples = samples.get(..scan.used).unwrap_or(&[]);
+        let levels = Levels::of(a, hold, a.first_index + a.samples);
         let deviation = a.deviation();
-        // edge_d >= 0: the scene's edge level is positive (validated).
-        let edge = a.edge_d.clamp(0, u32::MAX as i64) as u32;
-        let start = a.first_index + a.samples;
-        let mut peak_abs = a.peak_d.unsigned_abs().min(u32::MAX as u64) as u32;
-        let mut peak_positive = a.peak_d >= 0;
-        let mut new_peak: Option<(usize, i32)> = None;
-        // Where the rise's record closes (stream index) for a peak at stream index `p`, and
-        // where it closed in this call if a later peak came after that.
-        let onset = a.onset_index;
-        let rise_closing = |p: u64| onset + Rise::closing(p.saturating_sub(onset));
-        let mut peak_at = a.peak_index;
-        let mut rise_closes: Option<u64> = None;
-        let mut separation = a.separation;
-        let open_at_start = separation.is_none();
-        let mut separation_c = a.separation_c;
-        let mut quiet = a.quiet;
-        // Back at the baseline long enough since the peak for a new hit to be a new impact.
-        let mut returned = a.returned;
-        // `k` after the latest quiet sample before a louder one, in this call.
-        let mut last_quiet_k: Option<usize> = None;
-        let mut sum: i64 = 0;
-        let mut used = samples.len();
-        let mut ended = None;
-        let (d_hi, d_lo) = (a.d_hi, a.d_lo);
-        // The kinematics' online sums ([`super::online`]): `Σ` of the running `Σ d` per
-        // sample here, the rest once per call.
-        let mut sum2: i64 = 0;
-        let n = samples.len();
-        let mut k = 0;
-        // Alternating stretches of samples beyond the edge level (loud) and within it
-        // (quiet), each in a tight loop; what is rare (a new peak, a sign flip, a new hit,
-        // the hold reached) leaves the tight loop for the full test.
-        'scan: while k < n {
-            // Loud: `e` is the deviation signed so that the peak's direction is positive.
-            // Anything that may matter lies outside `lo..=hi`: a new peak either way, a sign
-            // flip while there is no separation, a new hit beyond the trigger once the
-            // signal has returned.
-            let marks = |peak_abs: u32, positive: bool, returned: bool, open: bool| {
-                let peak = peak_abs.min(i32::MAX as u32) as i32;
-                let trigger = if positive {
-                    d_hi
-                } else {
-                    d_lo.saturating_neg()
-                };
-                let hi = if returned { trigger.min(peak) } else { peak };
-                let lo = if open { 0 } else { -peak };
-                (if positive { 1 } else { -1 }, trigger, lo, hi)
-            };
-            let (mut sign, mut trigger, mut lo, mut hi) =
-                marks(peak_abs, peak_positive, returned, separation.is_none());
-            while let Some(&x) = samples.get(k) {
-                let d = deviation.of(x);
-                let abs = d.unsigned_abs();
-                if abs <= edge {
-                    break;
-                }
-                let e = d.wrapping_mul(sign);
-                if e > hi || e < lo {
-                    if returned && e > trigger {
-                        // Back at the baseline, then a new hit the same way beyond the
-                        // trigger: the next impact starts with this sample.
-                        ended = Some(End::NextHit);
-                        used = k;
-                        break 'scan;
-                    }
-                    if abs > peak_abs {
-                        // The rise's record closed if the samples went past its closing
-                        // point for the peak so far before this one came (it lies at least
-                        // 16 samples past that peak: a peak close after it cannot).
-                        let near = new_peak.is_some_and(|(kp, _)| k - kp <= 16);
-                        if !near
-                            && rise_closes.is_none()
-                            && start + k as u64 > rise_closing(peak_at)
-                        {
-                            rise_closes = Some(rise_closing(peak_at));
-                        }
-                        peak_at = start + k as u64;
-                        peak_abs = abs;
-                        peak_positive = d >= 0;
-                        new_peak = Some((k, d));
-                        separation = None;
-                        returned = false;
-                    } else if separation.is_none() && e < 0 {
-                        // Across the whole band between two samples (a sign flip): the
-                        // signal came back between them.
-                        separation = Some(start + k as u64);
-                        separation_c = a.total_c + sum;
-                    }
-                    (sign, trigger, lo, hi) =
-                        marks(peak_abs, peak_positive, returned, separation.is_none());
-                }
-                if quiet > 0 {
-                    last_quiet_k = Some(k);
-                    quiet = 0;
-                }
-                sum += d as i64;
-                sum2 = sum2.wrapping_add(sum);
-                k += 1;
-            }
-            // Quiet: the first quiet sample after the peak is the separation.
-            if k < n && separation.is_none() {
-                separation = Some(start + k as u64);
-                separation_c = a.total_c + sum;
-            }
-            while let Some(&x) = samples.get(k) {
-                let d = deviation.of(x);
-                if d.unsigned_abs() > edge {
-                    break;
-                }
-                quiet += 1;
-                sum += d as i64;
-                sum2 = sum2.wrapping_add(sum);
-                if quiet >= first_mark {
-                    returned |= quiet >= min_gap;
-                    if quiet >= hold && start + k as u64 > a.trigger_index {
-                        ended = Some(End::Quiet);
-                        used = k + 1;
-                        break 'scan;
-                    }
-                }
-                k += 1;
-            }
-        }
-        let kept = samples.get(..used).unwrap_or(&[]);
+        let mut walk = Walk::load(a, samples.len());
+        walk.run(samples, deviation, &levels);
+        let kept = samples.get(..walk.used).unwrap_or(&[]);
         // Σ d' = Σ d - n G; Σ C' from Σ of the running Σ d: exact, once per call.
-        self.online.advance(kept, sum, sum2, scan.max);
+        self.run.online.advance(kept, walk.sum, walk.sum2, scan.max);
         // Only when the samples reach a rail does it matter which of them did.
         if scan.min <= lo || scan.max >= hi {
             a.clipped |= kept.iter().any(|&x| x <= lo || x >= hi);
         }
-        // The capture keeps the whole impact: a filter's lead-in gives way to it first (the
-        // window at every sample keeps the fits), then it goes on at a coarser step
-        // (`Capture::extend_decimating`).
-        if a.captured && !a.full {
-            a.full = match sink.buffer() {
-                Some(c) => {
-                    if a.filter_lead > 0 && c.held().len() + kept.len() > c.capacity() {
-                        c.drop_front(a.filter_lead as usize);
-                        a.filter_lead = 0;
-                    }
-                    c.extend_decimating(kept) < kept.len()
-                }
-                None => true,
-            };
-        }
-        if let Some((k, d)) = new_peak {
-            a.peak_d = d as i64;
-            a.peak_index = start + k as u64;
-        }
-        // The falling foot: from a new peak on, or going on until the separation.
-        let from = match new_peak {
-            Some((k, _)) => Some(k),
-            None if open_at_start => Some(0),
-            None => None,
-        };
-        if let Some(from) = from {
-            let to = separation.map_or(kept.len() as u64, |s| s.saturating_sub(start));
-            let to = (to as usize).min(kept.len());
-            let run = kept.get(from..to).unwrap_or(&[]);
-            record_fall(a, run, start + from as u64);
-        }
-        // Just after the latest quiet sample: the end of the run of quiet samples that
-        // is still going, or the one before the latest louder sample.
-        if quiet > 0 {
-            a.last_quiet = start + used as u64;
-        } else if let Some(k) = last_quiet_k {
-            a.last_quiet = start + k as u64;
-        }
-        if matches!(ended, Some(End::NextHit)) {
-            a.end_at = Some(a.last_quiet);
-        }
-        if !a.rise.done() {
-            // Up to where it closes: for the last peak, unless it closed before it.
-            let close = rise_closes.unwrap_or_else(|| rise_closing(a.peak_index));
-            let n = (close + 1).saturating_sub(start).min(kept.len() as u64) as usize;
-            let sign = a.sign;
-            a.rise.take(start.saturating_sub(a.onset_index), n, |k| {
-                kept.get(k).map_or(0, |&x| sign * deviation.of(x) as i64)
-            });
-            if start + kept.len() as u64 > close {
-                a.rise.close();
-            }
-        }
-        a.total_c += sum;
-        a.separation = separation;
-        a.separation_c = separation_c;
-        a.quiet = quiet;
-        a.returned = returned;
-        a.samples += used as u64;
-        if ended.is_none() {
-            ended = scan.settled.map(End::Settled);
-        }
+        capture_part(a, kept, sink);
+        let ended = walk.store(a, kept, &levels, deviation);
+        let ended = ended.or(scan.settled.map(End::Settled));
         let too_long = ended.is_none() && a.samples >= max_samples;
         // The ring keeps following the stream: the separation flank and the next impact's
         // pre-trigger history come from it.
         self.keep(kept);
         self.locate_separation();
         if let Some((onset, Some((at, offset, _)))) = self
+            .run
             .active
             .as_ref()
             .map(|a| (a.onset_index, a.separation_at))
         {
-            self.online
-                .follow_separation(&self.ring, self.index, onset, at, offset);
+            self.run
+                .online
+                .follow_separation(&self.ring, self.run.index, onset, at, offset);
         }
         if too_long {
             self.end_unreturned(Status::TooLong, sink);
-            return (used, None);
+            return (kept.len(), None);
         }
-        (used, ended)
+        (kept.len(), ended)
     }
 
     /// The impact ended (see [`End`]): hand it over, or, for a level change without a pulse,
     /// drop it; learn the baseline again after a level change.
     fn finish_impact<const CAP: usize>(&mut self, end: End, sink: &mut impl Sink<CAP>) {
-        let Some(a) = self.active.as_mut() else {
+        let Some(a) = self.run.active.as_mut() else {
             return;
         };
         let status = match end {
@@ -590,15 +400,15 @@ impl<const PRE: usize> Stream<PRE> {
                 // The flat run began `run_n` samples ago: the contact ended there at the
                 // latest.
                 if a.separation.is_none() {
-                    a.separation = Some(self.index - s.run_n);
+                    a.separation = Some(self.run.index - s.run_n);
                     a.separation_c = a.total_c - s.run_d;
                 }
                 // A pulse is a peak beyond the trigger from the new level too; else the
                 // "impact" was the level change itself.
                 let trigger_d = a.d_hi.min(-a.d_lo) as f64;
                 if libm::fabs(a.peak_d as f64 - s.level_d) <= trigger_d {
-                    self.active = None;
-                    self.counters.level_changes += 1;
+                    self.run.active = None;
+                    self.run.counters.level_changes += 1;
                 } else {
                     self.end_unreturned(Status::Settled, sink);
                 }
@@ -636,8 +446,8 @@ impl<const PRE: usize> Stream<PRE> {
         status: Status,
         sink: &mut impl Sink<CAP>,
     ) {
-        let settle = u64::from(self.settle);
-        if let Some(a) = self.active.as_mut() {
+        let settle = u64::from(self.limits.settle);
+        if let Some(a) = self.run.active.as_mut() {
             a.drift |= a.peak_index.saturating_sub(a.onset_index) > settle;
         }
         self.end(status, sink);
@@ -645,13 +455,15 @@ impl<const PRE: usize> Stream<PRE> {
 
     /// Hands the active impact over and returns to idle.
     pub(super) fn end<const CAP: usize>(&mut self, status: Status, sink: &mut impl Sink<CAP>) {
-        let Some(a) = self.active.take() else { return };
-        self.thresholds = None;
+        let Some(a) = self.run.active.take() else {
+            return;
+        };
+        self.run.thresholds = None;
         self.baseline.restart_stride();
-        self.last_end = a.separation.unwrap_or(self.index);
-        self.window_end = a.end_at.unwrap_or(self.index);
+        self.run.last_end = a.separation.unwrap_or(self.run.index);
+        self.run.window_end = a.end_at.unwrap_or(self.run.index);
         let level = self.baseline.mean() as f64;
-        if let Some(f) = self.trigger_filter.as_mut() {
+        if let Some(f) = self.run.trigger_filter.as_mut() {
             f.reset(level);
         }
         // The separation located while its flank was in the ring, else from the ring now.
@@ -665,16 +477,17 @@ impl<const PRE: usize> Stream<PRE> {
         let touch = self.touch(&a);
         let (touch_offset, lead_c, in_previous) = self.lobe(&a, touch);
         let touch = a.onset_index as f64 + touch_offset as f64;
-        let approach = self
-            .train
-            .approach(&self.scene, touch, self.v0, self.v0_measured);
+        let approach =
+            self.run
+                .train
+                .approach(&self.scene, touch, self.run.v0, self.run.v0_measured);
         // A light gate's reading is the next impact's approach speed, not its bounces'.
-        if self.v0_measured {
-            self.v0 = self.scene.v0_m_s();
-            self.v0_measured = false;
+        if self.run.v0_measured {
+            self.run.v0 = self.scene.v0_m_s();
+            self.run.v0_measured = false;
         }
         let mut summary = Summary {
-            index: self.counters.impacts.min(u32::MAX as u64) as u32,
+            index: self.run.counters.impacts.min(u32::MAX as u64) as u32,
             status,
             clipped: a.clipped,
             cut_at_start: a.cut_at_start,
@@ -688,7 +501,7 @@ impl<const PRE: usize> Stream<PRE> {
             touch_offset,
             separation_index: a.separation,
             separation_offset,
-            end_index: a.end_at.unwrap_or(self.index),
+            end_index: a.end_at.unwrap_or(self.run.index),
             base_sum: a.base_sum,
             base_n: a.base_n,
             peak_d: a.peak_d,
@@ -703,19 +516,19 @@ impl<const PRE: usize> Stream<PRE> {
         };
         // The online sums' crush and separation, now that touch and speed are final.
         if let Some(s) = a.separation {
-            self.online.follow_separation(
+            self.run.online.follow_separation(
                 &self.ring,
-                self.index,
+                self.run.index,
                 a.onset_index,
                 s,
                 separation_offset,
             );
         }
-        summary.motion = self.online.finish(&summary, &self.scene);
-        self.train.ended(&summary, &self.scene);
-        self.counters.impacts += 1;
+        summary.motion = self.run.online.finish(&summary, &self.scene);
+        self.run.train.ended(&summary, &self.scene);
+        self.run.counters.impacts += 1;
         if status != Status::Complete {
-            self.counters.incomplete += 1;
+            self.run.counters.incomplete += 1;
         }
         if status == Status::TooLong {
             // The baseline moved (or the sensor is stuck): learn it again.
@@ -727,7 +540,7 @@ impl<const PRE: usize> Stream<PRE> {
                 // With a CFC the capture goes on after the window for the filter's padding
                 // after the contact (as far as it holds), unless nothing more will come.
                 let contact_end = a.separation.unwrap_or(summary.end_index);
-                let until = contact_end.saturating_add(u64::from(self.filter_pad));
+                let until = contact_end.saturating_add(u64::from(self.limits.filter_pad));
                 let more = !matches!(status, Status::StreamEnded | Status::Gap);
                 // The stream index a capture filled at its step would reach.
                 let fills_to =
@@ -735,17 +548,35 @@ impl<const PRE: usize> Stream<PRE> {
                 let decimate = self.tail_decimates(&a, fills_to);
                 let room = !c.is_full() || decimate;
                 // (`is_full`: no room at the capture's step; only a decimating tail makes it.)
-                if self.filter_pad > 0 && more && !a.full && room && until > self.index {
-                    self.tail = Some((until, decimate));
+                if self.limits.filter_pad > 0 && more && !a.full && room && until > self.run.index {
+                    self.run.tail = Some((until, decimate));
                 } else {
                     sink.captured(&self.scene);
-                    self.handed_over = true;
+                    self.run.handed_over = true;
                 }
             }
             _ => {
-                self.counters.analyses_skipped += 1;
+                self.run.counters.analyses_skipped += 1;
                 sink.skipped(&report::streaming(&summary, &self.scene));
             }
         }
+    }
+}
+
+/// The capture keeps the whole impact `a`: a filter's lead-in gives way to it first (the
+/// window at every sample keeps the fits), then it goes on at a coarser step
+/// (`Capture::extend_decimating`).
+fn capture_part<const CAP: usize>(a: &mut Active, kept: &[i16], sink: &mut impl Sink<CAP>) {
+    if a.captured && !a.full {
+        a.full = match sink.buffer() {
+            Some(c) => {
+                if a.filter_lead > 0 && c.held().len() + kept.len() > c.capacity() {
+                    c.drop_front(a.filter_lead as usize);
+                    a.filter_lead = 0;
+                }
+                c.extend_decimating(kept) < kept.len()
+            }
+            None => true,
+        };
     }
 }

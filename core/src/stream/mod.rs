@@ -21,8 +21,10 @@ mod level;
 mod online;
 mod onset;
 mod rise;
+mod state;
 mod tail;
 pub mod train;
+mod walk;
 
 use crate::capture::Sink;
 use crate::consts::STANDARD_GRAVITY;
@@ -32,8 +34,8 @@ use crate::scene::{Approach, FitSet, Scene};
 use crate::signal::baseline::{Baseline, Stats, STRIDE};
 use crate::signal::ring::Ring;
 use crate::signal::Calibration;
-use active::Active;
 use onset::Onset;
+use state::{Limits, Run};
 
 /// Quiet strides in the baseline window (`64 * STRIDE` = 4096 samples).
 const BASELINE_STRIDES: usize = 64;
@@ -78,61 +80,12 @@ pub struct Counters {
 /// flank fits.
 pub struct Stream<const PRE: usize> {
     scene: Scene,
+    /// The scene in counts and samples.
+    limits: Limits,
     ring: Ring<PRE>,
     baseline: Baseline<BASELINE_STRIDES>,
-    active: Option<Active>,
-    /// Stream index of the next sample.
-    index: u64,
-    v0: Option<f32>,
-    /// `v0` is a light gate's reading ([`Self::set_approach_speed`]): it holds for every
-    /// impact, a bounce's too.
-    v0_measured: bool,
-    /// The previous impact, for bounce trains.
-    train: train::Tracker,
-    counters: Counters,
-    trigger_counts: f32,
-    edge_counts: f32,
-    hold: u32,
-    /// Samples a flat new level must last to be a level change.
-    settle: u32,
-    max_samples: u64,
-    /// The capture's length in use, samples ([`Self::configure_for`]; 0: all `CAP`).
-    capture_len: usize,
-    /// Trigger thresholds (raw counts) in force until the next refresh.
-    thresholds: Option<(i32, i32)>,
-    /// The ring's history is being run again after the first baseline (see `replay_history`).
-    replaying: bool,
-    /// The causal trigger filter, if the scene asks for one.
-    trigger_filter: Option<crate::signal::cfc::Causal>,
-    /// Stream index of the first sample after the last gap.
-    gap_end: Option<u64>,
-    /// Where the last impact's contact ended (its separation, or the end of its window): no
-    /// report starts before it.
-    last_end: u64,
-    /// The power of the latest foot that showed one clearly ([`crate::signal::power_flank`]):
-    /// the same contact's later, smaller impacts take it where their noise leaves it open.
-    foot_power: Option<f32>,
-    /// Where the last impact's window ended: the next capture does not reach back into it.
-    window_end: u64,
-    /// With a CFC: samples the filter needs on each side of a contact (SAE J211's padding);
-    /// with a specified pulse, the window its verdict watches (the larger of the two).
-    /// The capture takes them beyond the impact's window (a lead-in before it, a tail after
-    /// it), so neither ever changes where an impact starts or ends.
-    filter_pad: u32,
-    /// The impact just ended still takes samples into its capture up to this stream index
-    /// (its filter's tail), decimating it if full when the flag says so: handed over there,
-    /// at the next trigger, a gap or the end.
-    tail: Option<(u64, bool)>,
-    /// A trigger fired while a capture was handed over: the next call starts its impact at
-    /// its first sample (see [`Self::push_to_impact_end`]).
-    trigger_pending: bool,
-    /// A capture was handed over in this call.
-    handed_over: bool,
-    /// The baseline moved to another level (or is being learned again) since the last impact
-    /// started: the next one says so.
-    moved: bool,
-    /// The kinematics' sums of the impact being followed ([`online`]).
-    online: online::Online,
+    /// Everything else running changes.
+    run: Run,
 }
 
 impl<const PRE: usize> Stream<PRE> {
@@ -186,41 +139,10 @@ impl<const PRE: usize> Stream<PRE> {
                     hertz: false,
                 },
             },
+            limits: Limits::PLACEHOLDER,
             ring: Ring::new(),
             baseline: Baseline::new(),
-            active: None,
-            index: 0,
-            v0: None,
-            v0_measured: false,
-            train: train::Tracker::new(),
-            counters: Counters {
-                samples: 0,
-                impacts: 0,
-                incomplete: 0,
-                analyses_skipped: 0,
-                samples_lost: 0,
-                gaps: 0,
-                level_changes: 0,
-            },
-            trigger_counts: 1.0,
-            edge_counts: 0.25,
-            hold: 1,
-            settle: 1,
-            max_samples: 1,
-            capture_len: 0,
-            thresholds: None,
-            replaying: false,
-            trigger_filter: None,
-            gap_end: None,
-            last_end: 0,
-            foot_power: None,
-            window_end: 0,
-            filter_pad: 0,
-            tail: None,
-            trigger_pending: false,
-            handed_over: false,
-            moved: false,
-            online: online::Online::new(),
+            run: Run::new(),
         }
     }
 
@@ -237,13 +159,13 @@ impl<const PRE: usize> Stream<PRE> {
             });
         }
         self.configure(scene)?;
-        self.capture_len = cap;
+        self.limits.capture_len = cap;
         Ok(())
     }
 
     /// The capture's length in use for captures of `CAP` samples.
     fn capture_len<const CAP: usize>(&self) -> usize {
-        match self.capture_len {
+        match self.limits.capture_len {
             0 => CAP,
             n => n.min(CAP),
         }
@@ -258,44 +180,11 @@ impl<const PRE: usize> Stream<PRE> {
                 reason: "ring must be a power of two of at least 64 samples",
             });
         }
-        let gain = libm::fabsf(scene.calibration.gain_m_s2_per_count);
         self.scene = scene;
+        self.limits = Limits::of(&scene);
         self.ring.clear();
         self.baseline.clear();
-        self.active = None;
-        self.index = 0;
-        self.v0 = scene.v0_m_s();
-        self.v0_measured = false;
-        self.train = train::Tracker::new();
-        self.counters = Counters::default();
-        self.trigger_counts = scene.trigger_m_s2 / gain;
-        self.edge_counts = scene.edge_m_s2 / gain;
-        // With a CFC on the captured windows the filter needs its padding of signal around
-        // the contact (SAE J211): the capture takes it beyond the window (the hold does not
-        // change, nor does anything else the stream decides).
-        // A specified pulse's verdict watches its window around the pulse: the same padding.
-        self.filter_pad = scene.padding_samples();
-        self.hold = scene.samples(scene.hold_s);
-        self.settle = scene.samples(scene.settle_s);
-        self.max_samples = scene.samples(scene.max_impact_s) as u64;
-        self.capture_len = 0;
-        self.thresholds = None;
-        self.replaying = false;
-        self.gap_end = None;
-        self.last_end = 0;
-        self.foot_power = None;
-        self.window_end = 0;
-        self.tail = None;
-        self.trigger_pending = false;
-        self.handed_over = false;
-        self.moved = false;
-        // At rest at 0 until the first baseline resets it to the baseline's level.
-        self.trigger_filter = scene
-            .trigger_cfc
-            .and_then(|class| {
-                crate::signal::cfc::Biquad::cfc(class, scene.calibration.sample_rate_hz as f64)
-            })
-            .map(|b| crate::signal::cfc::Causal::new(b, 0.0));
+        self.run.restart(&scene);
         Ok(())
     }
 
@@ -306,12 +195,12 @@ impl<const PRE: usize> Stream<PRE> {
 
     /// Counters so far.
     pub fn counters(&self) -> Counters {
-        self.counters
+        self.run.counters
     }
 
     /// True while an impact is being followed.
     pub fn in_impact(&self) -> bool {
-        self.active.is_some()
+        self.run.active.is_some()
     }
 
     /// True once a baseline has been learned (impacts can be detected).
@@ -321,14 +210,14 @@ impl<const PRE: usize> Stream<PRE> {
 
     /// Stream index of the next sample.
     pub fn position(&self) -> u64 {
-        self.index
+        self.run.index
     }
 
     /// Sets the approach speed of the next impact (a light gate's reading), m/s: it holds for
     /// that impact only (after it the scene's is back), so no bounce takes it.
     pub fn set_approach_speed(&mut self, v0_m_s: Option<f32>) {
-        self.v0 = v0_m_s.filter(|v| v.is_finite() && *v > 0.0);
-        self.v0_measured = self.v0.is_some();
+        self.run.v0 = v0_m_s.filter(|v| v.is_finite() && *v > 0.0);
+        self.run.v0_measured = self.run.v0.is_some();
     }
 
     /// A block of samples (whatever the DMA hands over). Impacts go to `sink`.
@@ -351,11 +240,11 @@ impl<const PRE: usize> Stream<PRE> {
         sink: &mut impl Sink<CAP>,
     ) -> usize {
         let mut rest = block;
-        self.handed_over = false;
+        self.run.handed_over = false;
         while !rest.is_empty() {
-            if self.trigger_pending {
+            if self.run.trigger_pending {
                 // The trigger fired on this sample in the previous call.
-                self.trigger_pending = false;
+                self.run.trigger_pending = false;
                 let x = rest.first().copied().unwrap_or(0);
                 match self.onset(x) {
                     Onset::Pulse(level) => self.pulse(sink, x, level),
@@ -364,13 +253,13 @@ impl<const PRE: usize> Stream<PRE> {
                 }
                 continue;
             }
-            if self.handed_over {
+            if self.run.handed_over {
                 break;
             }
-            if self.active.is_some() {
+            if self.run.active.is_some() {
                 let used = self.run_active(rest, sink);
                 rest = rest.get(used..).unwrap_or(&[]);
-                if self.active.is_none() {
+                if self.run.active.is_none() {
                     break;
                 }
                 continue;
@@ -385,7 +274,7 @@ impl<const PRE: usize> Stream<PRE> {
                 rest = after;
                 if self.baseline.is_armed() {
                     let level = self.baseline.mean() as f64;
-                    if let Some(f) = self.trigger_filter.as_mut() {
+                    if let Some(f) = self.run.trigger_filter.as_mut() {
                         f.reset(level);
                     }
                     // The first baseline: look again at the history it did not cover, so an
@@ -395,7 +284,7 @@ impl<const PRE: usize> Stream<PRE> {
                 continue;
             }
             let (lo, hi) = self.current_thresholds();
-            let found = match self.trigger_filter.as_mut() {
+            let found = match self.run.trigger_filter.as_mut() {
                 None => {
                     // One vectorised pass for the stride statistics; the samples are
                     // scanned one by one only when the segment crosses a threshold.
@@ -450,11 +339,11 @@ impl<const PRE: usize> Stream<PRE> {
                             continue;
                         }
                     };
-                    if self.tail.is_some() || self.handed_over {
+                    if self.run.tail.is_some() || self.run.handed_over {
                         // The previous capture goes first (its tail ends here); the caller
                         // may wait for a free buffer before this impact starts.
                         self.hand_over(sink);
-                        self.trigger_pending = true;
+                        self.run.trigger_pending = true;
                         break;
                     }
                     self.pulse(sink, x, level);
@@ -472,26 +361,26 @@ impl<const PRE: usize> Stream<PRE> {
         if lost == 0 {
             return;
         }
-        if self.active.is_some() {
+        if self.run.active.is_some() {
             self.end(Status::Gap, sink);
         }
         self.hand_over(sink);
-        self.index += lost;
-        self.gap_end = Some(self.index);
-        self.counters.samples_lost += lost;
-        self.counters.gaps += 1;
+        self.run.index += lost;
+        self.run.gap_end = Some(self.run.index);
+        self.run.counters.samples_lost += lost;
+        self.run.counters.gaps += 1;
         self.ring.clear();
         self.baseline.restart_stride();
         let level = self.baseline.mean() as f64;
-        if let Some(f) = self.trigger_filter.as_mut() {
+        if let Some(f) = self.run.trigger_filter.as_mut() {
             f.reset(level);
         }
     }
 
     /// Ends the stream: an impact in progress ends with [`Status::StreamEnded`].
     pub fn finish<const CAP: usize>(&mut self, sink: &mut impl Sink<CAP>) {
-        self.trigger_pending = false;
-        if self.active.is_some() {
+        self.run.trigger_pending = false;
+        if self.run.active.is_some() {
             self.end_unreturned(Status::StreamEnded, sink);
         }
         self.hand_over(sink);
@@ -508,7 +397,7 @@ impl<const PRE: usize> Stream<PRE> {
     /// of the impact that ended last, if it still takes one.
     #[inline]
     fn keep_idle<const CAP: usize>(&mut self, samples: &[i16], sink: &mut impl Sink<CAP>) {
-        if let Some(until) = self.tail {
+        if let Some(until) = self.run.tail {
             self.extend_tail(until, samples, sink);
         }
         self.keep(samples);
@@ -518,26 +407,26 @@ impl<const PRE: usize> Stream<PRE> {
     #[inline]
     fn keep(&mut self, samples: &[i16]) {
         self.ring.extend(samples);
-        self.index += samples.len() as u64;
-        self.counters.samples += samples.len() as u64;
+        self.run.index += samples.len() as u64;
+        self.run.counters.samples += samples.len() as u64;
     }
 
     /// A stretch of idle samples into the baseline (not while the history is replayed).
     #[inline]
     fn learn(&mut self, stats: &Stats) {
-        if !self.replaying && self.baseline.add_stats(stats, self.edge_counts) {
-            self.thresholds = None;
+        if !self.run.replaying && self.baseline.add_stats(stats, self.limits.edge_counts) {
+            self.run.thresholds = None;
         }
     }
 
     /// The trigger thresholds for the current baseline (computed once per change).
     #[inline]
     fn current_thresholds(&mut self) -> (i32, i32) {
-        match self.thresholds {
+        match self.run.thresholds {
             Some(t) => t,
             None => {
                 let t = self.thresholds();
-                self.thresholds = Some(t);
+                self.run.thresholds = Some(t);
                 t
             }
         }
@@ -549,9 +438,9 @@ impl<const PRE: usize> Stream<PRE> {
     #[inline(never)]
     fn replay_history<const CAP: usize>(&mut self, sink: &mut impl Sink<CAP>) {
         let n = self.ring.take_history();
-        self.index -= n as u64;
-        self.counters.samples -= n as u64;
-        self.replaying = true;
+        self.run.index -= n as u64;
+        self.run.counters.samples -= n as u64;
+        self.run.replaying = true;
         let mut chunk = [0i16; STRIDE];
         let mut k = 0;
         while k < n {
@@ -561,7 +450,7 @@ impl<const PRE: usize> Stream<PRE> {
             self.push_block(part, sink);
             k += m;
         }
-        self.replaying = false;
+        self.run.replaying = false;
     }
 
     /// Forgets the baseline and the history (the level moved, or the sensor is stuck): the
@@ -569,15 +458,15 @@ impl<const PRE: usize> Stream<PRE> {
     fn relearn_baseline(&mut self) {
         self.ring.clear();
         self.baseline.clear();
-        self.thresholds = None;
-        self.moved = true;
+        self.run.thresholds = None;
+        self.run.moved = true;
     }
 
     /// Trigger thresholds in raw counts around the baseline.
     fn thresholds(&self) -> (i32, i32) {
         let mean = self.baseline.mean();
-        let lo = floor(mean - self.trigger_counts);
-        let hi = -floor(-(mean + self.trigger_counts));
+        let lo = floor(mean - self.limits.trigger_counts);
+        let hi = -floor(-(mean + self.limits.trigger_counts));
         (clamp_i32(lo), clamp_i32(hi))
     }
 }

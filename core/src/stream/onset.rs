@@ -43,7 +43,7 @@ impl<const PRE: usize> Stream<PRE> {
     /// names: the body falls before every touch, whatever the ring's length). `(Σx, n)` over
     /// the run, as the baseline's rational; `None` for no such run within the flanks' reach.
     pub(super) fn level_before(&self) -> Option<(i64, i64)> {
-        let edge = self.edge_counts;
+        let edge = self.limits.edge_counts;
         let mean = self.baseline.mean();
         // Stride `k` back from the newest sample: Σx, least and greatest sample.
         let stride = |k: usize| -> Option<(i32, i16, i16)> {
@@ -113,7 +113,7 @@ impl<const PRE: usize> Stream<PRE> {
         let needed = if in_free_fall {
             2 * STRIDE as i64
         } else {
-            i64::from(self.settle).max(STRIDE as i64)
+            i64::from(self.limits.settle).max(STRIDE as i64)
         };
         (varies && n >= needed).then_some((sum, n))
     }
@@ -145,15 +145,15 @@ impl<const PRE: usize> Stream<PRE> {
         };
         if let Some((sum, n)) = level {
             let from_level = x as f32 - sum as f32 / n as f32;
-            if libm::fabsf(from_level) <= self.trigger_counts {
+            if libm::fabsf(from_level) <= self.limits.trigger_counts {
                 return Onset::Moved((sum, n));
             }
         }
-        let window = (self.settle as usize / 2)
+        let window = (self.limits.settle as usize / 2)
             .clamp(2, REACH)
             .min(self.ring.len());
         let mean = self.baseline.mean();
-        let edge = self.edge_counts;
+        let edge = self.limits.edge_counts;
         let above = x as f32 > mean;
         let crept = window >= 2
             && self.ring.len() >= STRIDE
@@ -185,7 +185,7 @@ impl<const PRE: usize> Stream<PRE> {
         if let Some((sum, n)) = level {
             self.move_baseline(sum, n);
         }
-        let moved = core::mem::take(&mut self.moved);
+        let moved = core::mem::take(&mut self.run.moved);
         self.start(sink, x, moved);
     }
 
@@ -196,11 +196,11 @@ impl<const PRE: usize> Stream<PRE> {
     pub(super) fn move_baseline(&mut self, sum: i64, n: i64) {
         let free_fall = n > 0 && self.is_free_fall(sum as f32 / n as f32);
         self.baseline.restart_at(sum, n);
-        self.thresholds = None;
-        self.counters.level_changes += 1;
-        self.moved |= !free_fall;
+        self.run.thresholds = None;
+        self.run.counters.level_changes += 1;
+        self.run.moved |= !free_fall;
         let level = self.baseline.mean() as f64;
-        if let Some(f) = self.trigger_filter.as_mut() {
+        if let Some(f) = self.run.trigger_filter.as_mut() {
             f.reset(level);
         }
     }

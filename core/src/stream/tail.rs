@@ -17,7 +17,7 @@ impl<const PRE: usize> Stream<PRE> {
         samples: &[i16],
         sink: &mut impl Sink<CAP>,
     ) {
-        let n = usize::try_from(until.saturating_sub(self.index))
+        let n = usize::try_from(until.saturating_sub(self.run.index))
             .unwrap_or(usize::MAX)
             .min(samples.len());
         let part = samples.get(..n).unwrap_or(&[]);
@@ -29,16 +29,16 @@ impl<const PRE: usize> Stream<PRE> {
             };
             took < part.len()
         });
-        if full || n < samples.len() || self.index + n as u64 >= until {
+        if full || n < samples.len() || self.run.index + n as u64 >= until {
             self.hand_over(sink);
         }
     }
 
     /// Hands over the capture whose tail is being taken, if any.
     pub(super) fn hand_over<const CAP: usize>(&mut self, sink: &mut impl Sink<CAP>) {
-        if self.tail.take().is_some() {
+        if self.run.tail.take().is_some() {
             sink.captured(&self.scene);
-            self.handed_over = true;
+            self.run.handed_over = true;
         }
     }
 }
