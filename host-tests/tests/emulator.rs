@@ -1407,11 +1407,13 @@ fn vertical_drops_and_trains_match_the_host() {
     }
 }
 
-/// The bench (#41): a vertical train of seed 001's nonlinear law on a soft barrier
-/// (60 g at 1.3357 m/s, `F = k x (1 + c v)`, k 240 N/m: contacts of 55–64 ms, twice the
-/// board's 30.2 ms capture), 500 kS/s, in real time with the board's limits: every contact
-/// has its COR, crush time and deformations on the board, the host's to the bit, from the
-/// stream's online sums; nothing lost; the same with the shock spectra.
+/// The bench (#41): a 5 s recording of a vertical train of seed 001's nonlinear law
+/// on a soft barrier (60 g at 1.3357 m/s, `F = k x (1 + c v)`, k 240 N/m: contacts of
+/// 55–76 ms, up to 2.5 times the board's 30.2 ms capture, until the body stays on the
+/// barrier), 500 kS/s, in real time with the board's limits: every contact that ends has its
+/// COR, crush time and deformations on the board, the host's to the bit, from the stream's
+/// online sums; nothing lost; the same with the shock spectra. The last contact, where the
+/// body comes to rest on the barrier still ringing, never separates: it is the host's too.
 #[test]
 fn realtime_contacts_twice_the_capture_have_their_kinematics_on_the_board() {
     let scratch = Scratch::new();
@@ -1420,7 +1422,7 @@ fn realtime_contacts_twice_the_capture_have_their_kinematics_on_the_board() {
     let file = synth(
         &scratch,
         "soft-train.csv",
-        &common::soft_train_args("4", "0.8")[1..],
+        &common::soft_train_args("8", "5")[1..],
     );
     let scene = ["--mass", "0.06", "--v0", "1.3357", "--train", "flight"];
     for extra in [&[][..], &["--srs"][..]] {
@@ -1430,7 +1432,9 @@ fn realtime_contacts_twice_the_capture_have_their_kinematics_on_the_board() {
         let (host, _) = impact(&args);
         let host: serde_json::Value = serde_json::from_str(&host).unwrap();
         let host = host["impacts"].as_array().unwrap().clone();
-        assert_eq!(host.len(), 4);
+        // Six bounces, then the body rests on the barrier (its contact never separates).
+        assert_eq!(host.len(), 7);
+        assert_eq!(host[6]["status"], "too-long", "{}", host[6]);
         let mut args = vec!["emulate", &file, "--json", "--realtime", "--elf", &elf];
         args.extend(scene);
         args.extend(extra);
@@ -1440,6 +1444,12 @@ fn realtime_contacts_twice_the_capture_have_their_kinematics_on_the_board() {
         let board = json["impacts"].as_array().unwrap();
         assert_eq!(board.len(), host.len(), "{log}");
         for (e, h) in board.iter().zip(&host) {
+            let mut e_all = e.clone();
+            e_all.as_object_mut().unwrap().remove("report_latency_s");
+            if h["status"] == "too-long" {
+                assert_eq!(&e_all, h, "{extra:?}");
+                continue;
+            }
             assert!(h["duration_s"].as_f64().unwrap() > 0.0302, "{h}");
             // The capture kept the whole contact at a coarser step.
             assert_eq!(e["status"], "complete", "{e}");
@@ -1454,8 +1464,6 @@ fn realtime_contacts_twice_the_capture_have_their_kinematics_on_the_board() {
                 );
             }
             // The host analyses with the board's capture: every field is the board's.
-            let mut e_all = e.clone();
-            e_all.as_object_mut().unwrap().remove("report_latency_s");
             assert_eq!(&e_all, h, "{extra:?}");
             eprintln!(
                 "{extra:?} impact {}: COR {}, reported {:.1} ms after its hold",
