@@ -15,6 +15,8 @@
 //! last.
 
 pub mod verdict;
+#[cfg(test)]
+mod verdict_reference;
 
 use crate::error::Error;
 
@@ -363,6 +365,29 @@ impl Spec {
     /// least and the greatest acceptable acceleration.
     pub fn band_at(&self, u: f32) -> (f32, f32) {
         self.band_with(|u| self.shape.at(u), u)
+    }
+
+    /// Where `u` lies against the band's flat outside part `(-outside, outside)`, which
+    /// [`Self::band_with`] gives without reading the shape: -1 before the pulse and its slack
+    /// (or a user's band's first row), 1 after them, 0 between (the band follows the shape
+    /// or the rows). Monotone in `u`.
+    pub fn band_region(&self, u: f32) -> i8 {
+        let t = &self.tolerance;
+        if let Some(points) = self.band {
+            return match (table_at(points, u), points.first()) {
+                (Some(_), _) => 0,
+                (None, Some(first)) if u >= first.u => 1,
+                (None, _) => -1,
+            };
+        }
+        let (a, b) = (u - t.slack, u + t.slack);
+        if b < 0.0 {
+            -1
+        } else if a > 1.0 {
+            1
+        } else {
+            0
+        }
     }
 
     /// [`Self::band_at`] with the nominal shape given by `at` (over the peak, at `u` in
