@@ -134,7 +134,7 @@ pub fn analyse<const CAP: usize>(
         r.spectrum = spectrum(capture, scene, &settings, work);
     }
     if let Some(spec) = scene.spec {
-        r.verdict = Some(verdict(capture, scene, &spec, &r));
+        r.verdict = Some(verdict(capture, scene, &spec, &r, work));
     }
     r
 }
@@ -149,7 +149,11 @@ fn verdict<const CAP: usize>(
     scene: &Scene,
     spec: &crate::spec::Spec,
     r: &ImpactReport,
+    work: &mut Workspace<CAP>,
 ) -> Result<crate::spec::verdict::Verdict, crate::spec::verdict::Missing> {
+    use crate::spec::verdict::judge_in;
+    // The verdict's tables in the workspace (the spectra are done with it).
+    let scratch = &mut work.buf[..];
     let s = capture.summary();
     let samples = capture.held();
     let first = capture.held_from();
@@ -165,12 +169,12 @@ fn verdict<const CAP: usize>(
     let step = capture.step();
     if step == 1 {
         let a = |i: u64| value(usize::try_from(i.checked_sub(first)?).ok()?);
-        return crate::spec::verdict::judge(a, rate, spec, s.peak_index);
+        return judge_in(a, rate, spec, s.peak_index, scratch);
     }
     // In the capture's values, each at the middle of its group (`Capture::value_time`).
     let a = |k: u64| value(usize::try_from(k).ok()?);
     let peak = s.peak_index.saturating_sub(first) / u64::from(step);
-    let mut v = crate::spec::verdict::judge(a, value_rate(capture, scene), spec, peak)?;
+    let mut v = judge_in(a, value_rate(capture, scene), spec, peak, scratch)?;
     let shift = capture.value_time(0.0) / f64::from(rate);
     v.start_s += shift;
     v.worst_s += shift;

@@ -439,14 +439,21 @@ pub const NOMINAL_POINTS: usize = 256;
 
 /// A shape tabulated over its duration and read by linear interpolation: the verdict's
 /// thousands of band look-ups cost a multiply-add each instead of a sine (off the exact shape
-/// by at most 2e-5 of the peak, a thousandth of any band).
-pub struct Nominal {
-    table: [f32; NOMINAL_POINTS + 1],
+/// by at most 2e-5 of the peak, a thousandth of any band). Its table is the caller's (the
+/// analysis workspace on the board, not the stack).
+pub struct Nominal<'a> {
+    table: &'a [f32],
 }
 
-impl Nominal {
-    pub fn new(shape: Shape) -> Self {
-        let mut table = [0.0; NOMINAL_POINTS + 1];
+impl<'a> Nominal<'a> {
+    /// Values of its table.
+    pub const LEN: usize = NOMINAL_POINTS + 1;
+
+    /// `shape` tabulated in `table`'s first [`Self::LEN`] values (all of them if shorter:
+    /// the shape then reads 0 beyond).
+    pub fn fill(shape: Shape, table: &'a mut [f32]) -> Self {
+        let n = table.len().min(Self::LEN);
+        let (table, _) = table.split_at_mut(n);
         for (k, v) in table.iter_mut().enumerate() {
             *v = shape.at(k as f32 / NOMINAL_POINTS as f32);
         }

@@ -208,9 +208,10 @@ impl Placement {
 struct Search<'a, A: Fn(u64) -> Result<f32, Missing>> {
     a: A,
     spec: &'a Spec,
-    nominal: &'a Nominal,
+    nominal: &'a Nominal<'a>,
     w: &'a Window,
-    ext: &'a [(f32, f32); BUCKETS],
+    /// The signal's least and greatest value per bucket, in pairs ([`extremes`]).
+    ext: &'a [f32],
     /// The band outside the pulse and its rows (`band_with`'s flat part), m/s².
     outside: (f32, f32),
 }
@@ -293,7 +294,7 @@ impl<A: Fn(u64) -> Result<f32, Missing>> Search<'_, A> {
             let j = self.w.bucket(k);
             let end = self.w.bucket_start(j + 1);
             if k == self.w.bucket_start(j) && end <= k1 {
-                let (least, most) = self.ext.get(j).copied().unwrap_or_default();
+                let (least, most) = pair(self.ext, j);
                 let over = excursion(most, lo, hi).0.max(excursion(least, lo, hi).0);
                 if over > worst.worst && bucket.is_none_or(|(_, b)| over > b) {
                     bucket = Some((j, over));
@@ -359,16 +360,44 @@ fn first_where(from: u32, to: u32, p: impl Fn(u32) -> bool) -> u32 {
     lo
 }
 
-/// Judges the acceleration `a(i)` (m/s² in the pulse's direction, stream index `i`; `None`
-/// outside what is held) at `rate_hz` against `spec`, the measured peak at stream index
-/// `peak_index`. Written for the FPU: positions in f32 samples from the first sample watched
-/// (`base`), the shape tabulated, f64 only for the velocity change's sum.
+/// Values of scratch [`judge_in`] takes: the signal's extremes and the band's limits per
+/// bucket (a pair each), the nominal shape's table.
+pub const SCRATCH: usize = 4 * BUCKETS + Nominal::LEN;
+
+/// [`judge_in`] with its tables on the stack (3 KiB).
+#[inline(never)]
 pub fn judge(
     a: impl Fn(u64) -> Option<f32>,
     rate_hz: f32,
     spec: &Spec,
     peak_index: u64,
 ) -> Result<Verdict, Missing> {
+    let mut scratch = [0.0f32; SCRATCH];
+    judge_in(a, rate_hz, spec, peak_index, &mut scratch)
+}
+
+/// Judges the acceleration `a(i)` (m/s² in the pulse's direction, stream index `i`; `None`
+/// outside what is held) at `rate_hz` against `spec`, the measured peak at stream index
+/// `peak_index`, its tables in `scratch` (on the stack if it holds fewer than [`SCRATCH`]
+/// values). Written for the FPU: positions in f32 samples from the first sample watched
+/// (`base`), the shape tabulated, f64 only for the velocity change's sum.
+pub fn judge_in(
+    a: impl Fn(u64) -> Option<f32>,
+    rate_hz: f32,
+    spec: &Spec,
+    peak_index: u64,
+    scratch: &mut [f32],
+) -> Result<Verdict, Missing> {
+    let scratch_len = scratch.len();
+    let Some((ext, rest)) = scratch
+        .split_at_mut_checked(2 * BUCKETS)
+        .filter(|_| scratch_len >= SCRATCH)
+    else {
+        return judge(a, rate_hz, spec, peak_index);
+    };
+    let Some((limits, table)) = rest.split_at_mut_checked(2 * BUCKETS) else {
+        return judge(a, rate_hz, spec, peak_index);
+    };
     let w = Window::place(spec, rate_hz, peak_index, |i| a(i).is_some())?;
     // A sample the record does not hold is missing before the pulse when it lies before the
     // measured peak, after it otherwise.
@@ -379,21 +408,22 @@ pub fn judge(
             Missing::WindowAfter
         })
     };
-    let ext = extremes(&a, &w)?;
-    let nominal = Nominal::new(spec.shape);
+    extremes(&a, &w, ext)?;
+    let ext = &*ext;
+    let nominal = Nominal::fill(spec.shape, table);
     let peak = spec.peak_m_s2;
     let search = Search {
         a,
         spec,
         nominal: &nominal,
         w: &w,
-        ext: &ext,
+        ext,
         outside: (
             -spec.tolerance.outside * peak,
             spec.tolerance.outside * peak,
         ),
     };
-    let coarse = coarse_start(spec, &nominal, &w, &ext);
+    let coarse = coarse_start(spec, &nominal, &w, ext, limits);
     let fine = refine(&search, coarse)?;
     let delta_v = delta_v(&search.a, spec, &w, fine.start, rate_hz)?;
     let t = &spec.tolerance;
@@ -421,20 +451,33 @@ pub fn judge(
     })
 }
 
-/// The signal's least and greatest value in each of [`BUCKETS`] spans of the window.
+/// The signal's least and greatest value in each of [`BUCKETS`] spans of the window, in
+/// pairs in `ext`.
 fn extremes(
     a: &impl Fn(u64) -> Result<f32, Missing>,
     w: &Window,
-) -> Result<[(f32, f32); BUCKETS], Missing> {
-    let mut ext = [(f32::INFINITY, f32::NEG_INFINITY); BUCKETS];
+    ext: &mut [f32],
+) -> Result<(), Missing> {
+    for e in ext.chunks_exact_mut(2) {
+        e.copy_from_slice(&[f32::INFINITY, f32::NEG_INFINITY]);
+    }
     for k in 0..w.span {
         let v = a(w.base + u64::from(k))?;
-        if let Some(e) = ext.get_mut(w.bucket(k)) {
-            e.0 = e.0.min(v);
-            e.1 = e.1.max(v);
+        let j = w.bucket(k);
+        if let Some([least, most]) = ext.get_mut(2 * j..2 * j + 2) {
+            *least = least.min(v);
+            *most = most.max(v);
         }
     }
-    Ok(ext)
+    Ok(())
+}
+
+/// Pair `j` of a table of pairs (0s beyond it).
+fn pair(t: &[f32], j: usize) -> (f32, f32) {
+    match t.get(2 * j..2 * j + 2) {
+        Some(&[x, y]) => (x, y),
+        _ => (0.0, 0.0),
+    }
 }
 
 /// The start in whole buckets (samples from the window's base): nearest the peak-aligned one
@@ -444,16 +487,22 @@ fn extremes(
 /// samples to lie inside: the search finds where the pulse can fit, the exact pass says
 /// whether it does). The band is watched from `before` × D before the pulse to `watch` × D
 /// after it. At most 129 starts of 128 comparisons.
-fn coarse_start(spec: &Spec, nominal: &Nominal, w: &Window, ext: &[(f32, f32); BUCKETS]) -> f32 {
+fn coarse_start(
+    spec: &Spec,
+    nominal: &Nominal,
+    w: &Window,
+    ext: &[f32],
+    limits: &mut [f32],
+) -> f32 {
     let (d, lead, peak) = (w.d, w.lead, spec.peak_m_s2);
     let width = w.span as f32 / BUCKETS as f32;
     let watched = (((lead + (1.0 + w.watch) * d) / width) as usize).min(BUCKETS);
-    let mut limits = [(0.0f32, 0.0f32); BUCKETS];
-    for (j, l) in limits.iter_mut().enumerate().take(watched) {
+    for (j, l) in limits.chunks_exact_mut(2).enumerate().take(watched) {
         let u = |j: f32| (j * width - lead) / d;
         let (lo, hi) = band_over(spec, |u| nominal.at(u), u(j as f32), u(j as f32 + 1.0));
-        *l = (lo * peak, hi * peak);
+        l.copy_from_slice(&[lo * peak, hi * peak]);
     }
+    let limits = &*limits;
     let first = libm::ceilf(w.from / width) as usize;
     let steps = ((d / width) as usize).min(BUCKETS);
     let centre = libm::roundf((w.guess - lead) / width) as usize;
@@ -470,8 +519,11 @@ fn coarse_start(spec: &Spec, nominal: &Nominal, w: &Window, ext: &[(f32, f32); B
             continue;
         };
         let mut worst = f32::NEG_INFINITY;
-        for (&(lo, hi), &(lower, upper)) in ext.iter().skip(s).zip(limits.iter().take(watched)) {
-            worst = worst.max(hi - upper).max(lower - lo);
+        let buckets = ext.chunks_exact(2).skip(s);
+        for (e, l) in buckets.zip(limits.chunks_exact(2).take(watched)) {
+            if let (&[lo, hi], &[lower, upper]) = (e, l) {
+                worst = worst.max(hi - upper).max(lower - lo);
+            }
         }
         if better(worst, best.1) {
             best = (s, worst);

@@ -32,7 +32,8 @@ pub fn judge_reference(
         return Err(Missing::Resolution);
     }
     let peak = spec.peak_m_s2;
-    let nominal = Nominal::new(spec.shape);
+    let mut table = [0.0f32; Nominal::LEN];
+    let nominal = Nominal::fill(spec.shape, &mut table);
     let band = |u: f32| spec.band_with(|u| nominal.at(u), u);
     // The start where the nominal peak meets the measured one; the search half a duration
     // either way; the span the signal must cover for any of them, from `base` (its first
