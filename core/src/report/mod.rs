@@ -127,8 +127,9 @@ impl Flags {
     /// The signal never came back to the baseline and left it more than the settle time
     /// before the peak: the pulse rode on drift or an orientation change, which the start and
     /// duration take in; or a slow ramp into the pulse began beyond the flanks' reach
-    /// ([`crate::stream::REACH`] samples) or the record's start, so where the contact began
-    /// is unknown. Δv, the kinematics and the fits are absent.
+    /// ([`crate::stream::REACH`] samples), so where the contact began is unknown. (A record
+    /// that starts on a ramp is not flagged: its baseline is learned on the ramp.) Δv, the
+    /// kinematics and the fits are absent.
     pub const DRIFT: Flags = Flags(1 << 9);
     /// The pulse was already under way where the previous impact's contact ended (the signal
     /// never came back to the baseline between them): its start is that contact's end, so the

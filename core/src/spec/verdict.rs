@@ -169,7 +169,8 @@ impl Window {
 
     /// The bucket of sample `k`.
     fn bucket(&self, k: u32) -> usize {
-        (k as usize * BUCKETS / self.span as usize).min(BUCKETS - 1)
+        // (A span is at least 1 sample: `max` only keeps a division by 0 out of the code.)
+        (k as usize * BUCKETS / (self.span as usize).max(1)).min(BUCKETS - 1)
     }
 }
 

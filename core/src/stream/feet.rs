@@ -38,8 +38,9 @@ pub(super) struct Lobe {
     pub touch: f32,
     /// `Σ d` over its samples (0 for none).
     pub c: i64,
-    /// A ramp that runs back beyond the flanks' reach or the record's start: the pulse's
-    /// start, so its Δv, unknown.
+    /// A ramp that runs back beyond the flanks' reach: the pulse's start, so its Δv,
+    /// unknown. (Not at the record's start: a record that starts on a ramp learns its
+    /// baseline there, and the walk stops where the ramp crosses it.)
     pub cut: bool,
 }
 
@@ -51,9 +52,9 @@ impl<const PRE: usize> Stream<PRE> {
     /// dips: one ends it where the [`LOBE_LOOK`] samples from it back average within a
     /// [`LOBE_SHARE`]th of the edge level of the baseline (a slow ramp's noise dips to the
     /// baseline long before the ramp does: a 20 ms ramp to 5 g under 0.3 g of noise was cut
-    /// where it stood at half the edge level, and rejected, Δv 3.8 % low). Where it crosses (relative to the onset, samples), its samples, `Σ d` over
-    /// them, and whether the ramp runs back beyond the flanks' reach (or the record's start):
-    /// its start, and so the pulse's Δv, unknown.
+    /// where it stood at half the edge level, and rejected, Δv 3.8 % low). Where it crosses
+    /// (relative to the onset, samples), its samples, `Σ d` over them, and whether the ramp
+    /// runs back beyond the flanks' reach: its start, and so the pulse's Δv, unknown.
     pub(super) fn lobe_before(&self, o: OnsetWalk) -> Lobe {
         let OnsetWalk {
             pulse,
