@@ -132,7 +132,8 @@ impl Flags {
     /// kinematics and the fits are absent.
     pub const DRIFT: Flags = Flags(1 << 9);
     /// The pulse was already under way where the previous impact's contact ended (the signal
-    /// never came back to the baseline between them): its start is that contact's end, so the
+    /// never came back to the baseline between them), or a slow ramp into it where the
+    /// previous impact's window ended: its start is that contact's or window's end, so the
     /// start, duration and Δv cover only the part after it; the kinematics and the fits are
     /// absent.
     pub const IN_PREVIOUS: Flags = Flags(1 << 10);

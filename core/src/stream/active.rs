@@ -71,6 +71,8 @@ pub(super) struct Active {
     /// onset, samples) and `Σ d` over its samples.
     pub(super) lobe_touch: f32,
     pub(super) lobe_c: i64,
+    /// The lobe runs back to the previous impact's window ([`super::feet::Lobe`]).
+    pub(super) lobe_in_previous: bool,
     /// The sink gave a buffer for this impact.
     pub(super) captured: bool,
     /// The buffer overflowed.

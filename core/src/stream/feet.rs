@@ -12,7 +12,8 @@ use crate::signal::power_flank;
 
 /// Where a pulse left the edge level, as the trigger found it: samples from the newest back
 /// to the onset (the walk back), the pulse's sign, the baseline, the edge level (units of
-/// `d`), the trigger sample, and samples since the previous impact's window.
+/// `d`), the trigger sample, and samples since the previous impact's window (since the
+/// record's start if none came before: `after_impact` false).
 pub(super) struct OnsetWalk {
     pub pulse: usize,
     pub sign: i64,
@@ -20,6 +21,7 @@ pub(super) struct OnsetWalk {
     pub edge_d: i64,
     pub trigger_x: i16,
     pub since_last: usize,
+    pub after_impact: bool,
 }
 
 /// A dip to the baseline ends a slow ramp's lobe only where this many samples from it back
@@ -38,6 +40,9 @@ pub(super) struct Lobe {
     pub touch: f32,
     /// `Σ d` over its samples (0 for none).
     pub c: i64,
+    /// It runs back to the previous impact's window, still above the baseline there: the
+    /// pulse was under way before that window ended, and its Δv covers the part after it.
+    pub in_previous: bool,
     /// A ramp that runs back beyond the flanks' reach: the pulse's start, so its Δv,
     /// unknown. (Not at the record's start: a record that starts on a ramp learns its
     /// baseline there, and the walk stops where the ramp crosses it.)
@@ -63,6 +68,7 @@ impl<const PRE: usize> Stream<PRE> {
             edge_d,
             trigger_x,
             since_last,
+            after_impact,
         } = o;
         let pd = |i: usize| {
             self.ring
@@ -119,7 +125,7 @@ impl<const PRE: usize> Stream<PRE> {
             (len > 3).then(|| (mean(pulse), mean(pulse + len - quarter)))
         };
         let (mut lobe_len, mut lobe_c, _) = walk(0, 0, false);
-        let mut cut = false;
+        let (mut cut, mut in_previous) = (false, false);
         if let Some((newest, oldest)) = quarters(lobe_len) {
             if lobe_len >= LOBE_LOOK && 2 * newest >= edge_d && 4 * oldest > edge_d.max(newest) {
                 // A ramp that reaches the pulse, ended by its noise while still high: walk
@@ -130,7 +136,10 @@ impl<const PRE: usize> Stream<PRE> {
                 // stops): the ramp began further back.
                 let (len, c, judged) = walk(lobe_len, lobe_c, true);
                 (lobe_len, lobe_c) = (len, c);
-                cut = !judged && since_last > REACH.max(pulse + len);
+                // Ran out at the previous impact's window (nearer than the reach): the
+                // ramp was under way before it ended.
+                let at_window = !judged && after_impact && since_last <= REACH;
+                cut = !judged && since_last > REACH;
                 // A ramp whose start the walk found rises quarter by quarter (a wandering
                 // signal, which the walk crosses too, does not): else no lobe.
                 let quarter = |q: usize| -> i64 {
@@ -142,6 +151,7 @@ impl<const PRE: usize> Stream<PRE> {
                 let rises = quarter(3) <= quarter(2)
                     && quarter(2) <= quarter(1)
                     && quarter(1) <= quarter(0);
+                in_previous = at_window && rises;
                 if !(cut || rises) {
                     lobe_len = 0;
                     lobe_c = 0;
@@ -149,7 +159,8 @@ impl<const PRE: usize> Stream<PRE> {
             }
         }
         if let Some((newest, oldest)) = quarters(lobe_len) {
-            if 2 * newest < edge_d || 4 * oldest > edge_d.max(newest) || cut {
+            let ramp = 2 * newest >= edge_d && 4 * oldest <= edge_d.max(newest);
+            if !(ramp || in_previous) || cut {
                 lobe_len = 0;
                 lobe_c = 0;
             }
@@ -171,6 +182,7 @@ impl<const PRE: usize> Stream<PRE> {
         Lobe {
             touch: lobe_touch,
             c: lobe_c,
+            in_previous,
             cut,
         }
     }
@@ -229,7 +241,7 @@ impl<const PRE: usize> Stream<PRE> {
         let longer = a.lobe_touch < touch.0;
         let fits = a.lobe_touch >= a.touch_floor;
         if longer && fits {
-            (a.lobe_touch, a.lobe_c, false)
+            (a.lobe_touch, a.lobe_c, a.lobe_in_previous)
         } else {
             touch
         }

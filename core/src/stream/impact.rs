@@ -70,6 +70,7 @@ impl<const PRE: usize> Stream<PRE> {
             edge_d,
             trigger_x,
             since_last,
+            after_impact: self.run.counters.impacts > 0,
         });
         // The rise so far: the onset to the newest sample.
         let mut rise = Rise::new();
@@ -129,6 +130,7 @@ impl<const PRE: usize> Stream<PRE> {
             line_in_previous,
             lobe_touch: lobe.touch,
             lobe_c: lobe.c,
+            lobe_in_previous: lobe.in_previous,
             captured: capture.is_some(),
             full: false,
             // The walk back reached the gap: the pulse began while samples were lost.
