@@ -139,7 +139,7 @@ impl<const PRE: usize> Stream<PRE> {
                 // Ran out at the previous impact's window (nearer than the reach): the
                 // ramp was under way before it ended.
                 let at_window = !judged && after_impact && since_last <= REACH;
-                cut = !judged && since_last > REACH;
+                let at_reach = !judged && since_last > REACH;
                 // A ramp whose start the walk found rises quarter by quarter (a wandering
                 // signal, which the walk crosses too, does not): else no lobe.
                 let quarter = |q: usize| -> i64 {
@@ -151,7 +151,13 @@ impl<const PRE: usize> Stream<PRE> {
                 let rises = quarter(3) <= quarter(2)
                     && quarter(2) <= quarter(1)
                     && quarter(1) <= quarter(0);
-                in_previous = at_window && rises;
+                // Ran out, it is a ramp if it climbs from its oldest quarter to its second
+                // newest by a sixteenth of the edge level (the newest may hold the pulse's
+                // foot; a quarter's mean is far steadier than a sample): an offset that began
+                // beyond the walk leaves the pulse's own Δv, whatever its noise.
+                let climbs = rises && 16 * (quarter(1) - quarter(3)) > edge_d;
+                cut = at_reach && climbs;
+                in_previous = at_window && climbs;
                 if !(cut || rises) {
                     lobe_len = 0;
                     lobe_c = 0;
