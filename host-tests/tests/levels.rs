@@ -442,3 +442,59 @@ fn an_offset_beyond_the_reach_leaves_the_pulses_delta_v() {
         assert!((3.6..3.8).contains(&lo), "{level} g: {found:?}");
     }
 }
+
+/// The table channel, the record starting on a ramp into the pulse (15 ms to 5 g, begun 3 ms
+/// before the record, the pulse 12 ms into it) or on a flat level of 1.5 g, over noise of four
+/// seeds. On the ramp the baseline is learned from the record's first strides, which the
+/// signal never comes back to: it is not the sensor's zero, and Δv is unknown (`drift`),
+/// never a number short of the ramp (it was 4 % short with no flag). On the level the
+/// baseline is that level, and Δv is the pulse's.
+#[test]
+fn a_record_that_starts_on_a_ramp_leaves_delta_v_unknown() {
+    let scratch = Scratch::new();
+    let rate = 200_000.0;
+    let (t0, width, dv) = (0.012, 0.003, 3.6);
+    const G: f64 = impact_core::consts::STANDARD_GRAVITY;
+    let peak_g = dv * PI / (2.0 * width) / G;
+    for seed in 1..=4u64 {
+        for ramp in [true, false] {
+            let mut state = 0x9e37_79b9_7f4a_7c15u64 ^ seed.wrapping_mul(0x2545_f491_4f6c_dd1d);
+            let mut uniform = || {
+                state ^= state << 13;
+                state ^= state >> 7;
+                state ^= state << 17;
+                ((state >> 11) as f64 + 0.5) / (1u64 << 53) as f64
+            };
+            let mut csv = String::from("time_s,table_g\n");
+            let mut pulse = 0.0;
+            for k in 0..20_000u32 {
+                let t = f64::from(k) / rate;
+                let p = t - t0;
+                let level = if ramp { 5.0 * (t + 0.003) / 0.015 } else { 1.5 };
+                let mut a = if p < 0.0 { level } else { 0.0 };
+                if (0.0..width).contains(&p) {
+                    let sine = peak_g * (PI * p / width).sin();
+                    a += level * (PI * p / (2.0 * width)).cos().powi(2) + sine;
+                    pulse += sine * G / rate;
+                }
+                let (u1, u2) = (uniform(), uniform());
+                let noise = 0.3 * (-2.0 * u1.ln()).sqrt() * (2.0 * PI * u2).cos();
+                csv.push_str(&format!("{t:.6},{:.4}\n", 300.0 + a + noise));
+            }
+            let what = format!("seed {seed}, ramp {ramp}");
+            let file = scratch.text(&format!("start-{seed}-{ramp}.csv"), &csv);
+            let (out, _) = common::impact_ok(&["analyze", &file, "--json"]);
+            let j: serde_json::Value = serde_json::from_str(&out).unwrap();
+            let impacts = j["impacts"].as_array().unwrap();
+            assert_eq!(impacts.len(), 1, "{what}: {out}");
+            let i = &impacts[0];
+            if ramp {
+                assert!(i["delta_v_m_s"].is_null(), "{what}: {i}");
+                assert_eq!(i["null_reasons"]["delta_v_m_s"], "drift", "{what}");
+            } else {
+                let v = i["delta_v_m_s"].as_f64().expect("Δv");
+                assert!((v / pulse - 1.0).abs() <= 0.01, "{what}: Δv {v} vs {pulse}");
+            }
+        }
+    }
+}

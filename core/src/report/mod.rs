@@ -127,9 +127,10 @@ impl Flags {
     /// The signal never came back to the baseline and left it more than the settle time
     /// before the peak: the pulse rode on drift or an orientation change, which the start and
     /// duration take in; or a slow ramp into the pulse began beyond the flanks' reach
-    /// ([`crate::stream::REACH`] samples), so where the contact began is unknown. (A record
-    /// that starts on a ramp is not flagged: its baseline is learned on the ramp.) Δv, the
-    /// kinematics and the fits are absent.
+    /// ([`crate::stream::REACH`] samples), so where the contact began is unknown; or the
+    /// baseline was learned from a short stretch the signal never came back to (a record
+    /// that starts on a ramp: [`crate::signal::baseline::Baseline::unconfirmed`]), so the
+    /// zero is not the sensor's. Δv, the kinematics and the fits are absent.
     pub const DRIFT: Flags = Flags(1 << 9);
     /// The pulse was already under way where the previous impact's contact ended (the signal
     /// never came back to the baseline between them), or a slow ramp into it where the

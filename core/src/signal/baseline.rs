@@ -164,6 +164,9 @@ pub struct Baseline<const K: usize> {
     min: i16,
     max: i16,
     filled: usize,
+    /// Strides completed since the window's newest that did not enter it (moving, or
+    /// loud).
+    rejected: u32,
 }
 
 impl<const K: usize> Default for Baseline<K> {
@@ -184,6 +187,7 @@ impl<const K: usize> Baseline<K> {
             min: i16::MAX,
             max: i16::MIN,
             filled: 0,
+            rejected: 0,
         }
     }
 
@@ -217,6 +221,20 @@ impl<const K: usize> Baseline<K> {
             total / (self.len * STRIDE) as f32
         }
     }
+
+    /// Learned from a short stretch that the signal never came back to: fewer than
+    /// [`Self::SHORT`] strides in the window, and at least as many completed since its newest
+    /// without entering it. A record that starts on a moving signal (a ramp into its first
+    /// pulse) learns its first strides there, then rejects every stride after them as moving:
+    /// its zero is not the sensor's. (The stream asks it of the record's first baseline
+    /// only.)
+    pub fn unconfirmed(&self) -> bool {
+        self.len < Self::SHORT && self.rejected >= Self::SHORT as u32
+    }
+
+    /// Strides (512 samples) a window must hold, or the signal must stay off it, for
+    /// [`Self::unconfirmed`].
+    pub const SHORT: usize = 8;
 
     /// Samples still missing to complete the current stride.
     pub fn to_stride_end(&self) -> usize {
@@ -263,6 +281,8 @@ impl<const K: usize> Baseline<K> {
         };
         if quiet {
             self.push(acc);
+        } else {
+            self.rejected = self.rejected.saturating_add(1);
         }
         self.acc = 0;
         self.min = i16::MAX;
@@ -302,6 +322,7 @@ impl<const K: usize> Baseline<K> {
 
     /// A stride's sum into the window.
     fn push(&mut self, acc: i32) {
+        self.rejected = 0;
         if self.len == K {
             self.total -= self.sums[self.head % K] as i64;
         } else {

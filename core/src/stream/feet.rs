@@ -45,7 +45,8 @@ pub(super) struct Lobe {
     pub in_previous: bool,
     /// A ramp that runs back beyond the flanks' reach: the pulse's start, so its Δv,
     /// unknown. (Not at the record's start: a record that starts on a ramp learns its
-    /// baseline there, and the walk stops where the ramp crosses it.)
+    /// baseline there, and the walk stops where the ramp crosses it; that baseline is
+    /// flagged by [`crate::signal::baseline::Baseline::unconfirmed`].)
     pub cut: bool,
 }
 

@@ -34,6 +34,12 @@ impl<const PRE: usize> Stream<PRE> {
         // The impact is measured from the level just before it: the baseline (which moved to
         // the level the signal settled at since it was learned, if it did: `level_change`).
         let (base_sum, base_n) = self.baseline.rational();
+        // The record's first zero, learned from a few strides the signal never came back to
+        // (a record that starts on a ramp into its pulse): not the sensor's. (A level the
+        // signal settled at, a free fall's, is learned from what it held, however short.)
+        let counters = self.run.counters;
+        let unconfirmed =
+            counters.impacts == 0 && counters.level_changes == 0 && self.baseline.unconfirmed();
         let deviation = Deviation::new(base_sum, base_n);
         let edge_d = (self.limits.edge_counts * base_n as f32) as i64;
         let (lo, hi) = self.current_thresholds();
@@ -125,8 +131,9 @@ impl<const PRE: usize> Stream<PRE> {
             clipped: false,
             cut_at_start,
             level_change,
-            // A ramp into the pulse from beyond the flanks' reach: it rode on it.
-            drift: lobe.cut,
+            // A ramp into the pulse from beyond the flanks' reach, or a baseline the signal
+            // never came back to: it rode on it.
+            drift: lobe.cut || unconfirmed,
             line_in_previous,
             lobe_touch: lobe.touch,
             lobe_c: lobe.c,
