@@ -105,7 +105,8 @@ pub(super) struct Run {
 }
 
 impl Run {
-    /// Back to the start, in place (no copy of it on the stack), for `scene`: its approach
+    /// Back to the start, in place (over the constant [`Run::new`]; building a second `Run`
+    /// beside it and moving it in put 2.7 KiB more on the board's stack), for `scene`: its approach
     /// speed; its trigger filter at rest at 0 until the first baseline resets it to the
     /// baseline's level.
     pub fn restart(&mut self, scene: &Scene) {
