@@ -7,7 +7,8 @@
 //! written to a temporary file beside it, renamed into place once complete: a reader never
 //! sees half a file, two writers cannot interleave (the last rename wins), and an error or an
 //! interrupt leaves nothing behind (the temporary file is registered with
-//! [`crate::interrupt`], which removes it on Ctrl-C).
+//! [`crate::interrupt`], which removes it on Ctrl-C). The finished file keeps the target's
+//! mode (a new one gets 0666 less the umask); a read-only target is refused, never replaced.
 
 use std::io::Write;
 use std::path::{Path, PathBuf};
@@ -93,6 +94,14 @@ pub enum OutputError {
     },
     #[error("{option} {}: links to an input; it would be overwritten", .path.display())]
     LinksToAnInput { option: String, path: PathBuf },
+    /// An existing file this user may not write (a 0444 report kept as the signed copy):
+    /// it is not replaced behind the permission's back.
+    #[error(
+        "{option} {}: the file exists and is read-only; it is not replaced (make it writable, \
+         e.g. chmod u+w, or write to another file)",
+        .path.display()
+    )]
+    ReadOnly { option: String, path: PathBuf },
     #[error(
         "{option} {}: the output is {}: name the file .{ext}",
         .path.display(),
@@ -145,6 +154,12 @@ pub fn check(
             path: owned,
         });
     }
+    if exists_read_only(path) {
+        return Err(OutputError::ReadOnly {
+            option,
+            path: owned,
+        });
+    }
     if let Some(out) = identity(path) {
         for input in &inputs.paths {
             let same = if input.as_os_str() == "-" {
@@ -189,6 +204,57 @@ pub fn check(
     Ok(())
 }
 
+/// Whether `path` names an existing file that is read-only: no write bit at all (`chmod a-w`,
+/// the mark of a kept copy, which `rm` also asks about, even for root), or one this process
+/// may not write (`access(2)`'s `W_OK`: the bits as they apply to this user, a read-only mount).
+#[cfg(unix)]
+fn exists_read_only(path: &Path) -> bool {
+    use std::os::unix::ffi::OsStrExt;
+    use std::os::unix::fs::PermissionsExt;
+    let Ok(meta) = std::fs::metadata(path) else {
+        return false;
+    };
+    if meta.permissions().mode() & 0o222 == 0 {
+        return true;
+    }
+    let Ok(c) = std::ffi::CString::new(path.as_os_str().as_bytes()) else {
+        return false;
+    };
+    // SAFETY: `c` is a NUL-terminated path that outlives the call; access only reads it.
+    unsafe { libc::access(c.as_ptr(), libc::W_OK) != 0 }
+}
+
+#[cfg(not(unix))]
+fn exists_read_only(path: &Path) -> bool {
+    std::fs::metadata(path).is_ok_and(|m| m.permissions().readonly())
+}
+
+/// The mode the finished file gets: an existing target's own (a 0600 log stays private, a
+/// 0664 report stays group-writable), else a new file's as `open(2)` would give it, 0666
+/// less the umask.
+#[cfg(unix)]
+fn final_mode(path: &Path) -> u32 {
+    use std::os::unix::fs::PermissionsExt;
+    match std::fs::metadata(path) {
+        Ok(m) if m.is_file() => m.permissions().mode() & 0o7777,
+        _ => 0o666 & !umask(),
+    }
+}
+
+/// The process's umask, read without changing it (`/proc/self/status`, Linux 4.7 on); where
+/// it cannot be read, the common 022.
+#[cfg(unix)]
+fn umask() -> u32 {
+    std::fs::read_to_string("/proc/self/status")
+        .ok()
+        .and_then(|s| {
+            s.lines()
+                .find_map(|l| l.strip_prefix("Umask:"))
+                .and_then(|v| u32::from_str_radix(v.trim(), 8).ok())
+        })
+        .unwrap_or(0o022)
+}
+
 /// The directory `path` is in (`.` for a bare name).
 fn directory(path: &Path) -> &Path {
     match path.parent() {
@@ -204,7 +270,8 @@ pub fn write(path: &Path, bytes: &[u8]) -> Result<(), OutputError> {
 
 /// Writes `path` through `fill`, whole or not at all: into a temporary file beside it,
 /// renamed into place once `fill` and the flush succeed; on an error (a full disk, a file
-/// size limit) the temporary file is removed and the error names `path`.
+/// size limit) the temporary file is removed and the error names `path`. An existing file
+/// keeps its mode; one this user may not write is refused ([`OutputError::ReadOnly`]).
 pub fn write_with(
     path: &Path,
     fill: impl FnOnce(&mut dyn Write) -> std::io::Result<()>,
@@ -213,6 +280,12 @@ pub fn write_with(
         path: path.to_path_buf(),
         source,
     };
+    if exists_read_only(path) {
+        return Err(OutputError::ReadOnly {
+            option: "output".to_string(),
+            path: path.to_path_buf(),
+        });
+    }
     let name = path
         .file_name()
         .map_or_else(|| "output".into(), |n| n.to_string_lossy().into_owned());
@@ -227,11 +300,11 @@ pub fn write_with(
         fill(&mut w).map_err(failed)?;
         w.flush().map_err(failed)?;
     }
-    // A new file's usual permissions (the temporary one is private).
+    // The target's own mode, or a new file's (the temporary one is private).
     #[cfg(unix)]
     {
         use std::os::unix::fs::PermissionsExt;
-        let mode = std::fs::Permissions::from_mode(0o644);
+        let mode = std::fs::Permissions::from_mode(final_mode(path));
         std::fs::set_permissions(tmp.path(), mode).map_err(failed)?;
     }
     tmp.persist(path).map_err(|e| failed(e.error))?;

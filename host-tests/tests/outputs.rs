@@ -172,6 +172,52 @@ fn no_output_writes_over_an_input_whatever_the_path() {
     assert_eq!(std::fs::read(d.join("x-0.wav")).unwrap().len(), 44 + 2 * 4);
 }
 
+/// An output over an existing file keeps that file's mode (a private 0600 figure stays private,
+/// a 0664 one group-writable); a new one gets 0666 less the umask, as any tool's; a file this
+/// user may not write (a 0444 copy kept as signed) is refused, unchanged, with the fix.
+#[test]
+fn an_output_keeps_the_targets_mode_and_a_read_only_target_is_refused() {
+    use std::os::unix::fs::PermissionsExt;
+    let scratch = Scratch::new();
+    let d = scratch.path();
+    let csv = d.join("seed.csv");
+    seed(&csv);
+    let mode = |p: &Path| std::fs::metadata(p).unwrap().permissions().mode() & 0o7777;
+    let chmod = |p: &Path, m: u32| {
+        std::fs::set_permissions(p, std::fs::Permissions::from_mode(m)).unwrap();
+    };
+    for kept in [0o600, 0o640, 0o664] {
+        let fig = d.join(format!("kept{kept:o}.svg"));
+        std::fs::write(&fig, "old").unwrap();
+        chmod(&fig, kept);
+        impact_ok(&["analyze", s(&csv), "--plot", s(&fig)]);
+        assert_ne!(std::fs::read(&fig).unwrap(), b"old");
+        assert_eq!(mode(&fig), kept, "{}", fig.display());
+    }
+    // A new file under umask 077 (a shell's `umask 077`): 0600, not the 0644 it used to get.
+    let new = d.join("new.svg");
+    let out = Command::new("sh")
+        .args(["-c", "umask 077 && exec \"$0\" \"$@\""])
+        .arg(env!("CARGO_BIN_EXE_impact"))
+        .args(["analyze", s(&csv), "--plot", s(&new)])
+        .output()
+        .unwrap();
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    assert_eq!(mode(&new), 0o600);
+    // Read-only: refused before any work, the file as it was.
+    let signed = d.join("signed.svg");
+    std::fs::write(&signed, "signed").unwrap();
+    chmod(&signed, 0o444);
+    // No write bit at all is refused for every user, root too (as `rm` asks).
+    refused(
+        &["analyze", s(&csv), "--plot", s(&signed)],
+        None,
+        "read-only; it is not replaced",
+        &[&csv, &signed],
+    );
+    assert_eq!(mode(&signed), 0o444);
+}
+
 #[test]
 fn two_writers_of_one_figure_leave_one_whole_figure() {
     let scratch = Scratch::new();
