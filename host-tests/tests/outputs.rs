@@ -202,7 +202,11 @@ fn an_output_keeps_the_targets_mode_and_a_read_only_target_is_refused() {
         .args(["analyze", s(&csv), "--plot", s(&new)])
         .output()
         .unwrap();
-    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
     assert_eq!(mode(&new), 0o600);
     // Read-only: refused before any work, the file as it was.
     let signed = d.join("signed.svg");

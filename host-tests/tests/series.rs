@@ -221,6 +221,45 @@ fn folders_and_patterns_expand_and_a_failure_is_named() {
     assert!(!d.join("x.svg").exists());
 }
 
+/// A quoted `**` pattern over folders with links to a parent (a loop) and to a sibling: each
+/// recording is one entry, each folder entered once (a loop gave one file 41 entries, counted
+/// as 41 drops, and two loops made the walk exponential).
+#[test]
+fn a_pattern_through_linked_folders_counts_each_recording_once() {
+    let scratch = Scratch::new();
+    let lp = scratch.path().join("lp");
+    std::fs::create_dir_all(lp.join("day1/run")).unwrap();
+    std::fs::create_dir_all(lp.join("day2")).unwrap();
+    let seed = common::synth_t2();
+    std::fs::write(lp.join("day1/run/a.csv"), &seed).unwrap();
+    std::fs::write(lp.join("day2/b.csv"), &seed).unwrap();
+    for (link, to) in [
+        ("day1/run/up", "../.."),
+        ("day1/run/up2", ".."),
+        ("day2/back", "../day1"),
+        ("day2/again", "."),
+    ] {
+        std::os::unix::fs::symlink(to, lp.join(link)).unwrap();
+    }
+    let pattern = format!("{}/**/*.csv", lp.display());
+    let (out, _) = impact_ok(&[
+        "analyze", &pattern, "--mass", "0.06", "--v0", "1.3357", "--json",
+    ]);
+    let series = json(&out);
+    let files: Vec<&str> = series["entries"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|e| e["file"].as_str().unwrap())
+        .collect();
+    let want = [
+        lp.join("day1/run/a.csv").display().to_string(),
+        lp.join("day2/b.csv").display().to_string(),
+    ];
+    assert_eq!(files, want, "{out}");
+    assert_eq!(series["recordings"], 2, "{out}");
+}
+
 /// The statistics compare like with like: a clipped pulse (peak and Δv lower bounds) and one
 /// the recording cuts (`stream-ended`) are left out and counted by why, in the JSON, the
 /// table and the report; the two complete ones are the statistics' n.

@@ -6,6 +6,7 @@ pub mod bench;
 pub mod emulate;
 pub mod html;
 pub mod log;
+pub mod matches;
 pub mod progress;
 pub mod pulse;
 pub mod selftest;

@@ -40,6 +40,9 @@ pub enum SeriesError {
         pattern: String,
         source: glob::PatternError,
     },
+    /// A folder under a pattern that cannot be listed.
+    #[error(transparent)]
+    Walk(#[from] super::matches::WalkError),
     /// A pattern (as given) that matches no file.
     #[error("{pattern}: no file matches")]
     NoMatch { pattern: String },
@@ -147,7 +150,7 @@ pub fn is_series(files: &[PathBuf], channels: &[ColumnRef]) -> bool {
 }
 
 /// The series' recordings, in the order given: each file (a folder: its recordings by name;
-/// a pattern: its matches by name) with each of `channels` (none: `column`, or the file's
+/// a pattern: its matches by name, each file once, [`super::matches`]) with each of `channels` (none: `column`, or the file's
 /// default). A file given twice is analysed twice; a folder or pattern that holds no
 /// recording, and standard input, are errors.
 pub fn entries(
@@ -176,15 +179,11 @@ pub fn entries(
             paths.extend(found);
         } else if is_pattern(f) && !f.exists() {
             let pattern = f.to_string_lossy();
-            let mut found: Vec<PathBuf> = glob::glob(&pattern)
-                .map_err(|source| SeriesError::Pattern {
-                    pattern: pattern.to_string(),
-                    source,
-                })?
-                .filter_map(Result::ok)
-                .filter(|p| p.is_file())
-                .collect();
-            found.sort();
+            let compiled = glob::Pattern::new(&pattern).map_err(|source| SeriesError::Pattern {
+                pattern: pattern.to_string(),
+                source,
+            })?;
+            let found = super::matches::files(&pattern, &compiled)?;
             if found.is_empty() {
                 return Err(SeriesError::NoMatch {
                     pattern: pattern.to_string(),
