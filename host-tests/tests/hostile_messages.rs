@@ -357,3 +357,53 @@ fn a_byte_order_mark_after_the_first_line_is_refused_on_every_line() {
         assert_refused(Some(code), &err, &format!("stdin{want}"), "stdin");
     }
 }
+
+/// The enDAQ recording's bytes with `patch` (offset, new bytes) applied, as a file.
+fn ide_patched(scratch: &Scratch, name: &str, at: usize, bytes: &[u8]) -> PathBuf {
+    let root = PathBuf::from(env!("CARGO_MANIFEST_DIR"));
+    let mut ide = std::fs::read(root.join("data/endaq-high-drop/High-Drop.IDE")).unwrap();
+    // The CalibrationList's polynomial 35 (subchannel 32.2's): CalID at 427, its first
+    // coefficient's 8 bytes at 437; checked so that a changed file fails here, not later.
+    assert_eq!(&ide[427..431], &[0x4B, 0x03, 0x81, 35]);
+    assert_eq!(&ide[434..437], &[0x4B, 0x08, 0x88]);
+    ide[at..at + bytes.len()].copy_from_slice(bytes);
+    let path = scratch.path().join(name);
+    std::fs::write(&path, ide).unwrap();
+    path
+}
+
+/// A calibration coefficient that is NaN names the calibration and that the file's is damaged
+/// (it said "give a smaller --gain", which none was given); a subchannel whose calibration id
+/// is not in the file is read raw as idelib reads it, and a note says so (it was silent).
+#[test]
+fn an_ide_calibration_that_is_nan_or_missing_is_named() {
+    let scratch = Scratch::new();
+    let nan = ide_patched(&scratch, "nan.ide", 437, &f64::NAN.to_be_bytes());
+    let nan = nan.to_str().unwrap();
+    refused(
+        &["analyze", nan, "--column", "32.2"],
+        &[
+            "calibration 35 holds a coefficient that is not a finite number",
+            nan,
+        ],
+        &["--gain"],
+    );
+    // The subchannel read whole (--axes) meets it too.
+    refused(
+        &["analyze", nan, "--axes", "32.0,32.1,32.2"],
+        &["calibration 35 holds a coefficient that is not a finite number"],
+        &["--gain"],
+    );
+    let missing = ide_patched(&scratch, "missing.ide", 430, &[99]);
+    let (code, _, err) = impact(&["analyze", missing.to_str().unwrap(), "--column", "32.2"]);
+    assert_eq!(code, 0, "{err}");
+    assert!(
+        err.contains("32.2 Z (16g) [g]: its calibration 35 is not in the file's calibration list")
+            && err.contains("read uncalibrated"),
+        "{err}"
+    );
+    // Its neighbour keeps its own calibration: no note.
+    let (code, _, err) = impact(&["analyze", missing.to_str().unwrap(), "--column", "32.1"]);
+    assert_eq!(code, 0, "{err}");
+    assert!(!err.contains("calibration list"), "{err}");
+}

@@ -211,6 +211,11 @@ fn a_required_srs_judges_and_draws_each_impact_s_srs() {
             "frequency_hz,acceleration_g\n100,1\n",
             "at least two breakpoints",
         ),
+        // 1e308 g is a finite number that overflows in m/s²: it was compared in "NaN dB".
+        (
+            "frequency_hz,acceleration_g\n100,1e308\n200,1\n",
+            "line 2: acceleration_g \"1e308\" is too large to be an acceleration",
+        ),
         // CRLF and a comment between rows: lines counted as an editor counts them.
         (
             "# spec 7\r\nfrequency_hz,acceleration_g\r\n100,1\r\n# x\r\n50,1\r\n",

@@ -314,6 +314,14 @@ pub enum Malformation {
     FloatLength(usize),
     #[error("calibration polynomial without CalID")]
     CalibrationWithoutId,
+    /// A calibration used by the channel read whose coefficients or references include a
+    /// NaN or an infinity: its values cannot be calibrated.
+    #[error(
+        "calibration {id} holds a coefficient that is not a finite number (NaN or infinite): \
+         the recorder's calibration is damaged, its values cannot be calibrated \
+         (recalibrate the recorder, or read another channel with --column)"
+    )]
+    CalibrationNotFinite { id: u64 },
     #[error("bivariate calibration {id} without its channel reference")]
     BivariateWithoutReference { id: u64 },
     #[error("Channel without ChannelID")]

@@ -45,6 +45,15 @@ pub enum RequiredSrsFault {
         column: String,
         text: String,
     },
+    /// A value in g too large for m/s² (it overflows a 64-bit float).
+    #[error(
+        "line {line}: {column} {text:?} is too large to be an acceleration (give it in range)"
+    )]
+    Overflows {
+        line: usize,
+        column: String,
+        text: String,
+    },
     /// A natural frequency, Hz, not above the previous row's.
     #[error("line {line}: frequency_hz {frequency_hz} does not increase (after {last_hz})")]
     NotIncreasing {
@@ -109,6 +118,15 @@ impl RequiredSrs {
             };
             let f = value(f_col, "frequency_hz")?;
             let a = value(a_col, &header[a_col])? * scale;
+            // In g, a finite number can overflow in m/s² (1e308 g): refused as the number it
+            // is, never a comparison in NaN dB.
+            if !a.is_finite() {
+                return Err(err(RequiredSrsFault::Overflows {
+                    line,
+                    column: header[a_col].clone(),
+                    text: row.get(a_col).cloned().unwrap_or_default(),
+                }));
+            }
             if let Some(&(last, _)) = points.last() {
                 if f <= last {
                     return Err(err(RequiredSrsFault::NotIncreasing {
@@ -192,6 +210,9 @@ pub fn compare(
             continue;
         }
         let db = 20.0 * (a / r).log10();
+        if !db.is_finite() {
+            continue;
+        }
         let compared = worst.map_or(0, |w| w.compared) + 1;
         let within = worst.is_none_or(|w| w.within) && excess(db) <= 0.0;
         worst = Some(match worst {

@@ -40,6 +40,7 @@ impl Recording {
                     coeffs: Vec::new(),
                     reference: 0.0,
                     second: None,
+                    at,
                 },
             );
             let (mut ref2, mut ch2, mut sub2) = (0.0, None, None);
@@ -223,9 +224,26 @@ pub(super) struct Poly {
     pub(super) reference: f64,
     /// Bivariate: (reference of the 2nd variable, its channel, its subchannel).
     pub(super) second: Option<(f64, u64, u64)>,
+    /// Its element's byte offset in the file.
+    pub(super) at: u64,
 }
 
 impl Poly {
+    /// The polynomial if every coefficient and reference is a finite number; else the error
+    /// naming it (`id`), never values calibrated to NaN.
+    pub(super) fn finite(&self, id: u64) -> Result<&Self, IdeError> {
+        let second = self.second.map_or(0.0, |(r, _, _)| r);
+        let all = self.coeffs.iter().chain([&self.reference, &second]);
+        if all.into_iter().all(|v| v.is_finite()) {
+            Ok(self)
+        } else {
+            Err(IdeError::Malformed {
+                offset: self.at,
+                what: Malformation::CalibrationNotFinite { id },
+            })
+        }
+    }
+
     /// idelib's `Univariate._fastCoeffs`: a0*(x - ref) + a1 = a0*x + (a1 - a0*ref).
     pub(super) fn linear(&self, id: u64) -> Result<(f64, f64), IdeError> {
         match (self.second, self.coeffs.as_slice()) {

@@ -167,6 +167,21 @@ impl<R: Read + Seek> IdeFile<R> {
         &self.info
     }
 
+    /// The calibration ids that `channel`'s subchannel `sub` (or the channel itself) names but
+    /// the file's CalibrationList lacks: those values are read uncalibrated, as idelib reads
+    /// them.
+    pub fn missing_calibrations(&self, channel: u64, sub: u64) -> Vec<u64> {
+        let Some(ch) = self.info.channels.iter().find(|c| c.id == channel) else {
+            return Vec::new();
+        };
+        let sc = ch.subchannels.iter().find(|s| s.id == sub);
+        [ch.cal, sc.and_then(|s| s.cal)]
+            .into_iter()
+            .flatten()
+            .filter(|id| !self.info.cals.contains_key(id))
+            .collect()
+    }
+
     pub fn channels(&self) -> &[Channel] {
         &self.info.channels
     }
@@ -300,7 +315,7 @@ impl<R: Read + Seek> IdeFile<R> {
             .and_then(|id| self.info.cals.get(&id).map(|p| (id, p)))
         {
             None => (1.0, 0.0),
-            Some((id, p)) => p.linear(id).map_err(|_| {
+            Some((id, p)) => p.finite(id)?.linear(id).map_err(|_| {
                 IdeError::Unsupported(IdeUnsupported::ChannelCalibration { id, channel: ch.id })
             })?,
         };
@@ -310,6 +325,7 @@ impl<R: Read + Seek> IdeFile<R> {
         else {
             return Ok(Resolved::Linear(b.0, 0.0 + b.1));
         };
+        let p = p.finite(id)?;
         let Some((ref2, rc, rs)) = p.second else {
             let a = p.linear(id)?;
             return Ok(Resolved::Linear(a.0 * b.0, a.1 + a.0 * b.1));

@@ -134,6 +134,16 @@ pub fn pick<R: std::io::Read + std::io::Seek>(
             });
         }
     }
+    for &i in &chosen {
+        for id in file.missing_calibrations(channel, all[i].1) {
+            crate::note(&format!(
+                "{}: its calibration {id} is not in the file's calibration list, so its values \
+                 are read uncalibrated (raw, as enDAQ's idelib reads them) though labelled [{}]: \
+                 check their scale against a known level (1 g at rest)",
+                all[i].2, all[i].3
+            ));
+        }
+    }
     Ok(Pick {
         channel,
         subs: chosen.iter().map(|&i| all[i].1).collect(),
