@@ -55,7 +55,8 @@ pub enum Missing {
     WindowAfter,
     /// The nominal duration is shorter than 4 samples at this rate.
     Resolution,
-    /// A number of the verdict is beyond f32 (the scene's gain or peak out of any real range).
+    /// A number of the verdict is beyond f32 (the scene's gain or peak out of any real range),
+    /// or a sample in the window is not a number (a caller's NaN or infinity).
     Overflow,
 }
 
@@ -462,15 +463,23 @@ fn extremes(
     for e in ext.chunks_exact_mut(2) {
         e.copy_from_slice(&[f32::INFINITY, f32::NEG_INFINITY]);
     }
+    // A NaN is neither least nor greatest (`min`/`max` pass over it): the sum finds it, and
+    // an infinity, so that a window holding a non-number is no verdict, never a pass.
+    let mut sum = 0.0f32;
     for k in 0..w.span {
         let v = a(w.base + u64::from(k))?;
+        sum += v;
         let j = w.bucket(k);
         if let Some([least, most]) = ext.get_mut(2 * j..2 * j + 2) {
             *least = least.min(v);
             *most = most.max(v);
         }
     }
-    Ok(())
+    if sum.is_finite() {
+        Ok(())
+    } else {
+        Err(Missing::Overflow)
+    }
 }
 
 /// Pair `j` of a table of pairs (0s beyond it).
@@ -658,6 +667,35 @@ mod tests {
         assert!(early.pass && late.pass, "{early:?} {late:?}");
         assert_eq!(early.margin, late.margin);
         assert_eq!(early.delta_v_m_s, late.delta_v_m_s);
+    }
+
+    /// Samples that are not numbers in the watched window (a caller's signal: the board's
+    /// counts are always numbers) give no verdict: a run of NaN where the pulse is too high
+    /// passed, `min`/`max` passing over it.
+    #[test]
+    fn a_window_holding_a_non_number_is_no_verdict() {
+        let s = spec(Shape::HalfSine);
+        let (rate, dur, start) = (50_000.0f32, 0.011f32, 2000u64);
+        for bad in [f32::NAN, f32::INFINITY, f32::NEG_INFINITY] {
+            for (from, to) in [(2270, 2280), (2275, 2276), (1800, 1900)] {
+                let a = |i: u64| {
+                    (i < 10_000).then(|| {
+                        if (from..to).contains(&i) {
+                            bad
+                        } else {
+                            let u = (i as f32 - start as f32) / (dur * rate);
+                            500.0 * s.shape.at(u)
+                        }
+                    })
+                };
+                let peak = start + (0.5 * dur * rate) as u64;
+                assert_eq!(
+                    judge(a, rate, &s, peak),
+                    Err(Missing::Overflow),
+                    "{bad} {from}"
+                );
+            }
+        }
     }
 
     #[test]
