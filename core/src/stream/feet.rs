@@ -126,7 +126,11 @@ impl<const PRE: usize> Stream<PRE> {
             (len > 3).then(|| (mean(pulse), mean(pulse + len - quarter)))
         };
         let (mut lobe_len, mut lobe_c, _) = walk(0, 0, false);
-        let (mut cut, mut in_previous) = (false, false);
+        // The onset itself lies in the previous impact's window (the walk back from the
+        // trigger, above the edge level, reached it: no lobe is left to walk): the pulse was
+        // under way before that window ended, as a lobe that runs into it.
+        let onset_in_window = after_impact && since_last <= REACH && pulse >= since_last;
+        let (mut cut, mut in_previous) = (false, onset_in_window);
         if let Some((newest, oldest)) = quarters(lobe_len) {
             if lobe_len >= LOBE_LOOK && 2 * newest >= edge_d && 4 * oldest > edge_d.max(newest) {
                 // A ramp that reaches the pulse, ended by its noise while still high: walk
