@@ -193,6 +193,18 @@ fn a_required_srs_judges_and_draws_each_impact_s_srs() {
             .count(),
         2
     );
+    // Saved by Excel as "CSV UTF-8" (a byte-order mark first): read as without it.
+    let page = report_against(
+        d,
+        "bom",
+        "\u{feff}frequency_hz,acceleration_g\n1,10\n5,10\n",
+    )
+    .unwrap();
+    assert_eq!(
+        page.matches("not compared (no natural frequency in both)")
+            .count(),
+        2
+    );
     // A file that is no required SRS is refused, naming what is wrong.
     for (csv, want) in [
         (

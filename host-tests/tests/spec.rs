@@ -349,6 +349,16 @@ fn a_users_band_from_a_file_judges_as_written() {
         (f(&rows[4]["time_over_duration"]) - 0.5).abs() < 1e-6,
         "{s}"
     );
+    // The same band saved by Excel as "CSV UTF-8" (a byte-order mark first): the same band.
+    let bom = scratch.join("band-bom.csv");
+    let text = std::fs::read_to_string(band).unwrap();
+    std::fs::write(&bom, format!("\u{feff}{text}")).unwrap();
+    let (b, bj) = judged(
+        &file,
+        &format!("half-sine,50g,11ms,band-file={}", bom.display()),
+    );
+    assert_eq!(b["spec"]["pass"], true, "{}", b["spec"]);
+    assert_eq!(bj["spec"]["band_table"], s["band_table"], "{}", bj["spec"]);
     let file = recording(&scratch, "band-high", half_sine(57.0, 0.011));
     let (iec, _) = judged(&file, "half-sine,50g,11ms");
     assert_eq!(iec["spec"]["pass"], true, "{}", iec["spec"]);
