@@ -107,6 +107,7 @@ impl<'a> LogJson<'a> {
             gravity,
         };
         json.head.trains = crate::report::train::trains(json.impacts());
+        json.head.assume_rigid_barrier();
         // The events that are drift, not impacts (as `impact analyze` separates them).
         json.head.drifts = json
             .events()

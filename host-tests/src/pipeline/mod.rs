@@ -1146,6 +1146,7 @@ pub fn to_json(setup: &Setup, reports: &[ImpactReport]) -> AnalysisJson {
     };
     crate::report::separate_drifts(&mut a);
     a.trains = crate::report::train::trains(&a.impacts);
+    a.assume_rigid_barrier();
     a
 }
 

@@ -117,6 +117,12 @@ pub struct ImpactJson {
     pub spec: Option<Option<crate::report::spec::VerdictJson>>,
 }
 
+/// The assumption behind every COR, deformation and absorbed energy the tool reports: the body
+/// struck an immovable wall (`analyze` cannot be told a moving target; `simulate` can).
+pub const RIGID_BARRIER: &str = "the barrier is taken as rigid and fixed: COR, deformation and \
+     absorbed energy are the body's against an immovable wall (a target that moves or yields is \
+     not modelled here; impact simulate --target-mass, --target-stiffness model one)";
+
 /// The whole analysis as JSON.
 #[derive(Clone, Debug, Serialize, PartialEq)]
 pub struct AnalysisJson {
@@ -183,6 +189,16 @@ pub struct AnalysisJson {
     /// `impact log` / `impact emulate --waveforms`: the captured windows the board sent.
     #[serde(skip_serializing_if = "Vec::is_empty")]
     pub waveforms: Vec<crate::report::waveform::WaveformJson>,
+}
+
+impl AnalysisJson {
+    /// Whether the impacts have kinematics to report (an approach speed, or a bounce train's):
+    /// those assume a rigid barrier ([`RIGID_BARRIER`]), which is then said.
+    pub fn assume_rigid_barrier(&mut self) {
+        if self.v0_m_s.is_some() || self.train_speed.is_some() {
+            self.assumptions.push(RIGID_BARRIER.to_string());
+        }
+    }
 }
 
 /// The JSON of `a` with `impacts` in place of `a.impacts` (which must be empty), written to

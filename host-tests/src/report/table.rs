@@ -60,11 +60,12 @@ pub fn to_table(a: &AnalysisJson) -> String {
     if a.v0_m_s.is_some() {
         s.push_str(&match a.contact_gravity_m_s2 {
             Some(g) => format!(
-                "vertical: gravity ({}) taken out of each contact; Δv is the pulse's area\n",
+                "vertical: gravity ({}) taken out of each contact; Δv is the pulse's area; \
+                 a rigid, fixed barrier assumed\n",
                 human(g, "m/s²")
             ),
             None => "horizontal: the reading is the deceleration (--vertical for a vertical \
-                     impact given its v0)\n"
+                     impact given its v0); a rigid, fixed barrier assumed\n"
                 .to_string(),
         });
     }
