@@ -100,6 +100,27 @@ fn with_mass_and_v0_the_kinematics_and_fits_appear_and_a_plot_is_drawn() {
         (i["fits"]["nonlinear"]["c_s_m"].as_f64().unwrap() - 1.0).abs() < 0.02,
         "{i}"
     );
+    // The kinematics' assumption is said: a rigid, fixed barrier (none without v0).
+    let said = |v: &serde_json::Value| {
+        v["assumptions"].as_array().is_some_and(|a| {
+            a.iter()
+                .any(|s| s.as_str().unwrap().contains("rigid and fixed"))
+        })
+    };
+    assert!(said(&v), "{}", v["assumptions"]);
+    let (code, out, err) = impact(&["analyze", f.to_str().unwrap(), "--json"]);
+    assert_eq!(code, 0, "{err}");
+    assert!(!said(&serde_json::from_str(&out).unwrap()), "{out}");
+    let (code, out, err) = impact(&[
+        "analyze",
+        f.to_str().unwrap(),
+        "--mass",
+        "0.06",
+        "--v0",
+        "1.3357",
+    ]);
+    assert_eq!(code, 0, "{err}");
+    assert!(out.contains("a rigid, fixed barrier assumed"), "{out}");
     let drawn = std::fs::read_to_string(&svg).unwrap();
     assert!(drawn.contains("<svg") && drawn.contains("nonlinear fit"));
     // Every fit, the force–deformation loop; with --srs the spectra's panels.
