@@ -530,6 +530,23 @@ pub enum NpyFault {
     /// The header, as npyz read it.
     #[error("{}", one_line(.0))]
     Header(#[source] std::io::Error),
+    /// A header length (the prefix's) beyond the bytes after it, or beyond numpy's own limit
+    /// (`max_header_size`, 10 000 bytes): read no further.
+    #[error(
+        "the header declares {declared} bytes, but the file holds {available} after its prefix \
+         and numpy reads at most {limit}: not an array numpy wrote"
+    )]
+    HeaderSize {
+        declared: u64,
+        available: u64,
+        limit: u64,
+    },
+    /// Brackets nested deeper than a numeric array's header (a dict holding a shape tuple).
+    #[error(
+        "the header nests brackets {depth} deep; a numeric array's holds a dict and its shape \
+         tuple (2): a structured or malformed header"
+    )]
+    HeaderNesting { depth: usize },
     #[error("dtype {}: not one of float64, float32, int32, int16, uint16, int8, uint8", .0.descr())]
     Dtype(npyz::DType),
     #[error("shape {0:?}; a 1-D array or 2-D (samples × channels)")]

@@ -34,7 +34,8 @@ pub fn open_elements(path: &Path) -> Result<(Elements, Vec<u64>, npyz::Order), R
                 .map_err(|error| NpyFault::Element { element, error })
         }))
     }
-    let f = std::fs::File::open(path).map_err(|e| ReadError::new(path, e))?;
+    let mut f = std::fs::File::open(path).map_err(|e| ReadError::new(path, e))?;
+    check_header(&mut f).map_err(|e| ReadError::new(path, e))?;
     let file = npyz::NpyFile::new(BufReader::new(f))
         .map_err(|e| ReadError::new(path, NpyFault::Header(e)))?;
     let shape = file.shape().to_vec();
@@ -68,6 +69,80 @@ pub fn open_elements(path: &Path) -> Result<(Elements, Vec<u64>, npyz::Order), R
         Ok(r) => Ok((boxed(r), shape, order)),
         Err(_) => Err(ReadError::new(path, NpyFault::Dtype(dtype))),
     }
+}
+
+/// The largest header read, bytes: numpy's own reader refuses longer ones (`max_header_size`,
+/// numpy 1.24 on) unless told to trust the file.
+const MAX_HEADER: u64 = 10_000;
+
+/// The deepest brackets a numeric array's header holds: its dict, and the shape tuple in it.
+const MAX_NESTING: usize = 2;
+
+/// Checks the header before `npyz` reads it, which allocates the length the prefix declares
+/// (a 4 GiB one aborted the tool) and parses nested brackets in time doubling per level (20
+/// levels in 130 bytes: a hang): the length against the file and numpy's limit, the nesting
+/// against a numeric array's. Leaves `f` at its start. (A file too short for a prefix, or
+/// with another magic or version, is left to `npyz` to refuse.)
+fn check_header(f: &mut std::fs::File) -> Result<(), ReadErrorKind> {
+    use std::io::{Read, Seek, SeekFrom};
+    let len = f.metadata()?.len();
+    let mut prefix = [0u8; 12];
+    let mut got = 0;
+    while got < prefix.len() {
+        match f.read(&mut prefix[got..])? {
+            0 => break,
+            n => got += n,
+        }
+    }
+    let declared = match (&prefix[..6] == b"\x93NUMPY", prefix[6], got) {
+        (true, 1, 10..) => Some((u64::from(u16::from_le_bytes([prefix[8], prefix[9]])), 10)),
+        (true, 2 | 3, 12) => Some((
+            u64::from(u32::from_le_bytes([
+                prefix[8], prefix[9], prefix[10], prefix[11],
+            ])),
+            12,
+        )),
+        _ => None,
+    };
+    if let Some((declared, start)) = declared {
+        let available = len.saturating_sub(start);
+        if declared > MAX_HEADER || declared > available {
+            return Err(NpyFault::HeaderSize {
+                declared,
+                available,
+                limit: MAX_HEADER,
+            }
+            .into());
+        }
+        f.seek(SeekFrom::Start(start))?;
+        let mut header = Vec::new();
+        f.by_ref().take(declared).read_to_end(&mut header)?;
+        let depth = nesting(&header);
+        if depth > MAX_NESTING {
+            return Err(NpyFault::HeaderNesting { depth }.into());
+        }
+    }
+    f.seek(SeekFrom::Start(0))?;
+    Ok(())
+}
+
+/// The deepest nesting of `( [ {` in a header's text, outside its quoted strings.
+fn nesting(header: &[u8]) -> usize {
+    let (mut depth, mut deepest, mut quote) = (0usize, 0usize, None);
+    for &b in header {
+        match (quote, b) {
+            (Some(q), _) if b == q => quote = None,
+            (Some(_), _) => {}
+            (None, b'\'' | b'"') => quote = Some(b),
+            (None, b'(' | b'[' | b'{') => {
+                depth += 1;
+                deepest = deepest.max(depth);
+            }
+            (None, b')' | b']' | b'}') => depth = depth.saturating_sub(1),
+            _ => {}
+        }
+    }
+    deepest
 }
 
 /// Samples, channels and the chosen channel of an array of `shape`: 1-D, or 2-D samples ×
