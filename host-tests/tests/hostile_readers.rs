@@ -49,19 +49,19 @@ fn an_npy_header_is_checked_before_it_is_parsed() {
         .flat_map(|i| f64::from(i % 7).to_le_bytes())
         .collect();
     let good = "{'descr': '<f8', 'fortran_order': False, 'shape': (2000,), }";
-    let ok = scratch.file("ok.npy", &npy(1, good, None, &data));
+    let ok = scratch.file("ok.npy", npy(1, good, None, &data));
     let (code, _, err) = impact(&["analyze", ok.to_str().unwrap(), "--rate", "1000"]);
     assert_eq!(code, 0, "{err}");
-    let ok2 = scratch.file("ok2.npy", &npy(2, good, None, &data));
+    let ok2 = scratch.file("ok2.npy", npy(2, good, None, &data));
     let (code, _, err) = impact(&["analyze", ok2.to_str().unwrap(), "--rate", "1000"]);
     assert_eq!(code, 0, "{err}");
-    let huge = scratch.file("huge.npy", &npy(2, good, Some(u32::MAX), &data));
+    let huge = scratch.file("huge.npy", npy(2, good, Some(u32::MAX), &data));
     refused_in(
         &huge,
         "the header declares 4294967295 bytes, but the file holds 16116 after its prefix",
         Duration::from_secs(5),
     );
-    let past = scratch.file("past.npy", &npy(1, good, Some(60_000), &data[..64]));
+    let past = scratch.file("past.npy", npy(1, good, Some(60_000), &data[..64]));
     refused_in(
         &past,
         "the header declares 60000 bytes",
@@ -72,7 +72,7 @@ fn an_npy_header_is_checked_before_it_is_parsed() {
         "(".repeat(20),
         ")".repeat(20)
     );
-    let nested = scratch.file("nested.npy", &npy(1, &deep, None, &data));
+    let nested = scratch.file("nested.npy", npy(1, &deep, None, &data));
     refused_in(
         &nested,
         "the header nests brackets 21 deep",
