@@ -4,7 +4,7 @@
 
 use std::path::Path;
 
-pub use crate::error::{input_name, is_stdin, one_line, ColumnRef, DriftFault};
+pub use crate::error::{input_name, is_stdin, one_line, reads_once, ColumnRef, DriftFault};
 use crate::error::{At, Numbered, ReadError, ReadErrorKind, TooFewSamples};
 pub use crate::limits::{sig, DRIFT_BLOCK, DRIFT_LIMIT};
 pub use crate::time_axis::{Drift, INTERVAL_RANGE};

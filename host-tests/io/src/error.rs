@@ -171,6 +171,14 @@ pub fn is_stdin(path: &Path) -> bool {
     path.as_os_str() == "-"
 }
 
+/// Whether an input can be read only once, as it comes: standard input, or a path that names
+/// no regular file (a FIFO, a serial port, a device such as `/dev/zero`). Such an input is
+/// read in passes from a spool, never whole into memory (a FIFO's 30 MB took 462 MiB, a
+/// device without end every byte there was).
+pub fn reads_once(path: &Path) -> bool {
+    is_stdin(path) || std::fs::metadata(path).is_ok_and(|m| !m.is_file() && !m.is_dir())
+}
+
 /// How messages name an input: `stdin`, or the path.
 pub fn input_name(path: &Path) -> String {
     if is_stdin(path) {
@@ -648,6 +656,17 @@ pub enum SpoolError {
         #[source]
         error: std::io::Error,
     },
+    /// An input read once that went on past half the space free where its values are kept
+    /// (`limit` bytes, 8 a sample): one without end (a device, a FIFO left open).
+    #[error(
+        "the input went on past {} samples, the limit of its spool in {} ({} MB, at most half \
+         the space free there): an input without end is analysed as it comes with --stream (and --range, \
+         --trigger), or give a recording that ends",
+        .limit / 8,
+        .dir.display(),
+        .limit / 1_000_000
+    )]
+    Full { dir: PathBuf, limit: u64 },
     /// Writing or reading it.
     #[error("the spool in {}: {error}", .dir.display())]
     Use {

@@ -21,6 +21,9 @@ pub struct SpoolWriter {
     out: File,
     bytes: Vec<u8>,
     samples: u64,
+    /// The most bytes it takes: half the space free where it is made (an input without end,
+    /// `/dev/zero`, a logger's FIFO left open, fills no disk).
+    limit: u64,
 }
 
 impl SpoolWriter {
@@ -29,16 +32,31 @@ impl SpoolWriter {
             dir: std::env::temp_dir(),
             error,
         })?;
+        // (`IMPACT_SPOOL_LIMIT_BYTES`: a lower bound, for the tests.)
+        let test_limit = std::env::var("IMPACT_SPOOL_LIMIT_BYTES")
+            .ok()
+            .and_then(|v| v.parse::<u64>().ok());
+        let limit = free_bytes(&file)
+            .map_or(u64::MAX, |free| free / 2)
+            .min(test_limit.unwrap_or(u64::MAX));
         Ok(Self {
             out: file,
             bytes: Vec::new(),
             samples: 0,
+            limit,
         })
     }
 
     /// Appends the values. An error (a full disk) ends the spool: drop it, and its space is
     /// freed at once.
     pub fn write(&mut self, values: &[f64]) -> Result<(), SpoolError> {
+        let after = (self.samples + values.len() as u64).saturating_mul(8);
+        if after > self.limit {
+            return Err(SpoolError::Full {
+                dir: std::env::temp_dir(),
+                limit: self.limit,
+            });
+        }
         self.bytes.clear();
         self.bytes
             .extend(values.iter().flat_map(|v| v.to_le_bytes()));
@@ -159,6 +177,25 @@ impl Source for SpoolSource {
     fn t0(&self) -> f64 {
         self.axis.t0_s
     }
+}
+
+/// The bytes free to this user on the file system holding `file` (`fstatvfs`), if known.
+#[cfg(unix)]
+fn free_bytes(file: &File) -> Option<u64> {
+    use std::os::unix::io::AsRawFd;
+    let mut st = std::mem::MaybeUninit::<libc::statvfs>::uninit();
+    // SAFETY: the descriptor is open for the call; `st` is written whole on success.
+    let ok = unsafe { libc::fstatvfs(file.as_raw_fd(), st.as_mut_ptr()) } == 0;
+    ok.then(|| {
+        // SAFETY: fstatvfs returned 0, so it filled `st`.
+        let st = unsafe { st.assume_init() };
+        u64::from(st.f_bavail).saturating_mul(st.f_frsize as u64)
+    })
+}
+
+#[cfg(not(unix))]
+fn free_bytes(_: &File) -> Option<u64> {
+    None
 }
 
 fn failed(error: std::io::Error) -> SpoolError {

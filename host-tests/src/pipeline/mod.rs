@@ -128,9 +128,14 @@ pub enum PipelineError {
         column: String,
         samples: u64,
     },
-    /// Standard input's spool (its values kept for the later passes) not made or written.
-    #[error("stdin: {0}")]
-    Spool(#[source] std::sync::Arc<impact_io::error::SpoolError>),
+    /// The spool of an input read once (standard input, a FIFO, a device: its values kept for
+    /// the later passes) not made or written; `input` as messages name it.
+    #[error("{input}: {error}")]
+    Spool {
+        input: String,
+        #[source]
+        error: std::sync::Arc<impact_io::error::SpoolError>,
+    },
     #[error("the survey's thread panicked")]
     SurveyPanicked,
     #[error("the reader thread panicked")]

@@ -125,10 +125,10 @@ pub struct AnalyzeArgs {
     /// from standard input) in one pass as it is read, in memory that does not grow with its
     /// length; needs --range and --trigger (and --rate where the file holds no time); spikes
     /// are not screened; no --plot, --axes, --free-fall, --resample. Without it a regular
-    /// file or standard input is read in passes (a survey of the whole recording, then the
-    /// analysis), also in bounded memory, with the levels learned and spikes screened; a
-    /// CSV's or standard input's values are kept from the first pass in a temporary file
-    /// (TMPDIR, 8 bytes a sample).
+    /// file or standard input (or a FIFO, a device) is read in passes (a survey of the whole
+    /// recording, then the analysis), also in bounded memory, with the levels learned and
+    /// spikes screened; a CSV's or standard input's values are kept from the first pass in a
+    /// temporary file (TMPDIR, 8 bytes a sample, at most half its free space).
     #[arg(long, help_heading = "Input")]
     pub stream: bool,
     /// Units of the channel [default: named in its header, else g].

@@ -22,7 +22,7 @@ use std::sync::Arc;
 
 use crate::pipeline::{self, AnalyzeArgs, MonitorRun, PipelineError, Reading, Setup};
 use crate::read_errors::ReadFailure;
-use impact_io::channel::{input_name, is_stdin};
+use impact_io::channel::{input_name, reads_once};
 use impact_io::error::SpoolError;
 use impact_io::open_source;
 use impact_io::progress::Progress;
@@ -288,13 +288,13 @@ fn head_counts(
 }
 
 /// Whether `impact analyze` reads `args.file` in passes ([`analyze_in_passes`]): a regular
-/// file or standard input, without the options that need the whole recording in memory
+/// file, or an input read once (standard input, a FIFO, a device: from a spool), without the options that need the whole recording in memory
 /// (axes, free fall, resampling; a figure takes its windows in a last pass).
 pub fn in_passes(args: &AnalyzeArgs) -> bool {
     // (`IMPACT_READ_WHOLE` set: read whole, for the tests that compare the two ways.)
     !args.stream
         && std::env::var_os("IMPACT_READ_WHOLE").is_none()
-        && (is_stdin(&args.file) || std::fs::metadata(&args.file).is_ok_and(|m| m.is_file()))
+        && (reads_once(&args.file) || std::fs::metadata(&args.file).is_ok_and(|m| m.is_file()))
         && args.axes.is_empty()
         && args.free_fall.is_none()
         && !args.resample
@@ -316,6 +316,11 @@ fn survey_pass(
     // A spool that fails is dropped at once (its space freed); one that must not fail ends
     // the pass.
     let stops = spool.as_ref().is_some_and(|s| s.stops);
+    let input = spool.as_ref().map(|s| s.input.clone()).unwrap_or_default();
+    let spool_failed = |error: &Arc<SpoolError>| PipelineError::Spool {
+        input: input.clone(),
+        error: Arc::clone(error),
+    };
     let spool = spool.map(|s| Ok(s.writer));
     let failure = Arc::new(std::sync::OnceLock::<Arc<SpoolError>>::new());
     let (flat, spikes) = survey.take_shape().split();
@@ -343,7 +348,7 @@ fn survey_pass(
     // Each block, the head first: the removals put in, surveyed here and sent to the scans.
     let mut take = |block: &mut [f64]| {
         if let (true, Some(e)) = (stops, failure.get()) {
-            return Err(PipelineError::Spool(Arc::clone(e)));
+            return Err(spool_failed(e));
         }
         patch.values(block);
         survey.push_levels(block);
@@ -371,7 +376,7 @@ fn survey_pass(
     let spikes = spikes.map(Scan::finish).transpose()?.or(with_flat);
     let source = read?;
     if let (true, Some(Err(e))) = (stops, &spool) {
-        return Err(PipelineError::Spool(Arc::clone(e)));
+        return Err(spool_failed(e));
     }
     survey.put_shape(crate::pipeline::survey::Shape::join(flat, spikes));
     Ok(SurveyPass {
@@ -428,6 +433,8 @@ impl<S: Send + 'static> Scan<S> {
 struct Spooling {
     writer: SpoolWriter,
     stops: bool,
+    /// The input, as messages name it (`stdin`, or its path).
+    input: String,
 }
 
 impl Spooling {
@@ -435,9 +442,12 @@ impl Spooling {
     /// spool that cannot be made is an error for standard input (read once), a note for a
     /// file (read again for each pass).
     fn for_input(args: &AnalyzeArgs, name: &str) -> Result<Option<Self>, PipelineError> {
-        let stdin = is_stdin(&args.file);
+        let stdin = reads_once(&args.file);
         match spooled(args).then(SpoolWriter::new).transpose() {
-            Err(e) if stdin => Err(PipelineError::Spool(Arc::new(e))),
+            Err(e) if stdin => Err(PipelineError::Spool {
+                input: name.to_string(),
+                error: Arc::new(e),
+            }),
             Err(e) => {
                 crate::errln!("note: {e}: {name} is read again for each pass");
                 Ok(None)
@@ -445,6 +455,7 @@ impl Spooling {
             Ok(writer) => Ok(writer.map(|writer| Spooling {
                 writer,
                 stops: stdin,
+                input: name.to_string(),
             })),
         }
     }
@@ -461,7 +472,7 @@ struct SurveyPass {
 /// Whether the first pass keeps the values for the later ones ([`impact_io::spool`]): standard
 /// input (read once) and a CSV file (its parse costs more than reading the spool).
 fn spooled(args: &AnalyzeArgs) -> bool {
-    is_stdin(&args.file)
+    reads_once(&args.file)
         || impact_io::Format::of(&args.file, args.raw_type) == impact_io::Format::Csv
 }
 
