@@ -518,3 +518,42 @@ fn a_short_lead_in_before_a_slow_pulse_is_within_one_percent_or_unknown() {
         }
     }
 }
+
+/// Two sharp 1 ms hits of 2 m/s, the second after 0.3–0.9 ms of quiet (inside the first
+/// one's hold of 1 ms: its window ends on the second's onset), over 0.3 g of noise: the
+/// second is no continuation of the first. It keeps its Δv and its kinematics, unflagged
+/// (a pulse whose onset lay at the window's end was flagged `in-previous`, its COR dropped).
+#[test]
+fn a_sharp_hit_just_after_a_window_is_no_continuation() {
+    let scratch = Scratch::new();
+    let (t1, width, dv) = (0.05, 0.001, 2.0);
+    for (k, gap) in [0.0003, 0.0006, 0.0009].into_iter().enumerate() {
+        let t2 = t1 + width + gap;
+        let csv = table_channel(k as u64 + 1, 20_000, |t| {
+            sine_from(t, t1, width, dv) + sine_from(t, t2, width, dv)
+        });
+        let file = scratch.text(&format!("hits-{gap}.csv"), &csv);
+        let (out, _) = common::impact_ok(&[
+            "analyze",
+            &file,
+            "--json",
+            "--mass",
+            "0.1",
+            "--v0",
+            "1.2",
+            "--v0-every",
+        ]);
+        let j: serde_json::Value = serde_json::from_str(&out).unwrap();
+        let impacts = j["impacts"].as_array().unwrap();
+        let what = format!("a second hit {gap} s after the first");
+        assert_eq!(impacts.len(), 2, "{what}: {impacts:?}");
+        let i = &impacts[1];
+        assert!(
+            !i["flags"].to_string().contains("in-previous"),
+            "{what}: {i}"
+        );
+        let v = i["delta_v_m_s"].as_f64().expect("Δv");
+        assert!((v / dv - 1.0).abs() <= 0.01, "{what}: Δv {v}");
+        assert!(i["cor"].as_f64().is_some(), "{what}: {i}");
+    }
+}

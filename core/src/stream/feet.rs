@@ -127,9 +127,15 @@ impl<const PRE: usize> Stream<PRE> {
         };
         let (mut lobe_len, mut lobe_c, _) = walk(0, 0, false);
         // The onset itself lies in the previous impact's window (the walk back from the
-        // trigger, above the edge level, reached it: no lobe is left to walk): the pulse was
-        // under way before that window ended, as a lobe that runs into it.
-        let onset_in_window = after_impact && since_last <= REACH && pulse >= since_last;
+        // trigger, above the edge level, reached into it: no lobe is left to walk), or it is
+        // the window's first sample after its end with the window's last sample still half
+        // the edge level up (a window that ends on a new hit ends just before its onset: a
+        // sharp hit after quiet starts there from the baseline, and is no continuation): the
+        // pulse was under way before that window ended, as a lobe that runs into it.
+        let onset_in_window = after_impact
+            && since_last <= REACH
+            && (pulse > since_last
+                || (pulse == since_last && pd(pulse).is_some_and(|y| 2 * y >= edge_d)));
         let (mut cut, mut in_previous) = (false, onset_in_window);
         if let Some((newest, oldest)) = quarters(lobe_len) {
             if lobe_len >= LOBE_LOOK && 2 * newest >= edge_d && 4 * oldest > edge_d.max(newest) {
