@@ -8,7 +8,9 @@
 //! sees half a file, two writers cannot interleave (the last rename wins), and an error or an
 //! interrupt leaves nothing behind (the temporary file is registered with
 //! [`crate::interrupt`], which removes it on Ctrl-C). The finished file keeps the target's
-//! mode (a new one gets 0666 less the umask); a read-only target is refused, never replaced.
+//! permission bits (a new one gets 0666 less the umask; its owner is this user); a read-only
+//! target, a device or FIFO, or an unwritable folder is refused before any work, never
+//! replaced.
 
 use std::io::Write;
 use std::path::{Path, PathBuf};
@@ -94,14 +96,29 @@ pub enum OutputError {
     },
     #[error("{option} {}: links to an input; it would be overwritten", .path.display())]
     LinksToAnInput { option: String, path: PathBuf },
-    /// An existing file this user may not write (a 0444 report kept as the signed copy):
-    /// it is not replaced behind the permission's back.
+    /// An existing file this user may not write (a 0444 report kept as the signed copy,
+    /// another user's file): it is not replaced behind the permission's back.
     #[error(
-        "{option} {}: the file exists and is read-only; it is not replaced (make it writable, \
-         e.g. chmod u+w, or write to another file)",
+        "{option} {}: the file exists and is read-only; it is not replaced (make it writable \
+         for you, or write to another file)",
         .path.display()
     )]
     ReadOnly { option: String, path: PathBuf },
+    /// An existing path that is no regular file (a device such as `/dev/null`, a FIFO, a
+    /// socket): renaming a file over it would replace the device.
+    #[error(
+        "{option} {}: is not a regular file (a device, a FIFO or a socket); outputs are files \
+         (write to a file, or leave the option out)",
+        .path.display()
+    )]
+    NotAFile { option: String, path: PathBuf },
+    /// The folder the output goes in, where this user may not create files.
+    #[error("{option} {}: folder {} is not writable (write to another folder)", .path.display(), .dir.display())]
+    FolderReadOnly {
+        option: String,
+        path: PathBuf,
+        dir: PathBuf,
+    },
     #[error(
         "{option} {}: the output is {}: name the file .{ext}",
         .path.display(),
@@ -154,11 +171,8 @@ pub fn check(
             path: owned,
         });
     }
-    if exists_read_only(path) {
-        return Err(OutputError::ReadOnly {
-            option,
-            path: owned,
-        });
+    if let Some(e) = unwritable(&option, path) {
+        return Err(e);
     }
     if let Some(out) = identity(path) {
         for input in &inputs.paths {
@@ -204,55 +218,74 @@ pub fn check(
     Ok(())
 }
 
-/// Whether `path` names an existing file that is read-only: no write bit at all (`chmod a-w`,
-/// the mark of a kept copy, which `rm` also asks about, even for root), or one this process
-/// may not write (`access(2)`'s `W_OK`: the bits as they apply to this user, a read-only mount).
-#[cfg(unix)]
-fn exists_read_only(path: &Path) -> bool {
-    use std::os::unix::ffi::OsStrExt;
-    use std::os::unix::fs::PermissionsExt;
-    let Ok(meta) = std::fs::metadata(path) else {
-        return false;
-    };
-    if meta.permissions().mode() & 0o222 == 0 {
-        return true;
+/// Why `path` cannot take an output written beside it and renamed over it, if it cannot:
+/// an existing path that is no regular file, an existing file that is read-only (no write bit
+/// at all, `chmod a-w`, the mark of a kept copy, which `rm` also asks about, even for root; or
+/// one this user may not write), or a folder this user may not create the file in.
+fn unwritable(option: &str, path: &Path) -> Option<OutputError> {
+    let (option, owned) = (option.to_string(), path.to_path_buf());
+    if let Ok(meta) = std::fs::metadata(path) {
+        if !meta.is_file() && !meta.is_dir() {
+            return Some(OutputError::NotAFile {
+                option,
+                path: owned,
+            });
+        }
+        if meta.is_file() && (no_write_bit(&meta) || !may_write(path)) {
+            return Some(OutputError::ReadOnly {
+                option,
+                path: owned,
+            });
+        }
     }
-    let Ok(c) = std::ffi::CString::new(path.as_os_str().as_bytes()) else {
-        return false;
-    };
-    // SAFETY: `c` is a NUL-terminated path that outlives the call; access only reads it.
-    unsafe { libc::access(c.as_ptr(), libc::W_OK) != 0 }
+    let dir = directory(path);
+    if dir.is_dir() && !may_write(dir) {
+        return Some(OutputError::FolderReadOnly {
+            option,
+            path: owned,
+            dir: dir.to_path_buf(),
+        });
+    }
+    None
+}
+
+#[cfg(unix)]
+fn no_write_bit(meta: &std::fs::Metadata) -> bool {
+    use std::os::unix::fs::PermissionsExt;
+    meta.permissions().mode() & 0o222 == 0
 }
 
 #[cfg(not(unix))]
-fn exists_read_only(path: &Path) -> bool {
-    std::fs::metadata(path).is_ok_and(|m| m.permissions().readonly())
+fn no_write_bit(meta: &std::fs::Metadata) -> bool {
+    meta.permissions().readonly()
 }
 
-/// The mode the finished file gets: an existing target's own (a 0600 log stays private, a
-/// 0664 report stays group-writable), else a new file's as `open(2)` would give it, 0666
-/// less the umask.
+/// `access(2)`'s `W_OK` for this process: the bits as they apply to this user, a read-only
+/// mount.
 #[cfg(unix)]
-fn final_mode(path: &Path) -> u32 {
+fn may_write(path: &Path) -> bool {
+    use std::os::unix::ffi::OsStrExt;
+    let Ok(c) = std::ffi::CString::new(path.as_os_str().as_bytes()) else {
+        return true;
+    };
+    // SAFETY: `c` is a NUL-terminated path that outlives the call; access only reads it.
+    unsafe { libc::access(c.as_ptr(), libc::W_OK) == 0 }
+}
+
+#[cfg(not(unix))]
+fn may_write(_: &Path) -> bool {
+    true
+}
+
+/// The mode an existing target keeps (its permission bits, not setuid, setgid or sticky: the
+/// new file is this user's), if it exists.
+#[cfg(unix)]
+fn kept_mode(path: &Path) -> Option<u32> {
     use std::os::unix::fs::PermissionsExt;
-    match std::fs::metadata(path) {
-        Ok(m) if m.is_file() => m.permissions().mode() & 0o7777,
-        _ => 0o666 & !umask(),
-    }
-}
-
-/// The process's umask, read without changing it (`/proc/self/status`, Linux 4.7 on); where
-/// it cannot be read, the common 022.
-#[cfg(unix)]
-fn umask() -> u32 {
-    std::fs::read_to_string("/proc/self/status")
+    std::fs::metadata(path)
         .ok()
-        .and_then(|s| {
-            s.lines()
-                .find_map(|l| l.strip_prefix("Umask:"))
-                .and_then(|v| u32::from_str_radix(v.trim(), 8).ok())
-        })
-        .unwrap_or(0o022)
+        .filter(|m| m.is_file())
+        .map(|m| m.permissions().mode() & 0o777)
 }
 
 /// The directory `path` is in (`.` for a bare name).
@@ -280,31 +313,33 @@ pub fn write_with(
         path: path.to_path_buf(),
         source,
     };
-    if exists_read_only(path) {
-        return Err(OutputError::ReadOnly {
-            option: "output".to_string(),
-            path: path.to_path_buf(),
-        });
+    if let Some(e) = unwritable("output", path) {
+        return Err(e);
     }
     let name = path
         .file_name()
         .map_or_else(|| "output".into(), |n| n.to_string_lossy().into_owned());
-    let tmp = tempfile::Builder::new()
-        .prefix(&format!(".{name}."))
-        .suffix(".part")
-        .tempfile_in(directory(path))
-        .map_err(failed)?;
+    let prefix = format!(".{name}.");
+    let mut builder = tempfile::Builder::new();
+    builder.prefix(&prefix).suffix(".part");
+    // A new file's mode as any tool's: 0666 less the umask, which the kernel applies.
+    #[cfg(unix)]
+    {
+        use std::os::unix::fs::PermissionsExt;
+        builder.permissions(std::fs::Permissions::from_mode(0o666));
+    }
+    let tmp = builder.tempfile_in(directory(path)).map_err(failed)?;
     let guard = crate::interrupt::temporary(tmp.path());
     {
         let mut w = std::io::BufWriter::new(tmp.as_file());
         fill(&mut w).map_err(failed)?;
         w.flush().map_err(failed)?;
     }
-    // The target's own mode, or a new file's (the temporary one is private).
+    // An existing target's own mode (a 0600 figure stays 0600).
     #[cfg(unix)]
-    {
+    if let Some(mode) = kept_mode(path) {
         use std::os::unix::fs::PermissionsExt;
-        let mode = std::fs::Permissions::from_mode(final_mode(path));
+        let mode = std::fs::Permissions::from_mode(mode);
         std::fs::set_permissions(tmp.path(), mode).map_err(failed)?;
     }
     tmp.persist(path).map_err(|e| failed(e.error))?;

@@ -220,6 +220,28 @@ fn an_output_keeps_the_targets_mode_and_a_read_only_target_is_refused() {
         &[&csv, &signed],
     );
     assert_eq!(mode(&signed), 0o444);
+    // Setuid and setgid are not carried to a file this user now owns: the permission bits are.
+    let suid = d.join("suid.svg");
+    std::fs::write(&suid, "old").unwrap();
+    chmod(&suid, 0o6755);
+    impact_ok(&["analyze", s(&csv), "--plot", s(&suid)]);
+    assert_eq!(mode(&suid), 0o755);
+    // A FIFO (as a device such as /dev/null would be) is no file to rename over: refused,
+    // left a FIFO (as root, `--plot /dev/null` replaced the device with a regular file).
+    let fifo = d.join("fifo.svg");
+    assert!(Command::new("mkfifo")
+        .arg(&fifo)
+        .status()
+        .unwrap()
+        .success());
+    refused(
+        &["analyze", s(&csv), "--plot", s(&fifo)],
+        None,
+        "is not a regular file (a device, a FIFO or a socket)",
+        &[&csv],
+    );
+    use std::os::unix::fs::FileTypeExt;
+    assert!(std::fs::metadata(&fifo).unwrap().file_type().is_fifo());
 }
 
 #[test]
