@@ -180,7 +180,10 @@ impl Source for SpoolSource {
 }
 
 /// The bytes free to this user on the file system holding `file` (`fstatvfs`), if known.
+/// (`statvfs`'s field types differ between platforms: the conversions are not useless
+/// everywhere.)
 #[cfg(unix)]
+#[allow(clippy::useless_conversion, clippy::unnecessary_cast)]
 fn free_bytes(file: &File) -> Option<u64> {
     use std::os::unix::io::AsRawFd;
     let mut st = std::mem::MaybeUninit::<libc::statvfs>::uninit();
