@@ -78,6 +78,16 @@ fn an_npy_header_is_checked_before_it_is_parsed() {
         "the header nests brackets 21 deep",
         Duration::from_secs(5),
     );
+    // An escaped quote does not end its string (Python's reading): the brackets after it
+    // count.
+    let escaped = deep.replacen("'<f8'", "'\\''", 1);
+    assert!(escaped.contains("'\\''"), "{escaped}");
+    let escaped = scratch.file("escaped.npy", npy(1, &escaped, None, &data));
+    refused_in(
+        &escaped,
+        "the header nests brackets 21 deep",
+        Duration::from_secs(5),
+    );
 }
 
 /// A CSV of `n` rows at 100 kS/s with a 2 ms half-sine every 100 000 samples, 0.5 g noise-free.

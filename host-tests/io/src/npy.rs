@@ -126,11 +126,16 @@ fn check_header(f: &mut std::fs::File) -> Result<(), ReadErrorKind> {
     Ok(())
 }
 
-/// The deepest nesting of `( [ {` in a header's text, outside its quoted strings.
+/// The deepest nesting of `( [ {` in a header's text, outside its quoted strings (a
+/// backslash inside one escapes the next byte, as Python reads it; a triple quote reads as
+/// quotes that open and close, which can only count more brackets, never fewer).
 fn nesting(header: &[u8]) -> usize {
     let (mut depth, mut deepest, mut quote) = (0usize, 0usize, None);
+    let mut escaped = false;
     for &b in header {
         match (quote, b) {
+            (Some(_), _) if escaped => escaped = false,
+            (Some(_), b'\\') => escaped = true,
             (Some(q), _) if b == q => quote = None,
             (Some(_), _) => {}
             (None, b'\'' | b'"') => quote = Some(b),
