@@ -155,6 +155,13 @@ impl RequiredSrs {
     /// The required acceleration at `f_hz`, m/s² (log–log between the breakpoints); `None`
     /// outside them.
     pub fn at(&self, f_hz: f64) -> Option<f64> {
+        self.log10_at(f_hz).map(|l| 10f64.powf(l))
+    }
+
+    /// The common logarithm of [`Self::at`], interpolated in the log domain: finite for any
+    /// positive finite breakpoints (`at` itself can underflow or overflow between 1e-306 and
+    /// 1e300, where a ratio of the two in dB would be infinite).
+    pub fn log10_at(&self, f_hz: f64) -> Option<f64> {
         let (first, last) = (self.points[0].0, self.points[self.points.len() - 1].0);
         // A hair of slack: band centres computed as 1000 × 2^(k/n) are not always the
         // literal a file gives.
@@ -174,8 +181,9 @@ impl RequiredSrs {
             .position(|w| f <= w[1].0)
             .unwrap_or(self.points.len() - 2);
         let ((f0, a0), (f1, a1)) = (self.points[k], self.points[k + 1]);
-        let u = (f / f0).ln() / (f1 / f0).ln();
-        Some(a0 * (a1 / a0).powf(u))
+        let u = (f.ln() - f0.ln()) / (f1.ln() - f0.ln());
+        let (l0, l1) = (a0.log10(), a1.log10());
+        Some(l0 + (l1 - l0) * u)
     }
 }
 
@@ -205,14 +213,15 @@ pub fn compare(
     let excess = |db: f64| (db - high).max(low - db);
     let mut worst: Option<Comparison> = None;
     for (&f, &a) in frequency_hz.iter().zip(srs_m_s2) {
-        let Some(r) = required.at(f) else { continue };
+        let Some(r) = required.log10_at(f) else {
+            continue;
+        };
         if !(a.is_finite() && a > 0.0) {
             continue;
         }
-        let db = 20.0 * (a / r).log10();
-        if !db.is_finite() {
-            continue;
-        }
+        // In the log domain: finite for any positive finite pair (a ratio overflowed to an
+        // infinite dB, once skipped, which could turn a "no" into a "yes").
+        let db = 20.0 * (a.log10() - r);
         let compared = worst.map_or(0, |w| w.compared) + 1;
         let within = worst.is_none_or(|w| w.within) && excess(db) <= 0.0;
         worst = Some(match worst {
@@ -306,13 +315,31 @@ mod tests {
         assert_eq!(r.at(100.000_000_01), Some(10.0));
     }
 
+    /// A required SRS of 1e-306 m/s² at 100–200 Hz (its ratio to a measured 100 m/s²
+    /// overflows: an infinite dB, once skipped) then 100 m/s² at 300–400 Hz, where the
+    /// measurement meets it: "no", at 100 Hz (it said "yes").
+    #[test]
+    fn a_ratio_beyond_f64_is_still_judged() {
+        let r = required(&[
+            (100.0, 1e-306),
+            (200.0, 1e-306),
+            (300.0, 100.0),
+            (400.0, 100.0),
+        ]);
+        let f = [100.0, 150.0, 300.0, 400.0];
+        let c = compare(&r, &f, &[100.0, 100.0, 100.0, 100.0]).unwrap();
+        assert!(!c.within && c.compared == 4, "{c:?}");
+        assert_eq!(c.worst_hz, 100.0);
+        assert!((c.worst_db - 20.0 * 308.0).abs() < 1e-6, "{c:?}");
+    }
+
     #[test]
     fn a_measured_srs_is_within_the_tolerance_or_named_where_it_is_worst() {
         let r = required(&[(100.0, 100.0), (1000.0, 100.0)]);
         let db = |d: f64| 100.0 * 10f64.powf(d / 20.0);
         // Inside: the nearest a limit is +2.5 dB at 400 Hz; 50 Hz and 2 kHz not compared.
         let f = [50.0, 100.0, 200.0, 400.0, 800.0, 2000.0];
-        let c = compare(&r, &f, &[1.0, db(0.0), db(-1.0), db(2.5), db(0.5), 1.0]).unwrap();
+        let c = compare(&r, &f, &[1.0, db(0.0), db(-0.9), db(2.5), db(0.5), 1.0]).unwrap();
         assert!(c.within && c.worst_hz == 400.0 && c.compared == 4, "{c:?}");
         assert!((c.worst_db - 2.5).abs() < 1e-9);
         assert_eq!(cell(Some(&c)), "yes, worst at 400.0 Hz, +2.50 dB");
