@@ -9,8 +9,9 @@
 //! the band is flat (before and after the pulse and its slack, or a user's band's rows) a
 //! start's worst excursion is read off the same extremes (a bucket's samples are read only
 //! where its extreme is the greatest); a start whose excursion somewhere already reaches the
-//! best's is left there. Both give the verdict of reading every sample, bit for bit (the
-//! tests hold the search to the one that did, `verdict_reference.rs`).
+//! best's is left there. Both give the verdict of reading every sample, bit for bit, on a
+//! window of numbers (the tests hold the search to the one that did, `verdict_reference.rs`);
+//! a window holding a NaN or an infinity is no verdict here ([`Missing::Overflow`]).
 
 use super::{band_over, Nominal, Spec};
 
@@ -463,12 +464,13 @@ fn extremes(
     for e in ext.chunks_exact_mut(2) {
         e.copy_from_slice(&[f32::INFINITY, f32::NEG_INFINITY]);
     }
-    // A NaN is neither least nor greatest (`min`/`max` pass over it): the sum finds it, and
-    // an infinity, so that a window holding a non-number is no verdict, never a pass.
+    // A NaN is neither least nor greatest (`min`/`max` pass over it): `v - v`, 0 for every
+    // finite sample and NaN for a NaN or an infinity, finds it without a sum that could
+    // overflow, so that a window holding a non-number is no verdict, never a pass.
     let mut sum = 0.0f32;
     for k in 0..w.span {
         let v = a(w.base + u64::from(k))?;
-        sum += v;
+        sum += v - v;
         let j = w.bucket(k);
         if let Some([least, most]) = ext.get_mut(2 * j..2 * j + 2) {
             *least = least.min(v);

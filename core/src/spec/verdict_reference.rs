@@ -1,5 +1,6 @@
 //! The verdict's search as it was before it skipped the band's flat stretches (#44): kept
-//! for the tests only, which hold the search to give the same verdicts bit for bit.
+//! for the tests only, which hold the search to give the same verdicts bit for bit (on windows
+//! of numbers: the search refuses a NaN or an infinity, which this one passed over).
 
 use super::verdict::{Missing, Verdict, BUCKETS};
 use super::{band_over, Nominal, Spec};
