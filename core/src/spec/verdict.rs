@@ -470,7 +470,9 @@ fn extremes(
     let mut sum = 0.0f32;
     for k in 0..w.span {
         let v = a(w.base + u64::from(k))?;
-        sum += v - v;
+        #[allow(clippy::eq_op)]
+        let zero_or_nan = v - v;
+        sum += zero_or_nan;
         let j = w.bucket(k);
         if let Some([least, most]) = ext.get_mut(2 * j..2 * j + 2) {
             *least = least.min(v);
