@@ -360,13 +360,23 @@ fn a_byte_order_mark_after_the_first_line_is_refused_on_every_line() {
 
 /// The enDAQ recording's bytes with `patch` (offset, new bytes) applied, as a file.
 fn ide_patched(scratch: &Scratch, name: &str, at: usize, bytes: &[u8]) -> PathBuf {
+    ide_patches(scratch, name, &[(at, bytes)])
+}
+
+/// The enDAQ recording's bytes with each (offset, new bytes) applied, as a file.
+fn ide_patches(scratch: &Scratch, name: &str, patches: &[(usize, &[u8])]) -> PathBuf {
     let root = PathBuf::from(env!("CARGO_MANIFEST_DIR"));
     let mut ide = std::fs::read(root.join("data/endaq-high-drop/High-Drop.IDE")).unwrap();
     // The CalibrationList's polynomial 35 (subchannel 32.2's): CalID at 427, its first
     // coefficient's 8 bytes at 437; checked so that a changed file fails here, not later.
     assert_eq!(&ide[427..431], &[0x4B, 0x03, 0x81, 35]);
     assert_eq!(&ide[434..437], &[0x4B, 0x08, 0x88]);
-    ide[at..at + bytes.len()].copy_from_slice(bytes);
+    // Polynomial 32 (channel 32's own): its first coefficient's 8 bytes at 85.
+    assert_eq!(&ide[75..79], &[0x4B, 0x03, 0x81, 32]);
+    assert_eq!(&ide[82..85], &[0x4B, 0x08, 0x88]);
+    for &(at, bytes) in patches {
+        ide[at..at + bytes.len()].copy_from_slice(bytes);
+    }
     let path = scratch.path().join(name);
     std::fs::write(&path, ide).unwrap();
     path
@@ -394,12 +404,22 @@ fn an_ide_calibration_that_is_nan_or_missing_is_named() {
         &["calibration 35 holds a coefficient that is not a finite number"],
         &["--gain"],
     );
+    // Finite coefficients whose product overflows (the channel's 1e300 times the
+    // subchannel's 1e300): the same error, not values of infinity.
+    let big = 1e300f64.to_be_bytes();
+    let product = ide_patches(&scratch, "product.ide", &[(85, &big), (437, &big)]);
+    let product = product.to_str().unwrap();
+    refused(
+        &["analyze", product, "--column", "32.2"],
+        &["calibration 35 holds a coefficient that is not a finite number"],
+        &["--gain"],
+    );
     let missing = ide_patched(&scratch, "missing.ide", 430, &[99]);
     let (code, _, err) = impact(&["analyze", missing.to_str().unwrap(), "--column", "32.2"]);
     assert_eq!(code, 0, "{err}");
     assert!(
         err.contains("32.2 Z (16g) [g]: its calibration 35 is not in the file's calibration list")
-            && err.contains("read uncalibrated"),
+            && err.contains("may be uncalibrated"),
         "{err}"
     );
     // Its neighbour keeps its own calibration: no note.

@@ -325,8 +325,9 @@ pub enum Malformation {
     /// A calibration used by the channel read whose coefficients or references include a
     /// NaN or an infinity: its values cannot be calibrated.
     #[error(
-        "calibration {id} holds a coefficient that is not a finite number (NaN or infinite): \
-         the recorder's calibration is damaged, its values cannot be calibrated \
+        "calibration {id} holds a coefficient that is not a finite number (NaN or infinite, \
+         or so large that folding it in overflows): the recorder's calibration is damaged, its \
+         values cannot be calibrated \
          (recalibrate the recorder, or read another channel with --column)"
     )]
     CalibrationNotFinite { id: u64 },

@@ -170,16 +170,33 @@ impl<R: Read + Seek> IdeFile<R> {
     /// The calibration ids that `channel`'s subchannel `sub` (or the channel itself) names but
     /// the file's CalibrationList lacks: those values are read uncalibrated, as idelib reads
     /// them.
+    ///
+    /// A bivariate calibration's reference subchannel counts too (its mean enters the values).
     pub fn missing_calibrations(&self, channel: u64, sub: u64) -> Vec<u64> {
-        let Some(ch) = self.info.channels.iter().find(|c| c.id == channel) else {
-            return Vec::new();
+        let own = |channel: u64, sub: u64| -> Vec<Option<u64>> {
+            let Some(ch) = self.info.channels.iter().find(|c| c.id == channel) else {
+                return Vec::new();
+            };
+            let sc = ch.subchannels.iter().find(|s| s.id == sub);
+            vec![ch.cal, sc.and_then(|s| s.cal)]
         };
-        let sc = ch.subchannels.iter().find(|s| s.id == sub);
-        [ch.cal, sc.and_then(|s| s.cal)]
+        let mut ids = own(channel, sub);
+        let reference = ids
+            .last()
+            .copied()
+            .flatten()
+            .and_then(|id| self.info.cals.get(&id))
+            .and_then(|p| p.second);
+        if let Some((_, rc, rs)) = reference {
+            ids.extend(own(rc, rs));
+        }
+        let mut missing: Vec<u64> = ids
             .into_iter()
             .flatten()
             .filter(|id| !self.info.cals.contains_key(id))
-            .collect()
+            .collect();
+        missing.dedup();
+        missing
     }
 
     pub fn channels(&self) -> &[Channel] {
@@ -326,9 +343,21 @@ impl<R: Read + Seek> IdeFile<R> {
             return Ok(Resolved::Linear(b.0, 0.0 + b.1));
         };
         let p = p.finite(id)?;
+        let folded = |values: &[f64]| -> Result<(), IdeError> {
+            if values.iter().all(|v| v.is_finite()) {
+                Ok(())
+            } else {
+                Err(IdeError::Malformed {
+                    offset: p.at,
+                    what: Malformation::CalibrationNotFinite { id },
+                })
+            }
+        };
         let Some((ref2, rc, rs)) = p.second else {
             let a = p.linear(id)?;
-            return Ok(Resolved::Linear(a.0 * b.0, a.1 + a.0 * b.1));
+            let (gain, offset) = (a.0 * b.0, a.1 + a.0 * b.1);
+            folded(&[gain, offset])?;
+            return Ok(Resolved::Linear(gain, offset));
         };
         let &[c0, c1, c2, c3] = p.coeffs.as_slice() else {
             return Err(IdeError::Unsupported(
@@ -353,6 +382,7 @@ impl<R: Read + Seek> IdeFile<R> {
             a[0] * b.1 * 1.0 + a[2] * 1.0,
             a[0] * b.1 * 0.0 + a[1] * b.1 + a[2] * 0.0 + a[3],
         ];
+        folded(&d)?;
         Ok(Resolved::Bivariate(d, rc, rs))
     }
 

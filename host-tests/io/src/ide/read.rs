@@ -137,9 +137,10 @@ pub fn pick<R: std::io::Read + std::io::Seek>(
     for &i in &chosen {
         for id in file.missing_calibrations(channel, all[i].1) {
             crate::note(&format!(
-                "{}: its calibration {id} is not in the file's calibration list, so its values \
-                 are read uncalibrated (raw, as enDAQ's idelib reads them) though labelled [{}]: \
-                 check their scale against a known level (1 g at rest)",
+                "{}: its calibration {id} is not in the file's calibration list, so that \
+                 polynomial is skipped (as enDAQ's idelib skips it) and its values may be \
+                 uncalibrated though labelled [{}]: check their scale against a known level \
+                 (1 g at rest)",
                 all[i].2, all[i].3
             ));
         }
