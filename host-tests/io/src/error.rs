@@ -584,16 +584,13 @@ pub enum TdmsFault {
     /// The file could not be opened or measured.
     #[error("{}", one_line(.0))]
     Io(#[source] std::io::Error),
-    /// The segments' structure, checked before the library reads it: at byte `byte`.
+    /// The segments' structure, checked before any data is read: at byte `byte`.
     #[error("byte {byte}: {}", one_line(.fault))]
     Structure {
         byte: u64,
         #[source]
         fault: TdmsStructureFault,
     },
-    /// The library's error.
-    #[error("{}", one_line(.0))]
-    Library(#[source] tdms_rs::TdmsError),
     #[error("the file holds no channels")]
     NoChannels,
     #[error("channel {channel} not found again")]
@@ -615,8 +612,30 @@ pub enum TdmsStructureFault {
     MetadataPastEnd { bytes: u64 },
     #[error("a big-endian segment, which this reader does not read")]
     BigEndian,
-    #[error("interleaved channels (ToC bit 5), which this reader does not read: write the channels one after the other (npTDMS's default) or export a CSV")]
-    Interleaved,
+    #[error("interleaved channels (ToC bit 5) of {first} and {other} values a chunk: interleaved channels hold one value each a row; the segment's value counts are wrong")]
+    InterleavedCounts { first: u64, other: u64 },
+    #[error("an interleaved channel of type {0:#x} (strings or no type): interleaved channels must be numbers")]
+    InterleavedType(u32),
+    #[error(
+        "a segment of {bytes} bytes announced, {left} left in the file: the file is cut short"
+    )]
+    SegmentPastEnd { bytes: u64, left: u64 },
+    #[error(
+        "metadata of {raw} bytes, beyond the segment's {next}: a size in its lead-in is wrong"
+    )]
+    MetadataPastSegment { raw: u64, next: u64 },
+    #[error("{data} bytes of raw data, no whole number of its {chunk}-byte chunks (the value counts of its channels): a size in the segment is wrong")]
+    NotWholeChunks { data: u64, chunk: u64 },
+    #[error("{values} values of {bytes} bytes: more than any file holds")]
+    ValuesTooMany { values: u64, bytes: u64 },
+    #[error("an object's raw data index is the previous segment's, which it has none of")]
+    NoPreviousIndex,
+    #[error("an array of dimension {0}; a channel's values have dimension 1")]
+    Dimension(u32),
+    #[error("object path {0:?} is not '/', /'group' or /'group'/'channel'")]
+    ObjectPath(String),
+    #[error("the channel's data type changes from {from:#x} to {to:#x}")]
+    TypeChanges { from: u32, to: u32 },
     #[error("metadata of {bytes} bytes, more than a recording's")]
     MetadataTooLarge { bytes: u64 },
     #[error("DAQmx raw data, which this reader does not read")]
@@ -625,8 +644,6 @@ pub enum TdmsStructureFault {
     RawIndex { bytes: usize },
     #[error("property type {0:#x}")]
     PropertyType(u32),
-    #[error("next segment offset {0}")]
-    NextOffset(u64),
     #[error("next segment offset {0} goes back")]
     NextGoesBack(u64),
 }
@@ -634,13 +651,15 @@ pub enum TdmsStructureFault {
 /// A TDMS channel's faults (`TDMS group/channel: …`).
 #[derive(Debug, thiserror::Error)]
 pub enum TdmsChannelFault {
-    #[error("{values} values announced, more than the file's {file_bytes} bytes hold")]
-    TooManyValues { values: usize, file_bytes: u64 },
-    /// The library's error reading the values.
-    #[error("{}", one_line(.0))]
-    Read(#[source] tdms_rs::TdmsError),
-    #[error("channel type {0:?} is not a number this reads")]
-    DataType(tdms_rs::DataType),
+    /// Reading the values, at byte `byte`.
+    #[error("byte {byte}: {}", one_line(.error))]
+    Read {
+        byte: u64,
+        #[source]
+        error: std::io::Error,
+    },
+    #[error("channel type {0:#x} is not a number this reads (integers of 8 to 64 bits, floats of 32 or 64)")]
+    DataType(u32),
     #[error("value {0} is not finite")]
     NotFinite(usize),
     #[error(transparent)]
