@@ -212,4 +212,18 @@ fn an_input_without_end_stops_at_the_spools_limit() {
         let left: Vec<_> = std::fs::read_dir(&tmp).unwrap().collect();
         assert!(left.is_empty(), "{left:?}");
     }
+    // Read whole (as --axes, --free-fall or --resample read), a device stops at 256 MiB with
+    // its error, never an abort (it read until the memory ran out).
+    let out = std::process::Command::new(env!("CARGO_BIN_EXE_impact"))
+        .args(["analyze", zero.to_str().unwrap(), "--rate", "1000"])
+        .env("IMPACT_READ_WHOLE", "1")
+        .output()
+        .unwrap();
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_refused(
+        out.status.code(),
+        &err,
+        "a FIFO or device read whole holds more than 256 MiB",
+        "read whole",
+    );
 }

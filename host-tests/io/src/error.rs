@@ -711,6 +711,12 @@ pub enum ReadErrorKind {
     },
     /// The spool of the values read (not of the file itself).
     Spool(#[source] SpoolError),
+    /// A FIFO or a device read whole (not in passes) beyond `limit` bytes, or beyond the
+    /// memory there is (`memory`: the allocation failed first).
+    StreamTooLong {
+        limit: u64,
+        memory: bool,
+    },
 
     // CSV text.
     Record(#[source] RecordFault),
@@ -1009,6 +1015,15 @@ impl ReadErrorKind {
                 limit / 1024
             ),
             K::Spool(e) => write!(f, "{e}"),
+            K::StreamTooLong { limit, memory } => write!(
+                f,
+                "a FIFO or device read whole {}: save it to a file first, or read it in passes (without axes, free fall or resampling)",
+                if *memory {
+                    "needs more memory than there is".to_string()
+                } else {
+                    format!("holds more than {} MiB", limit >> 20)
+                }
+            ),
             K::Record(e) => write!(f, "{e}"),
             K::Csv(kind) => write!(f, "{kind:?}"),
             K::DecimalCommaDelimiter => write!(
@@ -1351,6 +1366,10 @@ mod tests {
             K::TooLarge {
                 limit: 1 << 20,
                 what: "scene file",
+            },
+            K::StreamTooLong {
+                limit: 1 << 28,
+                memory: false,
             },
             K::Record(RecordFault::LineTooLong),
             K::DecimalCommaDelimiter,

@@ -47,6 +47,41 @@ impl RawType {
     }
 }
 
+/// Most bytes of a FIFO or a device read whole (`/dev/zero` is endless; read in passes, such an
+/// input is spooled instead, [`crate::spool`]).
+pub const MAX_WHOLE_STREAM_BYTES: u64 = 1 << 28;
+
+/// The bytes of a FIFO or device `path`, at most `limit`: more, or more than the memory
+/// there is, is an error, never an abort.
+pub fn read_stream(path: &Path, limit: u64) -> Result<Vec<u8>, ReadError> {
+    use std::io::Read;
+    let err = |kind: ReadErrorKind| ReadError::new(path, kind);
+    let mut input = std::fs::File::open(path).map_err(|e| err(e.into()))?;
+    let mut bytes: Vec<u8> = Vec::new();
+    let mut block = vec![0u8; crate::sources::CHUNK];
+    loop {
+        let n = match input.read(&mut block) {
+            Ok(0) => return Ok(bytes),
+            Ok(n) => n,
+            Err(e) if e.kind() == std::io::ErrorKind::Interrupted => continue,
+            Err(e) => return Err(err(e.into())),
+        };
+        if (bytes.len() + n) as u64 > limit {
+            return Err(err(ReadErrorKind::StreamTooLong {
+                limit,
+                memory: false,
+            }));
+        }
+        if bytes.try_reserve(n).is_err() {
+            return Err(err(ReadErrorKind::StreamTooLong {
+                limit,
+                memory: true,
+            }));
+        }
+        bytes.extend_from_slice(&block[..n]);
+    }
+}
+
 /// Reads channel `opts.column` (0-based) of `channels` interleaved ones.
 pub fn read_raw(
     path: &Path,
@@ -67,7 +102,11 @@ pub fn read_raw(
     }
     let column =
         numbered_column(opts.column.as_ref(), channels, Numbered::FileChannels).map_err(err)?;
-    let bytes = std::fs::read(path).map_err(|e| err(e.into()))?;
+    let bytes = if crate::error::reads_once(path) {
+        read_stream(path, MAX_WHOLE_STREAM_BYTES)?
+    } else {
+        std::fs::read(path).map_err(|e| err(e.into()))?
+    };
     let frame = kind.bytes() * channels;
     if bytes.len() % frame != 0 {
         return Err(err(ReadErrorKind::RawPartialFrame {
@@ -77,7 +116,13 @@ pub fn read_raw(
             sample_bytes: kind.bytes(),
         }));
     }
-    let mut values = Vec::with_capacity(bytes.len() / frame);
+    let mut values = Vec::new();
+    if values.try_reserve_exact(bytes.len() / frame).is_err() {
+        return Err(err(ReadErrorKind::StreamTooLong {
+            limit: MAX_WHOLE_STREAM_BYTES,
+            memory: true,
+        }));
+    }
     let at = column * kind.bytes();
     kind.decode(&bytes, frame, at, |v| values.push(v))
         .map_err(|(k, value)| {
