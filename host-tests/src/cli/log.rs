@@ -259,20 +259,6 @@ pub fn read_log(path: &std::path::Path) -> Result<crate::firmware_link::log::Log
     reader.finish().map_err(in_log(&name))
 }
 
-/// The decoded log at `path` (`impact watch`'s session file) as `impact log`'s JSON, or CSV,
-/// written to `out`.
-pub fn export(
-    path: &std::path::Path,
-    csv: bool,
-    out: &mut impl Write,
-) -> Result<(), LogCommandError> {
-    let name = path.display().to_string();
-    let log = read_log(path)?;
-    Export::new(&log)?
-        .write(csv, out)
-        .map_err(|source| LogCommandError::Write { name, source })
-}
-
 /// The log read (`impact watch`'s session file), ready to be written as `impact log`'s JSON
 /// or CSV: [`Export::write`] writes it an impact at a time.
 pub struct Export<'a> {

@@ -277,6 +277,11 @@ pub enum WatchError {
     /// The bound listener's own address could not be read.
     #[error(transparent)]
     Address(std::io::Error),
+    /// No random token for a server on a wider address than loopback.
+    #[error(
+        "--listen: no random token for the page (/dev/urandom: {0}); give --listen 127.0.0.1:PORT"
+    )]
+    Token(std::io::Error),
     /// A line could not be kept in the session file.
     #[error("{}: {source}", .path.display())]
     Write {
@@ -340,19 +345,49 @@ pub fn run(args: &WatchArgs) -> Result<(), WatchError> {
         .as_ref()
         .and_then(|l| l.local_addr().ok())
         .is_some_and(|a| a.ip().is_loopback());
-    let hub = Arc::new(Hub::new(session, session_path.clone(), loopback));
+    // A server on a wider address than loopback asks for a token (in the URL it prints).
+    let token = match (&listener, loopback) {
+        (Some(_), false) => Some(server::new_token().map_err(WatchError::Token)?),
+        _ => None,
+    };
+    let hub = Arc::new(Hub::new(
+        session,
+        session_path.clone(),
+        loopback,
+        token.clone(),
+    ));
     let terminal = args.terminal;
     if let Some(l) = listener {
         let addr = l.local_addr().map_err(WatchError::Address)?;
-        crate::errln!(
-            "impact watch: http://{addr}/ (session file {})",
-            session_path.display()
-        );
-        if !loopback {
-            crate::errln!(
-                "impact watch: --listen {addr} is not a loopback address: anyone who can reach \
-                 it sees the session"
-            );
+        match &token {
+            None => crate::errln!(
+                "impact watch: http://{addr}/ (session file {})",
+                session_path.display()
+            ),
+            Some(token) => {
+                // An unspecified address (0.0.0.0) is reached by this machine's name.
+                let host = if addr.ip().is_unspecified() {
+                    server::machine_name().unwrap_or_else(|| "localhost".to_string())
+                } else {
+                    addr.ip().to_string()
+                };
+                let host = if host.contains(':') && !host.contains('[') {
+                    format!("[{host}]")
+                } else {
+                    host
+                };
+                crate::errln!(
+                    "impact watch: http://{host}:{}/?token={token} (session file {})",
+                    addr.port(),
+                    session_path.display()
+                );
+                crate::errln!(
+                    "impact watch: --listen {addr} is not a loopback address: a request must \
+                     carry the token of the URL above (open it once: the page keeps it), and \
+                     name this machine or an address of it; anyone who has the URL sees the \
+                     session (give --listen 127.0.0.1:PORT to serve this machine only)"
+                );
+            }
         }
         let h = hub.clone();
         std::thread::spawn(move || server::serve(l, h));
