@@ -1,6 +1,6 @@
 //! `impact log` on hostile and unusual logs, round three: a long log read in linear time and
 //! bounded memory, a board that restarted within the log (every run's impacts, each with its
-//! run), and field values no stream can hold refused by line and field.
+//! run), and field values no stream can hold passed over, named by line and field.
 
 use std::io::{BufRead, BufReader, Write};
 use std::process::{Command, Stdio};
@@ -165,7 +165,8 @@ fn a_scene_unlike_the_first_is_refused_naming_both_lines() {
     );
 }
 
-/// Times and lengths no stream can hold (`duration_s=1e30`) are refused by line and field:
+/// Times and lengths no stream can hold (`duration_s=1e30`) are passed over, named by line
+/// and field (the rest of the log read):
 /// every time within the stream up to the impact's end and a capture after it, the contact
 /// ending there, a width at most a capture, the deformation within reach of the impact speed.
 #[test]
@@ -215,11 +216,22 @@ fn absurd_times_and_lengths_are_refused_naming_line_and_field() {
             "line 2: max_deformation_m=5: implausible (at most 79.",
         ),
     ] {
-        let text = [SCENE, &impact_line(0, 0, Some((field, value)))].join("\n");
+        // The line is passed over and named; the log's other impacts are read.
+        let text = [
+            SCENE,
+            &impact_line(0, 0, Some((field, value))),
+            &impact_line(1, 1, None),
+        ]
+        .join("\n");
         let log = scratch.text(&format!("{field}-{value}.log"), &text);
-        let (code, _, err) = impact(&["log", &log]);
-        assert_refused(Some(code), &err, want, &format!("{field}={value}"));
+        let (code, out, err) = impact(&["log", &log]);
+        assert_eq!(code, 0, "{field}={value}: {err}");
+        assert!(err.contains(want) && err.contains("(skipped)"), "{err}");
         assert!(err.contains(&format!("{log}: line 2: ")), "{err}");
+        let j = json(&out);
+        assert_eq!(j["impacts"].as_array().unwrap().len(), 1, "{out}");
+        assert_eq!(j["impacts"][0]["index"], 1);
+        assert_eq!(j["skipped_lines"][0]["line"], 2);
     }
     // Without a scene line the rate comes with the first heartbeat: the impacts before it are
     // checked then, by their own lines.
@@ -229,12 +241,25 @@ fn absurd_times_and_lengths_are_refused_naming_line_and_field() {
     ]
     .join("\n");
     let log = scratch.text("no-scene.log", &text);
-    let (code, _, err) = impact(&["log", &log]);
+    let (code, out, err) = impact(&["log", &log]);
+    assert_eq!(code, 0, "{err}");
+    assert!(
+        err.contains("line 1: duration_s=1e30: implausible") && err.contains("(skipped)"),
+        "{err}"
+    );
+    assert_eq!(json(&out)["impacts"].as_array().unwrap().len(), 0);
+    // A scene whose rate no board samples at is passed over: its rate voids no check.
+    let text = [
+        SCENE.replace("rate_hz=500000.0", "rate_hz=1e-38"),
+        impact_line(0, 0, Some(("duration_s", "1e30"))),
+    ]
+    .join("\n");
+    let (code, _, err) = impact(&["log", &scratch.text("tiny-rate.log", &text)]);
     assert_refused(
         Some(code),
         &err,
-        "line 1: duration_s=1e30: implausible",
-        "no scene",
+        "line 1: rate_hz=1e-38: not a sample rate",
+        "rate",
     );
     // The genuine line is read.
     let text = [SCENE, &impact_line(0, 0, None)].join("\n");

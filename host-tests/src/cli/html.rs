@@ -234,6 +234,17 @@ fn provenance(
         for assumed in e.analysis.iter().flat_map(|a| &a.assumptions) {
             dd("assumed", assumed);
         }
+        // A board's log: the lines passed over (the first 20, and how many more).
+        let skipped: Vec<_> = e.analysis.iter().flat_map(|a| &a.skipped_lines).collect();
+        for s in skipped.iter().take(20) {
+            dd(
+                "skipped",
+                &format!("line {}: {} (skipped)", s.line, s.reason),
+            );
+        }
+        if skipped.len() > 20 {
+            dd("skipped", &format!("and {} more lines", skipped.len() - 20));
+        }
     }
     dd(
         "filter",
@@ -499,7 +510,10 @@ pub fn log_report(
         for (k, run) in log.runs.iter().enumerate() {
             let waves = &log.waveforms[run.waveforms.clone()];
             for r in &log.impacts[run.impacts.clone()] {
-                if figures.len() == MAX_FIGURES || !waves.iter().any(|w| w.index == r.index) {
+                let Some(wave) = waves.iter().find(|w| w.index == r.index) else {
+                    continue;
+                };
+                if figures.len() == MAX_FIGURES {
                     continue;
                 }
                 // (The board's windows hold no filter padding: no CFC trace.)
@@ -508,20 +522,22 @@ pub fn log_report(
                     cfc: None,
                     rate_hz: rate,
                     mass_kg: mass.map(f64::from),
-                    accel_m_s2: Box::new(move |i| {
-                        waves
-                            .iter()
-                            .find(|w| w.index == r.index)
-                            .and_then(|w| w.at_sample(i))
-                            .map(|c| f64::from(c) * gain)
-                    }),
+                    accel_m_s2: Box::new(move |i| wave.at_sample(i).map(|c| f64::from(c) * gain)),
                 };
+                let held =
+                    wave.first_sample..wave.first_sample.saturating_add(u64::from(wave.samples));
                 let title = if log.runs.len() > 1 {
                     format!("run {} impact {}", k + 1, r.index)
                 } else {
                     format!("impact {}", r.index)
                 };
-                figures.push(crate::cli::pulse::pulse_svg(&signal, spec, r, title));
+                figures.push(crate::cli::pulse::pulse_svg(
+                    &signal,
+                    spec,
+                    r,
+                    title,
+                    Some(held),
+                ));
             }
         }
     }
@@ -529,7 +545,13 @@ pub fn log_report(
         file: name,
         channel: "the board".into(),
         error: None,
-        notes: log.warnings.clone(),
+        notes: (log.warnings.iter().cloned())
+            .chain(
+                log.skipped
+                    .iter()
+                    .map(crate::firmware_link::log::Skipped::note),
+            )
+            .collect(),
         analysis: Some(analysis),
         figures,
     };

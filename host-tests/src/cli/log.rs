@@ -74,6 +74,15 @@ pub enum LogCommandError {
     /// What the whole log lacks for its report (no rate).
     #[error(transparent)]
     Report(LogError),
+    /// No rate: the lines that state one were passed over (the first named).
+    #[error(
+        "{name}: line {}: {}; no other scene, heartbeat or summary line gives the sample rate",
+        .skipped.line, .skipped.kind
+    )]
+    RateRefused {
+        name: String,
+        skipped: Box<crate::firmware_link::log::Skipped>,
+    },
     /// A value of the scene line the figure or the export needs.
     #[error(transparent)]
     Scene(#[from] FieldError),
@@ -156,7 +165,7 @@ pub fn log(args: &LogArgs) -> Result<Judged, LogCommandError> {
             })?,
         )
     };
-    let mut reader = LogReader::default();
+    let mut reader = LogReader::skipping();
     if let Some(elf) = &args.elf {
         let skipped = crate::firmware_link::decode::decode(elf, input, &name, |n, line| {
             reader
@@ -216,7 +225,7 @@ pub fn for_each_line<E: From<ReadLineError>>(
 }
 
 /// Reads the decoded log `input` (called `name` in errors) line by line into `reader`; a line
-/// longer than [`MAX_LINE_BYTES`] is an error.
+/// longer than [`MAX_LINE_BYTES`] is an error (not a decoded defmt log).
 fn read_text(input: impl Read, name: &str, reader: &mut LogReader) -> Result<(), LogCommandError> {
     for_each_line(input, name, |n, line, cut| {
         if cut {
@@ -237,34 +246,63 @@ fn in_log(name: &str) -> impl Fn(LogError) -> LogCommandError + '_ {
     }
 }
 
-/// The decoded log at `path` (`impact watch`'s session file), read and checked.
+/// The decoded log at `path` (`impact watch`'s session file), read and checked as `impact
+/// log` reads it (a bad line passed over and named: [`Log::skipped`](crate::firmware_link::log::Log)).
 pub fn read_log(path: &std::path::Path) -> Result<crate::firmware_link::log::Log, LogCommandError> {
     let name = path.display().to_string();
     let file = std::fs::File::open(path).map_err(|source| LogCommandError::Open {
         name: name.clone(),
         source,
     })?;
-    let mut reader = LogReader::default();
+    let mut reader = LogReader::skipping();
     read_text(file, &name, &mut reader)?;
     reader.finish().map_err(in_log(&name))
 }
 
-/// The decoded log at `path` (`impact watch`'s session file) as `impact log`'s JSON, or CSV,
-/// written to `out`.
-pub fn export(
-    path: &std::path::Path,
-    csv: bool,
-    out: &mut impl Write,
-) -> Result<(), LogCommandError> {
-    let name = path.display().to_string();
-    let log = read_log(path)?;
-    let json = LogJson::new(&log, 0.0).map_err(LogCommandError::Report)?;
-    if csv {
-        crate::report::csv::write_csv(&json.head, json.impacts(), out)
-    } else {
-        crate::report::write_json(&json.head, json.impacts(), out)
+/// The log read (`impact watch`'s session file), ready to be written as `impact log`'s JSON
+/// or CSV: [`Export::write`] writes it an impact at a time.
+pub struct Export<'a> {
+    json: LogJson<'a>,
+}
+
+impl<'a> Export<'a> {
+    pub fn new(log: &'a crate::firmware_link::log::Log) -> Result<Self, LogCommandError> {
+        let name = "the session file";
+        Ok(Self {
+            json: LogJson::new(log, 0.0).map_err(|e| no_rate(e, log, name))?,
+        })
     }
-    .map_err(|source| LogCommandError::Write { name, source })
+
+    /// Writes the JSON, or the CSV, to `out`, an impact at a time (never held whole).
+    pub fn write(&self, csv: bool, out: &mut impl Write) -> std::io::Result<()> {
+        let json = &self.json;
+        if csv {
+            crate::report::csv::write_csv(&json.head, json.impacts(), out)
+        } else {
+            crate::report::write_json(&json.head, json.impacts(), out)
+        }
+    }
+}
+
+/// A log's report that could not be made: without a rate because the lines that gave one
+/// were passed over, the first of them named.
+fn no_rate(e: LogError, log: &crate::firmware_link::log::Log, name: &str) -> LogCommandError {
+    use crate::firmware_link::line::LineKind;
+    let gave_rate = |s: &&crate::firmware_link::log::Skipped| {
+        matches!(
+            s.of,
+            Some(LineKind::Scene | LineKind::Heartbeat | LineKind::Summary)
+        )
+    };
+    match (&e.kind, log.skipped.iter().find(gave_rate)) {
+        (crate::firmware_link::log::LogErrorKind::NoRate, Some(s)) => {
+            LogCommandError::RateRefused {
+                name: name.to_string(),
+                skipped: Box::new(s.clone()),
+            }
+        }
+        _ => LogCommandError::Report(e),
+    }
 }
 
 /// The log read: its warnings on stderr, the figure and exports asked for, the JSON or CSV.
@@ -280,10 +318,13 @@ fn report(args: &LogArgs, reader: LogReader, name: &str) -> Result<Judged, LogCo
             restart: second.line,
         });
     }
+    let json = LogJson::new(&log, args.t0).map_err(|e| no_rate(e, &log, name))?;
     for w in &log.warnings {
         crate::errln!("warning: {name}: {w}");
     }
-    let json = LogJson::new(&log, args.t0).map_err(LogCommandError::Report)?;
+    for s in &log.skipped {
+        crate::errln!("warning: {name}: {s}");
+    }
     if args.plot.is_some() || args.export.is_some() {
         let scene = log.scene.as_ref().ok_or(LogCommandError::NoScene)?;
         let rate = f64::from(scene.rate_hz);

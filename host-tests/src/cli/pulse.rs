@@ -322,12 +322,15 @@ const COLUMNS: u64 = 400;
 
 /// Impact `r` of the recording `signal` reads drawn (`spec`: the scene's): above its baseline, in the direction of its peak;
 /// with a verdict, over the window it watched with the nominal pulse and band where it was
-/// placed, else from a quarter of its duration before it to a quarter after.
+/// placed, else from a quarter of its duration before it to a quarter after. `held`: the
+/// samples the signal holds, when it is a board's window (no other sample is read: what a
+/// figure loops over is bounded by what the log holds, whatever the report's times say).
 pub fn pulse_svg(
     signal: &crate::plot::Signal,
     spec: Option<&Spec>,
     r: &impact_core::ImpactReport,
     title: String,
+    held: Option<std::ops::Range<u64>>,
 ) -> Html {
     let rate = signal.rate_hz;
     let (from_s, to_s, placed) = window(spec, r);
@@ -347,7 +350,11 @@ pub fn pulse_svg(
         (0..cols)
             .filter_map(|c| {
                 let (from, to) = (i0 + c * n / cols, i0 + (c + 1) * n / cols);
-                let (lo, hi) = (from..to.max(from + 1))
+                let mut samples = from..to.max(from + 1);
+                if let Some(h) = &held {
+                    samples = samples.start.max(h.start)..samples.end.min(h.end);
+                }
+                let (lo, hi) = samples
                     .filter_map(a)
                     .map(|v| sign * v)
                     .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), v| {

@@ -334,6 +334,7 @@ fn analyze_one(args: &AnalyzeArgs, entry: &Entry, draw: bool) -> EntryJson {
                             setup.scene.spec.as_ref(),
                             r,
                             title(r, &channel),
+                            None,
                         )
                     })
                     // A recording read in passes holds only the first impacts' windows.

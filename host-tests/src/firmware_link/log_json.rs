@@ -98,6 +98,12 @@ impl<'a> LogJson<'a> {
             clipping: None,
             impacts: Vec::new(),
             drifts: Vec::new(),
+            skipped_lines: (log.skipped.iter())
+                .map(|s| crate::report::SkippedLineJson {
+                    line: s.line,
+                    reason: s.reason(),
+                })
+                .collect(),
         };
         let mut json = Self {
             head: a,

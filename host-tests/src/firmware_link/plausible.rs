@@ -21,6 +21,18 @@ pub enum Implausible {
     /// A capture's step is a power of two up to the coarsest the core decimates to.
     #[error("decimation={value}: not a power of two from 1 to {max}")]
     Decimation { value: u32, max: u32 },
+    /// An impact longer, in samples, than the scene lets the core follow one.
+    #[error(
+        "end_sample={end}: {} samples after start_sample={start}, and the scene's \
+         max_impact_s={max_impact_s} ends an impact after {limit} (a cut or garbled line)",
+        .end - .start
+    )]
+    Span {
+        start: u64,
+        end: u64,
+        max_impact_s: f64,
+        limit: u64,
+    },
     /// Beyond what the impact's stream allows (`limit`: s, or m for a `_m` field).
     #[error(
         "{field}={}: implausible (at most {}: {why})",
@@ -179,9 +191,25 @@ pub(crate) fn check_report(r: &ImpactReport) -> Result<(), Implausible> {
 /// whole range): with the scene's gain, the largest acceleration in a report.
 const MAX_DEVIATION_COUNTS: f64 = 65_535.0;
 
+/// What a run's lines tell an impact's values are checked against: its rate (the scene's,
+/// else a heartbeat's or the summary's), and the scene's gain and longest impact when a scene
+/// line came.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Bounds {
+    pub rate_hz: f64,
+    /// The scene's m/s² per count.
+    pub gain: Option<f64>,
+    /// The scene's `max_impact_s`: the core ends an impact that long (`too-long`).
+    pub max_impact_s: Option<f64>,
+}
+
 /// An impact's times and lengths within what its stream allows, at `rate_hz` samples per
 /// second (`gain`: the scene's m/s² per count, if the log has a scene line). All follow from
 /// the report's own sample positions:
+///
+/// * with the scene's `max_impact_s`, the impact spans (`end_sample - start_sample`) at most
+///   that long at the rate, and a capture more (the core ends an impact there; the slack
+///   covers a gap inside it): so no reader loops over more samples than a stream holds;
 ///
 /// * every time and duration (`start_s`, `peak_time_s`, `duration_s`, `crush_time_s`,
 ///   `fwhm_s`, `filtered_fwhm_s`, `flight_s`), s, lies in the stream up to the impact's end
@@ -197,11 +225,28 @@ const MAX_DEVIATION_COUNTS: f64 = 65_535.0;
 ///
 /// Fit parameters are not bounded (a poor fit may give any finite value). A slack of a sample
 /// and 1e-6 relative covers the f32 fields' rounding.
-pub(crate) fn check_plausible(
-    r: &ImpactReport,
-    rate_hz: f64,
-    gain: Option<f64>,
-) -> Result<(), Implausible> {
+pub(crate) fn check_plausible(r: &ImpactReport, bounds: &Bounds) -> Result<(), Implausible> {
+    let Bounds {
+        rate_hz,
+        gain,
+        max_impact_s,
+    } = *bounds;
+    if let Some(max_impact_s) = max_impact_s {
+        let limit = (max_impact_s * rate_hz).ceil() + CAPTURE_LEN as f64;
+        let limit = if limit < u64::MAX as f64 {
+            limit as u64
+        } else {
+            u64::MAX
+        };
+        if r.end_sample.saturating_sub(r.start_sample) > limit {
+            return Err(Implausible::Span {
+                start: r.start_sample,
+                end: r.end_sample,
+                max_impact_s,
+                limit,
+            });
+        }
+    }
     let sample = 1.0 / rate_hz;
     let max = 1u32 << impact_core::capture::MAX_DECIMATION_LOG2;
     if !r.decimation.is_power_of_two() || r.decimation > max {

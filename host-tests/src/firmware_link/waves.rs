@@ -111,6 +111,15 @@ impl Waveform {
         self.value((offset / u64::from(self.every)) as usize)
     }
 
+    /// The values received, each with its number (0-based, one per `every` samples), in
+    /// order: what arrived, whatever the `wave` line declared.
+    pub fn received(&self) -> impl Iterator<Item = (usize, i16)> + '_ {
+        self.received.iter().flat_map(|(&frame, counts)| {
+            let first = frame as usize * FRAME_LEN;
+            counts.iter().enumerate().map(move |(j, &c)| (first + j, c))
+        })
+    }
+
     /// Every value, if no frame is missing.
     pub fn complete(&self) -> Option<Vec<i16>> {
         (0..self.values()).map(|k| self.value(k)).collect()
@@ -200,15 +209,13 @@ pub fn export(
         let every = u64::from(w.every);
         if ext == "csv" {
             let mut text = String::from("time_s,accel_m_s2\n");
-            for k in 0..w.values() {
-                if let Some(c) = w.value(k) {
-                    let sample = w.first_sample + k as u64 * every;
-                    text.push_str(&format!(
-                        "{:.9},{:e}\n",
-                        sample as f64 / rate_hz,
-                        f64::from(c) * gain_m_s2_per_count
-                    ));
-                }
+            for (k, c) in w.received() {
+                let sample = w.first_sample.saturating_add(k as u64 * every);
+                text.push_str(&format!(
+                    "{:.9},{:e}\n",
+                    sample as f64 / rate_hz,
+                    f64::from(c) * gain_m_s2_per_count
+                ));
             }
             crate::output::write(&out, text.as_bytes())?;
         } else {

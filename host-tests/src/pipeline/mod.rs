@@ -1148,6 +1148,7 @@ pub fn to_json(setup: &Setup, reports: &[ImpactReport]) -> AnalysisJson {
             })
             .collect(),
         drifts: Vec::new(),
+        skipped_lines: Vec::new(),
     };
     crate::report::separate_drifts(&mut a);
     a.trains = crate::report::train::trains(&a.impacts);

@@ -189,6 +189,17 @@ pub struct AnalysisJson {
     /// `impact log` / `impact emulate --waveforms`: the captured windows the board sent.
     #[serde(skip_serializing_if = "Vec::is_empty")]
     pub waveforms: Vec<crate::report::waveform::WaveformJson>,
+    /// `impact log` (and `impact watch`'s exports): the log's lines passed over, each its
+    /// number and why (a line cut by the link, a value no board gives); absent when none.
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub skipped_lines: Vec<SkippedLineJson>,
+}
+
+/// A log's line passed over: its number (from 1) and why.
+#[derive(Clone, Debug, Serialize, PartialEq)]
+pub struct SkippedLineJson {
+    pub line: u64,
+    pub reason: String,
 }
 
 impl AnalysisJson {

@@ -69,29 +69,183 @@ fn default_session() -> PathBuf {
     ))
 }
 
-/// A file read as it grows: at its end, waits for more (a file cut shorter, a log started
-/// again, is read from its start).
+/// How much of a followed file's start is kept to tell a rewrite, bytes (and of the bytes
+/// just read, [`TAIL`]).
+const HEAD: usize = 4096;
+const TAIL: usize = 256;
+
+/// How a followed file was replaced.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum Replaced {
+    /// Another file at its path (another device and inode: a rotation, an atomic writer's
+    /// rename).
+    Rotated,
+    /// The same file, shorter than what was read, or its first bytes (or the last ones
+    /// read) changed.
+    Rewritten,
+}
+
+impl Replaced {
+    fn says(self, name: &str) -> String {
+        match self {
+            Replaced::Rotated => format!(
+                "{name} was replaced by another file (rotated, or written anew and renamed)"
+            ),
+            Replaced::Rewritten => {
+                format!("{name} was rewritten in place (it shrank, or bytes already read changed)")
+            }
+        }
+    }
+}
+
+/// A file read as it grows: at its end, waits for more. The file is told by its (device,
+/// inode), its size and its first bytes: at its end, every 50 ms, another file at the path
+/// (a rotation) or the same one shorter or with other first bytes (a rewrite) ends the reading
+/// of this one (`read` gives 0 until [`Follow::replaced`] is taken), and the reading starts
+/// again from the new file's first byte. Checked before every read (a stat and two reads of
+/// at most 4 KiB each, per 64 KiB read or 50 ms waited), so a replacement is not read as the
+/// old file's continuation. (A rewrite that leaves the
+/// first 4 KiB and the last 256 bytes read as they were, and grows, is not seen.)
 struct Follow {
+    path: PathBuf,
     file: std::fs::File,
     at: u64,
     follow: bool,
+    /// (device, inode) of the file read.
+    id: (u64, u64),
+    /// Its first bytes as read (up to [`HEAD`]) and the last read (up to [`TAIL`]).
+    head: Vec<u8>,
+    tail: Vec<u8>,
+    /// Why the file read was left for another, until the reading is started again.
+    replaced: Option<Replaced>,
+}
+
+fn file_id(m: &std::fs::Metadata) -> (u64, u64) {
+    use std::os::unix::fs::MetadataExt;
+    (m.dev(), m.ino())
+}
+
+impl Follow {
+    fn open(path: &std::path::Path, follow: bool) -> std::io::Result<Self> {
+        let file = std::fs::File::open(path)?;
+        let id = file_id(&file.metadata()?);
+        Ok(Self {
+            path: path.to_path_buf(),
+            file,
+            at: 0,
+            follow,
+            id,
+            head: Vec::new(),
+            tail: Vec::new(),
+            replaced: None,
+        })
+    }
+
+    /// Keeps what `bytes` (just read) add to the head and the tail.
+    fn note(&mut self, bytes: &[u8]) {
+        let room = HEAD.saturating_sub(self.head.len());
+        self.head.extend_from_slice(&bytes[..room.min(bytes.len())]);
+        self.tail
+            .extend_from_slice(&bytes[bytes.len().saturating_sub(TAIL)..]);
+        let extra = self.tail.len().saturating_sub(TAIL);
+        self.tail.drain(..extra);
+        self.at += bytes.len() as u64;
+    }
+
+    /// Whether the file was replaced since it was last read.
+    fn changed(&self) -> std::io::Result<Option<Replaced>> {
+        use std::os::unix::fs::FileExt;
+        // (A path missing for a moment, between a rotation's two renames, is no change yet.)
+        if let Ok(m) = std::fs::metadata(&self.path) {
+            if file_id(&m) != self.id {
+                return Ok(Some(Replaced::Rotated));
+            }
+        }
+        if self.file.metadata()?.len() < self.at {
+            return Ok(Some(Replaced::Rewritten));
+        }
+        let same = |bytes: &[u8], at: u64| -> std::io::Result<bool> {
+            let mut now = vec![0; bytes.len()];
+            match self.file.read_exact_at(&mut now, at) {
+                Ok(()) => Ok(now == bytes),
+                Err(e) if e.kind() == std::io::ErrorKind::UnexpectedEof => Ok(false),
+                Err(e) => Err(e),
+            }
+        };
+        let tail_at = self.at - self.tail.len() as u64;
+        if !same(&self.head, 0)? || !same(&self.tail, tail_at)? {
+            return Ok(Some(Replaced::Rewritten));
+        }
+        Ok(None)
+    }
+
+    /// Starts reading the file at the path again from its first byte.
+    fn restart(&mut self, why: Replaced) -> std::io::Result<()> {
+        use std::io::Seek;
+        if why == Replaced::Rotated {
+            let file = std::fs::File::open(&self.path)?;
+            self.id = file_id(&file.metadata()?);
+            self.file = file;
+        } else {
+            self.file.seek(std::io::SeekFrom::Start(0))?;
+        }
+        (self.at, self.replaced) = (0, Some(why));
+        self.head.clear();
+        self.tail.clear();
+        Ok(())
+    }
 }
 
 impl Read for Follow {
     fn read(&mut self, buf: &mut [u8]) -> std::io::Result<usize> {
+        if self.replaced.is_some() {
+            return Ok(0);
+        }
         loop {
+            // Checked before every read: bytes of a replacement are never read on from the
+            // old file's end.
+            match self.changed()? {
+                Some(Replaced::Rotated) if self.follow => {
+                    // What the old file got before it was replaced is read first.
+                    let n = self.file.read(buf)?;
+                    if n > 0 {
+                        self.note(&buf[..n]);
+                        return Ok(n);
+                    }
+                    self.restart(Replaced::Rotated)?;
+                    return Ok(0);
+                }
+                Some(Replaced::Rewritten) if self.follow => {
+                    self.restart(Replaced::Rewritten)?;
+                    return Ok(0);
+                }
+                _ => {}
+            }
             let n = self.file.read(buf)?;
             if n > 0 || !self.follow {
-                self.at += n as u64;
+                self.note(&buf[..n]);
                 return Ok(n);
             }
             std::thread::sleep(Duration::from_millis(50));
-            if self.file.metadata()?.len() < self.at {
-                use std::io::Seek;
-                self.at = self.file.seek(std::io::SeekFrom::Start(0))?;
-            }
         }
     }
+}
+
+/// The input: standard input, or a file followed (shared with the reading loop, which asks
+/// it whether the file was replaced when the reading ends).
+struct Input(Option<Arc<std::sync::Mutex<Follow>>>);
+
+impl Read for Input {
+    fn read(&mut self, buf: &mut [u8]) -> std::io::Result<usize> {
+        match &self.0 {
+            Some(f) => lock(f).read(buf),
+            None => std::io::stdin().read(buf),
+        }
+    }
+}
+
+fn lock<T>(m: &std::sync::Mutex<T>) -> std::sync::MutexGuard<'_, T> {
+    m.lock().unwrap_or_else(std::sync::PoisonError::into_inner)
 }
 
 /// Why `impact watch` could not start, or stopped.
@@ -123,6 +277,11 @@ pub enum WatchError {
     /// The bound listener's own address could not be read.
     #[error(transparent)]
     Address(std::io::Error),
+    /// No random token for a server on a wider address than loopback.
+    #[error(
+        "--listen: no random token for the page (/dev/urandom: {0}); give --listen 127.0.0.1:PORT"
+    )]
+    Token(std::io::Error),
     /// A line could not be kept in the session file.
     #[error("{}: {source}", .path.display())]
     Write {
@@ -152,19 +311,16 @@ pub fn run(args: &WatchArgs) -> Result<(), WatchError> {
         .with_some(args.elf.as_deref())
         .with_some(parsed.and_then(|a| a.band_file));
     crate::output::check("--session", &session_path, &inputs, None)?;
-    let source: Box<dyn Read + Send> = if stdin {
-        Box::new(std::io::stdin())
+    let follow = if stdin {
+        None
     } else {
-        let file = std::fs::File::open(&input).map_err(|source| WatchError::Open {
+        let f = Follow::open(&input, !args.once).map_err(|source| WatchError::Open {
             name: name.clone(),
             source,
         })?;
-        Box::new(Follow {
-            file,
-            at: 0,
-            follow: !args.once,
-        })
+        Some(Arc::new(std::sync::Mutex::new(f)))
     };
+    let mut source = Input(follow.clone());
     // Bound before the session file is made: a port in use is said at once.
     let listener = if args.terminal {
         None
@@ -183,25 +339,55 @@ pub fn run(args: &WatchArgs) -> Result<(), WatchError> {
             path: session_path.clone(),
             source,
         })?;
-    let mut log = std::io::BufWriter::new(file);
+    let log = std::cell::RefCell::new(std::io::BufWriter::new(file));
     let session = Session::new(&name, &session_path.display().to_string(), spec);
     let loopback = listener
         .as_ref()
         .and_then(|l| l.local_addr().ok())
         .is_some_and(|a| a.ip().is_loopback());
-    let hub = Arc::new(Hub::new(session, session_path.clone(), loopback));
+    // A server on a wider address than loopback asks for a token (in the URL it prints).
+    let token = match (&listener, loopback) {
+        (Some(_), false) => Some(server::new_token().map_err(WatchError::Token)?),
+        _ => None,
+    };
+    let hub = Arc::new(Hub::new(
+        session,
+        session_path.clone(),
+        loopback,
+        token.clone(),
+    ));
     let terminal = args.terminal;
     if let Some(l) = listener {
         let addr = l.local_addr().map_err(WatchError::Address)?;
-        crate::errln!(
-            "impact watch: http://{addr}/ (session file {})",
-            session_path.display()
-        );
-        if !loopback {
-            crate::errln!(
-                "impact watch: --listen {addr} is not a loopback address: anyone who can reach \
-                 it sees the session"
-            );
+        match &token {
+            None => crate::errln!(
+                "impact watch: http://{addr}/ (session file {})",
+                session_path.display()
+            ),
+            Some(token) => {
+                // An unspecified address (0.0.0.0) is reached by this machine's name.
+                let host = if addr.ip().is_unspecified() {
+                    server::machine_name().unwrap_or_else(|| "localhost".to_string())
+                } else {
+                    addr.ip().to_string()
+                };
+                let host = if host.contains(':') && !host.contains('[') {
+                    format!("[{host}]")
+                } else {
+                    host
+                };
+                crate::errln!(
+                    "impact watch: http://{host}:{}/?token={token} (session file {})",
+                    addr.port(),
+                    session_path.display()
+                );
+                crate::errln!(
+                    "impact watch: --listen {addr} is not a loopback address: a request must \
+                     carry the token of the URL above (open it once: the page keeps it), and \
+                     name this machine or an address of it; anyone who has the URL sees the \
+                     session (give --listen 127.0.0.1:PORT to serve this machine only)"
+                );
+            }
         }
         let h = hub.clone();
         std::thread::spawn(move || server::serve(l, h));
@@ -239,34 +425,53 @@ pub fn run(args: &WatchArgs) -> Result<(), WatchError> {
             }
         });
     }
-    let mut on_line = |n: u64, line: &str| -> Result<(), WatchError> {
+    // The session file: every line as it came.
+    let keep = |line: &str| -> Result<(), WatchError> {
+        let mut log = log.borrow_mut();
         writeln!(log, "{line}")
             .and_then(|()| log.flush())
             .map_err(|source| WatchError::Write {
                 path: session_path.clone(),
                 source,
-            })?;
+            })
+    };
+    let mut on_line = |n: u64, line: &str| -> Result<(), WatchError> {
+        keep(line)?;
         let events = hub.with(|s| s.line(n, line, now_ms()));
         if terminal {
             terminal::print(&events);
         }
         Ok(())
     };
-    match &args.elf {
-        Some(elf) => {
-            let skipped = crate::firmware_link::decode::decode(elf, source, &name, &mut on_line)?;
-            if skipped > 0 {
-                crate::errln!("warning: {name}: {skipped} malformed defmt frames skipped");
+    loop {
+        match &args.elf {
+            Some(elf) => {
+                let skipped =
+                    crate::firmware_link::decode::decode(elf, &mut source, &name, &mut on_line)?;
+                if skipped > 0 {
+                    crate::errln!("warning: {name}: {skipped} malformed defmt frames skipped");
+                }
             }
+            None => crate::cli::log::for_each_line(&mut source, &name, |n, line, cut| {
+                if cut {
+                    crate::errln!(
+                        "warning: {name}:{n}: a line longer than {MAX_LINE_BYTES} bytes, cut"
+                    );
+                }
+                on_line(n, line)
+            })?,
         }
-        None => crate::cli::log::for_each_line(source, &name, |n, line, cut| {
-            if cut {
-                crate::errln!(
-                    "warning: {name}:{n}: a line longer than {MAX_LINE_BYTES} bytes, cut"
-                );
-            }
-            on_line(n, line)
-        })?,
+        // A file replaced: a new run from the new file's first line (said in the session
+        // file too, as a line no reader takes for the board's).
+        let Some(why) = follow.as_ref().and_then(|f| lock(f).replaced.take()) else {
+            break;
+        };
+        let text = why.says(&name);
+        keep(&format!("impact watch: {text}; a new run from here"))?;
+        let events = hub.with(|s| s.input_replaced(&text, now_ms()));
+        if terminal {
+            terminal::print(&events);
+        }
     }
     let events = hub.with(|s| s.input_ended(now_ms()));
     if terminal {

@@ -13,6 +13,8 @@ use crate::firmware_link::line::{
     self, Counter, FieldError, Fields, ImpactLine, LineError, LineKind, SpecLine, SrsLine, State,
     WaveFrameLine, WaveLine,
 };
+use crate::firmware_link::log;
+use crate::firmware_link::plausible::Bounds;
 use crate::firmware_link::waves::{WaveError, Waveform};
 use crate::report::statistics::Running;
 
@@ -26,9 +28,6 @@ pub const RUNS: usize = 100;
 /// follow it at once from the board's reporter; the wait covers a file followed in 50 ms
 /// polls and a link's hiccups).
 pub const HOLD_MS: u64 = 300;
-/// The most values a window (`wave` line) read holds: a capture (15 104 values, each one
-/// sample or, decimated, the mean of several) with room to spare.
-const MAX_WAVE_VALUES: usize = 1 << 16;
 /// The longest text kept of a line's error or a scene's value, bytes.
 const MAX_TEXT: usize = 200;
 /// A board is silent when its last heartbeat (one a second) is older than this, ms: within
@@ -80,6 +79,10 @@ pub struct Session {
     started: bool,
     rate_hz: Option<f64>,
     gain: Option<f64>,
+    /// The scene's longest impact, s, and the run's rate from a heartbeat or summary (before
+    /// a scene line, or without one): what an impact is checked against.
+    max_impact_s: Option<f64>,
+    state_rate_hz: Option<f64>,
     /// Gravity in the contacts, m/s² (the scene line's; none: horizontal).
     contact_gravity_m_s2: Option<f32>,
     /// The window being received (only the newest is kept).
@@ -129,6 +132,8 @@ impl Session {
             started: false,
             rate_hz: None,
             gain: None,
+            max_impact_s: None,
+            state_rate_hz: None,
             contact_gravity_m_s2: None,
             wave: None,
             pending: None,
@@ -249,12 +254,25 @@ impl Session {
         Ok(())
     }
 
-    /// An `impact` line: it waits for its `srs` and `spec` lines.
+    /// What an impact is checked against: the run's rate (the scene's, else a heartbeat's),
+    /// the scene's gain and longest impact; `None` before any rate came.
+    fn bounds(&self) -> Option<Bounds> {
+        Some(Bounds {
+            rate_hz: self.rate_hz.or(self.state_rate_hz)?,
+            gain: self.gain,
+            max_impact_s: self.max_impact_s,
+        })
+    }
+
+    /// An `impact` line: it waits for its `srs` and `spec` lines. Only an impact `impact log`
+    /// takes ([`log::accept`]) is shown and enters the statistics.
     fn read_impact(&mut self, f: &Fields, now_ms: u64) -> Result<(), SessionError> {
+        let line = ImpactLine::parse(f)?;
+        log::accept(&line, self.bounds().as_ref())?;
         let ImpactLine {
             report,
             report_latency_s: latency_s,
-        } = ImpactLine::parse(f)?;
+        } = line;
         let wave = self.wave.take().filter(|w| w.index == report.index);
         self.started = true;
         self.pending = Some(Pending {
@@ -269,14 +287,8 @@ impl Session {
     /// A `wave` line: the window received next (only the newest is kept).
     fn read_wave(&mut self, f: &Fields) -> Result<(), SessionError> {
         self.started = true;
-        let w = Waveform::new(WaveLine::parse(f)?);
-        if w.values() > MAX_WAVE_VALUES {
-            return Err(SessionError::WaveTooLong {
-                samples: w.samples,
-                every: w.every,
-            });
-        }
-        self.wave = Some(w);
+        // (A line declaring more values than a window holds is refused as it is parsed.)
+        self.wave = Some(Waveform::new(WaveLine::parse(f)?));
         Ok(())
     }
 
@@ -288,7 +300,11 @@ impl Session {
     ) -> Result<(), SessionError> {
         self.started = true;
         self.last_heartbeat_ms = Some(now_ms);
-        let h = self.health(&State::new(f), now_ms)?;
+        let state = State::new(f);
+        let h = self.health(&state, now_ms)?;
+        if self.state_rate_hz.is_none() {
+            self.state_rate_hz = Some(f64::from(state.rate_hz()?));
+        }
         self.health = Some(h.clone());
         events.push(tagged("health", h));
         Ok(())
@@ -324,10 +340,13 @@ impl Session {
             self.run += 1;
             self.wave = None;
             self.ended = None;
+            self.state_rate_hz = None;
         }
         self.started = true;
         self.rate_hz = Some(rate_hz);
         self.gain = (f.readable::<f64>("gain_m_s2_per_count")).filter(|g| g.is_finite());
+        self.max_impact_s =
+            (f.readable::<f64>("max_impact_s")).filter(|x| x.is_finite() && *x > 0.0);
         // Gravity in the contacts (`none`: horizontal), for a bounce's COR.
         self.contact_gravity_m_s2 =
             (f.readable::<f32>("gravity_m_s2")).filter(|g| g.is_finite() && *g > 0.0);
@@ -345,9 +364,12 @@ impl Session {
             })
             .collect();
         self.board_spec(&f, events);
-        let run = json!({"run": self.run, "received_unix_ms": now_ms, "scene": scene});
+        let mut run = json!({"run": self.run, "received_unix_ms": now_ms, "scene": scene});
         if self.runs.back().is_some_and(|r| r["run"] == self.run) {
-            self.runs.pop_back();
+            // (A run the input's replacement began keeps saying so.)
+            if let Some(r) = self.runs.pop_back().filter(|r| !r["replaced"].is_null()) {
+                run["replaced"] = r["replaced"].clone();
+            }
         }
         push_bounded(&mut self.runs, run.clone(), RUNS);
         events.push(tagged("run", run));
@@ -629,6 +651,32 @@ impl Session {
         })
     }
 
+    /// The followed file was replaced (`why` says how: a new file at its path, or rewritten
+    /// in place): what follows is a new run, read from the new file's first line, never mixed
+    /// with the old one's (the waiting impact shown first). Said in a `warning` and in the
+    /// run's `replaced` (the terminal's line, the page's notice).
+    pub fn input_replaced(&mut self, why: &str, now_ms: u64) -> Vec<Value> {
+        let mut events = Vec::new();
+        self.show(&mut events);
+        self.run += 1;
+        self.started = false;
+        self.wave = None;
+        self.ended = None;
+        (
+            self.rate_hz,
+            self.gain,
+            self.max_impact_s,
+            self.state_rate_hz,
+        ) = (None, None, None, None);
+        self.contact_gravity_m_s2 = None;
+        let text = format!("{why}: run {} from its first line", self.run);
+        let run =
+            json!({"run": self.run, "received_unix_ms": now_ms, "scene": {}, "replaced": text});
+        push_bounded(&mut self.runs, run.clone(), RUNS);
+        events.push(tagged("run", run));
+        events
+    }
+
     /// The input ended (a closed pipe, the end of a file not followed): an `end` event
     /// unless the board's summary said so already.
     pub fn input_ended(&mut self, now_ms: u64) -> Vec<Value> {
@@ -671,10 +719,9 @@ pub enum SessionError {
          on the page; the session file has it (impact log reads it)"
     )]
     Late { kind: LineKind, index: u32 },
-    #[error(
-        "samples={samples} every={every}: a window of the board holds at most {MAX_WAVE_VALUES} values"
-    )]
-    WaveTooLong { samples: u32, every: u16 },
+    /// An impact `impact log` refuses (a value its stream cannot hold).
+    #[error(transparent)]
+    Refused(#[from] log::LogErrorKind),
 }
 
 /// `text`, at most [`MAX_TEXT`] bytes of it (cut at a character's boundary, marked).

@@ -22,6 +22,9 @@ pub fn print(events: &[Value]) {
         let line = match e["type"].as_str() {
             Some("impact") => Some(impact(e)),
             Some("health") => health(e),
+            Some("run") if e["replaced"].is_string() => {
+                Some(format!("── {} ──", e["replaced"].as_str().unwrap_or("")))
+            }
             Some("run") if e["run"].as_u64() > Some(1) => {
                 Some(format!("── the board restarted: run {} ──", e["run"]))
             }

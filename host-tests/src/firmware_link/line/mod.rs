@@ -21,7 +21,7 @@ pub use impact::ImpactLine;
 pub use scene::{spec_of, SceneDifference, SceneLine};
 pub use spectrum::{SpecLine, SrsLine};
 pub use state::{Counter, HeartbeatLine, State, SummaryLine};
-pub use wave::{WaveFrameLine, WaveLine};
+pub use wave::{WaveFrameLine, WaveLine, MAX_WAVE_VALUES};
 
 use crate::firmware_link::plausible::Implausible;
 
@@ -124,8 +124,12 @@ pub enum LineError {
     /// A report's number beyond what the firmware can report.
     #[error(transparent)]
     Implausible(#[from] Implausible),
-    /// A `rate_hz` that is not > 0.
-    #[error("rate_hz={value}: not a finite rate > 0")]
+    /// A `rate_hz` no board samples at (outside [`RATE_HZ`]).
+    #[error(
+        "rate_hz={}: not a sample rate from {} Hz to {:e} Hz (the core's highest): no board \
+         samples at it, and no time can be checked against it",
+        shown(*.value), RATE_HZ.start(), RATE_HZ.end()
+    )]
     Rate { value: f32 },
     /// An impact's `status` that is none of the core's.
     #[error("status={text}: unknown status")]
@@ -157,15 +161,42 @@ pub enum LineError {
         every: u16,
         expected: usize,
     },
+    /// A `wave` line declaring more values than a window of the board holds.
+    #[error(
+        "samples={samples} every={every}: {values} values, and a window of the board holds at \
+         most {max} (a capture, with room to spare): not the board's line"
+    )]
+    WaveTooLong {
+        samples: u32,
+        every: u16,
+        values: usize,
+        max: usize,
+    },
     /// A value of a `wave_frame` line's counts that is not an i16.
     #[error("counts: {text} is not an i16")]
     Count { text: String },
 }
 
-/// A line's `rate_hz`: finite and > 0.
+/// The sample rates a line may state, Hz: from 1 Hz (a board's heartbeat counts seconds of
+/// signal, and at a lower rate one capture of the board spans over four hours) to the core's
+/// highest, [`impact_core::scene::MAX_RATE_HZ`] (100 MHz: a scene beyond it is refused by the
+/// core, so no board or emulator runs one). A rate outside voids every check that a time is
+/// within its stream (`rate_hz=1e-38` made every duration plausible).
+pub const RATE_HZ: std::ops::RangeInclusive<f32> = 1.0..=impact_core::scene::MAX_RATE_HZ;
+
+/// `x` as read, or in exponent form when huge or tiny (`1e-38`).
+fn shown(x: f32) -> String {
+    if x != 0.0 && x.is_finite() && !(1e-4..1e9).contains(&x.abs()) {
+        format!("{x:e}")
+    } else {
+        x.to_string()
+    }
+}
+
+/// A line's `rate_hz`: within [`RATE_HZ`].
 pub fn rate(fields: &Fields) -> Result<f32, LineError> {
     let value: f32 = fields.num("rate_hz")?;
-    if value.is_finite() && value > 0.0 {
+    if RATE_HZ.contains(&value) {
         Ok(value)
     } else {
         Err(LineError::Rate { value })
@@ -201,8 +232,14 @@ mod tests {
         assert_eq!(rate_of("500000.0"), Ok(500000.0));
         assert_eq!(
             rate_of("-5").unwrap_err().to_string(),
-            "rate_hz=-5: not a finite rate > 0"
+            "rate_hz=-5: not a sample rate from 1 Hz to 1e8 Hz (the core's highest): no \
+             board samples at it, and no time can be checked against it"
         );
+        assert!(rate_of("1e-38")
+            .unwrap_err()
+            .to_string()
+            .starts_with("rate_hz=1e-38: not a sample rate"));
+        assert!(rate_of("1e9").is_err() && rate_of("1").is_ok() && rate_of("1e8").is_ok());
         assert_eq!(
             rate_of("1e39").unwrap_err().to_string(),
             "rate_hz=inf: not finite (a float out of range, or NaN)"

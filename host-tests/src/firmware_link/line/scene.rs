@@ -50,6 +50,12 @@ impl SceneLine {
         self.fields.opt("v0_m_s")
     }
 
+    /// The longest impact the core follows, s (`max_impact_s`; `None` if the line lacks it
+    /// or it is not a finite time > 0): only a bound on the impacts' sample spans.
+    pub fn max_impact_s(&self) -> Option<f64> {
+        (self.fields.readable::<f64>("max_impact_s")).filter(|x| x.is_finite() && *x > 0.0)
+    }
+
     /// Whether the scene asks for the two-phase fit.
     pub fn two_phase(&self) -> Result<bool, FieldError> {
         self.fields.flag("two_phase")

@@ -5,6 +5,11 @@ use impact_core::waveform;
 
 use super::{FieldError, Fields, LineError};
 
+/// The most values a window (`wave` line) holds: a capture
+/// ([`impact_core::board::CAPTURE_LEN`] values, each one sample or, decimated, the mean of
+/// several) with room to spare. What a window's readers loop over is bounded by it.
+pub const MAX_WAVE_VALUES: usize = 1 << 16;
+
 /// A `wave` line: the window of the impact with its `index`.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct WaveLine {
@@ -30,6 +35,15 @@ impl WaveLine {
         }
         let samples: u32 = f.num("samples")?;
         let frames: u32 = f.num("frames")?;
+        let values = waveform::values(samples as usize, every);
+        if values > MAX_WAVE_VALUES {
+            return Err(LineError::WaveTooLong {
+                samples,
+                every,
+                values,
+                max: MAX_WAVE_VALUES,
+            });
+        }
         let expected = waveform::frames(samples as usize, every);
         if frames as usize != expected {
             return Err(LineError::Frames {

@@ -122,6 +122,25 @@ pub enum LogErrorKind {
     NoRate,
 }
 
+impl LogErrorKind {
+    /// Whether the error is the line's own (its text cut or garbled, a value no board gives,
+    /// a line whose impact or window was such a line): a reader may pass over the line.
+    /// Errors only several lines show (two streams mixed, counters going back, a scene unlike
+    /// the first, counts at a run's end) are not.
+    pub fn is_the_lines(&self) -> bool {
+        matches!(
+            self,
+            LogErrorKind::Line(_)
+                | LogErrorKind::Implausible(_)
+                | LogErrorKind::Wave(_)
+                | LogErrorKind::NegativeLatency { .. }
+                | LogErrorKind::NoImpactFor { .. }
+                | LogErrorKind::NoWaveFor { .. }
+                | LogErrorKind::WaveAgain { .. }
+        )
+    }
+}
+
 impl From<FieldError> for LogErrorKind {
     fn from(e: FieldError) -> Self {
         LogErrorKind::Line(e.into())

@@ -13,10 +13,10 @@ use std::collections::HashMap;
 use impact_core::ImpactReport;
 
 use crate::firmware_link::line::{
-    self, FieldError, Fields, HeartbeatLine, ImpactLine, LineKind, SceneLine, SpecLine, SrsLine,
-    SummaryLine, WaveFrameLine, WaveLine,
+    self, Fields, HeartbeatLine, ImpactLine, LineKind, SceneLine, SpecLine, SrsLine, SummaryLine,
+    WaveFrameLine, WaveLine,
 };
-use crate::firmware_link::plausible::check_plausible;
+use crate::firmware_link::plausible::{check_plausible, Bounds};
 use crate::firmware_link::waves::Waveform;
 use error::At;
 use seq::SeqSet;
@@ -50,6 +50,71 @@ pub struct Log {
     pub lines_missing: u64,
     /// The runs, in the order of the log (one for a log without a restart).
     pub runs: Vec<Run>,
+    /// Lines passed over (a reader made by [`LogReader::skipping`]): each line's number and
+    /// why, in line order.
+    pub skipped: Vec<Skipped>,
+}
+
+/// A line passed over: its number and what is wrong with it, shown `line N: what (skipped)`.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Skipped {
+    pub line: u64,
+    pub kind: LogErrorKind,
+    /// The kind of line it is, when its name says it.
+    pub of: Option<LineKind>,
+}
+
+impl Skipped {
+    /// Why, for an output (JSON, CSV, a report): the error's text with a non-finite value it
+    /// quotes from the line (`inf`, `NaN`) said in words, so no output holds one.
+    pub fn reason(&self) -> String {
+        let text = self.kind.to_string();
+        let mut out = String::with_capacity(text.len());
+        let mut word = String::new();
+        let flush = |word: &mut String, out: &mut String| {
+            out.push_str(match word.to_ascii_lowercase().as_str() {
+                "inf" | "infinity" => "an infinite value",
+                "nan" => "not-a-number",
+                _ => word,
+            });
+            word.clear();
+        };
+        for c in text.chars() {
+            if c.is_ascii_alphanumeric() {
+                word.push(c);
+            } else {
+                flush(&mut word, &mut out);
+                out.push(c);
+            }
+        }
+        flush(&mut word, &mut out);
+        out
+    }
+
+    /// `line N: why (skipped)`, for an output ([`Skipped::reason`]).
+    pub fn note(&self) -> String {
+        format!("line {}: {} (skipped)", self.line, self.reason())
+    }
+}
+
+impl std::fmt::Display for Skipped {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(f, "line {}: {} (skipped)", self.line, self.kind)
+    }
+}
+
+/// Whether an impact line is one `impact log` takes: its latency a time >= 0 and, once its
+/// run's rate is known (`bounds`), its times, lengths and sample span within what its stream
+/// allows ([`check_plausible`]; its signs and ranges were checked as it was parsed). The live
+/// view's statistics take only the impacts this accepts.
+pub fn accept(line: &ImpactLine, bounds: Option<&Bounds>) -> Result<(), LogErrorKind> {
+    if let Some(value) = line.report_latency_s.filter(|&l| l < 0.0) {
+        return Err(LogErrorKind::NegativeLatency { value });
+    }
+    if let Some(b) = bounds {
+        check_plausible(&line.report, b)?;
+    }
+    Ok(())
 }
 
 /// One run of the board in a log: from its `scene` line (or the start of the log) to the
@@ -92,6 +157,9 @@ pub fn parse_log(text: &str) -> Result<Log, LogError> {
 #[derive(Default)]
 pub struct LogReader {
     log: Log,
+    /// Whether a line whose own text is wrong ([`LogErrorKind::is_the_lines`]) is passed
+    /// over and noted ([`Log::skipped`]) instead of ending the reading.
+    skip: bool,
     /// Line of the first `scene` line (`Log::scene`: every later run's must equal it).
     first_scene: u64,
     run: RunReader,
@@ -123,20 +191,67 @@ struct RunReader {
     /// scene's m/s² per count: what [`check_plausible`] needs.
     rate_hz: Option<f64>,
     gain: Option<f64>,
+    /// The scene's longest impact, s.
+    max_impact_s: Option<f64>,
     /// Impacts read before the run's rate was known (line, position): checked when it is.
     unchecked: Vec<(u64, usize)>,
 }
 
 impl LogReader {
+    /// A reader that passes over a line whose own text is wrong (a line cut by the link, a
+    /// value no board gives), noting it in [`Log::skipped`]; what only several lines show
+    /// (two streams mixed, counters going back) still ends the reading.
+    pub fn skipping() -> Self {
+        Self {
+            skip: true,
+            ..Self::default()
+        }
+    }
+
     /// Reads line `n` (1-based).
     pub fn line(&mut self, n: u64, text: &str) -> Result<(), LogError> {
+        match self.read(n, text) {
+            Err(e) if self.skip && e.line == Some(n) && e.kind.is_the_lines() => {
+                self.log.skipped.push(Skipped {
+                    line: n,
+                    kind: e.kind,
+                    of: line::find(text, &LineKind::ALL).map(|(k, _)| k),
+                });
+                Ok(())
+            }
+            r => r,
+        }
+    }
+
+    fn read(&mut self, n: u64, text: &str) -> Result<(), LogError> {
         let Some((kind, fields)) = line::find(text, &LineKind::ALL) else {
             return Ok(());
         };
         let fields = fields.at(n)?;
+        // A data line's sequence number (`seq`, absent from firmware that did not number
+        // them), counted once the line is read: a line passed over is a line missing.
+        let seq = if kind.is_data() {
+            fields.given::<u32>("seq").at(n)?
+        } else {
+            None
+        };
+        self.read_kind(n, kind, text, fields)?;
         if kind.is_data() {
-            self.seen(&fields).at(n)?;
+            self.run.started = true;
+            if let Some(seq) = seq {
+                self.run.seqs.insert(seq);
+            }
         }
+        Ok(())
+    }
+
+    fn read_kind(
+        &mut self,
+        n: u64,
+        kind: LineKind,
+        text: &str,
+        fields: Fields,
+    ) -> Result<(), LogError> {
         match kind {
             LineKind::Impact => self.impact(n, &fields),
             LineKind::Srs => self.srs(n, &fields),
@@ -153,32 +268,19 @@ impl LogReader {
     /// summary.
     pub fn finish(mut self) -> Result<Log, LogError> {
         self.end_run()?;
+        self.log.skipped.sort_by_key(|s| s.line);
         Ok(self.log)
     }
 
-    /// A data line's sequence number (`seq`, absent from firmware that did not number them).
-    fn seen(&mut self, f: &Fields) -> Result<(), FieldError> {
-        self.run.started = true;
-        if let Some(seq) = f.given("seq")? {
-            self.run.seqs.insert(seq);
-        }
-        Ok(())
-    }
-
     fn impact(&mut self, n: u64, f: &Fields) -> Result<(), LogError> {
+        let line = ImpactLine::parse(f).at(n)?;
+        let bounds = self.run.bounds();
+        accept(&line, bounds.as_ref()).at(n)?;
         let ImpactLine {
             report: r,
             report_latency_s: latency,
-        } = ImpactLine::parse(f).at(n)?;
-        if let Some(value) = latency.filter(|&l| l < 0.0) {
-            return Err(LogError::at(n, LogErrorKind::NegativeLatency { value }));
-        }
+        } = line;
         let run = &mut self.run;
-        if let Some(rate) = run.rate_hz {
-            check_plausible(&r, rate, run.gain).at(n)?;
-        } else {
-            run.unchecked.push((n, self.log.impacts.len()));
-        }
         if let Some(&(_, first)) = run.impacts.get(&r.index) {
             let index = r.index;
             return Err(LogError::at(n, LogErrorKind::ImpactAgain { index, first }));
@@ -187,6 +289,9 @@ impl LogReader {
             if r.index < prev.index && run.reordered.is_none() {
                 run.reordered = Some((n, r.index, prev.index));
             }
+        }
+        if bounds.is_none() {
+            run.unchecked.push((n, self.log.impacts.len()));
         }
         run.impacts.insert(r.index, (self.log.impacts.len(), n));
         self.log.impacts.push(r);
@@ -297,6 +402,7 @@ impl LogReader {
         self.run.line = n;
         self.run.started = true;
         self.run.gain = scene.gain_m_s2_per_count.map(f64::from);
+        self.run.max_impact_s = scene.max_impact_s();
         let rate = scene.rate_hz;
         if self.log.scene.is_none() {
             self.first_scene = n;
@@ -330,16 +436,53 @@ impl LogReader {
             return Ok(());
         }
         run.rate_hz = Some(f64::from(rate));
+        let Some(bounds) = run.bounds() else {
+            return Ok(());
+        };
+        let mut refused = Vec::new();
         for (line, k) in std::mem::take(&mut run.unchecked) {
-            check_plausible(&self.log.impacts[k], f64::from(rate), run.gain).at(line)?;
+            if let Err(e) = check_plausible(&self.log.impacts[k], &bounds) {
+                if !self.skip {
+                    return Err(LogError::at(line, e));
+                }
+                refused.push((line, k, e));
+            }
+        }
+        // Passed over now: out of the log, the later impacts' positions one less.
+        for (line, k, e) in refused.into_iter().rev() {
+            self.log.impacts.remove(k);
+            self.log.latencies.remove(k);
+            run.impacts.retain(|_, (at, _)| *at != k);
+            for (at, _) in run.impacts.values_mut() {
+                if *at > k {
+                    *at -= 1;
+                }
+            }
+            self.log.skipped.push(Skipped {
+                line,
+                kind: e.into(),
+                of: Some(LineKind::Impact),
+            });
         }
         Ok(())
+    }
+}
+
+impl RunReader {
+    /// What the run's impacts are checked against, once its rate is known.
+    fn bounds(&self) -> Option<Bounds> {
+        Some(Bounds {
+            rate_hz: self.rate_hz?,
+            gain: self.gain,
+            max_impact_s: self.max_impact_s,
+        })
     }
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::firmware_link::line::FieldError;
     use impact_core::Status;
 
     const LINE: &str = "0.013931 INFO  impact index=0 status=complete analysis=full clipped=false flags=0 start_sample=5000 end_sample=17000 start_s=0.01 peak_time_s=0.0100251 peak_acceleration_m_s2=4321.5 peak_force_n=259.29 delta_v_m_s=2.5 duration_s=0.0219 baseline_m_s2=0.2 fwhm_s=0.001 filtered_peak_acceleration_m_s2=none filtered_fwhm_s=none impact_velocity_m_s=1.3357 crush_time_s=0.0218 max_deformation_m=0.0186 rebound_velocity_m_s=1.16 cor=0.87 separation_deformation_m=0.0182 permanent_deformation_m=0.0182 absorbed_energy_j=none two_phase_kc_n_m=none two_phase_kr_n_m=none two_phase_c_n_s_m=none two_phase_permanent_deformation_m=none two_phase_residual=none nonlinear_k=1e6 nonlinear_c_s_m=0.5 nonlinear_exponent=1.2 nonlinear_residual=0.01 hertz_k=none hertz_residual=none report_latency_s=0.0123";
