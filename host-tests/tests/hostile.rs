@@ -4,13 +4,14 @@
 //! option or the file and line, or a correct, flagged result; nothing non-finite written.
 #![cfg(unix)]
 
-use std::io::{BufRead, BufReader, Read, Write};
-use std::os::unix::process::{CommandExt, ExitStatusExt};
+use std::io::{BufRead, BufReader, Write};
+use std::os::unix::process::ExitStatusExt;
 use std::path::PathBuf;
 use std::process::{Child, Command, Stdio};
-use std::time::{Duration, Instant};
+use std::time::Duration;
 
 mod common;
+use common::limited::{self, Run};
 use common::{Scratch, SYNTH_T2 as T2};
 
 /// Address space each `impact` process may map: far below what the cases used to take
@@ -20,75 +21,14 @@ const MEMORY_LIMIT_BYTES: u64 = 1 << 30;
 /// Longest a case may run.
 const TIME_LIMIT: Duration = Duration::from_secs(120);
 
-struct Run {
-    code: Option<i32>,
-    signal: Option<i32>,
-    out: String,
-    err: String,
-}
-
 /// Starts `impact ARGS` under [`MEMORY_LIMIT_BYTES`].
 fn spawn(args: &[&str], stdin: Stdio) -> Child {
-    let mut cmd = Command::new(env!("CARGO_BIN_EXE_impact"));
-    cmd.args(args)
-        .stdin(stdin)
-        .stdout(Stdio::piped())
-        .stderr(Stdio::piped());
-    // SAFETY: setrlimit is async-signal-safe; nothing else runs between fork and exec.
-    unsafe {
-        cmd.pre_exec(|| {
-            let limit = libc::rlimit {
-                rlim_cur: MEMORY_LIMIT_BYTES,
-                rlim_max: MEMORY_LIMIT_BYTES,
-            };
-            if libc::setrlimit(libc::RLIMIT_AS, &limit) != 0 {
-                return Err(std::io::Error::last_os_error());
-            }
-            Ok(())
-        });
-    }
-    cmd.spawn().expect("impact runs")
+    limited::spawn(args, &[], stdin, MEMORY_LIMIT_BYTES)
 }
 
 /// Waits for `child` (killing it past [`TIME_LIMIT`]) and checks what any run must satisfy.
-fn finish(mut child: Child, what: &str) -> Run {
-    // The caller may have read (and closed) stdout itself.
-    let out = child.stdout.take();
-    let mut err = child.stderr.take().unwrap();
-    let reader = std::thread::spawn(move || {
-        let mut o = Vec::new();
-        if let Some(mut out) = out {
-            let _ = out.read_to_end(&mut o);
-        }
-        o
-    });
-    let err_reader = std::thread::spawn(move || {
-        let mut e = Vec::new();
-        let _ = err.read_to_end(&mut e);
-        e
-    });
-    let start = Instant::now();
-    let status = loop {
-        if let Some(s) = child.try_wait().unwrap() {
-            break s;
-        }
-        if start.elapsed() > TIME_LIMIT {
-            let _ = child.kill();
-            panic!("{what}: still running after {TIME_LIMIT:?}");
-        }
-        std::thread::sleep(Duration::from_millis(5));
-    };
-    let run = Run {
-        code: status.code(),
-        signal: status.signal(),
-        out: String::from_utf8_lossy(&reader.join().unwrap()).into_owned(),
-        err: String::from_utf8_lossy(&err_reader.join().unwrap()).into_owned(),
-    };
-    assert!(
-        !run.err.contains("panicked") && !run.err.contains("memory allocation"),
-        "{what}: {}",
-        run.err
-    );
+fn finish(child: Child, what: &str) -> Run {
+    let run = limited::wait(child, what, TIME_LIMIT);
     assert!(
         run.code.is_some() || run.signal == Some(libc::SIGPIPE),
         "{what}: killed by signal {:?}: {}",

@@ -5,13 +5,12 @@
 //! limit: no panic, no allocation failure, no hang; a one-line error naming the file.
 #![cfg(unix)]
 
-use std::io::Read;
-use std::os::unix::process::CommandExt;
 use std::path::{Path, PathBuf};
-use std::process::{Child, Command, Stdio};
-use std::time::{Duration, Instant};
+use std::process::{Child, Stdio};
+use std::time::Duration;
 
 mod common;
+use common::limited::{self, Run};
 use common::Scratch;
 
 use impact_io::{ColumnRef, ReadOptions};
@@ -26,72 +25,15 @@ fn fixtures() -> PathBuf {
     PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("fixtures")
 }
 
-struct Run {
-    code: Option<i32>,
-    out: String,
-    err: String,
-}
-
 /// Starts `impact ARGS` under [`MEMORY_LIMIT_BYTES`], with `env` set.
 fn spawn(args: &[&str], env: &[(&str, &str)], stdin: Stdio) -> Child {
-    let mut cmd = Command::new(env!("CARGO_BIN_EXE_impact"));
-    cmd.args(args)
-        .envs(env.iter().copied())
-        .stdin(stdin)
-        .stdout(Stdio::piped())
-        .stderr(Stdio::piped());
-    // SAFETY: setrlimit is async-signal-safe; nothing else runs between fork and exec.
-    unsafe {
-        cmd.pre_exec(|| {
-            let limit = libc::rlimit {
-                rlim_cur: MEMORY_LIMIT_BYTES,
-                rlim_max: MEMORY_LIMIT_BYTES,
-            };
-            if libc::setrlimit(libc::RLIMIT_AS, &limit) != 0 {
-                return Err(std::io::Error::last_os_error());
-            }
-            Ok(())
-        });
-    }
-    cmd.spawn().expect("impact runs")
+    limited::spawn(args, env, stdin, MEMORY_LIMIT_BYTES)
 }
 
 /// Waits for `child` (killed past [`TIME_LIMIT`]): no panic, no allocation failure, no
 /// signal.
-fn finish(mut child: Child, what: &str) -> Run {
-    let mut out = child.stdout.take().unwrap();
-    let mut err = child.stderr.take().unwrap();
-    let out = std::thread::spawn(move || {
-        let mut o = Vec::new();
-        let _ = out.read_to_end(&mut o);
-        o
-    });
-    let err = std::thread::spawn(move || {
-        let mut e = Vec::new();
-        let _ = err.read_to_end(&mut e);
-        e
-    });
-    let start = Instant::now();
-    let status = loop {
-        if let Some(s) = child.try_wait().unwrap() {
-            break s;
-        }
-        if start.elapsed() > TIME_LIMIT {
-            let _ = child.kill();
-            panic!("{what}: still running after {TIME_LIMIT:?}");
-        }
-        std::thread::sleep(Duration::from_millis(5));
-    };
-    let run = Run {
-        code: status.code(),
-        out: String::from_utf8_lossy(&out.join().unwrap()).into_owned(),
-        err: String::from_utf8_lossy(&err.join().unwrap()).into_owned(),
-    };
-    assert!(
-        !run.err.contains("panicked") && !run.err.contains("memory allocation"),
-        "{what}: {}",
-        run.err
-    );
+fn finish(child: Child, what: &str) -> Run {
+    let run = limited::wait(child, what, TIME_LIMIT);
     assert!(
         run.code.is_some(),
         "{what}: killed by a signal: {}",

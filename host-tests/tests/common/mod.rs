@@ -4,6 +4,8 @@ use std::process::Command;
 
 pub mod board_log;
 pub mod browser;
+#[cfg(unix)]
+pub mod limited;
 
 /// Runs `impact ARGS`: (exit code, stdout, stderr).
 pub fn impact(args: &[&str]) -> (i32, String, String) {
