@@ -62,6 +62,25 @@ step "host tests (the documented commands, the emulated firmware against the hos
 # tests/report.rs loads the HTML report in headless Chromium, also installed above.
 IMPACT_REQUIRE_EMULATOR=1 IMPACT_REQUIRE_BROWSER=1 cargo test --workspace --exclude impact-firmware "${HOST[@]}"
 
+step "Python package: pip install ./host-tests/python, its tests against the tool, the docs' Python examples"
+# A virtual environment of the pinned test packages (made once: later runs need no network),
+# the package built from this tree with maturin (the host-test profile: the tool's build
+# above is reused), then pytest: every bundled recording analysed from Python equals
+# `impact analyze --json` bit for bit (host-tests/python/tests), and docs/python.md's
+# examples run as doctests.
+target="${CARGO_TARGET_DIR:-target}"
+venv="$target/python-venv"
+if ! "$venv/bin/python" -c 'import maturin, numpy, pandas, pytest, dask' 2>/dev/null; then
+  rm -rf "$venv"
+  python3 -m venv "$venv"
+  "$venv/bin/pip" install --quiet --disable-pip-version-check -r host-tests/python/requirements-test.txt
+fi
+cargo build --quiet "${HOST[@]}" -p impact-host --bin impact
+# (maturin's build hook runs the `maturin` the environment installed: its bin/ on the PATH.)
+PATH="$(cd "$venv/bin" && pwd):$PATH" "$venv/bin/pip" install --quiet --disable-pip-version-check --no-build-isolation --no-deps --force-reinstall ./host-tests/python
+IMPACT="$(cd "$target/host-test" && pwd)/impact" "$venv/bin/python" -m pytest -q -p no:cacheprovider \
+  host-tests/python/tests docs/python.md --doctest-glob='*.md' -o doctest_optionflags='ELLIPSIS NORMALIZE_WHITESPACE'
+
 step "golden outputs: the tool's outputs on scripts/golden.sh's commands, byte for byte (host-tests/golden)"
 scripts/golden.sh --check
 

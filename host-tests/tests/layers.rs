@@ -370,6 +370,11 @@ fn the_host_tool_and_its_readers_have_no_import_cycle() {
 }
 
 #[test]
+fn the_python_extension_has_no_import_cycle() {
+    assert_layered("host-tests/python/src/lib.rs");
+}
+
+#[test]
 fn a_cycle_is_found() {
     // The check itself: two sibling modules that use each other.
     let scratch = Scratch::new();

@@ -107,17 +107,27 @@ pub fn run(cmd: &AnalyzeCommand) -> Result<Judged, AnalyzeError> {
     } else {
         crate::out!("{}", report::to_table(&a));
     }
-    if let Some(path) = &args.plot {
-        let mut signal = setup.plot_signal();
-        // Titled with the recording it is drawn from.
-        let name = args.file.file_name().map_or_else(
-            || args.file.display().to_string(),
-            |n| n.to_string_lossy().into_owned(),
-        );
-        signal.title = format!("{name}, {}", signal.title);
-        plot::impacts(&signal, &reports, path)?;
-    }
+    draw(args, &setup, &reports)?;
     Ok(Judged::reports(&reports))
+}
+
+/// `--plot`'s figure of one recording's analysis, if asked, titled with the recording's name
+/// (the output already checked against the inputs: [`plot::check_output`]).
+pub fn draw(
+    args: &AnalyzeArgs,
+    setup: &pipeline::Setup,
+    reports: &[impact_core::ImpactReport],
+) -> Result<(), plot::PlotError> {
+    let Some(path) = &args.plot else {
+        return Ok(());
+    };
+    let mut signal = setup.plot_signal();
+    let name = args.file.file_name().map_or_else(
+        || args.file.display().to_string(),
+        |n| n.to_string_lossy().into_owned(),
+    );
+    signal.title = format!("{name}, {}", signal.title);
+    plot::impacts(&signal, reports, path)
 }
 
 /// A test series: every recording analysed, the rows and statistics printed, each

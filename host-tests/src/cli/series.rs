@@ -11,7 +11,7 @@ use serde::Serialize;
 
 use crate::pipeline::{self, AnalyzeArgs, PipelineError};
 use crate::report::fmt::human;
-use crate::report::statistics::{comparable, pass_rate, statistics, LeftOut, PassRate, Statistic};
+use crate::report::statistics::{LeftOut, PassRate, Statistic};
 use crate::report::{AnalysisJson, ImpactJson};
 
 /// The extensions of the recordings a folder contributes (as `impact analyze` reads them).
@@ -396,17 +396,15 @@ pub fn impacts(entries: &[EntryJson]) -> impl Iterator<Item = (&EntryJson, &Impa
 }
 
 pub fn to_json(entries: &[EntryJson]) -> SeriesJson<'_> {
-    let (kept, left_out) = comparable(impacts(entries).map(|(_, i)| i));
+    let s = crate::report::statistics::series_statistics(impacts(entries).map(|(_, i)| i));
     SeriesJson {
         recordings: entries.len(),
         failed: entries.iter().filter(|e| e.error.is_some()).count(),
-        impacts: impacts(entries).count(),
-        spec: pass_rate(impacts(entries).map(|(_, i)| i)),
-        statistics: statistics(kept.iter().copied()),
-        statistics_left_out: left_out,
-        bounce_statistics: crate::report::statistics::bounce_groups(
-            impacts(entries).map(|(_, i)| i),
-        ),
+        impacts: s.impacts,
+        spec: s.spec,
+        statistics: s.statistics,
+        statistics_left_out: s.statistics_left_out,
+        bounce_statistics: s.bounce_statistics,
         entries,
     }
 }

@@ -283,19 +283,38 @@ pub fn analyze(
         let reports = run(&setup.prepared.counts, &setup.scene, setup.capture_len)?;
         Ok((setup, reports))
     }?;
+    note_results(args, &setup, &reports);
+    Ok((setup, reports))
+}
+
+/// [`analyze`] of samples given in memory (the Python package's arrays): the options that
+/// read a file (`--stream`, the columns, the time base) do not apply; `args.file` only
+/// names the samples.
+pub fn analyze_samples(
+    args: &AnalyzeArgs,
+    samples: Samples<'_>,
+) -> Result<(Setup, Vec<ImpactReport>), PipelineError> {
+    let setup = setup_of(args, samples)?;
+    let reports = run(&setup.prepared.counts, &setup.scene, setup.capture_len)?;
+    note_results(args, &setup, &reports);
+    Ok((setup, reports))
+}
+
+/// The notes on an analysis's results: a spec far from every pulse, an implausible time
+/// base, decimated captures.
+fn note_results(args: &AnalyzeArgs, setup: &Setup, reports: &[ImpactReport]) {
     if let Some(note) = args
         .spec
-        .and_then(|s| spec::far_from_every_pulse(&s, &reports))
+        .and_then(|s| spec::far_from_every_pulse(&s, reports))
     {
         impact_io::note(&note);
     }
-    if let Some(note) = time_base_implausible(&setup.assumptions, &reports) {
+    if let Some(note) = time_base_implausible(&setup.assumptions, reports) {
         impact_io::note(&note);
     }
-    if let Some(note) = decimated(args, setup.rate_hz, &reports) {
+    if let Some(note) = decimated(args, setup.rate_hz, reports) {
         impact_io::note(&note);
     }
-    Ok((setup, reports))
 }
 
 /// A note when impacts outlasted the capture and were analysed at a coarser step: how many,
@@ -587,12 +606,61 @@ pub fn setup(
     args: &AnalyzeArgs,
     progress: impact_io::progress::Progress,
 ) -> Result<Setup, PipelineError> {
-    let file = scene_file(args)?;
     let ch = read_recording(&args.file, &args.read_options(progress)).map_err(ReadFailure::from)?;
-    let column = ch
-        .axes
-        .first()
-        .map_or(ch.name.as_str(), |(name, _)| name.as_str());
+    setup_of(args, Samples::of(&ch))
+}
+
+/// A channel's samples as the pipeline takes them, however they were had: a recording read
+/// ([`Samples::of`]) or an array given in memory (the Python package's, borrowed as it is).
+#[derive(Clone, Copy, Debug)]
+pub struct Samples<'a> {
+    /// The channel's header (empty where there is none).
+    pub name: &'a str,
+    /// The values in the channel's units (the resultant with `axes`).
+    pub values: &'a [f64],
+    /// Time of the first sample, s; the rate, S/s.
+    pub t0: f64,
+    pub rate_hz: f64,
+    /// Whether the samples were interpolated onto an even grid.
+    pub resampled: bool,
+    /// With `--axes`: each axis (header, values).
+    pub axes: &'a [(String, Vec<f64>)],
+    /// The time column's header when its unit was assumed (seconds).
+    pub time_unit_assumed: Option<&'a str>,
+}
+
+impl<'a> Samples<'a> {
+    /// The samples of a channel read from a recording.
+    pub fn of(ch: &'a impact_io::channel::Channel) -> Self {
+        Self {
+            name: &ch.name,
+            values: &ch.values,
+            t0: ch.time_s.first().copied().unwrap_or(0.0),
+            rate_hz: ch.rate_hz,
+            resampled: ch.resampled,
+            axes: &ch.axes,
+            time_unit_assumed: ch.time_unit_assumed.as_deref(),
+        }
+    }
+
+    /// Evenly spaced samples from time 0, one channel named `name`.
+    pub fn even(name: &'a str, values: &'a [f64], rate_hz: f64) -> Self {
+        Self {
+            name,
+            values,
+            t0: 0.0,
+            rate_hz,
+            resampled: false,
+            axes: &[],
+            time_unit_assumed: None,
+        }
+    }
+}
+
+/// [`setup`] of samples already had (the options' reading of the file left out).
+pub fn setup_of(args: &AnalyzeArgs, ch: Samples<'_>) -> Result<Setup, PipelineError> {
+    let file = scene_file(args)?;
+    let column = ch.axes.first().map_or(ch.name, |(name, _)| name.as_str());
     let (mass, scale, units, first_assumed) = mass_and_scale(args, &file, column)?;
     // Every axis in the first one's units (one scale takes them all to m/s²): axes whose
     // headers name other units are refused, not read 9.8× off.
@@ -611,7 +679,7 @@ pub fn setup(
     }
     let mut accel: Vec<f64> = ch.values.iter().map(|v| v * scale).collect();
     let full_scale = full_scale_m_s2(args, &file, mass);
-    let t0 = ch.time_s.first().copied().unwrap_or(0.0);
+    let t0 = ch.t0;
     // The survey, and again after glitches are removed (they set the extremes).
     let first = Survey::of(&accel, !args.keep_spikes)?;
     let spikes = screen::apply(&first.removals, &mut accel, t0, ch.rate_hz);
@@ -660,7 +728,7 @@ pub fn setup(
         mass,
     )?;
     let reading = Reading {
-        column: ch.name.clone(),
+        column: ch.name.to_string(),
         units,
         t0,
         samples: ch.values.len() as u64,
@@ -670,7 +738,7 @@ pub fn setup(
     setup.assumptions.extend(assumed);
     setup
         .assumptions
-        .extend(ch.time_unit_assumed.as_deref().map(assumed_time_unit));
+        .extend(ch.time_unit_assumed.map(assumed_time_unit));
     setup.prepared.counts = counts;
     setup.prepared.accel_m_s2 = accel;
     setup.spikes = spikes;
@@ -700,7 +768,7 @@ pub fn setup(
 /// parsers, [`scene_file`]); the units are those stated, else those the channel's header
 /// (`column`) names, else g (an error if the two disagree), and that assumption if g was
 /// assumed (kept as a note too).
-pub(crate) fn mass_and_scale(
+pub fn mass_and_scale(
     args: &AnalyzeArgs,
     file: &SceneFile,
     column: &str,

@@ -3,7 +3,7 @@
 use serde::Serialize;
 
 /// One axis over one impact. SI.
-#[derive(Clone, Debug, Serialize, PartialEq)]
+#[derive(Clone, Debug, Serialize, serde::Deserialize, PartialEq)]
 pub struct AxisJson {
     /// The column's header name.
     pub column: String,
@@ -25,7 +25,7 @@ pub struct AxisJson {
 }
 
 /// The per-axis part of an impact: the resultant's own peak (gravity included) and each axis.
-#[derive(Clone, Debug, Serialize, PartialEq)]
+#[derive(Clone, Debug, Serialize, serde::Deserialize, PartialEq)]
 pub struct AxesJson {
     /// Largest resultant inside the impact, m/s² (the report's peak is above its baseline).
     pub resultant_peak_m_s2: f64,

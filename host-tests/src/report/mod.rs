@@ -18,21 +18,21 @@ use std::collections::BTreeMap;
 
 use impact_core::report::{Fits, Flags};
 use impact_core::{FitSet, ImpactReport, Status};
-use serde::Serialize;
+use serde::{Deserialize, Serialize};
 
 pub use csv::to_csv;
 pub use screen::{Clipping, Spike};
 pub use table::to_table;
 
 /// Fits as JSON.
-#[derive(Clone, Debug, Default, Serialize, PartialEq)]
+#[derive(Clone, Debug, Default, Serialize, Deserialize, PartialEq)]
 pub struct FitsJson {
     pub two_phase: Option<TwoPhaseJson>,
     pub nonlinear: Option<NonlinearJson>,
     pub hertz: Option<HertzJson>,
 }
 
-#[derive(Clone, Debug, Serialize, PartialEq)]
+#[derive(Clone, Debug, Serialize, Deserialize, PartialEq)]
 pub struct TwoPhaseJson {
     pub kc_n_m: f64,
     pub kr_n_m: f64,
@@ -41,7 +41,7 @@ pub struct TwoPhaseJson {
     pub residual: f64,
 }
 
-#[derive(Clone, Debug, Serialize, PartialEq)]
+#[derive(Clone, Debug, Serialize, Deserialize, PartialEq)]
 pub struct NonlinearJson {
     pub k: f64,
     pub c_s_m: f64,
@@ -49,14 +49,15 @@ pub struct NonlinearJson {
     pub residual: f64,
 }
 
-#[derive(Clone, Debug, Serialize, PartialEq)]
+#[derive(Clone, Debug, Serialize, Deserialize, PartialEq)]
 pub struct HertzJson {
     pub k: f64,
     pub residual: f64,
 }
 
-/// One impact as JSON (SI field names).
-#[derive(Clone, Debug, Default, Serialize, PartialEq)]
+/// One impact as JSON (SI field names); read back as written (`Deserialize`: a series'
+/// statistics over analyses gathered elsewhere, the Python package's `impact.statistics`).
+#[derive(Clone, Debug, Default, Serialize, Deserialize, PartialEq)]
 pub struct ImpactJson {
     pub index: u32,
     pub status: String,
@@ -96,25 +97,39 @@ pub struct ImpactJson {
     pub null_reasons: BTreeMap<String, String>,
     /// Real-time emulation only: virtual time from the end of the impact's hold to its
     /// report, s.
-    #[serde(skip_serializing_if = "Option::is_none")]
+    #[serde(default, skip_serializing_if = "Option::is_none")]
     pub report_latency_s: Option<f64>,
     /// With `--srs`: the impact's shock spectra.
-    #[serde(skip_serializing_if = "Option::is_none")]
+    #[serde(default, skip_serializing_if = "Option::is_none")]
     pub shock_spectrum: Option<crate::report::spectrum::ShockSpectrumJson>,
     /// With `--axes`: the resultant's peak and each axis's peak and Δv.
-    #[serde(skip_serializing_if = "Option::is_none")]
+    #[serde(default, skip_serializing_if = "Option::is_none")]
     pub axes: Option<crate::report::axes::AxesJson>,
     /// A bounce of a train (`--train`): its flight, both approach speeds and their CORs;
     /// null for a train's first impact and without `--train`.
     pub bounce: Option<crate::report::train::BounceJson>,
     /// `impact log` of a log in which the board restarted: the run the impact is from (1 for
     /// the first; each run's indices and times start from 0).
-    #[serde(skip_serializing_if = "Option::is_none")]
+    #[serde(default, skip_serializing_if = "Option::is_none")]
     pub run: Option<u32>,
     /// With `--spec`: the verdict against the specified pulse (null, with its reason in
     /// `null_reasons.spec`, when the capture cannot show it).
-    #[serde(skip_serializing_if = "Option::is_none")]
+    #[serde(
+        default,
+        skip_serializing_if = "Option::is_none",
+        deserialize_with = "present"
+    )]
     pub spec: Option<Option<crate::report::spec::VerdictJson>>,
+}
+
+/// `ImpactJson::spec`'s reading: a field present (`null` too, a verdict that could not be
+/// judged) is `Some`; an absent one (serde's `default`) is `None`, as it was written.
+fn present<'de, D, T>(d: D) -> Result<Option<T>, D::Error>
+where
+    D: serde::Deserializer<'de>,
+    T: Deserialize<'de>,
+{
+    T::deserialize(d).map(Some)
 }
 
 /// The assumption behind every COR, deformation and absorbed energy the tool reports: the body

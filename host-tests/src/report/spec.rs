@@ -189,7 +189,7 @@ pub fn spec_json(spec: &Spec, named: Option<&str>) -> SpecJson {
 /// around the nominal pulse placed where it fits best (`nominal_start_s`) and the velocity
 /// change over the standards' window is within its tolerance. `margin` is the worst
 /// excursion beyond its limit over the nominal peak (negative: inside, by that much).
-#[derive(Clone, Debug, Serialize, PartialEq)]
+#[derive(Clone, Debug, Serialize, serde::Deserialize, PartialEq)]
 pub struct VerdictJson {
     pub pass: bool,
     pub band_pass: bool,

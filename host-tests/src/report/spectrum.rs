@@ -23,7 +23,7 @@ pub fn spectrum_json(s: &Spectrum) -> ShockSpectrumJson {
 }
 
 /// One impact's spectra.
-#[derive(Clone, Debug, Serialize, PartialEq)]
+#[derive(Clone, Debug, Serialize, serde::Deserialize, PartialEq)]
 pub struct ShockSpectrumJson {
     pub damping: f64,
     pub bands_per_octave: u32,

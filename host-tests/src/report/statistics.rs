@@ -6,6 +6,37 @@ use serde::Serialize;
 
 use super::ImpactJson;
 
+/// A series' statistics over its impacts, as `impact analyze FILES… --json` gives them (with
+/// the series' recordings and entries around them): the impacts, the pass rate, each
+/// metric's statistics over the comparable impacts, those left out, the later bounces'.
+#[derive(Clone, Debug, Serialize, PartialEq)]
+pub struct SeriesStatistics {
+    pub impacts: usize,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub spec: Option<PassRate>,
+    /// Over the comparable impacts only: complete, unclipped, each drop's first.
+    pub statistics: Vec<Statistic>,
+    /// The impacts the statistics left out, by why.
+    pub statistics_left_out: LeftOut,
+    /// The drops' later bounces, compared bounce by bounce: empty without bounces.
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub bounce_statistics: Vec<BounceGroup>,
+}
+
+/// The series' statistics over `impacts` (every impact of the series, in order).
+pub fn series_statistics<'a>(
+    impacts: impl Iterator<Item = &'a ImpactJson> + Clone,
+) -> SeriesStatistics {
+    let (kept, left_out) = comparable(impacts.clone());
+    SeriesStatistics {
+        impacts: impacts.clone().count(),
+        spec: pass_rate(impacts.clone()),
+        statistics: statistics(kept.iter().copied()),
+        statistics_left_out: left_out,
+        bounce_statistics: bounce_groups(impacts),
+    }
+}
+
 /// A metric across the series: its values' count, mean, sample standard deviation,
 /// coefficient of variation (sd / |mean|), least and greatest. `sd` and `cv` are null with a
 /// reason when they cannot be known (one value; a mean of zero).
@@ -357,6 +388,35 @@ mod tests {
             st.iter().all(|s| s.metric != "delta_v_m_s"),
             "no impact has one"
         );
+    }
+
+    #[test]
+    fn an_impact_reads_back_as_it_was_written() {
+        // Every optional part present and absent, a verdict not judged (`null`) apart from
+        // none asked (absent), and floats that a fast parser reads one ulp off.
+        let verdict = crate::report::spec::VerdictJson {
+            pass: false,
+            band_pass: true,
+            delta_v_pass: false,
+            margin: 0.012199679389595984,
+            worst_time_s: 0.1,
+            worst_m_s2: 1.0,
+            limit_m_s2: 2.0,
+            delta_v_m_s: 3.0,
+            nominal_start_s: 0.0,
+        };
+        let mut judged = impact(1.0, Some(0.012199679389595985));
+        judged.spec = Some(Some(verdict));
+        judged.null_reasons.insert("fits.hertz".into(), "not-asked".into());
+        let mut unjudged = impact(2.0, None);
+        unjudged.spec = Some(None);
+        unjudged.run = Some(2);
+        let none_asked = impact(3.0, None);
+        for i in [judged, unjudged, none_asked] {
+            let text = serde_json::to_string(&i).unwrap();
+            let back: ImpactJson = serde_json::from_str(&text).unwrap();
+            assert_eq!(back, i, "{text}");
+        }
     }
 
     #[test]

@@ -8,7 +8,7 @@ use super::ImpactJson;
 
 /// One bounce in the JSON: the flight and both measures of the approach speed, with the COR
 /// each gives and their disagreement.
-#[derive(Clone, Debug, Serialize, PartialEq)]
+#[derive(Clone, Debug, Serialize, serde::Deserialize, PartialEq)]
 pub struct BounceJson {
     /// 1 for the first bounce after the train's first impact.
     pub number: u32,
