@@ -67,7 +67,7 @@ def test_options_are_the_tools(cli, options):
 def test_a_failed_verdict_is_a_result_not_an_exception(cli):
     p = cli.run("analyze", AFRL, "--spec", "half-sine,10000g,0.5ms")
     assert p.returncode == 3
-    a = impact.judge(AFRL, "half-sine,10000g,0.5ms")
+    a = impact.spec(AFRL, "half-sine,10000g,0.5ms")
     assert a.passed is False and a.failed == a.judged == 1
     assert a.impacts["spec.pass"].tolist() == [False]
     assert a.json["spec"]["standard"] == "iec-60068-2-27"

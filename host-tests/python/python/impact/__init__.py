@@ -44,10 +44,10 @@ __all__ = [
     "SimulationError",
     "UsageError",
     "analyze",
-    "judge",
     "read",
     "series",
     "simulate",
+    "spec",
     "statistics",
 ]
 
@@ -269,7 +269,7 @@ def analyze(source: Union[PathLike, np.ndarray, Sequence[float]], *, rate: Optio
     return _analysed(_impact.analyze_array([name] + _argv(opts), arr))
 
 
-def judge(source: Union[PathLike, np.ndarray], spec: str, **options: Any) -> Analysis:
+def spec(source: Union[PathLike, np.ndarray], spec: str, **options: Any) -> Analysis:
     """Judges every impact against a specified pulse (``spec="half-sine,100g,3ms"``; the
     standards' tolerances as ``impact analyze --spec``); ``analysis.passed`` and the
     ``spec.*`` columns hold the verdicts, ``analysis.json["spec"]`` the spec as judged."""
