@@ -295,6 +295,17 @@ fn ten_thousand_impacts_keep_memory_flat_and_a_slow_page_never_holds_up_the_boar
 /// A headless Chromium on the view's page (killed with its process group when dropped), its
 /// profile in `scratch`.
 fn open_browser(browser: &str, addr: &str, scratch: &Scratch, name: &str) -> Ended {
+    open_page(
+        browser,
+        &format!("http://{addr}/"),
+        (1400, 1000),
+        scratch,
+        name,
+    )
+}
+
+/// A headless Chromium on `url` in a window of `size` (as [`open_browser`]).
+fn open_page(browser: &str, url: &str, size: (u32, u32), scratch: &Scratch, name: &str) -> Ended {
     use std::os::unix::process::CommandExt;
     let child = Command::new(browser)
         // Its own process group: its renderers and helpers end with it.
@@ -304,13 +315,13 @@ fn open_browser(browser: &str, addr: &str, scratch: &Scratch, name: &str) -> End
             "--no-sandbox",
             "--disable-gpu",
             "--remote-debugging-port=0",
-            "--window-size=1400,1000",
+            &format!("--window-size={},{}", size.0, size.1),
             "--enable-precise-memory-info",
             &format!(
                 "--user-data-dir={}",
                 scratch.join(&format!("profile-{name}")).display()
             ),
-            &format!("http://{addr}/"),
+            url,
         ])
         .stdout(Stdio::null())
         .stderr(Stdio::null())
@@ -757,10 +768,119 @@ impl Drop for Ended {
 /// The board's scene line states the pulse it judges: the view draws that one and says so;
 /// a `--spec` unlike it is named in a warning (the board's is drawn); a scene line whose spec
 /// is malformed is a warning, the session goes on.
+/// `impact watch --replay LOG`: a finished log fed at the pace it was written (its lines'
+/// board times), `--speed` times faster; slower than the board is refused (the page would
+/// call the board silent between its heartbeats).
+#[test]
+fn a_replay_keeps_the_pace_the_log_was_written_at() {
+    let scratch = Scratch::new();
+    let log = scratch.join("day.log");
+    // Three impacts over 1.2 s of board time, each line timed.
+    let mut lines = vec![SCENE.to_string()];
+    for k in 0..3u64 {
+        let t = 0.1 + 0.55 * k as f64;
+        let line = impact_line(2 * k, k, None);
+        lines.push(format!("{t:.6}{}", &line[line.find(' ').unwrap()..]));
+        lines.push(format!(
+            "{:.6} {}",
+            t + 0.01,
+            heartbeat(2 * k + 1, 1000, k + 1)
+        ));
+    }
+    std::fs::write(&log, lines.join("\n") + "\n").unwrap();
+    let run = |speed: &str, session: &str| {
+        let t = Instant::now();
+        let out = Command::new(env!("CARGO_BIN_EXE_impact"))
+            .args(["watch", "--terminal", "--replay"])
+            .arg(&log)
+            .args(["--speed", speed, "--session"])
+            .arg(scratch.join(session))
+            .output()
+            .unwrap();
+        (out, t.elapsed().as_secs_f64())
+    };
+    let (out, secs) = run("1", "one.log");
+    assert!(out.status.success(), "{out:?}");
+    let text = String::from_utf8_lossy(&out.stdout);
+    assert_eq!(text.matches("impact ").count(), 3, "{text}");
+    // 1.11 s from the first timed line to the last.
+    assert!((1.05..3.0).contains(&secs), "{secs} s");
+    let (out, secs) = run("4", "four.log");
+    assert!(out.status.success());
+    assert!((0.25..1.0).contains(&secs), "{secs} s at 4x");
+    // Every line kept in the session file, as it came.
+    assert_eq!(
+        std::fs::read_to_string(scratch.join("four.log")).unwrap(),
+        std::fs::read_to_string(&log).unwrap()
+    );
+    let (out, _) = run("0.5", "half.log");
+    assert_eq!(out.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&out.stderr).contains("from 1 to 1000 times"));
+}
+
+/// The scene line's fields of a board that judges a 60 g, 2.45 ms half-sine (IEC 60068-2-27).
+const BOARD_SPEC: &str = " spec=half-sine spec_peak_m_s2=588.399 spec_duration_s=0.00245 spec_band=0.2 spec_outside=0.2 spec_slack=0.1 spec_dv=0.15 spec_before=0.4 spec_after=0.1 spec_watch=1.1 spec_rise=none spec_fall=none spec_band_u=none spec_band_lower=none spec_band_upper=none";
+
+/// The bench view (`?bench`) in a 1920 × 1080 headless window, as the screen beside a drop
+/// tower shows it: the verdict is the largest text on the page, why it failed is said in
+/// words (by how much, where), and when the board falls silent the verdict stays, greyed.
+#[cfg(target_os = "linux")]
+#[test]
+fn the_bench_view_shows_the_verdict_largest_and_greys_it_when_the_board_falls_silent() {
+    let scratch = Scratch::new();
+    let Some(browser) = common::browser::chromium() else {
+        return;
+    };
+    let mut w = Watch::start(&scratch.join("bench.log"), &[]);
+    let url = format!("http://{}/?bench", w.addr);
+    let _page = open_page(browser, &url, (1920, 1080), &scratch, "bench");
+    wait_for_page(&w);
+    w.send(&format!("{SCENE}{BOARD_SPEC}"));
+    w.send(&heartbeat(0, 1000, 0));
+    w.send(&impact_line(1, 0, None));
+    // Outside the band by 20 % of the 60 g peak (12 g), 0.83 ms after the touch.
+    w.send("0.060000 INFO  spec seq=2 index=0 pass=false band_pass=false delta_v_pass=true margin=0.2 worst_s=0.0110 worst_m_s2=700.0 limit_m_s2=600.0 delta_v_m_s=1.5 start_s=0.01017");
+    let layout = |stale: bool| {
+        let t = Instant::now();
+        loop {
+            if let Some(r) = receipts(&w).into_iter().rev().find(|r| {
+                r.get("kind").is_some_and(|k| k == "layout")
+                    && r.get("verdict_text").is_some_and(|v| v == "FAIL")
+                    && r.get("verdict_stale")
+                        .is_some_and(|v| v == &stale.to_string())
+            }) {
+                return r;
+            }
+            assert!(
+                t.elapsed() < Duration::from_secs(20),
+                "no bench layout with a FAIL (stale {stale}): {:?}",
+                receipts(&w)
+            );
+            std::thread::sleep(Duration::from_millis(100));
+        }
+    };
+    for stale in [false, true] {
+        let r = layout(stale);
+        assert_eq!(r["largest"], "bench-verdict", "{r:?}");
+        // (The page's viewport: the window less headless Chromium's own frame.)
+        assert_eq!(r["width"], "1920");
+        let px: f64 = r["verdict_px"].parse().unwrap();
+        // 24 % of the viewport's height (over 900 px): readable across the room.
+        assert!(px >= 200.0, "{r:?}");
+        assert!(
+            r["why"].contains("band: outside by 12.00 g at 0.83 ms"),
+            "{r:?}"
+        );
+        if stale {
+            assert!(r["why"].contains("board SILENT"), "{r:?}");
+        }
+    }
+}
+
 #[test]
 fn the_board_states_the_pulse_it_judges_and_a_different_spec_is_warned() {
     let scratch = Scratch::new();
-    let board_spec = " spec=half-sine spec_peak_m_s2=588.399 spec_duration_s=0.00245 spec_band=0.2 spec_outside=0.2 spec_slack=0.1 spec_dv=0.15 spec_before=0.4 spec_after=0.1 spec_watch=1.1 spec_rise=none spec_fall=none spec_band_u=none spec_band_lower=none spec_band_upper=none";
+    let board_spec = BOARD_SPEC;
     // The session's lines (a log of 3 impacts whose scene lines are `scenes`, the first
     // replaced, the others inserted after its first impact) through `watch --terminal`.
     let run = |name: &str, scenes: &[String], spec: &[&str]| {

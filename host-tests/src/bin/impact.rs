@@ -30,7 +30,8 @@ const SYNTH_EXAMPLES: &str = "Examples:
 const REPORT_EXAMPLES: &str = "Examples:
   impact report host-tests/data/afrl-drop-tower/accel_5.csv --channels 1,2,3,4,5 --units kgn --spec half-sine,11000g,0.1ms --html afrl.html";
 const WATCH_EXAMPLES: &str = "Examples:
-  impact emulate seed.csv --mass 0.06 --v0 1.3357 --realtime --waveforms 8 | impact watch
+  impact emulate seed.csv --mass 0.06 --v0 1.3357 --realtime --waveforms 8 --log day.log
+  impact watch --replay day.log
   impact watch board.log --spec half-sine,100g,3ms
   impact watch board.log --terminal --once";
 const SELFTEST_EXAMPLES: &str = "Examples:

@@ -407,7 +407,9 @@ mod tests {
         };
         let mut judged = impact(1.0, Some(0.012199679389595985));
         judged.spec = Some(Some(verdict));
-        judged.null_reasons.insert("fits.hertz".into(), "not-asked".into());
+        judged
+            .null_reasons
+            .insert("fits.hertz".into(), "not-asked".into());
         let mut unjudged = impact(2.0, None);
         unjudged.spec = Some(None);
         unjudged.run = Some(2);

@@ -2,6 +2,7 @@
 //! --realtime`, a growing file, a raw defmt stream) shown live: a local web page, or one line
 //! per impact in the terminal; every line kept in the session file.
 
+mod replay;
 pub mod server;
 pub mod session;
 mod terminal;
@@ -45,6 +46,28 @@ pub struct WatchArgs {
     /// `impact-watch-<date>-<time>.log` here; never an existing file).
     #[arg(long, value_name = "FILE.log")]
     pub session: Option<PathBuf>,
+    /// Replay a finished log at the pace it was written (a demo, a second look at a
+    /// session): each line shown when as much wall-clock time has passed since the first
+    /// as the board's clock (the line's leading time, s) had, over --speed.
+    #[arg(long, value_name = "FILE.log", conflicts_with_all = ["input", "once", "elf"])]
+    pub replay: Option<PathBuf>,
+    /// With --replay: how many times faster than the board's clock (1 to 1000; not slower:
+    /// the page's health judges a heartbeat's age by the wall clock).
+    #[arg(long, value_name = "X", requires = "replay", value_parser = speed)]
+    pub speed: Option<f64>,
+}
+
+/// `--speed`: a finite factor within [1, 1000].
+fn speed(s: &str) -> Result<f64, String> {
+    match s.trim().parse::<f64>() {
+        Ok(x) if (1.0..=1000.0).contains(&x) => Ok(x),
+        Ok(_) => Err(
+            "from 1 to 1000 times the board's pace (slower, the page would call the board \
+             silent between heartbeats)"
+                .into(),
+        ),
+        Err(_) => Err("not a number".into()),
+    }
 }
 
 /// A new session file's default name: `impact-watch-YYYYMMDD-HHMMSS.log` (UTC).
@@ -296,7 +319,15 @@ pub enum WatchError {
 
 /// Runs `impact watch`.
 pub fn run(args: &WatchArgs) -> Result<(), WatchError> {
-    let input = args.input.clone().unwrap_or_else(|| PathBuf::from("-"));
+    let input = args
+        .replay
+        .clone()
+        .or_else(|| args.input.clone())
+        .unwrap_or_else(|| PathBuf::from("-"));
+    let mut pace = args
+        .replay
+        .as_ref()
+        .map(|_| replay::Pace::new(args.speed.unwrap_or(1.0)));
     let stdin = impact_io::channel::is_stdin(&input);
     let name = impact_io::channel::input_name(&input);
     let parsed = args
@@ -314,7 +345,8 @@ pub fn run(args: &WatchArgs) -> Result<(), WatchError> {
     let follow = if stdin {
         None
     } else {
-        let f = Follow::open(&input, !args.once).map_err(|source| WatchError::Open {
+        let follow = !args.once && args.replay.is_none();
+        let f = Follow::open(&input, follow).map_err(|source| WatchError::Open {
             name: name.clone(),
             source,
         })?;
@@ -436,6 +468,9 @@ pub fn run(args: &WatchArgs) -> Result<(), WatchError> {
             })
     };
     let mut on_line = |n: u64, line: &str| -> Result<(), WatchError> {
+        if let Some(pace) = pace.as_mut() {
+            pace.wait(line);
+        }
         keep(line)?;
         let events = hub.with(|s| s.line(n, line, now_ms()));
         if terminal {

@@ -820,6 +820,8 @@ fn spec_head(spec: &Spec, text: &str, from: &str, differs: Option<String>) -> Va
         "shape": spec.shape.name(),
         "peak_g": f64::from(spec.peak_m_s2) / STANDARD_GRAVITY,
         "duration_s": f64::from(spec.duration_s),
+        "nominal_delta_v_m_s": f64::from(spec.delta_v_m_s()),
+        "delta_v_tolerance": f64::from(spec.tolerance.delta_v),
         "from": from,
         "differs": differs,
     })
