@@ -70,10 +70,14 @@ step "Python package: pip install ./host-tests/python, its tests against the too
 # examples run as doctests.
 target="${CARGO_TARGET_DIR:-target}"
 venv="$target/python-venv"
-if ! "$venv/bin/python" -c 'import maturin, numpy, pandas, pytest, dask' 2>/dev/null; then
+# Made again when the pins change (the stamp holds their hash) or it does not work.
+pins="$(sha256sum host-tests/python/requirements-test.txt | cut -d' ' -f1)"
+if [[ "$(cat "$venv/pins" 2>/dev/null)" != "$pins" ]] \
+  || ! "$venv/bin/python" -c 'import maturin, numpy, pandas, pytest, dask' 2>/dev/null; then
   rm -rf "$venv"
   python3 -m venv "$venv"
   "$venv/bin/pip" install --quiet --disable-pip-version-check -r host-tests/python/requirements-test.txt
+  echo "$pins" > "$venv/pins"
 fi
 cargo build --quiet "${HOST[@]}" -p impact-host --bin impact
 # (maturin's build hook runs the `maturin` the environment installed: its bin/ on the PATH.)

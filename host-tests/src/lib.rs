@@ -44,10 +44,14 @@ pub enum WorkerError {
 pub fn on_big_stack<T: Send + 'static, E: From<WorkerError> + Send + 'static>(
     f: impl FnOnce() -> Result<T, E> + Send + 'static,
 ) -> Result<T, E> {
-    std::thread::Builder::new()
+    // The worker's notes go where the caller's go ([`impact_io::NoteScope`]).
+    let scope = impact_io::NoteScope::here();
+    let (result, notes) = std::thread::Builder::new()
         .stack_size(64 << 20)
-        .spawn(f)
+        .spawn(move || scope.run(f))
         .map_err(WorkerError::Spawn)?
         .join()
-        .map_err(|_| WorkerError::Panicked)?
+        .map_err(|_| WorkerError::Panicked)?;
+    notes.keep();
+    result
 }

@@ -241,6 +241,49 @@ pub fn with_own_notes<R>(names: OptionNames, f: impl FnOnce() -> R) -> (R, Vec<S
     (r, notes.iter().map(|n| n.text(names)).collect())
 }
 
+/// Whether the thread that starts a worker keeps its own notes ([`with_own_notes`]): the
+/// worker's notes then go back to it ([`WorkerNotes::keep`]), not to the process's, so an
+/// analysis run beside another (a series, Python threads) has all its notes and no other's.
+#[derive(Clone, Copy, Debug)]
+pub struct NoteScope {
+    own: bool,
+}
+
+/// The notes a worker thread gave in a [`NoteScope`] that keeps them apart.
+#[derive(Debug, Default)]
+pub struct WorkerNotes(Vec<Note>);
+
+impl NoteScope {
+    /// The calling thread's scope.
+    pub fn here() -> Self {
+        Self {
+            own: OWN_NOTES.with(|o| o.borrow().is_some()),
+        }
+    }
+
+    /// Runs `f` (on the worker thread) in this scope: its notes, if the starting thread
+    /// keeps its own, kept apart and returned.
+    pub fn run<R>(self, f: impl FnOnce() -> R) -> (R, WorkerNotes) {
+        if !self.own {
+            return (f(), WorkerNotes::default());
+        }
+        OWN_NOTES.with(|own| *own.borrow_mut() = Some(Vec::new()));
+        let r = f();
+        let notes = OWN_NOTES.with(|own| own.borrow_mut().take());
+        (r, WorkerNotes(notes.unwrap_or_default()))
+    }
+}
+
+impl WorkerNotes {
+    /// Keeps the worker's notes on the calling thread (the one that started it), as if it
+    /// had given them.
+    pub fn keep(self) {
+        for n in self.0 {
+            keep(n);
+        }
+    }
+}
+
 /// The notes kept so far (and forgets them), the settings they name written by `names`.
 pub fn take_notes(names: OptionNames) -> Vec<String> {
     NOTES

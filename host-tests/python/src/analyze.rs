@@ -8,7 +8,8 @@ use std::path::PathBuf;
 use clap::Parser;
 use impact_host::cli::analyze::AnalyzeCommand;
 use impact_host::cli::series as tool_series;
-use impact_host::pipeline::{self, AnalyzeArgs, PipelineError, Samples};
+use impact_host::pipeline::free_fall::FreeFallError;
+use impact_host::pipeline::{self, options, AnalyzeArgs, PipelineError, Samples};
 use impact_host::report::spec::Judged;
 use impact_host::report::ImpactJson;
 use impact_host::simulate::{self as tool_simulate, SimulateArgs, SimulateError};
@@ -17,7 +18,7 @@ use pyo3::prelude::*;
 
 use crate::{usage, AnalysisError, ReadError, SimulationError, UsageError};
 
-/// `impact analyze`'s command line, parsed as the tool parses it.
+// `impact analyze`'s command line, parsed as the tool parses it.
 #[derive(Parser)]
 #[command(name = "impact analyze", allow_negative_numbers = true)]
 struct AnalyzeCli {
@@ -25,7 +26,7 @@ struct AnalyzeCli {
     cmd: AnalyzeCommand,
 }
 
-/// `impact simulate`'s command line.
+// `impact simulate`'s command line.
 #[derive(Parser)]
 #[command(name = "impact simulate", allow_negative_numbers = true)]
 struct SimulateCli {
@@ -60,7 +61,14 @@ fn analysis_error(e: &PipelineError) -> PyErr {
         PipelineError::Read(_)
         | PipelineError::Spool { .. }
         | PipelineError::Memory { .. }
-        | PipelineError::TooFewSamples { .. } => ReadError::new_err(message),
+        | PipelineError::TooFewSamples { .. }
+        | PipelineError::NotFinite { .. }
+        | PipelineError::Scene(options::SceneError::Read(_))
+        | PipelineError::FreeFall(
+            FreeFallError::Read(_)
+            | FreeFallError::Columns { .. }
+            | FreeFallError::NoTimeColumn { .. },
+        ) => ReadError::new_err(message),
         PipelineError::Units(_)
         | PipelineError::Scene(_)
         | PipelineError::Cfc { .. }
@@ -78,16 +86,10 @@ fn analysis_error(e: &PipelineError) -> PyErr {
     }
 }
 
-/// Runs `f` with the notes it gives kept apart from another thread's analysis (and those a
-/// worker thread of it gave, kept by the process), the notes worded as the tool words them.
-fn with_notes<R>(f: impl FnOnce() -> R) -> (R, Vec<String>) {
-    let (r, mut notes) = impact_io::with_own_notes(impact_host::read_errors::flag, f);
-    for n in impact_host::take_notes() {
-        if !notes.contains(&n) {
-            notes.push(n);
-        }
-    }
-    (r, notes)
+/// Runs `f` with the notes it gives (its worker threads' too: `impact_io::NoteScope`) kept
+/// apart from another call's, worded as the tool words them.
+pub(crate) fn with_notes<R>(f: impl FnOnce() -> R) -> (R, Vec<String>) {
+    impact_io::with_own_notes(impact_host::read_errors::flag, f)
 }
 
 /// One recording's analysis as Python receives it (the notes not yet added).
@@ -194,6 +196,12 @@ pub fn analyze_array(
              analyse the .npy",
         ));
     }
+    // An array has no header to name its unit: it is said, not guessed from its name.
+    if args.units.is_none() && args.scene.is_none() {
+        return Err(UsageError::new_err(
+            "an array has no header to name its unit: give units= (g, m/s2, kgn or n)",
+        ));
+    }
     let Some(rate_hz) = args.rate else {
         return Err(UsageError::new_err(
             "an array has no time base: give rate= (samples per second)",
@@ -250,6 +258,13 @@ pub fn statistics(impacts_json: &str) -> PyResult<String> {
         .map_err(|e| UsageError::new_err(format!("not impacts as analyze gives them: {e}")))?;
     let s = impact_host::report::statistics::series_statistics(impacts.iter());
     serde_json::to_string(&s).map_err(json_error)
+}
+
+/// An impact's fields as the JSON has them when nothing is known (every column of an
+/// impacts table, for a table of no impact).
+#[pyfunction]
+pub fn impact_fields() -> PyResult<String> {
+    serde_json::to_string(&ImpactJson::default()).map_err(json_error)
 }
 
 /// `impact simulate [OPTIONS] --json`: one impact of a contact model, on a wall or a target.

@@ -48,10 +48,25 @@ create_exception!(
     "The model or its parameters refused."
 );
 
-/// A command line's parse error as the `UsageError` Python sees (clap's own message: the
-/// value refused, the accepted ones, a hint; no usage line).
+/// A command line's parse error as the `UsageError` Python sees: clap's own message (the
+/// value refused, the accepted ones, a hint) without its `error: ` and its pointer to
+/// `--help`; asked for help, where Python's is.
 fn usage(e: &clap::Error) -> PyErr {
-    UsageError::new_err(e.render().to_string().trim_end().to_string())
+    use clap::error::ErrorKind;
+    if matches!(e.kind(), ErrorKind::DisplayHelp | ErrorKind::DisplayVersion) {
+        return UsageError::new_err(
+            "help= is the command line's: in Python, help(impact.analyze) or \
+             docs/python.md (every option of `impact analyze --help` is a keyword)",
+        );
+    }
+    let text = e.render().to_string();
+    let lines: Vec<&str> = text
+        .lines()
+        .filter(|l| !l.starts_with("For more information, try"))
+        .collect();
+    let text = lines.join("\n");
+    let text = text.strip_prefix("error: ").unwrap_or(&text);
+    UsageError::new_err(text.trim_end().to_string())
 }
 
 #[pymodule]
@@ -68,6 +83,7 @@ fn _impact(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(analyze::series, m)?)?;
     m.add_function(wrap_pyfunction!(analyze::statistics, m)?)?;
     m.add_function(wrap_pyfunction!(analyze::simulate, m)?)?;
+    m.add_function(wrap_pyfunction!(analyze::impact_fields, m)?)?;
     m.add_function(wrap_pyfunction!(read::read, m)?)?;
     Ok(())
 }

@@ -16,34 +16,35 @@ use crate::ReadError;
 pub fn read<'py>(py: Python<'py>, argv: Vec<String>) -> PyResult<Bound<'py, PyDict>> {
     let cmd = super::analyze::parse(argv)?;
     let args = cmd.args;
-    let read = py.detach(|| -> PyResult<_> {
-        let ch = impact_io::read_recording(
-            &args.file,
-            &args.read_options(impact_io::progress::Progress::none()),
-        )
-        .map_err(|e| {
-            ReadError::new_err(impact_host::read_errors::ReadFailure::from(e).to_string())
-        })?;
-        let file = impact_host::pipeline::scene_file(&args)
-            .map_err(|e| crate::UsageError::new_err(e.to_string()))?;
-        let column = ch
-            .axes
-            .first()
-            .map_or(ch.name.as_str(), |(n, _)| n.as_str());
-        let (mass, scale, units, assumed) =
-            impact_host::pipeline::mass_and_scale(&args, &file, column)
+    let (read, notes) = py.detach(|| {
+        super::analyze::with_notes(|| -> PyResult<_> {
+            let ch = impact_io::read_recording(
+                &args.file,
+                &args.read_options(impact_io::progress::Progress::none()),
+            )
+            .map_err(|e| {
+                ReadError::new_err(impact_host::read_errors::ReadFailure::from(e).to_string())
+            })?;
+            let file = impact_host::pipeline::scene_file(&args)
                 .map_err(|e| crate::UsageError::new_err(e.to_string()))?;
-        // A force reads as an acceleration only over a known mass.
-        let known = units != impact_host::pipeline::Units::N || mass.is_some();
-        let mut assumptions: Vec<String> = assumed.iter().map(|a| a.text()).collect();
-        if let Some(t) = &ch.time_unit_assumed {
-            assumptions.push(format!(
-                "the time column {t:?} read in seconds (its unit not named)"
-            ));
-        }
-        let metadata = ide_metadata(&args.file);
-        Ok((ch, units, known.then_some(scale), assumptions, metadata))
-    })?;
+            let column = ch
+                .axes
+                .first()
+                .map_or(ch.name.as_str(), |(n, _)| n.as_str());
+            let (mass, scale, units, assumed) =
+                impact_host::pipeline::mass_and_scale(&args, &file, column)
+                    .map_err(|e| crate::UsageError::new_err(e.to_string()))?;
+            // A force reads as an acceleration only over a known mass.
+            let known = units != impact_host::pipeline::Units::N || mass.is_some();
+            let mut assumptions: Vec<String> = assumed.iter().map(|a| a.text()).collect();
+            if let Some(t) = &ch.time_unit_assumed {
+                assumptions.push(impact_host::pipeline::assumed_time_unit(t).text());
+            }
+            let metadata = ide_metadata(&args.file);
+            Ok((ch, units, known.then_some(scale), assumptions, metadata))
+        })
+    });
+    let read = read?;
     let (ch, units, to_m_s2, assumptions, metadata) = read;
     let d = PyDict::new(py);
     d.set_item("column", &ch.name)?;
@@ -53,6 +54,7 @@ pub fn read<'py>(py: Python<'py>, argv: Vec<String>) -> PyResult<Bound<'py, PyDi
     d.set_item("jitter", ch.jitter)?;
     d.set_item("resampled", ch.resampled)?;
     d.set_item("assumptions", assumptions)?;
+    d.set_item("notes", notes)?;
     d.set_item("metadata_json", metadata)?;
     let axes: Vec<(String, Bound<'py, PyArray1<f64>>)> = ch
         .axes

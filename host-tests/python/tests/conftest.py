@@ -41,10 +41,15 @@ class Cli:
         return subprocess.run([str(self.tool), *map(str, args)], capture_output=True, text=True, cwd=ROOT)
 
     def json(self, *args: str) -> dict:
+        return self.analysis(*args)[0]
+
+    def analysis(self, *args: str):
+        """The JSON and the notes (stderr's `note: ` lines, in order)."""
         p = self.run(*args, "--json")
         # 0: done; 3: done, a judged impact failed its spec (a result).
         assert p.returncode in (0, 3), p.stderr
-        return json.loads(p.stdout)
+        notes = [l[len("note: "):] for l in p.stderr.splitlines() if l.startswith("note: ")]
+        return json.loads(p.stdout), notes
 
 
 @pytest.fixture(scope="session")

@@ -21,6 +21,13 @@ def test_read_gives_the_samples_the_analysis_reads(cli):
     assert r.to_frame().index.name == "time_s"
 
 
+def test_read_says_what_it_chose_and_refuses_an_analysis_option():
+    r = impact.read(DATA / "afrl-drop-tower" / "series1_test1_full_100ms.csv")
+    assert len(r.notes) == 1 and r.notes[0].startswith("analysing bottom_kgn of 2 channels")
+    with pytest.raises(impact.UsageError, match="spec: an analysis's option"):
+        impact.read(IDE, spec="half-sine,100g,3ms")
+
+
 def test_read_says_what_it_assumed(tmp_path):
     f = tmp_path / "bare.csv"
     f.write_text("time_s,accel\n" + "".join(f"{i * 1e-4:.4f},{(i % 7) * 0.1}\n" for i in range(100)))

@@ -1,6 +1,7 @@
 """A series, in one process and on Dask: the same rows and statistics as
 `impact analyze FILES… --json`."""
 
+import json
 import pathlib
 import sys
 
@@ -27,12 +28,38 @@ def test_a_series_is_the_tools(cli):
 def test_a_failed_recording_is_an_entry_not_an_exception(cli, tmp_path):
     bad = tmp_path / "empty.csv"
     bad.write_text("time_s,accel_g\n")
-    want = cli.run("analyze", HAMMER[0], bad, "--json")
-    assert want.returncode == 1
+    p = cli.run("analyze", HAMMER[0], bad, "--json")
+    assert p.returncode == 1
     s = impact.series([HAMMER[0], bad])
-    assert s.json["failed"] == 1
+    assert s.json == json.loads(p.stdout)
     ((file, _), message), = s.failures.items()
-    assert file == str(bad) and message
+    assert file == str(bad)
+    assert message == json.loads(p.stdout)["entries"][1]["error"]
+
+
+def test_a_series_verdict_is_the_exit_status(cli):
+    p = cli.run("analyze", *AFRL, "--spec", "half-sine,10000g,0.5ms", "--json")
+    assert p.returncode == 3
+    s = impact.series(AFRL, spec="half-sine,10000g,0.5ms")
+    assert s.passed is False
+    assert impact.series(AFRL).passed is None
+    assert s.null_reasons.shape[0] == len(s.impacts)
+
+
+def test_bounce_statistics_gathered_are_the_series(cli, tmp_path):
+    trains = []
+    for seed in (1, 2):
+        f = tmp_path / f"train{seed}.csv"
+        p = cli.run("synth", "--model", "nonlinear", "--mass", "0.06", "--v0", "1.3357", "--stiffness", "1e4",
+                    "--damping", "0.5", "--bounces", "4", "--duration", "1.5", "--seed", str(seed), "-o", f)
+        assert p.returncode == 0, p.stderr
+        trains.append(f)
+    options = dict(mass=0.06, v0=1.3357, train="flight")
+    want = cli.json("analyze", *trains, *impact._argv(options))
+    assert want["bounce_statistics"], "the trains' bounces compared"
+    got = impact.statistics([impact.analyze(f, **options) for f in trains]).json
+    for key in ("impacts", "statistics", "statistics_left_out", "bounce_statistics"):
+        assert got.get(key) == want.get(key), key
 
 
 def test_statistics_gathered_from_single_analyses_are_the_series(cli):

@@ -136,6 +136,14 @@ pub enum PipelineError {
         #[source]
         error: std::sync::Arc<impact_io::error::SpoolError>,
     },
+    /// A sample given in memory that is not a finite number (the readers refuse the like in
+    /// a file: [`analyze_samples`]); `index` from 0.
+    #[error("{name}: sample {index} is {value}: not a finite number")]
+    NotFinite {
+        name: String,
+        index: u64,
+        value: f64,
+    },
     #[error("the survey's thread panicked")]
     SurveyPanicked,
     #[error("the reader thread panicked")]
@@ -294,6 +302,41 @@ pub fn analyze_samples(
     args: &AnalyzeArgs,
     samples: Samples<'_>,
 ) -> Result<(Setup, Vec<ImpactReport>), PipelineError> {
+    // What the readers hold a file's samples to: two at least, every one finite.
+    let n = samples.values.len();
+    if n < 2 {
+        return Err(PipelineError::TooFewSamples {
+            path: PathBuf::from(samples.name),
+            column: String::new(),
+            samples: n as u64,
+        });
+    }
+    if let Some((index, &value)) = samples
+        .values
+        .iter()
+        .enumerate()
+        .find(|(_, v)| !v.is_finite())
+    {
+        return Err(PipelineError::NotFinite {
+            name: samples.name.to_string(),
+            index: index as u64,
+            value,
+        });
+    }
+    // The signal (8 bytes a sample) and the counts twice (2 each): refused with the need
+    // when it cannot be had, never an abort half way.
+    let need = (n as u64).saturating_mul(12);
+    let mut probe: Vec<u8> = Vec::new();
+    if probe
+        .try_reserve_exact(usize::try_from(need).unwrap_or(usize::MAX))
+        .is_err()
+    {
+        return Err(PipelineError::Memory {
+            path: PathBuf::from(samples.name),
+            need_bytes: need,
+        });
+    }
+    drop(probe);
     let setup = setup_of(args, samples)?;
     let reports = run(&setup.prepared.counts, &setup.scene, setup.capture_len)?;
     note_results(args, &setup, &reports);
@@ -839,7 +882,7 @@ fn assumed_units(args: &AnalyzeArgs, file: &SceneFile, column: &str) -> Option<A
 }
 
 /// A time column (`column`) read in seconds, its header naming no unit and none given.
-pub(crate) fn assumed_time_unit(column: &str) -> Assumption {
+pub fn assumed_time_unit(column: &str) -> Assumption {
     Assumption::TimeUnit {
         column: column.to_string(),
     }

@@ -391,19 +391,22 @@ fn survey_pass(
 struct Scan<S> {
     blocks: std::sync::mpsc::SyncSender<Vec<f64>>,
     spare: std::sync::mpsc::Receiver<Vec<f64>>,
-    thread: std::thread::JoinHandle<S>,
+    thread: std::thread::JoinHandle<(S, impact_io::WorkerNotes)>,
 }
 
 impl<S: Send + 'static> Scan<S> {
     fn spawn(mut state: S, mut push: impl FnMut(&mut S, &[f64]) + Send + 'static) -> Self {
         let (blocks, rx) = std::sync::mpsc::sync_channel::<Vec<f64>>(4);
         let (back, spare) = std::sync::mpsc::channel::<Vec<f64>>();
+        let scope = impact_io::NoteScope::here();
         let thread = std::thread::spawn(move || {
-            for block in rx {
-                push(&mut state, &block);
-                let _ = back.send(block);
-            }
-            state
+            scope.run(|| {
+                for block in rx {
+                    push(&mut state, &block);
+                    let _ = back.send(block);
+                }
+                state
+            })
         });
         Self {
             blocks,
@@ -422,9 +425,12 @@ impl<S: Send + 'static> Scan<S> {
     /// The scan's state once it has every block sent.
     fn finish(self) -> Result<S, PipelineError> {
         drop(self.blocks);
-        self.thread
+        let (state, notes) = self
+            .thread
             .join()
-            .map_err(|_| PipelineError::SurveyPanicked)
+            .map_err(|_| PipelineError::SurveyPanicked)?;
+        notes.keep();
+        Ok(state)
     }
 }
 
@@ -487,20 +493,24 @@ fn read_ahead<T: Send + 'static>(
 ) -> Result<Box<dyn Source>, PipelineError> {
     let (tx, rx) = std::sync::mpsc::sync_channel::<Result<Vec<T>, PipelineError>>(4);
     let (back, spare) = std::sync::mpsc::channel::<Vec<T>>();
+    // The reader's notes (a channel chosen, a row skipped) go where the caller's go.
+    let scope = impact_io::NoteScope::here();
     let reader = std::thread::spawn(move || {
-        let mut scratch = Vec::with_capacity(CHUNK);
-        loop {
-            let mut chunk = spare.try_recv().unwrap_or_default();
-            chunk.clear();
-            if let Err(e) = fill(&mut *source, &mut scratch, &mut chunk) {
-                let _ = tx.send(Err(e));
-                break;
+        scope.run(|| {
+            let mut scratch = Vec::with_capacity(CHUNK);
+            loop {
+                let mut chunk = spare.try_recv().unwrap_or_default();
+                chunk.clear();
+                if let Err(e) = fill(&mut *source, &mut scratch, &mut chunk) {
+                    let _ = tx.send(Err(e));
+                    break;
+                }
+                if chunk.is_empty() || tx.send(Ok(chunk)).is_err() {
+                    break;
+                }
             }
-            if chunk.is_empty() || tx.send(Ok(chunk)).is_err() {
-                break;
-            }
-        }
-        source
+            source
+        })
     });
     let mut failed = None;
     for chunk in rx.iter() {
@@ -519,7 +529,8 @@ fn read_ahead<T: Send + 'static>(
         }
     }
     drop(rx);
-    let source = reader.join().map_err(|_| PipelineError::ReaderPanicked)?;
+    let (source, notes) = reader.join().map_err(|_| PipelineError::ReaderPanicked)?;
+    notes.keep();
     match failed {
         Some(e) => Err(e),
         None => Ok(source),

@@ -69,7 +69,8 @@ def _value(v: Any) -> str:
 
 def _argv(options: Mapping[str, Any]) -> list[str]:
     """Keyword arguments as ``impact analyze``'s options: ``True`` a flag, ``None`` and
-    ``False`` left out, a list joined with commas."""
+    ``False`` left out, a list joined with commas; each value joined to its flag
+    (``--column=-top``), so none is taken for an option."""
     argv: list[str] = []
     for key, v in options.items():
         if v is None or v is False:
@@ -78,23 +79,41 @@ def _argv(options: Mapping[str, Any]) -> list[str]:
         if v is True:
             argv.append(flag)
         elif isinstance(v, (list, tuple)):
-            argv += [flag, ",".join(_value(x) for x in v)]
+            argv.append(f"{flag}={','.join(_value(x) for x in v)}")
         else:
-            argv += [flag, _value(v)]
+            argv.append(f"{flag}={_value(v)}")
     return argv
+
+
+def _path(p: Any, what: str = "a recording") -> str:
+    """A path as the command line takes it, after every option (``--``): never read as an
+    option, and never ``-`` (the tool's standard input, not a Python script's)."""
+    if not isinstance(p, (str, os.PathLike)):
+        raise UsageError(f"{what}: a path (str or os.PathLike), not {type(p).__name__}")
+    text = os.fspath(p)
+    if not isinstance(text, str):
+        raise UsageError(f"{what}: a str path, not bytes")
+    if text == "-":
+        raise UsageError("'-' is the command line's standard input: give a file's path, or an array")
+    return text
+
+
+def _command(path: str, options: Mapping[str, Any]) -> list[str]:
+    return _argv(options) + ["--", path]
 
 
 # --- reading ---------------------------------------------------------------------------
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, eq=False)
 class Recording:
     """One channel of a recording as the tool reads it.
 
-    ``samples`` are in the file's ``units`` (``"g"``, ``"m/s²"``, ``"kgn"``, ``"N"``);
+    ``samples`` are in the file's ``units`` (``"g"``, ``"m/s2"``, ``"kgn"``, ``"n"``);
     ``samples * to_m_s2`` is the signal in m/s² (``to_m_s2`` is None for a force without a
-    mass). ``assumptions`` says what the tool assumed that the file did not (a unit).
-    ``metadata`` holds an enDAQ ``.IDE``'s recorder and channels (empty for other formats).
+    mass). ``assumptions`` says what the tool assumed that the file did not (a unit);
+    ``notes`` what it chose (a channel of several). ``metadata`` holds an enDAQ ``.IDE``'s
+    recorder and channels (empty for other formats).
     """
 
     samples: np.ndarray
@@ -108,6 +127,7 @@ class Recording:
     jitter: float
     axes: dict = field(default_factory=dict)
     metadata: dict = field(default_factory=dict)
+    notes: list = field(default_factory=list)
 
     def to_frame(self) -> pd.DataFrame:
         """The samples against time (``time_s`` the index), one column per axis too."""
@@ -116,11 +136,22 @@ class Recording:
         return pd.DataFrame(cols, index=pd.Index(self.time_s, name="time_s"))
 
 
+# The options that say how a recording is read and what its values are (the rest of
+# `impact analyze`'s are the analysis's, which `read` does not run).
+_READ_OPTIONS = frozenset({
+    "column", "axes", "rate", "time_column", "time_unit", "resample", "delimiter",
+    "decimal_comma", "raw_channels", "raw_type", "units", "mass", "gain", "invert", "scene",
+})
+
+
 def read(path: PathLike, *, column: Any = None, units: Optional[str] = None, **options: Any) -> Recording:
     """Reads one channel of a recording (CSV, TSV, LabVIEW text, WAV, ``.npy``, TDMS,
     enDAQ ``.IDE``, raw), with ``impact analyze``'s reading options (``column=``,
-    ``axes=``, ``rate=``, ``time_column=``, ``units=``, ``mass=``…)."""
-    d = _impact.read([os.fspath(path)] + _argv(dict(column=column, units=units, **options)))
+    ``axes=``, ``rate=``, ``time_column=``, ``time_unit=``, ``units=``, ``mass=``…)."""
+    other = sorted(set(options) - _READ_OPTIONS)
+    if other:
+        raise UsageError(f"read() reads a recording; {', '.join(other)}: an analysis's option (impact.analyze)")
+    d = _impact.read(_command(_path(path), dict(column=column, units=units, **options)))
     meta = json.loads(d["metadata_json"]) if d["metadata_json"] else {}
     return Recording(
         samples=d["samples"],
@@ -134,6 +165,7 @@ def read(path: PathLike, *, column: Any = None, units: Optional[str] = None, **o
         jitter=d["jitter"],
         axes=dict(d["axes"]),
         metadata=meta,
+        notes=list(d["notes"]),
     )
 
 
@@ -158,13 +190,30 @@ def _flatten(d: Mapping[str, Any], prefix: str = "") -> dict:
     return row
 
 
+_FIELDS: list = []
+
+
+def _fields() -> list:
+    """An impact's columns when nothing is known (the table of no impact has them)."""
+    if not _FIELDS:
+        _FIELDS.extend(_flatten(json.loads(_impact.impact_fields())))
+    return _FIELDS
+
+
 def _impacts_frame(impacts: Sequence[Mapping[str, Any]], extra: Optional[list] = None) -> pd.DataFrame:
     """One row per impact, the JSON's field names as columns (nested ones joined with
-    ``.``); a null number is NaN (its reason in ``null_reasons``)."""
+    ``.``); a null number is NaN (its reason in ``null_reasons``). A nested object null in
+    one impact and present in another (``bounce``) is its fields' columns, NaN there."""
     rows = [_flatten(i) for i in impacts]
+    names = {k for r in rows for k in r}
+    parents = {k for k in names if any(n.startswith(k + ".") for n in names)}
+    rows = [{k: v for k, v in r.items() if k not in parents} for r in rows]
     if extra is not None:
         rows = [{**e, **r} for e, r in zip(extra, rows)]
-    df = pd.DataFrame.from_records(rows)
+    if rows:
+        df = pd.DataFrame.from_records(rows)
+    else:
+        df = pd.DataFrame(columns=(list(extra[0]) if extra else []) + _fields())
     if "index" in df.columns and extra is None:
         df = df.set_index("index", drop=False)
         df.index.name = None
@@ -186,7 +235,7 @@ def _spectra(impacts: Sequence[Mapping[str, Any]]) -> list:
     return out
 
 
-@dataclass
+@dataclass(eq=False)
 class Analysis:
     """One recording's analysis: what ``impact analyze --json`` prints, as Python.
 
@@ -249,24 +298,38 @@ def _analysed(result) -> Analysis:
     return Analysis(json=json.loads(text), notes=list(notes), judged=judged, failed=failed, column=column, units=units)
 
 
+def _samples(source: Any) -> np.ndarray:
+    """An array's samples as float64 (the array itself when it is float64, C-contiguous and
+    aligned); real numbers only."""
+    arr = np.asarray(source)
+    if arr.dtype.kind not in "fiu":
+        raise UsageError(f"an array of real numbers (float or integer), not {arr.dtype}")
+    arr = np.require(arr, dtype=np.float64, requirements=["C", "A"])
+    if arr.ndim != 1:
+        raise UsageError(f"an array is one channel: 1-D samples, not shape {arr.shape}")
+    return arr
+
+
 def analyze(source: Union[PathLike, np.ndarray, Sequence[float]], *, rate: Optional[float] = None, units: Optional[str] = None, name: str = "array", **options: Any) -> Analysis:
     """Analyses a recording (a path) or samples in memory (an array with ``rate=`` in S/s
-    and ``units=``; evenly spaced from time 0), as ``impact analyze`` does.
+    and ``units=``; evenly spaced from time 0; ``name`` labels it), as ``impact analyze``
+    does.
 
     Common options: ``mass=`` (kg), ``v0=`` (m/s), ``drop_height=`` (m), ``train="flight"``,
     ``spec="half-sine,100g,3ms"``, ``srs=True``, ``cfc=1000``, ``column=``, ``axes=``,
     ``range=``, ``trigger=``; every other ``impact analyze`` option by its name.
-    A float64 array is read in place (no copy); another dtype is converted once.
+
+    A float64 array (C-contiguous, aligned) is read where it lies, without a copy; another
+    dtype or a list is converted once. The analysis itself takes about 12 bytes a sample
+    more (its signal and counts, as the command line's), refused with the need if that
+    memory cannot be had. The array is read with the GIL released: do not write to it from
+    another thread meanwhile.
     """
     opts = dict(rate=rate, units=units, **options)
-    if isinstance(source, (str, os.PathLike)):
-        return _analysed(_impact.analyze_file([os.fspath(source)] + _argv(opts)))
-    arr = np.ascontiguousarray(source, dtype=np.float64)
-    if arr.ndim != 1:
-        raise UsageError(f"an array is one channel: 1-D samples, not shape {arr.shape}")
-    if name.startswith("-"):
-        raise UsageError(f"name={name!r}: a channel's name does not begin with '-'")
-    return _analysed(_impact.analyze_array([name] + _argv(opts), arr))
+    if isinstance(source, (str, os.PathLike, bytes)):
+        return _analysed(_impact.analyze_file(_command(_path(source), opts)))
+    arr = _samples(source)
+    return _analysed(_impact.analyze_array(_command(str(name), opts), arr))
 
 
 def spec(source: Union[PathLike, np.ndarray], spec: str, **options: Any) -> Analysis:
@@ -279,7 +342,7 @@ def spec(source: Union[PathLike, np.ndarray], spec: str, **options: Any) -> Anal
 # --- series ----------------------------------------------------------------------------
 
 
-@dataclass
+@dataclass(eq=False)
 class SeriesStatistics:
     """A series' statistics as ``impact analyze FILES… --json`` gives them.
 
@@ -291,9 +354,8 @@ class SeriesStatistics:
     table: pd.DataFrame = field(init=False)
 
     def __post_init__(self) -> None:
-        self.table = pd.DataFrame.from_records(self.json.get("statistics", []))
-        if not self.table.empty:
-            self.table = self.table.set_index("metric")
+        columns = ["metric", "n", "mean", "sd", "cv", "min", "max", "null_reason"]
+        self.table = pd.DataFrame.from_records(self.json.get("statistics", []), columns=columns).set_index("metric")
 
     @property
     def left_out(self) -> dict:
@@ -316,15 +378,19 @@ def statistics(analyses: Iterable[Analysis]) -> SeriesStatistics:
     return SeriesStatistics(json=json.loads(_impact.statistics(json.dumps(impacts))))
 
 
-@dataclass
+@dataclass(eq=False)
 class Series:
     """A test series (``impact analyze FILES…``): every recording's impacts in one
-    DataFrame (``file`` and ``channel`` first), the statistics, and the recordings that
-    failed (each with its error: a failed recording is a result, not an exception)."""
+    DataFrame (``file`` and ``channel`` first), why each null is null, the spectra, the
+    statistics, and the recordings that failed (each with its error: a failed recording is
+    a result, not an exception). ``notes`` are the notes of the whole run; each recording's
+    own are its entry's (``json["entries"][k]["notes"]``)."""
 
     json: dict
     notes: list
     impacts: pd.DataFrame = field(init=False, repr=False)
+    null_reasons: pd.DataFrame = field(init=False, repr=False)
+    spectra: list = field(init=False, repr=False)
     statistics: SeriesStatistics = field(init=False, repr=False)
 
     def __post_init__(self) -> None:
@@ -333,7 +399,10 @@ class Series:
             for i in e.get("impacts", []):
                 rows.append(i)
                 extra.append({"file": e["file"], "channel": e["channel"]})
-        self.impacts = _impacts_frame(rows, extra) if rows else pd.DataFrame(columns=["file", "channel"])
+        # (No impact: the columns still there, `file` and `channel` first.)
+        self.impacts = _impacts_frame(rows, extra if rows else [{"file": None, "channel": None}])
+        self.null_reasons = _null_reasons_frame(rows, self.impacts.index)
+        self.spectra = _spectra(rows)
         self.statistics = SeriesStatistics(json={k: v for k, v in self.json.items() if k != "entries"})
 
     @property
@@ -343,20 +412,24 @@ class Series:
 
     @property
     def passed(self) -> Optional[bool]:
+        """Whether every judged impact of the series passed (None without a spec, or when
+        none could be judged); as the command line's exit status 3."""
         rate = self.json.get("spec")
         if not rate or not rate.get("judged"):
             return None
-        return rate.get("failed", 0) == 0
+        return rate["passed"] == rate["judged"]
 
 
 def series(files: Iterable[PathLike], **options: Any) -> Series:
     """Analyses recordings (files, folders, quoted patterns such as ``"runs/*.csv"``) with
     the same options, in parallel on this machine, as ``impact analyze FILES…``; for many
     machines map :func:`analyze` with Dask and gather with :func:`statistics`."""
-    paths = [os.fspath(f) for f in files]
+    if isinstance(files, (str, os.PathLike, bytes)):
+        raise UsageError("series() takes a list of recordings (one path: impact.analyze)")
+    paths = [_path(f) for f in files]
     if not paths:
         raise UsageError("a series needs at least one recording")
-    text, notes = _impact.series([paths[0]] + _argv(options), paths)
+    text, notes = _impact.series(_command(paths[0], options), paths)
     return Series(json=json.loads(text), notes=list(notes))
 
 
@@ -369,7 +442,7 @@ def simulate(model: str, **options: Any) -> dict:
     --json``: ``impact.simulate("hertz", mass=8.419e-3, v0=2, radius=6.35e-3,
     youngs=200e9, poisson=0.3)``. The result is the JSON as a dict; its time series, if any,
     as NumPy arrays."""
-    out = json.loads(_impact.simulate(_argv(dict(model=model, **options))))
+    out = json.loads(_impact.simulate(_argv(dict(model=model, **options)) + ["--"]))
     return _arrays(out)
 
 
@@ -377,7 +450,7 @@ def _arrays(v: Any) -> Any:
     """Lists of numbers in a JSON value as float64 arrays (recursively)."""
     if isinstance(v, dict):
         return {k: _arrays(x) for k, x in v.items()}
-    if isinstance(v, list) and len(v) > 1 and all(isinstance(x, (int, float)) and not isinstance(x, bool) for x in v):
+    if isinstance(v, list) and v and all(isinstance(x, (int, float)) and not isinstance(x, bool) for x in v):
         return np.asarray(v, dtype=np.float64)
     if isinstance(v, list):
         return [_arrays(x) for x in v]

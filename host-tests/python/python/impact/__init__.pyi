@@ -1,5 +1,5 @@
-# Type stubs of the `impact` package (editors complete from them; `mypy --strict` checks
-# scripts against them). The runtime is __init__.py over the Rust extension `_impact`.
+# Type stubs of the `impact` package (editors and type checkers complete and check from
+# them). The runtime is __init__.py over the Rust extension `_impact`.
 import os
 from typing import Any, Iterable, Mapping, Optional, Sequence, Union
 
@@ -38,6 +38,7 @@ class Recording:
     jitter: float
     axes: dict[str, npt.NDArray[np.float64]]
     metadata: dict[str, Any]
+    notes: list[str]
     def to_frame(self) -> pd.DataFrame: ...
 
 def read(
@@ -49,8 +50,15 @@ def read(
     rate: Optional[float] = ...,
     time_column: Union[str, int, None] = ...,
     time_unit: Optional[str] = ...,
+    resample: bool = ...,
+    delimiter: Optional[str] = ...,
+    decimal_comma: bool = ...,
+    raw_channels: Optional[int] = ...,
+    raw_type: Optional[str] = ...,
     mass: Optional[float] = ...,
-    **options: Any,
+    gain: Optional[float] = ...,
+    invert: bool = ...,
+    scene: Optional[PathLike] = ...,
 ) -> Recording: ...
 
 class Analysis:
@@ -108,11 +116,13 @@ class Series:
     json: dict[str, Any]
     notes: list[str]
     impacts: pd.DataFrame
+    null_reasons: pd.DataFrame
+    spectra: list[Optional[dict[str, npt.NDArray[np.float64]]]]
     statistics: SeriesStatistics
     @property
     def failures(self) -> dict[tuple[str, str], str]: ...
     @property
     def passed(self) -> Optional[bool]: ...
 
-def series(files: Iterable[PathLike], **options: Any) -> Series: ...
+def series(files: Sequence[PathLike], **options: Any) -> Series: ...
 def simulate(model: str, **options: Any) -> dict[str, Any]: ...
