@@ -98,6 +98,8 @@ fn q(v: f64, unit: &str) -> String {
 /// `measured` over `nominal`, as a signed percentage error.
 fn error_pct(measured: f64, nominal: f64) -> String {
     let e = 100.0 * (measured / nominal - 1.0);
+    // (A error that rounds to zero is written +0.0 %, never -0.0 %.)
+    let e = if e.abs() < 0.05 { 0.0 } else { e };
     if e.is_finite() {
         format!("{e:+.1} %")
     } else {
