@@ -2,9 +2,9 @@
 //! engineer can hand in and a quality manager sign: the verdict first (a banner, then each
 //! pulse against the nominal one: `verdict`), the title block (the lab's `--meta`, an `.IDE`
 //! recording's recorder and sensor, when and by what the report was written: `title`), the
-//! settings and every input with its SHA-256 (`provenance`), the series table and
-//! statistics, and every impact's pulse drawn with the nominal pulse, its tolerance band and
-//! the worst point when a specification is given.
+//! series table and statistics, every impact's pulse drawn with the nominal pulse, its
+//! tolerance band and the worst point when a specification is given, and last the settings
+//! and every input with its SHA-256 (`provenance`).
 
 pub mod board;
 pub mod provenance;
@@ -181,7 +181,7 @@ table.verdicts td.l{white-space:normal}";
 
 /// The page: `results` analysed with the windows' filter `cfc`, against `required`, with
 /// `front`'s title block and inputs: the verdict first, then who and what, the verdicts of each
-/// pulse, the settings and inputs, the series, the pulses.
+/// pulse, the series, the pulses; the settings and the inputs last.
 fn page(
     cfc: Option<u32>,
     results: &[EntryJson],
@@ -204,8 +204,6 @@ fn page(
     verdict::banner(&mut h, results);
     title::title_block(&mut h, &front.meta, &front.recorded, front.written);
     verdict::verdicts_table(&mut h, results);
-    provenance::settings(&mut h, cfc, results, required);
-    provenance::inputs_table(&mut h, &front.inputs);
     impacts_table(&mut h, results, required);
     for e in results {
         if let Some(err) = &e.error {
@@ -267,6 +265,9 @@ fn page(
     if let Some(r) = required {
         spectra(&mut h, results, r);
     }
+    // The appendix: how the report was made, and from what.
+    provenance::settings(&mut h, cfc, results, required);
+    provenance::inputs_table(&mut h, &front.inputs);
     h.raw("</body></html>\n");
     h
 }

@@ -135,6 +135,32 @@ pub fn why(c: Criterion, v: &VerdictJson, s: &SpecJson) -> String {
     }
 }
 
+/// [`why`] in a table's cell: the limit, the time and the values; Δv's tolerance and window
+/// (its error is in the row).
+fn why_short(c: Criterion, v: &VerdictJson, s: &SpecJson) -> String {
+    let g = |a: f64| q(a / STANDARD_GRAVITY, "g");
+    match c {
+        Criterion::BandUpper | Criterion::BandLower => format!(
+            "{} limit at t = {}: {} against {} (beyond by {:.1} % of the peak)",
+            if c == Criterion::BandUpper {
+                "upper"
+            } else {
+                "lower"
+            },
+            q(v.worst_time_s, "s"),
+            g(v.worst_m_s2),
+            g(v.limit_m_s2),
+            100.0 * v.margin,
+        ),
+        Criterion::DeltaV => format!(
+            "Δv outside ±{:.0} % (t = {} to {})",
+            100.0 * s.delta_v_tolerance,
+            q(v.nominal_start_s - s.before * s.duration_s, "s"),
+            q(v.nominal_start_s + (1.0 + s.after) * s.duration_s, "s"),
+        ),
+    }
+}
+
 /// The banner: the run's verdict, the counts, and each failing pulse named (at most
 /// [`MAX_NAMED`]) with what it failed, linked to its row of the verdicts' table.
 pub fn banner(h: &mut Html, results: &[EntryJson]) {
@@ -235,7 +261,7 @@ pub fn verdicts_table(h: &mut Html, results: &[EntryJson]) {
         s.before,
         s.after
     );
-    h.raw("<table class=\"verdicts\"><tr><th class=\"l\" rowspan=\"2\">pulse</th><th class=\"l\" rowspan=\"2\">verdict</th><th colspan=\"3\">peak (g)</th><th colspan=\"3\">duration</th><th colspan=\"3\">Δv (m/s)</th><th class=\"l\" rowspan=\"2\">failed: what, and where</th></tr>\n");
+    h.raw("<table class=\"verdicts\"><tr><th class=\"l\" rowspan=\"2\">pulse</th><th class=\"l\" rowspan=\"2\">verdict</th><th colspan=\"3\">peak (g)</th><th colspan=\"3\">duration</th><th colspan=\"3\">Δv (m/s)</th><th class=\"l\" rowspan=\"2\">failed: the band's limit or Δv, and where</th></tr>\n");
     h.raw("<tr><th>nominal</th><th>measured</th><th>error</th><th>nominal</th><th>measured</th><th>error</th><th>nominal</th><th>judged</th><th>error</th></tr>\n");
     let g = STANDARD_GRAVITY;
     for (k, (e, i)) in series::impacts(results).enumerate() {
@@ -285,7 +311,7 @@ pub fn verdicts_table(h: &mut Html, results: &[EntryJson]) {
                 } else {
                     html!(h, "<td class=\"fail\">{}</td>", error);
                 }
-                let what: Vec<String> = v.failed().iter().map(|&c| why(c, v, s)).collect();
+                let what: Vec<String> = v.failed().iter().map(|&c| why_short(c, v, s)).collect();
                 html!(
                     h,
                     "<td class=\"l\">{}</td></tr>\n",
