@@ -449,6 +449,7 @@ fn the_title_block_holds_the_lab_s_lines_and_the_recording_s_own() {
     );
     let (code, _, err) = impact(&["report", &ide(), "--meta", "operator", "--html", &html]);
     assert_eq!(code, 2, "a usage error: {err}");
+    assert!(err.contains("no `=` between a key and its value"), "{err}");
 }
 
 /// `bytes`' SHA-256 in lower-case hex.

@@ -41,6 +41,8 @@ pub struct MetaArgs {
 pub enum MetaLineError {
     #[error("no `=` or `:` between a key and its value")]
     NoSeparator,
+    #[error("no `=` between a key and its value")]
+    NoEquals,
     #[error("an empty key")]
     EmptyKey,
     #[error("a control character in {0}")]
@@ -73,7 +75,7 @@ pub enum MetaError {
 
 /// A `--meta` value: `KEY=VALUE`.
 fn parse_meta(s: &str) -> Result<(String, String), MetaLineError> {
-    let (k, v) = s.split_once('=').ok_or(MetaLineError::NoSeparator)?;
+    let (k, v) = s.split_once('=').ok_or(MetaLineError::NoEquals)?;
     entry(k, v)
 }
 
@@ -393,7 +395,7 @@ mod tests {
             ]
         );
         assert_eq!(parse_meta("x = 1 = 2"), Ok(("x".into(), "1 = 2".into())));
-        assert_eq!(parse_meta("x"), Err(MetaLineError::NoSeparator));
+        assert_eq!(parse_meta("x: 1"), Err(MetaLineError::NoEquals));
         assert_eq!(label("Test_ID"), "Test ID");
         assert_eq!(label("DUT"), "Device under test");
         assert_eq!(label("shaker"), "shaker");
