@@ -45,6 +45,8 @@ ln -s "$root/host-tests/fixtures" "$work/fixtures"
 ln -s "$root/host-tests/examples" "$work/examples"
 ln -s "$root/docs" "$work/docs"
 cd "$work"
+# The reports' time (the reproducible-builds convention; their commit is normalised below).
+export SOURCE_DATE_EPOCH=1764385620
 
 # A path as a literal sed pattern.
 literal() { printf '%s' "$1" | sed 's/[][\.*^$+?(){}|#/]/\\&/g'; }
@@ -66,6 +68,8 @@ normalise() {
     -e 's/^\[[0-9.:, ]+\]/[T]/' \
     -e 's/^[0-9]+\.[0-9]+ (TRACE|DEBUG|INFO|WARN|ERROR) /T \1 /' \
     -e 's/(busy )[0-9.]+ %/\1T %/g' \
+    -e 's/(git commit )([0-9a-f]{40}|unknown)/\1COMMIT/g' \
+    -e 's/(board.s session<\/td><td class="l">[^<]*<\/td><td>[0-9]+<\/td><td class="l hash">)[0-9a-f]{64}/\1HASH/' \
     -e 's/(stack )[0-9]+( of [0-9]+ B \()[0-9]+( %\))/\1T\2T\3/g' \
     -e '/^building the QEMU firmware/d' \
     "$1"

@@ -3,10 +3,15 @@
 //! browser (Chromium from the distribution's packages: `scripts/setup.sh` installs it; with
 //! `IMPACT_REQUIRE_BROWSER` set a missing browser is an error, not a skip): the page loads,
 //! every figure is there, and its screenshot is a full, non-blank image. A required SRS: each
-//! impact's SRS judged against it and drawn over it.
+//! impact's SRS judged against it and drawn over it. A deliverable to sign: the verdict's
+//! banner first, each failing pulse named with the criterion it failed and where; the title
+//! block (`--meta`, `--meta-file`, an `.IDE`'s recorder and sensor, the time and the tool's
+//! commit); every input's SHA-256; a hostile `--meta` escaped.
 
 use std::path::Path;
 use std::process::Command;
+
+use sha2::{Digest, Sha256};
 
 mod common;
 use common::browser::chromium;
@@ -297,6 +302,10 @@ fn the_report_loads_in_a_headless_browser_with_every_figure() {
     let dom_text = String::from_utf8_lossy(&dom.stdout);
     assert_eq!(dom_text.matches("<svg").count(), 5, "{dom_text}");
     assert!(dom_text.contains("statistics over the 0 comparable impacts"));
+    assert!(
+        dom_text.contains("<b>FAIL</b>: 0 of 5 pulses pass"),
+        "the banner"
+    );
     let log = String::from_utf8_lossy(&dom.stderr);
     assert!(
         !log.contains("Uncaught") && !log.contains(":CONSOLE("),
@@ -318,4 +327,313 @@ fn the_report_loads_in_a_headless_browser_with_every_figure() {
         "{} bytes: a blank page?",
         bytes.len()
     );
+}
+
+/// Runs `impact ARGS` with `SOURCE_DATE_EPOCH` set to `epoch`: (exit code, stdout, stderr).
+fn impact_at(epoch: &str, args: &[&str]) -> (i32, String, String) {
+    let out = Command::new(env!("CARGO_BIN_EXE_impact"))
+        .env("SOURCE_DATE_EPOCH", epoch)
+        .args(args)
+        .output()
+        .unwrap();
+    (
+        out.status.code().unwrap_or(-1),
+        String::from_utf8_lossy(&out.stdout).into_owned(),
+        String::from_utf8_lossy(&out.stderr).into_owned(),
+    )
+}
+
+fn ide() -> String {
+    format!(
+        "{}/data/endaq-high-drop/High-Drop.IDE",
+        env!("CARGO_MANIFEST_DIR")
+    )
+}
+
+/// A row of the title block.
+fn title_row(label: &str, value: &str) -> String {
+    format!("<tr><th class=\"l\">{label}</th><td class=\"l\">{value}</td></tr>")
+}
+
+#[test]
+fn the_title_block_holds_the_lab_s_lines_and_the_recording_s_own() {
+    let scratch = Scratch::new();
+    let meta = scratch.text(
+        "meta.txt",
+        "# drop 7\ntest-id = T-0042\ndut: bracket, rev B\ncalibration-due = 2027-01-31\n",
+    );
+    let html = scratch.join_str("ide.html");
+    let (code, _, err) = impact_at(
+        "1764385620",
+        &[
+            "report",
+            &ide(),
+            "--column",
+            "8.1",
+            "--meta-file",
+            &meta,
+            "--meta",
+            "operator=A. Smith",
+            "--meta",
+            "test-id=T-0043",
+            "--meta",
+            "shaker=LDS V8",
+            "--html",
+            &html,
+        ],
+    );
+    assert_eq!(code, 0, "{err}");
+    let page = std::fs::read_to_string(&html).unwrap();
+    // The lab's lines with their labels, in the order given: the file's, then --meta's (one
+    // that the file also gives takes its place with the command line's value); an unknown key
+    // as it is.
+    let rows = [
+        title_row("Test ID", "T-0043"),
+        title_row("Device under test", "bracket, rev B"),
+        title_row("Calibration due", "2027-01-31"),
+        title_row("Operator", "A. Smith"),
+        title_row("shaker", "LDS V8"),
+        title_row(
+            "Report written",
+            "2025-11-29T03:07:00Z (UTC, from SOURCE_DATE_EPOCH)",
+        ),
+    ];
+    let at: Vec<usize> = rows
+        .iter()
+        .map(|r| {
+            page.find(r.as_str())
+                .unwrap_or_else(|| panic!("{r} missing"))
+        })
+        .collect();
+    assert!(at.windows(2).all(|w| w[0] < w[1]), "the order: {at:?}");
+    assert!(!page.contains("T-0042"), "the file's test-id replaced");
+    // The tool's version and the commit it was built from (a copy without git: unknown).
+    let tool = format!(
+        "<th class=\"l\">Tool</th><td class=\"l\">impact {}, git commit ",
+        env!("CARGO_PKG_VERSION")
+    );
+    let k = page.find(&tool).expect("the tool's row") + tool.len();
+    let commit = &page[k..page[k..].find('<').unwrap() + k];
+    assert!(
+        commit == "unknown"
+            || (commit.len() == 40 && commit.bytes().all(|b| b.is_ascii_hexdigit())),
+        "{commit}"
+    );
+    // The recording's own account: the recorder, the analysed subchannel's sensor, the
+    // factory calibration (as enDAQ's idelib reads them from the file).
+    for want in [
+        "Slam Stick X (2000g+DC), part number LOG-0002-02kG-DC, serial 6468, firmware 1.20.1",
+        "832M1 PE Accelerometer, serial 5663-033 (subchannel 8.1 Z (2000g))",
+        "calibrated 2019-01-29, calibration no. 4953, no expiry recorded",
+    ] {
+        assert!(page.contains(want), "{want} missing");
+    }
+    // The block comes after the verdict's banner and before the series.
+    let banner = page.find("id=\"verdict\"").unwrap();
+    assert!(banner < at[0] && at[0] < page.find("<h2>Impacts</h2>").unwrap());
+    // A SOURCE_DATE_EPOCH that is no time, a meta line without a value's separator: refused.
+    let (code, _, err) = impact_at("tomorrow", &["report", &ide(), "--html", &html]);
+    common::assert_refused(
+        Some(code),
+        &err,
+        "SOURCE_DATE_EPOCH=\"tomorrow\"",
+        "a bad epoch",
+    );
+    let bad = scratch.text("bad.txt", "test-id = 1\njust words\n");
+    let (code, _, err) = impact(&["report", &ide(), "--meta-file", &bad, "--html", &html]);
+    common::assert_refused(
+        Some(code),
+        &err,
+        "bad.txt: line 2: no `=` or `:` between a key and its value",
+        "a bad meta file",
+    );
+    let (code, _, err) = impact(&["report", &ide(), "--meta", "operator", "--html", &html]);
+    assert_eq!(code, 2, "a usage error: {err}");
+    assert!(err.contains("no `=` between a key and its value"), "{err}");
+}
+
+/// `bytes`' SHA-256 in lower-case hex.
+fn sha256(bytes: &[u8]) -> String {
+    Sha256::digest(bytes)
+        .iter()
+        .map(|b| format!("{b:02x}"))
+        .collect()
+}
+
+#[test]
+fn every_input_is_listed_with_its_size_and_sha_256() {
+    let scratch = Scratch::new();
+    let required = scratch.text("required.csv", required_text());
+    let meta = scratch.text("meta.txt", "test-id: T-7\n");
+    let html = scratch.join_str("hashes.html");
+    let (code, _, err) = impact(&[
+        "report",
+        &afrl(),
+        "--channels",
+        "1,2",
+        "--units",
+        "kgn",
+        "--srs-required",
+        &required,
+        "--meta-file",
+        &meta,
+        "--html",
+        &html,
+    ]);
+    assert_eq!(code, 0, "{err}");
+    let page = std::fs::read_to_string(&html).unwrap();
+    // Each file once (the recording is analysed twice), with its role, size and hash.
+    for (role, path) in [
+        ("recording", afrl()),
+        ("required SRS", required.clone()),
+        ("meta file", meta.clone()),
+    ] {
+        let bytes = std::fs::read(&path).unwrap();
+        let row = format!(
+            "<tr><td class=\"l\">{role}</td><td class=\"l\">{path}</td><td>{}</td><td class=\"l hash\">{}</td></tr>",
+            bytes.len(),
+            sha256(&bytes)
+        );
+        assert_eq!(page.matches(&row).count(), 1, "{row}");
+    }
+    assert_eq!(page.matches("<td class=\"l hash\">").count(), 3);
+}
+
+#[test]
+fn the_verdict_comes_first_and_names_each_failing_pulse_with_what_it_failed_and_where() {
+    let scratch = Scratch::new();
+    let page = write_report(&scratch.join("afrl.html"));
+    // The banner first: before the title block, the verdicts, the settings and the table.
+    let banner = page
+        .find("<div class=\"banner banner-fail\" id=\"verdict\"><p class=\"headline\"><b>FAIL</b>: 0 of 5 pulses pass</p>")
+        .expect("the banner");
+    for later in [
+        "<table class=\"title\">",
+        "<h2>Verdicts</h2>",
+        "<h2>Settings and provenance</h2>",
+        "<h2>Impacts</h2>",
+        "<h2>Pulses</h2>",
+    ] {
+        assert!(
+            banner < page.find(later).unwrap(),
+            "{later} before the banner"
+        );
+    }
+    assert!(page[..banner].matches("<table").count() == 0);
+    // Each pulse named, with the criterion its verdict failed and where, as the JSON has it.
+    let (json, _) = impact_judged(&[
+        "analyze",
+        &afrl(),
+        "--channels",
+        "1,2,3,4,5",
+        "--units",
+        "kgn",
+        "--spec",
+        "half-sine,11000g,0.1ms",
+        "--json",
+    ]);
+    let j: serde_json::Value = serde_json::from_str(&json).unwrap();
+    let recordings = j["entries"].as_array().unwrap();
+    assert_eq!(recordings.len(), 5);
+    for (k, r) in recordings.iter().enumerate() {
+        let v = &r["impacts"][0]["spec"];
+        assert_eq!(v["pass"], false);
+        let limit = v["worst_limit"].as_str().unwrap();
+        let words = match limit {
+            "upper" => "above the band's upper limit",
+            "lower" => "below the band's lower limit",
+            other => panic!("worst_limit {other}"),
+        };
+        // The worst sample beyond its limit: above the upper one, below the lower one.
+        let (worst, lim) = (
+            v["worst_m_s2"].as_f64().unwrap(),
+            v["limit_m_s2"].as_f64().unwrap(),
+        );
+        assert_eq!(worst > lim, limit == "upper", "{v}");
+        let at = format!("at t = {:.1} µs", v["worst_time_s"].as_f64().unwrap() * 1e6);
+        let named = format!(
+            "<li><a href=\"#pulse-{k}\">accel_5.csv [{}] impact 0</a>: {words}: ",
+            k + 1
+        );
+        let li = page
+            .find(&named)
+            .unwrap_or_else(|| panic!("{named} missing"));
+        let line = &page[li..li + page[li..].find("</li>").unwrap()];
+        assert!(line.contains(&at), "{line}: {at}");
+        // Its row in the verdicts' table, which the banner links to.
+        assert!(page.contains(&format!("<tr id=\"pulse-{k}\"><td class=\"l\">accel_5.csv [{}] impact 0</td><td class=\"l fail\">FAIL</td>", k + 1)));
+    }
+    // The judged Δv against the nominal one, each pulse's worst point circled in its figure.
+    let nominal = j["entries"][0]["spec"]["nominal_delta_v_m_s"]
+        .as_f64()
+        .unwrap();
+    assert!(
+        page.contains(&format!("<td>{nominal:.3}</td>")),
+        "nominal Δv {nominal}"
+    );
+    assert_eq!(page.matches("<circle class=\"worst\"").count(), 5);
+    assert_eq!(page.matches(">worst point: fails</text>").count(), 5);
+}
+
+#[test]
+fn a_pulse_failing_its_delta_v_is_named_so_with_its_window() {
+    let scratch = Scratch::new();
+    let html = scratch.join_str("dv.html");
+    // AFRL's pulse as an 11 000 g, 100 µs half-sine with Δv within ±2 %: its Δv is 5 % high.
+    let (_, err) = impact_judged(&[
+        "report",
+        &format!(
+            "{}/data/afrl-drop-tower/series1_test1_full_100ms.csv",
+            env!("CARGO_MANIFEST_DIR")
+        ),
+        "--column",
+        "bottom_kgn",
+        "--spec",
+        "half-sine,11000g,0.1ms,dv=0.02",
+        "--html",
+        &html,
+    ]);
+    assert!(err.contains("1 of 1 judged impact failed"), "{err}");
+    let page = std::fs::read_to_string(&html).unwrap();
+    let li = page.find("<li><a href=\"#pulse-0\">").expect("named");
+    let line = &page[li..li + page[li..].find("</li>").unwrap()];
+    assert!(line.contains("below the band's lower limit: "), "{line}");
+    assert!(
+        line.contains("; Δv outside its tolerance: 7.240 m/s is +5.4 % of the nominal 6.867 m/s (tolerance ±2 %), integrated from t = "),
+        "{line}"
+    );
+}
+
+#[test]
+fn a_hostile_meta_value_reaches_the_page_escaped() {
+    let scratch = Scratch::new();
+    let meta = scratch.text("meta.txt", "lab = <img onerror=\"x\">&amp;\n");
+    let html = scratch.join_str("hostile.html");
+    let (code, _, err) = impact(&[
+        "report",
+        &ide(),
+        "--meta",
+        "operator=<script>alert(\"x\")</script>",
+        "--meta",
+        "<b>key</b>=v",
+        "--meta-file",
+        &meta,
+        "--html",
+        &html,
+    ]);
+    assert_eq!(code, 0, "{err}");
+    let page = std::fs::read_to_string(&html).unwrap();
+    for raw in ["<script", "<img", "<b>key"] {
+        assert!(!page.contains(raw), "{raw} unescaped");
+    }
+    for escaped in [
+        title_row(
+            "Operator",
+            "&lt;script&gt;alert(&quot;x&quot;)&lt;/script&gt;",
+        ),
+        title_row("&lt;b&gt;key&lt;/b&gt;", "v"),
+        title_row("Laboratory", "&lt;img onerror=&quot;x&quot;&gt;&amp;amp;"),
+    ] {
+        assert!(page.contains(&escaped), "{escaped} missing");
+    }
 }

@@ -188,7 +188,8 @@ pub fn spec_json(spec: &Spec, named: Option<&str>) -> SpecJson {
 /// One impact's verdict: pass only if every sample in the watched window lies within the band
 /// around the nominal pulse placed where it fits best (`nominal_start_s`) and the velocity
 /// change over the standards' window is within its tolerance. `margin` is the worst
-/// excursion beyond its limit over the nominal peak (negative: inside, by that much).
+/// excursion beyond its limit over the nominal peak (negative: inside, by that much), at
+/// `worst_time_s`, against the band's `worst_limit` (`limit_m_s2`).
 #[derive(Clone, Debug, Serialize, serde::Deserialize, PartialEq)]
 pub struct VerdictJson {
     pub pass: bool,
@@ -198,8 +199,71 @@ pub struct VerdictJson {
     pub worst_time_s: f64,
     pub worst_m_s2: f64,
     pub limit_m_s2: f64,
+    pub worst_limit: Limit,
     pub delta_v_m_s: f64,
     pub nominal_start_s: f64,
+}
+
+/// Which of the band's limits the worst point is measured against: beyond it when the band
+/// fails there, else the nearer one.
+#[derive(Clone, Copy, Debug, Serialize, serde::Deserialize, PartialEq, Eq)]
+#[serde(rename_all = "lowercase")]
+pub enum Limit {
+    Upper,
+    Lower,
+}
+
+impl Limit {
+    /// The limit the core's verdict measured its worst excursion against: its value `worst`
+    /// and the limit `limit` (m/s²) and how far beyond it (`margin`, negative inside). Beyond
+    /// the upper limit the value is above it; inside, the nearer limit is the upper one when
+    /// the value lies at or below it (the lower one lies below the value).
+    pub fn of(worst: f32, limit: f32, margin: f32) -> Limit {
+        if (margin > 0.0) == (worst > limit) {
+            Limit::Upper
+        } else {
+            Limit::Lower
+        }
+    }
+}
+
+/// A criterion of the verdict an impact failed.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Criterion {
+    /// A sample above the band's upper limit (at the worst point).
+    BandUpper,
+    /// A sample below the band's lower limit.
+    BandLower,
+    /// The velocity change outside its tolerance.
+    DeltaV,
+}
+
+impl Criterion {
+    /// In words, for the report.
+    pub fn words(self) -> &'static str {
+        match self {
+            Criterion::BandUpper => "above the band's upper limit",
+            Criterion::BandLower => "below the band's lower limit",
+            Criterion::DeltaV => "Δv outside its tolerance",
+        }
+    }
+}
+
+impl VerdictJson {
+    /// The criteria it failed, the band's first (none: it passed).
+    pub fn failed(&self) -> Vec<Criterion> {
+        let mut out = Vec::new();
+        if !self.band_pass {
+            out.push(match self.worst_limit {
+                Limit::Upper => Criterion::BandUpper,
+                Limit::Lower => Criterion::BandLower,
+            });
+        }
+        if !self.delta_v_pass {
+            out.push(Criterion::DeltaV);
+        }
+        out
+    }
 }
 
 /// The verdict as JSON, times from `t0`; `None` (null) if it could not be judged.
@@ -213,6 +277,7 @@ pub fn verdict_json(v: &Result<Verdict, Missing>, t0: f64) -> Option<VerdictJson
         worst_time_s: t0 + v.worst_s,
         worst_m_s2: f64::from(v.worst_m_s2),
         limit_m_s2: f64::from(v.limit_m_s2),
+        worst_limit: Limit::of(v.worst_m_s2, v.limit_m_s2, v.margin),
         delta_v_m_s: f64::from(v.delta_v_m_s),
         nominal_start_s: t0 + v.start_s,
     })
@@ -309,4 +374,19 @@ pub fn not_judged(reason: &str) -> String {
         _ => return reason.to_string(),
     };
     format!("{reason}: {words}")
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_worst_point_s_limit_is_the_one_it_is_beyond_or_nearest() {
+        // Beyond: above the upper limit, below the lower one.
+        assert_eq!(Limit::of(120.0, 110.0, 0.1), Limit::Upper);
+        assert_eq!(Limit::of(80.0, 90.0, 0.1), Limit::Lower);
+        // Inside: the upper limit above the value, the lower one below it.
+        assert_eq!(Limit::of(100.0, 110.0, -0.1), Limit::Upper);
+        assert_eq!(Limit::of(100.0, 90.0, -0.1), Limit::Lower);
+    }
 }

@@ -402,6 +402,7 @@ mod tests {
             worst_time_s: 0.1,
             worst_m_s2: 1.0,
             limit_m_s2: 2.0,
+            worst_limit: crate::report::spec::Limit::Upper,
             delta_v_m_s: 3.0,
             nominal_start_s: 0.0,
         };

@@ -2,6 +2,7 @@
 //! timecode scales) and calibration polynomials, from the `CalibrationList` and
 //! `RecordingProperties` elements (IDs from idelib's schemata/mide_ide.xml).
 
+use super::metadata::{self, Calibration, Recorder, Sensor};
 use super::{ebml, IdeError};
 use crate::error::{ChannelProblem, IdeUnsupported, Malformation};
 use std::collections::HashMap;
@@ -9,6 +10,7 @@ use std::collections::HashMap;
 const UNIVARIATE: u32 = 0x4B01;
 const BIVARIATE: u32 = 0x4B02;
 const RECORDER_INFO: u32 = 0x5210;
+const SENSOR_LIST: u32 = 0x5240;
 const CHANNEL_LIST: u32 = 0x5270;
 const CHANNEL: u32 = 0x5271;
 const SUBCHANNEL: u32 = 0x52A0;
@@ -18,9 +20,12 @@ const DEFAULT_TICK_US: f64 = 1_000_000.0 / 32768.0;
 /// What the header elements of a recording say.
 #[derive(Debug, Clone, Default)]
 pub struct Recording {
-    pub product_name: String,
-    pub part_number: String,
-    pub serial: Option<u64>,
+    /// The recorder (`RecorderInfo`).
+    pub recorder: Recorder,
+    /// Its sensors (`SensorList`), in the file's order.
+    pub sensors: Vec<Sensor>,
+    /// The factory calibration's date, expiry and number (`CalibrationList`).
+    pub calibration: Calibration,
     /// Session start, Unix seconds (TimeBaseUTC / TimeBaseUTCFine), if recorded.
     pub utc_start: Option<f64>,
     pub channels: Vec<Channel>,
@@ -31,7 +36,7 @@ impl Recording {
     pub(super) fn parse_calibration(&mut self, body: &[u8], base: u64) -> Result<(), IdeError> {
         for child in ebml::children(body, base) {
             let (kind, b, at) = child?;
-            if kind != UNIVARIATE && kind != BIVARIATE {
+            if self.calibration.read(kind, b, at) || (kind != UNIVARIATE && kind != BIVARIATE) {
                 continue;
             }
             let (mut id, mut p) = (
@@ -79,12 +84,14 @@ impl Recording {
     pub(super) fn parse_properties(&mut self, body: &[u8], base: u64) -> Result<(), IdeError> {
         for child in ebml::children(body, base) {
             let (id, b, at) = child?;
+            if id == SENSOR_LIST {
+                self.sensors = metadata::sensors(b, at);
+                continue;
+            }
             for c in ebml::children(b, at).filter(|_| id == RECORDER_INFO || id == CHANNEL_LIST) {
                 let (cid, v, o) = c?;
                 match (id, cid) {
-                    (RECORDER_INFO, 0x5212) => self.serial = Some(ebml::uint(v, o)?),
-                    (RECORDER_INFO, 0x5214) => self.product_name = ebml::string(v),
-                    (RECORDER_INFO, 0x5218) => self.part_number = ebml::string(v),
+                    (RECORDER_INFO, _) => self.recorder.read(cid, v, o),
                     (CHANNEL_LIST, CHANNEL) => {
                         let ch = parse_channel(v, o)?;
                         self.channels.retain(|c| c.id != ch.id);
@@ -196,6 +203,8 @@ pub struct SubChannel {
     pub label: String,
     /// Engineering units after calibration, e.g. "g".
     pub units: String,
+    /// The sensor it measures with (`SubChannelSensorRef`: a [`Sensor`]'s id).
+    pub sensor: Option<u64>,
     pub(super) cal: Option<u64>,
 }
 
@@ -291,6 +300,7 @@ fn parse_channel(body: &[u8], base: u64) -> Result<Channel, IdeError> {
                     name: String::new(),
                     label: String::new(),
                     units: String::new(),
+                    sensor: None,
                     cal: None,
                 };
                 for s in ebml::children(v, o) {
@@ -301,6 +311,7 @@ fn parse_channel(body: &[u8], base: u64) -> Result<Channel, IdeError> {
                         0x52A3 => sc.cal = Some(ebml::uint(sv, so)?),
                         0x52A5 => sc.label = ebml::string(sv),
                         0x52A6 => sc.units = ebml::string(sv),
+                        0x52A9 => sc.sensor = ebml::uint(sv, so).ok(),
                         _ => {}
                     }
                 }

@@ -17,11 +17,13 @@
 
 mod ebml;
 mod header;
+mod metadata;
 mod read;
 
 pub use crate::error::IdeError;
 use crate::error::{IdeUnsupported, Malformation, NotIde, ReferenceProblem};
 pub use header::{Channel, Recording, SubChannel};
+pub use metadata::{Calibration, Recorder, Sensor};
 pub use read::{is_ide, pick, read_ide, Blocks, Pick};
 use std::fs::File;
 use std::io::{BufReader, Read, Seek, SeekFrom};
@@ -205,6 +207,17 @@ impl<R: Read + Seek> IdeFile<R> {
 
     pub fn channel(&self, id: u64) -> Option<&Channel> {
         self.info.channels.iter().find(|c| c.id == id)
+    }
+
+    /// The sensor `channel`'s subchannel `sub` measures with, if the file names it.
+    pub fn sensor_of(&self, channel: u64, sub: u64) -> Option<&Sensor> {
+        let id = self
+            .channel(channel)?
+            .subchannels
+            .iter()
+            .find(|s| s.id == sub)?
+            .sensor?;
+        self.info.sensors.iter().find(|s| s.id == id)
     }
 
     /// All subchannels of a channel, calibrated, with their times.

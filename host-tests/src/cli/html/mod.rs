@@ -1,7 +1,17 @@
 //! `impact report … --html FILE`: one self-contained HTML file (no network, no script) a test
-//! engineer can hand in: the settings and provenance, the series table and statistics, and
-//! every impact's pulse drawn with the nominal pulse and its tolerance band when a
-//! specification is given.
+//! engineer can hand in and a quality manager sign: the verdict first (a banner, then each
+//! pulse against the nominal one: `verdict`), the title block (the lab's `--meta`, an `.IDE`
+//! recording's recorder and sensor, when and by what the report was written: `title`), the
+//! series table and statistics, every impact's pulse drawn with the nominal pulse, its
+//! tolerance band and the worst point when a specification is given, and last the settings
+//! and every input with its SHA-256 (`provenance`).
+
+pub mod board;
+pub mod provenance;
+pub mod title;
+pub mod verdict;
+
+pub use board::{log_report, LogReportError};
 
 use std::path::PathBuf;
 
@@ -14,6 +24,7 @@ use super::srs_required::{self, RequiredSrs};
 use crate::html;
 use crate::html::Html;
 use crate::report::fmt::human;
+use crate::report::spec::Criterion;
 
 /// `impact report`'s command line: the analysis's (one or more recordings), and the file.
 #[derive(clap::Args, Clone, Debug)]
@@ -32,6 +43,8 @@ pub struct ReportArgs {
     /// --srs.
     #[arg(long, value_name = "FILE.csv", help_heading = "Output")]
     pub srs_required: Option<PathBuf>,
+    #[command(flatten)]
+    pub meta: title::MetaArgs,
 }
 
 /// Why `impact report` failed.
@@ -45,22 +58,22 @@ pub enum ReportError {
     Output(#[from] crate::output::OutputError),
     #[error(transparent)]
     RequiredSrs(#[from] srs_required::RequiredSrsError),
+    #[error(transparent)]
+    Meta(#[from] title::MetaError),
+    #[error(transparent)]
+    Provenance(#[from] provenance::ProvenanceError),
     /// Some of the recordings failed (the page names each).
     #[error("{failed} of {recordings} recordings failed (each named in the report)")]
     Failed { failed: usize, recordings: usize },
 }
 
-/// Why a board's log could not be reported ([`log_report`]).
-#[derive(Debug, thiserror::Error)]
-pub enum LogReportError {
-    /// The log not read ([`crate::cli::log::read_log`]'s error; boxed, it is large).
-    #[error(transparent)]
-    ReadLog(Box<crate::cli::log::LogCommandError>),
-    #[error(transparent)]
-    Log(#[from] crate::firmware_link::log::LogError),
-    /// The log's scene line without a field the figures need.
-    #[error(transparent)]
-    Field(#[from] crate::firmware_link::line::FieldError),
+/// What the page says before the series: the title block's lines, what each `.IDE`
+/// recording says of itself, when the report was written, and the inputs digested.
+pub struct Front {
+    pub meta: Vec<(String, String)>,
+    pub recorded: Vec<title::Recorded>,
+    pub written: provenance::Written,
+    pub inputs: Vec<provenance::Input>,
 }
 
 /// Runs `impact report`; returns the verdicts (the exit status says whether one failed).
@@ -81,8 +94,11 @@ pub fn run(args: &ReportArgs) -> Result<crate::report::spec::Judged, ReportError
         .with_some(a.scene.as_deref())
         .with_some(a.free_fall.as_deref().map(crate::pipeline::free_fall::file))
         .with_some(args.srs_required.as_deref())
-        .with_some(a.spec.and_then(|s| s.band_file));
+        .with_some(a.spec.and_then(|s| s.band_file))
+        .with_some(args.meta.meta_file.as_deref());
     crate::output::check("--html", &args.html, &inputs, Some("html"))?;
+    let written = provenance::Written::now()?;
+    let meta = title::read_meta(&args.meta)?;
     let required = args
         .srs_required
         .as_deref()
@@ -92,7 +108,39 @@ pub fn run(args: &ReportArgs) -> Result<crate::report::spec::Judged, ReportError
     let mut a = a.clone();
     a.spectrum.srs |= required.is_some();
     let results = series::analyze_drawn(&a, &entries);
-    let page = page(a.cfc, &results, required.as_ref());
+    // Every input, each once, in the order given: the recordings, then the files the options
+    // name.
+    use provenance::Role;
+    let files: Vec<(Role, PathBuf)> = (entries.iter().map(|e| (Role::Recording, e.file.clone())))
+        .chain(a.scene.clone().map(|p| (Role::Scene, p)))
+        .chain(
+            (a.free_fall.as_deref().map(crate::pipeline::free_fall::file))
+                .map(|p| (Role::FreeFall, p.to_path_buf())),
+        )
+        .chain(
+            a.spec
+                .and_then(|s| s.band_file)
+                .map(|p| (Role::Band, p.to_path_buf())),
+        )
+        .chain(args.srs_required.clone().map(|p| (Role::RequiredSrs, p)))
+        .chain(args.meta.meta_file.clone().map(|p| (Role::Meta, p)))
+        .collect();
+    // Each `.IDE` recording's own account, once a file.
+    let mut recorded: Vec<title::Recorded> = Vec::new();
+    for e in &entries {
+        if let Some(r) = title::recorded(&e.file, e.column.as_ref(), &a.axes) {
+            if !recorded.contains(&r) {
+                recorded.push(r);
+            }
+        }
+    }
+    let front = Front {
+        meta,
+        recorded,
+        written,
+        inputs: provenance::inputs(&files),
+    };
+    let page = page(a.cfc, &results, required.as_ref(), &front);
     crate::output::write(&args.html, page.as_str().as_bytes())?;
     for e in &results {
         for n in &e.notes {
@@ -121,10 +169,25 @@ table{border-collapse:collapse;font-size:.85em;margin:.5em 0}\
 td,th{border:1px solid #ccc;padding:.2em .5em;text-align:right}th{background:#f3f3f3}\
 td.l,th.l{text-align:left}.pass{color:#080;font-weight:bold}.fail{color:#b00;font-weight:bold}\
 .figure{display:inline-block;margin:.5em;vertical-align:top}dl{display:grid;grid-template-columns:max-content auto;gap:.2em 1em}\
-dt{font-weight:bold}";
+dt{font-weight:bold}\
+.banner{border:2px solid #999;border-radius:4px;padding:.5em 1em;margin:1em 0;background:#f3f3f3}\
+.banner .headline{font-size:1.3em;margin:.2em 0}.banner ul{margin:.3em 0}\
+.banner-pass{border-color:#080;background:#eaf6ea}.banner-pass b{color:#080}\
+.banner-fail{border-color:#b00;background:#fcebea}.banner-fail b{color:#b00}\
+.banner-incomplete{border-color:#b80;background:#fff7e0}.banner-incomplete b{color:#960}\
+table.title{font-size:.95em;min-width:40em}table.title th{width:13em}th.sub{background:#e6ecf5}\
+.hash{font-family:monospace;font-size:.95em}table.verdicts td{vertical-align:top;white-space:nowrap}\
+table.verdicts td.l{white-space:normal}";
 
-/// The page: `results` analysed with the windows' filter `cfc`, against `required`.
-fn page(cfc: Option<u32>, results: &[EntryJson], required: Option<&RequiredSrs>) -> Html {
+/// The page: `results` analysed with the windows' filter `cfc`, against `required`, with
+/// `front`'s title block and inputs: the verdict first, then who and what, the verdicts of each
+/// pulse, the series, the pulses; the settings and the inputs last.
+fn page(
+    cfc: Option<u32>,
+    results: &[EntryJson],
+    required: Option<&RequiredSrs>,
+    front: &Front,
+) -> Html {
     let json = series::to_json(results);
     let mut h = Html::new();
     h.raw("<!DOCTYPE html>\n<html lang=\"en\"><head><meta charset=\"utf-8\"><title>Impact report</title><style>")
@@ -138,7 +201,9 @@ fn page(cfc: Option<u32>, results: &[EntryJson], required: Option<&RequiredSrs>)
         json.impacts,
         if json.impacts == 1 { "" } else { "s" },
     );
-    provenance(&mut h, cfc, results, required);
+    verdict::banner(&mut h, results);
+    title::title_block(&mut h, &front.meta, &front.recorded, front.written);
+    verdict::verdicts_table(&mut h, results);
     impacts_table(&mut h, results, required);
     for e in results {
         if let Some(err) = &e.error {
@@ -200,120 +265,11 @@ fn page(cfc: Option<u32>, results: &[EntryJson], required: Option<&RequiredSrs>)
     if let Some(r) = required {
         spectra(&mut h, results, r);
     }
+    // The appendix: how the report was made, and from what.
+    provenance::settings(&mut h, cfc, results, required);
+    provenance::inputs_table(&mut h, &front.inputs);
     h.raw("</body></html>\n");
     h
-}
-
-/// The settings and provenance: the tool, the command, each recording, the filter, the
-/// required SRS and the specification.
-fn provenance(
-    h: &mut Html,
-    cfc: Option<u32>,
-    results: &[EntryJson],
-    required: Option<&RequiredSrs>,
-) {
-    h.raw("<h2>Settings and provenance</h2><dl>");
-    let mut dd = |k: &str, v: &str| html!(h, "<dt>{}</dt><dd>{}</dd>", k, v);
-    dd("tool", &format!("impact {}", env!("CARGO_PKG_VERSION")));
-    dd("command", &std::env::args().collect::<Vec<_>>().join(" "));
-    for e in results {
-        let size =
-            std::fs::metadata(&e.file).map_or(String::new(), |m| format!(", {} bytes", m.len()));
-        let rate = e.analysis.as_ref().map_or(String::new(), |a| {
-            format!(
-                ", {} samples at {} S/s",
-                a.samples,
-                crate::report::fmt::sig(a.sample_rate_hz, 6)
-            )
-        });
-        dd(
-            "recording",
-            &format!("{} [{}]{size}{rate}", e.file, e.channel),
-        );
-        // What the tool assumed of this recording, where the customer reads its provenance.
-        for assumed in e.analysis.iter().flat_map(|a| &a.assumptions) {
-            dd("assumed", assumed);
-        }
-        // A board's log: the lines passed over (the first 20, and how many more).
-        let skipped: Vec<_> = e.analysis.iter().flat_map(|a| &a.skipped_lines).collect();
-        for s in skipped.iter().take(20) {
-            dd(
-                "skipped",
-                &format!("line {}: {} (skipped)", s.line, s.reason),
-            );
-        }
-        if skipped.len() > 20 {
-            dd("skipped", &format!("and {} more lines", skipped.len() - 20));
-        }
-    }
-    dd(
-        "filter",
-        &cfc.map_or("none (raw signal)".into(), |c| {
-            format!("CFC {c} (SAE J211) on the captured windows")
-        }),
-    );
-    if let Some(r) = required {
-        let (first, last) = (r.points()[0].0, r.points()[r.points().len() - 1].0);
-        let (low, high) = crate::standards::SRS_TOLERANCE_DB;
-        dd(
-            "required SRS",
-            &format!(
-                "{}: {} breakpoints, {} to {}; tolerance {low:+} dB, {high:+} dB ({})",
-                r.file,
-                r.points().len(),
-                human(first, "Hz").trim_end(),
-                human(last, "Hz").trim_end(),
-                crate::standards::SRS_TOLERANCE_SOURCE,
-            ),
-        );
-    }
-    if let Some(s) = results
-        .iter()
-        .find_map(|e| e.analysis.as_ref()?.spec.clone())
-    {
-        dd(
-            "specification",
-            crate::report::spec::table_head(&s)
-                .trim_end()
-                .trim_start_matches("spec: "),
-        );
-        if let Some(rows) = &s.band_table {
-            let rows: Vec<String> = rows
-                .iter()
-                .map(|r| {
-                    format!(
-                        "{}D: {}…{}",
-                        r.time_over_duration, r.lower_over_peak, r.upper_over_peak
-                    )
-                })
-                .collect();
-            dd(
-                "user's band",
-                &format!(
-                    "{} rows (time from the nominal start: lower…upper limit, × the peak): {}",
-                    rows.len(),
-                    rows.join("; ")
-                ),
-            );
-        }
-        for x in &s.sources {
-            dd(
-                &format!("source of {}", x.tolerance),
-                &format!("{} ({})", x.source, x.confidence),
-            );
-        }
-        if let (Some(o), Some(from)) = (s.delta_v_tolerance_other, s.delta_v_tolerance_other_source)
-        {
-            dd(
-                "Δv, other reading",
-                &format!(
-                    "±{:.0} %: {from}; each verdict says whether Δv passes under it",
-                    100.0 * o
-                ),
-            );
-        }
-    }
-    h.raw("</dl>\n");
 }
 
 /// A statistics table: a row per metric.
@@ -353,25 +309,31 @@ fn impacts_table(h: &mut Html, results: &[EntryJson], required: Option<&Required
                 verdict.raw("<span class=\"pass\">PASS</span>");
             }
             Some(Some(v)) => {
-                // Which part failed: the band (by its worst excursion) or Δv (by its offset
-                // from the nominal, and the standard's other reading when it has one).
+                // Which part failed: the band (its limit, by its worst excursion) or Δv (by
+                // its offset from the nominal, and the standard's other reading when it has
+                // one).
                 let spec = e.analysis.as_ref().and_then(|a| a.spec.as_ref());
                 let mut why = Vec::new();
-                if !v.band_pass {
-                    why.push(format!("band {:+.1} % of the peak", 100.0 * v.margin));
-                }
-                if !v.delta_v_pass {
-                    let off = spec.map_or(String::new(), |s| {
-                        format!(
-                            " {:+.1} % of nominal",
-                            100.0 * (v.delta_v_m_s / s.nominal_delta_v_m_s - 1.0)
-                        )
-                    });
-                    let other = match crate::report::spec::delta_v_pass_other(v, spec) {
-                        Some(true) => ", within the other reading's tolerance",
-                        _ => "",
+                for c in v.failed() {
+                    let text = match c {
+                        Criterion::BandUpper | Criterion::BandLower => {
+                            format!("{} by {:+.1} % of the peak", c.words(), 100.0 * v.margin)
+                        }
+                        Criterion::DeltaV => {
+                            let off = spec.map_or(String::new(), |s| {
+                                format!(
+                                    " {:+.1} % of nominal",
+                                    100.0 * (v.delta_v_m_s / s.nominal_delta_v_m_s - 1.0)
+                                )
+                            });
+                            let other = match crate::report::spec::delta_v_pass_other(v, spec) {
+                                Some(true) => ", within the other reading's tolerance",
+                                _ => "",
+                            };
+                            format!("Δv{off}{other}")
+                        }
                     };
-                    why.push(format!("Δv{off}{other}"));
+                    why.push(text);
                 }
                 html!(
                     verdict,
@@ -479,83 +441,6 @@ fn spectra(h: &mut Html, results: &[EntryJson], required: &RequiredSrs) {
             }
         }
     }
-}
-
-/// The report of a board's log (`impact watch`'s session file, exported from its page): the
-/// log's impacts as `impact log` reads them, each pulse drawn from the window the board sent
-/// (its run's), with `spec`'s band where its verdict placed it.
-pub fn log_report(
-    path: &std::path::Path,
-    spec: Option<(impact_core::spec::Spec, Option<&str>)>,
-) -> Result<String, LogReportError> {
-    let name = path.display().to_string();
-    let log = crate::cli::log::read_log(path).map_err(|e| LogReportError::ReadLog(Box::new(e)))?;
-    let mut analysis = crate::firmware_link::log_json::log_json(&log, 0.0)?;
-    // The pulse given (and the standard it named), else the one the board's scene line
-    // states (log_json's).
-    let board = log.scene.as_ref().and_then(|s| s.spec().ok()).flatten();
-    let (spec, named) = match spec {
-        Some((s, named)) => (Some(s), named),
-        None => (board, None),
-    };
-    if let Some(s) = &spec {
-        analysis.spec = Some(crate::report::spec::spec_json(s, named));
-    }
-    let spec = spec.as_ref();
-    let mut figures = Vec::new();
-    if let Some(scene) = &log.scene {
-        let rate = f64::from(scene.rate_hz);
-        let gain = f64::from(scene.gain()?);
-        let mass = scene.mass_kg()?;
-        for (k, run) in log.runs.iter().enumerate() {
-            let waves = &log.waveforms[run.waveforms.clone()];
-            for r in &log.impacts[run.impacts.clone()] {
-                let Some(wave) = waves.iter().find(|w| w.index == r.index) else {
-                    continue;
-                };
-                if figures.len() == MAX_FIGURES {
-                    continue;
-                }
-                // (The board's windows hold no filter padding: no CFC trace.)
-                let signal = crate::plot::Signal {
-                    title: String::new(),
-                    cfc: None,
-                    rate_hz: rate,
-                    mass_kg: mass.map(f64::from),
-                    accel_m_s2: Box::new(move |i| wave.at_sample(i).map(|c| f64::from(c) * gain)),
-                };
-                let held =
-                    wave.first_sample..wave.first_sample.saturating_add(u64::from(wave.samples));
-                let title = if log.runs.len() > 1 {
-                    format!("run {} impact {}", k + 1, r.index)
-                } else {
-                    format!("impact {}", r.index)
-                };
-                figures.push(crate::cli::pulse::pulse_svg(
-                    &signal,
-                    spec,
-                    r,
-                    title,
-                    Some(held),
-                ));
-            }
-        }
-    }
-    let entry = EntryJson {
-        file: name,
-        channel: "the board".into(),
-        error: None,
-        notes: (log.warnings.iter().cloned())
-            .chain(
-                log.skipped
-                    .iter()
-                    .map(crate::firmware_link::log::Skipped::note),
-            )
-            .collect(),
-        analysis: Some(analysis),
-        figures,
-    };
-    Ok(page(None, std::slice::from_ref(&entry), None).into_string())
 }
 
 /// An impact's status cell: its status and flags, a decimated capture's with its step.

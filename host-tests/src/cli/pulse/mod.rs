@@ -1,9 +1,14 @@
 //! An impact's pulse as an inline SVG for the HTML report: the measured acceleration in g
 //! above its baseline (min/max per column), with a specification's nominal pulse and band
-//! where its verdict placed them.
+//! where its verdict placed them and the verdict's worst point circled (as the live view's
+//! page circles it: red where the band fails there).
 
 use impact_core::consts::STANDARD_GRAVITY;
 use impact_core::spec::Spec;
+
+mod band;
+
+pub use band::{band, window, BandPoint};
 
 use crate::html;
 use crate::html::Html;
@@ -25,6 +30,29 @@ pub struct Pulse<'a> {
     /// The CFC-filtered signal's columns, likewise, and its legend (`CFC 1000`).
     pub filtered: Option<(String, Vec<Column>)>,
     pub spec: Option<(&'a Spec, f64)>,
+    /// The verdict's worst point, drawn as a circle.
+    pub worst: Option<Worst>,
+}
+
+/// A verdict's worst point: its time (s from the stream's start), its acceleration above the
+/// baseline in the pulse's direction (m/s², as the figure draws the signal), and whether it
+/// lies beyond the band (the band fails there).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Worst {
+    pub t_s: f64,
+    pub a_m_s2: f64,
+    pub beyond: bool,
+}
+
+impl Worst {
+    /// Its colour: red beyond the band, amber within it (the live view's).
+    fn colour(self) -> &'static str {
+        if self.beyond {
+            "#d62728"
+        } else {
+            "#e3a82b"
+        }
+    }
 }
 
 /// A tick's label: as few digits as the step needs.
@@ -62,12 +90,23 @@ pub fn svg(p: &Pulse) -> Html {
         y_lo = y_lo.min(b.1);
         y_hi = y_hi.max(b.2);
     }
+    // The worst point, where the window shows it.
+    let worst = p
+        .worst
+        .filter(|w| (t_first..=t_last).contains(&w.t_s) && w.a_m_s2.is_finite());
+    if let Some(w) = worst {
+        y_lo = y_lo.min(w.a_m_s2);
+        y_hi = y_hi.max(w.a_m_s2);
+    }
     let pad = 0.05 * (y_hi - y_lo).max(1e-9);
     let (y_lo, mut y_hi) = (y_lo - pad, y_hi + pad);
     let x = |t: f64| L + (t - t_first) / (t_last - t_first).max(1e-12) * (W - L - R);
     // The legend: in the upper right corner, or the left, whichever the curves leave free;
     // else the right, with the range raised until they pass below it.
-    let entries = 1 + usize::from(p.filtered.is_some()) + usize::from(!band.is_empty());
+    let entries = 1
+        + usize::from(p.filtered.is_some())
+        + usize::from(!band.is_empty())
+        + usize::from(worst.is_some());
     let legend_px = 14.0 * entries as f64 + 8.0;
     let highest = |from_px: f64, to_px: f64| {
         let within = |t: f64| (from_px..=to_px).contains(&x(t));
@@ -198,6 +237,15 @@ pub fn svg(p: &Pulse) -> Html {
             FILTERED
         );
     }
+    if let Some(w) = worst {
+        html!(
+            s,
+            "<circle class=\"worst\" cx=\"{:.1}\" cy=\"{:.1}\" r=\"6\" fill=\"none\" stroke=\"{}\" stroke-width=\"2\"/>",
+            x(w.t_s),
+            y(w.a_m_s2),
+            w.colour()
+        );
+    }
     // The legend, on white: each entry's stroke (markup) and its text.
     let mut raw_stroke = Html::new();
     html!(raw_stroke, "stroke=\"{}\" stroke-width=\"1.5\"", RAW);
@@ -222,7 +270,7 @@ pub fn svg(p: &Pulse) -> Html {
         "<g transform=\"translate({} {})\"><rect x=\"-4\" y=\"-8\" width=\"162\" height=\"{}\" fill=\"white\" fill-opacity=\"0.85\" stroke=\"#ccc\"/>",
         legend_x + 4.0,
         T + 11.0,
-        14 * entries.len() + 2
+        14 * (entries.len() + usize::from(worst.is_some())) + 2
     );
     for (k, (stroke, text)) in entries.iter().enumerate() {
         let y = 14 * k;
@@ -236,6 +284,21 @@ pub fn svg(p: &Pulse) -> Html {
             text
         );
     }
+    if let Some(w) = worst {
+        let y = 14 * entries.len();
+        html!(
+            s,
+            "<circle cx=\"9\" cy=\"{}\" r=\"4.5\" fill=\"none\" stroke=\"{}\" stroke-width=\"2\"/><text x=\"22\" y=\"{}\">{}</text>",
+            y,
+            w.colour(),
+            y + 4,
+            if w.beyond {
+                "worst point: fails"
+            } else {
+                "worst point: within"
+            }
+        );
+    }
     s.raw("</g></svg>");
     s
 }
@@ -245,77 +308,6 @@ const RAW: &str = "#c0392b";
 
 /// The CFC-filtered signal's colour: dark, over the raw one.
 const FILTERED: &str = "#192d78";
-
-/// A point of a tolerance band: `(t_s, lower, upper, nominal)`, the last three in m/s².
-pub type BandPoint = (f64, f64, f64, f64);
-
-/// `spec`'s tolerance band and nominal pulse placed at `start_s`, at 201 times over
-/// `[from_s, to_s]` (s from the stream's start); a user's band also at each of its rows, with
-/// the row's own limits (a step's two rows one after the other, and `outside` on the far side
-/// of its first and last rows), so that its corners and steps are drawn as judged.
-pub fn band(spec: &Spec, start_s: f64, from_s: f64, to_s: f64) -> Vec<BandPoint> {
-    let peak = f64::from(spec.peak_m_s2);
-    let duration = f64::from(spec.duration_s);
-    let u_at = |t: f64| ((t - start_s) / duration) as f32;
-    let point = |t: f64, (lo, hi): (f32, f32)| {
-        (
-            t,
-            f64::from(lo) * peak,
-            f64::from(hi) * peak,
-            f64::from(spec.shape.at(u_at(t))) * peak,
-        )
-    };
-    let grid = (0..=200).map(|k| from_s + (to_s - from_s) * f64::from(k) / 200.0);
-    let Some(rows) = spec.band else {
-        return grid.map(|t| point(t, spec.band_at(u_at(t)))).collect();
-    };
-    let outside = (-spec.tolerance.outside, spec.tolerance.outside);
-    let row_t = |u: f32| start_s + f64::from(u) * duration;
-    let mut points: Vec<BandPoint> = grid
-        .filter(|&t| rows.iter().all(|r| row_t(r.u) != t))
-        .map(|t| point(t, spec.band_at(u_at(t))))
-        .collect();
-    for (k, r) in rows.iter().enumerate() {
-        let t = row_t(r.u);
-        if !(from_s..=to_s).contains(&t) {
-            continue;
-        }
-        if k == 0 {
-            points.push(point(t, outside));
-        }
-        points.push(point(t, (r.lower, r.upper)));
-        if k + 1 == rows.len() {
-            points.push(point(t, outside));
-        }
-    }
-    // In time; at one time, in the order pushed (the grid's first, then the rows').
-    points.sort_by(|a, b| a.0.total_cmp(&b.0));
-    points
-}
-
-/// Where impact `r`'s pulse is drawn, s from the stream's start: with a verdict against
-/// `spec`, over the window it watched, with where it placed the nominal pulse; else from a
-/// quarter of its duration before first touch to a quarter after.
-pub fn window<'a>(
-    spec: Option<&'a Spec>,
-    r: &impact_core::ImpactReport,
-) -> (f64, f64, Option<(&'a Spec, f64)>) {
-    match (spec, &r.verdict) {
-        (Some(spec), Some(Ok(v))) => {
-            let d = f64::from(spec.duration_s);
-            let (before, watch) = spec.watched();
-            (
-                v.start_s - f64::from(before) * d,
-                v.start_s + f64::from(1.0 + watch) * d,
-                Some((spec, v.start_s)),
-            )
-        }
-        _ => {
-            let d = f64::from(r.duration_s);
-            (r.start_s - 0.25 * d, r.start_s + 1.25 * d, None)
-        }
-    }
-}
 
 /// Columns a pulse is drawn in (each its samples' least and greatest value).
 const COLUMNS: u64 = 400;
@@ -386,11 +378,22 @@ pub fn pulse_svg(
             _ => peak = format!("{peak} raw (CFC {class}: not drawn)"),
         }
     }
+    // The verdict's worst point (its time and value are the stream's, above the baseline in
+    // the pulse's direction: as the figure draws the signal).
+    let worst = match (&placed, &r.verdict) {
+        (Some(_), Some(Ok(v))) => Some(Worst {
+            t_s: v.worst_s,
+            a_m_s2: f64::from(v.worst_m_s2),
+            beyond: !v.band_pass,
+        }),
+        _ => None,
+    };
     svg(&Pulse {
         title: format!("{title}: {peak}"),
         columns: raw,
         filtered,
         spec: placed,
+        worst,
     })
 }
 
@@ -421,6 +424,7 @@ mod tests {
                 .collect(),
             filtered: None,
             spec: None,
+            worst: None,
         });
         for want in [
             ">acceleration (g)</text>",
