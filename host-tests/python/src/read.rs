@@ -67,14 +67,16 @@ pub fn read<'py>(py: Python<'py>, argv: Vec<String>) -> PyResult<Bound<'py, PyDi
     Ok(d)
 }
 
-/// An `.IDE` recording's recorder and channels as JSON text (none for another format, or a
-/// header that cannot be read: the read itself says why).
+/// An `.IDE` recording's own account as JSON text: its recorder, sensors, factory
+/// calibration, session start and channels (each subchannel with its sensor); none for another
+/// format, or a header that cannot be read (the read itself says why).
 fn ide_metadata(path: &std::path::Path) -> Option<String> {
     if !impact_io::ide::is_ide(path) {
         return None;
     }
     let file = IdeFile::open(path).ok()?;
     let info = file.info();
+    let r = &info.recorder;
     let channels: Vec<serde_json::Value> = info
         .channels
         .iter()
@@ -84,17 +86,30 @@ fn ide_metadata(path: &std::path::Path) -> Option<String> {
                 "name": c.name,
                 "subchannels": c.subchannels.iter().map(|s| serde_json::json!({
                     "id": s.id, "name": s.name, "label": s.label, "units": s.units,
+                    "sensor": file.sensor_of(c.id, s.id).map(|x| &x.name),
                 })).collect::<Vec<_>>(),
             })
         })
         .collect();
     let json = serde_json::json!({
         "recorder": {
-            "product_name": info.product_name,
-            "part_number": info.part_number,
-            "serial": info.serial,
-            "utc_start_s": info.utc_start,
+            "product_name": r.product_name,
+            "part_number": r.part_number,
+            "serial": r.serial,
+            "user_name": r.user_name,
+            "hardware_revision": r.hardware_revision,
+            "firmware": r.firmware,
+            "manufactured_unix_s": r.manufactured_unix_s,
         },
+        "sensors": info.sensors.iter().map(|x| serde_json::json!({
+            "id": x.id, "name": x.name, "serial": x.serial,
+        })).collect::<Vec<_>>(),
+        "calibration": {
+            "date_unix_s": info.calibration.date_unix_s,
+            "expiry_unix_s": info.calibration.expiry_unix_s,
+            "serial": info.calibration.serial,
+        },
+        "utc_start_s": info.utc_start,
         "channels": channels,
     });
     Some(json.to_string())

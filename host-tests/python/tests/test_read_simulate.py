@@ -39,9 +39,13 @@ def test_read_says_what_it_assumed(tmp_path):
 def test_an_ide_recording_brings_its_recorder_and_sensors():
     r = impact.read(IDE)
     rec = r.metadata["recorder"]
-    assert rec["part_number"].startswith("LOG-") and rec["serial"]
-    names = [s["name"] for c in r.metadata["channels"] for s in c["subchannels"]]
-    assert any("X" in n for n in names)
+    assert (rec["part_number"], rec["serial"], rec["firmware"]) == ("LOG-0002-02kG-DC", 6468, "1.20.1")
+    piezo = "832M1 PE Accelerometer"
+    assert {"id": 9, "name": piezo, "serial": "5663-033"} in r.metadata["sensors"]
+    assert r.metadata["calibration"]["serial"] == 4953
+    # The channel analysed (8.0, the 2000 g piezo's X) names its sensor.
+    ch8 = next(c for c in r.metadata["channels"] if c["id"] == 8)
+    assert ch8["subchannels"][0]["sensor"] == piezo
 
 
 def test_simulate_is_the_tools(cli):
