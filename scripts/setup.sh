@@ -3,7 +3,8 @@
 #   - the Cortex-M4F Rust target (thumbv7em-none-eabihf), rustfmt and clippy;
 #   - qemu-system-arm (Debian package) for the emulated firmware;
 #   - arm-none-eabi-objdump (Debian binutils-arm-none-eabi) for `impact bench m4`'s cycle model;
-#   - chromium (Debian package) for the HTML report's test in a real headless browser;
+#   - chromium (Debian package) for the HTML report's test in a real headless browser and for
+#     `impact report --pdf`; poppler-utils (pdftoppm, pdfinfo) for the PDF's test;
 #   - python3 with its venv module (Debian python3-venv) for the Python package's tests.
 # With --board, also probe-rs (crates.io `probe-rs-tools`, a few minutes to build) to flash
 # the STM32F4-Discovery and read its defmt log (`cargo fw-run`).
@@ -23,6 +24,7 @@ need_apt=()
 command -v qemu-system-arm >/dev/null || need_apt+=(qemu-system-arm)
 command -v arm-none-eabi-size >/dev/null || need_apt+=(binutils-arm-none-eabi)
 command -v chromium >/dev/null || need_apt+=(chromium)
+command -v pdftoppm >/dev/null || need_apt+=(poppler-utils)
 python3 -c 'import venv, ensurepip' 2>/dev/null || need_apt+=(python3-venv)
 if [[ ${#need_apt[@]} -gt 0 ]]; then
   sudo=""; [[ $(id -u) == 0 ]] || sudo="sudo"

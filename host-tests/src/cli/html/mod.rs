@@ -7,6 +7,7 @@
 //! and every input with its SHA-256 (`provenance`).
 
 pub mod board;
+pub mod pdf;
 pub mod provenance;
 pub mod title;
 pub mod verdict;
@@ -32,8 +33,26 @@ pub struct ReportArgs {
     #[command(flatten)]
     pub analyze: AnalyzeCommand,
     /// The report: one self-contained HTML file (its figures inline).
-    #[arg(long, value_name = "FILE.html", help_heading = "Output")]
-    pub html: PathBuf,
+    #[arg(
+        long,
+        value_name = "FILE.html",
+        help_heading = "Output",
+        required_unless_present = "pdf"
+    )]
+    pub html: Option<PathBuf>,
+    /// The report as a paginated PDF (printed by a headless Chromium: no figure, table row or
+    /// title block cut across pages).
+    #[arg(long, value_name = "FILE.pdf", help_heading = "Output")]
+    pub pdf: Option<PathBuf>,
+    /// The PDF's paper.
+    #[arg(
+        long,
+        value_enum,
+        default_value_t,
+        requires = "pdf",
+        help_heading = "Output"
+    )]
+    pub paper: pdf::Paper,
     /// A required SRS each impact's SRS is judged against (implies --srs).
     ///
     /// A required SRS: a CSV with the columns frequency_hz and acceleration_m_s2 (or
@@ -62,6 +81,8 @@ pub enum ReportError {
     Meta(#[from] title::MetaError),
     #[error(transparent)]
     Provenance(#[from] provenance::ProvenanceError),
+    #[error(transparent)]
+    Pdf(#[from] pdf::PdfError),
     /// Some of the recordings failed (the page names each).
     #[error("{failed} of {recordings} recordings failed (each named in the report)")]
     Failed { failed: usize, recordings: usize },
@@ -96,7 +117,12 @@ pub fn run(args: &ReportArgs) -> Result<crate::report::spec::Judged, ReportError
         .with_some(args.srs_required.as_deref())
         .with_some(a.spec.and_then(|s| s.band_file))
         .with_some(args.meta.meta_file.as_deref());
-    crate::output::check("--html", &args.html, &inputs, Some("html"))?;
+    if let Some(html) = &args.html {
+        crate::output::check("--html", html, &inputs, Some("html"))?;
+    }
+    if let Some(out) = &args.pdf {
+        crate::output::check("--pdf", out, &inputs, Some("pdf"))?;
+    }
     let written = provenance::Written::now()?;
     let meta = title::read_meta(&args.meta)?;
     let required = args
@@ -141,13 +167,20 @@ pub fn run(args: &ReportArgs) -> Result<crate::report::spec::Judged, ReportError
         inputs: provenance::inputs(&files),
     };
     let page = page(a.cfc, &results, required.as_ref(), &front);
-    crate::output::write(&args.html, page.as_str().as_bytes())?;
+    if let Some(html) = &args.html {
+        crate::output::write(html, page.as_str().as_bytes())?;
+    }
+    if let Some(out) = &args.pdf {
+        pdf::print(page.as_str(), args.paper, out)?;
+    }
     for e in &results {
         for n in &e.notes {
             crate::errln!("note: {}", series::failure(e, n));
         }
     }
-    crate::errln!("wrote {}", args.html.display());
+    for out in args.html.iter().chain(&args.pdf) {
+        crate::errln!("wrote {}", out.display());
+    }
     let failed = results.iter().filter(|e| e.error.is_some()).count();
     if failed > 0 {
         return Err(ReportError::Failed {
