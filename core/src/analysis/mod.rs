@@ -220,10 +220,11 @@ fn spectrum<const CAP: usize>(
     Some(sp)
 }
 
-/// The CFC-filtered acceleration of everything the capture holds, into the workspace, and its
+/// The acceleration of everything the capture holds filtered by the scene's window filter
+/// (a CFC or the low-pass), into the workspace, and its
 /// peak within the impact's window (index in the workspace, value); `None` if the filter has
-/// too little signal to settle on either side of the contact (SAE J211's padding) or cannot
-/// run at this rate.
+/// too little signal to settle on either side of the contact (its padding: SAE J211's for a
+/// CFC) or cannot run at this rate.
 ///
 /// Before the contact the padding is the lead-in the capture holds, or the start of the
 /// recording: there the filter starts at rest on the first sample, as a filter run over the
@@ -232,7 +233,7 @@ fn spectrum<const CAP: usize>(
 fn filter<const CAP: usize>(
     capture: &Capture<CAP>,
     scene: &Scene,
-    class: crate::signal::cfc::Cfc,
+    kind: crate::signal::window_filter::WindowFilter,
     work: &mut Workspace<CAP>,
 ) -> Option<(usize, f32)> {
     let s = capture.summary();
@@ -240,7 +241,7 @@ fn filter<const CAP: usize>(
     // (In the capture's values: a decimated capture's are `step` samples apart.)
     let step = u64::from(capture.step());
     let rate = value_rate(capture, scene);
-    let pad = class.padding_samples(rate) as u64;
+    let pad = kind.padding_samples(rate) as u64;
     let held_from = capture.held_from();
     let before = s.onset_index.saturating_sub(held_from) / step;
     let contact_end = s.separation_index.unwrap_or(s.end_index);
@@ -249,7 +250,7 @@ fn filter<const CAP: usize>(
     if (before < pad && !from_start) || after < pad {
         return None;
     }
-    let b = crate::signal::cfc::Biquad::cfc(class, rate as f64)?;
+    let b = kind.design(rate as f64)?;
     let a = work.buf.get_mut(..held.len())?;
     let per_count = report::per_count(scene, s.base_n);
     let deviation = Deviation::new(s.base_sum, s.base_n);
@@ -342,8 +343,8 @@ fn analyse_kinematics<const CAP: usize>(
     let filter_lead = s.filter_lead as usize;
     let mut filtered: Option<(usize, f32)> = None;
     #[cfg(feature = "cfc")]
-    if let Some(class) = scene.cfc {
-        filtered = filter(capture, scene, class, work);
+    if let Some(kind) = scene.window_filter() {
+        filtered = filter(capture, scene, kind, work);
         if filtered.is_none() {
             r.flags.insert(Flags::CFC_WINDOW);
         }

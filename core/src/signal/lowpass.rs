@@ -116,7 +116,7 @@ impl Lowpass {
 pub const PADDING_PERIODS: [f64; MAX_ORDER as usize] = [
     0.7071067811865475,
     1.0,
-    1.4142135623730951,
+    core::f64::consts::SQRT_2,
     1.8477590650225735,
     2.2882456112707374,
     2.732050807568877,
@@ -136,9 +136,11 @@ impl Butterworth {
     /// The sections of `order` (1 to 8) at `cutoff_hz` for `rate_hz`; `None` unless
     /// `0 < cutoff < rate / 2` and both are finite.
     pub fn new(order: u8, cutoff_hz: f64, rate_hz: f64) -> Option<Self> {
-        if !(MIN_ORDER..=MAX_ORDER).contains(&order)
-            || !(cutoff_hz > 0.0 && rate_hz.is_finite() && cutoff_hz < rate_hz / 2.0)
-        {
+        let designable = (MIN_ORDER..=MAX_ORDER).contains(&order)
+            && cutoff_hz > 0.0
+            && rate_hz.is_finite()
+            && cutoff_hz < rate_hz / 2.0;
+        if !designable {
             return None;
         }
         let k = libm::tan(core::f64::consts::PI * cutoff_hz / rate_hz);

@@ -12,6 +12,7 @@ pub mod resultant;
 pub mod ring;
 pub mod spectrum;
 pub mod srs;
+pub mod window_filter;
 
 /// Converts raw integer samples to physical units. SI throughout.
 #[derive(Clone, Copy, Debug, PartialEq)]

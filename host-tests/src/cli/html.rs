@@ -92,7 +92,23 @@ pub fn run(args: &ReportArgs) -> Result<crate::report::spec::Judged, ReportError
     let mut a = a.clone();
     a.spectrum.srs |= required.is_some();
     let results = series::analyze_drawn(&a, &entries);
-    let page = page(a.cfc, &results, required.as_ref());
+    // The windows' filter as the command line and the scene file set it (the first
+    // recording's scene; every recording takes the same options).
+    let filter = results
+        .iter()
+        .filter_map(|e| e.analysis.as_ref())
+        .find_map(|a| a.lowpass.as_ref())
+        .map(|l| {
+            format!(
+                "Butterworth {} (phaseless, SciPy's sosfiltfilt) on the captured windows",
+                l.name()
+            )
+        })
+        .or_else(|| {
+            a.cfc
+                .map(|c| format!("CFC {c} (SAE J211) on the captured windows"))
+        });
+    let page = page(filter.as_deref(), &results, required.as_ref());
     crate::output::write(&args.html, page.as_str().as_bytes())?;
     for e in &results {
         for n in &e.notes {
@@ -123,8 +139,9 @@ td.l,th.l{text-align:left}.pass{color:#080;font-weight:bold}.fail{color:#b00;fon
 .figure{display:inline-block;margin:.5em;vertical-align:top}dl{display:grid;grid-template-columns:max-content auto;gap:.2em 1em}\
 dt{font-weight:bold}";
 
-/// The page: `results` analysed with the windows' filter `cfc`, against `required`.
-fn page(cfc: Option<u32>, results: &[EntryJson], required: Option<&RequiredSrs>) -> Html {
+/// The page: `results` analysed with the windows' filter `filter` (its description), against
+/// `required`.
+fn page(filter: Option<&str>, results: &[EntryJson], required: Option<&RequiredSrs>) -> Html {
     let json = series::to_json(results);
     let mut h = Html::new();
     h.raw("<!DOCTYPE html>\n<html lang=\"en\"><head><meta charset=\"utf-8\"><title>Impact report</title><style>")
@@ -138,7 +155,7 @@ fn page(cfc: Option<u32>, results: &[EntryJson], required: Option<&RequiredSrs>)
         json.impacts,
         if json.impacts == 1 { "" } else { "s" },
     );
-    provenance(&mut h, cfc, results, required);
+    provenance(&mut h, filter, results, required);
     impacts_table(&mut h, results, required);
     for e in results {
         if let Some(err) = &e.error {
@@ -208,7 +225,7 @@ fn page(cfc: Option<u32>, results: &[EntryJson], required: Option<&RequiredSrs>)
 /// required SRS and the specification.
 fn provenance(
     h: &mut Html,
-    cfc: Option<u32>,
+    filter: Option<&str>,
     results: &[EntryJson],
     required: Option<&RequiredSrs>,
 ) {
@@ -246,12 +263,7 @@ fn provenance(
             dd("skipped", &format!("and {} more lines", skipped.len() - 20));
         }
     }
-    dd(
-        "filter",
-        &cfc.map_or("none (raw signal)".into(), |c| {
-            format!("CFC {c} (SAE J211) on the captured windows")
-        }),
-    );
+    dd("filter", filter.unwrap_or("none (raw signal)"));
     if let Some(r) = required {
         let (first, last) = (r.points()[0].0, r.points()[r.points().len() - 1].0);
         let (low, high) = crate::standards::SRS_TOLERANCE_DB;
@@ -519,7 +531,7 @@ pub fn log_report(
                 // (The board's windows hold no filter padding: no CFC trace.)
                 let signal = crate::plot::Signal {
                     title: String::new(),
-                    cfc: None,
+                    filter: None,
                     rate_hz: rate,
                     mass_kg: mass.map(f64::from),
                     accel_m_s2: Box::new(move |i| wave.at_sample(i).map(|c| f64::from(c) * gain)),
