@@ -161,7 +161,7 @@ impl defmt::Format for SceneError {
 /// | `hold`, `max_impact`, `settle` | s |
 /// | `clip` | `LOW:HIGH` rails in counts (i16) |
 /// | `cfc`, `trigger_cfc` | 60, 180, 600, 1000 or `none` |
-/// | `lowpass` | a Butterworth low-pass on the captured windows, `ORDER,CUTOFF` (1 to 8, Hz: `4,1000`), or `none` |
+/// | `lowpass` | a Butterworth low-pass on the captured windows, `ORDER:CUTOFF` (1 to 8, Hz: `4:1000`; a colon, as semihosting passes no comma), or `none` |
 /// | `two_phase`, `nonlinear`, `fit_exponent`, `hertz` | `0` or `1` |
 /// | `exponent` | nonlinear exponent when not fitted (f32) |
 /// | `train` | bounce trains: `flight`, `rebound` (which speed the kinematics use) or `none` |
@@ -212,7 +212,7 @@ pub fn apply(scene: &mut Scene, key: &str, value: &str) -> Result<(), SceneError
         if v == "none" {
             return Ok(None);
         }
-        let (order, cutoff) = v.split_once(',').ok_or(SceneError::BadValue)?;
+        let (order, cutoff) = v.split_once(':').ok_or(SceneError::BadValue)?;
         let order = order.parse::<u8>().map_err(|_| SceneError::BadValue)?;
         impact_core::signal::lowpass::Lowpass::new(order, float(cutoff)?)
             .map(Some)

@@ -139,8 +139,9 @@ pub fn scene_args(scene: &Scene) -> Vec<String> {
         format!("trigger_cfc={}", class(scene.trigger_cfc)),
         format!(
             "lowpass={}",
+            // (`ORDER:CUTOFF`: semihosting passes no comma.)
             scene.lowpass.map_or("none".to_string(), |l| format!(
-                "{},{}",
+                "{}:{}",
                 l.order,
                 f(l.cutoff_hz)
             ))
