@@ -72,6 +72,7 @@ pub const BENCH: Scene = Scene {
     settle_s: 0.05,
     clip_counts: CLIP_COUNTS,
     cfc: None,
+    lowpass: None,
     trigger_cfc: None,
     // The exponent is fitted, as on the host (`impact bench m4`: the whole analysis of the
     // seed impact, all three fits included, costs about 3 M instructions, ~25 ms).
@@ -160,6 +161,7 @@ impl defmt::Format for SceneError {
 /// | `hold`, `max_impact`, `settle` | s |
 /// | `clip` | `LOW:HIGH` rails in counts (i16) |
 /// | `cfc`, `trigger_cfc` | 60, 180, 600, 1000 or `none` |
+/// | `lowpass` | a Butterworth low-pass on the captured windows, `ORDER:CUTOFF` (1 to 8, Hz: `4:1000`; a colon, as semihosting passes no comma), or `none` |
 /// | `two_phase`, `nonlinear`, `fit_exponent`, `hertz` | `0` or `1` |
 /// | `exponent` | nonlinear exponent when not fitted (f32) |
 /// | `train` | bounce trains: `flight`, `rebound` (which speed the kinematics use) or `none` |
@@ -206,6 +208,16 @@ pub fn apply(scene: &mut Scene, key: &str, value: &str) -> Result<(), SceneError
             .map(Some)
             .ok_or(SceneError::BadValue)
     }
+    fn lowpass(v: &str) -> Result<Option<impact_core::signal::lowpass::Lowpass>, SceneError> {
+        if v == "none" {
+            return Ok(None);
+        }
+        let (order, cutoff) = v.split_once(':').ok_or(SceneError::BadValue)?;
+        let order = order.parse::<u8>().map_err(|_| SceneError::BadValue)?;
+        impact_core::signal::lowpass::Lowpass::new(order, float(cutoff)?)
+            .map(Some)
+            .map_err(|_| SceneError::BadValue)
+    }
     match key {
         "gain" => scene.calibration.gain_m_s2_per_count = float(value)?,
         "rate" => scene.calibration.sample_rate_hz = float(value)?,
@@ -233,6 +245,7 @@ pub fn apply(scene: &mut Scene, key: &str, value: &str) -> Result<(), SceneError
             scene.clip_counts = (lo, hi);
         }
         "cfc" => scene.cfc = cfc(value)?,
+        "lowpass" => scene.lowpass = lowpass(value)?,
         "trigger_cfc" => scene.trigger_cfc = cfc(value)?,
         "two_phase" => scene.fits.two_phase = flag(value)?,
         "nonlinear" => scene.fits.nonlinear = flag(value)?,

@@ -105,3 +105,95 @@ pub fn positive_f64(s: &str) -> Result<f64, NumberError> {
         Err(_) => Err(NumberError::NotANumber),
     }
 }
+
+/// `--lowpass ORDER,CUTOFF`: a Butterworth low-pass's order and cut-off, Hz.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct LowpassArg {
+    pub order: u8,
+    pub cutoff_hz: f64,
+}
+
+/// Why `--lowpass` was refused (clap names the option and the value given); each says the
+/// fix. Its cut-off against the recording's rate is checked with the rate
+/// (`pipeline::PipelineError::LowpassCutoff`).
+#[derive(Clone, Debug, PartialEq, thiserror::Error)]
+pub enum LowpassArgError {
+    #[error(
+        "expected ORDER,CUTOFF: an order of 1 to 8 and a cut-off in Hz (`4,1000` or `4,1kHz`)"
+    )]
+    Shape,
+    #[error(
+        "order `{0}`: the order must be a whole number from 1 to 8 (each pass rolls off at 6 dB \
+         per octave per order; 2 or 4 are usual): `4,1000`"
+    )]
+    Order(String),
+    #[error(
+        "cut-off `{given}`: {why}; give Hz as a number or with a unit: `1000`, `1000Hz`, \
+         `1kHz`, `0.5MHz`"
+    )]
+    Cutoff { given: String, why: NumberError },
+}
+
+/// `--lowpass`: ORDER (1 to 8) and CUTOFF (Hz, a bare number or with `Hz`, `kHz`, `MHz`).
+pub fn lowpass(s: &str) -> Result<LowpassArg, LowpassArgError> {
+    use impact_core::signal::lowpass::{MAX_ORDER, MIN_ORDER};
+    let (order, cutoff) = s.split_once(',').ok_or(LowpassArgError::Shape)?;
+    let order_ok = order
+        .trim()
+        .parse::<u8>()
+        .ok()
+        .filter(|o| (MIN_ORDER..=MAX_ORDER).contains(o));
+    let Some(order) = order_ok else {
+        return Err(LowpassArgError::Order(order.trim().to_string()));
+    };
+    let given = cutoff.trim();
+    let lower = given.to_ascii_lowercase();
+    let (number, scale) = [("mhz", 1e6), ("khz", 1e3), ("hz", 1.0)]
+        .into_iter()
+        .find_map(|(unit, scale)| lower.strip_suffix(unit).map(|n| (n, scale)))
+        .unwrap_or((lower.as_str(), 1.0));
+    let cutoff_hz = within(number, &FREQUENCY_HZ)
+        .and_then(|v| Ok(FREQUENCY_HZ.check(v * scale)?))
+        .map_err(|why| LowpassArgError::Cutoff {
+            given: given.to_string(),
+            why,
+        })?;
+    Ok(LowpassArg { order, cutoff_hz })
+}
+
+#[cfg(test)]
+mod lowpass_tests {
+    use super::*;
+
+    #[test]
+    fn takes_an_order_and_a_cutoff_with_or_without_a_unit() {
+        let lp = |order, cutoff_hz| Ok(LowpassArg { order, cutoff_hz });
+        assert_eq!(lowpass("4,1000"), lp(4, 1000.0));
+        assert_eq!(lowpass("4,1kHz"), lp(4, 1000.0));
+        assert_eq!(lowpass("2, 1.5 kHz"), lp(2, 1500.0));
+        assert_eq!(lowpass("1,250Hz"), lp(1, 250.0));
+        assert_eq!(lowpass("8,0.1MHz"), lp(8, 100_000.0));
+        assert_eq!(lowpass("3,2khz"), lp(3, 2000.0));
+    }
+
+    #[test]
+    fn refuses_a_bad_order_or_cutoff_with_the_fix() {
+        assert_eq!(lowpass("4"), Err(LowpassArgError::Shape));
+        for bad in ["0", "9", "-1", "2.5", "four", ""] {
+            assert_eq!(
+                lowpass(&format!("{bad},1000")),
+                Err(LowpassArgError::Order(bad.to_string())),
+                "{bad}"
+            );
+        }
+        for bad in ["0", "-5", "1 kg", "fast", "nan", "inf", "kHz", "1e40"] {
+            let e = lowpass(&format!("4,{bad}")).unwrap_err();
+            assert!(matches!(e, LowpassArgError::Cutoff { .. }), "{bad}: {e:?}");
+            assert!(e.to_string().contains("`1kHz`"), "{e}");
+        }
+        assert!(lowpass("9,1000")
+            .unwrap_err()
+            .to_string()
+            .contains("1 to 8"));
+    }
+}

@@ -114,6 +114,17 @@ fn afrl_drop_tower_recording() {
     emulator_matches_host(file, &["--units", "kgn"]);
 }
 
+#[test]
+fn a_lowpass_on_the_board_is_the_hosts_and_its_log_names_it() {
+    // The firmware takes `lowpass=ORDER:CUTOFF`, filters the captures as the host does and
+    // states it on its scene line, from which `impact log` gives the same JSON (`lowpass`).
+    let file = concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/data/afrl-drop-tower/series1_test1_full_100ms.csv"
+    );
+    emulator_matches_host(file, &["--units", "kgn", "--lowpass", "3,5kHz"]);
+}
+
 fn data(rel: &str) -> String {
     format!("{}/data/{rel}", env!("CARGO_MANIFEST_DIR"))
 }

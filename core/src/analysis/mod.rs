@@ -1,4 +1,4 @@
-//! The per-impact analysis of a finished capture: width at half maximum (on the CFC-filtered
+//! The per-impact analysis of a finished capture: width at half maximum (on the filtered
 //! signal if the scene asks for a filter), and, when the approach speed is known, the
 //! kinematics (crush time, deformations, COR) and the model fits. Runs once per impact,
 //! wherever the capture was handed (inline on the host, in a low-priority task on the
@@ -220,10 +220,10 @@ fn spectrum<const CAP: usize>(
     Some(sp)
 }
 
-/// The CFC-filtered acceleration of everything the capture holds, into the workspace, and its
-/// peak within the impact's window (index in the workspace, value); `None` if the filter has
-/// too little signal to settle on either side of the contact (SAE J211's padding) or cannot
-/// run at this rate.
+/// The acceleration of everything the capture holds filtered by the scene's window filter
+/// (a CFC or the low-pass), into the workspace, and its peak within the impact's window
+/// (index in the workspace, value); `None` if the filter has too little signal to settle on
+/// either side of the contact (its padding: SAE J211's for a CFC) or cannot run at this rate.
 ///
 /// Before the contact the padding is the lead-in the capture holds, or the start of the
 /// recording: there the filter starts at rest on the first sample, as a filter run over the
@@ -232,7 +232,7 @@ fn spectrum<const CAP: usize>(
 fn filter<const CAP: usize>(
     capture: &Capture<CAP>,
     scene: &Scene,
-    class: crate::signal::cfc::Cfc,
+    kind: crate::signal::window_filter::WindowFilter,
     work: &mut Workspace<CAP>,
 ) -> Option<(usize, f32)> {
     let s = capture.summary();
@@ -240,7 +240,7 @@ fn filter<const CAP: usize>(
     // (In the capture's values: a decimated capture's are `step` samples apart.)
     let step = u64::from(capture.step());
     let rate = value_rate(capture, scene);
-    let pad = class.padding_samples(rate) as u64;
+    let pad = kind.padding_samples(rate) as u64;
     let held_from = capture.held_from();
     let before = s.onset_index.saturating_sub(held_from) / step;
     let contact_end = s.separation_index.unwrap_or(s.end_index);
@@ -249,7 +249,7 @@ fn filter<const CAP: usize>(
     if (before < pad && !from_start) || after < pad {
         return None;
     }
-    let b = crate::signal::cfc::Biquad::cfc(class, rate as f64)?;
+    let b = kind.design(rate as f64)?;
     let a = work.buf.get_mut(..held.len())?;
     let per_count = report::per_count(scene, s.base_n);
     let deviation = Deviation::new(s.base_sum, s.base_n);
@@ -337,18 +337,18 @@ fn analyse_kinematics<const CAP: usize>(
     let deviation = Deviation::new(s.base_sum, s.base_n);
     let raw = |i: usize| samples.get(i).map_or(0, |&x| deviation.of(x));
 
-    // With a CFC, the filtered acceleration of everything held (the filter's lead-in, the
+    // With a CFC or the low-pass, the filtered acceleration of everything held (the filter's lead-in, the
     // window, its tail) in the workspace, and its peak in the window.
     let filter_lead = s.filter_lead as usize;
     let mut filtered: Option<(usize, f32)> = None;
     #[cfg(feature = "cfc")]
-    if let Some(class) = scene.cfc {
-        filtered = filter(capture, scene, class, work);
+    if let Some(kind) = scene.window_filter() {
+        filtered = filter(capture, scene, kind, work);
         if filtered.is_none() {
             r.flags.insert(Flags::CFC_WINDOW);
         }
     }
-    // The filtered peak and its width, with a CFC.
+    // The filtered peak and its width, with a CFC or the low-pass.
     if let Some((i, v)) = filtered {
         let held = capture.held().len();
         let a = work.buf.get(..held).unwrap_or(&[]);
@@ -426,7 +426,7 @@ fn analyse_kinematics<const CAP: usize>(
     let f_peak = libm::fabsf(peak_a) * fit_mass.unwrap_or(0.0);
     if points > 0 {
         let f_scale = fit_mass.unwrap_or(0.0) / f_peak;
-        // With a CFC the filtered acceleration fills the workspace: point i reads sample
+        // With a filter the filtered acceleration fills the workspace: point i reads sample
         // filter_lead + onset + i every >= i, so compacting it forwards in place overwrites
         // nothing unread.
         let start = onset - frame.lead as usize;

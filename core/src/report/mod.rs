@@ -106,8 +106,9 @@ impl Flags {
     pub const NO_STOP: Flags = Flags(1 << 2);
     /// Half the raw peak is not reached on both sides inside the capture: no FWHM.
     pub const HALF_MAXIMUM_OUTSIDE: Flags = Flags(1 << 3);
-    /// The capture holds less signal around the contact than the CFC filter needs to settle
-    /// (SAE J211's padding): the filtered peak and its FWHM are absent.
+    /// The capture holds less signal around the contact than the window filter (the CFC or
+    /// the low-pass) needs to settle (its padding: SAE J211's for a CFC): the filtered peak
+    /// and its FWHM are absent.
     pub const CFC_WINDOW: Flags = Flags(1 << 4);
     /// The approach speed is unknown (no `v0`, drop height, free fall or light gate): the
     /// kinematics and the fits are absent.
@@ -274,9 +275,9 @@ pub struct ImpactReport {
     pub baseline_m_s2: f32,
     /// Width at half the peak of the raw signal, s (a filter never changes it).
     pub fwhm_s: Option<f32>,
-    /// Peak of the CFC-filtered signal, m/s² (only with a CFC).
+    /// Peak of the filtered signal, m/s² (only with a CFC or the low-pass).
     pub filtered_peak_acceleration_m_s2: Option<f32>,
-    /// Width at half the filtered peak, s (only with a CFC).
+    /// Width at half the filtered peak, s (only with a CFC or the low-pass).
     pub filtered_fwhm_s: Option<f32>,
     /// Samples per value of the capture the analysis fields were measured on: 1, or the power
     /// of two a contact longer than the capture was decimated to ([`Flags::DECIMATED`]).

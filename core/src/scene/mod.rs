@@ -4,7 +4,9 @@ use crate::consts::STANDARD_GRAVITY;
 use crate::error::positive;
 use crate::error::Error;
 use crate::signal::cfc::Cfc;
+use crate::signal::lowpass::Lowpass;
 use crate::signal::spectrum::SpectrumSettings;
+use crate::signal::window_filter::WindowFilter;
 use crate::signal::Calibration;
 pub mod train;
 
@@ -105,6 +107,9 @@ pub struct Scene {
     pub clip_counts: (i16, i16),
     /// Phaseless SAE J211 filter for the captured window's acceleration.
     pub cfc: Option<Cfc>,
+    /// Or a phaseless Butterworth low-pass of the lab's choosing (not both:
+    /// [`Scene::window_filter`]).
+    pub lowpass: Option<Lowpass>,
     /// Causal J211 filter on the live trigger path (rejects spikes and noise above the
     /// class; costs an f64 biquad per idle sample, so it is off unless asked for).
     pub trigger_cfc: Option<Cfc>,
@@ -150,6 +155,7 @@ impl Scene {
             settle_s: 0.05,
             clip_counts: (i16::MIN, i16::MAX),
             cfc: None,
+            lowpass: None,
             trigger_cfc: None,
             fits: FitSet::none(),
             gravity_m_s2: STANDARD_GRAVITY as f32,
@@ -281,12 +287,26 @@ impl Scene {
                 }
             }
         }
+        if let Some(l) = self.lowpass {
+            if self.cfc.is_some() {
+                return Err(Error::InvalidParameter {
+                    name: "lowpass",
+                    reason: "one filter on the captured windows: a CFC or a low-pass, not both",
+                });
+            }
+            l.check(c.sample_rate_hz)?;
+        }
         #[cfg(not(feature = "cfc"))]
-        if self.cfc.is_some() {
-            return Err(Error::InvalidParameter {
-                name: "cfc",
-                reason: "filtering not compiled in (feature `cfc`)",
-            });
+        for (on, name) in [
+            (self.cfc.is_some(), "cfc"),
+            (self.lowpass.is_some(), "lowpass"),
+        ] {
+            if on {
+                return Err(Error::InvalidParameter {
+                    name,
+                    reason: "filtering not compiled in (feature `cfc`)",
+                });
+            }
         }
         #[cfg(not(feature = "fit"))]
         if self.fits.any() {
@@ -298,13 +318,22 @@ impl Scene {
         Ok(())
     }
 
+    /// The phaseless filter on the captured windows: the CFC class, or the low-pass.
+    pub fn window_filter(&self) -> Option<WindowFilter> {
+        match (self.cfc, self.lowpass) {
+            (Some(c), _) => Some(WindowFilter::Cfc(c)),
+            (None, Some(l)) => Some(WindowFilter::Lowpass(l)),
+            (None, None) => None,
+        }
+    }
+
     /// Samples a capture holds beyond the impact's contact on either side, as far as the
-    /// signal reaches: the CFC's padding (SAE J211) or the specified pulse's verdict's,
-    /// whichever is longer; 0 with neither.
+    /// signal reaches: the window filter's padding (the CFC's, SAE J211, or the low-pass's)
+    /// or the specified pulse's verdict's, whichever is longer; 0 with neither.
     pub fn padding_samples(&self) -> u32 {
         let rate = self.calibration.sample_rate_hz;
-        self.cfc
-            .map_or(0, |c| c.padding_samples(rate))
+        self.window_filter()
+            .map_or(0, |f| f.padding_samples(rate))
             .max(self.spec.map_or(0, |s| s.padding_samples(rate)))
     }
 

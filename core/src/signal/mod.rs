@@ -1,15 +1,18 @@
-//! Signal path building blocks: calibration, pre-trigger ring, exact integration, CFC filters.
+//! Signal path building blocks: calibration, pre-trigger ring, exact integration, CFC and
+//! Butterworth low-pass filters.
 
 pub mod baseline;
 pub mod cfc;
 pub mod copy;
 pub mod flank;
 pub mod integrate;
+pub mod lowpass;
 pub mod power_flank;
 pub mod resultant;
 pub mod ring;
 pub mod spectrum;
 pub mod srs;
+pub mod window_filter;
 
 /// Converts raw integer samples to physical units. SI throughout.
 #[derive(Clone, Copy, Debug, PartialEq)]

@@ -441,7 +441,7 @@ impl<const PRE: usize> Stream<PRE> {
         });
         let held_from = a.first_index.saturating_sub(u64::from(a.filter_lead));
         let before = a.onset_index.saturating_sub(held_from);
-        let filter_served = self.scene.cfc.is_some_and(|c| {
+        let filter_served = self.scene.window_filter().is_some_and(|c| {
             before >= u64::from(c.padding_samples(rate)) || (held_from == 0 && !a.cut_at_start)
         });
         verdict_short || filter_served

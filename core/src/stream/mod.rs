@@ -123,6 +123,7 @@ impl<const PRE: usize> Stream<PRE> {
                 settle_s: 1.0,
                 clip_counts: (i16::MIN, i16::MAX),
                 cfc: None,
+                lowpass: None,
                 trigger_cfc: None,
                 gravity_m_s2: STANDARD_GRAVITY as f32,
                 vertical: false,

@@ -22,8 +22,9 @@ pub(super) struct Limits {
     pub max_samples: u64,
     /// The capture's length in use, samples ([`super::Stream::configure_for`]; 0: all `CAP`).
     pub capture_len: usize,
-    /// With a CFC: samples the filter needs on each side of a contact (SAE J211's padding);
-    /// with a specified pulse, the window its verdict watches (the larger of the two).
+    /// With a CFC or the low-pass: samples the filter needs on each side of a contact (SAE
+    /// J211's padding, or the low-pass's); with a specified pulse, the window its verdict
+    /// watches (the larger of the two).
     /// The capture takes them beyond the impact's window (a lead-in before it, a tail after
     /// it), so neither ever changes where an impact starts or ends.
     pub filter_pad: u32,

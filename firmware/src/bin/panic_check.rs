@@ -101,6 +101,8 @@ fn scene() -> Scene {
         settle_s: 0.05,
         clip_counts: (0, 4095),
         cfc: Some(Cfc::Cfc1000),
+        // (Unknown after `black_box` too: the low-pass's path is linked as the CFC's is.)
+        lowpass: None,
         trigger_cfc: Some(Cfc::Cfc1000),
         fits: FitSet::all(),
         // Vertical, so that the gravity shift of the kinematics is linked in too.

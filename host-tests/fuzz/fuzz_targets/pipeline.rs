@@ -98,6 +98,12 @@ fn scene(b: &mut Bytes) -> (Scene, bool) {
         settle_s: settle_samples as f32 / rate,
         clip_counts: clip,
         cfc: cfc(cfc_byte),
+        // Where no CFC is drawn, now and then a Butterworth low-pass of any order, its cut-off
+        // from half the rate down to a 1700th of it.
+        lowpass: (cfc_byte % 6 == 4).then_some(impact_core::signal::lowpass::Lowpass {
+            order: 1 + (cfc_byte >> 3) % 8,
+            cutoff_hz: rate / (2.0 + f32::from(cfc_byte / 6) * 40.0),
+        }),
         trigger_cfc: cfc(cfc_byte / 6),
         fits: FitSet {
             two_phase: fit_byte & 1 != 0,

@@ -336,16 +336,22 @@ fn report(args: &LogArgs, reader: LogReader, name: &str) -> Result<Judged, LogCo
             let mass = scene.mass_kg()?;
             let waves = &log.waveforms;
             // The board sends the impact's window only: not the samples around it that its
-            // CFC filtered.
-            let cfc = scene.cfc();
+            // CFC (or low-pass) filtered.
+            let filter = match (scene.cfc(), scene.lowpass()) {
+                (Some(c), _) => Some(format!("CFC {c}")),
+                (None, Some(l)) => Some(crate::report::filter::name(
+                    &impact_core::signal::window_filter::WindowFilter::Lowpass(l),
+                )),
+                (None, None) => None,
+            };
             let signal = crate::plot::Signal {
                 title: format!(
                     "{name}: the board's captured windows, m/s² above the baseline{}",
-                    cfc.map_or(String::new(), |c| format!(
-                        " (raw: the windows hold too little for its CFC {c} trace)"
+                    filter.map_or(String::new(), |f| format!(
+                        " (raw: the windows hold too little for its {f} trace)"
                     ))
                 ),
-                cfc: None,
+                filter: None,
                 rate_hz: rate,
                 mass_kg: mass.map(f64::from),
                 accel_m_s2: Box::new(move |i| {

@@ -79,6 +79,10 @@ impl<'a> LogJson<'a> {
             spec: spec
                 .as_ref()
                 .map(|s| crate::report::spec::spec_json(s, None)),
+            // The low-pass the board filtered with, as its scene line states it.
+            lowpass: scene
+                .and_then(SceneLine::lowpass)
+                .map(|l| crate::report::filter::LowpassJson::of(&l, rate)),
             trains: Vec::new(),
             waveforms: (log.waveforms.iter().enumerate())
                 .map(|(k, w)| {

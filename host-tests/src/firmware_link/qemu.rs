@@ -137,6 +137,15 @@ pub fn scene_args(scene: &Scene) -> Vec<String> {
         format!("clip={}:{}", scene.clip_counts.0, scene.clip_counts.1),
         format!("cfc={}", class(scene.cfc)),
         format!("trigger_cfc={}", class(scene.trigger_cfc)),
+        format!(
+            "lowpass={}",
+            // (`ORDER:CUTOFF`: semihosting passes no comma.)
+            scene.lowpass.map_or("none".to_string(), |l| format!(
+                "{}:{}",
+                l.order,
+                f(l.cutoff_hz)
+            ))
+        ),
         format!("two_phase={}", b(scene.fits.two_phase)),
         format!("nonlinear={}", b(scene.fits.nonlinear)),
         format!("fit_exponent={}", b(scene.fits.fit_exponent)),

@@ -19,10 +19,11 @@ pub mod survey;
 use impact_core::consts::STANDARD_GRAVITY;
 use impact_core::monitor::Monitor;
 use impact_core::signal::cfc::Cfc;
+use impact_core::signal::lowpass::Lowpass;
 use impact_core::{Approach, Calibration, FitSet, ImpactReport, Scene};
 
 use crate::pipeline::free_fall::free_fall_before;
-use crate::report::fmt::shortest;
+use crate::report::fmt::{shortest, sig};
 use crate::report::{impact_json, AnalysisJson, Clipping, Spike, SPIKE_REMOVED};
 use impact_io::quantise::to_count;
 use impact_io::read_recording;
@@ -57,6 +58,23 @@ pub enum PipelineError {
     /// A CFC class (`--cfc`, the scene file's `cfc`, `--trigger-cfc`) none of SAE J211's.
     #[error("{setting}: {class} is not one of 60, 180, 600, 1000")]
     Cfc { setting: Setting, class: u32 },
+    /// `--lowpass`'s cut-off at or above the Nyquist frequency of the recording's rate.
+    #[error(
+        "--lowpass: cut-off {} Hz is not below the Nyquist frequency, {} Hz (half the \
+         recording's {} S/s): choose a cut-off below it",
+        sig(*.cutoff_hz, 6), sig(*.rate_hz / 2.0, 6), sig(*.rate_hz, 6)
+    )]
+    LowpassAboveNyquist { cutoff_hz: f64, rate_hz: f64 },
+    /// `--lowpass`'s cut-off below the core's lowest for the rate
+    /// (`impact_core::signal::lowpass::MAX_RATE_OVER_CUTOFF`).
+    #[error(
+        "--lowpass: cut-off {} Hz is below {} Hz, the recording's {} S/s over 100 000 (the \
+         filter's gain at 0 Hz drifts below it): choose a cut-off of at least {} Hz, or \
+         resample the recording slower",
+        sig(*.cutoff_hz, 6), sig(*.rate_hz / impact_core::signal::lowpass::MAX_RATE_OVER_CUTOFF, 6),
+        sig(*.rate_hz, 6), sig(*.rate_hz / impact_core::signal::lowpass::MAX_RATE_OVER_CUTOFF, 6)
+    )]
+    LowpassTooLow { cutoff_hz: f64, rate_hz: f64 },
     /// The scene refused by the core: its parameter named as it was given (an option or
     /// the scene file's key).
     #[error("{setting}: {reason}")]
@@ -617,15 +635,17 @@ impl Setup {
             title: format!(
                 "{}: raw signal above its baseline, m/s²{}",
                 self.column.as_deref().unwrap_or("acceleration"),
-                self.scene.cfc.map_or(String::new(), |c| format!(
-                    "; CFC {} (SAE J211, phaseless) over the deceleration",
-                    c.class()
-                )),
+                self.scene
+                    .window_filter()
+                    .map_or(String::new(), |f| format!(
+                        "; {} over the deceleration",
+                        crate::report::filter::description(&f)
+                    )),
             ),
-            cfc: self
+            filter: self
                 .scene
-                .cfc
-                .map(|c| (c, u64::from(self.scene.padding_samples()))),
+                .window_filter()
+                .map(|f| (f, u64::from(self.scene.padding_samples()))),
             rate_hz: f64::from(self.scene.calibration.sample_rate_hz),
             mass_kg: self.scene.mass_kg.map(f64::from),
             accel_m_s2: Box::new(move |i| {
@@ -927,6 +947,22 @@ pub(crate) fn build_scene(
         })?),
         None => None,
     };
+    // `--lowpass` on the command line overrides a scene file's `cfc` (clap refuses it with
+    // `--cfc`).
+    if let Some(l) = args.lowpass {
+        scene.cfc = None;
+        let lowpass = Lowpass::new(l.order, l.cutoff_hz as f32).map_err(PipelineError::Core)?;
+        let rate = calibration.sample_rate_hz;
+        if lowpass.check(rate).is_err() {
+            let (cutoff_hz, rate_hz) = (shortest(lowpass.cutoff_hz), shortest(rate));
+            return Err(if f64::from(lowpass.cutoff_hz) >= f64::from(rate) / 2.0 {
+                PipelineError::LowpassAboveNyquist { cutoff_hz, rate_hz }
+            } else {
+                PipelineError::LowpassTooLow { cutoff_hz, rate_hz }
+            });
+        }
+        scene.lowpass = Some(lowpass);
+    }
     scene.trigger_cfc = match args.trigger_cfc {
         Some(c) => Some(Cfc::from_class(c).ok_or(PipelineError::Cfc {
             setting: Setting::Option("trigger-cfc"),
@@ -1003,6 +1039,7 @@ fn name_of(args: &AnalyzeArgs, file: &SceneFile, name: &'static str) -> Setting 
         "max-impact" => (args.max_impact.is_some(), file.max_impact.is_some()),
         "settle" => (args.settle.is_some(), file.settle.is_some()),
         "cfc" => (args.cfc.is_some(), file.cfc.is_some()),
+        "lowpass" => (args.lowpass.is_some(), false),
         // Only the scene file sets the exponent.
         "exponent" => (false, true),
         _ => (true, false),
@@ -1214,6 +1251,9 @@ pub fn to_json(setup: &Setup, reports: &[ImpactReport]) -> AnalysisJson {
             .spec
             .as_ref()
             .map(|s| crate::report::spec::spec_json(s, setup.spec_standard)),
+        lowpass: (setup.scene.lowpass.as_ref()).map(|l| {
+            crate::report::filter::LowpassJson::of(l, setup.scene.calibration.sample_rate_hz)
+        }),
         trains: Vec::new(),
         waveforms: Vec::new(),
         impacts: reports

@@ -215,6 +215,15 @@ pub struct AnalyzeArgs {
     /// SAE J211 channel frequency class for the captured windows: 60, 180, 600 or 1000.
     #[arg(long, help_heading = "Analysis")]
     pub cfc: Option<u32>,
+    /// Butterworth low-pass for the captured windows, not a CFC: ORDER,CUTOFF (`4,1kHz`).
+    ///
+    /// A phaseless Butterworth low-pass for the captured windows instead of a CFC: ORDER (1
+    /// to 8) and CUTOFF in Hz (`4,1000`, `4,1kHz`), below half the sample rate; SciPy's
+    /// `butter(ORDER, CUTOFF, fs=rate, output='sos')` run forward and backward
+    /// (`sosfiltfilt`). CUTOFF is one pass's −3 dB point: forward and backward the filter is
+    /// −6 dB there. Overrides a scene file's `cfc`.
+    #[arg(long, help_heading = "Analysis", value_name = "ORDER,CUTOFF", value_parser = parse::lowpass, conflicts_with = "cfc")]
+    pub lowpass: Option<parse::LowpassArg>,
     /// Capture length, samples [default: the board's, 15104].
     ///
     /// Capture length, samples, up to 131072 [default: the board's, 15104, so `analyze` and

@@ -3,21 +3,23 @@
 //! and with `--srs` the SRS and PVSS.
 
 use impact_core::signal::cfc::Cfc;
+use impact_core::signal::window_filter::WindowFilter;
 use plotters::prelude::*;
 
 use super::signal::{window, Signal};
 use super::{draw_panel, write_svg, Curve, Panel, PlotError};
 
-/// The CFC-filtered trace's colour: dark, over the light raw one.
+/// The filtered trace's colour (a CFC's or the low-pass's): dark, over the light raw one.
 const CFC_TRACE: RGBColor = RGBColor(25, 45, 120);
 
-/// A CFC trace's legend.
-fn cfc_label(class: Cfc) -> &'static str {
-    match class {
-        Cfc::Cfc60 => "CFC 60",
-        Cfc::Cfc180 => "CFC 180",
-        Cfc::Cfc600 => "CFC 600",
-        Cfc::Cfc1000 => "CFC 1000",
+/// A filtered trace's legend (the low-pass's setting is in the figure's title).
+fn cfc_label(kind: WindowFilter) -> &'static str {
+    match kind {
+        WindowFilter::Cfc(Cfc::Cfc60) => "CFC 60",
+        WindowFilter::Cfc(Cfc::Cfc180) => "CFC 180",
+        WindowFilter::Cfc(Cfc::Cfc600) => "CFC 600",
+        WindowFilter::Cfc(Cfc::Cfc1000) => "CFC 1000",
+        WindowFilter::Lowpass(_) => "low-pass",
     }
 }
 
@@ -224,12 +226,12 @@ fn model_curves(
     curves
 }
 
-/// With a CFC, its trace over the raw one (the analysis's filter on the samples it
+/// With a CFC or the low-pass, its trace over the raw one (the analysis's filter on the samples it
 /// filtered) put first in `curves`; else, or where it cannot be drawn, the deceleration
 /// panel's title saying so.
 fn cfc_trace(signal: &Signal, r: &impact_core::ImpactReport, curves: &mut Vec<Curve>) -> String {
     let title = "deceleration, m/s² (left) and g (right)".to_string();
-    let Some((class, _)) = signal.cfc else {
+    let Some((kind, _)) = signal.filter else {
         return title;
     };
     let (samples, t_ms) = window_ms(signal, r);
@@ -241,10 +243,13 @@ fn cfc_trace(signal: &Signal, r: &impact_core::ImpactReport, curves: &mut Vec<Cu
                     Some((t_ms(i), *v))
                 })
                 .collect();
-            curves.insert(0, (cfc_label(class), CFC_TRACE, trace));
+            curves.insert(0, (cfc_label(kind), CFC_TRACE, trace));
             title
         }
-        None => format!("deceleration, m/s², g: CFC {} not drawn", class.class()),
+        None => format!(
+            "deceleration, m/s², g: {} not drawn",
+            crate::report::filter::name(&kind)
+        ),
     }
 }
 

@@ -1,7 +1,7 @@
 //! What the figures draw from: the signal the pipeline analysed, each impact's window, and
-//! its CFC-filtered trace by the analysis's own filter.
+//! its filtered trace (a CFC's or the low-pass's) by the analysis's own filter.
 
-use impact_core::signal::cfc::{Biquad, Cfc};
+use impact_core::signal::window_filter::WindowFilter;
 use impact_core::ImpactReport;
 
 /// What the impact figure draws from: the signal the pipeline analysed (the counts times
@@ -16,9 +16,10 @@ pub struct Signal<'a> {
     pub accel_m_s2: Box<dyn Fn(u64) -> Option<f64> + 'a>,
     /// The figure's title: what was drawn (file, channel, filter).
     pub title: String,
-    /// The analysis's CFC, if any, and the samples its capture held on either side of the
-    /// contact (`Scene::padding_samples`): the filtered trace is drawn from the same samples.
-    pub cfc: Option<(Cfc, u64)>,
+    /// The analysis's window filter (a CFC or the low-pass), if any, and the samples its
+    /// capture held on either side of the contact (`Scene::padding_samples`): the filtered
+    /// trace is drawn from the same samples.
+    pub filter: Option<(WindowFilter, u64)>,
 }
 
 /// The samples the figure draws of impact `r` at `rate_hz`: from two before first touch to
@@ -55,17 +56,17 @@ pub fn read_window(r: &ImpactReport, rate_hz: f64, padding: u64) -> (u64, u64) {
     (first, (a + n).max(b + m) - first)
 }
 
-/// Impact `r`'s acceleration above its baseline (m/s²) filtered by the analysis's CFC, as the
-/// analysis filtered it: the same J211 section run forward and back in `f32`
-/// ([`Biquad::phaseless_f32`]) over the samples its capture held (from the start of the
+/// Impact `r`'s acceleration above its baseline (m/s²) filtered by the analysis's window
+/// filter, as the analysis filtered it: the same sections run forward and back in `f32`
+/// (`Designed::phaseless_f32`) over the samples its capture held (from the start of the
 /// recording, or to its end, where those come first), `(first sample, values)`. `None` without
-/// a CFC, when the analysis had no filtered peak (too little signal around the contact: the
+/// a filter, when the analysis had no filtered peak (too little signal around the contact: the
 /// report's `cfc_window` flag), or when the signal does not hold those samples (a board's
 /// windows, which are the impact's window only).
 pub fn filtered(signal: &Signal, r: &ImpactReport) -> Option<(u64, Vec<f64>)> {
-    let (class, padding) = signal.cfc?;
+    let (kind, padding) = signal.filter?;
     r.filtered_peak_acceleration_m_s2?;
-    let section = Biquad::cfc(class, signal.rate_hz)?;
+    let section = kind.design(signal.rate_hz)?;
     let (first, n) = held(r, signal.rate_hz, padding);
     let base = f64::from(r.baseline_m_s2);
     let mut a: Vec<f32> = (first..first + n)

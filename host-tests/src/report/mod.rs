@@ -5,6 +5,7 @@
 
 pub mod axes;
 pub mod csv;
+pub mod filter;
 pub mod fmt;
 pub mod screen;
 pub mod spec;
@@ -193,6 +194,10 @@ pub struct AnalysisJson {
     /// `spec`).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub spec: Option<crate::report::spec::SpecJson>,
+    /// With `--lowpass`: the Butterworth low-pass of the filtered fields (absent with a CFC
+    /// or no filter).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub lowpass: Option<crate::report::filter::LowpassJson>,
     pub impacts: Vec<ImpactJson>,
     /// Events the board's trigger took that are no impact: the signal drifted (it left the
     /// baseline and never came back, with no pulse in it: half its peak not reached on both

@@ -131,10 +131,13 @@ pub fn to_table(a: &AnalysisJson) -> String {
                 |w| human(w, "s")
             ),
         ));
-        // With a CFC, the filtered peak and width beside the raw ones above.
+        // With a CFC or a low-pass, the filtered peak and width beside the raw ones above.
+        let filtered = a.lowpass.as_ref().map_or("CFC-filtered".to_string(), |l| {
+            format!("low-pass-filtered (order {}, {} Hz)", l.order, l.cutoff_hz)
+        });
         if let Some(p) = i.filtered_peak_acceleration_m_s2 {
             s.push_str(&format!(
-                "    CFC-filtered: peak {} ({}), FWHM {}\n",
+                "    {filtered}: peak {} ({}), FWHM {}\n",
                 human(p, "m/s²"),
                 human(p / STANDARD_GRAVITY, "g"),
                 i.filtered_fwhm_s.map_or_else(
@@ -147,7 +150,7 @@ pub fn to_table(a: &AnalysisJson) -> String {
             .get("filtered_peak_acceleration_m_s2")
             .filter(|r| *r != "no-cfc")
         {
-            s.push_str(&format!("    CFC-filtered: unknown ({why})\n"));
+            s.push_str(&format!("    {filtered}: unknown ({why})\n"));
         }
         // Why the kinematics are missing, unless simply because v0 was not given.
         if let Some(why) = i

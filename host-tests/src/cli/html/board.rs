@@ -58,7 +58,7 @@ pub fn log_report(
                 // (The board's windows hold no filter padding: no CFC trace.)
                 let signal = crate::plot::Signal {
                     title: String::new(),
-                    cfc: None,
+                    filter: None,
                     rate_hz: rate,
                     mass_kg: mass.map(f64::from),
                     accel_m_s2: Box::new(move |i| wave.at_sample(i).map(|c| f64::from(c) * gain)),

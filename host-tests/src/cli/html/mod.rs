@@ -166,7 +166,23 @@ pub fn run(args: &ReportArgs) -> Result<crate::report::spec::Judged, ReportError
         written,
         inputs: provenance::inputs(&files),
     };
-    let page = page(a.cfc, &results, required.as_ref(), &front);
+    // The windows' filter as the command line and the scene file set it (the first
+    // recording's scene; every recording takes the same options).
+    let filter = results
+        .iter()
+        .filter_map(|e| e.analysis.as_ref())
+        .find_map(|a| a.lowpass.as_ref())
+        .map(|l| {
+            format!(
+                "Butterworth {} (phaseless, SciPy's sosfiltfilt) on the captured windows",
+                l.name()
+            )
+        })
+        .or_else(|| {
+            a.cfc
+                .map(|c| format!("CFC {c} (SAE J211) on the captured windows"))
+        });
+    let page = page(filter.as_deref(), &results, required.as_ref(), &front);
     if let Some(html) = &args.html {
         crate::output::write(html, page.as_str().as_bytes())?;
     }
@@ -212,11 +228,11 @@ table.title{font-size:.95em;min-width:40em}table.title th{width:13em}th.sub{back
 .hash{font-family:monospace;font-size:.95em}table.verdicts td{vertical-align:top;white-space:nowrap}\
 table.verdicts td.l{white-space:normal}";
 
-/// The page: `results` analysed with the windows' filter `cfc`, against `required`, with
+/// The page: `results` analysed with the windows' filter `filter` (its description), against `required`, with
 /// `front`'s title block and inputs: the verdict first, then who and what, the verdicts of each
 /// pulse, the series, the pulses; the settings and the inputs last.
 fn page(
-    cfc: Option<u32>,
+    filter: Option<&str>,
     results: &[EntryJson],
     required: Option<&RequiredSrs>,
     front: &Front,
@@ -299,7 +315,7 @@ fn page(
         spectra(&mut h, results, r);
     }
     // The appendix: how the report was made, and from what.
-    provenance::settings(&mut h, cfc, results, required);
+    provenance::settings(&mut h, filter, results, required);
     provenance::inputs_table(&mut h, &front.inputs);
     h.raw("</body></html>\n");
     h

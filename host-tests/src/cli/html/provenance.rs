@@ -217,7 +217,7 @@ fn civil_from_days(days: i64) -> (i64, i64, i64) {
 /// specification with its standard's sources.
 pub fn settings(
     h: &mut Html,
-    cfc: Option<u32>,
+    filter: Option<&str>,
     results: &[EntryJson],
     required: Option<&RequiredSrs>,
 ) {
@@ -254,12 +254,7 @@ pub fn settings(
             dd("skipped", &format!("and {} more lines", skipped.len() - 20));
         }
     }
-    dd(
-        "filter",
-        &cfc.map_or("none (raw signal)".into(), |c| {
-            format!("CFC {c} (SAE J211) on the captured windows")
-        }),
-    );
+    dd("filter", filter.unwrap_or("none (raw signal)"));
     if let Some(r) = required {
         let (first, last) = (r.points()[0].0, r.points()[r.points().len() - 1].0);
         let (low, high) = crate::standards::SRS_TOLERANCE_DB;

@@ -360,8 +360,8 @@ pub fn pulse_svg(
     let g = |a: f32| human(f64::from(a) / STANDARD_GRAVITY, "g");
     let mut peak = format!("peak {}", g(r.peak_acceleration_m_s2));
     let mut filtered = None;
-    if let Some((class, _)) = signal.cfc {
-        let class = class.class();
+    if let Some((kind, _)) = signal.filter {
+        let name = crate::report::filter::name(&kind);
         match (
             crate::plot::filtered(signal, r),
             r.filtered_peak_acceleration_m_s2,
@@ -372,10 +372,10 @@ pub fn pulse_svg(
                         .get(usize::try_from(i.checked_sub(first)?).ok()?)
                         .copied()
                 });
-                peak = format!("{peak} raw, {} CFC {class}", g(f));
-                filtered = Some((format!("CFC {class}"), trace));
+                peak = format!("{peak} raw, {} {name}", g(f));
+                filtered = Some((name, trace));
             }
-            _ => peak = format!("{peak} raw (CFC {class}: not drawn)"),
+            _ => peak = format!("{peak} raw ({name}: not drawn)"),
         }
     }
     // The verdict's worst point (its time and value are the stream's, above the baseline in

@@ -95,6 +95,14 @@ impl SceneLine {
         self.fields.get("cfc").filter(|c| *c != "none")
     }
 
+    /// The Butterworth low-pass the board filters with, if the line states one
+    /// (`lowpass_order`, `lowpass_cutoff_hz`; absent in an older board's line) the core takes.
+    pub fn lowpass(&self) -> Option<impact_core::signal::lowpass::Lowpass> {
+        let order = self.fields.readable::<u8>("lowpass_order")?;
+        let cutoff = self.fields.readable::<f32>("lowpass_cutoff_hz")?;
+        impact_core::signal::lowpass::Lowpass::new(order, cutoff).ok()
+    }
+
     /// The pulse the board judges ([`spec_of`] its fields).
     pub fn spec(&self) -> Result<Option<impact_core::spec::Spec>, LineError> {
         spec_of(&self.fields)
