@@ -45,9 +45,14 @@ fn main() {
     if !own {
         return;
     }
-    // Built again when HEAD moves: HEAD, the branch it names, the packed refs (only files that
-    // exist: cargo reruns a script on every build for a missing one).
-    let mut watched = vec!["HEAD".to_string(), "packed-refs".to_string()];
+    // Built again when HEAD moves: HEAD, the branch it names, the packed refs, and HEAD's log
+    // (written on every commit, checkout and reset, whether the branch's ref is loose or
+    // packed); only files that exist: cargo reruns a script on every build for a missing one.
+    let mut watched = vec![
+        "HEAD".to_string(),
+        "packed-refs".to_string(),
+        "logs/HEAD".to_string(),
+    ];
     watched.extend(git(&dir, &["symbolic-ref", "-q", "HEAD"]));
     for name in watched {
         let path = git(

@@ -129,7 +129,7 @@ def shoot(url, out, size=(1400, 1000), after=0, timeout=60.0):
         dt.call("Page.navigate", url=url)
         t0 = time.monotonic()
         shown = "(S.last && Number.isFinite(S.last.index) ? S.last.index : -1)"
-        while (dt.evaluate(shown) or -1) < after:
+        while (lambda v: -1 if v is None else v)(dt.evaluate(shown)) < after:
             if time.monotonic() - t0 > timeout:
                 raise TimeoutError(f"{url}: impact {after} not shown within {timeout:.0f} s")
             time.sleep(0.05)

@@ -550,7 +550,8 @@ fn the_verdict_comes_first_and_names_each_failing_pulse_with_what_it_failed_and_
             v["limit_m_s2"].as_f64().unwrap(),
         );
         assert_eq!(worst > lim, limit == "upper", "{v}");
-        let at = format!("at t = {:.1} µs", v["worst_time_s"].as_f64().unwrap() * 1e6);
+        // On the recording's clock to the microsecond.
+        let at = format!("at t = {:.6} s", v["worst_time_s"].as_f64().unwrap());
         let named = format!(
             "<li><a href=\"#pulse-{k}\">accel_5.csv [{}] impact 0</a>: {words}: ",
             k + 1
@@ -636,4 +637,91 @@ fn a_hostile_meta_value_reaches_the_page_escaped() {
     ] {
         assert!(page.contains(&escaped), "{escaped} missing");
     }
+}
+
+/// What a quality manager could be misled by is refused or said: a recording of the series
+/// with no pulse makes the verdict INCOMPLETE and is named; a contact that had not ended has
+/// a duration that is a lower bound (no error made of it); a meta file that is no regular
+/// file, a key that would pose as the tool's own row, two spellings of one key, and a
+/// bidi override are refused; a recording read through a pipe is not given the hash of
+/// whatever the pipe holds later.
+#[cfg(unix)]
+#[test]
+fn what_would_mislead_a_signed_report_is_refused_or_said() {
+    let scratch = Scratch::new();
+    let accel_5 = format!(
+        "{}/data/afrl-drop-tower/accel_5.csv",
+        env!("CARGO_MANIFEST_DIR")
+    );
+    let quiet = scratch.join("quiet.csv");
+    let rows: String = (0..2000)
+        .map(|k| format!("{:.6},0.0\n", k as f64 * 1e-6))
+        .collect();
+    std::fs::write(&quiet, format!("time_s,accel\n{rows}")).unwrap();
+    let html = scratch.join("q.html");
+    let (code, _, err) = common::impact(&[
+        "report",
+        &accel_5,
+        quiet.to_str().unwrap(),
+        "--column",
+        "1",
+        "--units",
+        "kgn",
+        "--spec",
+        "half-sine,11000g,0.1ms,band=0.9,outside=0.9",
+        "--html",
+        html.to_str().unwrap(),
+    ]);
+    assert!(code == 0 || code == 3, "{err}");
+    let page = std::fs::read_to_string(&html).unwrap();
+    assert!(
+        page.contains("<b>INCOMPLETE</b>"),
+        "a recording without a pulse"
+    );
+    assert!(page.contains("1 recording without a pulse"));
+    assert!(page.contains("quiet.csv [") && page.contains("no pulse found, nothing judged"));
+    // accel_5's contact runs to the end of its capture: a lower bound, no error.
+    assert!(
+        page.contains("<td>≥ 410.9 µs</td><td>— (stream-ended)</td>"),
+        "duration"
+    );
+    let refused = |args: &[&str], want: &str| {
+        let mut all = vec!["report", &accel_5, "--units", "kgn", "--html"];
+        let out = scratch.join("r.html");
+        all.push(out.to_str().unwrap());
+        all.extend(args);
+        let (code, _, err) = common::impact(&all);
+        assert_ne!(code, 0, "{args:?}");
+        assert!(err.contains(want), "{args:?}: {err}");
+    };
+    refused(
+        &["--meta", "Report written=2001-01-01"],
+        "the tool's own row",
+    );
+    refused(
+        &["--meta", "test-id=1", "--meta", "TEST_ID=2"],
+        "given twice",
+    );
+    let bidi = scratch.join("bidi.txt");
+    std::fs::write(&bidi, "operator = A\u{202e}B\n").unwrap();
+    refused(
+        &["--meta-file", bidi.to_str().unwrap()],
+        "a control character in the value",
+    );
+    refused(&["--meta-file", "/dev/zero"], "not a regular file");
+    // A recording through a pipe: listed without a hash, and why.
+    let piped = scratch.join("p.html");
+    let status = std::process::Command::new("bash")
+        .arg("-c")
+        .arg(format!(
+            "{} report <(cat {accel_5}) --column 1 --units kgn --html {}",
+            env!("CARGO_BIN_EXE_impact"),
+            piped.display()
+        ))
+        .status()
+        .unwrap();
+    assert!(status.success());
+    let page = std::fs::read_to_string(&piped).unwrap();
+    assert!(page.contains("not a regular file: read once as it streamed, so not hashed"));
+    assert!(!page.contains("e3b0c44298fc1c149afbf4c8996fb92427ae41e4649b934ca495991b7852b855"));
 }

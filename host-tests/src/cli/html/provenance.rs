@@ -71,6 +71,13 @@ pub struct Digested {
 
 /// `path`'s size and SHA-256, read in 64 KiB pieces.
 pub fn digest(path: &Path) -> Result<Digested, std::io::Error> {
+    // A pipe, FIFO or device was read once, as it streamed: opened again it would give other
+    // bytes (none, or never an end), so its hash would not be of what was analysed.
+    if !std::fs::metadata(path)?.is_file() {
+        return Err(std::io::Error::other(
+            "not a regular file: read once as it streamed, so not hashed",
+        ));
+    }
     let mut file = std::fs::File::open(path)?;
     let mut hasher = Sha256::new();
     let mut buf = vec![0u8; 64 << 10];

@@ -49,6 +49,9 @@ pub enum MetaLineError {
     Control(&'static str),
     #[error("the key {0:?} given twice")]
     Twice(String),
+    /// A key that would show as one of the rows the tool writes itself.
+    #[error("the key {0:?} is the tool's own row (the report writes it): give another")]
+    Reserved(String),
 }
 
 /// Why the title block could not be read.
@@ -85,15 +88,33 @@ fn entry(key: &str, value: &str) -> Result<(String, String), MetaLineError> {
     if key.is_empty() {
         return Err(MetaLineError::EmptyKey);
     }
-    if key.chars().any(char::is_control) {
+    // Control characters, and the invisible ones that reorder or hide text (bidi overrides,
+    // zero-width marks): a signed page shows what it holds.
+    let hidden = |c: char| {
+        c.is_control()
+            || matches!(c, '\u{200b}'..='\u{200f}' | '\u{202a}'..='\u{202e}' | '\u{2060}'..='\u{2069}' | '\u{feff}')
+    };
+    if key.chars().any(hidden) {
         return Err(MetaLineError::Control("the key"));
     }
-    if value.chars().any(char::is_control) {
+    if value.chars().any(hidden) {
         return Err(MetaLineError::Control("the value"));
+    }
+    if RESERVED.contains(&norm(key).as_str()) {
+        return Err(MetaLineError::Reserved(key.to_string()));
     }
     Ok((key.to_string(), value.to_string()))
 }
 
+/// A key as its label reads it: any case, `_` and spaces as `-` (two keys the same here are
+/// one row).
+fn norm(key: &str) -> String {
+    key.to_lowercase().replace(['_', ' '], "-")
+}
+
+/// The rows the tool writes itself, as [`norm`] reads them: not a `--meta` key (a line
+/// claiming another report time or tool would sit beside the real one, styled the same).
+const RESERVED: [&str; 4] = ["report-written", "tool", "recorder", "factory-calibration"];
 /// A meta file's lines (`text`): `key = value` or `key: value`, split at the first of the two.
 pub fn parse_meta_file(text: &str) -> Result<Vec<(String, String)>, (usize, MetaLineError)> {
     let text = text.strip_prefix('\u{feff}').unwrap_or(text);
@@ -108,7 +129,7 @@ pub fn parse_meta_file(text: &str) -> Result<Vec<(String, String)>, (usize, Meta
             .find(['=', ':'])
             .ok_or((at, MetaLineError::NoSeparator))?;
         let (key, value) = entry(&line[..cut], &line[cut + 1..]).map_err(|e| (at, e))?;
-        if out.iter().any(|(k, _)| *k == key) {
+        if out.iter().any(|(k, _)| norm(k) == norm(&key)) {
             return Err((at, MetaLineError::Twice(key)));
         }
         out.push((key, value));
@@ -124,10 +145,13 @@ pub fn read_meta(args: &MetaArgs) -> Result<Vec<(String, String)>, MetaError> {
         None => Vec::new(),
     };
     for (k, (key, value)) in args.meta.iter().enumerate() {
-        if args.meta[..k].iter().any(|(other, _)| other == key) {
+        if args.meta[..k]
+            .iter()
+            .any(|(other, _)| norm(other) == norm(key))
+        {
             return Err(MetaError::Option(MetaLineError::Twice(key.clone())));
         }
-        match lines.iter_mut().find(|(other, _)| other == key) {
+        match lines.iter_mut().find(|(other, _)| norm(other) == norm(key)) {
             Some(line) => line.1 = value.clone(),
             None => lines.push((key.clone(), value.clone())),
         }
@@ -140,14 +164,27 @@ fn read_meta_file(path: &Path) -> Result<Vec<(String, String)>, MetaError> {
         path: path.to_path_buf(),
         source,
     };
-    let size = std::fs::metadata(path).map_err(read)?.len();
+    // A regular file (a FIFO or a device would be read once for the title block and again,
+    // differently or never ending, for its hash), read to at most the cap.
+    let meta = std::fs::metadata(path).map_err(read)?;
+    if !meta.is_file() {
+        return Err(read(std::io::Error::other(
+            "not a regular file (a title block is read from a file, and hashed from it)",
+        )));
+    }
+    let mut bytes = Vec::new();
+    std::io::Read::read_to_end(
+        &mut std::io::Read::take(std::fs::File::open(path).map_err(read)?, MAX_META_FILE + 1),
+        &mut bytes,
+    )
+    .map_err(read)?;
+    let size = bytes.len() as u64;
     if size > MAX_META_FILE {
         return Err(MetaError::TooLarge {
             path: path.to_path_buf(),
             size,
         });
     }
-    let bytes = std::fs::read(path).map_err(read)?;
     let text = String::from_utf8(bytes).map_err(|_| MetaError::NotText {
         path: path.to_path_buf(),
     })?;

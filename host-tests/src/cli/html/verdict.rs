@@ -36,12 +36,18 @@ pub struct Tally {
     pub not_judged: usize,
     /// Recordings that could not be analysed.
     pub recordings_failed: usize,
+    /// Recordings analysed in which no pulse was found (nothing of theirs judged).
+    pub recordings_without_pulse: usize,
 }
 
 impl Tally {
     fn of(results: &[EntryJson]) -> Self {
         let mut t = Tally {
             recordings_failed: results.iter().filter(|e| e.error.is_some()).count(),
+            recordings_without_pulse: results
+                .iter()
+                .filter(|e| e.analysis.as_ref().is_some_and(|a| a.impacts.is_empty()))
+                .count(),
             ..Tally::default()
         };
         for (_, i) in series::impacts(results) {
@@ -63,7 +69,11 @@ impl Tally {
             Overall::NotJudged
         } else if self.passed < self.judged {
             Overall::Fail
-        } else if self.judged > 0 && self.not_judged == 0 && self.recordings_failed == 0 {
+        } else if self.judged > 0
+            && self.not_judged == 0
+            && self.recordings_failed == 0
+            && self.recordings_without_pulse == 0
+        {
             Overall::Pass
         } else {
             Overall::Incomplete
@@ -117,7 +127,7 @@ pub fn why(c: Criterion, v: &VerdictJson, s: &SpecJson) -> String {
             "{}: {} at t = {} ({} after the nominal start), limit {}, beyond by {:.1} % of the peak",
             c.words(),
             g(v.worst_m_s2),
-            q(v.worst_time_s, "s"),
+            clock(v.worst_time_s),
             q(v.worst_time_s - v.nominal_start_s, "s"),
             g(v.limit_m_s2),
             100.0 * v.margin,
@@ -129,10 +139,16 @@ pub fn why(c: Criterion, v: &VerdictJson, s: &SpecJson) -> String {
             error_pct(v.delta_v_m_s, s.nominal_delta_v_m_s),
             q(s.nominal_delta_v_m_s, "m/s"),
             100.0 * s.delta_v_tolerance,
-            q(v.nominal_start_s - s.before * s.duration_s, "s"),
-            q(v.nominal_start_s + (1.0 + s.after) * s.duration_s, "s"),
+            clock(v.nominal_start_s - s.before * s.duration_s),
+            clock(v.nominal_start_s + (1.0 + s.after) * s.duration_s),
         ),
     }
+}
+
+/// A time on the recording's clock, to the microsecond (a time 14.6 s into a recording
+/// keeps its sample: four significant digits would not).
+fn clock(t: f64) -> String {
+    format!("{t:.6} s")
 }
 
 /// [`why`] in a table's cell: the limit, the time and the values; Δv's tolerance and window
@@ -147,7 +163,7 @@ fn why_short(c: Criterion, v: &VerdictJson, s: &SpecJson) -> String {
             } else {
                 "lower"
             },
-            q(v.worst_time_s, "s"),
+            clock(v.worst_time_s),
             g(v.worst_m_s2),
             g(v.limit_m_s2),
             100.0 * v.margin,
@@ -155,8 +171,8 @@ fn why_short(c: Criterion, v: &VerdictJson, s: &SpecJson) -> String {
         Criterion::DeltaV => format!(
             "Δv outside ±{:.0} % (t = {} to {})",
             100.0 * s.delta_v_tolerance,
-            q(v.nominal_start_s - s.before * s.duration_s, "s"),
-            q(v.nominal_start_s + (1.0 + s.after) * s.duration_s, "s"),
+            clock(v.nominal_start_s - s.before * s.duration_s),
+            clock(v.nominal_start_s + (1.0 + s.after) * s.duration_s),
         ),
     }
 }
@@ -202,7 +218,34 @@ pub fn banner(h: &mut Html, results: &[EntryJson]) {
             if t.recordings_failed == 1 { "" } else { "s" }
         );
     }
+    if t.recordings_without_pulse > 0 {
+        html!(
+            h,
+            "; {} recording{} without a pulse",
+            t.recordings_without_pulse,
+            if t.recordings_without_pulse == 1 {
+                ""
+            } else {
+                "s"
+            }
+        );
+    }
     h.raw("</p>\n");
+    if spec.is_some() && t.recordings_without_pulse > 0 {
+        h.raw("<ul class=\"failing\">\n");
+        for e in results
+            .iter()
+            .filter(|e| e.analysis.as_ref().is_some_and(|a| a.impacts.is_empty()))
+        {
+            html!(
+                h,
+                "<li>{} [{}]: no pulse found, nothing judged</li>\n",
+                e.file,
+                e.channel
+            );
+        }
+        h.raw("</ul>\n");
+    }
     if let Some(s) = spec {
         let failing: Vec<(usize, &EntryJson, &ImpactJson, &VerdictJson)> = series::impacts(results)
             .enumerate()
@@ -254,7 +297,7 @@ pub fn verdicts_table(h: &mut Html, results: &[EntryJson]) {
     h.raw("<h2>Verdicts</h2>\n");
     html!(
         h,
-        "<p>Against {}. The peak is the measured signal's above its baseline; the duration the stream's (first touch to the contact's end); Δv the verdict's, integrated over −{}D…+{}D around the nominal pulse placed where it fits best. The band's worst point is circled on each pulse's figure.</p>\n",
+        "<p>Against {}. The peak is the measured signal's above its baseline, as a magnitude (a pulse recorded negative has its sign reversed here); the duration the stream's (first touch to the contact's end; ≥ and no error where the contact had not ended); Δv the verdict's, integrated over −{}D…+{}D around the nominal pulse placed where it fits best. The band's worst point is circled on each pulse's figure.</p>\n",
         crate::report::spec::table_head(s)
             .trim_end()
             .trim_start_matches("spec: "),
@@ -287,15 +330,23 @@ pub fn verdicts_table(h: &mut Html, results: &[EntryJson]) {
                 h.raw("<td class=\"l\">not judged</td>");
             }
         }
+        // A contact that had not ended (cut by the recording's end or a gap, or still under
+        // way) has a duration that is only a lower bound: no error is made of it.
+        let ended = i.status == "complete";
         html!(
             h,
-            "<td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td>",
+            "<td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}{}</td><td>{}</td>",
             q(s.peak_m_s2 / g, ""),
             q(peak / g, ""),
             error_pct(peak, s.peak_m_s2),
             q(s.duration_s, "s"),
+            if ended { "" } else { "≥ " },
             q(i.duration_s, "s"),
-            error_pct(i.duration_s, s.duration_s),
+            if ended {
+                error_pct(i.duration_s, s.duration_s)
+            } else {
+                format!("— ({})", i.status)
+            },
         );
         match verdict {
             Some(v) => {
