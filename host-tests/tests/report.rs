@@ -724,4 +724,37 @@ fn what_would_mislead_a_signed_report_is_refused_or_said() {
     let page = std::fs::read_to_string(&piped).unwrap();
     assert!(page.contains("not a regular file: read once as it streamed, so not hashed"));
     assert!(!page.contains("e3b0c44298fc1c149afbf4c8996fb92427ae41e4649b934ca495991b7852b855"));
+    // A file named in bytes that are not UTF-8, and an argument with a space: the command
+    // row quotes it as a shell would take it back; no panic.
+    use std::os::unix::ffi::OsStrExt;
+    let odd = scratch
+        .join("x")
+        .with_file_name(std::ffi::OsStr::from_bytes(b"\xff.csv"));
+    std::fs::copy(&accel_5, &odd).unwrap();
+    let out = scratch.join("odd.html");
+    let o = std::process::Command::new(env!("CARGO_BIN_EXE_impact"))
+        .arg("report")
+        .arg(&odd)
+        .args([
+            "--column",
+            "1",
+            "--units",
+            "kgn",
+            "--meta",
+            "operator=A. Smith",
+            "--html",
+        ])
+        .arg(&out)
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "{o:?}");
+    let page = std::fs::read_to_string(&out).unwrap();
+    assert!(
+        page.contains("\u{fffd}.csv&#39;") || page.contains("\u{fffd}.csv'"),
+        "the file's name"
+    );
+    assert!(
+        page.contains("--meta &#39;operator=A. Smith&#39;")
+            || page.contains("--meta 'operator=A. Smith'")
+    );
 }

@@ -230,7 +230,7 @@ pub fn settings(
 ) {
     h.raw("<h2>Settings and provenance</h2><dl>");
     let mut dd = |k: &str, v: &str| html!(h, "<dt>{}</dt><dd>{}</dd>", k, v);
-    dd("command", &std::env::args().collect::<Vec<_>>().join(" "));
+    dd("command", &command_line());
     for e in results {
         let size =
             std::fs::metadata(&e.file).map_or(String::new(), |m| format!(", {} bytes", m.len()));
@@ -397,4 +397,23 @@ mod tests {
             }
         );
     }
+}
+
+/// The command line as a shell would take it back: each argument quoted where it needs it
+/// (`--meta 'operator=A. Smith'`), bytes that are not UTF-8 shown as U+FFFD (never a panic).
+fn command_line() -> String {
+    std::env::args_os()
+        .map(|a| {
+            let a = a.to_string_lossy();
+            let plain = !a.is_empty()
+                && a.chars()
+                    .all(|c| c.is_ascii_alphanumeric() || "-_./,=:+@%".contains(c));
+            if plain {
+                a.into_owned()
+            } else {
+                format!("'{}'", a.replace('\'', "'\\''"))
+            }
+        })
+        .collect::<Vec<_>>()
+        .join(" ")
 }
