@@ -352,6 +352,25 @@ pub fn inputs_table(h: &mut Html, inputs: &[Input]) {
     h.raw("</table>\n");
 }
 
+/// The command line as a shell would take it back: each argument quoted where it needs it
+/// (`--meta 'operator=A. Smith'`), bytes that are not UTF-8 shown as U+FFFD (never a panic).
+fn command_line() -> String {
+    std::env::args_os()
+        .map(|a| {
+            let a = a.to_string_lossy();
+            let plain = !a.is_empty()
+                && a.chars()
+                    .all(|c| c.is_ascii_alphanumeric() || "-_./,=:+@%".contains(c));
+            if plain {
+                a.into_owned()
+            } else {
+                format!("'{}'", a.replace('\'', "'\\''"))
+            }
+        })
+        .collect::<Vec<_>>()
+        .join(" ")
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -397,23 +416,4 @@ mod tests {
             }
         );
     }
-}
-
-/// The command line as a shell would take it back: each argument quoted where it needs it
-/// (`--meta 'operator=A. Smith'`), bytes that are not UTF-8 shown as U+FFFD (never a panic).
-fn command_line() -> String {
-    std::env::args_os()
-        .map(|a| {
-            let a = a.to_string_lossy();
-            let plain = !a.is_empty()
-                && a.chars()
-                    .all(|c| c.is_ascii_alphanumeric() || "-_./,=:+@%".contains(c));
-            if plain {
-                a.into_owned()
-            } else {
-                format!("'{}'", a.replace('\'', "'\\''"))
-            }
-        })
-        .collect::<Vec<_>>()
-        .join(" ")
 }
