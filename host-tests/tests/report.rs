@@ -758,3 +758,36 @@ fn what_would_mislead_a_signed_report_is_refused_or_said() {
             || page.contains("--meta 'operator=A. Smith'")
     );
 }
+
+/// `impact report --srs` (no required SRS): each impact's SRS drawn in its own section, one
+/// figure per impact with a spectrum; without `--srs`, no such section.
+#[test]
+fn srs_alone_draws_each_impacts_spectrum() {
+    let scratch = Scratch::new();
+    let file = format!(
+        "{}/data/endaq-high-drop/High-Drop_2000g-PE_13.4-15.0s.csv",
+        env!("CARGO_MANIFEST_DIR")
+    );
+    let run = |extra: &[&str], name: &str| {
+        let out = scratch.join(name);
+        let mut args = vec!["report", &file, "--html", out.to_str().unwrap()];
+        args.extend(extra);
+        let (code, _, err) = common::impact(&args);
+        assert_eq!(code, 0, "{err}");
+        std::fs::read_to_string(out).unwrap()
+    };
+    let json = common::impact_ok(&["analyze", &file, "--srs", "--json"]).0;
+    let j: serde_json::Value = serde_json::from_str(&json).unwrap();
+    let with = j["impacts"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .filter(|i| !i["shock_spectrum"].is_null())
+        .count();
+    assert!(with > 0);
+    let page = run(&["--srs"], "srs.html");
+    assert!(page.contains("<h2>Shock response spectra</h2>"));
+    assert_eq!(page.matches(": SRS, m/s² (left), g (right)").count(), with);
+    let page = run(&[], "plain.html");
+    assert!(!page.contains("Shock response spectra"));
+}

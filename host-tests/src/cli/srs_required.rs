@@ -254,18 +254,18 @@ pub fn cell(c: Option<&Comparison>) -> String {
     }
 }
 
-/// The measured SRS and the required one with its tolerance's limits dashed, log–log in m/s²
-/// (g on the right), titled `title`: an inline SVG for the report.
+/// The measured SRS, and the required one (if given) with its tolerance's limits dashed,
+/// log–log in m/s² (g on the right), titled `title`: an inline SVG for the report.
 pub fn svg(
     title: &str,
     frequency_hz: &[f64],
     srs_m_s2: &[f64],
-    required: &RequiredSrs,
+    required: Option<&RequiredSrs>,
 ) -> Result<crate::html::Html, PlotError> {
     let (low, high) = SRS_TOLERANCE_DB;
-    let scaled = |db: f64| -> Vec<(f64, f64)> {
+    let scaled = |r: &RequiredSrs, db: f64| -> Vec<(f64, f64)> {
         let k = 10f64.powf(db / 20.0);
-        required.points.iter().map(|&(f, a)| (f, a * k)).collect()
+        r.points.iter().map(|&(f, a)| (f, a * k)).collect()
     };
     const REQUIRED: RGBColor = RGBColor(30, 30, 30);
     const LIMIT: RGBColor = RGBColor(110, 110, 110);
@@ -278,11 +278,17 @@ pub fn svg(
             .zip(srs_m_s2.iter().copied())
             .collect(),
         measured_label: "measured SRS",
-        models: vec![("required", REQUIRED, scaled(0.0))],
-        dashed: vec![
-            ("+3 dB", LIMIT, scaled(high)),
-            ("−1.5 dB", LIMIT, scaled(low)),
-        ],
+        models: required
+            .map(|r| vec![("required", REQUIRED, scaled(r, 0.0))])
+            .unwrap_or_default(),
+        dashed: required
+            .map(|r| {
+                vec![
+                    ("+3 dB", LIMIT, scaled(r, high)),
+                    ("−1.5 dB", LIMIT, scaled(r, low)),
+                ]
+            })
+            .unwrap_or_default(),
         log: true,
         g_axis: true,
         legend: true,

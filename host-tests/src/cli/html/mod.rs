@@ -311,8 +311,9 @@ fn page(
             html!(h, "<div class=\"figure\">{}</div>\n", f);
         }
     }
-    if let Some(r) = required {
-        spectra(&mut h, results, r);
+    // The spectra: with --srs each impact's, over the required one with --srs-required.
+    if required.is_some() || series::impacts(results).any(|(_, i)| i.shock_spectrum.is_some()) {
+        spectra(&mut h, results, required);
     }
     // The appendix: how the report was made, and from what.
     provenance::settings(&mut h, filter, results, required);
@@ -443,18 +444,27 @@ fn impacts_table(h: &mut Html, results: &[EntryJson], required: Option<&Required
     h.raw("</table>\n");
 }
 
-/// The section of each impact's SRS drawn over the required one (at most [`MAX_FIGURES`]).
-fn spectra(h: &mut Html, results: &[EntryJson], required: &RequiredSrs) {
-    h.raw("<h2>Shock response spectra against the required SRS</h2>\n");
-    let (low, high) = crate::standards::SRS_TOLERANCE_DB;
-    html!(
-        h,
-        "<p>Each impact's SRS (maximax absolute acceleration) over the required SRS of {}, its tolerance ({:+} dB, {:+} dB, {}) dashed.</p>\n",
-        required.file,
-        low,
-        high,
-        crate::standards::SRS_TOLERANCE_SOURCE
-    );
+/// The section of each impact's SRS, drawn over the required one when there is one (at most
+/// [`MAX_FIGURES`]).
+fn spectra(h: &mut Html, results: &[EntryJson], required: Option<&RequiredSrs>) {
+    match required {
+        Some(required) => {
+            h.raw("<h2>Shock response spectra against the required SRS</h2>\n");
+            let (low, high) = crate::standards::SRS_TOLERANCE_DB;
+            html!(
+                h,
+                "<p>Each impact's SRS (maximax absolute acceleration) over the required SRS of {}, its tolerance ({:+} dB, {:+} dB, {}) dashed.</p>\n",
+                required.file,
+                low,
+                high,
+                crate::standards::SRS_TOLERANCE_SOURCE
+            );
+        }
+        None => {
+            h.raw("<h2>Shock response spectra</h2>\n");
+            h.raw("<p>Each impact's SRS (maximax absolute acceleration of the oscillators, their damping and bands as the settings give them).</p>\n");
+        }
+    }
     let mut drawn = 0;
     for (e, i) in series::impacts(results) {
         let Some(sp) = &i.shock_spectrum else {
