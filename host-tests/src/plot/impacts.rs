@@ -54,7 +54,13 @@ pub fn impacts(
             reports.len()
         ));
     }
-    let cols = if spectra { 6 } else { 4 };
+    // Only the panels an impact can fill (no empty "needs v0" panel): as many columns as the
+    // fullest row needs.
+    let cols = shown
+        .iter()
+        .map(|r| kinematics_panels(signal, r).len() + if spectra { 2 } else { 0 })
+        .max()
+        .unwrap_or(1);
     write_svg(
         path,
         (400 * cols as u32, 330 * shown.len() as u32 + TITLE_HEIGHT),
@@ -84,12 +90,14 @@ fn draw_impacts(
     root.fill(&WHITE)?;
     let rows = root.split_evenly((shown.len(), cols));
     for (k, r) in shown.iter().enumerate() {
-        let mut panels = kinematics_panels(signal, r);
-        if spectra {
-            panels.extend(spectrum_panels(r));
-        }
-        for (j, p) in panels.iter().enumerate() {
+        for (j, p) in kinematics_panels(signal, r).iter().enumerate() {
             draw_panel(&rows[k * cols + j], Some(r.index), p)?;
+        }
+        // The spectra in the last two columns of every row, one above another.
+        if spectra {
+            for (j, p) in spectrum_panels(r).iter().enumerate() {
+                draw_panel(&rows[k * cols + cols - 2 + j], Some(r.index), p)?;
+            }
         }
     }
     Ok(())
@@ -279,7 +287,8 @@ fn kinematics_panels<'a>(signal: &Signal, r: &impact_core::ImpactReport) -> Vec<
         deformation_mm.clear();
         force_loop.clear();
     }
-    // Without v0 the integrals start from rest: said in the titles; no loop.
+    // Without v0 the integrals start from rest: said in the titles; no loop (its panel left
+    // out, not drawn empty).
     let known = v0.is_some();
     let force_title = match (known, signal.mass_kg.is_some()) {
         _ if refused => "force against deformation: no Δv (see the report)",
@@ -290,6 +299,7 @@ fn kinematics_panels<'a>(signal: &Signal, r: &impact_core::ImpactReport) -> Vec<
         (true, true) => "force against deformation, N",
         (true, false) => "deceleration against deformation, m/s²",
     };
+    let loop_drawn = known && !refused;
     let (vel_title, def_title) = if refused {
         (
             "velocity: no Δv (see the report)",
@@ -314,18 +324,23 @@ fn kinematics_panels<'a>(signal: &Signal, r: &impact_core::ImpactReport) -> Vec<
         g_axis,
         legend,
     };
-    vec![
-        Panel {
-            measured_label: raw_label,
-            ..panel(
-                decel_title.into(),
-                "time from touch, ms",
-                accel,
-                c_a,
-                true,
-                true,
-            )
-        },
+    let decel = Panel {
+        measured_label: raw_label,
+        ..panel(
+            decel_title.into(),
+            "time from touch, ms",
+            accel,
+            c_a,
+            true,
+            true,
+        )
+    };
+    // A Δv refused leaves the deceleration only: its integrals are not drawn.
+    if refused {
+        return vec![decel];
+    }
+    let mut panels = vec![
+        decel,
         panel(
             vel_title.into(),
             "time from touch, ms",
@@ -342,15 +357,18 @@ fn kinematics_panels<'a>(signal: &Signal, r: &impact_core::ImpactReport) -> Vec<
             false,
             false,
         ),
-        panel(
+    ];
+    if loop_drawn {
+        panels.push(panel(
             force_title.into(),
             "deformation, mm",
             force_loop,
             c_f,
             false,
             false,
-        ),
-    ]
+        ));
+    }
+    panels
 }
 
 /// The SRS and PVSS panels of impact `r` (empty where it has no spectra).
