@@ -558,7 +558,7 @@ fn a_drifting_time_axis_is_refused_alike_everywhere_or_resampled() {
 
 /// A plot never draws what the report refuses: the enDAQ piezo channel's impact has no Δv
 /// (`ac-coupled`), so its figure has no velocity, deformation or force loop (it drew a
-/// velocity change of -13 m/s), and says why.
+/// velocity change of -13 m/s), only the deceleration, whose title says why.
 #[test]
 fn a_plot_draws_no_velocity_the_report_refuses() {
     let pe = root().join("data/endaq-high-drop/High-Drop_2000g-PE_13.4-15.0s.csv");
@@ -573,6 +573,10 @@ fn a_plot_draws_no_velocity_the_report_refuses() {
         svg.to_str().unwrap(),
     ]);
     let text = std::fs::read_to_string(&svg).unwrap_or_else(|e| panic!("{e}: {err}"));
-    assert!(text.contains("velocity: no Δv (see the report)"), "{err}");
+    assert!(
+        text.contains("no Δv (see the report): no velocity or deformation"),
+        "{err}"
+    );
     assert!(!text.contains("velocity change from touch"));
+    assert!(!text.contains("deformation, mm") && !text.contains("velocity, m/s"));
 }

@@ -425,15 +425,18 @@ fn hostile_text_shows_as_text_on_the_live_page() {
     let t = Instant::now();
     let shown = loop {
         let r = receipts(&w);
+        // (The end and the count of unreadable lines reach the page in separate events: the
+        // notices that show both.)
         if let Some(n) = r.iter().rev().find(|r| {
             r.get("kind").is_some_and(|k| k == "notices")
-                && r.get("text").is_some_and(|t| t.contains(&ended))
+                && r.get("text")
+                    .is_some_and(|t| t.contains(&ended) && t.contains(&quoted))
         }) {
             break n.clone();
         }
         assert!(
             t.elapsed() < Duration::from_secs(20),
-            "the page never showed the stream's end: {r:?}"
+            "the page never showed the stream's end and the quoted value: {r:?}"
         );
         std::thread::sleep(Duration::from_millis(100));
     };

@@ -335,9 +335,17 @@ fn kinematics_panels<'a>(signal: &Signal, r: &impact_core::ImpactReport) -> Vec<
             true,
         )
     };
-    // A Δv refused leaves the deceleration only: its integrals are not drawn.
+    // A Δv refused leaves the deceleration only, its title saying why the integrals are not
+    // drawn.
     if refused {
-        return vec![decel];
+        return vec![Panel {
+            title: format!(
+                "{}; no Δv (see the report): no velocity or deformation",
+                decel.title
+            )
+            .into(),
+            ..decel
+        }];
     }
     let mut panels = vec![
         decel,
