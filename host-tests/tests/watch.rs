@@ -813,6 +813,20 @@ fn a_replay_keeps_the_pace_the_log_was_written_at() {
         std::fs::read_to_string(scratch.join("four.log")).unwrap(),
         std::fs::read_to_string(&log).unwrap()
     );
+    // A session file's marker of a replaced input: a new run there, as it was live.
+    let marked = scratch.join("marked.log");
+    let mut with_marker = lines.clone();
+    with_marker.insert(3, "impact watch: day.log was rewritten in place (it shrank, or bytes already read changed); a new run from here".to_string());
+    std::fs::write(&marked, with_marker.join("\n") + "\n").unwrap();
+    let out = Command::new(env!("CARGO_BIN_EXE_impact"))
+        .args(["watch", "--terminal", "--replay"])
+        .arg(&marked)
+        .args(["--speed", "100", "--session"])
+        .arg(scratch.join("marked-session.log"))
+        .output()
+        .unwrap();
+    let text = String::from_utf8_lossy(&out.stdout);
+    assert!(text.contains("run 2"), "{text}");
     let (out, _) = run("0.5", "half.log");
     assert_eq!(out.status.code(), Some(2));
     assert!(String::from_utf8_lossy(&out.stderr).contains("from 1 to 1000 times"));

@@ -70,6 +70,11 @@ fn speed(s: &str) -> Result<f64, String> {
     }
 }
 
+/// The session file's line for an input replaced (a rotation, a rewrite): the prefix and the
+/// suffix around why (a replay of the session starts a new run there too).
+const REPLACED_PREFIX: &str = "impact watch: ";
+const REPLACED_SUFFIX: &str = "; a new run from here";
+
 /// A new session file's default name: `impact-watch-YYYYMMDD-HHMMSS.log` (UTC).
 fn default_session() -> PathBuf {
     let secs = now_ms() / 1000;
@@ -467,12 +472,22 @@ pub fn run(args: &WatchArgs) -> Result<(), WatchError> {
                 source,
             })
     };
+    let replaying = pace.is_some();
     let mut on_line = |n: u64, line: &str| -> Result<(), WatchError> {
         if let Some(pace) = pace.as_mut() {
             pace.wait(line);
         }
         keep(line)?;
-        let events = hub.with(|s| s.line(n, line, now_ms()));
+        // A session file replayed: its own marker of a replaced input starts a new run, as it
+        // did live.
+        let marker = line
+            .strip_prefix(REPLACED_PREFIX)
+            .and_then(|l| l.strip_suffix(REPLACED_SUFFIX))
+            .filter(|_| replaying);
+        let events = match marker {
+            Some(text) => hub.with(|s| s.input_replaced(text, now_ms())),
+            None => hub.with(|s| s.line(n, line, now_ms())),
+        };
         if terminal {
             terminal::print(&events);
         }
@@ -502,7 +517,7 @@ pub fn run(args: &WatchArgs) -> Result<(), WatchError> {
             break;
         };
         let text = why.says(&name);
-        keep(&format!("impact watch: {text}; a new run from here"))?;
+        keep(&format!("{REPLACED_PREFIX}{text}{REPLACED_SUFFIX}"))?;
         let events = hub.with(|s| s.input_replaced(&text, now_ms()));
         if terminal {
             terminal::print(&events);
