@@ -123,11 +123,6 @@ fn check(pdf: &Path, paper: (f64, f64), scratch: &Scratch) -> usize {
     n
 }
 
-fn report(args: &[&str]) -> (i32, String) {
-    let (code, _, err) = common::impact(args);
-    (code, err)
-}
-
 #[test]
 fn the_afrl_series_and_the_ide_recording_print_whole_on_a4_and_letter() {
     let scratch = Scratch::new();
@@ -138,7 +133,7 @@ fn the_afrl_series_and_the_ide_recording_print_whole_on_a4_and_letter() {
     let accel_5 = format!("{data}/afrl-drop-tower/accel_5.csv");
     let high_drop = format!("{data}/endaq-high-drop/High-Drop.IDE");
     let afrl = scratch.join("afrl.pdf");
-    let (code, err) = report(&[
+    let (code, _, err) = common::impact(&[
         "report",
         &accel_5,
         "--channels",
@@ -158,7 +153,7 @@ fn the_afrl_series_and_the_ide_recording_print_whole_on_a4_and_letter() {
     let a4 = check(&afrl, (595.0, 842.0), &Scratch::new());
     let ide = scratch.join("ide.pdf");
     let html = scratch.join("ide.html");
-    let (code, err) = report(&[
+    let (code, _, err) = common::impact(&[
         "report",
         &high_drop,
         "--srs",

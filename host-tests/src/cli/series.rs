@@ -11,7 +11,7 @@ use serde::Serialize;
 
 use crate::pipeline::{self, AnalyzeArgs, PipelineError};
 use crate::report::fmt::human;
-use crate::report::statistics::{LeftOut, PassRate, Statistic};
+use crate::report::statistics::{series_statistics, SeriesStatistics, Statistic};
 use crate::report::{AnalysisJson, ImpactJson};
 
 /// The extensions of the recordings a folder contributes (as `impact analyze` reads them).
@@ -367,22 +367,14 @@ fn analyze_one(args: &AnalyzeArgs, entry: &Entry, draw: bool) -> EntryJson {
     }
 }
 
-/// The series as JSON: every recording's analysis (or its error), then the statistics.
+/// The series as JSON: every recording's analysis (or its error), then the statistics
+/// ([`SeriesStatistics`]'s fields, in its order).
 #[derive(Debug, Serialize)]
 pub struct SeriesJson<'a> {
     pub recordings: usize,
     pub failed: usize,
-    pub impacts: usize,
-    #[serde(skip_serializing_if = "Option::is_none")]
-    pub spec: Option<PassRate>,
-    /// Over the comparable impacts only: complete, unclipped, each drop's first.
-    pub statistics: Vec<Statistic>,
-    /// The impacts the statistics left out, by why.
-    pub statistics_left_out: LeftOut,
-    /// The drops' later bounces, compared bounce by bounce (bounce 1 of every drop, bounce
-    /// 2, …): complete and unclipped ones; empty without bounces.
-    #[serde(skip_serializing_if = "Vec::is_empty")]
-    pub bounce_statistics: Vec<crate::report::statistics::BounceGroup>,
+    #[serde(flatten)]
+    pub summary: SeriesStatistics,
     pub entries: &'a [EntryJson],
 }
 
@@ -396,15 +388,10 @@ pub fn impacts(entries: &[EntryJson]) -> impl Iterator<Item = (&EntryJson, &Impa
 }
 
 pub fn to_json(entries: &[EntryJson]) -> SeriesJson<'_> {
-    let s = crate::report::statistics::series_statistics(impacts(entries).map(|(_, i)| i));
     SeriesJson {
         recordings: entries.len(),
         failed: entries.iter().filter(|e| e.error.is_some()).count(),
-        impacts: s.impacts,
-        spec: s.spec,
-        statistics: s.statistics,
-        statistics_left_out: s.statistics_left_out,
-        bounce_statistics: s.bounce_statistics,
+        summary: series_statistics(impacts(entries).map(|(_, i)| i)),
         entries,
     }
 }
@@ -444,7 +431,7 @@ pub fn to_table(entries: &[EntryJson]) -> String {
     let mut s = format!(
         "series: {} recordings, {} impacts{}\n",
         json.recordings,
-        json.impacts,
+        json.summary.impacts,
         if json.failed > 0 {
             format!(", {} FAILED", json.failed)
         } else {
@@ -486,7 +473,7 @@ pub fn to_table(entries: &[EntryJson]) -> String {
         "file", "channel", "#", "start", "peak", "peak", "Δv", "duration", "COR", "status",
     ];
     s.push_str(&columns(&head, &rows));
-    if let Some(r) = &json.spec {
+    if let Some(r) = &json.summary.spec {
         s.push_str(&format!(
             "\nspec: {} of {} judged impacts pass{}{}\n",
             r.passed,
@@ -500,14 +487,14 @@ pub fn to_table(entries: &[EntryJson]) -> String {
             }
         ));
     }
-    if let Some(text) = json.statistics_left_out.text(json.impacts) {
+    if let Some(text) = json.summary.statistics_left_out.text(json.summary.impacts) {
         s.push_str(&format!("\n{text}\n"));
     }
-    if !json.statistics.is_empty() {
+    if !json.summary.statistics.is_empty() {
         s.push_str("\nstatistics (sd: sample standard deviation; CV: sd / |mean|)\n");
-        s.push_str(&statistics_table(&json.statistics));
+        s.push_str(&statistics_table(&json.summary.statistics));
     }
-    for g in &json.bounce_statistics {
+    for g in &json.summary.bounce_statistics {
         s.push_str(&format!(
             "\nstatistics of bounce {} (each drop's, complete and unclipped)\n",
             g.bounce_number

@@ -343,18 +343,10 @@ pub fn analyze_samples(
     }
     // The signal (8 bytes a sample) and the counts twice (2 each): refused with the need
     // when it cannot be had, never an abort half way.
-    let need = (n as u64).saturating_mul(12);
-    let mut probe: Vec<u8> = Vec::new();
-    if probe
-        .try_reserve_exact(usize::try_from(need).unwrap_or(usize::MAX))
-        .is_err()
-    {
-        return Err(PipelineError::Memory {
-            path: PathBuf::from(samples.name),
-            need_bytes: need,
-        });
-    }
-    drop(probe);
+    memory_to_be_had(
+        std::path::Path::new(samples.name),
+        (n as u64).saturating_mul(12),
+    )?;
     let setup = setup_of(args, samples)?;
     let reports = run(&setup.prepared.counts, &setup.scene, setup.capture_len)?;
     note_results(args, &setup, &reports);
@@ -439,6 +431,19 @@ pub fn time_base_implausible(
     })
 }
 
+/// Whether `need_bytes` of memory can be had now (reserved and given back): the analysis of
+/// `path` refused with its need when it cannot ([`PipelineError::Memory`]), never an abort half
+/// way.
+fn memory_to_be_had(path: &std::path::Path, need_bytes: u64) -> Result<(), PipelineError> {
+    let mut probe: Vec<u8> = Vec::new();
+    probe
+        .try_reserve_exact(usize::try_from(need_bytes).unwrap_or(usize::MAX))
+        .map_err(|_| PipelineError::Memory {
+            path: path.to_path_buf(),
+            need_bytes,
+        })
+}
+
 /// Checks that a recording read whole (for `--axes`, `--free-fall`, `--resample` or an
 /// ADXL375's axes) finds the memory it takes (its values, the signal and the counts: about
 /// three times a CSV's size, ten times a binary file's): a message naming the need when it
@@ -451,17 +456,7 @@ pub fn memory_for_whole(file: &std::path::Path) -> Result<(), PipelineError> {
     );
     let need = size.saturating_mul(if binary { 10 } else { 3 });
     let gb = |b: u64| b as f64 / 1e9;
-    let mut probe: Vec<u8> = Vec::new();
-    if probe
-        .try_reserve_exact(usize::try_from(need).unwrap_or(usize::MAX))
-        .is_err()
-    {
-        return Err(PipelineError::Memory {
-            path: file.to_path_buf(),
-            need_bytes: need,
-        });
-    }
-    drop(probe);
+    memory_to_be_had(file, need)?;
     if size > 1 << 30 {
         crate::errln!(
             "note: {} is {:.1} GB: read whole (for --axes, --free-fall, --resample or --adxl375) it takes some {:.0} GB of memory",

@@ -247,8 +247,8 @@ fn page(
         "<h1>Impact report: {} recording{}, {} impact{}</h1>\n",
         json.recordings,
         if json.recordings == 1 { "" } else { "s" },
-        json.impacts,
-        if json.impacts == 1 { "" } else { "s" },
+        json.summary.impacts,
+        if json.summary.impacts == 1 { "" } else { "s" },
     );
     verdict::banner(&mut h, results);
     title::title_block(&mut h, &front.meta, &front.recorded, front.written);
@@ -263,7 +263,7 @@ fn page(
             );
         }
     }
-    if let Some(r) = &json.spec {
+    if let Some(r) = &json.summary.spec {
         html!(
             h,
             "<p><b>Specification:</b> {} of {} judged impacts pass{}{}.</p>\n",
@@ -278,14 +278,14 @@ fn page(
             }
         );
     }
-    if let Some(text) = json.statistics_left_out.text(json.impacts) {
+    if let Some(text) = json.summary.statistics_left_out.text(json.summary.impacts) {
         html!(h, "<p>{}.</p>\n", text);
     }
-    if !json.statistics.is_empty() {
+    if !json.summary.statistics.is_empty() {
         h.raw("<h2>Statistics across the series</h2><p>sd: sample standard deviation; CV: sd / |mean|.</p>");
-        statistics_table(&mut h, &json.statistics);
+        statistics_table(&mut h, &json.summary.statistics);
     }
-    for g in &json.bounce_statistics {
+    for g in &json.summary.bounce_statistics {
         html!(
             h,
             "<h3>Bounce {} of each drop</h3><p>Complete and unclipped.</p>",
@@ -296,7 +296,7 @@ fn page(
     // The pulses.
     h.raw("<h2>Pulses</h2>\n");
     let drawn: usize = results.iter().map(|e| e.figures.len()).sum();
-    let total = json.impacts;
+    let total = json.summary.impacts;
     if drawn < total {
         html!(
             h,

@@ -44,10 +44,7 @@ impl Tally {
     fn of(results: &[EntryJson]) -> Self {
         let mut t = Tally {
             recordings_failed: results.iter().filter(|e| e.error.is_some()).count(),
-            recordings_without_pulse: results
-                .iter()
-                .filter(|e| e.analysis.as_ref().is_some_and(|a| a.impacts.is_empty()))
-                .count(),
+            recordings_without_pulse: results.iter().filter(|e| without_pulse(e)).count(),
             ..Tally::default()
         };
         for (_, i) in series::impacts(results) {
@@ -79,6 +76,11 @@ impl Tally {
             Overall::Incomplete
         }
     }
+}
+
+/// Whether `e` was analysed and no pulse found in it (nothing of its judged).
+fn without_pulse(e: &EntryJson) -> bool {
+    e.analysis.as_ref().is_some_and(|a| a.impacts.is_empty())
 }
 
 /// The specification the results were judged against (every recording's is the same).
@@ -233,10 +235,7 @@ pub fn banner(h: &mut Html, results: &[EntryJson]) {
     h.raw("</p>\n");
     if spec.is_some() && t.recordings_without_pulse > 0 {
         h.raw("<ul class=\"failing\">\n");
-        for e in results
-            .iter()
-            .filter(|e| e.analysis.as_ref().is_some_and(|a| a.impacts.is_empty()))
-        {
+        for e in results.iter().filter(|e| without_pulse(e)) {
             html!(
                 h,
                 "<li>{} [{}]: no pulse found, nothing judged</li>\n",
