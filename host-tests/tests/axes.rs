@@ -82,3 +82,103 @@ fn a_pulse_split_over_axes_gives_each_its_share() {
         assert!(err.contains("--axes"), "{err}");
     }
 }
+
+/// A 50 g, 6 ms half-sine along z (on 1 g of gravity) with `cross` of it along x and noise
+/// on y, at 50 kS/s: the CSV's path.
+fn shock_with_cross_axis(scratch: &Scratch, name: &str, cross: f64) -> String {
+    let rate = 50_000.0;
+    let d = 0.006;
+    let mut csv = String::from("time_s,x_g,y_g,z_g\n");
+    for k in 0..10_000u32 {
+        let t = f64::from(k) / rate - 0.05;
+        let pulse = if (0.0..d).contains(&t) {
+            50.0 * (std::f64::consts::PI * t / d).sin()
+        } else {
+            0.0
+        };
+        let noise = |s: u32| {
+            0.02 * (((k.wrapping_add(s).wrapping_mul(2_654_435_761) >> 16) % 1000) as f64 / 500.0
+                - 1.0)
+        };
+        csv.push_str(&format!(
+            "{:.6},{:.5},{:.5},{:.5}\n",
+            t + 0.05,
+            cross * pulse + noise(1),
+            noise(2),
+            1.0 + pulse + noise(3)
+        ));
+    }
+    scratch.text(&format!("{name}.csv"), &csv)
+}
+
+/// The transverse-motion check (IEC 60068-2-27's 30 % of the nominal peak): a cross axis at
+/// 20 % passes, at 40 % fails the pulse (exit status 3) though the resultant meets the band;
+/// the limit and the main axis can be given; a main axis not among the axes is refused.
+#[test]
+fn a_cross_axis_beyond_the_transverse_limit_fails_the_pulse() {
+    let scratch = Scratch::new();
+    let run = |file: &str, more: &[&str]| {
+        let mut a = vec![
+            "analyze",
+            file,
+            "--axes",
+            "x_g,y_g,z_g",
+            "--spec",
+            "half-sine,50g,6ms",
+        ];
+        a.extend_from_slice(more);
+        common::impact(&a)
+    };
+    let json = |file: &str, more: &[&str]| -> (i32, Value) {
+        let mut m = more.to_vec();
+        m.push("--json");
+        let (code, out, err) = run(file, &m);
+        let j: Value = serde_json::from_str(&out).unwrap_or_else(|e| panic!("{e}: {err}"));
+        (code, j["impacts"][0]["spec"].clone())
+    };
+    let low = shock_with_cross_axis(&scratch, "low", 0.2);
+    let (code, v) = json(&low, &[]);
+    assert_eq!(code, 0, "{v}");
+    let t = &v["transverse"];
+    assert_eq!(t["main_axis"], "z_g");
+    assert_eq!(t["main_axis_from"], "largest-peak");
+    assert_eq!(t["limit_fraction"], 0.3);
+    assert_eq!(t["pass"], true);
+    let x = t["cross_axes"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .find(|c| c["column"] == "x_g")
+        .unwrap();
+    let share = x["fraction_of_nominal_peak"].as_f64().unwrap();
+    assert!((share - 0.2).abs() < 0.005, "{share}");
+
+    let high = shock_with_cross_axis(&scratch, "high", 0.4);
+    let (code, v) = json(&high, &[]);
+    assert_eq!(code, 3, "{v}");
+    assert_eq!(v["pass"], false);
+    assert_eq!(v["band_pass"], true, "the resultant meets the band: {v}");
+    assert_eq!(v["transverse"]["pass"], false);
+    let (_, table, _) = run(&high, &[]);
+    assert!(table.contains("x_g 40.0 % EXCEEDED"), "{table}");
+    assert!(table.contains("spec: FAIL"), "{table}");
+    // A looser limit passes it; naming x the main axis makes z the cross axis, beyond.
+    assert_eq!(json(&high, &["--transverse-limit", "0.5"]).0, 0);
+    let (code, v) = json(&low, &["--main-axis", "x_g"]);
+    assert_eq!(code, 3);
+    assert_eq!(v["transverse"]["main_axis"], "x_g");
+    assert_eq!(v["transverse"]["main_axis_from"], "main-axis");
+    let (code, _, err) = run(&low, &["--main-axis", "w_g"]);
+    assert_ne!(code, 0);
+    assert!(err.contains("--main-axis w_g: not one of --axes"), "{err}");
+    // The limit needs a pulse to be a fraction of.
+    let (code, _, err) = common::impact(&[
+        "analyze",
+        &low,
+        "--axes",
+        "x_g,y_g,z_g",
+        "--transverse-limit",
+        "0.3",
+    ]);
+    assert_eq!(code, 2, "{err}");
+}

@@ -401,3 +401,137 @@ fn bounces_are_compared_bounce_by_bounce() {
         "{table}"
     );
 }
+
+/// A 50 kS/s recording in g of a 6 ms half-sine of `peak` g at 50 ms (and 1 mg of ripple).
+fn half_sine_file(scratch: &Scratch, name: &str, peak: f64) -> String {
+    let mut csv = String::from("time_s,accel_g\n");
+    for k in 0..10_000u32 {
+        let t = f64::from(k) / 50_000.0 - 0.05;
+        let p = if (0.0..0.006).contains(&t) {
+            peak * (std::f64::consts::PI * t / 0.006).sin()
+        } else {
+            0.0
+        };
+        csv.push_str(&format!(
+            "{:.6},{:.5}\n",
+            t + 0.05,
+            p + 0.001 * f64::from(k % 7)
+        ));
+    }
+    scratch.text(name, &csv)
+}
+
+/// `--direction`: a series' recordings grouped by shock direction, from the file name (its
+/// pattern's group), the channel, or the report's `--meta direction=`; each direction's
+/// verdicts and statistics; a recording with none named in a note and grouped last.
+#[test]
+fn a_series_is_judged_and_compared_direction_by_direction() {
+    let scratch = Scratch::new();
+    let files = [
+        half_sine_file(&scratch, "shock_+Z_1.csv", 50.0),
+        half_sine_file(&scratch, "shock_-Z_1.csv", 65.0),
+        half_sine_file(&scratch, "shock_+Z_2.csv", 52.0),
+        half_sine_file(&scratch, "other.csv", 50.0),
+    ];
+    let mut args: Vec<&str> = vec!["analyze"];
+    args.extend(files.iter().map(String::as_str));
+    args.extend([
+        "--spec",
+        "half-sine,50g,6ms",
+        "--direction",
+        "name:_([+-][XYZ])_",
+    ]);
+    let (code, out, err) = impact(&[args.as_slice(), &["--json"]].concat());
+    assert_eq!(code, 3, "-Z's 65 g fails: {err}");
+    assert!(
+        err.contains("other.csv: no direction (--direction name:_([+-][XYZ])_)"),
+        "{err}"
+    );
+    let s = json(&out);
+    let groups = s["direction_statistics"].as_array().unwrap();
+    let summary: Vec<(serde_json::Value, u64, u64, u64)> = groups
+        .iter()
+        .map(|g| {
+            (
+                g["direction"].clone(),
+                g["recordings"].as_u64().unwrap(),
+                g["spec"]["judged"].as_u64().unwrap(),
+                g["spec"]["passed"].as_u64().unwrap(),
+            )
+        })
+        .collect();
+    assert_eq!(
+        summary,
+        [
+            ("+Z".into(), 2, 2, 2),
+            ("-Z".into(), 1, 1, 0),
+            (serde_json::Value::Null, 1, 1, 1)
+        ]
+    );
+    let peak = |g: &serde_json::Value| {
+        g["statistics"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .find(|m| m["metric"] == "peak_acceleration_g")
+            .unwrap()["mean"]
+            .as_f64()
+            .unwrap()
+    };
+    assert!((peak(&groups[0]) - 51.0).abs() < 0.05, "{}", groups[0]);
+    assert_eq!(s["entries"][1]["direction"], "-Z");
+    assert!(s["entries"][3].get("direction").is_none());
+    // The table's section and the CSV's column.
+    let (_, table, _) = impact(&args);
+    assert!(
+        table.contains("direction +Z: 2 recordings, 2 impacts; spec: 2 of 2 judged impacts pass"),
+        "{table}"
+    );
+    let (_, csv, _) = impact(&[args.as_slice(), &["--csv"]].concat());
+    let mut lines = csv.lines();
+    assert!(lines
+        .next()
+        .unwrap()
+        .starts_with("file,channel,direction,index,"));
+    assert!(lines.next().unwrap().contains(",'+Z,"), "{csv}");
+    // The channel as the direction: a series over channels.
+    let (out, _) = impact_ok(&[
+        "analyze",
+        &data("afrl-drop-tower/accel_5.csv"),
+        "--channels",
+        "1,2",
+        "--units",
+        "kgn",
+        "--direction",
+        "channel",
+        "--json",
+    ]);
+    let s = json(&out);
+    let d: Vec<&str> = s["direction_statistics"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|g| g["direction"].as_str().unwrap())
+        .collect();
+    assert_eq!(d, ["1", "2"]);
+    // The report: a fixed direction from its title block, and the page's section.
+    let html = scratch.join_str("r.html");
+    let (code, _, err) = impact(&[
+        "report",
+        &files[0],
+        &files[2],
+        "--spec",
+        "half-sine,50g,6ms",
+        "--meta",
+        "direction=+Z",
+        "--html",
+        &html,
+    ]);
+    assert_eq!(code, 0, "{err}");
+    let page = std::fs::read_to_string(&html).unwrap();
+    assert!(page.contains("<h2>By direction</h2>"), "{page}");
+    assert!(page.contains("impact 0 (direction +Z)"));
+    // A pattern that is none is a usage error.
+    let (code, _, err) = impact(&["analyze", &files[0], "--direction", "name:("]);
+    assert_eq!(code, 2, "{err}");
+}

@@ -37,6 +37,16 @@ pub struct AnalyzeCommand {
         help_heading = "Input"
     )]
     pub channels: Vec<ColumnRef>,
+    /// A series' shock direction per recording: `channel` or `name:PATTERN`.
+    ///
+    /// Each recording's shock direction, for statistics and verdicts direction by direction
+    /// (a shock test's 3 shocks in each of 6 directions): `channel` (each channel of
+    /// --channels is a direction) or `name:PATTERN`, a regular expression over the file's
+    /// name whose first group (else whole match) is the direction (`name:_([+-][XYZ])_`). A
+    /// recording with none is named in a note. `impact report` also takes `--meta
+    /// direction=+Z`, one direction for every recording.
+    #[arg(long, value_name = "SOURCE", value_parser = super::direction::parse, help_heading = "Input")]
+    pub direction: Option<super::direction::Direction>,
 }
 
 /// The files an analysis reads (no output may write over one): the recording, the scene
@@ -88,7 +98,7 @@ impl From<pipeline::PipelineError> for AnalyzeError {
 pub fn run(cmd: &AnalyzeCommand) -> Result<Judged, AnalyzeError> {
     let mut files = vec![cmd.args.file.clone()];
     files.extend(cmd.more.iter().cloned());
-    if series::is_series(&files, &cmd.channels) {
+    if series::is_series(&files, &cmd.channels) || cmd.direction.is_some() {
         return run_series(cmd, &files);
     }
     let args = &cmd.args;
@@ -108,7 +118,9 @@ pub fn run(cmd: &AnalyzeCommand) -> Result<Judged, AnalyzeError> {
         crate::out!("{}", report::to_table(&a));
     }
     draw(args, &setup, &reports)?;
-    Ok(Judged::reports(&reports))
+    // The verdicts as the output shows them (with --axes, the transverse check's too), as a
+    // series counts them.
+    Ok(Judged::impacts(&a.impacts))
 }
 
 /// `--plot`'s figure of one recording's analysis, if asked, titled with the recording's name
@@ -137,7 +149,10 @@ fn run_series(cmd: &AnalyzeCommand, files: &[PathBuf]) -> Result<Judged, Analyze
     if args.plot.is_some() {
         return Err(AnalyzeError::PlotSeries);
     }
-    let entries = series::entries(files, &cmd.channels, args.column.as_ref())?;
+    let mut entries = series::entries(files, &cmd.channels, args.column.as_ref())?;
+    if let Some(d) = &cmd.direction {
+        series::with_directions(&mut entries, d);
+    }
     let results = series::analyze(args, &entries);
     for e in &results {
         for n in &e.notes {

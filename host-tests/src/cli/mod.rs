@@ -3,6 +3,7 @@
 
 pub mod analyze;
 pub mod bench;
+pub mod direction;
 pub mod emulate;
 pub mod html;
 pub mod log;

@@ -11,7 +11,9 @@ use serde::Serialize;
 
 use crate::pipeline::{self, AnalyzeArgs, PipelineError};
 use crate::report::fmt::human;
-use crate::report::statistics::{series_statistics, SeriesStatistics, Statistic};
+use crate::report::statistics::{
+    direction_groups, series_statistics, DirectionGroup, SeriesStatistics, Statistic,
+};
 use crate::report::{AnalysisJson, ImpactJson};
 
 /// The extensions of the recordings a folder contributes (as `impact analyze` reads them).
@@ -116,6 +118,8 @@ impl std::fmt::Display for Failed {
 pub struct Entry {
     pub file: PathBuf,
     pub column: Option<ColumnRef>,
+    /// Its shock direction (`--direction`; none: not asked, or not found).
+    pub direction: Option<String>,
 }
 
 impl Entry {
@@ -205,9 +209,31 @@ pub fn entries(
             columns.iter().map(move |column| Entry {
                 file: file.clone(),
                 column: column.clone(),
+                direction: None,
             })
         })
         .collect())
+}
+
+/// Gives every entry its direction from `source`; a note names each recording it finds none
+/// for (its impacts are grouped as of no direction).
+pub fn with_directions(entries: &mut [Entry], source: &super::direction::Direction) {
+    for e in entries {
+        e.direction = source.of(&e.file, &e.channel());
+        if e.direction.is_none() {
+            crate::note(
+                &Named {
+                    file: &e.file.display().to_string(),
+                    channel: &e.channel(),
+                    what: format!(
+                        "no direction ({}): its impacts are grouped as of none",
+                        source.words()
+                    ),
+                }
+                .to_string(),
+            );
+        }
+    }
 }
 
 fn is_recording(path: &Path) -> bool {
@@ -226,6 +252,9 @@ fn is_recording(path: &Path) -> bool {
 pub struct EntryJson {
     pub file: String,
     pub channel: String,
+    /// Its shock direction (`--direction`), if asked and found.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub direction: Option<String>,
     #[serde(
         skip_serializing_if = "Option::is_none",
         serialize_with = "error_message"
@@ -292,6 +321,7 @@ fn analyze_all(args: &AnalyzeArgs, entries: &[Entry], draw: bool) -> Vec<EntryJs
             None => out.push(EntryJson {
                 file: entry.file.display().to_string(),
                 channel: entry.channel(),
+                direction: entry.direction.clone(),
                 error: Some(EntryError::Internal),
                 notes: Vec::new(),
                 analysis: None,
@@ -360,6 +390,7 @@ fn analyze_one(args: &AnalyzeArgs, entry: &Entry, draw: bool) -> EntryJson {
     EntryJson {
         file: entry.file.display().to_string(),
         channel: entry.shown_channel(analysis.as_ref().and_then(|a| a.column.as_deref())),
+        direction: entry.direction.clone(),
         error,
         notes,
         analysis,
@@ -375,6 +406,9 @@ pub struct SeriesJson<'a> {
     pub failed: usize,
     #[serde(flatten)]
     pub summary: SeriesStatistics,
+    /// With `--direction`: the statistics of each direction's recordings.
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub direction_statistics: Vec<DirectionGroup>,
     pub entries: &'a [EntryJson],
 }
 
@@ -392,11 +426,22 @@ pub fn to_json(entries: &[EntryJson]) -> SeriesJson<'_> {
         recordings: entries.len(),
         failed: entries.iter().filter(|e| e.error.is_some()).count(),
         summary: series_statistics(impacts(entries).map(|(_, i)| i)),
+        direction_statistics: if entries.iter().any(|e| e.direction.is_some()) {
+            direction_groups(entries.iter().map(|e| {
+                (
+                    e.direction.as_deref(),
+                    e.analysis.as_ref().map_or(&[][..], |a| &a.impacts[..]),
+                )
+            }))
+        } else {
+            Vec::new()
+        },
         entries,
     }
 }
 
-/// The series as CSV: `analyze --csv`'s columns with `file` and `channel` first and
+/// The series as CSV: `analyze --csv`'s columns with `file` and `channel` (and with
+/// `--direction`, `direction`) first and
 /// `peak_acceleration_g` last, one row per impact of every recording.
 pub fn to_csv(entries: &[EntryJson]) -> String {
     let Some(first) = entries.iter().find_map(|e| e.analysis.as_ref()) else {
@@ -404,7 +449,11 @@ pub fn to_csv(entries: &[EntryJson]) -> String {
     };
     let columns = crate::report::csv::Columns::of(first, impacts(entries).map(|(_, i)| i));
     let mut w = crate::report::csv::writer(Vec::new());
+    let directions = entries.iter().any(|e| e.direction.is_some());
     let mut header = vec!["file".to_string(), "channel".to_string()];
+    if directions {
+        header.push("direction".into());
+    }
     header.extend(columns.header());
     header.push("peak_acceleration_g".into());
     // Writing to a Vec cannot fail.
@@ -414,6 +463,11 @@ pub fn to_csv(entries: &[EntryJson]) -> String {
             crate::report::csv::text(&e.file),
             crate::report::csv::text(&e.channel),
         ];
+        if directions {
+            row.push(crate::report::csv::text(
+                e.direction.as_deref().unwrap_or(""),
+            ));
+        }
         row.extend(columns.row(i));
         // In the f32 digits of the peak it comes from.
         row.push(crate::report::fmt::number(f64::from(
@@ -501,10 +555,39 @@ pub fn to_table(entries: &[EntryJson]) -> String {
         ));
         s.push_str(&statistics_table(&g.statistics));
     }
+    for g in &json.direction_statistics {
+        s.push_str(&direction_section(g));
+    }
     for e in entries {
         if let Some(err) = &e.error {
             s.push_str(&format!("FAILED {}\n", failure(e, err.of_recording())));
         }
+    }
+    s
+}
+
+/// A direction's lines in the table: its recordings, impacts and verdicts, its statistics.
+fn direction_section(g: &DirectionGroup) -> String {
+    let mut s = format!(
+        "\ndirection {}: {} recording{}, {} impact{}{}\n",
+        g.direction.as_deref().unwrap_or("none found"),
+        g.recordings,
+        if g.recordings == 1 { "" } else { "s" },
+        g.summary.impacts,
+        if g.summary.impacts == 1 { "" } else { "s" },
+        g.summary.spec.as_ref().map_or(String::new(), |r| format!(
+            "; spec: {} of {} judged impacts pass{}",
+            r.passed,
+            r.judged,
+            if r.not_judged > 0 {
+                format!(", {} NOT JUDGED", r.not_judged)
+            } else {
+                String::new()
+            }
+        ))
+    );
+    if !g.summary.statistics.is_empty() {
+        s.push_str(&statistics_table(&g.summary.statistics));
     }
     s
 }

@@ -5,7 +5,7 @@
 use impact_core::report::AC_COUPLED_RATIO;
 use impact_core::ImpactReport;
 
-use crate::pipeline::screen;
+use crate::pipeline::{screen, PipelineError};
 use crate::report::axes::{AxesJson, AxisJson};
 use crate::report::Clipping;
 
@@ -149,5 +149,61 @@ pub fn impact_axes(
         resultant_peak_m_s2,
         delta_v_magnitude_m_s,
         axes,
+    }
+}
+
+/// The transverse-motion check's settings (`--axes` with `--spec`).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct TransverseCheck {
+    /// A cross axis's peak limit over the nominal peak.
+    pub limit_fraction: f64,
+    /// The main axis, an index into `--axes` (none: each impact's largest).
+    pub main: Option<usize>,
+}
+
+/// IEC 60068-2-27:2008, 4.1.3 (recalled): a cross axis within 30 % of the nominal peak.
+pub const TRANSVERSE_LIMIT: f64 = 0.3;
+
+impl TransverseCheck {
+    /// The check `args` ask for: none without both `--axes` and `--spec`.
+    pub fn of(args: &crate::pipeline::AnalyzeArgs) -> Result<Option<Self>, PipelineError> {
+        if args.axes.is_empty() || args.spec.is_none() {
+            return Ok(None);
+        }
+        let main = match &args.main_axis {
+            None => None,
+            Some(m) => Some(args.axes.iter().position(|a| a == m).ok_or_else(|| {
+                PipelineError::MainAxis {
+                    given: m.to_string(),
+                    axes: args
+                        .axes
+                        .iter()
+                        .map(ToString::to_string)
+                        .collect::<Vec<_>>()
+                        .join(","),
+                }
+            })?),
+        };
+        Ok(Some(Self {
+            limit_fraction: args.transverse_limit.unwrap_or(TRANSVERSE_LIMIT),
+            main,
+        }))
+    }
+
+    /// Adds the transverse check of `axes` to the impact's verdict against a nominal peak
+    /// `nominal_m_s2`: a cross axis beyond the limit fails it; a clipped one within it makes
+    /// it unknown (null, reason `transverse-clipped`).
+    pub fn judge(&self, j: &mut crate::report::ImpactJson, axes: &AxesJson, nominal_m_s2: f64) {
+        let Some(Some(v)) = &mut j.spec else { return };
+        match crate::report::axes::transverse(axes, nominal_m_s2, self.limit_fraction, self.main) {
+            Ok(t) => {
+                v.pass &= t.pass;
+                v.transverse = Some(t);
+            }
+            Err(why) => {
+                j.spec = Some(None);
+                j.null_reasons.insert("spec".into(), why.reason().into());
+            }
+        }
     }
 }

@@ -55,6 +55,9 @@ pub enum PipelineError {
     Memory { path: PathBuf, need_bytes: u64 },
     #[error("--free-fall: no impact in the recording")]
     NoImpactForFreeFall,
+    /// `--main-axis` not one of `--axes`.
+    #[error("--main-axis {given}: not one of --axes ({axes}): name the intended direction's axis as --axes does")]
+    MainAxis { given: String, axes: String },
     /// A CFC class (`--cfc`, the scene file's `cfc`, `--trigger-cfc`) none of SAE J211's.
     #[error("{setting}: {class} is not one of 60, 180, 600, 1000")]
     Cfc { setting: Setting, class: u32 },
@@ -555,6 +558,8 @@ pub struct Setup {
     pub resampled: bool,
     /// With `--axes`: each axis in m/s² and its rails.
     pub axes: Vec<crate::pipeline::axes::Axis>,
+    /// With `--axes` and `--spec`: the transverse-motion check's limit and main axis.
+    pub transverse: Option<crate::pipeline::axes::TransverseCheck>,
     /// A recording read in passes keeps no counts: the windows `--plot` draws, read in a
     /// last pass (first sample's stream index, counts).
     pub windows: Vec<(u64, Vec<i16>)>,
@@ -619,6 +624,7 @@ impl Setup {
             clipping: None,
             resampled: false,
             axes: Vec::new(),
+            transverse: None,
             windows: Vec::new(),
             assumptions: Vec::new(),
         }
@@ -803,6 +809,7 @@ pub fn setup_of(args: &AnalyzeArgs, ch: Samples<'_>) -> Result<Setup, PipelineEr
     setup.clipping = clipping;
     setup.resampled = ch.resampled;
     setup.axes = axes;
+    setup.transverse = crate::pipeline::axes::TransverseCheck::of(args)?;
     if let Some(spec) = &args.free_fall {
         // First pass without v0 to find the first impact, then the free fall before it.
         let first = run(&setup.prepared.counts, &setup.scene, setup.capture_len)?;
@@ -1281,6 +1288,9 @@ pub fn to_json(setup: &Setup, reports: &[ImpactReport]) -> AnalysisJson {
                     j.delta_v_m_s = None;
                     j.null_reasons
                         .insert("delta_v_m_s".into(), "resultant".into());
+                    if let (Some(check), Some(spec)) = (&setup.transverse, &setup.scene.spec) {
+                        check.judge(&mut j, &x, f64::from(spec.peak_m_s2));
+                    }
                     j.axes = Some(x);
                 }
                 if setup

@@ -87,6 +87,20 @@ pub struct AnalyzeArgs {
     /// magnitude) and no approach speed applies.
     #[arg(long, help_heading = "Input", value_delimiter = ',', conflicts_with_all = ["column", "invert", "v0", "drop_height", "free_fall", "train"])]
     pub axes: Vec<ColumnRef>,
+    /// With `--axes` and `--spec`: the intended shock direction's axis, one of `--axes`.
+    ///
+    /// With `--axes` and `--spec`: the intended shock direction's axis, as `--axes` names it;
+    /// the others are cross axes, checked against `--transverse-limit` [default: in each
+    /// impact the axis with the largest peak, which the verdict says].
+    #[arg(long, help_heading = "Analysis", value_name = "AXIS", requires_all = ["axes", "spec"])]
+    pub main_axis: Option<ColumnRef>,
+    /// With `--axes` and `--spec`: a cross axis's peak limit, over the nominal peak [default: 0.3].
+    ///
+    /// With `--axes` and `--spec`: the transverse-motion limit, a cross axis's peak deviation
+    /// over the nominal pulse's peak [default: 0.3, IEC 60068-2-27's 30 %]; beyond it the
+    /// pulse fails.
+    #[arg(long, help_heading = "Analysis", value_name = "FRACTION", requires_all = ["axes", "spec"], value_parser = parse::positive_f64)]
+    pub transverse_limit: Option<f64>,
     /// The time column [default: the column whose header starts with "time"].
     #[arg(long, help_heading = "Input")]
     pub time_column: Option<ColumnRef>,

@@ -119,9 +119,21 @@ impl Columns {
                     "spec_limit_m_s2",
                     "spec_delta_v_m_s",
                     "spec_nominal_start_s",
+                    "spec_worst_limit",
                 ]
                 .map(String::from),
             );
+            // The transverse check (IEC 60068-2-27) of the axes.
+            if self.axes.is_some() {
+                h.extend(
+                    [
+                        "spec_transverse_pass",
+                        "spec_transverse_main_axis",
+                        "spec_transverse_worst_fraction",
+                    ]
+                    .map(String::from),
+                );
+            }
         }
         if self.run {
             h.push("run".into());
@@ -217,7 +229,20 @@ impl Columns {
                 o(v.map(|v| v.limit_m_s2)),
                 o(v.map(|v| v.delta_v_m_s)),
                 o(v.map(|v| v.nominal_start_s)),
+                v.map_or(String::new(), |v| match v.worst_limit {
+                    crate::report::spec::Limit::Upper => "upper".into(),
+                    crate::report::spec::Limit::Lower => "lower".into(),
+                }),
             ]);
+            if self.axes.is_some() {
+                let t = v.and_then(|v| v.transverse.as_ref());
+                row.extend([
+                    t.map_or(String::new(), |t| t.pass.to_string()),
+                    t.map_or(String::new(), |t| text(&t.main_axis)),
+                    o(t.and_then(|t| t.worst())
+                        .map(|w| w.fraction_of_nominal_peak)),
+                ]);
+            }
         }
         if self.run {
             row.push(i.run.map_or(String::new(), |r| r.to_string()));

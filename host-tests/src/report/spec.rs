@@ -202,6 +202,9 @@ pub struct VerdictJson {
     pub worst_limit: Limit,
     pub delta_v_m_s: f64,
     pub nominal_start_s: f64,
+    /// With `--axes`: the transverse-motion check, part of `pass`.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub transverse: Option<super::axes::TransverseJson>,
 }
 
 /// Which of the band's limits the worst point is measured against: beyond it when the band
@@ -236,6 +239,8 @@ pub enum Criterion {
     BandLower,
     /// The velocity change outside its tolerance.
     DeltaV,
+    /// A cross axis beyond the transverse-motion limit (`--axes`).
+    Transverse,
 }
 
 impl Criterion {
@@ -245,6 +250,7 @@ impl Criterion {
             Criterion::BandUpper => "above the band's upper limit",
             Criterion::BandLower => "below the band's lower limit",
             Criterion::DeltaV => "Δv outside its tolerance",
+            Criterion::Transverse => "a cross axis beyond the transverse limit",
         }
     }
 }
@@ -261,6 +267,9 @@ impl VerdictJson {
         }
         if !self.delta_v_pass {
             out.push(Criterion::DeltaV);
+        }
+        if self.transverse.as_ref().is_some_and(|t| !t.pass) {
+            out.push(Criterion::Transverse);
         }
         out
     }
@@ -280,6 +289,7 @@ pub fn verdict_json(v: &Result<Verdict, Missing>, t0: f64) -> Option<VerdictJson
         worst_limit: Limit::of(v.worst_m_s2, v.limit_m_s2, v.margin),
         delta_v_m_s: f64::from(v.delta_v_m_s),
         nominal_start_s: t0 + v.start_s,
+        transverse: None,
     })
 }
 
@@ -337,7 +347,7 @@ pub fn table_line(
         );
     };
     format!(
-        "    spec: {}: band {} (worst {} at {:.6} s, limit {}: {} {:.1} % of the peak), Δv {} {}\n",
+        "    spec: {}: band {} (worst {} at {:.6} s, limit {}: {} {:.1} % of the peak), Δv {} {}{}\n",
         if v.pass { "PASS" } else { "FAIL" },
         if v.band_pass { "within" } else { "EXCEEDED" },
         human(v.worst_m_s2, "m/s²"),
@@ -356,6 +366,9 @@ pub fn table_line(
             (false, Some(true)) => "OUTSIDE its tolerance (within the other reading's)",
             (false, _) => "OUTSIDE its tolerance",
         },
+        v.transverse
+            .as_ref()
+            .map_or(String::new(), |t| format!("; {}", super::axes::transverse_words(t))),
     )
 }
 
@@ -371,6 +384,9 @@ pub fn not_judged(reason: &str) -> String {
         }
         "spec-resolution" => "the nominal duration is shorter than 4 samples at this rate",
         "spec-overflow" => "a number of the verdict is beyond f32",
+        "transverse-clipped" => {
+            "a cross axis reached its rail within the transverse limit: its true peak may lie beyond it"
+        }
         _ => return reason.to_string(),
     };
     format!("{reason}: {words}")

@@ -37,6 +37,43 @@ pub fn series_statistics<'a>(
     }
 }
 
+/// A series' recordings of one shock direction (`--direction`) and their statistics, as
+/// the whole series' ([`SeriesStatistics`]).
+#[derive(Clone, Debug, Serialize, PartialEq)]
+pub struct DirectionGroup {
+    /// Null: the recordings whose direction was not found.
+    pub direction: Option<String>,
+    pub recordings: usize,
+    #[serde(flatten)]
+    pub summary: SeriesStatistics,
+}
+
+/// The series' `recordings` (each one's direction and impacts) grouped by direction, in the
+/// order each direction first appears (the recordings with none last).
+pub fn direction_groups<'a>(
+    recordings: impl Iterator<Item = (Option<&'a str>, &'a [ImpactJson])> + Clone,
+) -> Vec<DirectionGroup> {
+    let mut directions: Vec<Option<&str>> = Vec::new();
+    for (d, _) in recordings.clone() {
+        if !directions.contains(&d) {
+            directions.push(d);
+        }
+    }
+    // The recordings with no direction last.
+    directions.sort_by_key(Option::is_none);
+    directions
+        .into_iter()
+        .map(|d| {
+            let of = recordings.clone().filter(move |(x, _)| *x == d);
+            DirectionGroup {
+                direction: d.map(str::to_string),
+                recordings: of.clone().count(),
+                summary: series_statistics(of.flat_map(|(_, i)| i.iter())),
+            }
+        })
+        .collect()
+}
+
 /// A metric across the series: its values' count, mean, sample standard deviation,
 /// coefficient of variation (sd / |mean|), least and greatest. `sd` and `cv` are null with a
 /// reason when they cannot be known (one value; a mean of zero).
@@ -405,6 +442,20 @@ mod tests {
             worst_limit: crate::report::spec::Limit::Upper,
             delta_v_m_s: 3.0,
             nominal_start_s: 0.0,
+            transverse: Some(crate::report::axes::TransverseJson {
+                main_axis: "z_g".into(),
+                main_axis_from: "largest-peak".into(),
+                limit_fraction: 0.3,
+                limit_m_s2: 147.0,
+                cross_axes: vec![crate::report::axes::CrossAxisJson {
+                    column: "x_g".into(),
+                    peak_acceleration_m_s2: -12.5,
+                    peak_time_s: 0.25,
+                    fraction_of_nominal_peak: 0.025,
+                    pass: true,
+                }],
+                pass: true,
+            }),
         };
         let mut judged = impact(1.0, Some(0.012199679389595985));
         judged.spec = Some(Some(verdict));

@@ -83,6 +83,7 @@ pub fn log_report(
     let entry = EntryJson {
         file: name,
         channel: "the board".into(),
+        direction: None,
         error: None,
         notes: (log.warnings.iter().cloned())
             .chain(

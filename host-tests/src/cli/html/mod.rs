@@ -7,6 +7,7 @@
 //! and every input with its SHA-256 (`provenance`).
 
 pub mod board;
+mod directions;
 pub mod pdf;
 pub mod provenance;
 pub mod title;
@@ -106,7 +107,7 @@ pub fn run(args: &ReportArgs) -> Result<crate::report::spec::Judged, ReportError
     }
     let mut files = vec![a.file.clone()];
     files.extend(cmd.more.iter().cloned());
-    let entries = series::entries(&files, &cmd.channels, a.column.as_ref())?;
+    let mut entries = series::entries(&files, &cmd.channels, a.column.as_ref())?;
     let mut inputs = crate::output::Inputs::new();
     for e in &entries {
         inputs = inputs.with(&e.file);
@@ -125,6 +126,15 @@ pub fn run(args: &ReportArgs) -> Result<crate::report::spec::Judged, ReportError
     }
     let written = provenance::Written::now()?;
     let meta = title::read_meta(&args.meta)?;
+    // A direction by --direction, else one for the whole report by --meta direction=.
+    let direction = cmd.direction.clone().or_else(|| {
+        meta.iter()
+            .find(|(k, _)| title::label(k) == title::label("direction"))
+            .map(|(_, v)| super::direction::Direction::Fixed(v.clone()))
+    });
+    if let Some(d) = &direction {
+        series::with_directions(&mut entries, d);
+    }
     let required = args
         .srs_required
         .as_deref()
@@ -293,6 +303,7 @@ fn page(
         );
         statistics_table(&mut h, &g.statistics);
     }
+    directions::by_direction(&mut h, &json.direction_statistics);
     // The pulses.
     h.raw("<h2>Pulses</h2>\n");
     let drawn: usize = results.iter().map(|e| e.figures.len()).sum();
@@ -382,6 +393,12 @@ fn impacts_table(h: &mut Html, results: &[EntryJson], required: Option<&Required
                             };
                             format!("Δv{off}{other}")
                         }
+                        Criterion::Transverse => format!(
+                            "transverse: {}",
+                            v.transverse
+                                .as_ref()
+                                .map_or(String::new(), |t| t.worst_words())
+                        ),
                     };
                     why.push(text);
                 }

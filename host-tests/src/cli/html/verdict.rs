@@ -95,7 +95,10 @@ fn name(e: &EntryJson, i: &ImpactJson) -> String {
     let file = std::path::Path::new(&e.file)
         .file_name()
         .map_or_else(|| e.file.clone(), |n| n.to_string_lossy().into_owned());
-    format!("{file} [{}] impact {}", e.channel, i.index)
+    match &e.direction {
+        Some(d) => format!("{file} [{}] impact {} (direction {d})", e.channel, i.index),
+        None => format!("{file} [{}] impact {}", e.channel, i.index),
+    }
 }
 
 /// A number as the page writes it (`—` for one that is not finite, which no page shows).
@@ -144,6 +147,25 @@ pub fn why(c: Criterion, v: &VerdictJson, s: &SpecJson) -> String {
             clock(v.nominal_start_s - s.before * s.duration_s),
             clock(v.nominal_start_s + (1.0 + s.after) * s.duration_s),
         ),
+        Criterion::Transverse => transverse_why(c, v, g),
+    }
+}
+
+/// A failed transverse check: the worst cross axis's peak, when, and its share of the
+/// nominal peak against the limit.
+fn transverse_why(c: Criterion, v: &VerdictJson, g: impl Fn(f64) -> String) -> String {
+    let Some(t) = &v.transverse else {
+        return c.words().to_string();
+    };
+    match t.worst() {
+        Some(x) => format!(
+            "{} at t = {} ({}): {}",
+            c.words(),
+            clock(x.peak_time_s),
+            g(x.peak_acceleration_m_s2),
+            t.worst_words()
+        ),
+        None => c.words().to_string(),
     }
 }
 
@@ -176,6 +198,13 @@ fn why_short(c: Criterion, v: &VerdictJson, s: &SpecJson) -> String {
             clock(v.nominal_start_s - s.before * s.duration_s),
             clock(v.nominal_start_s + (1.0 + s.after) * s.duration_s),
         ),
+        Criterion::Transverse => v.transverse.as_ref().map_or(String::new(), |t| {
+            format!(
+                "transverse at t = {}: {}",
+                t.worst().map_or(String::new(), |x| clock(x.peak_time_s)),
+                t.worst_words()
+            )
+        }),
     }
 }
 
