@@ -1,7 +1,9 @@
 //! The git commit the `impact` tool is built from, for `impact report`'s provenance: the
 //! environment variable `IMPACT_GIT_COMMIT` when the build sets it (`.ci/run`, which builds a
 //! `git archive` copy), else `git rev-parse HEAD` of the repository this crate is in, else
-//! `unknown` (a copy without `.git`, no git installed). Never a build failure.
+//! `unknown` (a copy without `.git`, no git installed); and whether the tool's own sources
+//! differ from that commit (`IMPACT_GIT_DIRTY`, `1` or empty: a report says "with changes not
+//! committed"). Never a build failure.
 
 use std::path::{Path, PathBuf};
 use std::process::Command;
@@ -40,10 +42,36 @@ fn main() {
         .then(|| git(&dir, &["rev-parse", "HEAD"]))
         .flatten()
         .filter(|c| is_commit(c));
+    // The tool's own sources changed since that commit (tracked files only: the crates the
+    // tool is built from and the lock file); a commit given from outside is taken as clean.
+    let dirty = found.is_some()
+        && given.is_none()
+        && git(
+            &dir,
+            &[
+                "status",
+                "--porcelain",
+                "--untracked-files=no",
+                "--",
+                "../core",
+                ".",
+                "../Cargo.toml",
+                "../Cargo.lock",
+            ],
+        )
+        .is_some();
     let commit = given.or(found).unwrap_or_else(|| "unknown".to_string());
     println!("cargo:rustc-env=IMPACT_GIT_COMMIT={commit}");
+    println!(
+        "cargo:rustc-env=IMPACT_GIT_DIRTY={}",
+        if dirty { "1" } else { "" }
+    );
     if !own {
         return;
+    }
+    // Run again when a source of the tool changes, so that the mark follows the tree.
+    for source in ["../core/src", "src", "io/src", "../Cargo.lock"] {
+        println!("cargo:rerun-if-changed={source}");
     }
     // Built again when HEAD moves: HEAD, the branch it names, the packed refs, and HEAD's log
     // (written on every commit, checkout and reset, whether the branch's ref is loose or

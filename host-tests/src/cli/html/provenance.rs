@@ -16,6 +16,9 @@ use crate::report::fmt::human;
 /// The git commit the tool was built from (`build.rs`: `unknown` without one).
 pub const COMMIT: &str = env!("IMPACT_GIT_COMMIT");
 
+/// Whether the tool's sources differed from [`COMMIT`] when it was built (`build.rs`).
+pub const DIRTY: bool = !env!("IMPACT_GIT_DIRTY").is_empty();
+
 /// The environment variable that fixes the report's time (seconds since 1970-01-01 UTC).
 pub const SOURCE_DATE_EPOCH: &str = "SOURCE_DATE_EPOCH";
 

@@ -306,9 +306,14 @@ pub fn title_block(
         h,
         "Tool",
         &format!(
-            "impact {}, git commit {}",
+            "impact {}, git commit {}{}",
             env!("CARGO_PKG_VERSION"),
-            provenance::COMMIT
+            provenance::COMMIT,
+            if provenance::DIRTY {
+                " with changes not committed (a development build: not for a signed report)"
+            } else {
+                ""
+            }
         ),
     );
     for r in recorded {
