@@ -65,9 +65,30 @@ fn the_report_is_one_self_contained_page_with_every_pulse() {
     ] {
         assert!(page.contains(want), "{want} missing");
     }
-    // One figure per impact, each with the measured trace and the band.
+    // One figure per impact, each with the measured trace and the band, its time told from
+    // the nominal pulse's start (as the verdict's "after the nominal start"), placed on the
+    // recording's clock where the verdict placed it.
     assert_eq!(page.matches("<svg").count(), 5);
     assert_eq!(page.matches("nominal, tolerance band").count(), 5);
+    assert_eq!(
+        page.matches("time from the nominal pulse's start, t = ")
+            .count(),
+        5
+    );
+    let start = first_nominal_start();
+    assert!(
+        page.contains(&format!(
+            "time from the nominal pulse's start, t = {start:.6} s"
+        )),
+        "{start}"
+    );
+    // The impacts' table names each file within the folder it gives once (the full path is
+    // in the inputs' table).
+    assert!(page.contains("<tr><td class=\"l\">accel_5.csv</td>"));
+    assert!(page.contains(&format!(
+        "Files in {}",
+        Path::new(&afrl()).parent().unwrap().display()
+    )));
     // The numbers in the table are the series' own.
     let (json, _) = impact_judged(&[
         "analyze",
@@ -95,6 +116,24 @@ fn the_report_is_one_self_contained_page_with_every_pulse() {
         "would be overwritten",
         "--html onto an input",
     );
+}
+
+/// The first repeat's nominal start (s on the recording's clock), as `impact analyze`
+/// judges it.
+fn first_nominal_start() -> f64 {
+    let (json, _) = impact_judged(&[
+        "analyze",
+        &afrl(),
+        "--column",
+        "1",
+        "--units",
+        "kgn",
+        "--spec",
+        "half-sine,11000g,0.1ms",
+        "--json",
+    ]);
+    let j: serde_json::Value = serde_json::from_str(&json).unwrap();
+    j["impacts"][0]["spec"]["nominal_start_s"].as_f64().unwrap()
 }
 
 /// Channel `channel`'s SRS (Hz, m/s²) as `impact analyze --srs --json` gives it.

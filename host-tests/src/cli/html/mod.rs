@@ -360,7 +360,11 @@ fn impacts_table(h: &mut Html, results: &[EntryJson], required: Option<&Required
         h.raw("<th class=\"l\">SRS within −1.5/+3 dB of required</th>");
     }
     h.raw("</tr>\n");
-    for (e, i) in series::impacts(results) {
+    let files: Vec<&str> = series::impacts(results)
+        .map(|(e, _)| e.file.as_str())
+        .collect();
+    let (folder, short) = verdict::short_files(&files);
+    for ((e, i), file) in series::impacts(results).zip(&short) {
         let o = |v: Option<f64>, u: &str| {
             v.map_or("—".into(), |v| human(v, u).trim_end().to_string())
         };
@@ -422,7 +426,7 @@ fn impacts_table(h: &mut Html, results: &[EntryJson], required: Option<&Required
         html!(
             h,
             "<tr><td class=\"l\">{}</td><td class=\"l\">{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td class=\"l\">{}</td><td class=\"l\">{}</td>",
-            e.file,
+            file,
             e.channel,
             i.index,
             human(i.start_s, "s"),
@@ -459,6 +463,13 @@ fn impacts_table(h: &mut Html, results: &[EntryJson], required: Option<&Required
         h.raw("</tr>\n");
     }
     h.raw("</table>\n");
+    if !folder.is_empty() {
+        html!(
+            h,
+            "<p class=\"note\">Files in {} (each input's full path and SHA-256: Inputs, at the end).</p>\n",
+            folder
+        );
+    }
 }
 
 /// The section of each impact's SRS, drawn over the required one when there is one (at most

@@ -90,6 +90,38 @@ pub fn spec_of(results: &[EntryJson]) -> Option<&SpecJson> {
         .find_map(|e| e.analysis.as_ref()?.spec.as_ref())
 }
 
+/// The recordings' files as a table shows them: relative to the folder they all lie in
+/// (that folder, and each full path in the inputs' table), so that a row's file is its name
+/// where they share a folder, not a path wrapped over lines; and that folder (empty: none
+/// shared).
+pub fn short_files(files: &[&str]) -> (String, Vec<String>) {
+    let parent = |f: &str| {
+        std::path::Path::new(f)
+            .parent()
+            .map(std::path::Path::to_path_buf)
+            .unwrap_or_default()
+    };
+    let mut common = files.first().map(|f| parent(f)).unwrap_or_default();
+    for f in files {
+        while !std::path::Path::new(f).starts_with(&common) {
+            if !common.pop() {
+                break;
+            }
+        }
+    }
+    let short = files
+        .iter()
+        .map(|f| {
+            std::path::Path::new(f)
+                .strip_prefix(&common)
+                .ok()
+                .filter(|r| !r.as_os_str().is_empty())
+                .map_or_else(|| f.to_string(), |r| r.display().to_string())
+        })
+        .collect();
+    (common.display().to_string(), short)
+}
+
 /// A pulse's name: its file's name, channel and index.
 fn name(e: &EntryJson, i: &ImpactJson) -> String {
     let file = std::path::Path::new(&e.file)
@@ -418,4 +450,19 @@ pub fn verdicts_table(h: &mut Html, results: &[EntryJson]) {
         }
     }
     h.raw("</table>\n");
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn files_are_shown_relative_to_their_shared_folder() {
+        let (folder, short) = short_files(&["/d/runs/a.csv", "/d/runs/b/c.csv", "/d/runs/a.csv"]);
+        assert_eq!(folder, "/d/runs");
+        assert_eq!(short, ["a.csv", "b/c.csv", "a.csv"]);
+        let (folder, short) = short_files(&["x.csv", "/abs/y.csv"]);
+        assert_eq!(folder, "");
+        assert_eq!(short, ["x.csv", "/abs/y.csv"]);
+    }
 }

@@ -62,7 +62,8 @@ fn label(v: f64, step: f64) -> String {
 }
 
 /// The pulse as an inline SVG: acceleration in g (left; m/s² on the right) against time in ms
-/// from the window's start, the measured signal as a min/max band per column, the band and
+/// from the nominal pulse's start (without a specification, the window's start), said on the
+/// recording's clock, the measured signal as a min/max band per column, the band and
 /// the nominal pulse dashed.
 pub fn svg(p: &Pulse) -> Html {
     const W: f64 = 530.0;
@@ -138,12 +139,13 @@ pub fn svg(p: &Pulse) -> Html {
         W, H, W, H, p.title, W, H
     );
     html!(s, "<text x=\"{}\" y=\"16\" text-anchor=\"middle\" font-size=\"12\" font-weight=\"bold\">{}</text>", W / 2.0, p.title);
-    // Grid and ticks: time in ms from the window's start, acceleration in g.
-    let span_ms = (t_last - t_first) * 1e3;
-    let xt = linear_ticks(0.0, span_ms, 6);
+    // Grid and ticks: time in ms from the origin (the nominal pulse's start, where the
+    // verdict's times are told from; else the window's start), acceleration in g.
+    let origin = p.spec.map_or(t_first, |(_, start)| start);
+    let xt = linear_ticks((t_first - origin) * 1e3, (t_last - origin) * 1e3, 6);
     let xstep = xt.get(1).zip(xt.first()).map_or(1.0, |(b, a)| b - a);
     for v in &xt {
-        let px = x(t_first + v * 1e-3);
+        let px = x(origin + v * 1e-3);
         html!(s, "<line x1=\"{:.1}\" y1=\"{}\" x2=\"{:.1}\" y2=\"{}\" stroke=\"#eee\"/><text x=\"{:.1}\" y=\"{}\" text-anchor=\"middle\">{}</text>", px, T, px, H - B, px, H - B + 14.0, label(*v, xstep));
     }
     let yt = linear_ticks(y_lo / g, y_hi / g, 6);
@@ -168,10 +170,15 @@ pub fn svg(p: &Pulse) -> Html {
     );
     html!(
         s,
-        "<text x=\"{}\" y=\"{}\" text-anchor=\"middle\">time from {:.3} ms (ms)</text>",
+        "<text x=\"{}\" y=\"{}\" text-anchor=\"middle\">{} t = {:.6} s on the recording's clock (ms)</text>",
         (L + W - R) / 2.0,
         H - 8.0,
-        t_first * 1e3
+        if p.spec.is_some() {
+            "time from the nominal pulse's start,"
+        } else {
+            "time from"
+        },
+        origin
     );
     html!(s, "<text transform=\"translate(14 {}) rotate(-90)\" text-anchor=\"middle\">acceleration (g)</text>", (T + H - B) / 2.0);
     html!(s, "<text transform=\"translate({} {}) rotate(90)\" text-anchor=\"middle\">acceleration (m/s²)</text>", W - 12.0, (T + H - B) / 2.0);
