@@ -14,23 +14,9 @@ use serde_json::Value;
 const G: f64 = impact_core::consts::STANDARD_GRAVITY;
 
 /// The drop rendered at `rate` as a 16-bit ADC over ±`full_scale` m/s² would record it
-/// (a code of noise, quantised: a sensor whose flat stretches do not vary is stuck),
-/// written as `time_s,accel_g`.
+/// ([`impact_host::testkit::sensor::csv`]).
 fn csv(drop: &Drop, rate: f64, seconds: f64, full_scale: f64) -> (String, Vec<ContactTruth>) {
-    let r = drop.render(rate, (seconds * rate) as usize).unwrap();
-    let lsb = 2.0 * full_scale / 65536.0;
-    let mut s = String::from("time_s,accel_g\n");
-    let mut seed = 0x2545_f491_4f6c_dd1du64;
-    for (k, a) in r.accel_m_s2.iter().enumerate() {
-        // Uniform noise of ±1 code (xorshift).
-        seed ^= seed << 13;
-        seed ^= seed >> 7;
-        seed ^= seed << 17;
-        let noise = 2.0 * ((seed >> 11) as f64 / (1u64 << 53) as f64) - 1.0;
-        let q = ((a / lsb + noise).round() * lsb).clamp(-full_scale, full_scale);
-        s.push_str(&format!("{:.9},{:.9e}\n", k as f64 / rate, q / G));
-    }
-    (s, r.contacts)
+    impact_host::testkit::sensor::csv(drop, rate, seconds, full_scale).expect("a valid drop")
 }
 
 fn analyse(scratch: &Scratch, name: &str, text: String, options: &[&str]) -> Value {

@@ -1633,3 +1633,141 @@ fn the_self_test_passes_what_the_dac_plays_and_fails_a_faulty_loop() {
     assert!(lines(&out, "pass").is_empty(), "{out}");
     assert!(out.contains("self-test FAIL: 0 of 10 pulses came"), "{out}");
 }
+
+/// Every law of the drop tests whose contacts fit the board's capture at 500 kS/s (the
+/// seed's soft law, contacts of 45–60 ms, is the decimated capture's: `realtime_*`).
+fn board_laws() -> [(&'static str, impact_core::Model<f64>); 5] {
+    use impact_core::model::{Hertz, KelvinVoigt, Linear, Nonlinear, TwoPhase};
+    use impact_core::Model;
+    [
+        ("linear", Model::Linear(Linear { k: 1e4 })),
+        ("hertz", Model::Hertz(Hertz { k: 5e5 })),
+        (
+            "nonlinear",
+            Model::Nonlinear(Nonlinear {
+                k: 1e4,
+                c: 0.5,
+                n: 1.0,
+            }),
+        ),
+        (
+            "kelvin-voigt",
+            Model::KelvinVoigt(KelvinVoigt { k: 1e4, c: 5.0 }),
+        ),
+        (
+            "two-phase",
+            Model::TwoPhase(TwoPhase {
+                kc: 0.06 * (1.3357f64 / 0.0186).powi(2),
+                kr: 12376.0,
+                c: 2.0,
+                permanent_m: Some(0.0182),
+            }),
+        ),
+    ]
+}
+
+/// The board's reports of `file` (analysed with `options`) against the generator's
+/// contacts `truth`: equal to the host's bit for bit, and each contact's v0 and COR (and
+/// with `kinematics`, crush time and maximum deformation) within 1 %.
+fn board_within_one_percent(
+    file: &str,
+    options: &[&str],
+    truth: &[impact_host::drop::ContactTruth],
+    what: &str,
+    kinematics: bool,
+) {
+    let Some(elf) = firmware() else { return };
+    let elf = elf.to_string_lossy().into_owned();
+    // (Not `impact log`: a log does not carry --range's rails, the JSON's `clipping`.)
+    emulator_and_log_match_host(file, options, false);
+    let mut args = vec!["emulate", file, "--json", "--elf", &elf];
+    args.extend(options);
+    let (out, _) = impact(&args);
+    let v: serde_json::Value = serde_json::from_str(&out).unwrap();
+    let impacts = v["impacts"].as_array().unwrap();
+    assert_eq!(impacts.len(), truth.len(), "{what}: {out}");
+    for (k, (r, t)) in impacts.iter().zip(truth).enumerate() {
+        let Some(sep) = &t.separation else { continue };
+        let near = |field: &str, want: f64| {
+            let got = r[field]
+                .as_f64()
+                .unwrap_or_else(|| panic!("{what}, contact {k}, {field}: {r}"));
+            assert!(
+                (got / want - 1.0).abs() <= 0.01,
+                "{what}, contact {k}, {field}: {got} on the board, {want} true"
+            );
+        };
+        near("impact_velocity_m_s", t.approach_m_s);
+        near("cor", sep.cor);
+        if kinematics {
+            near("crush_time_s", t.crush_time_s.unwrap());
+            near("max_deformation_m", t.max_deformation_m.unwrap());
+        }
+    }
+}
+
+/// Drops from rest of every law (the physical generator, `impact_host::drop`: held at +1 g,
+/// released, 91 mm of free fall, gravity in the contact) and bounce trains (six contacts
+/// from 1.3357 m/s, `--train flight`), at 500 kS/s, their contacts within the board's
+/// capture: the board's reports equal the host's, bit for bit, and v0 and the COR of every
+/// contact (a drop's crush time and maximum deformation too) are the generator's within 1 %,
+/// as `tests/drops.rs` holds the host's at every rate and touch phase.
+#[test]
+fn drops_and_trains_on_the_board_are_the_hosts_and_within_one_percent() {
+    use impact_host::drop::{Drop, Start};
+    let scratch = Scratch::new();
+    if firmware().is_none() {
+        return;
+    }
+    for (name, law) in board_laws() {
+        let drop = |start, contacts| Drop {
+            law,
+            mass_kg: 0.06,
+            gravity_m_s2: impact_core::consts::STANDARD_GRAVITY,
+            start,
+            max_contacts: contacts,
+            min_rebound_m_s: 1e-3,
+        };
+        let from_rest = drop(
+            Start::Rest {
+                rest_s: 0.05,
+                height_m: 0.091,
+            },
+            1,
+        );
+        let (text, truth) =
+            impact_host::testkit::sensor::csv(&from_rest, 500_000.0, 0.3, 2000.0).unwrap();
+        let file = scratch.text(&format!("{name}-rest.csv"), &text);
+        board_within_one_percent(
+            &file,
+            &[
+                "--mass",
+                "0.06",
+                "--drop-height",
+                "0.091",
+                "--range",
+                "2000",
+            ],
+            &truth,
+            &format!("{name} from rest"),
+            true,
+        );
+        let train = drop(
+            Start::Moving {
+                touch_s: 0.0123,
+                v0_m_s: 1.3357,
+            },
+            6,
+        );
+        let (text, truth) =
+            impact_host::testkit::sensor::csv(&train, 500_000.0, 1.5, 1000.0).unwrap();
+        let file = scratch.text(&format!("{name}-train.csv"), &text);
+        board_within_one_percent(
+            &file,
+            &["--mass", "0.06", "--v0", "1.3357", "--train", "flight"],
+            &truth,
+            &format!("{name} train"),
+            false,
+        );
+    }
+}
