@@ -182,3 +182,64 @@ fn a_cross_axis_beyond_the_transverse_limit_fails_the_pulse() {
     ]);
     assert_eq!(code, 2, "{err}");
 }
+
+/// Each axis zeroed before the magnitude (SAE J211, ISO 6487): a 12.6 g, 10 ms half-sine
+/// along x, along −z, along +z and at 45° in the xz plane, with gravity's 1 g on z (a sled, a
+/// drop table) or on y, and noise on every axis, peaks at 12.6 g and gives its Δv's
+/// magnitude within 1 % (the magnitudes' difference, `|f| − |f₀|`, gave x 7.6 % low and −z
+/// 16 % low).
+#[test]
+fn each_axis_is_zeroed_before_the_magnitude_whatever_the_gravity() {
+    let scratch = Scratch::new();
+    let (rate, d, peak_g) = (20_000.0, 0.010, 12.6);
+    let s45 = std::f64::consts::FRAC_1_SQRT_2;
+    for (dir, gravity, what) in [
+        ([1.0, 0.0, 0.0], [0.0, 0.0, 1.0], "x, gravity on z"),
+        ([0.0, 0.0, -1.0], [0.0, 0.0, 1.0], "-z, gravity on z"),
+        ([0.0, 0.0, 1.0], [0.0, 0.0, 1.0], "+z, gravity on z"),
+        ([s45, 0.0, s45], [0.0, 0.0, 1.0], "45° in xz, gravity on z"),
+        ([1.0, 0.0, 0.0], [0.0, -1.0, 0.0], "x, gravity on -y"),
+    ] {
+        let mut csv = String::from("time_s,x_g,y_g,z_g\n");
+        for k in 0..8_000u32 {
+            let t = f64::from(k) / rate - 0.2;
+            let p = if (0.0..d).contains(&t) {
+                peak_g * (std::f64::consts::PI * t / d).sin()
+            } else {
+                0.0
+            };
+            let noise = |axis: u32| {
+                let h = (k.wrapping_add(axis * 7919)).wrapping_mul(2_654_435_761) >> 16;
+                0.005 * ((h % 1000) as f64 / 500.0 - 1.0)
+            };
+            let v: Vec<String> = (0..3)
+                .map(|i| format!("{:.6}", gravity[i] + dir[i] * p + noise(i as u32)))
+                .collect();
+            csv.push_str(&format!("{:.6},{}\n", f64::from(k) / rate, v.join(",")));
+        }
+        let f = scratch.file(&format!("{what}.csv"), &csv);
+        let (out, _) = impact_ok(&[
+            "analyze",
+            f.to_str().unwrap(),
+            "--axes",
+            "x_g,y_g,z_g",
+            "--json",
+        ]);
+        let j: Value = serde_json::from_str(&out).unwrap();
+        let impacts = j["impacts"].as_array().unwrap();
+        assert_eq!(impacts.len(), 1, "{what}: {out}");
+        let i = &impacts[0];
+        let g = impact_core::consts::STANDARD_GRAVITY;
+        let peak = i["peak_acceleration_m_s2"].as_f64().unwrap() / g;
+        assert!(
+            (peak / peak_g - 1.0).abs() <= 0.01,
+            "{what}: peak {peak} g, true {peak_g} g"
+        );
+        let dv = i["axes"]["delta_v_magnitude_m_s"].as_f64().unwrap();
+        let want = 2.0 / std::f64::consts::PI * peak_g * g * d;
+        assert!(
+            (dv / want - 1.0).abs() <= 0.01,
+            "{what}: |Δv| {dv}, true {want}"
+        );
+    }
+}

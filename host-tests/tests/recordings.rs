@@ -347,7 +347,13 @@ fn endaq_three_axes_give_one_report_per_bounce_with_the_resultants_peak() {
     assert_eq!(a.impacts.len(), z.impacts.len() + 1);
     ordered_and_disjoint(&a);
     let y_hit = a.impacts.remove(1);
-    assert!((y_hit.start_s - 14.716).abs() < 0.002, "{}", y_hit.start_s);
+    // (Its onset within three samples at 390 S/s: zeroed per axis, the magnitude leaves the
+    // noise two samples sooner than the magnitudes' difference did.)
+    assert!(
+        (y_hit.start_s - 14.716).abs() < 3.0 / 390.0,
+        "{}",
+        y_hit.start_s
+    );
     let y = &y_hit.axes.as_ref().unwrap().axes[1];
     assert!((y.peak_acceleration_m_s2 + 19.1).abs() < 1.0, "{y:?}");
     for (r, zr) in a.impacts.iter().zip(&z.impacts) {

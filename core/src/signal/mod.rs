@@ -1,6 +1,7 @@
 //! Signal path building blocks: calibration, pre-trigger ring, exact integration, CFC and
 //! Butterworth low-pass filters.
 
+pub mod axes_zero;
 pub mod baseline;
 pub mod cfc;
 pub mod copy;

@@ -1,6 +1,8 @@
-//! Three axes (`--axes x,y,z`): the pipeline runs on the resultant `sqrt(x² + y² + z²)` (the
-//! trigger on |a|, as crash and drop practice report it), and each impact gets every axis's
-//! own peak and Δv over its contact.
+//! Three axes (`--axes x,y,z`): the pipeline runs on the magnitude of the axes' deviations from
+//! their own zeros, `|f − f₀|` ([`impact_core::signal::axes_zero`]: each axis zeroed before
+//! the magnitude, as SAE J211 and ISO 6487 zero each channel; the trigger on it, as crash and
+//! drop practice report |a|), and each impact gets every axis's own peak and Δv over its
+//! contact.
 
 use impact_core::report::AC_COUPLED_RATIO;
 use impact_core::ImpactReport;
@@ -203,6 +205,70 @@ impl TransverseCheck {
             Err(why) => {
                 j.spec = Some(None);
                 j.null_reasons.insert("spec".into(), why.reason().into());
+            }
+        }
+    }
+}
+
+/// The counts the stream analyses with `--axes`: each axis in counts of `gain_m_s2_per_count`
+/// (a third axis of zeros for two), zeroed each on its own and their magnitude taken
+/// ([`impact_core::signal::axes_zero::AxesZero`]) with the scene's edge level and settle time.
+pub fn zeroed_counts(
+    axes: &[Axis],
+    scene: &impact_core::Scene,
+    gain_m_s2_per_count: f64,
+    to_count: impl Fn(f64, f64) -> i16,
+) -> Vec<i16> {
+    let rate = f64::from(scene.calibration.sample_rate_hz);
+    let edge_counts = (f64::from(scene.edge_m_s2) / gain_m_s2_per_count) as f32;
+    let settle = (f64::from(scene.settle_s) * rate).clamp(0.0, f64::from(u32::MAX)) as u32;
+    let mut zero = impact_core::signal::axes_zero::AxesZero::new(
+        edge_counts,
+        settle,
+        free_fall(f64::from(scene.gravity_m_s2), gain_m_s2_per_count, rate),
+    );
+    let n = axes.iter().map(|a| a.accel_m_s2.len()).max().unwrap_or(0);
+    (0..n)
+        .map(|i| {
+            let c = |k: usize| {
+                axes.get(k)
+                    .and_then(|a| a.accel_m_s2.get(i))
+                    .map_or(0, |&v| to_count(v, gain_m_s2_per_count))
+            };
+            zero.push([c(0), c(1), c(2)])
+        })
+        .collect()
+}
+
+/// Free fall for three axes: their magnitude below a quarter of g for 10 ms (at least 8
+/// samples): a pulse's zero crossing is quicker; a flight between bounces, longer.
+pub fn free_fall(
+    gravity_m_s2: f64,
+    gain_m_s2_per_count: f64,
+    rate_hz: f64,
+) -> impact_core::signal::axes_zero::FreeFall {
+    impact_core::signal::axes_zero::FreeFall {
+        below_counts: (0.25 * gravity_m_s2 / gain_m_s2_per_count) as f32,
+        samples: (0.01 * rate_hz).clamp(8.0, f64::from(u32::MAX)) as u32,
+    }
+}
+
+/// Removes the spikes found on the resultant (`removals`) from an axis: each spike's samples
+/// replaced by the straight line between the axis's own neighbours.
+pub fn remove_spikes(axis: &mut [f64], removals: &[crate::pipeline::screen::Removal]) {
+    for r in removals {
+        let (at, len) = (r.spike.sample as usize, r.spike.samples as usize);
+        let before = at.checked_sub(1).and_then(|k| axis.get(k)).copied();
+        let after = axis.get(at + len).copied();
+        let (a, b) = match (before, after) {
+            (Some(a), Some(b)) => (a, b),
+            (Some(a), None) => (a, a),
+            (None, Some(b)) => (b, b),
+            (None, None) => continue,
+        };
+        for j in 0..len {
+            if let Some(v) = axis.get_mut(at + j) {
+                *v = a + (b - a) * (j + 1) as f64 / (len + 1) as f64;
             }
         }
     }

@@ -747,6 +747,7 @@ pub fn setup_of(args: &AnalyzeArgs, ch: Samples<'_>) -> Result<Setup, PipelineEr
     // The survey, and again after glitches are removed (they set the extremes).
     let first = Survey::of(&accel, !args.keep_spikes)?;
     let spikes = screen::apply(&first.removals, &mut accel, t0, ch.rate_hz);
+    let first_removals = first.removals.clone();
     let survey = if spikes.is_empty() {
         first
     } else {
@@ -758,7 +759,8 @@ pub fn setup_of(args: &AnalyzeArgs, ch: Samples<'_>) -> Result<Setup, PipelineEr
         .axes
         .iter()
         .map(|(name, v)| {
-            let a = v.iter().map(|x| x * scale).collect();
+            let mut a: Vec<f64> = v.iter().map(|x| x * scale).collect();
+            crate::pipeline::axes::remove_spikes(&mut a, &first_removals);
             crate::pipeline::axes::Axis::new(name.clone(), a, full_scale)
         })
         .collect();
@@ -766,7 +768,10 @@ pub fn setup_of(args: &AnalyzeArgs, ch: Samples<'_>) -> Result<Setup, PipelineEr
     let levels = if axes.is_empty() {
         survey::levels(&survey, full_scale, trigger, edge, vertical(args, &file))?
     } else {
-        let fs = full_scale.map(|fs| fs * (axes.len() as f64).sqrt());
+        // The zeroed magnitude |f − f₀| reaches |f| + |f₀|: counts for twice the resultant's
+        // range (the sensor's, or the largest reading).
+        let fs = 2.0 * full_scale.map_or(survey.peak_m_s2(), |fs| fs * (axes.len() as f64).sqrt());
+        let fs = Some(fs);
         survey::Levels {
             clipping: None,
             ..survey::levels(&survey, fs, trigger, edge, vertical(args, &file))?
@@ -777,10 +782,6 @@ pub fn setup_of(args: &AnalyzeArgs, ch: Samples<'_>) -> Result<Setup, PipelineEr
         gain_m_s2_per_count: levels.gain_m_s2_per_count as f32,
         sample_rate_hz: ch.rate_hz as f32,
     };
-    let counts = accel
-        .iter()
-        .map(|v| to_count(*v, levels.gain_m_s2_per_count))
-        .collect();
     let (trigger, edge) = (levels.trigger_m_s2, levels.edge_m_s2);
     let resolved = build_scene(
         args,
@@ -791,6 +792,20 @@ pub fn setup_of(args: &AnalyzeArgs, ch: Samples<'_>) -> Result<Setup, PipelineEr
         clipping.as_ref(),
         mass,
     )?;
+    // With --axes, each axis zeroed before the magnitude (the scene's edge and settle time).
+    let counts = if axes.is_empty() {
+        accel
+            .iter()
+            .map(|v| to_count(*v, levels.gain_m_s2_per_count))
+            .collect()
+    } else {
+        crate::pipeline::axes::zeroed_counts(
+            &axes,
+            &resolved.scene,
+            levels.gain_m_s2_per_count,
+            to_count,
+        )
+    };
     let reading = Reading {
         column: ch.name.to_string(),
         units,
