@@ -9,7 +9,7 @@ pub(crate) mod ticks;
 
 pub use impacts::{impacts, SHOWN};
 pub use signal::{filtered, read_window, window, Signal};
-use ticks::{log_tick, log_ticks, tick};
+use ticks::{log_ticks, AxisFormat, LABELS};
 
 use impact_core::consts::STANDARD_GRAVITY;
 use plotters::prelude::*;
@@ -190,7 +190,6 @@ pub(crate) fn draw_panel(
     index: Option<u32>,
     p: &Panel,
 ) -> Result<(), PlotError> {
-    let label = if p.log { log_tick } else { tick };
     let finite =
         |q: &(f64, f64)| q.0.is_finite() && q.1.is_finite() && (!p.log || (q.0 > 0.0 && q.1 > 0.0));
     let all = p
@@ -222,6 +221,32 @@ pub(crate) fn draw_panel(
         Some(i) => format!("impact {i} — {}", p.title),
         None => p.title.to_string(),
     };
+    let g = STANDARD_GRAVITY;
+    // A log axis's decades numbered, never crowding (ticks::log_ticks): labels 40 px apart
+    // across (`100k` is some 25 px wide), 16 px up (a line).
+    let (x_ticks, y_ticks, g_ticks) = if p.log {
+        (
+            log_ticks(x0, x1, width, 40.0),
+            log_ticks(y0, y1, height, 16.0),
+            log_ticks(y0 / g, y1 / g, height, 16.0),
+        )
+    } else {
+        Default::default()
+    };
+    // Each axis's labels in one format, chosen from all of them (ticks::AxisFormat).
+    let (fx, fy, fg) = if p.log {
+        (
+            AxisFormat::log(&x_ticks.0),
+            AxisFormat::log(&y_ticks.0),
+            AxisFormat::log(&g_ticks.0),
+        )
+    } else {
+        (
+            AxisFormat::linear(x0, x1),
+            AxisFormat::linear(y0, y1),
+            AxisFormat::linear(y0 / g, y1 / g),
+        )
+    };
     let mut builder = ChartBuilder::on(area);
     builder
         .caption(caption, ("sans-serif", 15))
@@ -232,11 +257,13 @@ pub(crate) fn draw_panel(
     // The measured curve and each model's on `chart`, the mesh, the legend.
     macro_rules! curves {
         ($chart:ident) => {{
-            let format = |v: &f64| label(*v);
+            let (x_format, y_format) = (|v: &f64| fx.label(*v), |v: &f64| fy.label(*v));
             let mut mesh = $chart.configure_mesh();
             mesh.x_desc(p.x_label)
-                .x_label_formatter(&format)
-                .y_label_formatter(&format);
+                .x_labels(LABELS)
+                .y_labels(LABELS)
+                .x_label_formatter(&x_format)
+                .y_label_formatter(&y_format);
             if p.g_axis {
                 mesh.y_desc("m/s²");
             }
@@ -304,7 +331,8 @@ pub(crate) fn draw_panel(
                 chart
                     .configure_secondary_axes()
                     .y_desc("g")
-                    .y_label_formatter(&|v| label(*v))
+                    .y_labels(LABELS)
+                    .y_label_formatter(&|v| fg.label(*v))
                     .draw()?;
                 curves!(chart);
             } else {
@@ -312,21 +340,17 @@ pub(crate) fn draw_panel(
             }
         }};
     }
-    let g = STANDARD_GRAVITY;
     if p.log {
-        // Each axis's decades numbered, never crowding (ticks::log_ticks).
-        let axis = |lo: f64, hi: f64, length: f64, spacing: f64| {
-            let (labelled, light) = log_ticks(lo, hi, length, spacing);
+        let axis = |(labelled, light): &(Vec<f64>, Vec<f64>), lo: f64, hi: f64| {
             (lo..hi)
                 .log_scale()
-                .with_key_points(labelled)
-                .with_light_points(light)
+                .with_key_points(labelled.clone())
+                .with_light_points(light.clone())
         };
-        // Labels 40 px apart across (`100k` is some 25 px wide), 16 px up (a line).
         chart!(
-            axis(x0, x1, width, 40.0),
-            axis(y0, y1, height, 16.0),
-            axis(y0 / g, y1 / g, height, 16.0)
+            axis(&x_ticks, x0, x1),
+            axis(&y_ticks, y0, y1),
+            axis(&g_ticks, y0 / g, y1 / g)
         );
     } else {
         chart!(x0..x1, y0..y1, y0 / g..y1 / g);
@@ -486,6 +510,33 @@ mod tests {
         // Without it, no labels on the right.
         let svg = panel_svg(vec![(0.0, 0.0), (1.0, 98.0)], false, false);
         assert!(labels_in(&svg, 345.0..400.0, 0.0..250.0).is_empty());
+    }
+
+    #[test]
+    fn each_axis_labels_its_ticks_in_one_format() {
+        use super::ticks::tests::one_format;
+        // A deformation from 0 to -3 µm against time from -0.08 ms: one by one, the labels
+        // read -500µ next to -0.001 and 0.1 next to 0.15.
+        let svg = panel_svg(
+            (0..=50)
+                .map(|k| {
+                    let t = -0.08 + f64::from(k) * 0.01;
+                    (t, -3e-3 * (t.max(0.0) / 0.42).powi(2))
+                })
+                .collect(),
+            false,
+            true,
+        );
+        let left = labels_in(&svg, 0.0..68.0, 30.0..262.0);
+        let left: Vec<String> = left.into_iter().filter(|t| t != "m/s²").collect();
+        let under = labels_in(&svg, 60.0..340.0, 262.0..285.0);
+        let right = labels_in(&svg, 330.0..400.0, 30.0..262.0);
+        let right: Vec<String> = right.into_iter().filter(|t| t != "g").collect();
+        for labels in [&left, &under, &right] {
+            assert!(labels.len() >= 4 && one_format(labels), "{labels:?}");
+        }
+        assert!(left.contains(&"-1000µ".to_string()), "{left:?}");
+        assert!(under.contains(&"0.10".to_string()), "{under:?}");
     }
 
     #[test]
