@@ -361,8 +361,10 @@ fn report(args: &LogArgs, reader: LogReader, name: &str) -> Result<Judged, LogCo
                         .map(|c| f64::from(c) * gain)
                 }),
             };
+            // The pulse the board's scene line states, as the report's pulses take it.
+            let spec = scene.spec().ok().flatten();
             // (plot::impacts says "wrote PATH".)
-            crate::plot::impacts(&signal, &log.impacts, path)?;
+            crate::plot::impacts(&signal, spec.as_ref(), &log.impacts, path)?;
         }
         if let Some(path) = &args.export {
             let inputs = crate::output::Inputs::new()

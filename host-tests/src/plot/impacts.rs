@@ -6,8 +6,10 @@ use impact_core::signal::cfc::Cfc;
 use impact_core::signal::window_filter::WindowFilter;
 use plotters::prelude::*;
 
+use impact_core::spec::Spec;
+
 use super::signal::{window, Signal};
-use super::{draw_panel, write_svg, Curve, Panel, PlotError};
+use super::{draw_panel, write_svg, Curve, Panel, PlotError, SpecDrawn};
 
 /// The filtered trace's colour (a CFC's or the low-pass's): dark, over the light raw one.
 const CFC_TRACE: RGBColor = RGBColor(25, 45, 120);
@@ -32,9 +34,11 @@ pub const SHOWN: usize = 6;
 /// Per impact (up to [`SHOWN`]), as in the seed papers' figures: deceleration, velocity and
 /// deformation against time from touch, the force–deformation loop, with the fitted models
 /// (two-phase, nonlinear, Hertz) simulated from the same touch over the measured curves; with
-/// `--srs`, the SRS and the PVSS (log–log).
+/// `--srs`, the SRS and the PVSS (log–log); with a verdict against `spec` (the scene's), its
+/// band, nominal pulse, watched window and worst point on the deceleration.
 pub fn impacts(
     signal: &Signal,
+    spec: Option<&Spec>,
     reports: &[impact_core::ImpactReport],
     path: &std::path::Path,
 ) -> Result<(), PlotError> {
@@ -58,7 +62,7 @@ pub fn impacts(
     // fullest row needs.
     let cols = shown
         .iter()
-        .map(|r| kinematics_panels(signal, r).len() + if spectra { 2 } else { 0 })
+        .map(|r| kinematics_panels(signal, spec, r).len() + if spectra { 2 } else { 0 })
         .max()
         .unwrap_or(1);
     write_svg(
@@ -72,7 +76,7 @@ pub fn impacts(
                 (12, 10),
                 ("sans-serif", 18).into_font().style(FontStyle::Bold),
             ))?;
-            draw_impacts(&body, signal, &shown, cols, spectra)
+            draw_impacts(&body, (signal, spec), &shown, cols, spectra)
         },
     )?;
     crate::errln!("wrote {}", path.display());
@@ -82,7 +86,7 @@ pub fn impacts(
 /// The impacts figure's panels on `root` (see [`impacts`]): a row per impact.
 fn draw_impacts(
     root: &DrawingArea<SVGBackend, plotters::coord::Shift>,
-    signal: &Signal,
+    (signal, spec): (&Signal, Option<&Spec>),
     shown: &[&impact_core::ImpactReport],
     cols: usize,
     spectra: bool,
@@ -90,7 +94,7 @@ fn draw_impacts(
     root.fill(&WHITE)?;
     let rows = root.split_evenly((shown.len(), cols));
     for (k, r) in shown.iter().enumerate() {
-        for (j, p) in kinematics_panels(signal, r).iter().enumerate() {
+        for (j, p) in kinematics_panels(signal, spec, r).iter().enumerate() {
             draw_panel(&rows[k * cols + j], Some(r.index), p)?;
         }
         // The spectra in the last two columns of every row, one above another.
@@ -115,6 +119,60 @@ fn window_ms(
     (start..start + len, move |i: usize| {
         (i as f64 / fs - start_s) * 1e3
     })
+}
+
+/// With a verdict against `spec`, what the deceleration panel of impact `r` draws of it
+/// (placed as the verdict placed it: [`super::band`]): the band and the nominal pulse, the
+/// window it watched and its worst point, in ms from the touch and in the direction of the
+/// peak, times `scale` (m/s² to the panel's unit).
+fn spec_drawn(spec: Option<&Spec>, r: &impact_core::ImpactReport, scale: f64) -> Option<SpecDrawn> {
+    let (from_s, to_s, placed) = super::band::window(spec, r);
+    let (spec, start_s) = placed?;
+    let Some(Ok(v)) = &r.verdict else {
+        return None;
+    };
+    let k = scale
+        * if r.peak_acceleration_m_s2 < 0.0 {
+            -1.0
+        } else {
+            1.0
+        };
+    let ms = |t: f64| (t - r.start_s) * 1e3;
+    let band = super::band::band(spec, start_s, from_s, to_s)
+        .into_iter()
+        .map(|(t, lo, hi, nominal)| {
+            (
+                ms(t),
+                (lo * k).min(hi * k),
+                (lo * k).max(hi * k),
+                nominal * k,
+            )
+        })
+        .collect();
+    let worst = (ms(v.worst_s), f64::from(v.worst_m_s2) * k, !v.band_pass);
+    Some(SpecDrawn {
+        band,
+        watched: (ms(from_s), ms(to_s)),
+        worst: (worst.0.is_finite() && worst.1.is_finite()).then_some(worst),
+    })
+}
+
+/// The samples the deceleration panel of impact `r` draws: its window, and the window the
+/// verdict watched (`watched`, ms from the touch) and a tenth of its span either side (so
+/// that its edges show) where that reaches further.
+fn drawn_samples(
+    signal: &Signal,
+    r: &impact_core::ImpactReport,
+    watched: Option<(f64, f64)>,
+) -> std::ops::Range<usize> {
+    let (samples, _) = window_ms(signal, r);
+    let Some((from_ms, to_ms)) = watched else {
+        return samples;
+    };
+    let margin = 0.1 * (to_ms - from_ms);
+    let (from_ms, to_ms) = (from_ms - margin, to_ms + margin);
+    let at = |ms: f64| ((r.start_s + ms * 1e-3) * signal.rate_hz).max(0.0);
+    samples.start.min(at(from_ms).floor() as usize)..samples.end.max(at(to_ms).ceil() as usize + 1)
 }
 
 /// What an impact's window shows, measured: the deceleration above the baseline, and from
@@ -237,12 +295,17 @@ fn model_curves(
 /// With a CFC or the low-pass, its trace over the raw one (the analysis's filter on the samples it
 /// filtered) put first in `curves`; else, or where it cannot be drawn, the deceleration
 /// panel's title saying so.
-fn cfc_trace(signal: &Signal, r: &impact_core::ImpactReport, curves: &mut Vec<Curve>) -> String {
+fn cfc_trace(
+    signal: &Signal,
+    r: &impact_core::ImpactReport,
+    samples: std::ops::Range<usize>,
+    curves: &mut Vec<Curve>,
+) -> String {
     let title = "deceleration, m/s² (left) and g (right)".to_string();
     let Some((kind, _)) = signal.filter else {
         return title;
     };
-    let (samples, t_ms) = window_ms(signal, r);
+    let (_, t_ms) = window_ms(signal, r);
     match super::filtered(signal, r) {
         Some((first, values)) => {
             let trace = samples
@@ -263,9 +326,13 @@ fn cfc_trace(signal: &Signal, r: &impact_core::ImpactReport, curves: &mut Vec<Cu
 
 /// The four kinematic panels of impact `r`: deceleration, velocity, deformation, and force
 /// against deformation, measured with the fitted models over them.
-fn kinematics_panels<'a>(signal: &Signal, r: &impact_core::ImpactReport) -> Vec<Panel<'a>> {
+fn kinematics_panels<'a>(
+    signal: &Signal,
+    spec: Option<&Spec>,
+    r: &impact_core::ImpactReport,
+) -> Vec<Panel<'a>> {
     let Measured {
-        accel,
+        mut accel,
         mut velocity,
         mut deformation_mm,
         mut force_loop,
@@ -273,7 +340,18 @@ fn kinematics_panels<'a>(signal: &Signal, r: &impact_core::ImpactReport) -> Vec<
     let v0 = r.kinematics.map(|k| k.impact_velocity_m_s as f64);
     let points = 4 * accel.len() as u64 + 1024;
     let [mut c_a, c_v, c_x, c_f] = model_curves(r, v0, signal.mass_kg, signal.rate_hz, points);
-    let decel_title = cfc_trace(signal, r, &mut c_a);
+    // With a verdict, the deceleration over the window it watched too.
+    let spec = spec_drawn(spec, r, 1.0);
+    let samples = drawn_samples(signal, r, spec.as_ref().map(|s| s.watched));
+    if spec.is_some() {
+        let (_, t_ms) = window_ms(signal, r);
+        let base = r.baseline_m_s2 as f64;
+        accel = samples
+            .clone()
+            .filter_map(|i| Some((t_ms(i), (signal.accel_m_s2)(i as u64)? - base)))
+            .collect();
+    }
+    let decel_title = cfc_trace(signal, r, samples, &mut c_a);
     let raw_label = if c_a.first().is_some_and(|c| c.1 == CFC_TRACE) {
         "raw"
     } else {
@@ -323,9 +401,11 @@ fn kinematics_panels<'a>(signal: &Signal, r: &impact_core::ImpactReport) -> Vec<
         log: false,
         g_axis,
         legend,
+        spec: None,
     };
     let decel = Panel {
         measured_label: raw_label,
+        spec,
         ..panel(
             decel_title.into(),
             "time from touch, ms",
@@ -403,6 +483,7 @@ fn spectrum_panels<'a>(r: &impact_core::ImpactReport) -> [Panel<'a>; 2] {
             log: true,
             g_axis: true,
             legend: false,
+            spec: None,
         },
         Panel {
             title: "pseudo-velocity shock spectrum, m/s".into(),
@@ -414,6 +495,7 @@ fn spectrum_panels<'a>(r: &impact_core::ImpactReport) -> [Panel<'a>; 2] {
             log: true,
             g_axis: false,
             legend: false,
+            spec: None,
         },
     ]
 }

@@ -6,9 +6,7 @@
 use impact_core::consts::STANDARD_GRAVITY;
 use impact_core::spec::Spec;
 
-mod band;
-
-pub use band::{band, window, BandPoint};
+pub use crate::plot::band::{band, window, BandPoint};
 
 use crate::html;
 use crate::html::Html;
