@@ -368,3 +368,40 @@ fn a_spec_run_draws_its_band_and_the_window_it_watched() {
         assert!(!drawn.contains(absent), "{absent} drawn without --spec");
     }
 }
+
+/// A force channel (the impact hammer's `force_n`) is drawn as force: its panel titled and
+/// scaled in N (the peak force the report gives, not that force over the mass), no g axis,
+/// no m/s² anywhere in the deceleration's place.
+#[test]
+fn a_force_channel_is_drawn_in_newtons_without_a_g_axis() {
+    let scratch = Scratch::new();
+    let f = data("pyfrf-impact-hammer/measurement_1.csv");
+    let svg = scratch.join_str("force.svg");
+    for mass in [None, Some("0.5")] {
+        let mut args = vec!["analyze", f.to_str().unwrap(), "--plot", &svg];
+        args.extend(mass.map(|m| ["--mass", m]).iter().flatten());
+        impact_ok(&args);
+        let drawn = std::fs::read_to_string(&svg).unwrap();
+        let t = texts(&drawn);
+        assert!(
+            t.iter().any(|(_, _, s)| s == "impact 0 — force, N"),
+            "{mass:?}: no force panel"
+        );
+        assert!(
+            t[0].2.contains("raw signal above its baseline, N"),
+            "{}",
+            t[0].2
+        );
+        for (_, _, s) in &t {
+            assert!(!s.contains("m/s²") && s != "g", "{mass:?}: {s:?} drawn");
+        }
+        // The force axis (left of the first panel) reaches the peak of 68.6 N, not 137 m/s²
+        // (68.6 N over 0.5 kg).
+        let top = t
+            .iter()
+            .filter(|(x, y, _)| *x < 68.0 && *y > 60.0)
+            .filter_map(|(_, _, s)| s.parse::<f64>().ok())
+            .fold(f64::MIN, f64::max);
+        assert!((68.6..100.0).contains(&top), "{mass:?}: {top}");
+    }
+}

@@ -354,6 +354,7 @@ fn report(args: &LogArgs, reader: LogReader, name: &str) -> Result<Judged, LogCo
                 filter: None,
                 rate_hz: rate,
                 mass_kg: mass.map(f64::from),
+                force_kg: None,
                 accel_m_s2: Box::new(move |i| {
                     waves
                         .iter()

@@ -301,7 +301,14 @@ fn cfc_trace(
     samples: std::ops::Range<usize>,
     curves: &mut Vec<Curve>,
 ) -> String {
-    let title = "deceleration, m/s² (left) and g (right)".to_string();
+    let (title, quantity) = match signal.force_kg {
+        Some(_) => ("force, N", "force, N"),
+        None => (
+            "deceleration, m/s² (left) and g (right)",
+            "deceleration, m/s², g",
+        ),
+    };
+    let title = title.to_string();
     let Some((kind, _)) = signal.filter else {
         return title;
     };
@@ -318,9 +325,58 @@ fn cfc_trace(
             title
         }
         None => format!(
-            "deceleration, m/s², g: {} not drawn",
+            "{quantity}: {} not drawn",
             crate::report::filter::name(&kind)
         ),
+    }
+}
+
+/// The deceleration panel of impact `r` (`accel`: measured over its window; `models`: the
+/// fits'): with a verdict against `spec`, over the window it watched too, with its band; on a
+/// force channel, in N (no g axis).
+fn decel_panel<'a>(
+    signal: &Signal,
+    spec: Option<&Spec>,
+    r: &impact_core::ImpactReport,
+    mut accel: Vec<(f64, f64)>,
+    mut models: Vec<Curve>,
+) -> Panel<'a> {
+    let spec = spec_drawn(spec, r, signal.force_kg.unwrap_or(1.0));
+    let samples = drawn_samples(signal, r, spec.as_ref().map(|s| s.watched));
+    if spec.is_some() {
+        let (_, t_ms) = window_ms(signal, r);
+        let base = r.baseline_m_s2 as f64;
+        accel = samples
+            .clone()
+            .filter_map(|i| Some((t_ms(i), (signal.accel_m_s2)(i as u64)? - base)))
+            .collect();
+    }
+    let title = cfc_trace(signal, r, samples, &mut models);
+    let raw_label = if models.first().is_some_and(|c| c.1 == CFC_TRACE) {
+        "raw"
+    } else {
+        "measured"
+    };
+    // A force channel's values back in N (the mass they were divided by).
+    if let Some(m) = signal.force_kg {
+        for q in accel
+            .iter_mut()
+            .chain(models.iter_mut().flat_map(|c| c.2.iter_mut()))
+        {
+            q.1 *= m;
+        }
+    }
+    Panel {
+        title: title.into(),
+        x_label: "time from touch, ms",
+        measured: accel,
+        measured_label: raw_label,
+        models,
+        dashed: Vec::new(),
+        log: false,
+        g_axis: signal.force_kg.is_none(),
+        legend: true,
+        spec,
     }
 }
 
@@ -339,24 +395,8 @@ fn kinematics_panels<'a>(
     } = Measured::of(signal, r);
     let v0 = r.kinematics.map(|k| k.impact_velocity_m_s as f64);
     let points = 4 * accel.len() as u64 + 1024;
-    let [mut c_a, c_v, c_x, c_f] = model_curves(r, v0, signal.mass_kg, signal.rate_hz, points);
-    // With a verdict, the deceleration over the window it watched too.
-    let spec = spec_drawn(spec, r, 1.0);
-    let samples = drawn_samples(signal, r, spec.as_ref().map(|s| s.watched));
-    if spec.is_some() {
-        let (_, t_ms) = window_ms(signal, r);
-        let base = r.baseline_m_s2 as f64;
-        accel = samples
-            .clone()
-            .filter_map(|i| Some((t_ms(i), (signal.accel_m_s2)(i as u64)? - base)))
-            .collect();
-    }
-    let decel_title = cfc_trace(signal, r, samples, &mut c_a);
-    let raw_label = if c_a.first().is_some_and(|c| c.1 == CFC_TRACE) {
-        "raw"
-    } else {
-        "measured"
-    };
+    let [c_a, c_v, c_x, c_f] = model_curves(r, v0, signal.mass_kg, signal.rate_hz, points);
+    let decel = decel_panel(signal, spec, r, std::mem::take(&mut accel), c_a);
     // A Δv the report refuses (a channel that does not hold DC) is not drawn either: no
     // velocity, deformation or loop from its integral.
     let refused = r.delta_v_m_s.is_none();
@@ -374,7 +414,9 @@ fn kinematics_panels<'a>(
             force_loop.clear();
             "force against deformation: needs v0"
         }
+        // (On a force channel without a mass, its force over 1 kg times 1 kg: N.)
         (true, true) => "force against deformation, N",
+        (true, false) if signal.force_kg.is_some() => "force against deformation, N",
         (true, false) => "deceleration against deformation, m/s²",
     };
     let loop_drawn = known && !refused;
@@ -402,18 +444,6 @@ fn kinematics_panels<'a>(
         g_axis,
         legend,
         spec: None,
-    };
-    let decel = Panel {
-        measured_label: raw_label,
-        spec,
-        ..panel(
-            decel_title.into(),
-            "time from touch, ms",
-            accel,
-            c_a,
-            true,
-            true,
-        )
     };
     // A Δv refused leaves the deceleration only, its title saying why the integrals are not
     // drawn.
