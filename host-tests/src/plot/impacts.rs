@@ -121,42 +121,6 @@ fn window_ms(
     })
 }
 
-/// With a verdict against `spec`, what the deceleration panel of impact `r` draws of it
-/// (placed as the verdict placed it: [`super::band`]): the band and the nominal pulse, the
-/// window it watched and its worst point, in ms from the touch and in the direction of the
-/// peak, times `scale` (m/s² to the panel's unit).
-fn spec_drawn(spec: Option<&Spec>, r: &impact_core::ImpactReport, scale: f64) -> Option<SpecDrawn> {
-    let (from_s, to_s, placed) = super::band::window(spec, r);
-    let (spec, start_s) = placed?;
-    let Some(Ok(v)) = &r.verdict else {
-        return None;
-    };
-    let k = scale
-        * if r.peak_acceleration_m_s2 < 0.0 {
-            -1.0
-        } else {
-            1.0
-        };
-    let ms = |t: f64| (t - r.start_s) * 1e3;
-    let band = super::band::band(spec, start_s, from_s, to_s)
-        .into_iter()
-        .map(|(t, lo, hi, nominal)| {
-            (
-                ms(t),
-                (lo * k).min(hi * k),
-                (lo * k).max(hi * k),
-                nominal * k,
-            )
-        })
-        .collect();
-    let worst = (ms(v.worst_s), f64::from(v.worst_m_s2) * k, !v.band_pass);
-    Some(SpecDrawn {
-        band,
-        watched: (ms(from_s), ms(to_s)),
-        worst: (worst.0.is_finite() && worst.1.is_finite()).then_some(worst),
-    })
-}
-
 /// The samples the deceleration panel of impact `r` draws: its window, and the window the
 /// verdict watched (`watched`, ms from the touch) and a tenth of its span either side (so
 /// that its edges show) where that reaches further.
@@ -341,7 +305,7 @@ fn decel_panel<'a>(
     mut accel: Vec<(f64, f64)>,
     mut models: Vec<Curve>,
 ) -> Panel<'a> {
-    let spec = spec_drawn(spec, r, signal.force_kg.unwrap_or(1.0));
+    let spec = SpecDrawn::of(spec, r, signal.force_kg.unwrap_or(1.0));
     let samples = drawn_samples(signal, r, spec.as_ref().map(|s| s.watched));
     if spec.is_some() {
         let (_, t_ms) = window_ms(signal, r);

@@ -1,15 +1,22 @@
 //! The figures' primitives: the output checked and written (SVG, or PNG: [`png`]), panels of
-//! curves drawn with plotters; the impacts figure ([`mod@impacts`]), what it draws from ([`signal`]) and the tick
-//! labels ([`ticks`]).
+//! curves drawn with plotters; the impacts figure ([`mod@impacts`]), what it draws from
+//! ([`signal`]), where a pulse is drawn and a specification's band placed ([`band`]), a
+//! specified pulse on a panel ([`spec`]), where a legend goes ([`legend`]) and the tick
+//! labels, one format per axis ([`ticks`]).
 
 pub mod band;
 mod impacts;
+mod legend;
 mod png;
 mod signal;
+mod spec;
 pub(crate) mod ticks;
 
 pub use impacts::{impacts, SHOWN};
+use legend::{above_legend, legend_corner};
 pub use signal::{filtered, read_window, window, Signal};
+pub(crate) use spec::SpecDrawn;
+use spec::{draw_spec_over, draw_spec_under};
 use ticks::{log_ticks, AxisFormat, LABELS};
 
 use impact_core::consts::STANDARD_GRAVITY;
@@ -134,145 +141,6 @@ pub(crate) struct Panel<'a> {
     /// A specified pulse against time: its band, the window its verdict watched, its worst
     /// point.
     pub(crate) spec: Option<SpecDrawn>,
-}
-
-/// A specified pulse drawn on a panel against time, in the panel's units: its tolerance band
-/// and nominal pulse where the verdict placed them ([`band::band`]), the window the verdict
-/// watched ([`band::window`]) and its worst point.
-pub(crate) struct SpecDrawn {
-    /// `(t, lower, upper, nominal)`.
-    pub(crate) band: Vec<band::BandPoint>,
-    /// The window the verdict watched, `(from, to)`.
-    pub(crate) watched: (f64, f64),
-    /// The verdict's worst point `(t, value)` and whether it lies beyond the band.
-    pub(crate) worst: Option<(f64, f64, bool)>,
-}
-
-/// The band's colour, and the nominal pulse's (green: apart from the measured blue).
-const BAND: RGBColor = RGBColor(46, 139, 87);
-const NOMINAL: RGBColor = RGBColor(20, 90, 50);
-
-/// The watched window's shade and edges.
-const WATCHED: RGBColor = RGBColor(120, 120, 120);
-
-/// The worst point's colours: beyond the band, within it (the report's and the live view's).
-const FAILS: RGBColor = RGBColor(214, 39, 40);
-const WITHIN: RGBColor = RGBColor(227, 168, 43);
-
-impl SpecDrawn {
-    /// Its points: the band's limits and the nominal pulse, the watched window's edges at
-    /// `y`, the worst point.
-    fn points(&self, y: f64) -> impl Iterator<Item = (f64, f64)> + '_ {
-        self.band
-            .iter()
-            .flat_map(|b| [(b.0, b.1), (b.0, b.2), (b.0, b.3)])
-            .chain([(self.watched.0, y), (self.watched.1, y)])
-            .chain(self.worst.map(|w| (w.0, w.1)))
-    }
-
-    /// Its legend's lines: the window, the band, the nominal pulse, the worst point.
-    fn entries(&self) -> usize {
-        1 + 2 * usize::from(!self.band.is_empty()) + usize::from(self.worst.is_some())
-    }
-}
-
-/// Draws `s` under a panel's curves on `chart` (from `y0` to `y1`): the window the verdict
-/// watched, shaded between its edges, and the tolerance band, shaded between its limits.
-fn draw_spec_under<X, Y>(
-    chart: &mut ChartContext<'_, SVGBackend<'_>, Cartesian2d<X, Y>>,
-    s: &SpecDrawn,
-    (y0, y1): (f64, f64),
-) -> Result<(), PlotError>
-where
-    X: Ranged<ValueType = f64>,
-    Y: Ranged<ValueType = f64>,
-{
-    let (w0, w1) = s.watched;
-    chart
-        .draw_series(std::iter::once(Rectangle::new(
-            [(w0, y0), (w1, y1)],
-            WATCHED.mix(0.1).filled(),
-        )))?
-        .label("watched window")
-        .legend(|(x, y)| {
-            Rectangle::new(
-                [(x, y - 5), (x + 18, y + 5)],
-                ShapeStyle::from(WATCHED.mix(0.25)).filled(),
-            )
-        });
-    chart.draw_series(
-        [w0, w1].map(|t| PathElement::new(vec![(t, y0), (t, y1)], WATCHED.stroke_width(1))),
-    )?;
-    if s.band.is_empty() {
-        return Ok(());
-    }
-    let outline: Vec<(f64, f64)> = (s.band.iter().map(|b| (b.0, b.2)))
-        .chain(s.band.iter().rev().map(|b| (b.0, b.1)))
-        .collect();
-    chart
-        .draw_series(std::iter::once(Polygon::new(
-            outline,
-            BAND.mix(0.18).filled(),
-        )))?
-        .label("tolerance band")
-        .legend(|(x, y)| {
-            Rectangle::new(
-                [(x, y - 5), (x + 18, y + 5)],
-                ShapeStyle::from(BAND.mix(0.35)).filled(),
-            )
-        });
-    for limit in [
-        |b: &band::BandPoint| (b.0, b.1),
-        |b: &band::BandPoint| (b.0, b.2),
-    ] {
-        chart.draw_series(LineSeries::new(
-            s.band.iter().map(limit),
-            BAND.mix(0.7).stroke_width(1),
-        ))?;
-    }
-    Ok(())
-}
-
-/// Draws `s` over a panel's curves on `chart`: the nominal pulse dashed, the worst point
-/// circled (red beyond the band, amber within it).
-fn draw_spec_over<X, Y>(
-    chart: &mut ChartContext<'_, SVGBackend<'_>, Cartesian2d<X, Y>>,
-    s: &SpecDrawn,
-) -> Result<(), PlotError>
-where
-    X: Ranged<ValueType = f64>,
-    Y: Ranged<ValueType = f64>,
-{
-    if !s.band.is_empty() {
-        chart
-            .draw_series(DashedLineSeries::new(
-                s.band.iter().map(|b| (b.0, b.3)),
-                6,
-                4,
-                NOMINAL.stroke_width(2),
-            ))?
-            .label("nominal pulse")
-            .legend(|(x, y)| {
-                plotters::element::DashedPathElement::new(
-                    vec![(x, y), (x + 18, y)],
-                    5,
-                    3,
-                    NOMINAL.stroke_width(2),
-                )
-            });
-    }
-    if let Some((t, v, beyond)) = s.worst {
-        let c = if beyond { FAILS } else { WITHIN };
-        chart
-            .draw_series(std::iter::once(Circle::new((t, v), 6, c.stroke_width(2))))?
-            .label(if beyond {
-                "worst point: fails"
-            } else {
-                "worst point: within"
-            })
-            .legend(move |(x, y)| Circle::new((x + 9, y), 4, c.stroke_width(2)));
-    }
-    Ok(())
 }
 
 /// A panel's width in pixel columns, at most (its curves are drawn at most twice this many
@@ -527,112 +395,6 @@ pub(crate) fn draw_panel(
         chart!(x0..x1, y0..y1, y0 / g..y1 / g);
     }
     Ok(())
-}
-
-/// The top of linear panel `p`'s range (its axes' `ranges`, `size` in px) that leaves room
-/// for a legend of `entries` lines in the upper right corner above its curves and band.
-fn above_legend(
-    p: &Panel,
-    (x0, x1, y0, y1): (f64, f64, f64, f64),
-    (width, height): (f64, f64),
-    entries: usize,
-) -> f64 {
-    // The legend's box: some 160 px wide, 16 px a line, as a share of the plot area.
-    let (w, h) = (
-        (160.0 / width).min(0.9),
-        ((16.0 * entries as f64 + 14.0) / height).min(0.8),
-    );
-    let from = x1 - w * (x1 - x0);
-    let top = (p.measured.iter())
-        .chain(p.models.iter().chain(&p.dashed).flat_map(|c| c.2.iter()))
-        .copied()
-        .chain(
-            p.spec
-                .iter()
-                .flat_map(|s| s.band.iter().map(|b| (b.0, b.2))),
-        )
-        .filter(|q| q.0 >= from && q.1.is_finite())
-        .fold(f64::NEG_INFINITY, |m, q| m.max(q.1));
-    // (top - h y0) / (1 - h): the top at h below the range's.
-    if top.is_finite() {
-        y1.max((top - h * y0) / (1.0 - h))
-    } else {
-        y1
-    }
-}
-
-/// The corner of `p`'s plot area (its axes' `ranges`, `size` in px) where a legend of
-/// `entries` lines covers the fewest points of its curves: upper right unless another corner
-/// is emptier.
-fn legend_corner(
-    p: &Panel,
-    (x0, x1, y0, y1): (f64, f64, f64, f64),
-    (width, height): (f64, f64),
-    entries: usize,
-) -> SeriesLabelPosition {
-    // Where a value lies across an axis, 0 to 1.
-    let unit = |v: f64, lo: f64, hi: f64| {
-        if p.log {
-            (v / lo).ln() / (hi / lo).ln()
-        } else {
-            (v - lo) / (hi - lo)
-        }
-    };
-    // The legend's box: some 150 px wide, 19 px a line, as a share of the plot area.
-    let (w, h) = (
-        (150.0 / width).min(0.9),
-        ((19.0 * entries as f64 + 12.0) / height).min(0.9),
-    );
-    let corners = [
-        (
-            SeriesLabelPosition::UpperRight,
-            1.0 - w..=1.0,
-            1.0 - h..=1.0,
-        ),
-        (SeriesLabelPosition::LowerRight, 1.0 - w..=1.0, 0.0..=h),
-        (SeriesLabelPosition::UpperLeft, 0.0..=w, 1.0 - h..=1.0),
-        (SeriesLabelPosition::LowerLeft, 0.0..=w, 0.0..=h),
-    ];
-    // Every curve's points across the plot area; a curve of few points (a required SRS's
-    // breakpoints) 16 to each straight piece, so that one crossing a corner is seen there.
-    let mut points: Vec<(f64, f64)> = Vec::new();
-    let spec: Vec<(f64, f64)> = (p.spec.iter())
-        .flat_map(|s| s.band.iter().flat_map(|b| [(b.0, b.1), (b.0, b.2)]))
-        .collect();
-    for curve in std::iter::once(&p.measured)
-        .chain(p.models.iter().chain(&p.dashed).map(|c| &c.2))
-        .chain(std::iter::once(&spec))
-    {
-        let across: Vec<(f64, f64)> = curve
-            .iter()
-            .map(|q| (unit(q.0, x0, x1), unit(q.1, y0, y1)))
-            .filter(|q| q.0.is_finite() && q.1.is_finite())
-            .collect();
-        if across.len() < 200 {
-            for w in across.windows(2) {
-                points.extend((0..16).map(|k| {
-                    let t = f64::from(k) / 16.0;
-                    (
-                        w[0].0 + t * (w[1].0 - w[0].0),
-                        w[0].1 + t * (w[1].1 - w[0].1),
-                    )
-                }));
-            }
-            points.extend(across.last());
-        } else {
-            points.extend(across);
-        }
-    }
-    let covered = |xs: &std::ops::RangeInclusive<f64>, ys: &std::ops::RangeInclusive<f64>| {
-        points
-            .iter()
-            .filter(|q| xs.contains(&q.0) && ys.contains(&q.1))
-            .count()
-    };
-    corners
-        .into_iter()
-        .min_by_key(|(_, xs, ys)| covered(xs, ys))
-        .map_or(SeriesLabelPosition::UpperRight, |c| c.0)
 }
 
 #[cfg(test)]
