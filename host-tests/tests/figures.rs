@@ -239,3 +239,169 @@ fn plot_png_is_the_figure_rasterised_the_same_on_any_machine() {
     assert!(err.contains("would be overwritten"), "{err}");
     assert_eq!(std::fs::read(&input).unwrap(), std::fs::read(&f).unwrap());
 }
+
+/// An SVG's `<text>` elements: `(x, y, text)`.
+fn texts(svg: &str) -> Vec<(f64, f64, String)> {
+    svg.split("<text")
+        .skip(1)
+        .filter_map(|t| {
+            let text = t[t.find('>')? + 1..t.find("</text>")?].trim().to_string();
+            Some((attr(t, "x")?, attr(t, "y")?, text))
+        })
+        .collect()
+}
+
+/// Attribute `name` of the element starting `element`, as a number.
+fn attr(element: &str, name: &str) -> Option<f64> {
+    let key = format!(" {name}=\"");
+    let rest = &element[element.find(&key)? + key.len()..];
+    rest[..rest.find('"')?].parse().ok()
+}
+
+/// A 10 g, 3 ms half-sine (a linear contact of 1 kg at 100 kS/s) in `scratch`.
+fn half_sine(scratch: &Scratch) -> String {
+    let file = scratch.join_str("half-sine.csv");
+    impact_ok(&[
+        "synth",
+        "--model",
+        "linear",
+        "--mass",
+        "1",
+        "--stiffness",
+        "1.0966e6",
+        "--v0",
+        "0.0937",
+        "--rate",
+        "100000",
+        "--full-scale",
+        "400",
+        "--output",
+        &file,
+    ]);
+    file
+}
+
+/// With `--spec`, the deceleration panel draws the tolerance band and the nominal pulse, shades
+/// the window the verdict watched and circles its worst point, each where the verdict put it
+/// (read back through the panel's own tick labels), with legend entries; without, none of it.
+#[test]
+fn a_spec_run_draws_its_band_and_the_window_it_watched() {
+    let scratch = Scratch::new();
+    let file = half_sine(&scratch);
+    let svg = scratch.join_str("spec.svg");
+    let spec = "half-sine,10g,3ms";
+    let (json, _) = impact_ok(&["analyze", &file, "--spec", spec, "--json"]);
+    impact_ok(&["analyze", &file, "--spec", spec, "--plot", &svg]);
+    let drawn = std::fs::read_to_string(&svg).unwrap();
+    let j: serde_json::Value = serde_json::from_str(&json).unwrap();
+    let i = &j["impacts"][0];
+    let num = |v: &serde_json::Value| v.as_f64().unwrap();
+    let (start, placed) = (num(&i["start_s"]), num(&i["spec"]["nominal_start_s"]));
+    let d = num(&j["spec"]["duration_s"]);
+    let (before, watch) = (num(&j["spec"]["before"]), num(&j["spec"]["watch"]));
+    // ms from the touch to px, from the first panel's time labels (under it, left of 400 px).
+    let t = texts(&drawn);
+    let ticks: Vec<(f64, f64)> = t
+        .iter()
+        .filter(|(x, y, _)| *x < 400.0 && (330.0..345.0).contains(y))
+        .filter_map(|(x, _, s)| Some((s.parse::<f64>().ok()?, *x)))
+        .collect();
+    assert!(ticks.len() >= 4, "{ticks:?}");
+    let (a, b) = (ticks[0], ticks[ticks.len() - 1]);
+    let px = |ms: f64| a.1 + (ms - a.0) / (b.0 - a.0) * (b.1 - a.1);
+    let ms = |s: f64| (s - start) * 1e3;
+    // The watched window: a shaded rectangle from before·D ahead of the placed pulse to
+    // watch·D past its end.
+    let rect = drawn
+        .split("<rect")
+        .find(|r| r.contains("fill=\"#787878\""))
+        .expect("no watched window drawn");
+    let (x, w) = (attr(rect, "x").unwrap(), attr(rect, "width").unwrap());
+    let (from, to) = (
+        px(ms(placed - before * d)),
+        px(ms(placed + (1.0 + watch) * d)),
+    );
+    assert!((x - from).abs() <= 2.0, "{x} against {from}");
+    assert!((x + w - to).abs() <= 2.0, "{} against {to}", x + w);
+    // The band, shaded, and the nominal pulse, dashed (many short dark green strokes).
+    assert!(drawn.contains("<polygon opacity=\"0.18\" fill=\"#2E8B57\""));
+    assert!(
+        drawn
+            .matches("stroke=\"#145A32\" stroke-width=\"2\"")
+            .count()
+            > 20
+    );
+    // The worst point, at its time, on the curve's scale (0 m/s² where the left axis says 0).
+    let circle = drawn
+        .split("<circle")
+        .find(|c| c.contains("r=\"6\""))
+        .expect("no worst point drawn");
+    let worst = num(&i["spec"]["worst_time_s"]);
+    assert!((attr(circle, "cx").unwrap() - px(ms(worst))).abs() <= 2.0);
+    let zero = t
+        .iter()
+        .find(|(x, y, s)| *x < 68.0 && *y > 60.0 && s == "0")
+        .unwrap();
+    let value_px = attr(circle, "cy").unwrap() - (zero.1 - 4.0);
+    assert!(value_px.abs() <= 6.0, "{value_px}");
+    for entry in [
+        "watched window",
+        "tolerance band",
+        "nominal pulse",
+        "worst point: within",
+    ] {
+        assert!(
+            t.iter().any(|(_, _, s)| s == entry),
+            "{entry} not in the legend"
+        );
+    }
+    // Without --spec, none of it.
+    impact_ok(&["analyze", &file, "--plot", &svg]);
+    let drawn = std::fs::read_to_string(&svg).unwrap();
+    for absent in [
+        "#787878",
+        "<polygon",
+        "watched window",
+        "tolerance band",
+        "worst point",
+    ] {
+        assert!(!drawn.contains(absent), "{absent} drawn without --spec");
+    }
+}
+
+/// A force channel (the impact hammer's `force_n`) is drawn as force: its panel titled and
+/// scaled in N (the peak force the report gives, not that force over the mass), no g axis,
+/// no m/s² anywhere in the deceleration's place.
+#[test]
+fn a_force_channel_is_drawn_in_newtons_without_a_g_axis() {
+    let scratch = Scratch::new();
+    let f = data("pyfrf-impact-hammer/measurement_1.csv");
+    let svg = scratch.join_str("force.svg");
+    for mass in [None, Some("0.5")] {
+        let mut args = vec!["analyze", f.to_str().unwrap(), "--plot", &svg];
+        args.extend(mass.map(|m| ["--mass", m]).iter().flatten());
+        impact_ok(&args);
+        let drawn = std::fs::read_to_string(&svg).unwrap();
+        let t = texts(&drawn);
+        assert!(
+            t.iter().any(|(_, _, s)| s == "impact 0 — force, N"),
+            "{mass:?}: no force panel"
+        );
+        assert!(
+            t[0].2.contains("raw signal above its baseline, N"),
+            "{}",
+            t[0].2
+        );
+        for (_, _, s) in &t {
+            assert!(!s.contains("m/s²") && s != "g", "{mass:?}: {s:?} drawn");
+        }
+        // The force axis (left of the first panel) reaches the peak of 68.6 N, not 137 m/s²
+        // (68.6 N over 0.5 kg).
+        let top = t
+            .iter()
+            .filter(|(x, y, _)| *x < 68.0 && *y > 60.0)
+            .filter_map(|(_, _, s)| s.parse::<f64>().ok())
+            .fold(f64::MIN, f64::max);
+        assert!((68.6..100.0).contains(&top), "{mass:?}: {top}");
+    }
+}

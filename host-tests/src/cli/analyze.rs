@@ -139,7 +139,7 @@ pub fn draw(
         |n| n.to_string_lossy().into_owned(),
     );
     signal.title = format!("{name}, {}", signal.title);
-    plot::impacts(&signal, reports, path)
+    plot::impacts(&signal, setup.scene.spec.as_ref(), reports, path)
 }
 
 /// A test series: every recording analysed, the rows and statistics printed, each

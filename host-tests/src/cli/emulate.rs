@@ -451,7 +451,7 @@ pub fn emulate(args: &EmulateArgs) -> Result<crate::report::spec::Judged, Emulat
             |n| n.to_string_lossy().into_owned(),
         );
         signal.title = format!("{name} on the emulated board, {}", signal.title);
-        crate::plot::impacts(&signal, &log.impacts, path)?;
+        crate::plot::impacts(&signal, setup.scene.spec.as_ref(), &log.impacts, path)?;
     }
     Ok(crate::report::spec::Judged::reports(&log.impacts))
 }

@@ -354,6 +354,7 @@ fn report(args: &LogArgs, reader: LogReader, name: &str) -> Result<Judged, LogCo
                 filter: None,
                 rate_hz: rate,
                 mass_kg: mass.map(f64::from),
+                force_kg: None,
                 accel_m_s2: Box::new(move |i| {
                     waves
                         .iter()
@@ -361,8 +362,10 @@ fn report(args: &LogArgs, reader: LogReader, name: &str) -> Result<Judged, LogCo
                         .map(|c| f64::from(c) * gain)
                 }),
             };
+            // The pulse the board's scene line states, as the report's pulses take it.
+            let spec = scene.spec().ok().flatten();
             // (plot::impacts says "wrote PATH".)
-            crate::plot::impacts(&signal, &log.impacts, path)?;
+            crate::plot::impacts(&signal, spec.as_ref(), &log.impacts, path)?;
         }
         if let Some(path) = &args.export {
             let inputs = crate::output::Inputs::new()

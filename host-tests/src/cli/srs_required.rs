@@ -292,6 +292,7 @@ pub fn svg(
         log: true,
         g_axis: true,
         legend: true,
+        spec: None,
     };
     svg_html((530, 340), |root| {
         root.fill(&WHITE)?;

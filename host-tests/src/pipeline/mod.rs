@@ -632,15 +632,23 @@ impl Setup {
 
     /// The signal the figure draws: the counts the pipeline analysed times the gain.
     pub fn plot_signal(&self) -> crate::plot::Signal<'_> {
+        // A force channel's values were divided by the mass (1 kg without one) into m/s².
+        let force_kg = (self.units == Units::N).then(|| self.scene.mass_kg.map_or(1.0, f64::from));
         crate::plot::Signal {
             title: format!(
-                "{}: raw signal above its baseline, m/s²{}",
+                "{}: raw signal above its baseline, {}{}",
                 self.column.as_deref().unwrap_or("acceleration"),
+                if force_kg.is_some() { "N" } else { "m/s²" },
                 self.scene
                     .window_filter()
                     .map_or(String::new(), |f| format!(
-                        "; {} over the deceleration",
-                        crate::report::filter::description(&f)
+                        "; {} over the {}",
+                        crate::report::filter::description(&f),
+                        if force_kg.is_some() {
+                            "force"
+                        } else {
+                            "deceleration"
+                        }
                     )),
             ),
             filter: self
@@ -649,6 +657,7 @@ impl Setup {
                 .map(|f| (f, u64::from(self.scene.padding_samples()))),
             rate_hz: f64::from(self.scene.calibration.sample_rate_hz),
             mass_kg: self.scene.mass_kg.map(f64::from),
+            force_kg,
             accel_m_s2: Box::new(move |i| {
                 let gain = f64::from(self.scene.calibration.gain_m_s2_per_count);
                 let count = match self

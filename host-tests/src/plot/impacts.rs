@@ -6,8 +6,10 @@ use impact_core::signal::cfc::Cfc;
 use impact_core::signal::window_filter::WindowFilter;
 use plotters::prelude::*;
 
+use impact_core::spec::Spec;
+
 use super::signal::{window, Signal};
-use super::{draw_panel, write_svg, Curve, Panel, PlotError};
+use super::{draw_panel, write_svg, Curve, Panel, PlotError, SpecDrawn};
 
 /// The filtered trace's colour (a CFC's or the low-pass's): dark, over the light raw one.
 const CFC_TRACE: RGBColor = RGBColor(25, 45, 120);
@@ -32,9 +34,11 @@ pub const SHOWN: usize = 6;
 /// Per impact (up to [`SHOWN`]), as in the seed papers' figures: deceleration, velocity and
 /// deformation against time from touch, the force–deformation loop, with the fitted models
 /// (two-phase, nonlinear, Hertz) simulated from the same touch over the measured curves; with
-/// `--srs`, the SRS and the PVSS (log–log).
+/// `--srs`, the SRS and the PVSS (log–log); with a verdict against `spec` (the scene's), its
+/// band, nominal pulse, watched window and worst point on the deceleration.
 pub fn impacts(
     signal: &Signal,
+    spec: Option<&Spec>,
     reports: &[impact_core::ImpactReport],
     path: &std::path::Path,
 ) -> Result<(), PlotError> {
@@ -58,7 +62,7 @@ pub fn impacts(
     // fullest row needs.
     let cols = shown
         .iter()
-        .map(|r| kinematics_panels(signal, r).len() + if spectra { 2 } else { 0 })
+        .map(|r| kinematics_panels(signal, spec, r).len() + if spectra { 2 } else { 0 })
         .max()
         .unwrap_or(1);
     write_svg(
@@ -72,7 +76,7 @@ pub fn impacts(
                 (12, 10),
                 ("sans-serif", 18).into_font().style(FontStyle::Bold),
             ))?;
-            draw_impacts(&body, signal, &shown, cols, spectra)
+            draw_impacts(&body, (signal, spec), &shown, cols, spectra)
         },
     )?;
     crate::errln!("wrote {}", path.display());
@@ -82,7 +86,7 @@ pub fn impacts(
 /// The impacts figure's panels on `root` (see [`impacts`]): a row per impact.
 fn draw_impacts(
     root: &DrawingArea<SVGBackend, plotters::coord::Shift>,
-    signal: &Signal,
+    (signal, spec): (&Signal, Option<&Spec>),
     shown: &[&impact_core::ImpactReport],
     cols: usize,
     spectra: bool,
@@ -90,7 +94,7 @@ fn draw_impacts(
     root.fill(&WHITE)?;
     let rows = root.split_evenly((shown.len(), cols));
     for (k, r) in shown.iter().enumerate() {
-        for (j, p) in kinematics_panels(signal, r).iter().enumerate() {
+        for (j, p) in kinematics_panels(signal, spec, r).iter().enumerate() {
             draw_panel(&rows[k * cols + j], Some(r.index), p)?;
         }
         // The spectra in the last two columns of every row, one above another.
@@ -115,6 +119,24 @@ fn window_ms(
     (start..start + len, move |i: usize| {
         (i as f64 / fs - start_s) * 1e3
     })
+}
+
+/// The samples the deceleration panel of impact `r` draws: its window, and the window the
+/// verdict watched (`watched`, ms from the touch) and a tenth of its span either side (so
+/// that its edges show) where that reaches further.
+fn drawn_samples(
+    signal: &Signal,
+    r: &impact_core::ImpactReport,
+    watched: Option<(f64, f64)>,
+) -> std::ops::Range<usize> {
+    let (samples, _) = window_ms(signal, r);
+    let Some((from_ms, to_ms)) = watched else {
+        return samples;
+    };
+    let margin = 0.1 * (to_ms - from_ms);
+    let (from_ms, to_ms) = (from_ms - margin, to_ms + margin);
+    let at = |ms: f64| ((r.start_s + ms * 1e-3) * signal.rate_hz).max(0.0);
+    samples.start.min(at(from_ms).floor() as usize)..samples.end.max(at(to_ms).ceil() as usize + 1)
 }
 
 /// What an impact's window shows, measured: the deceleration above the baseline, and from
@@ -237,12 +259,24 @@ fn model_curves(
 /// With a CFC or the low-pass, its trace over the raw one (the analysis's filter on the samples it
 /// filtered) put first in `curves`; else, or where it cannot be drawn, the deceleration
 /// panel's title saying so.
-fn cfc_trace(signal: &Signal, r: &impact_core::ImpactReport, curves: &mut Vec<Curve>) -> String {
-    let title = "deceleration, m/s² (left) and g (right)".to_string();
+fn cfc_trace(
+    signal: &Signal,
+    r: &impact_core::ImpactReport,
+    samples: std::ops::Range<usize>,
+    curves: &mut Vec<Curve>,
+) -> String {
+    let (title, quantity) = match signal.force_kg {
+        Some(_) => ("force, N", "force, N"),
+        None => (
+            "deceleration, m/s² (left) and g (right)",
+            "deceleration, m/s², g",
+        ),
+    };
+    let title = title.to_string();
     let Some((kind, _)) = signal.filter else {
         return title;
     };
-    let (samples, t_ms) = window_ms(signal, r);
+    let (_, t_ms) = window_ms(signal, r);
     match super::filtered(signal, r) {
         Some((first, values)) => {
             let trace = samples
@@ -255,30 +289,78 @@ fn cfc_trace(signal: &Signal, r: &impact_core::ImpactReport, curves: &mut Vec<Cu
             title
         }
         None => format!(
-            "deceleration, m/s², g: {} not drawn",
+            "{quantity}: {} not drawn",
             crate::report::filter::name(&kind)
         ),
     }
 }
 
+/// The deceleration panel of impact `r` (`accel`: measured over its window; `models`: the
+/// fits'): with a verdict against `spec`, over the window it watched too, with its band; on a
+/// force channel, in N (no g axis).
+fn decel_panel<'a>(
+    signal: &Signal,
+    spec: Option<&Spec>,
+    r: &impact_core::ImpactReport,
+    mut accel: Vec<(f64, f64)>,
+    mut models: Vec<Curve>,
+) -> Panel<'a> {
+    let spec = SpecDrawn::of(spec, r, signal.force_kg.unwrap_or(1.0));
+    let samples = drawn_samples(signal, r, spec.as_ref().map(|s| s.watched));
+    if spec.is_some() {
+        let (_, t_ms) = window_ms(signal, r);
+        let base = r.baseline_m_s2 as f64;
+        accel = samples
+            .clone()
+            .filter_map(|i| Some((t_ms(i), (signal.accel_m_s2)(i as u64)? - base)))
+            .collect();
+    }
+    let title = cfc_trace(signal, r, samples, &mut models);
+    let raw_label = if models.first().is_some_and(|c| c.1 == CFC_TRACE) {
+        "raw"
+    } else {
+        "measured"
+    };
+    // A force channel's values back in N (the mass they were divided by).
+    if let Some(m) = signal.force_kg {
+        for q in accel
+            .iter_mut()
+            .chain(models.iter_mut().flat_map(|c| c.2.iter_mut()))
+        {
+            q.1 *= m;
+        }
+    }
+    Panel {
+        title: title.into(),
+        x_label: "time from touch, ms",
+        measured: accel,
+        measured_label: raw_label,
+        models,
+        dashed: Vec::new(),
+        log: false,
+        g_axis: signal.force_kg.is_none(),
+        legend: true,
+        spec,
+    }
+}
+
 /// The four kinematic panels of impact `r`: deceleration, velocity, deformation, and force
 /// against deformation, measured with the fitted models over them.
-fn kinematics_panels<'a>(signal: &Signal, r: &impact_core::ImpactReport) -> Vec<Panel<'a>> {
+fn kinematics_panels<'a>(
+    signal: &Signal,
+    spec: Option<&Spec>,
+    r: &impact_core::ImpactReport,
+) -> Vec<Panel<'a>> {
     let Measured {
-        accel,
+        mut accel,
         mut velocity,
         mut deformation_mm,
         mut force_loop,
     } = Measured::of(signal, r);
     let v0 = r.kinematics.map(|k| k.impact_velocity_m_s as f64);
     let points = 4 * accel.len() as u64 + 1024;
-    let [mut c_a, c_v, c_x, c_f] = model_curves(r, v0, signal.mass_kg, signal.rate_hz, points);
-    let decel_title = cfc_trace(signal, r, &mut c_a);
-    let raw_label = if c_a.first().is_some_and(|c| c.1 == CFC_TRACE) {
-        "raw"
-    } else {
-        "measured"
-    };
+    let [c_a, c_v, c_x, c_f] = model_curves(r, v0, signal.mass_kg, signal.rate_hz, points);
+    let decel = decel_panel(signal, spec, r, std::mem::take(&mut accel), c_a);
     // A Δv the report refuses (a channel that does not hold DC) is not drawn either: no
     // velocity, deformation or loop from its integral.
     let refused = r.delta_v_m_s.is_none();
@@ -296,7 +378,9 @@ fn kinematics_panels<'a>(signal: &Signal, r: &impact_core::ImpactReport) -> Vec<
             force_loop.clear();
             "force against deformation: needs v0"
         }
+        // (On a force channel without a mass, its force over 1 kg times 1 kg: N.)
         (true, true) => "force against deformation, N",
+        (true, false) if signal.force_kg.is_some() => "force against deformation, N",
         (true, false) => "deceleration against deformation, m/s²",
     };
     let loop_drawn = known && !refused;
@@ -323,17 +407,7 @@ fn kinematics_panels<'a>(signal: &Signal, r: &impact_core::ImpactReport) -> Vec<
         log: false,
         g_axis,
         legend,
-    };
-    let decel = Panel {
-        measured_label: raw_label,
-        ..panel(
-            decel_title.into(),
-            "time from touch, ms",
-            accel,
-            c_a,
-            true,
-            true,
-        )
+        spec: None,
     };
     // A Δv refused leaves the deceleration only, its title saying why the integrals are not
     // drawn.
@@ -403,6 +477,7 @@ fn spectrum_panels<'a>(r: &impact_core::ImpactReport) -> [Panel<'a>; 2] {
             log: true,
             g_axis: true,
             legend: false,
+            spec: None,
         },
         Panel {
             title: "pseudo-velocity shock spectrum, m/s".into(),
@@ -414,6 +489,7 @@ fn spectrum_panels<'a>(r: &impact_core::ImpactReport) -> [Panel<'a>; 2] {
             log: true,
             g_axis: false,
             legend: false,
+            spec: None,
         },
     ]
 }

@@ -1,15 +1,23 @@
 //! The figures' primitives: the output checked and written (SVG, or PNG: [`png`]), panels of
-//! curves drawn with plotters; the impacts figure ([`mod@impacts`]), what it draws from ([`signal`]) and the tick
-//! labels ([`ticks`]).
+//! curves drawn with plotters; the impacts figure ([`mod@impacts`]), what it draws from
+//! ([`signal`]), where a pulse is drawn and a specification's band placed ([`band`]), a
+//! specified pulse on a panel ([`spec`]), where a legend goes ([`legend`]) and the tick
+//! labels, one format per axis ([`ticks`]).
 
+pub mod band;
 mod impacts;
+mod legend;
 mod png;
 mod signal;
+mod spec;
 pub(crate) mod ticks;
 
 pub use impacts::{impacts, SHOWN};
+use legend::{above_legend, legend_corner};
 pub use signal::{filtered, read_window, window, Signal};
-use ticks::{log_tick, log_ticks, tick};
+pub(crate) use spec::SpecDrawn;
+use spec::{draw_spec_over, draw_spec_under};
+use ticks::{log_ticks, AxisFormat, LABELS};
 
 use impact_core::consts::STANDARD_GRAVITY;
 use plotters::prelude::*;
@@ -130,6 +138,9 @@ pub(crate) struct Panel<'a> {
     /// The values are m/s²: the same range in g on a second axis on the right.
     pub(crate) g_axis: bool,
     pub(crate) legend: bool,
+    /// A specified pulse against time: its band, the window its verdict watched, its worst
+    /// point.
+    pub(crate) spec: Option<SpecDrawn>,
 }
 
 /// A panel's width in pixel columns, at most (its curves are drawn at most twice this many
@@ -190,13 +201,20 @@ pub(crate) fn draw_panel(
     index: Option<u32>,
     p: &Panel,
 ) -> Result<(), PlotError> {
-    let label = if p.log { log_tick } else { tick };
     let finite =
         |q: &(f64, f64)| q.0.is_finite() && q.1.is_finite() && (!p.log || (q.0 > 0.0 && q.1 > 0.0));
+    let first_y = p.measured.first().map_or(0.0, |q| q.1);
     let all = p
         .measured
         .iter()
-        .chain(p.models.iter().chain(&p.dashed).flat_map(|c| c.2.iter()))
+        .copied()
+        .chain(
+            p.models
+                .iter()
+                .chain(&p.dashed)
+                .flat_map(|c| c.2.iter().copied()),
+        )
+        .chain(p.spec.iter().flat_map(|s| s.points(first_y)))
         .filter(|q| finite(q));
     let (mut x0, mut x1, mut y0, mut y1) = (f64::MAX, f64::MIN, f64::MAX, f64::MIN);
     for q in all {
@@ -216,11 +234,51 @@ pub(crate) fn draw_panel(
     // The plot area's size: the area less its margins, caption and label areas.
     let width = f64::from(w) - 76.0 - if p.g_axis { 60.0 } else { 0.0 };
     let height = f64::from(h) - 71.0;
-    let entries = usize::from(!p.measured.is_empty()) + p.models.len() + p.dashed.len();
-    let corner = legend_corner(p, (x0, x1, y0, y1), (width, height), entries);
+    let entries = usize::from(!p.measured.is_empty())
+        + p.models.len()
+        + p.dashed.len()
+        + p.spec.as_ref().map_or(0, SpecDrawn::entries);
+    // A specified pulse's panel: its legend upper right, the range raised until the curves
+    // pass below it (its band spans every corner: the report's pulses do the same).
+    let (y1, corner) = match &p.spec {
+        Some(_) if p.legend && !p.log => (
+            above_legend(p, (x0, x1, y0, y1), (width, height), entries),
+            SeriesLabelPosition::UpperRight,
+        ),
+        _ => (
+            y1,
+            legend_corner(p, (x0, x1, y0, y1), (width, height), entries),
+        ),
+    };
     let caption = match index {
         Some(i) => format!("impact {i} — {}", p.title),
         None => p.title.to_string(),
+    };
+    let g = STANDARD_GRAVITY;
+    // A log axis's decades numbered, never crowding (ticks::log_ticks): labels 40 px apart
+    // across (`100k` is some 25 px wide), 16 px up (a line).
+    let (x_ticks, y_ticks, g_ticks) = if p.log {
+        (
+            log_ticks(x0, x1, width, 40.0),
+            log_ticks(y0, y1, height, 16.0),
+            log_ticks(y0 / g, y1 / g, height, 16.0),
+        )
+    } else {
+        Default::default()
+    };
+    // Each axis's labels in one format, chosen from all of them (ticks::AxisFormat).
+    let (fx, fy, fg) = if p.log {
+        (
+            AxisFormat::log(&x_ticks.0),
+            AxisFormat::log(&y_ticks.0),
+            AxisFormat::log(&g_ticks.0),
+        )
+    } else {
+        (
+            AxisFormat::linear(x0, x1),
+            AxisFormat::linear(y0, y1),
+            AxisFormat::linear(y0 / g, y1 / g),
+        )
     };
     let mut builder = ChartBuilder::on(area);
     builder
@@ -232,15 +290,20 @@ pub(crate) fn draw_panel(
     // The measured curve and each model's on `chart`, the mesh, the legend.
     macro_rules! curves {
         ($chart:ident) => {{
-            let format = |v: &f64| label(*v);
+            let (x_format, y_format) = (|v: &f64| fx.label(*v), |v: &f64| fy.label(*v));
             let mut mesh = $chart.configure_mesh();
             mesh.x_desc(p.x_label)
-                .x_label_formatter(&format)
-                .y_label_formatter(&format);
+                .x_labels(LABELS)
+                .y_labels(LABELS)
+                .x_label_formatter(&x_format)
+                .y_label_formatter(&y_format);
             if p.g_axis {
                 mesh.y_desc("m/s²");
             }
             mesh.draw()?;
+            if let Some(s) = &p.spec {
+                draw_spec_under(&mut $chart, s, (y0, y1))?;
+            }
             if !p.measured.is_empty() {
                 $chart
                     .draw_series(LineSeries::new(
@@ -285,6 +348,9 @@ pub(crate) fn draw_panel(
                         )
                     });
             }
+            if let Some(s) = &p.spec {
+                draw_spec_over(&mut $chart, s)?;
+            }
             if p.legend {
                 $chart
                     .configure_series_labels()
@@ -304,7 +370,8 @@ pub(crate) fn draw_panel(
                 chart
                     .configure_secondary_axes()
                     .y_desc("g")
-                    .y_label_formatter(&|v| label(*v))
+                    .y_labels(LABELS)
+                    .y_label_formatter(&|v| fg.label(*v))
                     .draw()?;
                 curves!(chart);
             } else {
@@ -312,95 +379,22 @@ pub(crate) fn draw_panel(
             }
         }};
     }
-    let g = STANDARD_GRAVITY;
     if p.log {
-        // Each axis's decades numbered, never crowding (ticks::log_ticks).
-        let axis = |lo: f64, hi: f64, length: f64, spacing: f64| {
-            let (labelled, light) = log_ticks(lo, hi, length, spacing);
+        let axis = |(labelled, light): &(Vec<f64>, Vec<f64>), lo: f64, hi: f64| {
             (lo..hi)
                 .log_scale()
-                .with_key_points(labelled)
-                .with_light_points(light)
+                .with_key_points(labelled.clone())
+                .with_light_points(light.clone())
         };
-        // Labels 40 px apart across (`100k` is some 25 px wide), 16 px up (a line).
         chart!(
-            axis(x0, x1, width, 40.0),
-            axis(y0, y1, height, 16.0),
-            axis(y0 / g, y1 / g, height, 16.0)
+            axis(&x_ticks, x0, x1),
+            axis(&y_ticks, y0, y1),
+            axis(&g_ticks, y0 / g, y1 / g)
         );
     } else {
         chart!(x0..x1, y0..y1, y0 / g..y1 / g);
     }
     Ok(())
-}
-
-/// The corner of `p`'s plot area (its axes' `ranges`, `size` in px) where a legend of
-/// `entries` lines covers the fewest points of its curves: upper right unless another corner
-/// is emptier.
-fn legend_corner(
-    p: &Panel,
-    (x0, x1, y0, y1): (f64, f64, f64, f64),
-    (width, height): (f64, f64),
-    entries: usize,
-) -> SeriesLabelPosition {
-    // Where a value lies across an axis, 0 to 1.
-    let unit = |v: f64, lo: f64, hi: f64| {
-        if p.log {
-            (v / lo).ln() / (hi / lo).ln()
-        } else {
-            (v - lo) / (hi - lo)
-        }
-    };
-    // The legend's box: some 150 px wide, 19 px a line, as a share of the plot area.
-    let (w, h) = (
-        (150.0 / width).min(0.9),
-        ((19.0 * entries as f64 + 12.0) / height).min(0.9),
-    );
-    let corners = [
-        (
-            SeriesLabelPosition::UpperRight,
-            1.0 - w..=1.0,
-            1.0 - h..=1.0,
-        ),
-        (SeriesLabelPosition::LowerRight, 1.0 - w..=1.0, 0.0..=h),
-        (SeriesLabelPosition::UpperLeft, 0.0..=w, 1.0 - h..=1.0),
-        (SeriesLabelPosition::LowerLeft, 0.0..=w, 0.0..=h),
-    ];
-    // Every curve's points across the plot area; a curve of few points (a required SRS's
-    // breakpoints) 16 to each straight piece, so that one crossing a corner is seen there.
-    let mut points: Vec<(f64, f64)> = Vec::new();
-    for curve in std::iter::once(&p.measured).chain(p.models.iter().chain(&p.dashed).map(|c| &c.2))
-    {
-        let across: Vec<(f64, f64)> = curve
-            .iter()
-            .map(|q| (unit(q.0, x0, x1), unit(q.1, y0, y1)))
-            .filter(|q| q.0.is_finite() && q.1.is_finite())
-            .collect();
-        if across.len() < 200 {
-            for w in across.windows(2) {
-                points.extend((0..16).map(|k| {
-                    let t = f64::from(k) / 16.0;
-                    (
-                        w[0].0 + t * (w[1].0 - w[0].0),
-                        w[0].1 + t * (w[1].1 - w[0].1),
-                    )
-                }));
-            }
-            points.extend(across.last());
-        } else {
-            points.extend(across);
-        }
-    }
-    let covered = |xs: &std::ops::RangeInclusive<f64>, ys: &std::ops::RangeInclusive<f64>| {
-        points
-            .iter()
-            .filter(|q| xs.contains(&q.0) && ys.contains(&q.1))
-            .count()
-    };
-    corners
-        .into_iter()
-        .min_by_key(|(_, xs, ys)| covered(xs, ys))
-        .map_or(SeriesLabelPosition::UpperRight, |c| c.0)
 }
 
 #[cfg(test)]
@@ -450,6 +444,7 @@ mod tests {
                     log,
                     g_axis,
                     legend: false,
+                    spec: None,
                 },
             )
         })
@@ -486,6 +481,33 @@ mod tests {
         // Without it, no labels on the right.
         let svg = panel_svg(vec![(0.0, 0.0), (1.0, 98.0)], false, false);
         assert!(labels_in(&svg, 345.0..400.0, 0.0..250.0).is_empty());
+    }
+
+    #[test]
+    fn each_axis_labels_its_ticks_in_one_format() {
+        use super::ticks::tests::one_format;
+        // A deformation from 0 to -3 µm against time from -0.08 ms: one by one, the labels
+        // read -500µ next to -0.001 and 0.1 next to 0.15.
+        let svg = panel_svg(
+            (0..=50)
+                .map(|k| {
+                    let t = -0.08 + f64::from(k) * 0.01;
+                    (t, -3e-3 * (t.max(0.0) / 0.42).powi(2))
+                })
+                .collect(),
+            false,
+            true,
+        );
+        let left = labels_in(&svg, 0.0..68.0, 30.0..262.0);
+        let left: Vec<String> = left.into_iter().filter(|t| t != "m/s²").collect();
+        let under = labels_in(&svg, 60.0..340.0, 262.0..285.0);
+        let right = labels_in(&svg, 330.0..400.0, 30.0..262.0);
+        let right: Vec<String> = right.into_iter().filter(|t| t != "g").collect();
+        for labels in [&left, &under, &right] {
+            assert!(labels.len() >= 4 && one_format(labels), "{labels:?}");
+        }
+        assert!(left.contains(&"-1000µ".to_string()), "{left:?}");
+        assert!(under.contains(&"0.10".to_string()), "{under:?}");
     }
 
     #[test]

@@ -67,6 +67,7 @@ pub fn wall_contact(
                 log: false,
                 g_axis: false,
                 legend: j == 0,
+                spec: None,
             };
             draw_panel(&areas[j], None, &p)?;
         }

@@ -61,6 +61,7 @@ pub fn log_report(
                     filter: None,
                     rate_hz: rate,
                     mass_kg: mass.map(f64::from),
+                    force_kg: None,
                     accel_m_s2: Box::new(move |i| wave.at_sample(i).map(|c| f64::from(c) * gain)),
                 };
                 let held =

@@ -6,13 +6,11 @@
 use impact_core::consts::STANDARD_GRAVITY;
 use impact_core::spec::Spec;
 
-mod band;
-
-pub use band::{band, window, BandPoint};
+pub use crate::plot::band::{band, window, BandPoint};
 
 use crate::html;
 use crate::html::Html;
-use crate::plot::ticks::{linear_ticks, tick};
+use crate::plot::ticks::{linear_ticks, AxisFormat};
 use crate::report::fmt::human;
 
 /// The largest number of impacts drawn (each figure is a few kB; the table has them all).
@@ -156,9 +154,10 @@ pub fn svg(p: &Pulse) -> Html {
     }
     // The same range in m/s² on the right.
     let yt = linear_ticks(y_lo, y_hi, 6);
+    let format = AxisFormat::of(&yt);
     for v in &yt {
         let py = y(*v);
-        html!(s, "<line x1=\"{}\" y1=\"{:.1}\" x2=\"{}\" y2=\"{:.1}\" stroke=\"#999\"/><text x=\"{}\" y=\"{:.1}\">{}</text>", W - R, py, W - R + 4.0, py, W - R + 6.0, py + 4.0, tick(*v));
+        html!(s, "<line x1=\"{}\" y1=\"{:.1}\" x2=\"{}\" y2=\"{:.1}\" stroke=\"#999\"/><text x=\"{}\" y=\"{:.1}\">{}</text>", W - R, py, W - R + 4.0, py, W - R + 6.0, py + 4.0, format.label(*v));
     }
     html!(
         s,
