@@ -43,7 +43,8 @@ fn main() {
         .flatten()
         .filter(|c| is_commit(c));
     // The tool's own sources changed since that commit (tracked files only: the crates the
-    // tool is built from and the lock file); a commit given from outside is taken as clean.
+    // tool is built from, the firmware it links for its self-test and bench scene, and the
+    // lock file); a commit given from outside is taken as clean.
     let dirty = found.is_some()
         && given.is_none()
         && git(
@@ -54,6 +55,7 @@ fn main() {
                 "--untracked-files=no",
                 "--",
                 "../core",
+                "../firmware",
                 ".",
                 "../Cargo.toml",
                 "../Cargo.lock",
@@ -70,7 +72,16 @@ fn main() {
         return;
     }
     // Run again when a source of the tool changes, so that the mark follows the tree.
-    for source in ["../core/src", "src", "io/src", "../Cargo.lock"] {
+    for source in [
+        "../core/src",
+        "../firmware/src",
+        "../firmware/Cargo.toml",
+        "src",
+        "io/src",
+        "assets",
+        "Cargo.toml",
+        "../Cargo.lock",
+    ] {
         println!("cargo:rerun-if-changed={source}");
     }
     // Built again when HEAD moves: HEAD, the branch it names, the packed refs, and HEAD's log

@@ -86,13 +86,18 @@ fn a_pulse_split_over_axes_gives_each_its_share() {
 /// A 50 g, 6 ms half-sine along z (on 1 g of gravity) with `cross` of it along x and noise
 /// on y, at 50 kS/s: the CSV's path.
 fn shock_with_cross_axis(scratch: &Scratch, name: &str, cross: f64) -> String {
+    shock(scratch, name, 50.0, cross, f64::INFINITY)
+}
+
+/// As [`shock_with_cross_axis`], the pulse `peak` g, the x axis clipped flat at `rail` g.
+fn shock(scratch: &Scratch, name: &str, peak: f64, cross: f64, rail: f64) -> String {
     let rate = 50_000.0;
     let d = 0.006;
     let mut csv = String::from("time_s,x_g,y_g,z_g\n");
     for k in 0..10_000u32 {
         let t = f64::from(k) / rate - 0.05;
         let pulse = if (0.0..d).contains(&t) {
-            50.0 * (std::f64::consts::PI * t / d).sin()
+            peak * (std::f64::consts::PI * t / d).sin()
         } else {
             0.0
         };
@@ -103,7 +108,7 @@ fn shock_with_cross_axis(scratch: &Scratch, name: &str, cross: f64) -> String {
         csv.push_str(&format!(
             "{:.6},{:.5},{:.5},{:.5}\n",
             t + 0.05,
-            cross * pulse + noise(1),
+            (cross * pulse + noise(1)).min(rail),
             noise(2),
             1.0 + pulse + noise(3)
         ));
@@ -171,6 +176,22 @@ fn a_cross_axis_beyond_the_transverse_limit_fails_the_pulse() {
     let (code, _, err) = run(&low, &["--main-axis", "w_g"]);
     assert_ne!(code, 0);
     assert!(err.contains("--main-axis w_g: not one of --axes"), "{err}");
+    // A cross axis clipped within the limit (flat at 8 g, 16 % of 50 g): a pulse that met
+    // its band is not judged (its cross axis may lie beyond); one that failed it still fails.
+    let clipped = shock(&scratch, "clipped", 50.0, 0.3, 8.0);
+    let (code, v) = json(&clipped, &[]);
+    assert_eq!((code, v.clone()), (0, Value::Null));
+    let (_, out, _) = run(&clipped, &["--json"]);
+    let j: Value = serde_json::from_str(&out).unwrap();
+    assert_eq!(
+        j["impacts"][0]["null_reasons"]["spec"],
+        "transverse-clipped"
+    );
+    let failing = shock(&scratch, "failing", 65.0, 0.3, 8.0);
+    let (code, v) = json(&failing, &[]);
+    assert_eq!(code, 3, "{v}");
+    assert_eq!(v["band_pass"], false);
+    assert!(v.get("transverse").is_none(), "{v}");
     // The limit needs a pulse to be a fraction of.
     let (code, _, err) = common::impact(&[
         "analyze",

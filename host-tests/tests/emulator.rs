@@ -1687,7 +1687,6 @@ fn board_within_one_percent(
     let impacts = v["impacts"].as_array().unwrap();
     assert_eq!(impacts.len(), truth.len(), "{what}: {out}");
     for (k, (r, t)) in impacts.iter().zip(truth).enumerate() {
-        let Some(sep) = &t.separation else { continue };
         let near = |field: &str, want: f64| {
             let got = r[field]
                 .as_f64()
@@ -1698,6 +1697,7 @@ fn board_within_one_percent(
             );
         };
         near("impact_velocity_m_s", t.approach_m_s);
+        let Some(sep) = &t.separation else { continue };
         near("cor", sep.cor);
         if kinematics {
             near("crush_time_s", t.crush_time_s.unwrap());

@@ -834,3 +834,46 @@ fn srs_alone_draws_each_impacts_spectrum() {
     let page = run(&[], "plain.html");
     assert!(!page.contains("Shock response spectra"));
 }
+
+/// A recording whose clock starts at 100 s: the pulse figure's origin is said on that clock,
+/// as the verdict's `nominal_start_s` is.
+#[test]
+fn the_pulse_figure_says_its_origin_on_the_recording_s_clock() {
+    let scratch = Scratch::new();
+    let mut csv = String::from("time_s,accel_g\n");
+    for k in 0..10_000u32 {
+        let t = f64::from(k) / 50_000.0 - 0.05;
+        let p = if (0.0..0.006).contains(&t) {
+            50.0 * (std::f64::consts::PI * t / 0.006).sin()
+        } else {
+            0.0
+        };
+        csv.push_str(&format!(
+            "{:.6},{:.5}\n",
+            100.0 + t + 0.05,
+            p + 0.001 * f64::from(k % 7)
+        ));
+    }
+    let file = scratch.text("late.csv", &csv);
+    let html = scratch.join_str("late.html");
+    let (code, _, err) = impact(&[
+        "report",
+        &file,
+        "--spec",
+        "half-sine,50g,6ms",
+        "--html",
+        &html,
+    ]);
+    assert_eq!(code, 0, "{err}");
+    let (json, _) = impact_judged(&["analyze", &file, "--spec", "half-sine,50g,6ms", "--json"]);
+    let j: serde_json::Value = serde_json::from_str(&json).unwrap();
+    let start = j["impacts"][0]["spec"]["nominal_start_s"].as_f64().unwrap();
+    assert!(start > 100.0, "{start}");
+    let page = std::fs::read_to_string(&html).unwrap();
+    assert!(
+        page.contains(&format!(
+            "time from the nominal pulse's start, t = {start:.6} s on the recording's clock"
+        )),
+        "{start}"
+    );
+}

@@ -474,3 +474,33 @@ fn a_time_base_that_makes_an_impossible_delta_v_is_named_with_the_fix() {
     assert!(err.contains("names no unit: read in seconds"), "{err}");
     assert!(!err.contains("beyond any drop"), "{err}");
 }
+
+/// A force channel without a mass is analysed per kilogram, and says so (a note and the
+/// JSON's `assumptions`); with `--mass` nothing is assumed.
+#[test]
+fn a_force_without_a_mass_is_said_to_be_per_kilogram() {
+    let file = format!(
+        "{}/data/pyfrf-impact-hammer/measurement_1.csv",
+        env!("CARGO_MANIFEST_DIR")
+    );
+    let (json, err) = impact_ok(&["analyze", &file, "--column", "force_n", "--json"]);
+    assert!(
+        err.contains("no --mass was given: it is analysed per kilogram"),
+        "{err}"
+    );
+    let j: serde_json::Value = serde_json::from_str(&json).unwrap();
+    assert!(
+        j["assumptions"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .any(|a| a.as_str().unwrap().contains("analysed per kilogram")),
+        "{json}"
+    );
+    let (json, err) = impact_ok(&[
+        "analyze", &file, "--column", "force_n", "--mass", "0.2", "--json",
+    ]);
+    let j: serde_json::Value = serde_json::from_str(&json).unwrap();
+    assert!(j.get("assumptions").is_none(), "{json}");
+    assert!(!err.contains("per kilogram"), "{err}");
+}

@@ -27,7 +27,8 @@ pub struct AxesZero {
     edge: f32,
     /// Strides a new level must hold, flat, to become the zero.
     settle_strides: u32,
-    /// The stride being accumulated (aligned with the zeros' own): Σ, min, max per axis.
+    /// The stride being accumulated (from the first sample, as the zeros' own until a free
+    /// fall restarts theirs): Σ, min, max per axis.
     sum: [i32; 3],
     min: [i16; 3],
     max: [i16; 3],
@@ -41,6 +42,23 @@ pub struct AxesZero {
     fall_samples: u32,
     /// Samples in a row of free fall so far.
     falling: u32,
+    /// Each axis's rails (counts): a stride touching one is no level.
+    rails: [(i16, i16); 3],
+    /// Whether any stride of the run varied at all (a level without noise is a stuck
+    /// sensor, not a level).
+    run_varies: bool,
+}
+
+/// What [`AxesZero`] is set with.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Settings {
+    /// The edge level, counts (the scene's): a quiet sample lies within it of the zero.
+    pub edge_counts: f32,
+    /// A new level becomes the zero after this many samples (the scene's settle time).
+    pub settle_samples: u32,
+    pub free_fall: FreeFall,
+    /// Each axis's rails, counts (`(i16::MIN, i16::MAX)`: none known).
+    pub rails: [(i16, i16); 3],
 }
 
 /// What [`AxesZero`] takes as free fall: the three axes' magnitude below `below_counts` (a
@@ -55,10 +73,15 @@ pub struct FreeFall {
 }
 
 impl AxesZero {
-    /// Axes whose quiet samples lie within `edge_counts` of their zero (the scene's edge
-    /// level in counts), a new level becoming the zero after `settle_samples` (the scene's
-    /// settle time; at least one stride). A non-finite or negative edge is taken as 0.
-    pub fn new(edge_counts: f32, settle_samples: u32, free_fall: FreeFall) -> Self {
+    /// Axes zeroed with `settings` (a new level after at least one stride; a non-finite or
+    /// negative edge or free-fall level taken as 0).
+    pub fn new(settings: Settings) -> Self {
+        let Settings {
+            edge_counts,
+            settle_samples,
+            free_fall,
+            rails,
+        } = settings;
         let finite = |v: f32| if v.is_finite() && v > 0.0 { v } else { 0.0 };
         let edge = finite(edge_counts);
         let below = finite(free_fall.below_counts);
@@ -77,7 +100,46 @@ impl AxesZero {
             fall_below_sq: below * below,
             fall_samples: free_fall.samples.max(1),
             falling: 0,
+            rails,
+            run_varies: false,
         }
+    }
+
+    /// Starts from `zero` (each axis's zero until a quiet stride is learned) rather than
+    /// the first sample: a record that begins inside a pulse ([`Self::first_quiet`]).
+    pub fn seed(&mut self, zero: [i16; 3]) {
+        self.first = Some(zero);
+        // Learned as one quiet stride: later strides are quiet only near it.
+        for (z, &v) in self.zeros.iter_mut().zip(&zero) {
+            z.restart_at(i64::from(v) * STRIDE as i64, STRIDE as i64);
+        }
+    }
+
+    /// The mean of the first stride of `samples` that is flat on every axis (each within
+    /// twice `edge_counts`, touching no rail, varying), rounded: a record's zero, found
+    /// ahead when the record is at hand.
+    pub fn first_quiet(samples: &[[i16; 3]], settings: &Settings) -> Option<[i16; 3]> {
+        samples.chunks_exact(STRIDE).find_map(|stride| {
+            let mut sum = [0i32; 3];
+            let mut min = [i16::MAX; 3];
+            let mut max = [i16::MIN; 3];
+            for s in stride {
+                for i in 0..3 {
+                    sum[i] += i32::from(s[i]);
+                    min[i] = min[i].min(s[i]);
+                    max[i] = max[i].max(s[i]);
+                }
+            }
+            let flat = (0..3).all(|i| {
+                f32::from(max[i]) - f32::from(min[i]) <= 2.0 * settings.edge_counts
+                    && min[i] > settings.rails[i].0
+                    && max[i] < settings.rails[i].1
+            });
+            let varies = (0..3).any(|i| max[i] > min[i]);
+            (flat && varies).then(|| {
+                sum.map(|v| libm::roundf(v as f32 / STRIDE as f32).clamp(-32768.0, 32767.0) as i16)
+            })
+        })
     }
 
     /// Each axis's zero, counts (its first sample until a quiet stride is learned; 0 before
@@ -142,7 +204,13 @@ impl AxesZero {
     /// a run beyond the edge level from the zeros for the settle time becomes the zeros.
     fn stride_done(&mut self, zeros: [f32; 3]) {
         let span = 2.0 * self.edge;
-        let flat = (0..3).all(|i| f32::from(self.max[i]) - f32::from(self.min[i]) <= span);
+        // Flat: within twice the edge level, at no rail (a clipped or stuck axis is no level).
+        let flat = (0..3).all(|i| {
+            f32::from(self.max[i]) - f32::from(self.min[i]) <= span
+                && self.min[i] > self.rails[i].0
+                && self.max[i] < self.rails[i].1
+        });
+        let varies = (0..3).any(|i| self.max[i] > self.min[i]);
         let mean: [f32; 3] = core::array::from_fn(|i| self.sum[i] as f32 / STRIDE as f32);
         let beyond = (0..3).any(|i| libm::fabsf(mean[i] - zeros[i]) > self.edge);
         // A body that fell and came to rest keeps free fall as its zero: its rest is the
@@ -156,15 +224,17 @@ impl AxesZero {
         let same = (0..3).all(|i| libm::fabsf(mean[i] - self.run_first[i]) <= self.edge);
         if self.run_strides > 0 && same {
             self.run_strides += 1;
+            self.run_varies |= varies;
             for i in 0..3 {
                 self.run_sum[i] += i64::from(self.sum[i]);
             }
         } else {
             self.run_strides = 1;
+            self.run_varies = varies;
             self.run_first = mean;
             self.run_sum = self.sum.map(i64::from);
         }
-        if self.run_strides >= self.settle_strides {
+        if self.run_strides >= self.settle_strides && self.run_varies {
             let n = i64::from(self.run_strides) * STRIDE as i64;
             // The newest strides only, as many as a zero holds.
             let keep = n.min((ZERO_STRIDES * STRIDE) as i64);
@@ -182,11 +252,20 @@ mod tests {
     extern crate std;
     use super::*;
 
-    /// 1 g is 100 counts: free fall below 25 for 50 samples.
+    /// 1 g is 100 counts: free fall below 25 for 50 samples; no rails.
     const FALL: FreeFall = FreeFall {
         below_counts: 25.0,
         samples: 50,
     };
+
+    fn zeroed(edge_counts: f32, settle_samples: u32) -> AxesZero {
+        AxesZero::new(Settings {
+            edge_counts,
+            settle_samples,
+            free_fall: FALL,
+            rails: [(i16::MIN, i16::MAX); 3],
+        })
+    }
 
     /// Noise of about ±`amp` counts (deterministic).
     fn noise(k: u32, axis: u32, amp: f32) -> f32 {
@@ -197,7 +276,7 @@ mod tests {
     /// A half-sine of `peak` counts along `dir` (a unit vector), 600 samples long from sample
     /// 2 000, on `rest` counts per axis, with ±2 counts of noise: the largest output.
     fn peak_of(rest: [f32; 3], dir: [f32; 3], peak: f32) -> i16 {
-        let mut z = AxesZero::new(10.0, 5_000, FALL);
+        let mut z = zeroed(10.0, 5_000);
         let mut best = 0;
         for k in 0..4_000u32 {
             let t = k as f32 - 2_000.0;
@@ -230,7 +309,7 @@ mod tests {
 
     #[test]
     fn a_level_held_for_the_settle_time_becomes_the_zero_and_a_pulse_does_not() {
-        let mut z = AxesZero::new(10.0, 2_000, FALL);
+        let mut z = zeroed(10.0, 2_000);
         // At rest on z (100 counts), then in free fall (0 on every axis) for 4 000 samples.
         for k in 0..3_000u32 {
             z.push([0, 0, 100 + (k % 3) as i16 - 1]);
@@ -253,7 +332,7 @@ mod tests {
 
     #[test]
     fn a_tumbling_body_reads_zero_in_flight_and_its_rest_after_the_fall_is_g() {
-        let mut z = AxesZero::new(5.0, 2_000, FALL);
+        let mut z = zeroed(5.0, 2_000);
         let run = |z: &mut AxesZero, n: u32, s: &dyn Fn(u32) -> [i16; 3]| {
             (0..n).map(|k| z.push(s(k))).collect::<std::vec::Vec<i16>>()
         };
@@ -281,7 +360,7 @@ mod tests {
 
     #[test]
     fn a_recorder_turned_onto_another_face_at_rest_is_zeroed_there() {
-        let mut z = AxesZero::new(5.0, 2_000, FALL);
+        let mut z = zeroed(5.0, 2_000);
         for k in 0..3_000u32 {
             z.push([0, 0, 100 + (k % 3) as i16 - 1]);
         }
@@ -294,15 +373,67 @@ mod tests {
     }
 
     #[test]
+    fn an_axis_stuck_at_its_rail_or_without_noise_is_no_new_zero() {
+        let rails = [(-1_000, 1_000); 3];
+        for (stuck, what) in [(1_000, "at its rail"), (400, "without noise")] {
+            let mut z = AxesZero::new(Settings {
+                edge_counts: 5.0,
+                settle_samples: 500,
+                free_fall: FALL,
+                rails,
+            });
+            for k in 0..3_000u32 {
+                z.push([0, 0, 100 + (k % 3) as i16 - 1]);
+            }
+            let mut last = 0;
+            for _ in 0..5_000 {
+                last = z.push([stuck, 0, 100]);
+            }
+            assert_eq!(last, stuck, "{what}: {:?}", z.zeros());
+        }
+    }
+
+    #[test]
+    fn a_record_that_starts_inside_a_pulse_is_zeroed_from_its_first_quiet_stride() {
+        // 600 samples of a decaying pulse on x, then rest on z.
+        let samples: std::vec::Vec<[i16; 3]> = (0..3_000u32)
+            .map(|k| {
+                let p = if k < 600 {
+                    libm::roundf(1_000.0 * libm::cosf(core::f32::consts::PI * k as f32 / 1_200.0))
+                        as i16
+                } else {
+                    0
+                };
+                [p, 0, 100 + (k % 3) as i16 - 1]
+            })
+            .collect();
+        let settings = Settings {
+            edge_counts: 5.0,
+            settle_samples: 500,
+            free_fall: FALL,
+            rails: [(i16::MIN, i16::MAX); 3],
+        };
+        let zero = AxesZero::first_quiet(&samples, &settings).unwrap();
+        assert_eq!(zero, [0, 0, 100]);
+        let mut z = AxesZero::new(settings);
+        z.seed(zero);
+        let out: std::vec::Vec<i16> = samples.iter().map(|&s| z.push(s)).collect();
+        // The pulse from its first sample, then the rest at 0: no step, no plateau.
+        assert!((i32::from(out[0]) - 1_000).abs() <= 2, "{}", out[0]);
+        assert!(out[700..].iter().all(|&v| v <= 2));
+    }
+
+    #[test]
     fn any_input_gives_a_count_and_no_panic() {
-        let mut z = AxesZero::new(
-            f32::NAN,
-            0,
-            FreeFall {
+        let mut z = AxesZero::new(Settings {
+            edge_counts: f32::NAN,
+            settle_samples: 0,
+            free_fall: FreeFall {
                 below_counts: f32::NAN,
                 samples: 0,
             },
-        );
+            rails: [(0, 0); 3],
+        });
         for s in [
             [i16::MIN; 3],
             [i16::MAX; 3],
@@ -314,13 +445,30 @@ mod tests {
                 assert!(z.push(s) >= 0);
             }
         }
-        let mut z = AxesZero::new(
-            f32::INFINITY,
-            u32::MAX,
-            FreeFall {
+        let mut z = AxesZero::new(Settings {
+            edge_counts: f32::INFINITY,
+            settle_samples: u32::MAX,
+            free_fall: FreeFall {
                 below_counts: f32::INFINITY,
                 samples: u32::MAX,
             },
+            rails: [(i16::MAX, i16::MIN); 3],
+        });
+        let stuck = [[7i16; 3]; 128];
+        assert_eq!(
+            AxesZero::first_quiet(
+                &stuck,
+                &Settings {
+                    edge_counts: f32::NAN,
+                    settle_samples: 0,
+                    free_fall: FreeFall {
+                        below_counts: 0.0,
+                        samples: 0
+                    },
+                    rails: [(i16::MIN, i16::MAX); 3],
+                }
+            ),
+            None
         );
         assert_eq!(z.push([i16::MIN; 3]), 0);
         assert_eq!(z.push([i16::MAX; 3]), i16::MAX);

@@ -56,9 +56,14 @@ impl Direction {
             Direction::Fixed(d) => Some(d.clone()),
             Direction::Name(re) => {
                 let name = file.file_name()?.to_string_lossy();
-                let c = re.captures(&name)?;
-                let m = c.get(1).or_else(|| c.get(0))?;
-                (!m.as_str().is_empty()).then(|| m.as_str().to_string())
+                // The first group where the pattern has one (a group that did not take part
+                // gives none, not the whole match), else the whole match; the first match
+                // that is not empty.
+                let grouped = re.captures_len() > 1;
+                re.captures_iter(&name).find_map(|c| {
+                    let m = if grouped { c.get(1) } else { c.get(0) }?;
+                    (!m.as_str().is_empty()).then(|| m.as_str().to_string())
+                })
             }
         }
     }
@@ -96,6 +101,15 @@ mod tests {
             Some("x_g")
         );
         assert_eq!(parse("channel").unwrap().of(Path::new("a.csv"), ""), None);
+        // An optional group that did not take part is no direction; an empty match hides
+        // no later one.
+        let optional = parse("name:shock_([+-][XYZ])?").unwrap();
+        assert_eq!(optional.of(Path::new("shock_3.csv"), ""), None);
+        let empty_first = parse("name:[+-]?[XYZ]?").unwrap();
+        assert_eq!(
+            empty_first.of(Path::new("shock_+Z.csv"), "").as_deref(),
+            Some("+Z")
+        );
         assert!(matches!(
             parse("name:("),
             Err(DirectionError::Pattern { .. })

@@ -422,6 +422,8 @@ pub fn emulate(args: &EmulateArgs) -> Result<crate::report::spec::Judged, Emulat
         json.waveforms = log.waveforms.iter().map(|w| w.json()).collect();
     }
     let mut out = crate::output::stdout();
+    // The verdicts as the output shows them (with --axes, the transverse check's too).
+    let judged = crate::report::spec::Judged::impacts(&json.impacts);
     let text = if a.json {
         serde_json::to_string_pretty(&json)? + "\n"
     } else if a.csv {
@@ -453,7 +455,7 @@ pub fn emulate(args: &EmulateArgs) -> Result<crate::report::spec::Judged, Emulat
         signal.title = format!("{name} on the emulated board, {}", signal.title);
         crate::plot::impacts(&signal, setup.scene.spec.as_ref(), &log.impacts, path)?;
     }
-    Ok(crate::report::spec::Judged::reports(&log.impacts))
+    Ok(judged)
 }
 
 /// `n` little-endian i16 counts from index `from` of the file at `path`.

@@ -355,6 +355,7 @@ fn report(args: &LogArgs, reader: LogReader, name: &str) -> Result<Judged, LogCo
                 rate_hz: rate,
                 mass_kg: mass.map(f64::from),
                 force_kg: None,
+                t0_s: 0.0,
                 accel_m_s2: Box::new(move |i| {
                     waves
                         .iter()

@@ -194,7 +194,8 @@ impl TransverseCheck {
 
     /// Adds the transverse check of `axes` to the impact's verdict against a nominal peak
     /// `nominal_m_s2`: a cross axis beyond the limit fails it; a clipped one within it makes
-    /// it unknown (null, reason `transverse-clipped`).
+    /// a passing verdict unknown (null, reason `transverse-clipped`) and leaves a failing one
+    /// failed (`null_reasons["spec.transverse"]`).
     pub fn judge(&self, j: &mut crate::report::ImpactJson, axes: &AxesJson, nominal_m_s2: f64) {
         let Some(Some(v)) = &mut j.spec else { return };
         match crate::report::axes::transverse(axes, nominal_m_s2, self.limit_fraction, self.main) {
@@ -202,9 +203,15 @@ impl TransverseCheck {
                 v.pass &= t.pass;
                 v.transverse = Some(t);
             }
-            Err(why) => {
+            // A pulse that failed its band or Δv fails whatever the cross axes; one that
+            // passed them is not judged.
+            Err(why) if v.pass => {
                 j.spec = Some(None);
                 j.null_reasons.insert("spec".into(), why.reason().into());
+            }
+            Err(why) => {
+                j.null_reasons
+                    .insert("spec.transverse".into(), why.reason().into());
             }
         }
     }
@@ -212,32 +219,46 @@ impl TransverseCheck {
 
 /// The counts the stream analyses with `--axes`: each axis in counts of `gain_m_s2_per_count`
 /// (a third axis of zeros for two), zeroed each on its own and their magnitude taken
-/// ([`impact_core::signal::axes_zero::AxesZero`]) with the scene's edge level and settle time.
+/// ([`impact_core::signal::axes_zero::AxesZero`]) with the scene's edge level and settle time
+/// and each axis's rails, from the record's first quiet stride (found ahead: a record that
+/// starts inside a pulse is not zeroed there).
 pub fn zeroed_counts(
     axes: &[Axis],
     scene: &impact_core::Scene,
     gain_m_s2_per_count: f64,
     to_count: impl Fn(f64, f64) -> i16,
 ) -> Vec<i16> {
+    use impact_core::signal::axes_zero::{AxesZero, Settings};
     let rate = f64::from(scene.calibration.sample_rate_hz);
-    let edge_counts = (f64::from(scene.edge_m_s2) / gain_m_s2_per_count) as f32;
-    let settle = (f64::from(scene.settle_s) * rate).clamp(0.0, f64::from(u32::MAX)) as u32;
-    let mut zero = impact_core::signal::axes_zero::AxesZero::new(
-        edge_counts,
-        settle,
-        free_fall(f64::from(scene.gravity_m_s2), gain_m_s2_per_count, rate),
-    );
     let n = axes.iter().map(|a| a.accel_m_s2.len()).max().unwrap_or(0);
-    (0..n)
+    let samples: Vec<[i16; 3]> = (0..n)
         .map(|i| {
-            let c = |k: usize| {
+            std::array::from_fn(|k| {
                 axes.get(k)
                     .and_then(|a| a.accel_m_s2.get(i))
                     .map_or(0, |&v| to_count(v, gain_m_s2_per_count))
-            };
-            zero.push([c(0), c(1), c(2)])
+            })
         })
-        .collect()
+        .collect();
+    let rails = std::array::from_fn(|k| {
+        let rail = |v: Option<f64>, none: i16| v.map_or(none, |v| to_count(v, gain_m_s2_per_count));
+        axes.get(k)
+            .and_then(|a| a.rails.as_ref())
+            .map_or((i16::MIN, i16::MAX), |r| {
+                (rail(r.low_m_s2, i16::MIN), rail(r.high_m_s2, i16::MAX))
+            })
+    });
+    let settings = Settings {
+        edge_counts: (f64::from(scene.edge_m_s2) / gain_m_s2_per_count) as f32,
+        settle_samples: (f64::from(scene.settle_s) * rate).clamp(0.0, f64::from(u32::MAX)) as u32,
+        free_fall: free_fall(f64::from(scene.gravity_m_s2), gain_m_s2_per_count, rate),
+        rails,
+    };
+    let mut zero = AxesZero::new(settings);
+    if let Some(first) = AxesZero::first_quiet(&samples, &settings) {
+        zero.seed(first);
+    }
+    samples.into_iter().map(|s| zero.push(s)).collect()
 }
 
 /// Free fall for three axes: their magnitude below a quarter of g for 10 ms (at least 8

@@ -657,6 +657,7 @@ impl Setup {
                 .map(|f| (f, u64::from(self.scene.padding_samples()))),
             rate_hz: f64::from(self.scene.calibration.sample_rate_hz),
             mass_kg: self.scene.mass_kg.map(f64::from),
+            t0_s: self.prepared.t0,
             force_kg,
             accel_m_s2: Box::new(move |i| {
                 let gain = f64::from(self.scene.calibration.gain_m_s2_per_count);
@@ -737,7 +738,7 @@ pub fn setup_of(args: &AnalyzeArgs, ch: Samples<'_>) -> Result<Setup, PipelineEr
     let (mass, scale, units, first_assumed) = mass_and_scale(args, &file, column)?;
     // Every axis in the first one's units (one scale takes them all to m/s²): axes whose
     // headers name other units are refused, not read 9.8× off.
-    let mut assumed: Vec<Assumption> = first_assumed.into_iter().collect();
+    let mut assumed: Vec<Assumption> = first_assumed;
     for (name, _) in ch.axes.iter().skip(1) {
         let (_, _, u, axis_assumed) = mass_and_scale(args, &file, name)?;
         if u != units {
@@ -748,7 +749,12 @@ pub fn setup_of(args: &AnalyzeArgs, ch: Samples<'_>) -> Result<Setup, PipelineEr
                 other_units: u.name(),
             });
         }
-        assumed.extend(axis_assumed);
+        // (Each assumption once: every axis is in the first one's units.)
+        for a in axis_assumed {
+            if !assumed.contains(&a) {
+                assumed.push(a);
+            }
+        }
     }
     let mut accel: Vec<f64> = ch.values.iter().map(|v| v * scale).collect();
     let full_scale = full_scale_m_s2(args, &file, mass);
@@ -777,13 +783,15 @@ pub fn setup_of(args: &AnalyzeArgs, ch: Samples<'_>) -> Result<Setup, PipelineEr
     let levels = if axes.is_empty() {
         survey::levels(&survey, full_scale, trigger, edge, vertical(args, &file))?
     } else {
+        let fs = full_scale.map(|fs| fs * (axes.len() as f64).sqrt());
+        let levels = survey::levels(&survey, fs, trigger, edge, vertical(args, &file))?;
         // The zeroed magnitude |f − f₀| reaches |f| + |f₀|: counts for twice the resultant's
-        // range (the sensor's, or the largest reading).
-        let fs = 2.0 * full_scale.map_or(survey.peak_m_s2(), |fs| fs * (axes.len() as f64).sqrt());
-        let fs = Some(fs);
+        // range (the sensor's, or the largest reading; checked as such above).
+        let range = fs.unwrap_or_else(|| survey.peak_m_s2());
         survey::Levels {
             clipping: None,
-            ..survey::levels(&survey, fs, trigger, edge, vertical(args, &file))?
+            gain_m_s2_per_count: impact_io::quantise::gain_for(2.0 * range),
+            ..levels
         }
     };
     let clipping = levels.clipping.clone();
@@ -861,10 +869,17 @@ pub fn mass_and_scale(
     args: &AnalyzeArgs,
     file: &SceneFile,
     column: &str,
-) -> Result<(Option<f64>, f64, Units, Option<Assumption>), PipelineError> {
+) -> Result<(Option<f64>, f64, Units, Vec<Assumption>), PipelineError> {
     let mass = args.mass.or(file.mass);
     let units = Units::resolve(args.units.or(file.units), column).map_err(UnitsFailure)?;
-    let assumed = assumed_units(args, file, column).map(Assumption::noted);
+    let mut assumed: Vec<Assumption> = assumed_units(args, file, column)
+        .map(Assumption::noted)
+        .into_iter()
+        .collect();
+    // A force is an acceleration only over a mass: without one, per kilogram, said.
+    if units == Units::N && mass.is_none() {
+        assumed.push(Assumption::ForcePerKilogram.noted());
+    }
     let invert = args.invert || file.invert.unwrap_or(false);
     let scale = units.to_m_s2(mass) * args.gain.unwrap_or(1.0) * if invert { -1.0 } else { 1.0 };
     Ok((mass, scale, units, assumed))
@@ -881,6 +896,9 @@ pub enum Assumption {
     FreeFallTimeUnit { file: String, column: String },
     /// `--free-fall`'s file (`file`): a column (`column`) that names no unit read as g.
     FreeFallUnits { file: String, column: String },
+    /// A force channel (N) without a mass: analysed per kilogram (its "accelerations" are
+    /// the force over 1 kg).
+    ForcePerKilogram,
 }
 
 impl Assumption {
@@ -900,6 +918,7 @@ impl Assumption {
             Assumption::FreeFallUnits { file, column } => {
                 format!("--free-fall {file}: {column} names no unit: read as g")
             }
+            Assumption::ForcePerKilogram => "the channel is a force (N) and no --mass was given: it is analysed per kilogram, its accelerations and Δv those of a 1 kg body (give --mass for the body's own)".to_string(),
         }
     }
 

@@ -15,6 +15,9 @@ pub struct Signal<'a> {
     /// A force channel (`--units n`, a `force_n` column): the mass its values in N were
     /// divided by into m/s² (the body's, else 1 kg), by which the figure draws them in N.
     pub force_kg: Option<f64>,
+    /// The recording's time of stream sample 0, s (a board's log: 0), for times said on the
+    /// recording's clock.
+    pub t0_s: f64,
     /// Acceleration of stream sample `i`, m/s² (`None` where it is not known).
     pub accel_m_s2: Box<dyn Fn(u64) -> Option<f64> + 'a>,
     /// The figure's title: what was drawn (file, channel, filter).

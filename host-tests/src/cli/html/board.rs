@@ -62,6 +62,7 @@ pub fn log_report(
                     rate_hz: rate,
                     mass_kg: mass.map(f64::from),
                     force_kg: None,
+                    t0_s: 0.0,
                     accel_m_s2: Box::new(move |i| wave.at_sample(i).map(|c| f64::from(c) * gain)),
                 };
                 let held =

@@ -30,6 +30,8 @@ pub struct Pulse<'a> {
     pub spec: Option<(&'a Spec, f64)>,
     /// The verdict's worst point, drawn as a circle.
     pub worst: Option<Worst>,
+    /// The recording's time of stream time 0, s: the axis's origin said on its clock.
+    pub t0_s: f64,
 }
 
 /// A verdict's worst point: its time (s from the stream's start), its acceleration above the
@@ -177,7 +179,7 @@ pub fn svg(p: &Pulse) -> Html {
         } else {
             "time from"
         },
-        origin
+        p.t0_s + origin
     );
     html!(s, "<text transform=\"translate(14 {}) rotate(-90)\" text-anchor=\"middle\">acceleration (g)</text>", (T + H - B) / 2.0);
     html!(s, "<text transform=\"translate({} {}) rotate(90)\" text-anchor=\"middle\">acceleration (m/s²)</text>", W - 12.0, (T + H - B) / 2.0);
@@ -400,6 +402,7 @@ pub fn pulse_svg(
         filtered,
         spec: placed,
         worst,
+        t0_s: signal.t0_s,
     })
 }
 
@@ -431,6 +434,7 @@ mod tests {
             filtered: None,
             spec: None,
             worst: None,
+            t0_s: 0.0,
         });
         for want in [
             ">acceleration (g)</text>",
