@@ -68,7 +68,7 @@ normalise() {
     -e 's/^\[[0-9.:, ]+\]/[T]/' \
     -e 's/^[0-9]+\.[0-9]+ (TRACE|DEBUG|INFO|WARN|ERROR) /T \1 /' \
     -e 's/(busy )[0-9.]+ %/\1T %/g' \
-    -e 's/(git commit )([0-9a-f]{40}|unknown)/\1COMMIT/g' \
+    -e 's/(git commit )([0-9a-f]{40}|unknown)( with changes not committed \(a development build: not for a signed report\))?/\1COMMIT/g' \
     -e 's/(board.s session<\/td><td class="l">[^<]*<\/td><td>[0-9]+<\/td><td class="l hash">)[0-9a-f]{64}/\1HASH/' \
     -e 's/(stack )[0-9]+( of [0-9]+ B \()[0-9]+( %\))/\1T\2T\3/g' \
     -e '/^building the QEMU firmware/d' \

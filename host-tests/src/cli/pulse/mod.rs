@@ -32,6 +32,9 @@ pub struct Pulse<'a> {
     pub worst: Option<Worst>,
     /// The recording's time of stream time 0, s: the axis's origin said on its clock.
     pub t0_s: f64,
+    /// A force channel: the mass its values in N were divided by (the figure draws N, with
+    /// no g axis); none for an acceleration.
+    pub force_kg: Option<f64>,
 }
 
 /// A verdict's worst point: its time (s from the stream's start), its acceleration above the
@@ -148,14 +151,21 @@ pub fn svg(p: &Pulse) -> Html {
         let px = x(origin + v * 1e-3);
         html!(s, "<line x1=\"{:.1}\" y1=\"{}\" x2=\"{:.1}\" y2=\"{}\" stroke=\"#eee\"/><text x=\"{:.1}\" y=\"{}\" text-anchor=\"middle\">{}</text>", px, T, px, H - B, px, H - B + 14.0, label(*v, xstep));
     }
-    let yt = linear_ticks(y_lo / g, y_hi / g, 6);
+    // The left axis in g (a force channel: in N, the values times the mass they were
+    // divided by).
+    let per = p.force_kg.map_or(1.0 / g, |m| m);
+    let yt = linear_ticks(y_lo * per, y_hi * per, 6);
     let ystep = yt.get(1).zip(yt.first()).map_or(1.0, |(b, a)| b - a);
     for v in &yt {
-        let py = y(v * g);
+        let py = y(v / per);
         html!(s, "<line x1=\"{}\" y1=\"{:.1}\" x2=\"{}\" y2=\"{:.1}\" stroke=\"#eee\"/><text x=\"{}\" y=\"{:.1}\" text-anchor=\"end\">{}</text>", L, py, W - R, py, L - 4.0, py + 4.0, label(*v, ystep));
     }
-    // The same range in m/s² on the right.
-    let yt = linear_ticks(y_lo, y_hi, 6);
+    // The same range in m/s² on the right (none for a force).
+    let yt = if p.force_kg.is_some() {
+        Vec::new()
+    } else {
+        linear_ticks(y_lo, y_hi, 6)
+    };
     let format = AxisFormat::of(&yt);
     for v in &yt {
         let py = y(*v);
@@ -181,8 +191,12 @@ pub fn svg(p: &Pulse) -> Html {
         },
         p.t0_s + origin
     );
-    html!(s, "<text transform=\"translate(14 {}) rotate(-90)\" text-anchor=\"middle\">acceleration (g)</text>", (T + H - B) / 2.0);
-    html!(s, "<text transform=\"translate({} {}) rotate(90)\" text-anchor=\"middle\">acceleration (m/s²)</text>", W - 12.0, (T + H - B) / 2.0);
+    if p.force_kg.is_some() {
+        html!(s, "<text transform=\"translate(14 {}) rotate(-90)\" text-anchor=\"middle\">force (N)</text>", (T + H - B) / 2.0);
+    } else {
+        html!(s, "<text transform=\"translate(14 {}) rotate(-90)\" text-anchor=\"middle\">acceleration (g)</text>", (T + H - B) / 2.0);
+        html!(s, "<text transform=\"translate({} {}) rotate(90)\" text-anchor=\"middle\">acceleration (m/s²)</text>", W - 12.0, (T + H - B) / 2.0);
+    }
     // The band (shaded between its limits) and the nominal pulse (dashed).
     if !band.is_empty() {
         let mut d = Html::new();
@@ -365,7 +379,11 @@ pub fn pulse_svg(
             .collect()
     };
     let raw = columns(&|i| Some((signal.accel_m_s2)(i)? - base));
-    let g = |a: f32| human(f64::from(a) / STANDARD_GRAVITY, "g");
+    // The peaks in g, or a force channel's in N.
+    let g = |a: f32| match signal.force_kg {
+        Some(m) => human(f64::from(a) * m, "N"),
+        None => human(f64::from(a) / STANDARD_GRAVITY, "g"),
+    };
     let mut peak = format!("peak {}", g(r.peak_acceleration_m_s2));
     let mut filtered = None;
     if let Some((kind, _)) = signal.filter {
@@ -403,6 +421,7 @@ pub fn pulse_svg(
         spec: placed,
         worst,
         t0_s: signal.t0_s,
+        force_kg: signal.force_kg,
     })
 }
 
@@ -423,6 +442,24 @@ mod tests {
     }
 
     #[test]
+    fn a_force_is_drawn_in_newtons_with_no_g_axis() {
+        // 70 m/s² of a force divided by 0.5 kg: 35 N.
+        let s = svg(&Pulse {
+            title: "hammer".into(),
+            columns: (0..100).map(|k| (f64::from(k) * 1e-5, 0.0, 70.0)).collect(),
+            filtered: None,
+            spec: None,
+            worst: None,
+            t0_s: 0.0,
+            force_kg: Some(0.5),
+        })
+        .into_string();
+        assert!(s.contains(">force (N)</text>"), "{s}");
+        assert!(!s.contains("acceleration"), "{s}");
+        assert!(s.contains(">30</text>") && !s.contains(">70</text>"), "{s}");
+    }
+
+    #[test]
     fn the_pulse_is_in_g_with_m_s2_on_the_right() {
         // A 10 g step: g ticks 0–10 on the left, m/s² 0–100 on the right.
         let g = STANDARD_GRAVITY;
@@ -435,6 +472,7 @@ mod tests {
             spec: None,
             worst: None,
             t0_s: 0.0,
+            force_kg: None,
         });
         for want in [
             ">acceleration (g)</text>",
