@@ -574,7 +574,7 @@ fn a_plot_draws_no_velocity_the_report_refuses() {
     ]);
     let text = std::fs::read_to_string(&svg).unwrap_or_else(|e| panic!("{e}: {err}"));
     assert!(
-        text.contains("no Δv (see the report): no velocity or deformation"),
+        text.contains("Δv unknown: no velocity or deformation"),
         "{err}"
     );
     assert!(!text.contains("velocity change from touch"));

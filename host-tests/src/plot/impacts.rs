@@ -413,11 +413,7 @@ fn kinematics_panels<'a>(
     // drawn.
     if refused {
         return vec![Panel {
-            title: format!(
-                "{}; no Δv (see the report): no velocity or deformation",
-                decel.title
-            )
-            .into(),
+            title: format!("{}; Δv unknown: no velocity or deformation", decel.title).into(),
             ..decel
         }];
     }

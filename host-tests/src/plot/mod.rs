@@ -280,9 +280,14 @@ pub(crate) fn draw_panel(
             AxisFormat::linear(y0 / g, y1 / g),
         )
     };
+    // The caption within the panel: a long one (an impact whose Δv was refused says why) in
+    // a smaller type. DejaVu Sans sets some 0.55 em a character, and the SVG backend draws a
+    // size at about 0.8 of its pixels.
+    let chars = caption.chars().count().max(1) as f64;
+    let size = (f64::from(w) / (0.55 * 0.8 * chars)).clamp(9.0, 15.0);
     let mut builder = ChartBuilder::on(area);
     builder
-        .caption(caption, ("sans-serif", 15))
+        .caption(caption, ("sans-serif", size))
         .margin(8)
         .x_label_area_size(30)
         .y_label_area_size(60)
