@@ -173,6 +173,25 @@ fn a_cross_axis_beyond_the_transverse_limit_fails_the_pulse() {
     assert_eq!(code, 3);
     assert_eq!(v["transverse"]["main_axis"], "x_g");
     assert_eq!(v["transverse"]["main_axis_from"], "main-axis");
+    // The main axis by its header where --axes gives indices.
+    let (code, out, err) = common::impact(&[
+        "analyze",
+        &low,
+        "--axes",
+        "1,2,3",
+        "--spec",
+        "half-sine,50g,6ms",
+        "--main-axis",
+        "z_g",
+        "--json",
+    ]);
+    assert_eq!(code, 0, "{err}");
+    let j: Value = serde_json::from_str(&out).unwrap();
+    assert_eq!(j["impacts"][0]["spec"]["transverse"]["main_axis"], "z_g");
+    assert_eq!(
+        j["impacts"][0]["spec"]["transverse"]["main_axis_from"],
+        "main-axis"
+    );
     let (code, _, err) = run(&low, &["--main-axis", "w_g"]);
     assert_ne!(code, 0);
     assert!(err.contains("--main-axis w_g: not one of --axes"), "{err}");

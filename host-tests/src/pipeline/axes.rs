@@ -6,6 +6,7 @@
 
 use impact_core::report::AC_COUPLED_RATIO;
 use impact_core::ImpactReport;
+use impact_io::channel::ColumnRef;
 
 use crate::pipeline::{screen, PipelineError};
 use crate::report::axes::{AxesJson, AxisJson};
@@ -168,23 +169,36 @@ pub const TRANSVERSE_LIMIT: f64 = 0.3;
 
 impl TransverseCheck {
     /// The check `args` ask for: none without both `--axes` and `--spec`.
-    pub fn of(args: &crate::pipeline::AnalyzeArgs) -> Result<Option<Self>, PipelineError> {
+    /// `names` are the axes' header names, in `--axes`' order: `--main-axis` is one of
+    /// `--axes` as written there, or an axis's header name (`--axes 1,2,3 --main-axis z_g`).
+    pub fn of(
+        args: &crate::pipeline::AnalyzeArgs,
+        names: &[&str],
+    ) -> Result<Option<Self>, PipelineError> {
         if args.axes.is_empty() || args.spec.is_none() {
             return Ok(None);
         }
+        let named = |m: &ColumnRef| match m {
+            ColumnRef::Name(n) => names.iter().position(|a| a == n),
+            ColumnRef::Index(_) => None,
+        };
         let main = match &args.main_axis {
             None => None,
-            Some(m) => Some(args.axes.iter().position(|a| a == m).ok_or_else(|| {
-                PipelineError::MainAxis {
-                    given: m.to_string(),
-                    axes: args
-                        .axes
-                        .iter()
-                        .map(ToString::to_string)
-                        .collect::<Vec<_>>()
-                        .join(","),
-                }
-            })?),
+            Some(m) => Some(
+                args.axes
+                    .iter()
+                    .position(|a| a == m)
+                    .or_else(|| named(m))
+                    .ok_or_else(|| PipelineError::MainAxis {
+                        given: m.to_string(),
+                        axes: args
+                            .axes
+                            .iter()
+                            .map(ToString::to_string)
+                            .collect::<Vec<_>>()
+                            .join(","),
+                    })?,
+            ),
         };
         Ok(Some(Self {
             limit_fraction: args.transverse_limit.unwrap_or(TRANSVERSE_LIMIT),

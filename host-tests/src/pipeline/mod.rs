@@ -841,7 +841,8 @@ pub fn setup_of(args: &AnalyzeArgs, ch: Samples<'_>) -> Result<Setup, PipelineEr
     setup.clipping = clipping;
     setup.resampled = ch.resampled;
     setup.axes = axes;
-    setup.transverse = crate::pipeline::axes::TransverseCheck::of(args)?;
+    let names: Vec<&str> = setup.axes.iter().map(|a| a.name.as_str()).collect();
+    setup.transverse = crate::pipeline::axes::TransverseCheck::of(args, &names)?;
     if let Some(spec) = &args.free_fall {
         // First pass without v0 to find the first impact, then the free fall before it.
         let first = run(&setup.prepared.counts, &setup.scene, setup.capture_len)?;

@@ -89,9 +89,10 @@ pub struct AnalyzeArgs {
     pub axes: Vec<ColumnRef>,
     /// With `--axes` and `--spec`: the intended shock direction's axis, one of `--axes`.
     ///
-    /// With `--axes` and `--spec`: the intended shock direction's axis, as `--axes` names it;
-    /// the others are cross axes, checked against `--transverse-limit` [default: in each
-    /// impact the axis with the largest peak, which the verdict says].
+    /// With `--axes` and `--spec`: the intended shock direction's axis, as `--axes` names it
+    /// or by its header name; the others are cross axes, checked against
+    /// `--transverse-limit` [default: in each impact the axis with the largest peak, which
+    /// the verdict says].
     #[arg(long, help_heading = "Analysis", value_name = "AXIS", requires_all = ["axes", "spec"])]
     pub main_axis: Option<ColumnRef>,
     /// With `--axes` and `--spec`: a cross axis's peak limit, over the nominal peak [default: 0.3].
