@@ -570,7 +570,7 @@ pub fn to_table(entries: &[EntryJson]) -> String {
 fn direction_section(g: &DirectionGroup) -> String {
     let mut s = format!(
         "\ndirection {}: {} recording{}, {} impact{}{}\n",
-        g.direction.as_deref().unwrap_or("none found"),
+        g.shown(),
         g.recordings,
         if g.recordings == 1 { "" } else { "s" },
         g.summary.impacts,

@@ -290,7 +290,8 @@ pub fn free_fall(
 
 /// Removes the spikes found on the resultant (`removals`) from an axis: each spike's samples
 /// replaced by the straight line between the axis's own neighbours.
-pub fn remove_spikes(axis: &mut [f64], removals: &[crate::pipeline::screen::Removal]) {
+pub fn remove_spikes(axis: &mut [f64], removals: &[screen::Removal]) {
+    // One at a time, in order: a spike's neighbour may be the one just removed.
     for r in removals {
         let (at, len) = (r.spike.sample as usize, r.spike.samples as usize);
         let before = at.checked_sub(1).and_then(|k| axis.get(k)).copied();
@@ -301,10 +302,6 @@ pub fn remove_spikes(axis: &mut [f64], removals: &[crate::pipeline::screen::Remo
             (None, Some(b)) => (b, b),
             (None, None) => continue,
         };
-        for j in 0..len {
-            if let Some(v) = axis.get_mut(at + j) {
-                *v = a + (b - a) * (j + 1) as f64 / (len + 1) as f64;
-            }
-        }
+        screen::fill(&[r.between(a, b)], axis);
     }
 }

@@ -48,6 +48,14 @@ pub struct DirectionGroup {
     pub summary: SeriesStatistics,
 }
 
+impl DirectionGroup {
+    /// Its direction as the table and the report show it (`none found` for the recordings
+    /// without one).
+    pub fn shown(&self) -> &str {
+        self.direction.as_deref().unwrap_or("none found")
+    }
+}
+
 /// The series' `recordings` (each one's direction and impacts) grouped by direction, in the
 /// order each direction first appears (the recordings with none last).
 pub fn direction_groups<'a>(

@@ -27,7 +27,7 @@ pub fn by_direction(h: &mut Html, groups: &[DirectionGroup]) {
         html!(
             h,
             "<tr><td class=\"l\">{}</td><td>{}</td><td>{}</td><td>{}</td></tr>\n",
-            name(g),
+            g.shown(),
             g.recordings,
             g.summary.impacts,
             verdicts
@@ -35,12 +35,7 @@ pub fn by_direction(h: &mut Html, groups: &[DirectionGroup]) {
     }
     h.raw("</table>\n");
     for g in groups.iter().filter(|g| !g.summary.statistics.is_empty()) {
-        html!(h, "<h3>Statistics of direction {}</h3>\n", name(g));
+        html!(h, "<h3>Statistics of direction {}</h3>\n", g.shown());
         super::statistics_table(h, &g.summary.statistics);
     }
-}
-
-/// A group's direction as shown (`none found` for the recordings without one).
-pub fn name(g: &DirectionGroup) -> &str {
-    g.direction.as_deref().unwrap_or("none found")
 }

@@ -10,7 +10,7 @@ pub mod rails;
 pub mod spikes;
 
 pub use rails::{flat_tops, from_range, FlatTops, RAIL_FRACTION};
-pub use spikes::{apply, Removal, SpikeScan, TooManyGlitches, MAX_GLITCHES};
+pub use spikes::{apply, fill, Removal, SpikeScan, TooManyGlitches, MAX_GLITCHES};
 
 #[cfg(test)]
 mod tests {

@@ -31,6 +31,16 @@ impl Removal {
         }
     }
 
+    /// The same spike's removal from another channel of the recording (an axis), whose
+    /// neighbours of it are `before_m_s2` and `after_m_s2`.
+    pub fn between(&self, before_m_s2: f64, after_m_s2: f64) -> Self {
+        Self {
+            spike: self.spike.clone(),
+            before_m_s2,
+            after_m_s2,
+        }
+    }
+
     /// The value that replaces its sample `j` (0 or 1): on the straight line between the
     /// neighbours.
     pub fn value(&self, j: usize) -> f64 {
@@ -42,16 +52,19 @@ impl Removal {
 /// Replaces each removal's samples in `x` by its straight line; the spikes, timed from the
 /// first sample's time `t0_s` at `rate_hz` (as the impacts are).
 pub fn apply(removals: &[Removal], x: &mut [f64], t0_s: f64, rate_hz: f64) -> Vec<Spike> {
-    let mut spikes = Vec::with_capacity(removals.len());
+    fill(removals, x);
+    removals.iter().map(|r| r.timed(t0_s, rate_hz)).collect()
+}
+
+/// Replaces each removal's samples in `x` by its straight line.
+pub fn fill(removals: &[Removal], x: &mut [f64]) {
     for r in removals {
         for j in 0..r.spike.samples as usize {
             if let Some(v) = x.get_mut(r.spike.sample as usize + j) {
                 *v = r.value(j);
             }
         }
-        spikes.push(r.timed(t0_s, rate_hz));
     }
-    spikes
 }
 
 /// A one- or two-sample stretch that stands out from the line between its neighbours.
