@@ -43,28 +43,30 @@ fn within(got: &Value, want: f64, rel: f64, what: &str) {
     );
 }
 
-/// Each contact's kinematics against the truth, within 1 % (`touch`: the crush time's and
-/// `x_m`'s, which hang on where first touch is found).
-fn check(r: &Value, t: &ContactTruth, law: &str, what: &str, touch: f64) {
+/// Each contact's kinematics at `rate` against the truth, within 1 % (the crush time and
+/// `x_m` within [`Touch`]'s, as they hang on where first touch is found).
+fn check(r: &Value, t: &ContactTruth, law: &str, what: &str, rate: f64) {
     let s = t.separation.unwrap();
+    let touch = Touch::of(law, rate, t);
     let w = |f: &str| format!("{what}: {f}");
-    within(&r["cor"], s.cor, 0.01, &w("cor"));
+    let rebound = 0.01 + touch.dv_m_s / s.rebound_m_s;
+    within(&r["cor"], s.cor, rebound, &w("cor"));
     within(
         &r["rebound_velocity_m_s"],
         s.rebound_m_s,
-        0.01,
+        rebound,
         &w("rebound"),
     );
     within(
         &r["crush_time_s"],
         t.crush_time_s.unwrap(),
-        touch,
+        touch.crush,
         &w("crush"),
     );
     within(
         &r["max_deformation_m"],
         t.max_deformation_m.unwrap(),
-        touch,
+        touch.x_m,
         &w("x_m"),
     );
     within(&r["peak_force_n"], t.peak_force_n, 0.01, &w("peak force"));
@@ -75,7 +77,7 @@ fn check(r: &Value, t: &ContactTruth, law: &str, what: &str, touch: f64) {
     let x_m = t.max_deformation_m.unwrap();
     match r["permanent_deformation_m"].as_f64() {
         Some(set) => assert!(
-            (set - s.set_m).abs() <= touch * x_m,
+            (set - s.set_m).abs() <= touch.x_m * x_m,
             "{}: {set} vs true {}",
             w("set"),
             s.set_m
@@ -90,7 +92,7 @@ fn check(r: &Value, t: &ContactTruth, law: &str, what: &str, touch: f64) {
     let x_sep = r["separation_deformation_m"].as_f64().unwrap();
     assert!(
         // (First touch's error, and separation's: both ends of the contact's feet.)
-        (x_sep - s.deformation_m).abs() <= 2.0 * touch * x_m,
+        (x_sep - s.deformation_m).abs() <= 2.0 * touch.x_m * x_m,
         "{}: {x_sep} vs true {}",
         w("x at separation"),
         s.deformation_m
@@ -99,23 +101,53 @@ fn check(r: &Value, t: &ContactTruth, law: &str, what: &str, touch: f64) {
     let e0 = 0.5 * 0.06 * t.approach_m_s * t.approach_m_s;
     let e = r["absorbed_energy_j"].as_f64().unwrap();
     assert!(
-        (e - s.absorbed_energy_j).abs() <= 0.01 * e0,
+        (e - s.absorbed_energy_j).abs() <= 0.01 * e0 + 0.06 * s.rebound_m_s * touch.dv_m_s,
         "{}: {e} J vs true {} J ({:+.2} % of ½ m v0²)",
         w("absorbed energy"),
         s.absorbed_energy_j,
         (e - s.absorbed_energy_j) / e0 * 100.0
     );
-    within(&r["delta_v_m_s"], s.delta_v_m_s, 0.01, &w("Δv"));
+    within(
+        &r["delta_v_m_s"],
+        s.delta_v_m_s,
+        0.01 + touch.dv_m_s / s.delta_v_m_s,
+        &w("Δv"),
+    );
 }
 
-/// The crush time's and `x_m`'s tolerance: 1 % and the samples first touch may be off by,
-/// which hang on the foot: a sample (a linear foot's straight-line fit at 100 kS/s puts
-/// touch up to 0.7 samples early, x_m +1.4 %), two for a Kelvin–Voigt pad, whose force steps
-/// to `c v0` at touch (1.4 samples early at 20 kS/s: crush +1.9 %, x_m +3.2 %). Open (#40:
-/// touch where the force is zero, to a fraction of a sample, for every foot).
-fn touch_tolerance(law: &str, rate: f64, t: &ContactTruth) -> f64 {
-    let samples = if law == "kelvin-voigt" { 2.0 } else { 1.0 };
-    0.01 + samples / (rate * t.crush_time_s.unwrap())
+/// The crush time's and `x_m`'s tolerances (relative): 1 %, or where the force jumps at
+/// touch (a Kelvin–Voigt pad's `c v0`, the dented two-phase pad's damper) half a sample's
+/// share of them: the touch lies anywhere between the last sample without force and the
+/// first with, and the middle of that interval is the best the samples tell. And the Δv a
+/// jump inside the contact leaves unknown, m/s: the virgin two-phase pad's force steps from
+/// `kc x_m` to `kr (x_m - x_p)` at the crush, somewhere within a sample, and the pulse's area
+/// is known to half a sample of that step (at 20 kS/s, the seed pad's COR to ±0.9 %).
+struct Touch {
+    crush: f64,
+    x_m: f64,
+    dv_m_s: f64,
+}
+
+impl Touch {
+    fn of(law: &str, rate: f64, t: &ContactTruth) -> Self {
+        let half = if matches!(law, "kelvin-voigt" | "two-phase") {
+            0.5 / rate
+        } else {
+            0.0
+        };
+        let x_m = t.max_deformation_m.unwrap();
+        let step_n = match seed_two_phase_pad() {
+            Model::TwoPhase(p) if law == "two-phase" && t.surface_m == 0.0 => {
+                (p.kc * x_m - p.kr * (x_m - p.permanent_m.unwrap())).abs()
+            }
+            _ => 0.0,
+        };
+        Touch {
+            crush: 0.01f64.max(half / t.crush_time_s.unwrap()),
+            x_m: 0.01f64.max(half * t.approach_m_s / x_m),
+            dv_m_s: step_n / 0.06 * 0.5 / rate,
+        }
+    }
 }
 
 /// A Kelvin–Voigt pad (k 1e4 N/m, c 5 N s/m): relaxes in c/k = 0.5 ms, keeps no set.
@@ -175,23 +207,21 @@ fn a_vertical_contact_takes_gravity_out() {
             assert_eq!(a["contact_gravity_m_s2"], 9.80665);
             let impacts = a["impacts"].as_array().unwrap();
             assert_eq!(impacts.len(), 1, "{name} at {rate}");
-            let touch = touch_tolerance(name, rate, &truth[0]);
             check(
                 &impacts[0],
                 &truth[0],
                 name,
                 &format!("{name} at {rate} S/s"),
-                touch,
+                rate,
             );
         }
     }
 }
 
 /// A bounce train of seed 001's nonlinear law, each bounce's approach from the previous
-/// rebound (`--train rebound`): gravity out of every contact, within 1 % on every bounce.
-/// Not yet every field of a two-phase pad's (reloading its dent, COR ~0.9: bounce 1's
-/// absorbed energy is 2.7 % high: open, #40); the landing of both pads is
-/// `a_bounce_lands_where_the_pad_is`.
+/// rebound (`--train rebound`): gravity out of every contact, within 1 % on every bounce
+/// (every law's, from the flight: `bounce_trains_of_every_law_within_one_percent`; the
+/// landing on both pads: `a_bounce_lands_where_the_pad_is`).
 #[test]
 fn a_nonlinear_bounce_train_within_one_percent() {
     let scratch = Scratch::new();
@@ -219,7 +249,7 @@ fn a_nonlinear_bounce_train_within_one_percent() {
                 &format!("{what}: v0"),
             );
             if t.separation.is_some() {
-                check(r, t, name, &what, 0.01);
+                check(r, t, name, &what, rate);
             }
         }
     }
@@ -247,13 +277,14 @@ fn drops_from_rest_are_measured_from_free_fall() {
             (0.091, 100_000.0),
             (0.091, 20_000.0),
             (0.005, 500_000.0),
+            (0.005, 20_000.0),
         ] {
             // The seed's two-phase pad from 5 mm (kc 309 N/m: a 2 mm static deflection, a
             // foot below the noise for tens of ms) ends `no-stop`: open (#40).
             if name == "two-phase" && height < 0.01 {
                 continue;
             }
-            for phase in [0.0, 0.37, 0.71] {
+            for phase in [0.0, 0.37, 0.5, 0.71] {
                 let drop = Drop {
                     law,
                     mass_kg: 0.06,
@@ -299,8 +330,7 @@ fn drops_from_rest_are_measured_from_free_fall() {
                     1e-3,
                     &what,
                 );
-                let touch = touch_tolerance(name, rate, &truth[0]);
-                check(r, &truth[0], name, &what, touch);
+                check(r, &truth[0], name, &what, rate);
             }
         }
     }
@@ -452,8 +482,12 @@ fn a_body_settling_on_a_soft_pad_is_one_contact_that_never_ends() {
 
 /// Bounce trains of every law (linear and Hertz elastic, Kelvin–Voigt, the seed's two-phase
 /// pad, seed 001's law stiff and soft: contacts of 1 to 60 ms), at 500, 100 and 20 kS/s, with
-/// the kinematics' speed from the flight (`--train flight`): v0, the rebound, the COR and the
-/// rebound's landed measure of the speed within 1 % on every bounce that separates. From the
+/// the kinematics' speed from the flight (`--train flight`): v0, the rebound, the COR, the
+/// rebound's landed measure of the speed, the crush time, x_m, the set, the deformation at
+/// separation, the energy and the peak force within 1 % on every bounce that separates
+/// ([`check`]: the crush time and x_m within half a sample where the force jumps at touch;
+/// bounces 1 and 3 at 20 kS/s were 2.3 samples early, crush time +3 %, x_m +4.7 %, where
+/// the walk back through the foot's noise after a flight set first touch). From the
 /// previous rebound (`--train rebound`, a chain: each bounce inherits the previous one's
 /// error with its sign turned), the same at 500 and 100 kS/s for the pads that leave the body
 /// at their surface or their set; not yet at 20 kS/s (the chain's COR 1.1–2.6 % off by bounce
@@ -511,6 +545,10 @@ fn bounce_trains_of_every_law_within_one_percent() {
                             0.01,
                             &format!("{what}: v0 from the rebound"),
                         );
+                    }
+                    // Every bounce's crush time, x_m, set, energy and peak force too.
+                    if speed == "flight" {
+                        check(r, t, name, &what, rate);
                     }
                 }
             }

@@ -1699,19 +1699,29 @@ fn board_within_one_percent(
         near("impact_velocity_m_s", t.approach_m_s);
         let Some(sep) = &t.separation else { continue };
         near("cor", sep.cor);
+        near("peak_force_n", t.peak_force_n);
         if kinematics {
             near("crush_time_s", t.crush_time_s.unwrap());
             near("max_deformation_m", t.max_deformation_m.unwrap());
+            // The energy within 1 % of the impact's (½ m v0²).
+            let e0 = 0.5 * 0.06 * t.approach_m_s * t.approach_m_s;
+            let e = r["absorbed_energy_j"].as_f64().unwrap();
+            assert!(
+                (e - sep.absorbed_energy_j).abs() <= 0.01 * e0,
+                "{what}, contact {k}: {e} J on the board, {} J true",
+                sep.absorbed_energy_j
+            );
         }
     }
 }
 
 /// Drops from rest of every law (the physical generator, `impact_host::drop`: held at +1 g,
-/// released, 91 mm of free fall, gravity in the contact) and bounce trains (six contacts
-/// from 1.3357 m/s, `--train flight`), at 500 kS/s, their contacts within the board's
-/// capture: the board's reports equal the host's, bit for bit, and v0 and the COR of every
-/// contact (a drop's crush time and maximum deformation too) are the generator's within 1 %,
-/// as `tests/drops.rs` holds the host's at every rate and touch phase.
+/// released, 91 mm of free fall, gravity in the contact) at 500, 100 and 20 kS/s, and bounce
+/// trains (six contacts from 1.3357 m/s, `--train flight`) at 500 kS/s, their contacts within
+/// the board's capture: the board's reports equal the host's, bit for bit, and v0, the COR
+/// and the peak force of every contact (a drop's crush time, maximum deformation and
+/// absorbed energy too) are the generator's within 1 %, as `tests/drops.rs` holds the host's
+/// at every rate and touch phase.
 #[test]
 fn drops_and_trains_on_the_board_are_the_hosts_and_within_one_percent() {
     use impact_host::drop::{Drop, Start};
@@ -1728,30 +1738,32 @@ fn drops_and_trains_on_the_board_are_the_hosts_and_within_one_percent() {
             max_contacts: contacts,
             min_rebound_m_s: 1e-3,
         };
-        let from_rest = drop(
-            Start::Rest {
-                rest_s: 0.05,
-                height_m: 0.091,
-            },
-            1,
-        );
-        let (text, truth) =
-            impact_host::testkit::sensor::csv(&from_rest, 500_000.0, 0.3, 2000.0).unwrap();
-        let file = scratch.text(&format!("{name}-rest.csv"), &text);
-        board_within_one_percent(
-            &file,
-            &[
-                "--mass",
-                "0.06",
-                "--drop-height",
-                "0.091",
-                "--range",
-                "2000",
-            ],
-            &truth,
-            &format!("{name} from rest"),
-            true,
-        );
+        for rate in [500_000.0, 100_000.0, 20_000.0] {
+            let from_rest = drop(
+                Start::Rest {
+                    rest_s: 0.05 + 0.37 / rate,
+                    height_m: 0.091,
+                },
+                1,
+            );
+            let (text, truth) =
+                impact_host::testkit::sensor::csv(&from_rest, rate, 0.3, 2000.0).unwrap();
+            let file = scratch.text(&format!("{name}-rest-{rate}.csv"), &text);
+            board_within_one_percent(
+                &file,
+                &[
+                    "--mass",
+                    "0.06",
+                    "--drop-height",
+                    "0.091",
+                    "--range",
+                    "2000",
+                ],
+                &truth,
+                &format!("{name} from rest at {rate} S/s"),
+                true,
+            );
+        }
         let train = drop(
             Start::Moving {
                 touch_s: 0.0123,

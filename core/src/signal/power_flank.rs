@@ -115,9 +115,9 @@ fn fit(
     // The power the same contact showed clearly before (`prior`) wherever it fits at least as
     // well as the line: a smaller impact's noise may favour another power by chance, and a
     // zero extrapolated with the wrong one is off by many samples.
-    let (prior, only) = match choice {
-        Choice::Free { prior } => (prior, false),
-        Choice::Only(p) => (Some(p), true),
+    let (prior, only, line_ok) = match choice {
+        Choice::Free { prior, line } => (prior, false, line),
+        Choice::Only(p) => (Some(p), true, false),
     };
     let prior = POWERS
         .iter()
@@ -128,6 +128,7 @@ fn fit(
     let (k, (_, slope, icept), clear) = match prior {
         Some((j, f)) => (j, f, false),
         None if clear && !only => (k, (unexplained, slope, icept), true),
+        None if line_ok => (0, fits[0], false),
         None => return None,
     };
     let x0 = -icept / slope;
@@ -162,8 +163,10 @@ fn fit(
 /// Which powers a fit may take.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum Choice {
-    /// The best (see [`zero`]), or `prior` where it fits no worse than the line.
-    Free { prior: Option<f32> },
+    /// The best (see [`zero`]), or `prior` where it fits no worse than the line; with
+    /// `line`, the straight line itself where no power is clearly better (the caller has no
+    /// better line: its flank between the edge and flank levels held too few samples).
+    Free { prior: Option<f32>, line: bool },
     /// This power only, where it fits no worse than the line (a falling foot takes its
     /// rising foot's: a damped law's slow return is no power curve, and a foot fitted as
     /// one there would put separation far out in it).
@@ -272,7 +275,10 @@ mod tests {
                 rising,
                 outside,
                 0.02,
-                Choice::Free { prior: None },
+                Choice::Free {
+                    prior: None,
+                    line: false,
+                },
             )
             .unwrap();
             assert!((f.zero - x0).abs() < 0.05, "{} vs {x0}", f.zero);
@@ -289,7 +295,16 @@ mod tests {
         let pts = foot(-3.4, 1.0, 40.0, true);
         let outside = pts.clone().map(|q| q.0).fold(f32::MAX, f32::min) - 1.0;
         assert_eq!(
-            zero(pts, true, outside, 0.02, Choice::Free { prior: None }),
+            zero(
+                pts,
+                true,
+                outside,
+                0.02,
+                Choice::Free {
+                    prior: None,
+                    line: false
+                }
+            ),
             None
         );
         // Too few points.
@@ -299,7 +314,10 @@ mod tests {
                 true,
                 -1.0,
                 0.05,
-                Choice::Free { prior: None }
+                Choice::Free {
+                    prior: None,
+                    line: false
+                }
             ),
             None
         );

@@ -15,6 +15,9 @@ pub(super) struct Active {
     pub(super) trigger_index: u64,
     pub(super) onset_index: u64,
     pub(super) touch_offset: f32,
+    /// `touch_offset` is the zero of a line fitted to the flank (at least three samples
+    /// between the edge and flank levels), not a crossing between two samples.
+    pub(super) line_fitted: bool,
     /// The earliest first touch relative to the onset (the previous contact's end), samples.
     pub(super) touch_floor: f32,
     pub(super) base_sum: i64,

@@ -34,6 +34,20 @@ pub(super) const LOBE_LOOK: usize = 64;
 /// level is 5 times a sample's), so its foot left below is a small part of its area.
 pub(super) const LOBE_SHARE: i64 = 16;
 
+/// A lobe replaces the fitted first touch only where it begins more than this many samples
+/// before it, and the sum of its samples before it stands out of the noise
+/// ([`LOBE_SIGNIFICANCE`]): else they are the same foot's samples within the noise, walked
+/// back to the first sample the noise put at the baseline (0.4 to 7 samples early, after a
+/// flight whose baseline was learnt in a few strides).
+pub(super) const LOBE_BEYOND_FIT: f32 = 2.0;
+
+/// See [`LOBE_BEYOND_FIT`]: the sum of `n` samples before the fitted touch stands out of the
+/// noise above this many edge levels times `√n`: three standard deviations of a noise whose
+/// own is a fifth of the edge level. (A walk that stops at the first sample at the baseline
+/// crosses only samples above it, 0.8 σ each on average: it stands out only past 14 samples,
+/// where it is a foot.)
+pub(super) const LOBE_SIGNIFICANCE: f32 = 0.6;
+
 /// The whole lobe before an onset ([`Stream::lobe_before`]).
 pub(super) struct Lobe {
     /// Where it crosses the baseline, relative to the onset, samples.
@@ -253,14 +267,30 @@ impl<const PRE: usize> Stream<PRE> {
     /// `Σ d` before the onset, inside the previous contact): a slow ramp below the edge
     /// level before the pulse (a pad or felt compressing) is part of the contact, however
     /// long it is against the pulse (a lobe that does not rise to the pulse is none:
-    /// [`Self::lobe_before`]). Not into the previous contact.
+    /// [`Self::lobe_before`]). Not into the previous contact. A lobe that begins within
+    /// [`LOBE_BEYOND_FIT`] samples of the fitted touch is the same foot: touch stays the
+    /// fit's (the lobe's crossing is where the noise first put a sample at the baseline),
+    /// `Σ d` the lobe's samples' (a ramp's are more than the fitted curve's).
     pub(super) fn lobe(&self, a: &Active, touch: (f32, i64, bool)) -> (f32, i64, bool) {
         let longer = a.lobe_touch < touch.0;
         let fits = a.lobe_touch >= a.touch_floor;
-        if longer && fits {
+        if !(longer && fits) {
+            // (A lobe into the previous impact's window says the pulse was under way before
+            // that window ended, wherever a fit put touch.)
+            return (touch.0, touch.1, touch.2 || (fits && a.lobe_in_previous));
+        }
+        // The lobe's samples before the fitted touch: a foot's or a ramp's sum stands out of
+        // the noise; the noise's that a walk to the first sample at the baseline crosses
+        // does not.
+        let before = touch.0 - a.lobe_touch;
+        let sum = (a.sign * (a.lobe_c - touch.1)) as f32;
+        let ramp = sum > LOBE_SIGNIFICANCE * a.edge_d as f32 * libm::sqrtf(before.max(0.0));
+        // (A lobe into the previous impact's window is never the foot's noise: it says the
+        // pulse was under way before that window ended.)
+        if a.lobe_in_previous || (before > LOBE_BEYOND_FIT && ramp) {
             (a.lobe_touch, a.lobe_c, a.lobe_in_previous)
         } else {
-            touch
+            (touch.0, a.lobe_c, touch.2)
         }
     }
 
@@ -286,6 +316,7 @@ impl<const PRE: usize> Stream<PRE> {
             .map(|(p, d)| (p as f32, d as f32 / peak));
         let choice = power_flank::Choice::Free {
             prior: self.run.foot_power,
+            line: !a.line_fitted,
         };
         power_flank::zero(points, true, -1.0, a.edge_d as f32 / peak, choice)
     }
@@ -366,6 +397,10 @@ impl<const PRE: usize> Stream<PRE> {
         match flank.zero(false, 1.0, a.edge_d as f64) {
             Some(z) => (z - 1.0) as f32,
             None => match (pd(last), pd(separation)) {
+                // A drop from beyond the flank level within one sample (a law whose force
+                // steps to zero: a damper's `c v` at separation): the zero lies anywhere in
+                // that sample interval, and its middle is the estimate with no bias.
+                (Some(y0), Some(_)) if y0 > a.flank_d => -0.5,
                 (Some(y0), Some(y1)) => {
                     (crossing(y0 as f64, y1 as f64, a.edge_d as f64) - 1.0) as f32
                 }

@@ -54,7 +54,8 @@ impl<const PRE: usize> Stream<PRE> {
         let ring = &self.ring;
         let back = |i: usize| ring.back(i).filter(|_| i < REACH);
         let pd = |i: usize| back(i).map(|x| sign * deviation.of(x) as i64);
-        let (pulse, touch_offset) = self.rising_flank(sign, deviation, edge_d, flank_d, trigger_x);
+        let (pulse, touch_offset, line_fitted) =
+            self.rising_flank(sign, deviation, edge_d, flank_d, trigger_x);
         let onset_index = self.run.index - pulse as u64;
         let cut_at_start = onset_index == 0 && pd(pulse).is_none();
         // First touch cannot come before the previous contact ended: reports never overlap.
@@ -106,6 +107,7 @@ impl<const PRE: usize> Stream<PRE> {
             trigger_index: self.run.index,
             onset_index,
             touch_offset,
+            line_fitted,
             touch_floor,
             base_sum,
             base_n,
@@ -206,7 +208,8 @@ impl<const PRE: usize> Stream<PRE> {
     /// The pulse's rising flank, walking back from the newest sample (the trigger's) while
     /// it is beyond the edge level the pulse's way (`sign`): how many samples the pulse has
     /// risen for (the onset is that many back) and first touch, fractional samples from the
-    /// onset (the flank's line through zero, or the edge crossing before the onset).
+    /// onset (the flank's line through zero, or the edge crossing before the onset, or the
+    /// middle of the sample interval a jump crossed), and whether it is the line's.
     fn rising_flank(
         &self,
         sign: i64,
@@ -214,7 +217,7 @@ impl<const PRE: usize> Stream<PRE> {
         edge_d: i64,
         flank_d: i64,
         trigger_x: i16,
-    ) -> (usize, f32) {
+    ) -> (usize, f32, bool) {
         // The ring's samples within the flanks' reach, newest first.
         let ring = &self.ring;
         let back = |i: usize| ring.back(i).filter(|_| i < REACH);
@@ -235,7 +238,8 @@ impl<const PRE: usize> Stream<PRE> {
                 _ => break,
             }
         }
-        let touch_offset = match flank.zero(true, -1.0, edge_d as f64) {
+        let fitted = flank.zero(true, -1.0, edge_d as f64);
+        let touch_offset = match fitted {
             Some(z) => z as f32,
             // The edge crossing between the last sample before the pulse and the onset (the
             // trigger sample itself when the pulse starts there).
@@ -245,6 +249,10 @@ impl<const PRE: usize> Stream<PRE> {
                     None => Some(sign * deviation.of(trigger_x) as i64),
                 };
                 match (pd(pulse), onset) {
+                    // A jump past the flank level within one sample (Kelvin–Voigt's `c v0`,
+                    // or a foot steeper than the sampling resolves): touch lies anywhere in
+                    // that sample interval, and its middle is the estimate with no bias.
+                    (Some(_), Some(y1)) if y1 > flank_d => -0.5,
                     (Some(y0), Some(y1)) => {
                         (crossing(y0 as f64, y1 as f64, edge_d as f64) - 1.0) as f32
                     }
@@ -252,7 +260,7 @@ impl<const PRE: usize> Stream<PRE> {
                 }
             }
         };
-        (pulse, touch_offset)
+        (pulse, touch_offset, fitted.is_some())
     }
 
     /// The window's samples the ring holds, replayed into the impact at its start: the
