@@ -49,6 +49,17 @@ fn check(r: &Value, t: &ContactTruth, law: &str, what: &str, rate: f64) {
     let s = t.separation.unwrap();
     let touch = Touch::of(law, rate, t);
     let w = |f: &str| format!("{what}: {f}");
+    // First touch itself: within 0.6 of a sample (a step's middle, half a sample from where
+    // it may lie), or 4 µs where the foot rises slowly out of the noise (2 samples at
+    // 500 kS/s: a Hertz foot's power fit).
+    let start = r["start_s"].as_f64().unwrap();
+    assert!(
+        (start - t.touch_s).abs() <= (0.6 / rate).max(4e-6),
+        "{}: {start} s vs true {} s ({:+.2} samples)",
+        w("first touch"),
+        t.touch_s,
+        (start - t.touch_s) * rate
+    );
     let rebound = 0.01 + touch.dv_m_s / s.rebound_m_s;
     within(&r["cor"], s.cor, rebound, &w("cor"));
     within(
@@ -130,11 +141,9 @@ struct Touch {
 
 impl Touch {
     fn of(law: &str, rate: f64, t: &ContactTruth) -> Self {
-        let half = if matches!(law, "kelvin-voigt" | "two-phase") {
-            0.5 / rate
-        } else {
-            0.0
-        };
+        // (The two-phase pad's damper acts on reloading its dent, not on its virgin surface.)
+        let jumps = law == "kelvin-voigt" || (law == "two-phase" && t.surface_m > 0.0);
+        let half = if jumps { 0.5 / rate } else { 0.0 };
         let x_m = t.max_deformation_m.unwrap();
         let step_n = match seed_two_phase_pad() {
             Model::TwoPhase(p) if law == "two-phase" && t.surface_m == 0.0 => {
@@ -550,6 +559,99 @@ fn bounce_trains_of_every_law_within_one_percent() {
                     if speed == "flight" {
                         check(r, t, name, &what, rate);
                     }
+                }
+            }
+        }
+    }
+}
+
+/// 1 ms contacts (linear, Hertz, seed 001's law and Kelvin–Voigt, 91 mm drops from rest) at
+/// coarse rates, four touch phases: at 100 kS/s (100 samples a contact) every field within
+/// 1 % ([`check`]: Kelvin–Voigt's crush time and `x_m` within half a sample); at 20 kS/s
+/// (20 samples) the crush time and `x_m` of the laws whose foot starts smooth and straight
+/// (linear, seed 001's) within 1 %: the onset's step past the flank level is placed from its
+/// first three samples, not in the middle of the interval before it (up to ±6 % on `x_m`).
+/// Not yet: Hertz and Kelvin–Voigt at 20 kS/s, and coarser rates (docs/accuracy.md; #43).
+#[test]
+fn a_one_millisecond_contact_at_coarse_rates() {
+    let scratch = Scratch::new();
+    let k = 0.06 * (std::f64::consts::PI / 1e-3f64).powi(2);
+    let laws = [
+        ("linear", Model::Linear(impact_core::model::Linear { k })),
+        (
+            "hertz",
+            Model::Hertz(impact_core::model::Hertz { k: 3.0e7 }),
+        ),
+        (
+            "nonlinear",
+            Model::Nonlinear(Nonlinear { k, c: 0.3, n: 1.0 }),
+        ),
+        (
+            "kelvin-voigt",
+            Model::KelvinVoigt(KelvinVoigt { k, c: 20.0 }),
+        ),
+    ];
+    for (name, law) in laws {
+        for rate in [100_000.0, 20_000.0] {
+            if rate < 1e5 && !matches!(name, "linear" | "nonlinear") {
+                continue;
+            }
+            for phase in [0.0, 0.25, 0.5, 0.75] {
+                let drop = Drop {
+                    law,
+                    mass_kg: 0.06,
+                    gravity_m_s2: G,
+                    start: Start::Rest {
+                        rest_s: 0.05 + phase / rate,
+                        height_m: 0.091,
+                    },
+                    max_contacts: 1,
+                    min_rebound_m_s: 1e-3,
+                };
+                let what = format!("1 ms {name} at {rate} S/s, phase {phase}");
+                let (text, truth) = csv(&drop, rate, 0.5, 20_000.0);
+                let a = analyse(
+                    &scratch,
+                    &format!("short-{name}-{rate}-{phase}.csv"),
+                    text,
+                    &["--drop-height", "0.091", "--range", "20000"],
+                );
+                let impacts = a["impacts"].as_array().unwrap();
+                assert_eq!(impacts.len(), 1, "{what}: {impacts:#?}");
+                let (r, t) = (&impacts[0], &truth[0]);
+                if rate >= 1e5 && name != "kelvin-voigt" {
+                    check(r, t, name, &what, rate);
+                } else if rate >= 1e5 {
+                    // (Its set is null at 1 ms: `set-not-resolved`, the restitution's points
+                    // too few to tell a set from none.)
+                    let (s, touch) = (t.separation.unwrap(), Touch::of(name, rate, t));
+                    within(&r["cor"], s.cor, 0.01, &format!("{what}: cor"));
+                    within(
+                        &r["peak_force_n"],
+                        t.peak_force_n,
+                        0.01,
+                        &format!("{what}: peak"),
+                    );
+                    within(
+                        &r["crush_time_s"],
+                        t.crush_time_s.unwrap(),
+                        touch.crush,
+                        &what,
+                    );
+                    within(
+                        &r["max_deformation_m"],
+                        t.max_deformation_m.unwrap(),
+                        touch.x_m,
+                        &what,
+                    );
+                } else {
+                    within(&r["crush_time_s"], t.crush_time_s.unwrap(), 0.01, &what);
+                    within(
+                        &r["max_deformation_m"],
+                        t.max_deformation_m.unwrap(),
+                        0.01,
+                        &what,
+                    );
                 }
             }
         }

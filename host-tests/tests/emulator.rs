@@ -1675,6 +1675,7 @@ fn board_within_one_percent(
     truth: &[impact_host::drop::ContactTruth],
     what: &str,
     kinematics: bool,
+    touch_slack_s: f64,
 ) {
     let Some(elf) = firmware() else { return };
     let elf = elf.to_string_lossy().into_owned();
@@ -1687,22 +1688,29 @@ fn board_within_one_percent(
     let impacts = v["impacts"].as_array().unwrap();
     assert_eq!(impacts.len(), truth.len(), "{what}: {out}");
     for (k, (r, t)) in impacts.iter().zip(truth).enumerate() {
-        let near = |field: &str, want: f64| {
+        let near_within = |field: &str, want: f64, rel: f64| {
             let got = r[field]
                 .as_f64()
                 .unwrap_or_else(|| panic!("{what}, contact {k}, {field}: {r}"));
             assert!(
-                (got / want - 1.0).abs() <= 0.01,
+                (got / want - 1.0).abs() <= rel,
                 "{what}, contact {k}, {field}: {got} on the board, {want} true"
             );
         };
+        let near = |field: &str, want: f64| near_within(field, want, 0.01);
         near("impact_velocity_m_s", t.approach_m_s);
         let Some(sep) = &t.separation else { continue };
         near("cor", sep.cor);
         near("peak_force_n", t.peak_force_n);
         if kinematics {
-            near("crush_time_s", t.crush_time_s.unwrap());
-            near("max_deformation_m", t.max_deformation_m.unwrap());
+            // (Within half a sample where the force jumps at touch, as `tests/drops.rs`.)
+            let (crush, x_m) = (t.crush_time_s.unwrap(), t.max_deformation_m.unwrap());
+            near_within("crush_time_s", crush, 0.01f64.max(touch_slack_s / crush));
+            near_within(
+                "max_deformation_m",
+                x_m,
+                0.01f64.max(touch_slack_s * t.approach_m_s / x_m),
+            );
             // The energy within 1 % of the impact's (½ m v0²).
             let e0 = 0.5 * 0.06 * t.approach_m_s * t.approach_m_s;
             let e = r["absorbed_energy_j"].as_f64().unwrap();
@@ -1762,6 +1770,11 @@ fn drops_and_trains_on_the_board_are_the_hosts_and_within_one_percent() {
                 &truth,
                 &format!("{name} from rest at {rate} S/s"),
                 true,
+                if name == "kelvin-voigt" {
+                    0.5 / rate
+                } else {
+                    0.0
+                },
             );
         }
         let train = drop(
@@ -1780,6 +1793,7 @@ fn drops_and_trains_on_the_board_are_the_hosts_and_within_one_percent() {
             &truth,
             &format!("{name} train"),
             false,
+            0.0,
         );
     }
 }

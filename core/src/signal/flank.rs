@@ -29,6 +29,16 @@ impl Flank {
         true
     }
 
+    /// Points held.
+    pub fn len(&self) -> i64 {
+        self.n
+    }
+
+    /// No points held.
+    pub fn is_empty(&self) -> bool {
+        self.n == 0
+    }
+
     /// Where the fitted line reaches zero, if it is a flank: at least three points, rising
     /// (`rising`) or falling, reaching zero within one point spacing beyond the points on the
     /// `outside` side, and passing below `1.5 edge` at `outside` (the sample next to the flank

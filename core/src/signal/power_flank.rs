@@ -33,8 +33,9 @@ pub const BETTER: f32 = 0.5;
 
 /// The zero of the best power fit to `points` (position in samples, `|d| / peak` in `(0, 1]`)
 /// and its power, if a power above 1 fits clearly better than the line, or `prior` (the power
-/// an earlier foot of the same contact showed clearly) fits no worse than it (else `None`:
-/// the straight-line estimate stands), and it is a flank: rising (`rising`) or falling, its zero
+/// an earlier foot of the same contact showed clearly) fits no worse than it (else the line's
+/// zero where the caller asks for it, [`Choice::Free`]'s `line`; else `None`: the caller's
+/// straight-line estimate stands), and it is a flank: rising (`rising`) or falling, its zero
 /// within one point spacing of `outside` (the sample next to the foot, within the edge
 /// level) and no further beyond it than the fitted curve takes to rise to four edge levels,
 /// and the fit reading at most `1.5 edge` or [`JUMP`] at `outside` (`edge` as a fraction of
@@ -160,6 +161,48 @@ fn fit(
     })
 }
 
+/// Where a foot that stepped from within the edge level past the flank level in one sample
+/// reaches zero, relative to its first sample, from its first three samples `y` (deviations,
+/// the pulse positive, the first at 0): under the power of [`POWERS`] that puts the three
+/// most nearly on a line (`|d|^(1/p)` against the position), the line through the first two
+/// where it reaches zero within the interval before the first (a foot the sampling is too
+/// coarse to fit: a 1 ms contact at 20 kS/s); else the middle of that interval (a jump,
+/// Kelvin–Voigt's `c v0`: touch lies anywhere in it, and its middle is the estimate with no
+/// bias). In `[-1, 0]`. (A jump onto a ramp, `c v0 + k v0 t`, is a straight line too: it
+/// reads as a ramp that began up to a sample earlier.)
+pub fn steep_zero(y: [f32; 3]) -> f32 {
+    let [y0, y1, y2] = y;
+    if !(y0 > 0.0 && y1 > y0 && y2.is_finite()) {
+        return -0.5;
+    }
+    // Scaled by the largest, so each root is of a number in (0, 1].
+    let top = y0.max(y1).max(y2);
+    let best = POWERS
+        .iter()
+        .map(|&p| {
+            let z = [
+                root(y0 / top, p),
+                root(y1 / top, p),
+                root(y2.max(0.0) / top, p),
+            ];
+            // How far the middle lies off the line through the outer two, over the rise.
+            let bend =
+                libm::fabsf(z[1] - 0.5 * (z[0] + z[2])) / (z[2] - z[0]).max(f32::MIN_POSITIVE);
+            (bend, p, z)
+        })
+        .fold(None, |best: Option<(f32, f32, [f32; 3])>, c| match best {
+            Some(b) if b.0 <= c.0 => Some(b),
+            _ => Some(c),
+        });
+    let Some((_, _, z)) = best else { return -0.5 };
+    let zero = -z[0] / (z[1] - z[0]);
+    if (-1.0..=0.0).contains(&zero) {
+        zero
+    } else {
+        -0.5
+    }
+}
+
 /// Which powers a fit may take.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum Choice {
@@ -250,6 +293,24 @@ mod tests {
             .filter(|q| q.1 > 0.02 && q.1 <= FOOT)
     }
 
+    /// The first three samples of feet `A (x - x0)^p` from `x0` in the interval before the
+    /// first sample: the zero of each law's power within a few hundredths of a sample; a
+    /// jump onto a slow ramp gives the middle.
+    #[test]
+    fn a_steep_foot_is_placed_within_its_interval_and_a_jump_at_its_middle() {
+        for p in POWERS {
+            for x0 in [-0.9f32, -0.5, -0.1] {
+                let y = [0.0f32, 1.0, 2.0].map(|x| 40.0 * power(x - x0, p));
+                let z = steep_zero(y);
+                assert!((z - x0).abs() < 0.02, "power {p}, zero {x0}: {z}");
+            }
+        }
+        assert_eq!(steep_zero([100.0, 104.0, 108.0]), -0.5);
+        assert_eq!(steep_zero([0.0, 10.0, 20.0]), -0.5);
+        assert_eq!(steep_zero([10.0, 10.0, 20.0]), -0.5);
+        assert_eq!(steep_zero([f32::NAN, 10.0, 20.0]), -0.5);
+    }
+
     #[test]
     fn the_f32_cube_root_is_libms() {
         for k in 1..2000 {
@@ -291,22 +352,14 @@ mod tests {
                 );
             }
         }
-        // A straight foot: the line stands.
+        // A straight foot: the caller's line stands, or this one's where it is asked for.
         let pts = foot(-3.4, 1.0, 40.0, true);
         let outside = pts.clone().map(|q| q.0).fold(f32::MAX, f32::min) - 1.0;
-        assert_eq!(
-            zero(
-                pts,
-                true,
-                outside,
-                0.02,
-                Choice::Free {
-                    prior: None,
-                    line: false
-                }
-            ),
-            None
-        );
+        let free = |line| Choice::Free { prior: None, line };
+        assert_eq!(zero(pts.clone(), true, outside, 0.02, free(false)), None);
+        let line = zero(pts, true, outside, 0.02, free(true)).unwrap();
+        assert!((line.zero + 3.4).abs() < 0.05, "{}", line.zero);
+        assert_eq!((line.power, line.clear), (1.0, false));
         // Too few points.
         assert_eq!(
             zero(

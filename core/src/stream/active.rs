@@ -15,9 +15,8 @@ pub(super) struct Active {
     pub(super) trigger_index: u64,
     pub(super) onset_index: u64,
     pub(super) touch_offset: f32,
-    /// `touch_offset` is the zero of a line fitted to the flank (at least three samples
-    /// between the edge and flank levels), not a crossing between two samples.
-    pub(super) line_fitted: bool,
+    /// How `touch_offset` was found at the trigger.
+    pub(super) flank_touch: FlankTouch,
     /// The earliest first touch relative to the onset (the previous contact's end), samples.
     pub(super) touch_floor: f32,
     pub(super) base_sum: i64,
@@ -88,6 +87,24 @@ pub(super) struct Active {
     /// after the last quiet sample).
     pub(super) end_at: Option<u64>,
     pub(super) level: LevelWatch,
+}
+
+/// How first touch was found at the trigger, from the rising flank in the ring
+/// (`Stream::rising_flank`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(super) enum FlankTouch {
+    /// The zero of the line fitted to the flank's samples between the edge and flank levels.
+    Line,
+    /// The onset stepped past the flank level from within the edge level: the middle of the
+    /// sample interval before it (`Stream::touch` places it within that interval from the
+    /// onset and the next two samples).
+    Steep,
+    /// The edge level's crossing before the onset (late by design: the foot below the edge
+    /// level lies before it): the flank held too few samples for a line.
+    Crossing,
+    /// The edge level's crossing, the flank's line refused (a jump onto it, or a zero out of
+    /// its reach).
+    Refused,
 }
 
 impl Active {

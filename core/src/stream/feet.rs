@@ -3,7 +3,7 @@
 //! a ramp rises into the onset, the falling flank's straight line or edge crossing otherwise;
 //! and the falling foot's record.
 
-use super::active::Active;
+use super::active::{Active, FlankTouch};
 use super::rise::Fall;
 use super::{Stream, REACH};
 use crate::signal::baseline::{Deviation, Stats, STRIDE};
@@ -242,14 +242,29 @@ impl<const PRE: usize> Stream<PRE> {
         }
     }
 
-    /// First touch relative to the onset and `Σ d` over the foot before the onset: where the
-    /// rising foot, fitted as a power curve ([`power_flank`]), reaches zero force, else the
-    /// straight line's (`touch_offset`, `lead_c`); and whether it lies inside the previous
-    /// impact's contact (then it is that contact's end).
-    pub(super) fn touch(&mut self, a: &Active) -> (f32, i64, bool) {
-        let line = (a.touch_offset, a.lead_c, a.line_in_previous);
+    /// First touch relative to the onset, `Σ d` over the foot before the onset, and whether
+    /// it lies inside the previous impact's contact (then it is that contact's end): where the
+    /// rising foot, fitted as a power curve ([`power_flank`]), reaches zero force; where the
+    /// flank stepped past the flank level, from the onset and the next two samples
+    /// ([`Self::steep_touch`]); else the trigger's estimate (`touch_offset`, `lead_c`). And
+    /// whether it is a fit's zero (not the edge crossing, late by design).
+    pub(super) fn touch(&mut self, a: &Active) -> ((f32, i64, bool), bool) {
+        let trigger = (a.touch_offset, a.lead_c, a.line_in_previous);
         let peak = a.peak_d.unsigned_abs() as f32;
-        match self.rise_foot(a) {
+        let foot = self.rise_foot(a).filter(|foot| {
+            // The foot's straight line (where no power is clearly better) stands where the
+            // trigger's flank had too few samples for a line (its zero before the onset,
+            // [`power_flank::zero`]), or near the interval a step crossed.
+            foot.power != 1.0
+                || match a.flank_touch {
+                    FlankTouch::Crossing => true,
+                    // (The sample before the step may already be on the foot, within the
+                    // edge level: its zero may lie before that sample, not before the next.)
+                    FlankTouch::Steep => (-2.0..=0.0).contains(&foot.zero),
+                    FlankTouch::Line | FlankTouch::Refused => false,
+                }
+        });
+        match foot {
             Some(foot) => {
                 if foot.clear {
                     self.run.foot_power = Some(foot.power);
@@ -257,26 +272,50 @@ impl<const PRE: usize> Stream<PRE> {
                 let touch = foot.zero.max(a.touch_floor);
                 let lead = libm::floorf(-touch).max(0.0) as i64;
                 let c = foot.sum(-lead, 0) * peak * a.sign as f32;
-                (touch, c as i64, foot.zero < a.touch_floor)
+                ((touch, c as i64, foot.zero < a.touch_floor), true)
             }
-            None => line,
+            None => match self.steep_touch(a) {
+                Some(z) => ((z.max(a.touch_floor), a.lead_c, a.line_in_previous), true),
+                // (A step's middle is no edge crossing either.)
+                None => (
+                    trigger,
+                    matches!(a.flank_touch, FlankTouch::Line | FlankTouch::Steep),
+                ),
+            },
         }
     }
 
+    /// First touch relative to the onset where the onset stepped past the flank level
+    /// ([`FlankTouch::Steep`]): from the onset and the next two samples (the rise record's
+    /// head), [`power_flank::steep_zero`].
+    fn steep_touch(&self, a: &Active) -> Option<f32> {
+        if a.flank_touch != FlankTouch::Steep {
+            return None;
+        }
+        let [y0, y1, y2] = a.rise.head()?;
+        Some(power_flank::steep_zero([y0 as f32, y1 as f32, y2 as f32]))
+    }
+
     /// First touch where the whole lobe begins, if that is earlier than `touch` (first touch,
-    /// `Σ d` before the onset, inside the previous contact): a slow ramp below the edge
-    /// level before the pulse (a pad or felt compressing) is part of the contact, however
-    /// long it is against the pulse (a lobe that does not rise to the pulse is none:
-    /// [`Self::lobe_before`]). Not into the previous contact. A lobe that begins within
-    /// [`LOBE_BEYOND_FIT`] samples of the fitted touch is the same foot: touch stays the
-    /// fit's (the lobe's crossing is where the noise first put a sample at the baseline),
-    /// `Σ d` the lobe's samples' (a ramp's are more than the fitted curve's).
-    pub(super) fn lobe(&self, a: &Active, touch: (f32, i64, bool)) -> (f32, i64, bool) {
+    /// `Σ d` before the onset, inside the previous contact; `fitted`: a fit's zero, not the
+    /// edge crossing): a slow ramp below the edge level before the pulse (a pad or felt
+    /// compressing) is part of the contact, however long it is against the pulse (a lobe
+    /// that does not rise to the pulse is none: [`Self::lobe_before`]). Not into the
+    /// previous contact. Against a fit's zero, only a lobe that begins more than
+    /// [`LOBE_BEYOND_FIT`] samples before it with a sum before it that stands out of the
+    /// noise ([`LOBE_SIGNIFICANCE`]): nearer, or within the noise, it is the same foot,
+    /// walked back to the first sample the noise put at the baseline, and the fit stands. A
+    /// lobe into the previous impact's window always says so (`in_previous`), wherever it
+    /// puts touch.
+    pub(super) fn lobe(
+        &self,
+        a: &Active,
+        touch: (f32, i64, bool),
+        fitted: bool,
+    ) -> (f32, i64, bool) {
         let longer = a.lobe_touch < touch.0;
         let fits = a.lobe_touch >= a.touch_floor;
         if !(longer && fits) {
-            // (A lobe into the previous impact's window says the pulse was under way before
-            // that window ended, wherever a fit put touch.)
             return (touch.0, touch.1, touch.2 || (fits && a.lobe_in_previous));
         }
         // The lobe's samples before the fitted touch: a foot's or a ramp's sum stands out of
@@ -285,12 +324,10 @@ impl<const PRE: usize> Stream<PRE> {
         let before = touch.0 - a.lobe_touch;
         let sum = (a.sign * (a.lobe_c - touch.1)) as f32;
         let ramp = sum > LOBE_SIGNIFICANCE * a.edge_d as f32 * libm::sqrtf(before.max(0.0));
-        // (A lobe into the previous impact's window is never the foot's noise: it says the
-        // pulse was under way before that window ended.)
-        if a.lobe_in_previous || (before > LOBE_BEYOND_FIT && ramp) {
+        if !fitted || a.lobe_in_previous || (before > LOBE_BEYOND_FIT && ramp) {
             (a.lobe_touch, a.lobe_c, a.lobe_in_previous)
         } else {
-            (touch.0, a.lobe_c, touch.2)
+            touch
         }
     }
 
@@ -316,7 +353,7 @@ impl<const PRE: usize> Stream<PRE> {
             .map(|(p, d)| (p as f32, d as f32 / peak));
         let choice = power_flank::Choice::Free {
             prior: self.run.foot_power,
-            line: !a.line_fitted,
+            line: matches!(a.flank_touch, FlankTouch::Crossing | FlankTouch::Steep),
         };
         power_flank::zero(points, true, -1.0, a.edge_d as f32 / peak, choice)
     }
@@ -397,10 +434,18 @@ impl<const PRE: usize> Stream<PRE> {
         match flank.zero(false, 1.0, a.edge_d as f64) {
             Some(z) => (z - 1.0) as f32,
             None => match (pd(last), pd(separation)) {
-                // A drop from beyond the flank level within one sample (a law whose force
-                // steps to zero: a damper's `c v` at separation): the zero lies anywhere in
-                // that sample interval, and its middle is the estimate with no bias.
-                (Some(y0), Some(_)) if y0 > a.flank_d => -0.5,
+                // A step down from beyond the flank level within one sample to a sample that
+                // has not crossed zero: a foot steeper than the sampling resolves, or a law
+                // whose force steps to zero (a damper's `c v` at separation). (Mirrored: the
+                // last sample, and the two before it. Where the next sample has crossed, the
+                // zero lies between the two, as the line between them says.)
+                (Some(y0), Some(y1)) if y0 > a.flank_d && y1 > 0 => {
+                    let at = |j: u64| last.checked_sub(j).and_then(pd).map_or(-1.0, |y| y as f32);
+                    -1.0 - power_flank::steep_zero([y0 as f32, at(1), at(2)])
+                }
+                (Some(y0), Some(y1)) if y0 > a.flank_d => {
+                    (crossing(y0 as f64, y1 as f64, 0.0) - 1.0) as f32
+                }
                 (Some(y0), Some(y1)) => {
                     (crossing(y0 as f64, y1 as f64, a.edge_d as f64) - 1.0) as f32
                 }

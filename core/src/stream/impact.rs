@@ -9,7 +9,7 @@
 //! (rest, free fall: the baseline is learned again, and a level change without a pulse is no
 //! impact at all); or for the reasons of [`Status`].
 
-use super::active::Active;
+use super::active::{Active, FlankTouch};
 use super::feet::{record_fall, OnsetWalk};
 use super::level::LevelWatch;
 use super::rise::{Fall, Rise};
@@ -54,7 +54,7 @@ impl<const PRE: usize> Stream<PRE> {
         let ring = &self.ring;
         let back = |i: usize| ring.back(i).filter(|_| i < REACH);
         let pd = |i: usize| back(i).map(|x| sign * deviation.of(x) as i64);
-        let (pulse, touch_offset, line_fitted) =
+        let (pulse, touch_offset, flank_touch) =
             self.rising_flank(sign, deviation, edge_d, flank_d, trigger_x);
         let onset_index = self.run.index - pulse as u64;
         let cut_at_start = onset_index == 0 && pd(pulse).is_none();
@@ -107,7 +107,7 @@ impl<const PRE: usize> Stream<PRE> {
             trigger_index: self.run.index,
             onset_index,
             touch_offset,
-            line_fitted,
+            flank_touch,
             touch_floor,
             base_sum,
             base_n,
@@ -209,7 +209,8 @@ impl<const PRE: usize> Stream<PRE> {
     /// it is beyond the edge level the pulse's way (`sign`): how many samples the pulse has
     /// risen for (the onset is that many back) and first touch, fractional samples from the
     /// onset (the flank's line through zero, or the edge crossing before the onset, or the
-    /// middle of the sample interval a jump crossed), and whether it is the line's.
+    /// middle of the sample interval a step past the flank level crossed), and which of
+    /// these it is.
     fn rising_flank(
         &self,
         sign: i64,
@@ -217,7 +218,7 @@ impl<const PRE: usize> Stream<PRE> {
         edge_d: i64,
         flank_d: i64,
         trigger_x: i16,
-    ) -> (usize, f32, bool) {
+    ) -> (usize, f32, FlankTouch) {
         // The ring's samples within the flanks' reach, newest first.
         let ring = &self.ring;
         let back = |i: usize| ring.back(i).filter(|_| i < REACH);
@@ -238,9 +239,16 @@ impl<const PRE: usize> Stream<PRE> {
                 _ => break,
             }
         }
-        let fitted = flank.zero(true, -1.0, edge_d as f64);
-        let touch_offset = match fitted {
-            Some(z) => z as f32,
+        let mut how = if flank.len() < 3 {
+            FlankTouch::Crossing
+        } else {
+            FlankTouch::Refused
+        };
+        let touch_offset = match flank.zero(true, -1.0, edge_d as f64) {
+            Some(z) => {
+                how = FlankTouch::Line;
+                z as f32
+            }
             // The edge crossing between the last sample before the pulse and the onset (the
             // trigger sample itself when the pulse starts there).
             None => {
@@ -249,10 +257,14 @@ impl<const PRE: usize> Stream<PRE> {
                     None => Some(sign * deviation.of(trigger_x) as i64),
                 };
                 match (pd(pulse), onset) {
-                    // A jump past the flank level within one sample (Kelvin–Voigt's `c v0`,
-                    // or a foot steeper than the sampling resolves): touch lies anywhere in
-                    // that sample interval, and its middle is the estimate with no bias.
-                    (Some(_), Some(y1)) if y1 > flank_d => -0.5,
+                    // A step past the flank level within one sample: a foot steeper than the
+                    // sampling resolves, or a jump (Kelvin–Voigt's `c v0`).
+                    // (The middle of the interval before it until the next sample tells more:
+                    // [`Stream::touch`].)
+                    (Some(_), Some(y1)) if y1 > flank_d => {
+                        how = FlankTouch::Steep;
+                        -0.5
+                    }
                     (Some(y0), Some(y1)) => {
                         (crossing(y0 as f64, y1 as f64, edge_d as f64) - 1.0) as f32
                     }
@@ -260,7 +272,7 @@ impl<const PRE: usize> Stream<PRE> {
                 }
             }
         };
-        (pulse, touch_offset, fitted.is_some())
+        (pulse, touch_offset, how)
     }
 
     /// The window's samples the ring holds, replayed into the impact at its start: the
@@ -491,8 +503,8 @@ impl<const PRE: usize> Stream<PRE> {
         };
         // A rising foot that is a power curve puts first touch where it reaches zero force;
         // the contact's Δv runs from touch to separation, the feet below the edge included.
-        let touch = self.touch(&a);
-        let (touch_offset, lead_c, in_previous) = self.lobe(&a, touch);
+        let (touch, fitted) = self.touch(&a);
+        let (touch_offset, lead_c, in_previous) = self.lobe(&a, touch, fitted);
         let touch = a.onset_index as f64 + touch_offset as f64;
         let approach =
             self.run

@@ -19,6 +19,9 @@ pub struct Rise {
     len: usize,
     pos: [u32; RISE_POINTS],
     d: [i32; RISE_POINTS],
+    /// The onset's sample and the next two, whatever the stride (a step's three samples:
+    /// [`crate::signal::power_flank::steep_zero`]); `None` until taken.
+    head: [Option<i32>; 3],
     done: bool,
 }
 
@@ -35,6 +38,7 @@ impl Rise {
             len: 0,
             pos: [0; RISE_POINTS],
             d: [0; RISE_POINTS],
+            head: [None; 3],
             done: false,
         }
     }
@@ -64,6 +68,11 @@ impl Rise {
     pub fn take(&mut self, pos0: u64, n: usize, d: impl Fn(usize) -> i64) {
         if self.done {
             return;
+        }
+        for (at, slot) in self.head.iter_mut().enumerate() {
+            if let Some(k) = (at as u64).checked_sub(pos0).filter(|&k| k < n as u64) {
+                *slot = Some(d(k as usize).clamp(i32::MIN as i64, i32::MAX as i64) as i32);
+            }
         }
         // The stride is a power of two: positions on it by masks (a 64-bit division is a
         // library call on the Cortex-M4).
@@ -102,6 +111,14 @@ impl Rise {
                 self.len += 1;
             }
             k += u64::from(self.stride);
+        }
+    }
+
+    /// The onset's sample and the next two, once taken.
+    pub fn head(&self) -> Option<[i32; 3]> {
+        match self.head {
+            [Some(a), Some(b), Some(c)] => Some([a, b, c]),
+            _ => None,
         }
     }
 
