@@ -50,8 +50,9 @@ fn check(r: &Value, t: &ContactTruth, law: &str, what: &str, rate: f64) {
     let touch = Touch::of(law, rate, t);
     let w = |f: &str| format!("{what}: {f}");
     // First touch itself: within 0.6 of a sample (a step's middle, half a sample from where
-    // it may lie), or 4 µs where the foot rises slowly out of the noise (2 samples at
-    // 500 kS/s: a Hertz foot's power fit).
+    // it may lie), or 4 µs, where a foot's first samples lie within the noise (2 samples at
+    // 500 kS/s: a Hertz foot's power fit 1.7 samples early, the soft pads' and a 5 mm drop's
+    // slow feet up to 1.35).
     let start = r["start_s"].as_f64().unwrap();
     assert!(
         (start - t.touch_s).abs() <= (0.6 / rate).max(4e-6),
@@ -93,8 +94,11 @@ fn check(r: &Value, t: &ContactTruth, law: &str, what: &str, rate: f64) {
             w("set"),
             s.set_m
         ),
+        // (A contact of a millisecond: its restitution's points too few to tell a set from
+        // none, `set-not-resolved`.)
         None => assert!(
-            !matches!(law, "linear" | "kelvin-voigt" | "two-phase"),
+            !matches!(law, "linear" | "kelvin-voigt" | "two-phase")
+                || t.crush_time_s.unwrap() < 1e-3,
             "{}: null ({})",
             w("set"),
             r["null_reasons"]["permanent_deformation_m"]
@@ -567,10 +571,11 @@ fn bounce_trains_of_every_law_within_one_percent() {
 
 /// 1 ms contacts (linear, Hertz, seed 001's law and Kelvin–Voigt, 91 mm drops from rest) at
 /// coarse rates, four touch phases: at 100 kS/s (100 samples a contact) every field within
-/// 1 % ([`check`]: Kelvin–Voigt's crush time and `x_m` within half a sample); at 20 kS/s
-/// (20 samples) the crush time and `x_m` of the laws whose foot starts smooth and straight
-/// (linear, seed 001's) within 1 %: the onset's step past the flank level is placed from its
-/// first three samples, not in the middle of the interval before it (up to ±6 % on `x_m`).
+/// 1 % ([`check`]: Kelvin–Voigt's crush time and `x_m` within half a sample, its set null);
+/// at 20 kS/s (20 samples) first touch within a tenth of a sample and the COR, crush time and
+/// `x_m` within 1 % for the laws whose foot starts smooth and straight (linear, seed 001's):
+/// the onset's step past the flank level is placed from its first three samples, not in the
+/// middle of the interval before it (up to ±6 % on `x_m`).
 /// Not yet: Hertz and Kelvin–Voigt at 20 kS/s, and coarser rates (docs/accuracy.md; #43).
 #[test]
 fn a_one_millisecond_contact_at_coarse_rates() {
@@ -619,32 +624,17 @@ fn a_one_millisecond_contact_at_coarse_rates() {
                 let impacts = a["impacts"].as_array().unwrap();
                 assert_eq!(impacts.len(), 1, "{what}: {impacts:#?}");
                 let (r, t) = (&impacts[0], &truth[0]);
-                if rate >= 1e5 && name != "kelvin-voigt" {
+                if rate >= 1e5 {
                     check(r, t, name, &what, rate);
-                } else if rate >= 1e5 {
-                    // (Its set is null at 1 ms: `set-not-resolved`, the restitution's points
-                    // too few to tell a set from none.)
-                    let (s, touch) = (t.separation.unwrap(), Touch::of(name, rate, t));
-                    within(&r["cor"], s.cor, 0.01, &format!("{what}: cor"));
-                    within(
-                        &r["peak_force_n"],
-                        t.peak_force_n,
-                        0.01,
-                        &format!("{what}: peak"),
-                    );
-                    within(
-                        &r["crush_time_s"],
-                        t.crush_time_s.unwrap(),
-                        touch.crush,
-                        &what,
-                    );
-                    within(
-                        &r["max_deformation_m"],
-                        t.max_deformation_m.unwrap(),
-                        touch.x_m,
-                        &what,
-                    );
                 } else {
+                    // First touch from the step's three samples: within a tenth of a sample.
+                    let start = r["start_s"].as_f64().unwrap();
+                    assert!(
+                        (start - t.touch_s).abs() * rate <= 0.1,
+                        "{what}: first touch {:+.3} samples",
+                        (start - t.touch_s) * rate
+                    );
+                    within(&r["cor"], t.separation.unwrap().cor, 0.01, &what);
                     within(&r["crush_time_s"], t.crush_time_s.unwrap(), 0.01, &what);
                     within(
                         &r["max_deformation_m"],

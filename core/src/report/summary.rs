@@ -42,8 +42,10 @@ pub struct Summary {
     /// The signal never came back and the onset came more than the settle time before the
     /// peak: the pulse rode on drift, which its start, duration and Δv take in.
     pub drift: bool,
-    /// The pulse was already beyond the edge level where the previous impact's contact ended
-    /// (the signal never came back between them): its start is that contact's end.
+    /// The pulse was under way before the previous impact's window ended: beyond the edge
+    /// level where that contact ended (the signal never came back between them: its start is
+    /// that contact's end), or on a ramp under the edge level that runs back into that window
+    /// (its start where the ramp or the foot's fit puts it, not before that window's end).
     pub in_previous: bool,
     /// The impact follows a flight and the scene's approach speed is only the first
     /// impact's: `v0_m_s` is `None` for that reason ([`crate::stream::train`]).

@@ -208,7 +208,8 @@ pub fn steep_zero(y: [f32; 3]) -> f32 {
 pub enum Choice {
     /// The best (see [`zero`]), or `prior` where it fits no worse than the line; with
     /// `line`, the straight line itself where no power is clearly better (the caller has no
-    /// better line: its flank between the edge and flank levels held too few samples).
+    /// better line: its flank between the edge and flank levels held too few samples, or
+    /// stepped past the flank level in one).
     Free { prior: Option<f32>, line: bool },
     /// This power only, where it fits no worse than the line (a falling foot takes its
     /// rising foot's: a damped law's slow return is no power curve, and a foot fitted as

@@ -43,7 +43,7 @@ pub(super) struct Active {
     /// its flank was still in the ring (a long ring-down after it would push it out).
     pub(super) separation_at: Option<(u64, f32, i64)>,
     /// The rising side, for the foot's fit at the end; the pulse's sign; `Σ d` over the whole
-    /// samples from the straight-line first touch to the onset.
+    /// samples from the trigger's first touch (`touch_offset`) to the onset.
     pub(super) rise: Rise,
     /// The falling foot: from where the signal last came down through the foot's top after
     /// the latest peak to the separation (so its fit sees the whole foot, averaged, for any
@@ -67,7 +67,7 @@ pub(super) struct Active {
     /// The signal did not come back, and the onset came more than the settle time before the
     /// peak: the pulse rode on drift; or a ramp into it began beyond the flanks' reach.
     pub(super) drift: bool,
-    /// The rising flank's straight line reaches zero inside the previous impact's contact.
+    /// The trigger's first touch (`touch_offset`) lies inside the previous impact's contact.
     pub(super) line_in_previous: bool,
     /// The whole lobe before the onset: where it crosses the baseline (relative to the
     /// onset, samples) and `Σ d` over its samples.
@@ -95,12 +95,14 @@ pub(super) struct Active {
 pub(super) enum FlankTouch {
     /// The zero of the line fitted to the flank's samples between the edge and flank levels.
     Line,
-    /// The onset stepped past the flank level from within the edge level: the middle of the
-    /// sample interval before it (`Stream::touch` places it within that interval from the
-    /// onset and the next two samples).
+    /// The onset stepped past the flank level from the sample before it (within the edge
+    /// level, or beyond it the other way: ringing): the middle of the sample interval before
+    /// it (`Stream::touch` places it within that interval from the onset and the next two
+    /// samples).
     Steep,
     /// The edge level's crossing before the onset (late by design: the foot below the edge
-    /// level lies before it): the flank held too few samples for a line.
+    /// level lies before it), or the onset itself where the ring holds no sample before it:
+    /// the flank held too few samples for a line.
     Crossing,
     /// The edge level's crossing, the flank's line refused (a jump onto it, or a zero out of
     /// its reach).

@@ -1,7 +1,8 @@
 //! Where the contact begins and ends, as the physics defines them (where the contact force is
 //! zero): the feet of the pulse fitted as power curves ([`power_flank`]), the whole lobe where
-//! a ramp rises into the onset, the falling flank's straight line or edge crossing otherwise;
-//! and the falling foot's record.
+//! a ramp rises into the onset, a step past the flank level placed from its three samples
+//! ([`power_flank::steep_zero`]), the falling flank's straight line, zero crossing or edge
+//! crossing otherwise; and the falling foot's record.
 
 use super::active::{Active, FlankTouch};
 use super::rise::Fall;
@@ -316,11 +317,13 @@ impl<const PRE: usize> Stream<PRE> {
         let longer = a.lobe_touch < touch.0;
         let fits = a.lobe_touch >= a.touch_floor;
         if !(longer && fits) {
-            return (touch.0, touch.1, touch.2 || (fits && a.lobe_in_previous));
+            return (touch.0, touch.1, touch.2 || a.lobe_in_previous);
         }
         // The lobe's samples before the fitted touch: a foot's or a ramp's sum stands out of
         // the noise; the noise's that a walk to the first sample at the baseline crosses
-        // does not.
+        // does not. (The difference of the lobe's sum and the fit's over the samples after
+        // its touch: where that is the fitted curve's, not the samples', their noise enters
+        // too, and the test is a little looser than its 3σ.)
         let before = touch.0 - a.lobe_touch;
         let sum = (a.sign * (a.lobe_c - touch.1)) as f32;
         let ramp = sum > LOBE_SIGNIFICANCE * a.edge_d as f32 * libm::sqrtf(before.max(0.0));
@@ -392,8 +395,11 @@ impl<const PRE: usize> Stream<PRE> {
     }
 
     /// The separation relative to `separation_index`: the falling flank (from the ring)
-    /// extrapolated to zero, the zero crossing for a sign flip across the whole edge band,
-    /// or the edge crossing between the last sample beyond the edge and the first within it.
+    /// extrapolated to zero, the zero crossing for a sign flip across the whole edge band; a
+    /// step down from beyond the flank level within one sample placed from its three samples
+    /// ([`power_flank::steep_zero`], mirrored), or at the zero crossing where the first quiet
+    /// sample has crossed zero; else the edge crossing between the last sample beyond the
+    /// edge and the first within it.
     pub(super) fn separation_offset(&self, a: &Active, separation: u64) -> f32 {
         let deviation = a.deviation();
         // The ring ends at `self.run.index - 1`: sample `i` is `back(index - 1 - i)`; no further
@@ -440,7 +446,12 @@ impl<const PRE: usize> Stream<PRE> {
                 // last sample, and the two before it. Where the next sample has crossed, the
                 // zero lies between the two, as the line between them says.)
                 (Some(y0), Some(y1)) if y0 > a.flank_d && y1 > 0 => {
-                    let at = |j: u64| last.checked_sub(j).and_then(pd).map_or(-1.0, |y| y as f32);
+                    // (A sample the ring no longer holds is none: `steep_zero` refuses NaN.)
+                    let at = |j: u64| {
+                        last.checked_sub(j)
+                            .and_then(pd)
+                            .map_or(f32::NAN, |y| y as f32)
+                    };
                     -1.0 - power_flank::steep_zero([y0 as f32, at(1), at(2)])
                 }
                 (Some(y0), Some(y1)) if y0 > a.flank_d => {

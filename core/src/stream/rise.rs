@@ -231,6 +231,28 @@ impl Fall {
 mod tests {
     use super::*;
 
+    /// The onset's sample and the next two, however the rise is taken in pieces (from the
+    /// trigger, `pulse` samples of it already in the ring) and whatever the stride.
+    #[test]
+    fn the_head_is_the_onset_and_the_next_two_samples() {
+        let d = |k: u64| 10 * k as i64 + 7;
+        for pulse in [0usize, 1, 2, 3, 5] {
+            for split in 1..6 {
+                let mut r = Rise::new();
+                // At the trigger: positions 0..pulse from the ring.
+                r.take(0, pulse, |k| d(k as u64));
+                // Then the stream, `split` samples at a time, from position `pulse`.
+                let mut pos = pulse as u64;
+                while pos < 2000 {
+                    r.take(pos, split, |k| d(pos + k as u64));
+                    pos += split as u64;
+                }
+                assert_eq!(r.head(), Some([7, 17, 27]), "pulse {pulse}, split {split}");
+            }
+        }
+        assert_eq!(Rise::new().head(), None);
+    }
+
     #[test]
     fn the_fall_keeps_bucket_means_and_merges_them_when_full() {
         // A ramp 1000, 999, ... in pieces of 37: at most FALL_POINTS buckets, each the exact
