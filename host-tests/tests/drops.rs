@@ -50,12 +50,15 @@ fn check(r: &Value, t: &ContactTruth, law: &str, what: &str, rate: f64) {
     let touch = Touch::of(law, rate, t);
     let w = |f: &str| format!("{what}: {f}");
     // First touch itself: within 0.6 of a sample (a step's middle, half a sample from where
-    // it may lie), or 4 µs, where a foot's first samples lie within the noise (2 samples at
-    // 500 kS/s: a Hertz foot's power fit 1.7 samples early, the soft pads' and a 5 mm drop's
-    // slow feet up to 1.35).
+    // it may lie), or where a foot's first samples lie within the noise, 5 µs (2.5 samples at
+    // 500 kS/s: a Hertz foot's power fit 1.7 samples early; the seed's soft two-phase pad up
+    // to 2 either way) or the time its mean slope takes to rise two codes of the ±2000 m/s²
+    // ADC (the soft pad from 5 mm: 62 µs, where 20 kS/s puts touch 0.65 samples early).
+    let code = 4000.0 / 65536.0;
+    let slope = std::f64::consts::FRAC_PI_2 * t.peak_force_n / 0.06 / t.crush_time_s.unwrap();
     let start = r["start_s"].as_f64().unwrap();
     assert!(
-        (start - t.touch_s).abs() <= (0.6 / rate).max(4e-6),
+        (start - t.touch_s).abs() <= (0.6 / rate).max(5e-6).max(2.0 * code / slope),
         "{}: {start} s vs true {} s ({:+.2} samples)",
         w("first touch"),
         t.touch_s,
@@ -97,8 +100,10 @@ fn check(r: &Value, t: &ContactTruth, law: &str, what: &str, rate: f64) {
         // (A contact of a millisecond: its restitution's points too few to tell a set from
         // none, `set-not-resolved`.)
         None => assert!(
-            !matches!(law, "linear" | "kelvin-voigt" | "two-phase")
-                || t.crush_time_s.unwrap() < 1e-3,
+            !matches!(
+                law,
+                "linear" | "kelvin-voigt" | "two-phase" | "two-phase-continuous"
+            ) || t.crush_time_s.unwrap() < 1e-3,
             "{}: null ({})",
             w("set"),
             r["null_reasons"]["permanent_deformation_m"]
@@ -283,6 +288,18 @@ fn drops_from_rest_are_measured_from_free_fall() {
         ("nonlinear", seed_nonlinear_stiff()),
         ("kelvin-voigt", kelvin_voigt_pad()),
         ("two-phase", seed_two_phase_pad()),
+        // The seed's pad with its set from force continuity (`x_p = x_m (1 − kc/kr)`): a
+        // set that follows the crush, from 91 mm or 5 mm.
+        (
+            "two-phase-continuous",
+            Model::TwoPhase(TwoPhase {
+                permanent_m: None,
+                ..match seed_two_phase_pad() {
+                    Model::TwoPhase(p) => p,
+                    _ => unreachable!(),
+                }
+            }),
+        ),
     ];
     for (name, law) in laws {
         for (height, rate) in [
@@ -292,8 +309,11 @@ fn drops_from_rest_are_measured_from_free_fall() {
             (0.005, 500_000.0),
             (0.005, 20_000.0),
         ] {
-            // The seed's two-phase pad from 5 mm (kc 309 N/m: a 2 mm static deflection, a
-            // foot below the noise for tens of ms) ends `no-stop`: open (#40).
+            // Not the seed's two-phase pad from 5 mm: its fixed set (18.2 mm) lies deeper than
+            // that drop's crush (6.7 mm), so the pad lets go at the crush (COR 0; a 1 %
+            // tolerance on 0 is none) and the body's stop coincides with the contact's end
+            // (`no-stop` at 20 kS/s where the sums' stop falls just past it). The pad whose
+            // set follows the crush stands in for it.
             if name == "two-phase" && height < 0.01 {
                 continue;
             }
@@ -324,8 +344,14 @@ fn drops_from_rest_are_measured_from_free_fall() {
                 assert_eq!(impacts.len(), 1, "{what}: {impacts:#?}");
                 let r = &impacts[0];
                 assert_eq!(r["status"], "complete", "{what}");
+                // No flag but `decimated` (a contact longer than the capture, kept at a
+                // coarser step: the 5 mm drop on the soft pad, 32 ms).
                 assert!(
-                    r["flags"].as_array().unwrap().is_empty(),
+                    r["flags"]
+                        .as_array()
+                        .unwrap()
+                        .iter()
+                        .all(|f| f == "decimated"),
                     "{what}: {}",
                     r["flags"]
                 );
