@@ -191,6 +191,22 @@ fn seed_nonlinear() -> Model<f64> {
     })
 }
 
+/// One contact of the 60 g body held at rest for 50 ms and `phase` of a sample at `rate`,
+/// released, falling `height_m`.
+fn from_rest(law: Model<f64>, height_m: f64, rate: f64, phase: f64) -> Drop {
+    Drop {
+        law,
+        mass_kg: 0.06,
+        gravity_m_s2: G,
+        start: Start::Rest {
+            rest_s: 0.05 + phase / rate,
+            height_m,
+        },
+        max_contacts: 1,
+        min_rebound_m_s: 1e-3,
+    }
+}
+
 fn moving(law: Model<f64>, contacts: u32) -> Drop {
     Drop {
         law,
@@ -318,17 +334,7 @@ fn drops_from_rest_are_measured_from_free_fall() {
                 continue;
             }
             for phase in [0.0, 0.37, 0.5, 0.71] {
-                let drop = Drop {
-                    law,
-                    mass_kg: 0.06,
-                    gravity_m_s2: G,
-                    start: Start::Rest {
-                        rest_s: 0.05 + phase / rate,
-                        height_m: height,
-                    },
-                    max_contacts: 1,
-                    min_rebound_m_s: 1e-3,
-                };
+                let drop = from_rest(law, height, rate, phase);
                 let what = format!("{name} from {height} m at {rate} S/s, phase {phase}");
                 let (text, truth) = csv(&drop, rate, 1.0, 2000.0);
                 let h = height.to_string();
@@ -628,17 +634,7 @@ fn a_one_millisecond_contact_at_coarse_rates() {
                 continue;
             }
             for phase in [0.0, 0.25, 0.5, 0.75] {
-                let drop = Drop {
-                    law,
-                    mass_kg: 0.06,
-                    gravity_m_s2: G,
-                    start: Start::Rest {
-                        rest_s: 0.05 + phase / rate,
-                        height_m: 0.091,
-                    },
-                    max_contacts: 1,
-                    min_rebound_m_s: 1e-3,
-                };
+                let drop = from_rest(law, 0.091, rate, phase);
                 let what = format!("1 ms {name} at {rate} S/s, phase {phase}");
                 let (text, truth) = csv(&drop, rate, 0.5, 20_000.0);
                 let a = analyse(

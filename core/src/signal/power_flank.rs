@@ -188,13 +188,10 @@ pub fn steep_zero(y: [f32; 3]) -> f32 {
             // How far the middle lies off the line through the outer two, over the rise.
             let bend =
                 libm::fabsf(z[1] - 0.5 * (z[0] + z[2])) / (z[2] - z[0]).max(f32::MIN_POSITIVE);
-            (bend, p, z)
+            (bend, z)
         })
-        .fold(None, |best: Option<(f32, f32, [f32; 3])>, c| match best {
-            Some(b) if b.0 <= c.0 => Some(b),
-            _ => Some(c),
-        });
-    let Some((_, _, z)) = best else { return -0.5 };
+        .min_by(|a, b| a.0.total_cmp(&b.0));
+    let Some((_, z)) = best else { return -0.5 };
     let zero = -z[0] / (z[1] - z[0]);
     if (-1.0..=0.0).contains(&zero) {
         zero
