@@ -533,11 +533,15 @@ fn a_body_settling_on_a_soft_pad_is_one_contact_that_never_ends() {
 /// ([`check`]: the crush time and x_m within half a sample where the force jumps at touch;
 /// bounces 1 and 3 at 20 kS/s were 2.3 samples early, crush time +3 %, x_m +4.7 %, where
 /// the walk back through the foot's noise after a flight set first touch). From the
-/// previous rebound (`--train rebound`, a chain: each bounce inherits the previous one's
-/// error with its sign turned), the same at 500 and 100 kS/s for the pads that leave the body
-/// at their surface or their set; not yet at 20 kS/s (the chain's COR 1.1–2.6 % off by bounce
-/// 5) nor on a Kelvin–Voigt pad (each bounce `g c / k` too fast: COR 4–5 % low by bounce 5):
-/// open (#40).
+/// previous rebound (`--train rebound`, a chain: each bounce's speed the previous rebound
+/// brought down by the flight's time, `g t - v_r`), v0, the COR and the rebound within 1 % at
+/// 500 and 100 kS/s on every pad (a Kelvin–Voigt pad's bounce 5 was 1.9 % fast when the
+/// chain landed each bounce where it left). At 20 kS/s the chain adds each contact's Δv error
+/// (0.1–0.3 % of the speed): v0 within 1 % on every bounce but the seed's virgin pad's (its
+/// force steps down at the crush, and the chain takes that step's half-sample share, +0.7 %
+/// of the rebound, into every later bounce: 1.3 % by bounce 5; open, #40), and the COR
+/// and the rebound within 1 % beyond what the chain's own speed error moves them (the
+/// rebound by `1/COR` times its share, the COR by `1 + 1/COR` times).
 #[test]
 fn bounce_trains_of_every_law_within_one_percent() {
     let scratch = Scratch::new();
@@ -556,9 +560,9 @@ fn bounce_trains_of_every_law_within_one_percent() {
         for rate in [500_000.0, 100_000.0, 20_000.0] {
             let (text, truth) = csv(&moving(law, 6), rate, 1.5, 1000.0);
             for speed in ["flight", "rebound"] {
-                if speed == "rebound" && (rate < 1e5 || name == "kelvin-voigt") {
-                    continue;
-                }
+                // The chain at 20 kS/s: the speed within 1 % (not the virgin pad's), the
+                // COR within 1 % beyond the share the speed's error moves it.
+                let chained = speed == "rebound" && rate < 1e5;
                 let a = analyse(
                     &scratch,
                     &format!("every-{name}-{rate}-{speed}.csv"),
@@ -570,17 +574,28 @@ fn bounce_trains_of_every_law_within_one_percent() {
                 for (i, (r, t)) in impacts.iter().zip(&truth).enumerate() {
                     let what = format!("{name} at {rate} S/s, {speed}, bounce {i}");
                     let Some(s) = t.separation else { continue };
-                    within(
-                        &r["impact_velocity_m_s"],
-                        t.approach_m_s,
-                        0.01,
-                        &format!("{what}: v0"),
-                    );
-                    within(&r["cor"], s.cor, 0.01, &format!("{what}: cor"));
+                    let v0 = r["impact_velocity_m_s"].as_f64().unwrap();
+                    let share = (v0 / t.approach_m_s - 1.0).abs();
+                    if !(chained && name == "two-phase") {
+                        within(
+                            &r["impact_velocity_m_s"],
+                            t.approach_m_s,
+                            0.01,
+                            &format!("{what}: v0"),
+                        );
+                    }
+                    // (The rebound `Δv - v0` moves by the speed's error, `1/COR` of its
+                    // share; the COR by both.)
+                    let (moved, cor_moved) = if chained {
+                        (share / s.cor, share / s.cor + share)
+                    } else {
+                        (0.0, 0.0)
+                    };
+                    within(&r["cor"], s.cor, 0.01 + cor_moved, &format!("{what}: cor"));
                     within(
                         &r["rebound_velocity_m_s"],
                         s.rebound_m_s,
-                        0.01,
+                        0.01 + moved,
                         &format!("{what}: rebound"),
                     );
                     if i > 0 && speed == "flight" {
@@ -605,10 +620,13 @@ fn bounce_trains_of_every_law_within_one_percent() {
 /// coarse rates, four touch phases: at 100 kS/s (100 samples a contact) every field within
 /// 1 % ([`check`]: Kelvin–Voigt's crush time and `x_m` within half a sample, its set null);
 /// at 20 kS/s (20 samples) first touch within a tenth of a sample and the COR, crush time and
-/// `x_m` within 1 % for the laws whose foot starts smooth and straight (linear, seed 001's):
+/// `x_m` within 1 % for the laws whose force starts from zero (linear, Hertz, seed 001's):
 /// the onset's step past the flank level is placed from its first three samples, not in the
-/// middle of the interval before it (up to ±6 % on `x_m`).
-/// Not yet: Hertz and Kelvin–Voigt at 20 kS/s, and coarser rates (docs/accuracy.md; #43).
+/// middle of the interval before it (up to ±6 % on `x_m`), and so is an onset just past the
+/// edge level whose next two samples lie on its power curve (Hertz at phase 0.25: the walk
+/// back to the baseline had it 0.87 samples early, `x_m` +12.6 %).
+/// Not yet: Kelvin–Voigt at 20 kS/s (its jump: touch anywhere in a sample), and coarser
+/// rates (docs/accuracy.md; #43).
 #[test]
 fn a_one_millisecond_contact_at_coarse_rates() {
     let scratch = Scratch::new();
@@ -630,7 +648,7 @@ fn a_one_millisecond_contact_at_coarse_rates() {
     ];
     for (name, law) in laws {
         for rate in [100_000.0, 20_000.0] {
-            if rate < 1e5 && !matches!(name, "linear" | "nonlinear") {
+            if rate < 1e5 && name == "kelvin-voigt" {
                 continue;
             }
             for phase in [0.0, 0.25, 0.5, 0.75] {

@@ -13,8 +13,9 @@ pub struct Bounce {
     pub flight_s: f32,
     /// The landing speed the flight time gives, `g t / 2 - h / t`, m/s.
     pub v0_flight_m_s: f32,
-    /// The previous impact's rebound, m/s (the body taken to land where it left); absent if
-    /// it had none (no Δv, a COR out of range).
+    /// The previous impact's rebound `v_r` brought down by the flight `t`, `g t - v_r`, m/s;
+    /// absent if it had none (no Δv, a COR out of range) or the flight was too short to come
+    /// back from it.
     pub v0_rebound_m_s: Option<f32>,
     /// `h`: how far above the previous separation the body landed, m. The body leaves a pad
     /// at its separation deformation `x_sep`; a pad that recovers its shape (elastic,

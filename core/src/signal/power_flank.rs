@@ -171,13 +171,40 @@ fn fit(
 /// bias). In `[-1, 0]`. (A jump onto a ramp, `c v0 + k v0 t`, is a straight line too: it
 /// reads as a ramp that began up to a sample earlier.)
 pub fn steep_zero(y: [f32; 3]) -> f32 {
+    match head_line(y) {
+        Some((zero, _)) if (-1.0..=0.0).contains(&zero) => zero,
+        _ => -0.5,
+    }
+}
+
+/// How far the middle of three samples may lie off the line through the outer two, over
+/// the rise, for [`head_zero`] to take their line: a power curve's three first samples lie
+/// on it within 0.3 % (a Hertz foot at 20 kS/s, its first sample a tenth of a sample in);
+/// a slow foot's noise puts them off it by far more.
+pub const HEAD_BEND: f32 = 0.02;
+
+/// Where a foot whose first sample lies just past the edge level (its flank too short for a
+/// line: one sample to the flank level) reaches zero, relative to that sample, from its
+/// first three samples `y`, as [`steep_zero`] does, but only where the power puts them on a
+/// line (within [`HEAD_BEND`]) whose zero lies in the interval before the first: a foot the
+/// sampling resolves in three samples (a Hertz contact's `t^1.5` at 20 kS/s). Else `None`
+/// (the caller's estimate stands).
+pub fn head_zero(y: [f32; 3]) -> Option<f32> {
+    let (zero, bend) = head_line(y)?;
+    ((-1.0..=0.0).contains(&zero) && bend <= HEAD_BEND).then_some(zero)
+}
+
+/// The zero of the line through the first two of three samples under the power of
+/// [`POWERS`] that puts them most nearly on a line, and how far the middle one lies off the
+/// line through the outer two, over the rise; `None` unless they rise.
+fn head_line(y: [f32; 3]) -> Option<(f32, f32)> {
     let [y0, y1, y2] = y;
     if !(y0 > 0.0 && y1 > y0 && y2.is_finite()) {
-        return -0.5;
+        return None;
     }
     // Scaled by the largest, so each root is of a number in (0, 1].
     let top = y0.max(y1).max(y2);
-    let best = POWERS
+    let (bend, z) = POWERS
         .iter()
         .map(|&p| {
             let z = [
@@ -190,14 +217,9 @@ pub fn steep_zero(y: [f32; 3]) -> f32 {
                 libm::fabsf(z[1] - 0.5 * (z[0] + z[2])) / (z[2] - z[0]).max(f32::MIN_POSITIVE);
             (bend, z)
         })
-        .min_by(|a, b| a.0.total_cmp(&b.0));
-    let Some((_, z)) = best else { return -0.5 };
+        .min_by(|a, b| a.0.total_cmp(&b.0))?;
     let zero = -z[0] / (z[1] - z[0]);
-    if (-1.0..=0.0).contains(&zero) {
-        zero
-    } else {
-        -0.5
-    }
+    zero.is_finite().then_some((zero, bend))
 }
 
 /// Which powers a fit may take.
@@ -307,6 +329,23 @@ mod tests {
         assert_eq!(steep_zero([0.0, 10.0, 20.0]), -0.5);
         assert_eq!(steep_zero([10.0, 10.0, 20.0]), -0.5);
         assert_eq!(steep_zero([f32::NAN, 10.0, 20.0]), -0.5);
+    }
+
+    #[test]
+    fn a_head_on_a_power_curve_gives_its_zero_and_any_other_none() {
+        // The Hertz foot at 20 kS/s that the walk back put 0.87 samples early.
+        let z = head_zero([56402.0, 1411154.0, 3620690.0]).unwrap();
+        assert!((z + 0.134).abs() < 0.01, "{z}");
+        for p in POWERS {
+            let y = [0.0f32, 1.0, 2.0].map(|x| 40.0 * power(x + 0.3, p));
+            assert!((head_zero(y).unwrap() + 0.3).abs() < 0.02, "power {p}");
+        }
+        // Bent off every power's line (noise on a slow foot), a zero beyond the interval,
+        // no rise: none.
+        assert_eq!(head_zero([10.0, 30.0, 31.0]), None);
+        assert_eq!(head_zero([100.0, 104.0, 108.0]), None);
+        assert_eq!(head_zero([10.0, 10.0, 20.0]), None);
+        assert_eq!(head_zero([f32::NAN, 10.0, 20.0]), None);
     }
 
     #[test]

@@ -275,7 +275,7 @@ impl<const PRE: usize> Stream<PRE> {
                 let c = foot.sum(-lead, 0) * peak * a.sign as f32;
                 ((touch, c as i64, foot.zero < a.touch_floor), true)
             }
-            None => match self.steep_touch(a) {
+            None => match self.head_touch(a) {
                 Some(z) => ((z.max(a.touch_floor), a.lead_c, a.line_in_previous), true),
                 // (A step's middle is no edge crossing either.)
                 None => (
@@ -286,15 +286,19 @@ impl<const PRE: usize> Stream<PRE> {
         }
     }
 
-    /// First touch relative to the onset where the onset stepped past the flank level
-    /// ([`FlankTouch::Steep`]): from the onset and the next two samples (the rise record's
-    /// head), [`power_flank::steep_zero`].
-    fn steep_touch(&self, a: &Active) -> Option<f32> {
-        if a.flank_touch != FlankTouch::Steep {
-            return None;
+    /// First touch relative to the onset from the onset and the next two samples (the rise
+    /// record's head): where the onset stepped past the flank level
+    /// ([`FlankTouch::Steep`]), [`power_flank::steep_zero`]; where it lies just past the edge
+    /// level and the flank had no line ([`FlankTouch::Crossing`]), [`power_flank::head_zero`]
+    /// if the three lie on a power curve (a Hertz foot at 20 kS/s, its onset a tenth of a
+    /// sample in: else the walk back to the baseline puts touch up to a sample early).
+    fn head_touch(&self, a: &Active) -> Option<f32> {
+        let head = || a.rise.head().map(|y| y.map(|d| d as f32));
+        match a.flank_touch {
+            FlankTouch::Steep => Some(power_flank::steep_zero(head()?)),
+            FlankTouch::Crossing => power_flank::head_zero(head()?),
+            FlankTouch::Line | FlankTouch::Refused => None,
         }
-        let [y0, y1, y2] = a.rise.head()?;
-        Some(power_flank::steep_zero([y0 as f32, y1 as f32, y2 as f32]))
     }
 
     /// First touch where the whole lobe begins, if that is earlier than `touch` (first touch,

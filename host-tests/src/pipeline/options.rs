@@ -471,7 +471,8 @@ pub enum SpeedArg {
     /// `g t / 2 - h / t`, from the flight `t` since the previous separation (`h`: how far
     /// above where it left the body lands, the pad recovered or dented).
     Flight,
-    /// The previous impact's rebound (`Δv - v0 - g t_c`).
+    /// The previous impact's rebound `v_r` (`Δv - v0 - g t_c`) brought down by the flight
+    /// `t`: `g t - v_r`.
     Rebound,
 }
 
@@ -482,7 +483,8 @@ pub struct TrainArgs {
     ///
     /// Bounce trains: each impact after the first of a drop takes its approach speed from the
     /// flight time since the previous separation (`flight`, vertical flight under gravity
-    /// along the sensor's axis, no drag) or from the previous rebound (`rebound`); the first
+    /// along the sensor's axis, no drag) or from the previous rebound brought down by the
+    /// flight (`rebound`, a chain: each bounce keeps the previous one's error); the first
     /// impact takes --v0, --drop-height or --free-fall. Both speeds are reported.
     #[arg(long, help_heading = "Analysis", value_enum)]
     pub train: Option<SpeedArg>,

@@ -16,7 +16,8 @@ pub struct BounceJson {
     pub flight_s: f64,
     /// The landing speed the flight gives, `g t / 2 - h / t`, m/s.
     pub v0_flight_m_s: f64,
-    /// The previous impact's rebound, m/s (null: it had none).
+    /// The previous impact's rebound `v_r` brought down by the flight `t`, `g t - v_r`, m/s
+    /// (null: it had none).
     pub v0_rebound_m_s: Option<f64>,
     /// `h`, how far above the previous separation the body landed, m: the previous separation
     /// deformation (the pad recovered its shape) or 0 (it kept the dent), as the previous
