@@ -463,7 +463,16 @@ fn analyse_kinematics<const CAP: usize>(
         };
         r.flags.remove(Flags::NO_STOP);
         r.flags.remove(Flags::KINEMATICS_NOT_HELD);
-        report::motion::kinematics(&mut r, scene, &frame, &frame.found(crush, separation));
+        let found = frame.found(crush, separation);
+        // A force that steps at the crush: Δv takes the area the sums missed, as the
+        // stream's does where its sums found it (on every sample, not a decimated capture's
+        // means; `s.motion` holds nothing here, so no step is counted twice).
+        if found.step_c != 0 && step == 1 {
+            let mut stepped = *s;
+            stepped.motion = report::motion::Record::found(found);
+            r.delta_v_m_s = report::measured(&stepped, scene).delta_v_m_s;
+        }
+        report::motion::kinematics(&mut r, scene, &frame, &found);
     }
     let Some(k) = r.kinematics else {
         return r;

@@ -83,13 +83,25 @@ fn run_to_stop(s: &mut Sums, samples: &[i16], dev: Deviation, c_stop: i64) -> Op
                 c: c_next,
                 q: q + c_next,
             };
-            Some(Crush { at, c_next })
+            Some(Crush {
+                at,
+                c_next,
+                beside: None,
+            })
         }
         None => {
             *s = at;
             None
         }
     }
+}
+
+/// The deviations of the samples just before and after sample `k` of `samples`, if both
+/// are there ([`Crush::beside`]).
+pub(crate) fn beside(samples: &[i16], k: usize, dev: Deviation) -> Option<(i64, i64)> {
+    let before = samples.get(k.checked_sub(1)?)?;
+    let after = samples.get(k.checked_add(1)?)?;
+    Some((dev.of(*before) as i64, dev.of(*after) as i64))
 }
 
 /// Runs the sums over `samples` (the raw samples from the frame's first; `dev` removes the
@@ -169,7 +181,11 @@ pub fn integrate(
         let k = s.k as usize;
         crush = run_to_stop(&mut s, samples.get(k..).unwrap_or(&[]), dev, c_stop);
     }
-    let crush = crush?;
+    let mut crush = crush?;
+    // (Not within the foot, where the online sums look for no step either.)
+    if crush.at.k >= frame.lead {
+        crush.beside = beside(samples, crush.at.k as usize, dev);
+    }
     let [Some(s0), Some(s1)] = at_sep else {
         return None;
     };

@@ -367,7 +367,10 @@ pub(crate) fn measured(s: &Summary, scene: &Scene) -> ImpactReport {
     if s.in_previous {
         flags.insert(Flags::IN_PREVIOUS);
     }
-    let delta_v = match s.contact_c {
+    // (A force that steps at the crush: the contact's Δv takes the area the sums missed,
+    // where they found the crush.)
+    let step_c = s.motion.get().map_or(0, |f| f.step_c);
+    let delta_v = match s.contact_c.map(|c| c.wrapping_add(step_c)) {
         _ if s.drift => None,
         Some(c) if c != 0 && (s.total_c as f64 / c as f64) < AC_COUPLED_RATIO => {
             flags.insert(Flags::AC_COUPLED);

@@ -37,11 +37,63 @@ impl Sums {
 }
 
 /// Where the velocity first reached zero: the state before the sample whose `C` first reached
-/// [`Scale::c_stop`], and `C` after it.
+/// [`Scale::c_stop`], and `C` after it; and the deviations (`d'`) of the samples just before
+/// and just after that one, where the sums' samples hold both (a force that steps at the
+/// crush is placed from them: [`Frame::found`]).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub struct Crush {
     pub at: Sums,
     pub c_next: i64,
+    pub beside: Option<(i64, i64)>,
+}
+
+/// A force steps at the crush where the crush's sample lies this many times further from
+/// one neighbour than from the other (at least a count)…
+pub const STEP_RATIO: f64 = 8.0;
+/// …and the step is at least this share of the crush's sample: a pad that crushes and
+/// unloads along another line (the two-phase law's `kc x_m` to `kr (x_m - x_p)`: 14 % on the
+/// seed's pad), not the noise on a smooth force (Kelvin–Voigt's force falls through the
+/// crush, an elastic law's peaks there: both neighbours alike).
+pub const STEP_SHARE: f64 = 0.05;
+
+/// A force that steps at the crush, placed there: the crush's sample stands for the whole
+/// interval around it (the midpoint rule), which holds the force before the step up to the
+/// crush and the force after it beyond.
+#[derive(Clone, Copy, Debug, PartialEq)]
+struct Step {
+    /// The crush, in samples from the start of the crush sample's interval (`[0, 1]`).
+    f: f64,
+    /// The area the sums missed over that interval, in units of `C`.
+    c: f64,
+}
+
+impl Step {
+    /// The step at `crush`, if its sample and neighbours show one that lies where the sums
+    /// put the stop: `rem` is `C` left to the stop before the crush's sample (`v / kv`).
+    fn of(crush: &Crush, rem: f64) -> Option<Self> {
+        let (before, after) = crush.beside?;
+        let d = crush.c_next.wrapping_sub(crush.at.c) as f64;
+        let (p, q) = (before as f64, after as f64);
+        let (to_p, to_q) = (libm::fabs(d - p), libm::fabs(d - q));
+        let (near, far) = (to_p.min(to_q), to_p.max(to_q));
+        if !(d > 0.0 && far > STEP_RATIO * near.max(1.0) && far > STEP_SHARE * d) {
+            return None;
+        }
+        if to_p <= to_q {
+            // The sample reads the loading side: the step came after its instant, where
+            // the force `d` reached the stop.
+            let f = rem / d;
+            (0.5..=1.0).contains(&f).then_some(Self {
+                f,
+                c: (q - d) * (1.0 - f),
+            })
+        } else {
+            // The unloading side: the force was the loading side's `p` up to the stop, before
+            // the sample's instant.
+            let f = rem / p;
+            (p > 0.0 && (0.0..=0.5).contains(&f)).then_some(Self { f, c: (p - d) * f })
+        }
+    }
 }
 
 /// What turns sums into metres and metres per second.
@@ -174,21 +226,31 @@ impl Frame {
         })
     }
 
-    /// The kinematics from the crush and the separation's two states.
+    /// The kinematics from the crush and the separation's two states. A force that steps at
+    /// the crush ([`STEP_RATIO`], [`STEP_SHARE`]: the two-phase law unloading along another
+    /// line) is placed there, not at the crush sample's interval's edge: the crush within
+    /// the interval from the force on the stop's side, and the area the sums missed
+    /// (`step_c`: half a sample of the step at most) added to the velocity after it.
     pub fn found(&self, crush: Crush, separation: [Sums; 2]) -> Found {
         let scale = &self.scale;
         let (v, v_next) = (scale.velocity(crush.at.c), scale.velocity(crush.c_next));
-        let f = v / (v - v_next);
+        let step = Step::of(&crush, v / scale.kv);
+        let f = step.map_or(v / (v - v_next), |s| s.f);
         let x_max = scale.deformation(crush.at.k, crush.at.t()) + scale.dt * f * v / 2.0;
         let [s0, s1] = separation;
         let (x0, x1) = (
             scale.deformation(s0.k, s0.t()),
             scale.deformation(s1.k, s1.t()),
         );
+        // The velocity after the crush's interval is `kv step_c` lower than the sums': the
+        // deformation at the separation, that much less for the time since.
+        let step_c = step.map_or(0.0, |s| s.c);
+        let since = (self.separation - (crush.at.k as f64 + 0.5)).max(0.0);
         Found {
             crush: crush.at.k as f64 + f - 0.5,
             x_max,
-            x_sep: x0 + self.frac * (x1 - x0),
+            x_sep: x0 + self.frac * (x1 - x0) - scale.kv * step_c * scale.dt * since,
+            step_c: libm::round(step_c) as i64,
         }
     }
 }
@@ -221,4 +283,60 @@ pub fn kinematics(r: &mut ImpactReport, scene: &Scene, frame: &Frame, found: &Fo
                 + gravity.map_or(0.0, |g| m * g * found.x_sep as f32)
         }),
     });
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The crush's sample `d` after `c` of the sums, its neighbours `p` and `q`.
+    fn crush(c: i64, d: i64, p: i64, q: i64) -> Crush {
+        Crush {
+            at: Sums { k: 10, c, q: 0 },
+            c_next: c + d,
+            beside: Some((p, q)),
+        }
+    }
+
+    #[test]
+    fn a_force_that_steps_at_the_crush_is_placed_there() {
+        // Loading at 1000 counts, unloading at 800: the stop 700 of `C` into the sample.
+        // The sample reads the loading side (the step after its instant): the stop at 0.7 of
+        // the interval, the rest of it at 800, not 1000.
+        let s = Step::of(&crush(0, 1000, 1000, 800), 700.0).unwrap();
+        assert!(
+            (s.f - 0.7).abs() < 1e-12 && (s.c - -200.0 * 0.3).abs() < 1e-9,
+            "{s:?}"
+        );
+        // The sample reads the unloading side: the stop 300 in at the loading force, 0.3 of
+        // the interval, which the sums took at 800.
+        let s = Step::of(&crush(0, 800, 1000, 800), 300.0).unwrap();
+        assert!(
+            (s.f - 0.3).abs() < 1e-12 && (s.c - 200.0 * 0.3).abs() < 1e-9,
+            "{s:?}"
+        );
+        // A stop the step cannot lie at (the loading side's sample puts it before its
+        // instant; the unloading side's after): none.
+        assert_eq!(Step::of(&crush(0, 1000, 1000, 800), 300.0), None);
+        assert_eq!(Step::of(&crush(0, 800, 1000, 800), 700.0), None);
+    }
+
+    #[test]
+    fn a_smooth_force_through_the_crush_is_no_step() {
+        // An elastic law's peak (both neighbours a little lower), Kelvin–Voigt's falling
+        // force (evenly), noise of a count, a step under 5 % of the force, none kept beside.
+        for (d, p, q) in [
+            (1000, 990, 990),
+            (1000, 1010, 990),
+            (1000, 1001, 1000),
+            (1000, 1000, 960),
+        ] {
+            assert_eq!(Step::of(&crush(0, d, p, q), 500.0), None, "{d} {p} {q}");
+        }
+        let none = Crush {
+            beside: None,
+            ..crush(0, 1000, 1000, 800)
+        };
+        assert_eq!(Step::of(&none, 700.0), None);
+    }
 }

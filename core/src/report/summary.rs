@@ -81,7 +81,7 @@ pub struct Summary {
     /// `Σ d` over the contact, from the onset to the separation (exclusive), if the signal
     /// came back; for a captured impact also over its feet below the edge level: the whole
     /// samples from first touch to the onset and from the separation sample to the falling
-    /// flank's zero.
+    /// flank's zero. (The report's Δv adds the online sums' [`Found::step_c`].)
     pub contact_c: Option<i64>,
     /// The approach speed of this impact, m/s: the scene's (or a light gate's), or, in a
     /// bounce train, the bounce's ([`crate::stream::train`]).
@@ -214,6 +214,7 @@ impl Record {
             crush: 0.0,
             x_max: 0.0,
             x_sep: 0.0,
+            step_c: 0,
         },
     };
 
@@ -259,6 +260,10 @@ pub struct Found {
     pub x_max: f64,
     /// The deformation at the separation, m.
     pub x_sep: f64,
+    /// The area the sums missed where the force steps at the crush, in units of `C`
+    /// (`Σ d`): the report's Δv adds it to [`Summary::contact_c`]
+    /// ([`crate::report::motion::Frame::found`], [`crate::report::measured`]).
+    pub step_c: i64,
 }
 
 #[cfg(test)]

@@ -8,9 +8,9 @@ pub enum TrainSpeed {
     /// `g t / 2 - h / t` from the flight `t` since the previous separation and the landing
     /// height `h` (`stream/train.rs`): each bounce measured afresh (the default).
     Flight,
-    /// The previous impact's rebound (`Δv - v0 - g t_c`, the body taken to land where it
-    /// left): no assumption on the flight's direction, but each bounce inherits the previous
-    /// one's error.
+    /// The previous impact's rebound `v_r` (`Δv - v0 - g t_c`) brought down by the flight
+    /// `t`, `g t - v_r` (vertical flight, no landing height needed): a chain, each bounce
+    /// keeping the previous one's speed error and adding its contact's Δv error.
     Rebound,
 }
 

@@ -180,11 +180,12 @@ pub fn steep_zero(y: [f32; 3]) -> f32 {
 /// How far the middle of three samples may lie off the line through the outer two, over
 /// the rise, for [`head_zero`] to take their line: a power curve's three first samples lie
 /// on it within 0.3 % (a Hertz foot at 20 kS/s, its first sample a tenth of a sample in);
-/// a slow foot's noise puts them off it by far more.
+/// noise, or a law between the powers (an exponent of 1.6: 0.9–2.3 %, its zero up to 0.09
+/// samples off), puts them further off, and the caller's estimate stands.
 pub const HEAD_BEND: f32 = 0.02;
 
 /// Where a foot whose first sample lies just past the edge level (its flank too short for a
-/// line: one sample to the flank level) reaches zero, relative to that sample, from its
+/// line: fewer than three samples to the flank level) reaches zero, relative to that sample, from its
 /// first three samples `y`, as [`steep_zero`] does, but only where the power puts them on a
 /// line (within [`HEAD_BEND`]) whose zero lies in the interval before the first: a foot the
 /// sampling resolves in three samples (a Hertz contact's `t^1.5` at 20 kS/s). Else `None`

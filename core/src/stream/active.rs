@@ -102,7 +102,8 @@ pub(super) enum FlankTouch {
     Steep,
     /// The edge level's crossing before the onset (late by design: the foot below the edge
     /// level lies before it), or the onset itself where the ring holds no sample before it:
-    /// the flank held too few samples for a line.
+    /// the flank held too few samples for a line (`Stream::touch` places it from the onset
+    /// and the next two samples where they lie on a power curve).
     Crossing,
     /// The edge level's crossing, the flank's line refused (a jump onto it, or a zero out of
     /// its reach).

@@ -1,8 +1,9 @@
 //! Where the contact begins and ends, as the physics defines them (where the contact force is
 //! zero): the feet of the pulse fitted as power curves ([`power_flank`]), the whole lobe where
 //! a ramp rises into the onset, a step past the flank level placed from its three samples
-//! ([`power_flank::steep_zero`]), the falling flank's straight line, zero crossing or edge
-//! crossing otherwise; and the falling foot's record.
+//! ([`power_flank::steep_zero`]) and so an onset just past the edge level whose three lie on
+//! a power curve ([`power_flank::head_zero`]), the falling flank's straight line, zero
+//! crossing or edge crossing otherwise; and the falling foot's record.
 
 use super::active::{Active, FlankTouch};
 use super::rise::Fall;
@@ -246,9 +247,10 @@ impl<const PRE: usize> Stream<PRE> {
     /// First touch relative to the onset, `Σ d` over the foot before the onset, and whether
     /// it lies inside the previous impact's contact (then it is that contact's end): where the
     /// rising foot, fitted as a power curve ([`power_flank`]), reaches zero force; where the
-    /// flank stepped past the flank level, from the onset and the next two samples
-    /// ([`Self::steep_touch`]); else the trigger's estimate (`touch_offset`, `lead_c`). And
-    /// whether it is a fit's zero (not the edge crossing, late by design).
+    /// flank stepped past the flank level, or the flank held too few samples for a line and
+    /// the onset's three lie on a power curve, from those three ([`Self::head_touch`]); else
+    /// the trigger's estimate (`touch_offset`, `lead_c`). And whether it is a fit's zero (not
+    /// the edge crossing, late by design).
     pub(super) fn touch(&mut self, a: &Active) -> ((f32, i64, bool), bool) {
         let trigger = (a.touch_offset, a.lead_c, a.line_in_previous);
         let peak = a.peak_d.unsigned_abs() as f32;
@@ -276,7 +278,7 @@ impl<const PRE: usize> Stream<PRE> {
                 ((touch, c as i64, foot.zero < a.touch_floor), true)
             }
             None => match self.head_touch(a) {
-                Some(z) => ((z.max(a.touch_floor), a.lead_c, a.line_in_previous), true),
+                Some(z) => ((z.max(a.touch_floor), a.lead_c, z < a.touch_floor), true),
                 // (A step's middle is no edge crossing either.)
                 None => (
                     trigger,
@@ -291,12 +293,20 @@ impl<const PRE: usize> Stream<PRE> {
     /// ([`FlankTouch::Steep`]), [`power_flank::steep_zero`]; where it lies just past the edge
     /// level and the flank had no line ([`FlankTouch::Crossing`]), [`power_flank::head_zero`]
     /// if the three lie on a power curve (a Hertz foot at 20 kS/s, its onset a tenth of a
-    /// sample in: else the walk back to the baseline puts touch up to a sample early).
+    /// sample in: else the walk back to the baseline puts touch up to a sample early) and
+    /// the sample before the onset is quiet, as that curve says (the lobe walked back from
+    /// the onset ends within the interval before it, or its one sample there holds less
+    /// than half the edge level: a foot that began earlier is the lobe's).
     fn head_touch(&self, a: &Active) -> Option<f32> {
         let head = || a.rise.head().map(|y| y.map(|d| d as f32));
         match a.flank_touch {
             FlankTouch::Steep => Some(power_flank::steep_zero(head()?)),
-            FlankTouch::Crossing => power_flank::head_zero(head()?),
+            FlankTouch::Crossing => {
+                let lobe = (a.sign * a.lobe_c) as f32;
+                let quiet =
+                    a.lobe_touch >= -1.0 || (a.lobe_touch >= -2.0 && lobe <= 0.5 * a.edge_d as f32);
+                power_flank::head_zero(head()?).filter(|_| quiet)
+            }
             FlankTouch::Line | FlankTouch::Refused => None,
         }
     }

@@ -442,12 +442,15 @@ impl Online {
             return Err(Missing::CrushNotHeld);
         }
         let (mut k, mut c, mut q) = (from.k, from.c, from.q);
-        for &x in self.band.get(..self.band_len).unwrap_or(&[]) {
+        let band = self.band.get(..self.band_len).unwrap_or(&[]);
+        for (i, &x) in band.iter().enumerate() {
             let c_next = c.wrapping_add(self.motion.of(x) as i64);
             if c_next >= theta {
                 return Ok(Crush {
                     at: shifted(lead, k, c, q),
                     c_next: lead.l.wrapping_add(c_next),
+                    // (The band's first sample's predecessor is not kept: none.)
+                    beside: crate::analysis::motion::beside(band, i, self.motion),
                 });
             }
             c = c_next;
@@ -471,6 +474,8 @@ impl Online {
                 return Ok(Crush {
                     at: Sums { k: k as u32, c, q },
                     c_next,
+                    // (A crush within the foot: no step looked for.)
+                    beside: None,
                 });
             }
             c = c_next;

@@ -20,7 +20,8 @@ pub struct Rise {
     pos: [u32; RISE_POINTS],
     d: [i32; RISE_POINTS],
     /// The onset's sample and the next two, whatever the stride (a step's three samples:
-    /// [`crate::signal::power_flank::steep_zero`]); `None` until taken.
+    /// [`crate::signal::power_flank::steep_zero`], or a short flank's:
+    /// [`crate::signal::power_flank::head_zero`]); `None` until taken.
     head: [Option<i32>; 3],
     done: bool,
 }

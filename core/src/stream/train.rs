@@ -40,13 +40,17 @@
 //! on every bounce, `x_sep / t ≈ c g / 2 k`, while the rebound carries the approach speed's
 //! error), and a choice made by it would confirm itself bounce after bounce (a wrong dent
 //! makes the next rebound low by the same `x_sep / t`). Without a rebound the pad recovers.
-//! `h = x_sep` is taken only where it leaves a landing speed (`x_sep / t < g t / 2`, and
-//! `v_r² > 2 g x_sep`); the report's `landing_height_m` gives the `h` used.
+//! `h = x_sep` is taken only where it leaves a landing speed (`x_sep / t < g t / 2`) and the
+//! rebound could have climbed it (`v_r² > 2 g x_sep`); the report's `landing_height_m`
+//! gives the `h` used.
 //!
-//! A flight longer than the scene's longest (a new drop, the body picked up), a previous
-//! impact without a separation (settled, too long, a gap, the stream ended) or without an
-//! approach speed ends the train: the next impact is a first one, with the scene's
-//! [`crate::scene::Approach`].
+//! A flight longer than the scene's longest (a new drop, the body picked up) ends the train:
+//! the next impact is a first one, with the scene's [`crate::scene::Approach`]. After a
+//! previous impact without a separation (settled, too long, a gap, the stream ended) there
+//! is no flight to time: the next impact, if within a flight of it, has no speed but a light
+//! gate's. After one without an approach speed (so without a rebound) or with a rebound the
+//! flight could not have come back from (`g t <= v_r`), the bounce has its flight's measure
+//! alone (under `--train rebound`, no speed, nor has the chain after it).
 //!
 //! Without a train the scene's approach speed (a drop's `v0` or height) is the first
 //! impact's: an impact that follows a flight (its first touch within a train's longest

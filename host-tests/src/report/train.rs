@@ -17,7 +17,7 @@ pub struct BounceJson {
     /// The landing speed the flight gives, `g t / 2 - h / t`, m/s.
     pub v0_flight_m_s: f64,
     /// The previous impact's rebound `v_r` brought down by the flight `t`, `g t - v_r`, m/s
-    /// (null: it had none).
+    /// (null: it had none, or the flight was too short to come back from it).
     pub v0_rebound_m_s: Option<f64>,
     /// `h`, how far above the previous separation the body landed, m: the previous separation
     /// deformation (the pad recovered its shape) or 0 (it kept the dent), as the previous
@@ -25,7 +25,7 @@ pub struct BounceJson {
     pub landing_height_m: f64,
     /// `(Δv - v0) / v0` with each speed; null when it cannot be known, the reason beside:
     /// `clipped` (Δv a lower bound), `ac-coupled` (no Δv), `no-rebound` (no previous rebound,
-    /// or it was clipped), `cor-out-of-range` (outside
+    /// it was clipped, or the flight was too short to come back from it), `cor-out-of-range` (outside
     /// core's [-0.02, 1.02]: that speed or the signal is wrong).
     pub cor_flight: Option<f64>,
     #[serde(skip_serializing_if = "Option::is_none")]
