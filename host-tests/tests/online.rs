@@ -225,3 +225,50 @@ fn a_next_hit_lends_its_flank_to_no_crush() {
     }
     assert!(compared >= 3000, "{compared}");
 }
+
+/// A force that steps down at the crush (a pad unloading along another line: a quarter sine
+/// up to `peak` counts over `rise` samples, then 0.86 of it falling as a quarter cosine over
+/// as many), its crush `phase` of a sample after a sample's instant, at the approach speed
+/// whose area the rise holds: the online sums and the capture pass place the step alike,
+/// bit for bit, wherever the band the online sums keep begins (the crush its first sample
+/// or not), and the COR is the true 0.86 within 0.05 % (taken at the sample's interval's
+/// edge, up to half a sample of the step: 0.1 %).
+#[test]
+fn a_force_that_steps_at_the_crush_is_placed_alike_online_and_by_the_pass() {
+    let rate = 100_000.0;
+    let (rise, peak, after) = (100.0, 2000.0, 0.86);
+    let v0 = peak * 2.0 * rise / std::f64::consts::PI * 0.05 / rate;
+    for k in 0..40 {
+        let phase = k as f64 / 40.0;
+        let force = |t: f64| {
+            if t <= 0.0 || t >= 2.0 * rise {
+                0.0
+            } else if t < rise {
+                peak * (std::f64::consts::FRAC_PI_2 * t / rise).sin()
+            } else {
+                after * peak * (std::f64::consts::FRAC_PI_2 * (t - rise) / rise).cos()
+            }
+        };
+        let mut x = vec![2000i16; 20_000];
+        // First touch `phase` of a sample before a sample's instant.
+        x.extend(
+            (0..(2.0 * rise) as usize + 2)
+                .map(|j| (2000.0 + force(j as f64 + 1.0 - phase)).round() as i16),
+        );
+        x.extend(std::iter::repeat_n(2000i16, 20_000));
+        // A few counts' margin on the band: the stop anywhere from its first sample on.
+        let out = run::<65_536>(&x, scene(rate, v0 as f32, false));
+        assert_eq!(out.len(), 1, "phase {phase}");
+        let (online, pass) = (&out[0].0, out[0].1.as_ref().expect("captured"));
+        assert_eq!(
+            bits(online),
+            bits(pass),
+            "phase {phase}: {online:?} vs {pass:?}"
+        );
+        let cor = online.kinematics.expect("kinematics").cor as f64;
+        assert!(
+            (cor / after - 1.0).abs() < 5e-4,
+            "phase {phase}: COR {cor} vs {after}"
+        );
+    }
+}

@@ -453,7 +453,14 @@ fn analyse_kinematics<const CAP: usize>(
         v: &mut *velocity,
         every,
     });
-    let passed = motion::integrate(from_onset, motion, &frame, out);
+    let passed = motion::integrate(from_onset, motion, &frame, out).map(|(mut crush, sep)| {
+        // (A decimated capture's values are means: a step at the crush is the stream's to
+        // place, on every sample.)
+        if step > 1 {
+            crush.beside = None;
+        }
+        (crush, sep)
+    });
     if from_stream.is_none() {
         // The pass holds what the online sums lost.
         let Some((crush, separation)) = passed else {
@@ -465,12 +472,10 @@ fn analyse_kinematics<const CAP: usize>(
         r.flags.remove(Flags::KINEMATICS_NOT_HELD);
         let found = frame.found(crush, separation);
         // A force that steps at the crush: Δv takes the area the sums missed, as the
-        // stream's does where its sums found it (on every sample, not a decimated capture's
-        // means; `s.motion` holds nothing here, so no step is counted twice).
-        if found.step_c != 0 && step == 1 {
-            let mut stepped = *s;
-            stepped.motion = report::motion::Record::found(found);
-            r.delta_v_m_s = report::measured(&stepped, scene).delta_v_m_s;
+        // stream's does where its sums found it (`s.motion` holds nothing here, so no step
+        // is counted twice).
+        if found.step_c != 0 {
+            r.delta_v_m_s = report::contact_delta_v(s, scene, found.step_c, &mut r.flags);
         }
         report::motion::kinematics(&mut r, scene, &frame, &found);
     }

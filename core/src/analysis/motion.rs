@@ -98,10 +98,10 @@ fn run_to_stop(s: &mut Sums, samples: &[i16], dev: Deviation, c_stop: i64) -> Op
 
 /// The deviations of the samples just before and after sample `k` of `samples`, if both
 /// are there ([`Crush::beside`]).
-pub(crate) fn beside(samples: &[i16], k: usize, dev: Deviation) -> Option<(i64, i64)> {
+pub(crate) fn beside(samples: &[i16], k: usize, dev: Deviation) -> Option<(i32, i32)> {
     let before = samples.get(k.checked_sub(1)?)?;
     let after = samples.get(k.checked_add(1)?)?;
-    Some((dev.of(*before) as i64, dev.of(*after) as i64))
+    Some((dev.of(*before), dev.of(*after)))
 }
 
 /// Runs the sums over `samples` (the raw samples from the frame's first; `dev` removes the
@@ -240,6 +240,7 @@ mod tests {
             kv: 1e-3,
             dt: 1e-3,
             x_lead: 0.0,
+            count: 1.0,
         };
         let fr = frame(scale, 150.5);
         // The sums start half a sample before the onset's instant (x_lead there): v reaches 0

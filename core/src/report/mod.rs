@@ -334,6 +334,27 @@ pub fn streaming(s: &Summary, scene: &Scene) -> ImpactReport {
     r
 }
 
+/// The contact's Δv, m/s, with `step_c` added to its sums (a force that steps at the crush:
+/// [`motion::Frame::found`]); none for drift, or with [`Flags::AC_COUPLED`] in `flags` where
+/// the whole window undoes most of it.
+pub(crate) fn contact_delta_v(
+    s: &Summary,
+    scene: &Scene,
+    step_c: i64,
+    flags: &mut Flags,
+) -> Option<f32> {
+    let fs = scene.calibration.sample_rate_hz as f64;
+    let per_d = scene.calibration.gain_m_s2_per_count as f64 / s.base_n.max(1) as f64;
+    match s.contact_c.map(|c| c.wrapping_add(step_c)) {
+        _ if s.drift => None,
+        Some(c) if c != 0 && (s.total_c as f64 / c as f64) < AC_COUPLED_RATIO => {
+            flags.insert(Flags::AC_COUPLED);
+            None
+        }
+        c => Some((c.unwrap_or(s.total_c) as f64 * per_d / fs) as f32),
+    }
+}
+
 /// The streaming fields alone (peak, Δv, times, flags), no kinematics: what a bounce
 /// train needs of the previous impact.
 pub(crate) fn measured(s: &Summary, scene: &Scene) -> ImpactReport {
@@ -370,14 +391,7 @@ pub(crate) fn measured(s: &Summary, scene: &Scene) -> ImpactReport {
     // (A force that steps at the crush: the contact's Δv takes the area the sums missed,
     // where they found the crush.)
     let step_c = s.motion.get().map_or(0, |f| f.step_c);
-    let delta_v = match s.contact_c.map(|c| c.wrapping_add(step_c)) {
-        _ if s.drift => None,
-        Some(c) if c != 0 && (s.total_c as f64 / c as f64) < AC_COUPLED_RATIO => {
-            flags.insert(Flags::AC_COUPLED);
-            None
-        }
-        c => Some((c.unwrap_or(s.total_c) as f64 * per_d / fs) as f32),
-    };
+    let delta_v = contact_delta_v(s, scene, step_c, &mut flags);
     let end = match s.separation_index {
         Some(i) => i as f64 + s.separation_offset as f64,
         None => s.end_index as f64,

@@ -44,17 +44,25 @@ impl Sums {
 pub struct Crush {
     pub at: Sums,
     pub c_next: i64,
-    pub beside: Option<(i64, i64)>,
+    pub beside: Option<(i32, i32)>,
 }
 
 /// A force steps at the crush where the crush's sample lies this many times further from
-/// one neighbour than from the other (at least a count)…
+/// one neighbour than from the other (the nearer at least [`STEP_NOISE`] ADC counts off)…
 pub const STEP_RATIO: f64 = 8.0;
+/// …counting the nearer neighbour at least this many ADC counts off (quantised samples are
+/// often equal: their noise is what a step must stand out of)…
+pub const STEP_NOISE: f64 = 2.0;
 /// …and the step is at least this share of the crush's sample: a pad that crushes and
 /// unloads along another line (the two-phase law's `kc x_m` to `kr (x_m - x_p)`: 14 % on the
 /// seed's pad), not the noise on a smooth force (Kelvin–Voigt's force falls through the
-/// crush, an elastic law's peaks there: both neighbours alike).
+/// crush, an elastic law's peaks there: both neighbours alike)…
 pub const STEP_SHARE: f64 = 0.05;
+/// …in a contact of at least this many samples: coarser, a smooth force bends enough
+/// between samples to look like one (a Kelvin–Voigt contact of 6–14 samples, its peak just
+/// before the crush: one phase in five), and a step's half sample is no longer the error
+/// that matters.
+pub const STEP_MIN_SAMPLES: f64 = 32.0;
 
 /// A force that steps at the crush, placed there: the crush's sample stands for the whole
 /// interval around it (the midpoint rule), which holds the force before the step up to the
@@ -69,14 +77,16 @@ struct Step {
 
 impl Step {
     /// The step at `crush`, if its sample and neighbours show one that lies where the sums
-    /// put the stop: `rem` is `C` left to the stop before the crush's sample (`v / kv`).
-    fn of(crush: &Crush, rem: f64) -> Option<Self> {
+    /// put the stop: `rem` is `C` left to the stop before the crush's sample (`v / kv`),
+    /// `count` one ADC count in units of `C`'s samples.
+    fn of(crush: &Crush, rem: f64, count: f64) -> Option<Self> {
         let (before, after) = crush.beside?;
         let d = crush.c_next.wrapping_sub(crush.at.c) as f64;
         let (p, q) = (before as f64, after as f64);
         let (to_p, to_q) = (libm::fabs(d - p), libm::fabs(d - q));
         let (near, far) = (to_p.min(to_q), to_p.max(to_q));
-        if !(d > 0.0 && far > STEP_RATIO * near.max(1.0) && far > STEP_SHARE * d) {
+        let floor = STEP_NOISE * count;
+        if !(d > 0.0 && far > STEP_RATIO * near.max(floor) && far > STEP_SHARE * d) {
             return None;
         }
         if to_p <= to_q {
@@ -108,6 +118,8 @@ pub struct Scale {
     /// Deformation at half a sample before the integration's first sample, m (first touch
     /// came a fraction of a sample earlier or later, at `v0`: negative if later).
     pub x_lead: f64,
+    /// One ADC count in units of the deviation `d'` (the baseline's samples `W`).
+    pub count: f64,
 }
 
 impl Scale {
@@ -120,6 +132,7 @@ impl Scale {
             kv: scene.calibration.gain_m_s2_per_count as f64 / base_n.max(1) as f64 / fs,
             dt: 1.0 / fs,
             x_lead,
+            count: base_n.max(1) as f64,
         }
     }
 
@@ -234,7 +247,10 @@ impl Frame {
     pub fn found(&self, crush: Crush, separation: [Sums; 2]) -> Found {
         let scale = &self.scale;
         let (v, v_next) = (scale.velocity(crush.at.c), scale.velocity(crush.c_next));
-        let step = Step::of(&crush, v / scale.kv);
+        // (`W`, the baseline's samples, is one count in `d'`: `kv = gain / (W fs)`.)
+        let count = scale.count;
+        let step = Step::of(&crush, v / scale.kv, count)
+            .filter(|_| self.separation - self.touch >= STEP_MIN_SAMPLES);
         let f = step.map_or(v / (v - v_next), |s| s.f);
         let x_max = scale.deformation(crush.at.k, crush.at.t()) + scale.dt * f * v / 2.0;
         let [s0, s1] = separation;
@@ -294,7 +310,7 @@ mod tests {
         Crush {
             at: Sums { k: 10, c, q: 0 },
             c_next: c + d,
-            beside: Some((p, q)),
+            beside: Some((p as i32, q as i32)),
         }
     }
 
@@ -303,40 +319,81 @@ mod tests {
         // Loading at 1000 counts, unloading at 800: the stop 700 of `C` into the sample.
         // The sample reads the loading side (the step after its instant): the stop at 0.7 of
         // the interval, the rest of it at 800, not 1000.
-        let s = Step::of(&crush(0, 1000, 1000, 800), 700.0).unwrap();
+        let s = Step::of(&crush(0, 1000, 1000, 800), 700.0, 1.0).unwrap();
         assert!(
             (s.f - 0.7).abs() < 1e-12 && (s.c - -200.0 * 0.3).abs() < 1e-9,
             "{s:?}"
         );
         // The sample reads the unloading side: the stop 300 in at the loading force, 0.3 of
         // the interval, which the sums took at 800.
-        let s = Step::of(&crush(0, 800, 1000, 800), 300.0).unwrap();
+        let s = Step::of(&crush(0, 800, 1000, 800), 300.0, 1.0).unwrap();
         assert!(
             (s.f - 0.3).abs() < 1e-12 && (s.c - 200.0 * 0.3).abs() < 1e-9,
             "{s:?}"
         );
         // A stop the step cannot lie at (the loading side's sample puts it before its
         // instant; the unloading side's after): none.
-        assert_eq!(Step::of(&crush(0, 1000, 1000, 800), 300.0), None);
-        assert_eq!(Step::of(&crush(0, 800, 1000, 800), 700.0), None);
+        assert_eq!(Step::of(&crush(0, 1000, 1000, 800), 300.0, 1.0), None);
+        assert_eq!(Step::of(&crush(0, 800, 1000, 800), 700.0, 1.0), None);
     }
 
     #[test]
     fn a_smooth_force_through_the_crush_is_no_step() {
         // An elastic law's peak (both neighbours a little lower), Kelvin–Voigt's falling
-        // force (evenly), noise of a count, a step under 5 % of the force, none kept beside.
-        for (d, p, q) in [
-            (1000, 990, 990),
-            (1000, 1010, 990),
-            (1000, 1001, 1000),
-            (1000, 1000, 960),
-        ] {
-            assert_eq!(Step::of(&crush(0, d, p, q), 500.0), None, "{d} {p} {q}");
+        // force (evenly), a step under 5 % of the force: none.
+        for (d, p, q) in [(1000, 990, 990), (1000, 1010, 990), (1000, 1000, 960)] {
+            assert_eq!(
+                Step::of(&crush(0, d, p, q), 500.0, 1.0),
+                None,
+                "{d} {p} {q}"
+            );
         }
+        // Noise on a small pulse (100 counts): the nearer neighbour a count off, the other
+        // 12 (in units of `d'`, 16 to a count): a step for a floor of a fraction of a count,
+        // none for [`STEP_NOISE`] counts.
+        let noisy = crush(0, 100 * 16, 101 * 16, 88 * 16);
+        assert!(Step::of(&noisy, 1200.0, 1.0 / 16.0).is_some());
+        assert_eq!(Step::of(&noisy, 1200.0, 16.0), None);
         let none = Crush {
             beside: None,
             ..crush(0, 1000, 1000, 800)
         };
-        assert_eq!(Step::of(&none, 700.0), None);
+        assert_eq!(Step::of(&none, 700.0, 1.0), None);
+    }
+
+    /// A frame whose sums start at first touch, at `v0` 1 m/s and 1 count = 1 unit of `d'`,
+    /// separating after `len` samples.
+    fn frame(len: f64) -> Frame {
+        let sep_at = len + 0.5;
+        Frame {
+            lead: 0,
+            touch: 0.0,
+            separation: len,
+            sep_floor: libm::floor(sep_at) as u32,
+            frac: sep_at - libm::floor(sep_at),
+            scale: Scale {
+                v0: 1.0,
+                kv: 1e-3,
+                dt: 1e-4,
+                x_lead: 0.0,
+                count: 1.0,
+            },
+        }
+    }
+
+    #[test]
+    fn a_step_counts_only_in_a_contact_the_sampling_resolves() {
+        // A Kelvin–Voigt contact of 10 samples at 20 kS/s whose peak lies just before the
+        // crush: 982, 992 at the crush, 907 after (its sample nearer the one before): no
+        // step, though it reads as one; the same in a contact of 40 samples, a step.
+        let (c, d) = (1000 - 700, 992);
+        let crush = Crush {
+            at: Sums { k: 5, c, q: 0 },
+            c_next: c + d,
+            beside: Some((982, 907)),
+        };
+        let sums = [Sums::default(); 2];
+        assert_eq!(frame(10.0).found(crush, sums).step_c, 0);
+        assert_ne!(frame(40.0).found(crush, sums).step_c, 0);
     }
 }

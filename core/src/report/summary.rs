@@ -81,7 +81,8 @@ pub struct Summary {
     /// `Σ d` over the contact, from the onset to the separation (exclusive), if the signal
     /// came back; for a captured impact also over its feet below the edge level: the whole
     /// samples from first touch to the onset and from the separation sample to the falling
-    /// flank's zero. (The report's Δv adds the online sums' [`Found::step_c`].)
+    /// flank's zero. (The report's Δv adds the online sums' [`Found::step_c`], or the
+    /// capture pass's where the online sums found no crush.)
     pub contact_c: Option<i64>,
     /// The approach speed of this impact, m/s: the scene's (or a light gate's), or, in a
     /// bounce train, the bounce's ([`crate::stream::train`]).

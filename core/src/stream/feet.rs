@@ -64,6 +64,9 @@ pub(super) struct Lobe {
     /// baseline there, and the walk stops where the ramp crosses it; that baseline is
     /// flagged by [`crate::signal::baseline::Baseline::unconfirmed`].)
     pub cut: bool,
+    /// The sample just before the onset (`d`, the pulse's side positive), if the ring held
+    /// it.
+    pub before: Option<i64>,
 }
 
 impl<const PRE: usize> Stream<PRE> {
@@ -217,6 +220,7 @@ impl<const PRE: usize> Stream<PRE> {
             c: lobe_c,
             in_previous,
             cut,
+            before: pd(pulse),
         }
     }
 
@@ -294,19 +298,13 @@ impl<const PRE: usize> Stream<PRE> {
     /// level and the flank had no line ([`FlankTouch::Crossing`]), [`power_flank::head_zero`]
     /// if the three lie on a power curve (a Hertz foot at 20 kS/s, its onset a tenth of a
     /// sample in: else the walk back to the baseline puts touch up to a sample early) and
-    /// the sample before the onset is quiet, as that curve says (the lobe walked back from
-    /// the onset ends within the interval before it, or its one sample there holds less
-    /// than half the edge level: a foot that began earlier is the lobe's).
+    /// the sample before the onset is quiet, as that curve says (within half the edge level:
+    /// a foot that began earlier is the lobe's).
     fn head_touch(&self, a: &Active) -> Option<f32> {
         let head = || a.rise.head().map(|y| y.map(|d| d as f32));
         match a.flank_touch {
             FlankTouch::Steep => Some(power_flank::steep_zero(head()?)),
-            FlankTouch::Crossing => {
-                let lobe = (a.sign * a.lobe_c) as f32;
-                let quiet =
-                    a.lobe_touch >= -1.0 || (a.lobe_touch >= -2.0 && lobe <= 0.5 * a.edge_d as f32);
-                power_flank::head_zero(head()?).filter(|_| quiet)
-            }
+            FlankTouch::Crossing => power_flank::head_zero(head()?).filter(|_| a.quiet_before),
             FlankTouch::Line | FlankTouch::Refused => None,
         }
     }

@@ -94,6 +94,12 @@ pub(super) struct Online {
     band_from: Option<Sums>,
     band_len: usize,
     band: [i16; BAND],
+    /// The raw samples just before the band's first and just after its last (a crush at
+    /// either end has its neighbours, as the capture's pass does: [`Crush::beside`]).
+    band_before: Option<i16>,
+    band_after: Option<i16>,
+    /// The last raw sample the sums took (`None` before any, and none before the onset).
+    last_x: Option<i16>,
     /// `p_1 ..`: the raw samples before the onset, newest first.
     before: [i16; BEFORE],
     before_len: usize,
@@ -115,6 +121,9 @@ impl Online {
             band_from: None,
             band_len: 0,
             band: [0; BAND],
+            band_before: None,
+            band_after: None,
+            last_x: None,
             before: [0; BEFORE],
             before_len: 0,
             lobe: None,
@@ -147,6 +156,8 @@ impl Online {
         self.q = 0;
         self.band_from = None;
         self.band_len = 0;
+        self.band_before = None;
+        self.band_after = None;
         self.around = None;
         self.lobe = None;
         // Sample `r` before the onset is the ring's `pulse + r - 1` from the newest.
@@ -159,6 +170,7 @@ impl Online {
                 self.before_len = r;
             }
         }
+        self.last_x = self.before.first().copied().filter(|_| self.before_len > 0);
         let leads = leads.map(|l| l.min(room));
         if let Some(&far) = leads.iter().filter(|&&l| l > self.before_len).max() {
             // Oldest first: the `far` samples before the pulse's, straight from the ring.
@@ -241,22 +253,27 @@ impl Online {
     fn stride(&mut self, part: &[i16]) {
         bulk(self.motion, part, &mut self.c, &mut self.q);
         self.m += part.len() as u64;
+        if let Some(&x) = part.last() {
+            self.last_x = Some(x);
+        }
     }
 
     /// Samples one by one, each tested against the band.
     fn run_checked(&mut self, xs: &[i16]) {
         let motion = self.motion;
         let (mut m, mut c, mut q, mut mark) = (self.m, self.c, self.q, self.mark);
+        let mut prev = self.last_x;
         for &x in xs {
             let (c0, q0) = (c, q);
             c = c.wrapping_add(motion.of(x) as i64);
             q = q.wrapping_add(c);
             if c >= mark {
-                mark = self.band_step(x, m, c0, q0);
+                mark = self.band_step(x, prev, m, c0, q0);
             }
+            prev = Some(x);
             m += 1;
         }
-        (self.m, self.c, self.q, self.mark) = (m, c, q, mark);
+        (self.m, self.c, self.q, self.mark, self.last_x) = (m, c, q, mark, prev);
     }
 
     /// The sums over the `len` samples of foot before the onset, from the kept samples or
@@ -294,28 +311,31 @@ impl Online {
             .wrapping_add(sum2)
             .wrapping_sub(ramp);
         self.m += n as u64;
+        if let Some(&x) = kept.last() {
+            self.last_x = Some(x);
+        }
     }
 
     /// Sample `x`, the `m`-th from the onset, took the sums to `C' >= mark`; `(c, q)` are
-    /// the sums before it. Returns the next mark.
+    /// the sums before it, `prev` the sample before it. Returns the next mark.
     #[inline(never)]
-    fn band_step(&mut self, x: i16, m: u64, c: i64, q: i64) -> i64 {
+    fn band_step(&mut self, x: i16, prev: Option<i16>, m: u64, c: i64, q: i64) -> i64 {
         if self.band_from.is_none() {
             self.band_from = Some(Sums {
                 k: u32::try_from(m).unwrap_or(u32::MAX),
                 c,
                 q,
             });
+            self.band_before = prev;
         }
         if let Some(slot) = self.band.get_mut(self.band_len) {
             *slot = x;
             self.band_len += 1;
+            return i64::MIN;
         }
-        if self.band_len < BAND {
-            i64::MIN
-        } else {
-            i64::MAX
-        }
+        // Full: the sample after its last.
+        self.band_after = Some(x);
+        i64::MAX
     }
 
     /// The separation at stream index `index` (offset `offset`) of an impact whose onset is
@@ -408,8 +428,12 @@ impl Online {
             return Record::missing(Missing::EdgeNotHeld);
         };
         let crush = match self.crush(lead, c_stop) {
-            // The sample that stopped it must lie in the window.
-            Ok(c) if u64::from(c.at.k) < reach => c,
+            // The sample that stopped it must lie in the window (and its neighbour after it,
+            // to be counted, as the pass's samples end there).
+            Ok(c) if u64::from(c.at.k) < reach => Crush {
+                beside: c.beside.filter(|_| u64::from(c.at.k) + 1 < reach),
+                ..c
+            },
             Ok(_) => return Record::missing(Missing::NoStop),
             Err(why) => return Record::missing(why),
         };
@@ -446,11 +470,21 @@ impl Online {
         for (i, &x) in band.iter().enumerate() {
             let c_next = c.wrapping_add(self.motion.of(x) as i64);
             if c_next >= theta {
+                let before = match i.checked_sub(1) {
+                    Some(j) => band.get(j).copied(),
+                    None => self.band_before,
+                };
+                let after = match band.get(i + 1) {
+                    Some(&x) => Some(x),
+                    None if i + 1 == BAND => self.band_after,
+                    None => None,
+                };
                 return Ok(Crush {
                     at: shifted(lead, k, c, q),
                     c_next: lead.l.wrapping_add(c_next),
-                    // (The band's first sample's predecessor is not kept: none.)
-                    beside: crate::analysis::motion::beside(band, i, self.motion),
+                    beside: before
+                        .zip(after)
+                        .map(|(b, a)| (self.motion.of(b), self.motion.of(a))),
                 });
             }
             c = c_next;
