@@ -230,9 +230,9 @@ fn a_next_hit_lends_its_flank_to_no_crush() {
 /// up to `peak` counts over `rise` samples, then 0.86 of it falling as a quarter cosine over
 /// as many), its crush `phase` of a sample after a sample's instant, at the approach speed
 /// whose area the rise holds: the online sums and the capture pass place the step alike,
-/// bit for bit, wherever the band the online sums keep begins (the crush its first sample
-/// or not), and the COR is the true 0.86 within 0.05 % (taken at the sample's interval's
-/// edge, up to half a sample of the step: 0.1 %).
+/// bit for bit (here the crush is the first sample of the band the online sums keep: its
+/// neighbour before is the one kept beside the band), and the COR is the true 0.86 within
+/// 0.05 % (taken at the sample's interval's edge, up to half a sample of the step: 0.128 %).
 #[test]
 fn a_force_that_steps_at_the_crush_is_placed_alike_online_and_by_the_pass() {
     let rate = 100_000.0;

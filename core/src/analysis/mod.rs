@@ -475,6 +475,7 @@ fn analyse_kinematics<const CAP: usize>(
         // stream's does where its sums found it (`s.motion` holds nothing here, so no step
         // is counted twice).
         if found.step_c != 0 {
+            r.flags.remove(Flags::AC_COUPLED);
             r.delta_v_m_s = report::contact_delta_v(s, scene, found.step_c, &mut r.flags);
         }
         report::motion::kinematics(&mut r, scene, &frame, &found);

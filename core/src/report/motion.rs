@@ -64,6 +64,11 @@ pub const STEP_SHARE: f64 = 0.05;
 /// that matters.
 pub const STEP_MIN_SAMPLES: f64 = 32.0;
 
+/// How far past the sample's instant the stop may lie on the side its sample does not
+/// read, samples, and still be the step's (placed at the instant): the sums' own error puts
+/// a stop that lies at the instant a little either side of it.
+pub const STEP_SLACK: f64 = 0.05;
+
 /// A force that steps at the crush, placed there: the crush's sample stands for the whole
 /// interval around it (the midpoint rule), which holds the force before the step up to the
 /// crush and the force after it beyond.
@@ -93,15 +98,21 @@ impl Step {
             // The sample reads the loading side: the step came after its instant, where
             // the force `d` reached the stop.
             let f = rem / d;
-            (0.5..=1.0).contains(&f).then_some(Self {
-                f,
-                c: (q - d) * (1.0 - f),
+            (0.5 - STEP_SLACK..=1.0).contains(&f).then(|| {
+                let f = f.max(0.5);
+                Self {
+                    f,
+                    c: (q - d) * (1.0 - f),
+                }
             })
         } else {
             // The unloading side: the force was the loading side's `p` up to the stop, before
             // the sample's instant.
             let f = rem / p;
-            (p > 0.0 && (0.0..=0.5).contains(&f)).then_some(Self { f, c: (p - d) * f })
+            (p > 0.0 && (0.0..=0.5 + STEP_SLACK).contains(&f)).then(|| {
+                let f = f.min(0.5);
+                Self { f, c: (p - d) * f }
+            })
         }
     }
 }
@@ -331,8 +342,20 @@ mod tests {
             (s.f - 0.3).abs() < 1e-12 && (s.c - 200.0 * 0.3).abs() < 1e-9,
             "{s:?}"
         );
-        // A stop the step cannot lie at (the loading side's sample puts it before its
-        // instant; the unloading side's after): none.
+        // A stop just past the sample's instant on the side its sample does not read (the
+        // sums' own error): the step at the instant.
+        let s = Step::of(&crush(0, 1000, 1000, 800), 480.0, 1.0).unwrap();
+        assert!(
+            (s.f - 0.5).abs() < 1e-12 && (s.c - -100.0).abs() < 1e-9,
+            "{s:?}"
+        );
+        let s = Step::of(&crush(0, 800, 1000, 800), 520.0, 1.0).unwrap();
+        assert!(
+            (s.f - 0.5).abs() < 1e-12 && (s.c - 100.0).abs() < 1e-9,
+            "{s:?}"
+        );
+        // A stop the step cannot lie at (the loading side's sample puts it well before its
+        // instant; the unloading side's well after): none.
         assert_eq!(Step::of(&crush(0, 1000, 1000, 800), 300.0, 1.0), None);
         assert_eq!(Step::of(&crush(0, 800, 1000, 800), 700.0, 1.0), None);
     }

@@ -75,7 +75,8 @@ pub(super) struct Active {
     pub(super) lobe_c: i64,
     /// The lobe runs back to the previous impact's window ([`super::feet::Lobe`]).
     pub(super) lobe_in_previous: bool,
-    /// The sample just before the onset lies within half the edge level (the ring held it).
+    /// The sample just before the onset lies within half the edge level either way (the
+    /// ring held it).
     pub(super) quiet_before: bool,
     /// The sink gave a buffer for this impact.
     pub(super) captured: bool,

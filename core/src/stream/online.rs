@@ -87,7 +87,7 @@ pub(super) struct Online {
     c: i64,
     q: i64,
     /// The band takes the samples from the first whose `C'` reaches this on (`i64::MIN`:
-    /// while it fills; `i64::MAX`: never, or full).
+    /// while it fills, and for the sample after it; `i64::MAX`: never, or full).
     mark: i64,
     /// Where the band starts: the first `C'` at or above it.
     lo: i64,
@@ -98,7 +98,8 @@ pub(super) struct Online {
     /// either end has its neighbours, as the capture's pass does: [`Crush::beside`]).
     band_before: Option<i16>,
     band_after: Option<i16>,
-    /// The last raw sample the sums took (`None` before any, and none before the onset).
+    /// The raw sample before the next one the sums take (`p_1` at the onset; `None` where
+    /// not kept).
     last_x: Option<i16>,
     /// `p_1 ..`: the raw samples before the onset, newest first.
     before: [i16; BEFORE],
@@ -479,11 +480,14 @@ impl Online {
                     None if i + 1 == BAND => self.band_after,
                     None => None,
                 };
+                let at = shifted(lead, k, c, q);
                 return Ok(Crush {
-                    at: shifted(lead, k, c, q),
+                    at,
                     c_next: lead.l.wrapping_add(c_next),
+                    // (The pass's first sample has none before it in the pass's samples.)
                     beside: before
                         .zip(after)
+                        .filter(|_| at.k > 0)
                         .map(|(b, a)| (self.motion.of(b), self.motion.of(a))),
                 });
             }
@@ -587,4 +591,43 @@ fn bulk(motion: Deviation, part: &[i16], c: &mut i64, q: &mut i64) {
         .wrapping_add(n.wrapping_mul(sum))
         .wrapping_sub(weighted);
     *c = c.wrapping_add(sum);
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Online sums whose full band (sample `j`: `10 + j`, from the state after 5 samples)
+    /// has `before` and `after` kept beside it.
+    fn band(before: Option<i16>, after: Option<i16>) -> Online {
+        let mut o = Online::new();
+        o.band_from = Some(Sums { k: 5, c: 0, q: 0 });
+        o.band_len = BAND;
+        for (j, slot) in o.band.iter_mut().enumerate() {
+            *slot = 10 + j as i16;
+        }
+        (o.band_before, o.band_after) = (before, after);
+        o.lo = 0;
+        o
+    }
+
+    /// The stop that band sample `i` reaches first.
+    fn stop_at(i: usize) -> i64 {
+        (0..=i).map(|j| 10 + j as i64).sum::<i64>() - 1
+    }
+
+    #[test]
+    fn a_crush_anywhere_in_the_band_has_its_neighbours() {
+        let lead = Lead::default();
+        let o = band(Some(7), Some(900));
+        let beside = |i: usize| o.crush(lead, stop_at(i)).unwrap().beside;
+        assert_eq!(beside(0), Some((7, 11)), "first: the one kept before");
+        assert_eq!(beside(60), Some((69, 71)), "inside");
+        assert_eq!(beside(BAND - 1), Some((10 + BAND as i32 - 2, 900)), "last");
+        // Not kept beside it (the ring held none, or the stream ended): none.
+        let o = band(None, None);
+        assert_eq!(o.crush(lead, stop_at(0)).unwrap().beside, None);
+        assert_eq!(o.crush(lead, stop_at(BAND - 1)).unwrap().beside, None);
+        assert!(o.crush(lead, stop_at(60)).unwrap().beside.is_some());
+    }
 }
