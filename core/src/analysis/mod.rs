@@ -453,14 +453,12 @@ fn analyse_kinematics<const CAP: usize>(
         v: &mut *velocity,
         every,
     });
-    let passed = motion::integrate(from_onset, motion, &frame, out).map(|(mut crush, sep)| {
-        // (A decimated capture's values are means: a step at the crush is the stream's to
-        // place, on every sample.)
-        if step > 1 {
-            crush.beside = None;
-        }
-        (crush, sep)
-    });
+    let mut passed = motion::integrate(from_onset, motion, &frame, out);
+    // (A decimated capture's values are means: a step at the crush is the stream's to place,
+    // on every sample.)
+    if let (Some((crush, _)), true) = (passed.as_mut(), step > 1) {
+        crush.beside = None;
+    }
     if from_stream.is_none() {
         // The pass holds what the online sums lost.
         let Some((crush, separation)) = passed else {
