@@ -456,7 +456,7 @@ fn analyse_kinematics<const CAP: usize>(
     let mut passed = motion::integrate(from_onset, motion, &frame, out);
     // (A decimated capture's values are means: a step at the crush is the stream's to place,
     // on every sample.)
-    if let (Some((crush, _)), true) = (passed.as_mut(), step > 1) {
+    if let Some((crush, _)) = passed.as_mut().filter(|_| step > 1) {
         crush.beside = None;
     }
     if from_stream.is_none() {

@@ -258,10 +258,10 @@ impl Frame {
     pub fn found(&self, crush: Crush, separation: [Sums; 2]) -> Found {
         let scale = &self.scale;
         let (v, v_next) = (scale.velocity(crush.at.c), scale.velocity(crush.c_next));
-        // (`W`, the baseline's samples, is one count in `d'`: `kv = gain / (W fs)`.)
-        let count = scale.count;
-        let step = Step::of(&crush, v / scale.kv, count)
-            .filter(|_| self.separation - self.touch >= STEP_MIN_SAMPLES);
+        let resolved = self.separation - self.touch >= STEP_MIN_SAMPLES;
+        let step = resolved
+            .then(|| Step::of(&crush, v / scale.kv, scale.count))
+            .flatten();
         let f = step.map_or(v / (v - v_next), |s| s.f);
         let x_max = scale.deformation(crush.at.k, crush.at.t()) + scale.dt * f * v / 2.0;
         let [s0, s1] = separation;
