@@ -43,11 +43,13 @@ fn within(got: &Value, want: f64, rel: f64, what: &str) {
     );
 }
 
-/// Each contact's kinematics at `rate` against the truth, within 1 % (the crush time and
-/// `x_m` within [`Touch`]'s, as they hang on where first touch is found).
+/// Each contact's kinematics at `rate` against the truth, within 1 %. (Where the force
+/// jumps at touch, a Kelvin–Voigt pad's `c v0` or the dented two-phase pad's damper, touch
+/// lies anywhere in the interval before the jump: its middle had the crush time and `x_m`
+/// up to half a sample off, ±0.8 % of `x_m` on the Kelvin–Voigt pad at 20 kS/s, and the
+/// tests allowed that; the compression's law now places it, `core/src/analysis/jump.rs`.)
 fn check(r: &Value, t: &ContactTruth, law: &str, what: &str, rate: f64) {
     let s = t.separation.unwrap();
-    let touch = Touch::of(law, rate, t);
     let w = |f: &str| format!("{what}: {f}");
     // First touch itself: within 0.6 of a sample (a step's middle, half a sample from where
     // it may lie), or where a foot's first samples lie within the noise, 5 µs (2.5 samples at
@@ -57,8 +59,17 @@ fn check(r: &Value, t: &ContactTruth, law: &str, what: &str, rate: f64) {
     let code = 4000.0 / 65536.0;
     let slope = std::f64::consts::FRAC_PI_2 * t.peak_force_n / 0.06 / t.crush_time_s.unwrap();
     let start = r["start_s"].as_f64().unwrap();
+    // Where the force jumps at touch and a sample is 10 µs or longer, within 0.35 of a
+    // sample: the compression's law places it in the interval (its middle was up to half a
+    // sample off; the Kelvin–Voigt pad from 5 mm at 20 kS/s is placed 0.28 samples late).
+    let jumps = law == "kelvin-voigt" || (law == "two-phase" && t.surface_m > 0.0);
+    let tolerance = if jumps && rate <= 100e3 {
+        0.35 / rate
+    } else {
+        (0.6 / rate).max(5e-6).max(2.0 * code / slope)
+    };
     assert!(
-        (start - t.touch_s).abs() <= (0.6 / rate).max(5e-6).max(2.0 * code / slope),
+        (start - t.touch_s).abs() <= tolerance,
         "{}: {start} s vs true {} s ({:+.2} samples)",
         w("first touch"),
         t.touch_s,
@@ -74,13 +85,13 @@ fn check(r: &Value, t: &ContactTruth, law: &str, what: &str, rate: f64) {
     within(
         &r["crush_time_s"],
         t.crush_time_s.unwrap(),
-        touch.crush,
+        0.01,
         &w("crush"),
     );
     within(
         &r["max_deformation_m"],
         t.max_deformation_m.unwrap(),
-        touch.x_m,
+        0.01,
         &w("x_m"),
     );
     within(&r["peak_force_n"], t.peak_force_n, 0.01, &w("peak force"));
@@ -91,7 +102,7 @@ fn check(r: &Value, t: &ContactTruth, law: &str, what: &str, rate: f64) {
     let x_m = t.max_deformation_m.unwrap();
     match r["permanent_deformation_m"].as_f64() {
         Some(set) => assert!(
-            (set - s.set_m).abs() <= touch.x_m * x_m,
+            (set - s.set_m).abs() <= 0.01 * x_m,
             "{}: {set} vs true {}",
             w("set"),
             s.set_m
@@ -111,7 +122,7 @@ fn check(r: &Value, t: &ContactTruth, law: &str, what: &str, rate: f64) {
     let x_sep = r["separation_deformation_m"].as_f64().unwrap();
     assert!(
         // (First touch's error, and separation's: both ends of the contact's feet.)
-        (x_sep - s.deformation_m).abs() <= 2.0 * touch.x_m * x_m,
+        (x_sep - s.deformation_m).abs() <= 0.02 * x_m,
         "{}: {x_sep} vs true {}",
         w("x at separation"),
         s.deformation_m
@@ -127,31 +138,6 @@ fn check(r: &Value, t: &ContactTruth, law: &str, what: &str, rate: f64) {
         (e - s.absorbed_energy_j) / e0 * 100.0
     );
     within(&r["delta_v_m_s"], s.delta_v_m_s, 0.01, &w("Δv"));
-}
-
-/// The crush time's and `x_m`'s tolerances (relative): 1 %, or where the force jumps at
-/// touch (a Kelvin–Voigt pad's `c v0`, the dented two-phase pad's damper) half a sample's
-/// share of them: the touch lies anywhere between the last sample without force and the
-/// first with, and the middle of that interval is the best the samples tell. (The virgin
-/// two-phase pad's force steps from `kc x_m` to `kr (x_m - x_p)` at the crush: placed there,
-/// its Δv, COR and energy are held to 1 % like any other's; taken at the sample's interval's
-/// edge, the seed pad's COR was +0.9 % and its energy −1.05 % at 20 kS/s.)
-struct Touch {
-    crush: f64,
-    x_m: f64,
-}
-
-impl Touch {
-    fn of(law: &str, rate: f64, t: &ContactTruth) -> Self {
-        // (The two-phase pad's damper acts on reloading its dent, not on its virgin surface.)
-        let jumps = law == "kelvin-voigt" || (law == "two-phase" && t.surface_m > 0.0);
-        let half = if jumps { 0.5 / rate } else { 0.0 };
-        let x_m = t.max_deformation_m.unwrap();
-        Touch {
-            crush: 0.01f64.max(half / t.crush_time_s.unwrap()),
-            x_m: 0.01f64.max(half * t.approach_m_s / x_m),
-        }
-    }
 }
 
 /// A Kelvin–Voigt pad (k 1e4 N/m, c 5 N s/m): relaxes in c/k = 0.5 ms, keeps no set.
@@ -530,8 +516,7 @@ fn a_body_settling_on_a_soft_pad_is_one_contact_that_never_ends() {
 /// the kinematics' speed from the flight (`--train flight`): v0, the rebound, the COR, the
 /// rebound's measure of the speed, the crush time, x_m, the set, the deformation at
 /// separation, the energy and the peak force within 1 % on every bounce that separates
-/// ([`check`]: the crush time and x_m within half a sample where the force jumps at touch;
-/// bounces 1 and 3 at 20 kS/s were 2.3 samples early, crush time +3 %, x_m +4.7 %, where
+/// ([`check`]; bounces 1 and 3 at 20 kS/s were 2.3 samples early, crush time +3 %, x_m +4.7 %, where
 /// the walk back through the foot's noise after a flight set first touch). From the
 /// previous rebound (`--train rebound`, a chain: each bounce's speed the previous rebound
 /// brought down by the flight's time, `g t - v_r`), v0, the COR and the rebound within 1 % at
@@ -615,15 +600,16 @@ fn bounce_trains_of_every_law_within_one_percent() {
 
 /// 1 ms contacts (linear, Hertz, seed 001's law and Kelvin–Voigt, 91 mm drops from rest) at
 /// coarse rates, four touch phases: at 100 kS/s (100 samples a contact) every field within
-/// 1 % ([`check`]: Kelvin–Voigt's crush time and `x_m` within half a sample, its set null);
+/// 1 % ([`check`]: Kelvin–Voigt's set null);
 /// at 20 kS/s (20 samples) first touch within a tenth of a sample and the COR, crush time and
 /// `x_m` within 1 % for the laws whose force starts from zero (linear, Hertz, seed 001's):
 /// the onset's step past the flank level is placed from its first three samples, not in the
 /// middle of the interval before it (up to ±6 % on `x_m`), and so is an onset just past the
 /// edge level whose next two samples lie on its power curve (Hertz at phase 0.25: the walk
 /// back to the baseline had it 0.87 samples early, `x_m` +12.6 %).
-/// Not yet: Kelvin–Voigt at 20 kS/s (its jump: touch anywhere in a sample), and coarser
-/// rates (docs/accuracy.md; #43).
+/// Not yet: Kelvin–Voigt at 20 kS/s (its jump is placed from the compression at three of
+/// the four phases; at phase 0.25 the onset is not taken for a jump and touch lands 0.71
+/// samples early, `x_m` +11 %), and coarser rates (docs/accuracy.md; #43).
 #[test]
 fn a_one_millisecond_contact_at_coarse_rates() {
     let scratch = Scratch::new();

@@ -6,6 +6,8 @@
 //! few thousand points: no per-sample floating point unless a CFC filter is asked for.
 
 use crate::capture::Capture;
+#[cfg(feature = "fit")]
+pub mod jump;
 pub mod motion;
 
 use crate::report::motion::{motion_deviation, Frame};
@@ -299,6 +301,55 @@ fn coarse<const CAP: usize>(
     (c, coarse)
 }
 
+/// A contact's samples from the integration's first, the kinematics' deviation and frame.
+#[cfg(feature = "fit")]
+struct Jump<'a> {
+    samples: &'a [i16],
+    motion: Deviation,
+    frame: &'a Frame,
+}
+
+/// Places first touch where the force jumped at it from the compression's law
+/// ([`jump::shift`]) and moves the report's start, duration, Δv and kinematics (`found`
+/// with them) by it, and the fit points (the first `x.len()` of `points`). Not inlined:
+/// its frame stays out of the analysis task's.
+#[cfg(feature = "fit")]
+#[inline(never)]
+fn place_jump(
+    r: &mut ImpactReport,
+    scene: &Scene,
+    s: &crate::capture::Summary,
+    jump: Jump<'_>,
+    found: &mut report::motion::Found,
+    points: PointsOut<'_>,
+) -> Option<()> {
+    let Jump {
+        samples,
+        motion,
+        frame,
+    } = jump;
+    // Gravity's shift of the kinematics' deviation, exactly as it was taken off.
+    let g_d = i64::from(Deviation::new(s.base_sum, s.base_n).of(0)) - i64::from(motion.of(0));
+    let shift = jump::shift(samples, motion, g_d, frame, found)?;
+    let crush = libm::floor(found.crush + 0.5) as usize;
+    let d_crush = f64::from(motion.of(*samples.get(crush)?));
+    let mut moved = *frame;
+    let dv = shift.apply(&mut moved, found, d_crush);
+    let dt = frame.scale.dt;
+    r.start_s -= shift.s * dt;
+    r.duration_s += (shift.s * dt) as f32;
+    r.delta_v_m_s = r.delta_v_m_s.map(|v| v + dv as f32);
+    r.kinematics = None;
+    report::motion::kinematics(r, scene, &moved, found);
+    for (i, (x, v)) in points.x.iter_mut().zip(points.v.iter_mut()).enumerate() {
+        // (Point i: the state after sample every i, at time every i + ½.)
+        let (dx, dv) = shift.at(frame, (points.every * i) as f64 + 0.5);
+        *x += dx as f32;
+        *v += (dv / frame.scale.v0) as f32;
+    }
+    Some(())
+}
+
 /// The analysis with the kinematics from the pass over the capture alone, the stream's
 /// online sums left out: what the two are held to (they give the same bits wherever the
 /// capture holds the contact at every sample; `host-tests/tests/online.rs`; on a decimated
@@ -315,7 +366,9 @@ pub fn analyse_by_pass<const CAP: usize>(
     analyse_kinematics(capture, &s, scene, work)
 }
 
-/// Everything but the spectra, for the capture's summary `s`.
+/// Everything but the spectra, for the capture's summary `s`. Not inlined: its frame is
+/// gone before the spectra's and the verdict's.
+#[inline(never)]
 fn analyse_kinematics<const CAP: usize>(
     capture: &Capture<CAP>,
     s: &crate::capture::Summary,
@@ -420,7 +473,9 @@ fn analyse_kinematics<const CAP: usize>(
         }
         _ => 0,
     };
-    if points == 0 && from_stream.is_some() {
+    // (A jump's touch is placed from the pass's samples, fits or not.)
+    let jump = s.touch_jump && step == 1 && r.kinematics.is_some() && cfg!(feature = "fit");
+    if points == 0 && from_stream.is_some() && !jump {
         return r;
     }
     let f_peak = libm::fabsf(peak_a) * fit_mass.unwrap_or(0.0);
@@ -478,20 +533,36 @@ fn analyse_kinematics<const CAP: usize>(
         }
         report::motion::kinematics(&mut r, scene, &frame, &found);
     }
-    let Some(k) = r.kinematics else {
+    if r.kinematics.is_none() {
         return r;
-    };
+    }
     // The maximum deformation in f64, from whichever sums gave the kinematics.
     let found = match from_stream {
         Some(found) => Some(found),
         None => passed.map(|(crush, separation)| frame.found(crush, separation)),
     };
-    let (Some(found), Some(_)) = (found, passed) else {
+    let (Some(mut found), Some(_)) = (found, passed) else {
         return r;
     };
+    // First touch in a jump's interval, from the contact's law: the kinematics and the fit
+    // points move with it.
+    #[cfg(feature = "fit")]
+    if jump {
+        let jump = Jump {
+            samples: from_onset,
+            motion,
+            frame: &frame,
+        };
+        let points = PointsOut {
+            x: &mut *deformation,
+            v: &mut *velocity,
+            every,
+        };
+        place_jump(&mut r, scene, s, jump, &mut found, points);
+    }
 
     #[cfg(feature = "fit")]
-    if points > 0 {
+    if let (Some(k), true) = (r.kinematics, points > 0) {
         use crate::fit;
         // The points were integrated in metres: scale them by the maximum deformation.
         let inv_x = (1.0 / found.x_max) as f32;

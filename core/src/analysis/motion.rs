@@ -28,7 +28,7 @@ pub struct PointsOut<'a> {
 /// `v` as f32 by the FPU's 32-bit conversions (two of them, a multiply-add; `i64 as f32` is
 /// a soft-float call on the Cortex-M4): within two f32 roundings of the exact value.
 #[inline]
-fn to_f32(v: i64) -> f32 {
+pub(crate) fn to_f32(v: i64) -> f32 {
     // Sign and magnitude: both halves non-negative, so nothing cancels.
     let m = v.unsigned_abs();
     let f = (m >> 32) as u32 as f32 * 4_294_967_296.0 + m as u32 as f32;

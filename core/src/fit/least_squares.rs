@@ -53,29 +53,30 @@ impl Points<'_> {
     }
 }
 
-/// Solves the 3×3 system `A θ = b` by Gaussian elimination with partial pivoting.
+/// Solves the N×N system `A θ = b` by Gaussian elimination with partial pivoting.
 #[allow(clippy::needless_range_loop)]
-fn solve3(mut a: [[f64; 3]; 3], mut b: [f64; 3]) -> Option<[f64; 3]> {
-    for col in 0..3 {
+pub(crate) fn solve<const N: usize>(mut a: [[f64; N]; N], mut b: [f64; N]) -> Option<[f64; N]> {
+    for col in 0..N {
         let pivot =
-            (col..3).max_by(|&i, &j| libm::fabs(a[i][col]).total_cmp(&libm::fabs(a[j][col])))?;
-        if !(libm::fabs(a[pivot][col]) > 1e-300) {
+            (col..N).max_by(|&i, &j| libm::fabs(a[i][col]).total_cmp(&libm::fabs(a[j][col])))?;
+        // (`pivot < N` always; said, so that no bounds check is left to panic.)
+        if pivot >= N || !(libm::fabs(a[pivot][col]) > 1e-300) {
             return None;
         }
         a.swap(col, pivot);
         b.swap(col, pivot);
-        for row in col + 1..3 {
+        for row in col + 1..N {
             let f = a[row][col] / a[col][col];
-            for k in col..3 {
+            for k in col..N {
                 a[row][k] -= f * a[col][k];
             }
             b[row] -= f * b[col];
         }
     }
-    let mut x = [0.0; 3];
-    for row in (0..3).rev() {
+    let mut x = [0.0; N];
+    for row in (0..N).rev() {
         let mut s = b[row];
-        for k in row + 1..3 {
+        for k in row + 1..N {
             s -= a[row][k] * x[k];
         }
         x[row] = s / a[row][row];
@@ -98,6 +99,8 @@ fn residual(p: &Points<'_>, mut model: impl FnMut(f32, f32) -> f32) -> f32 {
 /// restitution `F = kr (x - x_p) + c v`, fitted as `kr (X - 1) + b + c V` (columns centred
 /// at the maximum deformation, where `X` and 1 would be nearly collinear); `line` is
 /// [`restitution`]'s, fitted once for this fit and the [`set`].
+// (Not inlined: each fit's frame stays out of the analysis task's.)
+#[inline(never)]
 pub fn two_phase(p: &Points<'_>, line: Option<Restitution>) -> Option<TwoPhaseFit> {
     if !p.usable() {
         return None;
@@ -165,7 +168,7 @@ pub fn restitution(p: &Points<'_>) -> Option<Restitution> {
         restitution.add([u * u, u, u * v, 1.0, v, v * v, u * f, f, v * f]);
     }
     let [uu, u, uv, n, sv, vv, uf, sf, vf] = restitution.get();
-    let [kr, b, c] = solve3([[uu, u, uv], [u, n, sv], [uv, sv, vv]], [uf, sf, vf])?;
+    let [kr, b, c] = solve([[uu, u, uv], [u, n, sv], [uv, sv, vv]], [uf, sf, vf])?;
     Some(Restitution { kr, b, c })
 }
 
@@ -221,6 +224,8 @@ fn nonlinear_at(p: &Points<'_>, xn: impl Fn(usize, f32) -> f32) -> Option<(f64, 
 
 /// Nonlinear `F = k x^n (1 + c v)`, the exponent fixed at `n`, or searched in [1, 2.5] when
 /// `n` is `None` (`ln_x`, at least as long as the points, is scratch for `ln X`).
+// (Not inlined: each fit's frame stays out of the analysis task's.)
+#[inline(never)]
 pub fn nonlinear(p: &Points<'_>, n: Option<f32>, ln_x: &mut [f32]) -> Option<NonlinearFit> {
     if !p.usable() {
         return None;
@@ -283,6 +288,8 @@ pub fn nonlinear(p: &Points<'_>, n: Option<f32>, ln_x: &mut [f32]) -> Option<Non
 }
 
 /// Hertz `F = K x^1.5`.
+// (Not inlined: each fit's frame stays out of the analysis task's.)
+#[inline(never)]
 pub fn hertz(p: &Points<'_>) -> Option<HertzFit> {
     if !p.usable() {
         return None;

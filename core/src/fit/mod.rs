@@ -15,9 +15,13 @@ mod least_squares;
 #[cfg(feature = "fit")]
 mod sums;
 #[cfg(feature = "fit")]
+pub(crate) use least_squares::solve;
+#[cfg(feature = "fit")]
 pub use least_squares::{
     hertz, nonlinear, restitution, set, two_phase, Points, Restitution, SET_RESIDUAL,
 };
+#[cfg(feature = "fit")]
+pub(crate) use sums::Sums;
 
 /// Two-phase Kelvin–Voigt parameters identified from one impact.
 #[derive(Clone, Copy, Debug, PartialEq)]

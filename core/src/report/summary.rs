@@ -63,6 +63,11 @@ pub struct Summary {
     /// zero force (its foot fitted as a power curve on a captured impact,
     /// [`crate::signal::power_flank`], else a straight line), or the edge crossing.
     pub touch_offset: f32,
+    /// First touch is the middle of the interval before a force that jumped there from zero
+    /// (a damper's `c v0`, [`crate::signal::power_flank::steep_zero`]): the samples cannot
+    /// tell where in that interval it lies; the analysis places it from the contact's law
+    /// where it can ([`crate::analysis::jump`]).
+    pub touch_jump: bool,
     /// Stream index of the first sample back within the edge level after the peak, if any.
     pub separation_index: Option<u64>,
     /// Separation relative to `separation_index`, samples (the falling flank extrapolated to
@@ -163,6 +168,7 @@ impl Summary {
         filter_lead: 0,
         onset_index: 0,
         touch_offset: 0.0,
+        touch_jump: false,
         separation_index: None,
         separation_offset: 0.0,
         end_index: 0,

@@ -171,10 +171,17 @@ fn fit(
 /// bias). In `[-1, 0]`. (A jump onto a ramp, `c v0 + k v0 t`, is a straight line too: it
 /// reads as a ramp that began up to a sample earlier.)
 pub fn steep_zero(y: [f32; 3]) -> f32 {
-    match head_line(y) {
-        Some((zero, _)) if (-1.0..=0.0).contains(&zero) => zero,
-        _ => -0.5,
-    }
+    steep_line_zero(y).unwrap_or(JUMP_MIDDLE)
+}
+
+/// Where [`steep_zero`] puts a jump's touch: the middle of the interval before it.
+pub const JUMP_MIDDLE: f32 = -0.5;
+
+/// [`steep_zero`]'s line's zero, `None` where it takes the middle of the interval (a jump).
+pub fn steep_line_zero(y: [f32; 3]) -> Option<f32> {
+    head_line(y)
+        .map(|(zero, _)| zero)
+        .filter(|zero| (-1.0..=0.0).contains(zero))
 }
 
 /// How far the middle of three samples may lie off the line through the outer two, over

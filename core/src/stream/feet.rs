@@ -255,7 +255,7 @@ impl<const PRE: usize> Stream<PRE> {
     /// the onset's three lie on a power curve, from those three ([`Self::head_touch`]); else
     /// the trigger's estimate (`touch_offset`, `lead_c`). And whether it is a fit's zero (not
     /// the edge crossing, late by design).
-    pub(super) fn touch(&mut self, a: &Active) -> ((f32, i64, bool), bool) {
+    pub(super) fn touch(&mut self, a: &Active) -> ((f32, i64, bool), bool, bool) {
         let trigger = (a.touch_offset, a.lead_c, a.line_in_previous);
         let peak = a.peak_d.unsigned_abs() as f32;
         let foot = self.rise_foot(a).filter(|foot| {
@@ -279,14 +279,22 @@ impl<const PRE: usize> Stream<PRE> {
                 let touch = foot.zero.max(a.touch_floor);
                 let lead = libm::floorf(-touch).max(0.0) as i64;
                 let c = foot.sum(-lead, 0) * peak * a.sign as f32;
-                ((touch, c as i64, foot.zero < a.touch_floor), true)
+                ((touch, c as i64, foot.zero < a.touch_floor), true, false)
             }
             None => match self.head_touch(a) {
-                Some(z) => ((z.max(a.touch_floor), a.lead_c, z < a.touch_floor), true),
+                Some((z, jump)) => {
+                    let touch = z.max(a.touch_floor);
+                    (
+                        (touch, a.lead_c, z < a.touch_floor),
+                        true,
+                        jump && touch == z,
+                    )
+                }
                 // (A step's middle is no edge crossing either.)
                 None => (
                     trigger,
                     matches!(a.flank_touch, FlankTouch::Line | FlankTouch::Steep),
+                    false,
                 ),
             },
         }
@@ -300,11 +308,17 @@ impl<const PRE: usize> Stream<PRE> {
     /// sample in: else the walk back to the baseline puts touch up to a sample early) and
     /// the sample before the onset is quiet, as that curve says (within half the edge level:
     /// a foot that began earlier is the lobe's).
-    fn head_touch(&self, a: &Active) -> Option<f32> {
+    /// And whether touch is a jump's middle ([`crate::capture::Summary::touch_jump`]).
+    fn head_touch(&self, a: &Active) -> Option<(f32, bool)> {
         let head = || a.rise.head().map(|y| y.map(|d| d as f32));
         match a.flank_touch {
-            FlankTouch::Steep => Some(power_flank::steep_zero(head()?)),
-            FlankTouch::Crossing => power_flank::head_zero(head()?).filter(|_| a.quiet_before),
+            FlankTouch::Steep => Some(match power_flank::steep_line_zero(head()?) {
+                Some(zero) => (zero, false),
+                None => (power_flank::JUMP_MIDDLE, true),
+            }),
+            FlankTouch::Crossing => power_flank::head_zero(head()?)
+                .filter(|_| a.quiet_before)
+                .map(|zero| (zero, false)),
             FlankTouch::Line | FlankTouch::Refused => None,
         }
     }

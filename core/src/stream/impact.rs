@@ -504,8 +504,10 @@ impl<const PRE: usize> Stream<PRE> {
         };
         // A rising foot that is a power curve puts first touch where it reaches zero force;
         // the contact's Δv runs from touch to separation, the feet below the edge included.
-        let (touch, fitted) = self.touch(&a);
+        let (touch, fitted, jump) = self.touch(&a);
         let (touch_offset, lead_c, in_previous) = self.lobe(&a, touch, fitted);
+        // (A lobe that begins earlier is no jump.)
+        let touch_jump = jump && touch_offset == touch.0 && !in_previous;
         let touch = a.onset_index as f64 + touch_offset as f64;
         let approach =
             self.run
@@ -529,6 +531,7 @@ impl<const PRE: usize> Stream<PRE> {
             filter_lead: a.filter_lead,
             onset_index: a.onset_index,
             touch_offset,
+            touch_jump,
             separation_index: a.separation,
             separation_offset,
             end_index: a.end_at.unwrap_or(self.run.index),
