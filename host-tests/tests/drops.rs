@@ -59,12 +59,12 @@ fn check(r: &Value, t: &ContactTruth, law: &str, what: &str, rate: f64) {
     let code = 4000.0 / 65536.0;
     let slope = std::f64::consts::FRAC_PI_2 * t.peak_force_n / 0.06 / t.crush_time_s.unwrap();
     let start = r["start_s"].as_f64().unwrap();
-    // Where the force jumps at touch and a sample is 10 µs or longer, within 0.35 of a
+    // Where the force jumps at touch and a sample is 10 µs or longer, within 0.2 of a
     // sample: the compression's law places it in the interval (its middle was up to half a
-    // sample off; the Kelvin–Voigt pad from 5 mm at 20 kS/s is placed 0.28 samples late).
+    // sample off; the Kelvin–Voigt pad from 5 mm at 20 kS/s is placed within 0.08).
     let jumps = law == "kelvin-voigt" || (law == "two-phase" && t.surface_m > 0.0);
     let tolerance = if jumps && rate <= 100e3 {
-        0.35 / rate
+        0.2 / rate
     } else {
         (0.6 / rate).max(5e-6).max(2.0 * code / slope)
     };
@@ -95,8 +95,7 @@ fn check(r: &Value, t: &ContactTruth, law: &str, what: &str, rate: f64) {
         &w("x_m"),
     );
     within(&r["peak_force_n"], t.peak_force_n, 0.01, &w("peak force"));
-    // The set after recovery within 1 % of x_m (and the touch's share: every deformation
-    // carries first touch's error): reported for the laws whose unloading is an
+    // The set after recovery within 1 % of x_m: reported for the laws whose unloading is an
     // elastic and a viscous part (linear, Kelvin–Voigt, two-phase), null (the record cannot
     // tell) or right for the others.
     let x_m = t.max_deformation_m.unwrap();

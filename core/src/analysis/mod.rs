@@ -474,7 +474,11 @@ fn analyse_kinematics<const CAP: usize>(
         _ => 0,
     };
     // (A jump's touch is placed from the pass's samples, fits or not.)
-    let jump = s.touch_jump && step == 1 && r.kinematics.is_some() && cfg!(feature = "fit");
+    // (The pass gives the kinematics where the stream's sums have none.)
+    let jump = s.touch_jump
+        && step == 1
+        && (r.kinematics.is_some() || from_stream.is_none())
+        && cfg!(feature = "fit");
     if points == 0 && from_stream.is_some() && !jump {
         return r;
     }

@@ -254,7 +254,8 @@ impl<const PRE: usize> Stream<PRE> {
     /// flank stepped past the flank level, or the flank held too few samples for a line and
     /// the onset's three lie on a power curve, from those three ([`Self::head_touch`]); else
     /// the trigger's estimate (`touch_offset`, `lead_c`). And whether it is a fit's zero (not
-    /// the edge crossing, late by design).
+    /// the edge crossing, late by design), and whether it is a jump's middle with the jump's
+    /// interval clear of the previous contact ([`crate::capture::Summary::touch_jump`]).
     pub(super) fn touch(&mut self, a: &Active) -> ((f32, i64, bool), bool, bool) {
         let trigger = (a.touch_offset, a.lead_c, a.line_in_previous);
         let peak = a.peak_d.unsigned_abs() as f32;
@@ -284,11 +285,10 @@ impl<const PRE: usize> Stream<PRE> {
             None => match self.head_touch(a) {
                 Some((z, jump)) => {
                     let touch = z.max(a.touch_floor);
-                    (
-                        (touch, a.lead_c, z < a.touch_floor),
-                        true,
-                        jump && touch == z,
-                    )
+                    // (A jump's whole interval clear of the previous contact: the analysis
+                    // may place touch anywhere in it.)
+                    let jump = jump && a.touch_floor <= -1.0;
+                    ((touch, a.lead_c, z < a.touch_floor), true, jump)
                 }
                 // (A step's middle is no edge crossing either.)
                 None => (
