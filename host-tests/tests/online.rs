@@ -274,34 +274,30 @@ fn a_force_that_steps_at_the_crush_is_placed_alike_online_and_by_the_pass() {
 }
 
 /// A Kelvin–Voigt contact (the 60 g body at 1.3357 m/s on a 1e4 N/m, 5 N s/m pad: `c v0`
-/// at touch) at 20 kS/s with touch `phase` of a sample before sample `at`: the samples on a
-/// baseline of 2000 counts of 0.05 m/s², and the true crush time (s).
+/// at touch; the physical generator, `impact_host::drop`, without gravity) at `rate` with
+/// touch `phase` of a sample before sample `at`: the samples on a baseline of 2000 counts of
+/// 0.05 m/s², 0.2 s of them after touch, and the true crush time (s).
 fn kelvin_voigt(phase: f64, at: usize, rate: f64) -> (Vec<i16>, f64) {
-    let (k, c, v0) = (1e4 / 0.06, 5.0 / 0.06, 1.3357);
-    let mut x = vec![2000i16; at];
-    let (mut d, mut v, mut t) = (0.0f64, v0, 0.0f64);
-    let h = 1.0 / rate / 2000.0;
-    let mut crush = None;
-    let mut next = phase;
-    loop {
-        while t + h <= next / rate {
-            let a = (k * d + c * v).max(0.0);
-            if v > 0.0 && v - a * h <= 0.0 {
-                crush.get_or_insert(t);
-            }
-            d += v * h;
-            v -= a * h;
-            t += h;
-        }
-        let a = k * d + c * v;
-        if a <= 0.0 && crush.is_some() {
-            break;
-        }
-        x.push((2000.0 + a.max(0.0) / 0.05).round() as i16);
-        next += 1.0;
-    }
-    x.extend(std::iter::repeat_n(2000i16, (0.2 * rate) as usize));
-    (x, crush.unwrap())
+    use impact_core::model::KelvinVoigt;
+    use impact_host::drop::{Drop, Start};
+    let drop = Drop {
+        law: impact_core::Model::KelvinVoigt(KelvinVoigt { k: 1e4, c: 5.0 }),
+        mass_kg: 0.06,
+        gravity_m_s2: 0.0,
+        start: Start::Moving {
+            touch_s: (at as f64 - phase) / rate,
+            v0_m_s: 1.3357,
+        },
+        max_contacts: 1,
+        min_rebound_m_s: 1e-3,
+    };
+    let rendered = drop.render(rate, at + (0.2 * rate) as usize).unwrap();
+    let x = rendered
+        .accel_m_s2
+        .iter()
+        .map(|a| (2000.0 + a / 0.05).round() as i16)
+        .collect();
+    (x, rendered.contacts[0].crush_time_s.unwrap())
 }
 
 /// A force that jumps at touch: the analysis places touch from the compression's law

@@ -60,19 +60,21 @@ pub const JUMP_COUNTS: f64 = 1.0;
 pub const JUMP_MIN_SAMPLES: usize = 8;
 
 /// Touch placed in the jump's interval: `s` samples earlier than its middle (`-0.5..=0.5`);
-/// `h` the force at touch (the reading's, units of `d`) and `lost` the body's deceleration
-/// then (`h` less gravity's shift).
+/// `h` the force at touch (the reading's, units of `d`), `lost` the body's deceleration
+/// then (`h` less gravity's shift) and `d_crush` the crush's sample's deviation (units of
+/// `d`, gravity's shift taken off).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Shift {
     pub s: f64,
     pub h: f64,
     pub lost: f64,
+    pub d_crush: f64,
 }
 
-/// The shift of touch from the compression `samples` (from the integration's first up to
-/// the crush's sample, exclusive), `dev` the kinematics' deviation (gravity's shift `g_d`
-/// taken off), `None` where the law is not that or the samples too few. Not inlined: its
-/// sums stay off the caller's frame.
+/// The shift of touch from the contact's `samples` (from the integration's first; the
+/// compression is those before the crush's sample), `dev` the kinematics' deviation
+/// (gravity's shift `g_d` taken off), `None` where the law is not that or the samples too
+/// few. Not inlined: its sums stay off the caller's frame.
 #[inline(never)]
 pub fn shift(
     samples: &[i16],
@@ -82,11 +84,14 @@ pub fn shift(
     found: &Found,
 ) -> Option<Shift> {
     let scale = &frame.scale;
+    // (The crush's sample: the one whose interval holds the crush.)
     let n = libm::floor(found.crush + 0.5);
-    if !(n >= JUMP_MIN_SAMPLES as f64 && n <= JUMP_MAX_SAMPLES as f64 && n < samples.len() as f64) {
+    let held = JUMP_MIN_SAMPLES as f64..=JUMP_MAX_SAMPLES as f64;
+    if !(held.contains(&n) && n < samples.len() as f64) {
         return None;
     }
     let compression = samples.get(..n as usize)?;
+    let d_crush = f64::from(dev.of(*samples.get(n as usize)?));
     let w0 = scale.v0 / scale.kv;
     let g = g_d as f64;
     // The shift the fit gives with the deformation's slope taken as `w0 - l σ`, `f(σ)`:
@@ -130,6 +135,7 @@ pub fn shift(
         s: estimate.clamp(-0.5, 0.5),
         h: placed.h,
         lost: placed.lost,
+        d_crush,
     })
 }
 
@@ -297,10 +303,10 @@ fn residual(samples: &[i16], dev: Deviation, w0: f64, tilt: f64, b: &[f64; 4]) -
 }
 
 impl Shift {
-    /// Moves `frame`'s touch and `found`'s crush and deformations by the shift; `d_crush`:
-    /// the crush's sample's deviation (units of `d`, gravity's shift taken off). Returns the
+    /// Moves `frame`'s touch and `found`'s crush and deformations by the shift. Returns the
     /// area of the reading the sums missed, as Δv (m/s).
-    pub fn apply(&self, frame: &mut Frame, found: &mut Found, d_crush: f64) -> f64 {
+    pub fn apply(&self, frame: &mut Frame, found: &mut Found) -> f64 {
+        let d_crush = self.d_crush;
         found.x_max += self.at(frame, found.crush).0;
         found.x_sep += self.at(frame, frame.separation).0;
         // The velocity reached zero `lost s / d_crush` samples earlier (no further than the
@@ -330,34 +336,12 @@ mod tests {
     use crate::report::motion::Scale;
 
     /// A pad's compression read every `dt` (counts of `q` m/s² each) with touch `s` samples
-    /// before the middle of the interval before sample 0, under gravity `g` (m/s², the body
-    /// decelerating at the reading less `g`): the reading `k x + c v` per unit mass, or
-    /// `k x^1.5` (`hertz`). With the frame and the crush the sums see, and the true crush
-    /// time (s) and maximum deformation (m).
-    fn pad(
-        k: f64,
-        c: f64,
-        hertz: bool,
-        s: f64,
-        g: f64,
-    ) -> (heapless::Vec<i16, 512>, Frame, f64, (f64, f64)) {
-        pad_at(k, c, hertz, s, g, 1.3357)
-    }
-
-    fn pad_at(
-        k: f64,
-        c: f64,
-        hertz: bool,
-        s: f64,
-        g: f64,
-        v0: f64,
-    ) -> (heapless::Vec<i16, 512>, Frame, f64, (f64, f64)) {
-        stiffening(k, c, hertz, s, g, v0, 0.0)
-    }
-
-    /// [`pad_at`]'s pad, `stiffer` stiffer at 3.3 mm (about its `x_m`) than affine:
-    /// `k x (1 + stiffer x / 3.3 mm) + c v`.
-    fn stiffening(
+    /// before the middle of the interval before sample 0, the body at `v0` under gravity `g`
+    /// (m/s², decelerating at the reading less `g`): per unit mass, the reading
+    /// `k x (1 + stiffer x / 3.3 mm) + c v` (`stiffer`: how much stiffer than affine at about
+    /// its `x_m`), or `k x^1.5 + c v` (`hertz`).
+    #[derive(Clone, Copy)]
+    struct Pad {
         k: f64,
         c: f64,
         hertz: bool,
@@ -365,54 +349,83 @@ mod tests {
         g: f64,
         v0: f64,
         stiffer: f64,
-    ) -> (heapless::Vec<i16, 512>, Frame, f64, (f64, f64)) {
-        let (dt, q) = (5e-5, 0.05);
-        let (mut x, mut v, mut t) = (0.0f64, v0, 0.0f64);
-        let mut samples = heapless::Vec::<i16, 512>::new();
-        let mut crush = None;
-        let mut truth = (0.0, 0.0);
-        let reading = |x: f64, v: f64| {
-            if hertz {
-                k * libm::pow(x.max(0.0), 1.5) + c * v
-            } else {
-                k * x * (1.0 + stiffer * x / 3.3e-3) + c * v
+    }
+
+    impl Pad {
+        /// The 60 g body at 1.3357 m/s onto a 1e4 N/m pad with a damper of `c` N s/m, no
+        /// gravity, touch `s` samples before the middle.
+        fn kelvin_voigt(c: f64, s: f64) -> Self {
+            Self {
+                k: 1e4 / 0.06,
+                c: c / 0.06,
+                hertz: false,
+                s,
+                g: 0.0,
+                v0: 1.3357,
+                stiffer: 0.0,
             }
-        };
-        // Fine Euler steps from touch at -(0.5 + s) samples.
-        let h = dt / 2000.0;
-        let mut next = 0.5 + s;
-        while samples.len() < 300 {
-            while t + h <= next * dt {
-                let a = reading(x, v) - g;
-                if v > 0.0 && v - a * h <= 0.0 && crush.is_none() {
-                    crush = Some(t / dt - 0.5 - s);
-                    truth = (t, x);
-                }
-                x += v * h;
-                v -= a * h;
-                t += h;
-            }
-            samples
-                .push(libm::round(reading(x, v) / q).clamp(-32000.0, 32000.0) as i16)
-                .unwrap();
-            next += 1.0;
         }
-        let scale = Scale {
-            v0,
-            kv: q * dt,
-            dt,
-            x_lead: 0.0,
-            count: 1.0,
-        };
-        let frame = Frame {
-            lead: 0,
-            touch: -0.5,
-            separation: 250.0,
-            sep_floor: 250,
-            frac: 0.5,
-            scale,
-        };
-        (samples, frame, crush.unwrap(), truth)
+
+        /// The samples, with the frame and the crush the sums see, and the true crush time
+        /// (s) and maximum deformation (m).
+        fn render(self) -> (heapless::Vec<i16, 512>, Frame, f64, (f64, f64)) {
+            let Pad {
+                k,
+                c,
+                hertz,
+                s,
+                g,
+                v0,
+                stiffer,
+            } = self;
+            let (dt, q) = (5e-5, 0.05);
+            let (mut x, mut v, mut t) = (0.0f64, v0, 0.0f64);
+            let mut samples = heapless::Vec::<i16, 512>::new();
+            let mut crush = None;
+            let mut truth = (0.0, 0.0);
+            let reading = |x: f64, v: f64| {
+                if hertz {
+                    k * libm::pow(x.max(0.0), 1.5) + c * v
+                } else {
+                    k * x * (1.0 + stiffer * x / 3.3e-3) + c * v
+                }
+            };
+            // Fine Euler steps from touch at -(0.5 + s) samples.
+            let h = dt / 2000.0;
+            let mut next = 0.5 + s;
+            while samples.len() < 300 {
+                while t + h <= next * dt {
+                    let a = reading(x, v) - g;
+                    if v > 0.0 && v - a * h <= 0.0 && crush.is_none() {
+                        crush = Some(t / dt - 0.5 - s);
+                        truth = (t, x);
+                    }
+                    x += v * h;
+                    v -= a * h;
+                    t += h;
+                }
+                samples
+                    .push(libm::round(reading(x, v) / q).clamp(-32000.0, 32000.0) as i16)
+                    .unwrap();
+                next += 1.0;
+            }
+            let scale = Scale {
+                v0,
+                kv: q * dt,
+                dt,
+                x_lead: 0.0,
+                count: 1.0,
+            };
+            let frame = Frame {
+                lead: 0,
+                touch: -0.5,
+                separation: 250.0,
+                sep_floor: 250,
+                frac: 0.5,
+                scale,
+            };
+            (samples, frame, crush.unwrap(), truth)
+        }
     }
 
     fn found(crush: f64) -> Found {
@@ -432,7 +445,7 @@ mod tests {
     fn a_jump_onto_an_affine_pad_is_placed_within_a_tenth_of_a_sample() {
         for c in [5.0, 12.0, 13.0, 15.0, 30.0, 60.0] {
             for s in [-0.45, -0.2, 0.0, 0.3, 0.45] {
-                let (samples, frame, crush, _) = pad(1e4 / 0.06, c / 0.06, false, s, 0.0);
+                let (samples, frame, crush, _) = Pad::kelvin_voigt(c, s).render();
                 let dev = Deviation::new(0, 1);
                 let got = shift(&samples, dev, 0, &frame, &found(crush));
                 let Some(got) = got else {
@@ -462,8 +475,12 @@ mod tests {
             (0.45, 1.3357),
             (0.45, 0.313),
         ] {
-            let (samples, mut frame, _, (crush_s, x_m)) =
-                pad_at(1e4 / 0.06, 5.0 / 0.06, false, s, g, v0);
+            let (samples, mut frame, _, (crush_s, x_m)) = Pad {
+                g,
+                v0,
+                ..Pad::kelvin_voigt(5.0, s)
+            }
+            .render();
             let dev = Deviation::new(0, 1).above(g / 0.05);
             let g_d = i64::from(Deviation::new(0, 1).of(0)) - i64::from(dev.of(0));
             let (crush, seps) =
@@ -477,8 +494,7 @@ mod tests {
             );
             let got = shift(&samples, dev, g_d, &frame, &found).unwrap();
             assert!((got.s - s).abs() < 0.1, "{s}: {got:?}");
-            let d_crush = f64::from(dev.of(samples[libm::floor(found.crush + 0.5) as usize]));
-            got.apply(&mut frame, &mut found, d_crush);
+            got.apply(&mut frame, &mut found);
             let after = (
                 crush_time(&frame, &found) / crush_s - 1.0,
                 found.x_max / x_m - 1.0,
@@ -500,8 +516,11 @@ mod tests {
         let dev = Deviation::new(0, 1);
         for stiffer in [0.003, 0.006, 0.03, 0.1, 0.3, 1.0] {
             for s in [-0.45, 0.0, 0.45] {
-                let (samples, frame, crush, _) =
-                    stiffening(1e4 / 0.06, 5.0 / 0.06, false, s, 0.0, 1.3357, stiffer);
+                let (samples, frame, crush, _) = Pad {
+                    stiffer,
+                    ..Pad::kelvin_voigt(5.0, s)
+                }
+                .render();
                 let got = shift(&samples, dev, 0, &frame, &found(crush));
                 // (Placed even at twice the stiffness at x_m: the fit's own curvature;
                 // without it, 3 % stiffer put it 0.8 samples off inside every gate.)
@@ -512,13 +531,18 @@ mod tests {
         // A Hertz law with a damper (it jumps by `c v0` too): refused, the middle stands.
         for c in [1.0, 5.0, 20.0] {
             for s in [-0.45, 0.0, 0.45] {
-                let (samples, frame, crush, _) = pad(2e7, c / 0.06, true, s, 0.0);
+                let (samples, frame, crush, _) = Pad {
+                    k: 2e7,
+                    hertz: true,
+                    ..Pad::kelvin_voigt(c, s)
+                }
+                .render();
                 let got = shift(&samples, dev, 0, &frame, &found(crush));
                 assert_eq!(got, None, "hertz, c {c}, {s}");
             }
         }
         // Too few samples to fit.
-        let (samples, frame, _, _) = pad(1e4 / 0.06, 5.0 / 0.06, false, 0.3, 0.0);
+        let (samples, frame, _, _) = Pad::kelvin_voigt(5.0, 0.3).render();
         assert_eq!(shift(&samples, dev, 0, &frame, &found(5.0)), None);
         assert_eq!(shift(&samples[..3], dev, 0, &frame, &found(20.0)), None);
     }

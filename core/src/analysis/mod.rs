@@ -331,10 +331,8 @@ fn place_jump(
     // Gravity's shift of the kinematics' deviation, exactly as it was taken off.
     let g_d = i64::from(Deviation::new(s.base_sum, s.base_n).of(0)) - i64::from(motion.of(0));
     let shift = jump::shift(samples, motion, g_d, frame, found)?;
-    let crush = libm::floor(found.crush + 0.5) as usize;
-    let d_crush = f64::from(motion.of(*samples.get(crush)?));
     let mut moved = *frame;
-    let dv = shift.apply(&mut moved, found, d_crush);
+    let dv = shift.apply(&mut moved, found);
     let dt = frame.scale.dt;
     r.start_s -= shift.s * dt;
     r.duration_s += (shift.s * dt) as f32;
