@@ -51,7 +51,7 @@ fn table(b: &Value) -> String {
          | the board's whole analysis (report and the three fits, n fitted) | {} |\n\
          | shock spectra (SRS, PVSS, half-sine; 1/6 octave) | {} |\n\
          | verdict against a specified pulse (3 ms half-sine, IEC 60068-2-27) | {} |\n\
-         | the same verdict against a user's band of 9 rows | {} |\n\
+         | the same verdict against a user's band of 64 rows | {} |\n\
          {}\n\
          Headroom of the in-impact path on the STM32F407 at 168 MHz: {:.0} % at 500 kS/s, \
          {:.0} % at the ADC's top rate of 2.4 MS/s.",

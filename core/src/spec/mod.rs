@@ -19,6 +19,7 @@ pub mod verdict;
 mod verdict_reference;
 
 use crate::error::Error;
+use crate::numeric::{fmax, fmin};
 
 /// A nominal pulse's shape.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -205,7 +206,7 @@ fn table_at(points: &[BandPoint], u: f32) -> Option<(f32, f32)> {
     if p.u == u {
         // A step: its second row, if any, is the next.
         return Some(match points.get(i + 1).filter(|q| q.u == u) {
-            Some(q) => (p.lower.min(q.lower), p.upper.max(q.upper)),
+            Some(q) => (fmin(p.lower, q.lower), fmax(p.upper, q.upper)),
             None => (p.lower, p.upper),
         });
     }
@@ -403,20 +404,20 @@ impl Spec {
         }
         // The nominal's extremes over [u - slack, u + slack] (its shapes rise then fall: the
         // ends, and the peak where it lies inside).
-        let ends = [at(a.max(0.0)), at(b.min(1.0))];
+        let ends = [at(fmax(a, 0.0)), at(fmin(b, 1.0))];
         let p = self.shape.peak_at();
         let hi = if (a..=b).contains(&p) {
             1.0
         } else {
-            ends[0].max(ends[1])
+            fmax(ends[0], ends[1])
         };
         // Past either end of the pulse the nominal is 0 there: the lower limit is 0's.
         let lo = if a < 0.0 || b > 1.0 {
             0.0
         } else {
-            ends[0].min(ends[1])
+            fmin(ends[0], ends[1])
         };
-        ((lo - t.band).max(-t.outside.max(t.band)), hi + t.band)
+        (fmax(lo - t.band, -fmax(t.outside, t.band)), hi + t.band)
     }
 }
 
@@ -425,13 +426,51 @@ impl Spec {
 /// span leaves the table; otherwise the band at both ends (the verdict's coarse search).
 pub fn band_over(spec: &Spec, at: impl Fn(f32) -> f32, u0: f32, u1: f32) -> (f32, f32) {
     let (a, b) = (spec.band_with(&at, u0), spec.band_with(&at, u1));
-    let (mut lo, mut hi) = (a.0.min(b.0), a.1.max(b.1));
+    let (mut lo, mut hi) = (fmin(a.0, b.0), fmax(a.1, b.1));
     if let Some(points) = spec.band {
-        for p in points.iter().filter(|p| p.u > u0 && p.u < u1) {
-            (lo, hi) = (lo.min(p.lower), hi.max(p.upper));
+        for p in rows_within(points, u0, u1).filter(|p| p.u > u0 && p.u < u1) {
+            (lo, hi) = (fmin(lo, p.lower), fmax(hi, p.upper));
         }
     }
     (lo, hi)
+}
+
+/// Bounds on the tightest limits of `spec`'s band over `[u0, u1]` (`u0 <= u1`, both where
+/// the band follows the pulse or its rows: [`Spec::band_region`] 0), the nominal shape given
+/// by `at`: (a lower limit no point's exceeds, an upper limit no point's falls below), up to
+/// the rounding of its evaluation (ulps; the verdict allows for them). A user's band at both
+/// ends and at its rows between them (it is linear between rows); the standard band at both
+/// ends, its upper limit being the greatest of a shape that rises then falls over a window
+/// sliding with `u`, and its lower limit the least over it (monotone in `u` on either side of
+/// the peak's `± slack` and of the pulse's ends' `slack` inward), else the nominal's
+/// greatest, 1.
+pub fn band_bound(spec: &Spec, at: impl Fn(f32) -> f32, u0: f32, u1: f32) -> (f32, f32) {
+    let (a, b) = (spec.band_with(&at, u0), spec.band_with(&at, u1));
+    let (mut lo, mut hi) = (fmax(a.0, b.0), fmin(a.1, b.1));
+    if let Some(points) = spec.band {
+        for p in rows_within(points, u0, u1) {
+            (lo, hi) = (fmax(lo, p.lower), fmin(hi, p.upper));
+        }
+        return (lo, hi);
+    }
+    let s = spec.tolerance.slack;
+    let p = spec.shape.peak_at();
+    // Where the lower limit may turn: at the peak's window and where a pulse's end leaves it.
+    let turns = |x: f32| u0 < x && x < u1;
+    if (u0 < p + s && u1 > p - s) || turns(s) || turns(1.0 - s) {
+        lo = fmax(1.0 - spec.tolerance.band, lo);
+    }
+    (lo, hi)
+}
+
+/// A user's band's rows at `u0..=u1`, in order (its rows' times are non-decreasing).
+fn rows_within(points: &[BandPoint], u0: f32, u1: f32) -> impl Iterator<Item = &BandPoint> {
+    let first = points.partition_point(|p| p.u < u0);
+    points
+        .get(first..)
+        .unwrap_or(&[])
+        .iter()
+        .take_while(move |p| p.u <= u1)
 }
 
 /// Points of the tabulated nominal shape ([`Nominal`]), past the first.

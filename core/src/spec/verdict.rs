@@ -8,15 +8,28 @@
 //! 128 comparisons), then over every sample for up to 9 starts around the best one. Where
 //! the band is flat (before and after the pulse and its slack, or a user's band's rows) a
 //! start's worst excursion is read off the same extremes (a bucket's samples are read only
-//! where its extreme is the greatest); a start whose excursion somewhere already reaches the
-//! best's is left there. Both give the verdict of reading every sample, bit for bit, on a
-//! window of numbers (the tests hold the search to the one that did, `verdict_reference.rs`);
-//! a window holding a NaN or an infinity is no verdict here ([`Missing::Overflow`]).
+//! where its extreme is the greatest); where it follows the pulse (or the rows), each
+//! bucket's excursion is bounded by its extremes against the band's tightest limits over it
+//! ([`super::band_bound`]) and the buckets are read greatest bound first, only while one may
+//! still matter; a start whose excursion somewhere already reaches the best's is left there.
+//! All give the verdict of reading every sample, bit for bit, on a window of numbers (the
+//! tests hold the search to the one that did, `verdict_reference.rs`); a window holding a NaN
+//! or an infinity is no verdict here ([`Missing::Overflow`]). The window's samples are read
+//! from the record once, into the scratch after the tables (the board's analysis workspace).
+//! A user's band does not tabulate the nominal shape (257 `sinf`, in f64 on the board's libm:
+//! about a third of a verdict against a standard's band on the Cortex-M4).
 
-use super::{band_over, Nominal, Spec};
+use super::{band_bound, band_over, Nominal, Spec};
+use crate::numeric::fmax;
+use core::cell::Cell;
 
 /// Spans the signal is summarised in for the search (its least and greatest value each).
 pub const BUCKETS: usize = 128;
+
+/// A bucket's bound on the excursion is widened by this much of itself and of the peak: the
+/// band's limits at its samples may stray from its bound's by the rounding of their
+/// evaluation (a few ulps: 10⁻⁷ of them).
+const BOUND_SLACK: f32 = 1e-5;
 
 /// The verdict of one impact.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -206,10 +219,31 @@ impl Placement {
     }
 }
 
-/// The search's fixed parts: the signal (every sample of the window is held: the extremes'
-/// pass read them all), the band, the window and the signal's extremes per bucket.
-struct Search<'a, A: Fn(u64) -> Result<f32, Missing>> {
-    a: A,
+/// The signal over the window, by sample from its base: held in the workspace (read from the
+/// record once, by the extremes' pass) or, where the workspace is too short for it, read from
+/// the record each time (every sample of the window is held there: that pass read them all).
+/// (Not generic over the record's reader: the search is compiled once, not once per caller.)
+enum Signal<'a> {
+    Held(&'a [f32]),
+    Read(&'a dyn Fn(u32) -> Result<f32, Missing>),
+}
+
+impl Signal<'_> {
+    /// Sample `k` of the window.
+    #[inline(always)]
+    fn at(&self, k: u32) -> Result<f32, Missing> {
+        match self {
+            // (Never beyond: the window's samples are `0..span`.)
+            Signal::Held(v) => v.get(k as usize).copied().ok_or(Missing::WindowAfter),
+            Signal::Read(read) => read(k),
+        }
+    }
+}
+
+/// The search's fixed parts: the signal, the band, the window and the signal's extremes per
+/// bucket.
+struct Search<'a> {
+    a: Signal<'a>,
     spec: &'a Spec,
     nominal: &'a Nominal<'a>,
     w: &'a Window,
@@ -217,13 +251,16 @@ struct Search<'a, A: Fn(u64) -> Result<f32, Missing>> {
     ext: &'a [f32],
     /// The band outside the pulse and its rows (`band_with`'s flat part), m/s².
     outside: (f32, f32),
+    /// A bound per bucket on the excursion over it ([`Self::pulse_worst`]'s, BUCKETS of
+    /// them).
+    bounds: &'a [Cell<f32>],
 }
 
-impl<A: Fn(u64) -> Result<f32, Missing>> Search<'_, A> {
+impl Search<'_> {
     /// The excursion at sample `k` for a start at `start`: (how far beyond, the value, the
     /// limit).
     fn excursion(&self, k: u32, start: f32) -> Result<(f32, f32, f32), Missing> {
-        let v = (self.a)(self.w.base + u64::from(k))?;
+        let v = self.a.at(k)?;
         let (lo, hi) = self
             .spec
             .band_with(|u| self.nominal.at(u), self.u(k, start));
@@ -258,19 +295,13 @@ impl<A: Fn(u64) -> Result<f32, Missing>> Search<'_, A> {
         let after = first_where(inside, k1 + 1, |k| region(k) > 0);
         let before = self.flat_worst(start, k0, inside)?;
         let behind = self.flat_worst(start, after, k1 + 1)?;
-        if before.worst.max(behind.worst) >= best.worst {
+        if fmax(before.worst, behind.worst) >= best.worst {
             return Ok(());
         }
-        let mut within = Placement::none(start);
-        for k in inside..after {
-            let (over, v, lim) = self.excursion(k, start)?;
-            if over > within.worst {
-                within.set(over, k, v, lim);
-                if over >= best.worst {
-                    return Ok(());
-                }
-            }
-        }
+        let floor = fmax(before.worst, behind.worst);
+        let Some(within) = self.pulse_worst(start, inside, after, floor, best.worst)? else {
+            return Ok(());
+        };
         // In the samples' order: the first of the greatest.
         let mut worst = before;
         for p in [within, behind] {
@@ -282,6 +313,67 @@ impl<A: Fn(u64) -> Result<f32, Missing>> Search<'_, A> {
             *best = worst;
         }
         Ok(())
+    }
+
+    /// [`Self::try_start`]'s reading over `k0..k1`, where the band follows the pulse (or a
+    /// user's rows): each bucket's excursion bounded by its extremes against the band's
+    /// tightest limits over its samples ([`band_bound`]), then the buckets read in full,
+    /// greatest bound first, while one may reach the greatest excursion found or `floor` (the
+    /// flat stretches' worst: below it this stretch's worst is not the placement's). The
+    /// first sample of the greatest excursion, as reading every sample in order finds it
+    /// where it reaches `floor`; `None` where a sample's reaches `best` (the start cannot be
+    /// better; no unread one can reach it either).
+    fn pulse_worst(
+        &self,
+        start: f32,
+        k0: u32,
+        k1: u32,
+        floor: f32,
+        best: f32,
+    ) -> Result<Option<Placement>, Missing> {
+        let mut worst = Placement::none(start);
+        if k0 >= k1 {
+            return Ok(Some(worst));
+        }
+        let (w, peak) = (self.w, self.spec.peak_m_s2);
+        let (j0, j1) = (w.bucket(k0), w.bucket(k1 - 1));
+        let samples = |j: usize| (w.bucket_start(j).max(k0), w.bucket_start(j + 1).min(k1));
+        let bounds = self.bounds.get(..=j1 - j0).unwrap_or(&[]);
+        for (j, bound) in (j0..).zip(bounds) {
+            let (a, z) = samples(j);
+            bound.set(if a < z {
+                let (u0, u1) = (self.u(a, start), self.u(z - 1, start));
+                let (lo, hi) = band_bound(self.spec, |u| self.nominal.at(u), u0, u1);
+                let (least, most) = pair(self.ext, j);
+                let over = fmax(most - hi * peak, lo * peak - least);
+                over + (libm::fabsf(over) + libm::fabsf(peak)) * BOUND_SLACK
+            } else {
+                f32::NAN
+            });
+        }
+        // The unread bucket of greatest bound while it may reach the bar (NaN: read).
+        while let Some((i, _)) = bounds
+            .iter()
+            .enumerate()
+            .map(|(i, b)| (i, b.get()))
+            .filter(|&(_, b)| b >= fmax(floor, worst.worst))
+            .reduce(|m, x| if x.1 > m.1 { x } else { m })
+        {
+            if let Some(b) = bounds.get(i) {
+                b.set(f32::NAN);
+            }
+            let (a, z) = samples(j0 + i);
+            for k in a..z {
+                let (over, v, lim) = self.excursion(k, start)?;
+                if over >= best {
+                    return Ok(None);
+                }
+                if over > worst.worst || (over == worst.worst && k < worst.worst_k) {
+                    worst.set(over, k, v, lim);
+                }
+            }
+        }
+        Ok(Some(worst))
     }
 
     /// [`Self::try_start`]'s reading over `k0..k1`, where the band is the flat outside one:
@@ -298,7 +390,7 @@ impl<A: Fn(u64) -> Result<f32, Missing>> Search<'_, A> {
             let end = self.w.bucket_start(j + 1);
             if k == self.w.bucket_start(j) && end <= k1 {
                 let (least, most) = pair(self.ext, j);
-                let over = excursion(most, lo, hi).0.max(excursion(least, lo, hi).0);
+                let over = fmax(excursion(most, lo, hi).0, excursion(least, lo, hi).0);
                 if over > worst.worst && bucket.is_none_or(|(_, b)| over > b) {
                     bucket = Some((j, over));
                 }
@@ -307,7 +399,7 @@ impl<A: Fn(u64) -> Result<f32, Missing>> Search<'_, A> {
             }
             // A sample of a bucket the range holds in part; after a bucket that beat it, it
             // is the bucket's to beat.
-            let v = (self.a)(self.w.base + u64::from(k))?;
+            let v = self.a.at(k)?;
             let (over, v, lim) = excursion(v, lo, hi);
             let to_beat = bucket.map_or(worst.worst, |(_, b)| b);
             if over > to_beat {
@@ -328,7 +420,7 @@ impl<A: Fn(u64) -> Result<f32, Missing>> Search<'_, A> {
     fn bucket_worst(&self, j: usize, worst: &mut Placement) -> Result<(), Missing> {
         let (lo, hi) = self.outside;
         for k in self.w.bucket_start(j)..self.w.bucket_start(j + 1) {
-            let v = (self.a)(self.w.base + u64::from(k))?;
+            let v = self.a.at(k)?;
             let (over, v, lim) = excursion(v, lo, hi);
             if over > worst.worst {
                 worst.set(over, k, v, lim);
@@ -363,8 +455,9 @@ fn first_where(from: u32, to: u32, p: impl Fn(u32) -> bool) -> u32 {
     lo
 }
 
-/// Values of scratch [`judge_in`] takes: the signal's extremes and the band's limits per
-/// bucket (a pair each), the nominal shape's table.
+/// Values of scratch [`judge_in`] takes for its tables: the signal's extremes and the band's
+/// limits per bucket (a pair each), the nominal shape's table. The window's samples follow
+/// them where the scratch holds them too.
 pub const SCRATCH: usize = 4 * BUCKETS + Nominal::LEN;
 
 /// [`judge_in`] with its tables on the stack (3 KiB).
@@ -382,8 +475,10 @@ pub fn judge(
 /// Judges the acceleration `a(i)` (m/s² in the pulse's direction, stream index `i`; `None`
 /// outside what is held) at `rate_hz` against `spec`, the measured peak at stream index
 /// `peak_index`, its tables in `scratch` (on the stack if it holds fewer than [`SCRATCH`]
-/// values). Written for the FPU: positions in f32 samples from the first sample watched
-/// (`base`), the shape tabulated, f64 only for the velocity change's sum.
+/// values) and the window's samples after them (read from `a` once; each time they are
+/// needed if the scratch is too short). Written for the FPU: positions in f32 samples from
+/// the first sample watched (`base`), the shape tabulated, compensated f32 sums for the
+/// velocity change.
 pub fn judge_in(
     a: impl Fn(u64) -> Option<f32>,
     rate_hz: f32,
@@ -398,23 +493,40 @@ pub fn judge_in(
     else {
         return judge(a, rate_hz, spec, peak_index);
     };
-    let Some((limits, table)) = rest.split_at_mut_checked(2 * BUCKETS) else {
+    let Some((limits, (table, values))) = rest
+        .split_at_mut_checked(2 * BUCKETS)
+        .and_then(|(l, r)| Some((l, r.split_at_mut_checked(Nominal::LEN)?)))
+    else {
         return judge(a, rate_hz, spec, peak_index);
     };
     let w = Window::place(spec, rate_hz, peak_index, |i| a(i).is_some())?;
-    // A sample the record does not hold is missing before the pulse when it lies before the
-    // measured peak, after it otherwise.
-    let a = |i: u64| {
+    // Sample `k` of the window; one the record does not hold is missing before the pulse when
+    // it lies before the measured peak, after it otherwise.
+    let read = |k: u32| {
+        let i = w.base + u64::from(k);
         a(i).ok_or(if i < peak_index {
             Missing::WindowBefore
         } else {
             Missing::WindowAfter
         })
     };
-    extremes(&a, &w, ext)?;
+    let a = match values.get_mut(..w.span as usize) {
+        Some(held) => {
+            extremes(&read, &w, ext, Some(&mut *held))?;
+            Signal::Held(&*held)
+        }
+        None => {
+            extremes(&read, &w, ext, None)?;
+            Signal::Read(&read)
+        }
+    };
     let ext = &*ext;
-    let nominal = Nominal::fill(spec.shape, table);
+    // A user's band is its rows: the nominal shape is not read (its table, 257 sines on the
+    // board's libm, would cost a quarter of the verdict).
+    let tabulated = if spec.band.is_some() { 0 } else { table.len() };
+    let nominal = Nominal::fill(spec.shape, table.get_mut(..tabulated).unwrap_or(&mut []));
     let peak = spec.peak_m_s2;
+    let coarse = coarse_start(spec, &nominal, &w, ext, limits);
     let search = Search {
         a,
         spec,
@@ -425,8 +537,8 @@ pub fn judge_in(
             -spec.tolerance.outside * peak,
             spec.tolerance.outside * peak,
         ),
+        bounds: Cell::from_mut(limits).as_slice_of_cells(),
     };
-    let coarse = coarse_start(spec, &nominal, &w, ext, limits);
     let fine = refine(&search, coarse)?;
     let delta_v = delta_v(&search.a, spec, &w, fine.start, rate_hz)?;
     let t = &spec.tolerance;
@@ -455,29 +567,36 @@ pub fn judge_in(
 }
 
 /// The signal's least and greatest value in each of [`BUCKETS`] spans of the window, in
-/// pairs in `ext`.
+/// pairs in `ext`; the samples kept in `held` if given.
 fn extremes(
-    a: &impl Fn(u64) -> Result<f32, Missing>,
+    a: &impl Fn(u32) -> Result<f32, Missing>,
     w: &Window,
     ext: &mut [f32],
+    mut held: Option<&mut [f32]>,
 ) -> Result<(), Missing> {
-    for e in ext.chunks_exact_mut(2) {
-        e.copy_from_slice(&[f32::INFINITY, f32::NEG_INFINITY]);
-    }
-    // A NaN is neither least nor greatest (`min`/`max` pass over it): `v - v`, 0 for every
+    // A NaN is neither least nor greatest (`fmin`/`fmax` pass over it): `v - v`, 0 for every
     // finite sample and NaN for a NaN or an infinity, finds it without a sum that could
     // overflow, so that a window holding a non-number is no verdict, never a pass.
     let mut sum = 0.0f32;
-    for k in 0..w.span {
-        let v = a(w.base + u64::from(k))?;
-        #[allow(clippy::eq_op)]
-        let zero_or_nan = v - v;
-        sum += zero_or_nan;
-        let j = w.bucket(k);
-        if let Some([least, most]) = ext.get_mut(2 * j..2 * j + 2) {
-            *least = least.min(v);
-            *most = most.max(v);
+    for (j, e) in ext.chunks_exact_mut(2).enumerate() {
+        let (mut least, mut most) = (f32::INFINITY, f32::NEG_INFINITY);
+        for k in w.bucket_start(j)..w.bucket_start(j + 1) {
+            let v = a(k)?;
+            if let Some(slot) = held.as_deref_mut().and_then(|h| h.get_mut(k as usize)) {
+                *slot = v;
+            }
+            #[allow(clippy::eq_op)]
+            let zero_or_nan = v - v;
+            sum += zero_or_nan;
+            // `fmin(least, v)` and `fmax(most, v)`, bit for bit (`most` is never a NaN).
+            if v <= least {
+                least = v;
+            }
+            if most < v {
+                most = v;
+            }
         }
+        e.copy_from_slice(&[least, most]);
     }
     if sum.is_finite() {
         Ok(())
@@ -536,7 +655,12 @@ fn coarse_start(
         let buckets = ext.chunks_exact(2).skip(s);
         for (e, l) in buckets.zip(limits.chunks_exact(2).take(watched)) {
             if let (&[lo, hi], &[lower, upper]) = (e, l) {
-                worst = worst.max(hi - upper).max(lower - lo);
+                // `fmax` twice, bit for bit (`worst` is never a NaN).
+                for over in [hi - upper, lower - lo] {
+                    if worst < over {
+                        worst = over;
+                    }
+                }
             }
         }
         if better(worst, best.1) {
@@ -549,10 +673,7 @@ fn coarse_start(
 /// Every sample, for the coarse start and then, halving the step from half a bucket down to
 /// an eighth (at least a sample), a step either way of the best so far: the placement of
 /// least worst excursion. The first start that passes is the one (the nearest).
-fn refine<A: Fn(u64) -> Result<f32, Missing>>(
-    search: &Search<'_, A>,
-    coarse: f32,
-) -> Result<Placement, Missing> {
+fn refine(search: &Search<'_>, coarse: f32) -> Result<Placement, Missing> {
     let width = search.w.span as f32 / BUCKETS as f32;
     let mut fine = Placement {
         start: coarse,
@@ -572,7 +693,7 @@ fn refine<A: Fn(u64) -> Result<f32, Missing>>(
         if step <= 1.0 || step <= width / 8.0 {
             break;
         }
-        step = (step / 2.0).max(1.0);
+        step = fmax(step / 2.0, 1.0);
     }
     Ok(fine)
 }
@@ -580,7 +701,7 @@ fn refine<A: Fn(u64) -> Result<f32, Missing>>(
 /// The velocity change from `before` × D before the pulse starting at `start` to `after`
 /// × D after it, m/s: compensated f32 sums (Kahan), an f64's accuracy at the FPU's speed.
 fn delta_v(
-    a: &impl Fn(u64) -> Result<f32, Missing>,
+    a: &Signal<'_>,
     spec: &Spec,
     w: &Window,
     start: f32,
@@ -591,7 +712,7 @@ fn delta_v(
     let k1 = (libm::floorf(start + (1.0 + t.after) * d) as u32).min(w.span - 1);
     let (mut sum, mut carry) = (0.0f32, 0.0f32);
     for k in k0..=k1 {
-        let y = a(w.base + u64::from(k))? - carry;
+        let y = a.at(k)? - carry;
         let next = sum + y;
         carry = (next - sum) - y;
         sum = next;
@@ -1083,6 +1204,7 @@ mod tests {
             },
         ];
         let mut passes = 0;
+        let mut scratch = [0.0f32; SCRATCH + 32_768];
         for case in 0..600 {
             let shape = shapes[case % 3];
             // Half the cases near the nominal pulse (most pass), half anything (most fail).
@@ -1118,6 +1240,8 @@ mod tests {
             let peak_index = (start + measured.peak_at() * d) as u64;
             let want = judge_reference(a, rate, &spec, peak_index);
             let got = judge(a, rate, &spec, peak_index);
+            // The window's samples held in the scratch, as the board's analysis holds them.
+            let held = judge_in(a, rate, &spec, peak_index, &mut scratch);
             let bits = |v: &Result<Verdict, Missing>| {
                 v.map(|v| {
                     (
@@ -1132,6 +1256,11 @@ mod tests {
                 })
             };
             assert_eq!(bits(&got), bits(&want), "case {case}: {got:?} vs {want:?}");
+            assert_eq!(
+                bits(&held),
+                bits(&want),
+                "case {case}: {held:?} vs {want:?}"
+            );
             passes += usize::from(want.is_ok_and(|v| v.band_pass));
         }
         // Both sides of the band are exercised.
