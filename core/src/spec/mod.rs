@@ -476,31 +476,46 @@ fn rows_within(points: &[BandPoint], u0: f32, u1: f32) -> impl Iterator<Item = &
 /// Points of the tabulated nominal shape ([`Nominal`]), past the first.
 pub const NOMINAL_POINTS: usize = 256;
 
-/// A shape tabulated over its duration and read by linear interpolation: the verdict's
-/// thousands of band look-ups cost a multiply-add each instead of a sine (off the exact shape
-/// by at most 2e-5 of the peak, a thousandth of any band). Its table is the caller's (the
-/// analysis workspace on the board, not the stack).
+/// The nominal shape as the verdict reads it: a half-sine tabulated over its duration and
+/// read by linear interpolation (the verdict's thousands of band look-ups cost a multiply-add
+/// each instead of a sine: off the exact shape by at most 2e-5 of the peak, a thousandth of
+/// any band; its table peaks at the sine's, `u` = 1/2, a table point); the straight-line
+/// shapes exactly (a division at most: a table's points would cut a trapezoid's corners,
+/// and move the peak of a short top away from [`Shape::peak_at`], where the band and its
+/// bounds ([`band_bound`]) take it: a rise of 0.001 D read 0.75 of the peak low there). Its
+/// table is the caller's (the analysis workspace on the board, not the stack).
 pub struct Nominal<'a> {
     table: &'a [f32],
+    /// The shape read exactly (not tabulated).
+    exact: Option<Shape>,
 }
 
 impl<'a> Nominal<'a> {
     /// Values of its table.
     pub const LEN: usize = NOMINAL_POINTS + 1;
 
-    /// `shape` tabulated in `table`'s first [`Self::LEN`] values (all of them if shorter:
-    /// the shape then reads 0 beyond).
+    /// A half-sine tabulated in `table`'s first [`Self::LEN`] values (all of them if shorter:
+    /// the shape then reads 0 beyond); the other shapes read exactly.
     pub fn fill(shape: Shape, table: &'a mut [f32]) -> Self {
+        if !matches!(shape, Shape::HalfSine) {
+            return Self {
+                table: &[],
+                exact: Some(shape),
+            };
+        }
         let n = table.len().min(Self::LEN);
         let (table, _) = table.split_at_mut(n);
         for (k, v) in table.iter_mut().enumerate() {
             *v = shape.at(k as f32 / NOMINAL_POINTS as f32);
         }
-        Self { table }
+        Self { table, exact: None }
     }
 
     /// The shape at `u` in `[0, 1]` (clamped).
     pub fn at(&self, u: f32) -> f32 {
+        if let Some(shape) = self.exact {
+            return shape.at(u.clamp(0.0, 1.0));
+        }
         let x = u.clamp(0.0, 1.0) * NOMINAL_POINTS as f32;
         let k = (x as usize).min(NOMINAL_POINTS - 1);
         let f = x - k as f32;
@@ -508,5 +523,104 @@ impl<'a> Nominal<'a> {
             (Some(&y0), Some(&y1)) => y0 + f * (y1 - y0),
             _ => 0.0,
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// [`band_bound`] is a bound: every `u` of a span (many f32s along it and its ends) has
+    /// its band's lower limit at or below the bound's and its upper at or above, up to the
+    /// verdict's allowance for rounding (1e-5 of the peak): every shape (trapezoids with a
+    /// top far shorter than a table step among them), slacks from none to a whole duration,
+    /// outside limits below and above the band, and a user's band with steps, rows at ±10.
+    #[test]
+    fn band_bound_bounds_the_band_over_every_span() {
+        let shapes = [
+            Shape::HalfSine,
+            Shape::Sawtooth,
+            Shape::Trapezoid {
+                rise: 0.1,
+                fall: 0.1,
+            },
+            Shape::Trapezoid {
+                rise: 0.001,
+                fall: 0.999,
+            },
+            Shape::Trapezoid {
+                rise: 0.3,
+                fall: 0.7,
+            },
+        ];
+        const fn row(u: f32, lower: f32, upper: f32) -> BandPoint {
+            BandPoint { u, lower, upper }
+        }
+        static ROWS: [BandPoint; 8] = [
+            row(-0.4, -0.2, 0.2),
+            row(0.0, -0.2, 0.2),
+            row(0.0, 0.5, 10.0),
+            row(0.3, -10.0, 1.5),
+            row(0.5, 0.8, 1.2),
+            row(0.5, 0.1, 9.0),
+            row(1.0, -0.2, 0.2),
+            row(1.5, -0.2, 0.2),
+        ];
+        let mut table = [0.0f32; Nominal::LEN];
+        let mut checked = 0usize;
+        for shape in shapes {
+            let nominal = Nominal::fill(shape, &mut table);
+            let at = |u: f32| nominal.at(u);
+            for slack in [0.0f32, 1e-7, 0.01, 0.05, 0.5, 1.0] {
+                for (band, outside) in [(0.2f32, 0.2f32), (0.2, 0.1), (0.15, 0.3), (0.0, 0.2)] {
+                    for user in [false, true] {
+                        let spec = Spec {
+                            shape,
+                            peak_m_s2: 1.0,
+                            duration_s: 0.01,
+                            tolerance: Tolerance {
+                                band,
+                                outside,
+                                slack,
+                                delta_v: 0.15,
+                                before: 0.4,
+                                after: 0.1,
+                                watch: 1.5,
+                            },
+                            band: user.then_some(&ROWS[..]),
+                        };
+                        checked += bounds_hold(&spec, &at);
+                    }
+                }
+            }
+        }
+        assert!(checked > 100_000, "{checked}");
+    }
+
+    /// [`band_bound_bounds_the_band_over_every_span`] for one spec: spans of several widths
+    /// along where the band follows the pulse; how many points it checked.
+    fn bounds_hold(spec: &Spec, at: &impl Fn(f32) -> f32) -> usize {
+        let mut checked = 0;
+        for width in [1e-4f32, 3e-3, 0.02, 0.1] {
+            let mut u0 = -1.2f32;
+            while u0 < 2.2 {
+                let u1 = u0 + width;
+                if spec.band_region(u0) == 0 && spec.band_region(u1) == 0 {
+                    let (lo, hi) = band_bound(spec, at, u0, u1);
+                    let mut u = u0;
+                    while u <= u1 {
+                        let (l, h) = spec.band_with(at, if u + width / 40.0 > u1 { u1 } else { u });
+                        assert!(
+                            l <= lo + 1e-5 && h >= hi - 1e-5,
+                            "{spec:?}: at {u} in [{u0}, {u1}] ({l}, {h}) against ({lo}, {hi})"
+                        );
+                        checked += 1;
+                        u += width / 40.0;
+                    }
+                }
+                u0 += width * 0.613;
+            }
+        }
+        checked
     }
 }

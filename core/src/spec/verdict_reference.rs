@@ -20,7 +20,7 @@ fn better(worst: f32, best: f32) -> bool {
 /// Judges the acceleration `a(i)` (m/s² in the pulse's direction, stream index `i`; `None`
 /// outside what is held) at `rate_hz` against `spec`, the measured peak at stream index
 /// `peak_index`. Written for the FPU: positions in f32 samples from the first sample watched
-/// (`base`), the shape tabulated, f64 only for the velocity change's sum.
+/// (`base`), the half-sine tabulated, compensated f32 sums for the velocity change.
 pub fn judge_reference(
     a: impl Fn(u64) -> Option<f32>,
     rate_hz: f32,
