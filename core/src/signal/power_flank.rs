@@ -202,17 +202,40 @@ pub fn head_zero(y: [f32; 3]) -> Option<f32> {
     ((-1.0..=0.0).contains(&zero) && bend <= HEAD_BEND).then_some(zero)
 }
 
+/// The zero of [`head_zero`]'s curve through three rising samples (the first at 0) where
+/// they lie on one (within [`HEAD_BEND`]), wherever it lies, and the curve's value at `t`
+/// (0 before its zero).
+pub fn head_reach(y: [f32; 3], t: f32) -> Option<(f32, f32)> {
+    let h = head_fit(y)?;
+    let z = h.z0 + (h.z1 - h.z0) * t;
+    (h.bend <= HEAD_BEND).then(|| (h.zero, h.top * power(z.max(0.0), h.p)))
+}
+
 /// The zero of the line through the first two of three samples under the power of
 /// [`POWERS`] that puts them most nearly on a line, and how far the middle one lies off the
 /// line through the outer two, over the rise; `None` unless they rise.
 fn head_line(y: [f32; 3]) -> Option<(f32, f32)> {
+    head_fit(y).map(|h| (h.zero, h.bend))
+}
+
+/// [`head_line`]'s curve: `y = top (z0 + (z1 - z0) t)^p` through the first two samples.
+struct Head {
+    zero: f32,
+    bend: f32,
+    p: f32,
+    top: f32,
+    z0: f32,
+    z1: f32,
+}
+
+fn head_fit(y: [f32; 3]) -> Option<Head> {
     let [y0, y1, y2] = y;
     if !(y0 > 0.0 && y1 > y0 && y2.is_finite()) {
         return None;
     }
     // Scaled by the largest, so each root is of a number in (0, 1].
     let top = y0.max(y1).max(y2);
-    let (bend, z) = POWERS
+    let (bend, z, p) = POWERS
         .iter()
         .map(|&p| {
             let z = [
@@ -223,11 +246,18 @@ fn head_line(y: [f32; 3]) -> Option<(f32, f32)> {
             // How far the middle lies off the line through the outer two, over the rise.
             let bend =
                 libm::fabsf(z[1] - 0.5 * (z[0] + z[2])) / (z[2] - z[0]).max(f32::MIN_POSITIVE);
-            (bend, z)
+            (bend, z, p)
         })
         .min_by(|a, b| a.0.total_cmp(&b.0))?;
     let zero = -z[0] / (z[1] - z[0]);
-    zero.is_finite().then_some((zero, bend))
+    zero.is_finite().then_some(Head {
+        zero,
+        bend,
+        p,
+        top,
+        z0: z[0],
+        z1: z[1],
+    })
 }
 
 /// Which powers a fit may take.
@@ -419,5 +449,31 @@ mod tests {
             ),
             None
         );
+    }
+
+    /// [`head_reach`]: a Hertz head (`t^1.5`) whose zero lies 0.02 of a sample before the
+    /// sample before it gives that zero and reads that sample within a thousandth of the
+    /// head's top; a jump onto a ramp (`A + B t`) reads `A − (1 − τ) B` there, not 0; an
+    /// unbent head off every power is none.
+    #[test]
+    fn head_reach_extends_a_power_head_one_sample_back() {
+        for (p, x0) in [(1.5f32, -1.02f32), (1.0, -1.3), (2.0, -1.6)] {
+            let y = [0.0f32, 1.0, 2.0].map(|k| libm::powf(k - x0, p));
+            let (zero, at) = head_reach(y, -1.0).unwrap();
+            let truth = libm::powf(-1.0 - x0, p);
+            assert!((zero - x0).abs() < 1e-3, "{p} {x0}: {zero}");
+            assert!(
+                (at - truth).abs() < 1e-3 * y[2],
+                "{p} {x0}: {at} vs {truth}"
+            );
+        }
+        // A jump of A onto a ramp of B a sample, its first sample tau after touch.
+        let (a, b, tau) = (0.675f32, 1.0f32, 0.4f32);
+        let y = [0.0f32, 1.0, 2.0].map(|k| a + b * (k + tau));
+        let (zero, at) = head_reach(y, -1.0).unwrap();
+        assert!((zero + a / b + tau).abs() < 1e-4, "{zero}");
+        assert!((at - (a - (1.0 - tau) * b)).abs() < 1e-4, "{at}");
+        // Three samples that bend beyond every power: none.
+        assert_eq!(head_reach([1.0, 10.0, 10.5], -1.0), None);
     }
 }

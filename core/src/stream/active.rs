@@ -78,6 +78,8 @@ pub(super) struct Active {
     /// The sample just before the onset lies within half the edge level either way (the
     /// ring held it).
     pub(super) quiet_before: bool,
+    /// The sample just before the onset (`d`, the pulse's side positive), if the ring held it.
+    pub(super) before_d: Option<i64>,
     /// The sink gave a buffer for this impact.
     pub(super) captured: bool,
     /// The buffer overflowed.

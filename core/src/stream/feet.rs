@@ -288,7 +288,14 @@ impl<const PRE: usize> Stream<PRE> {
                     // (A jump's whole interval clear of the previous contact: the analysis
                     // may place touch anywhere in it.)
                     let jump = jump && a.touch_floor <= -1.0;
-                    ((touch, a.lead_c, z < a.touch_floor), true, jump)
+                    // Touch before the sample before the onset ([`earlier_foot`]): that
+                    // sample is the foot's, in `Σ d` as the kinematics integrate it (the
+                    // trigger's touch, a step's middle or the edge crossing, had none).
+                    let c = match a.before_d {
+                        Some(before) if touch < -1.0 => a.sign * before,
+                        _ => a.lead_c,
+                    };
+                    ((touch, c, z < a.touch_floor), true, jump)
                 }
                 // (A step's middle is no edge crossing either.)
                 None => (
@@ -307,17 +314,23 @@ impl<const PRE: usize> Stream<PRE> {
     /// if the three lie on a power curve (a Hertz foot at 20 kS/s, its onset a tenth of a
     /// sample in: else the walk back to the baseline puts touch up to a sample early) and
     /// the sample before the onset is quiet, as that curve says (within half the edge level:
-    /// a foot that began earlier is the lobe's).
+    /// a foot that began earlier is the lobe's). Either way, where that curve reaches zero
+    /// before the sample before the onset and reads that sample there ([`earlier_foot`]),
+    /// its zero.
     /// And whether touch is a jump's middle ([`crate::capture::Summary::touch_jump`]).
     fn head_touch(&self, a: &Active) -> Option<(f32, bool)> {
-        let head = || a.rise.head().map(|y| y.map(|d| d as f32));
+        let head = a.rise.head().map(|y| y.map(|d| d as f32))?;
         match a.flank_touch {
-            FlankTouch::Steep => Some(match power_flank::steep_line_zero(head()?) {
+            FlankTouch::Steep => Some(match power_flank::steep_line_zero(head) {
                 Some(zero) => (zero, false),
-                None => (power_flank::JUMP_MIDDLE, true),
+                None => match earlier_foot(a, head) {
+                    Some(zero) => (zero, false),
+                    None => (power_flank::JUMP_MIDDLE, true),
+                },
             }),
-            FlankTouch::Crossing => power_flank::head_zero(head()?)
+            FlankTouch::Crossing => power_flank::head_zero(head)
                 .filter(|_| a.quiet_before)
+                .or_else(|| earlier_foot(a, head))
                 .map(|zero| (zero, false)),
             FlankTouch::Line | FlankTouch::Refused => None,
         }
@@ -522,4 +535,26 @@ pub(super) fn record_fall(a: &mut Active, run: &[i16], at: u64) {
         None => 0,
     };
     a.fall.take(run.get(from..).unwrap_or(&[]), w, s, sign);
+}
+
+/// First touch relative to the onset where the foot began before the sample before the
+/// onset (`before`, within the edge level): the onset's three samples lie on a power curve
+/// ([`power_flank::head_reach`]: within [`power_flank::HEAD_BEND`]) whose zero lies in the
+/// interval before that sample, clear of the previous contact, and the curve reads that
+/// sample there within half the edge level (its noise). A force rising from zero with touch
+/// just before a sample the sampling put at the baseline (a Hertz foot at 20 kS/s, touch
+/// 0.009 of a sample before it: the onset stepped past the flank level, the interval before
+/// it was taken for a jump's and touch put in its middle, half a sample late, `x_m` 7.5 %
+/// low). A jump onto a ramp (`c v0 + k v0 t`, the first sample `τ` after touch) has a quiet
+/// sample before it where the head's line reads `c v0 − (1 − τ) k v0 dt`: refused where that
+/// exceeds half the edge level, which a jump of a few samples' rise does (the jump's fit in
+/// the analysis places it); a smaller jump may be taken for a ramp that began up to a sample
+/// earlier, as [`power_flank::steep_zero`] says of its own line.
+fn earlier_foot(a: &Active, head: [f32; 3]) -> Option<f32> {
+    let before = a.before_d? as f32;
+    let (zero, at_before) = power_flank::head_reach(head, -1.0)?;
+    let noise = 0.5 * a.edge_d as f32;
+    let clear = zero >= a.touch_floor;
+    ((-2.0..-1.0).contains(&zero) && clear && libm::fabsf(before - at_before) <= noise)
+        .then_some(zero)
 }

@@ -141,6 +141,7 @@ impl<const PRE: usize> Stream<PRE> {
             lobe_c: lobe.c,
             lobe_in_previous: lobe.in_previous,
             quiet_before: lobe.before.is_some_and(|d| 2 * d.abs() <= edge_d),
+            before_d: lobe.before,
             captured: capture.is_some(),
             full: false,
             // The walk back reached the gap: the pulse began while samples were lost.
