@@ -30,6 +30,8 @@ pub enum BenchError {
     Core(#[from] impact_core::Error),
     #[error(transparent)]
     Log(#[from] crate::firmware_link::log::LogError),
+    #[error(transparent)]
+    Spec(#[from] crate::pipeline::spec::SpecError),
     /// The thread a bench runs on (with its big stack) could not be started, or panicked.
     #[error(transparent)]
     Worker(#[from] crate::WorkerError),

@@ -1,7 +1,8 @@
 //! `impact bench realtime`: the firmware in real-time emulation (QEMU `-icount shift=3`, the
 //! emulated DMA) on trains of impacts: how late each report comes, and how many impacts per
 //! second it sustains with nothing lost and every impact fully analysed, with and without
-//! the fits, for the seed bench at 500 kS/s and for AFRL-like short pulses at 1 MS/s.
+//! the fits, for the seed bench at 500 kS/s and for AFRL-like short pulses at 1 MS/s; and
+//! the seed bench with everything on (the fits, the shock spectra and a verdict).
 
 use std::path::Path;
 use std::time::Duration;
@@ -45,6 +46,37 @@ struct Case {
     scene: Scene,
     /// Spacings tried, s, from the widest: the train's nominal spacing first.
     spacings: &'static [f64],
+    /// With everything on, if the case runs that too: its spacings (the analysis takes
+    /// longer than some of the others').
+    everything: Option<&'static [f64]>,
+}
+
+/// What the board does with each impact in a run.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum Work {
+    /// The streaming fields only.
+    Stream,
+    /// The analysis with the three fits (the exponent fitted).
+    Fits,
+    /// The fits, the shock spectra (SRS and PVSS, 1/6 octave from 10 Hz) and a verdict
+    /// ([`EVERYTHING_SPEC`]).
+    Everything,
+}
+
+/// The specified pulse the seed bench is judged against with everything on (a rig striking
+/// at one speed; its pulse is no such half-sine and fails it, which costs the verdict its
+/// whole search).
+pub const EVERYTHING_SPEC: &str = "half-sine,10g,3ms";
+
+impl Work {
+    fn label(self) -> &'static str {
+        match self {
+            Work::Stream => "no",
+            Work::Fits => "fits",
+            Work::Everything => "fits, spectra, verdict",
+        }
+    }
 }
 
 fn cases() -> Vec<Case> {
@@ -64,6 +96,7 @@ fn cases() -> Vec<Case> {
         impact: Impact::new(cases::BENCH_MASS_KG, cases::BENCH_V0_M_S),
         // Below ~27.3 ms (26 ms of pulse and the 2 ms hold) two impacts are one.
         spacings: &[0.08, 0.06, 0.05, 0.04, 0.035, 0.03, 0.028],
+        everything: Some(&[0.16, 0.125, 0.1, 0.08, 0.06, 0.05, 0.04, 0.035, 0.03, 0.028]),
     };
     // AFRL-like: a 150 µs pulse of ~7 kg_n (Δv 7 m/s), 12 bits over ±2e5 m/s², 1 MS/s.
     let mut afrl_sensor = Sensor::adc12(2e5);
@@ -78,6 +111,7 @@ fn cases() -> Vec<Case> {
         impact: Impact::new(m, v0),
         // Below ~1.2 ms (the pulse and the 1 ms hold) two impacts are one.
         spacings: &[0.01, 0.005, 0.003, 0.002, 0.0015, 0.00125],
+        everything: None,
     };
     vec![seed, afrl]
 }
@@ -102,6 +136,8 @@ pub struct TrainRun {
     pub reports: usize,
     pub samples_lost: u64,
     pub analyses_skipped: u64,
+    /// Reports without the spectra or the verdict the scene asked for.
+    pub missing_work: u64,
     pub latency_median_s: Option<f64>,
     pub latency_max_s: Option<f64>,
 }
@@ -111,7 +147,7 @@ pub struct TrainRun {
 pub struct CaseResult {
     pub case: String,
     pub rate_hz: f64,
-    pub fits: bool,
+    pub work: Work,
     /// The train at the widest spacing.
     pub nominal: TrainRun,
     /// Highest impact rate tried with nothing lost and every impact analysed, per second.
@@ -162,6 +198,10 @@ fn train(
         (summary.state.readable(counter)).ok_or(BenchError::NoCounter { counter })
     };
     let mut latencies: Vec<f64> = log.latencies.iter().flatten().map(|&l| l as f64).collect();
+    let missing = |r: &&impact_core::ImpactReport| {
+        (scene.spectrum.is_some() && r.spectrum.is_none())
+            || (scene.spec.is_some() && r.verdict.is_none())
+    };
     let max = latencies.iter().copied().reduce(f64::max);
     Ok(TrainRun {
         spacing_s: spacing,
@@ -173,12 +213,13 @@ fn train(
             .iter()
             .filter(|r| r.analysis == Analysis::Skipped)
             .count() as u64,
+        missing_work: log.impacts.iter().filter(missing).count() as u64,
         latency_median_s: impact_io::time_axis::median(&mut latencies),
         latency_max_s: max,
     })
 }
 
-/// Runs every case with and without fits.
+/// Runs every case with and without fits, and the seed bench with everything on.
 pub fn run(args: &RealtimeArgs) -> Result<Vec<CaseResult>, BenchError> {
     qemu::tools_available()?;
     let elf = match &args.elf {
@@ -187,22 +228,28 @@ pub fn run(args: &RealtimeArgs) -> Result<Vec<CaseResult>, BenchError> {
     };
     let mut out = Vec::new();
     for case in cases() {
-        for fits in [true, false] {
-            let mut scene = case.scene;
-            scene.fits = if fits { FitSet::all() } else { FitSet::none() };
+        let works = [
+            (Work::Fits, Some(case.spacings)),
+            (Work::Stream, Some(case.spacings)),
+            (Work::Everything, case.everything),
+        ];
+        for (work, spacings) in works {
+            let Some(spacings) = spacings else { continue };
+            let scene = work_scene(case.scene, work)?;
             let mut runs = Vec::new();
-            for &spacing in case.spacings {
+            for &spacing in spacings {
                 let r = train(&elf, &case, &scene, args.impacts, spacing, args.clock_shift)?;
                 if !args.json {
                     crate::errln!(
-                        "{} {} fits, {:.1} ms apart: {} of {} reported, lost {}, skipped {}, latency median {} max {}",
+                        "{}, {}, {:.1} ms apart: {} of {} reported, lost {}, skipped {}, without their spectra or verdict {}, latency median {} max {}",
                         case.name,
-                        if fits { "with" } else { "without" },
+                        work.label(),
                         spacing * 1e3,
                         r.reports,
                         r.impacts,
                         r.samples_lost,
                         r.analyses_skipped,
+                        r.missing_work,
                         ms(r.latency_median_s),
                         ms(r.latency_max_s),
                     );
@@ -214,11 +261,11 @@ pub fn run(args: &RealtimeArgs) -> Result<Vec<CaseResult>, BenchError> {
             out.push(CaseResult {
                 case: case.name.to_string(),
                 rate_hz: case.sensor.rate_hz,
-                fits,
+                work,
                 nominal: runs[0].clone(),
                 max_rate_fully_analysed_hz: rate(
                     runs.iter()
-                        .take_while(|r| ok(r) && r.analyses_skipped == 0)
+                        .take_while(|r| ok(r) && r.analyses_skipped == 0 && r.missing_work == 0)
                         .last(),
                 ),
                 max_rate_lossless_hz: rate(runs.iter().take_while(ok).last()),
@@ -229,6 +276,20 @@ pub fn run(args: &RealtimeArgs) -> Result<Vec<CaseResult>, BenchError> {
     Ok(out)
 }
 
+/// The case's scene for `work`.
+fn work_scene(mut scene: Scene, work: Work) -> Result<Scene, BenchError> {
+    scene.fits = if work == Work::Stream {
+        FitSet::none()
+    } else {
+        FitSet::all()
+    };
+    if work == Work::Everything {
+        scene.spectrum = Some(impact_core::signal::spectrum::SpectrumSettings::new());
+        scene.spec = Some(crate::pipeline::spec::parse(EVERYTHING_SPEC)?.spec);
+    }
+    Ok(scene)
+}
+
 fn ms(v: Option<f64>) -> String {
     v.map_or("-".into(), |v| format!("{:.1} ms", v * 1e3))
 }
@@ -236,13 +297,13 @@ fn ms(v: Option<f64>) -> String {
 /// The results as a table.
 pub fn table(results: &[CaseResult]) -> String {
     let mut s = String::from(
-        "case | fits | report latency at the widest spacing (median / max) | highest rate tried, every impact analysed | highest rate tried, nothing lost\n",
+        "case | analysis | report latency at the widest spacing (median / max) | highest rate tried, every impact analysed | highest rate tried, nothing lost\n",
     );
     for r in results {
         s.push_str(&format!(
             "{} | {} | {} / {} ({:.0} ms apart) | {} | {}\n",
             r.case,
-            if r.fits { "yes" } else { "no" },
+            r.work.label(),
             ms(r.nominal.latency_median_s),
             ms(r.nominal.latency_max_s),
             r.nominal.spacing_s * 1e3,
