@@ -538,10 +538,14 @@ pub(super) fn record_fall(a: &mut Active, run: &[i16], at: u64) {
 }
 
 /// First touch relative to the onset where the foot began before the sample before the
-/// onset (`before`, within the edge level): the onset's three samples lie on a power curve
-/// ([`power_flank::head_reach`]: within [`power_flank::HEAD_BEND`]) whose zero lies in the
-/// interval before that sample, clear of the previous contact, and the curve reads that
-/// sample there within half the edge level (its noise). A force rising from zero with touch
+/// onset (`before`, within the edge level), clear of the previous contact: where that sample
+/// and the onset's first two lie on a power curve ([`power_flank::head_zero`]: within
+/// [`power_flank::HEAD_BEND`]) whose zero lies in the interval before it (a foot whose first
+/// sample stayed within the edge level: seed 001's law at 20 kS/s, that sample at 0.8 of
+/// it, the onset's head too bent by the deceleration for a power curve of its own: taken for
+/// a jump, `x_m` −8.6 %); else where the onset's three samples lie on a power curve
+/// ([`power_flank::head_reach`]) whose zero lies in the interval before that sample and the
+/// curve reads that sample there within half the edge level (its noise). A force rising from zero with touch
 /// just before a sample the sampling put at the baseline (a Hertz foot at 20 kS/s, touch
 /// 0.009 of a sample before it: the onset stepped past the flank level, the interval before
 /// it was taken for a jump's and touch put in its middle, half a sample late, `x_m` 7.5 %
@@ -552,9 +556,15 @@ pub(super) fn record_fall(a: &mut Active, run: &[i16], at: u64) {
 /// earlier, as [`power_flank::steep_zero`] says of its own line.
 fn earlier_foot(a: &Active, head: [f32; 3]) -> Option<f32> {
     let before = a.before_d? as f32;
-    let (zero, at_before) = power_flank::head_reach(head, -1.0)?;
-    let noise = 0.5 * a.edge_d as f32;
-    let clear = zero >= a.touch_floor;
-    ((-2.0..-1.0).contains(&zero) && clear && libm::fabsf(before - at_before) <= noise)
-        .then_some(zero)
+    let [y0, y1, _] = head;
+    let zero = match power_flank::head_zero([before, y0, y1]) {
+        // That sample on the foot, the onset's first two on its curve: its zero, from it.
+        Some(zero) => zero - 1.0,
+        None => {
+            let (zero, at_before) = power_flank::head_reach(head, -1.0)?;
+            let noise = 0.5 * a.edge_d as f32;
+            (libm::fabsf(before - at_before) <= noise).then_some(zero)?
+        }
+    };
+    ((-2.0..-1.0).contains(&zero) && zero >= a.touch_floor).then_some(zero)
 }
