@@ -192,7 +192,8 @@ pub fn steep_line_zero(y: [f32; 3]) -> Option<f32> {
 pub const HEAD_BEND: f32 = 0.02;
 
 /// Where a foot whose first sample lies just past the edge level (its flank too short for a
-/// line: fewer than three samples to the flank level) reaches zero, relative to that sample, from its
+/// line: fewer than three samples to the flank level), or just within it on the foot, reaches
+/// zero, relative to that sample, from its
 /// first three samples `y`, as [`steep_zero`] does, but only where the power puts them on a
 /// line (within [`HEAD_BEND`]) whose zero lies in the interval before the first: a foot the
 /// sampling resolves in three samples (a Hertz contact's `t^1.5` at 20 kS/s). Else `None`

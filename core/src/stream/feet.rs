@@ -539,8 +539,9 @@ pub(super) fn record_fall(a: &mut Active, run: &[i16], at: u64) {
 
 /// First touch relative to the onset where the foot began before the sample before the
 /// onset (`before`, within the edge level), clear of the previous contact: where that sample
-/// and the onset's first two lie on a power curve ([`power_flank::head_zero`]: within
-/// [`power_flank::HEAD_BEND`]) whose zero lies in the interval before it (a foot whose first
+/// stands out of the noise (over half the edge level) and lies with the onset's first two on
+/// a power curve ([`power_flank::head_zero`]: within [`power_flank::HEAD_BEND`]) whose zero
+/// lies in the interval before it (a foot whose first
 /// sample stayed within the edge level: seed 001's law at 20 kS/s, that sample at 0.8 of
 /// it, the onset's head too bent by the deceleration for a power curve of its own: taken for
 /// a jump, `x_m` −8.6 %); else where the onset's three samples lie on a power curve
@@ -557,12 +558,18 @@ pub(super) fn record_fall(a: &mut Active, run: &[i16], at: u64) {
 fn earlier_foot(a: &Active, head: [f32; 3]) -> Option<f32> {
     let before = a.before_d? as f32;
     let [y0, y1, _] = head;
-    let zero = match power_flank::head_zero([before, y0, y1]) {
+    let noise = 0.5 * a.edge_d as f32;
+    // (Only a sample that stands out of the noise: a jump's quiet sample before it, a little
+    // above the baseline, would put a jump onto a ramp on a curve within `HEAD_BEND` of the
+    // jump's size.)
+    let on_foot = (before > noise)
+        .then(|| power_flank::head_zero([before, y0, y1]))
+        .flatten();
+    let zero = match on_foot {
         // That sample on the foot, the onset's first two on its curve: its zero, from it.
         Some(zero) => zero - 1.0,
         None => {
             let (zero, at_before) = power_flank::head_reach(head, -1.0)?;
-            let noise = 0.5 * a.edge_d as f32;
             (libm::fabsf(before - at_before) <= noise).then_some(zero)?
         }
     };
