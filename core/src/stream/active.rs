@@ -75,11 +75,9 @@ pub(super) struct Active {
     pub(super) lobe_c: i64,
     /// The lobe runs back to the previous impact's window ([`super::feet::Lobe`]).
     pub(super) lobe_in_previous: bool,
-    /// The sample just before the onset lies within half the edge level either way (the
-    /// ring held it).
-    pub(super) quiet_before: bool,
-    /// The sample just before the onset (`d`, the pulse's side positive), if the ring held it.
-    pub(super) before_d: Option<i64>,
+    /// The sample just before the onset (`d`, the pulse's side positive), if the ring held it
+    /// (a deviation of one sample: within i32, as `Deviation::of` gives it).
+    pub(super) before_d: Option<i32>,
     /// The sink gave a buffer for this impact.
     pub(super) captured: bool,
     /// The buffer overflowed.
@@ -116,6 +114,13 @@ pub(super) enum FlankTouch {
 }
 
 impl Active {
+    /// The sample just before the onset lies within half the edge level either way (the
+    /// ring held it).
+    pub(super) fn quiet_before(&self) -> bool {
+        self.before_d
+            .is_some_and(|d| 2 * i64::from(d).abs() <= self.edge_d)
+    }
+
     pub(super) fn deviation(&self) -> Deviation {
         Deviation::new(self.base_sum, self.base_n)
     }

@@ -292,7 +292,7 @@ impl<const PRE: usize> Stream<PRE> {
                     // sample is the foot's, in `Σ d` as the kinematics integrate it (the
                     // trigger's touch, a step's middle or the edge crossing, had none).
                     let c = match a.before_d {
-                        Some(before) if touch < -1.0 => a.sign * before,
+                        Some(before) if touch < -1.0 => a.sign * i64::from(before),
                         _ => a.lead_c,
                     };
                     ((touch, c, z < a.touch_floor), true, jump)
@@ -329,7 +329,7 @@ impl<const PRE: usize> Stream<PRE> {
                 },
             }),
             FlankTouch::Crossing => power_flank::head_zero(head)
-                .filter(|_| a.quiet_before)
+                .filter(|_| a.quiet_before())
                 .or_else(|| earlier_foot(a, head))
                 .map(|zero| (zero, false)),
             FlankTouch::Line | FlankTouch::Refused => None,

@@ -140,8 +140,7 @@ impl<const PRE: usize> Stream<PRE> {
             lobe_touch: lobe.touch,
             lobe_c: lobe.c,
             lobe_in_previous: lobe.in_previous,
-            quiet_before: lobe.before.is_some_and(|d| 2 * d.abs() <= edge_d),
-            before_d: lobe.before,
+            before_d: lobe.before.and_then(|d| i32::try_from(d).ok()),
             captured: capture.is_some(),
             full: false,
             // The walk back reached the gap: the pulse began while samples were lost.
