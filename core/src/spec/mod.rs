@@ -530,6 +530,31 @@ impl<'a> Nominal<'a> {
 mod tests {
     use super::*;
 
+    /// The shapes the verdict's tests judge and bound: the three standard ones first (rows
+    /// tabulated from them pass `validate`), then an initial-peak pulse written as a
+    /// trapezoid (its top far shorter than a table step or a sample), an unequal one and one
+    /// without a top.
+    pub(super) const SHAPES_UNDER_TEST: [Shape; 6] = [
+        Shape::HalfSine,
+        Shape::Sawtooth,
+        Shape::Trapezoid {
+            rise: 0.1,
+            fall: 0.1,
+        },
+        Shape::Trapezoid {
+            rise: 0.001,
+            fall: 0.999,
+        },
+        Shape::Trapezoid {
+            rise: 0.3,
+            fall: 0.6,
+        },
+        Shape::Trapezoid {
+            rise: 0.3,
+            fall: 0.7,
+        },
+    ];
+
     /// [`band_bound`] is a bound: every `u` of a span (many f32s along it and its ends) has
     /// its band's lower limit at or below the bound's and its upper at or above, up to the
     /// verdict's allowance for rounding (1e-5 of the peak): every shape (trapezoids with a
@@ -537,22 +562,6 @@ mod tests {
     /// outside limits below and above the band, and a user's band with steps, rows at ±10.
     #[test]
     fn band_bound_bounds_the_band_over_every_span() {
-        let shapes = [
-            Shape::HalfSine,
-            Shape::Sawtooth,
-            Shape::Trapezoid {
-                rise: 0.1,
-                fall: 0.1,
-            },
-            Shape::Trapezoid {
-                rise: 0.001,
-                fall: 0.999,
-            },
-            Shape::Trapezoid {
-                rise: 0.3,
-                fall: 0.7,
-            },
-        ];
         const fn row(u: f32, lower: f32, upper: f32) -> BandPoint {
             BandPoint { u, lower, upper }
         }
@@ -568,7 +577,7 @@ mod tests {
         ];
         let mut table = [0.0f32; Nominal::LEN];
         let mut checked = 0usize;
-        for shape in shapes {
+        for shape in SHAPES_UNDER_TEST {
             let nominal = Nominal::fill(shape, &mut table);
             let at = |u: f32| nominal.at(u);
             for slack in [0.0f32, 1e-7, 0.01, 0.05, 0.5, 1.0] {

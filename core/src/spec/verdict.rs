@@ -1187,6 +1187,22 @@ mod tests {
         assert!(wide.delta_v_pass && wide.band_pass, "{wide:?}");
     }
 
+    /// Every field of a verdict as bits (the reason where there is none), to compare two.
+    #[allow(clippy::type_complexity)]
+    fn bits(v: &Result<Verdict, Missing>) -> Result<(bool, u64, u32, u64, u32, u32, u32), Missing> {
+        v.map(|v| {
+            (
+                v.pass,
+                v.start_s.to_bits(),
+                v.margin.to_bits(),
+                v.worst_s.to_bits(),
+                v.worst_m_s2.to_bits(),
+                v.limit_m_s2.to_bits(),
+                v.delta_v_m_s.to_bits(),
+            )
+        })
+    }
+
     /// The search that reads the band's flat stretches off the buckets gives the verdict of
     /// the one that read every sample ([`crate::spec::verdict_reference`]), bit for bit:
     /// pulses of every shape, longer and shorter, higher and lower than the nominal one, with
@@ -1202,24 +1218,7 @@ mod tests {
             seed ^= seed << 17;
             (seed >> 11) as f32 / (1u64 << 53) as f32
         };
-        let shapes = [
-            Shape::HalfSine,
-            Shape::Sawtooth,
-            Shape::Trapezoid {
-                rise: 0.1,
-                fall: 0.1,
-            },
-            // An initial-peak pulse written as a trapezoid (its top far shorter than a
-            // sample), and an unequal one.
-            Shape::Trapezoid {
-                rise: 0.001,
-                fall: 0.999,
-            },
-            Shape::Trapezoid {
-                rise: 0.3,
-                fall: 0.6,
-            },
-        ];
+        let shapes = crate::spec::tests::SHAPES_UNDER_TEST;
         let mut passes = 0;
         let mut scratch = [0.0f32; SCRATCH + 32_768];
         for case in 0..1000 {
@@ -1266,19 +1265,6 @@ mod tests {
             let got = judge(a, rate, &spec, peak_index);
             // The window's samples held in the scratch, as the board's analysis holds them.
             let held = judge_in(a, rate, &spec, peak_index, &mut scratch);
-            let bits = |v: &Result<Verdict, Missing>| {
-                v.map(|v| {
-                    (
-                        v.pass,
-                        v.start_s.to_bits(),
-                        v.margin.to_bits(),
-                        v.worst_s.to_bits(),
-                        v.worst_m_s2.to_bits(),
-                        v.limit_m_s2.to_bits(),
-                        v.delta_v_m_s.to_bits(),
-                    )
-                })
-            };
             assert_eq!(bits(&got), bits(&want), "case {case}: {got:?} vs {want:?}");
             assert_eq!(
                 bits(&held),
@@ -1317,16 +1303,6 @@ mod tests {
             };
             let peak = (start + shape.peak_at() * d) as u64;
             let (got, want) = (judge(a, rate, &s, peak), judge_reference(a, rate, &s, peak));
-            let bits = |v: &Result<Verdict, Missing>| {
-                v.map(|v| {
-                    (
-                        v.pass,
-                        v.start_s.to_bits(),
-                        v.margin.to_bits(),
-                        v.worst_s.to_bits(),
-                    )
-                })
-            };
             assert_eq!(bits(&got), bits(&want), "{offset}: {got:?} vs {want:?}");
         }
     }
