@@ -611,9 +611,13 @@ fn bounce_trains_of_every_law_within_one_percent() {
 /// half a sample late, `x_m` −7.5 %), or just before a sample on the foot within the edge
 /// level, which lies on one power curve with the onset's first two (seed 001's law at phase
 /// 0.375: the onset's head too bent for a curve of its own, `x_m` −8.6 %).
+/// At 10 and 5 kS/s (5 and 2.5 samples to the crush: a wrong guess of where in the interval
+/// before the onset touch fell had moved `x_m` by −15 % and −28 %) every law, Kelvin–Voigt
+/// too, is flagged `undersampled`, its crush time, deformations and fits null with that
+/// reason, its COR within 5 % and 10 %.
 /// Not yet: Kelvin–Voigt at 20 kS/s (its jump is placed from the compression at five of
 /// eight phases; at phases 0.125–0.375 the onset is not taken for a jump and touch lands 0.7
-/// samples early, `x_m` +11 %), and coarser rates (docs/accuracy.md; #43).
+/// samples early, `x_m` +11 %, reported: docs/accuracy.md; #43).
 #[test]
 fn a_one_millisecond_contact_at_coarse_rates() {
     let scratch = Scratch::new();
@@ -634,8 +638,9 @@ fn a_one_millisecond_contact_at_coarse_rates() {
         ),
     ];
     for (name, law) in laws {
-        for rate in [100_000.0, 20_000.0] {
-            if rate < 1e5 && name == "kelvin-voigt" {
+        for rate in [100_000.0, 20_000.0, 10_000.0, 5_000.0] {
+            // (Kelvin–Voigt at 20 kS/s: three of eight phases +11 % on `x_m`, open.)
+            if rate == 20e3 && name == "kelvin-voigt" {
                 continue;
             }
             for phase in [0.0, 0.125, 0.25, 0.375, 0.5, 0.625, 0.75, 0.875] {
@@ -653,6 +658,35 @@ fn a_one_millisecond_contact_at_coarse_rates() {
                 let (r, t) = (&impacts[0], &truth[0]);
                 if rate >= 1e5 {
                     check(r, t, name, &what, rate);
+                } else if rate < 16e3 {
+                    // Fewer than 8 samples to the crush (5 at 10 kS/s): where in the interval
+                    // before the onset the contact began the samples cannot tell, so no crush
+                    // time, deformation or fit, each saying why; the COR (from Δv) within the
+                    // issue's 5 % at 10 kS/s, 10 % at 5 kS/s.
+                    // (Or, an elastic contact's Δv read past the COR's tolerance above 1 at
+                    // 5 kS/s, no kinematics at all, `cor-out-of-range`.)
+                    let flags = r["flags"].as_array().unwrap();
+                    let cor = t.separation.unwrap().cor;
+                    if rate < 1e4 && cor > 0.95 && flags.iter().any(|f| f == "cor-out-of-range") {
+                        assert_eq!(r["null_reasons"]["cor"], "cor-out-of-range", "{what}");
+                        assert_eq!(r["null_reasons"]["crush_time_s"], "cor-out-of-range");
+                        continue;
+                    }
+                    assert!(
+                        flags.iter().any(|f| f == "undersampled"),
+                        "{what}: {flags:?}"
+                    );
+                    for field in [
+                        "crush_time_s",
+                        "max_deformation_m",
+                        "separation_deformation_m",
+                        "permanent_deformation_m",
+                    ] {
+                        assert!(r[field].is_null(), "{what}: {field} {}", r[field]);
+                        assert_eq!(r["null_reasons"][field], "undersampled", "{what}: {field}");
+                    }
+                    let tolerance = if rate >= 1e4 { 0.05 } else { 0.1 };
+                    within(&r["cor"], cor, tolerance, &what);
                 } else {
                     // First touch from the step's three samples: within a tenth of a sample.
                     let start = r["start_s"].as_f64().unwrap();
@@ -660,6 +694,14 @@ fn a_one_millisecond_contact_at_coarse_rates() {
                         (start - t.touch_s).abs() * rate <= 0.1,
                         "{what}: first touch {:+.3} samples",
                         (start - t.touch_s) * rate
+                    );
+                    assert!(
+                        !r["flags"]
+                            .as_array()
+                            .unwrap()
+                            .iter()
+                            .any(|f| f == "undersampled"),
+                        "{what}"
                     );
                     within(&r["cor"], t.separation.unwrap().cor, 0.01, &what);
                     within(&r["crush_time_s"], t.crush_time_s.unwrap(), 0.01, &what);

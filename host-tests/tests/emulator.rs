@@ -1731,6 +1731,69 @@ fn board_within_one_percent(
     }
 }
 
+/// A 1 ms contact at 10 kS/s (5 samples to the crush) on the board: its report equals the
+/// host's, bit for bit, flagged `undersampled`, no crush time or deformation, each null saying
+/// why (the host's own figures: `tests/drops.rs`). At phase 0.75 the host had put touch 0.44
+/// samples late, `x_m` −13 %, as `complete`.
+#[test]
+fn a_contact_its_samples_cannot_place_is_undersampled_on_the_board() {
+    use impact_core::Model;
+    use impact_host::drop::{Drop, Start};
+    let scratch = Scratch::new();
+    let Some(elf) = firmware() else { return };
+    let elf = elf.to_string_lossy().into_owned();
+    let k = 0.06 * (std::f64::consts::PI / 1e-3f64).powi(2);
+    let rate = 10_000.0;
+    for (name, law) in [
+        ("linear", Model::Linear(impact_core::model::Linear { k })),
+        (
+            "hertz",
+            Model::Hertz(impact_core::model::Hertz { k: 3.0e7 }),
+        ),
+    ] {
+        let drop = Drop {
+            law,
+            mass_kg: 0.06,
+            gravity_m_s2: impact_core::consts::STANDARD_GRAVITY,
+            start: Start::Rest {
+                rest_s: 0.05 + 0.75 / rate,
+                height_m: 0.091,
+            },
+            max_contacts: 1,
+            min_rebound_m_s: 1e-3,
+        };
+        let (text, _) = impact_host::testkit::sensor::csv(&drop, rate, 0.3, 20_000.0).unwrap();
+        let file = scratch.text(&format!("short-{name}.csv"), &text);
+        let options = [
+            "--mass",
+            "0.06",
+            "--drop-height",
+            "0.091",
+            "--range",
+            "20000",
+        ];
+        emulator_and_log_match_host(&file, &options, false);
+        let mut args = vec!["emulate", file.as_str(), "--json", "--elf", &elf];
+        args.extend(options);
+        let (out, _) = impact(&args);
+        let v: serde_json::Value = serde_json::from_str(&out).unwrap();
+        let r = &v["impacts"][0];
+        assert!(
+            r["flags"]
+                .as_array()
+                .unwrap()
+                .iter()
+                .any(|f| f == "undersampled"),
+            "{name}: {r}"
+        );
+        assert!(r["cor"].is_number(), "{name}: {r}");
+        for field in ["crush_time_s", "max_deformation_m"] {
+            assert!(r[field].is_null(), "{name}: {field}");
+            assert_eq!(r["null_reasons"][field], "undersampled", "{name}");
+        }
+    }
+}
+
 /// Drops from rest of every law (the physical generator, `impact_host::drop`: held at +1 g,
 /// released, 91 mm of free fall, gravity in the contact; three touch phases at 100 and
 /// 20 kS/s) and bounce trains (six contacts from

@@ -215,6 +215,12 @@ fn absurd_times_and_lengths_are_refused_naming_line_and_field() {
             "5",
             "line 2: max_deformation_m=5: implausible (at most 79.",
         ),
+        // A crush time absent where the flags do not say `undersampled`.
+        (
+            "crush_time_s",
+            "none",
+            "line 2: crush_time_s, max_deformation_m and separation_deformation_m: none where",
+        ),
     ] {
         // The line is passed over and named; the log's other impacts are read.
         let text = [

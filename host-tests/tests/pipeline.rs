@@ -127,14 +127,14 @@ fn synthetic_recordings_give_each_models_exact_outcome() {
         within(
             name,
             "crush time",
-            k.crush_time_s as f64,
+            k.crush_time_s.expect("a crush time") as f64,
             t.crush_time_s,
             tol_t,
         );
         within(
             name,
             "max deformation",
-            k.max_deformation_m as f64,
+            k.max_deformation_m.expect("x_m") as f64,
             t.max_deformation_m,
             tol_t,
         );
@@ -162,12 +162,11 @@ fn synthetic_recordings_give_each_models_exact_outcome() {
         );
         // The deformation at separation (the model outcome's `permanent_deformation_m`):
         // within 1 % of x_m of the truth (zero for most laws).
-        let xs_err = (k.separation_deformation_m as f64 - t.permanent_deformation_m).abs()
-            / t.max_deformation_m;
+        let x_sep = k.separation_deformation_m.expect("x at separation");
+        let xs_err = (x_sep as f64 - t.permanent_deformation_m).abs() / t.max_deformation_m;
         assert!(
             xs_err < 0.01,
-            "{name}: x at separation {} vs {}",
-            k.separation_deformation_m,
+            "{name}: x at separation {x_sep} vs {}",
             t.permanent_deformation_m
         );
         // The touch happened at 12.3456 ms.

@@ -564,7 +564,12 @@ fn analyse_kinematics<const CAP: usize>(
     }
 
     #[cfg(feature = "fit")]
-    if let (Some(k), true) = (r.kinematics, points > 0) {
+    // (Not where the compression is too short for `x_m`: [`Flags::UNDERSAMPLED`].)
+    if let (Some(k), Some(x_m), true) = (
+        r.kinematics,
+        r.kinematics.and_then(|k| k.max_deformation_m),
+        points > 0,
+    ) {
         use crate::fit;
         // The points were integrated in metres: scale them by the maximum deformation.
         let inv_x = (1.0 / found.x_max) as f32;
@@ -575,7 +580,7 @@ fn analyse_kinematics<const CAP: usize>(
             x: deformation,
             v: velocity,
             f: force,
-            x_m: k.max_deformation_m,
+            x_m,
             v0: k.impact_velocity_m_s,
             f_peak,
         };

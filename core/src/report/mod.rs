@@ -161,9 +161,16 @@ impl Flags {
     /// `filtered_fwhm_s` (a decimated capture whose filtered width is too coarse to resolve
     /// does not set it: that is [`Self::DECIMATED`]'s).
     pub const FILTERED_HALF_MAXIMUM_OUTSIDE: Flags = Flags(1 << 14);
+    /// The compression (first touch to the crush) spans fewer samples than
+    /// [`motion::MIN_CRUSH_SAMPLES`]: where in the sample interval before the onset the
+    /// contact began, the samples cannot tell (a foot's curve or a jump's law places it, and
+    /// a wrong guess moves the crush time and `x_m` by up to a sample's share of them: −15 %
+    /// on a 1 ms contact at 10 kS/s): the crush time, the deformations and the fits are
+    /// absent; the COR, the rebound and the energy (from Δv) stand.
+    pub const UNDERSAMPLED: Flags = Flags(1 << 15);
 
     /// Every flag with its name in the reports.
-    pub const NAMES: [(Flags, &'static str); 15] = [
+    pub const NAMES: [(Flags, &'static str); 16] = [
         (Flags::AC_COUPLED, "ac-coupled"),
         (Flags::COR_OUT_OF_RANGE, "cor-out-of-range"),
         (Flags::NO_STOP, "no-stop"),
@@ -182,6 +189,7 @@ impl Flags {
             Flags::FILTERED_HALF_MAXIMUM_OUTSIDE,
             "filtered-half-maximum-outside",
         ),
+        (Flags::UNDERSAMPLED, "undersampled"),
     ];
 
     pub const fn empty() -> Self {
@@ -215,17 +223,18 @@ impl Flags {
 pub struct Kinematics {
     /// Approach speed used, m/s.
     pub impact_velocity_m_s: f32,
-    /// From first touch to zero velocity, s.
-    pub crush_time_s: f32,
-    /// Deformation at zero velocity, m.
-    pub max_deformation_m: f32,
+    /// From first touch to zero velocity, s (`None`: [`Flags::UNDERSAMPLED`]).
+    pub crush_time_s: Option<f32>,
+    /// Deformation at zero velocity, m (`None`: [`Flags::UNDERSAMPLED`]).
+    pub max_deformation_m: Option<f32>,
     /// Speed after the impact (`Δv - v0`), m/s.
     pub rebound_velocity_m_s: f32,
     /// `v' / v0`.
     pub cor: f32,
     /// Deformation at separation (where the contact force returned to zero), m: the set
-    /// plus what the pad's viscous part still held (a Kelvin–Voigt pad's `c v_r / k`).
-    pub separation_deformation_m: f32,
+    /// plus what the pad's viscous part still held (a Kelvin–Voigt pad's `c v_r / k`)
+    /// (`None`: [`Flags::UNDERSAMPLED`]).
+    pub separation_deformation_m: Option<f32>,
     /// The set the pad keeps once it has recovered, m ([`crate::fit::set`]): 0 for a
     /// Kelvin–Voigt pad, `x_p` for the two-phase law; `None` where the record cannot tell
     /// (the unloading no line of an elastic and a viscous part, or no fit points: no mass or

@@ -282,10 +282,24 @@ impl Frame {
     }
 }
 
+/// Fewest samples from first touch to the crush for the crush time and the deformations
+/// ([`Flags::UNDERSAMPLED`]). Where the force steps or rises steeply at touch, first touch
+/// lies somewhere in the interval before the onset, and the foot's power curve or the jump's
+/// law places it there; where that guess is wrong (the samples cannot tell a steep foot from
+/// a jump at some touch phases) first touch is off by 0.3 to 0.9 of a sample, which moves
+/// the crush time by that share of the compression and `x_m` by `v0` times it. On 1 ms
+/// contacts (`docs/accuracy.md`) that is up to −15 % at 10 kS/s (5 samples to the crush),
+/// −28 % at 5 kS/s; 8 samples (a 1 ms contact at 16 kS/s) and more report them.
+pub const MIN_CRUSH_SAMPLES: f64 = 8.0;
+
 /// Fills in `r`'s kinematics from what the sums found in `frame`: the rebound from the
-/// report's Δv, the COR (flagged and left out beyond its tolerance), the energy absorbed.
-/// The set a pad keeps comes from the fits ([`crate::fit::set`]).
+/// report's Δv, the COR (flagged and left out beyond its tolerance), the energy absorbed;
+/// the crush time and the deformations where the compression spans [`MIN_CRUSH_SAMPLES`]
+/// (else flagged [`Flags::UNDERSAMPLED`] and left out). The set a pad keeps comes from the
+/// fits ([`crate::fit::set`]).
 pub fn kinematics(r: &mut ImpactReport, scene: &Scene, frame: &Frame, found: &Found) {
+    // (Again where a jump's law moved first touch: [`crate::analysis`].)
+    r.flags.remove(Flags::UNDERSAMPLED);
     let v0 = frame.scale.v0 as f32;
     let gravity = scene.contact_gravity_m_s2();
     let Some(rebound) = rebound_m_s(r, v0, gravity) else {
@@ -296,13 +310,19 @@ pub fn kinematics(r: &mut ImpactReport, scene: &Scene, frame: &Frame, found: &Fo
         r.flags.insert(Flags::COR_OUT_OF_RANGE);
         return;
     }
+    let crush_samples = found.crush - frame.touch;
+    let resolved = crush_samples >= MIN_CRUSH_SAMPLES;
+    if !resolved {
+        r.flags.insert(Flags::UNDERSAMPLED);
+    }
+    let held = |v: f64| resolved.then_some(v as f32);
     r.kinematics = Some(Kinematics {
         impact_velocity_m_s: v0,
-        crush_time_s: ((found.crush - frame.touch) * frame.scale.dt) as f32,
-        max_deformation_m: found.x_max as f32,
+        crush_time_s: held(crush_samples * frame.scale.dt),
+        max_deformation_m: held(found.x_max),
         rebound_velocity_m_s: rebound,
         cor,
-        separation_deformation_m: found.x_sep as f32,
+        separation_deformation_m: held(found.x_sep),
         permanent_deformation_m: None,
         // Gravity's work over the contact counts in a vertical one.
         absorbed_energy_j: scene.mass_kg.map(|m| {

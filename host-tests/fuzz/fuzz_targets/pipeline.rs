@@ -197,11 +197,11 @@ fn finite(r: &ImpactReport) -> bool {
         && r.peak_force_n.is_none_or(f32::is_finite);
     if let Some(k) = &r.kinematics {
         ok &= k.impact_velocity_m_s.is_finite()
-            && k.crush_time_s.is_finite()
-            && k.max_deformation_m.is_finite()
+            && k.crush_time_s.is_none_or(f32::is_finite)
+            && k.max_deformation_m.is_none_or(f32::is_finite)
             && k.rebound_velocity_m_s.is_finite()
             && k.cor.is_finite()
-            && k.separation_deformation_m.is_finite()
+            && k.separation_deformation_m.is_none_or(f32::is_finite)
             && k.permanent_deformation_m.is_none_or(f32::is_finite)
             && k.absorbed_energy_j.is_none_or(f32::is_finite);
     }

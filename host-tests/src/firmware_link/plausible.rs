@@ -18,6 +18,13 @@ pub enum Implausible {
     },
     #[error("end_sample={end} before start_sample={start}")]
     EndBeforeStart { start: u64, end: u64 },
+    /// The crush time, `x_m` and the deformation at separation are absent together, and
+    /// exactly where the flags say `undersampled`.
+    #[error(
+        "crush_time_s, max_deformation_m and separation_deformation_m: none where flags has \
+         no undersampled bit, or a value where it has (a garbled line)"
+    )]
+    Undersampled,
     /// A capture's step is a power of two up to the coarsest the core decimates to.
     #[error("decimation={value}: not a power of two from 1 to {max}")]
     Decimation { value: u32, max: u32 },
@@ -154,8 +161,24 @@ pub(crate) fn check_report(r: &ImpactReport) -> Result<(), Implausible> {
         non_negative("landing_height_m", b.landing_height_m.into())?;
     }
     if let Some(k) = &r.kinematics {
-        non_negative("crush_time_s", k.crush_time_s.into())?;
-        non_negative("max_deformation_m", k.max_deformation_m.into())?;
+        let undersampled = r.flags.contains(impact_core::report::Flags::UNDERSAMPLED);
+        let absent = [
+            k.crush_time_s,
+            k.max_deformation_m,
+            k.separation_deformation_m,
+        ]
+        .map(|v| v.is_none());
+        if absent.iter().any(|&a| a != undersampled) {
+            return Err(Implausible::Undersampled);
+        }
+        for (field, value) in [
+            ("crush_time_s", k.crush_time_s),
+            ("max_deformation_m", k.max_deformation_m),
+        ] {
+            if let Some(v) = value {
+                non_negative(field, v.into())?;
+            }
+        }
         if k.impact_velocity_m_s <= 0.0 {
             let v = k.impact_velocity_m_s.into();
             return out_of_range("impact_velocity_m_s", v, Range::Positive);
@@ -164,9 +187,10 @@ pub(crate) fn check_report(r: &ImpactReport) -> Result<(), Implausible> {
         if !(-COR_TOLERANCE..=1.0 + COR_TOLERANCE).contains(&k.cor) {
             return out_of_range("cor", k.cor.into(), Range::Cor);
         }
-        let x = k.max_deformation_m;
+        // (An undersampled compression has no deformations to compare.)
+        let x = k.max_deformation_m.unwrap_or(f32::INFINITY);
         for (field, value) in [
-            ("separation_deformation_m", Some(k.separation_deformation_m)),
+            ("separation_deformation_m", k.separation_deformation_m),
             ("permanent_deformation_m", k.permanent_deformation_m),
         ] {
             if let Some(v) = value.filter(|v| !(-x..=x).contains(v)) {
@@ -282,17 +306,20 @@ pub(crate) fn check_plausible(r: &ImpactReport, bounds: &Bounds) -> Result<(), I
     if let Some(b) = &r.bounce {
         at_most("flight_s", b.flight_s.into(), stream, in_stream)?;
     }
-    if let Some(k) = &r.kinematics {
-        let c = k.crush_time_s;
+    if let Some((k, c)) = r
+        .kinematics
+        .as_ref()
+        .and_then(|k| Some((k, k.crush_time_s?)))
+    {
         at_most("crush_time_s", c.into(), stream - r.start_s, contact)?;
-        if let Some(gain) = gain {
+        if let (Some(gain), Some(x_m)) = (gain, k.max_deformation_m) {
             // A sample more of travel: first touch may fall a fraction of one before the onset.
             let t = f64::from(c) + sample;
             let a = MAX_DEVIATION_COUNTS * gain.abs();
             let reach = f64::from(k.impact_velocity_m_s) * t + 0.5 * a * t * t;
             at_most(
                 "max_deformation_m",
-                k.max_deformation_m.into(),
+                x_m.into(),
                 reach,
                 "impact_velocity_m_s over crush_time_s under the largest acceleration the counts hold",
             )?;

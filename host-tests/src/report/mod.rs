@@ -397,6 +397,15 @@ pub fn null_reasons(r: &ImpactReport, fits: &FitSet) -> BTreeMap<String, String>
             put(field, why);
         }
     } else {
+        if flag(Flags::UNDERSAMPLED) {
+            for field in [
+                "crush_time_s",
+                "max_deformation_m",
+                "separation_deformation_m",
+            ] {
+                put(field, "undersampled");
+            }
+        }
         if r.kinematics.is_some_and(|k| k.absorbed_energy_j.is_none()) {
             put("absorbed_energy_j", "no-mass");
         }
@@ -406,7 +415,9 @@ pub fn null_reasons(r: &ImpactReport, fits: &FitSet) -> BTreeMap<String, String>
             // The stream's online sums gave the kinematics of a contact no capture held
             // whole; else no line of an elastic and a viscous part holds the unloading, or no
             // fit points were taken (no mass, no fit asked).
-            let why = if skipped {
+            let why = if flag(Flags::UNDERSAMPLED) {
+                "undersampled"
+            } else if skipped {
                 "analysis-skipped"
             } else if r.status == Status::BufferFull {
                 "capture-full"
@@ -426,6 +437,7 @@ pub fn null_reasons(r: &ImpactReport, fits: &FitSet) -> BTreeMap<String, String>
                 _ if !asked => "not-asked",
                 _ if r.peak_force_n.is_none() => "no-mass",
                 Some(k) => k.as_str(),
+                None if flag(Flags::UNDERSAMPLED) => "undersampled",
                 // Kinematics from the online sums, but the loop the fits need was not held.
                 None if skipped => "analysis-skipped",
                 None if r.status == Status::BufferFull => "capture-full",
@@ -468,11 +480,11 @@ pub fn impact_json(
         filtered_fwhm_s: r.filtered_fwhm_s.map(f),
         decimation: r.decimation,
         impact_velocity_m_s: k.map(|k| f(k.impact_velocity_m_s)),
-        crush_time_s: k.map(|k| f(k.crush_time_s)),
-        max_deformation_m: k.map(|k| f(k.max_deformation_m)),
+        crush_time_s: k.and_then(|k| k.crush_time_s).map(f),
+        max_deformation_m: k.and_then(|k| k.max_deformation_m).map(f),
         rebound_velocity_m_s: k.map(|k| f(k.rebound_velocity_m_s)),
         cor: k.map(|k| f(k.cor)),
-        separation_deformation_m: k.map(|k| f(k.separation_deformation_m)),
+        separation_deformation_m: k.and_then(|k| k.separation_deformation_m).map(f),
         permanent_deformation_m: k.and_then(|k| k.permanent_deformation_m).map(f),
         absorbed_energy_j: k.and_then(|k| k.absorbed_energy_j).map(f),
         fits: fits_json(&r.fits),

@@ -93,11 +93,11 @@ fn kinematics(f: &Fields) -> Result<Option<Kinematics>, LineError> {
     };
     Ok(Some(Kinematics {
         impact_velocity_m_s: v0,
-        crush_time_s: f.num("crush_time_s")?,
-        max_deformation_m: f.num("max_deformation_m")?,
+        crush_time_s: f.opt("crush_time_s")?,
+        max_deformation_m: f.opt("max_deformation_m")?,
         rebound_velocity_m_s: f.num("rebound_velocity_m_s")?,
         cor: f.num("cor")?,
-        separation_deformation_m: f.num("separation_deformation_m")?,
+        separation_deformation_m: f.opt("separation_deformation_m")?,
         permanent_deformation_m: f.opt("permanent_deformation_m")?,
         absorbed_energy_j: f.opt("absorbed_energy_j")?,
     }))
