@@ -656,6 +656,15 @@ fn a_one_millisecond_contact_at_coarse_rates() {
                 let impacts = a["impacts"].as_array().unwrap();
                 assert_eq!(impacts.len(), 1, "{what}: {impacts:#?}");
                 let (r, t) = (&impacts[0], &truth[0]);
+                // First touch within the sample interval the report states, at every rate.
+                let u = r["touch_uncertainty_s"].as_f64().unwrap();
+                assert_eq!(u, 1.0 / rate, "{what}");
+                let start = r["start_s"].as_f64().unwrap();
+                assert!(
+                    (start - t.touch_s).abs() <= u,
+                    "{what}: touch {start} vs {}",
+                    t.touch_s
+                );
                 if rate >= 1e5 {
                     check(r, t, name, &what, rate);
                 } else if rate < 16e3 {
@@ -684,6 +693,12 @@ fn a_one_millisecond_contact_at_coarse_rates() {
                     ] {
                         assert!(r[field].is_null(), "{what}: {field} {}", r[field]);
                         assert_eq!(r["null_reasons"][field], "undersampled", "{what}: {field}");
+                    }
+                    // No fit either (they take `x_m` and first touch), each saying why.
+                    for fit in ["two_phase", "nonlinear", "hertz"] {
+                        assert!(r["fits"][fit].is_null(), "{what}: {fit} {}", r["fits"][fit]);
+                        let why = &r["null_reasons"][format!("fits.{fit}")];
+                        assert_eq!(why, "undersampled", "{what}: {fit}");
                     }
                     let tolerance = if rate >= 1e4 { 0.05 } else { 0.1 };
                     within(&r["cor"], cor, tolerance, &what);

@@ -221,6 +221,12 @@ fn absurd_times_and_lengths_are_refused_naming_line_and_field() {
             "none",
             "line 2: crush_time_s, max_deformation_m and separation_deformation_m: none where",
         ),
+        // And the flags saying `undersampled` (32768) over a crush time and deformations.
+        (
+            "flags",
+            "32768",
+            "line 2: crush_time_s, max_deformation_m and separation_deformation_m: none where",
+        ),
     ] {
         // The line is passed over and named; the log's other impacts are read.
         let text = [

@@ -702,6 +702,16 @@ fn a_recording_that_starts_inside_an_impact_flags_it() {
             "{name}: {cut:#?}"
         );
         assert!(cut.cor.is_none(), "{name}");
+        // Its start is the record's, no first touch: no touch uncertainty, saying why; the
+        // clean one's is a sample.
+        assert!(cut.touch_uncertainty_s.is_none(), "{name}");
+        assert_eq!(
+            cut.null_reasons
+                .get("touch_uncertainty_s")
+                .map(String::as_str),
+            Some("cut-at-start")
+        );
+        assert_eq!(clean.touch_uncertainty_s, Some(1.0 / fs), "{name}");
         assert!(
             !clean.flags.iter().any(|f| f == "cut-at-start"),
             "{name}: {clean:#?}"

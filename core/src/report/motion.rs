@@ -310,15 +310,16 @@ pub fn kinematics(r: &mut ImpactReport, scene: &Scene, frame: &Frame, found: &Fo
         r.flags.insert(Flags::COR_OUT_OF_RANGE);
         return;
     }
-    let crush_samples = found.crush - frame.touch;
-    let resolved = crush_samples >= MIN_CRUSH_SAMPLES;
+    let crush_s = (found.crush - frame.touch) * frame.scale.dt;
+    // In the stream's samples (a decimated capture's pass counts coarser values).
+    let resolved = crush_s * scene.calibration.sample_rate_hz as f64 >= MIN_CRUSH_SAMPLES;
     if !resolved {
         r.flags.insert(Flags::UNDERSAMPLED);
     }
     let held = |v: f64| resolved.then_some(v as f32);
     r.kinematics = Some(Kinematics {
         impact_velocity_m_s: v0,
-        crush_time_s: held(crush_samples * frame.scale.dt),
+        crush_time_s: held(crush_s),
         max_deformation_m: held(found.x_max),
         rebound_velocity_m_s: rebound,
         cor,

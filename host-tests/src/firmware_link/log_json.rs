@@ -27,6 +27,8 @@ pub struct LogJson<'a> {
     fits: impact_core::FitSet,
     /// Gravity in the contacts, m/s² (the scene line's `gravity_m_s2`; none: horizontal).
     gravity: Option<f32>,
+    /// The stream's rate, S/s (the scene line's, else the board's state's).
+    rate_hz: f64,
 }
 
 impl<'a> LogJson<'a> {
@@ -115,6 +117,7 @@ impl<'a> LogJson<'a> {
             t0,
             fits,
             gravity,
+            rate_hz: f64::from(rate),
         };
         json.head.trains = crate::report::train::trains(json.impacts());
         json.head.assume_rigid_barrier();
@@ -138,7 +141,13 @@ impl<'a> LogJson<'a> {
         let log = self.log;
         let runs = log.runs.len() > 1;
         (log.impacts.iter().zip(&log.latencies).enumerate()).map(move |(k, (r, latency))| {
-            let mut j = crate::report::impact_json(r, self.t0, &self.fits, self.gravity);
+            let mut j = crate::report::impact_json(
+                r,
+                self.t0,
+                &self.fits,
+                self.gravity,
+                Some(self.rate_hz),
+            );
             j.report_latency_s = latency.map(f64::from);
             j.run = runs.then(|| log.runs.partition_point(|run| run.impacts.end <= k) as u32 + 1);
             j

@@ -22,7 +22,8 @@ pub enum Implausible {
     /// exactly where the flags say `undersampled`.
     #[error(
         "crush_time_s, max_deformation_m and separation_deformation_m: none where flags has \
-         no undersampled bit, or a value where it has (a garbled line)"
+         no undersampled bit, or a value (or a permanent_deformation_m) where it has (a garbled \
+         line)"
     )]
     Undersampled,
     /// A capture's step is a power of two up to the coarsest the core decimates to.
@@ -168,7 +169,9 @@ pub(crate) fn check_report(r: &ImpactReport) -> Result<(), Implausible> {
             k.separation_deformation_m,
         ]
         .map(|v| v.is_none());
-        if absent.iter().any(|&a| a != undersampled) {
+        // (Nor a set where the compression was too short for `x_m`.)
+        let set = undersampled && k.permanent_deformation_m.is_some();
+        if set || absent.iter().any(|&a| a != undersampled) {
             return Err(Implausible::Undersampled);
         }
         for (field, value) in [

@@ -1311,6 +1311,7 @@ pub fn to_json(setup: &Setup, reports: &[ImpactReport]) -> AnalysisJson {
                     setup.prepared.t0,
                     &setup.scene.fits,
                     setup.scene.contact_gravity_m_s2(),
+                    Some(setup.scene.calibration.sample_rate_hz as f64),
                 );
                 if !setup.axes.is_empty() {
                     let previous_end = k

@@ -70,6 +70,16 @@ pub struct ImpactJson {
     pub start_sample: u64,
     pub end_sample: u64,
     pub start_s: f64,
+    /// What the sample rate leaves first touch (`start_s`) within, s: one sample interval
+    /// of the stream. Touch lies between the last sample at the baseline and the first past
+    /// it; the foot's power curve or the jump's law places it there, and where that guess
+    /// is wrong (a jump smaller than a sample's rise taken for a steep foot) it is off by up
+    /// to most of this. The crush time is as uncertain, `x_m` by `impact_velocity_m_s` times
+    /// it. (A foot that rises under the noise can put touch further off: 1.7 samples at
+    /// 500 kS/s, `docs/accuracy.md`.) Null where `start_s` is no first touch (`cut-at-start`,
+    /// `in-previous`, `drift`) or no rate is known.
+    #[serde(default)]
+    pub touch_uncertainty_s: Option<f64>,
     pub peak_time_s: f64,
     pub peak_acceleration_m_s2: f64,
     pub peak_force_n: Option<f64>,
@@ -449,16 +459,34 @@ pub fn null_reasons(r: &ImpactReport, fits: &FitSet) -> BTreeMap<String, String>
     out
 }
 
+/// Why `start_s` is no first touch, if it is none: the flag that says so.
+fn start_not_touch(r: &ImpactReport) -> Option<&'static str> {
+    [
+        (Flags::CUT_AT_START, "cut-at-start"),
+        (Flags::IN_PREVIOUS, "in-previous"),
+        (Flags::DRIFT, "drift"),
+    ]
+    .into_iter()
+    .find(|(f, _)| r.flags.contains(*f))
+    .map(|(_, name)| name)
+}
+
 /// A core report as JSON; times shifted by `t0` (the recording's first time stamp); `fits`
 /// is what the scene asked for (for the reasons of absent fits); `gravity_m_s2` the gravity
-/// in its contacts (a bounce's COR by either source takes it out).
+/// in its contacts (a bounce's COR by either source takes it out); `rate_hz` the stream's
+/// rate (first touch's uncertainty), if known.
 pub fn impact_json(
     r: &ImpactReport,
     t0: f64,
     fits: &FitSet,
     gravity_m_s2: Option<f32>,
+    rate_hz: Option<f64>,
 ) -> ImpactJson {
     let k = r.kinematics;
+    let touch_uncertainty_s = rate_hz
+        .filter(|r| r.is_finite() && *r > 0.0)
+        .map(|r| 1.0 / r)
+        .filter(|_| start_not_touch(r).is_none());
     let f = |v: f32| v as f64;
     ImpactJson {
         index: r.index,
@@ -469,6 +497,7 @@ pub fn impact_json(
         start_sample: r.start_sample,
         end_sample: r.end_sample,
         start_s: t0 + r.start_s,
+        touch_uncertainty_s,
         peak_time_s: t0 + r.peak_time_s,
         peak_acceleration_m_s2: f(r.peak_acceleration_m_s2),
         peak_force_n: r.peak_force_n.map(f),
@@ -488,7 +517,14 @@ pub fn impact_json(
         permanent_deformation_m: k.and_then(|k| k.permanent_deformation_m).map(f),
         absorbed_energy_j: k.and_then(|k| k.absorbed_energy_j).map(f),
         fits: fits_json(&r.fits),
-        null_reasons: null_reasons(r, fits),
+        null_reasons: {
+            let mut why = null_reasons(r, fits);
+            if touch_uncertainty_s.is_none() {
+                let reason = start_not_touch(r).unwrap_or("no-rate");
+                why.insert("touch_uncertainty_s".into(), reason.into());
+            }
+            why
+        },
         report_latency_s: None,
         shock_spectrum: r
             .spectrum

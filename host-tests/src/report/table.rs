@@ -188,23 +188,36 @@ pub fn to_table(a: &AnalysisJson) -> String {
                 a.spec.as_ref(),
             ));
         }
-        if let (Some(v0), Some(tm), Some(xm), Some(v1), Some(cor), Some(xs)) = (
-            i.impact_velocity_m_s,
-            i.crush_time_s,
-            i.max_deformation_m,
-            i.rebound_velocity_m_s,
-            i.cor,
-            i.separation_deformation_m,
-        ) {
+        if let (Some(v0), Some(v1), Some(cor)) =
+            (i.impact_velocity_m_s, i.rebound_velocity_m_s, i.cor)
+        {
+            // A field the kinematics left out says why (`undersampled`: the crush time and
+            // the deformations).
+            let or_why = |v: Option<f64>, unit: &str, field: &str| {
+                v.map_or_else(
+                    || {
+                        let why = i.null_reasons.get(field).map_or("absent", String::as_str);
+                        format!("none ({why})")
+                    },
+                    |v| human(v, unit),
+                )
+            };
+            let set = match (
+                i.permanent_deformation_m,
+                i.null_reasons.get("permanent_deformation_m"),
+            ) {
+                (Some(x), _) => human(x, "m"),
+                (None, Some(why)) if why == "undersampled" => format!("none ({why})"),
+                (None, _) => "not resolved".to_string(),
+            };
             s.push_str(&format!(
                 "    v0 {}, crush time {}, x_m {}, rebound {}, COR {cor:.4}, x at separation {}, set {}{}\n",
                 human(v0, "m/s"),
-                human(tm, "s"),
-                human(xm, "m"),
+                or_why(i.crush_time_s, "s", "crush_time_s"),
+                or_why(i.max_deformation_m, "m", "max_deformation_m"),
                 human(v1, "m/s"),
-                human(xs, "m"),
-                i.permanent_deformation_m
-                    .map_or("not resolved".to_string(), |x| human(x, "m")),
+                or_why(i.separation_deformation_m, "m", "separation_deformation_m"),
+                set,
                 i.absorbed_energy_j
                     .map_or(String::new(), |e| format!(", absorbed {}", human(e, "J")))
             ));

@@ -484,6 +484,7 @@ impl Session {
             0.0,
             &impact_core::FitSet::default(),
             self.contact_gravity_m_s2,
+            self.rate_hz.or(self.state_rate_hz),
         );
         let g = STANDARD_GRAVITY;
         let verdict = r.verdict.as_ref().map(|v| match v {
