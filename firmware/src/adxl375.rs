@@ -163,8 +163,8 @@ pub enum Axis {
     X,
     Y,
     Z,
-    /// `sqrt(x² + y² + z²)` (crash and drop practice: the trigger on |a| whatever the
-    /// direction of the hit).
+    /// `|f − f₀|` of the three axes each zeroed ([`Picker`]; crash and drop practice: the
+    /// trigger on |a| whatever the direction of the hit).
     Resultant,
 }
 
@@ -175,13 +175,53 @@ impl Axis {
         matches!(self, Axis::Resultant)
     }
 
-    /// The stream's sample of one three-axis sample.
+    /// The stream's sample of one three-axis sample, the resultant of the axes as they read
+    /// (not zeroed: [`Picker`] zeroes them).
     pub fn pick(self, [x, y, z]: Axes) -> i16 {
         match self {
             Axis::X => x,
             Axis::Y => y,
             Axis::Z => z,
             Axis::Resultant => resultant_counts(x, y, z),
+        }
+    }
+}
+
+/// Each axis's rails, counts: 13-bit two's complement.
+pub const AXIS_RAILS: (i16, i16) = (-4096, 4095);
+
+/// The resultant's clip level, counts: an axis at its rail puts the magnitude of the zeroed
+/// axes at least this high while its zero lies within 64 counts (3.1 g) of 0 toward that
+/// rail (at rest the zeros are gravity's 1 g, 20 counts, shared among the axes).
+pub const RESULTANT_CLIP: i16 = AXIS_RAILS.1 - 64;
+
+/// What the stream gets of each three-axis sample, with the state the resultant needs: the
+/// axes zeroed each on its own before their magnitude, `|f − f₀|` (as SAE J211 and ISO 6487
+/// zero every channel before a resultant: a 12.6 g pulse along x with gravity's 1 g on z
+/// had peaked 7.6 % low as `|f| − |f₀|`, the stream's baseline taking out the magnitude at
+/// rest), with the scene's edge level, settle time and free fall
+/// ([`impact_core::signal::axes_zero::AxesZero`], the host's `impact emulate --adxl375`'s
+/// too).
+pub struct Picker {
+    axis: Axis,
+    zero: impact_core::signal::axes_zero::AxesZero,
+}
+
+impl Picker {
+    /// `axis` of each sample, the axes zeroed with `settings` for the resultant
+    /// ([`impact_core::Scene::axes_zero`] with [`AXIS_RAILS`]).
+    pub fn new(axis: Axis, settings: impact_core::signal::axes_zero::Settings) -> Self {
+        Self {
+            axis,
+            zero: impact_core::signal::axes_zero::AxesZero::new(settings),
+        }
+    }
+
+    /// The stream's sample of one three-axis sample (the resultant learns from it).
+    pub fn pick(&mut self, sample: Axes) -> i16 {
+        match self.axis {
+            Axis::Resultant => self.zero.push(sample),
+            axis => axis.pick(sample),
         }
     }
 }

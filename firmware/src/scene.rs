@@ -29,15 +29,17 @@ const CALIBRATION: Calibration = Calibration {
     sample_rate_hz: crate::SAMPLE_RATE_HZ as f32,
 };
 /// ADXL375: 13-bit two's-complement output per axis (±200 g is about ±4082 counts); the
-/// stream is the resultant (never negative), which reaches 4095 whenever an axis is at its
-/// rail: `clipped` then means an axis may have clipped (conservative: a large hit spread over
-/// axes is marked too, none at a rail is missed).
+/// stream is the magnitude of the axes each zeroed (never negative), which reaches
+/// [`crate::adxl375::RESULTANT_CLIP`] (4031) whenever an axis is at its rail and its zero
+/// lies within 3.1 g of 0: `clipped` then means an axis may have clipped (conservative: a
+/// large hit spread over axes is marked too; an axis at its rail with its zero further than
+/// 3.1 g toward that rail, held for the settle time before the hit, is missed).
 /// One axis (`adxl375::AXIS`) has both rails, -4096 and 4095.
 #[cfg(feature = "adxl375")]
 const CLIP_COUNTS: (i16, i16) = if crate::adxl375::AXIS.is_resultant() {
-    (i16::MIN, 4095)
+    (i16::MIN, crate::adxl375::RESULTANT_CLIP)
 } else {
-    (-4096, 4095)
+    crate::adxl375::AXIS_RAILS
 };
 
 /// The seed bench's approach speed.

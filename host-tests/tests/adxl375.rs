@@ -392,7 +392,7 @@ fn the_resultant_of_three_axes_is_the_rounded_magnitude() {
         let r = s.magnitude();
         let e = exact(s);
         assert!((r as f64 - e).abs() <= 0.5, "{s:?}: {r} vs {e}");
-        // At a rail on any axis the resultant reaches the scene's clip level.
+        // At a rail on any axis the plain magnitude reaches 4095.
         if [s.x, s.y, s.z].iter().any(|v| *v >= 4095 || *v <= -4096) {
             assert!(r >= 4095);
         }
@@ -546,4 +546,46 @@ fn a_full_fifo_is_no_gap() {
         false_gaps * 20 < full,
         "{false_gaps} gaps of {full} polls that found the FIFO full and lost nothing"
     );
+}
+
+/// The board's resultant (`adxl375::Picker`) is the magnitude of the axes each zeroed: at
+/// rest under 1 g on z it reads about 0, not 20 counts; and an axis at either rail, its
+/// zero 20 counts (1 g) or 64 counts (3.1 g) off 0 toward that rail, reads at least
+/// `RESULTANT_CLIP`, the scene's clip level, so the impact is flagged clipped.
+#[test]
+fn the_zeroed_resultant_reaches_the_clip_level_at_any_rail() {
+    use adxl375::{Axis, Picker, AXIS_RAILS, RESULTANT_CLIP};
+    let mut scene = impact_core::Scene::new(
+        impact_core::signal::Calibration {
+            gain_m_s2_per_count: 0.049 * 9.80665,
+            sample_rate_hz: 3200.0,
+        },
+        10.0,
+    );
+    scene.edge_m_s2 = 2.0;
+    let settings = scene.axes_zero([AXIS_RAILS; 3]);
+    for axis in 0..3 {
+        for rail in [AXIS_RAILS.0, AXIS_RAILS.1] {
+            for lean in [20i16, 64] {
+                let mut rest = [0i16; 3];
+                rest[axis] = if rail > 0 { lean } else { -lean };
+                let mut picker = Picker::new(Axis::Resultant, settings);
+                // A second of rest (its noise one count) for the zeros to learn.
+                let mut at_rest = 0;
+                for k in 0..3200 {
+                    let mut s = rest;
+                    s[(axis + 1) % 3] += (k % 3) as i16 - 1;
+                    at_rest = picker.pick(s);
+                }
+                assert!(at_rest <= 2, "axis {axis}, rest {rest:?}: {at_rest}");
+                let mut hit = rest;
+                hit[axis] = rail;
+                let r = picker.pick(hit);
+                assert!(
+                    r >= RESULTANT_CLIP,
+                    "axis {axis} at {rail}, zero {rest:?}: {r} < {RESULTANT_CLIP}"
+                );
+            }
+        }
+    }
 }

@@ -140,6 +140,28 @@ pub struct Scene {
 }
 
 impl Scene {
+    /// The settings three axes are zeroed with in this scene
+    /// ([`crate::signal::axes_zero`]), each axis's rails `rails` (counts): the edge level
+    /// and settle time in the scene's counts and samples, free fall below a quarter of its
+    /// gravity for 10 ms (at least 8 samples: a pulse's zero crossing is quicker, a flight
+    /// between bounces longer). The board's ADXL375 source and `impact emulate --adxl375`
+    /// take these, so both zero alike.
+    pub fn axes_zero(&self, rails: [(i16, i16); 3]) -> crate::signal::axes_zero::Settings {
+        use crate::signal::axes_zero::{FreeFall, Settings};
+        let gain = f64::from(self.calibration.gain_m_s2_per_count);
+        let rate = f64::from(self.calibration.sample_rate_hz);
+        Settings {
+            edge_counts: (f64::from(self.edge_m_s2) / gain) as f32,
+            settle_samples: (f64::from(self.settle_s) * rate).clamp(0.0, f64::from(u32::MAX))
+                as u32,
+            free_fall: FreeFall {
+                below_counts: (0.25 * f64::from(self.gravity_m_s2) / gain) as f32,
+                samples: (0.01 * rate).clamp(8.0, f64::from(u32::MAX)) as u32,
+            },
+            rails,
+        }
+    }
+
     /// A scene with the usual defaults: trigger at `trigger_m_s2`, edges at a quarter of it,
     /// 1 ms hold, 50 ms to settle at a new level, 1 s maximum impact, full i16 rails, no
     /// filter, no fits.

@@ -6,7 +6,7 @@
 
 use defmt::{warn, Format};
 use embassy_time::{Duration, Instant, Ticker};
-use impact_firmware::adxl375::{Axes, Axis};
+use impact_firmware::adxl375::{Axes, Picker};
 
 use crate::source::sender::{BlockSender, SOURCE_STATS};
 use impact_firmware::fifo::LossCounter;
@@ -50,12 +50,13 @@ pub trait Fifo {
     async fn read(&mut self, out: &mut [Axes; MAX_ENTRIES]) -> Result<Read, Poll<Self::Error>>;
 }
 
-/// Polls `fifo` every [`POLL_PERIOD`] until it ends; the sensor started producing at
-/// `started` at `rate_hz`. Returns when the FIFO says no more samples will come.
+/// Polls `fifo` every [`POLL_PERIOD`] until it ends, each sample `picker`'s (the resultant
+/// of the zeroed axes, or one axis); the sensor started producing at `started` at `rate_hz`.
+/// Returns when the FIFO says no more samples will come.
 pub async fn run<F: Fifo>(
     fifo: &mut F,
     sender: &mut BlockSender,
-    axis: Axis,
+    picker: &mut Picker,
     rate_hz: f32,
     started: Instant,
 ) {
@@ -87,9 +88,15 @@ pub async fn run<F: Fifo>(
         }
         let taken = entries.get(..read.samples).unwrap_or(&[]);
         if !taken.is_empty() {
+            // Picked before publishing: the resultant's zeros learn every sample the part
+            // gave, whether or not the queue has room for the block (the host's, every one).
+            let mut picked = [0i16; MAX_ENTRIES];
+            for (slot, &sample) in picked.iter_mut().zip(taken) {
+                *slot = picker.pick(sample);
+            }
             sender.publish(taken.len(), |block| {
-                for (slot, &sample) in block.iter_mut().zip(taken) {
-                    *slot = axis.pick(sample);
+                for (slot, &v) in block.iter_mut().zip(&picked) {
+                    *slot = v;
                 }
             });
         }

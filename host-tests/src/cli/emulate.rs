@@ -188,16 +188,17 @@ pub const ADXL375_GAIN_M_S2: f32 = 0.049 * impact_core::consts::STANDARD_GRAVITY
 pub const ADXL375_RATES_HZ: [f64; 6] = [3200.0, 1600.0, 800.0, 400.0, 200.0, 100.0];
 
 /// One axis's range on the ADXL375: 13-bit two's complement, counts.
-const ADXL375_AXIS_COUNTS: (i16, i16) = (-4096, 4095);
+const ADXL375_AXIS_COUNTS: (i16, i16) = impact_firmware::adxl375::AXIS_RAILS;
 
-/// The resultant's rail on the board (the firmware's `CLIP_COUNTS` with the ADXL375): it
-/// reaches 4095 counts whenever an axis is at its rail.
-const ADXL375_CLIP_COUNTS: (i16, i16) = (i16::MIN, 4095);
+/// The resultant's rail on the board (the firmware's `CLIP_COUNTS` with the ADXL375, its
+/// `RESULTANT_CLIP`): the magnitude of the zeroed axes reaches 4031 counts whenever an axis
+/// is at its rail and its zero lies within 64 counts (3.1 g) of 0.
+const ADXL375_CLIP_COUNTS: (i16, i16) = (i16::MIN, impact_firmware::adxl375::RESULTANT_CLIP);
 
 /// Turns a prepared recording into what an ADXL375 would give: each axis (`setup.axes`, or
 /// the channel as x) in the part's counts, and the setup changed to the board's ADXL375 scene
-/// (scale, rails) with what the board streams as its counts: the resultant of the axes, or
-/// the one channel's axis.
+/// (scale, rails) with what the board streams as its counts: the magnitude of the axes each
+/// zeroed, or the one channel's axis.
 pub fn adxl375_axes(setup: &mut pipeline::Setup) -> Result<Vec<[i16; 3]>, EmulateError> {
     let rate = setup.rate_hz;
     if !ADXL375_RATES_HZ
@@ -229,18 +230,17 @@ pub fn adxl375_axes(setup: &mut pipeline::Setup) -> Result<Vec<[i16; 3]>, Emulat
         })
         .collect();
     let one_axis = setup.axes.is_empty();
-    setup.prepared.counts = axes
-        .iter()
-        .map(|&[x, y, z]| {
-            if one_axis {
-                x
-            } else {
-                impact_core::signal::resultant::resultant_counts(x, y, z)
-            }
-        })
-        .collect();
     setup.scene.calibration.gain_m_s2_per_count = ADXL375_GAIN_M_S2;
     setup.prepared.calibration.gain_m_s2_per_count = ADXL375_GAIN_M_S2;
+    // The board's resultant: the axes each zeroed as the scene says, as they come (no look
+    // ahead), then their magnitude (the firmware's `adxl375::Picker`).
+    let mut zero = impact_core::signal::axes_zero::AxesZero::new(
+        setup.scene.axes_zero([ADXL375_AXIS_COUNTS; 3]),
+    );
+    setup.prepared.counts = axes
+        .iter()
+        .map(|&s| if one_axis { s[0] } else { zero.push(s) })
+        .collect();
     setup.scene.clip_counts = if one_axis {
         ADXL375_AXIS_COUNTS
     } else {
@@ -418,7 +418,10 @@ pub fn emulate(args: &EmulateArgs) -> Result<crate::report::spec::Judged, Emulat
         j.report_latency_s = latency.map(f64::from);
     }
     if let Some(every) = args.waveforms {
-        check_waveforms(&log, &replayed, every)?;
+        // The board's zeroed resultant learns its zeros from the samples it got: after a
+        // FIFO loss they follow other samples than the host's, and its values can differ.
+        let zeroed_after_loss = args.adxl375 && !a.axes.is_empty() && lost > 0;
+        check_waveforms(&log, &replayed, every, !zeroed_after_loss)?;
         json.waveforms = log.waveforms.iter().map(|w| w.json()).collect();
     }
     let mut out = crate::output::stdout();
@@ -486,6 +489,7 @@ pub fn check_waveforms(
     log: &crate::firmware_link::log::Log,
     replayed: &dyn Fn(u64, usize) -> Result<Vec<i16>, ReplayError>,
     every: u16,
+    compare_values: bool,
 ) -> Result<(), WaveformMismatch> {
     let analysed = log
         .impacts
@@ -525,6 +529,10 @@ pub fn check_waveforms(
         };
         let window = replayed(w.first_sample, w.samples as usize)
             .map_err(|_| WaveformMismatch::Beyond { index: w.index })?;
+        if !compare_values {
+            frames += w.frames;
+            continue;
+        }
         let window = window.as_slice();
         let mut expected = [0i16; impact_core::waveform::FRAME_LEN];
         for k in 0..w.frames as usize {
@@ -551,10 +559,18 @@ pub fn check_waveforms(
     } else {
         String::new()
     };
-    crate::errln!(
-        "waveforms: {} windows, {frames} frames, equal to the replayed samples{coarse}",
-        log.waveforms.len()
-    );
+    if compare_values {
+        crate::errln!(
+            "waveforms: {} windows, {frames} frames, equal to the replayed samples{coarse}",
+            log.waveforms.len()
+        );
+    } else {
+        crate::errln!(
+            "waveforms: {} windows, {frames} frames, their values not compared: the ADXL375 \
+             lost samples, and the board's zeros learned without them",
+            log.waveforms.len()
+        );
+    }
     Ok(())
 }
 

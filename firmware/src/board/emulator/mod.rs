@@ -22,7 +22,7 @@ use impact_core::Scene;
 use static_cell::ConstStaticCell;
 
 use crate::tasks::stream::Backpressure;
-use impact_firmware::adxl375::Axis;
+use impact_firmware::adxl375::{Axis, Picker};
 use impact_firmware::reset_record::{Cause, Record};
 use impact_firmware::scene::{BandTableError, SceneError};
 use impact_firmware::semihosting as host;
@@ -321,6 +321,14 @@ pub fn init(previous: Option<Record>) -> Setup {
 pub fn spawn_sources(setup: Setup, high: SendSpawner, samples: crate::queues::SampleSender) {
     let c = &setup.config;
     let rate = c.scene.calibration.sample_rate_hz;
+    // The ADXL375's axes zeroed as the scene says (the host's `emulate --adxl375` too): one
+    // picker, whichever source runs (in a static: two tasks' futures holding one each did
+    // not fit the emulator's RAM).
+    static PICKER: static_cell::StaticCell<Picker> = static_cell::StaticCell::new();
+    let picker = c.adxl375.then(|| {
+        let zero = c.scene.axes_zero([impact_firmware::adxl375::AXIS_RAILS; 3]);
+        &mut *PICKER.init(Picker::new(c.axis, zero))
+    });
     let file = match super::replay::open(c.samples_path, rate, c.adxl375) {
         Ok(file) => file,
         Err(e) => {
@@ -334,11 +342,11 @@ pub fn spawn_sources(setup: Setup, high: SendSpawner, samples: crate::queues::Sa
                 "replay: real time, {=f32} x the recording's rate",
                 c.rate_scale
             );
-            if c.adxl375 {
+            if let Some(picker) = picker {
                 high.spawn(unwrap!(super::replay::adxl375(
                     file,
                     rate * c.rate_scale,
-                    c.axis,
+                    picker,
                     c.stall,
                     samples
                 )));
@@ -353,8 +361,7 @@ pub fn spawn_sources(setup: Setup, high: SendSpawner, samples: crate::queues::Sa
         }
         Pacing::Lossless => {
             info!("replay: lossless");
-            let axes = c.adxl375.then_some(c.axis);
-            high.spawn(unwrap!(super::replay::lossless(file, axes, samples)));
+            high.spawn(unwrap!(super::replay::lossless(file, picker, samples)));
         }
     }
 }

@@ -25,7 +25,7 @@ use super::dma::{self, Take};
 use crate::queues::{SampleSender, StreamEnd, BLOCK_LEN};
 use crate::source::poll;
 use crate::source::sender::{BlockSender, SAMPLE_CLOCK, SOURCE_STATS};
-use impact_firmware::adxl375::Axis;
+use impact_firmware::adxl375::Picker;
 use impact_firmware::semihosting::{HostError, HostFile};
 
 /// Bytes per sample in the file: one axis, or three (the ADXL375 path).
@@ -71,10 +71,10 @@ pub fn open(path: &str, rate_hz: f32, axes: bool) -> Result<HostFile, ReplayErro
 }
 
 /// Replays the file block by block (with `axes`, three-axis samples, of which the axis
-/// given goes to the stream),
+/// given goes to the stream, the resultant of the axes zeroed with the settings given),
 /// waiting for room in the queue, then ends the stream.
 #[embassy_executor::task]
-pub async fn lossless(file: HostFile, axes: Option<Axis>, samples: SampleSender) {
+pub async fn lossless(file: HostFile, axes: Option<&'static mut Picker>, samples: SampleSender) {
     let mut sender = BlockSender::new(samples);
     let end = match replay_all(&mut sender, file, axes).await {
         Ok(()) => StreamEnd::Complete,
@@ -90,10 +90,9 @@ pub async fn lossless(file: HostFile, axes: Option<Axis>, samples: SampleSender)
 async fn replay_all(
     sender: &mut BlockSender,
     mut file: HostFile,
-    axes: Option<Axis>,
+    mut picker: Option<&'static mut Picker>,
 ) -> Result<(), ReplayError> {
-    let width = sample_bytes(axes.is_some());
-    let axis = axes.unwrap_or(Axis::Resultant);
+    let width = sample_bytes(picker.is_some());
     let mut raw = [0u8; BLOCK_LEN * 6];
     let raw = raw.get_mut(..BLOCK_LEN * width).unwrap_or(&mut []);
     loop {
@@ -111,11 +110,13 @@ async fn replay_all(
                 for (sample, le) in block.iter_mut().zip(bytes.chunks_exact(width)) {
                     *sample = match *le {
                         [lo, hi] => i16::from_le_bytes([lo, hi]),
-                        [x0, x1, y0, y1, z0, z1] => axis.pick([
-                            i16::from_le_bytes([x0, x1]),
-                            i16::from_le_bytes([y0, y1]),
-                            i16::from_le_bytes([z0, z1]),
-                        ]),
+                        [x0, x1, y0, y1, z0, z1] => picker.as_mut().map_or(0, |p| {
+                            p.pick([
+                                i16::from_le_bytes([x0, x1]),
+                                i16::from_le_bytes([y0, y1]),
+                                i16::from_le_bytes([z0, z1]),
+                            ])
+                        }),
                         _ => 0,
                     };
                 }
@@ -135,7 +136,7 @@ async fn replay_all(
 pub async fn adxl375(
     file: HostFile,
     rate_hz: f32,
-    axis: Axis,
+    picker: &'static mut Picker,
     stall: Option<(u32, u32)>,
     samples: SampleSender,
 ) {
@@ -144,7 +145,7 @@ pub async fn adxl375(
     let started = Instant::now();
     adxl375::start(file, f64::from(rate_hz));
     let mut part = adxl375::EmulatedAdxl375 { stall, polls: 0 };
-    poll::run(&mut part, &mut sender, axis, rate_hz, started).await;
+    poll::run(&mut part, &mut sender, picker, rate_hz, started).await;
     let (produced, overwritten) = adxl375::counts();
     info!(
         "emulated ADXL375: {} samples produced, {} overwritten unread",

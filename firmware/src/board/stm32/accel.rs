@@ -135,10 +135,13 @@ pub async fn sampler(mut sensor: Sensor, samples: crate::queues::SampleSender) {
         DATA_RATE.hz(),
         POLL_PERIOD.as_millis()
     );
+    // The axes zeroed as the bench's scene says.
+    let zero = impact_firmware::scene::BENCH.axes_zero([impact_firmware::adxl375::AXIS_RAILS; 3]);
+    let mut picker = impact_firmware::adxl375::Picker::new(AXIS, zero);
     poll::run(
         &mut sensor,
         &mut sender,
-        AXIS,
+        &mut picker,
         SAMPLE_RATE_HZ as f32,
         started,
     )
