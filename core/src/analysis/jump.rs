@@ -19,6 +19,12 @@
 //! `δa / (k v0 dt / m)` samples (0.09 per m/s² for that drop at 20 kS/s), which the
 //! residual cannot see.
 //!
+//! The same holds where the onset's first samples lay on a line whose zero falls in the
+//! interval (a jump onto a ramp, smaller than a sample's rise, reads as a ramp that began
+//! earlier: Kelvin–Voigt at 20 kS/s had touch 0.7 samples early): the frame's touch is then
+//! that zero, `s` is counted from it, the jump's force the sums missed (`missed`) from the
+//! middle, where the sums begin; where the fit does not hold, the line's zero stands.
+//!
 //! In the sums' units (time in samples from the integration's start, velocity `w = v / kv`
 //! in units of `C`, deformation `y = x / (kv dt)`), with `V_j = C_j + d_j / 2` the velocity
 //! lost by sample `j`'s instant and `Π_j` the deformation lost (its integral):
@@ -49,7 +55,7 @@ use crate::signal::baseline::Deviation;
 /// velocity and smooth in the deformation lies on it within its samples' noise (a
 /// Kelvin–Voigt pad, quantised: 4e-5 of its mean force at 20 kS/s); a Hertz foot with a damper
 /// (its `x^1.5` at touch) lies 1.3 times this and more off, or gives a shift beyond the
-/// interval, and the middle stands.
+/// interval, and the frame's touch (the middle, or a steep line's zero) stands.
 pub const JUMP_RESIDUAL: f64 = 1e-3;
 
 /// ADC counts of RMS noise the fit's residual may hold beyond [`JUMP_RESIDUAL`] (a small
@@ -59,13 +65,17 @@ pub const JUMP_COUNTS: f64 = 1.0;
 /// Fewest compression samples the fit needs (four unknowns and their noise).
 pub const JUMP_MIN_SAMPLES: usize = 8;
 
-/// Touch placed in the jump's interval: `s` samples earlier than its middle (`-0.5..=0.5`);
-/// `h` the force at touch (the reading's, units of `d`), `lost` the body's deceleration
-/// then (`h` less gravity's shift) and `d_crush` the crush's sample's deviation (units of
-/// `d`, gravity's shift taken off).
+/// Touch placed in the jump's interval: `s` samples earlier than the frame's (its middle,
+/// `-0.5..=0.5`, where the stream took a jump; a steep line's zero, where the onset's first
+/// samples lay on a line, which a jump onto a ramp gives too); `missed` the samples of the
+/// jump's force before the sums' first interval (`s` from the middle: the sums start half a
+/// sample before the onset); `h` the force at touch (the reading's, units of `d`), `lost`
+/// the body's deceleration then (`h` less gravity's shift) and `d_crush` the crush's
+/// sample's deviation (units of `d`, gravity's shift taken off).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Shift {
     pub s: f64,
+    pub missed: f64,
     pub h: f64,
     pub lost: f64,
     pub d_crush: f64,
@@ -84,6 +94,11 @@ pub fn shift(
     found: &Found,
 ) -> Option<Shift> {
     let scale = &frame.scale;
+    // (Touch in the interval before the onset: the integration starts at the onset. A
+    // steep line's zero at -1 exactly would start it at the quiet sample before.)
+    if frame.lead != 0 {
+        return None;
+    }
     // (The crush's sample: the one whose interval holds the crush.)
     let n = libm::floor(found.crush + 0.5);
     let held = JUMP_MIN_SAMPLES as f64..=JUMP_MAX_SAMPLES as f64;
@@ -100,7 +115,14 @@ pub fn shift(
     // iteration, secant steps from σ = 0 and σ = 1, and where the slope lies near 1 every
     // σ fits about alike and the samples cannot tell `s` ([`JUMP_SLOPE`]).
     let y_lead = scale.x_lead / (scale.kv * scale.dt);
-    let at = |sigma: f64, l: f64| fitted(compression, dev, (w0, y_lead), g, l * sigma);
+    // Where the frame's touch lies past the interval's middle, samples (0 for a jump's
+    // middle; a steep line's zero anywhere in the interval): the jump's force from a touch
+    // σ earlier is missed by the sums for σ less that.
+    let past_middle = frame.touch - (f64::from(frame.lead) - 0.5);
+    let at = |sigma: f64, l: f64| {
+        let tilt = l * (sigma - past_middle);
+        fitted(compression, dev, (w0, y_lead), g, (tilt, past_middle))
+    };
     let first = at(0.0, 0.0)?;
     let l = first.lost;
     let mut lo = (0.0, first.s);
@@ -126,13 +148,16 @@ pub fn shift(
     }
     // (Beyond the interval by more than the fit's own scatter: not this law.)
     let holds = placed.fits
-        && estimate.abs() <= 1.0
+        && (estimate - past_middle).abs() <= 1.0
         && residual(compression, dev, w0, placed.tilt, &placed.b)
             <= JUMP_RESIDUAL + JUMP_COUNTS * scale.count * n / w0;
     // (The secant's estimate, not the last fit's `f(σ)`: that carries the slope times σ's
     // distance from the root, and the f32 sums' jitter where the steps did not settle.)
-    holds.then(|| Shift {
-        s: estimate.clamp(-0.5, 0.5),
+    // (max/min, not clamp: clamp asserts its bounds are ordered.)
+    let s = estimate.max(past_middle - 0.5).min(past_middle + 0.5);
+    holds.then_some(Shift {
+        s,
+        missed: s - past_middle,
         h: placed.h,
         lost: placed.lost,
         d_crush,
@@ -178,17 +203,19 @@ fn fitted(
     dev: Deviation,
     (w0, y_lead): (f64, f64),
     g: f64,
-    tilt: f64,
+    (tilt, past): (f64, f64),
 ) -> Option<Fitted> {
     let Line { k, k2, cw, b0, b } = line(samples, dev, w0, tilt)?;
     let h = cw * w0;
     let lost = h - g;
     let lever = k * (w0 - lost / 2.0) - cw * lost;
     let a = y_lead + w0 / 2.0;
-    let base = b0 - k * a - cw * w0 + g;
+    // (The jump's force the sums missed is `s - past` samples' of it: `past` how far the
+    // frame's touch lies past the interval's middle, 0 for the middle.)
+    let base = b0 - k * a - cw * w0 + g - past * lost * (k / 2.0 + cw);
     let mut s = base / lever;
     for _ in 0..3 {
-        let c0 = a + s * (w0 - lost / 2.0);
+        let c0 = a + s * (w0 - lost / 2.0) + past * lost / 2.0;
         s = (base + k2 * c0 * c0) / lever;
     }
     // (`lever`, how far a shift moves the intercept, may take either sign: the deformation
@@ -309,24 +336,28 @@ impl Shift {
         let d_crush = self.d_crush;
         found.x_max += self.at(frame, found.crush).0;
         found.x_sep += self.at(frame, frame.separation).0;
-        // The velocity reached zero `lost s / d_crush` samples earlier (no further than the
-        // shift itself: a crush's sample that reads less than the force at touch is noise).
+        // The velocity reached zero `lost missed / d_crush` samples earlier (no further than
+        // the missed stretch itself: a crush's sample that reads less than the force at
+        // touch is noise).
         if d_crush > 0.0 {
             // (max/min, not clamp: clamp asserts its bounds are ordered.)
-            let half = libm::fabs(self.s);
-            found.crush -= (self.lost * self.s / d_crush).max(-half).min(half);
+            let half = libm::fabs(self.missed);
+            found.crush -= (self.lost * self.missed / d_crush).max(-half).min(half);
         }
         frame.touch -= self.s;
-        frame.scale.kv * self.h * self.s
+        frame.scale.kv * self.h * self.missed
     }
 
     /// The shift's change of the deformation (m) and the velocity (m/s) at time `t`
     /// (samples from the integration's start): the deformation was short by
-    /// `s dt (v0 - kv l (t + ½))`, the velocity high by `kv l s` (`l`: [`Self::lost`]).
+    /// `dt (s v0 - missed kv l (t + ½))`, the velocity high by `kv l missed` (`l`:
+    /// [`Self::lost`]).
     pub fn at(&self, frame: &Frame, t: f64) -> (f64, f64) {
         let scale = &frame.scale;
-        let x = self.s * scale.dt * (scale.v0 - scale.kv * self.lost * (t + 0.5));
-        (x, -scale.kv * self.lost * self.s)
+        let lost = scale.kv * self.lost * (t + 0.5);
+        // (Written so that a jump's middle, `missed == s`, gives the bits it gave.)
+        let x = self.s * scale.dt * (scale.v0 - lost) + (self.s - self.missed) * scale.dt * lost;
+        (x, -scale.kv * self.lost * self.missed)
     }
 }
 

@@ -63,10 +63,11 @@ pub struct Summary {
     /// zero force (its foot fitted as a power curve on a captured impact,
     /// [`crate::signal::power_flank`], else a straight line), or the edge crossing.
     pub touch_offset: f32,
-    /// First touch is the middle of the interval before a force that jumped there from zero
-    /// (a damper's `c v0`, [`crate::signal::power_flank::steep_zero`]): the samples cannot
-    /// tell where in that interval it lies; the analysis places it from the contact's law
-    /// where it can ([`crate::analysis::jump`]).
+    /// First touch lies in the interval before a force that may have jumped there from zero
+    /// (a damper's `c v0`, [`crate::signal::power_flank::steep_zero`]): at its middle, or at
+    /// the zero of the onset's line (a jump onto a ramp, smaller than a sample's rise, lies
+    /// on one); the samples cannot tell where in that interval it lies; the analysis places
+    /// it from the contact's law where it can ([`crate::analysis::jump`]).
     pub touch_jump: bool,
     /// Stream index of the first sample back within the edge level after the peak, if any.
     pub separation_index: Option<u64>,

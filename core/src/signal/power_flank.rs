@@ -177,7 +177,8 @@ pub fn steep_zero(y: [f32; 3]) -> f32 {
 /// Where [`steep_zero`] puts a jump's touch: the middle of the interval before it.
 pub const JUMP_MIDDLE: f32 = -0.5;
 
-/// [`steep_zero`]'s line's zero, `None` where it takes the middle of the interval (a jump).
+/// [`steep_zero`]'s line's zero, `None` where it takes the middle of the interval (a jump;
+/// a zero it gives may be a jump's too, onto a ramp: the stream's caller says so).
 pub fn steep_line_zero(y: [f32; 3]) -> Option<f32> {
     head_line(y)
         .map(|(zero, _)| zero)
