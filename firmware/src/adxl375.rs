@@ -24,7 +24,6 @@
 
 use embedded_hal_async::delay::DelayNs;
 use embedded_hal_async::spi::{Operation, SpiDevice};
-use impact_core::signal::resultant::resultant_counts;
 
 /// Register addresses (ADXL375 data sheet, Table 14).
 pub mod reg {
@@ -174,17 +173,6 @@ impl Axis {
     pub const fn is_resultant(self) -> bool {
         matches!(self, Axis::Resultant)
     }
-
-    /// The stream's sample of one three-axis sample, the resultant of the axes as they read
-    /// (not zeroed: [`Picker`] zeroes them).
-    pub fn pick(self, [x, y, z]: Axes) -> i16 {
-        match self {
-            Axis::X => x,
-            Axis::Y => y,
-            Axis::Z => z,
-            Axis::Resultant => resultant_counts(x, y, z),
-        }
-    }
 }
 
 /// Each axis's rails, counts: 13-bit two's complement.
@@ -219,9 +207,12 @@ impl Picker {
 
     /// The stream's sample of one three-axis sample (the resultant learns from it).
     pub fn pick(&mut self, sample: Axes) -> i16 {
+        let [x, y, z] = sample;
         match self.axis {
+            Axis::X => x,
+            Axis::Y => y,
+            Axis::Z => z,
             Axis::Resultant => self.zero.push(sample),
-            axis => axis.pick(sample),
         }
     }
 }

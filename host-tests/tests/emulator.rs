@@ -1056,28 +1056,24 @@ fn realtime_spectra_and_a_bounce_train_to_10_ms_flights_lose_nothing() {
     within_board_limits(&log);
 }
 
-/// A three-axis recording at the ADXL375's 3200 S/s: `n` seed-bench impacts `every` s apart
-/// from 0.1 s on, the pulse along the unit vector (0.6, 0.48, 0.64); returns the CSV's path.
-fn adxl375_train(scratch: &Scratch, n: usize, every: f64) -> String {
+/// `impact synth`'s CSV (one column, in g) of `n` seed-bench impacts `every` s apart from
+/// 0.1 s on at the ADXL375's 3200 S/s.
+fn seed_train_at_3200(n: usize, every: f64) -> String {
     let (n_s, every_s) = (n.to_string(), every.to_string());
     let duration = (0.1 + n as f64 * every).to_string();
     let args: Vec<&str> = ["synth"]
         .into_iter()
         .chain(impact_host::synth::SEED_BENCH_ARGS)
-        .chain([
-            "--rate",
-            "3200",
-            "--touch",
-            "0.1",
-            "--impacts",
-            &n_s,
-            "--every",
-            &every_s,
-            "--duration",
-            &duration,
-        ])
+        .chain(["--rate", "3200", "--touch", "0.1", "--impacts", &n_s])
+        .chain(["--every", &every_s, "--duration", &duration])
         .collect();
-    let (csv, _) = impact(&args);
+    impact(&args).0
+}
+
+/// A three-axis recording at the ADXL375's 3200 S/s: `n` seed-bench impacts `every` s apart
+/// from 0.1 s on, the pulse along the unit vector (0.6, 0.48, 0.64); returns the CSV's path.
+fn adxl375_train(scratch: &Scratch, n: usize, every: f64) -> String {
+    let csv = seed_train_at_3200(n, every);
     let mut out = String::from("time_s,x_g,y_g,z_g\n");
     for line in csv.lines().skip(1) {
         let (t, a) = line.split_once(',').unwrap();
@@ -1185,13 +1181,7 @@ fn the_adxl375_resultant_zeroes_each_axis_before_the_magnitude() {
     let scratch = Scratch::new();
     let Some(elf) = firmware() else { return };
     let elf = elf.to_string_lossy().into_owned();
-    let args: Vec<&str> = ["synth"]
-        .into_iter()
-        .chain(impact_host::synth::SEED_BENCH_ARGS)
-        .chain(["--rate", "3200", "--touch", "0.1", "--impacts", "3"])
-        .chain(["--every", "0.3", "--duration", "1.0"])
-        .collect();
-    let (csv, _) = impact(&args);
+    let csv = seed_train_at_3200(3, 0.3);
     // (The synth's column is in g, its rest at the sensor's offset: the pulse's peak is the
     // largest reading less the first.)
     let g: Vec<f64> = csv

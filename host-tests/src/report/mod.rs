@@ -461,14 +461,10 @@ pub fn null_reasons(r: &ImpactReport, fits: &FitSet) -> BTreeMap<String, String>
 
 /// Why `start_s` is no first touch, if it is none: the flag that says so.
 fn start_not_touch(r: &ImpactReport) -> Option<&'static str> {
-    [
-        (Flags::CUT_AT_START, "cut-at-start"),
-        (Flags::IN_PREVIOUS, "in-previous"),
-        (Flags::DRIFT, "drift"),
-    ]
-    .into_iter()
-    .find(|(f, _)| r.flags.contains(*f))
-    .map(|(_, name)| name)
+    [Flags::CUT_AT_START, Flags::IN_PREVIOUS, Flags::DRIFT]
+        .into_iter()
+        .find(|f| r.flags.contains(*f))
+        .and_then(|f| f.names().next())
 }
 
 /// A core report as JSON; times shifted by `t0` (the recording's first time stamp); `fits`
