@@ -95,6 +95,7 @@ pub const BENCH: Scene = Scene {
     spec: None,
     // The captured windows stay on the board (`wave=1` in the emulator sends them).
     waveform_every: 0,
+    target: None,
 };
 
 /// Why [`band_table`] gave no table.
@@ -282,6 +283,26 @@ pub fn apply(scene: &mut Scene, key: &str, value: &str) -> Result<(), SceneError
                 _ => sp.low_hz = float(value)?,
             }
             scene.spectrum = Some(sp);
+        }
+        "target_mass" => {
+            scene.target = opt_float(value)?.map(|mass_kg| impact_core::two_body::SpringMass {
+                mass_kg,
+                ..scene.target.unwrap_or(impact_core::two_body::SpringMass {
+                    mass_kg,
+                    stiffness_n_m: 0.0,
+                    damping_n_s_m: 0.0,
+                })
+            })
+        }
+        "target_stiffness" | "target_damping" => {
+            let mut t = scene.target.ok_or(SceneError::BadValue)?;
+            let v = float(value)?;
+            if key == "target_stiffness" {
+                t.stiffness_n_m = v;
+            } else {
+                t.damping_n_s_m = v;
+            }
+            scene.target = Some(t);
         }
         "gravity" => scene.gravity_m_s2 = float(value)?,
         "vertical" => scene.vertical = flag(value)?,

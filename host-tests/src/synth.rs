@@ -282,6 +282,17 @@ pub struct SynthArgs {
         conflicts_with = "impacts"
     )]
     pub bounces: u32,
+    /// The body strikes a target on a spring and damper to ground, not a wall: its mass, kg
+    /// (one strike at --v0, horizontal or --vertical; the recording is the body's reading,
+    /// `F / m`).
+    #[arg(long, help_heading = "Target", conflicts_with_all = ["drop_height", "bounces", "impacts"])]
+    pub target_mass: Option<f64>,
+    /// The target's spring to ground, N/m [default: 0, a free body].
+    #[arg(long, help_heading = "Target", requires = "target_mass")]
+    pub target_stiffness: Option<f64>,
+    /// The target's damper to ground, N s/m [default: 0].
+    #[arg(long, help_heading = "Target", requires = "target_mass")]
+    pub target_damping: Option<f64>,
 }
 
 /// `impact synth` arguments of the seed-001 bench impact (60 g at 1.3357 m/s into the
@@ -395,6 +406,18 @@ pub fn synth(args: &SynthArgs) -> Result<Recording, SynthError> {
     if args.bounces == 0 || args.bounces > 10_000 {
         return invalid("--bounces", "lie in 1..=10000");
     }
+    if let Some(strike) = args.strike(&model) {
+        let n = (args.duration * args.rate).ceil() as usize;
+        let (accel, truth) = strike.render(args.rate, n)?;
+        let (samples, clipped) = quantise(&sensor, &accel);
+        return Ok(Recording {
+            samples,
+            calibration: sensor.calibration(),
+            truth: vec![strike_outcome(&truth)],
+            clipped,
+            ended: None,
+        });
+    }
     if args.physical() {
         let n = (args.duration * args.rate).ceil() as usize;
         let rendered = bounce_drop(args, &model).render(args.rate, n)?;
@@ -434,6 +457,42 @@ impl SynthArgs {
     /// rest, or a vertical impact.
     pub fn physical(&self) -> bool {
         self.bounces > 1 || self.drop_height.is_some() || self.vertical
+    }
+}
+
+impl SynthArgs {
+    /// The strike on a target `--target-mass` asks for, if it does.
+    pub fn strike(&self, model: &impact_core::Model<f64>) -> Option<crate::drop::mounted::Strike> {
+        Some(crate::drop::mounted::Strike {
+            law: *model,
+            mass_kg: self.mass,
+            v0_m_s: self.v0_m_s(),
+            touch_s: self.touch,
+            gravity_m_s2: if self.vertical {
+                impact_core::consts::STANDARD_GRAVITY
+            } else {
+                0.0
+            },
+            mount: crate::drop::mounted::Mount {
+                mass_kg: self.target_mass?,
+                stiffness_n_m: self.target_stiffness.unwrap_or(0.0),
+                damping_n_s_m: self.target_damping.unwrap_or(0.0),
+            },
+        })
+    }
+}
+
+/// A strike's truth as a model outcome (relative to the target: Newton's COR, `δ`).
+fn strike_outcome(t: &crate::drop::mounted::StrikeTruth) -> ImpactOutcome<f64> {
+    ImpactOutcome {
+        max_deformation_m: t.max_deformation_m,
+        crush_time_s: t.crush_time_s,
+        contact_time_s: t.contact_time_s,
+        rebound_velocity_m_s: t.rebound_m_s,
+        cor: t.cor,
+        peak_force_n: t.peak_force_n,
+        permanent_deformation_m: t.separation_deformation_m,
+        rhs_evaluations: 0,
     }
 }
 

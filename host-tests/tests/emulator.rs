@@ -1937,3 +1937,94 @@ fn drops_and_trains_on_the_board_are_the_hosts_and_within_one_percent() {
         }
     }
 }
+
+/// A body striking a mounted target (`--target-mass`, its spring and damper): the board
+/// gets the target in its scene, states it on its scene line, and reports the contact's
+/// kinematics (Newton's COR, the relative crush and deformation, the contact's work) with
+/// the host's bits; both within 1 % of the strike generator's truth.
+#[test]
+fn the_contact_on_a_mounted_target_is_the_hosts_on_the_board() {
+    use impact_core::model::{Hertz, TwoPhase};
+    use impact_core::Model;
+    use impact_host::drop::mounted::{Mount, Strike};
+    let scratch = Scratch::new();
+    let Some(elf) = firmware() else { return };
+    let elf = elf.to_string_lossy().into_owned();
+    let rate = 500e3;
+    let mount = Mount {
+        mass_kg: 0.1,
+        stiffness_n_m: 1e6,
+        damping_n_s_m: 40.0,
+    };
+    let seed_pad = Model::TwoPhase(TwoPhase {
+        kc: 0.06 * (1.3357f64 / 0.0186).powi(2),
+        kr: 12376.0,
+        c: 2.0,
+        permanent_m: Some(0.0182),
+    });
+    for (name, law) in [
+        ("hertz", Model::Hertz(Hertz { k: 1e9 })),
+        ("two-phase", seed_pad),
+    ] {
+        let strike = Strike {
+            law,
+            mass_kg: 0.06,
+            v0_m_s: 1.3357,
+            touch_s: 0.0123 + 0.3 / rate,
+            mount,
+            gravity_m_s2: 0.0,
+        };
+        let n = ((strike.touch_s + 0.06) * rate) as usize;
+        let (accel, truth) = strike.render(rate, n).unwrap();
+        let range = 2.0 * truth.peak_force_n / 0.06;
+        let text = impact_host::testkit::sensor::csv_of(&accel, rate, range);
+        let file = scratch.text(&format!("strike-{name}.csv"), &text);
+        let range = format!("{range}");
+        let options = [
+            "--mass",
+            "0.06",
+            "--v0",
+            "1.3357",
+            "--range",
+            &range,
+            "--target-mass",
+            "0.1",
+            "--target-stiffness",
+            "1e6",
+            "--target-damping",
+            "40",
+        ];
+        // (The log alone cannot know the --range the host's clipping names.)
+        emulator_and_log_match_host(&file, &options, false);
+        let mut args = vec!["emulate", file.as_str(), "--json", "--elf", &elf];
+        args.extend(options);
+        let (out, log) = impact(&args);
+        let log_path = scratch.text(&format!("strike-{name}.log"), &log);
+        let (from_log, _) = impact(&["log", &log_path, "--json"]);
+        let from_log: serde_json::Value = serde_json::from_str(&from_log).unwrap();
+        assert!(
+            log.contains(
+                "target_mass_kg=0.1 target_stiffness_n_m=1000000.0 target_damping_n_s_m=40.0"
+            ),
+            "{name}: the scene line does not state the target\n{log}"
+        );
+        let v: serde_json::Value = serde_json::from_str(&out).unwrap();
+        assert_eq!(v["target"]["mass_kg"], 0.1, "{name}: {}", v["target"]);
+        // The log alone: the target from the scene line, the same impact, the same words.
+        for key in ["target", "impacts", "assumptions"] {
+            assert_eq!(from_log[key], v[key], "{name}: impact log's {key}");
+        }
+        let r = &v["impacts"][0];
+        for (field, want) in [
+            ("cor", truth.cor),
+            ("max_deformation_m", truth.max_deformation_m),
+            ("crush_time_s", truth.crush_time_s),
+        ] {
+            let got = r[field].as_f64().unwrap_or(f64::NAN);
+            assert!(
+                ((got - want) / want).abs() <= 0.01,
+                "{name}: {field} {got} vs true {want}"
+            );
+        }
+    }
+}

@@ -9,6 +9,7 @@ use crate::capture::Capture;
 #[cfg(feature = "fit")]
 pub mod jump;
 pub mod motion;
+pub mod target;
 
 use crate::report::motion::{motion_deviation, Frame};
 use crate::report::{self, Analysis, Flags, ImpactReport, Status};
@@ -365,7 +366,10 @@ pub fn analyse_by_pass<const CAP: usize>(
 }
 
 /// Everything but the spectra, for the capture's summary `s`. Not inlined: its frame is
-/// gone before the spectra's and the verdict's.
+/// gone before the spectra's and the verdict's. Against a target ([`Scene::target`]) the
+/// kinematics are the contact's ([`target`]) or none: where the capture cannot give them
+/// (it does not hold the whole contact), the impactor's own are no answer
+/// ([`Flags::KINEMATICS_NOT_HELD`]).
 #[inline(never)]
 fn analyse_kinematics<const CAP: usize>(
     capture: &Capture<CAP>,
@@ -373,7 +377,27 @@ fn analyse_kinematics<const CAP: usize>(
     scene: &Scene,
     work: &mut Workspace<CAP>,
 ) -> ImpactReport {
+    let mut relative = false;
     let mut r = report::streaming(s, scene);
+    analyse_contact(&mut r, capture, s, scene, work, &mut relative);
+    if scene.target.is_some() && !relative {
+        report::without_target_kinematics(&mut r);
+    }
+    r
+}
+
+/// [`analyse_kinematics`]' work; `relative` set where the kinematics were made the
+/// contact's against the scene's target (or found to have no stop there). Inlined: one
+/// frame, one report (the report is large: its spectrum).
+#[inline(always)]
+fn analyse_contact<const CAP: usize>(
+    r: &mut ImpactReport,
+    capture: &Capture<CAP>,
+    s: &crate::capture::Summary,
+    scene: &Scene,
+    work: &mut Workspace<CAP>,
+    relative: &mut bool,
+) {
     r.analysis = Analysis::Full;
     let samples = capture.samples();
     let n = samples.len();
@@ -448,11 +472,11 @@ fn analyse_kinematics<const CAP: usize>(
     let whole = s.status == Status::Complete && !(s.clipped || s.cut_at_start || s.in_previous);
     let resolves = |f: &Frame| step == 1 || f.separation - f.touch >= f64::from(RESOLVED_WIDTH);
     let Some(frame) = Frame::of(s, scene, Some(n)).filter(|f| whole && resolves(f)) else {
-        return r;
+        return;
     };
     let from_stream = s.motion.get().ok();
     let Some(onset) = s.onset_index.checked_sub(s.first_index).map(|o| o as usize) else {
-        return r;
+        return;
     };
     let motion = motion_deviation(s.base_sum, s.base_n, scene);
     let from_onset = samples.get(onset - frame.lead as usize..).unwrap_or(&[]);
@@ -466,7 +490,7 @@ fn analyse_kinematics<const CAP: usize>(
     let fit_len = contact.min(libm::ceil(frame.separation) as usize);
     let every = fit_len.div_ceil(MAX_FIT_POINTS).max(1);
     let points = match fit_mass {
-        Some(_) if r.kinematics.is_some() || from_stream.is_none() => {
+        Some(_) if r.kinematics.is_some() || from_stream.is_none() || scene.target.is_some() => {
             fit_len.div_ceil(every).min(work.buf.len() / 4)
         }
         _ => 0,
@@ -474,11 +498,12 @@ fn analyse_kinematics<const CAP: usize>(
     // (A jump's touch is placed from the pass's samples, fits or not.)
     // (The pass gives the kinematics where the stream's sums have none.)
     let jump = s.touch_jump
+        && scene.target.is_none()
         && step == 1
         && (r.kinematics.is_some() || from_stream.is_none())
         && cfg!(feature = "fit");
-    if points == 0 && from_stream.is_some() && !jump {
-        return r;
+    if points == 0 && from_stream.is_some() && !jump && scene.target.is_none() {
+        return;
     }
     let f_peak = libm::fabsf(peak_a) * fit_mass.unwrap_or(0.0);
     if points > 0 {
@@ -516,52 +541,73 @@ fn analyse_kinematics<const CAP: usize>(
     if let Some((crush, _)) = passed.as_mut().filter(|_| step > 1) {
         crush.beside = None;
     }
-    if from_stream.is_none() {
-        // The pass holds what the online sums lost.
-        let Some((crush, separation)) = passed else {
-            r.flags.insert(Flags::NO_STOP);
-            r.flags.remove(Flags::KINEMATICS_NOT_HELD);
-            return r;
-        };
-        r.flags.remove(Flags::NO_STOP);
-        r.flags.remove(Flags::KINEMATICS_NOT_HELD);
-        let found = frame.found(crush, separation);
-        // A force that steps at the crush: Δv takes the area the sums missed, as the
-        // stream's does where its sums found it (`s.motion` holds nothing here, so no step
-        // is counted twice).
-        if found.step_c != 0 {
-            r.flags.remove(Flags::AC_COUPLED);
-            r.delta_v_m_s = report::contact_delta_v(s, scene, found.step_c, &mut r.flags);
-        }
-        report::motion::kinematics(&mut r, scene, &frame, &found);
-    }
-    if r.kinematics.is_none() {
-        return r;
-    }
-    // The maximum deformation in f64, from whichever sums gave the kinematics.
-    let found = match from_stream {
-        Some(found) => Some(found),
-        None => passed.map(|(crush, separation)| frame.found(crush, separation)),
-    };
-    let (Some(mut found), Some(_)) = (found, passed) else {
-        return r;
-    };
-    // First touch in a jump's interval, from the contact's law: the kinematics and the fit
-    // points move with it.
-    #[cfg(feature = "fit")]
-    if jump {
-        let jump = Jump {
-            samples: from_onset,
-            motion,
-            frame: &frame,
-        };
-        let points = PointsOut {
+    // Against a target: the contact's kinematics from a pass of their own (the body's
+    // verdicts replaced), the fit points in the contact's frame.
+    let x_max = if let (Some(t), Some(m1)) = (scene.target, scene.mass_kg) {
+        *relative = true;
+        let out = (points > 0).then_some(PointsOut {
             x: &mut *deformation,
             v: &mut *velocity,
             every,
+        });
+        let dev = target::Deviations {
+            motion,
+            force: deviation,
         };
-        place_jump(&mut r, scene, s, jump, &mut found, points);
-    }
+        match target::contact(r, scene, &frame, from_onset, dev, &t, m1, out) {
+            Some(x_max) => x_max,
+            None => return,
+        }
+    } else {
+        if from_stream.is_none() {
+            // The pass holds what the online sums lost.
+            let Some((crush, separation)) = passed else {
+                r.flags.insert(Flags::NO_STOP);
+                r.flags.remove(Flags::KINEMATICS_NOT_HELD);
+                return;
+            };
+            r.flags.remove(Flags::NO_STOP);
+            r.flags.remove(Flags::KINEMATICS_NOT_HELD);
+            let found = frame.found(crush, separation);
+            // A force that steps at the crush: Δv takes the area the sums missed, as the
+            // stream's does where its sums found it (`s.motion` holds nothing here, so no step
+            // is counted twice).
+            if found.step_c != 0 {
+                r.flags.remove(Flags::AC_COUPLED);
+                r.delta_v_m_s = report::contact_delta_v(s, scene, found.step_c, &mut r.flags);
+            }
+            report::motion::kinematics(r, scene, &frame, &found);
+        }
+        if r.kinematics.is_none() {
+            return;
+        }
+        // The maximum deformation in f64, from whichever sums gave the kinematics.
+        let found = match from_stream {
+            Some(found) => Some(found),
+            None => passed.map(|(crush, separation)| frame.found(crush, separation)),
+        };
+        let (Some(mut found), Some(_)) = (found, passed) else {
+            return;
+        };
+        // First touch in a jump's interval, from the contact's law: the kinematics and the fit
+        // points move with it.
+        #[cfg(feature = "fit")]
+        if jump {
+            let jump = Jump {
+                samples: from_onset,
+                motion,
+                frame: &frame,
+            };
+            let points = PointsOut {
+                x: &mut *deformation,
+                v: &mut *velocity,
+                every,
+            };
+            place_jump(r, scene, s, jump, &mut found, points);
+        }
+
+        found.x_max
+    };
 
     #[cfg(feature = "fit")]
     // (Not where the compression is too short for `x_m`: [`Flags::UNDERSAMPLED`].)
@@ -572,7 +618,7 @@ fn analyse_kinematics<const CAP: usize>(
     ) {
         use crate::fit;
         // The points were integrated in metres: scale them by the maximum deformation.
-        let inv_x = (1.0 / found.x_max) as f32;
+        let inv_x = (1.0 / x_max) as f32;
         for x in deformation.iter_mut() {
             *x *= inv_x;
         }
@@ -598,5 +644,4 @@ fn analyse_kinematics<const CAP: usize>(
             k.permanent_deformation_m = pad_set;
         }
     }
-    r
 }

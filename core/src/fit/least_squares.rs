@@ -4,8 +4,10 @@ use super::sums::Sums;
 use super::{HertzFit, NonlinearFit, TwoPhaseFit};
 use crate::real::Real;
 
-/// `x^1.5` with the FPU's square root on the Cortex-M4 (`Real::sqrt`).
+/// `x^1.5` with the FPU's square root on the Cortex-M4 (`Real::sqrt`); 0 for a point a
+/// hair below zero (where an elastic contact lets go: the sums' own rounding).
 fn pow15(x: f32) -> f32 {
+    let x = x.max(0.0);
     x * <f32 as Real>::sqrt(x)
 }
 use crate::numeric::roots::brent_min;
@@ -253,7 +255,8 @@ pub fn nonlinear(p: &Points<'_>, n: Option<f32>, ln_x: &mut [f32]) -> Option<Non
             return None;
         }
         for (l, &x) in ln_x.iter_mut().zip(p.x) {
-            *l = libm::logf(x);
+            // (A point a hair below zero, where an elastic contact lets go: x^n = 0.)
+            *l = libm::logf(x.max(0.0));
         }
     }
     let ln = &ln_x[..ln_x.len().min(p.len())];

@@ -326,6 +326,20 @@ pub fn rebound_m_s(r: &ImpactReport, v0: f32, gravity_m_s2: Option<f32>) -> Opti
 /// The report of what the stream measured (`analysis` skipped): its fields and the
 /// kinematics its online sums found; the analysis fills in the rest.
 pub fn streaming(s: &Summary, scene: &Scene) -> ImpactReport {
+    streaming_as(s, scene, false)
+}
+
+/// The report of an impact whose analysis was skipped: [`streaming`]'s, less the
+/// kinematics against a target (the online sums are the impactor's, and only the analysis
+/// of a capture gives the contact's).
+pub fn skipped(s: &Summary, scene: &Scene) -> ImpactReport {
+    streaming_as(s, scene, true)
+}
+
+/// [`streaming`], or [`skipped`]'s. (One function, one report built in place: the report
+/// is large, and a second copy on the stream task's stack cost it 0.9 KiB.)
+#[inline(always)]
+fn streaming_as(s: &Summary, scene: &Scene, skipped: bool) -> ImpactReport {
     let mut r = measured(s, scene);
     // The kinematics from the stream's online sums, however long the contact.
     match s.motion.get() {
@@ -340,7 +354,27 @@ pub fn streaming(s: &Summary, scene: &Scene) -> ImpactReport {
         }
         Err(_) => {}
     }
+    if skipped && scene.target.is_some() {
+        without_target_kinematics(&mut r);
+    }
     r
+}
+
+/// Empties the kinematics and the fits of an impact on a target whose contact's kinematics
+/// could not be found ([`Flags::KINEMATICS_NOT_HELD`]: the impactor's own, against the
+/// rigid wall they assume, would be a plausible-looking wrong answer).
+pub fn without_target_kinematics(r: &mut ImpactReport) {
+    // The body's own verdicts on its kinematics (no stop, its COR out of range, too few
+    // samples) say nothing of the contact's: they give way to the one that does.
+    let body = [Flags::NO_STOP, Flags::COR_OUT_OF_RANGE, Flags::UNDERSAMPLED];
+    let tried = body.iter().any(|f| r.flags.contains(*f));
+    if r.kinematics.take().is_some() || tried {
+        r.flags.insert(Flags::KINEMATICS_NOT_HELD);
+    }
+    for f in body {
+        r.flags.remove(f);
+    }
+    r.fits = Fits::default();
 }
 
 /// The contact's Δv, m/s, with `step_c` added to its sums (a force that steps at the crush:

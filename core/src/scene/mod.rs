@@ -1,8 +1,8 @@
 //! What a bench is and which stages of the pipeline it needs; shared by host and firmware.
 
 use crate::consts::STANDARD_GRAVITY;
-use crate::error::positive;
 use crate::error::Error;
+use crate::error::{non_negative, positive};
 use crate::signal::cfc::Cfc;
 use crate::signal::lowpass::Lowpass;
 use crate::signal::spectrum::SpectrumSettings;
@@ -137,6 +137,11 @@ pub struct Scene {
     /// Send each captured window off the board after its analysis ([`crate::waveform`]):
     /// 0 not, 1 whole, `N` the mean of every `N` samples.
     pub waveform_every: u16,
+    /// The body struck a target on a spring and damper to ground, not a rigid wall
+    /// (the analysis's `target` pass): the COR, crush time, deformations and absorbed energy
+    /// are the contact's, relative to the target's measured-force response. `None`: a rigid,
+    /// fixed barrier.
+    pub target: Option<crate::two_body::SpringMass<f32>>,
 }
 
 impl Scene {
@@ -187,6 +192,7 @@ impl Scene {
             spectrum: None,
             spec: None,
             waveform_every: 0,
+            target: None,
         }
     }
 
@@ -252,6 +258,40 @@ impl Scene {
                 name: "gravity",
                 reason: "must be within the sensor's range (at most 32768 counts)",
             });
+        }
+        if let Some(t) = self.target {
+            positive(t.mass_kg, "target-mass")?;
+            non_negative(t.stiffness_n_m, "target-stiffness")?;
+            non_negative(t.damping_n_s_m, "target-damping")?;
+            if self.mass_kg.is_none() {
+                return Err(Error::InvalidParameter {
+                    name: "target-mass",
+                    reason: "needs the body's mass: the measured force (mass times the reading) drives the target",
+                });
+            }
+            if self.train.is_some() {
+                return Err(Error::InvalidParameter {
+                    name: "target-mass",
+                    reason: "cannot be given with a bounce train: each contact's kinematics assume the target at rest at first touch, and a bounce comes back to a target still moving",
+                });
+            }
+            // The target's velocity after the largest force the sensor can read, held for
+            // the longest pass, must be a finite f32 (at this rate; a decimated capture's
+            // coarser step gives less).
+            let dt = 1.0 / c.sample_rate_hz as f64;
+            let largest_force =
+                self.mass_kg.unwrap_or(0.0) as f64 * c.gain_m_s2_per_count.abs() as f64 * 65536.0;
+            // (The longest pass: the analysis's exact sums cover at most 2^17 samples.)
+            let steps = (1u32 << 17) as f64;
+            let finite = crate::two_body::step::Discrete::new(&t, dt).is_some_and(|d| {
+                d.largest_gain() as f64 * largest_force * steps <= f32::MAX as f64 / 1e3
+            });
+            if !finite {
+                return Err(Error::InvalidParameter {
+                    name: "target-mass",
+                    reason: "too light for the forces the sensor reads: the target's motion would overflow",
+                });
+            }
         }
         if let Some(t) = self.train {
             positive(t.max_flight_s, "max-flight")?;
@@ -369,5 +409,59 @@ impl Scene {
         } else {
             1
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::two_body::SpringMass;
+
+    fn with_target(mass_kg: f32, stiffness_n_m: f32) -> Scene {
+        let mut s = Scene::new(
+            Calibration {
+                gain_m_s2_per_count: 1.0,
+                sample_rate_hz: 500e3,
+            },
+            10.0,
+        );
+        s.mass_kg = Some(0.06);
+        s.target = Some(SpringMass {
+            mass_kg,
+            stiffness_n_m,
+            damping_n_s_m: 0.0,
+        });
+        s
+    }
+
+    #[test]
+    fn a_target_the_pass_cannot_step_in_f32_is_refused() {
+        assert_eq!(with_target(0.3, 4e4).validate(), Ok(()));
+        // So light that the largest force the sensor reads would overflow its velocity.
+        let err = with_target(1e-36, 0.0).validate();
+        assert!(
+            matches!(
+                err,
+                Err(Error::InvalidParameter {
+                    name: "target-mass",
+                    ..
+                })
+            ),
+            "{err:?}"
+        );
+        let err = with_target(0.3, -1.0).validate();
+        assert!(
+            matches!(
+                err,
+                Err(Error::InvalidParameter {
+                    name: "target-stiffness",
+                    ..
+                })
+            ),
+            "{err:?}"
+        );
+        let mut no_mass = with_target(0.3, 0.0);
+        no_mass.mass_kg = None;
+        assert!(no_mass.validate().is_err());
     }
 }

@@ -590,7 +590,7 @@ impl<const PRE: usize> Stream<PRE> {
             }
             _ => {
                 self.run.counters.analyses_skipped += 1;
-                sink.skipped(&report::streaming(&summary, &self.scene));
+                sink.skipped(&report::skipped(&summary, &self.scene));
             }
         }
     }

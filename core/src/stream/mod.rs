@@ -132,6 +132,7 @@ impl<const PRE: usize> Stream<PRE> {
                 spectrum: None,
                 spec: None,
                 waveform_every: 0,
+                target: None,
                 fits: FitSet {
                     two_phase: false,
                     nonlinear: false,

@@ -20,6 +20,7 @@ mod coupled;
 mod exact;
 pub mod free;
 pub mod matrix;
+pub mod step;
 
 pub use coupled::Sample;
 

@@ -130,6 +130,7 @@ fn scene() -> Scene {
             band: Some(&BAND),
         }),
         waveform_every: 1,
+        target: None,
     })
 }
 

@@ -502,7 +502,7 @@ pub fn log_scene(scene: &Scene) {
     };
     let band = spec.and_then(|s| s.band);
     info!(
-        "scene rate_hz={=f32} gain_m_s2_per_count={=f32} mass_kg={} v0_m_s={} drop_height_m={} trigger_m_s2={=f32} edge_m_s2={=f32} hold_s={=f32} max_impact_s={=f32} settle_s={=f32} clip_low={=i16} clip_high={=i16} cfc={} trigger_cfc={} lowpass_order={} lowpass_cutoff_hz={} two_phase={=bool} nonlinear={=bool} fit_exponent={=bool} exponent={=f32} hertz={=bool} train={=str} gravity_m_s2={} max_flight_s={} srs={=bool} wave_every={=u16} v0_every={=bool} spec={=str} spec_peak_m_s2={} spec_duration_s={} spec_band={} spec_outside={} spec_slack={} spec_dv={} spec_before={} spec_after={} spec_watch={} spec_rise={} spec_fall={} spec_band_u={} spec_band_lower={} spec_band_upper={}",
+        "scene rate_hz={=f32} gain_m_s2_per_count={=f32} mass_kg={} v0_m_s={} drop_height_m={} trigger_m_s2={=f32} edge_m_s2={=f32} hold_s={=f32} max_impact_s={=f32} settle_s={=f32} clip_low={=i16} clip_high={=i16} cfc={} trigger_cfc={} lowpass_order={} lowpass_cutoff_hz={} two_phase={=bool} nonlinear={=bool} fit_exponent={=bool} exponent={=f32} hertz={=bool} train={=str} gravity_m_s2={} max_flight_s={} srs={=bool} wave_every={=u16} v0_every={=bool} spec={=str} spec_peak_m_s2={} spec_duration_s={} spec_band={} spec_outside={} spec_slack={} spec_dv={} spec_before={} spec_after={} spec_watch={} spec_rise={} spec_fall={} spec_band_u={} spec_band_lower={} spec_band_upper={} target_mass_kg={} target_stiffness_n_m={} target_damping_n_s_m={}",
         scene.calibration.sample_rate_hz,
         scene.calibration.gain_m_s2_per_count,
         Opt(scene.mass_kg),
@@ -546,6 +546,10 @@ pub fn log_scene(scene: &Scene) {
         BandColumn(band, |p| p.u),
         BandColumn(band, |p| p.lower),
         BandColumn(band, |p| p.upper),
+        // The target the kinematics are relative to (`none`: a rigid, fixed barrier).
+        Opt(scene.target.map(|t| t.mass_kg)),
+        Opt(scene.target.map(|t| t.stiffness_n_m)),
+        Opt(scene.target.map(|t| t.damping_n_s_m)),
     );
 }
 

@@ -149,6 +149,7 @@ fn scene(b: &mut Bytes) -> (Scene, bool) {
             band: (cfc_byte & 0x80 != 0).then_some(&BAND[..]),
         }),
         waveform_every: u16::from(stage_byte >> 4),
+        target: None,
     };
     (scene, !raw)
 }

@@ -21,6 +21,7 @@
 //! - absorbed energy `m v0²/2 - m v_r²/2 + m g x_sep`: gravity's work in the contact counts.
 
 pub mod contact;
+pub mod mounted;
 pub mod pad;
 
 use contact::{Body, State};

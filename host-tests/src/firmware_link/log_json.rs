@@ -85,6 +85,10 @@ impl<'a> LogJson<'a> {
             lowpass: scene
                 .and_then(SceneLine::lowpass)
                 .map(|l| crate::report::filter::LowpassJson::of(&l, rate)),
+            target: scene
+                .and_then(SceneLine::target)
+                .as_ref()
+                .map(crate::report::TargetJson::of),
             trains: Vec::new(),
             waveforms: (log.waveforms.iter().enumerate())
                 .map(|(k, w)| {

@@ -194,6 +194,13 @@ pub fn scene_args(scene: &Scene) -> Vec<String> {
             format!("spec_watch={}", f(t.watch)),
         ]);
     }
+    if let Some(t) = scene.target {
+        args.extend([
+            format!("target_mass={}", f(t.mass_kg)),
+            format!("target_stiffness={}", f(t.stiffness_n_m)),
+            format!("target_damping={}", f(t.damping_n_s_m)),
+        ]);
+    }
     args.push(format!("wave={}", scene.waveform_every));
     args
 }

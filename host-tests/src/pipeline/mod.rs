@@ -368,14 +368,19 @@ fn note_results(args: &AnalyzeArgs, setup: &Setup, reports: &[ImpactReport]) {
     if let Some(note) = time_base_implausible(&setup.assumptions, reports) {
         impact_io::note(&note);
     }
-    if let Some(note) = decimated(args, setup.rate_hz, reports) {
+    if let Some(note) = decimated(args, &setup.scene, setup.rate_hz, reports) {
         impact_io::note(&note);
     }
 }
 
 /// A note when impacts outlasted the capture and were analysed at a coarser step: how many,
 /// what they lack, and the option that holds every sample (if it can).
-pub fn decimated(args: &AnalyzeArgs, rate_hz: f64, reports: &[ImpactReport]) -> Option<String> {
+pub fn decimated(
+    args: &AnalyzeArgs,
+    scene: &Scene,
+    rate_hz: f64,
+    reports: &[ImpactReport],
+) -> Option<String> {
     let coarse: Vec<_> = reports
         .iter()
         .filter(|r| r.flags.contains(impact_core::report::Flags::DECIMATED))
@@ -396,8 +401,15 @@ pub fn decimated(args: &AnalyzeArgs, rate_hz: f64, reports: &[ImpactReport]) -> 
     } else {
         String::new()
     };
+    // Against a target the kinematics are the capture's pass's (the online sums are the
+    // body's alone).
+    let kinematics = if scene.target.is_some() {
+        "their kinematics against the target, widths, filter, spectra, verdict and fits come from those means"
+    } else {
+        "their kinematics come from every sample, their widths, filter, spectra, verdict and fits from those means"
+    };
     Some(format!(
-        "{} of {} impacts outlasted {whose} ({len} samples, {}) and were held as the means of up to {step} samples (flag decimated): their kinematics come from every sample, their widths, filter, spectra, verdict and fits from those means{lift}",
+        "{} of {} impacts outlasted {whose} ({len} samples, {}) and were held as the means of up to {step} samples (flag decimated): {kinematics}{lift}",
         coarse.len(),
         reports.len(),
         human(len as f64 / rate_hz, "s"),
@@ -1050,6 +1062,31 @@ pub(crate) fn build_scene(
         args.train.vertical || file.vertical.unwrap_or(false) || args.free_fall.is_some();
     scene.train = args.train.train();
     scene.v0_every = args.v0_every || file.v0_every.unwrap_or(false);
+    // The target, each of its numbers the command line's, else the scene file's.
+    let (k2, c2) = (
+        args.target_stiffness.or(file.target_stiffness),
+        args.target_damping.or(file.target_damping),
+    );
+    scene.target = match args.target_mass.or(file.target_mass) {
+        Some(m) => Some(impact_core::two_body::SpringMass {
+            mass_kg: m as f32,
+            stiffness_n_m: k2.unwrap_or(0.0) as f32,
+            damping_n_s_m: c2.unwrap_or(0.0) as f32,
+        }),
+        // (The command line's clap refuses these without --target-mass; a scene file's.)
+        None if k2.is_some() || c2.is_some() => {
+            let name = if k2.is_some() {
+                "target-stiffness"
+            } else {
+                "target-damping"
+            };
+            return Err(PipelineError::Invalid {
+                setting: name_of(args, file, name),
+                reason: "needs the target's mass (target_mass)",
+            });
+        }
+        None => None,
+    };
     scene.spectrum = args.spectrum.settings();
     scene.spec = args.spec.map(|s| s.spec);
     scene.validate().map_err(|e| match e {
@@ -1086,6 +1123,12 @@ fn name_of(args: &AnalyzeArgs, file: &SceneFile, name: &'static str) -> Setting 
         "settle" => (args.settle.is_some(), file.settle.is_some()),
         "cfc" => (args.cfc.is_some(), file.cfc.is_some()),
         "lowpass" => (args.lowpass.is_some(), false),
+        "target-mass" => (args.target_mass.is_some(), file.target_mass.is_some()),
+        "target-stiffness" => (
+            args.target_stiffness.is_some(),
+            file.target_stiffness.is_some(),
+        ),
+        "target-damping" => (args.target_damping.is_some(), file.target_damping.is_some()),
         // Only the scene file sets the exponent.
         "exponent" => (false, true),
         _ => (true, false),
@@ -1297,6 +1340,11 @@ pub fn to_json(setup: &Setup, reports: &[ImpactReport]) -> AnalysisJson {
             .spec
             .as_ref()
             .map(|s| crate::report::spec::spec_json(s, setup.spec_standard)),
+        target: setup
+            .scene
+            .target
+            .as_ref()
+            .map(crate::report::TargetJson::of),
         lowpass: (setup.scene.lowpass.as_ref()).map(|l| {
             crate::report::filter::LowpassJson::of(l, setup.scene.calibration.sample_rate_hz)
         }),

@@ -50,6 +50,10 @@ pub struct SceneFile {
     pub vertical: Option<bool>,
     /// Every impact comes at `v0` (as `--v0-every`).
     pub v0_every: Option<bool>,
+    /// The target (as `--target-mass`, `--target-stiffness`, `--target-damping`).
+    pub target_mass: Option<f64>,
+    pub target_stiffness: Option<f64>,
+    pub target_damping: Option<f64>,
 }
 
 /// Which fits to run (scene file).
@@ -190,6 +194,23 @@ pub struct AnalyzeArgs {
     /// Drop height, m: v0 = sqrt(2 g h).
     #[arg(long, help_heading = "Bench", conflicts_with = "free_fall", value_parser = parse::height_m)]
     pub drop_height: Option<f64>,
+    /// Target mass m2, kg: the body struck a mass on a spring and damper to ground, not a
+    /// rigid wall.
+    ///
+    /// Target mass m2, kg: the body struck a mass on a spring and damper to ground (a mounted
+    /// anvil, a load cell's platen, a specimen on its fixture), not a rigid wall. The
+    /// measured force (--mass times the reading) drives the target, and the COR (Newton's,
+    /// relative), the crush time, the deformations and the absorbed energy (the contact's
+    /// work) are the contact's, relative to the target's motion. Without it a rigid, fixed
+    /// barrier is assumed, and said.
+    #[arg(long, help_heading = "Target", value_parser = parse::mass_kg)]
+    pub target_mass: Option<f64>,
+    /// The target's spring to ground k2, N/m [default: 0, a free body].
+    #[arg(long, help_heading = "Target", requires = "target_mass")]
+    pub target_stiffness: Option<f64>,
+    /// The target's damper to ground c2, N s/m [default: 0].
+    #[arg(long, help_heading = "Target", requires = "target_mass")]
+    pub target_damping: Option<f64>,
     /// DC accelerometer file (g), optionally `:COLUMN`: v0 = g × free-fall time before the impact.
     #[arg(long, help_heading = "Bench", value_name = "FILE[:COLUMN]")]
     pub free_fall: Option<String>,
@@ -428,6 +449,7 @@ impl SceneFile {
         let exponent = self.fits.as_ref().and_then(|f| f.exponent);
         for (key, value, limits) in [
             ("mass", self.mass, &parse::MASS_KG),
+            ("target_mass", self.target_mass, &parse::MASS_KG),
             ("v0", self.v0, &parse::SPEED_M_S),
             ("drop_height", self.drop_height, &parse::HEIGHT_M),
             ("hold", self.hold, &parse::SECONDS),

@@ -147,7 +147,36 @@ where
 /// struck an immovable wall (`analyze` cannot be told a moving target; `simulate` can).
 pub const RIGID_BARRIER: &str = "the barrier is taken as rigid and fixed: COR, deformation and \
      absorbed energy are the body's against an immovable wall (a target that moves or yields is \
-     not modelled here; impact simulate --target-mass, --target-stiffness model one)";
+     not modelled here unless --target-mass gives it)";
+
+/// What the kinematics are against a target the user gave (`--target-mass`): said where the
+/// rigid barrier would otherwise be.
+pub const TARGET_RELATIVE: &str = "the kinematics are the contact's against the target given \
+     (a mass on a spring and damper to ground, {target}, driven by the measured force, --mass \
+     times the reading): the COR is Newton's (the separation speed relative to the target over the \
+     approach speed), the crush time and deformations are the relative approach's, and the \
+     absorbed energy is the contact's work (the body's loss less what went into the target); \
+     the rebound velocity is the body's own; the target is taken at rest at each first touch \
+     (a strike before it has settled from the last is measured as if it had)";
+
+/// The target of `--target-mass` (SI).
+#[derive(Clone, Debug, Serialize, PartialEq)]
+pub struct TargetJson {
+    pub mass_kg: f64,
+    pub stiffness_n_m: f64,
+    pub damping_n_s_m: f64,
+}
+
+impl TargetJson {
+    pub fn of(t: &impact_core::two_body::SpringMass<f32>) -> Self {
+        use crate::report::fmt::shortest;
+        Self {
+            mass_kg: shortest(t.mass_kg),
+            stiffness_n_m: shortest(t.stiffness_n_m),
+            damping_n_s_m: shortest(t.damping_n_s_m),
+        }
+    }
+}
 
 /// The whole analysis as JSON.
 #[derive(Clone, Debug, Serialize, PartialEq)]
@@ -208,6 +237,10 @@ pub struct AnalysisJson {
     /// or no filter).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub lowpass: Option<crate::report::filter::LowpassJson>,
+    /// With `--target-mass`: the target the body struck (the kinematics are the contact's,
+    /// relative to it: [`TARGET_RELATIVE`]); absent for the rigid, fixed barrier assumed.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub target: Option<TargetJson>,
     pub impacts: Vec<ImpactJson>,
     /// Events the board's trigger took that are no impact: the signal drifted (it left the
     /// baseline and never came back, with no pulse in it: half its peak not reached on both
@@ -235,9 +268,21 @@ pub struct SkippedLineJson {
 impl AnalysisJson {
     /// Whether the impacts have kinematics to report (an approach speed, or a bounce train's):
     /// those assume a rigid barrier ([`RIGID_BARRIER`]), which is then said.
+    /// With a target ([`Self::target`]) that is no assumption: what the kinematics are
+    /// against it is said instead ([`TARGET_RELATIVE`]).
     pub fn assume_rigid_barrier(&mut self) {
         if self.v0_m_s.is_some() || self.train_speed.is_some() {
-            self.assumptions.push(RIGID_BARRIER.to_string());
+            let said = match &self.target {
+                Some(t) => TARGET_RELATIVE.replace(
+                    "{target}",
+                    &format!(
+                        "{} kg, {} N/m, {} N s/m",
+                        t.mass_kg, t.stiffness_n_m, t.damping_n_s_m
+                    ),
+                ),
+                None => RIGID_BARRIER.to_string(),
+            };
+            self.assumptions.push(said);
         }
     }
 }

@@ -57,16 +57,25 @@ pub fn to_table(a: &AnalysisJson) -> String {
         },
     );
     // The frame the kinematics assumed, whenever there are kinematics to assume it for.
+    let barrier = match &a.target {
+        Some(t) => format!(
+            "kinematics relative to the target ({} kg, {} N/m, {} N s/m): Newton's COR, the \
+             contact's deformation and work",
+            t.mass_kg, t.stiffness_n_m, t.damping_n_s_m
+        ),
+        None => "a rigid, fixed barrier assumed".to_string(),
+    };
     if a.v0_m_s.is_some() {
         s.push_str(&match a.contact_gravity_m_s2 {
             Some(g) => format!(
                 "vertical: gravity ({}) taken out of each contact; Δv is the pulse's area; \
-                 a rigid, fixed barrier assumed\n",
+                 {barrier}\n",
                 human(g, "m/s²")
             ),
-            None => "horizontal: the reading is the deceleration (--vertical for a vertical \
-                     impact given its v0); a rigid, fixed barrier assumed\n"
-                .to_string(),
+            None => format!(
+                "horizontal: the reading is the deceleration (--vertical for a vertical \
+                 impact given its v0); {barrier}\n"
+            ),
         });
     }
     if a.resampled {

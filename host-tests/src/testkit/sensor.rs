@@ -14,12 +14,17 @@ pub fn csv(
     seconds: f64,
     full_scale: f64,
 ) -> Option<(String, Vec<ContactTruth>)> {
-    let g = impact_core::consts::STANDARD_GRAVITY;
     let r = drop.render(rate, (seconds * rate) as usize).ok()?;
+    Some((csv_of(&r.accel_m_s2, rate, full_scale), r.contacts))
+}
+
+/// Readings `accel` (m/s², sample `k` at `k / rate`) as [`csv`] records them.
+pub fn csv_of(accel: &[f64], rate: f64, full_scale: f64) -> String {
+    let g = impact_core::consts::STANDARD_GRAVITY;
     let lsb = 2.0 * full_scale / 65536.0;
     let mut s = String::from("time_s,accel_g\n");
     let mut seed = 0x2545_f491_4f6c_dd1du64;
-    for (k, a) in r.accel_m_s2.iter().enumerate() {
+    for (k, a) in accel.iter().enumerate() {
         // Uniform noise of ±1 code (xorshift).
         seed ^= seed << 13;
         seed ^= seed >> 7;
@@ -28,5 +33,5 @@ pub fn csv(
         let q = ((a / lsb + noise).round() * lsb).clamp(-full_scale, full_scale);
         s.push_str(&format!("{:.9},{:.9e}\n", k as f64 / rate, q / g));
     }
-    Some((s, r.contacts))
+    s
 }

@@ -103,6 +103,16 @@ impl SceneLine {
         impact_core::signal::lowpass::Lowpass::new(order, cutoff).ok()
     }
 
+    /// The target the board's kinematics are relative to (`target_mass_kg` and its spring and
+    /// damper; absent or `none`: a rigid, fixed barrier, as an older board's line).
+    pub fn target(&self) -> Option<impact_core::two_body::SpringMass<f32>> {
+        Some(impact_core::two_body::SpringMass {
+            mass_kg: self.fields.readable::<f32>("target_mass_kg")?,
+            stiffness_n_m: self.fields.readable::<f32>("target_stiffness_n_m")?,
+            damping_n_s_m: self.fields.readable::<f32>("target_damping_n_s_m")?,
+        })
+    }
+
     /// The pulse the board judges ([`spec_of`] its fields).
     pub fn spec(&self) -> Result<Option<impact_core::spec::Spec>, LineError> {
         spec_of(&self.fields)
