@@ -180,6 +180,8 @@ impl defmt::Format for SceneError {
 /// | `spec_rise`, `spec_fall` | a trapezoid's ramps, × the duration (after `spec=trapezoid`) |
 /// | `spec_table` | emulator only, not here: a file of the user's band ([`impact_core::spec::Spec::band`]), read by the emulator board; on the STM32 set `band: Some(&BAND)` of a `static` table in [`BENCH`]'s spec (docs/standards.md) |
 /// | `wave` | send each captured window: `0` not, `1` whole, `N` the mean of every `N` samples |
+/// | `target_mass` | the target the body strikes, kg (a mass on a spring and damper to ground: the kinematics are the contact's), or `none` (a rigid, fixed barrier) |
+/// | `target_stiffness`, `target_damping` | its spring, N/m, and damper, N s/m, to ground (after `target_mass`; 0 without them) |
 ///
 /// Floats are parsed by `core`'s correctly rounded parser, so the shortest round-trip decimal
 /// of an `f32` (Rust's `{}` or `{:e}`) gives back exactly that `f32`.

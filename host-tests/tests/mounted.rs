@@ -235,8 +235,8 @@ fn a_light_free_target_the_body_follows_is_still_measured() {
         gravity_m_s2: 0.0,
     };
     check(&scratch, &strike, 500e3, &[], "hertz on a free 30 g body");
-    // A 0.1 kg body with the seed's nonlinear pad: the body rebounds slower than the
-    // target's share, so its own COR is out of range read as a wall.
+    // The 60 g body with a Hunt–Crossley pad on a free 50 g body: it moves on forward after
+    // the contact (its own COR −0.19, no stop read as a wall).
     let strike = Strike {
         law: laws()[2].1,
         mount: Mount {
@@ -418,5 +418,75 @@ fn a_contact_longer_than_the_capture_is_measured_on_its_means() {
     ] {
         let e = off(&r[field], want);
         assert!(e.abs() <= 0.01, "{field} {:+.3} %", e * 100.0);
+    }
+}
+
+#[test]
+fn where_the_contact_cannot_be_known_against_a_target_it_is_null_with_its_reason() {
+    let scratch = Scratch::new();
+    let strike = Strike {
+        law: laws()[0].1,
+        mass_kg: 0.06,
+        v0_m_s: 1.3357,
+        touch_s: 0.0123,
+        mount: STIFF,
+        gravity_m_s2: 0.0,
+    };
+    let peak = strike_peak(&strike, 500e3) / 0.06;
+    let n = ((strike.touch_s + 0.08) * 500e3) as usize;
+    let (accel, _) = strike.render(500e3, n).unwrap();
+    let run = |range: f64, target: &[&str]| -> Value {
+        let text = impact_host::testkit::sensor::csv_of(&accel, 500e3, range);
+        let path = scratch.file("strike.csv", text);
+        let range = format!("{range}");
+        let mut args = vec![
+            "analyze",
+            path.to_str().unwrap(),
+            "--json",
+            "--mass",
+            "0.06",
+            "--v0",
+            "1.3357",
+            "--range",
+            &range,
+        ];
+        args.extend(target);
+        let json: Value = serde_json::from_str(&impact_ok(&args).0).unwrap();
+        json["impacts"][0].clone()
+    };
+    // A target ten thousand times lighter than the mount (a free 10 mg): the contact's COR
+    // such a target gives is far beyond 1, so none.
+    let r = run(2.0 * peak, &["--target-mass", "1e-5"]);
+    assert_eq!(r["flags"], serde_json::json!(["cor-out-of-range"]), "{r}");
+    for field in [
+        "cor",
+        "crush_time_s",
+        "max_deformation_m",
+        "absorbed_energy_j",
+    ] {
+        assert_eq!(r[field], Value::Null, "{field}: {r}");
+        assert_eq!(r["null_reasons"][field], "cor-out-of-range", "{field}");
+    }
+    // Clipped at half the peak: the capture is no whole contact; the clip says why.
+    let r = run(
+        0.5 * peak,
+        &["--target-mass", "0.1", "--target-stiffness", "1e6"],
+    );
+    assert!(
+        r["flags"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .any(|f| f == "clipped"),
+        "{r}"
+    );
+    for field in [
+        "cor",
+        "crush_time_s",
+        "max_deformation_m",
+        "absorbed_energy_j",
+    ] {
+        assert_eq!(r[field], Value::Null, "{field}: {r}");
+        assert_eq!(r["null_reasons"][field], "clipped", "{field}");
     }
 }

@@ -381,7 +381,7 @@ fn analyse_kinematics<const CAP: usize>(
     let mut r = report::streaming(s, scene);
     analyse_contact(&mut r, capture, s, scene, work, &mut relative);
     if scene.target.is_some() && !relative {
-        report::without_target_kinematics(&mut r);
+        report::without_target_kinematics(&mut r, true);
     }
     r
 }

@@ -93,8 +93,8 @@ pub struct Deviations {
 
 /// The sums over `samples` (the raw samples from the frame's first) with the target driven
 /// by `m1` times the reading: the relative crush and separation. The fit points, where
-/// given, move into the relative frame (the target's displacement and velocity at each
-/// point taken off).
+/// given, are written in the relative frame (the deformation and its rate, in units of
+/// `v0`, after sample `every i`).
 pub fn relative(
     samples: &[i16],
     dev: Deviations,
@@ -150,8 +150,9 @@ pub fn relative(
             if j % every == 0 {
                 let i = j / every;
                 if let (Some(px), Some(pv)) = (p.x.get_mut(i), p.v.get_mut(i)) {
-                    *px -= z.0;
-                    *pv -= z.1 / v0;
+                    // (As the body's pass writes its own: the deformation not below zero.)
+                    *px = x.max(0.0);
+                    *pv = u / v0;
                 }
             }
         }
@@ -167,9 +168,13 @@ pub fn relative(
             at_sep[1] = Some(here);
         }
     }
+    // (A state that overflowed never stops: not held, not "no stop".)
     let [Some(s0), Some(s1)] = at_sep else {
         return Err(Missing::NotHeld);
     };
+    if !(z.0.is_finite() && z.1.is_finite() && work.is_finite()) {
+        return Err(Missing::NotHeld);
+    }
     let (crush, x_max) = crush.ok_or(Missing::NoStop)?;
     let frac = frame.frac as f32;
     let lerp = |a: f32, b: f32| (a + frac * (b - a)) as f64;
@@ -263,6 +268,15 @@ pub fn kinematics(r: &mut ImpactReport, scene: &Scene, frame: &Frame, rel: &Rela
         r.flags.insert(Flags::UNDERSAMPLED);
     }
     let held = |v: f64| resolved.then_some(v as f32);
+    let absorbed = scene.mass_kg.map(|m| {
+        0.5 * m * (v0 * v0 - rebound * rebound) + gravity.map_or(0.0, |g| m * g * rel.x1_sep as f32)
+            - rel.target_work_j as f32
+    });
+    if absorbed.is_some_and(|e| !e.is_finite()) {
+        r.flags.remove(Flags::UNDERSAMPLED);
+        r.flags.insert(Flags::KINEMATICS_NOT_HELD);
+        return;
+    }
     r.kinematics = Some(Kinematics {
         impact_velocity_m_s: v0,
         crush_time_s: held(crush_s),
@@ -271,10 +285,6 @@ pub fn kinematics(r: &mut ImpactReport, scene: &Scene, frame: &Frame, rel: &Rela
         cor,
         separation_deformation_m: held(rel.x_sep),
         permanent_deformation_m: None,
-        absorbed_energy_j: scene.mass_kg.map(|m| {
-            0.5 * m * (v0 * v0 - rebound * rebound)
-                + gravity.map_or(0.0, |g| m * g * rel.x1_sep as f32)
-                - rel.target_work_j as f32
-        }),
+        absorbed_energy_j: absorbed,
     });
 }

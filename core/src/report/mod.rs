@@ -147,13 +147,16 @@ impl Flags {
     pub const APPROACH_UNKNOWN: Flags = Flags(1 << 11);
     /// No capture holds the whole contact (it outlasted the capture, or the analysis was
     /// skipped) and the stream's online sums lost its crush or its separation (first touch or
-    /// the approach speed found at the end moved them beyond the samples kept around them):
-    /// the kinematics and the fits are absent.
+    /// the approach speed found at the end moved them beyond the samples kept around them);
+    /// or, against a target ([`Scene::target`]), no capture holds the whole contact (the
+    /// online sums are the body's alone) or its relative motion overflowed: the kinematics
+    /// and the fits are absent.
     pub const KINEMATICS_NOT_HELD: Flags = Flags(1 << 12);
     /// The contact outlasted the capture, which holds it whole at a coarser step: each value
     /// the mean of `decimation` samples. The streaming fields and the kinematics are the
     /// stream's (every sample); the widths, the filtered fields, the spectra, the verdict,
-    /// the fit points (and the kinematics where the stream's online sums lost them) are
+    /// the fit points (and the kinematics where the stream's online sums lost them, or
+    /// against a target) are
     /// measured on the coarser values, as on a recording at the coarser rate, where they
     /// resolve them (else absent).
     pub const DECIMATED: Flags = Flags(1 << 13);
@@ -355,7 +358,8 @@ fn streaming_as(s: &Summary, scene: &Scene, skipped: bool) -> ImpactReport {
         Err(_) => {}
     }
     if skipped && scene.target.is_some() {
-        without_target_kinematics(&mut r);
+        // (Its null reason is the skipped analysis's: no flag stands for it.)
+        without_target_kinematics(&mut r, false);
     }
     r
 }
@@ -363,12 +367,12 @@ fn streaming_as(s: &Summary, scene: &Scene, skipped: bool) -> ImpactReport {
 /// Empties the kinematics and the fits of an impact on a target whose contact's kinematics
 /// could not be found ([`Flags::KINEMATICS_NOT_HELD`]: the impactor's own, against the
 /// rigid wall they assume, would be a plausible-looking wrong answer).
-pub fn without_target_kinematics(r: &mut ImpactReport) {
+pub fn without_target_kinematics(r: &mut ImpactReport, flag: bool) {
     // The body's own verdicts on its kinematics (no stop, its COR out of range, too few
     // samples) say nothing of the contact's: they give way to the one that does.
     let body = [Flags::NO_STOP, Flags::COR_OUT_OF_RANGE, Flags::UNDERSAMPLED];
     let tried = body.iter().any(|f| r.flags.contains(*f));
-    if r.kinematics.take().is_some() || tried {
+    if (r.kinematics.take().is_some() || tried) && flag {
         r.flags.insert(Flags::KINEMATICS_NOT_HELD);
     }
     for f in body {

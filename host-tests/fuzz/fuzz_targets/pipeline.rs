@@ -149,7 +149,13 @@ fn scene(b: &mut Bytes) -> (Scene, bool) {
             band: (cfc_byte & 0x80 != 0).then_some(&BAND[..]),
         }),
         waveform_every: u16::from(stage_byte >> 4),
-        target: None,
+        // Now and then (no train: the scene refuses one) a target from a free body of
+        // 1 mg to a 10 kg mount on a spring up to 2.6e6 N/m, from the bytes drawn above.
+        target: (stage_byte & 0x23 == 0x20).then(|| impact_core::two_body::SpringMass {
+            mass_kg: 1e-7 * 10f32.powi(i32::from(fit_byte >> 5) + 1),
+            stiffness_n_m: f32::from(cfc_byte) * 1e4,
+            damping_n_s_m: f32::from(fit_byte & 0x1f),
+        }),
     };
     (scene, !raw)
 }

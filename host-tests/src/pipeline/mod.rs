@@ -1073,7 +1073,7 @@ pub(crate) fn build_scene(
             stiffness_n_m: k2.unwrap_or(0.0) as f32,
             damping_n_s_m: c2.unwrap_or(0.0) as f32,
         }),
-        // (The command line's clap refuses these without --target-mass; a scene file's.)
+        // (A spring or damper given without a mass on either.)
         None if k2.is_some() || c2.is_some() => {
             let name = if k2.is_some() {
                 "target-stiffness"
@@ -1082,7 +1082,7 @@ pub(crate) fn build_scene(
             };
             return Err(PipelineError::Invalid {
                 setting: name_of(args, file, name),
-                reason: "needs the target's mass (target_mass)",
+                reason: "needs the target's mass (--target-mass, or a scene file's target_mass)",
             });
         }
         None => None,

@@ -206,10 +206,10 @@ pub struct AnalyzeArgs {
     #[arg(long, help_heading = "Target", value_parser = parse::mass_kg)]
     pub target_mass: Option<f64>,
     /// The target's spring to ground k2, N/m [default: 0, a free body].
-    #[arg(long, help_heading = "Target", requires = "target_mass")]
+    #[arg(long, help_heading = "Target")]
     pub target_stiffness: Option<f64>,
     /// The target's damper to ground c2, N s/m [default: 0].
-    #[arg(long, help_heading = "Target", requires = "target_mass")]
+    #[arg(long, help_heading = "Target")]
     pub target_damping: Option<f64>,
     /// DC accelerometer file (g), optionally `:COLUMN`: v0 = g × free-fall time before the impact.
     #[arg(long, help_heading = "Bench", value_name = "FILE[:COLUMN]")]
