@@ -554,7 +554,7 @@ fn analyse_contact<const CAP: usize>(
             motion,
             force: deviation,
         };
-        match target::contact(r, scene, &frame, from_onset, dev, &t, m1, out) {
+        match target::contact(r, scene, &frame, from_onset, dev, &t, m1, out, s.touch_jump) {
             Some(x_max) => x_max,
             None => return,
         }

@@ -18,7 +18,7 @@ pub fn csv(
     Some((csv_of(&r.accel_m_s2, rate, full_scale), r.contacts))
 }
 
-/// Readings `accel` (m/s², sample `k` at `k / rate`) as [`csv`] records them.
+/// Readings `accel` (m/s², sample `k` at `k / rate`) as [`csv()`] records them.
 pub fn csv_of(accel: &[f64], rate: f64, full_scale: f64) -> String {
     let g = impact_core::consts::STANDARD_GRAVITY;
     let lsb = 2.0 * full_scale / 65536.0;
