@@ -7,7 +7,8 @@ use crate::real::Real;
 /// `x^1.5` with the FPU's square root on the Cortex-M4 (`Real::sqrt`); 0 for a point a
 /// hair below zero (where an elastic contact lets go: the sums' own rounding).
 fn pow15(x: f32) -> f32 {
-    let x = x.max(0.0);
+    // (A compare and select: `f32::max` is a libm call on the M4, which has no `VMAXNM`.)
+    let x = if x > 0.0 { x } else { 0.0 };
     x * <f32 as Real>::sqrt(x)
 }
 use crate::numeric::roots::brent_min;
@@ -256,7 +257,7 @@ pub fn nonlinear(p: &Points<'_>, n: Option<f32>, ln_x: &mut [f32]) -> Option<Non
         }
         for (l, &x) in ln_x.iter_mut().zip(p.x) {
             // (A point a hair below zero, where an elastic contact lets go: x^n = 0.)
-            *l = libm::logf(x.max(0.0));
+            *l = libm::logf(if x > 0.0 { x } else { 0.0 });
         }
     }
     let ln = &ln_x[..ln_x.len().min(p.len())];
