@@ -1781,7 +1781,8 @@ fn board_within_one_percent(
 /// A 1 ms contact at 10 kS/s (5 samples to the crush) on the board: its report equals the
 /// host's, bit for bit, flagged `undersampled`, no crush time or deformation, each null saying
 /// why (the host's own figures: `tests/drops.rs`). At phase 0.75 the host had put touch 0.44
-/// samples late, `x_m` −13 %, as `complete`.
+/// samples late, `x_m` −13 %, as `complete`. And a Kelvin–Voigt contact at 16 kS/s whose
+/// jump's touch the law cannot place (`x_m` had been +11.5 %, unflagged).
 #[test]
 fn a_contact_its_samples_cannot_place_is_undersampled_on_the_board() {
     use impact_core::Model;
@@ -1790,12 +1791,27 @@ fn a_contact_its_samples_cannot_place_is_undersampled_on_the_board() {
     let Some(elf) = firmware() else { return };
     let elf = elf.to_string_lossy().into_owned();
     let k = 0.06 * (std::f64::consts::PI / 1e-3f64).powi(2);
-    let rate = 10_000.0;
-    for (name, law) in [
-        ("linear", Model::Linear(impact_core::model::Linear { k })),
+    // Too few samples to the crush (10 kS/s); and a jump's touch the compression's law
+    // cannot place, which may lie a sample from where its line put it (Kelvin–Voigt at
+    // 16 kS/s, touch on a sample: `Summary::touch_reach`).
+    for (name, law, rate, phase) in [
+        (
+            "linear",
+            Model::Linear(impact_core::model::Linear { k }),
+            10_000.0,
+            0.75,
+        ),
         (
             "hertz",
             Model::Hertz(impact_core::model::Hertz { k: 3.0e7 }),
+            10_000.0,
+            0.75,
+        ),
+        (
+            "kelvin-voigt",
+            Model::KelvinVoigt(impact_core::model::KelvinVoigt { k, c: 20.0 }),
+            16_000.0,
+            0.0,
         ),
     ] {
         let drop = Drop {
@@ -1803,7 +1819,7 @@ fn a_contact_its_samples_cannot_place_is_undersampled_on_the_board() {
             mass_kg: 0.06,
             gravity_m_s2: impact_core::consts::STANDARD_GRAVITY,
             start: Start::Rest {
-                rest_s: 0.05 + 0.75 / rate,
+                rest_s: 0.05 + phase / rate,
                 height_m: 0.091,
             },
             max_contacts: 1,

@@ -23,7 +23,10 @@
 //! interval (a jump onto a ramp, smaller than a sample's rise, reads as a ramp that began
 //! earlier: Kelvin–Voigt at 20 kS/s had touch 0.7 samples early): the frame's touch is then
 //! that zero, `s` is counted from it, the jump's force the sums missed (`missed`) from the
-//! middle, where the sums begin; where the fit does not hold, the line's zero stands.
+//! middle, where the sums begin; where the fit ran and does not hold, the line's zero
+//! stands (a ramp's: [`Unplaced::NotThisLaw`]); where it could not run
+//! ([`Unplaced::Unfit`]), the kinematics state how far touch may lie
+//! ([`crate::capture::Summary::touch_reach`]) and are null where that matters.
 //!
 //! In the sums' units (time in samples from the integration's start, velocity `w = v / kv`
 //! in units of `C`, deformation `y = x / (kv dt)`), with `V_j = C_j + d_j / 2` the velocity
@@ -81,10 +84,26 @@ pub struct Shift {
     pub d_crush: f64,
 }
 
+/// Why [`shift`] did not place touch.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Unplaced {
+    /// No fit: fewer compression samples than [`JUMP_MIN_SAMPLES`] (or more than
+    /// [`JUMP_MAX_SAMPLES`], where half a sample is under 0.1 % of the crush time), or touch
+    /// before the sample before the onset (the fit places it in the interval before the
+    /// onset only). Where the frame's touch is a line's zero, a jump after it onto a ramp
+    /// is as likely as a ramp begun there.
+    Unfit,
+    /// The fit ran and the compression does not follow a law with a jump at touch that
+    /// places it (no force at touch, a residual beyond its samples' noise, a shift beyond the
+    /// interval, or every shift fitting about alike): the frame's touch stands (a line's
+    /// zero: a ramp's, or a power foot's).
+    NotThisLaw,
+}
+
 /// The shift of touch from the contact's `samples` (from the integration's first; the
 /// compression is those before the crush's sample), `dev` the kinematics' deviation
-/// (gravity's shift `g_d` taken off), `None` where the law is not that or the samples too
-/// few. Not inlined: its sums stay off the caller's frame.
+/// (gravity's shift `g_d` taken off), or why not. Not inlined: its sums stay off the
+/// caller's frame.
 #[inline(never)]
 pub fn shift(
     samples: &[i16],
@@ -92,21 +111,22 @@ pub fn shift(
     g_d: i64,
     frame: &Frame,
     found: &Found,
-) -> Option<Shift> {
+) -> Result<Shift, Unplaced> {
     let scale = &frame.scale;
     // (Touch in the interval before the onset: the integration starts at the onset. A
     // steep line's zero at -1 exactly would start it at the quiet sample before.)
     if frame.lead != 0 {
-        return None;
+        return Err(Unplaced::Unfit);
     }
     // (The crush's sample: the one whose interval holds the crush.)
     let n = libm::floor(found.crush + 0.5);
     let held = JUMP_MIN_SAMPLES as f64..=JUMP_MAX_SAMPLES as f64;
     if !(held.contains(&n) && n < samples.len() as f64) {
-        return None;
+        return Err(Unplaced::Unfit);
     }
-    let compression = samples.get(..n as usize)?;
-    let d_crush = f64::from(dev.of(*samples.get(n as usize)?));
+    let compression = samples.get(..n as usize).ok_or(Unplaced::Unfit)?;
+    let d_crush = f64::from(dev.of(*samples.get(n as usize).ok_or(Unplaced::Unfit)?));
+    let refused = Unplaced::NotThisLaw;
     let w0 = scale.v0 / scale.kv;
     let g = g_d as f64;
     // The shift the fit gives with the deformation's slope taken as `w0 - l σ`, `f(σ)`:
@@ -123,23 +143,23 @@ pub fn shift(
         let tilt = l * (sigma - past_middle);
         fitted(compression, dev, (w0, y_lead), g, (tilt, past_middle))
     };
-    let first = at(0.0, 0.0)?;
+    let first = at(0.0, 0.0).ok_or(refused)?;
     let l = first.lost;
     let mut lo = (0.0, first.s);
-    let mut hi = (1.0, at(1.0, l)?.s);
+    let mut hi = (1.0, at(1.0, l).ok_or(refused)?.s);
     let mut placed = first;
     let mut estimate = f64::NAN;
     for _ in 0..JUMP_STEPS {
         let slope = (hi.1 - lo.1) / (hi.0 - lo.0);
         if !(libm::fabs(1.0 - slope) >= JUMP_SLOPE) {
-            return None;
+            return Err(refused);
         }
         let sigma = lo.0 + (lo.1 - lo.0) / (1.0 - slope);
         if !sigma.is_finite() {
-            return None;
+            return Err(refused);
         }
         estimate = sigma;
-        placed = at(sigma, l)?;
+        placed = at(sigma, l).ok_or(refused)?;
         let settled = libm::fabs(placed.s - sigma) < 0.005;
         (lo, hi) = (hi, (sigma, placed.s));
         if settled {
@@ -155,13 +175,15 @@ pub fn shift(
     // distance from the root, and the f32 sums' jitter where the steps did not settle.)
     // (max/min, not clamp: clamp asserts its bounds are ordered.)
     let s = estimate.max(past_middle - 0.5).min(past_middle + 0.5);
-    holds.then_some(Shift {
-        s,
-        missed: s - past_middle,
-        h: placed.h,
-        lost: placed.lost,
-        d_crush,
-    })
+    holds
+        .then_some(Shift {
+            s,
+            missed: s - past_middle,
+            h: placed.h,
+            lost: placed.lost,
+            d_crush,
+        })
+        .ok_or(refused)
 }
 
 /// Least distance of the secant's slope from 1 for [`shift`] to place touch: the error of
@@ -450,6 +472,7 @@ mod tests {
             let frame = Frame {
                 lead: 0,
                 touch: -0.5,
+                touch_reach: 0.0,
                 separation: 250.0,
                 sep_floor: 250,
                 frac: 0.5,
@@ -479,7 +502,7 @@ mod tests {
                 let (samples, frame, crush, _) = Pad::kelvin_voigt(c, s).render();
                 let dev = Deviation::new(0, 1);
                 let got = shift(&samples, dev, 0, &frame, &found(crush));
-                let Some(got) = got else {
+                let Ok(got) = got else {
                     assert!((11.0..16.0).contains(&c), "c {c}, {s}: not placed");
                     continue;
                 };
@@ -555,7 +578,7 @@ mod tests {
                 let got = shift(&samples, dev, 0, &frame, &found(crush));
                 // (Placed even at twice the stiffness at x_m: the fit's own curvature;
                 // without it, 3 % stiffer put it 0.8 samples off inside every gate.)
-                let got = got.unwrap_or_else(|| panic!("{stiffer} {s}: not placed"));
+                let got = got.unwrap_or_else(|e| panic!("{stiffer} {s}: not placed, {e:?}"));
                 assert!((got.s - s).abs() < 0.1, "{stiffer} {s}: {got:?}");
             }
         }
@@ -569,12 +592,13 @@ mod tests {
                 }
                 .render();
                 let got = shift(&samples, dev, 0, &frame, &found(crush));
-                assert_eq!(got, None, "hertz, c {c}, {s}");
+                assert_eq!(got, Err(Unplaced::NotThisLaw), "hertz, c {c}, {s}");
             }
         }
         // Too few samples to fit.
         let (samples, frame, _, _) = Pad::kelvin_voigt(5.0, 0.3).render();
-        assert_eq!(shift(&samples, dev, 0, &frame, &found(5.0)), None);
-        assert_eq!(shift(&samples[..3], dev, 0, &frame, &found(20.0)), None);
+        let unfit = Err(Unplaced::Unfit);
+        assert_eq!(shift(&samples, dev, 0, &frame, &found(5.0)), unfit);
+        assert_eq!(shift(&samples[..3], dev, 0, &frame, &found(20.0)), unfit);
     }
 }

@@ -287,6 +287,7 @@ fn coarse<const CAP: usize>(
     c.filter_lead = lead as u32;
     c.onset_index = onset as u64;
     c.touch_offset = (touch - onset) as f32;
+    c.touch_reach = s.touch_reach / capture.step() as f32;
     if let Some(i) = s.separation_index {
         // The first quiet sample's instant, and the zero relative to it (as on every sample:
         // the frame keeps a separation past the capture's end within it).
@@ -312,8 +313,10 @@ struct Jump<'a> {
 
 /// Places first touch where the force jumped at it from the compression's law
 /// ([`jump::shift`]) and moves the report's start, duration, Δv and kinematics (`found`
-/// with them) by it, and the fit points (the first `x.len()` of `points`). Not inlined:
-/// its frame stays out of the analysis task's.
+/// with them) by it, and the fit points (the first `x.len()` of `points`). Where the
+/// compression's fit ran and refused a jump's law, a line's zero the touch stood on is a
+/// ramp's: the kinematics without the jump's reach ([`crate::capture::Summary::touch_reach`]). Not inlined: its frame stays out of the
+/// analysis task's.
 #[cfg(feature = "fit")]
 #[inline(never)]
 fn place_jump(
@@ -323,7 +326,7 @@ fn place_jump(
     jump: Jump<'_>,
     found: &mut report::motion::Found,
     points: PointsOut<'_>,
-) -> Option<()> {
+) {
     let Jump {
         samples,
         motion,
@@ -331,9 +334,23 @@ fn place_jump(
     } = jump;
     // Gravity's shift of the kinematics' deviation, exactly as it was taken off.
     let g_d = i64::from(Deviation::new(s.base_sum, s.base_n).of(0)) - i64::from(motion.of(0));
-    let shift = jump::shift(samples, motion, g_d, frame, found)?;
+    let shift = match jump::shift(samples, motion, g_d, frame, found) {
+        Ok(shift) => shift,
+        Err(jump::Unplaced::NotThisLaw)
+            if s.touch_offset != crate::signal::power_flank::JUMP_MIDDLE =>
+        {
+            let mut ramp = *frame;
+            ramp.touch_reach = 0.0;
+            r.kinematics = None;
+            report::motion::kinematics(r, scene, &ramp, found);
+            return;
+        }
+        Err(_) => return,
+    };
     let mut moved = *frame;
     let dv = shift.apply(&mut moved, found);
+    // (Placed: the law's touch.)
+    moved.touch_reach = 0.0;
     let dt = frame.scale.dt;
     r.start_s -= shift.s * dt;
     r.duration_s += (shift.s * dt) as f32;
@@ -346,7 +363,6 @@ fn place_jump(
         *x += dx as f32;
         *v += (dv / frame.scale.v0) as f32;
     }
-    Some(())
 }
 
 /// The analysis with the kinematics from the pass over the capture alone, the stream's
@@ -554,7 +570,7 @@ fn analyse_contact<const CAP: usize>(
             motion,
             force: deviation,
         };
-        match target::contact(r, scene, &frame, from_onset, dev, &t, m1, out, s.touch_jump) {
+        match target::contact(r, scene, &frame, from_onset, dev, &t, m1, out) {
             Some(x_max) => x_max,
             None => return,
         }

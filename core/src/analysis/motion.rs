@@ -224,6 +224,7 @@ mod tests {
         Frame {
             lead: 0,
             touch: 0.0,
+            touch_reach: 0.0,
             separation,
             sep_floor: sep_at.floor() as u32,
             frac: sep_at - sep_at.floor(),

@@ -33,7 +33,7 @@
 //! the crush at the rates tested (`tests/mounted.rs`).
 
 use super::motion::{to_f32, PointsOut};
-use crate::report::motion::{Frame, MIN_CRUSH_SAMPLES};
+use crate::report::motion::{touch_placed, Frame, MIN_CRUSH_SAMPLES};
 use crate::report::{rebound_m_s, Flags, ImpactReport, Kinematics, COR_TOLERANCE};
 use crate::scene::Scene;
 use crate::signal::baseline::Deviation;
@@ -199,13 +199,6 @@ pub fn relative(
     finite.then_some(rel).ok_or(Missing::NotHeld)
 }
 
-/// Against a target, where the force jumped at touch ([`crate::capture::Summary::touch_jump`]),
-/// the crush time and the deformations stand only where half a sample at `v0` is at most
-/// this share of `x_m` (else [`Flags::UNDERSAMPLED`]): where in the interval before the
-/// onset the contact began, the samples cannot tell, and this pass does not place it from
-/// the compression's law as the body's does (`analysis::jump`).
-pub const JUMP_TOUCH_SHARE: f64 = 0.01;
-
 /// The body's own verdicts on its kinematics, which against a target say nothing of the
 /// contact's.
 const BODY_ONLY: Flags = Flags(
@@ -232,7 +225,6 @@ pub fn contact(
     target: &SpringMass<f32>,
     mass_kg: f32,
     points: Option<PointsOut<'_>>,
-    touch_jump: bool,
 ) -> Option<f64> {
     r.flags.remove(BODY_ONLY);
     r.kinematics = None;
@@ -242,11 +234,11 @@ pub fn contact(
     match rel {
         Ok(rel) => {
             kinematics(r, scene, frame, &rel);
-            // A jump at touch, which this pass does not place: first touch lies anywhere in
-            // the interval before the onset, which moves `x_m` by up to half a sample at
-            // `v0` (measured: +7 % on a Kelvin–Voigt pad at 20 kS/s, 0.7 % at 100 kS/s).
-            let half = 0.5 * frame.scale.dt * frame.scale.v0;
-            if touch_jump && !(half <= JUMP_TOUCH_SHARE * rel.x_max) {
+            // A jump at touch, which this pass does not place (`analysis::jump` is the
+            // body's): first touch lies anywhere in its interval, which moves `x_m` by up
+            // to half a sample at `v0` from its middle (measured: +7 % on a Kelvin–Voigt
+            // pad at 20 kS/s, 0.7 % at 100 kS/s), as far as the onset from a line's zero.
+            if !touch_placed(frame.touch_reach, frame, rel.x_max) {
                 if let Some(k) = r.kinematics.as_mut() {
                     k.crush_time_s = None;
                     k.max_deformation_m = None;

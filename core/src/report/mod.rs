@@ -168,8 +168,10 @@ impl Flags {
     /// [`motion::MIN_CRUSH_SAMPLES`]: where in the sample interval before the onset the
     /// contact began, the samples cannot tell (a foot's curve or a jump's law places it, and
     /// a wrong guess moves the crush time and `x_m` by up to a sample's share of them: −15 %
-    /// on a 1 ms contact at 10 kS/s): the crush time, the deformations and the fits are
-    /// absent; the COR, the rebound and the energy (from Δv) stand.
+    /// on a 1 ms contact at 10 kS/s); or first touch lies in a jump's interval that neither
+    /// the contact's law placed nor is short enough ([`motion::JUMP_TOUCH_SHARE`]): the
+    /// crush time, the deformations and the fits are absent; the COR, the rebound and the
+    /// energy (from Δv) stand.
     pub const UNDERSAMPLED: Flags = Flags(1 << 15);
 
     /// Every flag with its name in the reports.

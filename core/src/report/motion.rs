@@ -178,6 +178,9 @@ pub struct Frame {
     pub lead: u32,
     /// First touch, fractional samples from the integration's first sample (`<= 0` … `< 1`).
     pub touch: f64,
+    /// Samples first touch may lie from `touch` where it is a jump's that the contact's law
+    /// has not placed ([`Summary::touch_reach`]); 0 where none, or placed.
+    pub touch_reach: f64,
     /// The separation, fractional samples from the integration's first sample.
     pub separation: f64,
     /// The separation's two states are after `sep_floor` and `sep_floor + 1` samples, and
@@ -240,6 +243,7 @@ impl Frame {
         Some(Self {
             lead: lead as u32,
             touch,
+            touch_reach: f64::from(s.touch_reach),
             separation,
             sep_floor: sep_floor as u32,
             frac: sep_at - sep_floor,
@@ -292,10 +296,25 @@ impl Frame {
 /// −28 % at 5 kS/s; 8 samples (a 1 ms contact at 16 kS/s) and more report them.
 pub const MIN_CRUSH_SAMPLES: f64 = 8.0;
 
+/// Where first touch lies in a jump's interval that the contact's law has not placed
+/// ([`Frame::touch_reach`]), the crush time and the deformations stand only where the
+/// farthest touch may lie from where it was put, at `v0`, is at most this share of `x_m`
+/// (else [`Flags::UNDERSAMPLED`]): the samples cannot tell where in that interval the
+/// contact began (measured: a Kelvin–Voigt pad at 20 kS/s, `x_m` +6.5 % on a wall and +7 %
+/// on a target; half a sample is 0.7 % of its `x_m` at 100 kS/s).
+pub const JUMP_TOUCH_SHARE: f64 = 0.01;
+
+/// Whether first touch, `reach` samples from where `frame` puts it at most, is known
+/// closely enough for the crush time and the deformations at `x_max` ([`JUMP_TOUCH_SHARE`]).
+pub fn touch_placed(reach: f64, frame: &Frame, x_max: f64) -> bool {
+    reach * frame.scale.dt * frame.scale.v0 <= JUMP_TOUCH_SHARE * x_max
+}
+
 /// Fills in `r`'s kinematics from what the sums found in `frame`: the rebound from the
 /// report's Δv, the COR (flagged and left out beyond its tolerance), the energy absorbed;
 /// the crush time and the deformations where the compression spans [`MIN_CRUSH_SAMPLES`]
-/// (else flagged [`Flags::UNDERSAMPLED`] and left out). The set a pad keeps comes from the
+/// and first touch is known closely enough ([`touch_placed`]; else flagged
+/// [`Flags::UNDERSAMPLED`] and left out). The set a pad keeps comes from the
 /// fits ([`crate::fit::set`]).
 pub fn kinematics(r: &mut ImpactReport, scene: &Scene, frame: &Frame, found: &Found) {
     // (Again where a jump's law moved first touch: [`crate::analysis`].)
@@ -312,7 +331,8 @@ pub fn kinematics(r: &mut ImpactReport, scene: &Scene, frame: &Frame, found: &Fo
     }
     let crush_s = (found.crush - frame.touch) * frame.scale.dt;
     // In the stream's samples (a decimated capture's pass counts coarser values).
-    let resolved = crush_s * scene.calibration.sample_rate_hz as f64 >= MIN_CRUSH_SAMPLES;
+    let resolved = crush_s * scene.calibration.sample_rate_hz as f64 >= MIN_CRUSH_SAMPLES
+        && touch_placed(frame.touch_reach, frame, found.x_max);
     if !resolved {
         r.flags.insert(Flags::UNDERSAMPLED);
     }
@@ -412,6 +432,7 @@ mod tests {
         Frame {
             lead: 0,
             touch: 0.0,
+            touch_reach: 0.0,
             separation: len,
             sep_floor: libm::floor(sep_at) as u32,
             frac: sep_at - libm::floor(sep_at),

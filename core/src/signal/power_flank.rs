@@ -180,9 +180,15 @@ pub const JUMP_MIDDLE: f32 = -0.5;
 /// [`steep_zero`]'s line's zero, `None` where it takes the middle of the interval (a jump;
 /// a zero it gives may be a jump's too, onto a ramp: the stream's caller says so).
 pub fn steep_line_zero(y: [f32; 3]) -> Option<f32> {
-    head_line(y)
-        .map(|(zero, _)| zero)
-        .filter(|zero| (-1.0..=0.0).contains(zero))
+    steep_line(y).map(|(zero, _)| zero)
+}
+
+/// [`steep_line_zero`], and whether its curve is a straight line (power 1: a jump onto a
+/// ramp gives one; a power curve other than the line, none).
+pub fn steep_line(y: [f32; 3]) -> Option<(f32, bool)> {
+    head_fit(y)
+        .map(|h| (h.zero, h.p == 1.0))
+        .filter(|(zero, _)| (-1.0..=0.0).contains(zero))
 }
 
 /// How far the middle of three samples may lie off the line through the outer two, over
@@ -204,13 +210,27 @@ pub fn head_zero(y: [f32; 3]) -> Option<f32> {
     ((-1.0..=0.0).contains(&zero) && bend <= HEAD_BEND).then_some(zero)
 }
 
+/// [`head_reach`]'s answer: the curve's zero (samples from the head's first), its value at
+/// the time asked (0 before its zero), and whether it is a straight line (power 1: a jump
+/// onto a ramp gives one too, so a line's zero before a quiet sample may be a jump's after
+/// it).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Reach {
+    pub zero: f32,
+    pub at: f32,
+    pub line: bool,
+}
+
 /// The zero of [`head_zero`]'s curve through three rising samples (the first at 0) where
-/// they lie on one (within [`HEAD_BEND`]), wherever it lies, and the curve's value at `t`
-/// (0 before its zero).
-pub fn head_reach(y: [f32; 3], t: f32) -> Option<(f32, f32)> {
+/// they lie on one (within [`HEAD_BEND`]), wherever it lies, and the curve's value at `t`.
+pub fn head_reach(y: [f32; 3], t: f32) -> Option<Reach> {
     let h = head_fit(y)?;
     let z = h.z0 + (h.z1 - h.z0) * t;
-    (h.bend <= HEAD_BEND).then(|| (h.zero, h.top * power(z.max(0.0), h.p)))
+    (h.bend <= HEAD_BEND).then(|| Reach {
+        zero: h.zero,
+        at: h.top * power(z.max(0.0), h.p),
+        line: h.p == 1.0,
+    })
 }
 
 /// The zero of the line through the first two of three samples under the power of
@@ -461,7 +481,8 @@ mod tests {
     fn head_reach_extends_a_power_head_one_sample_back() {
         for (p, x0) in [(1.5f32, -1.02f32), (1.0, -1.3), (2.0, -1.6)] {
             let y = [0.0f32, 1.0, 2.0].map(|k| libm::powf(k - x0, p));
-            let (zero, at) = head_reach(y, -1.0).unwrap();
+            let Reach { zero, at, line } = head_reach(y, -1.0).unwrap();
+            assert_eq!(line, p == 1.0);
             let truth = libm::powf(-1.0 - x0, p);
             assert!((zero - x0).abs() < 1e-3, "{p} {x0}: {zero}");
             assert!(
@@ -472,7 +493,8 @@ mod tests {
         // A jump of A onto a ramp of B a sample, its first sample tau after touch.
         let (a, b, tau) = (0.675f32, 1.0f32, 0.4f32);
         let y = [0.0f32, 1.0, 2.0].map(|k| a + b * (k + tau));
-        let (zero, at) = head_reach(y, -1.0).unwrap();
+        let Reach { zero, at, line } = head_reach(y, -1.0).unwrap();
+        assert!(line);
         assert!((zero + a / b + tau).abs() < 1e-4, "{zero}");
         assert!((at - (a - (1.0 - tau) * b)).abs() < 1e-4, "{at}");
         // Three samples that bend beyond every power: none.

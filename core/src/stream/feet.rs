@@ -254,9 +254,11 @@ impl<const PRE: usize> Stream<PRE> {
     /// flank stepped past the flank level, or the flank held too few samples for a line and
     /// the onset's three lie on a power curve, from those three ([`Self::head_touch`]); else
     /// the trigger's estimate (`touch_offset`, `lead_c`). And whether it is a fit's zero (not
-    /// the edge crossing, late by design), and whether it lies in a jump's interval (its
-    /// middle, or a steep line's zero) clear of the previous contact ([`crate::capture::Summary::touch_jump`]).
-    pub(super) fn touch(&mut self, a: &Active) -> ((f32, i64, bool), bool, bool) {
+    /// the edge crossing, late by design), and, where it lies in a jump's interval (its
+    /// middle, or a steep line's zero) clear of the previous contact
+    /// ([`crate::capture::Summary::touch_jump`]), its reach
+    /// ([`crate::capture::Summary::touch_reach`]).
+    pub(super) fn touch(&mut self, a: &Active) -> ((f32, i64, bool), bool, Option<f32>) {
         let trigger = (a.touch_offset, a.lead_c, a.line_in_previous);
         let peak = a.peak_d.unsigned_abs() as f32;
         let foot = self.rise_foot(a).filter(|foot| {
@@ -280,14 +282,14 @@ impl<const PRE: usize> Stream<PRE> {
                 let touch = foot.zero.max(a.touch_floor);
                 let lead = libm::floorf(-touch).max(0.0) as i64;
                 let c = foot.sum(-lead, 0) * peak * a.sign as f32;
-                ((touch, c as i64, foot.zero < a.touch_floor), true, false)
+                ((touch, c as i64, foot.zero < a.touch_floor), true, None)
             }
             None => match self.head_touch(a) {
-                Some((z, jump)) => {
+                Some((z, reach)) => {
                     let touch = z.max(a.touch_floor);
                     // (A jump's whole interval clear of the previous contact: the analysis
                     // may place touch anywhere in it.)
-                    let jump = jump && a.touch_floor <= -1.0;
+                    let jump = reach.filter(|_| a.touch_floor <= -1.0);
                     // Touch before the sample before the onset ([`earlier_foot`]): that
                     // sample is the foot's, in `Σ d` as the kinematics integrate it (the
                     // trigger's touch, a step's middle or the edge crossing, had none).
@@ -301,7 +303,7 @@ impl<const PRE: usize> Stream<PRE> {
                 None => (
                     trigger,
                     matches!(a.flank_touch, FlankTouch::Line | FlankTouch::Steep),
-                    false,
+                    None,
                 ),
             },
         }
@@ -320,23 +322,27 @@ impl<const PRE: usize> Stream<PRE> {
     /// a foot that began earlier is the lobe's). Either way, where that curve reaches zero
     /// before the sample before the onset and reads that sample there ([`earlier_foot`]),
     /// its zero.
-    /// And whether touch is in a jump's interval ([`crate::capture::Summary::touch_jump`]).
-    fn head_touch(&self, a: &Active) -> Option<(f32, bool)> {
+    /// And, where touch is in a jump's interval ([`crate::capture::Summary::touch_jump`]),
+    /// how far from it touch may lie ([`crate::capture::Summary::touch_reach`]).
+    fn head_touch(&self, a: &Active) -> Option<(f32, Option<f32>)> {
         let head = a.rise.head().map(|y| y.map(|d| d as f32))?;
         match a.flank_touch {
-            FlankTouch::Steep => Some(match power_flank::steep_line_zero(head) {
+            FlankTouch::Steep => Some(match power_flank::steep_line(head) {
                 // (A jump's interval too: Kelvin–Voigt's `c v0` below a sample's `k v0 dt`
-                // had touch 0.7 samples early at 20 kS/s, `x_m` +11 %.)
-                Some(zero) => (zero, true),
+                // had touch 0.7 samples early at 20 kS/s, `x_m` +11 %. Its reach from a
+                // line's zero to the onset; a power curve's zero is a foot's.)
+                Some((zero, line)) => (zero, Some(if line { -zero } else { 0.0 })),
                 None => match earlier_foot(a, head) {
-                    Some(zero) => (zero, false),
-                    None => (power_flank::JUMP_MIDDLE, true),
+                    Some((zero, line)) => (zero, line.then_some(-zero)),
+                    None => (power_flank::JUMP_MIDDLE, Some(JUMP_MIDDLE_REACH)),
                 },
             }),
             FlankTouch::Crossing => power_flank::head_zero(head)
                 .filter(|_| a.quiet_before())
-                .or_else(|| earlier_foot(a, head))
-                .map(|zero| (zero, false)),
+                .map(|zero| (zero, None))
+                .or_else(|| {
+                    earlier_foot(a, head).map(|(zero, line)| (zero, line.then_some(-zero)))
+                }),
             FlankTouch::Line | FlankTouch::Refused => None,
         }
     }
@@ -542,6 +548,10 @@ pub(super) fn record_fall(a: &mut Active, run: &[i16], at: u64) {
     a.fall.take(run.get(from..).unwrap_or(&[]), w, s, sign);
 }
 
+/// Samples first touch may lie from the middle of a jump's interval, where nothing narrowed
+/// it ([`power_flank::JUMP_MIDDLE`]).
+const JUMP_MIDDLE_REACH: f32 = 0.5;
+
 /// First touch relative to the onset where the foot began before the sample before the
 /// onset (`before`, within the edge level), clear of the previous contact: where that sample
 /// stands out of the noise (over half the edge level) and lies with the onset's first two on
@@ -559,8 +569,11 @@ pub(super) fn record_fall(a: &mut Active, run: &[i16], at: u64) {
 /// sample before it where the head's line reads `c v0 − (1 − τ) k v0 dt`: refused where that
 /// exceeds half the edge level, which a jump of a few samples' rise does (the jump's fit in
 /// the analysis places it); a smaller jump may be taken for a ramp that began up to a sample
-/// earlier, as [`power_flank::steep_zero`] says of its own line.
-fn earlier_foot(a: &Active, head: [f32; 3]) -> Option<f32> {
+/// earlier, as [`power_flank::steep_zero`] says of its own line: where the head is a
+/// straight line, its zero is given as a jump's too (touch lies between it and the onset;
+/// Kelvin–Voigt's `c v0` equal to a sample's `k v0 dt` at 20 kS/s, touch 0.05 of a sample
+/// after a sample, had it a sample early, `x_m` +6.5 %, unflagged).
+fn earlier_foot(a: &Active, head: [f32; 3]) -> Option<(f32, bool)> {
     let before = a.before_d? as f32;
     let [y0, y1, _] = head;
     let noise = 0.5 * a.edge_d as f32;
@@ -570,13 +583,13 @@ fn earlier_foot(a: &Active, head: [f32; 3]) -> Option<f32> {
     let on_foot = (before > noise)
         .then(|| power_flank::head_zero([before, y0, y1]))
         .flatten();
-    let zero = match on_foot {
+    let (zero, jump) = match on_foot {
         // That sample on the foot, the onset's first two on its curve: its zero, from it.
-        Some(zero) => zero - 1.0,
+        Some(zero) => (zero - 1.0, false),
         None => {
-            let (zero, at_before) = power_flank::head_reach(head, -1.0)?;
-            (libm::fabsf(before - at_before) <= noise).then_some(zero)?
+            let reach = power_flank::head_reach(head, -1.0)?;
+            (libm::fabsf(before - reach.at) <= noise).then_some((reach.zero, reach.line))?
         }
     };
-    ((-2.0..-1.0).contains(&zero) && zero >= a.touch_floor).then_some(zero)
+    ((-2.0..-1.0).contains(&zero) && zero >= a.touch_floor).then_some((zero, jump))
 }

@@ -507,7 +507,7 @@ impl<const PRE: usize> Stream<PRE> {
         let (touch, fitted, jump) = self.touch(&a);
         let (touch_offset, lead_c, in_previous) = self.lobe(&a, touch, fitted);
         // (A lobe that begins earlier is no jump.)
-        let touch_jump = jump && touch_offset == touch.0 && !in_previous;
+        let reach = jump.filter(|_| touch_offset == touch.0 && !in_previous);
         let touch = a.onset_index as f64 + touch_offset as f64;
         let approach =
             self.run
@@ -531,7 +531,8 @@ impl<const PRE: usize> Stream<PRE> {
             filter_lead: a.filter_lead,
             onset_index: a.onset_index,
             touch_offset,
-            touch_jump,
+            touch_jump: reach.is_some(),
+            touch_reach: reach.unwrap_or(0.0),
             separation_index: a.separation,
             separation_offset,
             end_index: a.end_at.unwrap_or(self.run.index),
