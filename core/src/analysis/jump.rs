@@ -87,16 +87,16 @@ pub struct Shift {
 /// Why [`shift`] did not place touch.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum Unplaced {
-    /// No fit: fewer compression samples than [`JUMP_MIN_SAMPLES`] (or more than
-    /// [`JUMP_MAX_SAMPLES`], where half a sample is under 0.1 % of the crush time), or touch
-    /// before the sample before the onset (the fit places it in the interval before the
-    /// onset only). Where the frame's touch is a line's zero, a jump after it onto a ramp
-    /// is as likely as a ramp begun there.
+    /// The samples cannot tell: fewer compression samples than [`JUMP_MIN_SAMPLES`] (or more
+    /// than [`JUMP_MAX_SAMPLES`], where half a sample is under 0.1 % of the crush time),
+    /// touch before the sample before the onset (the fit places it in the interval before
+    /// the onset only), or a fit whose shift no sample tells ([`JUMP_SLOPE`], [`JUMP_LEVER`],
+    /// a singular one). Where the frame's touch is a line's zero, a jump after it onto a
+    /// ramp is as likely as a ramp begun there.
     Unfit,
-    /// The fit ran and the compression does not follow a law with a jump at touch that
-    /// places it (no force at touch, a residual beyond its samples' noise, a shift beyond the
-    /// interval, or every shift fitting about alike): the frame's touch stands (a line's
-    /// zero: a ramp's, or a power foot's).
+    /// The fit ran and refutes a jump at touch: no force at touch or no stiffness, a residual
+    /// beyond its samples' noise, or a shift beyond the interval. A line's zero the frame's
+    /// touch stands on is a ramp's, and stands.
     NotThisLaw,
 }
 
@@ -143,23 +143,28 @@ pub fn shift(
         let tilt = l * (sigma - past_middle);
         fitted(compression, dev, (w0, y_lead), g, (tilt, past_middle))
     };
-    let first = at(0.0, 0.0).ok_or(refused)?;
+    let unfit = Unplaced::Unfit;
+    // A shift the fit cannot tell: taken as no jump (seed 001's `k x (1 + c v)`, which has
+    // none, reads as a damper whose shift the fit cannot tell at 20 and 25 kS/s, its line's
+    // zero right within 1 %).
+    let untold = |_: &Fitted| refused;
+    let first = at(0.0, 0.0).ok_or(unfit)?;
     let l = first.lost;
     let mut lo = (0.0, first.s);
-    let mut hi = (1.0, at(1.0, l).ok_or(refused)?.s);
+    let mut hi = (1.0, at(1.0, l).ok_or(unfit)?.s);
     let mut placed = first;
     let mut estimate = f64::NAN;
     for _ in 0..JUMP_STEPS {
         let slope = (hi.1 - lo.1) / (hi.0 - lo.0);
         if !(libm::fabs(1.0 - slope) >= JUMP_SLOPE) {
-            return Err(refused);
+            return Err(untold(&placed));
         }
         let sigma = lo.0 + (lo.1 - lo.0) / (1.0 - slope);
         if !sigma.is_finite() {
-            return Err(refused);
+            return Err(untold(&placed));
         }
         estimate = sigma;
-        placed = at(sigma, l).ok_or(refused)?;
+        placed = at(sigma, l).ok_or(unfit)?;
         let settled = libm::fabs(placed.s - sigma) < 0.005;
         (lo, hi) = (hi, (sigma, placed.s));
         if settled {
@@ -167,7 +172,10 @@ pub fn shift(
         }
     }
     // (Beyond the interval by more than the fit's own scatter: not this law.)
-    let holds = placed.fits
+    if !placed.told {
+        return Err(untold(&placed));
+    }
+    let holds = placed.law
         && (estimate - past_middle).abs() <= 1.0
         && residual(compression, dev, w0, placed.tilt, &placed.b)
             <= JUMP_RESIDUAL + JUMP_COUNTS * scale.count * n / w0;
@@ -205,13 +213,14 @@ const JUMP_STEPS: usize = 3;
 pub const JUMP_MAX_SAMPLES: usize = 512;
 
 /// One fit's shift, the force at touch `h`, the body's deceleration then `lost`, whether
-/// the law's stiffness and damper are both positive and its shift can be told (`fits`), and
-/// what [`residual`] needs (`tilt`, the coefficients `b`).
+/// whether the law's stiffness and damper are both positive (`law`) and its shift can be
+/// told (`told`), and what [`residual`] needs (`tilt`, the coefficients `b`).
 struct Fitted {
     s: f64,
     h: f64,
     lost: f64,
-    fits: bool,
+    law: bool,
+    told: bool,
     tilt: f64,
     b: [f64; 4],
 }
@@ -243,12 +252,12 @@ fn fitted(
     // (`lever`, how far a shift moves the intercept, may take either sign: the deformation
     // it adds against the speed its damper took; near zero, the samples cannot tell `s`.)
     let identifiable = libm::fabs(lever) > JUMP_LEVER * k * w0;
-    let fits = k > 0.0 && h > 0.0 && identifiable && s.is_finite();
     Some(Fitted {
         s,
         h,
         lost,
-        fits,
+        law: k > 0.0 && h > 0.0,
+        told: identifiable && s.is_finite(),
         tilt,
         b,
     })

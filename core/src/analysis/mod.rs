@@ -336,8 +336,11 @@ fn place_jump(
     let g_d = i64::from(Deviation::new(s.base_sum, s.base_n).of(0)) - i64::from(motion.of(0));
     let shift = match jump::shift(samples, motion, g_d, frame, found) {
         Ok(shift) => shift,
+        // (A line's zero in the interval before the onset, not its middle: the fit ran from
+        // there. A zero before it, where the capture starts at the onset, it did not place.)
         Err(jump::Unplaced::NotThisLaw)
-            if s.touch_offset != crate::signal::power_flank::JUMP_MIDDLE =>
+            if s.touch_offset != crate::signal::power_flank::JUMP_MIDDLE
+                && s.touch_offset >= -1.0 =>
         {
             let mut ramp = *frame;
             ramp.touch_reach = 0.0;

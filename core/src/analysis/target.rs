@@ -28,9 +28,10 @@
 //! Against a target the body's own verdicts (its velocity never reaching zero, its rebound
 //! over `v0` out of range) say nothing about the contact: a light target leaves the body
 //! moving on. The kinematics come from this pass alone; a jump at touch is not placed from
-//! the compression's law (that would move the body's motion alone), nor is a force that
-//! steps at the crush split (`report::motion::Step`): both are within a sample's share of
-//! the crush at the rates tested (`tests/mounted.rs`).
+//! the compression's law (that would move the body's motion alone): where how far touch may
+//! lie matters, the crush time and deformations are null ([`touch_placed`]); nor is a force
+//! that steps at the crush split (`report::motion::Step`), within a sample's share of the
+//! crush at the rates tested (`tests/mounted.rs`).
 
 use super::motion::{to_f32, PointsOut};
 use crate::report::motion::{touch_placed, Frame, MIN_CRUSH_SAMPLES};

@@ -307,7 +307,7 @@ pub const JUMP_TOUCH_SHARE: f64 = 0.01;
 /// Whether first touch, `reach` samples from where `frame` puts it at most, is known
 /// closely enough for the crush time and the deformations at `x_max` ([`JUMP_TOUCH_SHARE`]).
 pub fn touch_placed(reach: f64, frame: &Frame, x_max: f64) -> bool {
-    reach * frame.scale.dt * frame.scale.v0 <= JUMP_TOUCH_SHARE * x_max
+    reach <= 0.0 || reach * frame.scale.dt * frame.scale.v0 <= JUMP_TOUCH_SHARE * x_max
 }
 
 /// Fills in `r`'s kinematics from what the sums found in `frame`: the rebound from the

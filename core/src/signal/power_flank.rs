@@ -206,8 +206,13 @@ pub const HEAD_BEND: f32 = 0.02;
 /// sampling resolves in three samples (a Hertz contact's `t^1.5` at 20 kS/s). Else `None`
 /// (the caller's estimate stands).
 pub fn head_zero(y: [f32; 3]) -> Option<f32> {
-    let (zero, bend) = head_line(y)?;
-    ((-1.0..=0.0).contains(&zero) && bend <= HEAD_BEND).then_some(zero)
+    head_zero_line(y).map(|(zero, _)| zero)
+}
+
+/// [`head_zero`], and whether its curve is a straight line (power 1).
+pub fn head_zero_line(y: [f32; 3]) -> Option<(f32, bool)> {
+    let h = head_fit(y)?;
+    ((-1.0..=0.0).contains(&h.zero) && h.bend <= HEAD_BEND).then_some((h.zero, h.p == 1.0))
 }
 
 /// [`head_reach`]'s answer: the curve's zero (samples from the head's first), its value at
@@ -233,14 +238,7 @@ pub fn head_reach(y: [f32; 3], t: f32) -> Option<Reach> {
     })
 }
 
-/// The zero of the line through the first two of three samples under the power of
-/// [`POWERS`] that puts them most nearly on a line, and how far the middle one lies off the
-/// line through the outer two, over the rise; `None` unless they rise.
-fn head_line(y: [f32; 3]) -> Option<(f32, f32)> {
-    head_fit(y).map(|h| (h.zero, h.bend))
-}
-
-/// [`head_line`]'s curve: `y = top (z0 + (z1 - z0) t)^p` through the first two samples.
+/// [`head_fit`]'s curve: `y = top (z0 + (z1 - z0) t)^p` through the first two samples.
 struct Head {
     zero: f32,
     bend: f32,

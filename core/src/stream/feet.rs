@@ -314,7 +314,7 @@ impl<const PRE: usize> Stream<PRE> {
     /// ([`FlankTouch::Steep`]), [`power_flank::steep_zero`] (its line's zero in the interval
     /// before the onset is a jump's too, a jump onto a ramp, smaller than a sample's rise,
     /// reading as a ramp that began earlier: the analysis places touch from the compression's
-    /// law where that holds, and the line's zero stands where not); where it lies just past the edge
+    /// law where that holds, and the line's zero stands where its fit refuses a jump); where it lies just past the edge
     /// level and the flank had no line ([`FlankTouch::Crossing`]), [`power_flank::head_zero`]
     /// if the three lie on a power curve (a Hertz foot at 20 kS/s, its onset a tenth of a
     /// sample in: else the walk back to the baseline puts touch up to a sample early) and
@@ -332,17 +332,13 @@ impl<const PRE: usize> Stream<PRE> {
                 // had touch 0.7 samples early at 20 kS/s, `x_m` +11 %. Its reach from a
                 // line's zero to the onset; a power curve's zero is a foot's.)
                 Some((zero, line)) => (zero, Some(if line { -zero } else { 0.0 })),
-                None => match earlier_foot(a, head) {
-                    Some((zero, line)) => (zero, line.then_some(-zero)),
-                    None => (power_flank::JUMP_MIDDLE, Some(JUMP_MIDDLE_REACH)),
-                },
+                None => earlier_foot(a, head)
+                    .unwrap_or((power_flank::JUMP_MIDDLE, Some(JUMP_MIDDLE_REACH))),
             }),
             FlankTouch::Crossing => power_flank::head_zero(head)
                 .filter(|_| a.quiet_before())
                 .map(|zero| (zero, None))
-                .or_else(|| {
-                    earlier_foot(a, head).map(|(zero, line)| (zero, line.then_some(-zero)))
-                }),
+                .or_else(|| earlier_foot(a, head)),
             FlankTouch::Line | FlankTouch::Refused => None,
         }
     }
@@ -570,26 +566,32 @@ const JUMP_MIDDLE_REACH: f32 = 0.5;
 /// exceeds half the edge level, which a jump of a few samples' rise does (the jump's fit in
 /// the analysis places it); a smaller jump may be taken for a ramp that began up to a sample
 /// earlier, as [`power_flank::steep_zero`] says of its own line: where the head is a
-/// straight line, its zero is given as a jump's too (touch lies between it and the onset;
-/// Kelvin–Voigt's `c v0` equal to a sample's `k v0 dt` at 20 kS/s, touch 0.05 of a sample
-/// after a sample, had it a sample early, `x_m` +6.5 %, unflagged).
-fn earlier_foot(a: &Active, head: [f32; 3]) -> Option<(f32, bool)> {
+/// straight line, its zero is given as a jump's too, with how far touch may lie from it
+/// (as far as the onset; as far as the sample before it where that sample stands out of the
+/// noise: its force says touch came earlier). Kelvin–Voigt's `c v0` equal to a sample's
+/// `k v0 dt` at 20 kS/s, touch 0.05 of a sample after a sample, had it a sample early,
+/// `x_m` +6.5 %, unflagged.
+fn earlier_foot(a: &Active, head: [f32; 3]) -> Option<(f32, Option<f32>)> {
     let before = a.before_d? as f32;
     let [y0, y1, _] = head;
     let noise = 0.5 * a.edge_d as f32;
     // (Only a sample that stands out of the noise: a jump's quiet sample before it, a little
     // above the baseline, would put a jump onto a ramp on a curve within `HEAD_BEND` of the
     // jump's size.)
-    let on_foot = (before > noise)
-        .then(|| power_flank::head_zero([before, y0, y1]))
+    let stands_out = before > noise;
+    let on_foot = stands_out
+        .then(|| power_flank::head_zero_line([before, y0, y1]))
         .flatten();
-    let (zero, jump) = match on_foot {
+    let (zero, line) = match on_foot {
         // That sample on the foot, the onset's first two on its curve: its zero, from it.
-        Some(zero) => (zero - 1.0, false),
+        Some((zero, line)) => (zero - 1.0, line),
         None => {
             let reach = power_flank::head_reach(head, -1.0)?;
             (libm::fabsf(before - reach.at) <= noise).then_some((reach.zero, reach.line))?
         }
     };
-    ((-2.0..-1.0).contains(&zero) && zero >= a.touch_floor).then_some((zero, jump))
+    // A line's zero may be a jump's onto a ramp after it: before the sample before the onset
+    // where that sample stands out (its force says touch came earlier), else before the onset.
+    let reach = line.then_some(if stands_out { -1.0 - zero } else { -zero });
+    ((-2.0..-1.0).contains(&zero) && zero >= a.touch_floor).then_some((zero, reach))
 }
