@@ -549,19 +549,8 @@ fn analyse_contact<const CAP: usize>(
     let (force, rest) = work.buf.split_at_mut(points);
     let (velocity, rest) = rest.split_at_mut(points);
     let (deformation, ln_x) = rest.split_at_mut(points);
-    let out = (points > 0).then_some(PointsOut {
-        x: &mut *deformation,
-        v: &mut *velocity,
-        every,
-    });
-    let mut passed = motion::integrate(from_onset, motion, &frame, out);
-    // (A decimated capture's values are means: a step at the crush is the stream's to place,
-    // on every sample.)
-    if let Some((crush, _)) = passed.as_mut().filter(|_| step > 1) {
-        crush.beside = None;
-    }
     // Against a target: the contact's kinematics from a pass of their own (the body's
-    // verdicts replaced), the fit points in the contact's frame.
+    // verdicts replaced; the body's own pass not run), the fit points in the contact's frame.
     let x_max = if let (Some(t), Some(m1)) = (scene.target, scene.mass_kg) {
         *relative = true;
         let out = (points > 0).then_some(PointsOut {
@@ -578,6 +567,17 @@ fn analyse_contact<const CAP: usize>(
             None => return,
         }
     } else {
+        let out = (points > 0).then_some(PointsOut {
+            x: &mut *deformation,
+            v: &mut *velocity,
+            every,
+        });
+        let mut passed = motion::integrate(from_onset, motion, &frame, out);
+        // (A decimated capture's values are means: a step at the crush is the stream's to
+        // place, on every sample.)
+        if let Some((crush, _)) = passed.as_mut().filter(|_| step > 1) {
+            crush.beside = None;
+        }
         if from_stream.is_none() {
             // The pass holds what the online sums lost.
             let Some((crush, separation)) = passed else {
