@@ -87,16 +87,17 @@ pub struct Shift {
 /// Why [`shift`] did not place touch.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum Unplaced {
-    /// The samples cannot tell: fewer compression samples than [`JUMP_MIN_SAMPLES`] (or more
-    /// than [`JUMP_MAX_SAMPLES`], where half a sample is under 0.1 % of the crush time),
-    /// touch before the sample before the onset (the fit places it in the interval before
-    /// the onset only), or a fit whose shift no sample tells ([`JUMP_SLOPE`], [`JUMP_LEVER`],
-    /// a singular one). Where the frame's touch is a line's zero, a jump after it onto a
-    /// ramp is as likely as a ramp begun there.
+    /// No fit: fewer compression samples than [`JUMP_MIN_SAMPLES`] (or more than
+    /// [`JUMP_MAX_SAMPLES`], where half a sample is under 0.1 % of the crush time), touch
+    /// before the sample before the onset (the fit places it in the interval before the
+    /// onset only), or a singular fit. Where the frame's touch is a line's zero, a jump after
+    /// it onto a ramp is as likely as a ramp begun there.
     Unfit,
-    /// The fit ran and refutes a jump at touch: no force at touch or no stiffness, a residual
-    /// beyond its samples' noise, or a shift beyond the interval. A line's zero the frame's
-    /// touch stands on is a ramp's, and stands.
+    /// The fit ran and does not place a jump at touch: no force at touch or no stiffness, a
+    /// residual beyond its samples' noise, a shift beyond the interval, or a shift no sample
+    /// tells ([`JUMP_SLOPE`], [`JUMP_LEVER`]: taken as no jump, since seed 001's
+    /// `k x (1 + c v)`, which has none, reads so at 20 and 25 kS/s, its line's zero right
+    /// within 1 %). A line's zero the frame's touch stands on is a ramp's, and stands.
     NotThisLaw,
 }
 
@@ -144,10 +145,6 @@ pub fn shift(
         fitted(compression, dev, (w0, y_lead), g, (tilt, past_middle))
     };
     let unfit = Unplaced::Unfit;
-    // A shift the fit cannot tell: taken as no jump (seed 001's `k x (1 + c v)`, which has
-    // none, reads as a damper whose shift the fit cannot tell at 20 and 25 kS/s, its line's
-    // zero right within 1 %).
-    let untold = |_: &Fitted| refused;
     let first = at(0.0, 0.0).ok_or(unfit)?;
     let l = first.lost;
     let mut lo = (0.0, first.s);
@@ -157,11 +154,11 @@ pub fn shift(
     for _ in 0..JUMP_STEPS {
         let slope = (hi.1 - lo.1) / (hi.0 - lo.0);
         if !(libm::fabs(1.0 - slope) >= JUMP_SLOPE) {
-            return Err(untold(&placed));
+            return Err(refused);
         }
         let sigma = lo.0 + (lo.1 - lo.0) / (1.0 - slope);
         if !sigma.is_finite() {
-            return Err(untold(&placed));
+            return Err(refused);
         }
         estimate = sigma;
         placed = at(sigma, l).ok_or(unfit)?;
@@ -171,10 +168,11 @@ pub fn shift(
             break;
         }
     }
-    // (Beyond the interval by more than the fit's own scatter: not this law.)
+    // (A shift no sample tells: see [`Unplaced::NotThisLaw`].)
     if !placed.told {
-        return Err(untold(&placed));
+        return Err(refused);
     }
+    // (Beyond the interval by more than the fit's own scatter: not this law.)
     let holds = placed.law
         && (estimate - past_middle).abs() <= 1.0
         && residual(compression, dev, w0, placed.tilt, &placed.b)
@@ -213,7 +211,7 @@ const JUMP_STEPS: usize = 3;
 pub const JUMP_MAX_SAMPLES: usize = 512;
 
 /// One fit's shift, the force at touch `h`, the body's deceleration then `lost`, whether
-/// whether the law's stiffness and damper are both positive (`law`) and its shift can be
+/// the law's stiffness and damper are both positive (`law`) and its shift can be
 /// told (`told`), and what [`residual`] needs (`tilt`, the coefficients `b`).
 struct Fitted {
     s: f64,

@@ -340,7 +340,7 @@ fn place_jump(
         // there. A zero before it, where the capture starts at the onset, it did not place.)
         Err(jump::Unplaced::NotThisLaw)
             if s.touch_offset != crate::signal::power_flank::JUMP_MIDDLE
-                && s.touch_offset >= -1.0 =>
+                && s.touch_offset > -1.0 =>
         {
             let mut ramp = *frame;
             ramp.touch_reach = 0.0;
@@ -551,6 +551,7 @@ fn analyse_contact<const CAP: usize>(
     let (deformation, ln_x) = rest.split_at_mut(points);
     // Against a target: the contact's kinematics from a pass of their own (the body's
     // verdicts replaced; the body's own pass not run), the fit points in the contact's frame.
+    // (A target without the body's mass, which the scene refuses, takes the rigid path.)
     let x_max = if let (Some(t), Some(m1)) = (scene.target, scene.mass_kg) {
         *relative = true;
         let out = (points > 0).then_some(PointsOut {

@@ -66,16 +66,18 @@ pub struct Summary {
     /// First touch lies in the interval before a force that may have jumped there from zero
     /// (a damper's `c v0`, [`crate::signal::power_flank::steep_zero`]): at its middle, or at
     /// the zero of the onset's line (a jump onto a ramp, smaller than a sample's rise, lies
-    /// on one; where that zero lies before the quiet sample before the onset, touch lies
-    /// between it and the onset); the samples cannot tell where in that interval it lies;
+    /// on one; where that zero lies before the sample before the onset, touch lies between
+    /// it and the onset, or that sample where it stands out of the noise); the samples cannot
+    /// tell where in that interval it lies;
     /// the analysis places it from the contact's law where it can ([`crate::analysis::jump`]),
     /// and where not, says how far off it may be (`touch_reach`).
     pub touch_jump: bool,
     /// Samples first touch may lie from `touch_offset` where it is a jump's (`touch_jump`;
     /// else 0) and nothing but the contact's law can narrow it: half a sample from the
-    /// interval's middle; as far as the onset from a line's zero (a jump onto a ramp lies on
-    /// a line whose zero is earlier); 0 from a power curve's other than the line (a jump onto
-    /// a ramp gives none: the foot's zero).
+    /// interval's middle; from a line's zero (a jump onto a ramp lies on a line whose zero is
+    /// earlier), as far as the onset, or as far as the sample before it where that sample
+    /// stands out of the noise (its force says touch came earlier); 0 from a power curve's
+    /// other than the line (a jump onto a ramp gives none: the foot's zero).
     pub touch_reach: f32,
     /// Stream index of the first sample back within the edge level after the peak, if any.
     pub separation_index: Option<u64>,
