@@ -597,6 +597,54 @@ fn bounce_trains_of_every_law_within_one_percent() {
     }
 }
 
+/// The laws of a 1 ms contact for the 60 g body: linear, Hertz, seed 001's law and
+/// Kelvin–Voigt.
+fn one_millisecond_laws() -> [(&'static str, Model<f64>); 4] {
+    let k = 0.06 * (std::f64::consts::PI / 1e-3f64).powi(2);
+    [
+        ("linear", Model::Linear(impact_core::model::Linear { k })),
+        (
+            "hertz",
+            Model::Hertz(impact_core::model::Hertz { k: 3.0e7 }),
+        ),
+        (
+            "nonlinear",
+            Model::Nonlinear(Nonlinear { k, c: 0.3, n: 1.0 }),
+        ),
+        (
+            "kelvin-voigt",
+            Model::KelvinVoigt(KelvinVoigt { k, c: 20.0 }),
+        ),
+    ]
+}
+
+/// Law `name` dropped from rest 91 mm at `rate`, touch `phase` of a sample in, analysed
+/// (±20 000 m/s²): its one impact and the truth.
+fn one_millisecond_drop(
+    scratch: &Scratch,
+    name: &str,
+    law: Model<f64>,
+    rate: f64,
+    phase: f64,
+) -> (Value, ContactTruth) {
+    let drop = from_rest(law, 0.091, rate, phase);
+    let (text, truth) = csv(&drop, rate, 0.5, 20_000.0);
+    let a = analyse(
+        scratch,
+        &format!("short-{name}-{rate}-{phase}.csv"),
+        text,
+        &["--drop-height", "0.091", "--range", "20000"],
+    );
+    let impacts = a["impacts"].as_array().unwrap();
+    assert_eq!(
+        impacts.len(),
+        1,
+        "{name} at {rate} S/s, phase {phase}: {impacts:#?}"
+    );
+    let truth = truth.into_iter().next().expect("one contact");
+    (impacts[0].clone(), truth)
+}
+
 /// 1 ms contacts (linear, Hertz, seed 001's law and Kelvin–Voigt, 91 mm drops from rest) at
 /// coarse rates, eight touch phases: at 100 kS/s (100 samples a contact) every field within
 /// 1 % ([`check`]: Kelvin–Voigt's set null);
@@ -623,37 +671,11 @@ fn bounce_trains_of_every_law_within_one_percent() {
 #[test]
 fn a_one_millisecond_contact_at_coarse_rates() {
     let scratch = Scratch::new();
-    let k = 0.06 * (std::f64::consts::PI / 1e-3f64).powi(2);
-    let laws = [
-        ("linear", Model::Linear(impact_core::model::Linear { k })),
-        (
-            "hertz",
-            Model::Hertz(impact_core::model::Hertz { k: 3.0e7 }),
-        ),
-        (
-            "nonlinear",
-            Model::Nonlinear(Nonlinear { k, c: 0.3, n: 1.0 }),
-        ),
-        (
-            "kelvin-voigt",
-            Model::KelvinVoigt(KelvinVoigt { k, c: 20.0 }),
-        ),
-    ];
-    for (name, law) in laws {
+    for (name, law) in one_millisecond_laws() {
         for rate in [100_000.0, 20_000.0, 10_000.0, 5_000.0] {
             for phase in [0.0, 0.125, 0.25, 0.375, 0.5, 0.625, 0.75, 0.875] {
-                let drop = from_rest(law, 0.091, rate, phase);
                 let what = format!("1 ms {name} at {rate} S/s, phase {phase}");
-                let (text, truth) = csv(&drop, rate, 0.5, 20_000.0);
-                let a = analyse(
-                    &scratch,
-                    &format!("short-{name}-{rate}-{phase}.csv"),
-                    text,
-                    &["--drop-height", "0.091", "--range", "20000"],
-                );
-                let impacts = a["impacts"].as_array().unwrap();
-                assert_eq!(impacts.len(), 1, "{what}: {impacts:#?}");
-                let (r, t) = (&impacts[0], &truth[0]);
+                let (r, t) = &one_millisecond_drop(&scratch, name, law, rate, phase);
                 // First touch within the sample interval the report states, at every rate.
                 let u = r["touch_uncertainty_s"].as_f64().unwrap();
                 assert_eq!(u, 1.0 / rate, "{what}");
@@ -743,38 +765,12 @@ fn a_one_millisecond_contact_at_coarse_rates() {
 #[test]
 fn between_sixteen_and_twenty_five_kilosamples_within_two_percent_or_undersampled() {
     let scratch = Scratch::new();
-    let k = 0.06 * (std::f64::consts::PI / 1e-3f64).powi(2);
-    let laws = [
-        ("linear", Model::Linear(impact_core::model::Linear { k })),
-        (
-            "hertz",
-            Model::Hertz(impact_core::model::Hertz { k: 3.0e7 }),
-        ),
-        (
-            "nonlinear",
-            Model::Nonlinear(Nonlinear { k, c: 0.3, n: 1.0 }),
-        ),
-        (
-            "kelvin-voigt",
-            Model::KelvinVoigt(KelvinVoigt { k, c: 20.0 }),
-        ),
-    ];
     let (mut held, mut null) = (0, 0);
-    for (name, law) in laws {
+    for (name, law) in one_millisecond_laws() {
         for rate in [25_000.0, 16_000.0] {
             for phase in [0.0, 0.125, 0.25, 0.375, 0.5, 0.625, 0.75, 0.875, 0.95, 0.99] {
-                let drop = from_rest(law, 0.091, rate, phase);
                 let what = format!("1 ms {name} at {rate} S/s, phase {phase}");
-                let (text, truth) = csv(&drop, rate, 0.5, 20_000.0);
-                let a = analyse(
-                    &scratch,
-                    &format!("mid-{name}-{rate}-{phase}.csv"),
-                    text,
-                    &["--drop-height", "0.091", "--range", "20000"],
-                );
-                let impacts = a["impacts"].as_array().unwrap();
-                assert_eq!(impacts.len(), 1, "{what}");
-                let (r, t) = (&impacts[0], &truth[0]);
+                let (r, t) = &one_millisecond_drop(&scratch, name, law, rate, phase);
                 within(&r["cor"], t.separation.unwrap().cor, 0.02, &what);
                 // (The cases that had been wrong, unflagged: null.)
                 let was_wrong = matches!(

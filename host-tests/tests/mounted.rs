@@ -77,25 +77,38 @@ fn analyse(
 ) -> (Value, StrikeTruth) {
     let n = ((strike.touch_s + 0.08) * rate) as usize;
     let (accel, truth) = strike.render(rate, n).expect("a valid strike");
-    let text = impact_host::testkit::sensor::csv_of(&accel, rate, full_scale);
+    let extra: Vec<&str> = extra.iter().map(String::as_str).collect();
+    let (json, _) = analyse_accel(scratch, &accel, rate, full_scale, strike.v0_m_s, &extra);
+    let impacts = json["impacts"].as_array().unwrap();
+    assert_eq!(impacts.len(), 1, "{json:#}");
+    (json, truth)
+}
+
+/// The 60 g body's acceleration `accel` at `rate` (a 16-bit ADC over ±`full_scale`) analysed
+/// with `--v0 v0` and `extra`: the JSON and what the tool wrote on stderr.
+fn analyse_accel(
+    scratch: &Scratch,
+    accel: &[f64],
+    rate: f64,
+    full_scale: f64,
+    v0: f64,
+    extra: &[&str],
+) -> (Value, String) {
+    let text = impact_host::testkit::sensor::csv_of(accel, rate, full_scale);
     let path = scratch.file("strike.csv", text);
-    let mut args: Vec<String> = [
+    let v0 = v0.to_string();
+    let mut args = vec![
         "analyze",
         path.to_str().unwrap(),
         "--json",
         "--mass",
         "0.06",
-    ]
-    .iter()
-    .map(|s| s.to_string())
-    .collect();
-    args.extend(["--v0".into(), strike.v0_m_s.to_string()]);
+        "--v0",
+        &v0,
+    ];
     args.extend_from_slice(extra);
-    let args: Vec<&str> = args.iter().map(String::as_str).collect();
-    let json: Value = serde_json::from_str(&impact_ok(&args).0).unwrap();
-    let impacts = json["impacts"].as_array().unwrap();
-    assert_eq!(impacts.len(), 1, "{json:#}");
-    (json, truth)
+    let (out, err) = impact_ok(&args);
+    (serde_json::from_str(&out).unwrap(), err)
 }
 
 fn off(got: &Value, want: f64) -> f64 {
@@ -385,26 +398,13 @@ fn a_contact_longer_than_the_capture_is_measured_on_its_means() {
     let full_scale = 2.0 * strike_peak(&strike, 500e3) / 0.06;
     let n = ((strike.touch_s + 0.08) * 500e3) as usize;
     let (accel, t) = strike.render(500e3, n).unwrap();
-    let text = impact_host::testkit::sensor::csv_of(&accel, 500e3, full_scale);
-    let path = scratch.file("long.csv", text);
     // (The sensor's range said: the soft pulse's rounded top, flat over many codes, is no
     // rail.)
     let range = format!("{full_scale}");
-    let mut args = vec![
-        "analyze",
-        path.to_str().unwrap(),
-        "--json",
-        "--mass",
-        "0.06",
-        "--v0",
-        "1.3357",
-        "--range",
-        &range,
-    ];
+    let mut args = vec!["--range", &range];
     let target = target_args(&SOFT);
     args.extend(target.iter().map(String::as_str));
-    let (out, err) = impact_ok(&args);
-    let json: Value = serde_json::from_str(&out).unwrap();
+    let (json, err) = analyse_accel(&scratch, &accel, 500e3, full_scale, 1.3357, &args);
     let r = &json["impacts"][0];
     assert_eq!(r["flags"], serde_json::json!(["decimated"]), "{r}");
     assert!(
@@ -436,22 +436,10 @@ fn where_the_contact_cannot_be_known_against_a_target_it_is_null_with_its_reason
     let n = ((strike.touch_s + 0.08) * 500e3) as usize;
     let (accel, _) = strike.render(500e3, n).unwrap();
     let run = |range: f64, target: &[&str]| -> Value {
-        let text = impact_host::testkit::sensor::csv_of(&accel, 500e3, range);
-        let path = scratch.file("strike.csv", text);
-        let range = format!("{range}");
-        let mut args = vec![
-            "analyze",
-            path.to_str().unwrap(),
-            "--json",
-            "--mass",
-            "0.06",
-            "--v0",
-            "1.3357",
-            "--range",
-            &range,
-        ];
+        let range_arg = format!("{range}");
+        let mut args = vec!["--range", &range_arg];
         args.extend(target);
-        let json: Value = serde_json::from_str(&impact_ok(&args).0).unwrap();
+        let (json, _) = analyse_accel(&scratch, &accel, 500e3, range, 1.3357, &args);
         json["impacts"][0].clone()
     };
     // A target ten thousand times lighter than the mount (a free 10 mg): the contact's COR
