@@ -235,18 +235,6 @@ pub fn contact(
     match rel {
         Ok(rel) => {
             kinematics(r, scene, frame, &rel);
-            // A jump at touch, which this pass does not place (`analysis::jump` is the
-            // body's): first touch lies anywhere in its interval, which moves `x_m` by up
-            // to half a sample at `v0` from its middle (measured: +7 % on a Kelvin–Voigt
-            // pad at 20 kS/s, 0.7 % at 100 kS/s), as far as the onset from a line's zero.
-            if !touch_placed(frame.touch_reach, frame, rel.x_max) {
-                if let Some(k) = r.kinematics.as_mut() {
-                    k.crush_time_s = None;
-                    k.max_deformation_m = None;
-                    k.separation_deformation_m = None;
-                    r.flags.insert(Flags::UNDERSAMPLED);
-                }
-            }
             r.kinematics
                 .and_then(|k| k.max_deformation_m)
                 .map(|_| rel.x_max)
@@ -265,8 +253,12 @@ pub fn contact(
 /// `r`'s kinematics from the contact's relative motion: Newton's COR `(v' + w) / v0` (the
 /// body's rebound `v'` from Δv, as without a target), the crush time and the deformations
 /// relative to the target, the energy the contact absorbed (the body's loss, with gravity's
-/// work on it in a vertical contact, less the work done on the target). The COR's range and
-/// the compression's samples ([`MIN_CRUSH_SAMPLES`]) are checked as without a target.
+/// work on it in a vertical contact, less the work done on the target). The COR's range,
+/// the compression's samples ([`MIN_CRUSH_SAMPLES`]) and how far first touch may lie
+/// ([`touch_placed`]) are checked as without a target. (A jump at touch is not placed from
+/// the compression's law here, `analysis::jump` being the body's: first touch lies anywhere
+/// in its interval, up to half a sample from its middle, as far as the onset from a line's
+/// zero; measured +7 % on `x_m` on a Kelvin–Voigt pad at 20 kS/s, 0.7 % at 100 kS/s.)
 pub fn kinematics(r: &mut ImpactReport, scene: &Scene, frame: &Frame, rel: &Relative) {
     let v0 = frame.scale.v0 as f32;
     let gravity = scene.contact_gravity_m_s2();
@@ -279,7 +271,8 @@ pub fn kinematics(r: &mut ImpactReport, scene: &Scene, frame: &Frame, rel: &Rela
         return;
     }
     let crush_s = (rel.crush - frame.touch) * frame.scale.dt;
-    let resolved = crush_s * scene.calibration.sample_rate_hz as f64 >= MIN_CRUSH_SAMPLES;
+    let resolved = crush_s * scene.calibration.sample_rate_hz as f64 >= MIN_CRUSH_SAMPLES
+        && touch_placed(frame.touch_reach, frame, rel.x_max);
     if !resolved {
         r.flags.insert(Flags::UNDERSAMPLED);
     }
