@@ -130,6 +130,48 @@ pub fn band_table<E>(
     table.get(..n).ok_or(BandTableError::TooManyRows)
 }
 
+/// A state-space target from `n:A (row by row):B:C (displacement's row, velocity's)`, in the
+/// one static a scene's target can borrow ([`impact_core::two_body::SceneTarget`]; on the
+/// STM32 a `static` in flash in [`BENCH`] instead). The static lies in the CCM RAM beside the
+/// analysis's workspace (its 240 bytes do not fit the emulator's data RAM; written here,
+/// after start-up zeroed it). A second call, a wrong count of numbers or one that is not a
+/// number is a bad value; `Scene::validate` checks the target.
+#[cfg(target_os = "none")]
+fn target_space(value: &str) -> Result<&'static impact_core::two_body::Target<f32>, SceneError> {
+    use impact_core::two_body::{Target, MAX_STATES};
+    #[link_section = ".ccmram.target"]
+    static TARGET: static_cell::StaticCell<Target<f32>> = static_cell::StaticCell::new();
+    let mut values = value.split(':');
+    let n = (values.next())
+        .and_then(|v| v.parse::<usize>().ok())
+        .filter(|n| (1..=MAX_STATES).contains(n))
+        .ok_or(SceneError::BadValue)?;
+    let mut t = Target {
+        n,
+        a: [[0.0; MAX_STATES]; MAX_STATES],
+        b: [0.0; MAX_STATES],
+        c: [[0.0; MAX_STATES]; 2],
+        spring_mass: None,
+    };
+    let slots = (t.a.iter_mut().take(n).flat_map(|r| r.iter_mut().take(n)))
+        .chain(t.b.iter_mut().take(n))
+        .chain(t.c.iter_mut().flat_map(|r| r.iter_mut().take(n)));
+    for slot in slots {
+        let v = values.next().ok_or(SceneError::BadValue)?;
+        *slot = v.parse::<f32>().map_err(|_| SceneError::BadValue)?;
+    }
+    if values.next().is_some() {
+        return Err(SceneError::BadValue);
+    }
+    TARGET.try_init(t).map(|t| &*t).ok_or(SceneError::BadValue)
+}
+
+/// Off the board (the library on the host): no static to keep a target in.
+#[cfg(not(target_os = "none"))]
+fn target_space(_: &str) -> Result<&'static impact_core::two_body::Target<f32>, SceneError> {
+    Err(SceneError::BadValue)
+}
+
 /// Why a `key=value` scene argument was refused.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 #[cfg_attr(not(feature = "emulator"), allow(dead_code))]
@@ -182,6 +224,7 @@ impl defmt::Format for SceneError {
 /// | `wave` | send each captured window: `0` not, `1` whole, `N` the mean of every `N` samples |
 /// | `target_mass` | the target the body strikes, kg (a mass on a spring and damper to ground: the kinematics are the contact's), or `none` (a rigid, fixed barrier) |
 /// | `target_stiffness`, `target_damping` | its spring, N/m, and damper, N s/m, to ground (after `target_mass`; 0 without them) |
+/// | `target_space` | or a linear target in state-space form ([`impact_core::two_body::Target`]), `:`-separated: its order `n` (1 to 6), `A` row by row, `B`, `C` (the displacement's row, then the velocity's); once a run (kept in one static: [`target_space`]) |
 ///
 /// Floats are parsed by `core`'s correctly rounded parser, so the shortest round-trip decimal
 /// of an `f32` (Rust's `{}` or `{:e}`) gives back exactly that `f32`.
@@ -286,25 +329,34 @@ pub fn apply(scene: &mut Scene, key: &str, value: &str) -> Result<(), SceneError
             }
             scene.spectrum = Some(sp);
         }
-        "target_mass" => {
-            scene.target = opt_float(value)?.map(|mass_kg| impact_core::two_body::SpringMass {
-                mass_kg,
-                ..scene.target.unwrap_or(impact_core::two_body::SpringMass {
+        // A spring–mass target: each key rebuilds it from the numbers so far.
+        "target_mass" | "target_stiffness" | "target_damping" => {
+            use impact_core::two_body::{SceneTarget, SpringMass};
+            let old = scene.target.and_then(|t| t.spring_mass());
+            let s = match key {
+                "target_mass" => opt_float(value)?.map(|mass_kg| SpringMass {
                     mass_kg,
-                    stiffness_n_m: 0.0,
-                    damping_n_s_m: 0.0,
-                })
-            })
+                    ..old.unwrap_or(SpringMass {
+                        mass_kg,
+                        stiffness_n_m: 0.0,
+                        damping_n_s_m: 0.0,
+                    })
+                }),
+                "target_stiffness" => Some(SpringMass {
+                    stiffness_n_m: float(value)?,
+                    ..old.ok_or(SceneError::BadValue)?
+                }),
+                _ => Some(SpringMass {
+                    damping_n_s_m: float(value)?,
+                    ..old.ok_or(SceneError::BadValue)?
+                }),
+            };
+            scene.target = s.map(SceneTarget::SpringMass);
         }
-        "target_stiffness" | "target_damping" => {
-            let mut t = scene.target.ok_or(SceneError::BadValue)?;
-            let v = float(value)?;
-            if key == "target_stiffness" {
-                t.stiffness_n_m = v;
-            } else {
-                t.damping_n_s_m = v;
-            }
-            scene.target = Some(t);
+        "target_space" => {
+            scene.target = Some(impact_core::two_body::SceneTarget::StateSpace(
+                target_space(value)?,
+            ))
         }
         "gravity" => scene.gravity_m_s2 = float(value)?,
         "vertical" => scene.vertical = flag(value)?,

@@ -287,6 +287,12 @@ pub struct SynthArgs {
     /// `F / m`).
     #[arg(long, help_heading = "Target", conflicts_with_all = ["drop_height", "bounces", "impacts"])]
     pub target_mass: Option<f64>,
+    /// The body strikes a linear target in state-space form instead (JSON, as `impact
+    /// simulate --target`: input the contact force, N; outputs the contact point's
+    /// displacement, m, and velocity, m/s; at rest at first touch).
+    #[arg(long, help_heading = "Target", value_name = "FILE",
+          conflicts_with_all = ["drop_height", "bounces", "impacts", "target_mass"])]
+    pub target: Option<std::path::PathBuf>,
     /// The target's spring to ground, N/m [default: 0, a free body].
     #[arg(long, help_heading = "Target", requires = "target_mass")]
     pub target_stiffness: Option<f64>,
@@ -339,6 +345,9 @@ pub enum SynthError {
     Output(#[from] crate::output::OutputError),
     #[error("stdout: {0}")]
     Stdout(std::io::Error),
+    /// `--target FILE` not read or refused (boxed: its path and reasons are large).
+    #[error(transparent)]
+    Target(Box<crate::simulate::two_body::TargetError>),
 }
 
 /// `--drop-every` refused (clap shows it after the option and the value).
@@ -408,7 +417,11 @@ pub fn synth(args: &SynthArgs) -> Result<Recording, SynthError> {
     }
     if let Some(strike) = args.strike(&model) {
         let n = (args.duration * args.rate).ceil() as usize;
-        let (accel, truth) = strike.render(args.rate, n)?;
+        let space = (args.target.as_deref())
+            .map(crate::simulate::two_body::read_state_space)
+            .transpose()
+            .map_err(|e| SynthError::Target(Box::new(e)))?;
+        let (accel, truth) = strike.render_on(space.as_ref(), args.rate, n)?;
         let (samples, clipped) = quantise(&sensor, &accel);
         return Ok(Recording {
             samples,
@@ -461,8 +474,14 @@ impl SynthArgs {
 }
 
 impl SynthArgs {
-    /// The strike on a target `--target-mass` asks for, if it does.
+    /// The strike on a target `--target-mass` (or `--target`, whose state space the strike
+    /// is rendered on: its mount is then a placeholder) asks for, if it does.
     pub fn strike(&self, model: &impact_core::Model<f64>) -> Option<crate::drop::mounted::Strike> {
+        let mass_kg = match (self.target_mass, &self.target) {
+            (Some(m), _) => m,
+            (None, Some(_)) => 1.0,
+            (None, None) => return None,
+        };
         Some(crate::drop::mounted::Strike {
             law: *model,
             mass_kg: self.mass,
@@ -474,7 +493,7 @@ impl SynthArgs {
                 0.0
             },
             mount: crate::drop::mounted::Mount {
-                mass_kg: self.target_mass?,
+                mass_kg,
                 stiffness_n_m: self.target_stiffness.unwrap_or(0.0),
                 damping_n_s_m: self.target_damping.unwrap_or(0.0),
             },

@@ -1954,6 +1954,85 @@ fn drops_and_trains_on_the_board_are_the_hosts_and_within_one_percent() {
     }
 }
 
+/// A body striking a fixture of three masses given as a state space (`--target FILE`, as
+/// `impact simulate --target` takes it; six states, the most, so the longest scene key):
+/// the board gets it in its scene (`target_space`), states it on its scene line, and reports
+/// the contact's kinematics with the host's bits, within the board's limits; `impact log`
+/// reads the target back from that line.
+#[test]
+fn a_state_space_target_is_the_hosts_on_the_board() {
+    let scratch = Scratch::new();
+    let Some(elf) = firmware() else { return };
+    let elf = elf.to_string_lossy().into_owned();
+    // The plate (0.3 kg) on 4e4 N/m and 12 N s/m to a 1 kg base on 1e6 N/m and 60 N s/m to
+    // a 5 kg floor on 1e7 N/m and 200 N s/m.
+    let space = scratch.text(
+        "fixture.json",
+        r#"{"a": [[0, 1, 0, 0, 0, 0],
+                  [-133333.33333333334, -40, 133333.33333333334, 40, 0, 0],
+                  [0, 0, 0, 1, 0, 0],
+                  [40000, 12, -1040000, -72, 1000000, 60],
+                  [0, 0, 0, 0, 0, 1],
+                  [0, 0, 200000, 12, -2200000, -52]],
+            "b": [0, 3.3333333333333335, 0, 0, 0, 0],
+            "c": [[1, 0, 0, 0, 0, 0], [0, 1, 0, 0, 0, 0]]}"#,
+    );
+    let csv = scratch.join_str("fixture-strike.csv");
+    let (code, _, err) = common::impact(&[
+        "synth",
+        "--model",
+        "hertz",
+        "--mass",
+        "0.06",
+        "--v0",
+        "1.3357",
+        "--stiffness",
+        "1e9",
+        "--target",
+        &space,
+        "--full-scale",
+        "20000",
+        "--bits",
+        "15",
+        "--duration",
+        "0.03",
+        "-o",
+        &csv,
+    ]);
+    assert_eq!(code, 0, "{err}");
+    let options = [
+        "--mass",
+        "0.06",
+        "--v0",
+        "1.3357",
+        "--target",
+        space.as_str(),
+    ];
+    emulator_and_log_match_host(&csv, &options, false);
+    let mut args = vec!["emulate", csv.as_str(), "--json", "--elf", &elf];
+    args.extend(options);
+    let (out, log) = impact(&args);
+    within_board_limits(&log);
+    assert!(
+        log.contains("target_mass_kg=none target_stiffness_n_m=none target_damping_n_s_m=none target_space=6,0.0,1.0,0.0,0.0,0.0,0.0,-133333.33,"),
+        "the scene line does not state the target\n{log}"
+    );
+    let v: serde_json::Value = serde_json::from_str(&out).unwrap();
+    assert_eq!(
+        v["target"]["state_space"]["b"][1], 3.3333333,
+        "{}",
+        v["target"]
+    );
+    let log_path = scratch.text("fixture.log", &log);
+    let (from_log, _) = impact(&["log", &log_path, "--json"]);
+    let from_log: serde_json::Value = serde_json::from_str(&from_log).unwrap();
+    for key in ["target", "impacts", "assumptions"] {
+        assert_eq!(from_log[key], v[key], "impact log's {key}");
+    }
+    let cor = v["impacts"][0]["cor"].as_f64().unwrap();
+    assert!((cor - 0.999).abs() < 0.005, "{cor}");
+}
+
 /// A body striking a mounted target (`--target-mass`, its spring and damper): the board
 /// gets the target in its scene, states it on its scene line, and reports the contact's
 /// kinematics (Newton's COR, the relative crush and deformation, the contact's work) with

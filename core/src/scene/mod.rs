@@ -137,11 +137,11 @@ pub struct Scene {
     /// Send each captured window off the board after its analysis ([`crate::waveform`]):
     /// 0 not, 1 whole, `N` the mean of every `N` samples.
     pub waveform_every: u16,
-    /// The body struck a target on a spring and damper to ground, not a rigid wall
-    /// (the analysis's `target` pass): the COR, crush time, deformations and absorbed energy
-    /// are the contact's, relative to the target's measured-force response. `None`: a rigid,
-    /// fixed barrier.
-    pub target: Option<crate::two_body::SpringMass<f32>>,
+    /// The body struck a target that moves, not a rigid wall (the analysis's `target`
+    /// pass): a mass on a spring and damper to ground, or a linear state space. The COR,
+    /// crush time, deformations and absorbed energy are the contact's, relative to the
+    /// target's measured-force response. `None`: a rigid, fixed barrier.
+    pub target: Option<crate::two_body::SceneTarget>,
 }
 
 impl Scene {
@@ -260,22 +260,33 @@ impl Scene {
             });
         }
         if let Some(t) = self.target {
-            positive(t.mass_kg, "target-mass")?;
-            non_negative(t.stiffness_n_m, "target-stiffness")?;
-            non_negative(t.damping_n_s_m, "target-damping")?;
+            use crate::two_body::SceneTarget;
+            // Named as the user gave it: the spring–mass's options, or the state space.
+            let name = match t {
+                SceneTarget::SpringMass(s) => {
+                    positive(s.mass_kg, "target-mass")?;
+                    non_negative(s.stiffness_n_m, "target-stiffness")?;
+                    non_negative(s.damping_n_s_m, "target-damping")?;
+                    "target-mass"
+                }
+                SceneTarget::StateSpace(t) => {
+                    t.validate()?;
+                    "target"
+                }
+            };
             if self.mass_kg.is_none() {
                 return Err(Error::InvalidParameter {
-                    name: "target-mass",
+                    name,
                     reason: "needs the body's mass: the measured force (mass times the reading) drives the target",
                 });
             }
             if self.train.is_some() {
                 return Err(Error::InvalidParameter {
-                    name: "target-mass",
+                    name,
                     reason: "cannot be given with a bounce train: each contact's kinematics assume the target at rest at first touch, and a bounce comes back to a target still moving",
                 });
             }
-            // The target's velocity after the largest force the sensor can read, held for
+            // The target's motion after the largest force the sensor can read, held for
             // the longest pass, must be a finite f32 (at this rate; a decimated capture's
             // coarser step gives less).
             let dt = 1.0 / c.sample_rate_hz as f64;
@@ -283,13 +294,16 @@ impl Scene {
                 self.mass_kg.unwrap_or(0.0) as f64 * c.gain_m_s2_per_count.abs() as f64 * 65536.0;
             // (The longest pass: the analysis's exact sums cover at most 2^17 samples.)
             let steps = (1u32 << 17) as f64;
-            let finite = crate::two_body::step::Discrete::new(&t, dt).is_some_and(|d| {
+            let finite = crate::two_body::step::Stepper::new(&t, dt).is_some_and(|d| {
                 d.largest_gain() as f64 * largest_force * steps <= f32::MAX as f64 / 1e3
             });
             if !finite {
                 return Err(Error::InvalidParameter {
-                    name: "target-mass",
-                    reason: "too light for the forces the sensor reads: the target's motion would overflow",
+                    name,
+                    reason: match t {
+                        SceneTarget::SpringMass(_) => "too light for the forces the sensor reads: the target's motion would overflow",
+                        SceneTarget::StateSpace(_) => "too compliant for the forces the sensor reads: the target's motion would overflow",
+                    },
                 });
             }
         }
@@ -415,7 +429,8 @@ impl Scene {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::two_body::SpringMass;
+    use crate::two_body::{SceneTarget, SpringMass, Target};
+    extern crate std;
 
     fn with_target(mass_kg: f32, stiffness_n_m: f32) -> Scene {
         let mut s = Scene::new(
@@ -426,11 +441,11 @@ mod tests {
             10.0,
         );
         s.mass_kg = Some(0.06);
-        s.target = Some(SpringMass {
+        s.target = Some(SceneTarget::SpringMass(SpringMass {
             mass_kg,
             stiffness_n_m,
             damping_n_s_m: 0.0,
-        });
+        }));
         s
     }
 
@@ -463,5 +478,25 @@ mod tests {
         let mut no_mass = with_target(0.3, 0.0);
         no_mass.mass_kg = None;
         assert!(no_mass.validate().is_err());
+        // A state space is checked as one, named `target`: here an unstable one.
+        let mut unstable = with_target(0.3, 0.0);
+        let mut t = Target::of_spring_mass(SpringMass {
+            mass_kg: 0.3,
+            stiffness_n_m: -4e4,
+            damping_n_s_m: 0.0,
+        });
+        t.spring_mass = None;
+        static UNSTABLE: std::sync::OnceLock<Target<f32>> = std::sync::OnceLock::new();
+        unstable.target = Some(SceneTarget::StateSpace(UNSTABLE.get_or_init(|| t)));
+        let err = unstable.validate();
+        assert!(
+            matches!(err, Err(Error::InvalidParameter { name: "target", .. })),
+            "{err:?}"
+        );
+        // And a stable one passes.
+        t.a[1][0] = 4e4 / -0.3;
+        static STABLE: std::sync::OnceLock<Target<f32>> = std::sync::OnceLock::new();
+        unstable.target = Some(SceneTarget::StateSpace(STABLE.get_or_init(|| t)));
+        assert_eq!(unstable.validate(), Ok(()));
     }
 }

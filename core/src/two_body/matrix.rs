@@ -39,7 +39,7 @@ impl<R: Real> Mat<R> {
 
     /// `self * other` (orders must agree; the smaller is used).
     pub fn mul(&self, other: &Self) -> Self {
-        let n = self.n.min(other.n);
+        let n = self.n.min(other.n).min(DIM);
         let mut out = Self::zero(n);
         for i in 0..n {
             for k in 0..n {
@@ -102,8 +102,9 @@ impl<R: Real> Mat<R> {
     pub fn exp(&self, t: R) -> Option<Self> {
         let (balanced, d) = self.balance();
         let mut e = balanced.exp_unbalanced(t)?;
-        for i in 0..self.n {
-            for j in 0..self.n {
+        let n = self.n.min(DIM);
+        for i in 0..n {
+            for j in 0..n {
                 e.a[i][j] = e.a[i][j] * d[i] / d[j];
             }
         }
@@ -115,7 +116,7 @@ impl<R: Real> Mat<R> {
     fn balance(&self) -> (Self, Vector<R>) {
         let mut m = *self;
         let mut d = [R::ONE; DIM];
-        let n = self.n;
+        let n = self.n.min(DIM);
         for _sweep in 0..64 {
             let mut changed = false;
             for i in 0..n {
@@ -184,7 +185,7 @@ impl<R: Real> Mat<R> {
         let mut p = Self::identity(self.n);
         for k in (1..=18u32).rev() {
             p = x.mul(&p).scaled(R::ONE / R::from_u32(k));
-            for i in 0..self.n {
+            for i in 0..self.n.min(DIM) {
                 p.a[i][i] += R::ONE;
             }
         }
@@ -197,7 +198,7 @@ impl<R: Real> Mat<R> {
     /// The inverse by Gauss–Jordan elimination with partial pivoting; `None` if the matrix is
     /// singular (a pivot below `n` epsilons of its column's largest entry) or not finite.
     pub fn inverse(&self) -> Option<Self> {
-        let n = self.n;
+        let n = self.n.min(DIM);
         let mut m = *self;
         let mut inv = Self::identity(n);
         let scale = m.norm_inf();

@@ -61,6 +61,33 @@ pub struct Target<R> {
     pub spring_mass: Option<SpringMass<R>>,
 }
 
+/// The target a scene's analysis pushes ([`crate::scene::Scene::target`]): a spring–mass by
+/// value, or a state space by reference (its 240 bytes on the board kept once, in a `static`,
+/// not in every copy of the scene).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum SceneTarget {
+    SpringMass(SpringMass<f32>),
+    StateSpace(&'static Target<f32>),
+}
+
+impl SceneTarget {
+    /// The spring–mass, if the target is one.
+    pub fn spring_mass(&self) -> Option<SpringMass<f32>> {
+        match self {
+            Self::SpringMass(s) => Some(*s),
+            Self::StateSpace(_) => None,
+        }
+    }
+
+    /// The state space, if the target is one.
+    pub fn state_space(&self) -> Option<&'static Target<f32>> {
+        match self {
+            Self::SpringMass(_) => None,
+            Self::StateSpace(t) => Some(t),
+        }
+    }
+}
+
 fn invalid(name: &'static str, reason: &'static str) -> Error {
     Error::InvalidParameter { name, reason }
 }
@@ -75,25 +102,33 @@ impl<R: Real> Target<R> {
         if !(damping_n_s_m.is_finite() && damping_n_s_m >= R::ZERO) {
             return Err(invalid("target-damping", "must be finite and >= 0"));
         }
+        let t = Self::of_spring_mass(SpringMass {
+            mass_kg,
+            stiffness_n_m,
+            damping_n_s_m,
+        });
+        t.validate()?;
+        Ok(t)
+    }
+
+    /// The matrices of the spring–mass `s`, unchecked (a scene's target as its keys set it:
+    /// [`crate::scene::Scene::validate`] checks its parameters, and the analysis steps it by
+    /// them, [`step::Stepper`]).
+    pub fn of_spring_mass(s: SpringMass<R>) -> Self {
         let mut t = Self {
             n: 2,
             a: [[R::ZERO; MAX_STATES]; MAX_STATES],
             b: [R::ZERO; MAX_STATES],
             c: [[R::ZERO; MAX_STATES]; 2],
-            spring_mass: Some(SpringMass {
-                mass_kg,
-                stiffness_n_m,
-                damping_n_s_m,
-            }),
+            spring_mass: Some(s),
         };
         t.a[0][1] = R::ONE;
-        t.a[1][0] = -stiffness_n_m / mass_kg;
-        t.a[1][1] = -damping_n_s_m / mass_kg;
-        t.b[1] = R::ONE / mass_kg;
+        t.a[1][0] = -s.stiffness_n_m / s.mass_kg;
+        t.a[1][1] = -s.damping_n_s_m / s.mass_kg;
+        t.b[1] = R::ONE / s.mass_kg;
         t.c[0][0] = R::ONE;
         t.c[1][1] = R::ONE;
-        t.validate()?;
-        Ok(t)
+        t
     }
 
     /// A general linear target; `d` is the direct feed-through of the force to the
@@ -127,23 +162,34 @@ impl<R: Real> Target<R> {
     }
 
     /// The target's own matrix `A` as a [`Mat`].
+    /// (Every method reads at most [`MAX_STATES`] states, whatever `n` holds: none can fail
+    /// on an index, as the board's build requires.)
     pub fn a_mat(&self) -> Mat<R> {
-        let mut m = Mat::zero(self.n);
-        for i in 0..self.n {
-            m.a[i][..self.n].copy_from_slice(&self.a[i][..self.n]);
+        let n = self.n.min(MAX_STATES);
+        let mut m = Mat::zero(n);
+        for (out, row) in m.a.iter_mut().zip(&self.a).take(n) {
+            for (o, a) in out.iter_mut().zip(row).take(n) {
+                *o = *a;
+            }
         }
         m
     }
 
     fn row(&self, r: usize) -> Vector<R> {
         let mut v = [R::ZERO; DIM];
-        v[..self.n].copy_from_slice(&self.c[r][..self.n]);
+        if let Some(c) = self.c.get(r) {
+            for (o, c) in v.iter_mut().zip(c).take(self.n) {
+                *o = *c;
+            }
+        }
         v
     }
 
     fn b_vec(&self) -> Vector<R> {
         let mut v = [R::ZERO; DIM];
-        v[..self.n].copy_from_slice(&self.b[..self.n]);
+        for (o, b) in v.iter_mut().zip(&self.b).take(self.n) {
+            *o = *b;
+        }
         v
     }
 
@@ -151,9 +197,9 @@ impl<R: Real> Target<R> {
     pub fn outputs(&self, z: &[R; MAX_STATES]) -> (R, R) {
         let mut y = R::ZERO;
         let mut w = R::ZERO;
-        for i in 0..self.n {
-            y += self.c[0][i] * z[i];
-            w += self.c[1][i] * z[i];
+        for ((cx, cv), z) in self.c[0].iter().zip(&self.c[1]).zip(z).take(self.n) {
+            y += *cx * *z;
+            w += *cv * *z;
         }
         (y, w)
     }

@@ -502,7 +502,7 @@ pub fn log_scene(scene: &Scene) {
     };
     let band = spec.and_then(|s| s.band);
     info!(
-        "scene rate_hz={=f32} gain_m_s2_per_count={=f32} mass_kg={} v0_m_s={} drop_height_m={} trigger_m_s2={=f32} edge_m_s2={=f32} hold_s={=f32} max_impact_s={=f32} settle_s={=f32} clip_low={=i16} clip_high={=i16} cfc={} trigger_cfc={} lowpass_order={} lowpass_cutoff_hz={} two_phase={=bool} nonlinear={=bool} fit_exponent={=bool} exponent={=f32} hertz={=bool} train={=str} gravity_m_s2={} max_flight_s={} srs={=bool} wave_every={=u16} v0_every={=bool} spec={=str} spec_peak_m_s2={} spec_duration_s={} spec_band={} spec_outside={} spec_slack={} spec_dv={} spec_before={} spec_after={} spec_watch={} spec_rise={} spec_fall={} spec_band_u={} spec_band_lower={} spec_band_upper={} target_mass_kg={} target_stiffness_n_m={} target_damping_n_s_m={}",
+        "scene rate_hz={=f32} gain_m_s2_per_count={=f32} mass_kg={} v0_m_s={} drop_height_m={} trigger_m_s2={=f32} edge_m_s2={=f32} hold_s={=f32} max_impact_s={=f32} settle_s={=f32} clip_low={=i16} clip_high={=i16} cfc={} trigger_cfc={} lowpass_order={} lowpass_cutoff_hz={} two_phase={=bool} nonlinear={=bool} fit_exponent={=bool} exponent={=f32} hertz={=bool} train={=str} gravity_m_s2={} max_flight_s={} srs={=bool} wave_every={=u16} v0_every={=bool} spec={=str} spec_peak_m_s2={} spec_duration_s={} spec_band={} spec_outside={} spec_slack={} spec_dv={} spec_before={} spec_after={} spec_watch={} spec_rise={} spec_fall={} spec_band_u={} spec_band_lower={} spec_band_upper={} target_mass_kg={} target_stiffness_n_m={} target_damping_n_s_m={} target_space={}",
         scene.calibration.sample_rate_hz,
         scene.calibration.gain_m_s2_per_count,
         Opt(scene.mass_kg),
@@ -547,10 +547,33 @@ pub fn log_scene(scene: &Scene) {
         BandColumn(band, |p| p.lower),
         BandColumn(band, |p| p.upper),
         // The target the kinematics are relative to (`none`: a rigid, fixed barrier).
-        Opt(scene.target.map(|t| t.mass_kg)),
-        Opt(scene.target.map(|t| t.stiffness_n_m)),
-        Opt(scene.target.map(|t| t.damping_n_s_m)),
+        Opt(scene.target.and_then(|t| t.spring_mass()).map(|t| t.mass_kg)),
+        Opt(scene.target.and_then(|t| t.spring_mass()).map(|t| t.stiffness_n_m)),
+        Opt(scene.target.and_then(|t| t.spring_mass()).map(|t| t.damping_n_s_m)),
+        // Or a state space (`none` for a spring–mass or none).
+        TargetSpace(scene.target.and_then(|t| t.state_space())),
     );
+}
+
+/// A state-space target as a comma-separated list: its order `n`, `A` row by row, `B`, `C`
+/// (the displacement's row, then the velocity's); `none` without one.
+struct TargetSpace(Option<&'static impact_core::two_body::Target<f32>>);
+
+impl defmt::Format for TargetSpace {
+    fn format(&self, f: defmt::Formatter<'_>) {
+        let Some(t) = self.0 else {
+            defmt::write!(f, "none");
+            return;
+        };
+        let n = t.n.min(impact_core::two_body::MAX_STATES);
+        defmt::write!(f, "{=u32}", n as u32);
+        let values = (t.a.iter().take(n).flat_map(|r| r.iter().take(n)))
+            .chain(t.b.iter().take(n))
+            .chain(t.c.iter().flat_map(|r| r.iter().take(n)));
+        for v in values {
+            defmt::write!(f, ",{=f32}", *v);
+        }
+    }
 }
 
 /// One column of a user's band as a comma-separated list (`none` without a band).

@@ -150,11 +150,24 @@ fn scene(b: &mut Bytes) -> (Scene, bool) {
         }),
         waveform_every: u16::from(stage_byte >> 4),
         // Now and then (no train: the scene refuses one) a target from a free body of
-        // 1 mg to a 10 kg mount on a spring up to 2.6e6 N/m, from the bytes drawn above.
-        target: (stage_byte & 0x23 == 0x20).then(|| impact_core::two_body::SpringMass {
-            mass_kg: 1e-7 * 10f32.powi(i32::from(fit_byte >> 5) + 1),
-            stiffness_n_m: f32::from(cfc_byte) * 1e4,
-            damping_n_s_m: f32::from(fit_byte & 0x1f),
+        // 1 mg to a 10 kg mount on a spring up to 2.6e6 N/m, from the bytes drawn above;
+        // half of those as a state space (the same matrices, the general step; chosen by
+        // the waveform's top bit, which nothing about the target draws on).
+        target: (stage_byte & 0x23 == 0x20).then(|| {
+            use impact_core::two_body::{SceneTarget, SpringMass, Target};
+            let s = SpringMass {
+                mass_kg: 1e-7 * 10f32.powi(i32::from(fit_byte >> 5) + 1),
+                stiffness_n_m: f32::from(cfc_byte) * 1e4,
+                damping_n_s_m: f32::from(fit_byte & 0x1f),
+            };
+            if stage_byte & 0x80 != 0 {
+                // (Kept once per distinct target: at most 8 × 256 × 16 of them.)
+                let mut t = Target::of_spring_mass(s);
+                t.spring_mass = None;
+                SceneTarget::StateSpace(impact_host::simulate::two_body::interned(t))
+            } else {
+                SceneTarget::SpringMass(s)
+            }
         }),
     };
     (scene, !raw)

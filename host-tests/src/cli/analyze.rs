@@ -56,6 +56,7 @@ pub fn inputs(args: &AnalyzeArgs) -> Vec<&std::path::Path> {
     inputs.extend(args.scene.as_deref());
     inputs.extend(args.free_fall.as_deref().map(pipeline::free_fall::file));
     inputs.extend(args.spec.and_then(|s| s.band_file));
+    inputs.extend(args.target.as_deref());
     inputs
 }
 

@@ -30,7 +30,8 @@ pub fn run(command: SynthCommand) -> Result<(), SynthError> {
             return Err(SynthError::SameFile { path: o.clone() });
         }
     }
-    let inputs = crate::output::Inputs::new();
+    // (The target's file, the one input, is never written over.)
+    let inputs = (args.target.iter()).fold(crate::output::Inputs::new(), |all, t| all.with(t));
     for (option, path) in [("--output", &output), ("--raw", &raw)] {
         if let Some(path) = path {
             crate::output::check(option, path, &inputs, None)?;

@@ -1,6 +1,8 @@
 //! A horizontal strike on a target that moves, the tests' oracle for the contact's kinematics
 //! against it: the body (sensor on it) at `v0` strikes a pad on a mass `m2` held by a spring
-//! `k2` and damper `c2` to ground (seed 000, section 3.2), once.
+//! `k2` and damper `c2` to ground (seed 000, section 3.2), once; or on a linear target in
+//! state-space form (`z' = A z + B F`, its contact point at `y = Cx z`, `w = Cv z`:
+//! [`Strike::render_on`]).
 //!
 //! ```text
 //! m1 x1'' = m1 g - F,   m2 y'' = F - k2 y - c2 y',   F = law(δ, δ'),  δ = x1 - y
@@ -22,6 +24,7 @@
 
 use super::contact::STEPS_PER_SCALE;
 use super::pad::{Branch, Pad};
+use impact_core::two_body::{Target, MAX_STATES};
 use impact_core::{ContactLaw, Error, Impact, Model};
 
 /// The target: a mass on a spring and damper to ground.
@@ -71,60 +74,106 @@ pub struct StrikeTruth {
     pub body_cor: f64,
 }
 
+/// Components of the integrated state: the body's `x1`, `u1`, then the target's.
+const N: usize = 3 + MAX_STATES;
+
+/// The integrated state: `v = [x1, u1, target...]`, the target's a spring–mass's
+/// `(y, w, energy its damper took)` or a state space's `(z, ∫ F w dt)`.
 #[derive(Clone, Copy, Debug)]
 struct S {
     t: f64,
-    x1: f64,
-    u1: f64,
-    y: f64,
-    w: f64,
-    /// Energy the target's damper took, J.
-    damped: f64,
+    v: [f64; N],
+}
+
+/// The target the body strikes.
+#[derive(Clone, Copy)]
+enum Body<'a> {
+    Mount(Mount),
+    Space(&'a Target<f64>),
+}
+
+impl Body<'_> {
+    /// The contact point's displacement and velocity in `s`.
+    fn point(&self, s: &S) -> (f64, f64) {
+        match self {
+            Body::Mount(_) => (s.v[2], s.v[3]),
+            Body::Space(t) => {
+                let (mut y, mut w) = (0.0, 0.0);
+                for i in 0..t.n {
+                    y += t.c[0][i] * s.v[2 + i];
+                    w += t.c[1][i] * s.v[2 + i];
+                }
+                (y, w)
+            }
+        }
+    }
+
+    /// The work the contact force did on the target in `s`, J.
+    fn work(&self, s: &S) -> f64 {
+        match self {
+            Body::Mount(m) => {
+                let (y, w) = (s.v[2], s.v[3]);
+                0.5 * m.mass_kg * w * w + 0.5 * m.stiffness_n_m * y * y + s.v[4]
+            }
+            Body::Space(t) => s.v[2 + t.n],
+        }
+    }
 }
 
 struct System<'a> {
     pad: &'a Pad,
     m1: f64,
-    mount: Mount,
+    body: Body<'a>,
     g: f64,
 }
 
 impl System<'_> {
     fn raw_force(&self, s: &S, branch: Branch) -> f64 {
-        self.pad.raw_force(s.x1 - s.y, s.u1 - s.w, branch)
+        let (y, w) = self.body.point(s);
+        self.pad.raw_force(s.v[0] - y, s.v[1] - w, branch)
     }
 
-    fn rates(&self, s: &S, branch: Branch) -> [f64; 5] {
+    fn rates(&self, s: &S, branch: Branch) -> [f64; N] {
         let f = self.raw_force(s, branch);
-        let Mount {
-            mass_kg: m2,
-            stiffness_n_m: k2,
-            damping_n_s_m: c2,
-        } = self.mount;
-        [
-            s.u1,
-            self.g - f / self.m1,
-            s.w,
-            (f - k2 * s.y - c2 * s.w) / m2,
-            c2 * s.w * s.w,
-        ]
+        let mut r = [0.0; N];
+        r[0] = s.v[1];
+        r[1] = self.g - f / self.m1;
+        match self.body {
+            Body::Mount(Mount {
+                mass_kg: m2,
+                stiffness_n_m: k2,
+                damping_n_s_m: c2,
+            }) => {
+                let (y, w) = (s.v[2], s.v[3]);
+                r[2] = w;
+                r[3] = (f - k2 * y - c2 * w) / m2;
+                r[4] = c2 * w * w;
+            }
+            Body::Space(t) => {
+                for i in 0..t.n {
+                    let mut d = t.b[i] * f;
+                    for j in 0..t.n {
+                        d += t.a[i][j] * s.v[2 + j];
+                    }
+                    r[2 + i] = d;
+                }
+                r[2 + t.n] = f * self.body.point(s).1;
+            }
+        }
+        r
     }
 
     fn step(&self, s: &S, h: f64, branch: Branch) -> S {
-        let at = |s: &S, k: &[f64; 5], a: f64| S {
+        let at = |s: &S, k: &[f64; N], a: f64| S {
             t: s.t + a,
-            x1: s.x1 + a * k[0],
-            u1: s.u1 + a * k[1],
-            y: s.y + a * k[2],
-            w: s.w + a * k[3],
-            damped: s.damped + a * k[4],
+            v: core::array::from_fn(|i| s.v[i] + a * k[i]),
         };
         let k1 = self.rates(s, branch);
         let k2 = self.rates(&at(s, &k1, h / 2.0), branch);
         let k3 = self.rates(&at(s, &k2, h / 2.0), branch);
         let k4 = self.rates(&at(s, &k3, h), branch);
-        let mut k = [0.0; 5];
-        for i in 0..5 {
+        let mut k = [0.0; N];
+        for i in 0..N {
             k[i] = (k1[i] + 2.0 * k2[i] + 2.0 * k3[i] + k4[i]) / 6.0;
         }
         at(s, &k, h)
@@ -145,54 +194,94 @@ impl System<'_> {
     }
 }
 
+/// The target's fastest rate, 1/s: its spectral radius, `|A^64|^(1/64)` (an estimate from
+/// above; `|A|` where that fails). A fixture's `|A|` is `k / m` where its fastest mode is
+/// `sqrt(k / m)`: the norm alone would step a thousand times finer than it needs.
+fn fastest_rate(t: &Target<f64>) -> f64 {
+    let a = t.a_mat();
+    let norm = a.norm_inf();
+    if !(norm > 0.0 && norm.is_finite()) {
+        return norm;
+    }
+    let mut b = a.scaled(1.0 / norm);
+    for _ in 0..6 {
+        b = b.mul(&b);
+    }
+    let r = b.norm_inf().powf(1.0 / 64.0) * norm;
+    if r > 0.0 && r.is_finite() {
+        r
+    } else {
+        norm
+    }
+}
+
 impl Strike {
     /// Renders `n` samples at `rate_hz` of the body's reading (`F / m1`, m/s²) and the truth.
     pub fn render(&self, rate_hz: f64, n: usize) -> Result<(Vec<f64>, StrikeTruth), Error> {
+        self.render_on(None, rate_hz, n)
+    }
+
+    /// As [`Strike::render`], on the state-space target `space` (validated: `Cv = Cx A`,
+    /// `Cx B = 0`) instead of the mount where one is given.
+    pub fn render_on(
+        &self,
+        space: Option<&Target<f64>>,
+        rate_hz: f64,
+        n: usize,
+    ) -> Result<(Vec<f64>, StrikeTruth), Error> {
         self.law.validate()?;
         let bad = |name, reason| Err(Error::InvalidParameter { name, reason });
-        let Mount {
-            mass_kg: m2,
-            stiffness_n_m: k2,
-            damping_n_s_m: c2,
-        } = self.mount;
-        if !(m2.is_finite() && m2 > 0.0) {
-            return bad("target-mass", "must be finite and > 0");
-        }
-        if !(k2.is_finite() && k2 >= 0.0) {
-            return bad("target-stiffness", "must be finite and >= 0");
-        }
-        if !(c2.is_finite() && c2 >= 0.0) {
-            return bad("target-damping", "must be finite and >= 0");
-        }
+        let impact = Impact::new(self.mass_kg, self.v0_m_s);
+        let mut scale = ContactLaw::time_scale(&self.law, &impact);
+        let body = match space {
+            Some(t) => {
+                t.validate()?;
+                let rate = fastest_rate(t);
+                if rate > 0.0 {
+                    scale = scale.min(1.0 / rate);
+                }
+                Body::Space(t)
+            }
+            None => {
+                let Mount {
+                    mass_kg: m2,
+                    stiffness_n_m: k2,
+                    damping_n_s_m: c2,
+                } = self.mount;
+                if !(m2.is_finite() && m2 > 0.0) {
+                    return bad("target-mass", "must be finite and > 0");
+                }
+                if !(k2.is_finite() && k2 >= 0.0) {
+                    return bad("target-stiffness", "must be finite and >= 0");
+                }
+                if !(c2.is_finite() && c2 >= 0.0) {
+                    return bad("target-damping", "must be finite and >= 0");
+                }
+                if k2 > 0.0 {
+                    scale = scale.min((m2 / k2).sqrt());
+                }
+                if c2 > 0.0 {
+                    scale = scale.min(m2 / c2);
+                }
+                Body::Mount(self.mount)
+            }
+        };
         let pad = Pad::new(self.law);
         let sys = System {
             pad: &pad,
             m1: self.mass_kg,
-            mount: self.mount,
+            body,
             g: self.gravity_m_s2,
         };
-        let impact = Impact::new(self.mass_kg, self.v0_m_s);
-        let mut scale = ContactLaw::time_scale(&self.law, &impact);
-        if k2 > 0.0 {
-            scale = scale.min((m2 / k2).sqrt());
-        }
-        if c2 > 0.0 {
-            scale = scale.min(m2 / c2);
-        }
         let h = scale / STEPS_PER_SCALE;
         let mut out = Vec::with_capacity(n);
         let mut times = (0..n).map(|k| k as f64 / rate_hz).peekable();
         while times.next_if(|&t| t < self.touch_s).is_some() {
             out.push(0.0);
         }
-        let mut s = S {
-            t: self.touch_s,
-            x1: 0.0,
-            u1: self.v0_m_s,
-            y: 0.0,
-            w: 0.0,
-            damped: 0.0,
-        };
+        let mut v = [0.0; N];
+        v[1] = self.v0_m_s;
+        let mut s = S { t: self.touch_s, v };
         let mut branch = pad.first_branch();
         let mut crush: Option<S> = None;
         let mut peak: f64 = 0.0;
@@ -202,8 +291,9 @@ impl Strike {
                 return bad("target", "the contact did not end within 1e6 time scales");
             }
             let next = sys.step(&s, h, branch);
-            let (end, event) = if crush.is_none() && next.u1 - next.w <= 0.0 {
-                let tau = sys.locate(&s, h, branch, |x| -(x.u1 - x.w));
+            let rate = |x: &S| x.v[1] - body.point(x).1;
+            let (end, event) = if crush.is_none() && rate(&next) <= 0.0 {
+                let tau = sys.locate(&s, h, branch, |x| -rate(x));
                 (sys.step(&s, tau, branch), Some(true))
             } else if crush.is_some() && sys.raw_force(&next, branch) <= 0.0 {
                 let tau = sys.locate(&s, h, branch, |x| -sys.raw_force(x, branch));
@@ -224,7 +314,7 @@ impl Strike {
             match event {
                 Some(true) => {
                     crush = Some(s);
-                    branch = pad.after_max(branch, s.x1 - s.y);
+                    branch = pad.after_max(branch, s.v[0] - body.point(&s).0);
                     if sys.raw_force(&s, branch) <= 0.0 {
                         break s;
                     }
@@ -236,24 +326,27 @@ impl Strike {
         out.extend(times.map(|_| 0.0));
         let crush = crush.expect("the separation follows the crush");
         let m1 = self.mass_kg;
-        let target_work = 0.5 * m2 * sep.w * sep.w + 0.5 * k2 * sep.y * sep.y + sep.damped;
-        let body_loss = 0.5 * m1 * (self.v0_m_s * self.v0_m_s - sep.u1 * sep.u1)
-            + m1 * self.gravity_m_s2 * sep.x1;
+        let target_work = body.work(&sep);
+        let [x1, u1] = [sep.v[0], sep.v[1]];
+        let (y, w) = body.point(&sep);
+        let (crush_x1, crush_y) = (crush.v[0], body.point(&crush).0);
+        let body_loss =
+            0.5 * m1 * (self.v0_m_s * self.v0_m_s - u1 * u1) + m1 * self.gravity_m_s2 * x1;
         Ok((
             out,
             StrikeTruth {
                 touch_s: self.touch_s,
                 crush_time_s: crush.t - self.touch_s,
-                max_deformation_m: crush.x1 - crush.y,
+                max_deformation_m: crush_x1 - crush_y,
                 contact_time_s: sep.t - self.touch_s,
-                rebound_m_s: -sep.u1,
-                target_velocity_m_s: sep.w,
-                cor: (sep.w - sep.u1) / self.v0_m_s,
-                separation_deformation_m: sep.x1 - sep.y,
+                rebound_m_s: -u1,
+                target_velocity_m_s: w,
+                cor: (w - u1) / self.v0_m_s,
+                separation_deformation_m: x1 - y,
                 contact_work_j: body_loss - target_work,
                 target_work_j: target_work,
                 peak_force_n: peak,
-                body_cor: -sep.u1 / self.v0_m_s,
+                body_cor: -u1 / self.v0_m_s,
             },
         ))
     }

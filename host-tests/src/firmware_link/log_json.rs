@@ -2,7 +2,7 @@
 
 use impact_core::consts::STANDARD_GRAVITY;
 
-use crate::firmware_link::line::{FieldError, SceneLine};
+use crate::firmware_link::line::{FieldError, LineTarget, SceneLine};
 use crate::firmware_link::log::{Log, LogError, LogErrorKind, Run};
 use crate::report::{AnalysisJson, ImpactJson};
 
@@ -49,6 +49,9 @@ impl<'a> LogJson<'a> {
             .flatten();
         let (v0_m_s, v0_source) = approach(scene, gravity).map_err(LogError::whole)?;
         let fits = asked(scene).map_err(LogError::whole)?;
+        let target = (scene.map(SceneLine::target).transpose())
+            .map_err(LogError::whole)?
+            .flatten();
         let train_speed = scene.and_then(SceneLine::train).map(str::to_string);
         // The pulse the board judged, as its scene line states it.
         // (One this tool cannot read, a newer board's shape say, is said and left out.)
@@ -85,10 +88,10 @@ impl<'a> LogJson<'a> {
             lowpass: scene
                 .and_then(SceneLine::lowpass)
                 .map(|l| crate::report::filter::LowpassJson::of(&l, rate)),
-            target: scene
-                .and_then(SceneLine::target)
-                .as_ref()
-                .map(crate::report::TargetJson::of),
+            target: target.map(|t| match t {
+                LineTarget::SpringMass(s) => crate::report::TargetJson::of_spring_mass(&s),
+                LineTarget::StateSpace(t) => crate::report::TargetJson::of_state_space(&t),
+            }),
             trains: Vec::new(),
             waveforms: (log.waveforms.iter().enumerate())
                 .map(|(k, w)| {

@@ -109,6 +109,8 @@ pub enum StartFault {
     BelowStack,
 }
 
+use impact_core::two_body::SceneTarget;
+
 /// The scene as the firmware's `key=value` semihosting arguments. Floats are written as
 /// Rust's shortest round-trip decimals, which the firmware parses back to the same bits.
 pub fn scene_args(scene: &Scene) -> Vec<String> {
@@ -194,12 +196,25 @@ pub fn scene_args(scene: &Scene) -> Vec<String> {
             format!("spec_watch={}", f(t.watch)),
         ]);
     }
-    if let Some(t) = scene.target {
-        args.extend([
-            format!("target_mass={}", f(t.mass_kg)),
-            format!("target_stiffness={}", f(t.stiffness_n_m)),
-            format!("target_damping={}", f(t.damping_n_s_m)),
-        ]);
+    match scene.target {
+        Some(SceneTarget::SpringMass(s)) => args.extend([
+            format!("target_mass={}", f(s.mass_kg)),
+            format!("target_stiffness={}", f(s.stiffness_n_m)),
+            format!("target_damping={}", f(s.damping_n_s_m)),
+        ]),
+        // A state space: its order, `A` row by row, `B`, `C`, `:`-separated (semihosting
+        // passes no comma).
+        Some(SceneTarget::StateSpace(t)) => {
+            let n = t.n.min(impact_core::two_body::MAX_STATES);
+            let values = (t.a.iter().take(n).flat_map(|r| r.iter().take(n)))
+                .chain(t.b.iter().take(n))
+                .chain(t.c.iter().flat_map(|r| r.iter().take(n)));
+            let list: Vec<String> = std::iter::once(n.to_string())
+                .chain(values.map(|v| f(*v)))
+                .collect();
+            args.push(format!("target_space={}", list.join(":")));
+        }
+        None => {}
     }
     args.push(format!("wave={}", scene.waveform_every));
     args

@@ -50,6 +50,10 @@ pub enum PipelineError {
     FreeFall(#[from] free_fall::FreeFallError),
     #[error(transparent)]
     Worker(#[from] crate::WorkerError),
+    /// `--target FILE` not read, or not a target the analysis can push (boxed: its path
+    /// and reasons are large).
+    #[error(transparent)]
+    Target(Box<crate::simulate::two_body::TargetError>),
     /// A recording read whole would take `need_bytes` of memory, which cannot be had.
     #[error("{}: {}", .path.display(), NeedsMemory(*.need_bytes))]
     Memory { path: PathBuf, need_bytes: u64 },
@@ -1067,14 +1071,33 @@ pub(crate) fn build_scene(
         args.target_stiffness.or(file.target_stiffness),
         args.target_damping.or(file.target_damping),
     );
-    scene.target = match args.target_mass.or(file.target_mass) {
-        Some(m) => Some(impact_core::two_body::SpringMass {
+    use impact_core::two_body::{SceneTarget, SpringMass};
+    scene.target = match (&args.target, args.target_mass.or(file.target_mass)) {
+        // Two targets: the command line's state space and the scene file's spring–mass.
+        (Some(_), _)
+            if file.target_mass.is_some()
+                || file.target_stiffness.is_some()
+                || file.target_damping.is_some() =>
+        {
+            return Err(PipelineError::Invalid {
+                setting: Setting::Option("target"),
+                reason: "the scene file gives a spring–mass target (target_mass, target_stiffness, target_damping): give one target, the file's or this",
+            });
+        }
+        (Some(path), _) => {
+            let t = crate::simulate::two_body::read_state_space(path)
+                .map_err(|e| PipelineError::Target(Box::new(e)))?;
+            Some(SceneTarget::StateSpace(
+                crate::simulate::two_body::interned(crate::simulate::two_body::narrow(&t)),
+            ))
+        }
+        (None, Some(m)) => Some(SceneTarget::SpringMass(SpringMass {
             mass_kg: m as f32,
             stiffness_n_m: k2.unwrap_or(0.0) as f32,
             damping_n_s_m: c2.unwrap_or(0.0) as f32,
-        }),
+        })),
         // (A spring or damper given without a mass on either.)
-        None if k2.is_some() || c2.is_some() => {
+        (None, None) if k2.is_some() || c2.is_some() => {
             let name = if k2.is_some() {
                 "target-stiffness"
             } else {
@@ -1085,7 +1108,7 @@ pub(crate) fn build_scene(
                 reason: "needs the target's mass (--target-mass, or a scene file's target_mass)",
             });
         }
-        None => None,
+        (None, None) => None,
     };
     scene.spectrum = args.spectrum.settings();
     scene.spec = args.spec.map(|s| s.spec);

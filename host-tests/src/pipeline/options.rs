@@ -201,8 +201,8 @@ pub struct AnalyzeArgs {
     /// anvil, a load cell's platen, a specimen on its fixture), not a rigid wall. The
     /// measured force (--mass times the reading) drives the target, and the COR (Newton's,
     /// relative), the crush time, the deformations and the absorbed energy (the contact's
-    /// work) are the contact's, relative to the target's motion. Without it a rigid, fixed
-    /// barrier is assumed, and said.
+    /// work) are the contact's, relative to the target's motion. Without it (or --target) a
+    /// rigid, fixed barrier is assumed, and said.
     #[arg(long, help_heading = "Target", value_parser = parse::mass_kg)]
     pub target_mass: Option<f64>,
     /// The target's spring to ground k2, N/m [default: 0, a free body].
@@ -211,6 +211,18 @@ pub struct AnalyzeArgs {
     /// The target's damper to ground c2, N s/m [default: 0].
     #[arg(long, help_heading = "Target")]
     pub target_damping: Option<f64>,
+    /// A linear target in state-space form (JSON, as `impact simulate --target`): input the
+    /// contact force (N), outputs the contact point's displacement (m) and velocity (m/s).
+    ///
+    /// A linear target in state-space form, JSON `{"a": [[..]], "b": [..], "c": [[..], [..]],
+    /// "d": [0, 0]}` as `impact simulate --target` takes it: input the contact force (N),
+    /// outputs the contact point's displacement (m) and velocity (m/s), at most 6 states, at
+    /// rest at each first touch (a fixture of two masses, a mount identified by a modal fit).
+    /// The kinematics are the contact's relative to it, as with --target-mass; `impact
+    /// emulate` hands it to the board in its scene, whose scene line states it.
+    #[arg(long, help_heading = "Target", value_name = "FILE",
+          conflicts_with_all = ["target_mass", "target_stiffness", "target_damping"])]
+    pub target: Option<PathBuf>,
     /// DC accelerometer file (g), optionally `:COLUMN`: v0 = g × free-fall time before the impact.
     #[arg(long, help_heading = "Bench", value_name = "FILE[:COLUMN]")]
     pub free_fall: Option<String>,

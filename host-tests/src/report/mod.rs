@@ -144,36 +144,111 @@ where
 }
 
 /// The assumption behind every COR, deformation and absorbed energy the tool reports: the body
-/// struck an immovable wall (`analyze` cannot be told a moving target; `simulate` can).
+/// struck an immovable wall, unless a target was given (`--target-mass`, `--target`).
 pub const RIGID_BARRIER: &str = "the barrier is taken as rigid and fixed: COR, deformation and \
      absorbed energy are the body's against an immovable wall (a target that moves or yields is \
-     not modelled here unless --target-mass gives it)";
+     not modelled here unless --target-mass or --target gives it)";
 
-/// What the kinematics are against a target the user gave (`--target-mass`): said where the
+/// What the kinematics are against a target the user gave (`--target-mass`, `--target`): said where the
 /// rigid barrier would otherwise be.
 pub const TARGET_RELATIVE: &str = "the kinematics are the contact's against the target given \
-     (a mass on a spring and damper to ground, {target}, driven by the measured force, --mass \
+     ({target}, driven by the measured force, --mass \
      times the reading): the COR is Newton's (the separation speed relative to the target over the \
      approach speed), the crush time and deformations are the relative approach's, and the \
      absorbed energy is the contact's work (the body's loss less what went into the target); \
      the rebound velocity is the body's own; the target is taken at rest at each first touch \
      (a strike before it has settled from the last is measured as if it had)";
 
-/// The target of `--target-mass` (SI).
+/// The target of `--target-mass` (SI), or of `--target FILE` (its state space as the
+/// analysis took it, in f32, and the mass its contact point shows to an impulse).
 #[derive(Clone, Debug, Serialize, PartialEq)]
 pub struct TargetJson {
-    pub mass_kg: f64,
-    pub stiffness_n_m: f64,
-    pub damping_n_s_m: f64,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub mass_kg: Option<f64>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub stiffness_n_m: Option<f64>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub damping_n_s_m: Option<f64>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub state_space: Option<StateSpaceJson>,
+    /// `1 / (Cv B)`, kg: a state space's (a spring–mass's is its mass).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub contact_mass_kg: Option<f64>,
+}
+
+/// A state-space target: `z' = A z + B F`, displacement `Cx z` (m), velocity `Cv z` (m/s).
+#[derive(Clone, Debug, Serialize, PartialEq)]
+pub struct StateSpaceJson {
+    pub a: Vec<Vec<f64>>,
+    pub b: Vec<f64>,
+    /// Rows: displacement, velocity.
+    pub c: [Vec<f64>; 2],
 }
 
 impl TargetJson {
-    pub fn of(t: &impact_core::two_body::SpringMass<f32>) -> Self {
+    pub fn of(t: &impact_core::two_body::SceneTarget) -> Self {
+        use impact_core::two_body::SceneTarget;
+        match t {
+            SceneTarget::SpringMass(s) => Self::of_spring_mass(s),
+            SceneTarget::StateSpace(t) => Self::of_state_space(t),
+        }
+    }
+
+    pub fn of_spring_mass(s: &impact_core::two_body::SpringMass<f32>) -> Self {
         use crate::report::fmt::shortest;
         Self {
-            mass_kg: shortest(t.mass_kg),
-            stiffness_n_m: shortest(t.stiffness_n_m),
-            damping_n_s_m: shortest(t.damping_n_s_m),
+            mass_kg: Some(shortest(s.mass_kg)),
+            stiffness_n_m: Some(shortest(s.stiffness_n_m)),
+            damping_n_s_m: Some(shortest(s.damping_n_s_m)),
+            state_space: None,
+            contact_mass_kg: None,
+        }
+    }
+
+    pub fn of_state_space(t: &impact_core::two_body::Target<f32>) -> Self {
+        use crate::report::fmt::shortest;
+        let n = t.n.min(impact_core::two_body::MAX_STATES);
+        let row = |r: &[f32]| r.iter().take(n).map(|v| shortest(*v)).collect::<Vec<f64>>();
+        Self {
+            mass_kg: None,
+            stiffness_n_m: None,
+            damping_n_s_m: None,
+            state_space: Some(StateSpaceJson {
+                a: t.a.iter().take(n).map(|r| row(r)).collect(),
+                b: row(&t.b),
+                c: [row(&t.c[0]), row(&t.c[1])],
+            }),
+            contact_mass_kg: Some(shortest(t.contact_mass_kg())),
+        }
+    }
+
+    /// The target in words: `a mass on a spring and damper to ground, 0.3 kg, 40000 N/m,
+    /// 12 N s/m`, or `a linear state space of 4 states, contact-point mass 0.3 kg` (`1 / (Cv
+    /// B)`, what the contact point shows to an impulse).
+    pub fn describe(&self) -> String {
+        match &self.state_space {
+            Some(_) => format!("a linear {}", self.short()),
+            None => format!("a mass on a spring and damper to ground, {}", self.short()),
+        }
+    }
+
+    /// The target in few words: `0.3 kg, 40000 N/m, 12 N s/m`, or `state space of 4 states,
+    /// contact-point mass 0.3 kg`.
+    pub fn short(&self) -> String {
+        let n = |v: Option<f64>| v.map_or_else(|| "?".to_string(), |v| v.to_string());
+        match &self.state_space {
+            Some(ss) => format!(
+                "state space of {} state{}, contact-point mass {} kg",
+                ss.b.len(),
+                if ss.b.len() == 1 { "" } else { "s" },
+                n(self.contact_mass_kg)
+            ),
+            None => format!(
+                "{} kg, {} N/m, {} N s/m",
+                n(self.mass_kg),
+                n(self.stiffness_n_m),
+                n(self.damping_n_s_m)
+            ),
         }
     }
 }
@@ -237,7 +312,7 @@ pub struct AnalysisJson {
     /// or no filter).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub lowpass: Option<crate::report::filter::LowpassJson>,
-    /// With `--target-mass`: the target the body struck (the kinematics are the contact's,
+    /// With `--target-mass` or `--target`: the target the body struck (the kinematics are the contact's,
     /// relative to it: [`TARGET_RELATIVE`]); absent for the rigid, fixed barrier assumed.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub target: Option<TargetJson>,
@@ -273,13 +348,7 @@ impl AnalysisJson {
     pub fn assume_rigid_barrier(&mut self) {
         if self.v0_m_s.is_some() || self.train_speed.is_some() {
             let said = match &self.target {
-                Some(t) => TARGET_RELATIVE.replace(
-                    "{target}",
-                    &format!(
-                        "{} kg, {} N/m, {} N s/m",
-                        t.mass_kg, t.stiffness_n_m, t.damping_n_s_m
-                    ),
-                ),
+                Some(t) => TARGET_RELATIVE.replace("{target}", &t.describe()),
                 None => RIGID_BARRIER.to_string(),
             };
             self.assumptions.push(said);

@@ -59,9 +59,9 @@ pub fn to_table(a: &AnalysisJson) -> String {
     // The frame the kinematics assumed, whenever there are kinematics to assume it for.
     let barrier = match &a.target {
         Some(t) => format!(
-            "kinematics relative to the target ({} kg, {} N/m, {} N s/m): Newton's COR, the \
-             contact's deformation and work",
-            t.mass_kg, t.stiffness_n_m, t.damping_n_s_m
+            "kinematics relative to the target ({}): Newton's COR, the contact's deformation \
+             and work",
+            t.short()
         ),
         None => "a rigid, fixed barrier assumed".to_string(),
     };

@@ -95,7 +95,7 @@ pub enum TargetError {
     NotGiven,
 }
 
-fn read_state_space(path: &Path) -> Result<Target<f64>, TargetError> {
+pub(crate) fn read_state_space(path: &Path) -> Result<Target<f64>, TargetError> {
     let p = || path.to_path_buf();
     let bytes = impact_io::read_limited(path, 1 << 20, "target file").map_err(TargetError::Read)?;
     let f: StateSpaceFile =
@@ -196,6 +196,31 @@ pub struct TargetReport {
     pub solver: String,
     pub rhs_evaluations: u32,
     pub null_reasons: std::collections::BTreeMap<&'static str, &'static str>,
+}
+
+/// `t` kept for the process, as a scene's target borrows it
+/// ([`impact_core::two_body::SceneTarget::StateSpace`]; the board keeps its one in a static):
+/// once per distinct target, so however many scenes are built from the same few files,
+/// memory stays bounded by the targets given.
+pub fn interned(t: Target<f32>) -> &'static Target<f32> {
+    use std::collections::HashMap;
+    use std::sync::Mutex;
+    static KEPT: Mutex<Option<HashMap<Vec<u32>, &'static Target<f32>>>> = Mutex::new(None);
+    // Keyed by the bits of every number (the order, A, B, C, the spring–mass's).
+    let key: Vec<u32> = std::iter::once(t.n as u32)
+        .chain(t.a.iter().flatten().map(|v| v.to_bits()))
+        .chain(t.b.iter().map(|v| v.to_bits()))
+        .chain(t.c.iter().flatten().map(|v| v.to_bits()))
+        .chain(
+            t.spring_mass
+                .iter()
+                .flat_map(|s| [s.mass_kg, s.stiffness_n_m, s.damping_n_s_m].map(f32::to_bits)),
+        )
+        .collect();
+    let mut kept = KEPT.lock().unwrap_or_else(|e| e.into_inner());
+    kept.get_or_insert_with(HashMap::new)
+        .entry(key)
+        .or_insert_with(|| Box::leak(Box::new(t)))
 }
 
 #[allow(clippy::needless_range_loop)]

@@ -30,11 +30,13 @@ use impact_firmware::semihosting as host;
 pub use irq::{start_high, start_low, start_medium};
 
 /// Longest semihosting command line accepted, bytes: the recording's path and every scene
-/// key `impact emulate` passes (about 700 bytes with a spec) with room to spare. Read into
+/// key `impact emulate` passes (about 700 bytes with a spec, up to 900 more with a
+/// six-state target's `target_space`: 54 numbers of at most 16 characters) with room to
+/// spare. Read into
 /// `init`'s frame, not a static: the emulator's data RAM is the board's 104 KiB, which the
 /// board's own statics fill; only the samples file's path is kept (a static of
 /// [`host::MAX_PATH_LEN`] bytes).
-const COMMAND_LINE_LEN: usize = 1920;
+const COMMAND_LINE_LEN: usize = 2560;
 
 /// What the semihosting command line asks for:
 /// `<program> <samples-file> [realtime|lossless] [rate_scale=X] [stall=BLOCK:US]

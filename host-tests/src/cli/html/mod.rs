@@ -117,6 +117,7 @@ pub fn run(args: &ReportArgs) -> Result<crate::report::spec::Judged, ReportError
         .with_some(a.free_fall.as_deref().map(crate::pipeline::free_fall::file))
         .with_some(args.srs_required.as_deref())
         .with_some(a.spec.and_then(|s| s.band_file))
+        .with_some(a.target.as_deref())
         .with_some(args.meta.meta_file.as_deref());
     if let Some(html) = &args.html {
         crate::output::check("--html", html, &inputs, Some("html"))?;
@@ -158,6 +159,7 @@ pub fn run(args: &ReportArgs) -> Result<crate::report::spec::Judged, ReportError
                 .and_then(|s| s.band_file)
                 .map(|p| (Role::Band, p.to_path_buf())),
         )
+        .chain(a.target.clone().map(|p| (Role::Target, p)))
         .chain(args.srs_required.clone().map(|p| (Role::RequiredSrs, p)))
         .chain(args.meta.meta_file.clone().map(|p| (Role::Meta, p)))
         .collect();

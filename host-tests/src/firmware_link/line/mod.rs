@@ -18,7 +18,7 @@ mod wave;
 
 pub use fields::{FieldError, Fields, Number};
 pub use impact::ImpactLine;
-pub use scene::{spec_of, SceneDifference, SceneLine};
+pub use scene::{spec_of, LineTarget, SceneDifference, SceneLine};
 pub use spectrum::{SpecLine, SrsLine};
 pub use state::{Counter, HeartbeatLine, State, SummaryLine};
 pub use wave::{WaveFrameLine, WaveLine, MAX_WAVE_VALUES};
@@ -144,6 +144,12 @@ pub enum LineError {
     /// missing, its band's columns of different lengths, or refused by the core).
     #[error("scene: spec: {why}")]
     SceneSpec { why: String },
+    /// The scene line's `target_space` not a state space's list: its order (1 to 6), then
+    /// `n² + 3n` finite numbers.
+    #[error(
+        "scene: target_space={text}: not an order of 1 to 6 states and its n² + 3n finite numbers"
+    )]
+    SceneTarget { text: String },
     /// A value of an `srs` line's list that is not a finite number >= 0.
     #[error("{field}: {text} is not a finite value >= 0")]
     ListValue { field: &'static str, text: String },

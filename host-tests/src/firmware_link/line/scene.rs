@@ -14,6 +14,13 @@ pub struct SceneLine {
     fields: Fields,
 }
 
+/// The target a board's scene line states (owned: a log may state many).
+#[derive(Clone, Debug, PartialEq)]
+pub enum LineTarget {
+    SpringMass(impact_core::two_body::SpringMass<f32>),
+    StateSpace(Box<impact_core::two_body::Target<f32>>),
+}
+
 impl SceneLine {
     pub fn parse(fields: Fields) -> Result<Self, LineError> {
         Ok(Self {
@@ -104,13 +111,51 @@ impl SceneLine {
     }
 
     /// The target the board's kinematics are relative to (`target_mass_kg` and its spring and
-    /// damper; absent or `none`: a rigid, fixed barrier, as an older board's line).
-    pub fn target(&self) -> Option<impact_core::two_body::SpringMass<f32>> {
-        Some(impact_core::two_body::SpringMass {
-            mass_kg: self.fields.readable::<f32>("target_mass_kg")?,
-            stiffness_n_m: self.fields.readable::<f32>("target_stiffness_n_m")?,
-            damping_n_s_m: self.fields.readable::<f32>("target_damping_n_s_m")?,
-        })
+    /// damper, or `target_space`; absent or `none`: a rigid, fixed barrier, as an older
+    /// board's line). A `target_space` that is not a state space's list is an error, not a
+    /// rigid barrier: the board's numbers are relative to a target.
+    pub fn target(&self) -> Result<Option<LineTarget>, LineError> {
+        use impact_core::two_body::{SpringMass, Target, MAX_STATES};
+        if let Some(text) = self.fields.get("target_space").filter(|v| *v != "none") {
+            let bad = || LineError::SceneTarget {
+                text: text.to_string(),
+            };
+            let mut items = text.split(',');
+            let n = (items.next())
+                .and_then(|v| v.parse::<usize>().ok())
+                .filter(|n| (1..=MAX_STATES).contains(n))
+                .ok_or_else(bad)?;
+            let values: Vec<f32> = items
+                .map(|v| v.parse::<f32>().ok().filter(|x| x.is_finite()))
+                .collect::<Option<_>>()
+                .filter(|v: &Vec<f32>| v.len() == n * n + 3 * n)
+                .ok_or_else(bad)?;
+            let mut t = Target {
+                n,
+                a: [[0.0; MAX_STATES]; MAX_STATES],
+                b: [0.0; MAX_STATES],
+                c: [[0.0; MAX_STATES]; 2],
+                spring_mass: None,
+            };
+            let (a, rest) = values.split_at(n * n);
+            let (b, c) = rest.split_at(n);
+            for (row, v) in t.a.iter_mut().zip(a.chunks(n)) {
+                row[..n].copy_from_slice(v);
+            }
+            t.b[..n].copy_from_slice(b);
+            for (row, v) in t.c.iter_mut().zip(c.chunks(n)) {
+                row[..n].copy_from_slice(v);
+            }
+            return Ok(Some(LineTarget::StateSpace(Box::new(t))));
+        }
+        let spring = || {
+            Some(SpringMass {
+                mass_kg: self.fields.readable::<f32>("target_mass_kg")?,
+                stiffness_n_m: self.fields.readable::<f32>("target_stiffness_n_m")?,
+                damping_n_s_m: self.fields.readable::<f32>("target_damping_n_s_m")?,
+            })
+        };
+        Ok(spring().map(LineTarget::SpringMass))
     }
 
     /// The pulse the board judges ([`spec_of`] its fields).
