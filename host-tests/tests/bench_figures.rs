@@ -41,7 +41,7 @@ fn table(b: &Value) -> String {
         "| path | instructions / sample | estimated cycles / sample | target |\n\
          |---|---|---|---|\n\
          | idle (baseline, trigger check, pre-trigger ring) | **{:.2}** | {:.1} | ≤ 10 |\n\
-         | inside an impact (capture, exact sums, peak, separation, next hit, level watch, end detection, ring, the rise's record, the kinematics' online sums) | **{:.1}** | {:.1} | ≤ 60 |\n\
+         | inside an impact (capture, exact sums, peak, separation, next hit, level watch, end detection, ring, the rise's record, the kinematics' online sums) | **{:.1}** | {:.1} | ≤ 40 |\n\
          | the whole emulator firmware, idle (source, queue, tasks, executor, replay) | **{:.1}** | | |\n\
          \n\
          | per impact | instructions |\n\

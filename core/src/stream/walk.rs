@@ -147,8 +147,13 @@ impl Walk {
     }
 
     /// Runs over `samples`: alternating stretches of samples beyond the edge level (loud)
-    /// and within it (quiet), each in a tight loop; what is rare (a new peak, a sign flip,
-    /// a new hit, the hold reached) leaves the tight loop for the full test.
+    /// and within it (quiet). The samples that only add to the sums (a loud one inside its
+    /// band on the pulse's side once the quiet count is reset; a quiet one before the next
+    /// count that matters) go through [`run_in`], out of line so that its few values stay
+    /// in registers; what is rare (the first loud sample after quiet ones, a new peak, a
+    /// sign flip, a new hit, the counts that mark a return or the end) is taken here, one
+    /// sample at a time, with the same operations in the same order as one loop over every
+    /// sample would.
     #[inline(always)]
     pub fn run(&mut self, samples: &[i16], deviation: Deviation, l: &Levels) {
         let n = samples.len();
@@ -162,7 +167,16 @@ impl Walk {
                 self.returned,
                 self.separation.is_none(),
             );
-            while let Some(&x) = samples.get(k) {
+            let mut band = Band::loud(sign, lo, hi, edge);
+            loop {
+                // Loud samples inside the band add to the sums only.
+                if let (0, Some(band)) = (self.quiet, band) {
+                    let rest = samples.get(k..).unwrap_or(&[]);
+                    k += run_in(rest, deviation, band, &mut self.sum, &mut self.sum2);
+                }
+                let Some(&x) = samples.get(k) else {
+                    break 'scan;
+                };
                 let d = deviation.of(x);
                 let abs = d.unsigned_abs();
                 if abs <= edge {
@@ -191,6 +205,7 @@ impl Walk {
                         self.returned,
                         self.separation.is_none(),
                     );
+                    band = Band::loud(sign, lo, hi, edge);
                 }
                 if self.quiet > 0 {
                     self.last_quiet_k = Some(k);
@@ -201,27 +216,46 @@ impl Walk {
                 k += 1;
             }
             // Quiet: the first quiet sample after the peak is the separation.
-            if k < n && self.separation.is_none() {
+            if self.separation.is_none() {
                 self.separation = Some(start + k as u64);
                 self.separation_c = self.total_c + self.sum;
             }
-            while let Some(&x) = samples.get(k) {
-                let d = deviation.of(x);
-                if d.unsigned_abs() > edge {
-                    break;
+            while k < n {
+                // Quiet samples up to the next count that matters: the one that makes it a
+                // return (`min_gap`), the hold, or past the hold the first sample beyond the
+                // trigger.
+                let q = self.quiet;
+                let mut take = n - k;
+                if !self.returned && q < l.min_gap {
+                    take = take.min((l.min_gap - q) as usize);
                 }
-                self.quiet += 1;
-                self.sum += d as i64;
-                self.sum2 = self.sum2.wrapping_add(self.sum);
+                if q < l.hold {
+                    take = take.min((l.hold - q) as usize);
+                } else {
+                    let beyond = (l.trigger_index + 1).saturating_sub(start + k as u64);
+                    take = take.min(beyond.saturating_add(1).min(n as u64) as usize);
+                }
+                let run = samples.get(k..k + take).unwrap_or(&[]);
+                let got = match Band::quiet(edge) {
+                    Some(band) => run_in(run, deviation, band, &mut self.sum, &mut self.sum2),
+                    None => 0,
+                };
+                // (`got <= take <= n`: the count cannot wrap.)
+                self.quiet = self.quiet.saturating_add(got as u32);
+                k += got;
+                if got < take {
+                    // A loud sample at `k` (by the loud phase's own test: it takes it).
+                    continue 'scan;
+                }
+                // The last sample taken, `k - 1`, as one loop would check it.
                 if self.quiet >= l.first_mark {
                     self.returned |= self.quiet >= l.min_gap;
-                    if self.quiet >= l.hold && start + k as u64 > l.trigger_index {
+                    if self.quiet >= l.hold && start + (k - 1) as u64 > l.trigger_index {
                         self.ended = Some(End::Quiet);
-                        self.used = k + 1;
+                        self.used = k;
                         break 'scan;
                     }
                 }
-                k += 1;
             }
         }
     }
@@ -314,4 +348,77 @@ impl Walk {
         a.samples += self.used as u64;
         self.ended.take()
     }
+}
+
+/// An interval of `d`, `from..=to`, tested as `d - from <= width` unsigned (exact for every
+/// `d`: `to >= from`, both in i32).
+#[derive(Clone, Copy)]
+pub(super) struct Band {
+    from: i32,
+    width: u32,
+}
+
+impl Band {
+    /// `from..=to` (in i64, clamped to i32's range: `d` is an i32); `None` if empty.
+    #[inline(always)]
+    fn new(from: i64, to: i64) -> Option<Band> {
+        let clamp = |v: i64| v.clamp(i64::from(i32::MIN), i64::from(i32::MAX)) as i32;
+        let (from, to) = (clamp(from), clamp(to));
+        (from <= to).then(|| Band {
+            from,
+            width: (to as u32).wrapping_sub(from as u32),
+        })
+    }
+
+    /// The loud samples inside a loud sample's band on the pulse's side: `lo <= d * sign <=
+    /// hi` (`sign = ±1`) and `d * sign > edge`. (A loud sample inside the band on the other
+    /// side, `d * sign < -edge`, is the loop's own to take.)
+    #[inline(always)]
+    fn loud(sign: i32, lo: i32, hi: i32, edge: u32) -> Option<Band> {
+        let (lo, hi, edge) = (i64::from(lo), i64::from(hi), i64::from(edge));
+        let lo = lo.max(edge + 1);
+        if sign >= 0 {
+            Band::new(lo, hi)
+        } else {
+            Band::new(-hi, -lo)
+        }
+    }
+
+    /// The quiet samples: `|d| <= edge`.
+    #[inline(always)]
+    fn quiet(edge: u32) -> Option<Band> {
+        Band::new(-i64::from(edge), i64::from(edge))
+    }
+
+    /// `from <= d <= to`: `d - from` and `to - from` taken mod 2^32 (exact: `to >= from`).
+    #[inline(always)]
+    fn holds(self, d: i32) -> bool {
+        (d as u32).wrapping_sub(self.from as u32) <= self.width
+    }
+}
+
+/// The leading samples of `samples` whose `d` lies in `band`, added to the sums (`sum +=
+/// d`, `sum2 += sum`, wrapping as the loop's); how many. Out of line: its dozen values stay
+/// in registers (about 12 instructions a sample on the M4).
+#[inline(never)]
+fn run_in(
+    samples: &[i16],
+    deviation: Deviation,
+    band: Band,
+    sum: &mut i64,
+    sum2: &mut i64,
+) -> usize {
+    let (mut s, mut s2) = (*sum, *sum2);
+    let mut rest = samples;
+    while let [x, tail @ ..] = rest {
+        let d = deviation.of(*x);
+        if !band.holds(d) {
+            break;
+        }
+        s += d as i64;
+        s2 = s2.wrapping_add(s);
+        rest = tail;
+    }
+    (*sum, *sum2) = (s, s2);
+    samples.len() - rest.len()
 }

@@ -109,9 +109,11 @@ pub const BOARD_CLOCK_HZ: f64 = 168e6;
 pub const SEED_RATE_HZ: f64 = 500e3;
 /// The STM32F4 ADC's top rate (12 bits, 2.4 MS/s with one ADC), S/s.
 pub const ADC_TOP_RATE_HZ: f64 = 2.4e6;
-/// Targets of the issue: instructions per sample, idle and inside an impact.
+/// Targets of the issue: instructions per sample, idle and inside an impact (#44: the whole
+/// in-impact path, the online sums and the physics issues' work included, at most 40, which
+/// `--check` holds; the idle path's is printed).
 pub const IDLE_TARGET: f64 = 10.0;
-pub const IMPACT_TARGET: f64 = 60.0;
+pub const IMPACT_TARGET: f64 = 40.0;
 /// Per-impact targets (issue "analysis 20x cheaper"), instructions: the report without fits,
 /// the three fits with the exponent fixed together, the nonlinear fit with the exponent
 /// searched, and the board's whole analysis (report and its scene's fits).

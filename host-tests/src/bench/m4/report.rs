@@ -107,6 +107,12 @@ pub enum Regression {
         now: u64,
         target: u64,
     },
+    /// The in-impact path's instructions a sample over its absolute target.
+    OverSampleTarget {
+        name: &'static str,
+        now: f64,
+        target: f64,
+    },
 }
 
 impl std::fmt::Display for Regression {
@@ -118,6 +124,12 @@ impl std::fmt::Display for Regression {
             }
             Regression::OverTarget { name, now, target } => {
                 write!(f, "{name}: {now} instructions, over its target of {target}")
+            }
+            Regression::OverSampleTarget { name, now, target } => {
+                write!(
+                    f,
+                    "{name}: {now:.2} instructions a sample, over its target of {target}"
+                )
             }
         }
     }
@@ -233,6 +245,15 @@ pub fn check(r: &M4Report, baseline: &M4Report) -> Result<String, Regressed> {
         if now > target {
             failed.push(Regression::OverTarget { name, now, target });
         }
+    }
+    // #44's per-sample target for the in-impact path (a count that is not a number fails).
+    let (now, target) = (r.impact_instructions_per_sample, IMPACT_TARGET);
+    if now.partial_cmp(&target).is_none_or(|o| o.is_gt()) {
+        failed.push(Regression::OverSampleTarget {
+            name: "in impact",
+            now,
+            target,
+        });
     }
     if failed.is_empty() {
         Ok(text)
@@ -354,5 +375,18 @@ mod tests {
         r.analysis_instructions = ANALYSIS_TARGET;
         r.spectrum_instructions = SPECTRUM_TARGET + 1;
         assert!(check(&r, &base).is_err());
+        r.spectrum_instructions = SPECTRUM_TARGET;
+        // The in-impact path over #44's 40 a sample, though within 10 % of the baseline's.
+        assert_eq!(base.impact_instructions_per_sample, IMPACT_TARGET);
+        let over = |r: &M4Report| {
+            check(r, &base).err().is_some_and(|e| {
+                e.failed
+                    .iter()
+                    .any(|f| matches!(f, Regression::OverSampleTarget { .. }))
+            })
+        };
+        assert!(!over(&r));
+        r.impact_instructions_per_sample = IMPACT_TARGET + 0.5;
+        assert!(over(&r));
     }
 }
