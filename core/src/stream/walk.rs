@@ -232,7 +232,8 @@ impl Walk {
                 if q < l.hold {
                     take = take.min((l.hold - q) as usize);
                 } else {
-                    let beyond = (l.trigger_index + 1).saturating_sub(start + k as u64);
+                    let beyond =
+                        (l.trigger_index.saturating_add(1)).saturating_sub(start + k as u64);
                     take = take.min(beyond.saturating_add(1).min(n as u64) as usize);
                 }
                 let run = samples.get(k..k + take).unwrap_or(&[]);
@@ -240,21 +241,22 @@ impl Walk {
                     Some(band) => run_in(run, deviation, band, &mut self.sum, &mut self.sum2),
                     None => 0,
                 };
-                // (`got <= take <= n`: the count cannot wrap.)
                 self.quiet = self.quiet.saturating_add(got as u32);
                 k += got;
-                if got < take {
-                    // A loud sample at `k` (by the loud phase's own test: it takes it).
-                    continue 'scan;
-                }
-                // The last sample taken, `k - 1`, as one loop would check it.
-                if self.quiet >= l.first_mark {
+                // The last sample taken, `k - 1`, as one loop would check it (the counts
+                // only grow, so what any sample taken would set, the last sets; the end
+                // cannot come before it: `take` stops at the first sample where it can).
+                if got > 0 && self.quiet >= l.first_mark {
                     self.returned |= self.quiet >= l.min_gap;
                     if self.quiet >= l.hold && start + (k - 1) as u64 > l.trigger_index {
                         self.ended = Some(End::Quiet);
                         self.used = k;
                         break 'scan;
                     }
+                }
+                if got < take {
+                    // A loud sample at `k` (by the loud phase's own test: it takes it).
+                    continue 'scan;
                 }
             }
         }
@@ -359,14 +361,13 @@ pub(super) struct Band {
 }
 
 impl Band {
-    /// `from..=to` (in i64, clamped to i32's range: `d` is an i32); `None` if empty.
+    /// `from..=to` met with i32's range (`d` is an i32), in i64; `None` if that is empty.
     #[inline(always)]
     fn new(from: i64, to: i64) -> Option<Band> {
-        let clamp = |v: i64| v.clamp(i64::from(i32::MIN), i64::from(i32::MAX)) as i32;
-        let (from, to) = (clamp(from), clamp(to));
+        let (from, to) = (from.max(i64::from(i32::MIN)), to.min(i64::from(i32::MAX)));
         (from <= to).then(|| Band {
-            from,
-            width: (to as u32).wrapping_sub(from as u32),
+            from: from as i32,
+            width: (to as i32 as u32).wrapping_sub(from as i32 as u32),
         })
     }
 
@@ -422,3 +423,7 @@ fn run_in(
     (*sum, *sum2) = (s, s2);
     samples.len() - rest.len()
 }
+
+#[cfg(test)]
+#[path = "walk_tests.rs"]
+mod tests;
