@@ -146,17 +146,8 @@ fn target_space(value: &str) -> Result<&'static impact_core::two_body::Target<f3
         .and_then(|v| v.parse::<usize>().ok())
         .filter(|n| (1..=MAX_STATES).contains(n))
         .ok_or(SceneError::BadValue)?;
-    let mut t = Target {
-        n,
-        a: [[0.0; MAX_STATES]; MAX_STATES],
-        b: [0.0; MAX_STATES],
-        c: [[0.0; MAX_STATES]; 2],
-        spring_mass: None,
-    };
-    let slots = (t.a.iter_mut().take(n).flat_map(|r| r.iter_mut().take(n)))
-        .chain(t.b.iter_mut().take(n))
-        .chain(t.c.iter_mut().flat_map(|r| r.iter_mut().take(n)));
-    for slot in slots {
+    let mut t = Target::unset(n);
+    for slot in t.entries_mut() {
         let v = values.next().ok_or(SceneError::BadValue)?;
         *slot = v.parse::<f32>().map_err(|_| SceneError::BadValue)?;
     }

@@ -37,6 +37,16 @@ fn plate_on_base(m3: f64, k3: f64, c3: f64) -> Target<f64> {
     Target::state_space(4, a, b, c, [0.0, 0.0]).expect("a valid target")
 }
 
+/// The fixtures' plate alone, as `--target-mass` takes a spring–mass to ground.
+const PLATE_ALONE: [&str; 6] = [
+    "--target-mass",
+    "0.3",
+    "--target-stiffness",
+    "40000",
+    "--target-damping",
+    "12",
+];
+
 /// `t` as the JSON file `--target` reads.
 fn json_of(t: &Target<f64>) -> String {
     let n = t.n;
@@ -214,19 +224,7 @@ fn a_soft_base_matters_and_the_state_space_measures_it() {
     let errs = errors(&json["impacts"][0], &truth);
     eprintln!("soft base: {errs:.5?} (truth cor {:.4})", truth.cor);
     assert!(errs.iter().all(|e| e.abs() <= 0.01), "{errs:?}");
-    let plate = analyse(
-        &scratch,
-        &accel,
-        rate,
-        &[
-            "--target-mass",
-            "0.3",
-            "--target-stiffness",
-            "40000",
-            "--target-damping",
-            "12",
-        ],
-    );
+    let plate = analyse(&scratch, &accel, rate, &PLATE_ALONE);
     let plate_cor = plate["impacts"][0]["cor"].as_f64().unwrap();
     assert!(
         (plate_cor / truth.cor - 1.0).abs() > 0.1,
@@ -272,19 +270,7 @@ fn a_spring_mass_as_a_state_space_is_measured_as_target_mass_measures_it() {
         "{truth:?} {truth_ss:?}"
     );
     // And the analysis's.
-    let by_mass = analyse(
-        &scratch,
-        &accel,
-        rate,
-        &[
-            "--target-mass",
-            "0.3",
-            "--target-stiffness",
-            "40000",
-            "--target-damping",
-            "12",
-        ],
-    );
+    let by_mass = analyse(&scratch, &accel, rate, &PLATE_ALONE);
     let by_space = analyse(
         &scratch,
         &accel,

@@ -161,6 +161,40 @@ impl<R: Real> Target<R> {
         Ok(t)
     }
 
+    /// `n` states (at most [`MAX_STATES`]), every entry zero, not a spring–mass: to be filled
+    /// through [`Target::entries_mut`] (and checked by [`Target::validate`]).
+    pub fn unset(n: usize) -> Self {
+        Self {
+            n: n.min(MAX_STATES),
+            a: [[R::ZERO; MAX_STATES]; MAX_STATES],
+            b: [R::ZERO; MAX_STATES],
+            c: [[R::ZERO; MAX_STATES]; 2],
+            spring_mass: None,
+        }
+    }
+
+    /// The entries in the order of the board's `target_space` list (its scene key and its
+    /// scene line): `A` row by row, `B`, `C` (the displacement's row, then the velocity's);
+    /// `n² + 3n` of them.
+    pub fn entries(&self) -> impl Iterator<Item = &R> {
+        let n = self.n.min(MAX_STATES);
+        (self.a.iter().take(n).flat_map(move |r| r.iter().take(n)))
+            .chain(self.b.iter().take(n))
+            .chain(self.c.iter().flat_map(move |r| r.iter().take(n)))
+    }
+
+    /// [`Target::entries`], to write.
+    pub fn entries_mut(&mut self) -> impl Iterator<Item = &mut R> {
+        let n = self.n.min(MAX_STATES);
+        (self
+            .a
+            .iter_mut()
+            .take(n)
+            .flat_map(move |r| r.iter_mut().take(n)))
+        .chain(self.b.iter_mut().take(n))
+        .chain(self.c.iter_mut().flat_map(move |r| r.iter_mut().take(n)))
+    }
+
     /// The target's own matrix `A` as a [`Mat`].
     /// (Every method reads at most [`MAX_STATES`] states, whatever `n` holds: none can fail
     /// on an index, as the board's build requires.)

@@ -68,7 +68,7 @@ impl Discrete {
             [-k / m * dt, -c / m * dt, dt / m],
             [0.0, 0.0, 0.0],
         ];
-        let e = expm(&a)?;
+        let e = exp3(&a)?;
         let f = |v: f64| v as f32;
         let d = Self {
             phi: [[f(e[0][0]), f(e[0][1])], [f(e[1][0]), f(e[1][1])]],
@@ -223,16 +223,13 @@ impl Step for General {
     }
 }
 
-/// `a b` (sums in the order of the index: the same bits for every `K`).
-fn mul<const K: usize>(a: &[[f64; K]; K], b: &[[f64; K]; K]) -> [[f64; K]; K] {
-    let mut out = [[0.0; K]; K];
-    for i in 0..K {
-        for j in 0..K {
-            let mut s = a[i][0] * b[0][j];
-            for k in 1..K {
-                s += a[i][k] * b[k][j];
-            }
-            out[i][j] = s;
+type M3 = [[f64; 3]; 3];
+
+fn mul3(a: &M3, b: &M3) -> M3 {
+    let mut out = [[0.0; 3]; 3];
+    for i in 0..3 {
+        for j in 0..3 {
+            out[i][j] = a[i][0] * b[0][j] + a[i][1] * b[1][j] + a[i][2] * b[2][j];
         }
     }
     out
@@ -240,17 +237,10 @@ fn mul<const K: usize>(a: &[[f64; K]; K], b: &[[f64; K]; K]) -> [[f64; K]; K] {
 
 /// `exp(a)` by scaling and squaring with an 18-term Taylor series (`a` halved until its
 /// infinity norm is at most 1/2: the truncation `0.5^19 / 19!` is far below f64's epsilon).
-/// Fixed-size and index-safe (the board links it: no panic path).
-fn expm<const K: usize>(a: &[[f64; K]; K]) -> Option<[[f64; K]; K]> {
+fn exp3(a: &M3) -> Option<M3> {
     let norm = a
         .iter()
-        .map(|r| {
-            let mut s = libm::fabs(r.first().copied().unwrap_or(0.0));
-            for v in r.iter().skip(1) {
-                s += libm::fabs(*v);
-            }
-            s
-        })
+        .map(|r| libm::fabs(r[0]) + libm::fabs(r[1]) + libm::fabs(r[2]))
         .fold(0.0, f64::max);
     if !norm.is_finite() {
         return None;
@@ -262,11 +252,10 @@ fn expm<const K: usize>(a: &[[f64; K]; K]) -> Option<[[f64; K]; K]> {
         squarings += 1;
     }
     let b = a.map(|r| r.map(|v| v * scale));
-    let mut term: [[f64; K]; K] =
-        core::array::from_fn(|i| core::array::from_fn(|j| if i == j { 1.0 } else { 0.0 }));
+    let mut term = [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]];
     let mut sum = term;
     for j in 1..=18 {
-        term = mul(&term, &b);
+        term = mul3(&term, &b);
         for (s_row, t_row) in sum.iter_mut().zip(term.iter_mut()) {
             for (s, t) in s_row.iter_mut().zip(t_row.iter_mut()) {
                 *t /= j as f64;
@@ -275,7 +264,7 @@ fn expm<const K: usize>(a: &[[f64; K]; K]) -> Option<[[f64; K]; K]> {
         }
     }
     for _ in 0..squarings {
-        sum = mul(&sum, &sum);
+        sum = mul3(&sum, &sum);
     }
     sum.iter().flatten().all(|v| v.is_finite()).then_some(sum)
 }

@@ -567,10 +567,7 @@ impl defmt::Format for TargetSpace {
         };
         let n = t.n.min(impact_core::two_body::MAX_STATES);
         defmt::write!(f, "{=u32}", n as u32);
-        let values = (t.a.iter().take(n).flat_map(|r| r.iter().take(n)))
-            .chain(t.b.iter().take(n))
-            .chain(t.c.iter().flat_map(|r| r.iter().take(n)));
-        for v in values {
+        for v in t.entries() {
             defmt::write!(f, ",{=f32}", *v);
         }
     }

@@ -206,11 +206,8 @@ pub fn scene_args(scene: &Scene) -> Vec<String> {
         // passes no comma).
         Some(SceneTarget::StateSpace(t)) => {
             let n = t.n.min(impact_core::two_body::MAX_STATES);
-            let values = (t.a.iter().take(n).flat_map(|r| r.iter().take(n)))
-                .chain(t.b.iter().take(n))
-                .chain(t.c.iter().flat_map(|r| r.iter().take(n)));
             let list: Vec<String> = std::iter::once(n.to_string())
-                .chain(values.map(|v| f(*v)))
+                .chain(t.entries().map(|v| f(*v)))
                 .collect();
             args.push(format!("target_space={}", list.join(":")));
         }

@@ -130,21 +130,9 @@ impl SceneLine {
                 .collect::<Option<_>>()
                 .filter(|v: &Vec<f32>| v.len() == n * n + 3 * n)
                 .ok_or_else(bad)?;
-            let mut t = Target {
-                n,
-                a: [[0.0; MAX_STATES]; MAX_STATES],
-                b: [0.0; MAX_STATES],
-                c: [[0.0; MAX_STATES]; 2],
-                spring_mass: None,
-            };
-            let (a, rest) = values.split_at(n * n);
-            let (b, c) = rest.split_at(n);
-            for (row, v) in t.a.iter_mut().zip(a.chunks(n)) {
-                row[..n].copy_from_slice(v);
-            }
-            t.b[..n].copy_from_slice(b);
-            for (row, v) in t.c.iter_mut().zip(c.chunks(n)) {
-                row[..n].copy_from_slice(v);
+            let mut t = Target::unset(n);
+            for (slot, v) in t.entries_mut().zip(values) {
+                *slot = v;
             }
             return Ok(Some(LineTarget::StateSpace(Box::new(t))));
         }
