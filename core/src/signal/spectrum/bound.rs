@@ -208,13 +208,16 @@ pub(super) fn rests(input: Input, out: &mut [Rest; STAT_BLOCKS]) {
         let (u, v) = line(block);
         let mut s = Rest::default();
         let mut squares = 0.0f32;
-        for (m, &x) in block.iter().enumerate() {
-            let r = (x - (u + v * m as f32)).abs();
+        // `m` as f32, counted in f32 (exact below 2^24): no conversion a sample.
+        let mut m = 0.0f32;
+        for &x in block {
+            let r = (x - (u + v * m)).abs();
             s.sum += r;
             squares += r * r;
             if r > s.max {
                 s.max = r;
             }
+            m += 1.0;
         }
         // Rounded up a little: the sums in `f32`.
         s.norm = crate::real::fpu_sqrt(squares) * 1.0001;

@@ -35,46 +35,59 @@ pub(super) fn halve(x: &mut [f32], len: usize) -> Option<usize> {
     for (h, v) in head.iter_mut().zip(x.iter()) {
         *h = *v;
     }
-    for i in 0..out_len {
-        let centre = 2 * i as isize - SPAN as isize;
-        let at = |j: isize| -> f32 {
-            if j < 0 || j as usize >= len {
-                0.0
-            } else if (j as usize) < head.len() {
-                head.get(j as usize).copied().unwrap_or(0.0)
-            } else {
-                x.get(j as usize).copied().unwrap_or(0.0)
-            }
+    // Outputs whose 23 inputs lie past the copied head and before the end are one slice
+    // each (`2 i - 2 SPAN >= 2 SPAN`, `2 i < len`). In order of `i`: output `i` overwrites
+    // an input only outputs before it read.
+    let inner_to = len.div_ceil(2).min(out_len);
+    let inner_from = (2 * SPAN).min(inner_to);
+    for i in 0..inner_from {
+        let acc = edge(x, &head, len, i);
+        if let Some(slot) = x.get_mut(i) {
+            *slot = acc;
+        }
+    }
+    for i in inner_from..inner_to {
+        let first = 2 * i - 2 * SPAN;
+        let Some(w) = x
+            .get(first..first + 2 * SPAN + 1)
+            .and_then(|w| <&[f32; 2 * SPAN + 1]>::try_from(w).ok())
+        else {
+            break;
         };
-        // Away from both ends (and from the copied head) the 23 inputs are one slice.
-        let first = centre - SPAN as isize;
-        let inner = first >= head.len() as isize && (centre + SPAN as isize) < len as isize;
-        let window: Option<&[f32; 2 * SPAN + 1]> = if inner {
-            x.get(first as usize..first as usize + 2 * SPAN + 1)
-                .and_then(|w| w.try_into().ok())
-        } else {
-            None
-        };
-        let acc = match window {
-            Some(w) => {
-                let mut acc = HALF_BAND_CENTRE * w[SPAN];
-                for (k, h) in HALF_BAND.iter().enumerate() {
-                    acc += h * (w[SPAN - 1 - 2 * k] + w[SPAN + 1 + 2 * k]);
-                }
-                acc
-            }
-            None => {
-                let mut acc = HALF_BAND_CENTRE * at(centre);
-                for (k, h) in HALF_BAND.iter().enumerate() {
-                    let d = 2 * k as isize + 1;
-                    acc += h * (at(centre - d) + at(centre + d));
-                }
-                acc
-            }
-        };
+        let mut acc = HALF_BAND_CENTRE * w[SPAN];
+        for (k, h) in HALF_BAND.iter().enumerate() {
+            acc += h * (w[SPAN - 1 - 2 * k] + w[SPAN + 1 + 2 * k]);
+        }
+        if let Some(slot) = x.get_mut(i) {
+            *slot = acc;
+        }
+    }
+    for i in inner_to..out_len {
+        let acc = edge(x, &head, len, i);
         if let Some(slot) = x.get_mut(i) {
             *slot = acc;
         }
     }
     Some(out_len)
+}
+
+/// Output `i` of [`halve`] near either end: inputs before the first or past `len` are 0, the
+/// first `2 SPAN` read from `head`.
+pub(super) fn edge(x: &[f32], head: &[f32; 2 * SPAN], len: usize, i: usize) -> f32 {
+    let centre = 2 * i as isize - SPAN as isize;
+    let at = |j: isize| -> f32 {
+        if j < 0 || j as usize >= len {
+            0.0
+        } else if (j as usize) < head.len() {
+            head.get(j as usize).copied().unwrap_or(0.0)
+        } else {
+            x.get(j as usize).copied().unwrap_or(0.0)
+        }
+    };
+    let mut acc = HALF_BAND_CENTRE * at(centre);
+    for (k, h) in HALF_BAND.iter().enumerate() {
+        let d = 2 * k as isize + 1;
+        acc += h * (at(centre - d) + at(centre + d));
+    }
+    acc
 }

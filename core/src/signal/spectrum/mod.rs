@@ -276,6 +276,53 @@ mod tests {
         assert!(halve(&mut [1.0; 8], 8).is_none());
     }
 
+    /// Halving in place gives every output as the filter over an untouched copy does (the
+    /// edges' general sum), bit for bit, at every length around the edges' limits.
+    #[test]
+    fn halving_in_place_is_the_filter_over_a_copy() {
+        let mut state = 7u32;
+        for len in (0..120).chain([255, 256, 257, 1001]) {
+            let x: Vec<f32> = (0..len)
+                .map(|_| {
+                    state = state.wrapping_mul(1_664_525).wrapping_add(1_013_904_223);
+                    (state >> 8) as f32 / (1u32 << 24) as f32 - 0.5
+                })
+                .collect();
+            let mut head = [0.0f32; 2 * SPAN];
+            for (h, v) in head.iter_mut().zip(&x) {
+                *h = *v;
+            }
+            let mut y = x.clone();
+            match halve(&mut y, len) {
+                Some(out) => {
+                    assert_eq!(out, len / 2 + SPAN + 1);
+                    for (i, v) in y.iter().take(out).enumerate() {
+                        let want = halfband::edge(&x, &head, len, i);
+                        assert_eq!(v.to_bits(), want.to_bits(), "{len} {i}");
+                    }
+                    assert_eq!(y[out..], x[out..], "{len}");
+                }
+                None => assert_eq!(y, x),
+            }
+        }
+    }
+
+    /// The pre-emphasised copy is `emphasised` at every output, bit for bit, at every length
+    /// around the edges'.
+    #[test]
+    fn the_compensated_copy_is_the_pre_emphasis() {
+        for len in 0..40usize {
+            let mut x: Vec<f32> = (0..2 * len + 4).map(|k| (k as f32 * 0.37).sin()).collect();
+            let src = x[..len].to_vec();
+            assert_eq!(compensate(&mut x, len), Some(len..2 * len + 4));
+            for n in 0..len + 4 {
+                assert_eq!(x[len + n].to_bits(), emphasised(&src, n).to_bits(), "{len} {n}");
+            }
+            assert_eq!(x[..len], src[..]);
+        }
+        assert_eq!(compensate(&mut [0.0; 9], 3), None);
+    }
+
     /// A half-sine of `amp` m/s² lasting `dur` s at `rate` with `pad` zeros before and after.
     fn half_sine(amp: f64, dur: f64, rate: f64, pad: usize) -> Vec<f64> {
         let n = (dur * rate) as usize;
