@@ -366,3 +366,87 @@ fn a_state_space_target_the_tool_cannot_use_is_refused_naming_it() {
     assert_eq!(got, 1, "{err}");
     assert!(std::fs::read_to_string(good).unwrap().starts_with("{\"a\""));
 }
+
+/// A scene file takes the state space as `--target` does: by the name of its file (relative
+/// to the scene file's folder, not to where the tool runs) or written in it, with the same
+/// numbers; `--target` overrides it; a spring–mass beside it, a malformed one and an output
+/// over its file are refused, naming the scene file's key.
+#[test]
+fn a_scene_files_state_space_is_the_options() {
+    let scratch = Scratch::new();
+    let target = two_masses();
+    let s = strike(Model::Hertz(Hertz { k: 1e9 }), 0.0123);
+    let rate = 500e3;
+    let n = ((s.touch_s + 0.08) * rate) as usize;
+    let (accel, _) = s.render_on(Some(&target), rate, n).unwrap();
+    let sub = scratch.path().join("bench");
+    std::fs::create_dir(&sub).unwrap();
+    std::fs::write(sub.join("fixture.json"), json_of(&target)).unwrap();
+    let fixture = sub.join("fixture.json");
+    let fixture = fixture.to_str().unwrap();
+    let by_option = analyse(&scratch, &accel, rate, &["--target", fixture]);
+    let named = sub.join("named.json");
+    std::fs::write(&named, r#"{"target": "fixture.json"}"#).unwrap();
+    let inline = sub.join("inline.json");
+    let object: Value = serde_json::from_str(&json_of(&target)).unwrap();
+    std::fs::write(&inline, serde_json::json!({ "target": object }).to_string()).unwrap();
+    // (Another target: the plate on a soft base.)
+    let plate = scratch.file("plate.json", json_of(&plate_on_base(0.1, 2e4, 5.0)));
+    for (scene, extra) in [
+        (&named, vec![]),
+        (&inline, vec![]),
+        (&named, vec!["--target", fixture]),
+    ] {
+        let mut args = vec!["--scene", scene.to_str().unwrap()];
+        args.extend(extra);
+        let by_scene = analyse(&scratch, &accel, rate, &args);
+        assert_eq!(by_scene["target"], by_option["target"], "{args:?}");
+        assert_eq!(by_scene["impacts"], by_option["impacts"], "{args:?}");
+        assert_eq!(by_scene["assumptions"], by_option["assumptions"], "{args:?}");
+    }
+    // The command line's over the scene file's: a different target, different numbers.
+    let over = analyse(
+        &scratch,
+        &accel,
+        rate,
+        &["--scene", named.to_str().unwrap(), "--target", plate.to_str().unwrap()],
+    );
+    assert_ne!(over["impacts"][0]["cor"], by_option["impacts"][0]["cor"]);
+    let csv = scratch.join_str("strike.csv");
+    let refused = |scene: &str, extra: &[&str], want: &str| {
+        let path = sub.join("refused.json");
+        std::fs::write(&path, scene).unwrap();
+        let mut args = vec!["analyze", &csv, "--mass", "0.06", "--scene"];
+        let path = path.to_str().unwrap().to_string();
+        args.push(&path);
+        args.extend_from_slice(extra);
+        let (got, _, err) = common::impact(&args);
+        assert_eq!(got, 1, "{scene} {extra:?}: {err}");
+        assert!(err.contains(want), "{scene} {extra:?}: {err}");
+    };
+    let two = "refused.json: target: a state-space target, and a spring–mass given too";
+    refused(r#"{"target": "fixture.json", "target_mass": 0.3}"#, &[], two);
+    refused(r#"{"target": "fixture.json"}"#, &["--target-mass", "0.3"], two);
+    refused(
+        r#"{"target": {"a": [[0, 1], [-1, 0]], "b": [0, 1, 2], "c": [[1, 0], [0, 1]]}}"#,
+        &[],
+        "refused.json: target: B has 3 entries, not 2",
+    );
+    refused(
+        r#"{"target": "missing.json"}"#,
+        &[],
+        "refused.json: target ",
+    );
+    refused(r#"{"target": 3}"#, &[], "refused.json: target must be the name of");
+    // The file the scene file names is an input: no output over it.
+    let (got, _, err) = common::impact(&[
+        "report",
+        &csv,
+        "--scene",
+        named.to_str().unwrap(),
+        "--html",
+        fixture,
+    ]);
+    assert_eq!(got, 1, "{err}");
+    assert!(std::fs::read_to_string(fixture).unwrap().starts_with("{\"a\""));
+}

@@ -50,13 +50,16 @@ pub struct AnalyzeCommand {
 }
 
 /// The files an analysis reads (no output may write over one): the recording, the scene
-/// file, the free-fall recording, the user's band (`--spec …,band-file=`).
-pub fn inputs(args: &AnalyzeArgs) -> Vec<&std::path::Path> {
-    let mut inputs = vec![args.file.as_path()];
-    inputs.extend(args.scene.as_deref());
-    inputs.extend(args.free_fall.as_deref().map(pipeline::free_fall::file));
-    inputs.extend(args.spec.and_then(|s| s.band_file));
-    inputs.extend(args.target.as_deref());
+/// file, the free-fall recording, the user's band (`--spec …,band-file=`), the state-space
+/// target's file (`--target`'s or the scene file's).
+pub fn inputs(args: &AnalyzeArgs) -> Vec<std::path::PathBuf> {
+    let mut inputs = vec![args.file.clone()];
+    inputs.extend(args.scene.clone());
+    inputs.extend(
+        (args.free_fall.as_deref().map(pipeline::free_fall::file)).map(|p| p.to_path_buf()),
+    );
+    inputs.extend(args.spec.and_then(|s| s.band_file).map(|p| p.to_path_buf()));
+    inputs.extend(pipeline::options::target_file(args));
     inputs
 }
 

@@ -266,7 +266,7 @@ pub fn emulate(args: &EmulateArgs) -> Result<crate::report::spec::Judged, Emulat
     }
     // No output over an input (the recording, the scene, the free fall, the firmware).
     let mut inputs = super::analyze::inputs(a);
-    inputs.extend(args.elf.as_deref());
+    inputs.extend(args.elf.clone());
     if let Some(path) = &a.plot {
         crate::plot::check_output(path, &inputs)?;
     }

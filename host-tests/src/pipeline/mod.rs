@@ -1066,50 +1066,7 @@ pub(crate) fn build_scene(
         args.train.vertical || file.vertical.unwrap_or(false) || args.free_fall.is_some();
     scene.train = args.train.train();
     scene.v0_every = args.v0_every || file.v0_every.unwrap_or(false);
-    // The target, each of its numbers the command line's, else the scene file's.
-    let (k2, c2) = (
-        args.target_stiffness.or(file.target_stiffness),
-        args.target_damping.or(file.target_damping),
-    );
-    use impact_core::two_body::{SceneTarget, SpringMass};
-    scene.target = match (&args.target, args.target_mass.or(file.target_mass)) {
-        // Two targets: the command line's state space and the scene file's spring–mass.
-        (Some(_), _)
-            if file.target_mass.is_some()
-                || file.target_stiffness.is_some()
-                || file.target_damping.is_some() =>
-        {
-            return Err(PipelineError::Invalid {
-                setting: Setting::Option("target"),
-                reason: "the scene file gives a spring–mass target (target_mass, target_stiffness, target_damping): give one target, the file's or this",
-            });
-        }
-        (Some(path), _) => {
-            let t = crate::simulate::two_body::read_state_space(path)
-                .map_err(|e| PipelineError::Target(Box::new(e)))?;
-            Some(SceneTarget::StateSpace(
-                crate::simulate::two_body::interned(crate::simulate::two_body::narrow(&t)),
-            ))
-        }
-        (None, Some(m)) => Some(SceneTarget::SpringMass(SpringMass {
-            mass_kg: m as f32,
-            stiffness_n_m: k2.unwrap_or(0.0) as f32,
-            damping_n_s_m: c2.unwrap_or(0.0) as f32,
-        })),
-        // (A spring or damper given without a mass on either.)
-        (None, None) if k2.is_some() || c2.is_some() => {
-            let name = if k2.is_some() {
-                "target-stiffness"
-            } else {
-                "target-damping"
-            };
-            return Err(PipelineError::Invalid {
-                setting: name_of(args, file, name),
-                reason: "needs the target's mass (--target-mass, or a scene file's target_mass)",
-            });
-        }
-        (None, None) => None,
-    };
+    scene.target = target(args, file)?;
     scene.spectrum = args.spectrum.settings();
     scene.spec = args.spec.map(|s| s.spec);
     scene.validate().map_err(|e| match e {
@@ -1126,6 +1083,81 @@ pub(crate) fn build_scene(
         spec_standard: args.spec.map(|s| s.standard),
         capture_len: capture_len(args),
     })
+}
+
+/// The target: `--target`'s state space, else the scene file's (`target`), else the
+/// spring–mass, each of its numbers the command line's, else the scene file's; a state space
+/// and a spring–mass together are refused.
+fn target(
+    args: &AnalyzeArgs,
+    file: &SceneFile,
+) -> Result<Option<impact_core::two_body::SceneTarget>, PipelineError> {
+    use impact_core::two_body::{SceneTarget, SpringMass};
+    let (k2, c2) = (
+        args.target_stiffness.or(file.target_stiffness),
+        args.target_damping.or(file.target_damping),
+    );
+    let file_spring_mass = file.target_mass.is_some()
+        || file.target_stiffness.is_some()
+        || file.target_damping.is_some();
+    let space = |t: impact_core::two_body::Target<f64>| {
+        Some(SceneTarget::StateSpace(crate::simulate::two_body::interned(
+            crate::simulate::two_body::narrow(&t),
+        )))
+    };
+    let target_error = |e| PipelineError::Target(Box::new(e));
+    let file_space = args.scene.as_deref().zip(file.target.as_ref());
+    Ok(
+        match (&args.target, file_space, args.target_mass.or(file.target_mass)) {
+            // Two targets: a state space and a spring–mass.
+            (Some(_), _, _) if file_spring_mass => {
+                return Err(PipelineError::Invalid {
+                    setting: Setting::Option("target"),
+                    reason: "the scene file gives a spring–mass target (target_mass, target_stiffness, target_damping): give one target, the file's or this",
+                });
+            }
+            (None, Some((scene, _)), _)
+                if file_spring_mass
+                    || args.target_mass.is_some()
+                    || args.target_stiffness.is_some()
+                    || args.target_damping.is_some() =>
+            {
+                return Err(PipelineError::Invalid {
+                    setting: Setting::SceneKey {
+                        scene: scene.to_path_buf(),
+                        name: "target",
+                    },
+                    reason: "a state-space target, and a spring–mass given too (target_mass, target_stiffness, target_damping or their options): give one target",
+                });
+            }
+            // The command line's state space over the scene file's.
+            (Some(path), _, _) => space(
+                crate::simulate::two_body::read_state_space(path).map_err(target_error)?,
+            ),
+            (None, Some((scene, value)), _) => space(
+                crate::simulate::two_body::scene_state_space(scene, value)
+                    .map_err(target_error)?,
+            ),
+            (None, None, Some(m)) => Some(SceneTarget::SpringMass(SpringMass {
+                mass_kg: m as f32,
+                stiffness_n_m: k2.unwrap_or(0.0) as f32,
+                damping_n_s_m: c2.unwrap_or(0.0) as f32,
+            })),
+            // (A spring or damper given without a mass on either.)
+            (None, None, None) if k2.is_some() || c2.is_some() => {
+                let name = if k2.is_some() {
+                    "target-stiffness"
+                } else {
+                    "target-damping"
+                };
+                return Err(PipelineError::Invalid {
+                    setting: name_of(args, file, name),
+                    reason: "needs the target's mass (--target-mass, or a scene file's target_mass)",
+                });
+            }
+            (None, None, None) => None,
+        },
+    )
 }
 
 /// The quiet time that ends an impact when none is given, s.

@@ -54,6 +54,9 @@ pub struct SceneFile {
     pub target_mass: Option<f64>,
     pub target_stiffness: Option<f64>,
     pub target_damping: Option<f64>,
+    /// A linear target in state-space form (as `--target`): the name of its JSON file,
+    /// relative to the scene file's folder, or its object `{"a", "b", "c", "d"}` itself.
+    pub target: Option<serde_json::Value>,
 }
 
 /// Which fits to run (scene file).
@@ -327,6 +330,19 @@ impl AnalyzeArgs {
             progress,
         }
     }
+}
+
+/// The state-space target's file an analysis reads: `--target`'s, else the one the scene
+/// file's `target` names (`None` for one written in the scene file, or a scene file that
+/// cannot be read: the analysis says why).
+pub fn target_file(args: &AnalyzeArgs) -> Option<PathBuf> {
+    if let Some(p) = &args.target {
+        return Some(p.clone());
+    }
+    let scene = args.scene.as_deref()?;
+    let bytes = impact_io::read_limited(scene, 1 << 20, "scene file").ok()?;
+    let file: SceneFile = serde_json::from_slice(&bytes).ok()?;
+    crate::simulate::two_body::scene_target_path(scene, file.target.as_ref()?)
 }
 
 /// The `--scene` file's settings (all defaults without one), each number within its limits

@@ -54,10 +54,13 @@ const FORMATS: [&str; 2] = ["svg", "png"];
 /// Checks that `path` can take a figure before any work is done: its directory exists and it
 /// is none of the `inputs` (the same file, a link to one, standard input's file: the output
 /// rule of [`crate::output`]), and it is named `.svg` or `.png` (the format).
-pub fn check_output(path: &std::path::Path, inputs: &[&std::path::Path]) -> Result<(), PlotError> {
+pub fn check_output<P: AsRef<std::path::Path>>(
+    path: &std::path::Path,
+    inputs: &[P],
+) -> Result<(), PlotError> {
     let all = inputs
         .iter()
-        .fold(crate::output::Inputs::new(), |all, i| all.with(i));
+        .fold(crate::output::Inputs::new(), |all, i| all.with(i.as_ref()));
     crate::output::check("--plot", path, &all, None)?;
     if format(path).is_none() {
         return Err(PlotError::Format {

@@ -162,8 +162,9 @@ pub enum SimulateError {
     /// The figure's trajectory could not be sampled (the core's words, its parameter by name).
     #[error(transparent)]
     Trajectory(Error),
+    /// (Boxed: a target's error names its files.)
     #[error(transparent)]
-    Target(#[from] two_body::TargetError),
+    Target(Box<two_body::TargetError>),
     #[error("--with-linear: compares a Hertz contact with its linear spring; give --model hertz")]
     WithLinearNotHertz,
     #[error("--with-linear: against a wall only")]
@@ -180,6 +181,12 @@ pub enum SimulateError {
     Plot(#[from] crate::plot::PlotError),
     #[error(transparent)]
     Json(#[from] serde_json::Error),
+}
+
+impl From<two_body::TargetError> for SimulateError {
+    fn from(e: two_body::TargetError) -> Self {
+        SimulateError::Target(Box::new(e))
+    }
 }
 
 fn missing(option: &'static str, model: &'static str) -> ModelError {
@@ -347,7 +354,7 @@ pub fn run_any(args: &SimulateArgs) -> Result<Outcome, SimulateError> {
     if !args.target.given() {
         let report = run(args)?;
         if let Some(path) = &args.target.plot {
-            crate::plot::check_output(path, &[])?;
+            crate::plot::check_output::<&std::path::Path>(path, &[])?;
             let impact = Impact::new(args.mass, args.v0);
             let model = args.params.model(args.model, &impact)?;
             let mut models = vec![(args.model, model)];

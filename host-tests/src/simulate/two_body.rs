@@ -45,7 +45,7 @@ impl TargetArgs {
 
 #[derive(Deserialize)]
 #[serde(deny_unknown_fields)]
-struct StateSpaceFile {
+pub(crate) struct StateSpaceFile {
     a: Vec<Vec<f64>>,
     b: Vec<f64>,
     c: Vec<Vec<f64>>,
@@ -53,41 +53,73 @@ struct StateSpaceFile {
     d: Option<Vec<f64>>,
 }
 
-/// Why the target could not be built (`--target FILE`, `--target-mass`).
+/// Where a state-space target came from, as its errors name it.
+#[derive(Clone, Debug, PartialEq)]
+pub enum TargetAt {
+    /// `--target FILE`.
+    Option(PathBuf),
+    /// A scene file's `target`: written in it (no file), or a file it names.
+    Scene {
+        scene: PathBuf,
+        file: Option<PathBuf>,
+    },
+}
+
+impl std::fmt::Display for TargetAt {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            TargetAt::Option(p) => write!(f, "--target {}", p.display()),
+            TargetAt::Scene { scene, file: None } => write!(f, "{}: target", scene.display()),
+            TargetAt::Scene {
+                scene,
+                file: Some(p),
+            } => write!(f, "{}: target {}", scene.display(), p.display()),
+        }
+    }
+}
+
+/// Why the target could not be built (`--target FILE`, a scene file's `target`,
+/// `--target-mass`).
 #[derive(Debug, thiserror::Error)]
 pub enum TargetError {
     /// The file could not be read (a secondary input: `-` is a file there).
     #[error("--target {}", crate::read_errors::input_file_message(.0))]
     Read(impact_io::ReadError),
-    #[error("--target {}: {source}", .path.display())]
+    /// The file a scene file's `target` names could not be read.
+    #[error("{}: target {}", .scene.display(), crate::read_errors::input_file_message(.error))]
+    SceneRead {
+        scene: PathBuf,
+        error: Box<impact_io::ReadError>,
+    },
+    #[error("{at}: {source}")]
     Json {
-        path: PathBuf,
+        at: TargetAt,
         source: serde_json::Error,
     },
-    #[error("--target {}: A must have 1 to {MAX_STATES} rows, not {n}", .path.display())]
-    Rows { path: PathBuf, n: usize },
-    #[error("--target {}: A row {row} has {len} entries, not {n}", .path.display())]
+    #[error("{at}: A must have 1 to {MAX_STATES} rows, not {n}")]
+    Rows { at: TargetAt, n: usize },
+    #[error("{at}: A row {row} has {len} entries, not {n}")]
     Row {
-        path: PathBuf,
+        at: TargetAt,
         row: usize,
         len: usize,
         n: usize,
     },
-    #[error("--target {}: B has {len} entries, not {n}", .path.display())]
-    B { path: PathBuf, len: usize, n: usize },
-    #[error(
-        "--target {}: C must be two rows (displacement, velocity) of {n} entries",
-        .path.display()
-    )]
-    C { path: PathBuf, n: usize },
-    #[error("--target {}: D must have 2 entries, not {len}", .path.display())]
-    D { path: PathBuf, len: usize },
+    #[error("{at}: B has {len} entries, not {n}")]
+    B { at: TargetAt, len: usize, n: usize },
+    #[error("{at}: C must be two rows (displacement, velocity) of {n} entries")]
+    C { at: TargetAt, n: usize },
+    #[error("{at}: D must have 2 entries, not {len}")]
+    D { at: TargetAt, len: usize },
     /// The file's system refused by the core (its reason, without the parameter's name).
-    #[error("--target {}: {}", .path.display(), reason(.error))]
+    #[error("{at}: {}", reason(.error))]
     Invalid {
-        path: PathBuf,
+        at: TargetAt,
         error: impact_core::Error,
     },
+    /// A scene file's `target` neither a file's name nor a state space.
+    #[error("{}: target must be the name of a state-space target's file or the state space itself ({{\"a\": .., \"b\": .., \"c\": ..}})", .scene.display())]
+    SceneKind { scene: PathBuf },
     /// `--target-mass` and its spring refused by the core, named as its option.
     #[error("{}", crate::flags::core(*.0))]
     SpringMass(impact_core::Error),
@@ -96,19 +128,78 @@ pub enum TargetError {
 }
 
 pub(crate) fn read_state_space(path: &Path) -> Result<Target<f64>, TargetError> {
-    let p = || path.to_path_buf();
     let bytes = impact_io::read_limited(path, 1 << 20, "target file").map_err(TargetError::Read)?;
-    let f: StateSpaceFile =
-        serde_json::from_slice(&bytes).map_err(|source| TargetError::Json { path: p(), source })?;
+    state_space_json(&bytes, TargetAt::Option(path.to_path_buf()))
+}
+
+/// A scene file's `target` (`scene` the scene file's path): the name of a file, relative to
+/// the scene file's folder, or the state space's object itself.
+pub(crate) fn scene_state_space(
+    scene: &Path,
+    value: &serde_json::Value,
+) -> Result<Target<f64>, TargetError> {
+    let kind = || TargetError::SceneKind {
+        scene: scene.to_path_buf(),
+    };
+    match value {
+        serde_json::Value::String(_) => {
+            let path = scene_target_path(scene, value).ok_or_else(kind)?;
+            let bytes = impact_io::read_limited(&path, 1 << 20, "target file").map_err(
+                |error| TargetError::SceneRead {
+                    scene: scene.to_path_buf(),
+                    error: Box::new(error),
+                },
+            )?;
+            let at = TargetAt::Scene {
+                scene: scene.to_path_buf(),
+                file: Some(path),
+            };
+            state_space_json(&bytes, at)
+        }
+        serde_json::Value::Object(_) => {
+            let at = TargetAt::Scene {
+                scene: scene.to_path_buf(),
+                file: None,
+            };
+            match StateSpaceFile::deserialize(value) {
+                Ok(f) => state_space(f, &at),
+                Err(source) => Err(TargetError::Json { at, source }),
+            }
+        }
+        _ => Err(kind()),
+    }
+}
+
+/// The file a scene file's `target` names, relative to the scene file's folder (`None`
+/// unless the value is a string that is not empty).
+pub(crate) fn scene_target_path(scene: &Path, value: &serde_json::Value) -> Option<PathBuf> {
+    let name = Path::new(value.as_str().filter(|n| !n.is_empty())?);
+    Some(match scene.parent() {
+        Some(dir) if name.is_relative() => dir.join(name),
+        _ => name.to_path_buf(),
+    })
+}
+
+/// The state space of a target file's JSON.
+fn state_space_json(bytes: &[u8], at: TargetAt) -> Result<Target<f64>, TargetError> {
+    match serde_json::from_slice(bytes) {
+        Ok(f) => state_space(f, &at),
+        Err(source) => Err(TargetError::Json { at, source }),
+    }
+}
+
+/// The state space a file or a scene file's object holds, checked as the core checks it.
+fn state_space(f: StateSpaceFile, at: &TargetAt) -> Result<Target<f64>, TargetError> {
+    let p = || at.clone();
     let n = f.a.len();
     if n == 0 || n > MAX_STATES {
-        return Err(TargetError::Rows { path: p(), n });
+        return Err(TargetError::Rows { at: p(), n });
     }
     let mut a = [[0.0; MAX_STATES]; MAX_STATES];
     for (i, row) in f.a.iter().enumerate() {
         if row.len() != n {
             return Err(TargetError::Row {
-                path: p(),
+                at: p(),
                 row: i,
                 len: row.len(),
                 n,
@@ -118,7 +209,7 @@ pub(crate) fn read_state_space(path: &Path) -> Result<Target<f64>, TargetError> 
     }
     if f.b.len() != n {
         return Err(TargetError::B {
-            path: p(),
+            at: p(),
             len: f.b.len(),
             n,
         });
@@ -126,7 +217,7 @@ pub(crate) fn read_state_space(path: &Path) -> Result<Target<f64>, TargetError> 
     let mut b = [0.0; MAX_STATES];
     b[..n].copy_from_slice(&f.b);
     if f.c.len() != 2 || f.c.iter().any(|r| r.len() != n) {
-        return Err(TargetError::C { path: p(), n });
+        return Err(TargetError::C { at: p(), n });
     }
     let mut c = [[0.0; MAX_STATES]; 2];
     for (i, row) in f.c.iter().enumerate() {
@@ -137,12 +228,12 @@ pub(crate) fn read_state_space(path: &Path) -> Result<Target<f64>, TargetError> 
         Some([x, y]) => [*x, *y],
         Some(other) => {
             return Err(TargetError::D {
-                path: p(),
+                at: p(),
                 len: other.len(),
             })
         }
     };
-    Target::state_space(n, a, b, c, d).map_err(|error| TargetError::Invalid { path: p(), error })
+    Target::state_space(n, a, b, c, d).map_err(|error| TargetError::Invalid { at: p(), error })
 }
 
 /// The error's reason without its `--name:` prefix.

@@ -108,6 +108,7 @@ pub fn run(args: &ReportArgs) -> Result<crate::report::spec::Judged, ReportError
     let mut files = vec![a.file.clone()];
     files.extend(cmd.more.iter().cloned());
     let mut entries = series::entries(&files, &cmd.channels, a.column.as_ref())?;
+    let target = crate::pipeline::options::target_file(a);
     let mut inputs = crate::output::Inputs::new();
     for e in &entries {
         inputs = inputs.with(&e.file);
@@ -117,7 +118,7 @@ pub fn run(args: &ReportArgs) -> Result<crate::report::spec::Judged, ReportError
         .with_some(a.free_fall.as_deref().map(crate::pipeline::free_fall::file))
         .with_some(args.srs_required.as_deref())
         .with_some(a.spec.and_then(|s| s.band_file))
-        .with_some(a.target.as_deref())
+        .with_some(target.as_deref())
         .with_some(args.meta.meta_file.as_deref());
     if let Some(html) = &args.html {
         crate::output::check("--html", html, &inputs, Some("html"))?;
@@ -159,7 +160,7 @@ pub fn run(args: &ReportArgs) -> Result<crate::report::spec::Judged, ReportError
                 .and_then(|s| s.band_file)
                 .map(|p| (Role::Band, p.to_path_buf())),
         )
-        .chain(a.target.clone().map(|p| (Role::Target, p)))
+        .chain(target.clone().map(|p| (Role::Target, p)))
         .chain(args.srs_required.clone().map(|p| (Role::RequiredSrs, p)))
         .chain(args.meta.meta_file.clone().map(|p| (Role::Meta, p)))
         .collect();
