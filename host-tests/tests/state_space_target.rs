@@ -330,24 +330,24 @@ fn a_state_space_target_the_tool_cannot_use_is_refused_naming_it() {
         assert_eq!(got, code, "{args:?}: {err}");
         assert!(err.contains(want), "{args:?}: {err}");
     }
-    // A scene file's spring–mass beside it: two targets.
+    // The command line's state space over a scene file's spring–mass.
     let scene = scratch.file("scene.json", r#"{"mass": 0.06, "target_mass": 0.3}"#);
-    let (got, _, err) = common::impact(&[
+    let (out, _) = impact_ok(&[
         "analyze",
         csv,
+        "--json",
         "--scene",
         scene.to_str().unwrap(),
         "--target",
         good,
     ]);
-    assert_eq!(got, 1, "{err}");
-    assert!(
-        err.contains("--target: the scene file gives a spring–mass target"),
-        "{err}"
-    );
+    let json: Value = serde_json::from_str(&out).unwrap();
+    assert_eq!(json["target"]["state_space"]["a"].as_array().unwrap().len(), 4);
+    assert!(json["target"].get("mass_kg").is_none(), "{json}");
     // The target file is an input: no output over it (a report's either).
     let (got, _, err) = common::impact(&["report", csv, "--target", good, "--html", good]);
     assert_eq!(got, 1, "{err}");
+    assert!(err.contains("it would be overwritten"), "{err}");
     let (got, _, err) = common::impact(&[
         "synth",
         "--model",
@@ -424,20 +424,41 @@ fn a_scene_files_state_space_is_the_options() {
         assert_eq!(got, 1, "{scene} {extra:?}: {err}");
         assert!(err.contains(want), "{scene} {extra:?}: {err}");
     };
-    let two = "refused.json: target: a state-space target, and a spring–mass given too";
-    refused(r#"{"target": "fixture.json", "target_mass": 0.3}"#, &[], two);
-    refused(r#"{"target": "fixture.json"}"#, &["--target-mass", "0.3"], two);
+    refused(
+        r#"{"target": "fixture.json", "target_mass": 0.3}"#,
+        &[],
+        "refused.json: target: a state-space target, and a spring–mass too",
+    );
+    // A spring without its mass is not a target to override it with.
+    refused(
+        r#"{"target": "fixture.json"}"#,
+        &["--target-stiffness", "100"],
+        "--target-stiffness: needs the target's mass",
+    );
     refused(
         r#"{"target": {"a": [[0, 1], [-1, 0]], "b": [0, 1, 2], "c": [[1, 0], [0, 1]]}}"#,
         &[],
         "refused.json: target: B has 3 entries, not 2",
     );
+    // (Named relative to the scene file's folder.)
     refused(
         r#"{"target": "missing.json"}"#,
         &[],
-        "refused.json: target ",
+        &format!("refused.json: target {}", sub.join("missing.json").display()),
+    );
+    // The core's refusals of the target named as the scene file's key.
+    refused(
+        r#"{"target": "fixture.json"}"#,
+        &["--train", "flight"],
+        "refused.json: target: ",
     );
     refused(r#"{"target": 3}"#, &[], "refused.json: target must be the name of");
+    // Wrong in the file even where the command line overrides it.
+    refused(
+        r#"{"target": ""}"#,
+        &["--target", fixture],
+        "refused.json: target must be the name of",
+    );
     // The file the scene file names is an input: no output over it.
     let (got, _, err) = common::impact(&[
         "report",
@@ -448,5 +469,14 @@ fn a_scene_files_state_space_is_the_options() {
         fixture,
     ]);
     assert_eq!(got, 1, "{err}");
+    assert!(err.contains("it would be overwritten"), "{err}");
     assert!(std::fs::read_to_string(fixture).unwrap().starts_with("{\"a\""));
+    // `--target-mass` over the scene file's state space: a spring–mass, its file not read.
+    let spring = analyse(
+        &scratch,
+        &accel,
+        rate,
+        &["--scene", named.to_str().unwrap(), "--target-mass", "0.3"],
+    );
+    assert_eq!(spring["target"]["mass_kg"].as_f64(), Some(0.3), "{}", spring["target"]);
 }

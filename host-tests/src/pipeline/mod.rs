@@ -1085,14 +1085,29 @@ pub(crate) fn build_scene(
     })
 }
 
-/// The target: `--target`'s state space, else the scene file's (`target`), else the
-/// spring–mass, each of its numbers the command line's, else the scene file's; a state space
-/// and a spring–mass together are refused.
+/// The target. The command line's, if it gives one, over the scene file's: `--target`'s
+/// state space, else the spring–mass of `--target-mass` (its spring and damper the command
+/// line's, else the file's); else the scene file's, its state space (`target`) or its
+/// spring–mass (`target_mass`, both in one file refused). A spring or damper without a mass is
+/// refused.
 fn target(
     args: &AnalyzeArgs,
     file: &SceneFile,
 ) -> Result<Option<impact_core::two_body::SceneTarget>, PipelineError> {
     use impact_core::two_body::{SceneTarget, SpringMass};
+    let space = |t: impact_core::two_body::Target<f64>| {
+        Some(SceneTarget::StateSpace(crate::simulate::two_body::interned(
+            crate::simulate::two_body::narrow(&t),
+        )))
+    };
+    let target_error = |e| PipelineError::Target(Box::new(e));
+    let spring_mass = |m: f64, k2: Option<f64>, c2: Option<f64>| {
+        Some(SceneTarget::SpringMass(SpringMass {
+            mass_kg: m as f32,
+            stiffness_n_m: k2.unwrap_or(0.0) as f32,
+            damping_n_s_m: c2.unwrap_or(0.0) as f32,
+        }))
+    };
     let (k2, c2) = (
         args.target_stiffness.or(file.target_stiffness),
         args.target_damping.or(file.target_damping),
@@ -1100,51 +1115,30 @@ fn target(
     let file_spring_mass = file.target_mass.is_some()
         || file.target_stiffness.is_some()
         || file.target_damping.is_some();
-    let space = |t: impact_core::two_body::Target<f64>| {
-        Some(SceneTarget::StateSpace(crate::simulate::two_body::interned(
-            crate::simulate::two_body::narrow(&t),
-        )))
-    };
-    let target_error = |e| PipelineError::Target(Box::new(e));
     let file_space = args.scene.as_deref().zip(file.target.as_ref());
-    Ok(
-        match (&args.target, file_space, args.target_mass.or(file.target_mass)) {
-            // Two targets: a state space and a spring–mass.
-            (Some(_), _, _) if file_spring_mass => {
-                return Err(PipelineError::Invalid {
-                    setting: Setting::Option("target"),
-                    reason: "the scene file gives a spring–mass target (target_mass, target_stiffness, target_damping): give one target, the file's or this",
-                });
-            }
-            (None, Some((scene, _)), _)
-                if file_spring_mass
-                    || args.target_mass.is_some()
-                    || args.target_stiffness.is_some()
-                    || args.target_damping.is_some() =>
-            {
-                return Err(PipelineError::Invalid {
-                    setting: Setting::SceneKey {
-                        scene: scene.to_path_buf(),
-                        name: "target",
-                    },
-                    reason: "a state-space target, and a spring–mass given too (target_mass, target_stiffness, target_damping or their options): give one target",
-                });
-            }
-            // The command line's state space over the scene file's.
-            (Some(path), _, _) => space(
-                crate::simulate::two_body::read_state_space(path).map_err(target_error)?,
-            ),
-            (None, Some((scene, value)), _) => space(
-                crate::simulate::two_body::scene_state_space(scene, value)
-                    .map_err(target_error)?,
-            ),
-            (None, None, Some(m)) => Some(SceneTarget::SpringMass(SpringMass {
-                mass_kg: m as f32,
-                stiffness_n_m: k2.unwrap_or(0.0) as f32,
-                damping_n_s_m: c2.unwrap_or(0.0) as f32,
-            })),
+    if let Some((scene, _)) = file_space.filter(|_| file_spring_mass) {
+        return Err(PipelineError::Invalid {
+            setting: Setting::SceneKey {
+                scene: scene.to_path_buf(),
+                name: "target",
+            },
+            reason: "a state-space target, and a spring–mass too (target_mass, target_stiffness, target_damping): give one target",
+        });
+    }
+    Ok(match (&args.target, args.target_mass, file_space) {
+        // The command line's state space over any of the scene file's.
+        (Some(path), _, _) => space(
+            crate::simulate::two_body::read_state_space(path).map_err(target_error)?,
+        ),
+        // The command line's spring–mass over the file's state space.
+        (None, Some(m), Some(_)) => spring_mass(m, args.target_stiffness, args.target_damping),
+        (None, None, Some((scene, value))) if k2.is_none() && c2.is_none() => space(
+            crate::simulate::two_body::scene_state_space(scene, value).map_err(target_error)?,
+        ),
+        (None, m, _) => match (m.or(file.target_mass), k2.is_some() || c2.is_some()) {
+            (Some(m), _) => spring_mass(m, k2, c2),
             // (A spring or damper given without a mass on either.)
-            (None, None, None) if k2.is_some() || c2.is_some() => {
+            (None, true) => {
                 let name = if k2.is_some() {
                     "target-stiffness"
                 } else {
@@ -1155,9 +1149,9 @@ fn target(
                     reason: "needs the target's mass (--target-mass, or a scene file's target_mass)",
                 });
             }
-            (None, None, None) => None,
+            (None, false) => None,
         },
-    )
+    })
 }
 
 /// The quiet time that ends an impact when none is given, s.
@@ -1184,6 +1178,7 @@ fn name_of(args: &AnalyzeArgs, file: &SceneFile, name: &'static str) -> Setting 
             file.target_stiffness.is_some(),
         ),
         "target-damping" => (args.target_damping.is_some(), file.target_damping.is_some()),
+        "target" => (args.target.is_some(), file.target.is_some()),
         // Only the scene file sets the exponent.
         "exponent" => (false, true),
         _ => (true, false),

@@ -222,7 +222,9 @@ pub struct AnalyzeArgs {
     /// outputs the contact point's displacement (m) and velocity (m/s), at most 6 states, at
     /// rest at each first touch (a fixture of two masses, a mount identified by a modal fit).
     /// The kinematics are the contact's relative to it, as with --target-mass; `impact
-    /// emulate` hands it to the board in its scene, whose scene line states it.
+    /// emulate` hands it to the board in its scene, whose scene line states it. A scene
+    /// file's `target` (the file's name, relative to the scene file, or the object itself)
+    /// gives it too; this overrides it.
     #[arg(long, help_heading = "Target", value_name = "FILE",
           conflicts_with_all = ["target_mass", "target_stiffness", "target_damping"])]
     pub target: Option<PathBuf>,
@@ -333,13 +335,19 @@ impl AnalyzeArgs {
 }
 
 /// The state-space target's file an analysis reads: `--target`'s, else the one the scene
-/// file's `target` names (`None` for one written in the scene file, or a scene file that
-/// cannot be read: the analysis says why).
+/// file's `target` names (`None` for one written in the scene file, one `--target-mass`
+/// overrides, or a scene file that cannot be read or is not a regular file: the analysis
+/// says why, or reads it once).
 pub fn target_file(args: &AnalyzeArgs) -> Option<PathBuf> {
     if let Some(p) = &args.target {
         return Some(p.clone());
     }
-    let scene = args.scene.as_deref()?;
+    // (`--target-mass` overrides the scene file's; a scene file that is not a regular file,
+    // a pipe, is left for the analysis to read, once.)
+    let scene = args.scene.as_deref().filter(|_| args.target_mass.is_none())?;
+    if !std::fs::metadata(scene).is_ok_and(|m| m.is_file()) {
+        return None;
+    }
     let bytes = impact_io::read_limited(scene, 1 << 20, "scene file").ok()?;
     let file: SceneFile = serde_json::from_slice(&bytes).ok()?;
     crate::simulate::two_body::scene_target_path(scene, file.target.as_ref()?)
@@ -431,6 +439,9 @@ pub enum SceneError {
         key: &'static str,
         range: impact_io::limits::OutOfRange,
     },
+    /// The scene file's `target` neither a file's name nor an object.
+    #[error("{}: target must be the name of a state-space target's file or the state space itself ({{\"a\": .., \"b\": .., \"c\": ..}})", .path.display())]
+    TargetKind { path: PathBuf },
     /// A level (`--trigger`, `--edge`, `--range`, or the scene file's) outside
     /// [`parse::LEVEL_M_S2`] once in m/s².
     #[error("{setting} {level}: out of range ({})", parse::LEVEL_M_S2)]
@@ -474,6 +485,14 @@ impl SceneFile {
     /// the key: `scene.json: hold 1e-300: out of range (between 1e-30 and 1e30 s)`. (The
     /// levels are checked in m/s², with the mass: [`check_levels`].)
     pub fn check(&self, path: &Path) -> Result<(), SceneError> {
+        // The target's kind, even where the command line overrides it.
+        if let Some(t) = &self.target {
+            if !(t.is_object() || t.as_str().is_some_and(|n| !n.is_empty())) {
+                return Err(SceneError::TargetKind {
+                    path: path.to_path_buf(),
+                });
+            }
+        }
         let exponent = self.fits.as_ref().and_then(|f| f.exponent);
         for (key, value, limits) in [
             ("mass", self.mass, &parse::MASS_KG),
