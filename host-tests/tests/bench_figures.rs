@@ -94,3 +94,159 @@ fn the_docs_m4_figures_are_the_stored_baselines() {
         "docs/benchmarks.md's M4 figures are not the baseline's; put:\n{want}"
     );
 }
+
+/// A latency in ms as the README writes it: one decimal below 100 ms, none above; a dash
+/// where the bench measured none.
+fn latency_ms(v: &Value) -> String {
+    match v.as_f64().map(|s| s * 1e3) {
+        Some(ms) if ms >= 100.0 => format!("{ms:.0} ms"),
+        Some(ms) => format!("{ms:.1} ms"),
+        None => "—".into(),
+    }
+}
+
+/// A rate per second with at most one decimal (`12.5`, `25`).
+fn per_s(hz: f64) -> String {
+    let tenths = (hz * 10.0).round();
+    if tenths % 10.0 == 0.0 {
+        format!("{:.0}", tenths / 10.0)
+    } else {
+        format!("{:.1}", tenths / 10.0)
+    }
+}
+
+/// The README's real-time table, from `impact bench realtime --json` at clock shifts 2, 3
+/// and 4 (`runs[s]` the shift's cases).
+fn realtime_table(runs: &[Value; 3]) -> String {
+    let case = |run: &Value, name: &str, work: &str| -> Value {
+        run.as_array()
+            .unwrap()
+            .iter()
+            .find(|c| c["case"].as_str().unwrap().starts_with(name) && c["work"] == work)
+            .unwrap_or_else(|| panic!("{name} {work} missing"))
+            .clone()
+    };
+    let row = |name: &str, work: &str| -> String {
+        runs.iter()
+            .map(|r| latency_ms(&case(r, name, work)["nominal"]["latency_median_s"]))
+            .collect::<Vec<_>>()
+            .join(" | ")
+    };
+    let rates: Vec<String> = runs
+        .iter()
+        .map(|r| {
+            let c = case(r, "seed bench", "everything");
+            c["max_rate_fully_analysed_hz"]
+                .as_f64()
+                .map_or("none".into(), |hz| format!("{} /s", per_s(hz)))
+        })
+        .collect();
+    let spacings: Vec<f64> = case(&runs[1], "seed bench", "everything")["runs"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|r| r["spacing_s"].as_f64().unwrap())
+        .collect();
+    let widest = spacings.iter().copied().fold(0.0, f64::max);
+    let closest = spacings.iter().copied().fold(f64::INFINITY, f64::min);
+    format!(
+        "| report latency (median) | twice as fast (2) | the board (3) | half as fast (4) |\n\
+         |---|---|---|---|\n\
+         | seed bench, 500 kS/s, all fits | {} |\n\
+         | AFRL-like pulses, 1 MS/s, all fits | {} |\n\
+         | seed bench, everything on (fits, shock spectra, a verdict against a 10 g, 3 ms half-sine) | {} |\n\
+         | highest impact rate with everything on, every impact analysed at a pace the board keeps (seed bench, trains of ten; rates tried: {} to {} /s) | {} |",
+        row("seed bench", "fits"),
+        row("AFRL-like", "fits"),
+        row("seed bench", "everything"),
+        per_s(1.0 / widest),
+        per_s(1.0 / closest),
+        rates.join(" | "),
+    )
+}
+
+#[test]
+fn the_readmes_real_time_figures_are_the_stored_runs() {
+    let root = concat!(env!("CARGO_MANIFEST_DIR"), "/..");
+    let read = |n: u32| -> Value {
+        let path = format!("{root}/host-tests/bench/realtime-shift{n}.json");
+        serde_json::from_str(&std::fs::read_to_string(&path).unwrap()).unwrap()
+    };
+    let want = realtime_table(&[read(2), read(3), read(4)]);
+    let readme = std::fs::read_to_string(format!("{root}/README.md")).unwrap();
+    let start = "<!-- host-tests/bench/realtime-shift{2,3,4}.json -->\n";
+    let from = readme
+        .find(start)
+        .expect("the stored runs' block in README.md")
+        + start.len();
+    let to = from + readme[from..].find("\n<!-- end -->").unwrap();
+    assert_eq!(
+        &readme[from..to],
+        want,
+        "README.md's real-time figures are not the stored runs'; put:\n{want}"
+    );
+}
+
+/// docs/board.md's table of the same runs: each case's latency and the highest rate with
+/// every impact analysed (below the widest spacing's rate where none was).
+fn board_table(runs: &[Value; 3]) -> String {
+    let cell = |run: &Value, name: &str, work: &str| -> String {
+        let c = run
+            .as_array()
+            .unwrap()
+            .iter()
+            .find(|c| c["case"].as_str().unwrap().starts_with(name) && c["work"] == work)
+            .unwrap_or_else(|| panic!("{name} {work} missing"));
+        let rate = match c["max_rate_fully_analysed_hz"].as_f64() {
+            Some(hz) => format!("{} /s", per_s(hz)),
+            None => {
+                let widest = (c["runs"].as_array().unwrap().iter())
+                    .map(|r| r["spacing_s"].as_f64().unwrap())
+                    .fold(0.0, f64::max);
+                format!("below {} /s", per_s(1.0 / widest))
+            }
+        };
+        format!("{}, {rate}", latency_ms(&c["nominal"]["latency_median_s"]))
+    };
+    let row = |label: &str, name: &str, work: &str| -> String {
+        let cells: Vec<String> = runs.iter().map(|r| cell(r, name, work)).collect();
+        format!("| {label} | {} |\n", cells.join(" | "))
+    };
+    let mut t = String::from(
+        "| case | `--clock-shift 2` | `3` (the board) | `4` (half as fast) |\n|---|---|---|---|\n",
+    );
+    t.push_str(&row(
+        "seed bench, fits: latency median, rate with every impact analysed",
+        "seed bench",
+        "fits",
+    ));
+    t.push_str(&row("seed bench, no fits", "seed bench", "stream"));
+    t.push_str(&row(
+        "seed bench, fits, spectra, verdict",
+        "seed bench",
+        "everything",
+    ));
+    t.push_str(&row("AFRL-like, fits", "AFRL-like", "fits"));
+    t.push_str(&row("AFRL-like, no fits", "AFRL-like", "stream"));
+    t.pop();
+    t
+}
+
+#[test]
+fn the_boards_real_time_table_is_the_stored_runs() {
+    let root = concat!(env!("CARGO_MANIFEST_DIR"), "/..");
+    let read = |n: u32| -> Value {
+        let path = format!("{root}/host-tests/bench/realtime-shift{n}.json");
+        serde_json::from_str(&std::fs::read_to_string(&path).unwrap()).unwrap()
+    };
+    let want = board_table(&[read(2), read(3), read(4)]);
+    let docs = std::fs::read_to_string(format!("{root}/docs/board.md")).unwrap();
+    let start = "<!-- host-tests/bench/realtime-shift{2,3,4}.json -->\n";
+    let from = docs.find(start).expect("the stored runs' block in docs/board.md") + start.len();
+    let to = from + docs[from..].find("\n<!-- end -->").unwrap();
+    assert_eq!(
+        &docs[from..to],
+        want,
+        "docs/board.md's real-time table is not the stored runs'; put:\n{want}"
+    );
+}
