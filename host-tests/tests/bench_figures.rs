@@ -242,7 +242,10 @@ fn the_boards_real_time_table_is_the_stored_runs() {
     let want = board_table(&[read(2), read(3), read(4)]);
     let docs = std::fs::read_to_string(format!("{root}/docs/board.md")).unwrap();
     let start = "<!-- host-tests/bench/realtime-shift{2,3,4}.json -->\n";
-    let from = docs.find(start).expect("the stored runs' block in docs/board.md") + start.len();
+    let from = docs
+        .find(start)
+        .expect("the stored runs' block in docs/board.md")
+        + start.len();
     let to = from + docs[from..].find("\n<!-- end -->").unwrap();
     assert_eq!(
         &docs[from..to],

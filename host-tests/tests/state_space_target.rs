@@ -342,7 +342,10 @@ fn a_state_space_target_the_tool_cannot_use_is_refused_naming_it() {
         good,
     ]);
     let json: Value = serde_json::from_str(&out).unwrap();
-    assert_eq!(json["target"]["state_space"]["a"].as_array().unwrap().len(), 4);
+    assert_eq!(
+        json["target"]["state_space"]["a"].as_array().unwrap().len(),
+        4
+    );
     assert!(json["target"].get("mass_kg").is_none(), "{json}");
     // The target file is an input: no output over it (a report's either).
     let (got, _, err) = common::impact(&["report", csv, "--target", good, "--html", good]);
@@ -402,14 +405,22 @@ fn a_scene_files_state_space_is_the_options() {
         let by_scene = analyse(&scratch, &accel, rate, &args);
         assert_eq!(by_scene["target"], by_option["target"], "{args:?}");
         assert_eq!(by_scene["impacts"], by_option["impacts"], "{args:?}");
-        assert_eq!(by_scene["assumptions"], by_option["assumptions"], "{args:?}");
+        assert_eq!(
+            by_scene["assumptions"], by_option["assumptions"],
+            "{args:?}"
+        );
     }
     // The command line's over the scene file's: a different target, different numbers.
     let over = analyse(
         &scratch,
         &accel,
         rate,
-        &["--scene", named.to_str().unwrap(), "--target", plate.to_str().unwrap()],
+        &[
+            "--scene",
+            named.to_str().unwrap(),
+            "--target",
+            plate.to_str().unwrap(),
+        ],
     );
     assert_ne!(over["impacts"][0]["cor"], by_option["impacts"][0]["cor"]);
     let csv = scratch.join_str("strike.csv");
@@ -444,7 +455,10 @@ fn a_scene_files_state_space_is_the_options() {
     refused(
         r#"{"target": "missing.json"}"#,
         &[],
-        &format!("refused.json: target {}", sub.join("missing.json").display()),
+        &format!(
+            "refused.json: target {}",
+            sub.join("missing.json").display()
+        ),
     );
     // The core's refusals of the target named as the scene file's key.
     refused(
@@ -452,7 +466,11 @@ fn a_scene_files_state_space_is_the_options() {
         &["--train", "flight"],
         "refused.json: target: ",
     );
-    refused(r#"{"target": 3}"#, &[], "refused.json: target must be the name of");
+    refused(
+        r#"{"target": 3}"#,
+        &[],
+        "refused.json: target must be the name of",
+    );
     // Wrong in the file even where the command line overrides it.
     refused(
         r#"{"target": ""}"#,
@@ -470,7 +488,9 @@ fn a_scene_files_state_space_is_the_options() {
     ]);
     assert_eq!(got, 1, "{err}");
     assert!(err.contains("it would be overwritten"), "{err}");
-    assert!(std::fs::read_to_string(fixture).unwrap().starts_with("{\"a\""));
+    assert!(std::fs::read_to_string(fixture)
+        .unwrap()
+        .starts_with("{\"a\""));
     // `--target-mass` over the scene file's state space: a spring–mass, its file not read.
     let spring = analyse(
         &scratch,
@@ -478,5 +498,10 @@ fn a_scene_files_state_space_is_the_options() {
         rate,
         &["--scene", named.to_str().unwrap(), "--target-mass", "0.3"],
     );
-    assert_eq!(spring["target"]["mass_kg"].as_f64(), Some(0.3), "{}", spring["target"]);
+    assert_eq!(
+        spring["target"]["mass_kg"].as_f64(),
+        Some(0.3),
+        "{}",
+        spring["target"]
+    );
 }

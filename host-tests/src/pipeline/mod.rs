@@ -1096,9 +1096,9 @@ fn target(
 ) -> Result<Option<impact_core::two_body::SceneTarget>, PipelineError> {
     use impact_core::two_body::{SceneTarget, SpringMass};
     let space = |t: impact_core::two_body::Target<f64>| {
-        Some(SceneTarget::StateSpace(crate::simulate::two_body::interned(
-            crate::simulate::two_body::narrow(&t),
-        )))
+        Some(SceneTarget::StateSpace(
+            crate::simulate::two_body::interned(crate::simulate::two_body::narrow(&t)),
+        ))
     };
     let target_error = |e| PipelineError::Target(Box::new(e));
     let spring_mass = |m: f64, k2: Option<f64>, c2: Option<f64>| {
@@ -1127,14 +1127,14 @@ fn target(
     }
     Ok(match (&args.target, args.target_mass, file_space) {
         // The command line's state space over any of the scene file's.
-        (Some(path), _, _) => space(
-            crate::simulate::two_body::read_state_space(path).map_err(target_error)?,
-        ),
+        (Some(path), _, _) => {
+            space(crate::simulate::two_body::read_state_space(path).map_err(target_error)?)
+        }
         // The command line's spring–mass over the file's state space.
         (None, Some(m), Some(_)) => spring_mass(m, args.target_stiffness, args.target_damping),
-        (None, None, Some((scene, value))) if k2.is_none() && c2.is_none() => space(
-            crate::simulate::two_body::scene_state_space(scene, value).map_err(target_error)?,
-        ),
+        (None, None, Some((scene, value))) if k2.is_none() && c2.is_none() => {
+            space(crate::simulate::two_body::scene_state_space(scene, value).map_err(target_error)?)
+        }
         (None, m, _) => match (m.or(file.target_mass), k2.is_some() || c2.is_some()) {
             (Some(m), _) => spring_mass(m, k2, c2),
             // (A spring or damper given without a mass on either.)
@@ -1146,7 +1146,8 @@ fn target(
                 };
                 return Err(PipelineError::Invalid {
                     setting: name_of(args, file, name),
-                    reason: "needs the target's mass (--target-mass, or a scene file's target_mass)",
+                    reason:
+                        "needs the target's mass (--target-mass, or a scene file's target_mass)",
                 });
             }
             (None, false) => None,

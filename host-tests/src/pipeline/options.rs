@@ -344,7 +344,10 @@ pub fn target_file(args: &AnalyzeArgs) -> Option<PathBuf> {
     }
     // (`--target-mass` overrides the scene file's; a scene file that is not a regular file,
     // a pipe, is left for the analysis to read, once.)
-    let scene = args.scene.as_deref().filter(|_| args.target_mass.is_none())?;
+    let scene = args
+        .scene
+        .as_deref()
+        .filter(|_| args.target_mass.is_none())?;
     if !std::fs::metadata(scene).is_ok_and(|m| m.is_file()) {
         return None;
     }

@@ -144,12 +144,13 @@ pub(crate) fn scene_state_space(
     match value {
         serde_json::Value::String(_) => {
             let path = scene_target_path(scene, value).ok_or_else(kind)?;
-            let bytes = impact_io::read_limited(&path, 1 << 20, "target file").map_err(
-                |error| TargetError::SceneRead {
-                    scene: scene.to_path_buf(),
-                    error: Box::new(error),
-                },
-            )?;
+            let bytes =
+                impact_io::read_limited(&path, 1 << 20, "target file").map_err(|error| {
+                    TargetError::SceneRead {
+                        scene: scene.to_path_buf(),
+                        error: Box::new(error),
+                    }
+                })?;
             let at = TargetAt::Scene {
                 scene: scene.to_path_buf(),
                 file: Some(path),
