@@ -147,13 +147,15 @@ where
 /// struck an immovable wall, unless a target was given (`--target-mass`, `--target`).
 pub const RIGID_BARRIER: &str = "the barrier is taken as rigid and fixed: COR, deformation and \
      absorbed energy are the body's against an immovable wall (a target that moves or yields is \
-     not modelled here unless --target-mass or --target gives it)";
+     not modelled here unless --target-mass or --target gives it); the sensor is taken to ride \
+     the body (one on the target or anvil reads that one's motion, not the body's: the force, \
+     COR and deformations would not be these)";
 
 /// What the kinematics are against a target the user gave (`--target-mass`, `--target`): said where the
 /// rigid barrier would otherwise be.
 pub const TARGET_RELATIVE: &str = "the kinematics are the contact's against the target given \
      ({target}, driven by the measured force, --mass \
-     times the reading): the COR is Newton's (the separation speed relative to the target over the \
+     times the reading of the sensor, taken to ride the body): the COR is Newton's (the separation speed relative to the target over the \
      approach speed), the crush time and deformations are the relative approach's, and the \
      absorbed energy is the contact's work (the body's loss less what went into the target); \
      the rebound velocity is the body's own; the target is taken at rest at each first touch \

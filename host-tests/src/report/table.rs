@@ -57,13 +57,14 @@ pub fn to_table(a: &AnalysisJson) -> String {
         },
     );
     // The frame the kinematics assumed, whenever there are kinematics to assume it for.
+    // (Where the sensor is: the tool cannot tell a body's reading from a target's.)
     let barrier = match &a.target {
         Some(t) => format!(
-            "kinematics relative to the target ({}): Newton's COR, the contact's deformation \
-             and work",
+            "the sensor on the body, kinematics relative to the target ({}): Newton's COR, \
+             the contact's deformation and work",
             t.short()
         ),
-        None => "a rigid, fixed barrier assumed".to_string(),
+        None => "the sensor on the body, a rigid, fixed barrier assumed".to_string(),
     };
     if a.v0_m_s.is_some() {
         s.push_str(&match a.contact_gravity_m_s2 {
