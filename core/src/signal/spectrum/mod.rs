@@ -58,8 +58,8 @@ impl SpectrumSettings {
         }
     }
 
-    /// The band frequencies at `rate_hz` into `out`; how many (0 if the settings are invalid
-    /// or the bands would not fit [`MAX_BANDS`]). [`srs::bands`]'s, in `f32`: each band's
+    /// The band frequencies at `rate_hz` into `out`; how many (0 if the settings are invalid,
+    /// more than 12 bands an octave among them, or the bands would not fit [`MAX_BANDS`]). [`srs::bands`]'s, in `f32`: each band's
     /// `2^(j/n)` as `2^q 2^(r/n)` (`j = q n + r`), one `exp2` in `f64` per band of an octave
     /// rather than per band (on the M4 `f64` is software, some 1 500 instructions an
     /// `exp2`); the same `f32` frequencies (`the_bands_are_the_references`).

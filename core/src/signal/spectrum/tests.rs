@@ -115,6 +115,40 @@ fn the_bands_are_the_references() {
         }
     }
     assert!(checked > 2000, "{checked}");
+    // Every band a lowest band and rate can reach (the frequency depends on its index `j`
+    // alone), as `srs::bands` computes it.
+    for per in [6i32, 12] {
+        let n = f64::from(per);
+        for j in -2000i32..2000 {
+            let want = (1000.0 * libm::exp2(f64::from(j) / n)) as f32;
+            let q = libm::floor(f64::from(j) / n);
+            let r = (f64::from(j) - q * n) as i32;
+            let got = (1000.0 * libm::scalbn(libm::exp2(f64::from(r) / n), q as i32)) as f32;
+            assert_eq!(got.to_bits(), want.to_bits(), "{per} {j}");
+        }
+    }
+    // What cannot be had gives no band, never a panic.
+    for (per, low, rate) in [
+        (13u8, 10.0f32, 5e5f32),
+        (0, 10.0, 5e5),
+        (6, f32::NAN, 5e5),
+        (6, f32::INFINITY, 5e5),
+        (6, 1e-40, 5e5),
+        (6, -1.0, 5e5),
+        (6, 10.0, f32::INFINITY),
+        (6, 10.0, 0.0),
+    ] {
+        let s = SpectrumSettings {
+            damping: 0.05,
+            bands_per_octave: per,
+            low_hz: low,
+        };
+        assert_eq!(
+            s.bands(rate, &mut [0.0; MAX_BANDS]),
+            0,
+            "{per} {low} {rate}"
+        );
+    }
 }
 
 /// The impulse response's norm in closed form is at least the filter's own over a block
@@ -123,41 +157,47 @@ fn the_bands_are_the_references() {
 #[test]
 fn the_impulse_norm_bounds_the_filters_own() {
     use crate::signal::srs::Oscillator;
-    for rate in [1e4f32, 1e5, 5e5, 2e6] {
-        let mut freqs = [0.0f32; MAX_BANDS];
-        let n = SpectrumSettings::new().bands(rate, &mut freqs);
-        for &f in freqs.iter().take(n) {
-            // (At the rate each band runs at: 32 to 64 samples a period below rate / 64.)
-            let rate = if f > rate / 64.0 { rate } else { 48.0 * f };
-            for damping in [0.0, 0.01, 0.05, 0.3, 0.5] {
-                let Some(pair) = Oscillator::<f32>::pair(f, damping, rate) else {
-                    continue;
-                };
-                for o in pair {
-                    let [a1, a2] = o.a.map(f64::from);
-                    let [b0, b1, b2] = o.b.map(f64::from);
-                    let (mut w1, mut w2) = (0.0f64, 0.0f64);
-                    let mut sums = [0.0f64; 2];
-                    for k in 0..=BLOCK {
-                        let w = f64::from(u8::from(k == 0)) - a1 * w1 - a2 * w2;
-                        let y = b0 * w + b1 * w1 + b2 * w2;
-                        if k < BLOCK {
-                            sums[0] += y * y;
-                        }
-                        sums[1] += y * y;
-                        (w2, w1) = (w1, w);
+    // Every rate a band runs at, 8 to 64 samples a period (the bands at the full rate and
+    // the halved levels alike), finely; the bound's own limit, 140; every damping by 0.01.
+    let periods = (0..=192)
+        .map(|k| 8.0 * 2f32.powf(k as f32 / 64.0))
+        .chain([140.0]);
+    let mut checked = 0;
+    for per_period in periods {
+        let (f, rate) = (1000.0f32, 1000.0 * per_period);
+        for damping in (0..=50).map(|k| k as f32 / 100.0) {
+            let Some(pair) = Oscillator::<f32>::pair(f, damping, rate) else {
+                continue;
+            };
+            for o in pair {
+                let [a1, a2] = o.a.map(f64::from);
+                let [b0, b1, b2] = o.b.map(f64::from);
+                let (mut w1, mut w2) = (0.0f64, 0.0f64);
+                let mut sums = [0.0f64; 2];
+                for k in 0..=BLOCK {
+                    let w = f64::from(u8::from(k == 0)) - a1 * w1 - a2 * w2;
+                    let y = b0 * w + b1 * w1 + b2 * w2;
+                    if k < BLOCK {
+                        sums[0] += y * y;
                     }
-                    // (The closed form holds one sample more than the block.)
-                    let [block, more] = sums.map(f64::sqrt);
-                    let got = f64::from(bound::impulse_norm(o.a, o.b));
-                    assert!(
-                        got >= block && got >= more && got <= more * 1.002,
-                        "{f} Hz at {rate}, ζ {damping}: {got} against {block}, {more}"
-                    );
+                    sums[1] += y * y;
+                    (w2, w1) = (w1, w);
                 }
+                // (The closed form holds one sample more than the block.)
+                let [block, more] = sums.map(f64::sqrt);
+                let got = f64::from(bound::impulse_norm(o.a, o.b));
+                assert!(
+                    got >= block && got >= more && got <= more * 1.002,
+                    "{per_period} samples a period, ζ {damping}: {got} against {block}, {more}"
+                );
+                checked += 1;
             }
         }
     }
+    assert!(checked > 19_000, "{checked}");
+    // Beyond the limit there is no bound to take it.
+    let [acc, pv] = Oscillator::<f32>::pair(1000.0, 0.05, 1000.0 * 200.0).unwrap();
+    assert!(Bound::new(acc.a, [acc.b, pv.b]).is_none());
 }
 
 /// A half-sine of `amp` m/s² lasting `dur` s at `rate` with `pad` zeros before and after.
