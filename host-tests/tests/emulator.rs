@@ -2031,6 +2031,26 @@ fn a_state_space_target_is_the_hosts_on_the_board() {
     }
     let cor = v["impacts"][0]["cor"].as_f64().unwrap();
     assert!((cor - 0.999).abs() < 0.005, "{cor}");
+    // A scene file naming the same file (relative to its own folder) hands the board the
+    // same target: the same report.
+    let scene = scratch.text("scene.json", r#"{"target": "fixture.json"}"#);
+    let (by_scene, _) = impact(&[
+        "emulate",
+        csv.as_str(),
+        "--json",
+        "--elf",
+        &elf,
+        "--mass",
+        "0.06",
+        "--v0",
+        "1.3357",
+        "--scene",
+        &scene,
+    ]);
+    let by_scene: serde_json::Value = serde_json::from_str(&by_scene).unwrap();
+    for key in ["target", "impacts", "assumptions"] {
+        assert_eq!(by_scene[key], v[key], "the scene file's {key}");
+    }
 }
 
 /// A body striking a mounted target (`--target-mass`, its spring and damper): the board
