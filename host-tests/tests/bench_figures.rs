@@ -75,24 +75,52 @@ fn table(b: &Value) -> String {
 
 #[test]
 fn the_docs_m4_figures_are_the_stored_baselines() {
-    let root = concat!(env!("CARGO_MANIFEST_DIR"), "/..");
-    let baseline: Value = serde_json::from_str(
-        &std::fs::read_to_string(format!("{root}/host-tests/bench/m4-baseline.json")).unwrap(),
-    )
-    .unwrap();
-    let docs = std::fs::read_to_string(format!("{root}/docs/benchmarks.md")).unwrap();
-    let start = "<!-- host-tests/bench/m4-baseline.json -->\n";
-    let from = docs
-        .find(start)
-        .expect("the baseline's block in docs/benchmarks.md")
-        + start.len();
-    let to = from + docs[from..].find("\n<!-- end -->").unwrap();
-    let want = table(&baseline);
-    assert_eq!(
-        &docs[from..to],
-        want,
-        "docs/benchmarks.md's M4 figures are not the baseline's; put:\n{want}"
+    let baseline = read_json("host-tests/bench/m4-baseline.json");
+    assert_block(
+        "docs/benchmarks.md",
+        "<!-- host-tests/bench/m4-baseline.json -->\n",
+        &table(&baseline),
+        "docs/benchmarks.md's M4 figures are not the baseline's",
     );
+}
+
+/// The repository's file `path` (from its root), as JSON.
+fn read_json(path: &str) -> Value {
+    let root = concat!(env!("CARGO_MANIFEST_DIR"), "/..");
+    serde_json::from_str(&std::fs::read_to_string(format!("{root}/{path}")).unwrap()).unwrap()
+}
+
+/// The stored `impact bench realtime --clock-shift n --json` run.
+fn stored_run(n: u32) -> Value {
+    read_json(&format!("host-tests/bench/realtime-shift{n}.json"))
+}
+
+/// That the text between `start` and the next `<!-- end -->` of the repository's file `doc`
+/// is `want`; else `what` and the text to put.
+fn assert_block(doc: &str, start: &str, want: &str, what: &str) {
+    let root = concat!(env!("CARGO_MANIFEST_DIR"), "/..");
+    let text = std::fs::read_to_string(format!("{root}/{doc}")).unwrap();
+    let from = text
+        .find(start)
+        .unwrap_or_else(|| panic!("the stored block {start:?} in {doc}"))
+        + start.len();
+    let to = from + text[from..].find("\n<!-- end -->").unwrap();
+    assert_eq!(&text[from..to], want, "{what}; put:\n{want}");
+}
+
+/// The case of a run named from `name` whose analysis is `work` (`fits`, `stream`,
+/// `everything`).
+fn case<'a>(run: &'a Value, name: &str, work: &str) -> &'a Value {
+    run.as_array()
+        .unwrap()
+        .iter()
+        .find(|c| c["case"].as_str().unwrap().starts_with(name) && c["work"] == work)
+        .unwrap_or_else(|| panic!("{name} {work} missing"))
+}
+
+/// The spacings a case's trains were tried at, s.
+fn spacings(c: &Value) -> impl Iterator<Item = f64> + '_ {
+    (c["runs"].as_array().unwrap().iter()).map(|r| r["spacing_s"].as_f64().unwrap())
 }
 
 /// A latency in ms as the README writes it: one decimal below 100 ms, none above; a dash
@@ -158,14 +186,6 @@ fn per_s(hz: f64) -> String {
 /// The README's real-time table, from `impact bench realtime --json` at clock shifts 2, 3
 /// and 4 (`runs[s]` the shift's cases).
 fn realtime_table(runs: &[Value; 3]) -> String {
-    let case = |run: &Value, name: &str, work: &str| -> Value {
-        run.as_array()
-            .unwrap()
-            .iter()
-            .find(|c| c["case"].as_str().unwrap().starts_with(name) && c["work"] == work)
-            .unwrap_or_else(|| panic!("{name} {work} missing"))
-            .clone()
-    };
     let row = |name: &str, work: &str| -> String {
         runs.iter()
             .map(|r| latency_ms(&case(r, name, work)["nominal"]["latency_median_s"]))
@@ -181,14 +201,9 @@ fn realtime_table(runs: &[Value; 3]) -> String {
                 .map_or("none".into(), |hz| format!("{} /s", per_s(hz)))
         })
         .collect();
-    let spacings: Vec<f64> = case(&runs[1], "seed bench", "everything")["runs"]
-        .as_array()
-        .unwrap()
-        .iter()
-        .map(|r| r["spacing_s"].as_f64().unwrap())
-        .collect();
-    let widest = spacings.iter().copied().fold(0.0, f64::max);
-    let closest = spacings.iter().copied().fold(f64::INFINITY, f64::min);
+    let everything = case(&runs[1], "seed bench", "everything");
+    let widest = spacings(everything).fold(0.0, f64::max);
+    let closest = spacings(everything).fold(f64::INFINITY, f64::min);
     format!(
         "| report latency (median) | twice as fast (2) | the board (3) | half as fast (4) |\n\
          |---|---|---|---|\n\
@@ -207,23 +222,11 @@ fn realtime_table(runs: &[Value; 3]) -> String {
 
 #[test]
 fn the_readmes_real_time_figures_are_the_stored_runs() {
-    let root = concat!(env!("CARGO_MANIFEST_DIR"), "/..");
-    let read = |n: u32| -> Value {
-        let path = format!("{root}/host-tests/bench/realtime-shift{n}.json");
-        serde_json::from_str(&std::fs::read_to_string(&path).unwrap()).unwrap()
-    };
-    let want = realtime_table(&[read(2), read(3), read(4)]);
-    let readme = std::fs::read_to_string(format!("{root}/README.md")).unwrap();
-    let start = "<!-- host-tests/bench/realtime-shift{2,3,4}.json -->\n";
-    let from = readme
-        .find(start)
-        .expect("the stored runs' block in README.md")
-        + start.len();
-    let to = from + readme[from..].find("\n<!-- end -->").unwrap();
-    assert_eq!(
-        &readme[from..to],
-        want,
-        "README.md's real-time figures are not the stored runs'; put:\n{want}"
+    assert_block(
+        "README.md",
+        "<!-- host-tests/bench/realtime-shift{2,3,4}.json -->\n",
+        &realtime_table(&[stored_run(2), stored_run(3), stored_run(4)]),
+        "README.md's real-time figures are not the stored runs'",
     );
 }
 
@@ -231,20 +234,10 @@ fn the_readmes_real_time_figures_are_the_stored_runs() {
 /// every impact analysed (below the widest spacing's rate where none was).
 fn board_table(runs: &[Value; 3]) -> String {
     let cell = |run: &Value, name: &str, work: &str| -> String {
-        let c = run
-            .as_array()
-            .unwrap()
-            .iter()
-            .find(|c| c["case"].as_str().unwrap().starts_with(name) && c["work"] == work)
-            .unwrap_or_else(|| panic!("{name} {work} missing"));
+        let c = case(run, name, work);
         let rate = match c["max_rate_fully_analysed_hz"].as_f64() {
             Some(hz) => format!("{} /s", per_s(hz)),
-            None => {
-                let widest = (c["runs"].as_array().unwrap().iter())
-                    .map(|r| r["spacing_s"].as_f64().unwrap())
-                    .fold(0.0, f64::max);
-                format!("below {} /s", per_s(1.0 / widest))
-            }
+            None => format!("below {} /s", per_s(1.0 / spacings(c).fold(0.0, f64::max))),
         };
         format!("{}, {rate}", latency_ms(&c["nominal"]["latency_median_s"]))
     };
@@ -274,31 +267,21 @@ fn board_table(runs: &[Value; 3]) -> String {
 
 #[test]
 fn the_boards_real_time_table_is_the_stored_runs() {
-    let root = concat!(env!("CARGO_MANIFEST_DIR"), "/..");
-    let read = |n: u32| -> Value {
-        let path = format!("{root}/host-tests/bench/realtime-shift{n}.json");
-        serde_json::from_str(&std::fs::read_to_string(&path).unwrap()).unwrap()
-    };
-    let docs = std::fs::read_to_string(format!("{root}/docs/board.md")).unwrap();
     for (start, want) in [
         (
             "<!-- host-tests/bench/realtime-shift3.json -->\n",
-            shift3_table(&read(3)),
+            shift3_table(&stored_run(3)),
         ),
         (
             "<!-- host-tests/bench/realtime-shift{2,3,4}.json -->\n",
-            board_table(&[read(2), read(3), read(4)]),
+            board_table(&[stored_run(2), stored_run(3), stored_run(4)]),
         ),
     ] {
-        let from = docs
-            .find(start)
-            .expect("the stored runs' block in docs/board.md")
-            + start.len();
-        let to = from + docs[from..].find("\n<!-- end -->").unwrap();
-        assert_eq!(
-            &docs[from..to],
-            want,
-            "docs/board.md's real-time table is not the stored runs'; put:\n{want}"
+        assert_block(
+            "docs/board.md",
+            start,
+            &want,
+            "docs/board.md's real-time table is not the stored runs'",
         );
     }
 }

@@ -351,9 +351,18 @@ pub fn target_file(args: &AnalyzeArgs) -> Option<PathBuf> {
     if !std::fs::metadata(scene).is_ok_and(|m| m.is_file()) {
         return None;
     }
-    let bytes = impact_io::read_limited(scene, 1 << 20, "scene file").ok()?;
-    let file: SceneFile = serde_json::from_slice(&bytes).ok()?;
+    let file = read_scene(scene).ok()?;
     crate::simulate::two_body::scene_target_path(scene, file.target.as_ref()?)
+}
+
+/// The scene file at `path`, read (at most 1 MiB) and parsed, not yet checked.
+fn read_scene(path: &Path) -> Result<SceneFile, SceneError> {
+    let bytes = impact_io::read_limited(path, 1 << 20, "scene file")
+        .map_err(|e| SceneError::Read(e.into()))?;
+    serde_json::from_slice(&bytes).map_err(|source| SceneError::Json {
+        path: path.to_path_buf(),
+        source,
+    })
 }
 
 /// The `--scene` file's settings (all defaults without one), each number within its limits
@@ -362,13 +371,7 @@ pub fn scene_file(args: &AnalyzeArgs) -> Result<SceneFile, SceneError> {
     let file = match &args.scene {
         None => SceneFile::default(),
         Some(path) => {
-            let bytes = impact_io::read_limited(path, 1 << 20, "scene file")
-                .map_err(|e| SceneError::Read(e.into()))?;
-            let file: SceneFile =
-                serde_json::from_slice(&bytes).map_err(|source| SceneError::Json {
-                    path: path.clone(),
-                    source,
-                })?;
+            let file = read_scene(path)?;
             file.check(path)?;
             file
         }
