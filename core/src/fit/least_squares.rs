@@ -210,15 +210,20 @@ pub fn set(p: &Points<'_>, line: Option<Restitution>) -> Option<f32> {
 }
 
 /// `F = k X^n + q X^n V` at one exponent: `(k, q, rss)` in scaled units, from the normal
-/// equations (`rss = Σ F² - k Σ X^n F - q Σ X^n V F`), `X^n` given per point.
-fn nonlinear_at(p: &Points<'_>, xn: impl Fn(usize, f32) -> f32) -> Option<(f64, f64, f64)> {
-    let mut s = Sums::<6>::new();
-    for (i, (x, v, f)) in p.iter().enumerate() {
-        let a = xn(i, x);
-        let av = a * v;
-        s.add([a * a, a * av, av * av, a * f, av * f, f * f]);
-    }
-    let [a11, a12, a22, b1, b2, ff] = s.get();
+/// equations (`rss = Σ F² - k Σ X^n F - q Σ X^n V F`; `ff` is the points' `Σ F²`, the same
+/// at every exponent, summed once by [`force_squares`]).
+fn nonlinear_at(p: &Points<'_>, ff: f64, xn: Power<'_>) -> Option<(f64, f64, f64)> {
+    // The exponent's case chosen once, not at every point: a loop each.
+    let [a11, a12, a22, b1, b2] = match xn {
+        Power::One => normal_sums(p.iter()),
+        Power::ThreeHalves => normal_sums(p.iter().map(|(x, v, f)| (pow15(x), v, f))),
+        // (`ln` holds a logarithm for every point: `nonlinear` makes sure of it.)
+        Power::Exp(n, ln) => normal_sums(
+            p.iter()
+                .zip(ln)
+                .map(|((_, v, f), &l)| (crate::numeric::exp::exp(n * l), v, f)),
+        ),
+    };
     let det = a11 * a22 - a12 * a12;
     if !(det > 1e-300) {
         return None;
@@ -228,6 +233,58 @@ fn nonlinear_at(p: &Points<'_>, xn: impl Fn(usize, f32) -> f32) -> Option<(f64, 
     Some((k, q, (ff - k * b1 - q * b2).max(0.0)))
 }
 
+/// The normal equations' sums `Σ A², Σ A² V, Σ A² V², Σ A F, Σ A V F` over `(A, V, F)`,
+/// `A = X^n`.
+#[inline(always)]
+fn normal_sums(points: impl Iterator<Item = (f32, f32, f32)>) -> [f64; 5] {
+    let mut s = Sums::<5>::new();
+    for (a, v, f) in points {
+        let av = a * v;
+        s.add([a * a, a * av, av * av, a * f, av * f]);
+    }
+    s.get()
+}
+
+/// The points' `Σ F²`.
+fn force_squares(p: &Points<'_>) -> f64 {
+    let mut s = Sums::<1>::new();
+    for (_, _, f) in p.iter() {
+        s.add([f * f]);
+    }
+    s.get()[0]
+}
+
+/// `X^n` at one exponent: `X` itself at 1, [`pow15`] at 1.5, else `exp(n ln X)` from the
+/// points' logarithms (`ln 0 = -inf` gives 0; an f32 polynomial's exp, not libm's: most of
+/// the exponent search's cost, `crate::numeric::exp`).
+#[derive(Clone, Copy)]
+enum Power<'a> {
+    One,
+    ThreeHalves,
+    Exp(f32, &'a [f32]),
+}
+
+impl<'a> Power<'a> {
+    fn new(n: f32, ln: &'a [f32]) -> Self {
+        if n == 1.0 {
+            Power::One
+        } else if n == 1.5 {
+            Power::ThreeHalves
+        } else {
+            Power::Exp(n, ln)
+        }
+    }
+
+    /// `X^n` of point `i` (whose deformation is `x`).
+    fn at(self, i: usize, x: f32) -> f32 {
+        match self {
+            Power::One => x,
+            Power::ThreeHalves => pow15(x),
+            Power::Exp(n, ln) => ln.get(i).map_or(0.0, |&l| crate::numeric::exp::exp(n * l)),
+        }
+    }
+}
+
 /// Nonlinear `F = k x^n (1 + c v)`, the exponent fixed at `n`, or searched in [1, 2.5] when
 /// `n` is `None` (`ln_x`, at least as long as the points, is scratch for `ln X`).
 // (Not inlined: each fit's frame stays out of the analysis task's.)
@@ -235,19 +292,6 @@ fn nonlinear_at(p: &Points<'_>, xn: impl Fn(usize, f32) -> f32) -> Option<(f64, 
 pub fn nonlinear(p: &Points<'_>, n: Option<f32>, ln_x: &mut [f32]) -> Option<NonlinearFit> {
     if !p.usable() {
         return None;
-    }
-    fn power(n: f32, ln: &[f32]) -> impl Fn(usize, f32) -> f32 + '_ {
-        move |i: usize, x: f32| -> f32 {
-            if n == 1.0 {
-                x
-            } else if n == 1.5 {
-                pow15(x)
-            } else {
-                // x^n = exp(n ln x); ln 0 = -inf gives 0. (An f32 polynomial's exp, not
-                // libm's: most of the exponent search's cost, `crate::numeric::exp`.)
-                ln.get(i).map_or(0.0, |&l| crate::numeric::exp::exp(n * l))
-            }
-        }
     }
     // ln x once per point, for the exponents x^n is taken as exp(n ln x).
     let needs_ln = n.is_none_or(|n| n != 1.0 && n != 1.5);
@@ -264,8 +308,12 @@ pub fn nonlinear(p: &Points<'_>, n: Option<f32>, ln_x: &mut [f32]) -> Option<Non
     let n = match n {
         Some(n) => n,
         None => {
+            let ff = force_squares(p);
             let (n, _, _) = brent_min(
-                |n| nonlinear_at(p, power(n as f32, ln)).map_or(f64::INFINITY, |(_, _, rss)| rss),
+                |n| {
+                    nonlinear_at(p, ff, Power::new(n as f32, ln))
+                        .map_or(f64::INFINITY, |(_, _, rss)| rss)
+                },
                 EXPONENT_RANGE.0,
                 EXPONENT_RANGE.1,
                 EXPONENT_TOL,
@@ -274,15 +322,16 @@ pub fn nonlinear(p: &Points<'_>, n: Option<f32>, ln_x: &mut [f32]) -> Option<Non
             n as f32
         }
     };
-    let (k, q, _) = nonlinear_at(p, power(n, ln))?;
+    // (Its residual unused: no `Σ F²`.)
+    let (k, q, _) = nonlinear_at(p, 0.0, Power::new(n, ln))?;
     if !(k > 0.0) {
         return None;
     }
     let (k32, q32) = (k as f32, q as f32);
-    let xn = power(n, ln);
+    let xn = Power::new(n, ln);
     let mut i = 0;
     let rms = residual(p, |x, v| {
-        let a = xn(i, x);
+        let a = xn.at(i, x);
         i += 1;
         a * (k32 + q32 * v)
     });

@@ -35,14 +35,15 @@ const P: [f32; 7] = [
 #[inline]
 pub fn exp(y: f32) -> f32 {
     let t = y * LOG2_E;
-    if t.is_nan() {
-        return t;
-    }
-    if !(t >= -126.0) {
-        return 0.0;
-    }
-    if !(t < 128.0) {
-        return f32::INFINITY;
+    // The usual case tested first: two comparisons (NaN fails both) where three were.
+    if !(-126.0..128.0).contains(&t) {
+        return if t.is_nan() {
+            t
+        } else if t < 0.0 {
+            0.0
+        } else {
+            f32::INFINITY
+        };
     }
     // floor(t) in [-126, 127]: `as` truncates towards zero.
     let mut i = t as i32;
