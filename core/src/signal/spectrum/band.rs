@@ -43,25 +43,7 @@ pub(super) struct Pair {
 impl Pair {
     /// The recursion alone over `block` (the operations of [`Pair::run`], so the same state).
     pub(super) fn skim(&self, s: State, block: &[f32]) -> State {
-        let [a1, a2] = self.a;
-        let (mut v1, mut v2, mut v3) = (s.w1, s.w2, s.w3);
-        let mut pairs = block.chunks_exact(2);
-        for pair in &mut pairs {
-            if let [x0, x1] = *pair {
-                let wa = x0 - a1 * v1 - a2 * v2;
-                let wb = x1 - a1 * wa - a2 * v1;
-                (v3, v2, v1) = (v1, wa, wb);
-            }
-        }
-        for &x in pairs.remainder() {
-            let w = x - a1 * v1 - a2 * v2;
-            (v3, v2, v1) = (v2, v1, w);
-        }
-        State {
-            w1: v1,
-            w2: v2,
-            w3: v3,
-        }
+        super::skim::skim(self.a, s, block)
     }
 
     /// Both responses over `block`: the state after it, each response's largest `|y|` and

@@ -27,11 +27,13 @@ mod band;
 mod bound;
 mod emphasis;
 mod halfband;
+mod skim;
 
 use band::*;
 use bound::*;
 use emphasis::*;
 use halfband::*;
+pub use skim::mismatch as skim_mismatch;
 
 /// Most bands a spectrum holds (1/6 octave from 10 Hz to 125 kHz is 81).
 pub const MAX_BANDS: usize = 96;
