@@ -46,21 +46,29 @@ pub(super) fn halve(x: &mut [f32], len: usize) -> Option<usize> {
             *slot = acc;
         }
     }
-    for i in inner_from..inner_to {
+    // One at a time until a run's outputs lie before its window (`i + RUN <= 2 i - 2 SPAN`),
+    // then runs of `RUN`, then the rest one at a time.
+    let singles = (2 * SPAN + RUN).max(inner_from).min(inner_to);
+    for i in inner_from..singles {
+        inner(x, i);
+    }
+    let mut i = singles;
+    while i + RUN <= inner_to {
         let first = 2 * i - 2 * SPAN;
-        let Some(w) = x
-            .get(first..first + 2 * SPAN + 1)
-            .and_then(|w| <&[f32; 2 * SPAN + 1]>::try_from(w).ok())
-        else {
+        let (done, rest) = x.split_at_mut(first);
+        let (Some(out), Some(window)) = (
+            done.get_mut(i..i + RUN)
+                .and_then(|o| <&mut [f32; RUN]>::try_from(o).ok()),
+            rest.get(..WINDOW)
+                .and_then(|w| <&[f32; WINDOW]>::try_from(w).ok()),
+        ) else {
             break;
         };
-        let mut acc = HALF_BAND_CENTRE * w[SPAN];
-        for (k, h) in HALF_BAND.iter().enumerate() {
-            acc += h * (w[SPAN - 1 - 2 * k] + w[SPAN + 1 + 2 * k]);
-        }
-        if let Some(slot) = x.get_mut(i) {
-            *slot = acc;
-        }
+        run(window, out);
+        i += RUN;
+    }
+    for i in i..inner_to {
+        inner(x, i);
     }
     for i in inner_to..out_len {
         let acc = edge(x, &head, len, i);
@@ -69,6 +77,47 @@ pub(super) fn halve(x: &mut [f32], len: usize) -> Option<usize> {
         }
     }
     Some(out_len)
+}
+
+/// Inner output `i` of [`halve`] (its 23 inputs one slice, past the copied head and before
+/// the end).
+#[inline(always)]
+fn inner(x: &mut [f32], i: usize) {
+    let first = 2 * i - 2 * SPAN;
+    let Some(w) = x
+        .get(first..first + 2 * SPAN + 1)
+        .and_then(|w| <&[f32; 2 * SPAN + 1]>::try_from(w).ok())
+    else {
+        return;
+    };
+    let mut acc = HALF_BAND_CENTRE * w[SPAN];
+    for (k, h) in HALF_BAND.iter().enumerate() {
+        acc += h * (w[SPAN - 1 - 2 * k] + w[SPAN + 1 + 2 * k]);
+    }
+    if let Some(slot) = x.get_mut(i) {
+        *slot = acc;
+    }
+}
+
+/// Outputs a [`run`] computes at a time.
+const RUN: usize = 8;
+/// The inputs a run reads: `2 RUN - 2 + 2 SPAN + 1`.
+const WINDOW: usize = 2 * RUN + 2 * SPAN - 1;
+
+/// `RUN` consecutive inner outputs of [`halve`] from the inputs of their windows (the first
+/// output's window starts at `window[0]`, each next one two samples on): the same sums in
+/// the same order as one output at a time, with each input loaded once (`window` and `out`
+/// do not overlap: the compiler keeps the inputs in registers across the stores).
+#[inline(always)]
+fn run(window: &[f32; WINDOW], out: &mut [f32; RUN]) {
+    for (j, slot) in out.iter_mut().enumerate() {
+        let c = 2 * j + SPAN;
+        let mut acc = HALF_BAND_CENTRE * window[c];
+        for (k, h) in HALF_BAND.iter().enumerate() {
+            acc += h * (window[c - 1 - 2 * k] + window[c + 1 + 2 * k]);
+        }
+        *slot = acc;
+    }
 }
 
 /// Output `i` of [`halve`] near either end: inputs before the first or past `len` are 0, the
