@@ -13,7 +13,7 @@
 //! SRS at 200 Hz; halving at rate / 32 instead would save a fifth of the work and lose 0.8 %).
 //!
 //! Each band runs in two passes over blocks of [`BLOCK`] samples: the recursion alone
-//! (3.4 instructions a sample on the M4), marking each block with its state and a [`Bound`]
+//! (`skim`: 2.25 instructions a sample on the M4), marking each block with its state and a [`Bound`]
 //! on both responses over it; then both responses, keeping each block's largest `|y|`
 //! without a branch, only for the blocks whose bound reaches the largest `|y|` found so far
 //! (on the seed's impact 12 to 19 of 102 blocks a band). The result is the same, bit for
@@ -33,6 +33,10 @@ use band::*;
 use bound::*;
 use emphasis::*;
 use halfband::*;
+/// The board's self-test of its hand-written recursion (`m4-bench selftest`): the first
+/// length of `x` at which the spectra's first pass (each band's recursion alone, in a `VLDM`
+/// loop on the M4) differs by a bit from the portable loop, from a few states and poles;
+/// `None` if none does (always on the host, where both are the portable loop).
 pub use skim::mismatch as skim_mismatch;
 
 /// Most bands a spectrum holds (1/6 octave from 10 Hz to 125 kHz is 81).
