@@ -3,11 +3,11 @@
 //! window). Portable, and on the Cortex-M4 a loop of 16 samples per pass that loads 8 at a
 //! time (`VLDM`) into one of two banks of registers, so each sample costs its two
 //! multiply-subtracts, an eighth of a load and an eighth of the loop's count and branch: 2.25
-//! instructions where the compiled loop took 3.5 (a load per sample). (In cycles the gain is
-//! smaller: each `VMLS` takes 3 cycles, a `VLDM` of 8 takes 9: some 7.4 cycles a sample
-//! against 8.1 by the Cortex-M4's timings.) The same operations in the same order as the portable loop
-//! (`VMLS` rounds the product, then the difference, as the host does), so the same bits
-//! (`the_skim_is_the_recursion` on the host; on the board, `m4-bench selftest`).
+//! instructions where the compiled loop took 3.5 (a load per sample). In cycles the gain is
+//! smaller: each `VMLS` takes 3 cycles and a `VLDM` of 8 takes 9, some 7.4 cycles a sample
+//! against 8.1 by the Cortex-M4's timings. The same operations in the same order as the
+//! portable loop (`VMLS` rounds the product, then the difference, as the host does), so the
+//! same bits (`the_skim_is_the_recursion` on the host; on the board, `m4-bench selftest`).
 
 use super::band::State;
 
