@@ -65,7 +65,8 @@ pub(super) struct Best {
 /// solution), and the difference `e = w - α - β m` follows the recursion driven by `r`.
 /// With `p` the pole, `z = e1 - p̄ e2` evolves as `z ← p z + r` (`|p| <= 1`), and that part
 /// of `y` is `Re(g z)` for the state at the block's start plus the rest through the impulse
-/// response `h`: so `|y| <= |y_line| + |g| |z| + min(|b0| max|r| + |g| Σ|r|, ‖h‖ ‖r‖)`, with
+/// response `h`: so `|y| <= |y_line| + |g| |z| + min(|b0| ‖r‖ + |g| Σ|r|, ‖h‖ ‖r‖)` (the
+/// direct term's `max|r|` taken as `‖r‖`, never less: one statistic fewer a sample), with
 /// room for `f32` rounding.
 #[derive(Clone, Copy)]
 pub(super) struct Bound {
@@ -153,7 +154,7 @@ impl Bound {
             let y_line = if y1 > y0 { y1 } else { y0 };
             let rounding = (g * 512.0 * eps + 8.0 * eps * (b0.abs() + b1.abs() + b2.abs())) * scale;
             // The rest's part: by the triangle inequality, or by Cauchy–Schwarz.
-            let (by_sum, by_norm) = (d * rest.max + g * rest.sum, h * rest.norm);
+            let (by_sum, by_norm) = (d * rest.norm + g * rest.sum, h * rest.norm);
             let forced = if by_norm < by_sum { by_norm } else { by_sum };
             1.002 * (y_line + g * z + forced) + rounding
         })
@@ -193,18 +194,16 @@ pub(super) fn line(block: &[f32]) -> (f32, f32) {
     }
 }
 
-/// One block's input about its [`fn@line`]: `Σ|r|`, `max|r|` and `sqrt(Σ r²)`.
+/// One block's input about its [`fn@line`]: `Σ|r|` and `sqrt(Σ r²)`.
 #[derive(Clone, Copy, Default)]
 pub(super) struct Rest {
     pub(super) sum: f32,
-    pub(super) max: f32,
     pub(super) norm: f32,
 }
 
 impl Rest {
     pub(super) const ZERO: Self = Self {
         sum: 0.0,
-        max: 0.0,
         norm: 0.0,
     };
 }
@@ -231,9 +230,6 @@ pub(super) fn rests(input: Input, out: &mut [Rest; STAT_BLOCKS]) {
             let r = (x - (u + v * m)).abs();
             s.sum += r;
             squares += r * r;
-            if r > s.max {
-                s.max = r;
-            }
             m += 1.0;
         }
         // Rounded up a little: the sums in `f32`.
