@@ -14,6 +14,7 @@
 //! replaces the band and slack; `outside` still applies before its first row and after its
 //! last.
 
+mod half_sine;
 pub mod verdict;
 #[cfg(test)]
 mod verdict_reference;
@@ -505,8 +506,10 @@ impl<'a> Nominal<'a> {
         }
         let n = table.len().min(Self::LEN);
         let (table, _) = table.split_at_mut(n);
-        for (k, v) in table.iter_mut().enumerate() {
-            *v = shape.at(k as f32 / NOMINAL_POINTS as f32);
+        // `shape.at(k / NOMINAL_POINTS)`, stored (`half_sine`: the same bits, 257 `sinf`
+        // fewer per verdict).
+        for (v, &h) in table.iter_mut().zip(half_sine::HALF_SINE.iter()) {
+            *v = h;
         }
         Self { table, exact: None }
     }

@@ -16,8 +16,9 @@
 //! tests hold the search to the one that did, `verdict_reference.rs`); a window holding a NaN
 //! or an infinity is no verdict here ([`Missing::Overflow`]). The window's samples are read
 //! from the record once, into the scratch after the tables (the board's analysis workspace).
-//! A user's band does not tabulate the nominal shape (257 `sinf`, in f64 on the board's libm:
-//! about a third of a verdict against a standard's band on the Cortex-M4).
+//! The nominal half-sine's table is copied from constants (`spec/half_sine.rs`: 257 `sinf`,
+//! in f64 on the board's libm, were about a third of a verdict against a standard's band on
+//! the Cortex-M4); a user's band does not read the nominal shape at all.
 
 use super::{band_bound, band_over, Nominal, Spec};
 use crate::numeric::fmax;
@@ -528,8 +529,7 @@ pub fn judge_in(
         }
     };
     let ext = &*ext;
-    // A user's band is its rows: the nominal shape is not read (its table, 257 sines on the
-    // board's libm, would cost a third of the verdict).
+    // A user's band is its rows: the nominal shape is not read (its table not even copied).
     let tabulated = if spec.band.is_some() { 0 } else { table.len() };
     let nominal = Nominal::fill(spec.shape, table.get_mut(..tabulated).unwrap_or(&mut []));
     let peak = spec.peak_m_s2;
