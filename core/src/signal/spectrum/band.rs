@@ -3,16 +3,8 @@
 
 use super::bound::*;
 use super::emphasis::*;
+pub(super) use super::skim::State;
 use crate::signal::srs::Oscillator;
-
-/// The recursion's state before a sample: `w[n-1]`, `w[n-2]` and `w[n-3]` (the last for
-/// the output before it).
-#[derive(Clone, Copy, Default)]
-pub(super) struct State {
-    pub(super) w1: f32,
-    pub(super) w2: f32,
-    pub(super) w3: f32,
-}
 
 /// A block from the first pass: the state at its start and the [`Bound`] of each response.
 #[derive(Clone, Copy, Default)]

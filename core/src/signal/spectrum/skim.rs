@@ -9,7 +9,14 @@
 //! portable loop (`VMLS` rounds the product, then the difference, as the host does), so the
 //! same bits (`the_skim_is_the_recursion` on the host; on the board, `m4-bench selftest`).
 
-use super::band::State;
+/// The recursion's state before a sample: `w[n-1]`, `w[n-2]` and `w[n-3]` (the last for
+/// the output before it).
+#[derive(Clone, Copy, Default)]
+pub(super) struct State {
+    pub(super) w1: f32,
+    pub(super) w2: f32,
+    pub(super) w3: f32,
+}
 
 /// The recursion with poles `a` over `block` from state `s`: the state after it.
 #[inline]
