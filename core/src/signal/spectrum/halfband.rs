@@ -55,7 +55,9 @@ pub(super) fn halve(x: &mut [f32], len: usize) -> Option<usize> {
     let mut i = singles;
     while i + RUN <= inner_to {
         let first = 2 * i - 2 * SPAN;
-        let (done, rest) = x.split_at_mut(first);
+        let Some((done, rest)) = x.split_at_mut_checked(first) else {
+            break;
+        };
         let (Some(out), Some(window)) = (
             done.get_mut(i..i + RUN)
                 .and_then(|o| <&mut [f32; RUN]>::try_from(o).ok()),
