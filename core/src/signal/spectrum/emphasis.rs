@@ -8,6 +8,12 @@ use super::*;
 /// `1 + 2a (1 - cos 2x) + 2b (1 - cos 4x)`, `a = 23/180`, `b = -1/90` (0.01 % at `f T = 1/8`).
 pub(super) const EMPHASIS: [f32; 3] = [1.0 + 23.0 / 90.0 - 1.0 / 45.0, -23.0 / 180.0, 1.0 / 90.0];
 
+/// The pre-emphasis of one output from its five inputs, `w[2]` the centre.
+#[inline(always)]
+fn five([w0, w1, w2, w3, w4]: [f32; 5]) -> f32 {
+    EMPHASIS[0] * w2 + EMPHASIS[1] * (w1 + w3) + EMPHASIS[2] * (w0 + w4)
+}
+
 /// Output `n` of the pre-emphasis over `x[..len]`: input `n - 2` (outputs run from two
 /// samples before the first input to two after the last, `len + 4` of them).
 #[inline]
@@ -18,7 +24,7 @@ pub(super) fn emphasised(x: &[f32], n: usize) -> f32 {
         .and_then(|a| x.get(a..a + 5))
         .and_then(|w| <&[f32; 5]>::try_from(w).ok())
     {
-        return EMPHASIS[0] * w[2] + EMPHASIS[1] * (w[1] + w[3]) + EMPHASIS[2] * (w[0] + w[4]);
+        return five(*w);
     }
     let at = |j: isize| {
         if j < 0 {
@@ -28,9 +34,7 @@ pub(super) fn emphasised(x: &[f32], n: usize) -> f32 {
         }
     };
     let c = n as isize - 2;
-    EMPHASIS[0] * at(c)
-        + EMPHASIS[1] * (at(c - 1) + at(c + 1))
-        + EMPHASIS[2] * (at(c - 2) + at(c + 2))
+    five([at(c - 2), at(c - 1), at(c), at(c + 1), at(c + 2)])
 }
 
 /// The pre-emphasis of `x[..len]` into `x[len..2 len + 4]`; the range written, or `None`
@@ -60,8 +64,8 @@ pub(super) fn compensate(x: &mut [f32], len: usize) -> Option<core::ops::Range<u
         .iter_mut()
         .zip(src.get(from..).unwrap_or(&[]).windows(5))
     {
-        if let &[w0, w1, w2, w3, w4] = w {
-            *slot = EMPHASIS[0] * w2 + EMPHASIS[1] * (w1 + w3) + EMPHASIS[2] * (w0 + w4);
+        if let Ok(&w) = <&[f32; 5]>::try_from(w) {
+            *slot = five(w);
         }
     }
     let outputs = dst.len();
@@ -83,7 +87,7 @@ const RUN: usize = 8;
 fn run(window: &[f32; RUN + 4], out: &mut [f32; RUN]) {
     for (j, slot) in out.iter_mut().enumerate() {
         let w = |k: usize| window.get(j + k).copied().unwrap_or(0.0);
-        *slot = EMPHASIS[0] * w(2) + EMPHASIS[1] * (w(1) + w(3)) + EMPHASIS[2] * (w(0) + w(4));
+        *slot = five([w(0), w(1), w(2), w(3), w(4)]);
     }
 }
 

@@ -109,7 +109,9 @@ const WINDOW: usize = 2 * RUN + 2 * SPAN - 1;
 /// `RUN` consecutive inner outputs of [`halve`] from the inputs of their windows (the first
 /// output's window starts at `window[0]`, each next one two samples on): the same sums in
 /// the same order as one output at a time, with each input loaded once (`window` and `out`
-/// do not overlap: the compiler keeps the inputs in registers across the stores).
+/// do not overlap: the compiler keeps the inputs in registers across the stores). The sum is
+/// [`inner`]'s, spelt out on `window`: through a shared function over each output's 23-input
+/// slice the compiler shares fewer loads (16 k instructions more on the seed's spectra).
 #[inline(always)]
 fn run(window: &[f32; WINDOW], out: &mut [f32; RUN]) {
     for (j, slot) in out.iter_mut().enumerate() {
