@@ -209,10 +209,10 @@ pub fn set(p: &Points<'_>, line: Option<Restitution>) -> Option<f32> {
     (rms <= SET_RESIDUAL && inside).then_some(x_s)
 }
 
-/// `F = k X^n + q X^n V` at one exponent: `(k, q, rss)` in scaled units, from the normal
-/// equations (`rss = Σ F² - k Σ X^n F - q Σ X^n V F`; `ff` is the points' `Σ F²`, the same
-/// at every exponent, summed once by [`force_squares`]).
-fn nonlinear_at(p: &Points<'_>, ff: f64, xn: Power<'_>) -> Option<(f64, f64, f64)> {
+/// `F = k X^n + q X^n V` at one exponent: `(k, q)` in scaled units from the normal
+/// equations, and their right-hand sides `[Σ X^n F, Σ X^n V F]` (the residual is
+/// [`rss`]'s).
+fn nonlinear_at(p: &Points<'_>, xn: Power<'_>) -> Option<(f64, f64, [f64; 2])> {
     // The exponent's case chosen once, not at every point: a loop each.
     let [a11, a12, a22, b1, b2] = match xn {
         Power::One => normal_sums(p.iter()),
@@ -230,7 +230,14 @@ fn nonlinear_at(p: &Points<'_>, ff: f64, xn: Power<'_>) -> Option<(f64, f64, f64
     }
     let k = (b1 * a22 - b2 * a12) / det;
     let q = (a11 * b2 - a12 * b1) / det;
-    Some((k, q, (ff - k * b1 - q * b2).max(0.0)))
+    Some((k, q, [b1, b2]))
+}
+
+/// The residual sum of squares of [`nonlinear_at`]'s solution: `Σ F² - k Σ X^n F - q Σ X^n
+/// V F`, `ff` the points' `Σ F²` (the same at every exponent, summed once by
+/// [`force_squares`]).
+fn rss(ff: f64, (k, q, [b1, b2]): (f64, f64, [f64; 2])) -> f64 {
+    (ff - k * b1 - q * b2).max(0.0)
 }
 
 /// The normal equations' sums `Σ A², Σ A² V, Σ A² V², Σ A F, Σ A V F` over `(A, V, F)`,
@@ -310,10 +317,7 @@ pub fn nonlinear(p: &Points<'_>, n: Option<f32>, ln_x: &mut [f32]) -> Option<Non
         None => {
             let ff = force_squares(p);
             let (n, _, _) = brent_min(
-                |n| {
-                    nonlinear_at(p, ff, Power::new(n as f32, ln))
-                        .map_or(f64::INFINITY, |(_, _, rss)| rss)
-                },
+                |n| nonlinear_at(p, Power::new(n as f32, ln)).map_or(f64::INFINITY, |s| rss(ff, s)),
                 EXPONENT_RANGE.0,
                 EXPONENT_RANGE.1,
                 EXPONENT_TOL,
@@ -322,8 +326,7 @@ pub fn nonlinear(p: &Points<'_>, n: Option<f32>, ln_x: &mut [f32]) -> Option<Non
             n as f32
         }
     };
-    // (Its residual unused: no `Σ F²`.)
-    let (k, q, _) = nonlinear_at(p, 0.0, Power::new(n, ln))?;
+    let (k, q, _) = nonlinear_at(p, Power::new(n, ln))?;
     if !(k > 0.0) {
         return None;
     }
