@@ -13,10 +13,11 @@
 //! after the maximum deformation at which the force returns to zero; the deformation left then
 //! is the permanent deformation, the speed then the rebound speed `v'`, and `COR = v'/v0`.
 #![no_std]
-// No unsafe code but four `global_asm!` routines for the Cortex-M4F, each allowing it for
+// No unsafe code but five `global_asm!` routines for the Cortex-M4F, each allowing it for
 // itself: the FPU square root (`real::fpu_sqrt`), the idle path's SIMD stride statistics
-// (`signal::baseline::Stats::of`), its word-wise ring copy (`signal::copy`) and the spectra's
-// recursion (`signal::spectrum::skim`).
+// (`signal::baseline::Stats::of`), its word-wise ring copy (`signal::copy`), the spectra's
+// recursion (`signal::spectrum::skim`) and both their responses with each one's largest
+// `|y|` (`signal::spectrum::tops`).
 #![deny(unsafe_code)]
 // Guards are written `!(x > 0)` on purpose: they are true for NaN, so NaN never passes.
 #![allow(clippy::neg_cmp_op_on_partial_ord)]

@@ -16,7 +16,7 @@
 //!   <permanent|none>`: `reps` identical f32
 //!   [`impact_core::solve`] calls; prints their SysTick time and the outcome's bits;
 //! * `selftest`: the board's hand-written routines (SIMD stride statistics, word-wise copy,
-//!   the spectra's recursion, FPU square root)
+//!   the spectra's recursion and both responses, FPU square root)
 //!   against their portable references; prints `selftest ok`;
 //! * `math <op> <backend> <lo> <hi>`: [`MATH_CALLS`] calls of one maths function (`libm`,
 //!   `micromath`, or the FPU's `vsqrt`) on inputs spread over `lo..hi`; prints the SysTick time of the calls and of the bare loop.
@@ -359,7 +359,8 @@ fn stream(
 
 /// The board's hand-written routines against their portable references: the SIMD stride
 /// statistics at every alignment and length up to two strides, on extreme and random values,
-/// the word-wise copy, the spectra's recursion at every length up to 160 (`skim_mismatch`)
+/// the word-wise copy, the spectra's recursion and both responses at every length up to 160
+/// (`skim_mismatch`, `tops_mismatch`)
 /// and the FPU square root on a sweep of magnitudes. Prints `selftest ok` or the first
 /// mismatch.
 fn selftest() -> Result<(), ()> {
@@ -420,6 +421,10 @@ fn selftest() -> Result<(), ()> {
     let samples: [f32; 160] = core::array::from_fn(|k| f32::from(buf[k]) * 1e-3);
     if let Some(len) = impact_core::signal::spectrum::skim_mismatch(&samples) {
         hprintln!("selftest skim mismatch len={}", len);
+        return Err(());
+    }
+    if let Some(len) = impact_core::signal::spectrum::tops_mismatch(&samples) {
+        hprintln!("selftest tops mismatch len={}", len);
         return Err(());
     }
     let mut x = 1e-30f32;

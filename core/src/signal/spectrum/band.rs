@@ -4,6 +4,8 @@
 use super::bound::*;
 use super::emphasis::*;
 pub(super) use super::skim::State;
+pub(super) use super::tops::Filter;
+use super::tops::{step, value};
 use crate::signal::srs::Oscillator;
 
 /// A block from the first pass: the state at its start and the [`Bound`] of each response.
@@ -24,53 +26,26 @@ impl Mark {
     };
 }
 
-/// Both oscillators of a band in direct form II: one recursion (shared poles), two
-/// numerators (absolute acceleration, pseudo-velocity).
-#[derive(Clone, Copy)]
-pub(super) struct Pair {
-    pub(super) a: [f32; 2],
-    pub(super) num: [[f32; 3]; 2],
-}
-
-impl Pair {
-    /// The recursion alone over `block` (the operations of [`Pair::run`], so the same state).
+impl Filter {
+    /// The recursion alone over `block` (the operations of [`Filter::tops`], so the same
+    /// state).
     pub(super) fn skim(&self, s: State, block: &[f32]) -> State {
         super::skim::skim(self.a, s, block)
     }
 
-    /// Both responses over `block`: the state after it, each response's largest `|y|` and
-    /// the outputs of its last two samples (of an even block).
-    pub(super) fn run(&self, s: State, block: &[f32]) -> (State, [f32; 2], [[f32; 2]; 2]) {
-        let [a1, a2] = self.a;
-        let [[b0, b1, b2], [c0, c1, c2]] = self.num;
-        let (mut w1, mut w2, mut w3) = (s.w1, s.w2, s.w3);
-        let (mut top_a, mut top_p) = (0.0f32, 0.0f32);
-        let mut step = |xn: f32| {
-            let w = xn - a1 * w1 - a2 * w2;
-            let ya = b0 * w + b1 * w1 + b2 * w2;
-            let yp = c0 * w + c1 * w1 + c2 * w2;
-            (w3, w2, w1) = (w2, w1, w);
-            // Comparisons, not `f32::max` (a library call without VMAXNM on the M4), and
-            // no branch.
-            if ya.abs() > top_a {
-                top_a = ya.abs();
-            }
-            if yp.abs() > top_p {
-                top_p = yp.abs();
-            }
-            [ya, yp]
-        };
-        let mut last = [[0.0f32; 2]; 2];
-        let mut pairs = block.chunks_exact(2);
-        for pair in &mut pairs {
-            if let [x0, x1] = *pair {
-                last = [step(x0), step(x1)];
-            }
-        }
-        for &xn in pairs.remainder() {
-            step(xn);
-        }
-        (State { w1, w2, w3 }, [top_a, top_p], last)
+    /// Both responses over `block`: the state after it and each response's largest `|y|`.
+    pub(super) fn tops(&self, s: State, block: &[f32]) -> (State, [f32; 2]) {
+        let mut keys = [0; 2];
+        let end = super::tops::tops(self, s, &mut keys, block);
+        (end, keys.map(value))
+    }
+
+    /// Both responses over the two zeros after the input (the ramp back to rest): each
+    /// response's largest `|y|` and the outputs of both samples.
+    pub(super) fn ramp_down(&self, mut s: State) -> ([f32; 2], [[f32; 2]; 2]) {
+        let mut keys = [0; 2];
+        let last = [0, 1].map(|_| step(self, &mut s, &mut keys, 0.0));
+        (keys.map(value), last)
     }
 
     /// Each response's output before the sample whose state is `s`.
@@ -122,7 +97,7 @@ pub(super) fn band(
     let Some([acc, pv]) = Oscillator::<f32>::pair(f_hz, damping, rate_hz) else {
         return (0.0, 0.0);
     };
-    let filter = Pair {
+    let filter = Filter {
         a: acc.a,
         num: [acc.b, pv.b],
     };
@@ -157,7 +132,7 @@ pub(super) fn band(
             }
             // Unmarked (no bound, or beyond the marks): computed now.
             _ => {
-                let (end, tops, _) = filter.run(state, block);
+                let (end, tops) = filter.tops(state, block);
                 filter.settle(&mut best, tops, from, state);
                 state = end;
             }
@@ -165,14 +140,14 @@ pub(super) fn band(
         from += block.len();
     }
     // The two zeros after the input: always computed (their outputs start the residuals).
-    let (_, tops, [[ya_1, yp_1], [ya_2, yp_2]]) = filter.run(state, &[0.0, 0.0]);
+    let (tops, [[ya_1, yp_1], [ya_2, yp_2]]) = filter.ramp_down(state);
     filter.settle(&mut best, tops, n, state);
     // The marked blocks: those of the largest bounds first, then each whose bound reaches a
     // largest `|y|` so far.
     let mut evaluate = |k: usize, best: &mut [Best; 2]| {
         if let Some(mark) = marks.get(k) {
             let block = input.block(k * BLOCK, &mut buf);
-            let (_, tops, _) = filter.run(mark.start, block);
+            let (_, tops) = filter.tops(mark.start, block);
             filter.settle(best, tops, k * BLOCK, mark.start);
         }
     };

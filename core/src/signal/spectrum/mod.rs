@@ -14,8 +14,8 @@
 //!
 //! Each band runs in two passes over blocks of [`BLOCK`] samples: the recursion alone
 //! (`skim`: 2.25 instructions a sample on the M4), marking each block with its state and a [`Bound`]
-//! on both responses over it; then both responses, keeping each block's largest `|y|`
-//! without a branch, only for the blocks whose bound reaches the largest `|y|` found so far
+//! on both responses over it; then both responses (`tops`: 15.25 instructions a sample on
+//! the M4), keeping each block's largest `|y|` without a branch, only for the blocks whose bound reaches the largest `|y|` found so far
 //! (on the seed's impact 12 to 19 of 102 blocks a band). The result is the same, bit for
 //! bit, as computing every block; only the block that holds a response's peak is run again,
 //! for the samples around it.
@@ -28,6 +28,7 @@ mod bound;
 mod emphasis;
 mod halfband;
 mod skim;
+mod tops;
 
 use band::*;
 use bound::*;
@@ -38,6 +39,12 @@ use halfband::*;
 /// loop on the M4) differs by a bit from the portable loop, from a few states and poles;
 /// `None` if none does (always on the host, where both are the portable loop).
 pub use skim::mismatch as skim_mismatch;
+/// The board's self-test of its second hand-written loop (`m4-bench selftest`): the first
+/// length of `x` at which both responses over a block (each one's largest `|y|` kept, in a
+/// `VLDM` loop on the M4) differ by a bit from the portable loop, in the state or a largest
+/// `|y|`, from a few filters, states and largest values so far; `None` if none does
+/// (always on the host).
+pub use tops::mismatch as tops_mismatch;
 
 /// Most bands a spectrum holds (1/6 octave from 10 Hz to 125 kHz is 81).
 pub const MAX_BANDS: usize = 96;
