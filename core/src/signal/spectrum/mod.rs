@@ -75,7 +75,10 @@ impl SpectrumSettings {
     /// more than 12 bands an octave among them, or the bands would not fit [`MAX_BANDS`]). [`srs::bands`]'s, in `f32`: each band's
     /// `2^(j/n)` as `2^q 2^(r/n)` (`j = q n + r`), one `exp2` in `f64` per band of an octave
     /// rather than per band (on the M4 `f64` is software, some 1 500 instructions an
-    /// `exp2`); the same `f32` frequencies (`the_bands_are_the_references`).
+    /// `exp2`), and `j`'s `q` and `r` counted in integers (the f64 `floor(j / n)` and
+    /// `j - q n` are exact for these, so the same numbers, without a soft-float division,
+    /// floor and conversion a band); the same `f32` frequencies
+    /// (`the_bands_are_the_references`).
     pub fn bands(&self, rate_hz: f32, out: &mut [f32; MAX_BANDS]) -> usize {
         let per = usize::from(self.bands_per_octave);
         let (low, rate) = (self.low_hz as f64, rate_hz as f64);
@@ -88,15 +91,18 @@ impl SpectrumSettings {
         for (r, step) in steps.iter_mut().enumerate().take(per) {
             *step = libm::exp2(r as f64 / n);
         }
+        // The first band's `j = q n + r` (`as` saturates: a `q` beyond `i32` gives 0 or
+        // infinity below, as the f64 `q as i32` did).
+        let (first, per_i) = (first as i64, per as i64);
+        let (mut q, mut r) = (first.div_euclid(per_i), first.rem_euclid(per_i) as usize);
+        let top = rate / 8.0;
         let mut count = 0;
         loop {
-            let j = first + count as f64;
-            let q = libm::floor(j / n);
-            let Some(&step) = steps.get((j - q * n) as usize) else {
+            let Some(&step) = steps.get(r) else {
                 return 0;
             };
-            let f = 1000.0 * libm::scalbn(step, q as i32);
-            if !(f <= rate / 8.0) {
+            let f = 1000.0 * libm::scalbn(step, q.clamp(i32::MIN.into(), i32::MAX.into()) as i32);
+            if !(f <= top) {
                 return count;
             }
             match out.get_mut(count) {
@@ -105,6 +111,10 @@ impl SpectrumSettings {
                 None => return 0,
             }
             count += 1;
+            r += 1;
+            if r == per {
+                (q, r) = (q.saturating_add(1), 0);
+            }
         }
     }
 
