@@ -167,21 +167,63 @@ fn verdict<const CAP: usize>(
     } else {
         1.0
     };
-    let value = move |k: usize| Some(sign * deviation.of(*samples.get(k)?) as f32 * per_count);
     let rate = scene.calibration.sample_rate_hz;
     let step = capture.step();
+    let mut a = Held {
+        samples,
+        offset: first,
+        deviation,
+        per_count,
+        sign,
+    };
     if step == 1 {
-        let a = |i: u64| value(usize::try_from(i.checked_sub(first)?).ok()?);
         return judge_in(a, rate, spec, s.peak_index, scratch);
     }
     // In the capture's values, each at the middle of its group (`Capture::value_time`).
-    let a = |k: u64| value(usize::try_from(k).ok()?);
+    a.offset = 0;
     let peak = s.peak_index.saturating_sub(first) / u64::from(step);
     let mut v = judge_in(a, value_rate(capture, scene), spec, peak, scratch)?;
     let shift = capture.value_time(0.0) / f64::from(rate);
     v.start_s += shift;
     v.worst_s += shift;
     Ok(v)
+}
+
+/// The capture's values as a verdict reads them, in m/s² in the pulse's direction: value
+/// `k` at index `offset + k` (a stream index, or a decimated capture's value index).
+struct Held<'a> {
+    samples: &'a [i16],
+    offset: u64,
+    deviation: Deviation,
+    per_count: f32,
+    sign: f32,
+}
+
+impl Held<'_> {
+    fn value(&self, x: i16) -> f32 {
+        self.sign * self.deviation.of(x) as f32 * self.per_count
+    }
+}
+
+impl crate::spec::record::Record for Held<'_> {
+    fn at(&self, i: u64) -> Option<f32> {
+        let k = usize::try_from(i.checked_sub(self.offset)?).ok()?;
+        Some(self.value(*self.samples.get(k)?))
+    }
+
+    /// The capture holds its values in one piece: a run is a slice of them, converted.
+    fn run(&self, from: u64, out: &mut [f32]) -> bool {
+        let k = from
+            .checked_sub(self.offset)
+            .and_then(|k| usize::try_from(k).ok());
+        let Some(src) = k.and_then(|k| self.samples.get(k..k.checked_add(out.len())?)) else {
+            return false;
+        };
+        for (o, &x) in out.iter_mut().zip(src) {
+            *o = self.value(x);
+        }
+        true
+    }
 }
 
 /// The window from [`SPECTRUM_LEAD`] samples before the onset to the end of the capture, in

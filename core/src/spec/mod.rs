@@ -15,6 +15,7 @@
 //! last.
 
 mod half_sine;
+pub mod record;
 pub mod verdict;
 #[cfg(test)]
 mod verdict_reference;

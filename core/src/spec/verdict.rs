@@ -20,6 +20,7 @@
 //! in f64 on the board's libm, were about a third of a verdict against a standard's band on
 //! the Cortex-M4); a user's band does not read the nominal shape at all.
 
+use super::record::Record;
 use super::{band_bound, band_over, Nominal, Spec};
 use crate::numeric::fmax;
 use core::cell::Cell;
@@ -471,7 +472,7 @@ pub const SCRATCH: usize = 4 * BUCKETS + Nominal::LEN;
 /// [`judge_in`] with its tables on the stack (3 KiB).
 #[inline(never)]
 pub fn judge(
-    a: impl Fn(u64) -> Option<f32>,
+    a: impl Record,
     rate_hz: f32,
     spec: &Spec,
     peak_index: u64,
@@ -488,7 +489,7 @@ pub fn judge(
 /// Written for the FPU: positions in f32 samples from the first sample watched (`base`), the
 /// half-sine tabulated, compensated f32 sums for the velocity change.
 pub fn judge_in(
-    a: impl Fn(u64) -> Option<f32>,
+    a: impl Record,
     rate_hz: f32,
     spec: &Spec,
     peak_index: u64,
@@ -507,20 +508,27 @@ pub fn judge_in(
     else {
         return judge(a, rate_hz, spec, peak_index);
     };
-    let w = Window::place(spec, rate_hz, peak_index, |i| a(i).is_some())?;
+    let w = Window::place(spec, rate_hz, peak_index, |i| a.at(i).is_some())?;
     // Sample `k` of the window; one the record does not hold is missing before the pulse when
     // it lies before the measured peak, after it otherwise.
     let read = |k: u32| {
         let i = w.base + u64::from(k);
-        a(i).ok_or(if i < peak_index {
+        a.at(i).ok_or(if i < peak_index {
             Missing::WindowBefore
         } else {
             Missing::WindowAfter
         })
     };
     let a = match values.get_mut(..w.span as usize) {
+        // The record's run at once where it can give it (the same values), then the
+        // extremes over the copy; else sample by sample.
         Some(held) => {
-            extremes(&read, &w, ext, Some(&mut *held))?;
+            if a.run(w.base, held) {
+                let copy = |k: u32| Ok(held.get(k as usize).copied().unwrap_or(0.0));
+                extremes(&copy, &w, ext, None)?;
+            } else {
+                extremes(&read, &w, ext, Some(&mut *held))?;
+            }
             Signal::Held(&*held)
         }
         None => {
