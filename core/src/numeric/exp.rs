@@ -12,7 +12,7 @@
 //!
 //! Against `libm::expf` (within an ulp, 55 instructions a call on the M4, `impact bench m4`'s
 //! maths table): the nonlinear fit's exponent search takes `x^n = e^(n ln x)` at every point
-//! for every exponent it tries (about ten tries of up to 2048 points), most of its cost; this
+//! for every exponent it tries (about ten tries of up to 512 points), most of its cost; this
 //! one brings the board's three fits from 2.70 M to 2.40 M instructions.
 
 /// `log2 e`.

@@ -13,10 +13,11 @@
 //! SRS at 200 Hz; halving at rate / 32 instead would save a fifth of the work and lose 0.8 %).
 //!
 //! Each band runs in two passes over blocks of [`BLOCK`] samples: the recursion alone
-//! (`skim`: 2.25 instructions a sample on the M4), marking each block with its state and a [`Bound`]
-//! on both responses over it; then both responses (`tops`: 15.25 instructions a sample on
-//! the M4), keeping each block's largest `|y|` without a branch, only for the blocks whose bound reaches the largest `|y|` found so far
-//! (on the seed's impact 12 to 19 of 102 blocks a band). The result is the same, bit for
+//! (`skim`: 2.25 instructions a sample on the M4), marking each block with its state and a
+//! [`Bound`] on both responses over it; then both responses (`tops`: 15.25 instructions a
+//! sample on the M4), keeping each block's largest `|y|` without a branch, only for the
+//! blocks whose bound reaches the largest `|y|` found so far (on the seed's impact 12 to 19
+//! of 102 blocks a band). The result is the same, bit for
 //! bit, as computing every block; only the block that holds a response's peak is run again,
 //! for the samples around it.
 
