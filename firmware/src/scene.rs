@@ -77,7 +77,7 @@ pub const BENCH: Scene = Scene {
     lowpass: None,
     trigger_cfc: None,
     // The exponent is fitted, as on the host (`impact bench m4`: the whole analysis of the
-    // seed impact, all three fits included, costs about 2.1 M instructions, ~17 ms).
+    // seed impact, all three fits included, costs about 1.5 M instructions, ~12 ms).
     fits: FitSet {
         two_phase: true,
         nonlinear: true,
