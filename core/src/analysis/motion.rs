@@ -165,7 +165,8 @@ pub fn integrate(
             if let Some(p) = points.as_mut() {
                 if let (Some(x), Some(v)) = (p.x.get_mut(point), p.v.get_mut(point)) {
                     *v = 1.0 - pv * to_f32(s.c);
-                    *x = (px.0 + px.1 * s.k as f32 - px.2 * to_f32(s.t())).max(0.0);
+                    // (`fmax` inline: `f32::max` is a libm call on the M4, once a point.)
+                    *x = crate::numeric::fmax(px.0 + px.1 * s.k as f32 - px.2 * to_f32(s.t()), 0.0);
                 }
             }
             point += 1;
