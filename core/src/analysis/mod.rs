@@ -169,9 +169,11 @@ fn verdict<const CAP: usize>(
     };
     let rate = scene.calibration.sample_rate_hz;
     let step = capture.step();
-    let mut a = Held {
+    // Stream indices, or (decimated) the capture's values, each at the middle of its group
+    // (`Capture::value_time`).
+    let a = Held {
         samples,
-        offset: first,
+        offset: if step == 1 { first } else { 0 },
         deviation,
         per_count,
         sign,
@@ -179,8 +181,6 @@ fn verdict<const CAP: usize>(
     if step == 1 {
         return judge_in(a, rate, spec, s.peak_index, scratch);
     }
-    // In the capture's values, each at the middle of its group (`Capture::value_time`).
-    a.offset = 0;
     let peak = s.peak_index.saturating_sub(first) / u64::from(step);
     let mut v = judge_in(a, value_rate(capture, scene), spec, peak, scratch)?;
     let shift = capture.value_time(0.0) / f64::from(rate);
