@@ -38,6 +38,8 @@ pub mod signal;
 pub mod solve;
 pub mod spec;
 pub mod stream;
+#[cfg(test)]
+mod testing;
 pub mod two_body;
 pub mod waveform;
 

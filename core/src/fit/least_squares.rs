@@ -436,13 +436,7 @@ mod tests {
     fn the_exponent_from_a_fraction_of_the_points_is_the_alls() {
         let len = 2000;
         for (n, seed) in [(1.0f32, 1u64), (1.3, 2), (1.5, 3), (2.2, 4)] {
-            let mut state = seed;
-            let mut noise = move || {
-                state = state
-                    .wrapping_mul(6364136223846793005)
-                    .wrapping_add(1442695040888963407);
-                ((state >> 40) as f32 / (1u64 << 24) as f32) - 0.5
-            };
+            let mut noise = crate::testing::uniform(seed);
             // A loop: x up to 1 and back to 0 by another path, v from 1 to -0.6; F = x^n (1 + 0.5 v).
             let (mut x, mut v, mut f) = ([0.0f32; 2000], [0.0f32; 2000], [0.0f32; 2000]);
             for i in 0..len {

@@ -26,8 +26,8 @@ impl<F: Fn(u64) -> Option<f32>> Record for F {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::spec::verdict::{judge_in, SCRATCH};
-    use crate::spec::{Shape, Spec, Tolerance};
+    use crate::spec::verdict::{judge_in, tests::spec, SCRATCH};
+    use crate::spec::Shape;
     extern crate std;
     use std::vec;
     use std::vec::Vec;
@@ -62,21 +62,7 @@ mod tests {
     /// does or start after it.
     #[test]
     fn a_record_read_in_one_run_judges_as_one_read_by_sample() {
-        let spec = Spec {
-            shape: Shape::HalfSine,
-            peak_m_s2: 500.0,
-            duration_s: 0.011,
-            tolerance: Tolerance {
-                band: 0.2,
-                outside: 0.2,
-                slack: 0.0,
-                delta_v: 0.15,
-                before: 0.4,
-                after: 0.1,
-                watch: 1.5,
-            },
-            band: None,
-        };
+        let spec = spec(Shape::HalfSine);
         let (rate, start, n) = (50_000.0f32, 2000usize, 550usize);
         let mut runs = 0;
         for (peak, glitch, from, len) in [

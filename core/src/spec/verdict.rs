@@ -736,11 +736,13 @@ fn delta_v(
 }
 
 #[cfg(test)]
-mod tests {
+pub(super) mod tests {
     use super::*;
     use crate::spec::{BandPoint, Shape, Tolerance};
 
-    fn spec(shape: Shape) -> Spec {
+    /// A pulse of `shape`, 500 m/s² for 11 ms, IEC's tolerances with a 1.5 D watch (also
+    /// `record.rs`'s tests').
+    pub(in crate::spec) fn spec(shape: Shape) -> Spec {
         Spec {
             shape,
             peak_m_s2: 500.0,

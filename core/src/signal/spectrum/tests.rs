@@ -221,13 +221,7 @@ std::thread_local! {
 /// A noisy pulse: a half-sine of `amp` lasting `dur` s, a ringing tail and a step, with
 /// noise from a fixed generator.
 fn noisy(rate: f64, n: usize, seed: u64) -> Vec<f32> {
-    let mut state = seed;
-    let mut noise = move || {
-        state = state
-            .wrapping_mul(6364136223846793005)
-            .wrapping_add(1442695040888963407);
-        ((state >> 40) as f32 / (1u64 << 24) as f32) - 0.5
-    };
+    let mut noise = crate::testing::uniform(seed);
     (0..n)
         .map(|k| {
             let t = k as f64 / rate;
