@@ -73,7 +73,9 @@ impl<const PRE: usize, const CAP: usize> Monitor<PRE, CAP> {
     /// Starts over with `scene`, in place; fails on an invalid scene or sizes (the hold must
     /// be under half the capture), and then leaves the monitor as it was.
     pub fn configure(&mut self, scene: Scene) -> Result<(), Error> {
-        self.stream.configure_for(scene, self.capture.capacity())
+        self.stream.configure_for(scene, self.capture.capacity())?;
+        self.work.prepare(&scene);
+        Ok(())
     }
 
     /// As [`Self::configure`], with captures of `len` samples (at least 64, at most `CAP`): a
@@ -83,8 +85,9 @@ impl<const PRE: usize, const CAP: usize> Monitor<PRE, CAP> {
         let before = self.capture.capacity();
         self.capture.set_capacity(len);
         let done = self.stream.configure_for(scene, self.capture.capacity());
-        if done.is_err() {
-            self.capture.set_capacity(before);
+        match done {
+            Ok(()) => self.work.prepare(&scene),
+            Err(_) => self.capture.set_capacity(before),
         }
         done
     }

@@ -51,6 +51,16 @@ impl<const CAP: usize> Workspace<CAP> {
             spectrum: crate::signal::spectrum::Scratch::new(),
         }
     }
+
+    /// Makes what depends on `scene` alone before its first impact (the spectra's band
+    /// frequencies at its rate: [`crate::signal::spectrum::Scratch::prepare`]). An analysis
+    /// without it makes them at its first impact, with the same values.
+    pub fn prepare(&mut self, scene: &Scene) {
+        if let Some(settings) = &scene.spectrum {
+            self.spectrum
+                .prepare(settings, scene.calibration.sample_rate_hz);
+        }
+    }
 }
 
 /// Where `|a|` crosses `level` between samples `i` and `i + 1` (fractional sample index).

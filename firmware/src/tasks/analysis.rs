@@ -31,6 +31,8 @@ pub async fn analysis(scene: Scene, mut captures: CaptureReceiver) {
         error!("analysis: started twice");
         return;
     };
+    // The scene's share of the work (the spectra's bands) now, not at the first impact.
+    work.prepare(&scene);
     loop {
         let capture = captures.receive().await;
         let report = analyse(capture, &scene, work);

@@ -190,10 +190,17 @@ impl Spectrum {
 /// bands' frequencies (some 5 KiB), kept in the analysis's workspace instead of on the stack
 /// (on the board the analysis task runs on the one stack the interrupts share).
 /// `Scratch::new()` is all zeros.
+///
+/// The frequencies are a scene's, not an impact's: kept with the settings and rate they are
+/// for, and made again only when either changes (a decimated capture's rate, another scene),
+/// so an impact does not pay [`SpectrumSettings::bands`]'s `f64` (software on the M4, some
+/// 40 000 instructions) again; [`Scratch::prepare`] makes them before the first impact.
 pub struct Scratch {
     stats: [Rest; STAT_BLOCKS],
     marks: [Mark; STAT_BLOCKS],
     freqs: [f32; MAX_BANDS],
+    /// The settings and the rate's bits `freqs` holds the bands of, and how many.
+    freqs_for: Option<(SpectrumSettings, u32, usize)>,
 }
 
 impl Scratch {
@@ -202,6 +209,27 @@ impl Scratch {
             stats: [Rest::ZERO; STAT_BLOCKS],
             marks: [Mark::ZERO; STAT_BLOCKS],
             freqs: [0.0; MAX_BANDS],
+            freqs_for: None,
+        }
+    }
+
+    /// Makes the band frequencies of `settings` at `rate_hz` now (a scene's configuration),
+    /// so the first impact finds them made.
+    pub fn prepare(&mut self, settings: &SpectrumSettings, rate_hz: f32) {
+        self.bands(settings, rate_hz);
+    }
+
+    /// The band frequencies of `settings` at `rate_hz` in `freqs`, and how many: those held
+    /// if they are for the same settings and rate (the same bits), else made again.
+    fn bands(&mut self, settings: &SpectrumSettings, rate_hz: f32) -> usize {
+        let key = (*settings, rate_hz.to_bits());
+        match self.freqs_for {
+            Some((s, r, n)) if (s, r) == key => n,
+            _ => {
+                let n = settings.bands(rate_hz, &mut self.freqs);
+                self.freqs_for = Some((key.0, key.1, n));
+                n
+            }
         }
     }
 }
@@ -222,12 +250,13 @@ pub fn spectrum(
     scratch: &mut Scratch,
 ) -> Option<Spectrum> {
     settings.check_parameters().ok()?;
+    let n = scratch.bands(settings, rate_hz);
     let Scratch {
         stats,
         marks,
         freqs,
+        ..
     } = scratch;
-    let n = settings.bands(rate_hz, freqs);
     if n == 0 {
         return None;
     }

@@ -312,3 +312,47 @@ fn the_multirate_f32_spectra_follow_the_f64_reference() {
         assert!(worst < 2e-3, "{rate} {dur}: {worst}");
     }
 }
+
+/// One scratch kept over impacts of other rates and settings (a decimated capture, another
+/// scene) gives each the spectra a fresh scratch gives it, to the bit: its bands are made
+/// again whenever the rate or the settings change.
+#[test]
+fn a_scratch_kept_over_rates_and_settings_gives_a_fresh_ones_spectra() {
+    let twelve = SpectrumSettings {
+        bands_per_octave: 12,
+        low_hz: 1000.0,
+        ..SpectrumSettings::new()
+    };
+    let from_100 = SpectrumSettings {
+        low_hz: 100.0,
+        ..SpectrumSettings::new()
+    };
+    let cases = [
+        (1e6, SpectrumSettings::new()),
+        (5e5, SpectrumSettings::new()),
+        (1e6, SpectrumSettings::new()),
+        (1e6, twelve),
+        (1e6, from_100),
+        (2.5e5, from_100),
+    ];
+    let x = half_sine(1000.0, 1e-3, 1e6, 64);
+    let run = |rate: f64, settings: &SpectrumSettings, scratch: &mut Scratch| {
+        let mut buf: Vec<f32> = x.iter().map(|v| *v as f32).collect();
+        let len = buf.len();
+        spectrum(&mut buf, len, rate as f32, settings, scratch).unwrap()
+    };
+    let mut kept = Scratch::new();
+    kept.prepare(&SpectrumSettings::new(), 1e6);
+    for (rate, settings) in &cases {
+        let (got, want) = (
+            run(*rate, settings, &mut kept),
+            run(*rate, settings, &mut Scratch::new()),
+        );
+        assert_eq!(got.bands, want.bands, "{rate} {settings:?}");
+        assert_eq!(got.first_hz.to_bits(), want.first_hz.to_bits());
+        for k in 0..usize::from(want.bands) {
+            assert_eq!(got.srs_m_s2[k].to_bits(), want.srs_m_s2[k].to_bits());
+            assert_eq!(got.pvss_m_s[k].to_bits(), want.pvss_m_s[k].to_bits());
+        }
+    }
+}
