@@ -26,7 +26,7 @@ pub const MAX_FIT_POINTS: usize = 2048;
 /// `Workspace::new()` is all zeros, so a `static` one starts in `.bss`.
 pub struct Workspace<const CAP: usize> {
     buf: [f32; CAP],
-    /// The spectra's block statistics and marks.
+    /// The spectra's block statistics and marks, and the scene's band frequencies.
     spectrum: crate::signal::spectrum::Scratch,
 }
 

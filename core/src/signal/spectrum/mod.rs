@@ -187,20 +187,21 @@ impl Spectrum {
 }
 
 /// What the spectra need besides the samples: each block's statistics and marks and the
-/// bands' frequencies (some 5 KiB), kept in the analysis's workspace instead of on the stack
+/// bands' frequencies (some 4 KiB), kept in the analysis's workspace instead of on the stack
 /// (on the board the analysis task runs on the one stack the interrupts share).
 /// `Scratch::new()` is all zeros.
 ///
 /// The frequencies are a scene's, not an impact's: kept with the settings and rate they are
 /// for, and made again only when either changes (a decimated capture's rate, another scene),
 /// so an impact does not pay [`SpectrumSettings::bands`]'s `f64` (software on the M4, some
-/// 40 000 instructions) again; [`Scratch::prepare`] makes them before the first impact.
+/// 33 000 instructions) again; [`Scratch::prepare`] makes them before the first impact.
 pub struct Scratch {
     stats: [Rest; STAT_BLOCKS],
     marks: [Mark; STAT_BLOCKS],
     freqs: [f32; MAX_BANDS],
-    /// The settings and the rate's bits `freqs` holds the bands of, and how many.
-    freqs_for: Option<(SpectrumSettings, u32, usize)>,
+    /// The settings and the rate's bits `freqs` holds the bands of, and how many. All zeros
+    /// (the zero settings at rate 0, no band) is a true entry: `bands` gives those none.
+    freqs_for: (SpectrumSettings, u32, usize),
 }
 
 impl Scratch {
@@ -209,7 +210,15 @@ impl Scratch {
             stats: [Rest::ZERO; STAT_BLOCKS],
             marks: [Mark::ZERO; STAT_BLOCKS],
             freqs: [0.0; MAX_BANDS],
-            freqs_for: None,
+            freqs_for: (
+                SpectrumSettings {
+                    damping: 0.0,
+                    bands_per_octave: 0,
+                    low_hz: 0.0,
+                },
+                0,
+                0,
+            ),
         }
     }
 
@@ -224,10 +233,10 @@ impl Scratch {
     fn bands(&mut self, settings: &SpectrumSettings, rate_hz: f32) -> usize {
         let key = (*settings, rate_hz.to_bits());
         match self.freqs_for {
-            Some((s, r, n)) if (s, r) == key => n,
+            (s, r, n) if (s, r) == key => n,
             _ => {
                 let n = settings.bands(rate_hz, &mut self.freqs);
-                self.freqs_for = Some((key.0, key.1, n));
+                self.freqs_for = (key.0, key.1, n);
                 n
             }
         }

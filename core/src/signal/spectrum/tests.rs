@@ -327,11 +327,19 @@ fn a_scratch_kept_over_rates_and_settings_gives_a_fresh_ones_spectra() {
         low_hz: 100.0,
         ..SpectrumSettings::new()
     };
+    let six_from_1000 = SpectrumSettings {
+        bands_per_octave: 6,
+        ..twelve
+    };
+    // Each change alone: the rate, the lowest band, the bands an octave.
     let cases = [
         (1e6, SpectrumSettings::new()),
+        (1e6, from_100),
+        (5e5, from_100),
         (5e5, SpectrumSettings::new()),
         (1e6, SpectrumSettings::new()),
         (1e6, twelve),
+        (1e6, six_from_1000),
         (1e6, from_100),
         (2.5e5, from_100),
     ];
@@ -350,6 +358,10 @@ fn a_scratch_kept_over_rates_and_settings_gives_a_fresh_ones_spectra() {
         );
         assert_eq!(got.bands, want.bands, "{rate} {settings:?}");
         assert_eq!(got.first_hz.to_bits(), want.first_hz.to_bits());
+        assert_eq!(
+            got.half_sine.map(|(a, d)| (a.to_bits(), d.to_bits())),
+            want.half_sine.map(|(a, d)| (a.to_bits(), d.to_bits()))
+        );
         for k in 0..usize::from(want.bands) {
             assert_eq!(got.srs_m_s2[k].to_bits(), want.srs_m_s2[k].to_bits());
             assert_eq!(got.pvss_m_s[k].to_bits(), want.pvss_m_s[k].to_bits());

@@ -124,7 +124,7 @@ pub const ANALYSIS_TARGET: u64 = 5_000_000;
 /// The shock spectra of one impact at 1/6 octave (issue: spectra per impact on the board).
 pub const SPECTRUM_TARGET: u64 = 5_000_000;
 /// The scene keys of the spectra the bench measures (SRS and PVSS, 5 %, 1/6 octave from
-/// 10 Hz: 76 bands at 500 kS/s).
+/// 10 Hz: 75 bands at 500 kS/s).
 const SPECTRUM_KEYS: &str = "two_phase=0 nonlinear=0 hertz=0 srs=1";
 /// The verdict of one impact against a specified pulse (`--spec`, issue: "a compact verdict
 /// on the board, its cost measured").
