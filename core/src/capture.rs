@@ -59,8 +59,13 @@ impl<const CAP: usize> Capture<CAP> {
     /// Uses only the first `len` samples of the buffer (at least 64, at most `CAP`): a host
     /// analysing with the board's capture length.
     pub fn set_capacity(&mut self, len: usize) {
-        self.limit = len.clamp(64.min(CAP), CAP);
+        self.limit = Self::capacity_for(len);
         self.clear();
+    }
+
+    /// The length [`Self::set_capacity`] would use for `len`, without using it.
+    pub fn capacity_for(len: usize) -> usize {
+        len.clamp(64.min(CAP), CAP)
     }
 
     /// The buffer's length in use, samples.

@@ -81,15 +81,15 @@ impl<const PRE: usize, const CAP: usize> Monitor<PRE, CAP> {
     /// As [`Self::configure`], with captures of `len` samples (at least 64, at most `CAP`): a
     /// host analysing with the board's capture length. A contact longer than the capture is
     /// kept at a coarser step ([`Capture::extend_decimating`]).
+    ///
+    /// The scene and the length are checked before either is used: on a failure the capture
+    /// keeps what it holds (it used to be emptied, an impact under way cut).
     pub fn configure_with_capture(&mut self, scene: Scene, len: usize) -> Result<(), Error> {
-        let before = self.capture.capacity();
+        self.stream
+            .configure_for(scene, Capture::<CAP>::capacity_for(len))?;
         self.capture.set_capacity(len);
-        let done = self.stream.configure_for(scene, self.capture.capacity());
-        match done {
-            Ok(()) => self.work.prepare(&scene),
-            Err(_) => self.capture.set_capacity(before),
-        }
-        done
+        self.work.prepare(&scene);
+        Ok(())
     }
 
     /// The scene in use.
@@ -258,5 +258,51 @@ mod next_hit_tests {
         assert!((out[1].start_sample as i64 - 7332).abs() < 20, "{out:#?}");
         let dv = (out[0].delta_v_m_s.unwrap(), out[1].delta_v_m_s.unwrap());
         assert!((dv.0 / dv.1 - 1.0).abs() < 0.01, "{dv:?}");
+    }
+}
+
+#[cfg(test)]
+mod configure_tests {
+    extern crate std;
+    use crate::{Calibration, ImpactReport, Monitor, Scene};
+
+    /// A scene refused half way through an impact leaves the monitor as it was: the impact's
+    /// report is the one a monitor never asked gives, to the bit.
+    #[test]
+    fn a_refused_capture_length_leaves_an_impact_under_way_whole() {
+        let mut s = Scene::new(
+            Calibration {
+                gain_m_s2_per_count: 0.390625,
+                sample_rate_hz: 500_000.0,
+            },
+            10.0,
+        );
+        s.edge_m_s2 = 1.0;
+        s.hold_s = 2e-3;
+        let mut v = std::vec![100i16; 5000];
+        for k in 0..2000 {
+            v.push(100 + (50.0 * libm::sinf(core::f32::consts::PI * k as f32 / 2000.0)) as i16);
+        }
+        v.extend(core::iter::repeat_n(100i16, 5000));
+        let run = |refuse: bool| {
+            let mut m = Monitor::<4096, 32768>::new(s).unwrap();
+            let mut out = std::vec::Vec::new();
+            for (i, b) in v.chunks(256).enumerate() {
+                if refuse && i == 24 {
+                    assert!(m.in_impact());
+                    // A hold of 1000 samples does not fit under half of 1024.
+                    assert!(m.configure_with_capture(s, 1024).is_err());
+                }
+                m.push_block(b, &mut |r: &ImpactReport| out.push(*r));
+            }
+            m.finish(&mut |r: &ImpactReport| out.push(*r));
+            out
+        };
+        let (refused, asked_nothing) = (run(true), run(false));
+        assert_eq!(asked_nothing.len(), 1);
+        assert_eq!(
+            std::format!("{refused:?}"),
+            std::format!("{asked_nothing:?}")
+        );
     }
 }
