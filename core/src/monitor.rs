@@ -210,16 +210,14 @@ mod peak_tests {
     }
 }
 
+/// What the monitor's tests below share: a 500 kS/s scene and its half-sine pulse.
 #[cfg(test)]
-mod next_hit_tests {
+mod pulses {
     extern crate std;
-    use crate::{Calibration, ImpactReport, Monitor, Scene};
+    use crate::{Calibration, Scene};
 
-    /// Two pulses 0.6 ms apart with noise that flickers at the edge level on their flanks:
-    /// the signal came back for longer than an eighth of the hold, so they are two impacts,
-    /// the second starting where the first's window ends.
-    #[test]
-    fn a_second_hit_after_a_return_to_the_baseline_is_its_own_impact() {
+    /// 500 kS/s, 0.39 m/s² a count, a 10 m/s² trigger, a 1 m/s² edge and a 2 ms hold.
+    pub fn pulse_scene() -> Scene {
         let mut s = Scene::new(
             Calibration {
                 gain_m_s2_per_count: 0.390625,
@@ -229,16 +227,35 @@ mod next_hit_tests {
         );
         s.edge_m_s2 = 1.0;
         s.hold_s = 2e-3;
+        s
+    }
+
+    /// A half-sine of 50 counts over 2000 samples (4 ms) on a level of 100, appended to `v`.
+    pub fn push_pulse(v: &mut std::vec::Vec<i16>) {
+        for k in 0..2000 {
+            v.push(100 + (50.0 * libm::sinf(core::f32::consts::PI * k as f32 / 2000.0)) as i16);
+        }
+    }
+}
+
+#[cfg(test)]
+mod next_hit_tests {
+    extern crate std;
+    use super::pulses::{pulse_scene, push_pulse};
+    use crate::{ImpactReport, Monitor};
+
+    /// Two pulses 0.6 ms apart with noise that flickers at the edge level on their flanks:
+    /// the signal came back for longer than an eighth of the hold, so they are two impacts,
+    /// the second starting where the first's window ends.
+    #[test]
+    fn a_second_hit_after_a_return_to_the_baseline_is_its_own_impact() {
+        let s = pulse_scene();
         let mut m = Monitor::<4096, 32768>::new(s).unwrap();
         let mut v = std::vec::Vec::new();
         v.extend(core::iter::repeat_n(100i16, 5000));
-        for k in 0..2000 {
-            v.push(100 + (50.0 * libm::sinf(core::f32::consts::PI * k as f32 / 2000.0)) as i16);
-        }
+        push_pulse(&mut v);
         v.extend(core::iter::repeat_n(100i16, 300));
-        for k in 0..2000 {
-            v.push(100 + (50.0 * libm::sinf(core::f32::consts::PI * k as f32 / 2000.0)) as i16);
-        }
+        push_pulse(&mut v);
         v.extend(core::iter::repeat_n(100i16, 5000));
         let mut state = 1u32;
         for x in v.iter_mut() {
@@ -264,25 +281,16 @@ mod next_hit_tests {
 #[cfg(test)]
 mod configure_tests {
     extern crate std;
-    use crate::{Calibration, ImpactReport, Monitor, Scene};
+    use super::pulses::{pulse_scene, push_pulse};
+    use crate::{ImpactReport, Monitor};
 
     /// A scene refused half way through an impact leaves the monitor as it was: the impact's
     /// report is the one a monitor never asked gives, to the bit.
     #[test]
     fn a_refused_capture_length_leaves_an_impact_under_way_whole() {
-        let mut s = Scene::new(
-            Calibration {
-                gain_m_s2_per_count: 0.390625,
-                sample_rate_hz: 500_000.0,
-            },
-            10.0,
-        );
-        s.edge_m_s2 = 1.0;
-        s.hold_s = 2e-3;
+        let s = pulse_scene();
         let mut v = std::vec![100i16; 5000];
-        for k in 0..2000 {
-            v.push(100 + (50.0 * libm::sinf(core::f32::consts::PI * k as f32 / 2000.0)) as i16);
-        }
+        push_pulse(&mut v);
         v.extend(core::iter::repeat_n(100i16, 5000));
         let run = |refuse: bool| {
             let mut m = Monitor::<4096, 32768>::new(s).unwrap();
