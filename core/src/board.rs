@@ -12,7 +12,7 @@ pub const PRE_TRIGGER_LEN: usize = 4096;
 
 /// Capture length, samples: 30.2 ms at 500 kS/s (the seed bench's 27 ms window with room).
 /// 118 blocks of 128 samples, so that the analysis's workspace (4 bytes a sample and the
-/// spectra's 4 KiB scratch, 64 408 bytes) fits the STM32F407's 64 KiB CCM RAM.
+/// spectra's 3.5 KiB scratch, 63 896 bytes) fits the STM32F407's 64 KiB CCM RAM.
 pub const CAPTURE_LEN: usize = 15_104;
 
 /// The pipeline as the board runs it, in one object (host, benchmarks, panic check).

@@ -948,7 +948,7 @@ fn realtime_spectra_and_a_bounce_train_to_10_ms_flights_lose_nothing() {
     let scratch = Scratch::new();
     let Some(elf) = firmware() else { return };
     let elf = elf.to_string_lossy().into_owned();
-    // Five seed impacts with their shock spectra (3.3 M instructions each, at the lowest
+    // Five seed impacts with their shock spectra (3.2 M instructions each, at the lowest
     // priority): nothing lost, the stack within its margin.
     let file = seed_train(&scratch, 5, 0.08);
     let (out, log) = impact(&[

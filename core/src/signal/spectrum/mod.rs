@@ -187,7 +187,7 @@ impl Spectrum {
 }
 
 /// What the spectra need besides the samples: each block's statistics and marks and the
-/// bands' frequencies (some 4 KiB), kept in the analysis's workspace instead of on the stack
+/// bands' frequencies (some 3.5 KiB), kept in the analysis's workspace instead of on the stack
 /// (on the board the analysis task runs on the one stack the interrupts share).
 /// `Scratch::new()` is all zeros.
 ///
