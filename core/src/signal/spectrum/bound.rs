@@ -67,9 +67,11 @@ pub(super) struct Best {
 /// of `y` is `Re(g z)` for the state at the block's start plus the rest through the impulse
 /// response `h`: so `|y| <= |y_line| + |g| |z| + ‖h‖ ‖r‖` (Cauchy–Schwarz), with room for
 /// `f32` rounding. (The triangle inequality's `|b0| ‖r‖ + |g| Σ|r|`, kept as the smaller of
-/// the two until 2026-11-30, cost a second statistic a sample, `Σ|r|`, and pruned no more:
-/// on the seed's impact the second pass's instructions are the same within 0.03 % without
-/// it, and the spectra's some 100 000 fewer, `impact bench m4`.)
+/// the two until 2026-11-30, cost a second statistic a sample, `Σ|r|`, and on the seed's
+/// impact pruned no more: without it the second pass's instructions are the same within
+/// 0.03 %, and the spectra's some 100 000 fewer, `impact bench m4`. On a rest that is one
+/// spike it was the smaller, by up to some 8 times for a lightly damped band: such blocks
+/// may now be computed where they were skipped, which costs time, never a bit.)
 #[derive(Clone, Copy)]
 pub(super) struct Bound {
     pub(super) a: [f32; 2],
@@ -128,8 +130,8 @@ impl Bound {
         let (zr, zi) = (e1 - self.re * e2, self.im * e2);
         let z = crate::real::fpu_sqrt(zr * zr + zi * zi);
         let last = block.len().saturating_sub(1) as f32;
-        // The scale of `w` over the block, for the rounding of the recursion (at most 64
-        // steps of 4 operations) and of the outputs.
+        // The scale of `w` over the block, for the rounding of the recursion (at most
+        // `BLOCK` = 128 steps of 4 operations: the 512 below) and of the outputs.
         let scale = w1.abs() + w2.abs() + alpha.abs() + beta.abs() * (last + 2.0);
         let eps = f32::EPSILON;
         [0, 1].map(|k| {
