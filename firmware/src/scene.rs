@@ -206,7 +206,7 @@ impl defmt::Format for SceneError {
 /// | `v0_every` | `0` or `1`: every impact comes at `v0` (else an impact that follows a flight has no approach speed unless a train measures it) |
 /// | `max_flight` | a train's longest flight, s |
 /// | `srs` | `0` or `1`: shock spectra per impact |
-/// | `srs_damping`, `srs_bands`, `srs_low` | damping ratio, bands per octave (6, 12), lowest band, Hz |
+/// | `srs_damping`, `srs_bands`, `srs_low`, `srs_high` | damping ratio, bands per octave (6, 12), lowest band, Hz, highest band, Hz (`none`: rate / 8) |
 /// | `spec` | judge each impact against a specified pulse: `half-sine`, `sawtooth`, `trapezoid` or `none` |
 /// | `spec_peak`, `spec_duration` | its peak, m/s², and duration, s |
 /// | `spec_band`, `spec_outside`, `spec_slack`, `spec_dv`, `spec_before`, `spec_after`, `spec_watch` | its tolerances ([`impact_core::spec::Tolerance`]) |
@@ -309,14 +309,15 @@ pub fn apply(scene: &mut Scene, key: &str, value: &str) -> Result<(), SceneError
         "srs" => {
             scene.spectrum = flag(value)?.then(|| scene.spectrum.unwrap_or_default());
         }
-        "srs_damping" | "srs_bands" | "srs_low" => {
+        "srs_damping" | "srs_bands" | "srs_low" | "srs_high" => {
             let mut sp = scene.spectrum.ok_or(SceneError::BadValue)?;
             match key {
                 "srs_damping" => sp.damping = float(value)?,
                 "srs_bands" => {
                     sp.bands_per_octave = value.parse::<u8>().map_err(|_| SceneError::BadValue)?
                 }
-                _ => sp.low_hz = float(value)?,
+                "srs_low" => sp.low_hz = float(value)?,
+                _ => sp.high_hz = opt_float(value)?,
             }
             scene.spectrum = Some(sp);
         }

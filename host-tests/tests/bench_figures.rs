@@ -49,7 +49,8 @@ fn table(b: &Value) -> String {
          | trigger (onset, flanks, pre-trigger replay, the online sums' start) | {} |\n\
          | report without fits ({} samples) | {} |\n\
          | the board's whole analysis (report and the three fits, n fitted) | {} |\n\
-         | shock spectra (SRS, PVSS, half-sine; 1/6 octave) | {} |\n\
+         | shock spectra (SRS, PVSS, half-sine; 1/6 octave from 10 Hz to the rate / 8) | {} |\n\
+         | the same to 10 kHz (`--srs-high 10000`, MIL-STD-810's range) | {} |\n\
          | verdict against a specified pulse (3 ms half-sine, IEC 60068-2-27) | {} |\n\
          | the same verdict against a user's band of 64 rows | {} |\n\
          {}\n\
@@ -65,6 +66,7 @@ fn table(b: &Value) -> String {
         u("report_instructions"),
         u("analysis_instructions"),
         u("spectrum_instructions"),
+        u("spectrum_10khz_instructions"),
         u("spec_instructions"),
         u("spec_band_instructions"),
         fits(b),
@@ -283,5 +285,27 @@ fn the_boards_real_time_table_is_the_stored_runs() {
             &want,
             "docs/board.md's real-time table is not the stored runs'",
         );
+    }
+}
+
+/// docs/accuracy.md's prose figures of the spectra's cost are the baseline's, to 0.1 M: the
+/// default bands' and those to 10 kHz.
+#[test]
+fn the_accuracy_docs_spectra_costs_are_the_stored_baseline() {
+    let b = read_json("host-tests/bench/m4-baseline.json");
+    let root = concat!(env!("CARGO_MANIFEST_DIR"), "/..");
+    let text = std::fs::read_to_string(format!("{root}/docs/accuracy.md")).unwrap();
+    let m = |k: &str| b[k].as_f64().unwrap_or_else(|| panic!("{k} missing")) / 1e6;
+    for want in [
+        format!(
+            "**{:.1} M instructions** for the seed impact's",
+            m("spectrum_instructions")
+        ),
+        format!(
+            "**{:.1} M instructions** (the table",
+            m("spectrum_10khz_instructions")
+        ),
+    ] {
+        assert!(text.contains(&want), "docs/accuracy.md should say {want:?}");
     }
 }

@@ -400,11 +400,11 @@ fn waveforms_off_the_board_draw_the_same_figure() {
 
 #[test]
 fn shock_spectra_on_the_board_are_the_hosts() {
-    // The firmware's `srs` lines, decoded, give the host's spectra bit for bit.
-    emulator_matches_host(
-        &data("afrl-drop-tower/series1_test1_full_100ms.csv"),
-        &["--units", "kgn", "--srs"],
-    );
+    // The firmware's `srs` lines, decoded, give the host's spectra bit for bit: every band
+    // to the rate / 8 (114 kHz), and to MIL-STD-810's 10 kHz (the scene's `srs_high`).
+    let file = data("afrl-drop-tower/series1_test1_full_100ms.csv");
+    emulator_matches_host(&file, &["--units", "kgn", "--srs"]);
+    emulator_matches_host(&file, &["--units", "kgn", "--srs", "--srs-high", "10000"]);
 }
 
 #[test]

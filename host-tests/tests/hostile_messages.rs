@@ -133,6 +133,21 @@ fn values_the_core_cannot_hold_are_out_of_range_not_infinite() {
         &["--srs-low: no band between it and rate / 8"],
         &["--srs:"],
     );
+    // A highest band below the lowest names --srs-high; one without --srs, --srs.
+    refused(
+        &[
+            "analyze",
+            t2,
+            "--srs",
+            "--srs-low",
+            "100",
+            "--srs-high",
+            "50",
+        ],
+        &["--srs-high: no band between the lowest band and it"],
+        &["--srs:", "--srs-low:"],
+    );
+    refused(&["analyze", t2, "--srs-high", "1000"], &["--srs"], &[]);
     // A recording of zeros with a range of 1e-300 named an option that does not exist.
     let zeros: String = std::iter::once("time_s,accel_g\n".to_string())
         .chain((0..2000).map(|i| format!("{:.6},0\n", i as f64 * 2e-6)))

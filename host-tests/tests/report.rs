@@ -214,6 +214,31 @@ fn a_required_srs_judges_and_draws_each_impact_s_srs() {
     let page = report_against(d, "beyond", &required(4.0, false)).unwrap();
     assert!(page.contains("class=\"l fail\">no, worst at "), "the cell");
     assert!(page.contains(", +4.00 dB</td>"));
+    // Bands stopped at 10 kHz (--srs-high) against a requirement to 114 kHz (its own SRS): within where
+    // compared, said to be for that part only, and no pass.
+    let within = d.join("within-10k.csv");
+    std::fs::write(&within, required(2.0, false)).unwrap();
+    let html = d.join("within-10k.html");
+    let (code, _, err) = impact(&[
+        "report",
+        &afrl(),
+        "--channels",
+        "1",
+        "--units",
+        "kgn",
+        "--srs",
+        "--srs-high",
+        "10000",
+        "--srs-required",
+        within.to_str().unwrap(),
+        "--html",
+        html.to_str().unwrap(),
+    ]);
+    assert_eq!(code, 0, "{err}");
+    let page = std::fs::read_to_string(&html).unwrap();
+    let want = "<td class=\"l\">yes from 11.05 Hz to 8980 Hz only (required: 11.05 Hz to 1.140e5 Hz), worst at ";
+    assert!(page.contains(want), "{want}");
+    assert!(!page.contains("class=\"l pass\""));
     // Breakpoints outside the spectrum's band: nothing to compare.
     let page = report_against(d, "elsewhere", "frequency_hz,acceleration_g\n1,10\n5,10\n").unwrap();
     assert_eq!(

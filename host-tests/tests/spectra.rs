@@ -19,11 +19,20 @@ fn root() -> PathBuf {
 /// full-rate reference, the core's (the board's f32 multirate, in the report) and the
 /// report's baseline.
 fn spectra(args: AnalyzeArgs) -> (ShockSpectrumJson, ShockSpectrumJson, f64) {
+    spectra_to(args, None)
+}
+
+/// [`spectra`] with the highest band `srs_high` (`--srs-high`).
+fn spectra_to(
+    args: AnalyzeArgs,
+    srs_high: Option<f64>,
+) -> (ShockSpectrumJson, ShockSpectrumJson, f64) {
     let spec = SpectrumArgs {
         srs: true,
         srs_damping: 0.05,
         srs_bands: 6,
         srs_low: 10.0,
+        srs_high,
     };
     let args = AnalyzeArgs {
         spectrum: spec.clone(),
@@ -143,4 +152,28 @@ fn the_afrl_impacts_spectra_agree_with_endaq() {
     // against 50–1300 Hz) goes with the decimation, so its SRS reads up to 0.5 % low:
     // within 6e-3 (measured 4.9e-3; the PVSS within 1.3e-3).
     compare("afrl-test1", &board, 6e-3);
+}
+
+/// `--srs-high`: the AFRL impact's bands to 10 kHz (MIL-STD-810's range) are the first of
+/// its bands to the rate / 8, the same values on the board (bit for bit) and in the host's
+/// reference, and none above 10 kHz.
+#[test]
+fn a_highest_band_keeps_the_bands_below_it() {
+    let args = || AnalyzeArgs {
+        file: root().join("data/afrl-drop-tower/series1_test1_full_100ms.csv"),
+        units: Some(Units::Kgn),
+        ..Default::default()
+    };
+    let (s_all, board_all, _) = spectra(args());
+    let (s, board, _) = spectra_to(args(), Some(1e4));
+    let n = s.frequency_hz.len();
+    assert_eq!(board.frequency_hz, s.frequency_hz);
+    assert!(n > 30 && n + 10 < s_all.frequency_hz.len(), "{n}");
+    assert!(*s.frequency_hz.last().unwrap() <= 1e4);
+    assert!(s_all.frequency_hz[n] > 1e4);
+    for (some, all) in [(&s, &s_all), (&board, &board_all)] {
+        assert_eq!(some.frequency_hz[..], all.frequency_hz[..n]);
+        assert_eq!(some.srs_m_s2[..], all.srs_m_s2[..n]);
+        assert_eq!(some.pvss_m_s[..], all.pvss_m_s[..n]);
+    }
 }

@@ -243,19 +243,29 @@ impl<R: Real> Poles<R> {
     }
 }
 
-/// Band centre frequencies `1000 × 2^(k / per_octave)` Hz from `low_hz` up to `rate_hz / 8`
-/// (where the ramp-invariant filters still follow the oscillator closely), written into
-/// `out`; returns how many.
-pub fn bands(per_octave: u32, low_hz: f64, rate_hz: f64, out: &mut [f64]) -> usize {
+/// Band centre frequencies `1000 × 2^(k / per_octave)` Hz from `low_hz` up to the lower of
+/// `high_hz` (`None`: no limit) and `rate_hz / 8` (where the ramp-invariant filters still
+/// follow the oscillator closely), written into `out`; returns how many.
+pub fn bands(
+    per_octave: u32,
+    low_hz: f64,
+    high_hz: Option<f64>,
+    rate_hz: f64,
+    out: &mut [f64],
+) -> usize {
     if per_octave == 0 || !(low_hz > 0.0 && rate_hz.is_finite() && rate_hz > 0.0) {
         return 0;
     }
+    let top = match high_hz {
+        Some(high) => (rate_hz / 8.0).min(high),
+        None => rate_hz / 8.0,
+    };
     let n = per_octave as f64;
     let first = libm::ceil(n * libm::log2(low_hz / 1000.0) - 1e-9);
     let mut count = 0;
     for slot in out.iter_mut() {
         let f = 1000.0 * libm::exp2((first + count as f64) / n);
-        if f > rate_hz / 8.0 {
+        if !(f <= top) {
             break;
         }
         *slot = f;
@@ -383,7 +393,7 @@ mod tests {
     fn the_enveloping_half_sine_follows_gabersons_rule() {
         let (amp, dur) = (1000.0, 1e-3);
         let mut freqs = [0.0; 128];
-        let n = bands(12, 10.0, RATE, &mut freqs);
+        let n = bands(12, 10.0, None, RATE, &mut freqs);
         assert!(n > 100 && (freqs[0] - 10.0).abs() < 0.6 && freqs[n - 1] <= RATE / 8.0);
         let pvss: [f64; 128] = core::array::from_fn(|i| {
             Oscillator::new(Response::PseudoVelocity, freqs[i].max(1.0), 0.0, RATE)
@@ -416,6 +426,6 @@ mod tests {
         assert!(Oscillator::new(Response::AbsoluteAcceleration, RATE, 0.05, RATE).is_none());
         assert!(Oscillator::new(Response::AbsoluteAcceleration, 10.0, f64::NAN, RATE).is_none());
         assert!(Oscillator::new(Response::PseudoVelocity, 10.0, 0.05, f64::NAN).is_none());
-        assert_eq!(bands(6, 0.0, RATE, &mut [0.0; 4]), 0);
+        assert_eq!(bands(6, 0.0, None, RATE, &mut [0.0; 4]), 0);
     }
 }

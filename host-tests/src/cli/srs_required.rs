@@ -198,6 +198,43 @@ pub struct Comparison {
     pub worst_db: f64,
     /// The natural frequencies compared.
     pub compared: usize,
+    /// The required range the measured bands leave out, Hz: below their lowest or above their
+    /// highest by more than their spacing (a lowest band above the requirement's first
+    /// breakpoint, a highest band stopped by `--srs-high` or the rate / 8 below its last);
+    /// `None` if they span it. A "yes" there holds for the compared part only.
+    pub uncovered: Option<Uncovered>,
+}
+
+/// The measured bands against the requirement's range, Hz (see [`Comparison::uncovered`]).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Uncovered {
+    /// The lowest and highest natural frequencies compared.
+    pub compared: (f64, f64),
+    /// The requirement's first and last breakpoints.
+    pub required: (f64, f64),
+}
+
+/// The part of `required`'s range the bands `frequency_hz` (increasing) leave out: `None` if
+/// they reach within one of their own steps of either end, or beyond it.
+fn uncovered(
+    required: &RequiredSrs,
+    frequency_hz: &[f64],
+    compared: (f64, f64),
+) -> Option<Uncovered> {
+    let points = required.points();
+    let (first, last) = (points[0].0, points[points.len() - 1].0);
+    let (&f0, &fn_) = (frequency_hz.first()?, frequency_hz.last()?);
+    // The bands' ratio from one to the next (1 with a single band: any gap is one).
+    let step = match frequency_hz {
+        [a, b, ..] if *b > *a && *a > 0.0 => b / a,
+        _ => 1.0,
+    };
+    let short_below = f0 > first && f0 > first * step * (1.0 + 1e-9);
+    let short_above = fn_ < last && fn_ * step * (1.0 + 1e-9) < last;
+    (short_below || short_above).then_some(Uncovered {
+        compared,
+        required: (first, last),
+    })
 }
 
 /// The measured SRS (`srs_m_s2` at `frequency_hz`) against `required` at every natural
@@ -212,6 +249,7 @@ pub fn compare(
     // Beyond the nearer limit, dB (negative: inside by that much).
     let excess = |db: f64| (db - high).max(low - db);
     let mut worst: Option<Comparison> = None;
+    let mut span = (f64::INFINITY, 0.0f64);
     for (&f, &a) in frequency_hz.iter().zip(srs_m_s2) {
         let Some(r) = required.log10_at(f) else {
             continue;
@@ -222,6 +260,7 @@ pub fn compare(
         // In the log domain: finite for any positive finite pair (a ratio overflowed to an
         // infinite dB, once skipped, which could turn a "no" into a "yes").
         let db = 20.0 * (a.log10() - r);
+        span = (span.0.min(f), span.1.max(f));
         let compared = worst.map_or(0, |w| w.compared) + 1;
         let within = worst.is_none_or(|w| w.within) && excess(db) <= 0.0;
         worst = Some(match worst {
@@ -235,22 +274,46 @@ pub fn compare(
                 worst_hz: f,
                 worst_db: db,
                 compared,
+                uncovered: None,
             },
         });
     }
-    worst
+    worst.map(|w| Comparison {
+        uncovered: uncovered(required, frequency_hz, span),
+        ..w
+    })
 }
 
-/// The report's cell: `yes, worst at 1250 Hz, +2.10 dB` (or `no, …`), or why not compared.
+/// The report's cell: `yes, worst at 1250 Hz, +2.10 dB` (or `no, …`), or why not compared;
+/// over part of the requirement's range, `yes from 11.05 Hz to 8980 Hz only (required:
+/// 10.00 Hz to 50000 Hz), worst at …`.
 pub fn cell(c: Option<&Comparison>) -> String {
+    let hz = |f: f64| human(f, "Hz").trim_end().to_string();
     match c {
         Some(c) => format!(
-            "{}, worst at {}, {:+.2} dB",
+            "{}{}, worst at {}, {:+.2} dB",
             if c.within { "yes" } else { "no" },
-            human(c.worst_hz, "Hz").trim_end(),
+            c.uncovered.map_or(String::new(), |u| format!(
+                " from {} to {} only (required: {} to {})",
+                hz(u.compared.0),
+                hz(u.compared.1),
+                hz(u.required.0),
+                hz(u.required.1)
+            )),
+            hz(c.worst_hz),
             c.worst_db
         ),
         None => "not compared (no natural frequency in both)".into(),
+    }
+}
+
+/// The cell's class: `pass` within the tolerance over the whole required range, `fail`
+/// beyond it anywhere compared, neither for within over part of the range.
+pub fn class(c: Option<&Comparison>) -> &'static str {
+    match c {
+        Some(c) if !c.within => " fail",
+        Some(c) if c.uncovered.is_none() => " pass",
+        _ => "",
     }
 }
 
@@ -356,6 +419,52 @@ mod tests {
         assert_eq!(cell(Some(&c)), "no, worst at 200.0 Hz, -2.00 dB");
         // Nothing in common.
         assert_eq!(compare(&r, &[20.0, 5000.0], &[1.0, 1.0]), None);
+        assert_eq!(class(None), "");
+    }
+
+    /// Bands that stop short of the requirement's range by more than their spacing (a
+    /// highest band by `--srs-high` or the rate / 8, a lowest band by `--srs-low`) say which
+    /// part was compared, and a "yes" there is no pass; within one step, or beyond the
+    /// range, it is.
+    #[test]
+    fn bands_short_of_the_required_range_say_what_was_compared() {
+        let r = required(&[(10.0, 100.0), (50_000.0, 100.0)]);
+        let bands = |from: f64, to: f64| -> Vec<f64> {
+            (0..200)
+                .map(|k| 1000.0 * 2f64.powf(k as f64 / 6.0 - 10.0))
+                .filter(|f| (from..=to).contains(f))
+                .collect()
+        };
+        let judge = |f: &[f64]| compare(&r, f, &vec![100.0; f.len()]).unwrap();
+        // The rate / 8 at 500 kS/s: 11.05 Hz to 57 kHz spans it.
+        let c = judge(&bands(10.0, 62_500.0));
+        assert!(c.within && c.uncovered.is_none(), "{c:?}");
+        assert_eq!(class(Some(&c)), " pass");
+        // Within one step short at either end (11.05 Hz, 45.3 kHz): spanned.
+        let c = judge(&bands(11.0, 46_000.0));
+        assert!(c.uncovered.is_none(), "{c:?}");
+        // --srs-high 10000: 8980 Hz of 50 kHz.
+        let c = judge(&bands(10.0, 10_000.0));
+        let u = c.uncovered.expect("short of 50 kHz");
+        assert!(
+            u.compared.1 < 9000.0 && u.required == (10.0, 50_000.0),
+            "{u:?}"
+        );
+        assert_eq!(class(Some(&c)), "");
+        let text = cell(Some(&c));
+        assert!(
+            text.starts_with("yes from 11.05 Hz to 8980 Hz only (required: 10.00 Hz to 50000 Hz)"),
+            "{text}"
+        );
+        // --srs-low 100 against a requirement from 10 Hz; a failure stays one.
+        let c = compare(&r, &bands(100.0, 62_500.0), &vec![1.0; 45]).unwrap();
+        assert!(!c.within && c.uncovered.is_some(), "{c:?}");
+        assert_eq!(class(Some(&c)), " fail");
+        assert!(
+            cell(Some(&c)).starts_with("no from 111.4 Hz"),
+            "{}",
+            cell(Some(&c))
+        );
         assert!(cell(None).starts_with("not compared"));
     }
 }

@@ -609,9 +609,13 @@ pub struct SpectrumArgs {
     /// Bands per octave: 6 or 12 (centres 1000 × 2^(k/n) Hz).
     #[arg(long, help_heading = "Analysis", default_value_t = 6, requires = "srs", value_parser = per_octave)]
     pub srs_bands: u32,
-    /// Lowest band, Hz (the highest is an eighth of the sample rate).
+    /// Lowest band, Hz.
     #[arg(long, help_heading = "Analysis", default_value_t = 10.0, requires = "srs", value_parser = parse::frequency_hz)]
     pub srs_low: f64,
+    /// Highest band, Hz: a specification's range (10000 for MIL-STD-810's, say) need not pay for
+    /// the bands above it [default: an eighth of the sample rate, and never above it].
+    #[arg(long, help_heading = "Analysis", requires = "srs", value_parser = parse::frequency_hz)]
+    pub srs_high: Option<f64>,
 }
 
 impl SpectrumArgs {
@@ -621,6 +625,7 @@ impl SpectrumArgs {
             damping: self.srs_damping as f32,
             bands_per_octave: self.srs_bands as u8,
             low_hz: self.srs_low as f32,
+            high_hz: self.srs_high.map(|h| h as f32),
         })
     }
 }

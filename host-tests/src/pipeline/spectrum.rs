@@ -36,7 +36,13 @@ pub fn reference_spectrum(
     let window = &counts[from as usize..to as usize];
     let accel = || window.iter().map(|&c| c as f64 * gain - baseline);
     let mut freqs = vec![0.0; MAX_BANDS];
-    let n = srs::bands(args.srs_bands, args.srs_low, rate, &mut freqs);
+    let n = srs::bands(
+        args.srs_bands,
+        args.srs_low,
+        args.srs_high,
+        rate,
+        &mut freqs,
+    );
     freqs.truncate(n);
     let peak = |response| -> Vec<f64> {
         freqs

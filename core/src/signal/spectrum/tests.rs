@@ -79,12 +79,20 @@ fn the_compensated_copy_is_the_pre_emphasis() {
     assert_eq!(compensate(&mut [0.0; 9], 3), None);
 }
 
-/// The bands in `f32` are [`srs::bands`]'s, cast, for every lowest band and rate: the
-/// same frequencies, as many, and none where they would not fit.
+/// The bands in `f32` are [`srs::bands`]'s, cast, for every lowest band, highest band and
+/// rate: the same frequencies, as many, and none where they would not fit.
 #[test]
 fn the_bands_are_the_references() {
     let mut checked = 0;
-    for per in [6u8, 12] {
+    let highs = [
+        None,
+        Some(5.0f32),
+        Some(1000.0),
+        Some(8000.0),
+        Some(1e4),
+        Some(1e9),
+    ];
+    for (per, high) in [6u8, 12].into_iter().flat_map(|p| highs.map(|h| (p, h))) {
         for low in [
             1e-3f32, 0.7, 1.0, 10.0, 11.2, 33.0, 100.0, 999.0, 1000.0, 5e4,
         ] {
@@ -93,28 +101,29 @@ fn the_bands_are_the_references() {
                     damping: 0.05,
                     bands_per_octave: per,
                     low_hz: low,
+                    high_hz: high,
                 };
                 let mut f = [0.0f64; MAX_BANDS + 1];
-                let want = srs::bands(u32::from(per), low as f64, rate as f64, &mut f);
+                let (low64, high64) = (low as f64, high.map(f64::from));
+                let want = srs::bands(u32::from(per), low64, high64, rate as f64, &mut f);
                 let mut got = [0.0f32; MAX_BANDS];
                 let n = s.bands(rate, &mut got);
+                let case = (per, low, high, rate);
                 if want > MAX_BANDS {
-                    assert_eq!(n, 0, "{per} {low} {rate}");
+                    assert_eq!(n, 0, "{case:?}");
                     continue;
                 }
-                assert_eq!(n, want, "{per} {low} {rate}");
+                assert_eq!(n, want, "{case:?}");
                 for k in 0..n {
-                    assert_eq!(
-                        got[k].to_bits(),
-                        (f[k] as f32).to_bits(),
-                        "{per} {low} {rate} {k}"
-                    );
+                    assert_eq!(got[k].to_bits(), (f[k] as f32).to_bits(), "{case:?} {k}");
+                    // None above the highest band.
+                    assert!(high.is_none_or(|h| got[k] <= h), "{case:?} {k}");
                     checked += 1;
                 }
             }
         }
     }
-    assert!(checked > 2000, "{checked}");
+    assert!(checked > 8000, "{checked}");
     // Every band a lowest band and rate can reach (the frequency depends on its index `j`
     // alone), as `srs::bands` computes it.
     for per in [6i32, 12] {
@@ -142,6 +151,7 @@ fn the_bands_are_the_references() {
             damping: 0.05,
             bands_per_octave: per,
             low_hz: low,
+            high_hz: None,
         };
         assert_eq!(
             s.bands(rate, &mut [0.0; MAX_BANDS]),
@@ -296,7 +306,10 @@ fn the_multirate_f32_spectra_follow_the_f64_reference() {
         .unwrap();
         let mut worst: f64 = 0.0;
         let mut freqs = [0.0f64; MAX_BANDS];
-        assert_eq!(srs::bands(6, 10.0, rate, &mut freqs), s.bands as usize);
+        assert_eq!(
+            srs::bands(6, 10.0, None, rate, &mut freqs),
+            s.bands as usize
+        );
         for (k, &f) in freqs.iter().enumerate().take(s.bands as usize) {
             assert!((s.frequency_hz(k) / f - 1.0).abs() < 1e-12);
             for (resp, got) in [
@@ -331,8 +344,15 @@ fn a_scratch_kept_over_rates_and_settings_gives_a_fresh_ones_spectra() {
         bands_per_octave: 6,
         ..twelve
     };
-    // Each change alone: the rate, the lowest band, the bands an octave.
+    let to_10k = SpectrumSettings {
+        high_hz: Some(1e4),
+        ..SpectrumSettings::new()
+    };
+    // Each change alone: the rate, the lowest band, the bands an octave, the highest band.
     let cases = [
+        (1e6, to_10k),
+        (1e6, SpectrumSettings::new()),
+        (1e6, to_10k),
         (1e6, SpectrumSettings::new()),
         (1e6, from_100),
         (5e5, from_100),
@@ -367,4 +387,65 @@ fn a_scratch_kept_over_rates_and_settings_gives_a_fresh_ones_spectra() {
             assert_eq!(got.pvss_m_s[k].to_bits(), want.pvss_m_s[k].to_bits());
         }
     }
+}
+
+/// A highest band drops the bands above it and changes none below, to the bit (each band's
+/// rate and input are the same: the halvings follow the band, not the top), at rates where
+/// the highest band is at the full rate, decimated, or above the rate / 8; and a highest
+/// band below the lowest is refused by name, as one that is not a positive number.
+#[test]
+fn a_highest_band_keeps_the_bands_below_it() {
+    let x = half_sine(1000.0, 3e-3, 5e5, 64);
+    for rate in [5e5f32, 1e5, 2e4] {
+        let run = |high_hz| {
+            let mut buf: Vec<f32> = x.iter().map(|v| *v as f32).collect();
+            let len = buf.len();
+            let settings = SpectrumSettings {
+                high_hz,
+                ..SpectrumSettings::new()
+            };
+            spectrum(&mut buf, len, rate, &settings, &mut Scratch::new()).unwrap()
+        };
+        let all = run(None);
+        for high in [20.0f32, 1000.0, 1e4, 8000.0, 1e9] {
+            let some = run(Some(high));
+            let top = all.frequency_hz(usize::from(some.bands) - 1);
+            assert!(top <= f64::from(high) * 1.000_001, "{rate} {high}");
+            let above = usize::from(some.bands);
+            assert!(
+                above == usize::from(all.bands) || all.frequency_hz(above) > f64::from(high),
+                "{rate} {high}: a band at or below the highest was dropped"
+            );
+            assert_eq!(some.first_hz.to_bits(), all.first_hz.to_bits());
+            for k in 0..above {
+                assert_eq!(
+                    some.srs_m_s2[k].to_bits(),
+                    all.srs_m_s2[k].to_bits(),
+                    "{rate} {high} {k}"
+                );
+                assert_eq!(
+                    some.pvss_m_s[k].to_bits(),
+                    all.pvss_m_s[k].to_bits(),
+                    "{rate} {high} {k}"
+                );
+            }
+        }
+    }
+    let named = |high_hz| match (SpectrumSettings {
+        high_hz: Some(high_hz),
+        ..SpectrumSettings::new()
+    })
+    .check(5e5)
+    {
+        Err(Error::InvalidParameter { name, .. }) => name,
+        other => panic!("{high_hz}: {other:?}"),
+    };
+    for bad in [5.0f32, 0.0, -1.0, f32::NAN, f32::INFINITY] {
+        assert_eq!(named(bad), "srs-high", "{bad}");
+    }
+    let fine = SpectrumSettings {
+        high_hz: Some(1e4),
+        ..SpectrumSettings::new()
+    };
+    assert_eq!(fine.check(5e5), Ok(()));
 }

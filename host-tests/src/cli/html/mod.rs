@@ -446,15 +446,10 @@ fn impacts_table(h: &mut Html, results: &[EntryJson], required: Option<&Required
             match &i.shock_spectrum {
                 Some(sp) => {
                     let c = srs_required::compare(r, &sp.frequency_hz, &sp.srs_m_s2);
-                    let class = match c {
-                        Some(c) if c.within => " pass",
-                        Some(_) => " fail",
-                        None => "",
-                    };
                     html!(
                         h,
                         "<td class=\"l{}\">{}</td>",
-                        class,
+                        srs_required::class(c.as_ref()),
                         srs_required::cell(c.as_ref())
                     );
                 }
