@@ -24,7 +24,7 @@ pub const HEIGHT_M: Limits = positive("m");
 /// Gravity along the sensor's axis, m/s².
 pub const GRAVITY_M_S2: Limits = positive("m/s²");
 
-/// A frequency (the lowest spectrum band), Hz.
+/// A frequency (the lowest or highest spectrum band), Hz.
 pub const FREQUENCY_HZ: Limits = positive("Hz");
 
 /// The factor the channel's values are multiplied by first (`--gain`).
@@ -86,7 +86,7 @@ pub fn gravity_m_s2(s: &str) -> Result<f64, NumberError> {
     within(s, &GRAVITY_M_S2)
 }
 
-/// `--srs-low`, Hz ([`FREQUENCY_HZ`]).
+/// `--srs-low` and `--srs-high`, Hz ([`FREQUENCY_HZ`]).
 pub fn frequency_hz(s: &str) -> Result<f64, NumberError> {
     within(s, &FREQUENCY_HZ)
 }

@@ -133,7 +133,8 @@ fn values_the_core_cannot_hold_are_out_of_range_not_infinite() {
         &["--srs-low: no band between it and rate / 8"],
         &["--srs:"],
     );
-    // A highest band below the lowest names --srs-high; one without --srs, --srs.
+    // A highest band below the first band at or above the lowest names --srs-high; a
+    // spectrum's setting without the spectra names itself and the fix.
     refused(
         &[
             "analyze",
@@ -142,12 +143,21 @@ fn values_the_core_cannot_hold_are_out_of_range_not_infinite() {
             "--srs-low",
             "100",
             "--srs-high",
-            "50",
+            "105",
         ],
-        &["--srs-high: no band between the lowest band and it"],
+        &["--srs-high: below the first band at or above the lowest band"],
         &["--srs:", "--srs-low:"],
     );
-    refused(&["analyze", t2, "--srs-high", "1000"], &["--srs"], &[]);
+    for option in ["--srs-high", "--srs-low", "--srs-damping", "--srs-bands"] {
+        let value = if option == "--srs-bands" { "12" } else { "0.1" };
+        refused(
+            &["analyze", t2, option, value],
+            &[&format!(
+                "{option}: a shock spectrum's setting without the spectra: add --srs"
+            )],
+            &[],
+        );
+    }
     // A recording of zeros with a range of 1e-300 named an option that does not exist.
     let zeros: String = std::iter::once("time_s,accel_g\n".to_string())
         .chain((0..2000).map(|i| format!("{:.6},0\n", i as f64 * 2e-6)))

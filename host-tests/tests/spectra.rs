@@ -29,10 +29,8 @@ fn spectra_to(
 ) -> (ShockSpectrumJson, ShockSpectrumJson, f64) {
     let spec = SpectrumArgs {
         srs: true,
-        srs_damping: 0.05,
-        srs_bands: 6,
-        srs_low: 10.0,
         srs_high,
+        ..Default::default()
     };
     let args = AnalyzeArgs {
         spectrum: spec.clone(),

@@ -126,9 +126,11 @@ fn scene(b: &mut Bytes) -> (Scene, bool) {
             },
             max_flight_s: max_samples as f32 * 4.0 / rate,
         }),
-        // Spectra at 1/6 or 1/12 octave.
+        // Spectra at 1/6 or 1/12 octave, to the rate / 8 or to a tenth of the rate's bands
+        // (a highest band, at times below every band of a decimated capture's rate).
         spectrum: (stage_byte & 4 != 0).then(|| SpectrumSettings {
             bands_per_octave: if stage_byte & 8 != 0 { 12 } else { 6 },
+            high_hz: (stage_byte & 0x10 != 0).then_some(rate / 80.0),
             ..SpectrumSettings::new()
         }),
         // A specified half-sine of the trigger's tenfold over a hold's time (a verdict per

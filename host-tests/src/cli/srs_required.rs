@@ -198,9 +198,10 @@ pub struct Comparison {
     pub worst_db: f64,
     /// The natural frequencies compared.
     pub compared: usize,
-    /// The required range the measured bands leave out, Hz: below their lowest or above their
-    /// highest by more than their spacing (a lowest band above the requirement's first
-    /// breakpoint, a highest band stopped by `--srs-high` or the rate / 8 below its last);
+    /// The required range the bands compared leave out, Hz: where the next band below the
+    /// lowest compared, or above the highest, would still lie within the requirement's
+    /// breakpoints (a lowest band above its first breakpoint, a highest band stopped by
+    /// `--srs-high` or the rate / 8 below its last, bands without a value at either end);
     /// `None` if they span it. A "yes" there holds for the compared part only.
     pub uncovered: Option<Uncovered>,
 }
@@ -214,8 +215,10 @@ pub struct Uncovered {
     pub required: (f64, f64),
 }
 
-/// The part of `required`'s range the bands `frequency_hz` (increasing) leave out: `None` if
-/// they reach within one of their own steps of either end, or beyond it.
+/// The part of `required`'s range the bands compared (from `compared.0` to `compared.1`, Hz)
+/// leave out: `None` unless the band next to either end, one step of `frequency_hz`'s
+/// (increasing) beyond it, would still lie within the breakpoints (with
+/// [`RequiredSrs::log10_at`]'s slack).
 fn uncovered(
     required: &RequiredSrs,
     frequency_hz: &[f64],
@@ -223,14 +226,13 @@ fn uncovered(
 ) -> Option<Uncovered> {
     let points = required.points();
     let (first, last) = (points[0].0, points[points.len() - 1].0);
-    let (&f0, &fn_) = (frequency_hz.first()?, frequency_hz.last()?);
-    // The bands' ratio from one to the next (1 with a single band: any gap is one).
+    // The bands' ratio from one to the next (with a single band, an octave).
     let step = match frequency_hz {
         [a, b, ..] if *b > *a && *a > 0.0 => b / a,
-        _ => 1.0,
+        _ => 2.0,
     };
-    let short_below = f0 > first && f0 > first * step * (1.0 + 1e-9);
-    let short_above = fn_ < last && fn_ * step * (1.0 + 1e-9) < last;
+    let short_below = compared.0 / step >= first * (1.0 - 1e-9);
+    let short_above = compared.1 * step <= last * (1.0 + 1e-9);
     (short_below || short_above).then_some(Uncovered {
         compared,
         required: (first, last),
@@ -285,23 +287,23 @@ pub fn compare(
 }
 
 /// The report's cell: `yes, worst at 1250 Hz, +2.10 dB` (or `no, …`), or why not compared;
-/// over part of the requirement's range, `yes from 11.05 Hz to 8980 Hz only (required:
-/// 10.00 Hz to 50000 Hz), worst at …`.
+/// over part of the requirement's range, `…; compared from 11.05 Hz to 8980 Hz only, required
+/// from 10.00 Hz to 50000 Hz`.
 pub fn cell(c: Option<&Comparison>) -> String {
     let hz = |f: f64| human(f, "Hz").trim_end().to_string();
     match c {
         Some(c) => format!(
-            "{}{}, worst at {}, {:+.2} dB",
+            "{}, worst at {}, {:+.2} dB{}",
             if c.within { "yes" } else { "no" },
+            hz(c.worst_hz),
+            c.worst_db,
             c.uncovered.map_or(String::new(), |u| format!(
-                " from {} to {} only (required: {} to {})",
+                "; compared from {} to {} only, required from {} to {}",
                 hz(u.compared.0),
                 hz(u.compared.1),
                 hz(u.required.0),
                 hz(u.required.1)
             )),
-            hz(c.worst_hz),
-            c.worst_db
         ),
         None => "not compared (no natural frequency in both)".into(),
     }
@@ -453,18 +455,36 @@ mod tests {
         assert_eq!(class(Some(&c)), "");
         let text = cell(Some(&c));
         assert!(
-            text.starts_with("yes from 11.05 Hz to 8980 Hz only (required: 10.00 Hz to 50000 Hz)"),
+            text.starts_with("yes, worst at ")
+                && text.ends_with(
+                    " dB; compared from 11.05 Hz to 8980 Hz only, required from 10.00 Hz to 50000 Hz"
+                ),
             "{text}"
         );
         // --srs-low 100 against a requirement from 10 Hz; a failure stays one.
         let c = compare(&r, &bands(100.0, 62_500.0), &vec![1.0; 45]).unwrap();
         assert!(!c.within && c.uncovered.is_some(), "{c:?}");
         assert_eq!(class(Some(&c)), " fail");
-        assert!(
-            cell(Some(&c)).starts_with("no from 111.4 Hz"),
-            "{}",
-            cell(Some(&c))
-        );
+        let text = cell(Some(&c));
+        assert!(text.starts_with("no, worst at "), "{text}");
+        assert!(text.contains("; compared from 111.4 Hz to "), "{text}");
+        // The next band exactly on the last breakpoint, not computed: 2000 Hz of a
+        // requirement to 2000 Hz (--srs-high 1900).
+        let to_2k = required(&[(100.0, 100.0), (2000.0, 100.0)]);
+        let f = bands(100.0, 1900.0);
+        let c = compare(&to_2k, &f, &vec![100.0; f.len()]).unwrap();
+        assert!(c.within && c.uncovered.is_some(), "{c:?}");
+        // Bands without a value at the top are not compared: the range is the compared one.
+        let f = bands(10.0, 62_500.0);
+        let mut a = vec![100.0; f.len()];
+        let cut = f.iter().position(|&x| x > 9000.0).unwrap();
+        a[cut..].iter_mut().for_each(|v| *v = 0.0);
+        let c = compare(&r, &f, &a).unwrap();
+        let u = c.uncovered.expect("the top not compared");
+        assert!(u.compared.1 < 9000.0, "{u:?}");
+        // One band, inside a range an octave wide either side: short.
+        let c = compare(&r, &[1000.0], &[100.0]).unwrap();
+        assert!(c.uncovered.is_some(), "{c:?}");
         assert!(cell(None).starts_with("not compared"));
     }
 }

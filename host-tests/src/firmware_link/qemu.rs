@@ -161,7 +161,7 @@ pub fn scene_args(scene: &Scene) -> Vec<String> {
             format!("srs_damping={}", f(sp.damping)),
             format!("srs_bands={}", sp.bands_per_octave),
             format!("srs_low={}", f(sp.low_hz)),
-            format!("srs_high={}", sp.high_hz.map_or("none".to_string(), f)),
+            format!("srs_high={}", opt(sp.high_hz)),
         ]),
     }
     args.extend([

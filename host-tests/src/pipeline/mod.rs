@@ -1067,6 +1067,12 @@ pub(crate) fn build_scene(
     scene.train = args.train.train();
     scene.v0_every = args.v0_every || file.v0_every.unwrap_or(false);
     scene.target = target(args, file)?;
+    args.spectrum
+        .check()
+        .map_err(|setting| PipelineError::Invalid {
+            setting,
+            reason: "a shock spectrum's setting without the spectra: add --srs",
+        })?;
     scene.spectrum = args.spectrum.settings();
     scene.spec = args.spec.map(|s| s.spec);
     scene.validate().map_err(|e| match e {

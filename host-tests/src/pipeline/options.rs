@@ -597,36 +597,68 @@ impl TrainArgs {
     }
 }
 
-/// Shock-spectrum options.
+/// Shock-spectrum options. The settings are options without clap's `requires = "srs"`: `impact
+/// report --srs-required` implies `--srs` after parsing, so [`SpectrumArgs::check`] refuses
+/// a setting without the spectra once that is known.
 #[derive(Args, Clone, Debug, Default)]
 pub struct SpectrumArgs {
     /// Add each impact's SRS (maximax absolute acceleration), PVSS and enveloping half-sine.
     #[arg(long, help_heading = "Analysis")]
     pub srs: bool,
-    /// Damping ratio of the oscillators, in [0, 0.5].
-    #[arg(long, help_heading = "Analysis", default_value_t = 0.05, requires = "srs", value_parser = damping)]
-    pub srs_damping: f64,
-    /// Bands per octave: 6 or 12 (centres 1000 × 2^(k/n) Hz).
-    #[arg(long, help_heading = "Analysis", default_value_t = 6, requires = "srs", value_parser = per_octave)]
-    pub srs_bands: u32,
-    /// Lowest band, Hz.
-    #[arg(long, help_heading = "Analysis", default_value_t = 10.0, requires = "srs", value_parser = parse::frequency_hz)]
-    pub srs_low: f64,
+    /// Damping ratio of the oscillators, in [0, 0.5] [default: 0.05].
+    #[arg(long, help_heading = "Analysis", value_parser = damping)]
+    pub srs_damping: Option<f64>,
+    /// Bands per octave: 6 or 12 (centres 1000 × 2^(k/n) Hz) [default: 6].
+    #[arg(long, help_heading = "Analysis", value_parser = per_octave)]
+    pub srs_bands: Option<u32>,
+    /// Lowest band, Hz [default: 10].
+    #[arg(long, help_heading = "Analysis", value_parser = parse::frequency_hz)]
+    pub srs_low: Option<f64>,
     /// Highest band, Hz: a specification's range (10000 for MIL-STD-810's, say) need not pay for
     /// the bands above it [default: an eighth of the sample rate, and never above it].
-    #[arg(long, help_heading = "Analysis", requires = "srs", value_parser = parse::frequency_hz)]
+    #[arg(long, help_heading = "Analysis", value_parser = parse::frequency_hz)]
     pub srs_high: Option<f64>,
 }
 
 impl SpectrumArgs {
+    /// The oscillators' damping ratio (0.05 unless given).
+    pub fn damping(&self) -> f64 {
+        self.srs_damping.unwrap_or(0.05)
+    }
+
+    /// Bands per octave (6 unless given).
+    pub fn bands_per_octave(&self) -> u32 {
+        self.srs_bands.unwrap_or(6)
+    }
+
+    /// The lowest band, Hz (10 unless given).
+    pub fn low_hz(&self) -> f64 {
+        self.srs_low.unwrap_or(10.0)
+    }
+
     /// The scene's spectrum settings, if asked for.
     pub fn settings(&self) -> Option<SpectrumSettings> {
         self.srs.then_some(SpectrumSettings {
-            damping: self.srs_damping as f32,
-            bands_per_octave: self.srs_bands as u8,
-            low_hz: self.srs_low as f32,
+            damping: self.damping() as f32,
+            bands_per_octave: self.bands_per_octave() as u8,
+            low_hz: self.low_hz() as f32,
             high_hz: self.srs_high.map(|h| h as f32),
         })
+    }
+
+    /// A spectrum's setting without the spectra (`--srs`, or `impact report
+    /// --srs-required`) is refused, naming the first given: it would change nothing.
+    pub fn check(&self) -> Result<(), Setting> {
+        let given = [
+            ("srs-damping", self.srs_damping.is_some()),
+            ("srs-bands", self.srs_bands.is_some()),
+            ("srs-low", self.srs_low.is_some()),
+            ("srs-high", self.srs_high.is_some()),
+        ];
+        match given.iter().find(|(_, g)| *g) {
+            Some((name, _)) if !self.srs => Err(Setting::Option(name)),
+            _ => Ok(()),
+        }
     }
 }
 

@@ -36,10 +36,12 @@ pub fn reference_spectrum(
     let window = &counts[from as usize..to as usize];
     let accel = || window.iter().map(|&c| c as f64 * gain - baseline);
     let mut freqs = vec![0.0; MAX_BANDS];
+    // The bands' limits as the core's settings hold them (`f32`), so a limit within `f32`'s
+    // rounding of a band centre gives both the same bands.
     let n = srs::bands(
-        args.srs_bands,
-        args.srs_low,
-        args.srs_high,
+        args.bands_per_octave(),
+        f64::from(args.low_hz() as f32),
+        args.srs_high.map(|h| f64::from(h as f32)),
         rate,
         &mut freqs,
     );
@@ -48,17 +50,16 @@ pub fn reference_spectrum(
         freqs
             .iter()
             .map(|&f| {
-                Oscillator::new(response, f, args.srs_damping, rate)
-                    .map_or(0.0, |o| o.peak(accel()))
+                Oscillator::new(response, f, args.damping(), rate).map_or(0.0, |o| o.peak(accel()))
             })
             .collect()
     };
     let srs_m_s2 = peak(Response::AbsoluteAcceleration);
     let pvss_m_s = peak(Response::PseudoVelocity);
-    let half = srs::enveloping_half_sine(&freqs, &pvss_m_s, args.srs_damping);
+    let half = srs::enveloping_half_sine(&freqs, &pvss_m_s, args.damping());
     ShockSpectrumJson {
-        damping: args.srs_damping,
-        bands_per_octave: args.srs_bands,
+        damping: args.damping(),
+        bands_per_octave: args.bands_per_octave(),
         from_sample: from,
         to_sample: to,
         frequency_hz: freqs,

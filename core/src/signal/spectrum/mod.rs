@@ -58,7 +58,7 @@ pub struct SpectrumSettings {
     pub damping: f32,
     /// Bands per octave: 6 or 12.
     pub bands_per_octave: u8,
-    /// Lowest band, Hz (bands are `1000 × 2^(k/n)` Hz up to the rate / 8).
+    /// Lowest band, Hz (bands are `1000 × 2^(k/n)` Hz up to the highest, at most the rate / 8).
     pub low_hz: f32,
     /// Highest band, Hz: the bands stop at the lower of it and the rate / 8; `None`, at the
     /// rate / 8. A specification's range (MIL-STD-810's SRS to 10 kHz, say) need not pay for
@@ -134,26 +134,24 @@ impl SpectrumSettings {
     /// (`srs-damping`, `srs-bands`, `srs-low`, `srs-high`).
     pub fn check(&self, rate_hz: f32) -> Result<(), Error> {
         self.check_parameters()?;
+        let mut freqs = [0.0; MAX_BANDS];
+        if self.bands(rate_hz, &mut freqs) != 0 {
+            return Ok(());
+        }
         let unbounded = Self {
             high_hz: None,
             ..*self
         };
-        if self.high_hz.is_some()
-            && unbounded.bands(rate_hz, &mut [0.0; MAX_BANDS]) != 0
-            && self.bands(rate_hz, &mut [0.0; MAX_BANDS]) == 0
-        {
+        if self.high_hz.is_some() && unbounded.bands(rate_hz, &mut freqs) != 0 {
             return Err(Error::InvalidParameter {
                 name: "srs-high",
-                reason: "no band between the lowest band and it",
+                reason: "below the first band at or above the lowest band",
             });
         }
-        if self.bands(rate_hz, &mut [0.0; MAX_BANDS]) == 0 {
-            return Err(Error::InvalidParameter {
-                name: "srs-low",
-                reason: "no band between it and rate / 8, or more than 96 (below rate / 8 by at most 16 octaves at 6 bands per octave, 8 at 12)",
-            });
-        }
-        Ok(())
+        Err(Error::InvalidParameter {
+            name: "srs-low",
+            reason: "no band between it and rate / 8, or more than 96 (below rate / 8 by at most 16 octaves at 6 bands per octave, 8 at 12)",
+        })
     }
 
     /// Damping, bands per octave and lowest band, whatever the rate.

@@ -59,8 +59,9 @@ pub struct ReportArgs {
     /// A required SRS: a CSV with the columns frequency_hz and acceleration_m_s2 (or
     /// acceleration_g), straight between its breakpoints on log–log axes. Each impact's SRS is
     /// drawn over it with MIL-STD-810H Method 516.8's tolerance (−1.5 dB, +3 dB) dashed, and
-    /// the table says whether it lies within at every natural frequency both have. Implies
-    /// --srs.
+    /// the table says whether it lies within at every natural frequency both have, and which
+    /// part of the required range that was if the bands stop short of it (--srs-high,
+    /// --srs-low, the rate / 8). Implies --srs.
     #[arg(long, value_name = "FILE.csv", help_heading = "Output")]
     pub srs_required: Option<PathBuf>,
     #[command(flatten)]
