@@ -243,9 +243,16 @@ impl<R: Real> Poles<R> {
     }
 }
 
-/// Band centre frequencies `1000 × 2^(k / per_octave)` Hz from `low_hz` up to the lower of
-/// `high_hz` (`None`: no limit) and `rate_hz / 8` (where the ramp-invariant filters still
-/// follow the oscillator closely), written into `out`; returns how many.
+/// The highest a band may be, Hz: the lower of `high_hz` (`None`: no limit) and `rate_hz / 8`
+/// (where the ramp-invariant filters still follow the oscillator closely). A NaN `high_hz`
+/// is no limit (`f64::min`); the settings refuse one before.
+pub fn top_hz(rate_hz: f64, high_hz: Option<f64>) -> f64 {
+    let top = rate_hz / 8.0;
+    high_hz.map_or(top, |high| top.min(high))
+}
+
+/// Band centre frequencies `1000 × 2^(k / per_octave)` Hz from `low_hz` up to [`top_hz`],
+/// written into `out`; returns how many.
 pub fn bands(
     per_octave: u32,
     low_hz: f64,
@@ -256,10 +263,7 @@ pub fn bands(
     if per_octave == 0 || !(low_hz > 0.0 && rate_hz.is_finite() && rate_hz > 0.0) {
         return 0;
     }
-    let top = match high_hz {
-        Some(high) => (rate_hz / 8.0).min(high),
-        None => rate_hz / 8.0,
-    };
+    let top = top_hz(rate_hz, high_hz);
     let n = per_octave as f64;
     let first = libm::ceil(n * libm::log2(low_hz / 1000.0) - 1e-9);
     let mut count = 0;

@@ -104,10 +104,7 @@ impl SpectrumSettings {
         // infinity below, as the f64 `q as i32` did).
         let (first, per_i) = (first as i64, per as i64);
         let (mut q, mut r) = (first.div_euclid(per_i), first.rem_euclid(per_i) as usize);
-        let top = match self.high_hz {
-            Some(high) => (rate / 8.0).min(high as f64),
-            None => rate / 8.0,
-        };
+        let top = srs::top_hz(rate, self.high_hz.map(f64::from));
         let mut count = 0;
         loop {
             let Some(&step) = steps.get(r) else {
